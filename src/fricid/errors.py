@@ -1,0 +1,51 @@
+"""The exception hierarchy of fricid.
+
+Every error that bad input or bad options can cause is a :class:`FricidError`. The CLI turns
+one into a single line on stderr and exit status 2 (DESIGN.md, "Errors").
+"""
+
+from __future__ import annotations
+
+from os import PathLike
+
+__all__ = ["ConfigError", "DataError", "FricidError"]
+
+
+class FricidError(Exception):
+    """Base class of every error fricid raises on purpose."""
+
+
+class ConfigError(FricidError, ValueError):
+    """An option, parameter or setting is invalid (not the data)."""
+
+
+class DataError(FricidError, ValueError):
+    """Input data is invalid. Names the file, the row and the column where they are known.
+
+    ``row`` is the 1-based line number in the file where the file has lines (a CSV), else the
+    0-based index of the record.
+    """
+
+    def __init__(
+        self,
+        message: str,
+        *,
+        file: str | PathLike[str] | None = None,
+        row: int | None = None,
+        column: str | None = None,
+    ) -> None:
+        self.message = message
+        self.file = None if file is None else str(file)
+        self.row = row
+        self.column = column
+        super().__init__(self._render())
+
+    def _render(self) -> str:
+        where = []
+        if self.file is not None:
+            where.append(self.file)
+        if self.row is not None:
+            where.append(f"row {self.row}")
+        if self.column is not None:
+            where.append(f"column '{self.column}'")
+        return f"{', '.join(where)}: {self.message}" if where else self.message

@@ -1,0 +1,179 @@
+"""The analytic friction model interface.
+
+A model is a stateless description: named parameters with units and bounds (after lmfit's
+``Parameter``) and a vectorised ``predict(theta, X)`` (DESIGN.md, "Vectorised"):
+
+* ``theta`` is one parameter vector ``(d,)`` or a batch ``(k, d)``;
+* ``X`` is ``(n, 3)`` with columns velocity [rad/s], load [N m], temperature [degC]
+  (``FrictionSamples.X``); a model ignores the columns it does not use;
+* the result is ``(n,)`` or ``(k, n)`` friction torque [N m].
+
+Friction opposes motion, so every model is odd in velocity: ``f(-v) = -f(v)``. At exactly zero
+velocity ``sign(0) = 0``; exports offer a smoothed sign for controllers.
+"""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import ConfigError, DataError
+
+__all__ = ["INPUTS", "FrictionModel", "Parameter", "data_scales"]
+
+#: Input columns of X, in order.
+INPUTS: tuple[str, ...] = ("velocity", "load", "temperature")
+
+
+#: How a parameter's default and bounds scale with the data (see :func:`data_scales`).
+SCALE_KINDS = ("torque", "velocity", "viscous", "load_coef", "temp_coef", "velocity_temp", "one")
+
+
+@dataclass(frozen=True)
+class Parameter:
+    """One named model parameter (after lmfit's ``Parameter``).
+
+    ``default``, ``lower`` and ``upper`` are multiples of the data scale named by ``kind``
+    (:func:`data_scales`): a torque parameter bounded by ``[0, 2]`` may range up to twice the
+    largest measured friction. So default bounds fit a 0.1 N m wrist and a 100 N m shoulder alike.
+    """
+
+    name: str
+    unit: str
+    kind: str
+    default: float
+    lower: float
+    upper: float
+    description: str = ""
+
+    def __post_init__(self) -> None:
+        if self.kind not in SCALE_KINDS:
+            raise ConfigError(f"parameter '{self.name}': unknown scale kind '{self.kind}'")
+        if not (self.lower <= self.default <= self.upper):
+            raise ConfigError(
+                f"parameter '{self.name}': default {self.default} outside bounds "
+                f"[{self.lower}, {self.upper}]"
+            )
+
+
+class FrictionModel(ABC):
+    """Base class of the analytic friction models.
+
+    Subclasses set ``name`` (registry key), ``title``, ``equation`` (the paper reference),
+    ``inputs`` (which columns of X they use) and ``parameters``, and implement
+    :meth:`_predict` on a batch ``theta`` of shape ``(k, d)`` and inputs ``(n, 3)``.
+    """
+
+    name: str = ""
+    title: str = ""
+    equation: str = ""
+    inputs: tuple[str, ...] = ("velocity",)
+    parameters: tuple[Parameter, ...] = ()
+
+    # -- description ---------------------------------------------------------------------
+    @property
+    def param_names(self) -> tuple[str, ...]:
+        return tuple(p.name for p in self.parameters)
+
+    @property
+    def n_params(self) -> int:
+        return len(self.parameters)
+
+    def _scale(self, X, y) -> np.ndarray:
+        scales = data_scales(X, y)
+        return np.array([scales[p.kind] for p in self.parameters])
+
+    def defaults(self, X=None, y=None) -> np.ndarray:
+        """Default parameter vector ``(d,)``, scaled to the data when ``X, y`` are given."""
+        rel = np.array([p.default for p in self.parameters], dtype=float)
+        return rel * self._scale(X, y)
+
+    def bounds(self, X=None, y=None) -> np.ndarray:
+        """Default search bounds ``(d, 2)``, scaled to the data when ``X, y`` are given."""
+        rel = np.array([(p.lower, p.upper) for p in self.parameters], dtype=float)
+        return rel * self._scale(X, y)[:, None]
+
+    @property
+    def units(self) -> dict[str, str]:
+        return {p.name: p.unit for p in self.parameters}
+
+    @property
+    def is_asymmetric(self) -> bool:
+        return False
+
+    def param_vector(self, values: dict[str, float]) -> np.ndarray:
+        """A parameter vector from a name -> value mapping (all names required)."""
+        missing = [n for n in self.param_names if n not in values]
+        extra = [n for n in values if n not in self.param_names]
+        if missing or extra:
+            raise ConfigError(
+                f"model '{self.name}' takes parameters {', '.join(self.param_names)}"
+                + (f"; missing: {', '.join(missing)}" if missing else "")
+                + (f"; unknown: {', '.join(extra)}" if extra else "")
+            )
+        return np.array([float(values[n]) for n in self.param_names])
+
+    def __repr__(self) -> str:
+        return f"{type(self).__name__}({', '.join(self.param_names)})"
+
+    # -- evaluation ----------------------------------------------------------------------
+    def predict(self, theta, X) -> np.ndarray:
+        """Friction [N m] for parameters ``theta`` ((d,) or (k, d)) at inputs ``X`` ((n, 3))."""
+        theta = np.asarray(theta, dtype=float)
+        single = theta.ndim == 1
+        batch = np.atleast_2d(theta)
+        if batch.ndim != 2 or batch.shape[1] != self.n_params:
+            raise ConfigError(
+                f"model '{self.name}' takes {self.n_params} parameters "
+                f"({', '.join(self.param_names)}); got an array of shape {theta.shape}"
+            )
+        X = self.check_inputs(X)
+        out = self._predict(batch, X)
+        return out[0] if single else out
+
+    def check_inputs(self, X) -> np.ndarray:
+        """Validate and return ``X`` as a float array of shape ``(n, 3)``."""
+        X = np.asarray(X, dtype=float)
+        if X.ndim == 1:
+            X = np.column_stack([X, np.zeros_like(X), np.zeros_like(X)])
+        if X.ndim != 2 or X.shape[1] != len(INPUTS):
+            raise DataError(
+                f"model inputs must have shape (n, 3) with columns {', '.join(INPUTS)}; "
+                f"got shape {X.shape}"
+            )
+        return X
+
+    @abstractmethod
+    def _predict(self, theta: np.ndarray, X: np.ndarray) -> np.ndarray:
+        """Batch evaluation: ``theta`` (k, d), ``X`` (n, 3) -> (k, n)."""
+
+
+def data_scales(X=None, y=None) -> dict[str, float]:
+    """Typical magnitudes of the data, by kind: largest |friction| F, |velocity| V, |load| L,
+    |temperature| T, and their ratios. Without data every scale is 1."""
+    if X is None or y is None:
+        return dict.fromkeys(SCALE_KINDS, 1.0)
+    X = np.asarray(X, dtype=float)
+    y = np.asarray(y, dtype=float)
+
+    def big(a: np.ndarray) -> float:
+        m = float(np.max(np.abs(a))) if a.size else 0.0
+        return m if m > 0 and np.isfinite(m) else 1.0
+
+    F, V, L, T = big(y), big(X[:, 0]), big(X[:, 1]), big(X[:, 2])
+    return {
+        "torque": F,
+        "velocity": V,
+        "viscous": F / V,
+        "load_coef": F / L,
+        "temp_coef": F / T,
+        "velocity_temp": V / T,
+        "one": 1.0,
+    }
+
+
+def columns(theta: np.ndarray) -> list[np.ndarray]:
+    """Split a (k, d) batch into d column vectors of shape (k, 1), ready to broadcast."""
+    return [theta[:, j : j + 1] for j in range(theta.shape[1])]

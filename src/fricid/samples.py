@@ -1,0 +1,266 @@
+"""The two data types that travel through fricid: :class:`RawLog` and :class:`FrictionSamples`.
+
+Both hold SI units only (DESIGN.md, "Units") and validate themselves on construction, so a
+value of either type is always safe to use. Reading and writing them is :mod:`fricid.io`'s job.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field, replace
+from typing import Any
+
+import numpy as np
+
+from .errors import DataError
+
+__all__ = ["FrictionSamples", "RawLog", "SAMPLE_COLUMNS", "RAWLOG_COLUMNS"]
+
+#: Columns of a :class:`FrictionSamples` table and their units.
+SAMPLE_COLUMNS: dict[str, str] = {
+    "velocity": "rad/s",
+    "load": "N m",
+    "temperature": "degC",
+    "friction": "N m",
+    "direction": "1",
+    "count": "1",
+    "std": "N m",
+}
+
+#: Columns of a :class:`RawLog` and their units (``torque`` or ``current``, or both, present).
+RAWLOG_COLUMNS: dict[str, str] = {
+    "time": "s",
+    "position": "rad",
+    "velocity": "rad/s",
+    "torque": "N m",
+    "current": "A",
+    "temperature": "degC",
+}
+
+
+def _as_column(name: str, values, n: int | None, source: str | None) -> np.ndarray:
+    arr = np.asarray(values, dtype=float)
+    if arr.ndim == 0:
+        arr = np.full(n if n is not None else 1, float(arr))
+    if arr.ndim != 1:
+        raise DataError(f"must be one-dimensional, got shape {arr.shape}", file=source, column=name)
+    if n is not None and arr.shape[0] != n:
+        raise DataError(f"has {arr.shape[0]} values, expected {n}", file=source, column=name)
+    bad = ~np.isfinite(arr)
+    if bad.any():
+        row = int(np.flatnonzero(bad)[0])
+        raise DataError(f"non-finite value {arr[row]!r}", file=source, row=row, column=name)
+    return arr
+
+
+@dataclass(frozen=True, eq=False)
+class RawLog:
+    """A joint's raw log: one row per sample, SI units.
+
+    Attributes
+    ----------
+    time : (n,) s, strictly increasing.
+    position : (n,) rad.
+    velocity : (n,) rad/s.
+    temperature : (n,) degC (a scalar is broadcast).
+    torque : (n,) N m, motor torque, or None when only the current was logged.
+    current : (n,) A, motor current, or None when the torque was logged.
+    torque_constant : N m/A, the K of eq. 13 (BAS-RBFNN paper), tau = K I. Needed when only
+        the current was logged.
+    joint, source : names, for messages and provenance.
+    meta : anything else worth keeping (free-form).
+    """
+
+    time: np.ndarray
+    position: np.ndarray
+    velocity: np.ndarray
+    temperature: np.ndarray
+    torque: np.ndarray | None = None
+    current: np.ndarray | None = None
+    torque_constant: float | None = None
+    joint: str = "joint"
+    source: str | None = None
+    meta: Mapping[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        src = self.source
+        time = _as_column("time", self.time, None, src)
+        n = time.shape[0]
+        set_ = object.__setattr__
+        set_(self, "time", time)
+        for name in ("position", "velocity", "temperature"):
+            set_(self, name, _as_column(name, getattr(self, name), n, src))
+        if self.torque is None and self.current is None:
+            raise DataError("the log has neither a torque nor a current column", file=src)
+        for name in ("torque", "current"):
+            if getattr(self, name) is not None:
+                set_(self, name, _as_column(name, getattr(self, name), n, src))
+        if self.torque is None:
+            k = self.torque_constant
+            if k is None or not np.isfinite(k) or k <= 0:
+                raise DataError(
+                    "only current was logged, so a positive torque constant K [N m/A] is "
+                    f"needed (tau = K I, eq. 13); got {k!r}",
+                    file=src,
+                )
+        if n > 1:
+            dt = np.diff(time)
+            bad = np.flatnonzero(dt <= 0)
+            if bad.size:
+                row = int(bad[0]) + 1
+                raise DataError(
+                    f"time is not strictly increasing ({time[row - 1]!r} then {time[row]!r})",
+                    file=src,
+                    row=row,
+                    column="time",
+                )
+
+    def __len__(self) -> int:
+        return int(self.time.shape[0])
+
+    @property
+    def motor_torque(self) -> np.ndarray:
+        """Motor torque [N m]: the logged torque, else K times the current (eq. 13)."""
+        if self.torque is not None:
+            return self.torque
+        return self.current * float(self.torque_constant)
+
+    def slice(self, start: int, stop: int) -> RawLog:
+        """Rows ``start:stop`` as a new log (views, no copy)."""
+        s = np.s_[start:stop]
+        return replace(
+            self,
+            time=self.time[s],
+            position=self.position[s],
+            velocity=self.velocity[s],
+            temperature=self.temperature[s],
+            torque=None if self.torque is None else self.torque[s],
+            current=None if self.current is None else self.current[s],
+        )
+
+    @staticmethod
+    def concatenate(logs: list[RawLog]) -> RawLog:
+        """Join logs end to end (same joint, same kind of effort column)."""
+        if not logs:
+            raise DataError("no logs to concatenate")
+        first = logs[0]
+
+        def cat(name: str):
+            parts = [getattr(g, name) for g in logs]
+            if any(p is None for p in parts):
+                return None
+            return np.concatenate(parts)
+
+        return replace(
+            first,
+            time=cat("time"),
+            position=cat("position"),
+            velocity=cat("velocity"),
+            temperature=cat("temperature"),
+            torque=cat("torque"),
+            current=cat("current") if cat("torque") is None else None,
+        )
+
+
+@dataclass(frozen=True, eq=False)
+class FrictionSamples:
+    """Friction at operating points: one row per (velocity, load, temperature, direction).
+
+    ``direction`` is +1 or -1 for a sample measured in one direction of motion (velocity and
+    friction then carry that sign), or 0 when both directions were combined by eq. 11 of the
+    BAS-RBFNN paper (velocity and friction are then the positive-direction values).
+    ``count`` is the number of raw samples averaged and ``std`` their standard deviation [N m].
+
+    The model input matrix is :attr:`X`, columns (velocity, load, temperature); the target is
+    :attr:`friction`.
+    """
+
+    velocity: np.ndarray
+    load: np.ndarray
+    temperature: np.ndarray
+    friction: np.ndarray
+    direction: np.ndarray | None = None
+    count: np.ndarray | None = None
+    std: np.ndarray | None = None
+    source: str | None = None
+    meta: Mapping[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        src = self.source
+        set_ = object.__setattr__
+        velocity = _as_column("velocity", self.velocity, None, src)
+        n = velocity.shape[0]
+        if n == 0:
+            raise DataError("no friction samples", file=src)
+        set_(self, "velocity", velocity)
+        for name in ("load", "temperature", "friction"):
+            set_(self, name, _as_column(name, getattr(self, name), n, src))
+        direction = (
+            np.sign(velocity) if self.direction is None else _as_column("direction", self.direction, n, src)
+        )
+        bad = np.flatnonzero(~np.isin(direction, (-1.0, 0.0, 1.0)))
+        if bad.size:
+            row = int(bad[0])
+            raise DataError(
+                f"direction must be -1, 0 or +1, got {direction[row]!r}",
+                file=src,
+                row=row,
+                column="direction",
+            )
+        set_(self, "direction", direction.astype(np.int8))
+        count = np.ones(n) if self.count is None else _as_column("count", self.count, n, src)
+        if (count < 1).any():
+            row = int(np.flatnonzero(count < 1)[0])
+            raise DataError(f"count must be >= 1, got {count[row]!r}", file=src, row=row, column="count")
+        set_(self, "count", count.astype(np.int64))
+        std = np.zeros(n) if self.std is None else _as_column("std", self.std, n, src)
+        if (std < 0).any():
+            row = int(np.flatnonzero(std < 0)[0])
+            raise DataError(f"std must be >= 0, got {std[row]!r}", file=src, row=row, column="std")
+        set_(self, "std", std)
+        set_(self, "meta", dict(self.meta))
+
+    def __len__(self) -> int:
+        return int(self.velocity.shape[0])
+
+    @property
+    def X(self) -> np.ndarray:
+        """Model inputs, shape (n, 3): velocity [rad/s], load [N m], temperature [degC]."""
+        return np.column_stack([self.velocity, self.load, self.temperature])
+
+    @property
+    def y(self) -> np.ndarray:
+        """Model target: friction [N m]."""
+        return self.friction
+
+    def subset(self, mask) -> FrictionSamples:
+        """The rows selected by a boolean mask or an index array."""
+        idx = np.asarray(mask)
+        return replace(
+            self,
+            velocity=self.velocity[idx],
+            load=self.load[idx],
+            temperature=self.temperature[idx],
+            friction=self.friction[idx],
+            direction=self.direction[idx],
+            count=self.count[idx],
+            std=self.std[idx],
+        )
+
+    def directions(self) -> tuple[int, ...]:
+        """The distinct directions present, sorted."""
+        return tuple(int(d) for d in np.unique(self.direction))
+
+    def to_frame(self):
+        """A pandas DataFrame with the columns of :data:`SAMPLE_COLUMNS`."""
+        import pandas as pd
+
+        return pd.DataFrame({name: getattr(self, name) for name in SAMPLE_COLUMNS})
+
+    @classmethod
+    def concatenate(cls, parts: list[FrictionSamples]) -> FrictionSamples:
+        """Stack sample tables (metadata from the first)."""
+        if not parts:
+            raise DataError("no samples to concatenate")
+        cols = {name: np.concatenate([getattr(p, name) for p in parts]) for name in SAMPLE_COLUMNS}
+        return cls(**cols, source=parts[0].source, meta=parts[0].meta)

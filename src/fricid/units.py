@@ -1,0 +1,80 @@
+"""Units: SI inside (rad, rad/s, N m, A, degC, s); conversions happen once, at the edge.
+
+Every reader and CLI flag converts through :func:`to_si`, which knows each quantity's
+accepted unit spellings and refuses anything else with the list of what it accepts.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .errors import ConfigError
+
+__all__ = ["SI_UNITS", "UNITS", "from_si", "to_si"]
+
+#: The SI unit fricid uses inside for each quantity.
+SI_UNITS: dict[str, str] = {
+    "time": "s",
+    "position": "rad",
+    "velocity": "rad/s",
+    "torque": "N m",
+    "current": "A",
+    "temperature": "degC",
+    "torque_constant": "N m/A",
+}
+
+_DEG = math.pi / 180.0
+_RPM = 2.0 * math.pi / 60.0
+
+# quantity -> unit spelling -> (scale, offset): si = value * scale + offset
+UNITS: dict[str, dict[str, tuple[float, float]]] = {
+    "time": {"s": (1.0, 0.0), "ms": (1e-3, 0.0), "us": (1e-6, 0.0), "min": (60.0, 0.0)},
+    "position": {"rad": (1.0, 0.0), "deg": (_DEG, 0.0), "rev": (2.0 * math.pi, 0.0)},
+    "velocity": {
+        "rad/s": (1.0, 0.0),
+        "deg/s": (_DEG, 0.0),
+        "rpm": (_RPM, 0.0),
+        "rev/s": (2.0 * math.pi, 0.0),
+    },
+    "torque": {"N m": (1.0, 0.0), "Nm": (1.0, 0.0), "mN m": (1e-3, 0.0), "mNm": (1e-3, 0.0)},
+    "current": {"A": (1.0, 0.0), "mA": (1e-3, 0.0)},
+    "temperature": {"degC": (1.0, 0.0), "C": (1.0, 0.0), "K": (1.0, -273.15)},
+    "torque_constant": {"N m/A": (1.0, 0.0), "Nm/A": (1.0, 0.0), "mNm/A": (1e-3, 0.0)},
+}
+
+
+def _factor(quantity: str, unit: str) -> tuple[float, float]:
+    try:
+        table = UNITS[quantity]
+    except KeyError:
+        raise ConfigError(
+            f"unknown quantity '{quantity}'; known quantities: {', '.join(UNITS)}"
+        ) from None
+    try:
+        return table[unit.strip()]
+    except KeyError:
+        raise ConfigError(
+            f"unknown {quantity} unit '{unit}'; use one of: {', '.join(table)}"
+        ) from None
+
+
+def to_si(values, unit: str, quantity: str):
+    """Convert ``values`` given in ``unit`` to the SI unit of ``quantity``.
+
+    >>> round(float(to_si(60.0, "rpm", "velocity")), 6)
+    6.283185
+    """
+    scale, offset = _factor(quantity, unit)
+    if scale == 1.0 and offset == 0.0:
+        return values
+    return np.asarray(values, dtype=float) * scale + offset
+
+
+def from_si(values, unit: str, quantity: str):
+    """Convert SI ``values`` of ``quantity`` to ``unit`` (the inverse of :func:`to_si`)."""
+    scale, offset = _factor(quantity, unit)
+    if scale == 1.0 and offset == 0.0:
+        return values
+    return (np.asarray(values, dtype=float) - offset) / scale
