@@ -1,0 +1,104 @@
+"""``fricid fit``: identify a friction model from samples."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from ._app import app, console, err_console, handle_errors
+from ._options import parse_assignments, parse_ranges
+
+
+def _method_help() -> str:
+    from ..optim import METHODS
+
+    return "; ".join(f"{name}: {cls.summary}" for name, cls in METHODS.items())
+
+
+@app.command("fit")
+@handle_errors
+def fit_command(
+    samples: Annotated[Path, typer.Argument(help="Friction samples, CSV or Parquet "
+                                            "(from `fricid extract`).", exists=True,
+                                            dir_okay=False)],
+    model: Annotated[str, typer.Option("--model", "-m", help=(
+        "Model: coulomb_viscous (eq. 1), stribeck (eq. 2 / RWSAVSBAS eq. 7), msk (eq. 3, "
+        "load), vlt (eq. 4, load and temperature); append _asym for parameters per "
+        "direction."))] = "stribeck",
+    method: Annotated[str, typer.Option(help="Optimiser (see `fricid methods`): lm, trf, bas, "
+                                        "vsbas, ibas, rwsavsbas, ga, de, cmaes, bas+lm, ...")
+                      ] = "lm",
+    fix: Annotated[list[str] | None, typer.Option("--fix", help=(
+        "Hold a parameter at a value, NAME=VALUE (SI units), e.g. --fix delta=1. "
+        "Repeatable."))] = None,
+    bound: Annotated[list[str] | None, typer.Option("--bound", help=(
+        "Search range of a parameter, NAME=LOW:HIGH (SI units). Repeatable. Default ranges "
+        "scale with the data."))] = None,
+    seed: Annotated[int, typer.Option(help="Random seed (same seed, same result).")] = 0,
+    max_evals: Annotated[int | None, typer.Option(help="Budget in model evaluations.")] = None,
+    direction: Annotated[str, typer.Option(help=(
+        "Which samples to use: all, combined (direction 0), both (+1 and -1), pos, neg."))
+                         ] = "all",
+    out: Annotated[Path | None, typer.Option("--out", "-o", help=(
+        "Model file to write (JSON). Default: <samples>.<model>.json in the current "
+        "directory."))] = None,
+) -> None:
+    """Identify a friction model from samples and write it as a JSON model file.
+
+    Prints the fit report: parameters with standard errors and 95 % confidence intervals,
+    fitness (R^2), SSE, RMSE [N m], RMSPE, mean and max absolute error [N m].
+    """
+    from ..identify import fit
+    from ..io import read_samples
+
+    data = select_direction(read_samples(samples), direction)
+    fitted = fit(
+        data,
+        model,
+        method,
+        fixed=parse_assignments(fix, "--fix"),
+        bounds=parse_ranges(bound, "--bound"),
+        seed=seed,
+        max_evals=max_evals,
+    )
+    out = out or Path(f"{samples.stem}.{fitted.model}.json")
+    fitted.save(out)
+    console.print(fitted.report(), highlight=False, soft_wrap=True)
+    err_console.print(f"wrote {out}")
+
+
+def select_direction(samples, direction: str):
+    """The rows of ``samples`` for a --direction choice."""
+    import numpy as np
+
+    from ..errors import ConfigError, DataError
+
+    choices = {"all": None, "combined": [0], "both": [-1, 1], "pos": [1], "neg": [-1]}
+    if direction not in choices:
+        raise ConfigError(f"--direction must be one of: {', '.join(choices)}; got '{direction}'")
+    keep = choices[direction]
+    if keep is None:
+        return samples
+    mask = np.isin(samples.direction, keep)
+    if not mask.any():
+        raise DataError(f"no samples with direction {direction} (the file has directions "
+                        f"{samples.directions()})", file=samples.source)
+    return samples.subset(mask)
+
+
+@app.command("methods")
+def methods_command() -> None:
+    """List the optimisers and the models, with a line on each."""
+    from ..models import MODELS
+    from ..optim import METHODS
+
+    console.print("[bold]Models[/] (append _asym for per-direction parameters):")
+    for name, cls in MODELS.items():
+        m = cls()
+        console.print(f"  {name:<16} {m.title}; {m.equation}; parameters "
+                      f"{', '.join(m.param_names)}", highlight=False)
+    console.print("[bold]Methods[/]:")
+    for name, cls in METHODS.items():
+        console.print(f"  {name:<16} {cls.summary}", highlight=False)
