@@ -1,0 +1,137 @@
+"""``fricid extract``: raw log to friction samples (BAS-RBFNN paper, section 2)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import numpy as np
+import typer
+
+from ..errors import ConfigError
+from ._app import app, console, err_console, handle_errors
+from ._progress import progress_bar
+
+
+def parse_positions(text: str | None, unit: str) -> np.ndarray | None:
+    """``"-60:-20:2"`` (start:stop:step, stop included) or ``"-60,-40,-20"`` -> rad."""
+    from ..units import to_si
+
+    if text is None:
+        return None
+    try:
+        if ":" in text:
+            start, stop, step = (float(p) for p in text.split(":"))
+            if step <= 0 or stop < start:
+                raise ValueError
+            values = start + step * np.arange(int(np.floor((stop - start) / step + 1e-9)) + 1)
+        else:
+            values = np.array([float(p) for p in text.split(",")])
+    except ValueError:
+        raise ConfigError(
+            f"--positions takes START:STOP:STEP (step > 0) or a comma list; got '{text}'"
+        ) from None
+    return np.asarray(to_si(values, unit, "position"), dtype=float)
+
+
+@app.command("extract")
+@handle_errors
+def extract_command(
+    log: Annotated[Path, typer.Argument(help="Raw log (.parquet or .csv from `fricid "
+                                        "simulate` or a converted recording), or a folder of "
+                                        "steady-state EPOS recordings with --format epos.",
+                                        exists=True)],
+    out: Annotated[Path, typer.Option("--out", "-o", help="Samples to write (.csv or "
+                                      ".parquet): direction 0, combined by eq. 11.")
+                   ] = Path("samples.csv"),
+    by_direction: Annotated[Path | None, typer.Option(help="Also write the per-direction "
+                                                      "samples (+1 and -1) here.")] = None,
+    fmt: Annotated[str, typer.Option("--format", help="table (fricid's CSV/Parquet raw log) "
+                                     "or epos (a folder of Maxon EPOS recorder CSVs, one "
+                                     "steady velocity per file).")] = "table",
+    positions: Annotated[str | None, typer.Option(help=(
+        "Position bins START:STOP:STEP or a comma list, in --position-unit. Default: the "
+        "design recorded by `fricid simulate`, else one bin per steady traverse."))] = None,
+    position_unit: Annotated[str, typer.Option(help="Unit of --positions and "
+                                               "--bin-halfwidth: rad or deg.")] = "deg",
+    bin_halfwidth: Annotated[float | None, typer.Option(help="Half width of a position bin "
+                                                        "(default: half the spacing).")
+                             ] = None,
+    median_window: Annotated[int, typer.Option(help="Running-median window [samples] on the "
+                                               "current, odd; 1 disables.")] = 5,
+    gravity: Annotated[str | None, typer.Option(help="fit (joint with gravity: eq. 7, 11, 12) "
+                                                "or none (horizontal joint: torque is "
+                                                "friction). Default: from the log's design, "
+                                                "else fit with positions, none without.")
+                       ] = None,
+    flip_sign: Annotated[bool, typer.Option(help="EPOS: negate velocity and torque (motor "
+                                            "convention, as the lead-screw recordings need)."
+                                            )] = False,
+    nominal_torque: Annotated[float, typer.Option(help="EPOS: the motor's nominal torque "
+                                                  "[mN m], reference of the % channel.")
+                              ] = 9.84,
+    temperature: Annotated[float, typer.Option(help="EPOS: the temperature [degC] to "
+                                               "record (the recorder logs none).")] = 25.0,
+    chunk_rows: Annotated[int, typer.Option(help="Rows read at a time (bounded memory).")
+                          ] = 1_000_000,
+) -> None:
+    """Extract friction samples from a raw log: segment the constant-velocity traverses, median
+    filter the current, torque = K I (eq. 13), average the repetitions per position bin,
+    separate friction and gravity (eq. 9-11), fit p_x, p_y (eq. 7) and take the gravity torque
+    as the load (eq. 12). Writes samples with velocity [rad/s], load [N m], temperature [degC],
+    friction [N m], direction, count, std [N m]."""
+    from ..io import epos_steady_samples, write_samples
+
+    if fmt == "epos":
+        samples = epos_steady_samples(log, flip_sign=flip_sign, temperature=temperature,
+                                      nominal_torque=nominal_torque * 1e-3)
+        write_samples(samples, out)
+        err_console.print(f"wrote {out}: {len(samples)} steady operating points "
+                          f"(directions {samples.directions()})")
+        return
+    if fmt != "table":
+        raise ConfigError(f"--format must be table or epos; got '{fmt}'")
+    result = _extract_table(log, positions, position_unit, bin_halfwidth, median_window,
+                            gravity, chunk_rows)
+    write_samples(result.samples, out)
+    if by_direction is not None:
+        write_samples(result.by_direction, by_direction)
+    console.print(result.summary(), highlight=False)
+    err_console.print(f"wrote {out} ({len(result.samples)} samples)"
+                      + (f" and {by_direction}" if by_direction else ""))
+
+
+def _extract_table(log, positions, position_unit, bin_halfwidth, median_window, gravity,
+                   chunk_rows):
+    from ..extract import extract
+    from ..io import iter_rawlog
+    from ..units import to_si
+
+    pos = parse_positions(positions, position_unit)
+    half = None if bin_halfwidth is None else float(to_si(bin_halfwidth, position_unit,
+                                                          "position"))
+    chunks = iter_rawlog(log, chunk_rows=chunk_rows)
+    first = next(chunks, None)
+    if first is None:
+        raise ConfigError(f"{log}: the log has no rows")
+    hints = dict(first.meta.get("design", {})) if isinstance(first.meta, dict) else {}
+    if pos is None and "positions_rad" in hints:
+        pos = np.asarray(hints["positions_rad"], dtype=float)
+        half = half if half is not None else hints.get("bin_halfwidth_rad")
+        err_console.print(f"using the {len(pos)} position bins recorded with the log")
+    if gravity is None:
+        gravity = hints.get("gravity", "fit" if pos is not None else "none")
+
+    def stream():
+        yield first
+        yield from chunks
+
+    with progress_bar("extracting", total=None) as advance:
+
+        def counted():
+            for chunk in stream():
+                advance()
+                yield chunk
+
+        return extract(counted(), positions=pos, bin_halfwidth=half,
+                       median_window=median_window, gravity=gravity)
