@@ -158,7 +158,7 @@ class RawLog:
             velocity=cat("velocity"),
             temperature=cat("temperature"),
             torque=cat("torque"),
-            current=cat("current") if cat("torque") is None else None,
+            current=cat("current"),
         )
 
 

@@ -1,0 +1,25 @@
+"""Readers and writers: fricid's CSV and Parquet tables, Maxon EPOS recorder CSV, generic logs.
+
+Every reader converts to SI once, at the edge, and names the file, row and column of bad
+input (:class:`~fricid.errors.DataError`); every writer is atomic (DESIGN.md, "Files").
+"""
+
+from .atomic import atomic_path, atomic_write
+from .epos import DEFAULT_NOMINAL_TORQUE, epos_steady_samples, read_epos, read_epos_dir
+from .generic import read_table_log
+from .tables import iter_rawlog, read_rawlog, read_samples, write_rawlog, write_samples
+
+__all__ = [
+    "DEFAULT_NOMINAL_TORQUE",
+    "atomic_path",
+    "atomic_write",
+    "epos_steady_samples",
+    "iter_rawlog",
+    "read_epos",
+    "read_epos_dir",
+    "read_rawlog",
+    "read_samples",
+    "read_table_log",
+    "write_rawlog",
+    "write_samples",
+]

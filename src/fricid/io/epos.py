@@ -1,0 +1,427 @@
+"""Maxon EPOS Studio data-recorder CSV export.
+
+The format, as EPOS Studio 3.x writes it (``;``-separated, CRLF line ends)::
+
+    Date:;2020-07-08 21:28:28
+    Firmware Version:;0x0120;0x6150;0x0000;0x0000
+    ...
+    Sampling period:;128.000                 (ms)
+    Scale:;0;True;2.000;6.000;-14.000;2.000   (optional, repeated)
+    ;Velocity actual value averaged;Torque actual value averaged
+    ms;rpm;%
+    0.000;-1;-32.8
+    128.000;-7;-22.8
+
+:func:`read_epos` turns one file into a :class:`~fricid.samples.RawLog` in SI units;
+:func:`read_epos_dir` reads a folder of them; :func:`epos_steady_samples` turns a folder of
+steady-state recordings (one constant velocity per file) into friction samples.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import os
+import re
+from collections.abc import Iterable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from ..errors import ConfigError, DataError
+from ..samples import FrictionSamples, RawLog
+from ..units import UNITS, to_si
+
+__all__ = [
+    "DEFAULT_NOMINAL_TORQUE",
+    "epos_steady_samples",
+    "read_epos",
+    "read_epos_dir",
+]
+
+logger = logging.getLogger(__name__)
+
+#: Nominal torque [N m] of the Maxon motor in the lead-screw recordings of
+#: Mablekos-Alexiou et al. (IEEE T-RO 2021), 9.84 mNm: the reference of their ``%`` torque.
+DEFAULT_NOMINAL_TORQUE = 9.84e-3
+
+FORMAT = "maxon-epos-recorder"
+
+_HEADER = re.compile(r"^(?P<key>[^;]*?):(?:;(?P<value>.*))?$")
+_NUMBER_START = r"^\s*[+-]?(?:\d|\.\d)"
+# torque as a fraction of the nominal torque
+_TORQUE_FRACTION = {"%": 1e-2, "‰": 1e-3, "permille": 1e-3, "per mille": 1e-3}
+_COUNT_UNITS = ("qc", "inc", "counts")
+_TIME_ALIASES = {"µs": "us", "μs": "us", "sec": "s"}
+_QUANTITIES = ("position", "velocity", "torque", "current")
+_NOT_ACTUAL = ("demand", "target", "command", "setpoint", "set value", "window")
+
+
+@dataclass(frozen=True)
+class _Recording:
+    """An EPOS export as text: header, channel names, units and the numeric block."""
+
+    header: dict[str, Any]
+    channels: list[str]  # [time, channel 1, ...]
+    units: list[str]
+    units_line: int
+    data: np.ndarray  # (n, channels)
+    lines: np.ndarray  # (n,) 1-based line number of each data row
+
+
+def _read_text(path: Path) -> list[str]:
+    raw = path.read_bytes()
+    for encoding in ("utf-8-sig", "cp1252"):
+        try:
+            text = raw.decode(encoding)
+            break
+        except UnicodeDecodeError:
+            continue
+    else:  # pragma: no cover - cp1252 fails only on five undefined bytes
+        text = raw.decode("latin-1")
+    return [line.rstrip("\r") for line in text.split("\n")]
+
+
+def _fields(line: str) -> list[str]:
+    """``;``-separated fields, trailing empty ones dropped."""
+    fields = [f.strip() for f in line.split(";")]
+    while len(fields) > 1 and fields[-1] == "":
+        fields.pop()
+    return fields
+
+
+def _parse_header(lines: list[str], path: Path) -> tuple[dict[str, Any], int]:
+    """The ``Key:;value`` block as a dict, and the index of the channel line."""
+    header: dict[str, Any] = {}
+    for i, line in enumerate(lines):
+        if line.startswith(";"):
+            return header, i
+        m = _HEADER.match(line.strip())
+        if m and m.group("key").strip():
+            key, value = m.group("key").strip(), (m.group("value") or "").strip()
+            if key in header:  # repeated keys (Scale:) collect into a list
+                old = header[key]
+                header[key] = [*old, value] if isinstance(old, list) else [old, value]
+            else:
+                header[key] = value
+        elif line.strip():
+            logger.warning("%s, line %d: skipped unrecognised header line %r", path, i + 1, line)
+    raise DataError(
+        "no channel line (';<channel name>;...', naming the recorded channels) found; "
+        "is this an EPOS Studio data-recorder export?",
+        file=path,
+    )
+
+
+def _parse_data(lines: list[str], start: int, channels: list[str], path: Path):
+    """Numeric rows from ``lines[start:]``; text lines are skipped with a warning."""
+    body = pd.Series(lines[start:], index=np.arange(start + 1, len(lines) + 1), dtype=object)
+    body = body[body.str.strip() != ""].str.strip().str.rstrip(";").str.strip()
+    is_row = body.str.match(_NUMBER_START)
+    for line_no, text in body[~is_row].items():
+        logger.warning("%s, line %d: skipped non-numeric line %r", path, line_no, text)
+    rows = body[is_row]
+    if rows.empty:
+        raise DataError("no data rows after the units line", file=path)
+    k = len(channels)
+    widths = rows.str.count(";").to_numpy() + 1
+    if (widths != k).any():
+        i = int(np.flatnonzero(widths != k)[0])
+        raise DataError(
+            f"row has {widths[i]} fields, expected {k} ({', '.join(channels)})",
+            file=path,
+            row=int(rows.index[i]),
+        )
+    text = rows.str.split(";", expand=True)
+    data = np.empty((len(rows), k))
+    for j in range(k):
+        data[:, j] = pd.to_numeric(text[j].str.strip(), errors="coerce").to_numpy(float)
+    bad = ~np.isfinite(data)
+    if bad.any():
+        i = int(np.flatnonzero(bad.any(axis=1))[0])
+        j = int(np.flatnonzero(bad[i])[0])
+        raise DataError(
+            f"malformed number {text.iat[i, j]!r}",
+            file=path,
+            row=int(rows.index[i]),
+            column=channels[j],
+        )
+    return data, rows.index.to_numpy()
+
+
+def _parse(path: Path) -> _Recording:
+    lines = _read_text(path)
+    if not any(line.strip() for line in lines):
+        raise DataError("empty file", file=path)
+    header, at = _parse_header(lines, path)
+    names = _fields(lines[at])
+    channels = ["time", *names[1:]]
+    if len(channels) < 2:
+        raise DataError("the channel line names no channels", file=path, row=at + 1)
+    if at + 1 >= len(lines) or re.match(_NUMBER_START, lines[at + 1]):
+        raise DataError(
+            "no units line (e.g. 'ms;rpm;%') after the channel line; units must be explicit",
+            file=path,
+            row=at + 2,
+        )
+    units = _fields(lines[at + 1])
+    if len(units) < len(channels):
+        raise DataError(
+            f"the units line has {len(units)} units for {len(channels)} columns",
+            file=path,
+            row=at + 2,
+        )
+    data, line_numbers = _parse_data(lines, at + 2, channels, path)
+    return _Recording(header, channels, units[: len(channels)], at + 2, data, line_numbers)
+
+
+def _pick_channels(channels: list[str]) -> dict[str, int]:
+    """Which column holds each quantity: names containing 'velocity', 'torque', ...
+
+    When several match, an 'actual' value beats anything else and an 'averaged' one beats a
+    plain one; demand, target and command values are never taken for measurements.
+    """
+    picked: dict[str, int] = {}
+    for quantity in _QUANTITIES:
+        best, best_score = None, -1
+        for j, name in enumerate(channels[1:], start=1):
+            low = name.lower()
+            if quantity not in low or any(word in low for word in _NOT_ACTUAL):
+                continue
+            score = 2 * ("actual" in low) + ("averaged" in low)
+            if score > best_score:
+                best, best_score = j, score
+        if best is not None:
+            picked[quantity] = best
+    return picked
+
+
+def _unknown_unit(rec: _Recording, j: int, known: Iterable[str], path: Path) -> DataError:
+    return DataError(
+        f"unknown unit '{rec.units[j]}' for channel '{rec.channels[j]}'; known: {', '.join(known)}",
+        file=path,
+        row=rec.units_line,
+        column=rec.channels[j],
+    )
+
+
+def _convert(
+    rec: _Recording,
+    j: int,
+    quantity: str,
+    path: Path,
+    nominal_torque: float,
+    counts_per_turn: float | None,
+) -> np.ndarray:
+    """Column ``j`` of the recording in SI, by its unit in the units line."""
+    unit, values = rec.units[j], rec.data[:, j]
+    if quantity == "time":
+        unit = _TIME_ALIASES.get(unit, unit)
+    if quantity == "torque" and unit in _TORQUE_FRACTION:
+        return values * (_TORQUE_FRACTION[unit] * nominal_torque)
+    if quantity == "position" and unit in _COUNT_UNITS:
+        if counts_per_turn is None:
+            raise ConfigError(
+                f"{path}: the position channel is in encoder counts ('{unit}'); pass "
+                "counts_per_turn (e.g. 4 x encoder lines for quadrature counts)"
+            )
+        return values * (2.0 * math.pi / counts_per_turn)
+    if unit not in UNITS[quantity]:
+        known = list(UNITS[quantity])
+        if quantity == "torque":
+            known = [*_TORQUE_FRACTION, *known]
+        elif quantity == "position":
+            known = [*_COUNT_UNITS, *known]
+        raise _unknown_unit(rec, j, known, path)
+    return np.asarray(to_si(values, unit, quantity), dtype=float)
+
+
+def _integrate(time: np.ndarray, velocity: np.ndarray) -> np.ndarray:
+    """Position [rad] from velocity by the trapezoidal rule, starting at 0."""
+    steps = 0.5 * (velocity[1:] + velocity[:-1]) * np.diff(time)
+    return np.concatenate([[0.0], np.cumsum(steps)])
+
+
+def _positive(name: str, value: float | None) -> None:
+    if value is not None and not (np.isfinite(value) and value > 0):
+        raise ConfigError(f"{name} must be a positive number, got {value!r}")
+
+
+def read_epos(
+    path: str | os.PathLike[str],
+    *,
+    nominal_torque: float = DEFAULT_NOMINAL_TORQUE,
+    flip_sign: bool = False,
+    temperature: float = 25.0,
+    torque_constant: float | None = None,
+    counts_per_turn: float | None = None,
+    joint: str = "joint",
+) -> RawLog:
+    """Read one EPOS Studio data-recorder CSV export as a raw log in SI units.
+
+    Parameters
+    ----------
+    path : the exported file (never modified).
+    nominal_torque : the motor's nominal torque [N m], the reference of a torque channel in
+        ``%`` (or per mille). Default 9.84 mNm, the motor of the lead-screw recordings.
+    flip_sign : negate every motion and effort channel. The lead-screw recordings need it to
+        match their file names (``N.csv`` is +N rpm): their authors' converter flips both
+        velocity and torque (motor convention).
+    temperature : [degC], constant; the recorder has no temperature channel.
+    torque_constant : K [N m/A], needed when only a current channel was recorded.
+    counts_per_turn : encoder counts per revolution, needed for a position channel in counts.
+    joint : name for the log.
+
+    Returns
+    -------
+    RawLog
+        Channels are found by name (velocity, torque or current, position). Without a
+        position channel, position is the trapezoidal integral of velocity, starting at 0.
+        ``meta`` holds the header (``Key:`` -> value text; repeated keys, such as ``Scale``,
+        -> list), the channel names and units used, and the conversion options.
+
+    Raises
+    ------
+    DataError
+        Naming file, line and column: no channel or units line, an unknown unit of a used
+        channel, a number-like but malformed value, a short row, time not increasing.
+        A text line in or after the data block (a typed comment) is skipped with a warning.
+    """
+    path = Path(path)
+    _positive("nominal_torque", nominal_torque)
+    _positive("counts_per_turn", counts_per_turn)
+    rec = _parse(path)
+    picked = _pick_channels(rec.channels)
+    if "velocity" not in picked:
+        raise DataError(f"no velocity channel among {rec.channels[1:]}", file=path)
+    if "torque" not in picked and "current" not in picked:
+        raise DataError(f"no torque or current channel among {rec.channels[1:]}", file=path)
+
+    def si(quantity: str, j: int) -> np.ndarray:
+        return _convert(rec, j, quantity, path, nominal_torque, counts_per_turn)
+
+    time = si("time", 0)
+    dt = np.diff(time)
+    if (dt <= 0).any():
+        i = int(np.flatnonzero(dt <= 0)[0]) + 1
+        raise DataError(
+            f"time is not strictly increasing ({rec.data[i - 1, 0]!r} then {rec.data[i, 0]!r})",
+            file=path,
+            row=int(rec.lines[i]),
+            column="time",
+        )
+    sign = -1.0 if flip_sign else 1.0
+    values = {q: sign * si(q, j) for q, j in picked.items()}
+    position = values.get("position")
+    meta = {
+        "format": FORMAT,
+        "header": rec.header,
+        "channels": {q: rec.channels[j] for q, j in picked.items()},
+        "units": {q: rec.units[j] for q, j in picked.items()},
+        "flip_sign": bool(flip_sign),
+        "nominal_torque [N m]": float(nominal_torque),
+        "position_source": "channel" if position is not None else "integrated velocity",
+        "temperature_source": "constant parameter (no channel)",
+    }
+    return RawLog(
+        time=time,
+        position=_integrate(time, values["velocity"]) if position is None else position,
+        velocity=values["velocity"],
+        temperature=temperature,
+        torque=values.get("torque"),
+        current=values.get("current"),
+        torque_constant=torque_constant,
+        joint=joint,
+        source=str(path),
+        meta=meta,
+    )
+
+
+def _files(folder: str | os.PathLike[str], pattern: str) -> list[Path]:
+    folder = Path(folder)
+    if not folder.is_dir():
+        raise DataError("not a folder", file=folder)
+    files = sorted(p for p in folder.glob(pattern) if p.is_file())
+    if not files:
+        raise DataError(f"no files matching '{pattern}'", file=folder)
+    return files
+
+
+def read_epos_dir(
+    folder: str | os.PathLike[str], *, pattern: str = "*.csv", **options: Any
+) -> list[RawLog]:
+    """Read every EPOS export in ``folder`` (one :func:`read_epos` per file).
+
+    The logs are sorted by set-point, taken as each file's mean velocity (signed, after
+    ``flip_sign``); file names are not interpreted. ``options`` go to :func:`read_epos`.
+    """
+    logs = [read_epos(path, **options) for path in _files(folder, pattern)]
+    return sorted(logs, key=lambda log: float(np.mean(log.velocity)))
+
+
+def epos_steady_samples(
+    folder: str | os.PathLike[str],
+    *,
+    pattern: str = "*.csv",
+    nominal_torque: float = DEFAULT_NOMINAL_TORQUE,
+    flip_sign: bool = False,
+    temperature: float = 25.0,
+    load: float = 0.0,
+    torque_constant: float | None = None,
+) -> FrictionSamples:
+    """Friction samples from a folder of steady-state EPOS recordings, one point per file.
+
+    Each file is taken as one constant-velocity operating point already in steady state
+    (as in the lead-screw recordings): friction is the mean motor torque over the file,
+    velocity the mean velocity, direction the sign of the mean velocity, count the number
+    of rows and std the torque's sample standard deviation. Load and temperature are the
+    given constants (the recorder logs neither).
+
+    Raises
+    ------
+    DataError
+        For a file whose mean velocity is zero (no direction of motion).
+
+    Notes
+    -----
+    The lead-screw folder (32 files, 16 per direction) gives, as recorded
+    (``flip_sign=False``, the drive's sign convention): +3.56 mNm at +2.14 rpm (``n2.csv``)
+    and -2.77 mNm at -2.07 rpm (``2.csv``). With ``flip_sign=True`` (the authors' convention,
+    ``N.csv`` is +N rpm) the same two points read +2.77 mNm at +2.07 rpm and -3.56 mNm at
+    -2.14 rpm: which direction has the larger friction depends on the sign convention chosen.
+    """
+    logs = read_epos_dir(
+        folder,
+        pattern=pattern,
+        nominal_torque=nominal_torque,
+        flip_sign=flip_sign,
+        temperature=temperature,
+        torque_constant=torque_constant,
+    )
+    velocity = np.array([np.mean(log.velocity) for log in logs])
+    zero = np.flatnonzero(velocity == 0)
+    if zero.size:
+        raise DataError(
+            "mean velocity is zero: not a constant-velocity recording", file=logs[zero[0]].source
+        )
+    torque = [log.motor_torque for log in logs]
+    return FrictionSamples(
+        velocity=velocity,
+        load=load,
+        temperature=temperature,
+        friction=np.array([np.mean(t) for t in torque]),
+        direction=np.sign(velocity),
+        count=np.array([len(t) for t in torque]),
+        std=np.array([np.std(t, ddof=1) if len(t) > 1 else 0.0 for t in torque]),
+        source=str(folder),
+        meta={
+            "format": FORMAT,
+            "method": "steady state: per-file mean torque and velocity",
+            "files": [Path(log.source).name for log in logs],
+            "flip_sign": bool(flip_sign),
+            "nominal_torque [N m]": float(nominal_torque),
+        },
+    )

@@ -1,0 +1,160 @@
+"""Any CSV or Parquet joint log, read through an explicit column mapping and explicit units."""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Mapping
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import ConfigError, DataError
+from ..samples import RawLog
+from ..units import UNITS, to_si
+from ._columns import split_label
+from ._csv import read_numeric, read_preamble, record_line
+from ._parquet import open_parquet, read_columns
+
+__all__ = ["read_table_log"]
+
+#: Quantities a generic log can map, with the physical quantity of their unit.
+_QUANTITIES = ("time", "position", "velocity", "torque", "current", "temperature")
+
+
+def _check_mapping(
+    columns: Mapping[str, str], units: Mapping[str, str], temperature: float | None
+) -> None:
+    unknown = [q for q in columns if q not in _QUANTITIES]
+    if unknown:
+        raise ConfigError(
+            f"unknown quantity {unknown[0]!r} in columns; map any of: {', '.join(_QUANTITIES)}"
+        )
+    extra = [q for q in units if q not in columns]
+    if extra:
+        raise ConfigError(f"units given for {extra[0]!r}, which columns= does not map")
+    for q in ("time", "velocity"):
+        if q not in columns:
+            raise ConfigError(f"columns must map '{q}' (a column of the file)")
+    if "torque" not in columns and "current" not in columns:
+        raise ConfigError("columns must map 'torque' or 'current' (with torque_constant)")
+    if ("temperature" in columns) == (temperature is not None):
+        raise ConfigError(
+            "give the temperature either as a column (columns={'temperature': ...}) or as a "
+            "constant (temperature=...) [degC], not both and not neither"
+        )
+
+
+def _unit(quantity: str, label: str, units: Mapping[str, str]) -> str:
+    """The unit of a mapped column: from ``units``, else from its label ``"dq [deg/s]"``."""
+    given = units.get(quantity)
+    in_label = split_label(label)[1]
+    allowed = ", ".join(UNITS[quantity])
+    if given is not None and in_label is not None and given.strip() != in_label:
+        raise ConfigError(
+            f"column '{label}' says its unit is '{in_label}', but units= says '{given}' "
+            f"for {quantity}; give one unit (allowed: {allowed})"
+        )
+    unit = given if given is not None else in_label
+    if unit is None:
+        raise ConfigError(
+            f"no unit for {quantity} (column '{label}'); pass units={{'{quantity}': ...}} "
+            f"with one of: {allowed}"
+        )
+    if unit.strip() not in UNITS[quantity]:
+        raise ConfigError(f"unknown {quantity} unit '{unit}'; allowed units: {allowed}")
+    return unit.strip()
+
+
+def _integrate(time: np.ndarray, velocity: np.ndarray) -> np.ndarray:
+    steps = 0.5 * (velocity[1:] + velocity[:-1]) * np.diff(time)
+    return np.concatenate([[0.0], np.cumsum(steps)])
+
+
+def read_table_log(
+    path: str | os.PathLike[str],
+    columns: Mapping[str, str],
+    units: Mapping[str, str] | None = None,
+    *,
+    torque_constant: float | None = None,
+    temperature: float | None = None,
+    joint: str = "joint",
+) -> RawLog:
+    """Read a joint log from any CSV or Parquet table, given which column is what.
+
+    Parameters
+    ----------
+    path : ``.csv`` (comma-separated, header line, optional leading ``#`` lines) or
+        ``.parquet`` / ``.pq``.
+    columns : quantity -> column name in the file. Quantities: time and velocity (required),
+        torque or current (one required), position and temperature (optional), e.g.
+        ``{"time": "t", "position": "q", "velocity": "dq", "torque": "tau"}``.
+    units : quantity -> unit, e.g. ``{"velocity": "deg/s"}``. A unit may instead be written in
+        the column name (``"dq [deg/s]"``); every mapped column needs one or the other.
+    torque_constant : K [N m/A] for a current column (tau = K I, eq. 13 of the BAS-RBFNN paper).
+    temperature : constant temperature [degC] when the file has no temperature column.
+    joint : name for the log.
+
+    Returns
+    -------
+    RawLog
+        In SI. Without a position column, position is the trapezoidal integral of velocity
+        starting at 0.
+
+    Raises
+    ------
+    ConfigError
+        An unknown quantity or unit (listing the allowed ones), conflicting units, a missing
+        unit, or an incomplete mapping.
+    DataError
+        A mapped column missing from the file (listing the file's columns), a non-numeric or
+        non-finite value (file, line, column), time not increasing.
+    """
+    path = Path(path)
+    columns = dict(columns)
+    units = dict(units or {})
+    _check_mapping(columns, units, temperature)
+    suffix = path.suffix.lower()
+    if suffix == ".csv":
+        pre = read_preamble(path)
+        available = pre.labels
+    elif suffix in (".parquet", ".pq"):
+        pf = open_parquet(path)
+        available = pf.schema_arrow.names
+    else:
+        raise ConfigError(f"cannot read '{path}': use a .csv, .parquet or .pq file")
+    by_name = {a.strip(): a for a in reversed(available)}  # tolerate blanks around names
+    for quantity, label in columns.items():
+        if label not in available and label.strip() not in by_name:
+            raise DataError(
+                f"no column '{label}' (mapped to {quantity}); the file has: "
+                + ", ".join(repr(a) for a in available),
+                file=path,
+                column=label,
+            )
+        columns[quantity] = label if label in available else by_name[label.strip()]
+    unit_of = {q: _unit(q, label, units) for q, label in columns.items()}
+    labels = list(dict.fromkeys(columns.values()))
+    raw = read_numeric(pre, labels) if suffix == ".csv" else read_columns(pf, labels, path)
+    si = {
+        q: np.asarray(to_si(raw[label], unit_of[q], q), dtype=float) for q, label in columns.items()
+    }
+    time, velocity = si["time"], si["velocity"]
+    try:
+        return RawLog(
+            time=time,
+            position=si["position"] if "position" in si else _integrate(time, velocity),
+            velocity=velocity,
+            temperature=si.get("temperature", temperature),
+            torque=si.get("torque"),
+            current=si.get("current"),
+            torque_constant=torque_constant,
+            joint=joint,
+            source=str(path),
+            meta={"columns": columns, "units": unit_of},
+        )
+    except DataError as err:
+        row = err.row
+        if row is not None and suffix == ".csv":
+            row = record_line(pre, row)
+        column = columns.get(err.column, err.column) if err.column else None
+        raise DataError(err.message, file=path, row=row, column=column) from None
