@@ -1,0 +1,429 @@
+"""Raw log to friction samples: the BAS-RBFNN paper's section 2 as one function, :func:`extract`.
+
+1. Segment the constant-velocity portions (:mod:`.segment`) and group them into velocity and
+   temperature set-points.
+2. Median-filter the motor torque ``tau = K I`` (eq. 13) within each segment.
+3. Bin by position and average over the repetitions (:mod:`.bins`).
+4. Separate friction and gravity by eq. 11, fit eq. 7 and take the fitted gravity torque at
+   each bin as its load (eq. 12) (:mod:`.gravity`); or, for a horizontal joint
+   (``gravity="none"``, RWSAVSBAS paper section 2.1), take the torque as the friction.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Iterable, Iterator
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from scipy.ndimage import median_filter
+
+from ..errors import ConfigError, DataError
+from ..samples import FrictionSamples, RawLog
+from .bins import Cells, CellTable, PositionBins, pool_cells
+from .gravity import GravityFit, fit_gravity, separate
+from .segment import Segment, SegmentCounts, as_log_stream, cluster, iter_segments
+
+__all__ = ["GRAVITY_MODES", "SPIKE_SIGMAS", "Diagnostics", "ExtractionResult", "extract"]
+
+logger = logging.getLogger(__name__)
+
+#: Values of ``extract(..., gravity=...)``.
+GRAVITY_MODES = ("fit", "none")
+
+#: A filtered sample differing from the raw one by more than this many robust standard
+#: deviations (1.4826 MAD of the differences) is counted as a spike in the diagnostics.
+SPIKE_SIGMAS = 8.0
+
+
+@dataclass(frozen=True, eq=False)
+class Diagnostics:
+    """What extraction found and discarded.
+
+    Attributes
+    ----------
+    rows, chunks : raw samples and log chunks read.
+    runs : runs of one velocity sign examined (including the flicker of a noisy velocity at rest).
+    segments : constant-velocity segments kept.
+    dropped : runs dropped, by reason: ``short_run`` (fewer than ``min_samples``),
+        ``no_plateau`` (no sample near the median velocity), ``short_steady`` (too short after
+        removing ramps and settle margins).
+    spikes : samples the median filter changed by more than ``SPIKE_SIGMAS`` robust sigmas.
+    binned, outside_bins : steady samples inside / outside every position bin.
+    velocity_setpoints : rad/s, the speeds found (cluster medians).
+    temperature_setpoints : degC, the temperatures found.
+    passes_min, passes_max : fewest and most passes averaged into one sample.
+    """
+
+    rows: int
+    chunks: int
+    runs: int
+    segments: int
+    dropped: dict[str, int]
+    spikes: int
+    binned: int
+    outside_bins: int
+    velocity_setpoints: np.ndarray
+    temperature_setpoints: np.ndarray
+    passes_min: int
+    passes_max: int
+
+
+@dataclass(frozen=True, eq=False)
+class ExtractionResult:
+    """The friction samples of a log and how they were obtained.
+
+    Attributes
+    ----------
+    samples : combined samples, direction 0 (eq. 11): one row per (temperature, velocity,
+        position bin), sorted in that order; velocity and friction of the positive direction.
+    by_direction : the same operating points per direction (+1/-1, velocity and friction
+        signed; rows ordered as ``samples`` with -1 before +1): ``tau_f+- = tau+- + tau_g``
+        with the fitted gravity, which keeps a drive's asymmetry.
+    gravity : the eq. 7 fit, or None with ``gravity="none"``.
+    diagnostics : see :class:`Diagnostics`.
+    sem, direction_sem : N m, standard error of each row's friction from the scatter of the
+        repetitions (the noise floor; use it for weighting or tolerances).
+    position : rad, mean position of each combined row's samples.
+    options : the extraction options used (also in ``samples.meta["extract"]``).
+    """
+
+    samples: FrictionSamples
+    by_direction: FrictionSamples
+    gravity: GravityFit | None
+    diagnostics: Diagnostics
+    sem: np.ndarray
+    direction_sem: np.ndarray
+    position: np.ndarray
+    options: dict[str, Any] = field(default_factory=dict)
+
+    def summary(self) -> str:
+        """A few lines describing the result (for a report or the CLI)."""
+        d = self.diagnostics
+        lines = [
+            f"{len(self.samples)} samples ({len(self.by_direction)} per direction) from "
+            f"{d.segments} segments of {d.rows} rows; {d.spikes} spikes filtered",
+            f"{d.velocity_setpoints.size} velocity set-points "
+            f"({d.velocity_setpoints.min():.4g}-{d.velocity_setpoints.max():.4g} rad/s), "
+            f"{d.temperature_setpoints.size} temperatures, "
+            f"{d.passes_min}-{d.passes_max} passes per sample",
+        ]
+        if self.gravity is not None:
+            g = self.gravity
+            lines.append(
+                f"gravity (eq. 7): p_x = {g.p_x:.5g} +- {g.p_x_se:.2g}, "
+                f"p_y = {g.p_y:.5g} +- {g.p_y_se:.2g} N m, residual {g.residual_rms:.2g} N m"
+            )
+        return "\n".join(lines)
+
+
+class _Source:
+    """Passes a log stream through, remembering the first log's source name."""
+
+    def __init__(self, logs: RawLog | Iterable[RawLog]) -> None:
+        self.logs = logs
+        self.name: str | None = None
+
+    def __iter__(self) -> Iterator[RawLog]:
+        for log in as_log_stream(self.logs):
+            if self.name is None:
+                self.name = log.source
+            yield log
+
+
+def _count_spikes(raw: np.ndarray, filtered: np.ndarray) -> int:
+    """Samples the filter moved by more than SPIKE_SIGMAS robust sigmas (1.4826 MAD of the
+    changes; for quantised or noiseless data with MAD 0, the median nonzero change)."""
+    r = np.abs(raw - filtered)
+    scale = 1.4826 * float(np.median(r))
+    if scale == 0.0:
+        nonzero = r[r > 0]
+        if nonzero.size == 0:
+            return 0
+        scale = float(np.median(nonzero))
+    return int(np.count_nonzero(r > SPIKE_SIGMAS * scale))
+
+
+def _check_options(median_window, gravity, velocity_rtol, temperature_atol) -> None:
+    if int(median_window) != median_window or median_window < 1 or median_window % 2 == 0:
+        raise ConfigError(
+            f"median_window must be an odd positive integer (1: no filter), got {median_window!r}"
+        )
+    if gravity not in GRAVITY_MODES:
+        raise ConfigError(f"gravity must be one of {', '.join(GRAVITY_MODES)}; got {gravity!r}")
+    if not (velocity_rtol > 0):
+        raise ConfigError(f"velocity_rtol must be > 0, got {velocity_rtol!r}")
+    if not (temperature_atol > 0):
+        raise ConfigError(f"temperature_atol must be > 0 degC, got {temperature_atol!r}")
+
+
+def extract(
+    logs: RawLog | Iterable[RawLog],
+    *,
+    positions=None,
+    bin_halfwidth: float | None = None,
+    median_window: int = 5,
+    gravity: str = "fit",
+    velocity_tolerance: float = 0.05,
+    settle_time: float = 0.1,
+    min_samples: int = 20,
+    velocity_rtol: float = 0.05,
+    temperature_atol: float = 1.0,
+) -> ExtractionResult:
+    """Friction samples from raw constant-velocity sweeps (BAS-RBFNN paper, eq. 7-13).
+
+    Parameters
+    ----------
+    logs : one :class:`RawLog` or an iterable of consecutive chunks of one (streamed; memory
+        is bounded by a chunk plus one run). The torque is the logged torque or ``K I``.
+    positions : rad, centres of the position bins; None (default) makes each steady segment one
+        bin (right for a horizontal joint or a steady-state file; needs ``gravity="none"``).
+    bin_halfwidth : rad; default half the smallest spacing of ``positions``.
+    median_window : samples of the running median applied to the torque within each segment
+        (odd; 1 disables it). It removes current spikes.
+    gravity : "fit" (a joint with gravity: eq. 11 needs both directions at every operating
+        point, eq. 7 is fitted and gives the loads) or "none" (a horizontal joint: the torque is
+        the friction, load 0; eq. 11 combines the directions where both exist, a single
+        direction is used as measured).
+    velocity_tolerance : relative band around a run's median velocity that counts as steady.
+    settle_time : s trimmed from each end of a steady part.
+    min_samples : shortest steady part kept.
+    velocity_rtol : relative gap separating two velocity set-points.
+    temperature_atol : degC gap separating two temperature set-points.
+
+    Returns
+    -------
+    ExtractionResult
+
+    Raises
+    ------
+    DataError : no constant-velocity segment; one direction only where eq. 11 needs two (the
+        message lists the set-points and the missing direction); a gravity fit without two
+        distinct positions.
+    ConfigError : bad options, among them ``gravity="fit"`` without ``positions``.
+    """
+    _check_options(median_window, gravity, velocity_rtol, temperature_atol)
+    bins = PositionBins(positions, bin_halfwidth)
+    if gravity == "fit" and bins.auto:
+        raise ConfigError(
+            "gravity='fit' needs position bins (positions=..., eq. 7 is fitted across them); "
+            "without them each steady traverse is one bin, which suits a horizontal joint: "
+            "gravity='none'"
+        )
+    stream = _Source(logs)
+    counts = SegmentCounts()
+    segments = iter_segments(
+        stream,
+        velocity_tolerance=velocity_tolerance,
+        settle_time=settle_time,
+        min_samples=min_samples,
+        counts=counts,
+    )
+    acc = _Accumulator(bins, int(median_window))
+    for seg in segments:
+        acc.add(seg)
+    source = stream.name
+    if not acc.cells:
+        raise DataError(
+            f"no constant-velocity segment found in {counts.rows} rows: {counts.runs} runs of one "
+            f"velocity sign, {counts.dropped_short_run} shorter than min_samples={min_samples}, "
+            f"{counts.dropped_no_plateau} without a velocity plateau, "
+            f"{counts.dropped_short_steady} too short after trimming {settle_time} s of settling",
+            file=source,
+        )
+
+    # set-points: velocity by relative gaps, temperature by absolute gaps
+    v_label, v_set = cluster(np.array(acc.speeds), velocity_rtol, relative=True)
+    t_label, t_set = cluster(np.array(acc.temperatures), temperature_atol, relative=False)
+    shape = (t_set.size, v_set.size, bins.n_bins)
+    pooled = pool_cells(acc.table(t_label, v_label, shape), int(np.prod(shape)) * 2)
+    if not (pooled.count > 0).any():
+        raise DataError(
+            f"{len(acc.cells)} constant-velocity segments found, but none has samples inside the "
+            "position bins; check positions and bin_halfwidth (radians)",
+            file=source,
+        )
+    options = {
+        "positions": None if bins.auto else bins.centres.tolist(),
+        "bin_halfwidth": bins.halfwidth,
+        "median_window": int(median_window),
+        "gravity": gravity,
+        "velocity_tolerance": velocity_tolerance,
+        "settle_time": settle_time,
+        "min_samples": int(min_samples),
+        "velocity_rtol": velocity_rtol,
+        "temperature_atol": temperature_atol,
+    }
+    samples, by_direction, fit, sem, direction_sem, position = _assemble(
+        pooled, shape, t_set, v_set, gravity, source, {"extract": options}
+    )
+    passes = pooled.passes[pooled.count > 0]
+    diagnostics = Diagnostics(
+        rows=counts.rows,
+        chunks=counts.chunks,
+        runs=counts.runs,
+        segments=counts.kept,
+        dropped={
+            "short_run": counts.dropped_short_run,
+            "no_plateau": counts.dropped_no_plateau,
+            "short_steady": counts.dropped_short_steady,
+        },
+        spikes=acc.spikes,
+        binned=acc.binned,
+        outside_bins=acc.outside,
+        velocity_setpoints=v_set,
+        temperature_setpoints=t_set,
+        passes_min=int(passes.min()),
+        passes_max=int(passes.max()),
+    )
+    logger.info("extracted %d samples from %d segments", len(samples), counts.kept)
+    return ExtractionResult(
+        samples, by_direction, fit, diagnostics, sem, direction_sem, position, options
+    )
+
+
+class _Accumulator:
+    """Per-segment work: median filter (step 2), position bins (step 3), cell statistics."""
+
+    def __init__(self, bins: PositionBins, window: int) -> None:
+        self.bins = bins
+        self.window = window
+        self.speeds: list[float] = []
+        self.directions: list[int] = []
+        self.temperatures: list[float] = []
+        self.cells: list[Cells] = []
+        self.spikes = self.binned = self.outside = 0
+
+    def add(self, seg: Segment) -> None:
+        log = seg.log
+        raw = log.motor_torque  # eq. 13
+        if self.window > 1:
+            tau = median_filter(raw, size=self.window, mode="nearest")
+            self.spikes += _count_spikes(raw, tau)
+        else:
+            tau = raw
+        idx = self.bins.assign(log.position)
+        c = Cells.of(idx, tau, log.position, log.velocity, log.temperature, self.bins.n_bins)
+        n_in = int(c.count.sum())
+        self.binned += n_in
+        self.outside += len(log) - n_in
+        self.speeds.append(seg.speed)
+        self.directions.append(seg.direction)
+        self.temperatures.append(float(np.mean(log.temperature)))
+        self.cells.append(c)
+
+    def table(self, t_label: np.ndarray, v_label: np.ndarray, shape) -> CellTable:
+        """All cells, each labelled with its group (temperature, velocity, direction, bin)."""
+        _, nv, nb = shape
+        forward = (np.array(self.directions) > 0).astype(np.intp)  # 0: backward, 1: forward
+        first = ((t_label * nv + v_label) * 2 + forward) * nb
+        return CellTable(
+            group=(first[:, None] + np.arange(nb)[None, :]).ravel(),
+            **{
+                name: np.concatenate([getattr(c, name) for c in self.cells])
+                for name in ("count", "torque", "m2", "position", "velocity", "temperature")
+            },
+        )
+
+
+def _missing_message(has: np.ndarray, t_set, v_set) -> str:
+    """Describe the (temperature, velocity) set-points where one direction is missing;
+    ``has`` is (temperature, velocity, direction, bin)."""
+    lines = []
+    for it, iv in zip(*np.nonzero((has[:, :, 0] ^ has[:, :, 1]).any(axis=-1)), strict=True):
+        back, fwd = has[it, iv, 0], has[it, iv, 1]
+        parts = []
+        for name, mine, other in (("negative", back, fwd), ("positive", fwd, back)):
+            lacking = int((other & ~mine).sum())
+            if lacking:
+                parts.append(f"no {name}-direction data in {lacking} of {int(other.sum())} bins")
+        v = v_set[iv]
+        lines.append(
+            f"{t_set[it]:.4g} degC, {v:.4g} rad/s ({np.degrees(v):.4g} deg/s): " + ", ".join(parts)
+        )
+    more = f"; and {len(lines) - 5} more" if len(lines) > 5 else ""
+    return (
+        "eq. 11 separates friction from gravity with both directions of motion at every "
+        f"operating point, but {len(lines)} set-point(s) lack one: "
+        + "; ".join(lines[:5])
+        + more
+        + " (for a horizontal joint use gravity='none')"
+    )
+
+
+def _assemble(pooled, shape, t_set, v_set, gravity, source, meta):
+    """Step 4: eq. 11 per operating point, the eq. 7 fit, loads (eq. 12), sample tables."""
+    nt, nv, nb = shape
+
+    def grid(x: np.ndarray) -> np.ndarray:
+        return x.reshape(nt, nv, 2, nb).transpose(0, 1, 3, 2)  # (t, v, bin, direction)
+
+    count, tau, std, sem = (grid(getattr(pooled, k)) for k in ("count", "torque", "std", "sem"))
+    pos, vel, temp = (grid(getattr(pooled, k)) for k in ("position", "velocity", "temperature"))
+    has = count > 0
+    both = has[..., 0] & has[..., 1]
+    any_ = has[..., 0] | has[..., 1]
+    if gravity == "fit" and (any_ & ~both).any():
+        raise DataError(_missing_message(has.transpose(0, 1, 3, 2), t_set, v_set), file=source)
+
+    fit = None
+    if gravity == "fit":
+        _, tau_g = separate(tau[both][:, 1], tau[both][:, 0])
+        theta = 0.5 * (pos[both][:, 0] + pos[both][:, 1])
+        fit = fit_gravity(theta, tau_g, source=source)
+
+    rows = np.argwhere(any_)  # (t, v, bin), C order = sorted
+    sel = tuple(rows.T)
+    # per row, columns (backward, forward): count, torque, std, sem, position, velocity, temp
+    c_, t_, s_, e_, p_, v_, T_ = (a[sel] for a in (count, tau, std, sem, pos, vel, temp))
+    h = has[sel]
+    b2 = h[:, 0] & h[:, 1]
+    n_tot = c_.sum(axis=1)
+    with np.errstate(invalid="ignore"):
+        # combined (direction 0): eq. 11 where both directions exist, else the one measured
+        friction = np.where(b2, 0.5 * (t_[:, 1] - t_[:, 0]), np.where(h[:, 1], t_[:, 1], -t_[:, 0]))
+        velocity = np.where(b2, 0.5 * (v_[:, 1] - v_[:, 0]), np.where(h[:, 1], v_[:, 1], -v_[:, 0]))
+        position = np.nansum(np.where(h, p_ * c_, 0.0), axis=1) / n_tot
+        temperature = np.nansum(np.where(h, T_ * c_, 0.0), axis=1) / n_tot
+        m2 = np.where(h, s_**2 * np.maximum(c_ - 1, 0), 0.0).sum(axis=1)
+        std_c = np.sqrt(m2 / np.maximum(n_tot - h.sum(axis=1), 1))
+        sem_c = np.where(
+            b2,
+            0.5 * np.sqrt(e_[:, 0] ** 2 + e_[:, 1] ** 2),
+            np.nanmax(np.where(h, e_, np.nan), axis=1),
+        )
+    if fit is not None:
+        load = fit.torque(position)
+        friction_dir = t_ + fit.torque(p_)
+        load_dir = fit.torque(p_)
+    else:
+        load = np.zeros_like(position)
+        friction_dir = t_
+        load_dir = np.zeros_like(p_)
+    meta = {**meta, "gravity": None if fit is None else vars(fit)}
+    samples = FrictionSamples(
+        velocity=velocity,
+        load=load,
+        temperature=temperature,
+        friction=friction,
+        direction=np.zeros_like(friction),
+        count=n_tot,
+        std=std_c,
+        source=source,
+        meta=meta,
+    )
+    dsel = h.ravel()  # (row, direction) pairs present, -1 before +1
+    sign = np.tile([-1.0, 1.0], len(rows))
+    by_direction = FrictionSamples(
+        velocity=v_.ravel()[dsel],
+        load=load_dir.ravel()[dsel],
+        temperature=T_.ravel()[dsel],
+        friction=friction_dir.ravel()[dsel],
+        direction=sign[dsel],
+        count=c_.ravel()[dsel],
+        std=s_.ravel()[dsel],
+        source=source,
+        meta=meta,
+    )
+    return samples, by_direction, fit, sem_c, e_.ravel()[dsel], position

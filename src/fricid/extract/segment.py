@@ -1,0 +1,208 @@
+"""Find the constant-velocity portions of a (streamed) raw log.
+
+A *run* is a maximal stretch of samples whose measured velocity has one sign. Its *plateau* is
+the median velocity of the run (refined once: the median of the samples within the band); its
+*steady part* runs from the first to the last sample within ``velocity_tolerance`` of the
+plateau (which drops the acceleration and deceleration ramps), minus ``settle_time`` at each
+end (what is left of a ramp, and the drive settling). Runs whose steady part is shorter than
+``min_samples`` are dropped: dwells at rest, sign flicker of a noisy velocity near zero,
+aborted moves.
+
+Logs may arrive in chunks: the last run of a chunk may continue in the next one, so it is
+carried over and finished there. A chunk whose time does not continue the previous one (a new
+file) closes the open run.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Iterable, Iterator
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import ConfigError
+from ..samples import RawLog
+
+__all__ = ["Segment", "SegmentCounts", "as_log_stream", "cluster", "iter_segments"]
+
+logger = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class Segment:
+    """The steady part of one constant-velocity run.
+
+    ``row`` is the global 0-based index of the segment's first sample in the stream; ``plateau``
+    the run's median velocity [rad/s] (signed); ``direction`` +1 or -1; ``log`` the samples.
+    """
+
+    row: int
+    plateau: float
+    direction: int
+    log: RawLog
+
+    @property
+    def speed(self) -> float:
+        return abs(self.plateau)
+
+
+@dataclass
+class SegmentCounts:
+    """What segmentation saw: rows read, runs found, runs kept and dropped (by reason)."""
+
+    rows: int = 0
+    chunks: int = 0
+    runs: int = 0
+    kept: int = 0
+    dropped_short_run: int = 0
+    dropped_no_plateau: int = 0
+    dropped_short_steady: int = 0
+
+
+def as_log_stream(logs: RawLog | Iterable[RawLog]) -> Iterator[RawLog]:
+    """One RawLog or an iterable of them, as an iterator (type-checked)."""
+    if isinstance(logs, RawLog):
+        yield logs
+        return
+    for i, log in enumerate(logs):
+        if not isinstance(log, RawLog):
+            raise ConfigError(
+                f"extract: item {i} of 'logs' is a {type(log).__name__}, not a RawLog"
+            )
+        yield log
+
+
+def _steady(
+    log: RawLog,
+    start: int,
+    stop: int,
+    velocity_tolerance: float,
+    settle_time: float,
+    min_samples: int,
+    counts: SegmentCounts,
+) -> tuple[int, int, float] | None:
+    """Steady part (start, stop, plateau) of the run ``start:stop`` of ``log``, or None."""
+    counts.runs += 1
+    if stop - start < min_samples:
+        counts.dropped_short_run += 1
+        return None
+    v = log.velocity[start:stop]
+    plateau = float(np.median(v))
+    inside = np.flatnonzero(np.abs(v - plateau) <= velocity_tolerance * abs(plateau))
+    if inside.size:
+        # refine: the run's median is pulled towards the ramps; the band's median is not
+        plateau = float(np.median(v[inside]))
+        inside = np.flatnonzero(np.abs(v - plateau) <= velocity_tolerance * abs(plateau))
+    if plateau == 0.0 or inside.size == 0:
+        counts.dropped_no_plateau += 1
+        return None
+    a, b = start + int(inside[0]), start + int(inside[-1]) + 1
+    t = log.time[a:b]
+    a2 = a + int(np.searchsorted(t, t[0] + settle_time, side="left"))
+    b2 = a + int(np.searchsorted(t, t[-1] - settle_time, side="right"))
+    if b2 - a2 < min_samples:
+        counts.dropped_short_steady += 1
+        return None
+    counts.kept += 1
+    return a2, b2, plateau
+
+
+def iter_segments(
+    logs: RawLog | Iterable[RawLog],
+    *,
+    velocity_tolerance: float = 0.05,
+    settle_time: float = 0.1,
+    min_samples: int = 20,
+    counts: SegmentCounts | None = None,
+) -> Iterator[Segment]:
+    """Yield the constant-velocity segments of a log stream, in order.
+
+    Parameters
+    ----------
+    logs : one RawLog or an iterable of consecutive chunks (memory is bounded by one chunk plus
+        one run).
+    velocity_tolerance : relative band around the plateau velocity that counts as steady.
+    settle_time : s trimmed from each end of the steady part.
+    min_samples : shortest steady part kept.
+    counts : filled with what was found and dropped.
+    """
+    if not (0 < velocity_tolerance < 1):
+        raise ConfigError(f"velocity_tolerance must be in (0, 1), got {velocity_tolerance!r}")
+    if settle_time < 0:
+        raise ConfigError(f"settle_time must be >= 0 s, got {settle_time!r}")
+    if int(min_samples) != min_samples or min_samples < 1:
+        raise ConfigError(f"min_samples must be a positive integer, got {min_samples!r}")
+    counts = SegmentCounts() if counts is None else counts
+    options = (velocity_tolerance, settle_time, int(min_samples), counts)
+
+    carry: RawLog | None = None  # the open run, carried into the next chunk
+    carry_row = 0
+    for chunk in as_log_stream(logs):
+        counts.chunks += 1
+        counts.rows += len(chunk)
+        if len(chunk) == 0:
+            continue
+        if carry is not None and chunk.time[0] <= carry.time[-1]:
+            # time restarts: a new file; the open run ends here
+            found = _steady(carry, 0, len(carry), *options)
+            if found is not None:
+                yield _segment(carry, carry_row, *found)
+            carry_row += len(carry)
+            carry = None
+        if carry is None:
+            buf, buf_row = chunk, carry_row
+        else:
+            buf, buf_row = RawLog.concatenate([carry, chunk]), carry_row
+        sign = np.sign(buf.velocity)
+        edges = np.flatnonzero(sign[1:] != sign[:-1]) + 1
+        starts = np.concatenate(([0], edges))
+        stops = np.concatenate((edges, [len(buf)]))
+        for start, stop in zip(starts[:-1], stops[:-1], strict=True):
+            if sign[start] == 0:
+                continue
+            found = _steady(buf, int(start), int(stop), *options)
+            if found is not None:
+                yield _segment(buf, buf_row, *found)
+        last = int(starts[-1])
+        carry = buf.slice(last, len(buf))
+        carry_row = buf_row + last
+    if carry is not None and len(carry) and carry.velocity[0] != 0:
+        found = _steady(carry, 0, len(carry), *options)
+        if found is not None:
+            yield _segment(carry, carry_row, *found)
+    logger.debug("segmentation: %s", counts)
+
+
+def _segment(log: RawLog, row0: int, start: int, stop: int, plateau: float) -> Segment:
+    return Segment(
+        row=row0 + start,
+        plateau=plateau,
+        direction=1 if plateau > 0 else -1,
+        log=log.slice(start, stop),
+    )
+
+
+def cluster(
+    values: np.ndarray, tolerance: float, *, relative: bool
+) -> tuple[np.ndarray, np.ndarray]:
+    """Group 1-D values into set-points: sorted, a new group starts where the gap to the
+    previous value exceeds ``tolerance`` (relative to that value when ``relative``).
+
+    Returns (labels (n,), centres (k,)): labels number the groups in ascending order and each
+    centre is its group's median.
+    """
+    values = np.asarray(values, dtype=float)
+    if values.size == 0:
+        return np.zeros(0, dtype=np.intp), np.zeros(0)
+    order = np.argsort(values, kind="stable")
+    s = values[order]
+    gap = np.diff(s)
+    limit = tolerance * np.abs(s[:-1]) if relative else tolerance
+    new = np.concatenate(([0], (gap > limit).astype(np.intp)))
+    sorted_labels = np.cumsum(new)
+    labels = np.empty_like(sorted_labels)
+    labels[order] = sorted_labels
+    k = int(sorted_labels[-1]) + 1
+    centres = np.array([np.median(s[sorted_labels == j]) for j in range(k)])
+    return labels, centres

@@ -1,0 +1,54 @@
+"""The virtual joint: raw logs of constant-velocity sweeps from a known friction law.
+
+It is fricid's embedded default data and the test oracle:
+
+>>> from fricid.sim import preset, simulate, true_samples
+>>> scenario = preset("paper1", "quick")
+>>> logs = simulate(scenario, seed=1)            # one RawLog per velocity set-point
+>>> truth = true_samples(scenario)                # what extraction should recover
+
+Modules: :mod:`.laws` (true friction laws), :mod:`.design` (experiment designs, trapezoidal
+traverses), :mod:`.joint` (dynamics, noise, scenarios), :mod:`.simulate`, :mod:`.presets`,
+:mod:`.oracle`.
+"""
+
+from __future__ import annotations
+
+from .design import Design, Profile, Traverse
+from .joint import Joint, Noise, Scenario, gravity_torque
+from .laws import FrictionLaw, LoadTemperatureLaw, ModelLaw
+from .oracle import (
+    MEDIAN_EFFICIENCY,
+    expected_noise_std,
+    operating_grid,
+    true_gravity,
+    true_samples,
+)
+from .presets import PRESETS, SIZES, preset
+from .simulate import CHUNKS, SeedLike, root_entropy, simulate, simulate_log
+
+__all__ = [
+    "CHUNKS",
+    "MEDIAN_EFFICIENCY",
+    "PRESETS",
+    "SIZES",
+    "Design",
+    "FrictionLaw",
+    "Joint",
+    "LoadTemperatureLaw",
+    "ModelLaw",
+    "Noise",
+    "Profile",
+    "Scenario",
+    "SeedLike",
+    "Traverse",
+    "expected_noise_std",
+    "gravity_torque",
+    "operating_grid",
+    "preset",
+    "root_entropy",
+    "simulate",
+    "simulate_log",
+    "true_gravity",
+    "true_samples",
+]
