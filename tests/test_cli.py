@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 
+import numpy as np
 import pytest
 from typer.testing import CliRunner
 
@@ -93,3 +94,46 @@ def test_help_mentions_units():
         res = run(cmd, "--help")
         assert res.exit_code == 0
     assert "rad/s" in run("extract", "--help").output
+
+
+def _rawlog_csv(path, rows: str, header: str = "time [s],position [rad],velocity [rad/s],"
+                "torque [N m],temperature [degC]"):
+    path.write_text(header + "\n" + rows)
+    return path
+
+
+@pytest.mark.parametrize(
+    ("header", "rows", "message"),
+    [
+        ("time [s],position [rad],torque [N m],temperature [degC]", "0,0,1,25\n",
+         "velocity"),  # missing column
+        (None, "0,0,1,1,25\n0.004,0,1,oops,25\n", "row 3"),  # non-numeric value
+        (None, "0,0,1,1,25\n0.004,0,1,nan,25\n", "row 3"),  # NaN
+        (None, "0,0,1,1,25\n0.004,0,1,1,25\n0.002,0,1,1,25\n", "time"),  # non-monotonic time
+        ("time [s],position [rad],velocity [furlong/s],torque [N m],temperature [degC]",
+         "0,0,1,1,25\n", "furlong/s"),  # unknown unit
+        (None, "".join(f"{i * 0.004},0,0,0.1,25\n" for i in range(200)),
+         "constant-velocity"),  # at rest all along
+    ],
+)
+def test_extract_bad_logs(tmp_path, header, rows, message):
+    log = _rawlog_csv(tmp_path / "log.csv", rows, *( [header] if header else []))
+    out = tmp_path / "samples.csv"
+    res = run("extract", log, "--gravity", "none", "--out", out)
+    assert res.exit_code == 2, res.output
+    assert message in res.output
+    assert "log.csv" in res.output
+    assert "Traceback" not in res.output and len(res.output.strip().splitlines()) <= 3
+    assert not out.exists()
+
+
+def test_extract_one_direction_where_two_are_needed(tmp_path):
+    n = 2000
+    t = np.arange(n) * 0.004
+    rows = "".join(f"{ti},{0.1 * ti - 0.5},0.1,0.3,25\n" for ti in t)
+    log = _rawlog_csv(tmp_path / "log.csv", rows)
+    out = tmp_path / "samples.csv"
+    res = run("extract", log, "--positions", "-28:-24:2", "--gravity", "fit", "--out", out)
+    assert res.exit_code == 2, res.output
+    assert "direction" in res.output
+    assert not out.exists()

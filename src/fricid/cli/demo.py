@@ -33,7 +33,7 @@ def demo_command(
     t0 = time.perf_counter()
     res = run_demo(out, size=size, seed=seed, method=method,
                    progress=lambda msg: err_console.print(f"[dim]{msg}[/]"))
-    console.print(res.extraction.summary(), highlight=False)
+    console.print(res.extraction.summary(), markup=False, highlight=False)
     px, py = res.true_gravity
     console.print(f"true gravity:    p_x = {px:.5g}, p_y = {py:.5g} N m", highlight=False)
 

@@ -7,6 +7,7 @@ from typing import Annotated
 
 import numpy as np
 import typer
+from rich.markup import escape
 
 from ..errors import ConfigError
 from ._app import app, console, err_console, handle_errors
@@ -86,7 +87,7 @@ def extract_command(
         samples = epos_steady_samples(log, flip_sign=flip_sign, temperature=temperature,
                                       nominal_torque=nominal_torque * 1e-3)
         write_samples(samples, out)
-        err_console.print(f"wrote {out}: {len(samples)} steady operating points "
+        err_console.print(f"wrote {escape(str(out))}: {len(samples)} steady operating points "
                           f"(directions {samples.directions()})")
         return
     if fmt != "table":
@@ -96,8 +97,8 @@ def extract_command(
     write_samples(result.samples, out)
     if by_direction is not None:
         write_samples(result.by_direction, by_direction)
-    console.print(result.summary(), highlight=False)
-    err_console.print(f"wrote {out} ({len(result.samples)} samples)"
+    console.print(result.summary(), markup=False, highlight=False)
+    err_console.print(f"wrote {escape(str(out))} ({len(result.samples)} samples)"
                       + (f" and {by_direction}" if by_direction else ""))
 
 

@@ -6,6 +6,7 @@ from pathlib import Path
 from typing import Annotated
 
 import typer
+from rich.markup import escape
 
 from ._app import app, console, err_console, handle_errors
 from ._options import parse_assignments, parse_ranges
@@ -65,8 +66,8 @@ def fit_command(
     )
     out = out or Path(f"{samples.stem}.{fitted.model}.json")
     fitted.save(out)
-    console.print(fitted.report(), highlight=False, soft_wrap=True)
-    err_console.print(f"wrote {out}")
+    console.print(fitted.report(), markup=False, highlight=False, soft_wrap=True)
+    err_console.print(f"wrote {escape(str(out))}")
 
 
 def select_direction(samples, direction: str):

@@ -7,6 +7,7 @@ from pathlib import Path
 from typing import Annotated
 
 import typer
+from rich.markup import escape
 
 from ._app import app, err_console, handle_errors
 from ._progress import progress_bar
@@ -54,4 +55,4 @@ def simulate_command(
                 yield replace(log, meta={**log.meta, "design": hints})
 
     write_rawlog(chunks(), out)
-    err_console.print(f"wrote {out} ({scenario.name}, {size}, seed {seed})")
+    err_console.print(f"wrote {escape(str(out))} ({scenario.name}, {size}, seed {seed})")
