@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 from dataclasses import asdict, dataclass, field
+from functools import lru_cache
 from os import PathLike
 from pathlib import Path
 from typing import Any
@@ -56,6 +57,33 @@ def _clean(value: Any) -> Any:
 
 def _num(value: Any) -> float:
     return float("nan") if value is None else float(value)
+
+
+@lru_cache(maxsize=1)
+def _schema_validator():
+    """The validator of the model file's JSON Schema (``fricid/schemas/model.schema.json``)."""
+    from importlib.resources import files
+
+    from jsonschema import Draft202012Validator
+
+    text = files("fricid").joinpath("schemas", "model.schema.json").read_text(encoding="utf-8")
+    return Draft202012Validator(json.loads(text))
+
+
+def _validate_schema(d: dict[str, Any], source: str | None) -> None:
+    """Raise a :class:`DataError` naming the file and the first failing field."""
+    from jsonschema.exceptions import best_match
+
+    error = best_match(_schema_validator().iter_errors(d))
+    if error is None:
+        return
+    where = "/".join(str(p) for p in error.absolute_path) or "(top level)"
+    message = error.message if len(error.message) <= 200 else error.message[:197] + "..."
+    raise DataError(
+        f"field '{where}' does not match the model file schema (version {SCHEMA_VERSION}): "
+        f"{message}",
+        file=source,
+    )
 
 
 @dataclass
@@ -175,6 +203,7 @@ class FittedModel:
                 f"({__version__}) understands (version {SCHEMA_VERSION}); upgrade fricid",
                 file=source,
             )
+        _validate_schema(d, source)
         known = set(cls.__dataclass_fields__)
         kwargs = {k: v for k, v in d.items() if k in known}
         if "model" not in kwargs or "params" not in kwargs:

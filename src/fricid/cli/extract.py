@@ -47,9 +47,27 @@ def extract_command(
                    ] = Path("samples.csv"),
     by_direction: Annotated[Path | None, typer.Option(help="Also write the per-direction "
                                                       "samples (+1 and -1) here.")] = None,
-    fmt: Annotated[str, typer.Option("--format", help="table (fricid's CSV/Parquet raw log) "
-                                     "or epos (a folder of Maxon EPOS recorder CSVs, one "
-                                     "steady velocity per file).")] = "table",
+    fmt: Annotated[str, typer.Option("--format", help="table (fricid's CSV/Parquet raw log), "
+                                     "rosbag (a ROS 2 bag folder or .mcap/.db3 file with "
+                                     "sensor_msgs/msg/JointState; needs --joint) or epos (a "
+                                     "folder of Maxon EPOS recorder CSVs, one steady velocity "
+                                     "per file).")] = "table",
+    joint: Annotated[str | None, typer.Option(help="rosbag: the joint's name in "
+                                              "JointState.name.")] = None,
+    topic: Annotated[str, typer.Option(help="rosbag: the JointState topic.")
+                     ] = "/joint_states",
+    temperature_topic: Annotated[str | None, typer.Option(help="rosbag: a "
+                                                          "sensor_msgs/msg/Temperature topic "
+                                                          "[degC]; else --temperature is used."
+                                                          )] = None,
+    effort: Annotated[str, typer.Option(help="rosbag: what JointState.effort holds: torque "
+                                        "[N m] or current [A] (then give --torque-constant)."
+                                        )] = "torque",
+    torque_constant: Annotated[float | None, typer.Option(help="K [N m/A] of tau = K I "
+                                                          "(eq. 13), when effort is current."
+                                                          )] = None,
+    velocity_unit: Annotated[str, typer.Option(help="rosbag: unit of JointState.velocity.")
+                             ] = "rad/s",
     positions: Annotated[str | None, typer.Option(help=(
         "Position bins START:STOP:STEP or a comma list, in --position-unit. Default: the "
         "design recorded by `fricid simulate`, else one bin per steady traverse."))] = None,
@@ -71,8 +89,8 @@ def extract_command(
     nominal_torque: Annotated[float, typer.Option(help="EPOS: the motor's nominal torque "
                                                   "[mN m], reference of the % channel.")
                               ] = 9.84,
-    temperature: Annotated[float, typer.Option(help="EPOS: the temperature [degC] to "
-                                               "record (the recorder logs none).")] = 25.0,
+    temperature: Annotated[float, typer.Option(help="EPOS, rosbag: the temperature [degC] "
+                                               "to record when the log has none.")] = 25.0,
     chunk_rows: Annotated[int, typer.Option(help="Rows read at a time (bounded memory).")
                           ] = 1_000_000,
 ) -> None:
@@ -81,7 +99,7 @@ def extract_command(
     separate friction and gravity (eq. 9-11), fit p_x, p_y (eq. 7) and take the gravity torque
     as the load (eq. 12). Writes samples with velocity [rad/s], load [N m], temperature [degC],
     friction [N m], direction, count, std [N m]."""
-    from ..io import epos_steady_samples, write_samples
+    from ..io import epos_steady_samples, iter_rawlog, iter_rosbag, write_samples
 
     if fmt == "epos":
         samples = epos_steady_samples(log, flip_sign=flip_sign, temperature=temperature,
@@ -90,10 +108,22 @@ def extract_command(
         err_console.print(f"wrote {escape(str(out))}: {len(samples)} steady operating points "
                           f"(directions {samples.directions()})")
         return
-    if fmt != "table":
-        raise ConfigError(f"--format must be table or epos; got '{fmt}'")
-    result = _extract_table(log, positions, position_unit, bin_halfwidth, median_window,
-                            gravity, chunk_rows)
+    if fmt == "table":
+        chunks = iter_rawlog(log, chunk_rows=chunk_rows)
+    elif fmt == "rosbag":
+        if joint is None:
+            from ..io import rosbag_joints
+
+            raise ConfigError(f"--format rosbag needs --joint; {log} has joints: "
+                              f"{', '.join(rosbag_joints(log, topic=topic))}")
+        chunks = iter_rosbag(log, joint, topic=topic, temperature_topic=temperature_topic,
+                             temperature=None if temperature_topic else temperature,
+                             effort=effort, torque_constant=torque_constant,
+                             velocity_unit=velocity_unit, chunk_rows=chunk_rows)
+    else:
+        raise ConfigError(f"--format must be table, rosbag or epos; got '{fmt}'")
+    result = _extract_chunks(log, chunks, positions, position_unit, bin_halfwidth,
+                             median_window, gravity)
     write_samples(result.samples, out)
     if by_direction is not None:
         write_samples(result.by_direction, by_direction)
@@ -102,16 +132,14 @@ def extract_command(
                       + (f" and {by_direction}" if by_direction else ""))
 
 
-def _extract_table(log, positions, position_unit, bin_halfwidth, median_window, gravity,
-                   chunk_rows):
+def _extract_chunks(log, chunks, positions, position_unit, bin_halfwidth, median_window,
+                    gravity):
     from ..extract import extract
-    from ..io import iter_rawlog
     from ..units import to_si
 
     pos = parse_positions(positions, position_unit)
     half = None if bin_halfwidth is None else float(to_si(bin_halfwidth, position_unit,
                                                           "position"))
-    chunks = iter_rawlog(log, chunk_rows=chunk_rows)
     first = next(chunks, None)
     if first is None:
         raise ConfigError(f"{log}: the log has no rows")

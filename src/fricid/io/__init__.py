@@ -1,4 +1,5 @@
-"""Readers and writers: fricid's CSV and Parquet tables, Maxon EPOS recorder CSV, generic logs.
+"""Readers and writers: fricid's CSV and Parquet tables, Maxon EPOS recorder CSV, ROS 2 bags
+and MCAP, generic column-mapped logs.
 
 Every reader converts to SI once, at the edge, and names the file, row and column of bad
 input (:class:`~fricid.errors.DataError`); every writer is atomic (DESIGN.md, "Files").
@@ -7,6 +8,7 @@ input (:class:`~fricid.errors.DataError`); every writer is atomic (DESIGN.md, "F
 from .atomic import atomic_path, atomic_write
 from .epos import DEFAULT_NOMINAL_TORQUE, epos_steady_samples, read_epos, read_epos_dir
 from .generic import read_table_log
+from .rosbag import iter_rosbag, read_rosbag, rosbag_joints, rosbag_topics
 from .tables import iter_rawlog, read_rawlog, read_samples, write_rawlog, write_samples
 
 __all__ = [
@@ -15,11 +17,15 @@ __all__ = [
     "atomic_write",
     "epos_steady_samples",
     "iter_rawlog",
+    "iter_rosbag",
     "read_epos",
     "read_epos_dir",
     "read_rawlog",
+    "read_rosbag",
     "read_samples",
     "read_table_log",
+    "rosbag_joints",
+    "rosbag_topics",
     "write_rawlog",
     "write_samples",
 ]

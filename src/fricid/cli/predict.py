@@ -1,0 +1,130 @@
+"""``fricid predict``: friction of a model file at given points, or at a file of points."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from ._app import app, err_console, handle_errors
+
+
+def _unit_help(quantity: str) -> str:
+    from ..units import SI_UNITS, UNITS
+
+    return f"Unit of the {quantity} ({', '.join(UNITS[quantity])}; default {SI_UNITS[quantity]})."
+
+
+@app.command("predict")
+@handle_errors
+def predict_command(
+    model: Annotated[
+        Path,
+        typer.Argument(help="Model file (JSON, from `fricid fit`).", exists=True, dir_okay=False),
+    ],
+    velocity: Annotated[
+        list[float] | None,
+        typer.Option("--velocity", "-v", help="Velocity of a point (repeat for several points)."),
+    ] = None,
+    load: Annotated[
+        list[float] | None,
+        typer.Option(
+            help="Joint load [N m by default]: one value for all points, or one per --velocity. "
+            "Needed when the model depends on load."
+        ),
+    ] = None,
+    temperature: Annotated[
+        list[float] | None,
+        typer.Option(
+            help="Temperature [degC by default]: one value, or one per --velocity. Needed when "
+            "the model depends on temperature."
+        ),
+    ] = None,
+    input_file: Annotated[
+        Path | None,
+        typer.Option(
+            "--input",
+            "-i",
+            exists=True,
+            dir_okay=False,
+            help="File of points (CSV or Parquet) with a 'velocity' column and optional 'load' and "
+            "'temperature' columns; units in the column names ('velocity [deg/s]') or from the "
+            "unit flags. Missing columns take --load / --temperature.",
+        ),
+    ] = None,
+    velocity_unit: Annotated[str | None, typer.Option(help=_unit_help("velocity"))] = None,
+    load_unit: Annotated[str | None, typer.Option(help=_unit_help("torque"))] = None,
+    temperature_unit: Annotated[str | None, typer.Option(help=_unit_help("temperature"))] = None,
+    friction_unit: Annotated[
+        str, typer.Option(help="Unit of the friction written (N m, mNm, ...).")
+    ] = "N m",
+    smooth: Annotated[
+        str,
+        typer.Option(
+            help=(
+                "Smoothing near zero velocity, as the C export does: none, tanh (sign(v) -> "
+                "tanh(v/zone)), linear (straight line across |v| < zone)."
+            )
+        ),
+    ] = "none",
+    zone: Annotated[
+        float, typer.Option(help="Half-width of the smoothing zone, in the velocity unit.")
+    ] = 0.0,
+    out: Annotated[
+        Path | None,
+        typer.Option(
+            "--out", "-o", help=("CSV file to write (atomically). Default: CSV on stdout.")
+        ),
+    ] = None,
+) -> None:
+    """Friction of a model at operating points: CSV with velocity, load, temperature and
+    friction columns, each labelled with its unit.
+
+    Examples: `fricid predict m.json --velocity 0.1 --velocity 0.5 --load 0.2 --temperature 30`;
+    `fricid predict m.json --input points.csv --velocity-unit deg/s --out friction.csv`.
+    """
+    from ..errors import ConfigError
+    from ..export import Smoothing, smooth_predict, write_text
+    from ..export.points import points_matrix, points_table, read_points
+    from ..fitted import FittedModel
+    from ..units import to_si
+
+    fitted = FittedModel.load(model)
+    flags = {"velocity": velocity_unit, "load": load_unit, "temperature": temperature_unit}
+    quantity = {"velocity": "velocity", "load": "torque", "temperature": "temperature"}
+    given = {"velocity": velocity, "load": load, "temperature": temperature}
+    si = {
+        k: None if not v else to_si(list(v), flags[k] or "", quantity[k]) if flags[k] else list(v)
+        for k, v in given.items()
+    }
+    units = {k: u for k, u in flags.items() if u}
+    if input_file is not None:
+        if velocity:
+            raise ConfigError("give points either with --velocity or with --input, not both")
+        cols, file_units = read_points(input_file, flags)
+        units.update(file_units)
+        for name in ("load", "temperature"):
+            if name not in cols and si[name] is not None and len(si[name]) != 1:
+                raise ConfigError(f"with --input, --{name} is one value for every point")
+        X = points_matrix(
+            fitted,
+            cols["velocity"],
+            cols.get("load", si["load"]),
+            cols.get("temperature", si["temperature"]),
+        )
+    else:
+        if not velocity:
+            raise ConfigError("give the points: --velocity (repeatable), or --input FILE")
+        X = points_matrix(fitted, si["velocity"], si["load"], si["temperature"])
+    zone_si = float(to_si(zone, velocity_unit or "rad/s", "velocity"))
+    friction = smooth_predict(fitted, X, Smoothing(smooth, zone_si))
+    units["friction"] = friction_unit
+    text = points_table(X, friction, units)
+    if out is None:
+        sys.stdout.write(text)
+        sys.stdout.flush()
+    else:
+        write_text(text, out)
+        err_console.print(f"wrote {out} ({len(X)} points)")

@@ -1,0 +1,73 @@
+"""The figure of the compensation study (matplotlib, Agg canvas; no global backend state)."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+
+from .tracking import CompensationResult
+
+__all__ = ["plot_compensation"]
+
+
+def plot_compensation(result: CompensationResult, path: str | os.PathLike[str]) -> Path:
+    """Write a PNG of the study: reference and joint velocity, tracking error, and torques,
+    without and with feed-forward, against time. Written atomically."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    from ..io.atomic import atomic_path
+
+    runs = result.runs
+    t = runs["time"]
+    colours = {"without": "tab:red", "with": "tab:blue"}
+    labels = {
+        "without": "PD only",
+        "with": "PD + friction feed-forward",
+    }
+    fig = Figure(figsize=(9.0, 8.0), layout="constrained")
+    FigureCanvasAgg(fig)
+    ax_v, ax_e, ax_f = fig.subplots(3, 1, sharex=True)
+    ax_v.plot(t, runs["reference_velocity"], color="black", lw=1.0, ls="--", label="reference")
+    for k, key in enumerate(("without", "with")):
+        ax_v.plot(t, runs["velocity"][k], color=colours[key], lw=0.9, label=labels[key])
+        ax_e.plot(
+            t,
+            1e3 * runs["error"][k],
+            color=colours[key],
+            lw=0.9,
+            label=f"{labels[key]}: RMS {1e3 * result.rms[key]:.3g} mrad, "
+            f"max {1e3 * result.max[key]:.3g} mrad",
+        )
+    ax_f.plot(
+        t, runs["friction"][0], color=colours["without"], lw=0.9, label="friction, PD only run"
+    )
+    ax_f.plot(
+        t, runs["friction"][1], color=colours["with"], lw=0.9, label="friction, feed-forward run"
+    )
+    ax_f.plot(
+        t,
+        result.feedforward,
+        color="black",
+        lw=1.0,
+        ls="--",
+        label=f"feed-forward ({result.model})",
+    )
+    ax_v.set_ylabel("velocity [rad/s]")
+    ax_e.set_ylabel("tracking error [mrad]")
+    ax_f.set_ylabel("torque [N m]")
+    ax_f.set_xlabel("time [s]")
+    for ax in (ax_v, ax_e, ax_f):
+        ax.grid(True, alpha=0.3)
+        ax.legend(loc="upper right", fontsize="small")
+    kp, kd = result.config.gains
+    title = f"Friction compensation: model '{result.model}', true friction '{result.truth}'"
+    if np.isfinite(result.improvement):
+        title += f": RMS error {result.improvement:.3g}x smaller with feed-forward"
+    fig.suptitle(f"{title}\n(K_p {kp:.3g} N m/rad, K_d {kd:.3g} N m s/rad)")
+    path = Path(path)
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, format="png", dpi=110)
+    return path

@@ -1,0 +1,368 @@
+"""A joint tracking a slow sinusoid under PD control, without and with friction feed-forward.
+
+The study that shows why friction is identified (the RWSAVSBAS paper, conclusion 3: the model
+goes into the controller as torque feed-forward).
+
+The plant
+    ``J q'' = u - F(q', load, T)``: a rigid joint of inertia ``J`` [kg m^2] with friction
+    ``F`` from a true law. The true law is the model itself (``truth="model"``: what the
+    controller would gain if the model were exact), or the virtual joint's law of a
+    simulation preset (``truth="paper1"`` or ``"paper2"``, :func:`fricid.sim.preset`; its
+    inertia too): then the model is judged against friction it only approximates. Load and
+    temperature are constant; the load enters the friction law only (its own torque is
+    taken as compensated, e.g. gravity compensation, in both runs, so the comparison
+    isolates friction).
+Stiction
+    At zero velocity the joint sticks while the applied torque stays within the break-away
+    friction (the law just off zero, in the direction of the torque), and slips once it
+    exceeds it; a step that would carry the velocity through zero stops it at zero (the
+    Karnopp scheme, adapted to a fixed step). So the stick-slip at velocity reversals, where
+    PD control without friction compensation lags, is simulated rather than smoothed away.
+The controller
+    ``u = J q_r'' + K_p (q_r - q) + K_d (q_r' - q')`` plus, in the second run, the feed-forward
+    ``F_hat(q_r', load, T)``: the model evaluated at the reference velocity (optionally
+    smoothed near zero velocity, :mod:`fricid.export.smoothing`). By default ``K_p = J w^2``
+    and ``K_d = 2 zeta J w`` with ``w = 2 pi 10 Hz`` and ``zeta = 1``.
+The reference
+    ``q_r = A sin(2 pi f t)``: it crosses zero velocity twice per period. The joint starts on
+    the reference (``q = 0``, ``q' = q_r'(0)``).
+Integration
+    Semi-implicit Euler with a fixed step (default 0.2 ms); both runs advance together as one
+    batch, and the feed-forward is evaluated for the whole time grid at once.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from ..errors import ConfigError
+from ..fitted import FittedModel
+
+__all__ = [
+    "TRUTHS",
+    "CompensationResult",
+    "TrackingConfig",
+    "compensation_study",
+    "default_config",
+    "fitted_law",
+    "simulate_tracking",
+]
+
+#: True friction laws the study can use.
+TRUTHS = ("model", "paper1", "paper2")
+
+#: Velocity [rad/s] just off zero where the break-away friction is evaluated.
+_OFF_ZERO = 1e-9
+
+Law = Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray]
+
+
+@dataclass(frozen=True)
+class TrackingConfig:
+    """The experiment: reference, plant, controller and integration.
+
+    Attributes
+    ----------
+    amplitude : rad, of the reference sinusoid.
+    frequency : Hz, of the reference sinusoid.
+    periods : number of reference periods simulated.
+    inertia : kg m^2, of the joint (the controller knows it exactly).
+    kp, kd : PD gains [N m/rad, N m s/rad]; None gives ``J w^2`` and ``2 zeta J w``.
+    bandwidth : Hz, the ``w / 2 pi`` of the default gains.
+    damping : the ``zeta`` of the default gains.
+    load : N m, joint load (friction input only).
+    temperature : degC.
+    dt : s, integration step.
+    """
+
+    amplitude: float = 0.5
+    frequency: float = 0.2
+    periods: float = 2.0
+    inertia: float = 0.01
+    kp: float | None = None
+    kd: float | None = None
+    bandwidth: float = 10.0
+    damping: float = 1.0
+    load: float = 0.0
+    temperature: float = 25.0
+    dt: float = 2e-4
+
+    def __post_init__(self) -> None:
+        positive = ("amplitude", "frequency", "periods", "inertia", "bandwidth", "damping", "dt")
+        for name in positive:
+            value = getattr(self, name)
+            if not (isinstance(value, int | float) and math.isfinite(value) and value > 0):
+                raise ConfigError(f"TrackingConfig: '{name}' must be a number > 0, got {value!r}")
+        for name in ("kp", "kd"):
+            value = getattr(self, name)
+            if value is not None and not (math.isfinite(value) and value >= 0):
+                raise ConfigError(f"TrackingConfig: '{name}' must be >= 0, got {value!r}")
+        for name in ("load", "temperature"):
+            if not math.isfinite(getattr(self, name)):
+                raise ConfigError(f"TrackingConfig: '{name}' must be finite")
+        steps = self.n_steps
+        if steps > 20_000_000:
+            raise ConfigError(
+                f"TrackingConfig: {steps} integration steps is too many; raise dt or shorten "
+                "the run (periods, frequency)"
+            )
+        if self.dt > 0.05 / self.frequency:
+            raise ConfigError("TrackingConfig: dt must resolve the reference (dt <= 0.05 / f)")
+
+    @property
+    def gains(self) -> tuple[float, float]:
+        """``(K_p, K_d)``."""
+        w = 2.0 * math.pi * self.bandwidth
+        kp = self.inertia * w * w if self.kp is None else self.kp
+        kd = 2.0 * self.damping * self.inertia * w if self.kd is None else self.kd
+        return float(kp), float(kd)
+
+    @property
+    def n_steps(self) -> int:
+        return round(self.periods / self.frequency / self.dt)
+
+    def reference(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Time [s], position [rad], velocity [rad/s], acceleration [rad/s^2] of the reference."""
+        t = np.arange(self.n_steps + 1) * self.dt
+        w = 2.0 * math.pi * self.frequency
+        a = self.amplitude
+        return t, a * np.sin(w * t), a * w * np.cos(w * t), -a * w * w * np.sin(w * t)
+
+
+def default_config(fitted: FittedModel, **overrides: Any) -> TrackingConfig:
+    """A :class:`TrackingConfig` inside the model's operating range.
+
+    The reference's peak velocity is half the largest identified speed (0.5 rad/s without
+    an operating range), at the default frequency; load and temperature are the middle of
+    their identified ranges (0 N m and 25 degC without). ``overrides`` set any field;
+    ``peak_velocity`` [rad/s] sets the amplitude through the frequency.
+    """
+    rng = fitted.operating_range or {}
+
+    def middle(name: str, default: float) -> float:
+        pair = rng.get(name)
+        return default if not pair else 0.5 * (float(pair[0]) + float(pair[1]))
+
+    speed = rng.get("velocity")
+    peak = overrides.pop("peak_velocity", None)
+    if peak is None:
+        peak = 0.5 * max(abs(float(x)) for x in speed) if speed else 0.5
+    if not (math.isfinite(peak) and peak > 0):
+        raise ConfigError(f"the peak velocity must be > 0 rad/s, got {peak!r}")
+    frequency = overrides.get("frequency") or TrackingConfig.frequency
+    values: dict[str, Any] = {
+        "amplitude": peak / (2.0 * math.pi * frequency),
+        "load": middle("load", 0.0),
+        "temperature": middle("temperature", 25.0),
+    }
+    values.update({k: v for k, v in overrides.items() if v is not None})
+    return TrackingConfig(**values)
+
+
+def fitted_law(fitted: FittedModel) -> Law:
+    """A fitted model as a friction law ``law(velocity, load, temperature)`` (arrays that
+    broadcast), the parameter vector resolved once."""
+    if fitted.kind == "rbf":
+
+        def rbf_law(velocity, load, temperature):
+            v, lo, t = np.broadcast_arrays(velocity, load, temperature)
+            X = np.column_stack([v.ravel(), lo.ravel(), t.ravel()]).astype(float)
+            return fitted.predict(X).reshape(v.shape)
+
+        return rbf_law
+    model = fitted.friction_model()
+    theta = fitted.theta()[None, :]
+
+    def law(velocity, load, temperature):
+        v, lo, t = np.broadcast_arrays(velocity, load, temperature)
+        X = np.empty((v.size, 3))
+        X[:, 0], X[:, 1], X[:, 2] = v.ravel(), lo.ravel(), t.ravel()
+        return model._predict(theta, X)[0].reshape(v.shape)
+
+    return law
+
+
+def simulate_tracking(
+    law: Law, feedforward: np.ndarray, config: TrackingConfig
+) -> dict[str, np.ndarray]:
+    """Simulate ``k`` runs of the tracking experiment at once.
+
+    Parameters
+    ----------
+    law : the plant's true friction law.
+    feedforward : (k, n_steps + 1) feed-forward torque [N m] of each run on the time grid
+        (zeros for a run without compensation).
+    config : the experiment.
+
+    Returns
+    -------
+    dict
+        ``time`` (n,), and (k, n) arrays ``position``, ``velocity``, ``error`` (reference
+        minus position) [rad], ``torque`` (controller output) and ``friction`` [N m].
+    """
+    t, q_r, v_r, a_r = config.reference()
+    ff = np.atleast_2d(np.asarray(feedforward, dtype=float))
+    k, n = ff.shape[0], t.size
+    if ff.shape[1] != n:
+        raise ConfigError(f"feedforward must have {n} columns (the time grid), got {ff.shape[1]}")
+    kp, kd = config.gains
+    J, dt = config.inertia, config.dt
+    load = np.full(k, config.load)
+    temp = np.full(k, config.temperature)
+    q = np.zeros(k)
+    v = np.full(k, v_r[0])
+    out = {name: np.empty((k, n)) for name in ("position", "velocity", "torque", "friction")}
+    # the part of the command known in advance: inertia feed-forward plus friction feed-forward
+    base = J * a_r[None, :] + ff
+    for i in range(n):
+        u = base[:, i] + kp * (q_r[i] - q) + kd * (v_r[i] - v)
+        moving = v != 0.0
+        v_eval = np.where(moving, v, np.where(u >= 0.0, _OFF_ZERO, -_OFF_ZERO))
+        f = law(v_eval, load, temp)
+        stuck = ~moving & (np.abs(u) <= np.abs(f))
+        f = np.where(stuck, u, f)  # static friction balances the applied torque
+        out["position"][:, i] = q
+        out["velocity"][:, i] = v
+        out["torque"][:, i] = u
+        out["friction"][:, i] = f
+        v_new = v + (u - f) / J * dt
+        v_new = np.where(moving & (np.sign(v_new) != np.sign(v)), 0.0, v_new)
+        v = np.where(stuck, 0.0, v_new)
+        q = q + v * dt
+    out["error"] = q_r[None, :] - out["position"]
+    out["time"] = t
+    out["reference"] = q_r
+    out["reference_velocity"] = v_r
+    return out
+
+
+@dataclass(frozen=True)
+class CompensationResult:
+    """The two runs of :func:`compensation_study` and their tracking errors.
+
+    ``rms`` and ``max`` map ``"without"`` / ``"with"`` to the RMS and the largest absolute
+    tracking error [rad]; ``runs`` holds the simulated signals (``simulate_tracking``).
+    """
+
+    config: TrackingConfig
+    truth: str
+    model: str
+    rms: dict[str, float]
+    max: dict[str, float]
+    runs: dict[str, np.ndarray] = field(repr=False)
+    feedforward: np.ndarray = field(repr=False)
+    notes: list[str] = field(default_factory=list)
+
+    @property
+    def improvement(self) -> float:
+        """RMS error without over RMS error with feed-forward."""
+        return self.rms["without"] / self.rms["with"] if self.rms["with"] > 0 else math.inf
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready summary (errors in rad)."""
+        kp, kd = self.config.gains
+        return {
+            "model": self.model,
+            "truth": self.truth,
+            "rms_error_rad": dict(self.rms),
+            "max_error_rad": dict(self.max),
+            "rms_improvement": self.improvement,
+            "kp": kp,
+            "kd": kd,
+            "config": {k: getattr(self.config, k) for k in self.config.__dataclass_fields__},
+            "notes": list(self.notes),
+        }
+
+
+def _truth_law(truth: str, fitted: FittedModel) -> tuple[Law, float | None]:
+    """The plant's law and, for a preset, its inertia."""
+    key = str(truth).strip().lower()
+    if key == "model":
+        return fitted_law(fitted), None
+    if key not in TRUTHS:
+        raise ConfigError(f"unknown truth '{truth}'; choose one of: {', '.join(TRUTHS)}")
+    from ..sim import preset
+
+    joint = preset(key, "quick").joint
+    return joint.law, joint.inertia
+
+
+def _extrapolation_notes(fitted: FittedModel, v_r: np.ndarray, ff: np.ndarray, smoothing) -> list:
+    """A note when the reference runs below the identified speeds, where the feed-forward is
+    extrapolated (a fitted Stribeck peak can grow far beyond the data there)."""
+    pair = (fitted.operating_range or {}).get("velocity")
+    if not pair or (pair[0] < 0 < pair[1]):
+        return []
+    v_min = min(abs(float(pair[0])), abs(float(pair[1])))
+    zone = 0.0 if smoothing is None else smoothing.zone
+    below = np.abs(v_r) < v_min
+    if v_min <= 0 or zone >= v_min or not below.any():
+        return []
+    edge = np.abs(ff[~below]).max() if (~below).any() else 0.0
+    return [
+        f"the reference is below the identified speeds (|v| < {v_min:.4g} rad/s) "
+        f"{100 * below.mean():.2g} % of the time, where the feed-forward is extrapolated "
+        f"(up to {np.abs(ff[below]).max():.4g} N m, against at most {edge:.4g} N m elsewhere); "
+        f"--smooth linear --zone {v_min:.4g} holds it to the line between the identified edges"
+    ]
+
+
+def compensation_study(
+    fitted: FittedModel,
+    config: TrackingConfig | None = None,
+    *,
+    truth: str = "model",
+    smoothing=None,
+) -> CompensationResult:
+    """Track the reference without and with ``fitted`` as friction feed-forward.
+
+    Parameters
+    ----------
+    fitted : the identified model (the feed-forward).
+    config : the experiment (default :class:`TrackingConfig`). With ``truth`` a preset, the
+        preset joint's inertia replaces ``config.inertia``.
+    truth : the plant's friction: ``"model"`` (the model itself) or a simulation preset
+        (``"paper1"``, ``"paper2"``: the virtual joint's true law).
+    smoothing : :class:`fricid.export.Smoothing` of the feed-forward near zero velocity.
+
+    Returns
+    -------
+    CompensationResult
+        RMS and max tracking error of both runs, and the signals.
+    """
+    from dataclasses import replace
+
+    from ..export.smoothing import smooth_predict
+
+    config = config or TrackingConfig()
+    law, inertia = _truth_law(truth, fitted)
+    notes = []
+    if inertia is not None and inertia != config.inertia:
+        config = replace(config, inertia=inertia)
+        notes.append(f"inertia {inertia} kg m^2 from the '{truth}' preset joint")
+    _, _, v_r, _ = config.reference()
+    X = np.column_stack(
+        [v_r, np.full_like(v_r, config.load), np.full_like(v_r, config.temperature)]
+    )
+    ff = smooth_predict(fitted, X, smoothing)
+    notes += _extrapolation_notes(fitted, v_r, ff, smoothing)
+    runs = simulate_tracking(law, np.vstack([np.zeros_like(ff), ff]), config)
+    err = np.abs(runs["error"])
+    return CompensationResult(
+        config=config,
+        truth=str(truth).strip().lower(),
+        model=fitted.model,
+        rms={
+            "without": float(np.sqrt(np.mean(err[0] ** 2))),
+            "with": float(np.sqrt(np.mean(err[1] ** 2))),
+        },
+        max={"without": float(err[0].max()), "with": float(err[1].max())},
+        runs=runs,
+        feedforward=ff,
+        notes=notes,
+    )

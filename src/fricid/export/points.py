@@ -1,0 +1,193 @@
+"""Operating points in, friction out: the table side of ``fricid predict``.
+
+A file of points is a CSV (header line, optional leading ``#`` lines) or Parquet table with a
+``velocity`` column and optional ``load`` and ``temperature`` columns (names
+case-insensitive, other columns ignored). Each column's unit is written in its name
+(``velocity [deg/s]``) or given by the caller (``--velocity-unit``); when both are given they
+must agree, so a file is never read in mixed units by accident. Without either, the SI unit
+is assumed (rad/s, N m, degC).
+"""
+
+from __future__ import annotations
+
+import io
+import os
+from collections.abc import Mapping
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import ConfigError, DataError
+from ..fitted import FittedModel
+from ..io._columns import split_label
+from ..io._csv import read_numeric, read_preamble
+from ..io._parquet import open_parquet, read_columns, schema_meta
+from ..units import SI_UNITS, UNITS, from_si, to_si
+
+__all__ = ["INPUT_QUANTITY", "model_inputs", "points_matrix", "points_table", "read_points"]
+
+#: The model inputs and the physical quantity of each (for unit conversion).
+INPUT_QUANTITY: dict[str, str] = {
+    "velocity": "velocity",
+    "load": "torque",
+    "temperature": "temperature",
+}
+
+
+def model_inputs(fitted: FittedModel) -> tuple[str, ...]:
+    """The inputs the model uses (the RBF network: those its state names, else all three)."""
+    if fitted.kind == "rbf":
+        names = (fitted.state or {}).get("inputs")
+        if isinstance(names, list | tuple) and all(n in INPUT_QUANTITY for n in names):
+            return tuple(names)
+        return tuple(INPUT_QUANTITY)
+    return tuple(fitted.friction_model().inputs)
+
+
+def _unit_of(name: str, label: str, given: str | None, path: Path, meta_units) -> str:
+    quantity = INPUT_QUANTITY[name]
+    in_label = split_label(label)[1]
+    if in_label is None and isinstance(meta_units, dict):
+        in_label = meta_units.get(label) or meta_units.get(name)
+    if given is not None and in_label is not None and given.strip() != in_label.strip():
+        raise DataError(
+            f"mixed units: the column says {quantity} is in '{in_label}', but "
+            f"--{name}-unit says '{given}'; give one unit",
+            file=path,
+            column=label,
+        )
+    unit = (given or in_label or SI_UNITS[quantity]).strip()
+    if unit not in UNITS[quantity]:
+        raise DataError(
+            f"unknown {quantity} unit '{unit}'; use one of: {', '.join(UNITS[quantity])}",
+            file=path,
+            column=label,
+        )
+    return unit
+
+
+def read_points(
+    path: str | os.PathLike[str], units: Mapping[str, str | None] | None = None
+) -> tuple[dict[str, np.ndarray], dict[str, str]]:
+    """Read a file of operating points.
+
+    Parameters
+    ----------
+    path : ``.csv``, ``.parquet`` or ``.pq``.
+    units : input name -> unit given by the caller (None: from the column name, else SI).
+
+    Returns
+    -------
+    (columns, units)
+        SI arrays of the inputs present (velocity always), and the unit each was read in.
+
+    Raises
+    ------
+    DataError
+        No velocity column (the columns found are listed), a column whose unit disagrees
+        with ``units`` (mixed units), an unknown unit, a non-numeric or non-finite value
+        (file, line, column).
+    """
+    path = Path(path)
+    units = dict(units or {})
+    suffix = path.suffix.lower()
+    meta_units = None
+    if suffix == ".csv":
+        pre = read_preamble(path)
+        labels = pre.labels
+    elif suffix in (".parquet", ".pq"):
+        pf = open_parquet(path)
+        labels = pf.schema_arrow.names
+        meta_units = schema_meta(pf, path).get("units")
+    else:
+        raise ConfigError(f"cannot read '{path}': use a .csv, .parquet or .pq file of points")
+    found: dict[str, str] = {}
+    for label in labels:
+        name = split_label(label)[0].lower()
+        if name in INPUT_QUANTITY:
+            if name in found:
+                raise DataError(
+                    f"column '{name}' appears twice ('{found[name]}' and '{label}')",
+                    file=path,
+                    column=label,
+                )
+            found[name] = label
+    if "velocity" not in found:
+        raise DataError(
+            "missing column 'velocity' (e.g. 'velocity [rad/s]'); columns found: "
+            + (", ".join(repr(x) for x in labels) or "none"),
+            file=path,
+            column="velocity",
+        )
+    used = {
+        name: _unit_of(name, label, units.get(name), path, meta_units)
+        for name, label in found.items()
+    }
+    wanted = list(found.values())
+    raw = read_numeric(pre, wanted) if suffix == ".csv" else read_columns(pf, wanted, path)
+    cols = {
+        name: np.asarray(to_si(raw[label], used[name], INPUT_QUANTITY[name]), dtype=float)
+        for name, label in found.items()
+    }
+    return cols, used
+
+
+def points_matrix(
+    fitted: FittedModel,
+    velocity,
+    load=None,
+    temperature=None,
+) -> np.ndarray:
+    """Model inputs ``(n, 3)`` from SI values (arrays that broadcast, or None).
+
+    An input the model uses must be given; one it ignores defaults to 0 N m (load) or
+    25 degC (temperature).
+
+    Raises
+    ------
+    ConfigError
+        A needed input missing, or lengths that do not broadcast.
+    """
+    needed = model_inputs(fitted)
+    values = {"velocity": velocity, "load": load, "temperature": temperature}
+    defaults = {"load": 0.0, "temperature": 25.0}
+    for name in ("load", "temperature"):
+        if values[name] is None:
+            if name in needed:
+                raise ConfigError(
+                    f"model '{fitted.model}' depends on {name}; give --{name} (or a {name} "
+                    "column in the input file)"
+                )
+            values[name] = defaults[name]
+    try:
+        v, lo, t = np.broadcast_arrays(
+            *(np.atleast_1d(np.asarray(values[k], dtype=float)) for k in INPUT_QUANTITY)
+        )
+    except ValueError:
+        sizes = {k: np.size(values[k]) for k in INPUT_QUANTITY}
+        raise ConfigError(
+            "velocity, load and temperature must have one value each or the same number of "
+            f"values; got {sizes}"
+        ) from None
+    X = np.column_stack([v.ravel(), lo.ravel(), t.ravel()])
+    if not np.isfinite(X).all():
+        raise ConfigError("operating points must be finite numbers")
+    return X
+
+
+def points_table(X: np.ndarray, friction: np.ndarray, units: Mapping[str, str]) -> str:
+    """CSV text of points and friction, each column in ``units`` (SI where not given) and
+    labelled with it; 17 significant digits."""
+    out_units = {
+        "velocity": units.get("velocity") or SI_UNITS["velocity"],
+        "load": units.get("load") or SI_UNITS["torque"],
+        "temperature": units.get("temperature") or SI_UNITS["temperature"],
+        "friction": units.get("friction") or SI_UNITS["torque"],
+    }
+    quantity = {**INPUT_QUANTITY, "friction": "torque"}
+    data = {"velocity": X[:, 0], "load": X[:, 1], "temperature": X[:, 2], "friction": friction}
+    cols = [np.asarray(from_si(data[k], out_units[k], quantity[k]), dtype=float) for k in data]
+    buf = io.StringIO()
+    buf.write(",".join(f"{k} [{out_units[k]}]" for k in data) + "\n")
+    np.savetxt(buf, np.column_stack(cols), delimiter=",", fmt="%.17g")
+    return buf.getvalue()

@@ -1,0 +1,243 @@
+"""Least-squares Coulomb-viscous projection of any model over its operating range.
+
+Simulators and controller configurations hold friction as ``F = F_c sign(v) + b v`` (URDF
+``<dynamics friction= damping=>``, MJCF ``frictionloss``/``damping``), or as that pair per
+direction (the ros2_control-style YAML). :func:`project` finds the pair(s) closest to any
+fricid model, in the least-squares sense with ``F_c, b >= 0``, over a grid that spans the
+model's operating range, and measures what the projection loses.
+
+The grid
+    Velocity: 200 points per direction, evenly spaced over the identified range of ``|v|``
+    (``FittedModel.operating_range``; a range that does not reach 0, e.g. 0.005-4 rad/s, is
+    used as is, one that spans 0 gives ``(0, max]`` per side). A model identified on
+    direction-combined samples (positive velocities only) is odd in velocity, so the negative
+    side mirrors the positive one. Load and temperature: 7 points each, evenly spaced over
+    their identified ranges (one point where the range is a single value). The error
+    measures are the RMS and the largest absolute difference over this grid, and the RMS
+    difference relative to the RMS friction.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from scipy.optimize import nnls
+
+from ..fitted import FittedModel
+from ._common import ExportError
+
+__all__ = ["N_LEVELS", "N_VELOCITY", "Projection", "operating_grid", "project"]
+
+#: Velocity points per direction, and load / temperature levels, of the projection grid.
+N_VELOCITY = 200
+N_LEVELS = 7
+
+
+@dataclass(frozen=True)
+class Projection:
+    """A Coulomb-viscous projection and its error.
+
+    Attributes
+    ----------
+    coulomb : N m, ``F_c`` (both directions) or ``{"positive": .., "negative": ..}`` magnitudes.
+    viscous : N m s/rad, ``b``, likewise.
+    rms_error, max_error : N m, over the grid; ``max_at`` is (velocity, load, temperature)
+        where the largest error occurs.
+    rms_friction : N m, RMS of the model over the grid (the scale of ``relative_error``).
+    relative_error : ``rms_error / rms_friction``.
+    ranges : the grid's velocity (per side), load and temperature ranges.
+    lost : what the projection cannot hold, one phrase each, with numbers.
+    """
+
+    per_direction: bool
+    coulomb: dict[str, float]
+    viscous: dict[str, float]
+    rms_error: float
+    max_error: float
+    max_at: tuple[float, float, float]
+    rms_friction: float
+    relative_error: float
+    ranges: dict[str, Any] = field(default_factory=dict)
+    lost: list[str] = field(default_factory=list)
+
+    def summary(self) -> list[str]:
+        """Lines for a comment in the exported file."""
+        v = self.ranges
+        lines = [
+            "least-squares Coulomb-viscous projection (F_c, b >= 0) over the operating range: "
+            f"|velocity| {v['speed'][0]:.4g} to {v['speed'][1]:.4g} rad/s"
+            f"{' (mirrored: direction-combined model)' if v['mirrored'] else ''}, "
+            f"load {v['load'][0]:.4g} to {v['load'][1]:.4g} N m, "
+            f"temperature {v['temperature'][0]:.4g} to {v['temperature'][1]:.4g} degC",
+            f"projection error: RMS {self.rms_error:.4g} N m "
+            f"({100 * self.relative_error:.3g} % of the RMS friction {self.rms_friction:.4g} N m), "
+            f"max {self.max_error:.4g} N m at velocity {self.max_at[0]:.4g} rad/s, "
+            f"load {self.max_at[1]:.4g} N m, temperature {self.max_at[2]:.4g} degC",
+        ]
+        if self.lost:
+            lines.append("lost in this format: " + "; ".join(self.lost))
+        return lines
+
+
+def _range(fitted: FittedModel, name: str, override) -> tuple[float, float]:
+    if override is not None:
+        lo, hi = (float(x) for x in np.broadcast_to(np.asarray(override, dtype=float), (2,)))
+    else:
+        pair = (fitted.operating_range or {}).get(name)
+        if pair is None:
+            raise ExportError(
+                f"the model file has no operating range for {name}, so the projection has no "
+                f"range to work over; give one (e.g. {name}_range=(low, high) in SI units)"
+            )
+        lo, hi = float(pair[0]), float(pair[1])
+    if not (math.isfinite(lo) and math.isfinite(hi) and lo <= hi):
+        raise ExportError(f"the {name} range must be finite with low <= high, got ({lo}, {hi})")
+    return lo, hi
+
+
+def operating_grid(
+    fitted: FittedModel,
+    velocity_range=None,
+    load_range=None,
+    temperature_range=None,
+) -> tuple[np.ndarray, dict[str, Any]]:
+    """The projection grid ``X`` (n, 3) of a model, and its description.
+
+    ``*_range`` override the model's ``operating_range`` ([low, high] in SI units, or one
+    value for a fixed operating point).
+    """
+    v_lo, v_hi = _range(fitted, "velocity", velocity_range)
+    if v_lo >= 0 or v_hi <= 0:  # one direction only: |v| range, mirrored
+        a, b = sorted((abs(v_lo), abs(v_hi)))
+        mirrored = True
+        pos = np.linspace(a, b, N_VELOCITY) if b > a else np.full(1, b)
+        neg = -pos
+    else:
+        mirrored = False
+        pos = np.linspace(v_hi / N_VELOCITY, v_hi, N_VELOCITY)
+        neg = np.linspace(v_lo, v_lo / N_VELOCITY, N_VELOCITY)
+        a, b = 0.0, max(-v_lo, v_hi)
+    if b <= 0:
+        raise ExportError("the velocity range is zero; there is no motion to project over")
+    levels = {}
+    for name, override in (("load", load_range), ("temperature", temperature_range)):
+        lo, hi = _range(fitted, name, override)
+        levels[name] = np.linspace(lo, hi, N_LEVELS) if hi > lo else np.array([lo])
+    v = np.concatenate([neg, pos])
+    V, L, T = np.meshgrid(v, levels["load"], levels["temperature"], indexing="ij")
+    X = np.column_stack([V.ravel(), L.ravel(), T.ravel()])
+    info = {
+        "speed": (a, b),
+        "mirrored": mirrored,
+        "load": (float(levels["load"][0]), float(levels["load"][-1])),
+        "temperature": (float(levels["temperature"][0]), float(levels["temperature"][-1])),
+    }
+    return X, info
+
+
+def _nnls(A: np.ndarray, y: np.ndarray) -> np.ndarray:
+    scale = np.maximum(np.abs(A).max(axis=0), 1e-300)
+    x, _ = nnls(A / scale, y)
+    return x / scale
+
+
+def _inputs(fitted: FittedModel) -> tuple[str, ...]:
+    from .points import model_inputs
+
+    return model_inputs(fitted)
+
+
+def _lost(
+    fitted: FittedModel,
+    X: np.ndarray,
+    F: np.ndarray,
+    info: dict[str, Any],
+    per_direction: bool,
+    side_fits: dict[str, np.ndarray],
+) -> list[str]:
+    lost = []
+    inputs = _inputs(fitted)
+    if fitted.kind == "rbf":
+        lost.append("the RBF network's shape (only F_c and b remain)")
+    elif fitted.model.split("_asym")[0] != "coulomb_viscous":
+        v = X[:, 0]
+        slow = np.abs(v) == np.abs(v).min()
+        lost.append(
+            f"the velocity shape of '{fitted.model}' (e.g. the Stribeck break-away: "
+            f"{np.abs(F[slow]).max():.4g} N m at the lowest speed {np.abs(v).min():.4g} rad/s)"
+        )
+    for name in ("load", "temperature"):
+        lo, hi = info[name]
+        if name in inputs and hi > lo:
+            unit = "N m" if name == "load" else "degC"
+            lost.append(f"the {name} dependence ({name} {lo:.4g} to {hi:.4g} {unit})")
+    if not per_direction and {"positive", "negative"} <= side_fits.keys():
+        p, n = side_fits["positive"], side_fits["negative"]
+        if not np.allclose(p, n, rtol=1e-6, atol=1e-12):
+            lost.append(
+                f"the direction asymmetry (per direction F_c {p[0]:.4g} / {n[0]:.4g} N m, "
+                f"b {p[1]:.4g} / {n[1]:.4g} N m s/rad; one value for both here)"
+            )
+    return lost
+
+
+def project(
+    fitted: FittedModel,
+    per_direction: bool = False,
+    *,
+    velocity_range=None,
+    load_range=None,
+    temperature_range=None,
+) -> Projection:
+    """The least-squares Coulomb-viscous projection of ``fitted`` (see the module docstring).
+
+    Parameters
+    ----------
+    fitted : any model, analytic or RBF.
+    per_direction : one ``(F_c, b)`` pair for each direction of motion (else one for both).
+    velocity_range, load_range, temperature_range : override the model's operating range.
+
+    Returns
+    -------
+    Projection
+        The parameters, the error over the grid, and what is lost.
+    """
+    X, info = operating_grid(fitted, velocity_range, load_range, temperature_range)
+    F = fitted.predict(X)
+    v = X[:, 0]
+    s = np.sign(v)
+    pos = v > 0
+    side_fits = {
+        "positive": _nnls(np.column_stack([s[pos], v[pos]]), F[pos]),
+        "negative": _nnls(np.column_stack([-s[~pos], -v[~pos]]), -F[~pos]),
+    }
+    if per_direction:
+        fits = side_fits
+        approx = np.where(
+            pos,
+            fits["positive"][0] * s + fits["positive"][1] * v,
+            fits["negative"][0] * s + fits["negative"][1] * v,
+        )
+    else:
+        both = _nnls(np.column_stack([s, v]), F)
+        fits = {"both": both}
+        approx = both[0] * s + both[1] * v
+    resid = approx - F
+    k = int(np.argmax(np.abs(resid)))
+    rms_f = float(np.sqrt(np.mean(F**2)))
+    rms_e = float(np.sqrt(np.mean(resid**2)))
+    return Projection(
+        per_direction=per_direction,
+        coulomb={key: float(x[0]) for key, x in fits.items()},
+        viscous={key: float(x[1]) for key, x in fits.items()},
+        rms_error=rms_e,
+        max_error=float(np.abs(resid[k])),
+        max_at=(float(X[k, 0]), float(X[k, 1]), float(X[k, 2])),
+        rms_friction=rms_f,
+        relative_error=rms_e / rms_f if rms_f > 0 else 0.0,
+        ranges=info,
+        lost=_lost(fitted, X, F, info, per_direction, side_fits),
+    )
