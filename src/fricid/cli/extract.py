@@ -100,6 +100,7 @@ def extract_command(
     as the load (eq. 12). Writes samples with velocity [rad/s], load [N m], temperature [degC],
     friction [N m], direction, count, std [N m]."""
     from ..io import epos_steady_samples, iter_rawlog, iter_rosbag, write_samples
+    from ..units import to_si
 
     if fmt == "epos":
         samples = epos_steady_samples(log, flip_sign=flip_sign, temperature=temperature,
@@ -108,6 +109,9 @@ def extract_command(
         err_console.print(f"wrote {escape(str(out))}: {len(samples)} steady operating points "
                           f"(directions {samples.directions()})")
         return
+    pos = parse_positions(positions, position_unit)
+    half = None if bin_halfwidth is None else float(to_si(bin_halfwidth, position_unit,
+                                                          "position"))
     if fmt == "table":
         chunks = iter_rawlog(log, chunk_rows=chunk_rows)
     elif fmt == "rosbag":
@@ -122,8 +126,7 @@ def extract_command(
                              velocity_unit=velocity_unit, chunk_rows=chunk_rows)
     else:
         raise ConfigError(f"--format must be table, rosbag or epos; got '{fmt}'")
-    result = _extract_chunks(log, chunks, positions, position_unit, bin_halfwidth,
-                             median_window, gravity)
+    result = _extract_chunks(log, chunks, pos, half, median_window, gravity)
     write_samples(result.samples, out)
     if by_direction is not None:
         write_samples(result.by_direction, by_direction)
@@ -132,14 +135,8 @@ def extract_command(
                       + (f" and {by_direction}" if by_direction else ""))
 
 
-def _extract_chunks(log, chunks, positions, position_unit, bin_halfwidth, median_window,
-                    gravity):
+def _extract_chunks(log, chunks, pos, half, median_window, gravity):
     from ..extract import extract
-    from ..units import to_si
-
-    pos = parse_positions(positions, position_unit)
-    half = None if bin_halfwidth is None else float(to_si(bin_halfwidth, position_unit,
-                                                          "position"))
     first = next(chunks, None)
     if first is None:
         raise ConfigError(f"{log}: the log has no rows")

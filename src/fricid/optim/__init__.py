@@ -2,11 +2,51 @@
 
 ``minimize(fun, bounds, method=...)`` with methods registered in :data:`METHODS`. Nothing here
 knows about friction: objectives are plain batch functions ``(k, d) -> (k,)``.
+
+Methods (``METHODS[name].summary`` has the one-line description):
+
+* beetle antennae search family: ``bas``, ``vsbas``, ``ibas``, ``rwsavsbas``;
+* ``ga``, a real-coded genetic algorithm;
+* baselines: ``lm``, ``trf`` (scipy least squares), ``de``, ``dual_annealing`` (scipy),
+  ``cmaes`` (the ``cma`` package);
+* ``bas+lm``: a beetle global phase polished by Levenberg-Marquardt.
+
+``minimize(..., runs=N)`` makes N independent runs (seeds ``seed .. seed + N - 1``), batched
+into one objective call per iteration for bas, vsbas, ibas, rwsavsbas and ga.
+:class:`JitObjective` pairs an objective with a numba kernel for RWSAVSBAS's compiled path.
+Conventions (unit box, clipping, NaN, history, budgets): :mod:`fricid.optim._api`.
 """
 
 from __future__ import annotations
 
-from . import _least_squares  # noqa: F401  (registers lm, trf)
-from ._api import METHODS, OptimizeResult, check_bounds, minimize
+from . import (  # noqa: F401  (each registers its methods)
+    _bas,
+    _cmaes,
+    _ga,
+    _hybrid,
+    _ibas,
+    _least_squares,
+    _rwsavsbas,
+    _scipy_global,
+    _vsbas,
+)
+from ._api import METHODS, JitObjective, OptimizeResult, check_bounds, minimize
 
-__all__ = ["METHODS", "OptimizeResult", "check_bounds", "minimize"]
+__all__ = ["METHODS", "JitObjective", "OptimizeResult", "check_bounds", "minimize"]
+
+#: The order methods are listed in (errors, ``--help``): the beetle family first.
+_ORDER = (
+    "bas",
+    "vsbas",
+    "ibas",
+    "rwsavsbas",
+    "ga",
+    "bas+lm",
+    "lm",
+    "trf",
+    "de",
+    "dual_annealing",
+    "cmaes",
+)
+for _name in sorted(METHODS, key=lambda k: _ORDER.index(k) if k in _ORDER else len(_ORDER)):
+    METHODS[_name] = METHODS.pop(_name)

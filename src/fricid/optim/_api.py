@@ -2,7 +2,7 @@
 
 ``minimize(fun, bounds, method=..., seed=..., max_evals=..., options=..., callback=...)``
 dispatches to one solver class per method through :data:`METHODS`, and returns an
-:class:`OptimizeResult`.
+:class:`OptimizeResult` (or a list of them with ``runs=N``).
 
 Conventions every method honours:
 
@@ -11,20 +11,33 @@ Conventions every method honours:
   also take ``residuals``, a batch ``(k, d) -> (k, n)`` residual function; one residual
   vector is one evaluation.
 * Search happens in the unit box ``[0, 1]^d`` mapped linearly onto ``bounds``; candidates
-  that step outside are clipped back onto the box, so ``bounds`` are never left.
-* NaN (or inf) objective values count as the worst possible value, never as the best.
+  that step outside are **clipped** back onto the box (not reflected), so ``bounds`` are never
+  left. Step lengths and antenna lengths of the beetle methods are in these unit-box units:
+  the width of the bounds therefore sets how far a step of 0.1 goes in each parameter.
+* NaN (or inf) objective values count as the worst possible value (``+inf``), never as the
+  best. An objective that returns no finite value at all raises :class:`ConfigError`.
 * ``history`` is the best-so-far value against the evaluation count, an array ``(m, 2)``
-  with columns ``nfev, best fun``; it is monotone non-increasing.
+  with columns ``nfev, best fun``, one row per improvement plus the final count; it is
+  monotone (``nfev`` increasing, ``fun`` non-increasing).
 * Randomness comes only from ``seed`` (int or ``numpy.random.Generator``) through
   ``numpy.random.default_rng``; the integer seed used is recorded in the result.
+* ``runs=N`` makes N independent runs with seeds ``seed .. seed + N - 1``. Methods marked
+  ``batched`` advance all runs in lockstep and evaluate their candidates in one call of
+  ``fun`` per iteration; each run's result is still bit-identical to running it alone with
+  its seed, provided ``fun`` evaluates each row independently of the others (true of
+  element-wise numpy code). Other methods run the N runs one after another.
+* An objective may carry a ``jit_kernel`` attribute (see :class:`JitObjective`): a numba
+  function ``kernel(X, out, data)`` writing ``fun(X)`` into ``out``. Methods with a compiled fast
+  path (``rwsavsbas``) then run whole iterations in compiled code; all others, and those with
+  option ``jit=False``, call ``fun``.
 
 Optimisers know nothing of friction: this package imports nothing of fricid but ``errors``.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
-from typing import Any
+from collections.abc import Callable, Sequence
+from typing import Any, ClassVar
 
 import numpy as np
 
@@ -33,13 +46,22 @@ from ..errors import ConfigError
 __all__ = [
     "METHODS",
     "Budget",
+    "JitObjective",
     "Objective",
     "OptimizeResult",
     "Solver",
     "check_bounds",
+    "choice_option",
     "minimize",
+    "positive_option",
     "register",
 ]
+
+
+def clip01(U: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+    """``np.clip(U, 0, 1)`` without its Python-level overhead (hot loops call it often)."""
+    out = np.maximum(U, 0.0, out=out)
+    return np.minimum(out, 1.0, out=out)
 
 
 class OptimizeResult(dict):
@@ -69,6 +91,28 @@ class Budget(Exception):
     """Raised inside a solver when the evaluation budget is spent (caught by :func:`minimize`)."""
 
 
+class JitObjective:
+    """A batch objective with a compiled twin, for the compiled fast paths.
+
+    ``JitObjective(fun, kernel, data)`` is called like ``fun``; ``kernel`` must be a numba
+    ``@njit`` function ``kernel(X, out, data)`` that writes ``fun(X)`` for a C-contiguous
+    float64 batch ``X (k, d)`` (parameter space, not the unit box) into the float64 array
+    ``out (k,)``; ``data`` is a tuple (arrays, numbers) handed to every call, so one compiled
+    kernel (cacheable, defined at module level) serves any data set. Both must compute the
+    same function (up to rounding); methods without a fast path use ``fun``.
+    """
+
+    def __init__(
+        self, fun: Callable[[np.ndarray], np.ndarray], kernel: Any, data: tuple = ()
+    ) -> None:
+        self.fun = fun
+        self.jit_kernel = kernel
+        self.jit_data = tuple(data)
+
+    def __call__(self, X: np.ndarray) -> np.ndarray:
+        return self.fun(X)
+
+
 def check_bounds(bounds) -> np.ndarray:
     """Validate ``bounds`` (a sequence of (lower, upper) pairs) and return a ``(d, 2)`` array."""
     try:
@@ -92,12 +136,14 @@ def check_bounds(bounds) -> np.ndarray:
 
 
 class Objective:
-    """Wraps a batch objective: maps the unit box to bounds, counts evaluations, keeps the best.
+    """Wraps a batch objective for ``runs`` lockstep runs: maps the unit box to bounds, counts
+    evaluations, keeps each run's best point and its history.
 
-    ``__call__(U)`` takes unit-box points ``(k, d)`` (clipped to [0, 1]) and returns ``(k,)``
-    values with NaN/inf replaced by ``+inf``. It raises :class:`Budget` before evaluating a
-    batch that the budget cannot pay for in full, after spending what is left on a prefix, so
-    ``nfev`` never exceeds ``max_evals``.
+    ``__call__(U)`` takes unit-box points ``(runs, k, d)`` (clipped to [0, 1]), evaluates all
+    ``runs * k`` of them in one call of ``fun`` and returns ``(runs, k)`` values with NaN/inf
+    replaced by ``+inf``. ``nfev`` counts the evaluations of *each* run (they advance in
+    lockstep). A batch the budget cannot pay for in full is cut to what is left, evaluated,
+    and then :class:`Budget` is raised, so ``nfev`` never exceeds ``max_evals``.
     """
 
     def __init__(
@@ -106,23 +152,28 @@ class Objective:
         bounds: np.ndarray,
         max_evals: int,
         callback: Callable[[OptimizeResult], Any] | None = None,
+        runs: int = 1,
     ) -> None:
         self.fun = fun
+        self.kernel = getattr(fun, "jit_kernel", None)
+        self.kernel_data = tuple(getattr(fun, "jit_data", ()))
         self.lower = bounds[:, 0].copy()
         self.span = bounds[:, 1] - bounds[:, 0]
         self.dim = bounds.shape[0]
+        self.runs = int(runs)
         self.max_evals = int(max_evals)
         self.callback = callback
         self.nfev = 0
-        self.best_u = np.full(self.dim, np.nan)
-        self.best_f = np.inf
+        self.best_u = np.full((self.runs, self.dim), np.nan)
+        self.best_f = np.full(self.runs, np.inf)
+        self._rows = np.arange(self.runs)
         self._hist_n: list[int] = []
-        self._hist_f: list[float] = []
+        self._hist_f: list[np.ndarray] = []
         self.stopped_by_callback = False
 
     # unit box <-> parameters
     def to_x(self, U: np.ndarray) -> np.ndarray:
-        return self.lower + np.clip(U, 0.0, 1.0) * self.span
+        return self.lower + clip01(U) * self.span
 
     def to_u(self, X: np.ndarray) -> np.ndarray:
         return np.clip((np.asarray(X, dtype=float) - self.lower) / self.span, 0.0, 1.0)
@@ -132,66 +183,101 @@ class Objective:
         return self.max_evals - self.nfev
 
     def evaluate_x(self, X: np.ndarray) -> np.ndarray:
-        """Evaluate parameter-space points ``(k, d)`` (no clipping, no budget check)."""
-        X = np.atleast_2d(np.asarray(X, dtype=float))
-        f = np.asarray(self.fun(X), dtype=float)
+        """Evaluate parameter-space points ``(k, d)`` (no clipping, no counting)."""
+        if X.ndim != 2 or X.dtype != np.float64 or not X.flags.c_contiguous:
+            X = np.ascontiguousarray(np.atleast_2d(np.asarray(X, dtype=float)))
+        raw = self.fun(X)
+        try:
+            f = np.asarray(raw, dtype=float)
+        except (TypeError, ValueError) as exc:
+            raise ConfigError(
+                f"the objective must return an array of {X.shape[0]} numbers; {exc}"
+            ) from None
         if f.shape != (X.shape[0],):
             raise ConfigError(
                 f"the objective must return shape ({X.shape[0]},) for a batch of "
-                f"{X.shape[0]} points; got {f.shape}"
+                f"{X.shape[0]} points of shape {X.shape}; got {f.shape}"
             )
         return np.where(np.isfinite(f), f, np.inf)
 
     def __call__(self, U: np.ndarray) -> np.ndarray:
-        U = np.clip(np.atleast_2d(U), 0.0, 1.0)
-        k = U.shape[0]
+        U = clip01(U)
+        R, k, d = U.shape
         if k > self.remaining:
             if self.remaining > 0:
-                self(U[: self.remaining])
+                self(U[:, : self.remaining])
             raise Budget
-        f = self.evaluate_x(self.to_x(U))
+        f = self.evaluate_x(self.lower + U.reshape(R * k, d) * self.span).reshape(R, k)
         self.nfev += k
-        i = int(np.argmin(f))
-        if f[i] < self.best_f:
-            self.best_f = float(f[i])
-            self.best_u = U[i].copy()
-        self._hist_n.append(self.nfev)
-        self._hist_f.append(self.best_f)
+        self.offer(U, f)
         return f
 
+    def call1(self, U: np.ndarray) -> np.ndarray:
+        """Single-run convenience: ``(k, d) -> (k,)`` (``runs`` must be 1)."""
+        return self(np.asarray(U, dtype=float)[None])[0]
+
+    def offer(self, U: np.ndarray, f: np.ndarray) -> None:
+        """Offer evaluated (already counted) points ``U (runs, k, d)`` with values
+        ``f (runs, k)`` as best candidates; a snapshot is kept when any run improves."""
+        i = np.argmin(f, axis=1)
+        rows = self._rows
+        fi = f[rows, i]
+        better = fi < self.best_f
+        if better.any():
+            self.best_f[better] = fi[better]
+            self.best_u[better] = U[rows[better], i[better]]
+            self.snapshot()
+
     def record(self, u: np.ndarray, f: float) -> None:
-        """Offer a point evaluated outside ``__call__`` (already counted) as a best candidate."""
-        if f < self.best_f:
-            self.best_f = float(f)
-            self.best_u = np.asarray(u, dtype=float).copy()
-            self._hist_n.append(self.nfev)
-            self._hist_f.append(self.best_f)
+        """Single run: offer one point evaluated outside ``__call__`` (already counted)."""
+        self.offer(np.asarray(u, dtype=float)[None, None, :], np.array([[f]], dtype=float))
+
+    def snapshot(self) -> None:
+        self._hist_n.append(self.nfev)
+        self._hist_f.append(self.best_f.copy())
 
     def notify(self, nit: int) -> None:
-        """Call the user's callback with the intermediate result; it may stop the run."""
+        """Call the user's callback with each run's intermediate result; returning True or
+        raising ``StopIteration`` stops the run (all runs of a lockstep batch)."""
         if self.callback is None:
             return
-        res = OptimizeResult(x=self.to_x(self.best_u), fun=self.best_f, nfev=self.nfev, nit=nit)
-        try:
-            stop = self.callback(res)
-        except StopIteration:
-            stop = True
+        stop = False
+        for r in range(self.runs):
+            res = OptimizeResult(
+                x=self.to_x(self.best_u[r]), fun=float(self.best_f[r]), nfev=self.nfev, nit=nit
+            )
+            if self.runs > 1:
+                res["run"] = r
+            try:
+                stop = bool(self.callback(res)) or stop
+            except StopIteration:
+                stop = True
         if stop:
             self.stopped_by_callback = True
             raise Budget
 
-    @property
-    def history(self) -> np.ndarray:
-        if not self._hist_n:
+    def history(self, r: int = 0) -> np.ndarray:
+        """Run ``r``'s best-so-far against nfev: one row per improvement, plus the end."""
+        n = np.asarray(self._hist_n, dtype=float)
+        f = np.asarray([h[r] for h in self._hist_f], dtype=float)
+        if f.size:
+            prev = np.concatenate([[np.inf], np.minimum.accumulate(f)[:-1]])
+            keep = f < prev
+            n, f = n[keep], f[keep]
+        if f.size and n[-1] < self.nfev:
+            n, f = np.append(n, self.nfev), np.append(f, f[-1])
+        if not f.size:
             return np.empty((0, 2))
-        return np.column_stack([np.asarray(self._hist_n, float), np.asarray(self._hist_f)])
+        return np.column_stack([n, f])
 
 
 class Solver:
     """Base class of a method: ``__init__`` validates options, ``run`` searches.
 
-    Subclasses set ``name``, ``summary`` (one line for docs and errors), ``options``
-    (name -> default) and ``default_evals``, and implement :meth:`run`, which calls
+    Subclasses set ``name``, ``summary`` (one line for docs, ``--help`` and errors),
+    ``options`` (name -> default), ``default_evals`` (or override :meth:`default_budget`) and
+    ``batched`` (True when :meth:`run` advances ``objective.runs`` runs in lockstep, drawing
+    run ``r``'s random numbers from ``rngs[r]`` only), and implement :meth:`run`, which calls
     ``self.objective`` on unit-box batches until the budget raises :class:`Budget` or the
     method ends by itself; it returns ``(nit, message)``. ``self.nit`` is kept current so an
     interrupted run still reports its iterations.
@@ -199,29 +285,59 @@ class Solver:
 
     name: str = ""
     summary: str = ""
-    options: dict[str, Any] = {}
+    options: ClassVar[dict[str, Any]] = {}
     default_evals: int = 10_000
     uses_residuals: bool = False
+    batched: bool = False
 
-    def __init__(self, objective: Objective, rng: np.random.Generator, options: dict[str, Any],
-                 x0: np.ndarray | None = None,
-                 residuals: Callable[[np.ndarray], np.ndarray] | None = None) -> None:
+    def __init__(
+        self,
+        options: dict[str, Any],
+        *,
+        dim: int,
+        x0: np.ndarray | None = None,
+        residuals: Callable[[np.ndarray], np.ndarray] | None = None,
+    ) -> None:
         unknown = sorted(set(options) - set(self.options))
         if unknown:
             raise ConfigError(
                 f"unknown option(s) {', '.join(unknown)} for method '{self.name}'; "
                 f"it takes: {', '.join(self.options) or 'none'}"
             )
-        self.objective = objective
-        self.rng = rng
         self.opts = {**self.options, **options}
+        self.dim = int(dim)
         self.x0 = x0
         self.residuals = residuals
         self.nit = 0
+        self.objective: Objective
+        self.rngs: list[np.random.Generator] = []
         self.validate()
+
+    def bind(self, objective: Objective, rngs: Sequence[np.random.Generator]) -> Solver:
+        """Attach the objective and one random generator per run."""
+        self.objective = objective
+        self.rngs = list(rngs)
+        return self
+
+    @property
+    def rng(self) -> np.random.Generator:
+        """The generator of a single run."""
+        return self.rngs[0]
+
+    def default_budget(self) -> int:
+        """The evaluation budget when ``max_evals`` is None (may depend on the options)."""
+        return self.default_evals
 
     def validate(self) -> None:
         """Check ``self.opts``; raise :class:`ConfigError` naming the bad option."""
+
+    def start_points(self) -> np.ndarray:
+        """Each run's start in the unit box ``(runs, d)``: ``x0`` when given, else uniform from
+        that run's generator (its first draw)."""
+        obj = self.objective
+        if self.x0 is not None:
+            return np.broadcast_to(obj.to_u(self.x0), (obj.runs, obj.dim)).copy()
+        return np.stack([g.random(obj.dim) for g in self.rngs])
 
     def run(self) -> tuple[int, str]:  # pragma: no cover - abstract
         raise NotImplementedError
@@ -237,18 +353,40 @@ def register(cls: type[Solver]) -> type[Solver]:
     return cls
 
 
-def _seed(seed) -> tuple[np.random.Generator, int | None]:
-    if isinstance(seed, np.random.Generator):
-        return seed, None
-    if seed is None:
-        seed = int(np.random.SeedSequence().entropy % (2**32))
+def _check_seed_int(seed) -> int:
     if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or seed < 0:
         raise ConfigError(f"seed must be a non-negative int or a numpy Generator; got {seed!r}")
-    return np.random.default_rng(int(seed)), int(seed)
+    return int(seed)
 
 
-def positive_option(opts: dict[str, Any], name: str, method: str, *, integer: bool = False,
-                    open_unit: bool = False, allow_zero: bool = False) -> None:
+def _seeds(seed, runs: int | None) -> tuple[list[np.random.Generator], list[int | None]]:
+    """One generator per run, and the integer seed each was made from."""
+    if runs is None:
+        if isinstance(seed, np.random.Generator):
+            return [seed], [None]
+        if seed is None:
+            seed = int(np.random.SeedSequence().entropy % (2**32))
+        s = _check_seed_int(seed)
+        return [np.random.default_rng(s)], [s]
+    if isinstance(seed, np.random.Generator):
+        base = int(seed.integers(2**31))
+    elif seed is None:
+        base = int(np.random.SeedSequence().entropy % (2**31))
+    else:
+        base = _check_seed_int(seed)
+    seeds = [base + r for r in range(runs)]
+    return [np.random.default_rng(s) for s in seeds], list(seeds)
+
+
+def positive_option(
+    opts: dict[str, Any],
+    name: str,
+    method: str,
+    *,
+    integer: bool = False,
+    open_unit: bool = False,
+    allow_zero: bool = False,
+) -> None:
     """Raise :class:`ConfigError` unless ``opts[name]`` is a positive number (an int, or in
     the open interval (0, 1), when asked)."""
     v = opts[name]
@@ -259,9 +397,59 @@ def positive_option(opts: dict[str, Any], name: str, method: str, *, integer: bo
     if open_unit:
         ok = ok and 0 < v < 1
     if not ok:
-        need = "an integer > 0" if integer else "a number in (0, 1)" if open_unit else (
-            "a number >= 0" if allow_zero else "a number > 0")
+        need = (
+            "an integer > 0"
+            if integer
+            else "a number in (0, 1)"
+            if open_unit
+            else ("a number >= 0" if allow_zero else "a number > 0")
+        )
         raise ConfigError(f"option '{name}' of method '{method}' must be {need}; got {v!r}")
+
+
+def choice_option(opts: dict[str, Any], name: str, method: str, choices: Sequence[Any]) -> None:
+    """Raise :class:`ConfigError` unless ``opts[name]`` is one of ``choices``."""
+    v = opts[name]
+    if isinstance(v, str):
+        v = v.strip().lower()
+        opts[name] = v
+    if not any(v is c or (type(v) is type(c) and v == c) for c in choices):
+        shown = ", ".join(repr(c) for c in choices)
+        raise ConfigError(f"option '{name}' of method '{method}' must be one of {shown}; got {v!r}")
+
+
+def _result(objective: Objective, r: int, nit: int, message: str, key: str, seed) -> OptimizeResult:
+    best_f = float(objective.best_f[r])
+    finite = np.isfinite(best_f)
+    x = objective.to_x(objective.best_u[r]) if finite else np.full(objective.dim, np.nan)
+    return OptimizeResult(
+        x=x,
+        fun=best_f,
+        nfev=objective.nfev,
+        nit=nit,
+        history=objective.history(r),
+        message=message,
+        success=bool(finite),
+        method=key,
+        seed=seed,
+    )
+
+
+def _solve(solver: Solver, objective: Objective) -> tuple[int, str]:
+    try:
+        nit, message = solver.run()
+    except Budget:
+        nit = solver.nit
+        if objective.stopped_by_callback:
+            message = "stopped by the callback"
+        else:
+            message = f"evaluation budget of {objective.max_evals} spent"
+    if not np.isfinite(objective.best_f).any():
+        raise ConfigError(
+            f"the objective returned NaN or inf for every one of the {objective.nfev} "
+            "candidates evaluated; check it and the bounds"
+        )
+    return nit, message
 
 
 def minimize(
@@ -275,7 +463,8 @@ def minimize(
     callback: Callable[[OptimizeResult], Any] | None = None,
     x0=None,
     residuals: Callable[[np.ndarray], np.ndarray] | None = None,
-) -> OptimizeResult:
+    runs: int | None = None,
+) -> OptimizeResult | list[OptimizeResult]:
     """Minimise ``fun`` over the box ``bounds`` with ``method``.
 
     Parameters
@@ -285,66 +474,74 @@ def minimize(
     bounds : sequence of ``(lower, upper)``, one pair per parameter.
     method : a key of :data:`METHODS` (case-insensitive).
     seed : int or ``numpy.random.Generator``; the same seed gives the same result bit for bit.
-    max_evals : budget in candidate evaluations (method's default when None).
+    max_evals : budget in candidate evaluations per run (method's default when None).
     options : method options; unknown names raise :class:`ConfigError` listing the known ones.
-    callback : called with an intermediate :class:`OptimizeResult` after each iteration;
-        returning True or raising ``StopIteration`` stops the run.
-    x0 : optional starting point (methods that use one).
+    callback : called with an intermediate :class:`OptimizeResult` (``x``, ``fun``, ``nfev``,
+        ``nit``, and ``run`` with ``runs``) after each iteration; returning True or raising
+        ``StopIteration`` stops the run (every run of a lockstep batch).
+    x0 : optional starting point (methods that use one; every run starts there).
     residuals : callable ``(k, d) -> (k, n)`` for least-squares methods.
+    runs : None for one run (returns an :class:`OptimizeResult`), or N >= 1 independent runs
+        with seeds ``seed .. seed + N - 1`` (returns a list of N results, each identical to
+        ``minimize(..., seed=seed + r)``). A Generator ``seed`` gives the base seed by one draw.
+
+    Returns
+    -------
+    OptimizeResult, or a list of them with ``runs``.
     """
     key = str(method).strip().lower()
     if key not in METHODS:
-        raise ConfigError(f"unknown method '{method}'; choose one of: {', '.join(METHODS)}")
+        raise ConfigError(
+            f"unknown method '{method}'; choose one of: "
+            + "; ".join(f"{k} ({c.summary})" for k, c in METHODS.items())
+        )
     cls = METHODS[key]
     b = check_bounds(bounds)
     if fun is None and residuals is None:
         raise ConfigError("give an objective `fun`, or `residuals` for least squares")
     if cls.uses_residuals and residuals is None:
-        raise ConfigError(f"method '{key}' is a least-squares method and needs `residuals`")
+        raise ConfigError(f"method '{key}' ({cls.summary}) needs `residuals`")
     if fun is None:
         res_fun = residuals
 
         def fun(X: np.ndarray) -> np.ndarray:
             r = np.asarray(res_fun(X), dtype=float)
+            if r.ndim != 2 or r.shape[0] != X.shape[0]:
+                raise ConfigError(
+                    f"the residual function must return shape ({X.shape[0]}, n) for a batch of "
+                    f"{X.shape[0]} points; got {r.shape}"
+                )
             return np.einsum("kn,kn->k", r, r)
 
-    if max_evals is None:
-        max_evals = cls.default_evals
-    if isinstance(max_evals, bool) or not isinstance(max_evals, int | np.integer) or max_evals < 1:
+    if runs is not None and (
+        isinstance(runs, bool) or not isinstance(runs, int | np.integer) or runs < 1
+    ):
+        raise ConfigError(f"runs must be a positive integer or None; got {runs!r}")
+    if max_evals is not None and (
+        isinstance(max_evals, bool) or not isinstance(max_evals, int | np.integer) or max_evals < 1
+    ):
         raise ConfigError(f"max_evals must be a positive integer; got {max_evals!r}")
-    rng, used_seed = _seed(seed)
-    objective = Objective(fun, b, int(max_evals), callback)
     if x0 is not None:
         x0 = np.asarray(x0, dtype=float)
         if x0.shape != (b.shape[0],):
-            raise ConfigError(
-                f"x0 has shape {x0.shape}; the bounds give {b.shape[0]} parameters"
-            )
-        if np.any(x0 < b[:, 0]) or np.any(x0 > b[:, 1]):
+            raise ConfigError(f"x0 has shape {x0.shape}; the bounds give {b.shape[0]} parameters")
+        if not np.isfinite(x0).all() or np.any(x0 < b[:, 0]) or np.any(x0 > b[:, 1]):
             raise ConfigError("x0 lies outside the bounds")
-    solver = cls(objective, rng, dict(options or {}), x0=x0, residuals=residuals)
-    try:
-        nit, message = solver.run()
-        success = True
-    except Budget:
-        nit = solver.nit
-        if objective.stopped_by_callback:
-            message, success = "stopped by the callback", True
-        else:
-            message, success = f"evaluation budget of {objective.max_evals} spent", True
-    if not np.isfinite(objective.best_f):
-        success = False
-        message = "no finite objective value was found"
-    x = objective.to_x(objective.best_u) if np.isfinite(objective.best_f) else np.full(
-        b.shape[0], np.nan)
-    return OptimizeResult(
-        x=x,
-        fun=objective.best_f,
-        nfev=objective.nfev,
-        nit=nit,
-        history=objective.history,
-        message=message,
-        success=success,
-        method=key,
-        seed=used_seed,
-    )
+    opts = dict(options or {})
+    solver = cls(opts, dim=b.shape[0], x0=x0, residuals=residuals)
+    budget = int(max_evals) if max_evals is not None else solver.default_budget()
+    rngs, seeds = _seeds(seed, None if runs is None else int(runs))
+    n = len(rngs)
+
+    results: list[OptimizeResult] = []
+    if cls.batched:
+        objective = Objective(fun, b, budget, callback, runs=n)
+        nit, message = _solve(solver.bind(objective, rngs), objective)
+        results = [_result(objective, r, nit, message, key, seeds[r]) for r in range(n)]
+    else:
+        for r in range(n):
+            one = solver if r == 0 else cls(opts, dim=b.shape[0], x0=x0, residuals=residuals)
+            objective = Objective(fun, b, budget, callback, runs=1)
+            nit, message = _solve(one.bind(objective, [rngs[r]]), objective)
+            results.append(_result(objective, 0, nit, message, key, seeds[r]))
+    return results[0] if runs is None else results

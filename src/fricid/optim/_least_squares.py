@@ -13,6 +13,8 @@ says the best start is good enough.
 
 from __future__ import annotations
 
+from typing import Any, ClassVar
+
 import numpy as np
 from scipy.optimize import least_squares
 
@@ -25,7 +27,7 @@ __all__ = ["LeastSquaresLM", "LeastSquaresTRF"]
 class _LeastSquares(Solver):
     uses_residuals = True
     default_evals = 20_000
-    options = {"n_starts": 8, "ftol": 1e-12, "xtol": 1e-12, "gtol": 1e-12}
+    options: ClassVar[dict[str, Any]] = {"n_starts": 8, "ftol": 1e-12, "xtol": 1e-12, "gtol": 1e-12}
     scipy_method = ""
 
     def validate(self) -> None:
@@ -61,7 +63,7 @@ class _LeastSquares(Solver):
             sse = float(res @ res)
             if not np.isfinite(sse):
                 # scipy cannot step on non-finite residuals; a large finite one steers it away
-                return np.full(res.shape, 1e150)
+                return np.full(res.shape, 1e50)
             obj.record(u, sse)
             return res
 
