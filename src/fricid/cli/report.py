@@ -1,0 +1,78 @@
+"""``fricid report``: an HTML and Markdown report of one identified model on one data set."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from ._app import app, console, err_console, handle_errors
+
+
+@app.command("report")
+@handle_errors
+def report_command(
+    model: Annotated[
+        Path,
+        typer.Argument(help="Model file (JSON, from `fricid fit`).", exists=True, dir_okay=False),
+    ],
+    samples: Annotated[
+        Path, typer.Argument(help="Friction samples, CSV or Parquet.", exists=True, dir_okay=False)
+    ],
+    out: Annotated[
+        Path | None,
+        typer.Option(
+            "--out",
+            "-o",
+            help=(
+                "Folder to write (created; files of an earlier report there are replaced). "
+                "Default: <model>-report/ in the current directory."
+            ),
+        ),
+    ] = None,
+    velocity_unit: Annotated[
+        str, typer.Option(help="Velocity unit of the figures: rad/s, deg/s, rpm or rev/s.")
+    ] = "rad/s",
+    bootstrap: Annotated[
+        int,
+        typer.Option(
+            help="Bootstrap resamples for the RBF network's confidence intervals.", min=10
+        ),
+    ] = 200,
+    seed: Annotated[int, typer.Option(help="Seed of the bootstrap.")] = 0,
+) -> None:
+    """Write a report of MODEL on SAMPLES: parameters with 95 % confidence intervals, fit
+    metrics, measured against predicted friction over velocity, residuals against each input
+    and the optimiser's convergence.
+
+    Outputs in the folder: report.html (self-contained), report.md, one CSV per table and one
+    PNG per figure, written all or nothing.
+    """
+    from ..errors import ConfigError
+    from ..fitted import FittedModel
+    from ..io import read_samples
+    from ..report import model_report, write_document
+    from ..units import UNITS
+
+    if velocity_unit not in UNITS["velocity"]:
+        raise ConfigError(
+            f"--velocity-unit must be one of: {', '.join(UNITS['velocity'])}; got '{velocity_unit}'"
+        )
+    fitted = FittedModel.load(model)
+    data = read_samples(samples)
+    out = out or Path(f"{model.stem}-report")
+    with err_console.status("building the report", spinner="dots"):
+        doc = model_report(
+            fitted,
+            data,
+            velocity_unit=velocity_unit,
+            bootstrap=bootstrap,
+            seed=seed,
+            samples_label=samples.name,
+        )
+        path = write_document(doc, out)
+    console.print(str(path), highlight=False, soft_wrap=True)
+    err_console.print(
+        f"wrote {len(doc.tables())} tables and {len(doc.figures())} figures into {out}/"
+    )

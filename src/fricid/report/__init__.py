@@ -1,0 +1,29 @@
+"""Reports: figures, tables and their HTML and Markdown rendering.
+
+>>> from fricid.report import model_report, write_document
+>>> doc = model_report(fitted, samples)            # doctest: +SKIP
+>>> write_document(doc, "report/")                  # doctest: +SKIP
+
+:mod:`.document` (the format-free content), :mod:`.render` (HTML, Markdown), :mod:`.writer`
+(the folder, written all or nothing), :mod:`.style` and :mod:`.plots` (matplotlib, Agg only),
+:mod:`.model` (the report of one identified model), :mod:`.rbf` (the RBF network's part).
+"""
+
+from __future__ import annotations
+
+from .document import Document, Figure, Note, Section, Table
+from .model import model_report
+from .render import render_html, render_markdown
+from .writer import write_document
+
+__all__ = [
+    "Document",
+    "Figure",
+    "Note",
+    "Section",
+    "Table",
+    "model_report",
+    "render_html",
+    "render_markdown",
+    "write_document",
+]

@@ -1,0 +1,203 @@
+"""``fricid report``: one model on one data set, for every model family and real data."""
+
+from __future__ import annotations
+
+import io
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from fricid.cli import app
+from fricid.errors import ConfigError
+from fricid.extract import extract
+from fricid.identify import fit
+from fricid.io import epos_steady_samples, write_samples
+from fricid.report import Document, Figure, Table, model_report, write_document
+from fricid.report.render import render_html, render_markdown
+from fricid.sim import preset, simulate
+
+# CI clones main with shared/ beside it
+LEADSCREW = Path(__file__).resolve().parents[2] / "shared" / "data" / "real" / "epos-leadscrew"
+
+FAMILIES = ("coulomb_viscous", "stribeck", "msk", "vlt")
+
+
+def png_stats(data: bytes) -> tuple[tuple[int, int], float]:
+    """(width, height) and the pixel standard deviation of a PNG."""
+    import matplotlib.image as mpimg
+
+    img = mpimg.imread(io.BytesIO(data), format="png")
+    return (img.shape[1], img.shape[0]), float(np.std(img[..., :3]))
+
+
+def assert_report_folder(folder: Path, figures: set[str], tables: set[str]) -> None:
+    html = (folder / "report.html").read_text(encoding="utf-8")
+    md = (folder / "report.md").read_text(encoding="utf-8")
+    assert html.count("data:image/png;base64,") >= len(figures)
+    assert "<table>" in html
+    for name in figures:
+        data = (folder / f"{name}.png").read_bytes()
+        (w, h), spread = png_stats(data)
+        assert w >= 400 and h >= 300, name
+        assert spread > 0.02, f"{name}.png looks blank"
+        assert f"({name}.png)" in md
+    for name in tables:
+        assert (folder / f"{name}.csv").stat().st_size > 0
+        assert f"({name}.csv)" in md
+    manifest = json.loads((folder / "manifest.json").read_text())
+    assert set(manifest["files"]) >= {f"{n}.png" for n in figures} | {f"{n}.csv" for n in tables}
+    assert not [p for p in folder.parent.iterdir() if p.name.endswith(".tmp")]
+
+
+@pytest.fixture(scope="module")
+def paper1_samples():
+    scenario = preset("paper1", "quick")
+    result = extract(
+        simulate(scenario, seed=3),
+        positions=scenario.design.positions,
+        bin_halfwidth=scenario.design.bin_halfwidth,
+        gravity="fit",
+    )
+    return result.samples
+
+
+@pytest.fixture(scope="module")
+def leadscrew():
+    if not LEADSCREW.is_dir():
+        pytest.skip("lead-screw recordings not available")
+    return epos_steady_samples(LEADSCREW)
+
+
+@pytest.mark.parametrize("family", FAMILIES)
+def test_report_renders_for_each_family(family, paper1_samples, tmp_path):
+    fitted = fit(paper1_samples, family, "lm", max_evals=3000)
+    doc = model_report(fitted, paper1_samples, velocity_unit="deg/s")
+    out = tmp_path / "rep"
+    path = write_document(doc, out)
+    assert path == out / "report.html"
+    figures = {"friction_vs_velocity", "parity", "residuals", "convergence"}
+    assert_report_folder(out, figures, {"parameters", "metrics"})
+    params = (out / "parameters.csv").read_text()
+    for name in fitted.params:
+        assert name in params
+    assert "95% CI low" in params
+
+
+def test_report_on_real_leadscrew_per_direction(leadscrew, tmp_path):
+    fitted = fit(leadscrew, "stribeck_asym")
+    doc = model_report(fitted, leadscrew, velocity_unit="rpm")
+    write_document(doc, tmp_path / "rep")
+    assert_report_folder(
+        tmp_path / "rep",
+        {"friction_vs_velocity", "residuals", "parity"},
+        {"parameters", "metrics", "correlation"},
+    )
+    text = (tmp_path / "rep" / "report.md").read_text()
+    assert "tau_s_pos" in text and "tau_s_neg" in text
+    assert "mN m" in text or "N m" in text
+
+
+def test_cli_report(leadscrew, tmp_path):
+    fitted = fit(leadscrew, "stribeck_asym")
+    model = fitted.save(tmp_path / "m.json")
+    samples = write_samples(leadscrew, tmp_path / "s.csv")
+    res = CliRunner().invoke(
+        app,
+        [
+            "report",
+            str(model),
+            str(samples),
+            "--out",
+            str(tmp_path / "r"),
+            "--velocity-unit",
+            "rpm",
+        ],
+    )
+    assert res.exit_code == 0, res.output
+    assert (tmp_path / "r" / "report.html").is_file()
+    res = CliRunner().invoke(
+        app,
+        [
+            "report",
+            str(model),
+            str(samples),
+            "--out",
+            str(tmp_path / "r"),
+            "--velocity-unit",
+            "furlong",
+        ],
+    )
+    assert res.exit_code == 2
+    assert "velocity-unit" in res.output
+
+
+def _tiny_doc(png: bytes) -> Document:
+    import pandas as pd
+
+    doc = Document("t", "summary | with pipe", meta={"a": 1.5})
+    sec = doc.section("S", "- one\n- two")
+    sec.add(Table("tab", "A table", pd.DataFrame({"x": [1.0, np.nan], "y": ["a|b", "c"]})))
+    sec.add(Figure("fig", "A figure", png, "caption `code`"))
+    return doc
+
+
+def test_write_is_all_or_nothing(tmp_path, monkeypatch):
+    from fricid.report import writer
+
+    png = b"\x89PNG" + bytes(100)
+    out = tmp_path / "out"
+
+    def boom(doc):
+        raise RuntimeError("disk full")
+
+    monkeypatch.setattr(writer, "render_html", boom)
+    with pytest.raises(RuntimeError):
+        write_document(_tiny_doc(png), out)
+    assert not out.exists()
+    assert list(tmp_path.iterdir()) == []
+
+    # an existing folder keeps foreign files, loses stale report files
+    monkeypatch.undo()
+    out.mkdir()
+    (out / "mine.txt").write_text("keep")
+    write_document(_tiny_doc(png), out)
+    doc = _tiny_doc(png)
+    doc.sections[0].items.pop(0)  # drop the table: tab.csv is now stale
+    write_document(doc, out)
+    assert (out / "mine.txt").read_text() == "keep"
+    assert not (out / "tab.csv").exists()
+    assert (out / "fig.png").exists()
+
+
+def test_render_escapes_and_rejects_bad_items():
+    doc = _tiny_doc(b"\x89PNG" + bytes(10))
+    html = render_html(doc)
+    assert "<li>one</li>" in html and "<code>code</code>" in html
+    md = render_markdown(doc)
+    assert "a\\|b" in md and "| – |" in md.replace("–  ", "– ")
+    with pytest.raises(ConfigError):
+        Figure("Bad Name", "x", b"\x89PNG")
+    with pytest.raises(ConfigError):
+        Figure("ok", "x", b"GIF89a")
+
+
+def test_report_for_the_rbf_network_with_bootstrap(paper1_samples, tmp_path):
+    from fricid.fitted import FittedModel
+    from fricid.models.rbf import fit_rbf
+
+    fitted = fit_rbf(paper1_samples, n_centers=8, random_state=0)
+    path = fitted.save(tmp_path / "rbf.json")
+    fitted = FittedModel.load(path)
+    doc = model_report(fitted, paper1_samples, bootstrap=50)
+    write_document(doc, tmp_path / "rep")
+    assert_report_folder(
+        tmp_path / "rep",
+        {"friction_vs_velocity", "residuals", "parity"},
+        {"network", "parameters", "prediction_ci", "metrics"},
+    )
+    ci = __import__("pandas").read_csv(tmp_path / "rep" / "prediction_ci.csv")
+    assert (ci["95% CI low [N m]"] <= ci["predicted [N m]"] + 1e-12).all()
+    assert (ci["95% CI high [N m]"] >= ci["predicted [N m]"] - 1e-12).all()
