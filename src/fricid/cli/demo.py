@@ -8,6 +8,7 @@ from typing import Annotated
 
 import numpy as np
 import typer
+from rich.markup import escape
 from rich.table import Table
 
 from ._app import app, console, err_console, handle_errors
@@ -39,7 +40,7 @@ def demo_command(
 
     table = Table(title="Table 1: performance of the models (paper's values in brackets)")
     for col in ("model", "fitness", "RMSE [mN m]", "RMSPE", "max |err| [mN m]"):
-        table.add_column(col, justify="left" if col == "model" else "right")
+        table.add_column(escape(col), justify="left" if col == "model" else "right")
 
     def both(ours: float, paper: float, fmt: str) -> str:
         return f"{ours:{fmt}}" + ("" if np.isnan(paper) else f" [{paper:{fmt}}]")
