@@ -96,8 +96,11 @@ def test_help_mentions_units():
     assert "rad/s" in run("extract", "--help").output
 
 
-def _rawlog_csv(path, rows: str, header: str = "time [s],position [rad],velocity [rad/s],"
-                "torque [N m],temperature [degC]"):
+def _rawlog_csv(
+    path,
+    rows: str,
+    header: str = "time [s],position [rad],velocity [rad/s],torque [N m],temperature [degC]",
+):
     path.write_text(header + "\n" + rows)
     return path
 
@@ -105,19 +108,28 @@ def _rawlog_csv(path, rows: str, header: str = "time [s],position [rad],velocity
 @pytest.mark.parametrize(
     ("header", "rows", "message"),
     [
-        ("time [s],position [rad],torque [N m],temperature [degC]", "0,0,1,25\n",
-         "velocity"),  # missing column
+        (
+            "time [s],position [rad],torque [N m],temperature [degC]",
+            "0,0,1,25\n",
+            "velocity",
+        ),  # missing column
         (None, "0,0,1,1,25\n0.004,0,1,oops,25\n", "row 3"),  # non-numeric value
         (None, "0,0,1,1,25\n0.004,0,1,nan,25\n", "row 3"),  # NaN
         (None, "0,0,1,1,25\n0.004,0,1,1,25\n0.002,0,1,1,25\n", "time"),  # non-monotonic time
-        ("time [s],position [rad],velocity [furlong/s],torque [N m],temperature [degC]",
-         "0,0,1,1,25\n", "furlong/s"),  # unknown unit
-        (None, "".join(f"{i * 0.004},0,0,0.1,25\n" for i in range(200)),
-         "constant-velocity"),  # at rest all along
+        (
+            "time [s],position [rad],velocity [furlong/s],torque [N m],temperature [degC]",
+            "0,0,1,1,25\n",
+            "furlong/s",
+        ),  # unknown unit
+        (
+            None,
+            "".join(f"{i * 0.004},0,0,0.1,25\n" for i in range(200)),
+            "constant-velocity",
+        ),  # at rest all along
     ],
 )
 def test_extract_bad_logs(tmp_path, header, rows, message):
-    log = _rawlog_csv(tmp_path / "log.csv", rows, *( [header] if header else []))
+    log = _rawlog_csv(tmp_path / "log.csv", rows, *([header] if header else []))
     out = tmp_path / "samples.csv"
     res = run("extract", log, "--gravity", "none", "--out", out)
     assert res.exit_code == 2, res.output

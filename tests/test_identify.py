@@ -60,8 +60,9 @@ def test_asymmetric_needs_both_directions():
     s = stribeck_samples(0.0, 0)
     with pytest.raises(ConfigError, match="positive direction only"):
         fit(s, "stribeck_asym")
-    combined = FrictionSamples(velocity=[0.1, 0.2], load=0, temperature=25, friction=[1, 1],
-                               direction=[0, 0])
+    combined = FrictionSamples(
+        velocity=[0.1, 0.2], load=0, temperature=25, friction=[1, 1], direction=[0, 0]
+    )
     with pytest.raises(ConfigError, match="combine both directions"):
         fit(combined, "stribeck_asym")
 
@@ -101,7 +102,7 @@ def test_model_file_round_trip(tmp_path):
 def test_model_file_errors(tmp_path):
     p = tmp_path / "bad.json"
     p.write_text("{not json")
-    with pytest.raises(DataError, match="bad.json, row 1: not valid JSON"):
+    with pytest.raises(DataError, match=r"bad\.json, row 1: not valid JSON"):
         FittedModel.load(p)
     f = fit(stribeck_samples(0.0, 0), "coulomb_viscous")
     d = f.to_dict()

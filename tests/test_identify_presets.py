@@ -43,8 +43,10 @@ def test_paper2_stribeck_recovered_within_standard_errors(seed):
 
 def test_paper1_models_order_as_table1():
     samples = extracted("paper1", "reduced", 0).samples
-    fitness = {m: fit(samples, m, "lm").metrics["fitness"]
-               for m in ("coulomb_viscous", "stribeck", "msk", "vlt")}
+    fitness = {
+        m: fit(samples, m, "lm").metrics["fitness"]
+        for m in ("coulomb_viscous", "stribeck", "msk", "vlt")
+    }
     # adding the Stribeck effect, then load, then temperature improves fitness (Table 1)
     assert fitness["coulomb_viscous"] < fitness["stribeck"] - 0.05
     assert fitness["stribeck"] < fitness["msk"] - 0.02

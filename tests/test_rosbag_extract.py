@@ -52,8 +52,21 @@ def recorded(tmp_path_factory):
 def test_rosbag_extraction_matches_the_raw_log(recorded, tmp_path):
     bag, log, scenario = recorded
     out = tmp_path / "s.csv"
-    res = CliRunner().invoke(app, ["extract", str(bag), "--format", "rosbag", "--joint",
-                                   "axis3", "--gravity", "none", "--out", str(out)])
+    res = CliRunner().invoke(
+        app,
+        [
+            "extract",
+            str(bag),
+            "--format",
+            "rosbag",
+            "--joint",
+            "axis3",
+            "--gravity",
+            "none",
+            "--out",
+            str(out),
+        ],
+    )
     assert res.exit_code == 0, res.output
     from_bag = read_samples(out)
     direct = extract(log, **scenario.extract_options()).samples
@@ -66,7 +79,8 @@ def test_rosbag_extraction_matches_the_raw_log(recorded, tmp_path):
 
 def test_rosbag_without_joint_lists_the_joints(recorded, tmp_path):
     bag, _, _ = recorded
-    res = CliRunner().invoke(app, ["extract", str(bag), "--format", "rosbag",
-                                   "--out", str(tmp_path / "s.csv")])
+    res = CliRunner().invoke(
+        app, ["extract", str(bag), "--format", "rosbag", "--out", str(tmp_path / "s.csv")]
+    )
     assert res.exit_code == 2
     assert "axis1, axis3" in res.output

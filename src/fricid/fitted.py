@@ -160,15 +160,19 @@ class FittedModel:
     # -- text ----------------------------------------------------------------------------
     def report(self) -> str:
         """A plain-text fit report (after lmfit's ``fit_report``)."""
-        lines = [f"[[Model]] {self.model}   [[Method]] {self.method} (seed {self.seed}, "
-                 f"{self.nfev} evaluations)"]
+        lines = [
+            f"[[Model]] {self.model}   [[Method]] {self.method} (seed {self.seed}, "
+            f"{self.nfev} evaluations)"
+        ]
         m = self.metrics
         if m:
             lines.append(
                 "[[Fit statistics]] "
-                + ", ".join(f"{k} = {m[k]:.6g}" for k in ("n", "fitness", "sse", "rmse",
-                                                           "rmspe", "mae", "max_abs_error")
-                            if k in m)
+                + ", ".join(
+                    f"{k} = {m[k]:.6g}"
+                    for k in ("n", "fitness", "sse", "rmse", "rmspe", "mae", "max_abs_error")
+                    if k in m
+                )
             )
         lines.append("[[Parameters]]")
         for name, value in self.params.items():

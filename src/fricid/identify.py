@@ -29,8 +29,13 @@ __all__ = ["evaluate", "fit", "jacobian_uncertainty", "samples_hash"]
 def samples_hash(samples: FrictionSamples) -> str:
     """A short content hash of the samples (for provenance and caching)."""
     h = hashlib.sha256()
-    for a in (samples.velocity, samples.load, samples.temperature, samples.friction,
-              samples.direction.astype(float)):
+    for a in (
+        samples.velocity,
+        samples.load,
+        samples.temperature,
+        samples.friction,
+        samples.direction.astype(float),
+    ):
         h.update(np.ascontiguousarray(a, dtype=float).tobytes())
     return h.hexdigest()[:16]
 
@@ -52,8 +57,12 @@ def _check_directions(samples: FrictionSamples, model: FrictionModel) -> None:
             )
 
 
-def _resolve_bounds(model: FrictionModel, X: np.ndarray, y: np.ndarray,
-                    bounds: Mapping[str, tuple[float, float]] | None) -> np.ndarray:
+def _resolve_bounds(
+    model: FrictionModel,
+    X: np.ndarray,
+    y: np.ndarray,
+    bounds: Mapping[str, tuple[float, float]] | None,
+) -> np.ndarray:
     b = model.bounds(X, y)
     for name, pair in (bounds or {}).items():
         if name not in model.param_names:
@@ -204,8 +213,9 @@ def fit(
         seed=result.seed,
         nfev=int(result.nfev),
         history=np.asarray(result.history).tolist(),
-        bounds={n: [float(lo), float(hi)] for n, (lo, hi) in zip(free_names, free_bounds,
-                                                                  strict=True)},
+        bounds={
+            n: [float(lo), float(hi)] for n, (lo, hi) in zip(free_names, free_bounds, strict=True)
+        },
         operating_range={
             "velocity": [float(X[:, 0].min()), float(X[:, 0].max())],
             "load": [float(X[:, 1].min()), float(X[:, 1].max())],

@@ -14,7 +14,7 @@ import numpy as np
 
 from .errors import DataError
 
-__all__ = ["FrictionSamples", "RawLog", "SAMPLE_COLUMNS", "RAWLOG_COLUMNS"]
+__all__ = ["RAWLOG_COLUMNS", "SAMPLE_COLUMNS", "FrictionSamples", "RawLog"]
 
 #: Columns of a :class:`FrictionSamples` table and their units.
 SAMPLE_COLUMNS: dict[str, str] = {
@@ -196,7 +196,9 @@ class FrictionSamples:
         for name in ("load", "temperature", "friction"):
             set_(self, name, _as_column(name, getattr(self, name), n, src))
         direction = (
-            np.sign(velocity) if self.direction is None else _as_column("direction", self.direction, n, src)
+            np.sign(velocity)
+            if self.direction is None
+            else _as_column("direction", self.direction, n, src)
         )
         bad = np.flatnonzero(~np.isin(direction, (-1.0, 0.0, 1.0)))
         if bad.size:
@@ -211,7 +213,9 @@ class FrictionSamples:
         count = np.ones(n) if self.count is None else _as_column("count", self.count, n, src)
         if (count < 1).any():
             row = int(np.flatnonzero(count < 1)[0])
-            raise DataError(f"count must be >= 1, got {count[row]!r}", file=src, row=row, column="count")
+            raise DataError(
+                f"count must be >= 1, got {count[row]!r}", file=src, row=row, column="count"
+            )
         set_(self, "count", count.astype(np.int64))
         std = np.zeros(n) if self.std is None else _as_column("std", self.std, n, src)
         if (std < 0).any():

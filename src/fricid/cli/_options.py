@@ -22,8 +22,9 @@ def parse_assignments(items: list[str] | None, flag: str) -> dict[str, float]:
         try:
             out[name] = float(value)
         except ValueError:
-            raise typer.BadParameter(f"'{value}' is not a number (in '{item}')",
-                                     param_hint=flag) from None
+            raise typer.BadParameter(
+                f"'{value}' is not a number (in '{item}')", param_hint=flag
+            ) from None
     return out
 
 
@@ -36,8 +37,9 @@ def parse_ranges(items: list[str] | None, flag: str) -> dict[str, tuple[float, f
         try:
             out[name] = (float(lo), float(hi))
         except ValueError:
-            raise typer.BadParameter(f"expected NAME=LOW:HIGH, got '{item}'",
-                                     param_hint=flag) from None
+            raise typer.BadParameter(
+                f"expected NAME=LOW:HIGH, got '{item}'", param_hint=flag
+            ) from None
         if not sep:
             raise typer.BadParameter(f"expected NAME=LOW:HIGH, got '{item}'", param_hint=flag)
     return out

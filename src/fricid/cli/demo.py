@@ -17,11 +17,17 @@ from ._app import app, console, err_console, handle_errors
 @app.command("demo")
 @handle_errors
 def demo_command(
-    out: Annotated[Path, typer.Option("--out", "-o", help="Folder for samples, models and "
-                                      "the summary.")] = Path("fricid-demo"),
-    size: Annotated[str, typer.Option(help="Preset size: reduced (default, under a minute), "
-                                      "quick, or full (the paper's 6615 operating points; "
-                                      "minutes).")] = "reduced",
+    out: Annotated[
+        Path, typer.Option("--out", "-o", help="Folder for samples, models and the summary.")
+    ] = Path("fricid-demo"),
+    size: Annotated[
+        str,
+        typer.Option(
+            help="Preset size: reduced (default, under a minute), "
+            "quick, or full (the paper's 6615 operating points; "
+            "minutes)."
+        ),
+    ] = "reduced",
     seed: Annotated[int, typer.Option(help="Random seed.")] = 0,
     method: Annotated[str, typer.Option(help="Optimiser for the fits.")] = "lm",
 ) -> None:
@@ -32,8 +38,13 @@ def demo_command(
     from ..experiments.demo import run_demo
 
     t0 = time.perf_counter()
-    res = run_demo(out, size=size, seed=seed, method=method,
-                   progress=lambda msg: err_console.print(f"[dim]{msg}[/]"))
+    res = run_demo(
+        out,
+        size=size,
+        seed=seed,
+        method=method,
+        progress=lambda msg: err_console.print(f"[dim]{msg}[/]"),
+    )
     console.print(res.extraction.summary(), markup=False, highlight=False)
     px, py = res.true_gravity
     console.print(f"true gravity:    p_x = {px:.5g}, p_y = {py:.5g} N m", highlight=False)
@@ -46,10 +57,16 @@ def demo_command(
         return f"{ours:{fmt}}" + ("" if np.isnan(paper) else f" [{paper:{fmt}}]")
 
     for row in res.table.itertuples():
-        table.add_row(row.model, both(row.fitness, row.paper_fitness, ".4f"),
-                      both(row.rmse_mNm, row.paper_rmse, ".4g"),
-                      both(row.rmspe, row.paper_rmspe, ".4f"), f"{row.max_abs_error_mNm:.3g}")
+        table.add_row(
+            row.model,
+            both(row.fitness, row.paper_fitness, ".4f"),
+            both(row.rmse_mNm, row.paper_rmse, ".4g"),
+            both(row.rmspe, row.paper_rmspe, ".4f"),
+            f"{row.max_abs_error_mNm:.3g}",
+        )
     console.print(table)
-    console.print("[dim]The paper's RMSE has no stated unit (its scale does not match its "
-                  "Table 3 in N m): compare fitness, RMSPE and the ordering.[/]")
+    console.print(
+        "[dim]The paper's RMSE has no stated unit (its scale does not match its "
+        "Table 3 in N m): compare fitness, RMSPE and the ordering.[/]"
+    )
     console.print(f"wrote {res.out}/ in {time.perf_counter() - t0:.1f} s")

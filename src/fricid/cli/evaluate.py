@@ -15,10 +15,13 @@ from ._app import app, console, handle_errors
 @app.command("evaluate")
 @handle_errors
 def evaluate_command(
-    model: Annotated[Path, typer.Argument(help="Model file (JSON, from `fricid fit`).",
-                                          exists=True, dir_okay=False)],
-    samples: Annotated[Path, typer.Argument(help="Friction samples, CSV or Parquet.",
-                                            exists=True, dir_okay=False)],
+    model: Annotated[
+        Path,
+        typer.Argument(help="Model file (JSON, from `fricid fit`).", exists=True, dir_okay=False),
+    ],
+    samples: Annotated[
+        Path, typer.Argument(help="Friction samples, CSV or Parquet.", exists=True, dir_okay=False)
+    ],
     as_json: Annotated[bool, typer.Option("--json", help="Print the metrics as JSON.")] = False,
 ) -> None:
     """Evaluate a model file on samples: fitness (R^2), SSE [N m^2], RMSE [N m], RMSPE,

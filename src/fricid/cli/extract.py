@@ -38,61 +38,105 @@ def parse_positions(text: str | None, unit: str) -> np.ndarray | None:
 @app.command("extract")
 @handle_errors
 def extract_command(
-    log: Annotated[Path, typer.Argument(help="Raw log (.parquet or .csv from `fricid "
-                                        "simulate` or a converted recording), or a folder of "
-                                        "steady-state EPOS recordings with --format epos.",
-                                        exists=True)],
-    out: Annotated[Path, typer.Option("--out", "-o", help="Samples to write (.csv or "
-                                      ".parquet): direction 0, combined by eq. 11.")
-                   ] = Path("samples.csv"),
-    by_direction: Annotated[Path | None, typer.Option(help="Also write the per-direction "
-                                                      "samples (+1 and -1) here.")] = None,
-    fmt: Annotated[str, typer.Option("--format", help="table (fricid's CSV/Parquet raw log), "
-                                     "rosbag (a ROS 2 bag folder or .mcap/.db3 file with "
-                                     "sensor_msgs/msg/JointState; needs --joint) or epos (a "
-                                     "folder of Maxon EPOS recorder CSVs, one steady velocity "
-                                     "per file).")] = "table",
-    joint: Annotated[str | None, typer.Option(help="rosbag: the joint's name in "
-                                              "JointState.name.")] = None,
-    topic: Annotated[str, typer.Option(help="rosbag: the JointState topic.")
-                     ] = "/joint_states",
-    temperature_topic: Annotated[str | None, typer.Option(help="rosbag: a "
-                                                          "sensor_msgs/msg/Temperature topic "
-                                                          "[degC]; else --temperature is used."
-                                                          )] = None,
-    effort: Annotated[str, typer.Option(help="rosbag: what JointState.effort holds: torque "
-                                        "[N m] or current [A] (then give --torque-constant)."
-                                        )] = "torque",
-    torque_constant: Annotated[float | None, typer.Option(help="K [N m/A] of tau = K I "
-                                                          "(eq. 13), when effort is current."
-                                                          )] = None,
-    velocity_unit: Annotated[str, typer.Option(help="rosbag: unit of JointState.velocity.")
-                             ] = "rad/s",
-    positions: Annotated[str | None, typer.Option(help=(
-        "Position bins START:STOP:STEP or a comma list, in --position-unit. Default: the "
-        "design recorded by `fricid simulate`, else one bin per steady traverse."))] = None,
-    position_unit: Annotated[str, typer.Option(help="Unit of --positions and "
-                                               "--bin-halfwidth: rad or deg.")] = "deg",
-    bin_halfwidth: Annotated[float | None, typer.Option(help="Half width of a position bin "
-                                                        "(default: half the spacing).")
-                             ] = None,
-    median_window: Annotated[int, typer.Option(help="Running-median window [samples] on the "
-                                               "current, odd; 1 disables.")] = 5,
-    gravity: Annotated[str | None, typer.Option(help="fit (joint with gravity: eq. 7, 11, 12) "
-                                                "or none (horizontal joint: torque is "
-                                                "friction). Default: from the log's design, "
-                                                "else fit with positions, none without.")
-                       ] = None,
-    flip_sign: Annotated[bool, typer.Option(help="EPOS: negate velocity and torque (motor "
-                                            "convention, as the lead-screw recordings need)."
-                                            )] = False,
-    nominal_torque: Annotated[float, typer.Option(help="EPOS: the motor's nominal torque "
-                                                  "[mN m], reference of the % channel.")
-                              ] = 9.84,
-    temperature: Annotated[float, typer.Option(help="EPOS, rosbag: the temperature [degC] "
-                                               "to record when the log has none.")] = 25.0,
-    chunk_rows: Annotated[int, typer.Option(help="Rows read at a time (bounded memory).")
-                          ] = 1_000_000,
+    log: Annotated[
+        Path,
+        typer.Argument(
+            help="Raw log (.parquet or .csv from `fricid "
+            "simulate` or a converted recording), or a folder of "
+            "steady-state EPOS recordings with --format epos.",
+            exists=True,
+        ),
+    ],
+    out: Annotated[
+        Path,
+        typer.Option(
+            "--out",
+            "-o",
+            help="Samples to write (.csv or .parquet): direction 0, combined by eq. 11.",
+        ),
+    ] = Path("samples.csv"),
+    by_direction: Annotated[
+        Path | None, typer.Option(help="Also write the per-direction samples (+1 and -1) here.")
+    ] = None,
+    fmt: Annotated[
+        str,
+        typer.Option(
+            "--format",
+            help="table (fricid's CSV/Parquet raw log), "
+            "rosbag (a ROS 2 bag folder or .mcap/.db3 file with "
+            "sensor_msgs/msg/JointState; needs --joint) or epos (a "
+            "folder of Maxon EPOS recorder CSVs, one steady velocity "
+            "per file).",
+        ),
+    ] = "table",
+    joint: Annotated[
+        str | None, typer.Option(help="rosbag: the joint's name in JointState.name.")
+    ] = None,
+    topic: Annotated[str, typer.Option(help="rosbag: the JointState topic.")] = "/joint_states",
+    temperature_topic: Annotated[
+        str | None,
+        typer.Option(
+            help="rosbag: a sensor_msgs/msg/Temperature topic [degC]; else --temperature is used."
+        ),
+    ] = None,
+    effort: Annotated[
+        str,
+        typer.Option(
+            help="rosbag: what JointState.effort holds: torque "
+            "[N m] or current [A] (then give --torque-constant)."
+        ),
+    ] = "torque",
+    torque_constant: Annotated[
+        float | None, typer.Option(help="K [N m/A] of tau = K I (eq. 13), when effort is current.")
+    ] = None,
+    velocity_unit: Annotated[
+        str, typer.Option(help="rosbag: unit of JointState.velocity.")
+    ] = "rad/s",
+    positions: Annotated[
+        str | None,
+        typer.Option(
+            help=(
+                "Position bins START:STOP:STEP or a comma list, in --position-unit. Default: the "
+                "design recorded by `fricid simulate`, else one bin per steady traverse."
+            )
+        ),
+    ] = None,
+    position_unit: Annotated[
+        str, typer.Option(help="Unit of --positions and --bin-halfwidth: rad or deg.")
+    ] = "deg",
+    bin_halfwidth: Annotated[
+        float | None, typer.Option(help="Half width of a position bin (default: half the spacing).")
+    ] = None,
+    median_window: Annotated[
+        int, typer.Option(help="Running-median window [samples] on the current, odd; 1 disables.")
+    ] = 5,
+    gravity: Annotated[
+        str | None,
+        typer.Option(
+            help="fit (joint with gravity: eq. 7, 11, 12) "
+            "or none (horizontal joint: torque is "
+            "friction). Default: from the log's design, "
+            "else fit with positions, none without."
+        ),
+    ] = None,
+    flip_sign: Annotated[
+        bool,
+        typer.Option(
+            help="EPOS: negate velocity and torque (motor "
+            "convention, as the lead-screw recordings need)."
+        ),
+    ] = False,
+    nominal_torque: Annotated[
+        float,
+        typer.Option(help="EPOS: the motor's nominal torque [mN m], reference of the % channel."),
+    ] = 9.84,
+    temperature: Annotated[
+        float,
+        typer.Option(help="EPOS, rosbag: the temperature [degC] to record when the log has none."),
+    ] = 25.0,
+    chunk_rows: Annotated[
+        int, typer.Option(help="Rows read at a time (bounded memory).")
+    ] = 1_000_000,
 ) -> None:
     """Extract friction samples from a raw log: segment the constant-velocity traverses, median
     filter the current, torque = K I (eq. 13), average the repetitions per position bin,
@@ -103,27 +147,38 @@ def extract_command(
     from ..units import to_si
 
     if fmt == "epos":
-        samples = epos_steady_samples(log, flip_sign=flip_sign, temperature=temperature,
-                                      nominal_torque=nominal_torque * 1e-3)
+        samples = epos_steady_samples(
+            log, flip_sign=flip_sign, temperature=temperature, nominal_torque=nominal_torque * 1e-3
+        )
         write_samples(samples, out)
-        err_console.print(f"wrote {escape(str(out))}: {len(samples)} steady operating points "
-                          f"(directions {samples.directions()})")
+        err_console.print(
+            f"wrote {escape(str(out))}: {len(samples)} steady operating points "
+            f"(directions {samples.directions()})"
+        )
         return
     pos = parse_positions(positions, position_unit)
-    half = None if bin_halfwidth is None else float(to_si(bin_halfwidth, position_unit,
-                                                          "position"))
+    half = None if bin_halfwidth is None else float(to_si(bin_halfwidth, position_unit, "position"))
     if fmt == "table":
         chunks = iter_rawlog(log, chunk_rows=chunk_rows)
     elif fmt == "rosbag":
         if joint is None:
             from ..io import rosbag_joints
 
-            raise ConfigError(f"--format rosbag needs --joint; {log} has joints: "
-                              f"{', '.join(rosbag_joints(log, topic=topic))}")
-        chunks = iter_rosbag(log, joint, topic=topic, temperature_topic=temperature_topic,
-                             temperature=None if temperature_topic else temperature,
-                             effort=effort, torque_constant=torque_constant,
-                             velocity_unit=velocity_unit, chunk_rows=chunk_rows)
+            raise ConfigError(
+                f"--format rosbag needs --joint; {log} has joints: "
+                f"{', '.join(rosbag_joints(log, topic=topic))}"
+            )
+        chunks = iter_rosbag(
+            log,
+            joint,
+            topic=topic,
+            temperature_topic=temperature_topic,
+            temperature=None if temperature_topic else temperature,
+            effort=effort,
+            torque_constant=torque_constant,
+            velocity_unit=velocity_unit,
+            chunk_rows=chunk_rows,
+        )
     else:
         raise ConfigError(f"--format must be table, rosbag or epos; got '{fmt}'")
     result = _extract_chunks(log, chunks, pos, half, median_window, gravity)
@@ -131,12 +186,15 @@ def extract_command(
     if by_direction is not None:
         write_samples(result.by_direction, by_direction)
     console.print(result.summary(), markup=False, highlight=False)
-    err_console.print(f"wrote {escape(str(out))} ({len(result.samples)} samples)"
-                      + (f" and {by_direction}" if by_direction else ""))
+    err_console.print(
+        f"wrote {escape(str(out))} ({len(result.samples)} samples)"
+        + (f" and {by_direction}" if by_direction else "")
+    )
 
 
 def _extract_chunks(log, chunks, pos, half, median_window, gravity):
     from ..extract import extract
+
     first = next(chunks, None)
     if first is None:
         raise ConfigError(f"{log}: the log has no rows")
@@ -159,5 +217,10 @@ def _extract_chunks(log, chunks, pos, half, median_window, gravity):
                 advance()
                 yield chunk
 
-        return extract(counted(), positions=pos, bin_halfwidth=half,
-                       median_window=median_window, gravity=gravity)
+        return extract(
+            counted(),
+            positions=pos,
+            bin_halfwidth=half,
+            median_window=median_window,
+            gravity=gravity,
+        )

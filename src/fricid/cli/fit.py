@@ -21,30 +21,72 @@ def _method_help() -> str:
 @app.command("fit")
 @handle_errors
 def fit_command(
-    samples: Annotated[Path, typer.Argument(help="Friction samples, CSV or Parquet "
-                                            "(from `fricid extract`).", exists=True,
-                                            dir_okay=False)],
-    model: Annotated[str, typer.Option("--model", "-m", help=(
-        "Model: coulomb_viscous (eq. 1), stribeck (eq. 2 / RWSAVSBAS eq. 7), msk (eq. 3, "
-        "load), vlt (eq. 4, load and temperature); append _asym for parameters per "
-        "direction."))] = "stribeck",
-    method: Annotated[str, typer.Option(help="Optimiser (see `fricid methods`): lm, trf, bas, "
-                                        "vsbas, ibas, rwsavsbas, ga, de, cmaes, bas+lm, ...")
-                      ] = "lm",
-    fix: Annotated[list[str] | None, typer.Option("--fix", help=(
-        "Hold a parameter at a value, NAME=VALUE (SI units), e.g. --fix delta=1. "
-        "Repeatable."))] = None,
-    bound: Annotated[list[str] | None, typer.Option("--bound", help=(
-        "Search range of a parameter, NAME=LOW:HIGH (SI units). Repeatable. Default ranges "
-        "scale with the data."))] = None,
+    samples: Annotated[
+        Path,
+        typer.Argument(
+            help="Friction samples, CSV or Parquet (from `fricid extract`).",
+            exists=True,
+            dir_okay=False,
+        ),
+    ],
+    model: Annotated[
+        str,
+        typer.Option(
+            "--model",
+            "-m",
+            help=(
+                "Model: coulomb_viscous (eq. 1), stribeck (eq. 2 / RWSAVSBAS eq. 7), msk (eq. 3, "
+                "load), vlt (eq. 4, load and temperature); append _asym for parameters per "
+                "direction."
+            ),
+        ),
+    ] = "stribeck",
+    method: Annotated[
+        str,
+        typer.Option(
+            help="Optimiser (see `fricid methods`): lm, trf, bas, "
+            "vsbas, ibas, rwsavsbas, ga, de, cmaes, bas+lm, ..."
+        ),
+    ] = "lm",
+    fix: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--fix",
+            help=(
+                "Hold a parameter at a value, NAME=VALUE (SI units), e.g. --fix delta=1. "
+                "Repeatable."
+            ),
+        ),
+    ] = None,
+    bound: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--bound",
+            help=(
+                "Search range of a parameter, NAME=LOW:HIGH (SI units). Repeatable. Default ranges "
+                "scale with the data."
+            ),
+        ),
+    ] = None,
     seed: Annotated[int, typer.Option(help="Random seed (same seed, same result).")] = 0,
     max_evals: Annotated[int | None, typer.Option(help="Budget in model evaluations.")] = None,
-    direction: Annotated[str, typer.Option(help=(
-        "Which samples to use: all, combined (direction 0), both (+1 and -1), pos, neg."))
-                         ] = "all",
-    out: Annotated[Path | None, typer.Option("--out", "-o", help=(
-        "Model file to write (JSON). Default: <samples>.<model>.json in the current "
-        "directory."))] = None,
+    direction: Annotated[
+        str,
+        typer.Option(
+            help=("Which samples to use: all, combined (direction 0), both (+1 and -1), pos, neg.")
+        ),
+    ] = "all",
+    out: Annotated[
+        Path | None,
+        typer.Option(
+            "--out",
+            "-o",
+            help=(
+                "Model file to write (JSON). Default: <samples>.<model>.json in the current "
+                "directory."
+            ),
+        ),
+    ] = None,
 ) -> None:
     """Identify a friction model from samples and write it as a JSON model file.
 
@@ -84,8 +126,11 @@ def select_direction(samples, direction: str):
         return samples
     mask = np.isin(samples.direction, keep)
     if not mask.any():
-        raise DataError(f"no samples with direction {direction} (the file has directions "
-                        f"{samples.directions()})", file=samples.source)
+        raise DataError(
+            f"no samples with direction {direction} (the file has directions "
+            f"{samples.directions()})",
+            file=samples.source,
+        )
     return samples.subset(mask)
 
 
@@ -98,8 +143,10 @@ def methods_command() -> None:
     console.print("[bold]Models[/] (append _asym for per-direction parameters):")
     for name, cls in MODELS.items():
         m = cls()
-        console.print(f"  {name:<16} {m.title}; {m.equation}; parameters "
-                      f"{', '.join(m.param_names)}", highlight=False)
+        console.print(
+            f"  {name:<16} {m.title}; {m.equation}; parameters {', '.join(m.param_names)}",
+            highlight=False,
+        )
     console.print("[bold]Methods[/]:")
     for name, cls in METHODS.items():
         console.print(f"  {name:<16} {cls.summary}", highlight=False)

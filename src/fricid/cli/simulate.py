@@ -27,14 +27,27 @@ def design_hints(scenario) -> dict:
 @app.command("simulate")
 @handle_errors
 def simulate_command(
-    out: Annotated[Path, typer.Option("--out", "-o", help="Raw log to write: .parquet "
-                                      "(recommended for size) or .csv.")] = Path("log.parquet"),
-    preset: Annotated[str, typer.Option(help="paper1: the BAS-RBFNN experiment (gravity, "
-                                        "load and temperature effects); paper2: the RWSAVSBAS "
-                                        "one (horizontal joint, Stribeck).")] = "paper1",
-    size: Annotated[str, typer.Option(help="full (the paper's design; paper1 is ~70 million "
-                                      "samples), reduced (seconds), quick (tests).")
-                    ] = "reduced",
+    out: Annotated[
+        Path,
+        typer.Option(
+            "--out", "-o", help="Raw log to write: .parquet (recommended for size) or .csv."
+        ),
+    ] = Path("log.parquet"),
+    preset: Annotated[
+        str,
+        typer.Option(
+            help="paper1: the BAS-RBFNN experiment (gravity, "
+            "load and temperature effects); paper2: the RWSAVSBAS "
+            "one (horizontal joint, Stribeck)."
+        ),
+    ] = "paper1",
+    size: Annotated[
+        str,
+        typer.Option(
+            help="full (the paper's design; paper1 is ~70 million "
+            "samples), reduced (seconds), quick (tests)."
+        ),
+    ] = "reduced",
     seed: Annotated[int, typer.Option(help="Random seed (same seed, same log).")] = 0,
 ) -> None:
     """Simulate a bidirectional constant-velocity campaign on the virtual joint and write its

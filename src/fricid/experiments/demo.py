@@ -105,17 +105,35 @@ def run_demo(
     return DemoResult(table, models, result, truth, seconds, out)
 
 
-def summary_markdown(table: pd.DataFrame, result: ExtractionResult,
-                     truth: tuple[float, float], seconds: dict[str, float]) -> str:
+def summary_markdown(
+    table: pd.DataFrame,
+    result: ExtractionResult,
+    truth: tuple[float, float],
+    seconds: dict[str, float],
+) -> str:
     """The demo's summary as Markdown."""
     lines = ["# fricid demo: virtual joint, paper1 preset", "", "## Extraction", ""]
     lines += [f"    {line}" for line in result.summary().splitlines()]
-    lines += ["", f"True gravity coefficients: p_x = {truth[0]:.5g}, p_y = {truth[1]:.5g} N m.",
-              "", "## Table 1 (BAS-RBFNN paper), ours beside the paper's", ""]
-    lines.append(table.to_markdown(index=False, floatfmt=".4g") if _has_tabulate()
-                 else "```\n" + table.to_string(index=False) + "\n```")
-    lines += ["", "The paper's RMSE has no stated unit and a scale unlike its Table 3 (N m); "
-              "compare fitness and RMSPE, and the ordering.", "", "## Time", ""]
+    lines += [
+        "",
+        f"True gravity coefficients: p_x = {truth[0]:.5g}, p_y = {truth[1]:.5g} N m.",
+        "",
+        "## Table 1 (BAS-RBFNN paper), ours beside the paper's",
+        "",
+    ]
+    lines.append(
+        table.to_markdown(index=False, floatfmt=".4g")
+        if _has_tabulate()
+        else "```\n" + table.to_string(index=False) + "\n```"
+    )
+    lines += [
+        "",
+        "The paper's RMSE has no stated unit and a scale unlike its Table 3 (N m); "
+        "compare fitness and RMSPE, and the ordering.",
+        "",
+        "## Time",
+        "",
+    ]
     lines += [f"- {k}: {v:.2f} s" for k, v in seconds.items()]
     return "\n".join(lines) + "\n"
 

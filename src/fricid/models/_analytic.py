@@ -128,16 +128,16 @@ class VelocityLoadTemperature(FrictionModel):
         Parameter("f_vT", "N m/degC", "temp_coef", 0.0, -4.0, 4.0, "viscous level per degC"),
         Parameter("v_tl0", "rad/s", "velocity", 0.1, 1e-4, 1.0, "Stribeck velocity"),
         Parameter("v_v0", "rad/s", "velocity", 1.0, 1e-3, 20.0, "viscous saturation velocity"),
-        Parameter(
-            "v_vT", "rad/s/degC", "velocity_temp", 0.0, -1.0, 10.0, "its change per degC"
-        ),
+        Parameter("v_vT", "rad/s/degC", "velocity_temp", 0.0, -1.0, 10.0, "its change per degC"),
     )
 
     def _predict(self, theta, X):
         f_c, f_ctl, f_stl, f_v0, f_vt, v_tl0, v_v0, v_vt = columns(theta)
         v, load, temp = _vlt(X)
         av = np.abs(v)
-        coulomb = f_c + (f_ctl + f_stl * np.exp(-av / np.maximum(np.abs(v_tl0), _TINY))) * np.abs(load)
+        coulomb = f_c + (f_ctl + f_stl * np.exp(-av / np.maximum(np.abs(v_tl0), _TINY))) * np.abs(
+            load
+        )
         denom = np.maximum(np.abs(v_v0 + v_vt * temp), _TINY)
         viscous = (f_v0 + f_vt * temp) * (1.0 - np.exp(-av / denom))
         return np.sign(v) * (coulomb + viscous)

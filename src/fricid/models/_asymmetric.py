@@ -29,8 +29,15 @@ class Asymmetric(FrictionModel):
         self.equation = base.equation
         self.inputs = base.inputs
         self.parameters = tuple(
-            Parameter(f"{p.name}{suffix}", p.unit, p.kind, p.default, p.lower, p.upper,
-                      f"{p.description} ({word} direction)")
+            Parameter(
+                f"{p.name}{suffix}",
+                p.unit,
+                p.kind,
+                p.default,
+                p.lower,
+                p.upper,
+                f"{p.description} ({word} direction)",
+            )
             for suffix, word in (("_pos", "positive"), ("_neg", "negative"))
             for p in base.parameters
         )
