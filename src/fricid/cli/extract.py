@@ -35,6 +35,26 @@ def parse_positions(text: str | None, unit: str) -> np.ndarray | None:
     return np.asarray(to_si(values, unit, "position"), dtype=float)
 
 
+def parse_column_map(items: list[str] | None) -> tuple[dict[str, str], dict[str, str]]:
+    """``["time=t:ms", "velocity=dq"]`` -> ``({"time": "t", "velocity": "dq"}, {"time": "ms"})``."""
+    if not items:
+        raise ConfigError(
+            "--format generic needs --map QUANTITY=COLUMN[:UNIT] for time, velocity and torque "
+            "or current (e.g. --map time=t:s --map velocity=dq:deg/s --map torque=tau:Nm)"
+        )
+    columns: dict[str, str] = {}
+    units: dict[str, str] = {}
+    for item in items:
+        quantity, sep, rest = item.partition("=")
+        if not sep or not quantity.strip() or not rest.strip():
+            raise ConfigError(f"--map takes QUANTITY=COLUMN[:UNIT]; got '{item}'")
+        column, _, unit = rest.rpartition(":") if ":" in rest else (rest, "", "")
+        columns[quantity.strip()] = column.strip()
+        if unit.strip():
+            units[quantity.strip()] = unit.strip()
+    return columns, units
+
+
 @app.command("extract")
 @handle_errors
 def extract_command(
@@ -66,9 +86,19 @@ def extract_command(
             "rosbag (a ROS 2 bag folder or .mcap/.db3 file with "
             "sensor_msgs/msg/JointState; needs --joint) or epos (a "
             "folder of Maxon EPOS recorder CSVs, one steady velocity "
-            "per file).",
+            "per file) or generic (any CSV/Parquet table, with --map).",
         ),
     ] = "table",
+    column_map: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--map",
+            help="generic: QUANTITY=COLUMN[:UNIT], repeatable, e.g. --map time=t:ms --map "
+            "velocity=dq:deg/s --map current=i:A --map position=q:deg --map "
+            "temperature=T:degC. time, velocity and torque or current are required; a unit "
+            "may instead stand in the column name, as 'dq [deg/s]'.",
+        ),
+    ] = None,
     joint: Annotated[
         str | None, typer.Option(help="rosbag: the joint's name in JointState.name.")
     ] = None,
@@ -143,7 +173,13 @@ def extract_command(
     separate friction and gravity (eq. 9-11), fit p_x, p_y (eq. 7) and take the gravity torque
     as the load (eq. 12). Writes samples with velocity [rad/s], load [N m], temperature [degC],
     friction [N m], direction, count, std [N m]."""
-    from ..io import epos_steady_samples, iter_rawlog, iter_rosbag, write_samples
+    from ..io import (
+        epos_steady_samples,
+        iter_rawlog,
+        iter_rosbag,
+        read_table_log,
+        write_samples,
+    )
     from ..units import to_si
 
     if fmt == "epos":
@@ -160,6 +196,20 @@ def extract_command(
     half = None if bin_halfwidth is None else float(to_si(bin_halfwidth, position_unit, "position"))
     if fmt == "table":
         chunks = iter_rawlog(log, chunk_rows=chunk_rows)
+    elif fmt == "generic":
+        columns, units = parse_column_map(column_map)
+        has_temperature = "temperature" in columns
+        chunks = iter(
+            [
+                read_table_log(
+                    log,
+                    columns,
+                    units,
+                    torque_constant=torque_constant,
+                    temperature=None if has_temperature else temperature,
+                )
+            ]
+        )
     elif fmt == "rosbag":
         if joint is None:
             from ..io import rosbag_joints
@@ -180,7 +230,7 @@ def extract_command(
             chunk_rows=chunk_rows,
         )
     else:
-        raise ConfigError(f"--format must be table, rosbag or epos; got '{fmt}'")
+        raise ConfigError(f"--format must be table, generic, rosbag or epos; got '{fmt}'")
     result = _extract_chunks(log, chunks, pos, half, median_window, gravity)
     write_samples(result.samples, out)
     if by_direction is not None:
