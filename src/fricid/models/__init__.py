@@ -18,11 +18,21 @@ __all__ = [
     "FrictionModel",
     "LoadDependent",
     "Parameter",
+    "RBFNetRegressor",
     "Stribeck",
     "VelocityLoadTemperature",
     "data_scales",
     "get_model",
 ]
+
+def __getattr__(name: str):
+    # the RBF network needs scikit-learn; import it only when asked for (fast CLI start-up)
+    if name == "RBFNetRegressor":
+        from .rbf import RBFNetRegressor
+
+        return RBFNetRegressor
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
 
 #: The analytic models by registry name, in the order of the BAS-RBFNN paper's Table 1.
 MODELS: dict[str, type[FrictionModel]] = {
