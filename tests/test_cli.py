@@ -209,3 +209,15 @@ def test_extract_generic_table_with_units(tmp_path):
         tmp_path / "x.csv",
     )
     assert res.exit_code == 2 and "furlong/s" in res.output
+
+
+def test_fit_rbf_network_and_predict(demo_dir, tmp_path):
+    out = tmp_path / "rbf.json"
+    res = run("fit", demo_dir / "samples.csv", "--model", "rbf", "--centers", "12", "--out", out)
+    assert res.exit_code == 0, res.output
+    assert "12 Gaussian units" in res.output
+    res = run("evaluate", out, demo_dir / "samples.csv", "--json")
+    assert res.exit_code == 0, res.output
+    assert json.loads(res.stdout)["fitness"] > 0.9
+    res = run("fit", demo_dir / "samples.csv", "--model", "rbf", "--method", "de", "--out", out)
+    assert res.exit_code == 2 and "lsq, bas or ga" in res.output

@@ -174,6 +174,16 @@ class FittedModel:
                     if k in m
                 )
             )
+        if self.kind == "rbf" and self.state:
+            st = self.state
+            lines.append(
+                f"[[Network]] {len(st.get('centers', []))} Gaussian units (eq. 14), linear output "
+                f"(eq. 15){' with bias' if st.get('fit_bias') else ''}; inputs "
+                f"{', '.join(st.get('inputs', []))}; trainer {st.get('trainer')}"
+                + (f", encoding {st['encoding']}" if st.get("encoding") else "")
+                + (f", {st['n_epochs']} epochs" if st.get("n_epochs") else "")
+            )
+            return "\n".join(lines)
         lines.append("[[Parameters]]")
         for name, value in self.params.items():
             unit = self.units.get(name, "")

@@ -37,7 +37,8 @@ def fit_command(
             help=(
                 "Model: coulomb_viscous (eq. 1), stribeck (eq. 2 / RWSAVSBAS eq. 7), msk (eq. 3, "
                 "load), vlt (eq. 4, load and temperature); append _asym for parameters per "
-                "direction."
+                "direction; or rbf, the RBF neural network (eq. 14-15; --method lsq, bas for "
+                "BAS-RBFNN or ga for GA-RBFNN)."
             ),
         ),
     ] = "stribeck",
@@ -70,6 +71,12 @@ def fit_command(
     ] = None,
     seed: Annotated[int, typer.Option(help="Random seed (same seed, same result).")] = 0,
     max_evals: Annotated[int | None, typer.Option(help="Budget in model evaluations.")] = None,
+    centers: Annotated[
+        int, typer.Option(help="rbf: number of Gaussian units (hidden layer).")
+    ] = 40,
+    inputs: Annotated[
+        str, typer.Option(help="rbf: input columns, a comma list of velocity, load, temperature.")
+    ] = "velocity,load,temperature",
     direction: Annotated[
         str,
         typer.Option(
@@ -97,19 +104,41 @@ def fit_command(
     from ..io import read_samples
 
     data = select_direction(read_samples(samples), direction)
-    fitted = fit(
-        data,
-        model,
-        method,
-        fixed=parse_assignments(fix, "--fix"),
-        bounds=parse_ranges(bound, "--bound"),
-        seed=seed,
-        max_evals=max_evals,
-    )
+    if model.strip().lower() == "rbf":
+        fitted = _fit_rbf(data, method, centers, inputs, seed)
+    else:
+        fitted = fit(
+            data,
+            model,
+            method,
+            fixed=parse_assignments(fix, "--fix"),
+            bounds=parse_ranges(bound, "--bound"),
+            seed=seed,
+            max_evals=max_evals,
+        )
     out = out or Path(f"{samples.stem}.{fitted.model}.json")
     fitted.save(out)
     console.print(fitted.report(), markup=False, highlight=False, soft_wrap=True)
     err_console.print(f"wrote {escape(str(out))}")
+
+
+def _fit_rbf(samples, method: str, centers: int, inputs: str, seed: int):
+    """The RBF network: lsq (k-means, widths, ridge weights), bas (BAS-RBFNN) or ga."""
+    from ..errors import ConfigError
+    from ..models.rbf import fit_rbf
+
+    trainer = "lsq" if method == "lm" else method
+    if trainer not in ("lsq", "bas", "ga"):
+        raise ConfigError(f"--model rbf trains with --method lsq, bas or ga; got '{method}'")
+    names = [name.strip() for name in inputs.split(",") if name.strip()]
+    return fit_rbf(
+        samples,
+        names,
+        n_centers=centers,
+        trainer=trainer,
+        random_state=seed,
+        velocity_scale=0.035 if "velocity" in names else None,
+    )
 
 
 def select_direction(samples, direction: str):
