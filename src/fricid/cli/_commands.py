@@ -16,6 +16,9 @@ MODULES = (
     "predict",
     "export",
     "compensate",
+    "report",
+    "reproduce",
+    "fleet",
 )
 
 for _name in MODULES:

@@ -173,104 +173,70 @@ def extract_command(
     separate friction and gravity (eq. 9-11), fit p_x, p_y (eq. 7) and take the gravity torque
     as the load (eq. 12). Writes samples with velocity [rad/s], load [N m], temperature [degC],
     friction [N m], direction, count, std [N m]."""
-    from ..io import (
-        epos_steady_samples,
-        iter_rawlog,
-        iter_rosbag,
-        read_table_log,
-        write_samples,
-    )
+    from ..io import write_samples
+    from ..pipeline import load_joint
     from ..units import to_si
 
-    if fmt == "epos":
-        samples = epos_steady_samples(
-            log, flip_sign=flip_sign, temperature=temperature, nominal_torque=nominal_torque * 1e-3
-        )
-        write_samples(samples, out)
-        err_console.print(
-            f"wrote {escape(str(out))}: {len(samples)} steady operating points "
-            f"(directions {samples.directions()})"
-        )
-        return
     pos = parse_positions(positions, position_unit)
     half = None if bin_halfwidth is None else float(to_si(bin_halfwidth, position_unit, "position"))
+    extract_options = {
+        "positions": pos,
+        "bin_halfwidth": half,
+        "median_window": median_window,
+        "gravity": gravity,
+    }
     if fmt == "table":
-        chunks = iter_rawlog(log, chunk_rows=chunk_rows)
+        reader_options = {}
     elif fmt == "generic":
         columns, units = parse_column_map(column_map)
-        has_temperature = "temperature" in columns
-        chunks = iter(
-            [
-                read_table_log(
-                    log,
-                    columns,
-                    units,
-                    torque_constant=torque_constant,
-                    temperature=None if has_temperature else temperature,
-                )
-            ]
-        )
+        reader_options = {"columns": columns, "units": units, "torque_constant": torque_constant}
+        if "temperature" not in columns:
+            reader_options["temperature"] = temperature
     elif fmt == "rosbag":
-        if joint is None:
-            from ..io import rosbag_joints
-
-            raise ConfigError(
-                f"--format rosbag needs --joint; {log} has joints: "
-                f"{', '.join(rosbag_joints(log, topic=topic))}"
-            )
-        chunks = iter_rosbag(
-            log,
-            joint,
-            topic=topic,
-            temperature_topic=temperature_topic,
-            temperature=None if temperature_topic else temperature,
-            effort=effort,
-            torque_constant=torque_constant,
-            velocity_unit=velocity_unit,
-            chunk_rows=chunk_rows,
-        )
+        reader_options = {
+            "topic": topic,
+            "effort": effort,
+            "torque_constant": torque_constant,
+            "velocity_unit": velocity_unit,
+        }
+        if joint is not None:
+            reader_options["joint"] = joint
+        if temperature_topic:
+            reader_options["temperature_topic"] = temperature_topic
+        else:
+            reader_options["temperature"] = temperature
+    elif fmt == "epos":
+        reader_options = {
+            "flip_sign": flip_sign,
+            "temperature": temperature,
+            "nominal_torque": nominal_torque * 1e-3,
+        }
+        if log.is_dir():
+            extract_options = {}
     else:
         raise ConfigError(f"--format must be table, generic, rosbag or epos; got '{fmt}'")
-    result = _extract_chunks(log, chunks, pos, half, median_window, gravity)
-    write_samples(result.samples, out)
-    if by_direction is not None:
-        write_samples(result.by_direction, by_direction)
-    console.print(result.summary(), markup=False, highlight=False)
-    err_console.print(
-        f"wrote {escape(str(out))} ({len(result.samples)} samples)"
-        + (f" and {by_direction}" if by_direction else "")
-    )
-
-
-def _extract_chunks(log, chunks, pos, half, median_window, gravity):
-    from ..extract import extract
-
-    first = next(chunks, None)
-    if first is None:
-        raise ConfigError(f"{log}: the log has no rows")
-    hints = dict(first.meta.get("design", {})) if isinstance(first.meta, dict) else {}
-    if pos is None and "positions_rad" in hints:
-        pos = np.asarray(hints["positions_rad"], dtype=float)
-        half = half if half is not None else hints.get("bin_halfwidth_rad")
-        err_console.print(f"using the {len(pos)} position bins recorded with the log")
-    if gravity is None:
-        gravity = hints.get("gravity", "fit" if pos is not None else "none")
-
-    def stream():
-        yield first
-        yield from chunks
 
     with progress_bar("extracting", total=None) as advance:
-
-        def counted():
-            for chunk in stream():
-                advance()
-                yield chunk
-
-        return extract(
-            counted(),
-            positions=pos,
-            bin_halfwidth=half,
-            median_window=median_window,
-            gravity=gravity,
+        data = load_joint(
+            log,
+            fmt,
+            reader_options=reader_options,
+            extract_options=extract_options,
+            chunk_rows=chunk_rows,
+            on_chunk=advance,
         )
+    write_samples(data.samples, out)
+    if by_direction is not None:
+        write_samples(data.by_direction, by_direction)
+    if data.extraction is not None:
+        console.print(data.extraction.summary(), markup=False, highlight=False)
+        if pos is None and data.extraction.options.get("positions") is not None:
+            err_console.print("used the position bins recorded with the log")
+    else:
+        err_console.print(
+            f"{len(data.samples)} steady operating points (directions {data.samples.directions()})"
+        )
+    err_console.print(
+        f"wrote {escape(str(out))} ({len(data.samples)} samples)"
+        + (f" and {escape(str(by_direction))}" if by_direction else "")
+    )

@@ -102,6 +102,7 @@ def fit_command(
     """
     from ..identify import fit
     from ..io import read_samples
+    from ..pipeline import select_direction
 
     data = select_direction(read_samples(samples), direction)
     if model.strip().lower() == "rbf":
@@ -139,28 +140,6 @@ def _fit_rbf(samples, method: str, centers: int, inputs: str, seed: int):
         random_state=seed,
         velocity_scale=0.035 if "velocity" in names else None,
     )
-
-
-def select_direction(samples, direction: str):
-    """The rows of ``samples`` for a --direction choice."""
-    import numpy as np
-
-    from ..errors import ConfigError, DataError
-
-    choices = {"all": None, "combined": [0], "both": [-1, 1], "pos": [1], "neg": [-1]}
-    if direction not in choices:
-        raise ConfigError(f"--direction must be one of: {', '.join(choices)}; got '{direction}'")
-    keep = choices[direction]
-    if keep is None:
-        return samples
-    mask = np.isin(samples.direction, keep)
-    if not mask.any():
-        raise DataError(
-            f"no samples with direction {direction} (the file has directions "
-            f"{samples.directions()})",
-            file=samples.source,
-        )
-    return samples.subset(mask)
 
 
 @app.command("methods")

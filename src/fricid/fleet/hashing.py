@@ -1,0 +1,67 @@
+"""Content hashes of a joint's input and settings, and a cheap stat signature of the input.
+
+A re-run skips a joint whose input content and settings are unchanged. The content hash is
+computed by the worker that reads the log (so a plant's terabytes are not hashed twice, nor
+by the driver alone); the driver first compares the stat signature (sizes and modification
+times, as make and git do) and sends the previous content hash along, so a worker that finds
+the content unchanged returns at once.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from pathlib import Path
+from typing import Any
+
+from .. import __version__
+
+__all__ = ["RECORD_FORMAT", "input_files", "input_hash", "input_stat", "settings_hash"]
+
+#: Format of a joint's record (part of the settings hash: a new format re-runs every joint).
+RECORD_FORMAT = "fricid-fleet-record/1"
+
+_BLOCK = 1 << 20
+
+
+def input_files(path: Path, reader: str, reader_options: dict[str, Any]) -> list[Path]:
+    """The files a joint's log consists of: the file, or an EPOS folder's recordings.
+
+    Raises :class:`OSError` when the log is missing.
+    """
+    if reader == "epos" and path.is_dir():
+        pattern = str(reader_options.get("pattern", "*.csv"))
+        return sorted(p for p in path.glob(pattern) if p.is_file())
+    if not path.exists():
+        raise FileNotFoundError(2, "No such file or directory", str(path))
+    return [path]
+
+
+def input_hash(path: Path, reader: str, reader_options: dict[str, Any]) -> str:
+    """SHA-256 of the log's bytes (for a folder: of each file's name and bytes, in order)."""
+    h = hashlib.sha256()
+    files = input_files(path, reader, reader_options)
+    for f in files:
+        if len(files) > 1 or f != path:
+            h.update(f.name.encode("utf-8") + b"\0")
+        with open(f, "rb") as fh:
+            while block := fh.read(_BLOCK):
+                h.update(block)
+    return h.hexdigest()
+
+
+def input_stat(path: Path, reader: str, reader_options: dict[str, Any]) -> str | None:
+    """Paths, sizes and modification times of the log's files, hashed; None if unreadable."""
+    try:
+        files = input_files(path, reader, reader_options)
+        parts = [(str(f), f.stat().st_size, f.stat().st_mtime_ns) for f in files]
+    except OSError:
+        return None
+    return hashlib.sha256(json.dumps(parts).encode("utf-8")).hexdigest()[:32]
+
+
+def settings_hash(settings: dict[str, Any]) -> str:
+    """SHA-256 of a joint's settings, the record format and fricid's version."""
+    doc = {"settings": settings, "format": RECORD_FORMAT, "fricid": __version__}
+    text = json.dumps(doc, sort_keys=True, separators=(",", ":"), allow_nan=False)
+    return hashlib.sha256(text.encode("utf-8")).hexdigest()[:32]

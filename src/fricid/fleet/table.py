@@ -1,0 +1,234 @@
+"""The fleet's results table: one row per joint and model, as a Parquet dataset and a CSV.
+
+Columns (SI units; each parameter's unit in ``units``):
+
+- identity: ``robot``, ``joint``, ``date`` (measurement date), ``model``;
+- outcome: ``status`` (``ok`` or ``failed``), ``stage`` and ``error`` of a failure;
+- inputs: ``log``, ``reader``, ``method``, ``seed``, ``input_hash`` (SHA-256 of the log),
+  ``settings_hash``, ``n_samples``, ``directions``, the operating range ``speed_min``,
+  ``speed_max`` [rad/s], ``load_min``, ``load_max`` [N m], ``temperature_min``,
+  ``temperature_max`` [degC];
+- fit: ``fitness`` (R^2), ``sse`` [N m^2], ``rmse``, ``mae``, ``max_abs_error`` [N m],
+  ``rmspe`` (a fraction), ``nfev``, ``at_bound``, ``fixed``, ``units``, ``model_file``;
+  ``param_<name>``, ``stderr_<name>``, ``ci95_<name>`` (half-width of the 95 % CI);
+- run: ``time_extract_s``, ``time_fit_s``, ``time_total_s`` [s], ``worker``,
+  ``peak_rss_mb`` [MB], ``fricid_version``.
+
+Every column but the run columns (:data:`RUN_COLUMNS`) is the same, bit for bit, whichever
+executor computed the rows. The Parquet dataset (``results/``) is partitioned by robot and
+date (hive style, ``robot=<r>/date=<d>/``); it is written into a temporary folder and swapped
+in, and the CSV is written atomically, so a reader never sees a half-written table.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import uuid
+from collections.abc import Iterable
+from pathlib import Path
+from typing import Any
+
+import pandas as pd
+import pyarrow as pa
+import pyarrow.dataset as ds
+import pyarrow.parquet as pq
+
+from ..errors import DataError
+from ..io import atomic_write
+
+__all__ = [
+    "PARTITIONS",
+    "RUN_COLUMNS",
+    "read_results",
+    "results_table",
+    "write_results",
+]
+
+#: Partition columns of the Parquet dataset.
+PARTITIONS = ("robot", "date")
+
+_STRINGS = (
+    "robot",
+    "joint",
+    "date",
+    "model",
+    "status",
+    "stage",
+    "error",
+    "log",
+    "reader",
+    "method",
+    "input_hash",
+    "settings_hash",
+    "directions",
+    "at_bound",
+    "fixed",
+    "units",
+    "model_file",
+    "worker",
+    "fricid_version",
+)
+_INTS = ("seed", "n_samples", "nfev")
+_FLOATS = (
+    "speed_min",
+    "speed_max",
+    "load_min",
+    "load_max",
+    "temperature_min",
+    "temperature_max",
+    "fitness",
+    "sse",
+    "rmse",
+    "rmspe",
+    "mae",
+    "max_abs_error",
+)
+#: Columns that describe the run rather than the result (timing, process, memory).
+RUN_COLUMNS = ("time_extract_s", "time_fit_s", "time_total_s", "worker", "peak_rss_mb")
+_ORDER = (
+    "robot",
+    "joint",
+    "date",
+    "model",
+    "status",
+    "stage",
+    "error",
+    "log",
+    "reader",
+    "method",
+    "seed",
+    "input_hash",
+    "settings_hash",
+    "n_samples",
+    "directions",
+    *_FLOATS,
+    "nfev",
+    "at_bound",
+    "fixed",
+    "units",
+    "model_file",
+)
+_PREFIXES = ("param_", "stderr_", "ci95_")
+
+
+def _type(name: str) -> pa.DataType:
+    if name in _STRINGS:
+        return pa.string()
+    if name in _INTS:
+        return pa.int64()
+    return pa.float64()
+
+
+def _columns(rows: list[dict[str, Any]]) -> list[str]:
+    seen: dict[str, None] = {}
+    for row in rows:
+        seen.update(dict.fromkeys(row))
+    params = {p: [c for c in seen if c.startswith(p)] for p in _PREFIXES}
+    tail = [*RUN_COLUMNS, "fricid_version"]
+    return [
+        *(c for c in _ORDER if c in seen or c in ("robot", "joint", "date", "model", "status")),
+        *(c for p in _PREFIXES for c in params[p]),
+        *(c for c in seen if c not in _ORDER and not c.startswith(_PREFIXES) and c not in tail),
+        *(c for c in tail if c in seen),
+    ]
+
+
+def results_table(records: Iterable[dict[str, Any]]) -> pa.Table:
+    """The results table of joint records (their rows, in order), with explicit types."""
+    rows = [row for record in records for row in record.get("rows", [])]
+    names = _columns(rows)
+    schema = pa.schema([(n, _type(n)) for n in names])
+    return pa.Table.from_pylist([{n: row.get(n) for n in names} for row in rows], schema=schema)
+
+
+def _swap_in(tmp: Path, final: Path) -> None:
+    """Replace the folder ``final`` by ``tmp`` (two renames; the old one is deleted after)."""
+    old = None
+    if final.exists():
+        old = final.with_name(f".results-old-{os.getpid()}")
+        shutil.rmtree(old, ignore_errors=True)
+        os.replace(final, old)
+    os.replace(tmp, final)
+    if old is not None:
+        shutil.rmtree(old, ignore_errors=True)
+
+
+def write_results(table: pa.Table, root: str | os.PathLike[str]) -> tuple[Path, Path]:
+    """Write ``table`` as ``root/results/`` (Parquet, partitioned by robot and date) and
+    ``root/results.csv``. Returns both paths."""
+    root = Path(root)
+    root.mkdir(parents=True, exist_ok=True)
+    dataset = root / "results"
+    tmp = root / f".results-new-{os.getpid()}-{uuid.uuid4().hex[:8]}"
+    tmp.mkdir()  # (not mkdtemp: the folder gets the usual permissions)
+    try:
+        if table.num_rows:
+            pq.write_to_dataset(
+                table,
+                root_path=tmp,
+                partition_cols=list(PARTITIONS),
+                basename_template="part-{i}.parquet",
+                existing_data_behavior="error",
+            )
+        _swap_in(tmp, dataset)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    csv_path = root / "results.csv"
+    with atomic_write(csv_path, "w") as fh:
+        table.to_pandas().to_csv(fh, index=False)
+    return dataset, csv_path
+
+
+def _read_csv(path: Path) -> pd.DataFrame:
+    dtypes = {name: "string" for name in _STRINGS}
+    frame = pd.read_csv(path, dtype=dtypes)
+    for name in _INTS:
+        if name in frame:
+            frame[name] = frame[name].astype("Int64")
+    return frame
+
+
+def read_results(path: str | os.PathLike[str]) -> pd.DataFrame:
+    """Read a results table: an output folder of ``fricid fleet``, its ``results/`` dataset,
+    a ``results.csv`` or one Parquet file.
+
+    Returns a DataFrame sorted by robot, joint and model, with string identity columns.
+    """
+    path = Path(path)
+    if path.is_dir() and (path / "results").is_dir():
+        path = path / "results"
+    elif path.is_dir() and not any(path.rglob("*.parquet")) and (path / "results.csv").exists():
+        path = path / "results.csv"
+    if path.suffix.lower() == ".csv":
+        try:
+            frame = _read_csv(path)
+        except (OSError, ValueError, pd.errors.ParserError) as exc:
+            raise DataError(f"cannot read the results table: {exc}", file=path) from None
+    else:
+        if not path.exists():
+            raise DataError("no such results table (folder, results.csv or .parquet)", file=path)
+        try:
+            if path.is_dir():
+                part = ds.partitioning(
+                    pa.schema([(p, pa.string()) for p in PARTITIONS]), flavor="hive"
+                )
+                table = ds.dataset(path, format="parquet", partitioning=part).to_table()
+            else:
+                table = pq.read_table(path)
+        except (OSError, pa.ArrowException) as exc:
+            raise DataError(f"cannot read the results table: {exc}", file=path) from None
+        frame = table.to_pandas()
+        for name in _STRINGS:
+            if name in frame:
+                frame[name] = frame[name].astype("string")
+        for name in _INTS:
+            if name in frame:
+                frame[name] = frame[name].astype("Int64")
+    for name in ("robot", "joint", "model"):
+        if name not in frame:
+            raise DataError(f"not a fleet results table: no column '{name}'", file=path)
+    order = [c for c in _columns([dict.fromkeys(frame.columns)]) if c in frame]
+    frame = frame[order]
+    return frame.sort_values(["robot", "joint", "model"], kind="stable").reset_index(drop=True)

@@ -1,0 +1,392 @@
+"""One joint, from its raw log to fitted models: ``fricid extract`` then ``fricid fit``.
+
+The single-joint commands and ``fricid fleet`` run these functions, so a joint identified in a
+fleet is identified exactly as it would be by hand (DESIGN.md, "The flow of data"):
+
+>>> from fricid.pipeline import run_joint
+>>> run = run_joint("log.parquet", models=("stribeck", "vlt"), seed=0)  # doctest: +SKIP
+>>> run.fits["vlt"].report()                                             # doctest: +SKIP
+
+:func:`load_joint` reads a log with one of :data:`READERS` and extracts its friction samples;
+:func:`select_samples` picks the rows a model is fitted to; :func:`run_joint` does both and
+fits every model, isolating a model whose fit fails from the others.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .errors import ConfigError, DataError, FricidError
+from .extract import ExtractionResult, extract
+from .fitted import FittedModel
+from .samples import FrictionSamples, RawLog
+
+__all__ = [
+    "DIRECTIONS",
+    "EXTRACT_OPTIONS",
+    "READERS",
+    "READER_OPTIONS",
+    "SAMPLE_SETS",
+    "JointData",
+    "JointRun",
+    "load_joint",
+    "run_joint",
+    "select_direction",
+    "select_samples",
+]
+
+#: Readers of a joint's log: ``table`` (fricid's raw-log CSV/Parquet, as ``fricid simulate``
+#: writes), ``generic`` (any CSV/Parquet through a column mapping and units,
+#: :func:`fricid.io.read_table_log`), ``rosbag`` (a ROS 2 bag or MCAP file with
+#: ``sensor_msgs/msg/JointState``, :func:`fricid.io.iter_rosbag`) and ``epos`` (a Maxon EPOS
+#: recorder CSV, or a folder of steady-state recordings, one operating point per file).
+READERS: tuple[str, ...] = ("table", "generic", "rosbag", "epos")
+
+#: Options each reader accepts (SI units), passed to its :mod:`fricid.io` function.
+READER_OPTIONS: dict[str, tuple[str, ...]] = {
+    "table": (),
+    "generic": ("columns", "units", "torque_constant", "temperature"),
+    "rosbag": (
+        "joint",
+        "topic",
+        "temperature_topic",
+        "temperature",
+        "effort",
+        "effort_unit",
+        "torque_constant",
+        "position_unit",
+        "velocity_unit",
+        "time_source",
+    ),
+    "epos": (
+        "nominal_torque",
+        "flip_sign",
+        "temperature",
+        "torque_constant",
+        "counts_per_turn",
+        "pattern",
+        "load",
+    ),
+}
+
+#: Keyword options of :func:`fricid.extract.extract` a caller may set (SI units).
+EXTRACT_OPTIONS: tuple[str, ...] = (
+    "positions",
+    "bin_halfwidth",
+    "median_window",
+    "gravity",
+    "velocity_tolerance",
+    "settle_time",
+    "min_samples",
+    "velocity_rtol",
+    "temperature_atol",
+)
+
+#: Which samples a model is fitted to: ``auto`` (the per-direction samples for an ``*_asym``
+#: model, else the combined ones), ``combined`` (direction 0, eq. 11) or ``by_direction``.
+SAMPLE_SETS: tuple[str, ...] = ("auto", "combined", "by_direction")
+
+#: ``direction`` choices and the sample directions each keeps (None: all of them).
+DIRECTIONS: dict[str, list[int] | None] = {
+    "all": None,
+    "combined": [0],
+    "both": [-1, 1],
+    "pos": [1],
+    "neg": [-1],
+}
+
+_EPOS_FOLDER_ONLY = ("pattern", "load")
+
+
+@dataclass(frozen=True, eq=False)
+class JointData:
+    """The friction samples of one joint's log.
+
+    Attributes
+    ----------
+    samples : the combined samples (direction 0, eq. 11 of the BAS-RBFNN paper); for a folder
+        of steady-state EPOS recordings, the per-direction operating points as recorded.
+    by_direction : the per-direction samples (+1 and -1).
+    extraction : what :func:`fricid.extract.extract` returned (diagnostics, gravity fit), or
+        None when the reader gave samples directly.
+    """
+
+    samples: FrictionSamples
+    by_direction: FrictionSamples
+    extraction: ExtractionResult | None = None
+
+
+@dataclass(frozen=True, eq=False)
+class JointRun:
+    """The outcome of :func:`run_joint`.
+
+    Attributes
+    ----------
+    data : the extracted samples.
+    fits : model name -> fitted model, for the models whose fit succeeded.
+    errors : model name -> the error of a model whose fit failed.
+    used : model name -> the samples that model was fitted to.
+    extract_seconds : wall time of reading and extraction [s].
+    fit_seconds : model name -> wall time of its fit [s].
+    """
+
+    data: JointData
+    fits: dict[str, FittedModel] = field(default_factory=dict)
+    errors: dict[str, FricidError] = field(default_factory=dict)
+    used: dict[str, FrictionSamples] = field(default_factory=dict)
+    extract_seconds: float = 0.0
+    fit_seconds: dict[str, float] = field(default_factory=dict)
+
+
+def _check_keys(given: Mapping[str, Any], allowed: Sequence[str], what: str) -> None:
+    unknown = [k for k in given if k not in allowed]
+    if unknown:
+        choices = ", ".join(allowed) if allowed else "none"
+        raise ConfigError(f"unknown {what} '{unknown[0]}'; allowed: {choices}")
+
+
+def _check_reader(reader: str, options: Mapping[str, Any]) -> None:
+    if reader not in READERS:
+        raise ConfigError(f"unknown reader '{reader}'; choose one of: {', '.join(READERS)}")
+    _check_keys(options, READER_OPTIONS[reader], f"option of reader '{reader}'")
+
+
+def _design_hints(log: RawLog) -> dict[str, Any]:
+    """The extraction hints ``fricid simulate`` records with a log (``meta["design"]``)."""
+    meta = log.meta if isinstance(log.meta, Mapping) else {}
+    hints = meta.get("design", {})
+    return dict(hints) if isinstance(hints, Mapping) else {}
+
+
+def _extract_stream(
+    logs: Iterable[RawLog],
+    first: RawLog,
+    options: Mapping[str, Any],
+    on_chunk: Callable[[], None] | None,
+) -> JointData:
+    """Extract a log stream whose first chunk is ``first`` (already read from ``logs``).
+
+    Unset ``positions``, ``bin_halfwidth`` and ``gravity`` come from the design recorded with
+    the log (as ``fricid extract`` does); ``gravity`` then defaults to ``"fit"`` with position
+    bins and ``"none"`` without.
+    """
+    opts = dict(options)
+    hints = _design_hints(first)
+    if opts.get("positions") is None and "positions_rad" in hints:
+        opts["positions"] = np.asarray(hints["positions_rad"], dtype=float)
+        if opts.get("bin_halfwidth") is None:
+            opts["bin_halfwidth"] = hints.get("bin_halfwidth_rad")
+    if opts.get("gravity") is None:
+        with_bins = opts.get("positions") is not None
+        opts["gravity"] = hints.get("gravity", "fit" if with_bins else "none")
+    if opts.get("positions") is not None:
+        opts["positions"] = np.asarray(opts["positions"], dtype=float)
+
+    def stream() -> Iterator[RawLog]:
+        for chunk in _chain(first, logs):
+            if on_chunk is not None:
+                on_chunk()
+            yield chunk
+
+    result = extract(stream(), **opts)
+    return JointData(result.samples, result.by_direction, result)
+
+
+def _chain(first: RawLog, rest: Iterable[RawLog]) -> Iterator[RawLog]:
+    yield first
+    yield from rest
+
+
+def load_joint(
+    path: str | os.PathLike[str],
+    reader: str = "table",
+    *,
+    reader_options: Mapping[str, Any] | None = None,
+    extract_options: Mapping[str, Any] | None = None,
+    chunk_rows: int = 1_000_000,
+    on_chunk: Callable[[], None] | None = None,
+) -> JointData:
+    """Read a joint's log and extract its friction samples.
+
+    Parameters
+    ----------
+    path : the log: a fricid raw log (``table``), any CSV/Parquet table (``generic``), an EPOS
+        recorder CSV or a folder of steady-state EPOS recordings (``epos``).
+    reader : one of :data:`READERS`.
+    reader_options : the reader's options (:data:`READER_OPTIONS`, SI units), e.g. for
+        ``generic`` ``{"columns": {"time": "t", "velocity": "dq", "torque": "tau"},
+        "units": {"velocity": "deg/s"}, "temperature": 25.0}``.
+    extract_options : options of :func:`fricid.extract.extract` (:data:`EXTRACT_OPTIONS`).
+        Unset position bins and gravity mode come from the design a simulated log records.
+    chunk_rows : rows read at a time from a ``table`` log (bounded memory).
+    on_chunk : called once per chunk read (progress).
+
+    Returns
+    -------
+    JointData
+
+    Raises
+    ------
+    ConfigError : an unknown reader or option.
+    DataError : unreadable or unusable data (naming file, row and column where known).
+    """
+    from .io import epos_steady_samples, iter_rawlog, iter_rosbag, read_epos, read_table_log
+
+    path = Path(path)
+    ropts = dict(reader_options or {})
+    eopts = {k: v for k, v in dict(extract_options or {}).items() if v is not None}
+    _check_reader(reader, ropts)
+    _check_keys(eopts, EXTRACT_OPTIONS, "extraction option")
+    if reader == "epos" and path.is_dir():
+        if eopts:
+            raise ConfigError(
+                "a folder of steady-state EPOS recordings gives one operating point per file; "
+                f"extraction options ({', '.join(eopts)}) do not apply"
+            )
+        samples = epos_steady_samples(path, **ropts)
+        return JointData(samples, samples, None)
+    if reader == "epos":
+        extra = [k for k in _EPOS_FOLDER_ONLY if k in ropts]
+        if extra:
+            raise ConfigError(f"reader option '{extra[0]}' applies to a folder of EPOS recordings")
+        log = read_epos(path, **ropts)
+        return _extract_stream([], log, eopts, on_chunk)
+    if reader == "generic":
+        log = read_table_log(path, **ropts)
+        return _extract_stream([], log, eopts, on_chunk)
+    if reader == "rosbag":
+        if "joint" not in ropts:
+            from .io import rosbag_joints
+
+            topic = ropts.get("topic", "/joint_states")
+            raise ConfigError(
+                f"reading a bag needs the joint's name; {path} has joints: "
+                f"{', '.join(rosbag_joints(path, topic=topic))}"
+            )
+        chunks = iter_rosbag(path, chunk_rows=chunk_rows, **ropts)
+    else:
+        chunks = iter_rawlog(path, chunk_rows=chunk_rows)
+    first = next(chunks, None)
+    if first is None:  # pragma: no cover - iter_rawlog raises on an empty log
+        raise DataError("the log has no rows", file=path)
+    return _extract_stream(chunks, first, eopts, on_chunk)
+
+
+def select_direction(samples: FrictionSamples, direction: str = "all") -> FrictionSamples:
+    """The rows of ``samples`` for a ``direction`` choice (:data:`DIRECTIONS`)."""
+    if direction not in DIRECTIONS:
+        raise ConfigError(f"direction must be one of: {', '.join(DIRECTIONS)}; got '{direction}'")
+    keep = DIRECTIONS[direction]
+    if keep is None:
+        return samples
+    mask = np.isin(samples.direction, keep)
+    if not mask.any():
+        raise DataError(
+            f"no samples with direction {direction} (the samples have directions "
+            f"{samples.directions()})",
+            file=samples.source,
+        )
+    return samples.subset(mask)
+
+
+def select_samples(
+    data: JointData, model: str, *, samples: str = "auto", direction: str = "all"
+) -> FrictionSamples:
+    """The samples ``model`` is fitted to (:data:`SAMPLE_SETS`, then :data:`DIRECTIONS`)."""
+    from .models import get_model
+
+    if samples not in SAMPLE_SETS:
+        raise ConfigError(f"samples must be one of: {', '.join(SAMPLE_SETS)}; got '{samples}'")
+    if samples == "auto":
+        samples = "by_direction" if get_model(model).is_asymmetric else "combined"
+    chosen = data.by_direction if samples == "by_direction" else data.samples
+    return select_direction(chosen, direction)
+
+
+def run_joint(
+    path: str | os.PathLike[str],
+    *,
+    reader: str = "table",
+    reader_options: Mapping[str, Any] | None = None,
+    extract_options: Mapping[str, Any] | None = None,
+    models: Sequence[str] = ("stribeck",),
+    method: str = "lm",
+    seed: int = 0,
+    samples: str = "auto",
+    direction: str = "all",
+    fixed: Mapping[str, float] | None = None,
+    bounds: Mapping[str, tuple[float, float]] | None = None,
+    max_evals: int | None = None,
+    chunk_rows: int = 1_000_000,
+) -> JointRun:
+    """Identify one joint: :func:`load_joint`, then :func:`fricid.identify.fit` per model.
+
+    Parameters
+    ----------
+    path, reader, reader_options, extract_options, chunk_rows : see :func:`load_joint`.
+    models : model names (``fricid.models.MODELS``, ``*_asym`` for per-direction parameters).
+    method, seed, max_evals : passed to :func:`fricid.identify.fit`; every model is fitted with
+        the same ``seed``, so the run is reproducible bit for bit.
+    samples, direction : which samples each model is fitted to (:func:`select_samples`).
+    fixed, bounds : parameters held fixed / search ranges (SI), applied to every model that
+        has the parameter named.
+
+    Returns
+    -------
+    JointRun
+        A model whose fit fails (a :class:`~fricid.errors.FricidError`) is in ``errors``; the
+        other models are still fitted.
+
+    Raises
+    ------
+    FricidError : the log cannot be read or extracted (nothing can be fitted then).
+    """
+    from .identify import fit
+    from .models import get_model
+
+    if not models:
+        raise ConfigError("run_joint needs at least one model")
+    names = {n for m in models for n in get_model(m).param_names}
+    for what, given in (("fixed", fixed), ("bounds", bounds)):
+        unknown = sorted(set(given or {}) - names)
+        if unknown:
+            raise ConfigError(
+                f"{what} names '{unknown[0]}', a parameter of none of the models "
+                f"{', '.join(models)}; their parameters: {', '.join(sorted(names))}"
+            )
+    t0 = time.perf_counter()
+    data = load_joint(
+        path,
+        reader,
+        reader_options=reader_options,
+        extract_options=extract_options,
+        chunk_rows=chunk_rows,
+    )
+    run = JointRun(data, extract_seconds=time.perf_counter() - t0)
+    for name in models:
+        t1 = time.perf_counter()
+        try:
+            model = get_model(name)
+            own = set(model.param_names)
+            used = select_samples(data, name, samples=samples, direction=direction)
+            run.used[name] = used
+            run.fits[name] = fit(
+                used,
+                model,
+                method,
+                fixed={k: v for k, v in (fixed or {}).items() if k in own},
+                bounds={k: v for k, v in (bounds or {}).items() if k in own},
+                seed=seed,
+                max_evals=max_evals,
+            )
+        except FricidError as exc:
+            run.errors[name] = exc
+        run.fit_seconds[name] = time.perf_counter() - t1
+    return run
