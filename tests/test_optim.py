@@ -355,3 +355,20 @@ def test_bad_runs_seed_and_budget() -> None:
             minimize(sphere, B4, "bas", **kw)
     with pytest.raises(ConfigError, match="needs `residuals`"):
         minimize(sphere, B4, "lm")
+
+
+def test_bas_without_position_evaluates_only_the_antennae():
+    """eq. 18-21 need only f(x_r) and f(x_l): 2 evaluations an iteration, plus the final
+    position; the best point is still found on the sphere."""
+    from fricid.optim import minimize
+
+    def sphere(X):
+        return ((X - 0.3) ** 2).sum(axis=1)
+
+    res = minimize(
+        sphere, [(-1, 1)] * 4, "bas", seed=2, options={"n_iter": 300, "evaluate_position": False}
+    )
+    assert res.nfev == 2 * 300 + 1
+    assert res.fun < 1e-4
+    with pytest.raises(ConfigError, match="evaluate_position"):
+        minimize(sphere, [(-1, 1)] * 2, "bas", options={"evaluate_position": "no"})

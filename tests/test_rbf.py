@@ -57,6 +57,57 @@ def test_core_solvers_recover_known_output_weights():
     assert mse[1] < 1e-14 < mse[0] and mse[1] < mse[2]
 
 
+@pytest.mark.parametrize("fit_bias", [True, False])
+def test_ridge_scorer_is_the_mse_of_the_batch_ridge_solution(fit_bias, monkeypatch):
+    """The hybrid encoding's objective (one syrk per candidate on [Phi; 1; t]) equals the
+    plain route: design matrix, batched ridge weights, residuals; also across chunks."""
+    rng = np.random.default_rng(1)
+    Z = rng.uniform(-2, 2, size=(400, 3))
+    t = np.sin(Z[:, 0]) + 0.3 * Z[:, 1] * Z[:, 2] + 0.2
+    k, m = 7, 9
+    C = rng.uniform(-1.5, 1.5, size=(k, m, 3))
+    s = rng.uniform(0.4, 1.5, size=(k, m))
+    alpha = 1e-8
+    Phi = core.design(Z, C, s)
+    w, b = core.ridge_weights_batch(Phi, t, alpha, fit_bias)
+    r = core.output(Phi, w, b) - t
+    expected = np.einsum("kn,kn->k", r, r) / len(t)
+    scorer = core.RidgeScorer(Z, t, alpha, fit_bias)
+    np.testing.assert_allclose(scorer(C, s), expected, rtol=1e-9)
+    # again with the same buffer, then a different number of centres (a new buffer)
+    np.testing.assert_allclose(scorer(C[:2], s[:2]), expected[:2], rtol=1e-9)
+    Phi5 = core.design(Z, C[:, :5], s[:, :5])
+    w5, b5 = core.ridge_weights_batch(Phi5, t, alpha, fit_bias)
+    r5 = core.output(Phi5, w5, b5) - t
+    np.testing.assert_allclose(
+        scorer(C[:, :5], s[:, :5]), np.einsum("kn,kn->k", r5, r5) / len(t), rtol=1e-9
+    )
+    # candidates split into chunks of 3 give the same values
+    monkeypatch.setattr(core, "CHUNK_ELEMENTS", 3 * len(t) * (m + 2))
+    chunked = core.RidgeScorer(Z, t, alpha, fit_bias)(C, s)
+    np.testing.assert_allclose(chunked, expected, rtol=1e-9)
+
+
+def test_ridge_scorer_scores_an_exact_network_zero_and_ranks_like_the_plain_route():
+    """Data that are exactly an RBF network: its true centres score ~0, and candidates with
+    the centres moved further and further rank in the same order as by the plain route."""
+    rng = np.random.default_rng(6)
+    Z = rng.uniform(-2, 2, size=(500, 2))
+    C = rng.uniform(-1.5, 1.5, size=(6, 2))
+    s = rng.uniform(0.5, 1.0, 6)
+    t = gaussian_net(Z, C, s, rng.normal(size=6), 0.4)
+    Cb = C[None] + rng.normal(scale=[[[0.0]], [[0.01]], [[0.03]], [[0.1]], [[0.3]]], size=(5, 6, 2))
+    sb = np.broadcast_to(s, (5, 6))
+    mse = core.RidgeScorer(Z, t, 1e-14, True)(Cb, sb)
+    assert mse[0] < 1e-20
+    Phi = core.design(Z, Cb, sb)
+    w, b = core.ridge_weights_batch(Phi, t, 1e-14, True)
+    r = core.output(Phi, w, b) - t
+    plain = np.einsum("kn,kn->k", r, r) / len(t)
+    np.testing.assert_array_equal(np.argsort(mse), np.argsort(plain))
+    np.testing.assert_allclose(mse[1:], plain[1:], rtol=1e-6)
+
+
 def test_lsq_recovers_an_exact_rbf_network_with_known_centres():
     """Data in tight symmetric clusters around the true centres: k-means finds the centres
     exactly; the widths are the nearest-neighbour rule's (x1.5), so the network the ``lsq``

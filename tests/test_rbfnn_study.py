@@ -110,7 +110,8 @@ def test_tables_have_every_row_and_the_papers_numbers(result):
     assert len(runs) == 4 and (runs["evaluations"] <= 8 * 30).all()
     f10 = t["fig10"].set_index("model")
     assert f10.loc["BAS-RBFNN", "paper_max_mNm"] == pytest.approx(6.3)
-    assert len(t["targets"]) == 5 and t["targets"]["met"].dtype == bool
+    assert len(t["targets"]) == 6 and t["targets"]["met"].dtype == bool
+    assert set(t["timing_all_threads"]["threads"]) == {"all"}
     assert PAPER["target_mse"] == 1e-4
 
 

@@ -43,11 +43,14 @@ class BeetleSolver(Solver):
     2. antennae ``x_r = x + d_t b`` and ``x_l = x - d_t b`` (eq. 19), clipped to the box;
     3. evaluate ``x``, ``x_r``, ``x_l`` in one call (3 evaluations; the position is the point
        the previous step moved to, as in the reference code of [J] which evaluates it to keep
-       the best point seen);
+       the best point seen). With ``evaluate_position=False`` only the antennae are evaluated
+       (2 evaluations), which is all eq. 18-21 of [B] need: the best point seen is then the
+       best antenna (or the final position);
     4. step ``x <- x - delta_t b sign(f(x_r) - f(x_l))`` (eq. 20 written for minimisation),
        clipped to the box.
 
-    After the last iteration the final position is evaluated (``3 n_iter + 1`` evaluations).
+    After the last iteration the final position is evaluated (``3 n_iter + 1`` evaluations, or
+    ``2 n_iter + 1`` without the position).
     Subclasses give the schedule ``(d_t, delta_t)`` through :meth:`schedule`. The result is the
     best point evaluated.
     """
@@ -55,11 +58,20 @@ class BeetleSolver(Solver):
     batched = True
     options: ClassVar[dict[str, Any]] = {"n_iter": 1000}
 
+    def per_iteration(self) -> int:
+        return 3 if self.opts.get("evaluate_position", True) else 2
+
     def default_budget(self) -> int:
-        return 3 * int(self.opts["n_iter"]) + 1
+        return self.per_iteration() * int(self.opts["n_iter"]) + 1
 
     def validate(self) -> None:
         positive_option(self.opts, "n_iter", self.name, integer=True)
+        flag = self.opts.get("evaluate_position", True)
+        if not isinstance(flag, bool | np.bool_):
+            raise ConfigError(
+                f"option 'evaluate_position' of method '{self.name}' must be True or False; "
+                f"got {flag!r}"
+            )
 
     def schedule(self, n: int) -> tuple[np.ndarray, np.ndarray]:  # pragma: no cover - abstract
         """Antenna lengths ``d_t`` and steps ``delta_t`` for ``t = 0 .. n-1``."""
@@ -69,6 +81,7 @@ class BeetleSolver(Solver):
         obj = self.objective
         n_iter = int(self.opts["n_iter"])
         dist, step = self.schedule(n_iter)
+        with_position = self.per_iteration() == 3
         x = self.start_points()
         raw = None
         for t in range(n_iter):
@@ -77,8 +90,11 @@ class BeetleSolver(Solver):
             b = unit_directions(raw[:, t % BLOCK])
             xr = x + dist[t] * b
             xl = x - dist[t] * b
-            f = obj(np.stack([x, xr, xl], axis=1))
-            sgn = (f[:, 1] > f[:, 2]).astype(float) - (f[:, 1] < f[:, 2])
+            if with_position:
+                f = obj(np.stack([x, xr, xl], axis=1))[:, 1:]
+            else:
+                f = obj(np.stack([xr, xl], axis=1))
+            sgn = (f[:, 0] > f[:, 1]).astype(float) - (f[:, 0] < f[:, 1])
             x = clip01(x - step[t] * sgn[:, None] * b)
             self.nit = t + 1
             obj.notify(self.nit)
@@ -101,6 +117,8 @@ class BAS(BeetleSolver):
     n_iter : iterations (1000); ``3 n_iter + 1`` evaluations.
     d0, step0 : initial antenna length and step (0.2, 0.5).
     eta_d, d_inc, eta_step : the constants of eq. 21 (0.95, 0.01, 0.95).
+    evaluate_position : also evaluate the position each iteration, as [J]'s code (True), or
+        only the two antennae, as eq. 18-21 (False; 2 evaluations per iteration).
     """
 
     name = "bas"
@@ -112,6 +130,7 @@ class BAS(BeetleSolver):
         "eta_d": 0.95,
         "d_inc": 0.01,
         "eta_step": 0.95,
+        "evaluate_position": True,
     }
 
     def validate(self) -> None:
