@@ -7,7 +7,6 @@ then estimates the parameters' uncertainty from the Jacobian at the optimum.
 
 from __future__ import annotations
 
-import hashlib
 from collections.abc import Callable, Mapping
 from datetime import UTC, datetime
 from typing import Any
@@ -21,23 +20,9 @@ from .fitted import FittedModel
 from .metrics import metrics
 from .models import FrictionModel, get_model
 from .optim import METHODS, OptimizeResult, minimize
-from .samples import FrictionSamples
+from .samples import FrictionSamples, samples_hash
 
 __all__ = ["evaluate", "fit", "jacobian_uncertainty", "samples_hash"]
-
-
-def samples_hash(samples: FrictionSamples) -> str:
-    """A short content hash of the samples (for provenance and caching)."""
-    h = hashlib.sha256()
-    for a in (
-        samples.velocity,
-        samples.load,
-        samples.temperature,
-        samples.friction,
-        samples.direction.astype(float),
-    ):
-        h.update(np.ascontiguousarray(a, dtype=float).tobytes())
-    return h.hexdigest()[:16]
 
 
 def _check_directions(samples: FrictionSamples, model: FrictionModel) -> None:

@@ -6,6 +6,7 @@ value of either type is always safe to use. Reading and writing them is :mod:`fr
 
 from __future__ import annotations
 
+import hashlib
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from typing import Any
@@ -268,3 +269,17 @@ class FrictionSamples:
             raise DataError("no samples to concatenate")
         cols = {name: np.concatenate([getattr(p, name) for p in parts]) for name in SAMPLE_COLUMNS}
         return cls(**cols, source=parts[0].source, meta=parts[0].meta)
+
+
+def samples_hash(samples: FrictionSamples) -> str:
+    """A short content hash of the samples (for provenance and caching)."""
+    h = hashlib.sha256()
+    for a in (
+        samples.velocity,
+        samples.load,
+        samples.temperature,
+        samples.friction,
+        samples.direction.astype(float),
+    ):
+        h.update(np.ascontiguousarray(a, dtype=float).tobytes())
+    return h.hexdigest()[:16]

@@ -670,8 +670,8 @@ def to_fitted_model(
     """
     from .. import __version__
     from ..fitted import FittedModel
-    from ..identify import samples_hash
     from ..metrics import metrics
+    from ..samples import samples_hash
 
     names = _check_inputs(inputs)
     check_is_fitted(estimator)
