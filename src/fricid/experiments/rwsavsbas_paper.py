@@ -180,7 +180,7 @@ def _real_comparison(study, samples: FrictionSamples, quick: bool, seed: int) ->
         samples.velocity, samples.friction, bounds=scaled_bounds(samples)
     )
     fun = problem.objective(jit=True)
-    specs = [sp for sp in study._specs(quick) if sp.label in _PAPER_METHODS]
+    specs = [sp for sp in study.method_specs(quick) if sp.label in _PAPER_METHODS]
     results, settings = {}, {}
     for spec in specs:
         results[spec.label] = minimize(

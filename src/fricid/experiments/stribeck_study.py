@@ -264,6 +264,11 @@ def _specs(quick: bool) -> list[MethodSpec]:
     ]
 
 
+def method_specs(quick: bool = False) -> list[MethodSpec]:
+    """The methods the study compares, in order (the paper's three first), full or quick."""
+    return _specs(quick)
+
+
 def _readings(quick: bool) -> list[tuple[str, dict[str, Any]]]:
     return [
         ("default: wander along b, P counts, G updated at once", {}),

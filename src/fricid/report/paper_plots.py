@@ -16,10 +16,11 @@ __all__ = [
     "error_per_point",
     "gravity_fit",
     "indicator_bars",
+    "mse_curves",
     "prediction_panels",
     "stribeck_construction",
     "surfaces",
-    "unseen_errors",
+    "unseen_region",
 ]
 
 
@@ -205,29 +206,191 @@ def prediction_panels(
         return png(fig)
 
 
-def unseen_errors(errors: Mapping[str, np.ndarray], *, title: str) -> bytes:
-    """[B] Fig. 10: prediction errors over the samples of the unseen region."""
-    ef, eunit = torque_scale(np.concatenate([np.ravel(e) for e in errors.values()]))
+def mse_curves(
+    curves: Mapping[str, list[np.ndarray]],
+    target: float,
+    *,
+    title: str,
+    paper_epochs: Mapping[str, float] | None = None,
+    letters: str = "abcdefghij",
+    ncols: int | None = None,
+    sharey: bool = True,
+    log_epochs: bool = False,
+) -> bytes:
+    """[B] Fig. 9: the best training MSE against the epoch, one panel per method: each run
+    (seed) a thin line, their median a thick one (a run that stopped at the target carried on
+    at its last value), the target MSE dashed and, where given, the epoch at which the paper
+    reached it dotted. MSE on a log scale, shared by the panels if ``sharey``; ``log_epochs``:
+    epochs on a log scale too (linear below 1), for runs far shorter than the paper's."""
+    paper_epochs = paper_epochs or {}
+    n = len(curves)
+    ncols = ncols or min(n, 4)
+    nrows = -(-n // ncols)
+    finite = np.concatenate([np.ravel(c) for runs in curves.values() for c in runs])
+    finite = finite[np.isfinite(finite) & (finite > 0)]
+    lo = min(float(finite.min()), target) / 1.5
+    hi = max(float(finite.max()), target) * 1.5
     with styled():
-        fig, axes = new_figure(width=8.0, height=3.8)
-        ax = axes[0, 0]
-        for k, (name, e) in enumerate(errors.items()):
-            e = np.asarray(e) * ef
+        fig, axes = new_figure(
+            nrows, ncols, width=4.4 * ncols + 0.4, height=3.5 * nrows + 0.6, sharey=sharey
+        )
+        for ax in axes.ravel()[n:]:
+            ax.set_visible(False)
+        for k, (ax, (name, runs)) in enumerate(zip(axes.ravel(), curves.items(), strict=False)):
+            color = COLORS[k % len(COLORS)]
+            length = max(len(c) for c in runs)
+            padded = np.stack([np.concatenate([c, np.full(length - len(c), c[-1])]) for c in runs])
+            for c in runs:
+                ax.plot(np.arange(len(c)), c, "-", lw=0.7, alpha=0.45, color=color)
             ax.plot(
-                np.arange(1, e.size + 1),
-                e,
-                "-o",
-                ms=2.5,
-                lw=0.8,
-                color=COLORS[k % len(COLORS)],
-                label=f"{name}: mean |e| {np.mean(np.abs(e)):.3g}, max {np.max(np.abs(e)):.3g}"
-                f" {eunit}",
+                np.arange(length),
+                np.median(padded, axis=0),
+                "-",
+                lw=2.2,
+                color=color,
+                label=f"median of {len(runs)} runs",
             )
-        ax.axhline(0, color="0.3", lw=0.7)
-        ax.set_xlabel("sample number (unseen region)")
-        ax.set_ylabel(f"prediction error [{eunit}]")
-        ax.legend(loc="best")
-        ax.set_title(title)
+            ax.axhline(target, color="0.15", ls="--", lw=1.1, label=f"target MSE {target:g}")
+            reached = [int(np.argmax(c <= target)) for c in runs if np.any(c <= target)]
+            if reached:
+                ax.plot(
+                    reached,
+                    [target] * len(reached),
+                    "v",
+                    ms=6,
+                    color=color,
+                    mec="white",
+                    label=f"ours reached it ({len(reached)}/{len(runs)} runs)",
+                )
+            if name in paper_epochs:
+                ep = float(paper_epochs[name])
+                ax.axvline(ep, color="0.35", ls=":", lw=1.6)
+                ax.annotate(
+                    f"paper reached it: epoch {ep:g}",
+                    (ep, 0.5),
+                    xycoords=("data", "axes fraction"),
+                    xytext=(-3, 0),
+                    textcoords="offset points",
+                    rotation=90,
+                    ha="right",
+                    va="center",
+                    fontsize=8.5,
+                    color="0.2",
+                )
+                ax.set_xlim(0, max(length - 1, ep * 1.08))
+            else:
+                ax.set_xlim(0, max(length - 1, 1))
+            ax.set_yscale("log")
+            if sharey:
+                ax.set_ylim(lo, hi)
+            if log_epochs:
+                ax.set_xscale("symlog", linthresh=1.0)
+            ax.set_title(f"({letters[k]}) {name}", loc="left", fontsize=10)
+            ax.set_xlabel("epoch, log scale" if log_epochs else "epoch")
+            ax.legend(loc="upper right", fontsize=8)
+        for row in axes:
+            row[0].set_ylabel("training MSE (friction scaled to [-1, 1])")
+        fig.suptitle(title, fontweight="bold")
+        return png(fig)
+
+
+def unseen_region(
+    temperature: np.ndarray,
+    errors: Mapping[str, np.ndarray],
+    *,
+    title: str,
+    highlight: str,
+    train_max_temperature: float,
+    paper: Mapping[str, float] | None = None,
+) -> bytes:
+    """[B] Fig. 10: absolute prediction errors in the unseen region.
+
+    (a) the ``highlight`` model's error at each point (as the paper's figure), the points
+    inside the training temperatures shaded, the paper's mean and maximum as lines; (b) every
+    model's mean absolute error per temperature (log scale), the highest training temperature
+    marked: where the error grows with the distance from the training data."""
+    temperature = np.asarray(temperature, dtype=float)
+    allv = np.concatenate([np.ravel(e) for e in errors.values()])
+    f, unit = torque_scale(np.concatenate([np.ravel(errors[highlight]), [0.0]]))
+    paper = paper or {}
+    temps = np.unique(np.round(temperature, 6))
+    with styled():
+        fig, axes = new_figure(
+            1, 2, width=14.5, height=5.2, gridspec_kw={"width_ratios": [1.45, 1.0]}
+        )
+        a, b = axes[0]
+        e = np.abs(np.asarray(errors[highlight], dtype=float)) * f
+        idx = np.arange(1, e.size + 1)
+        inside = temperature <= train_max_temperature + 1e-9
+        if inside.any():
+            a.axvspan(
+                idx[inside].min() - 0.5,
+                idx[inside].max() + 0.5,
+                color="0.88",
+                zorder=0,
+                label=f"≤ {train_max_temperature:g} °C (inside the training temperatures)",
+            )
+        a.plot(idx, e, "-o", ms=2.8, lw=0.8, color=COLORS[0], label=f"{highlight} (ours)")
+        for key, ls in (("mean", "--"), ("max", ":")):
+            if key in paper:
+                a.axhline(
+                    paper[key] * f,
+                    color=COLORS[1],
+                    ls=ls,
+                    lw=1.4,
+                    label=f"paper's {key}: {paper[key] * f:.3g} {unit}",
+                )
+        a.axhline(
+            e.mean(), color=COLORS[0], ls="--", lw=1.2, label=f"our mean: {e.mean():.3g} {unit}"
+        )
+        for t in temps:
+            at = np.flatnonzero(np.isclose(temperature, t))
+            a.annotate(
+                f"{t:g} °C",
+                (idx[at].mean(), 1.0),
+                xycoords=("data", "axes fraction"),
+                ha="center",
+                va="top",
+                fontsize=8,
+                color="0.3",
+            )
+        a.set_ylim(0, max(float(e.max()), paper.get("max", 0.0) * f) * 1.12)
+        a.set_xlim(0.5, e.size + 0.5)
+        a.set_xlabel("sample number in the unseen region (ordered by temperature)")
+        a.set_ylabel(f"absolute error [{unit}]")
+        a.set_title(f"(a) {highlight}: error at each point", loc="left", fontsize=10)
+        a.legend(loc="upper center", bbox_to_anchor=(0.5, -0.15), ncols=3, fontsize=8)
+        bf, bunit = torque_scale(allv)
+        markers = ["o", "s", "^", "D", "v", "P", "X", "*"]
+        for k, (name, err) in enumerate(errors.items()):
+            err = np.abs(np.asarray(err, dtype=float))
+            means = [err[np.isclose(temperature, t)].mean() * bf for t in temps]
+            b.plot(
+                temps,
+                means,
+                "-" + markers[k % len(markers)],
+                ms=5,
+                lw=1.8 if name == highlight else 1.1,
+                color=COLORS[k % len(COLORS)],
+                label=name,
+            )
+        b.axvline(train_max_temperature, color="0.3", ls="--", lw=1.0)
+        b.annotate(
+            "highest training\ntemperature",
+            (train_max_temperature, 0.97),
+            xycoords=("data", "axes fraction"),
+            xytext=(4, 0),
+            textcoords="offset points",
+            va="top",
+            fontsize=8,
+            color="0.3",
+        )
+        b.set_yscale("log")
+        b.set_xlabel("temperature [°C]")
+        b.set_ylabel(f"mean absolute error [{bunit}], log scale")
+        b.set_title("(b) every model: mean error per temperature", loc="left", fontsize=10)
+        b.legend(loc="center left", bbox_to_anchor=(1.02, 0.5), fontsize=8)
+        fig.suptitle(title, fontweight="bold")
         return png(fig)
 
 
