@@ -621,7 +621,7 @@ def _table4(res, quick: bool) -> list:
         f"{printed['eta_step']:g} per iteration; GA's mutation index tuned likewise). With "
         "the constants as printed the step falls to "
         f"{100 * printed['eta_step'] ** 100:.2g} % of its start within 100 iterations while "
-        f"the antennae stay near {floor_paper:g}, so the beetle soon stops moving"
+        f"the antennae stay near {floor_paper:g}, so its search narrows early"
     )
     if eq21 is not None:
         e21, eg = float(eq21["epochs_median"]), float(ga["epochs_median"])
