@@ -8,7 +8,17 @@ from __future__ import annotations
 
 from os import PathLike
 
-__all__ = ["ConfigError", "DataError", "FricidError"]
+__all__ = [
+    "ConfigError",
+    "ConvergenceWarning",
+    "DataError",
+    "DataQualityWarning",
+    "ExtrapolationWarning",
+    "FricidError",
+    "FricidWarning",
+    "IdentifiabilityWarning",
+    "IgnoredArgumentWarning",
+]
 
 
 class FricidError(Exception):
@@ -49,3 +59,27 @@ class DataError(FricidError, ValueError):
         if self.column is not None:
             where.append(f"column '{self.column}'")
         return f"{', '.join(where)}: {self.message}" if where else self.message
+
+
+class FricidWarning(UserWarning):
+    """Base class of the caveats fricid attaches to an answer that stands (DESIGN.md, "Errors")."""
+
+
+class ConvergenceWarning(FricidWarning):
+    """An optimiser stopped before converging (budget spent, stopped, stalled)."""
+
+
+class ExtrapolationWarning(FricidWarning):
+    """A prediction lies outside the operating range the model was identified on."""
+
+
+class IdentifiabilityWarning(FricidWarning):
+    """The data cannot determine a parameter (at a bound, singular, strongly correlated)."""
+
+
+class DataQualityWarning(FricidWarning):
+    """The data were usable but something in them needs a look (outliers, scatter, transients)."""
+
+
+class IgnoredArgumentWarning(FricidWarning):
+    """An argument or option was given that the chosen method does not use."""

@@ -25,7 +25,9 @@ SI_UNITS: dict[str, str] = {
     "torque_constant": "N m/A",
 }
 
-_DEG = math.pi / 180.0
+#: One degree in radians (the one copy in fricid).
+DEG = math.pi / 180.0
+_DEG = DEG
 _RPM = 2.0 * math.pi / 60.0
 
 # quantity -> unit spelling -> (scale, offset): si = value * scale + offset

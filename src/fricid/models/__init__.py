@@ -25,6 +25,7 @@ __all__ = [
     "get_model",
 ]
 
+
 def __getattr__(name: str):
     # the RBF network needs scikit-learn; import it only when asked for (fast CLI start-up)
     if name == "RBFNetRegressor":

@@ -30,9 +30,16 @@ from . import (  # noqa: F401  (each registers its methods)
     _scipy_global,
     _vsbas,
 )
-from ._api import METHODS, JitObjective, OptimizeResult, check_bounds, minimize
+from ._api import METHODS, JitObjective, OptimizeResult, check_bounds, minimize, minimize_runs
 
-__all__ = ["METHODS", "JitObjective", "OptimizeResult", "check_bounds", "minimize"]
+__all__ = [
+    "METHODS",
+    "JitObjective",
+    "OptimizeResult",
+    "check_bounds",
+    "minimize",
+    "minimize_runs",
+]
 
 #: The order methods are listed in (errors, ``--help``): the beetle family first.
 _ORDER = (

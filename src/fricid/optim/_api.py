@@ -545,3 +545,37 @@ def minimize(
             nit, message = _solve(one.bind(objective, [rngs[r]]), objective)
             results.append(_result(objective, 0, nit, message, key, seeds[r]))
     return results[0] if runs is None else results
+
+
+def minimize_runs(
+    fun: Callable[[np.ndarray], np.ndarray] | None,
+    bounds,
+    method: str = "rwsavsbas",
+    *,
+    runs: int,
+    seed: int | np.random.Generator | None = None,
+    max_evals: int | None = None,
+    options: dict[str, Any] | None = None,
+    callback: Callable[[OptimizeResult], Any] | None = None,
+    x0=None,
+    residuals: Callable[[np.ndarray], np.ndarray] | None = None,
+) -> list[OptimizeResult]:
+    """``runs`` independent runs of :func:`minimize`, batched where the method allows.
+
+    Run ``r`` uses seed ``seed + r`` and equals ``minimize(..., seed=seed + r)`` bit for bit.
+    Returns a list of ``runs`` :class:`OptimizeResult`.
+    """
+    if isinstance(runs, bool) or not isinstance(runs, int | np.integer) or runs < 1:
+        raise ConfigError(f"runs must be a positive integer; got {runs!r}")
+    return minimize(
+        fun,
+        bounds,
+        method,
+        seed=seed,
+        max_evals=max_evals,
+        options=options,
+        callback=callback,
+        x0=x0,
+        residuals=residuals,
+        runs=int(runs),
+    )

@@ -14,13 +14,13 @@ from typing import Any
 import numpy as np
 from scipy import stats
 
-from . import __version__
-from .errors import ConfigError
-from .fitted import FittedModel
-from .metrics import metrics
-from .models import FrictionModel, get_model
-from .optim import METHODS, OptimizeResult, minimize
-from .samples import FrictionSamples, samples_hash
+from .. import __version__
+from ..errors import ConfigError
+from ..fitted import FittedModel
+from ..metrics import metrics
+from ..models import FrictionModel, get_model
+from ..optim import METHODS, OptimizeResult, minimize
+from ..samples import FrictionSamples, samples_hash
 
 __all__ = ["evaluate", "fit", "jacobian_uncertainty", "samples_hash"]
 
