@@ -378,6 +378,67 @@ def test_xml_and_yaml_exploits_through_the_cli(tmp_path):
 
 
 @pytest.mark.parametrize(
+    "name", ["m--->.json", "m *\n#define return return 1000.0 +\n.json", "a\u2028b: 1 #.json"]
+)
+def test_hostile_file_names_through_the_cli(tmp_path, name):
+    path = stribeck().save(tmp_path / name)
+    for target in ("urdf", "mjcf", "yaml"):
+        res = runner.invoke(app, ["export", str(path), "--to", target])
+        assert res.exit_code == 0, res.output
+        assert plain(name) in res.stdout and name not in res.stdout
+        if target == "yaml":
+            assert list(yaml.safe_load(res.stdout)) == ["friction_compensation"]
+        else:
+            parse_xml(res.stdout)
+    if CC is not None:
+        res = runner.invoke(app, ["export", str(path), "--to", "c", "--out", str(tmp_path / "c")])
+        assert res.exit_code == 0, res.output
+        check_c(tmp_path / "c", stribeck())
+
+
+@needs_cc
+@settings(max_examples=6, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(st.lists(st.floats(allow_nan=False, allow_infinity=False), min_size=1, max_size=64))
+def test_numbers_read_back_bit_for_bit_in_c(tmp_path_factory, values):
+    directory = tmp_path_factory.mktemp("numbers")
+    body = ", ".join(fmt_float(x, f"x[{i}]") for i, x in enumerate(values))
+    (directory / "n.c").write_text(
+        "#include <stdio.h>\n"
+        f"static const double x[{len(values)}] = {{{body}}};\n"
+        "int main(void)\n{\n    unsigned i;\n"
+        '    for (i = 0; i < sizeof x / sizeof x[0]; ++i)\n        printf("%a\\n", x[i]);\n'
+        "    return 0;\n}\n"
+    )
+    exe = directory / "n"
+    res = subprocess.run(
+        [CC, *CFLAGS, "-o", str(exe), str(directory / "n.c")], capture_output=True, text=True
+    )
+    assert res.returncode == 0, res.stderr
+    out = subprocess.run([str(exe)], capture_output=True, text=True, check=True).stdout.split()
+    assert [float.fromhex(h) for h in out] == values
+    assert [np.signbit(float.fromhex(h)) for h in out] == [np.signbit(x) for x in values]
+
+
+@needs_cc
+def test_hostile_rbf_model_compiles_and_matches_python(tmp_path):
+    from test_export import rbf_fitted
+
+    fitted = rbf_fitted(("velocity", "load"), 0.02)
+    fitted.method = EXPLOIT
+    fitted.provenance = {"source": CONSTRUCTOR}
+    fitted = FittedModel.load(fitted.save(tmp_path / "rbf--->.json"))
+    res = runner.invoke(
+        app, ["export", str(tmp_path / "rbf--->.json"), "--to", "c", "--out", str(tmp_path / "c")]
+    )
+    assert res.exit_code == 0, res.output
+    rng = np.random.default_rng(0)
+    X = np.column_stack([rng.uniform(-1, 1, 50), rng.uniform(0.15, 0.21, 50), np.full(50, 25.0)])
+    got = compile_and_run(tmp_path / "c", X)
+    np.testing.assert_allclose(got, fitted.predict(X), rtol=1e-9, atol=1e-12)
+    assert "#define" not in (tmp_path / "c" / "fricid_friction.c").read_text()
+
+
+@pytest.mark.parametrize(
     "prefix", ["", "1bad", "a b", "x */", "x;system", "a-b", "é", "_x", "a" * 64, "a\n"]
 )
 def test_prefix_is_a_strict_identifier(tmp_path, prefix):
@@ -413,6 +474,7 @@ def test_non_finite_model_in_a_file_gives_one_line_and_no_file(tmp_path):
     res = runner.invoke(app, ["export", str(path), "--to", "c", "--out", str(out)])
     assert res.exit_code == 2, res.output
     assert "Traceback" not in res.output and "tau_s" in res.output
+    assert "m.json" in res.output  # the file the user gave
     assert not out.exists()
 
 

@@ -92,7 +92,9 @@ def export_command(
     an escaper, and every number is checked finite. Files are written atomically; on error
     nothing is.
     """
-    from ..errors import ConfigError
+    from rich.markup import escape
+
+    from ..errors import ConfigError, DataError
     from ..export import TARGETS, Smoothing, description_text, export_c, file_sha256, write_text
     from ..fitted import FittedModel
 
@@ -101,36 +103,42 @@ def export_command(
         raise ConfigError(f"unknown export target '{to}'; choose one of: {', '.join(TARGETS)}")
     fitted = FittedModel.load(model)
     sha256 = file_sha256(model)
-    if target == "c":
-        paths = export_c(
+    try:
+        if target == "c":
+            paths = export_c(
+                fitted,
+                out or Path.cwd(),
+                Smoothing(smooth, zone),
+                prefix=prefix,
+                source=model.name,
+                sha256=sha256,
+                clamp=clamp,
+            )
+            for path in paths:
+                err_console.print(f"wrote {escape(str(path))}", highlight=False)
+            return
+        for flag, given in (("--smooth", smooth != "none"), ("--clamp", clamp)):
+            if given:
+                err_console.print(
+                    f"note: {flag} applies to the C export only; ignored for {target}"
+                )
+        options = {"node": node} if target == "yaml" else {}
+        text = description_text(
+            target,
             fitted,
-            out or Path.cwd(),
-            Smoothing(smooth, zone),
-            prefix=prefix,
+            joint=joint,
+            max_loss=max_loss,
             source=model.name,
             sha256=sha256,
-            clamp=clamp,
+            **options,
         )
-        for path in paths:
-            err_console.print(f"wrote {path}")
-        return
-    if smooth != "none":
-        err_console.print(f"note: --smooth applies to the C export only; ignored for {target}")
-    if clamp:
-        err_console.print(f"note: --clamp applies to the C export only; ignored for {target}")
-    options = {"node": node} if target == "yaml" else {}
-    text = description_text(
-        target,
-        fitted,
-        joint=joint,
-        max_loss=max_loss,
-        source=model.name,
-        sha256=sha256,
-        **options,
-    )
+    except DataError as exc:  # a bad value in the model: name the file the user gave
+        if exc.file is not None:
+            raise
+        raise DataError(exc.message, file=model, row=exc.row, column=exc.column) from None
     if out is None:
         sys.stdout.write(text)
         sys.stdout.flush()
     else:
         write_text(text, out)
-        err_console.print(f"wrote {out}")
+        err_console.print(f"wrote {escape(str(out))}", highlight=False)
