@@ -17,8 +17,8 @@ from fricid.control import (
     simulate_tracking,
 )
 from fricid.errors import ConfigError
-from fricid.export import Smoothing
 from fricid.fitted import FittedModel
+from fricid.models.smoothing import Smoothing
 from fricid.sim import preset
 
 runner = CliRunner()

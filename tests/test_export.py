@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from fricid.errors import ConfigError
 from fricid.export import ExportError, Smoothing, c_code, export_c, smooth_predict
 from fricid.fitted import FittedModel
 from fricid.models import MODELS, get_model
@@ -205,7 +206,7 @@ def test_unrepresentable_c_exports_say_so_and_write_nothing(tmp_path):
     fitted = make_fitted("stribeck", False)
     with pytest.raises(ExportError, match="not a C identifier"):
         export_c(fitted, tmp_path / "a", prefix="1bad")
-    with pytest.raises(ExportError, match="needs a zone half-width"):
+    with pytest.raises(ConfigError, match="needs a zone half-width"):
         export_c(fitted, tmp_path / "b", Smoothing("tanh", 0.0))
     unknown = make_fitted("stribeck", False)
     unknown.model = "lugre"

@@ -53,7 +53,23 @@ def export_command(
             help=("C only: the function is <prefix>_friction (change it to link several joints).")
         ),
     ] = "fricid",
+    clamp: Annotated[
+        bool,
+        typer.Option(
+            "--clamp/--no-clamp",
+            help=(
+                "C only. Hold the inputs inside the model's operating range (recorded in the "
+                "model file) before evaluating: load and temperature to [low, high]; velocity "
+                "to [low, high] if the range spans zero, else its magnitude to at most the "
+                "largest identified speed, sign kept. Off by default: outside the range the "
+                "model extrapolates. The header comment states the range either way."
+            ),
+        ),
+    ] = False,
     joint: Annotated[str, typer.Option(help="Joint name in URDF, MJCF and YAML.")] = "joint",
+    node: Annotated[
+        str, typer.Option(help="YAML only: the ROS 2 node name the parameters are under.")
+    ] = "friction_compensation",
     max_loss: Annotated[
         float,
         typer.Option(
@@ -71,29 +87,58 @@ def export_command(
     `double fricid_friction(double velocity, double load, double temperature)` in SI units,
     libm only, no allocation. URDF, MJCF and YAML hold Coulomb plus viscous friction, so they
     get the least-squares projection over the model's operating range, with its error and
-    what is lost stated in a comment. Files are written atomically; on error nothing is.
+    what is lost stated in a comment. Every file names the model by its file name (escaped)
+    and the SHA-256 of its bytes; no other text of the model file is written except through
+    an escaper, and every number is checked finite. Files are written atomically; on error
+    nothing is.
     """
-    from ..errors import ConfigError
-    from ..export import TARGETS, Smoothing, description_text, export_c, write_text
+    from rich.markup import escape
+
+    from ..errors import ConfigError, DataError
+    from ..export import TARGETS, Smoothing, description_text, export_c, file_sha256, write_text
     from ..fitted import FittedModel
 
     target = to.strip().lower()
     if target not in TARGETS:
         raise ConfigError(f"unknown export target '{to}'; choose one of: {', '.join(TARGETS)}")
     fitted = FittedModel.load(model)
-    if target == "c":
-        paths = export_c(
-            fitted, out or Path.cwd(), Smoothing(smooth, zone), prefix=prefix, source=model.name
+    sha256 = file_sha256(model)
+    try:
+        if target == "c":
+            paths = export_c(
+                fitted,
+                out or Path.cwd(),
+                Smoothing(smooth, zone),
+                prefix=prefix,
+                source=model.name,
+                sha256=sha256,
+                clamp=clamp,
+            )
+            for path in paths:
+                err_console.print(f"wrote {escape(str(path))}", highlight=False)
+            return
+        for flag, given in (("--smooth", smooth != "none"), ("--clamp", clamp)):
+            if given:
+                err_console.print(
+                    f"note: {flag} applies to the C export only; ignored for {target}"
+                )
+        options = {"node": node} if target == "yaml" else {}
+        text = description_text(
+            target,
+            fitted,
+            joint=joint,
+            max_loss=max_loss,
+            source=model.name,
+            sha256=sha256,
+            **options,
         )
-        for path in paths:
-            err_console.print(f"wrote {path}")
-        return
-    if smooth != "none":
-        err_console.print(f"note: --smooth applies to the C export only; ignored for {target}")
-    text = description_text(target, fitted, joint=joint, max_loss=max_loss, source=model.name)
+    except DataError as exc:  # a bad value in the model: name the file the user gave
+        if exc.file is not None:
+            raise
+        raise DataError(exc.message, file=model, row=exc.row, column=exc.column) from None
     if out is None:
         sys.stdout.write(text)
         sys.stdout.flush()
     else:
         write_text(text, out)
-        err_console.print(f"wrote {out}")
+        err_console.print(f"wrote {escape(str(out))}", highlight=False)

@@ -21,7 +21,7 @@ Stiction
 The controller
     ``u = J q_r'' + K_p (q_r - q) + K_d (q_r' - q')`` plus, in the second run, the feed-forward
     ``F_hat(q_r', load, T)``: the model evaluated at the reference velocity (optionally
-    smoothed near zero velocity, :mod:`fricid.export.smoothing`). By default ``K_p = J w^2``
+    smoothed near zero velocity, :mod:`fricid.models.smoothing`). By default ``K_p = J w^2``
     and ``K_d = 2 zeta J w`` with ``w = 2 pi 10 Hz`` and ``zeta = 1``.
 The reference
     ``q_r = A sin(2 pi f t)``: it crosses zero velocity twice per period. The joint starts on
@@ -328,7 +328,7 @@ def compensation_study(
         preset joint's inertia replaces ``config.inertia``.
     truth : the plant's friction: ``"model"`` (the model itself) or a simulation preset
         (``"paper1"``, ``"paper2"``: the virtual joint's true law).
-    smoothing : :class:`fricid.export.Smoothing` of the feed-forward near zero velocity.
+    smoothing : :class:`fricid.models.smoothing.Smoothing` of the feed-forward near zero velocity.
 
     Returns
     -------
@@ -337,7 +337,7 @@ def compensation_study(
     """
     from dataclasses import replace
 
-    from ..export.smoothing import smooth_predict
+    from ..models.smoothing import smooth_predict
 
     config = config or TrackingConfig()
     law, inertia = _truth_law(truth, fitted)

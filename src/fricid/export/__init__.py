@@ -2,18 +2,29 @@
 
 >>> from fricid.export import export_c, urdf_text, Smoothing      # doctest: +SKIP
 >>> export_c(fitted, "out/", Smoothing("tanh", 0.01))              # out/fricid_friction.[ch]
+>>> export_c(fitted, "out/", clamp=True)                           # inputs held in range
 >>> print(urdf_text(fitted, joint="elbow"))                        # <dynamics .../> + comment
 
 Targets that hold less than the model (URDF, MJCF and YAML hold Coulomb plus viscous
 friction) get the least-squares projection over the model's operating range, with its error
 and what is lost stated in the file; beyond a tolerance they refuse with an
-:class:`ExportError` that says what would be lost. Every file is written atomically.
+:class:`ExportError` that says what would be lost. Every file is written atomically
+(:mod:`fricid.io.atomic`).
+
+Model files travel between people and exports go into firmware, so data never becomes code
+(:mod:`fricid.export._common`): numbers go through one formatter that refuses NaN and inf,
+text from the model file only through a tested escaper, names through strict patterns; XML
+is built with :mod:`xml.etree.ElementTree` and YAML with :func:`yaml.safe_dump`; every file
+names the model by its SHA-256. Smoothing near zero velocity is a model concern and lives in
+:mod:`fricid.models.smoothing` (re-exported here).
 """
 
 from __future__ import annotations
 
-from ._common import ExportError
+from ..models.smoothing import SMOOTHINGS, Smoothing, smooth_predict
+from ._common import ExportError, file_sha256, model_sha256, plain
 from .c import CCode, c_code, export_c
+from .clamp import clamp_inputs, clamp_limits
 from .descriptions import (
     DEFAULT_MAX_LOSS,
     DESCRIPTION_TARGETS,
@@ -25,7 +36,6 @@ from .descriptions import (
 )
 from .projection import Projection, operating_grid, project
 from .schema import model_schema, schema_path, validate_model_dict
-from .smoothing import SMOOTHINGS, Smoothing, smooth_predict
 
 __all__ = [
     "DEFAULT_MAX_LOSS",
@@ -37,11 +47,16 @@ __all__ = [
     "Projection",
     "Smoothing",
     "c_code",
+    "clamp_inputs",
+    "clamp_limits",
     "description_text",
     "export_c",
+    "file_sha256",
     "mjcf_text",
     "model_schema",
+    "model_sha256",
     "operating_grid",
+    "plain",
     "project",
     "ros2_yaml_text",
     "schema_path",

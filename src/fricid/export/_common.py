@@ -1,45 +1,298 @@
-"""Shared pieces of the exporters: the error for what a target cannot hold, provenance text."""
+"""Shared pieces of the exporters: the one number formatter, the one text escaper, names.
+
+Data never becomes code (DESIGN.md, "Conventions"). A model file travels between people and
+an export goes into firmware, so nothing an exported file says comes from the model file
+except through the three gates of this module:
+
+:func:`fmt_float`
+    Every number: ``repr`` of the float (the shortest text that reads back bit for bit, a
+    valid C, XML attribute and YAML literal); NaN and infinities are refused with a
+    :class:`~fricid.errors.DataError` that names the parameter.
+:func:`plain`
+    Every piece of text from the file (method, data source, the model file's name):
+    percent-encoded down to a small alphabet (letters, digits, space and ``_.,:;=+()[]@/``,
+    with ``-`` only singly and never first or last). No ``*``, ``#``, ``<``, ``&``, quote,
+    ``?``, backslash, control or non-ASCII character survives, and ``--`` cannot form, so
+    the result cannot end a C ``/* */`` comment, an XML ``<!-- -->`` comment (or make it
+    invalid), a YAML ``#`` line, nor hold a C trigraph. The encoding is reversible
+    (``urllib.parse.unquote(text, errors="surrogatepass")``) up to a length limit.
+:func:`check_identifier` and :func:`check_name`
+    Names that become identifiers (the C prefix, joint and node names) must match a strict
+    pattern or the export is refused.
+
+Every export also names the model by its SHA-256 (of the file's bytes when the file is
+known, else of the model's canonical JSON), so a reader can tell which file it came from
+without trusting anything the file says.
+"""
 
 from __future__ import annotations
 
+import hashlib
+import json
 import math
+import numbers
+import os
+import re
+import string
+from pathlib import Path
 
 from .. import __version__
-from ..errors import ConfigError
+from ..errors import ConfigError, DataError
 from ..fitted import FittedModel
 
-__all__ = ["ExportError", "describe_model", "fmt_float"]
+__all__ = [
+    "ExportError",
+    "check_identifier",
+    "check_name",
+    "file_sha256",
+    "fmt_float",
+    "model_name",
+    "model_sha256",
+    "operating_pair",
+    "plain",
+    "range_lines",
+    "summary_lines",
+    "write_lines_checked",
+]
+
+#: Longest piece of file text written (the rest is counted, not written).
+PLAIN_LIMIT = 120
+
+_PLAIN = frozenset(string.ascii_letters + string.digits + " _.,:;=+()[]@/")
+_C_IDENT = re.compile(r"[A-Za-z][A-Za-z0-9_]{0,62}")
+_SHA256 = re.compile(r"[0-9a-f]{64}")
 
 
 class ExportError(ConfigError):
     """The export target cannot represent the model (the message says what would be lost)."""
 
 
-def fmt_float(value: float) -> str:
-    """A float written so that it reads back bit for bit (``repr``, 17 significant digits)."""
+def fmt_float(value: float, name: str = "value") -> str:
+    """A number for an exported file, written so that it reads back bit for bit.
+
+    Parameters
+    ----------
+    value : float
+        A real number (a bool or a non-number is refused).
+    name : str
+        What the number is (a parameter name), for the error message.
+
+    Returns
+    -------
+    str
+        ``repr(float(value))``: the shortest decimal text that reads back as the same double
+        (e.g. ``0.005``, ``-1e-05``, ``2.0``), valid in C99, XML attributes and YAML.
+
+    Raises
+    ------
+    DataError
+        ``value`` is NaN, infinite or not a real number; the message names ``name``.
+    """
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise DataError(f"{name} must be a number, got {type(value).__name__}", column=name)
     value = float(value)
     if not math.isfinite(value):
-        raise ExportError(f"cannot export the non-finite value {value!r}")
+        raise DataError(f"{name} is {value!r}: a non-finite value cannot be exported", column=name)
     return repr(value)
 
 
-def describe_model(fitted: FittedModel, source: str | None = None) -> list[str]:
-    """Lines of provenance for a comment at the top of an exported file."""
-    prov = fitted.provenance or {}
-    lines = [
-        f"fricid {__version__} export of the model '{fitted.model}'"
-        + (f" from {source}" if source else ""),
-        f"identified by {fitted.method or 'unknown method'} (seed {fitted.seed}) from "
-        f"{prov.get('source') or 'unrecorded data'}"
-        + (f", {prov['n_samples']} samples" if prov.get("n_samples") is not None else ""),
-    ]
-    if fitted.metrics:
-        m = fitted.metrics
-        parts = [
-            f"{k} {m[k]:.4g}"
-            for k in ("fitness", "rmse", "max_abs_error")
-            if isinstance(m.get(k), int | float)
-        ]
-        if parts:
-            lines.append("fit on its data: " + ", ".join(parts) + " (rmse, max error in N m)")
+def plain(text: object, limit: int = PLAIN_LIMIT) -> str:
+    """``text`` escaped so that it is inert in C, XML and YAML comments (module docstring).
+
+    Parameters
+    ----------
+    text : object
+        Text from a model file (anything else is converted with ``str``).
+    limit : int
+        Characters of ``text`` written; a longer text is cut there and the number of
+        characters left out is appended as ``[N more characters]``.
+
+    Returns
+    -------
+    str
+        Only letters, digits, space, ``_.,:;=+()[]@/``, ``%XX`` escapes and single ``-``
+        characters that neither start nor end it.
+    """
+    text = str(text)
+    extra = len(text) - limit
+    if extra > 0:
+        text = text[:limit]
+    out: list[str] = []
+    last = len(text) - 1
+    for i, ch in enumerate(text):
+        if ch in _PLAIN or (ch == "-" and 0 < i < last and not out[-1].endswith("-")):
+            out.append(ch)
+        else:
+            out.append("".join(f"%{b:02X}" for b in ch.encode("utf-8", "surrogatepass")))
+    if extra > 0:
+        out.append(f" [{extra} more characters]")
+    return "".join(out)
+
+
+def check_identifier(prefix: str) -> str:
+    """``prefix`` if it is a plain C identifier (a letter, then letters, digits or ``_``,
+    at most 63 characters), else :class:`ExportError`."""
+    if not isinstance(prefix, str) or not _C_IDENT.fullmatch(prefix):
+        raise ExportError(
+            f"prefix {prefix!r} is not a C identifier of the form [A-Za-z][A-Za-z0-9_]* "
+            "(at most 63 characters)"
+        )
+    return prefix
+
+
+def check_name(name: str, what: str, pattern: re.Pattern[str], allowed: str) -> str:
+    """``name`` if it matches ``pattern`` in full, else :class:`ExportError` naming ``what``
+    and the ``allowed`` form."""
+    if not isinstance(name, str) or not pattern.fullmatch(name):
+        raise ExportError(f"{what} {name!r} must {allowed}")
+    return name
+
+
+def file_sha256(path: str | os.PathLike[str]) -> str:
+    """SHA-256 (hex) of a file's bytes."""
+    digest = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for block in iter(lambda: fh.read(1 << 20), b""):
+            digest.update(block)
+    return digest.hexdigest()
+
+
+def model_sha256(fitted: FittedModel) -> str:
+    """SHA-256 (hex) of the model's canonical JSON (sorted keys, no spaces)."""
+    text = json.dumps(fitted.to_dict(), sort_keys=True, separators=(",", ":"), allow_nan=True)
+    return hashlib.sha256(text.encode("utf-8", "surrogatepass")).hexdigest()
+
+
+def model_name(fitted: FittedModel) -> str:
+    """The model's registry name, taken from the registry (never the file's text)."""
+    if fitted.model == "rbf":
+        return "rbf"
+    model = fitted.friction_model()  # ConfigError for a name the registry does not know
+    return model.name
+
+
+def _display(value: object) -> str | None:
+    """A finite number for a summary line (6 significant digits), else None."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        return None
+    value = float(value)
+    return f"{value:.6g}" if math.isfinite(value) else None
+
+
+def summary_lines(
+    fitted: FittedModel, source: str | None = None, sha256: str | None = None
+) -> list[str]:
+    """The fixed-format provenance lines at the top of every exported file.
+
+    Parameters
+    ----------
+    fitted : FittedModel
+        The model.
+    source : str, optional
+        The model file's name (escaped with :func:`plain`).
+    sha256 : str, optional
+        SHA-256 (64 lower-case hex digits) of the model file's bytes; without it, the SHA-256
+        of the model's canonical JSON is given and labelled so.
+
+    Returns
+    -------
+    list of str
+        Lines of fixed text, registry names, numbers and :func:`plain` text only.
+    """
+    lines = [f"fricid {plain(__version__)} export of the model '{model_name(fitted)}'"]
+    if sha256 is not None:
+        if not isinstance(sha256, str) or not _SHA256.fullmatch(sha256):
+            raise ExportError(f"sha256 must be 64 lower-case hex digits, got {sha256!r}")
+        lines.append(
+            f"model file sha256 {sha256}" + (f", file name {plain(source)}" if source else "")
+        )
+    else:
+        lines.append(
+            f"model content sha256 {model_sha256(fitted)} (canonical JSON)"
+            + (f", from {plain(source)}" if source else "")
+        )
+    prov = fitted.provenance if isinstance(fitted.provenance, dict) else {}
+    seed = fitted.seed
+    seed_text = str(seed) if isinstance(seed, int) and not isinstance(seed, bool) else "none"
+    n = prov.get("n_samples")
+    count = f", {n} samples" if isinstance(n, int) and not isinstance(n, bool) and n >= 0 else ""
+    data = prov.get("source")
+    lines.append(
+        f"identified by {plain(fitted.method) if fitted.method else 'an unrecorded method'} "
+        f"(seed {seed_text}) from {plain(data) if data else 'unrecorded data'}{count}"
+    )
+    metrics = fitted.metrics if isinstance(fitted.metrics, dict) else {}
+    parts = []
+    for key in ("fitness", "rmse", "max_abs_error"):
+        shown = _display(metrics.get(key))
+        if shown is not None:
+            parts.append(f"{key} {shown}")
+    if parts:
+        lines.append("fit on its data: " + ", ".join(parts) + " (rmse, max error in N m)")
     return lines
+
+
+def range_lines(fitted: FittedModel) -> list[str]:
+    """The operating range the model was identified on, numbers only (one line per input
+    recorded, or one line saying none is recorded).
+
+    Raises
+    ------
+    DataError
+        A recorded range that is not two finite numbers with low <= high.
+    """
+    ranges = fitted.operating_range if isinstance(fitted.operating_range, dict) else {}
+    units = {"velocity": "rad/s", "load": "N m", "temperature": "degC"}
+    lines = []
+    for name, unit in units.items():
+        pair = operating_pair(fitted, name, ranges)
+        if pair is not None:
+            lo, hi = pair
+            lines.append(f"  {name} {fmt_float(lo)} to {fmt_float(hi)} {unit}")
+    if not lines:
+        return ["Operating range: not recorded in the model file."]
+    return ["Operating range of the identification data (SI units):", *lines]
+
+
+def operating_pair(
+    fitted: FittedModel, name: str, ranges: dict | None = None
+) -> tuple[float, float] | None:
+    """``(low, high)`` of one input's recorded operating range, validated; None if absent."""
+    if ranges is None:
+        ranges = fitted.operating_range if isinstance(fitted.operating_range, dict) else {}
+    pair = ranges.get(name)
+    if pair is None:
+        return None
+    column = f"operating_range.{name}"
+    if not isinstance(pair, list | tuple) or len(pair) != 2:
+        raise DataError(f"{column} must be [low, high]", column=column)
+    lo, hi = (float(fmt_float(x, column)) for x in pair)
+    if lo > hi:
+        raise DataError(f"{column} has low > high ({lo!r} > {hi!r})", column=column)
+    return lo, hi
+
+
+def write_lines_checked(lines: list[str], forbidden: tuple[str, ...]) -> list[str]:
+    """``lines`` unchanged, after checking that each is printable ASCII (so no line break of
+    any kind, no control character) without a ``forbidden`` sequence: a last guard, as
+    :func:`plain` already makes these impossible.
+
+    Raises
+    ------
+    ExportError
+        A line that fails the check (an internal error: a template is wrong).
+    """
+    for line in lines:
+        bad = [x for x in forbidden if x in line]
+        if bad or not (line.isascii() and line.isprintable()):
+            what = repr(bad[0]) if bad else "a character that is not printable ASCII"
+            raise ExportError(f"internal error: comment line {line!r} holds {what}")
+    return lines
+
+
+def ensure_out_file(path: str | os.PathLike[str]) -> Path:
+    """``path`` as a Path, refusing an existing directory (an export writes a file there)."""
+    path = Path(path)
+    if path.is_dir():
+        raise ExportError(f"--out {path} is a directory; give the file to write")
+    return path

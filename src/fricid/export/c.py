@@ -5,14 +5,21 @@
     double fricid_friction(double velocity, double load, double temperature);
 
 friction torque [N m] at velocity [rad/s], joint load [N m] and temperature [degC], the same
-function as :func:`fricid.export.smoothing.smooth_predict` (``FittedModel.predict`` without
+function as :func:`fricid.models.smoothing.smooth_predict` (``FittedModel.predict`` without
 smoothing). The code needs only ``<math.h>`` (link with ``-lm``), allocates nothing, keeps no
-state and does no I/O; every parameter is a ``static const double`` written with 17
-significant digits, so it reads back bit for bit. Every model family is supported: the
-analytic models (symmetric or per direction) and the RBF network.
+state and does no I/O; every parameter is a ``static const double`` written by
+:func:`fricid.export._common.fmt_float` (``repr``: reads back bit for bit; NaN and inf are
+refused). Every model family is supported: the analytic models (symmetric or per direction)
+and the RBF network.
 
 The expressions follow the Python models operation for operation, so the C function agrees
 with ``FittedModel.predict`` to a few units in the last place (tests check 1e-12 relative).
+
+Nothing from the model file is written as code: the header comment is the fixed-format
+summary of :func:`fricid.export._common.summary_lines` (registry name, SHA-256, numbers, and
+file text only through the escaper :func:`~fricid.export._common.plain`), followed by the
+operating range of the identification data. With ``clamp=True`` (``fricid export --clamp``)
+the function holds its inputs inside that range first (:mod:`fricid.export.clamp`).
 """
 
 from __future__ import annotations
@@ -28,13 +35,21 @@ import numpy as np
 from .. import __version__
 from ..fitted import FittedModel
 from ..models import Asymmetric
-from ._common import ExportError, describe_model, fmt_float
-from .smoothing import VISCOUS_TERM, Smoothing
+from ..models.smoothing import VISCOUS_TERM, Smoothing
+from ._common import (
+    ExportError,
+    check_identifier,
+    fmt_float,
+    plain,
+    range_lines,
+    summary_lines,
+    write_lines_checked,
+)
+from .clamp import clamp_code
 
 __all__ = ["CCode", "c_code", "export_c"]
 
 _TINY = 1e-12  # the guard of fricid.models._analytic
-_IDENT = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
 
 
 @dataclass(frozen=True)
@@ -116,8 +131,9 @@ def _analytic_parts(fitted: FittedModel, smoothing: Smoothing) -> tuple[list[str
             what = par.description + (
                 f" ({'positive' if side == 'pos' else 'negative'} direction)" if asym else ""
             )
+            key = f"{par.name}_{side}" if asym else par.name
             consts.append(
-                f"static const double {prefix}{par.name} = {fmt_float(params[par.name])};"
+                f"static const double {prefix}{par.name} = {fmt_float(params[par.name], key)};"
                 f"  /* [{par.unit}] {what} */"
             )
         p = {f"{name}_guard": f"fmax(fabs({prefix}{name}), {fmt_float(_TINY)})" for name in guarded}
@@ -143,7 +159,7 @@ def _analytic_parts(fitted: FittedModel, smoothing: Smoothing) -> tuple[list[str
     sign = (
         "(double)((velocity > 0.0) - (velocity < 0.0))"
         if smoothing.kind != "tanh"
-        else f"tanh(velocity / {fmt_float(smoothing.zone)})"
+        else f"tanh(velocity / {fmt_float(smoothing.zone, 'zone')})"
     )
 
     def term(side: str) -> str:
@@ -177,9 +193,12 @@ def _analytic_parts(fitted: FittedModel, smoothing: Smoothing) -> tuple[list[str
 def _array(name: str, values: np.ndarray, what: str) -> str:
     values = np.asarray(values, dtype=float)
     if values.ndim == 1:
-        body = ", ".join(fmt_float(x) for x in values)
+        body = ", ".join(fmt_float(x, f"{name}[{i}]") for i, x in enumerate(values))
         return f"static const double {name}[{values.size}] = {{{body}}};  /* {what} */"
-    rows = ",\n    ".join("{" + ", ".join(fmt_float(x) for x in row) + "}" for row in values)
+    rows = ",\n    ".join(
+        "{" + ", ".join(fmt_float(x, f"{name}[{i}][{j}]") for j, x in enumerate(row)) + "}"
+        for i, row in enumerate(values)
+    )
     return (
         f"static const double {name}[{values.shape[0]}][{values.shape[1]}] = {{\n    {rows}\n}};"
         f"  /* {what} */"
@@ -193,7 +212,7 @@ def _rbf_parts(fitted: FittedModel) -> tuple[list[str], list[str]]:
 
     state = fitted.state
     rbf.predict_state(state, np.zeros((1, 3)))  # validates the state (DataError if malformed)
-    inputs = list(state["inputs"])
+    inputs = [str(name) for name in state["inputs"]]  # validated: velocity, load, temperature
     shift = np.asarray(state["input_shift"], dtype=float)
     scale = np.asarray(state["input_scale"], dtype=float)
     centers = np.asarray(state["centers"], dtype=float)
@@ -212,11 +231,12 @@ def _rbf_parts(fitted: FittedModel) -> tuple[list[str], list[str]]:
         _array("rbf_cc", cc, "squared norm of each centre"),
         _array("rbf_inv", inv, "0.5 / sigma^2 of each neuron"),
         _array("rbf_weights", weights, "output weights [N m]"),
-        f"static const double rbf_bias = {fmt_float(bias)};  /* output bias [N m] */",
+        f"static const double rbf_bias = {fmt_float(bias, 'state.bias')};  /* output bias [N m] */",
     ]
     if vscale is not None:
         consts.append(
-            f"static const double rbf_velocity_scale = {fmt_float(float(vscale))};"
+            "static const double rbf_velocity_scale = "
+            f"{fmt_float(float(vscale), 'state.velocity_scale')};"
             "  /* [rad/s] velocity warped by asinh(v / scale) */"
         )
     raw = {"velocity": "velocity", "load": "load", "temperature": "temperature"}
@@ -254,7 +274,7 @@ def _rbf_parts(fitted: FittedModel) -> tuple[list[str], list[str]]:
 
 
 def _linear_zone(zone: float) -> str:
-    z = fmt_float(zone)
+    z = fmt_float(zone, "zone")
     return (
         f"    if (fabs(velocity) < {z}) {{\n"
         f"        const double fp = model({z}, load, temperature);\n"
@@ -264,31 +284,55 @@ def _linear_zone(zone: float) -> str:
     )
 
 
+def _comment(lines: list[str]) -> str:
+    """A C block comment of ``lines`` (fixed text, numbers and escaped text only)."""
+    write_lines_checked(lines, ("*/", "/*", "??"))
+    return "/*\n" + "".join(f" * {line}".rstrip() + "\n" for line in lines) + " */\n"
+
+
 def c_code(
     fitted: FittedModel,
     smoothing: Smoothing | None = None,
     *,
     prefix: str = "fricid",
     source: str | None = None,
+    sha256: str | None = None,
+    clamp: bool = False,
 ) -> CCode:
     """C99 header and source for ``fitted`` (see the module docstring).
 
     Parameters
     ----------
-    fitted : any fitted model.
-    smoothing : near zero velocity (:mod:`fricid.export.smoothing`); default none.
-    prefix : C identifier; the function is ``<prefix>_friction`` in ``<prefix>_friction.h``
-        and ``.c`` (change it to link several joints into one program).
-    source : the model file's name, for the comment.
+    fitted : FittedModel
+        Any fitted model.
+    smoothing : Smoothing, optional
+        Near zero velocity (:mod:`fricid.models.smoothing`); default none.
+    prefix : str
+        A C identifier (``[A-Za-z][A-Za-z0-9_]*``); the function is ``<prefix>_friction`` in
+        ``<prefix>_friction.h`` and ``.c`` (change it to link several joints into one program).
+    source : str, optional
+        The model file's name, for the comment (escaped).
+    sha256 : str, optional
+        SHA-256 of the model file's bytes (:func:`fricid.export._common.file_sha256`); without
+        it the comment gives the SHA-256 of the model's canonical JSON.
+    clamp : bool
+        Hold the inputs inside the model's operating range (module docstring).
+
+    Returns
+    -------
+    CCode
+        The header and source texts and their file names.
 
     Raises
     ------
     ExportError
-        A model family without a C template, tanh smoothing of the RBF network, a bad prefix.
+        A model family without a C template, tanh smoothing of the RBF network, a bad prefix,
+        ``clamp`` without a recorded operating range.
+    DataError
+        A non-finite number in the model (named), a malformed RBF state or operating range.
     """
     smoothing = smoothing or Smoothing()
-    if not _IDENT.match(prefix):
-        raise ExportError(f"prefix {prefix!r} is not a C identifier ([A-Za-z_][A-Za-z0-9_]*)")
+    check_identifier(prefix)
     if smoothing.kind == "tanh" and fitted.kind == "rbf":
         raise ExportError(
             "tanh smoothing replaces sign(v) in an analytic model; the RBF network has no sign "
@@ -300,14 +344,24 @@ def c_code(
     function = f"{prefix}_friction"
     guard = f"{prefix.upper()}_FRICTION_H"
     header_name, source_name = f"{function}.h", f"{function}.c"
+    if clamp:
+        clamp_notes, clamp_body = clamp_code(fitted)
+    else:
+        clamp_notes = [
+            "Inputs are not clamped: outside the operating range the model extrapolates "
+            "(export with --clamp to hold them inside)."
+        ]
+        clamp_body = ""
     about = [
-        f"Generated by fricid {__version__}; do not edit (re-export the model instead).",
-        *describe_model(fitted, source),
+        f"Generated by fricid {plain(__version__)}; do not edit (re-export the model instead).",
+        *summary_lines(fitted, source, sha256),
         "Units (SI): velocity [rad/s], load [N m], temperature [degC], friction [N m].",
         f"Smoothing near zero velocity: {smoothing.describe()}.",
+        *range_lines(fitted),
+        *clamp_notes,
         "Real-time safe: no allocation, no state, no I/O; needs only libm (link with -lm).",
     ]
-    comment = "/*\n" + "".join(f" * {line}\n" for line in about) + " */\n"
+    comment = _comment(about)
     header = (
         comment + f"#ifndef {guard}\n#define {guard}\n\n"
         '#ifdef __cplusplus\nextern "C" {\n#endif\n\n'
@@ -328,6 +382,7 @@ def c_code(
         + "\n\n"
         + "\n".join(funcs)
         + f"\ndouble {function}(double velocity, double load, double temperature)\n{{\n"
+        + clamp_body
         + body
         + "}\n"
     )
@@ -341,21 +396,28 @@ def export_c(
     *,
     prefix: str = "fricid",
     source: str | None = None,
+    sha256: str | None = None,
+    clamp: bool = False,
 ) -> list[Path]:
     """Write ``<prefix>_friction.h`` and ``.c`` into ``out_dir`` (created if missing).
 
-    Both files are generated before anything is written, then each is written atomically, so
-    an error leaves nothing half-written. Returns the paths written.
+    Parameters are those of :func:`c_code`. Both files are generated before anything is
+    written, then written through :func:`fricid.io.atomic.atomic_write` (each to a temporary
+    file, both renamed only after both are complete), so an error leaves nothing
+    half-written. Returns the paths written.
     """
     from ..io.atomic import atomic_write
 
-    code = c_code(fitted, smoothing, prefix=prefix, source=source)
+    code = c_code(fitted, smoothing, prefix=prefix, source=source, sha256=sha256, clamp=clamp)
     out = Path(out_dir)
     if out.exists() and not out.is_dir():
         raise ExportError(
             f"--out {out} exists and is not a directory (the C export writes two files)"
         )
     paths = [out / code.header_name, out / code.source_name]
+    for path in paths:
+        if path.is_dir():
+            raise ExportError(f"{path} is a directory; the C export writes a file there")
     with atomic_write(paths[0]) as fh_h, atomic_write(paths[1]) as fh_c:
         fh_h.write(code.header)
         fh_c.write(code.source)

@@ -12,10 +12,22 @@ from __future__ import annotations
 
 import os
 import re
+import xml.etree.ElementTree as ET
 from pathlib import Path
 
+import yaml
+
 from ..fitted import FittedModel
-from ._common import ExportError, describe_model, fmt_float
+from ._common import (
+    ExportError,
+    check_name,
+    ensure_out_file,
+    fmt_float,
+    model_name,
+    plain,
+    summary_lines,
+    write_lines_checked,
+)
 from .projection import Projection, project
 
 __all__ = [
@@ -31,16 +43,27 @@ __all__ = [
 #: Default tolerance of a projection: RMS error / RMS friction over the operating range.
 DEFAULT_MAX_LOSS = 0.5
 
-_NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_./-]*$")
+_JOINT = re.compile(r"[A-Za-z_][A-Za-z0-9_./-]{0,127}")
+_NODE = re.compile(r"[A-Za-z_][A-Za-z0-9_]{0,127}")
 
 
-def _check_name(joint: str) -> str:
-    if not _NAME.match(joint):
-        raise ExportError(
-            f"joint name {joint!r} must start with a letter or '_' and hold only letters, "
-            "digits and _ . / -"
-        )
-    return joint
+def _check_joint(joint: str) -> str:
+    return check_name(
+        joint,
+        "joint name",
+        _JOINT,
+        "start with a letter or '_' and hold only letters, digits and _ . / - "
+        "(at most 128 characters)",
+    )
+
+
+def _check_node(node: str) -> str:
+    return check_name(
+        node,
+        "ROS 2 node name",
+        _NODE,
+        "start with a letter or '_' and hold only letters, digits and _ (at most 128 characters)",
+    )
 
 
 def _checked(
@@ -50,7 +73,7 @@ def _checked(
     if not proj.relative_error <= max_loss:
         lost = "; ".join(proj.lost) or "the model's shape"
         raise ExportError(
-            f"{target} cannot represent model '{fitted.model}' within the tolerance: its "
+            f"{target} cannot represent model '{model_name(fitted)}' within the tolerance: its "
             f"Coulomb-viscous projection misses it by {100 * proj.relative_error:.3g} % RMS "
             f"(max {proj.max_error:.4g} N m at {proj.max_at[0]:.4g} rad/s; tolerance "
             f"{100 * max_loss:.3g} %). Lost: {lost}. Export to C for the full model, or raise "
@@ -59,9 +82,20 @@ def _checked(
     return proj
 
 
-def _xml_comment(lines: list[str]) -> str:
-    body = "\n".join("     " + line.replace("--", "- -") for line in lines)
-    return "<!--\n" + body + "\n-->\n"
+def _xml(lines: list[str], element: ET.Element) -> str:
+    """An XML comment of ``lines``, then ``element``, both serialised by ElementTree.
+
+    ``lines`` hold fixed text, numbers and :func:`~fricid.export._common.plain` text only;
+    the check refuses ``--`` (which would end or invalidate the comment) as a last guard.
+    """
+    write_lines_checked(lines, ("--",))
+    comment = ET.Comment("\n" + "".join(f"     {line}\n" for line in lines))
+    return (
+        ET.tostring(comment, encoding="unicode")
+        + "\n"
+        + ET.tostring(element, encoding="unicode")
+        + "\n"
+    )
 
 
 def urdf_text(
@@ -70,23 +104,32 @@ def urdf_text(
     *,
     max_loss: float = DEFAULT_MAX_LOSS,
     source: str | None = None,
+    sha256: str | None = None,
     **ranges,
 ) -> str:
     """A URDF ``<dynamics damping= friction=/>`` element for the joint, with a comment.
 
     URDF ``friction`` is the Coulomb friction [N m] and ``damping`` the viscous coefficient
-    [N m s/rad]; both from the projection over the operating range.
+    [N m s/rad]; both from the projection over the operating range. ``source`` and
+    ``sha256`` name the model file in the comment
+    (:func:`fricid.export._common.summary_lines`); ``ranges`` override the operating range
+    (:func:`fricid.export.project`). The text is built with :mod:`xml.etree.ElementTree`.
     """
+    name = _check_joint(joint)
     proj = _checked(fitted, "URDF <dynamics>", False, max_loss, ranges)
     lines = [
-        *describe_model(fitted, source),
+        *summary_lines(fitted, source, sha256),
         *proj.summary(),
-        f'place inside <joint name="{_check_name(joint)}">; friction [N m], damping [N m s/rad]',
+        f"place inside the joint named {plain(name)}; friction [N m], damping [N m s/rad]",
     ]
-    return (
-        _xml_comment(lines) + f'<dynamics damping="{fmt_float(proj.viscous["both"])}" '
-        f'friction="{fmt_float(proj.coulomb["both"])}"/>\n'
+    element = ET.Element(
+        "dynamics",
+        {
+            "damping": fmt_float(proj.viscous["both"], "damping"),
+            "friction": fmt_float(proj.coulomb["both"], "friction"),
+        },
     )
+    return _xml(lines, element)
 
 
 def mjcf_text(
@@ -95,24 +138,31 @@ def mjcf_text(
     *,
     max_loss: float = DEFAULT_MAX_LOSS,
     source: str | None = None,
+    sha256: str | None = None,
     **ranges,
 ) -> str:
     """An MJCF ``<joint frictionloss= damping=/>`` element, with a comment.
 
     MuJoCo's ``frictionloss`` is the Coulomb (dry) friction [N m] and ``damping`` the viscous
-    coefficient [N m s/rad]; copy both attributes onto the joint of your model.
+    coefficient [N m s/rad]; copy both attributes onto the joint of your model. Other
+    arguments as for :func:`urdf_text`.
     """
+    name = _check_joint(joint)
     proj = _checked(fitted, "MJCF frictionloss/damping", False, max_loss, ranges)
     lines = [
-        *describe_model(fitted, source),
+        *summary_lines(fitted, source, sha256),
         *proj.summary(),
         "copy frictionloss [N m] and damping [N m s/rad] onto your <joint>",
     ]
-    return (
-        _xml_comment(lines) + f'<joint name="{_check_name(joint)}" '
-        f'frictionloss="{fmt_float(proj.coulomb["both"])}" '
-        f'damping="{fmt_float(proj.viscous["both"])}"/>\n'
+    element = ET.Element(
+        "joint",
+        {
+            "name": name,
+            "frictionloss": fmt_float(proj.coulomb["both"], "frictionloss"),
+            "damping": fmt_float(proj.viscous["both"], "damping"),
+        },
     )
+    return _xml(lines, element)
 
 
 def ros2_yaml_text(
@@ -122,37 +172,45 @@ def ros2_yaml_text(
     node: str = "friction_compensation",
     max_loss: float = DEFAULT_MAX_LOSS,
     source: str | None = None,
+    sha256: str | None = None,
     **ranges,
 ) -> str:
     """A ROS 2 parameter file with per-direction Coulomb and viscous friction of the joint.
 
     The compensating torque is ``coulomb_positive + viscous_positive v`` for ``v > 0`` and
     ``-coulomb_negative + viscous_negative v`` for ``v < 0`` (``coulomb_*`` are magnitudes
-    [N m], ``viscous_*`` in N m s/rad), under ``<node>: ros__parameters: <joint>:``.
+    [N m], ``viscous_*`` in N m s/rad), under ``<node>: ros__parameters: <joint>:``. The
+    document is written by :func:`yaml.safe_dump` under ``#`` comment lines; ``node`` must
+    be a plain ROS 2 node name. Other arguments as for :func:`urdf_text`.
     """
+    name = _check_joint(joint)
+    node = _check_node(node)
+    if name == "joints":
+        raise ExportError("joint name 'joints' is taken by the list of joints in the YAML")
     proj = _checked(fitted, "the per-direction Coulomb-viscous YAML", True, max_loss, ranges)
-    name = _check_name(joint)
     lines = [
-        *describe_model(fitted, source),
+        *summary_lines(fitted, source, sha256),
         *proj.summary(),
         "tau_ff = coulomb_positive + viscous_positive * v (v > 0); "
         "-coulomb_negative + viscous_negative * v (v < 0)",
         "units: coulomb_* [N m] (magnitudes), viscous_* [N m s/rad], velocity [rad/s]",
     ]
-    head = "".join(f"# {line}\n" for line in lines)
+    write_lines_checked(lines, ())
     c, b = proj.coulomb, proj.viscous
-    return head + (
-        f"{node}:\n"
-        "  ros__parameters:\n"
-        f"    joints: [{name}]\n"
-        f"    {name}:\n"
-        f"      coulomb_positive: {fmt_float(c['positive'])}\n"
-        f"      coulomb_negative: {fmt_float(c['negative'])}\n"
-        f"      viscous_positive: {fmt_float(b['positive'])}\n"
-        f"      viscous_negative: {fmt_float(b['negative'])}\n"
-        f"      projection_rms_error: {fmt_float(proj.rms_error)}\n"
-        f"      source_model: {fitted.model}\n"
-    )
+    values = {
+        "coulomb_positive": c["positive"],
+        "coulomb_negative": c["negative"],
+        "viscous_positive": b["positive"],
+        "viscous_negative": b["negative"],
+        "projection_rms_error": proj.rms_error,
+    }
+    joint_params: dict[str, object] = {
+        key: float(fmt_float(value, key)) for key, value in values.items()
+    }
+    joint_params["source_model"] = model_name(fitted)
+    doc = {node: {"ros__parameters": {"joints": [name], name: joint_params}}}
+    body = yaml.safe_dump(doc, sort_keys=False, default_flow_style=False, allow_unicode=False)
+    return "".join(f"# {line}\n" for line in lines) + body
 
 
 #: The description targets, by name, with their text builder.
@@ -175,7 +233,7 @@ def write_text(text: str, path: str | os.PathLike[str]) -> Path:
     """Write ``text`` to ``path`` atomically (nothing half-written on failure)."""
     from ..io.atomic import atomic_write
 
-    path = Path(path)
+    path = ensure_out_file(path)
     with atomic_write(path, "w") as fh:
         fh.write(text)
     return path

@@ -26,8 +26,9 @@ from typing import Any
 import numpy as np
 from scipy.optimize import nnls
 
+from ..errors import DataError
 from ..fitted import FittedModel
-from ._common import ExportError
+from ._common import ExportError, model_name
 
 __all__ = ["N_LEVELS", "N_VELOCITY", "Projection", "operating_grid", "project"]
 
@@ -162,11 +163,11 @@ def _lost(
     inputs = _inputs(fitted)
     if fitted.kind == "rbf":
         lost.append("the RBF network's shape (only F_c and b remain)")
-    elif fitted.model.split("_asym")[0] != "coulomb_viscous":
+    elif model_name(fitted).split("_asym")[0] != "coulomb_viscous":
         v = X[:, 0]
         slow = np.abs(v) == np.abs(v).min()
         lost.append(
-            f"the velocity shape of '{fitted.model}' (e.g. the Stribeck break-away: "
+            f"the velocity shape of '{model_name(fitted)}' (e.g. the Stribeck break-away: "
             f"{np.abs(F[slow]).max():.4g} N m at the lowest speed {np.abs(v).min():.4g} rad/s)"
         )
     for name in ("load", "temperature"):
@@ -207,6 +208,13 @@ def project(
     """
     X, info = operating_grid(fitted, velocity_range, load_range, temperature_range)
     F = fitted.predict(X)
+    if not np.isfinite(F).all():
+        k = int(np.argmin(np.isfinite(F)))
+        raise DataError(
+            f"model '{model_name(fitted)}' gives a non-finite friction ({F[k]!r}) at velocity "
+            f"{X[k, 0]!r} rad/s, load {X[k, 1]!r} N m, temperature {X[k, 2]!r} degC of its "
+            "operating range; it cannot be projected"
+        )
     v = X[:, 0]
     s = np.sign(v)
     pos = v > 0
