@@ -1,8 +1,9 @@
 """The optimiser API, shaped after ``scipy.optimize.minimize`` (DESIGN.md, "Optimiser API").
 
 ``minimize(fun, bounds, method=..., seed=..., max_evals=..., options=..., callback=...)``
-dispatches to one solver class per method through :data:`METHODS`, and returns an
-:class:`OptimizeResult` (or a list of them with ``runs=N``).
+dispatches to one solver class per method through :data:`METHODS`, and returns one
+:class:`OptimizeResult`; :func:`minimize_runs` makes independent runs (batched where the method
+allows) and returns a list of them.
 
 Conventions every method honours:
 
@@ -21,7 +22,19 @@ Conventions every method honours:
   monotone (``nfev`` increasing, ``fun`` non-increasing).
 * Randomness comes only from ``seed`` (int or ``numpy.random.Generator``) through
   ``numpy.random.default_rng``; the integer seed used is recorded in the result.
-* ``runs=N`` makes N independent runs with seeds ``seed .. seed + N - 1``. Methods marked
+* ``status`` says why a run ended (:data:`STATUS_MESSAGES`): ``0`` converged (the method's
+  own convergence criterion, stated in its docstring, was met), ``1`` evaluation budget spent,
+  ``2`` stopped by the callback, ``4`` the method's iteration limit or schedule ended without
+  meeting its criterion; ``3`` (no finite value) is the status of a run whose objective
+  returned no finite value, which :func:`minimize` raises as :class:`ConfigError`.
+  ``success`` is ``status == 0``: converged, not merely finished. Per method: ``lm``/``trf``
+  converge when scipy's ``least_squares`` met ``ftol``, ``xtol`` or ``gtol`` in the start that
+  found the best point; ``de`` and ``dual_annealing`` when scipy reports success (DE only
+  with a ``tol`` or ``atol`` option above its default 0); the beetle family when its step
+  schedule ran to the end with a last step of at most ``xtol`` (unit-box units); ``ga`` when
+  its stall criterion (option ``stall``) fired; ``cmaes`` (without restarts) when cma stopped
+  on ``tolfun``, ``tolx`` or ``tolfunhist``; ``bas+lm`` when its ``lm`` polish converged.
+* :func:`minimize_runs` makes N independent runs with seeds ``seed .. seed + N - 1``. Methods marked
   ``batched`` advance all runs in lockstep and evaluate their candidates in one call of
   ``fun`` per iteration; each run's result is still bit-identical to running it alone with
   its seed, provided ``fun`` evaluates each row independently of the others (true of
@@ -36,15 +49,22 @@ Optimisers know nothing of friction: this package imports nothing of fricid but 
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Callable, Sequence
 from typing import Any, ClassVar
 
 import numpy as np
 
-from ..errors import ConfigError
+from ..errors import ConfigError, IgnoredArgumentWarning
 
 __all__ = [
+    "BUDGET",
+    "CALLBACK",
+    "CONVERGED",
+    "ITERATIONS",
     "METHODS",
+    "NO_FINITE",
+    "STATUS_MESSAGES",
     "Budget",
     "JitObjective",
     "Objective",
@@ -53,9 +73,32 @@ __all__ = [
     "check_bounds",
     "choice_option",
     "minimize",
+    "minimize_runs",
     "positive_option",
     "register",
 ]
+
+
+#: ``OptimizeResult.status``: the method's convergence criterion was met.
+CONVERGED = 0
+#: ``OptimizeResult.status``: the evaluation budget (``max_evals``) was spent.
+BUDGET = 1
+#: ``OptimizeResult.status``: the callback stopped the run.
+CALLBACK = 2
+#: Status of a run whose objective returned no finite value (raised as :class:`ConfigError`).
+NO_FINITE = 3
+#: ``OptimizeResult.status``: the method's iteration limit or schedule ended unconverged.
+ITERATIONS = 4
+
+#: The standard message of each status (``OptimizeResult.message`` starts with it, or, for
+#: the budget, names the budget).
+STATUS_MESSAGES: dict[int, str] = {
+    CONVERGED: "converged",
+    BUDGET: "evaluation budget spent",
+    CALLBACK: "stopped by the callback",
+    NO_FINITE: "no finite objective value",
+    ITERATIONS: "iteration limit reached without convergence",
+}
 
 
 def clip01(U: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
@@ -68,8 +111,10 @@ class OptimizeResult(dict):
     """The result of :func:`minimize`: a dict with attribute access (like scipy's).
 
     Keys: ``x`` (best point, in bounds), ``fun`` (its value), ``nfev``, ``nit``,
-    ``history`` ((m, 2): nfev, best-so-far fun), ``message``, ``success``, ``method``,
-    ``seed`` (the integer seed used, or None when a Generator was passed); methods may add more.
+    ``history`` ((m, 2): nfev, best-so-far fun), ``status`` (int, see
+    :data:`STATUS_MESSAGES`), ``message`` (starting with the status's standard message, or
+    naming the budget), ``success`` (``status == 0``: converged), ``method``, ``seed`` (the
+    integer seed used, or None when a Generator was passed); methods may add more.
     """
 
     def __getattr__(self, name: str) -> Any:
@@ -82,7 +127,7 @@ class OptimizeResult(dict):
     __delattr__ = dict.__delitem__  # type: ignore[assignment]
 
     def __repr__(self) -> str:
-        keys = ("method", "fun", "x", "nfev", "nit", "success", "message")
+        keys = ("method", "fun", "x", "nfev", "nit", "status", "success", "message")
         body = ", ".join(f"{k}={self[k]!r}" for k in keys if k in self)
         return f"OptimizeResult({body})"
 
@@ -279,8 +324,9 @@ class Solver:
     ``batched`` (True when :meth:`run` advances ``objective.runs`` runs in lockstep, drawing
     run ``r``'s random numbers from ``rngs[r]`` only), and implement :meth:`run`, which calls
     ``self.objective`` on unit-box batches until the budget raises :class:`Budget` or the
-    method ends by itself; it returns ``(nit, message)``. ``self.nit`` is kept current so an
-    interrupted run still reports its iterations.
+    method ends by itself; it returns ``(nit, message)`` and sets ``self.converged`` to True
+    when its stated convergence criterion was met (the result's ``status`` 0; otherwise 4).
+    ``self.nit`` is kept current so an interrupted run still reports its iterations.
     """
 
     name: str = ""
@@ -309,6 +355,7 @@ class Solver:
         self.x0 = x0
         self.residuals = residuals
         self.nit = 0
+        self.converged = False
         self.objective: Objective
         self.rngs: list[np.random.Generator] = []
         self.validate()
@@ -418,38 +465,47 @@ def choice_option(opts: dict[str, Any], name: str, method: str, choices: Sequenc
         raise ConfigError(f"option '{name}' of method '{method}' must be one of {shown}; got {v!r}")
 
 
-def _result(objective: Objective, r: int, nit: int, message: str, key: str, seed) -> OptimizeResult:
+def _result(
+    objective: Objective, r: int, nit: int, status: int, message: str, key: str, seed
+) -> OptimizeResult:
     best_f = float(objective.best_f[r])
     finite = np.isfinite(best_f)
     x = objective.to_x(objective.best_u[r]) if finite else np.full(objective.dim, np.nan)
+    if not finite:
+        status, message = NO_FINITE, STATUS_MESSAGES[NO_FINITE]
     return OptimizeResult(
         x=x,
         fun=best_f,
         nfev=objective.nfev,
         nit=nit,
         history=objective.history(r),
+        status=status,
         message=message,
-        success=bool(finite),
+        success=status == CONVERGED,
         method=key,
         seed=seed,
     )
 
 
-def _solve(solver: Solver, objective: Objective) -> tuple[int, str]:
+def _solve(solver: Solver, objective: Objective) -> tuple[int, int, str]:
+    """Run ``solver``; return ``(nit, status, message)``."""
     try:
-        nit, message = solver.run()
+        nit, detail = solver.run()
     except Budget:
         nit = solver.nit
         if objective.stopped_by_callback:
-            message = "stopped by the callback"
+            status, message = CALLBACK, STATUS_MESSAGES[CALLBACK]
         else:
-            message = f"evaluation budget of {objective.max_evals} spent"
+            status, message = BUDGET, f"evaluation budget of {objective.max_evals} spent"
+    else:
+        status = CONVERGED if solver.converged else ITERATIONS
+        message = f"{STATUS_MESSAGES[status]}: {detail}"
     if not np.isfinite(objective.best_f).any():
         raise ConfigError(
-            f"the objective returned NaN or inf for every one of the {objective.nfev} "
-            "candidates evaluated; check it and the bounds"
+            f"{STATUS_MESSAGES[NO_FINITE]}: the objective returned NaN or inf for every one "
+            f"of the {objective.nfev} candidates evaluated; check it and the bounds"
         )
-    return nit, message
+    return nit, status, message
 
 
 def minimize(
@@ -463,88 +519,55 @@ def minimize(
     callback: Callable[[OptimizeResult], Any] | None = None,
     x0=None,
     residuals: Callable[[np.ndarray], np.ndarray] | None = None,
-    runs: int | None = None,
-) -> OptimizeResult | list[OptimizeResult]:
-    """Minimise ``fun`` over the box ``bounds`` with ``method``.
+) -> OptimizeResult:
+    """Minimise ``fun`` over the box ``bounds`` with ``method``: one run.
 
     Parameters
     ----------
-    fun : callable ``(k, d) -> (k,)``, or None when ``residuals`` is given (then ``fun`` is
-        the sum of squared residuals).
-    bounds : sequence of ``(lower, upper)``, one pair per parameter.
-    method : a key of :data:`METHODS` (case-insensitive).
-    seed : int or ``numpy.random.Generator``; the same seed gives the same result bit for bit.
-    max_evals : budget in candidate evaluations per run (method's default when None).
-    options : method options; unknown names raise :class:`ConfigError` listing the known ones.
-    callback : called with an intermediate :class:`OptimizeResult` (``x``, ``fun``, ``nfev``,
-        ``nit``, and ``run`` with ``runs``) after each iteration; returning True or raising
-        ``StopIteration`` stops the run (every run of a lockstep batch).
-    x0 : optional starting point (methods that use one; every run starts there).
-    residuals : callable ``(k, d) -> (k, n)`` for least-squares methods.
-    runs : None for one run (returns an :class:`OptimizeResult`), or N >= 1 independent runs
-        with seeds ``seed .. seed + N - 1`` (returns a list of N results, each identical to
-        ``minimize(..., seed=seed + r)``). A Generator ``seed`` gives the base seed by one draw.
+    fun : callable or None
+        Batch objective ``(k, d) -> (k,)``, or None when ``residuals`` is given (then ``fun``
+        is the sum of squared residuals).
+    bounds : sequence of (float, float)
+        ``(lower, upper)``, one pair per parameter.
+    method : str
+        A key of :data:`METHODS` (case-insensitive).
+    seed : int or numpy.random.Generator, optional
+        The same seed gives the same result bit for bit; None draws one (recorded in the
+        result).
+    max_evals : int, optional
+        Budget in candidate evaluations (the method's default when None).
+    options : dict, optional
+        Method options; unknown names raise :class:`ConfigError` listing the known ones.
+    callback : callable, optional
+        Called with an intermediate :class:`OptimizeResult` (``x``, ``fun``, ``nfev``,
+        ``nit``) after each iteration; returning True or raising ``StopIteration`` stops the
+        run (status 2).
+    x0 : array_like, optional
+        Starting point, for the methods that use one.
+    residuals : callable, optional
+        Batch residuals ``(k, d) -> (k, n)`` for the least-squares methods (``lm``, ``trf``,
+        ``bas+lm``). Given to another method together with ``fun``, it is ignored with an
+        :class:`~fricid.errors.IgnoredArgumentWarning`.
 
     Returns
     -------
-    OptimizeResult, or a list of them with ``runs``.
+    OptimizeResult
+        The run's result; ``success`` is True only when the method converged (``status``
+        0; see the module notes for each method's criterion).
+
+    Raises
+    ------
+    ConfigError
+        Bad method, bounds, options, seed or budget, or an objective that returned no
+        finite value at all.
+
+    See Also
+    --------
+    minimize_runs : independent runs, batched where the method allows.
     """
-    key = str(method).strip().lower()
-    if key not in METHODS:
-        raise ConfigError(
-            f"unknown method '{method}'; choose one of: "
-            + "; ".join(f"{k} ({c.summary})" for k, c in METHODS.items())
-        )
-    cls = METHODS[key]
-    b = check_bounds(bounds)
-    if fun is None and residuals is None:
-        raise ConfigError("give an objective `fun`, or `residuals` for least squares")
-    if cls.uses_residuals and residuals is None:
-        raise ConfigError(f"method '{key}' ({cls.summary}) needs `residuals`")
-    if fun is None:
-        res_fun = residuals
-
-        def fun(X: np.ndarray) -> np.ndarray:
-            r = np.asarray(res_fun(X), dtype=float)
-            if r.ndim != 2 or r.shape[0] != X.shape[0]:
-                raise ConfigError(
-                    f"the residual function must return shape ({X.shape[0]}, n) for a batch of "
-                    f"{X.shape[0]} points; got {r.shape}"
-                )
-            return np.einsum("kn,kn->k", r, r)
-
-    if runs is not None and (
-        isinstance(runs, bool) or not isinstance(runs, int | np.integer) or runs < 1
-    ):
-        raise ConfigError(f"runs must be a positive integer or None; got {runs!r}")
-    if max_evals is not None and (
-        isinstance(max_evals, bool) or not isinstance(max_evals, int | np.integer) or max_evals < 1
-    ):
-        raise ConfigError(f"max_evals must be a positive integer; got {max_evals!r}")
-    if x0 is not None:
-        x0 = np.asarray(x0, dtype=float)
-        if x0.shape != (b.shape[0],):
-            raise ConfigError(f"x0 has shape {x0.shape}; the bounds give {b.shape[0]} parameters")
-        if not np.isfinite(x0).all() or np.any(x0 < b[:, 0]) or np.any(x0 > b[:, 1]):
-            raise ConfigError("x0 lies outside the bounds")
-    opts = dict(options or {})
-    solver = cls(opts, dim=b.shape[0], x0=x0, residuals=residuals)
-    budget = int(max_evals) if max_evals is not None else solver.default_budget()
-    rngs, seeds = _seeds(seed, None if runs is None else int(runs))
-    n = len(rngs)
-
-    results: list[OptimizeResult] = []
-    if cls.batched:
-        objective = Objective(fun, b, budget, callback, runs=n)
-        nit, message = _solve(solver.bind(objective, rngs), objective)
-        results = [_result(objective, r, nit, message, key, seeds[r]) for r in range(n)]
-    else:
-        for r in range(n):
-            one = solver if r == 0 else cls(opts, dim=b.shape[0], x0=x0, residuals=residuals)
-            objective = Objective(fun, b, budget, callback, runs=1)
-            nit, message = _solve(one.bind(objective, [rngs[r]]), objective)
-            results.append(_result(objective, 0, nit, message, key, seeds[r]))
-    return results[0] if runs is None else results
+    return _minimize(
+        fun, bounds, method, seed, max_evals, options, callback, x0, residuals, None, 3
+    )[0]
 
 
 def minimize_runs(
@@ -562,20 +585,96 @@ def minimize_runs(
 ) -> list[OptimizeResult]:
     """``runs`` independent runs of :func:`minimize`, batched where the method allows.
 
-    Run ``r`` uses seed ``seed + r`` and equals ``minimize(..., seed=seed + r)`` bit for bit.
-    Returns a list of ``runs`` :class:`OptimizeResult`.
+    Parameters
+    ----------
+    fun, bounds, method, max_evals, options, x0, residuals
+        As for :func:`minimize` (``max_evals`` is the budget of each run).
+    runs : int
+        Number of runs, at least 1.
+    seed : int or numpy.random.Generator, optional
+        Run ``r`` uses seed ``seed + r``; a Generator gives the base seed by one draw, None
+        draws one.
+    callback : callable, optional
+        As for :func:`minimize`; the intermediate result also has ``run`` (its index) when
+        ``runs > 1``. Stopping one run of a lockstep batch stops them all.
+
+    Returns
+    -------
+    list of OptimizeResult
+        One per run. Methods marked ``batched`` (bas, vsbas, ibas, rwsavsbas, ga) advance the
+        runs in lockstep with one objective call per iteration for all of them; each run's
+        result is still bit-identical to ``minimize(..., seed=seed + r)``, provided ``fun``
+        evaluates each row independently of the others (true of element-wise numpy code).
+        Other methods make the runs one after another.
     """
     if isinstance(runs, bool) or not isinstance(runs, int | np.integer) or runs < 1:
         raise ConfigError(f"runs must be a positive integer; got {runs!r}")
-    return minimize(
-        fun,
-        bounds,
-        method,
-        seed=seed,
-        max_evals=max_evals,
-        options=options,
-        callback=callback,
-        x0=x0,
-        residuals=residuals,
-        runs=int(runs),
+    return _minimize(
+        fun, bounds, method, seed, max_evals, options, callback, x0, residuals, int(runs), 3
     )
+
+
+def _minimize(
+    fun, bounds, method, seed, max_evals, options, callback, x0, residuals, runs, stacklevel
+) -> list[OptimizeResult]:
+    """The one implementation behind :func:`minimize` (``runs`` None) and
+    :func:`minimize_runs`; ``stacklevel`` points warnings at their caller."""
+    key = str(method).strip().lower()
+    if key not in METHODS:
+        raise ConfigError(
+            f"unknown method '{method}'; choose one of: "
+            + "; ".join(f"{k} ({c.summary})" for k, c in METHODS.items())
+        )
+    cls = METHODS[key]
+    b = check_bounds(bounds)
+    if fun is None and residuals is None:
+        raise ConfigError("give an objective `fun`, or `residuals` for least squares")
+    if cls.uses_residuals and residuals is None:
+        raise ConfigError(f"method '{key}' ({cls.summary}) needs `residuals`")
+    if residuals is not None and fun is not None and not cls.uses_residuals:
+        warnings.warn(
+            f"method '{key}' does not use `residuals`; it minimises `fun` (least-squares "
+            "methods: " + ", ".join(k for k, c in METHODS.items() if c.uses_residuals) + ")",
+            IgnoredArgumentWarning,
+            stacklevel=stacklevel,
+        )
+    if fun is None:
+        res_fun = residuals
+
+        def fun(X: np.ndarray) -> np.ndarray:
+            r = np.asarray(res_fun(X), dtype=float)
+            if r.ndim != 2 or r.shape[0] != X.shape[0]:
+                raise ConfigError(
+                    f"the residual function must return shape ({X.shape[0]}, n) for a batch of "
+                    f"{X.shape[0]} points; got {r.shape}"
+                )
+            return np.einsum("kn,kn->k", r, r)
+
+    if max_evals is not None and (
+        isinstance(max_evals, bool) or not isinstance(max_evals, int | np.integer) or max_evals < 1
+    ):
+        raise ConfigError(f"max_evals must be a positive integer; got {max_evals!r}")
+    if x0 is not None:
+        x0 = np.asarray(x0, dtype=float)
+        if x0.shape != (b.shape[0],):
+            raise ConfigError(f"x0 has shape {x0.shape}; the bounds give {b.shape[0]} parameters")
+        if not np.isfinite(x0).all() or np.any(x0 < b[:, 0]) or np.any(x0 > b[:, 1]):
+            raise ConfigError("x0 lies outside the bounds")
+    opts = dict(options or {})
+    solver = cls(opts, dim=b.shape[0], x0=x0, residuals=residuals)
+    budget = int(max_evals) if max_evals is not None else solver.default_budget()
+    rngs, seeds = _seeds(seed, runs)
+    n = len(rngs)
+
+    results: list[OptimizeResult] = []
+    if solver.batched:
+        objective = Objective(fun, b, budget, callback, runs=n)
+        nit, status, message = _solve(solver.bind(objective, rngs), objective)
+        results = [_result(objective, r, nit, status, message, key, seeds[r]) for r in range(n)]
+    else:
+        for r in range(n):
+            one = solver if r == 0 else cls(opts, dim=b.shape[0], x0=x0, residuals=residuals)
+            objective = Objective(fun, b, budget, callback, runs=1)
+            nit, status, message = _solve(one.bind(objective, [rngs[r]]), objective)
+            results.append(_result(objective, 0, nit, status, message, key, seeds[r]))
+    return results

@@ -7,8 +7,11 @@ scipy, so it runs in an unconstrained variable ``z`` with ``u = (sin z + 1) / 2`
 transformation lmfit uses), which keeps every candidate inside the box.
 
 Starts: the first at ``x0`` (or the box centre), the others uniform in the box from ``seed``;
-``n_starts`` of them, each given an equal share of the remaining budget, unless ``tol_stop``
-says the best start is good enough.
+``n_starts`` of them, each given an equal share of the remaining budget.
+
+Convergence: a run has converged (status 0) when the start that found the best point ended
+by scipy's own criterion (``ftol``, ``xtol`` or ``gtol``; scipy's ``status > 0``), not by its
+share of the budget.
 """
 
 from __future__ import annotations
@@ -74,7 +77,9 @@ class _LeastSquares(Solver):
         starts = self._starts()
         fun = self._residual_fun()
         messages = []
+        self.converged = False
         for i, u0 in enumerate(starts):
+            before = float(obj.best_f[0])
             share = max(obj.remaining // (len(starts) - i), 1)
             if obj.remaining < 1:
                 break
@@ -91,6 +96,8 @@ class _LeastSquares(Solver):
                     x_scale=1.0,
                 )
                 messages.append(sol.message)
+                if float(obj.best_f[0]) < before:  # this start found the best point so far
+                    self.converged = sol.status > 0
             except Budget:
                 self.nit = i + 1
                 raise
