@@ -11,7 +11,8 @@ Starts: the first at ``x0`` (or the box centre), the others uniform in the box f
 
 Convergence: a run has converged (status 0) when the start that found the best point ended
 by scipy's own criterion (``ftol``, ``xtol`` or ``gtol``; scipy's ``status > 0``), not by its
-share of the budget.
+share of the budget; a later start that runs out of the budget then ends the run without
+changing that (the message says so). Otherwise the status is that of the budget.
 """
 
 from __future__ import annotations
@@ -96,11 +97,18 @@ class _LeastSquares(Solver):
                     x_scale=1.0,
                 )
                 messages.append(sol.message)
-                if float(obj.best_f[0]) < before:  # this start found the best point so far
+                if float(sol.fun @ sol.fun) <= float(obj.best_f[0]):  # its end is the best
                     self.converged = sol.status > 0
             except Budget:
                 self.nit = i + 1
-                raise
+                if float(obj.best_f[0]) < before:  # the best is this unfinished start's
+                    self.converged = False
+                if obj.stopped_by_callback or not self.converged:
+                    raise
+                return self.nit, (
+                    f"the best start converged; the budget of {obj.max_evals} was spent in "
+                    f"start {i + 1} of {len(starts)}"
+                )
             except ValueError as exc:  # scipy's own input checks (e.g. fewer residuals than d)
                 raise ConfigError(f"method '{self.name}': {exc}") from None
             self.nit = i + 1
