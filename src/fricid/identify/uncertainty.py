@@ -3,8 +3,14 @@
 The covariance is ``s^2 (J^T J)^+`` with ``s^2 = SSE / (n - p)`` and the pseudo-inverse taken
 through the singular value decomposition of ``J`` itself (never ``J^T J``, which would square
 its condition number), dropping singular values below ``eps * max(J.shape) * s[0]`` (scipy's
-``curve_fit``). A parameter whose direction is not in the span that is kept (it moves along
-a direction the data cannot see) is *not determined*: its standard error is NaN.
+``curve_fit``). ``J``'s columns are scaled to unit length first (as MINPACK scales its
+variables), so that the cut-off measures collinearity, not the parameters' units; the
+covariance is scaled back (for a full-rank ``J`` this is exactly ``s^2 (J^T J)^-1``).
+
+A parameter is *not determined* (standard error NaN) when its direction is not within the
+span of the singular vectors whose singular values exceed :data:`DETERMINED_RCOND` times the
+largest: a finite-difference Jacobian is accurate to about 1e-9 relative, so a direction the
+data cannot see shows a singular value of that size rather than one below scipy's cut-off.
 """
 
 from __future__ import annotations
@@ -16,8 +22,10 @@ import numpy as np
 __all__ = ["covariance_svd", "jacobian", "jacobian_uncertainty"]
 
 #: A parameter counts as determined when at least ``1 - DETERMINED_TOL`` of its unit vector's
-#: squared length lies in the span of the kept right singular vectors.
+#: squared length lies in the span of the right singular vectors (of the column-scaled
+#: Jacobian) with singular values above ``DETERMINED_RCOND * s[0]``.
 DETERMINED_TOL = 1e-6
+DETERMINED_RCOND = 1e-6
 
 
 def jacobian(
@@ -53,13 +61,15 @@ def covariance_svd(J: np.ndarray, s2: float) -> tuple[np.ndarray, np.ndarray]:
     p = J.shape[1]
     if not np.isfinite(J).all():
         return np.full((p, p), np.nan), np.zeros(p, dtype=bool)
-    _, s, VT = np.linalg.svd(J, full_matrices=False)
+    norms = np.linalg.norm(J, axis=0)
+    norms[norms == 0] = 1.0  # a parameter without effect: a zero column, singular value 0
+    _, s, VT = np.linalg.svd(J / norms, full_matrices=False)
     if s.size == 0 or s[0] == 0:
         return np.full((p, p), np.nan), np.zeros(p, dtype=bool)
     keep = s > np.finfo(float).eps * max(J.shape) * s[0]
-    s, VT = s[keep], VT[keep]
-    cov = s2 * (VT.T / s**2) @ VT
-    determined = np.sum(VT**2, axis=0) >= 1.0 - DETERMINED_TOL
+    cov = s2 * ((VT[keep].T / s[keep] ** 2) @ VT[keep]) / np.outer(norms, norms)
+    seen = VT[s > DETERMINED_RCOND * s[0]]
+    determined = np.sum(seen**2, axis=0) >= 1.0 - DETERMINED_TOL
     cov[~determined, :] = np.nan
     cov[:, ~determined] = np.nan
     return cov, determined
