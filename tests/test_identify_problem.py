@@ -253,3 +253,11 @@ def test_fitted_model_dispatches_prediction_through_the_model_registry(monkeypat
     assert not hasattr(fricid.models, "RBFNetRegressor")
     with pytest.raises(ConfigError, match="unknown model"):
         get_predictor("nope")
+
+
+def test_problem_docstring_example_runs():
+    import doctest
+
+    import fricid.identify.problem as module
+
+    assert doctest.testmod(module).failed == 0

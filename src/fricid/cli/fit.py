@@ -97,8 +97,11 @@ def fit_command(
 ) -> None:
     """Identify a friction model from samples and write it as a JSON model file.
 
-    Prints the fit report: parameters with standard errors and 95 % confidence intervals,
-    fitness (R^2), SSE, RMSE [N m], RMSPE, mean and max absolute error [N m].
+    Prints the fit report (after lmfit's): method, evaluations and convergence status; data
+    points, variables, chi-square (SSE [N m^2]), reduced chi-square, AIC, BIC, R^2; each
+    parameter with its standard error, 95 % confidence interval and start, flagged at a
+    boundary, at its initial value or not determined; correlations above 0.1. The RBF network
+    (--model rbf) goes through the same identification and prints its network instead.
     """
     from ..identify import fit
     from ..io import read_samples

@@ -86,7 +86,7 @@ class IdentificationProblem:
     >>> problem.free_names
     ['f_c', 'beta']
     >>> problem.evaluate(np.array([[0.3, 0.1], [0.3, 0.0]])).round(4)
-    array([0.    , 0.0255])
+    array([0.    , 0.0202])
     """
 
     def __init__(
