@@ -30,23 +30,6 @@ from .uncertainty import jacobian_uncertainty
 __all__ = ["evaluate", "fit"]
 
 
-def _check_directions(samples: FrictionSamples, model: FrictionModel) -> None:
-    dirs = set(samples.directions())
-    if model.is_asymmetric:
-        if 0 in dirs:
-            raise ConfigError(
-                f"model '{model.name}' has parameters per direction, but the samples combine "
-                "both directions (eq. 11); extract per-direction samples or fit the symmetric "
-                "model"
-            )
-        if not {-1, 1} <= dirs:
-            only = "positive" if 1 in dirs else "negative"
-            raise ConfigError(
-                f"model '{model.name}' has parameters per direction, but the samples hold the "
-                f"{only} direction only"
-            )
-
-
 def _provenance(samples: FrictionSamples) -> dict[str, Any]:
     return {
         "source": samples.source,
@@ -152,7 +135,6 @@ def fit(
             stacklevel=2,
         )
     model = get_model(model)
-    _check_directions(samples, model)
     problem = IdentificationProblem(model, samples, loss="sse", bounds=bounds, fixed=fixed)
     X, y = problem.X, problem.y
     if problem.n_obs < problem.n_free:

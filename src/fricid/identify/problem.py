@@ -27,6 +27,23 @@ __all__ = ["LOSSES", "IdentificationProblem", "Predictor"]
 LOSSES = ("sse", "mse")
 
 
+def _check_directions(samples: FrictionSamples, model: Any) -> None:
+    """A model with parameters per direction needs samples of each direction, not combined."""
+    dirs = set(samples.directions())
+    if 0 in dirs:
+        raise ConfigError(
+            f"model '{model.name}' has parameters per direction, but the samples combine "
+            "both directions (eq. 11); extract per-direction samples or fit the symmetric "
+            "model"
+        )
+    if not {-1, 1} <= dirs:
+        only = "positive" if 1 in dirs else "negative"
+        raise ConfigError(
+            f"model '{model.name}' has parameters per direction, but the samples hold the "
+            f"{only} direction only"
+        )
+
+
 class Predictor(Protocol):
     """What a problem needs of a model: a batch prediction ``(k, p), X -> (k, n)``."""
 
@@ -44,7 +61,9 @@ class IdentificationProblem:
         (then ``bounds`` must be the ``(p, 2)`` array and nothing can be fixed).
     samples : FrictionSamples or tuple of (ndarray, ndarray)
         The data: velocity, load, temperature, friction and direction from
-        :class:`~fricid.samples.FrictionSamples`, or ``(X, y)`` arrays for a generic model.
+        :class:`~fricid.samples.FrictionSamples` (a model with parameters per direction
+        needs samples of both directions, each apart: RWSAVSBAS paper eq. 11), or ``(X, y)``
+        arrays for a generic model.
     loss : {"sse", "mse"}, default "sse"
         See :data:`LOSSES`.
     bounds : mapping of str to (float, float), or array_like (p, 2), optional
@@ -103,6 +122,8 @@ class IdentificationProblem:
         if isinstance(samples, FrictionSamples):
             self.samples: FrictionSamples | None = samples
             X, y = samples.X, samples.y
+            if getattr(model, "is_asymmetric", False):
+                _check_directions(samples, model)
         else:
             self.samples = None
             X, y = samples
