@@ -206,6 +206,7 @@ def test_identify_fit_rbf_equals_fit_rbf():
     c = fit(s, "rbf", "bas", seed=3, max_evals=60, network={"n_centers": 6, "target_mse": None})
     d = fit_rbf(s, n_centers=6, trainer="bas", random_state=3, max_epochs=2, target_mse=None)
     assert c.method == "bas/hybrid" and c.state == d.state and c.nfev == d.nfev == 60
+    assert c.status == 1 and "budget" in c.message and a.status is None
     assert c.statistics["ndata"] == 120 and c.statistics["nvarys"] == 6 * 3 + 6 + 6 + 1
 
 

@@ -129,6 +129,10 @@ class RBFNetRegressor(RegressorMixin, BaseEstimator):
         Epochs run (0 for ``lsq``).
     n_evals_ : int
         Candidate networks evaluated (0 for ``lsq``).
+    status_, message_ : int or None, str
+        The optimiser's ``status`` and ``message`` (``fricid.optim.OptimizeResult``; 2,
+        "stopped by the callback", when the target MSE was reached); None and "" for ``lsq``
+        or a start that already met the target.
     epochs_to_target_ : int or None
         First epoch whose best MSE reached ``target_mse`` (0 if the start already did);
         None if it was not reached or there was no target.
@@ -304,6 +308,7 @@ class RBFNetRegressor(RegressorMixin, BaseEstimator):
 
         self.n_epochs_ = 0
         self.n_evals_ = 0
+        self.status_, self.message_ = None, ""
         self.mse_history_ = np.empty(0)
         self.initial_mse_ = mse0
         if trainer == "lsq":

@@ -214,6 +214,7 @@ def search_network(est: Any, method: str, Z: np.ndarray, t: np.ndarray, start: N
     est.mse_history_ = history
     est.n_epochs_ = n_epochs
     est.n_evals_ = nfev
+    est.status_, est.message_ = int(res.status), str(res.message)
     reached = np.flatnonzero(history <= target) if target is not None else np.empty(0)
     est.epochs_to_target_ = int(reached[0]) + 1 if reached.size else None
 

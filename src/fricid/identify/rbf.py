@@ -152,6 +152,8 @@ def to_fitted_model(
         method=trainer if trainer == "lsq" else f"{trainer}/{estimator.encoding}",
         seed=int(rs) if isinstance(rs, Integral) else None,
         nfev=int(estimator.n_evals_),
+        status=estimator.status_,
+        message=estimator.message_,
         history=history,
         operating_range={
             name: [float(X[:, INPUTS.index(name)].min()), float(X[:, INPUTS.index(name)].max())]
