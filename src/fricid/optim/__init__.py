@@ -32,15 +32,8 @@ from . import (  # noqa: F401  (each registers its methods)
     _scipy_global,
     _vsbas,
 )
-from ._api import (
-    METHODS,
-    STATUS_MESSAGES,
-    JitObjective,
-    OptimizeResult,
-    check_bounds,
-    minimize,
-    minimize_runs,
-)
+from ._api import METHODS, STATUS_MESSAGES, JitObjective, OptimizeResult, check_bounds
+from ._minimize import minimize, minimize_runs
 
 __all__ = [
     "METHODS",
