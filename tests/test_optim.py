@@ -9,8 +9,15 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from fricid.errors import ConfigError
-from fricid.optim import METHODS, JitObjective, OptimizeResult, minimize
+from fricid.errors import ConfigError, IgnoredArgumentWarning
+from fricid.optim import (
+    METHODS,
+    STATUS_MESSAGES,
+    JitObjective,
+    OptimizeResult,
+    minimize,
+    minimize_runs,
+)
 
 C4 = np.array([1.2, -0.7, 0.3, 2.1])
 B4 = [(-5.0, 5.0)] * 4
@@ -66,10 +73,15 @@ def test_every_method_is_covered() -> None:
         assert cls.summary and "\n" not in cls.summary
 
 
+def _res(method: str, residuals=sphere_res):
+    """``residuals`` for the least-squares methods, None for the others (which would warn)."""
+    return residuals if METHODS[method].uses_residuals else None
+
+
 def _run(method, fun=sphere, bounds=B4, seed=3, **kw) -> OptimizeResult:
     opts, evals = SMALL[method]
     kw.setdefault("max_evals", evals)
-    return minimize(fun, bounds, method, seed=seed, options=opts, residuals=sphere_res, **kw)
+    return minimize(fun, bounds, method, seed=seed, options=opts, residuals=_res(method), **kw)
 
 
 @pytest.mark.parametrize("method", list(SMALL))
@@ -95,7 +107,9 @@ def test_bounds_never_left_nfev_exact_history_monotone(method: str) -> None:
         return sphere_res(X)
 
     opts, evals = SMALL[method]
-    r = minimize(fun, bounds, method, seed=1, max_evals=evals, options=opts, residuals=res)
+    r = minimize(
+        fun, bounds, method, seed=1, max_evals=evals, options=opts, residuals=_res(method, res)
+    )
     X = np.vstack(seen)
     assert np.all(lo <= X) and np.all(hi >= X)
     assert np.all(r.x >= lo) and np.all(r.x <= hi)
@@ -105,7 +119,8 @@ def test_bounds_never_left_nfev_exact_history_monotone(method: str) -> None:
     assert h.shape[1] == 2 and len(h) >= 1
     assert np.all(np.diff(h[:, 0]) > 0) and np.all(np.diff(h[:, 1]) <= 0)
     assert h[-1, 0] == r.nfev and h[-1, 1] == r.fun
-    assert r.success and np.isfinite(r.fun)
+    assert np.isfinite(r.fun)
+    assert r.status in STATUS_MESSAGES and r.success == (r.status == 0)
 
 
 @pytest.mark.parametrize("method", ["bas", "rwsavsbas", "ga", "de", "cmaes", "lm", "bas+lm"])
@@ -143,11 +158,17 @@ def test_reaches_known_optimum(method: str) -> None:
     opts, budget, tol_sphere, tol_rosen = CONVERGENCE[method]
     for seed in (0, 1):
         r = minimize(
-            sphere, B4, method, seed=seed, max_evals=budget, options=opts, residuals=sphere_res
+            sphere, B4, method, seed=seed, max_evals=budget, options=opts, residuals=_res(method)
         )
         assert r.fun < tol_sphere, (seed, r.fun)
         r = minimize(
-            rosen, BR, method, seed=seed, max_evals=budget, options=opts, residuals=rosen_res
+            rosen,
+            BR,
+            method,
+            seed=seed,
+            max_evals=budget,
+            options=opts,
+            residuals=_res(method, rosen_res),
         )
         assert r.fun < tol_rosen, (seed, r.fun)
         if tol_rosen < 1e-6:
@@ -167,14 +188,14 @@ def test_rwsavsbas_against_bas_on_rastrigin_at_equal_evaluations() -> None:
     shows the same (5.97 .. 35.8 against BAS 3.5 .. 7.5).
     """
     bounds = [(-5.12, 5.12)] * 4
-    rws = minimize(rastrigin, bounds, "rwsavsbas", seed=0, runs=8, options=RWS_SHORT)
+    rws = minimize_runs(rastrigin, bounds, "rwsavsbas", seed=0, runs=8, options=RWS_SHORT)
     n = rws[0].nfev
-    bas = minimize(rastrigin, bounds, "bas", seed=0, runs=8, options={"n_iter": (n - 1) // 3})
+    bas = minimize_runs(rastrigin, bounds, "bas", seed=0, runs=8, options={"n_iter": (n - 1) // 3})
     assert all(r.nfev == n for r in bas)
     f_bas = np.array([r.fun for r in bas])
     f_paper = np.array([r.fun for r in rws])
     assert np.median(f_paper) > np.median(f_bas)  # documented: it does not win at step0 0.1
-    wide = minimize(
+    wide = minimize_runs(
         rastrigin, bounds, "rwsavsbas", seed=0, runs=8, options={**RWS_SHORT, "step0": 0.5}
     )
     f_wide = np.array([r.fun for r in wide])
@@ -187,7 +208,7 @@ def test_rwsavsbas_against_bas_on_rastrigin_at_equal_evaluations() -> None:
 @pytest.mark.parametrize("method", ["bas", "vsbas", "ibas", "rwsavsbas", "ga", "de"])
 def test_runs_equal_single_runs(method: str) -> None:
     opts, evals = SMALL[method]
-    batch = minimize(rastrigin, B4, method, seed=10, runs=3, max_evals=evals, options=opts)
+    batch = minimize_runs(rastrigin, B4, method, seed=10, runs=3, max_evals=evals, options=opts)
     assert isinstance(batch, list) and len(batch) == 3
     for r, res in enumerate(batch):
         one = minimize(rastrigin, B4, method, seed=10 + r, max_evals=evals, options=opts)
@@ -195,6 +216,7 @@ def test_runs_equal_single_runs(method: str) -> None:
         assert np.array_equal(res.x, one.x) and res.fun == one.fun
         assert res.nfev == one.nfev and res.nit == one.nit
         assert np.array_equal(res.history, one.history)
+        assert res.status == one.status and res.message == one.message
 
 
 def test_batched_methods_call_the_objective_once_per_iteration_for_all_runs() -> None:
@@ -204,12 +226,12 @@ def test_batched_methods_call_the_objective_once_per_iteration_for_all_runs() ->
         calls.append(len(X))
         return sphere(X)
 
-    minimize(fun, B4, "rwsavsbas", seed=0, runs=4, options={"n_outer": 2, "n_inner": 5})
+    minimize_runs(fun, B4, "rwsavsbas", seed=0, runs=4, options={"n_outer": 2, "n_inner": 5})
     assert calls[0] == 4 and set(calls[1:]) <= {12, 4}  # 3 antennae x 4 runs; outer: 1 x 4
 
 
 def test_runs_with_a_generator_seed_records_the_seeds() -> None:
-    res = minimize(
+    res = minimize_runs(
         sphere, B4, "vsbas", seed=np.random.default_rng(5), runs=2, options={"n_iter": 10}
     )
     assert res[1].seed == res[0].seed + 1
@@ -236,8 +258,8 @@ def test_compiled_rwsavsbas_matches_the_numpy_path(budget) -> None:
     two paths agree bit for bit, the budget cut mid-iteration included."""
     fast = JitObjective(sphere, _sphere_kernel, (C4,))
     opts = {"n_outer": 8, "n_inner": 20, "wander": "random", "phase": "random"}
-    a = minimize(fast, B4, "rwsavsbas", seed=2, runs=3, max_evals=budget, options=opts)
-    b = minimize(sphere, B4, "rwsavsbas", seed=2, runs=3, max_evals=budget, options=opts)
+    a = minimize_runs(fast, B4, "rwsavsbas", seed=2, runs=3, max_evals=budget, options=opts)
+    b = minimize_runs(sphere, B4, "rwsavsbas", seed=2, runs=3, max_evals=budget, options=opts)
     for ra, rb in zip(a, b, strict=True):
         assert ra.fun == rb.fun and np.array_equal(ra.x, rb.x)
         assert ra.nfev == rb.nfev and np.array_equal(ra.history, rb.history)
@@ -274,7 +296,7 @@ def test_jit_true_needs_a_kernel() -> None:
 )
 def test_bad_options_raise_config_error(method, options, match) -> None:
     with pytest.raises(ConfigError, match=match):
-        minimize(sphere, B4, method, options=options, residuals=sphere_res)
+        minimize(sphere, B4, method, options=options, residuals=_res(method))
 
 
 @pytest.mark.parametrize(
@@ -308,8 +330,10 @@ def test_objective_returning_only_nan_raises(method: str) -> None:
         return np.full((len(X), 6), np.nan)
 
     opts, evals = SMALL[method]
-    with pytest.raises(ConfigError, match="NaN or inf for every one"):
-        minimize(nan, B4, method, seed=0, max_evals=evals, options=opts, residuals=nan_res)
+    with pytest.raises(ConfigError, match=r"no finite objective value: .*NaN or inf for every one"):
+        minimize(
+            nan, B4, method, seed=0, max_evals=evals, options=opts, residuals=_res(method, nan_res)
+        )
 
 
 @pytest.mark.parametrize("method", list(SMALL))
@@ -326,7 +350,9 @@ def test_nan_is_worst_never_best(method: str) -> None:
         return np.where((np.sum(r * r, axis=1) < 1.0)[:, None], np.nan, r)
 
     opts, evals = SMALL[method]
-    r = minimize(fun, B4, method, seed=0, max_evals=evals, options=opts, residuals=res)
+    r = minimize(
+        fun, B4, method, seed=0, max_evals=evals, options=opts, residuals=_res(method, res)
+    )
     assert np.isfinite(r.fun) and r.fun >= 1.0
     assert np.sum((r.x - C4) ** 2) >= 1.0
     assert np.all(np.isfinite(r.history[:, 1]))
@@ -341,12 +367,14 @@ def test_callback_stops_and_sees_intermediate_results() -> None:
 
     r = minimize(sphere, B4, "vsbas", seed=0, callback=cb)
     assert r.nit == 5 and r.message == "stopped by the callback" and len(seen) == 5
+    assert r.status == 2 and not r.success
     assert all(np.isfinite(f) for _, f in seen)
 
 
 def test_bad_runs_seed_and_budget() -> None:
+    with pytest.raises(ConfigError, match="runs"):
+        minimize_runs(sphere, B4, "bas", runs=0)
     for kw, match in (
-        ({"runs": 0}, "runs"),
         ({"seed": -1}, "seed"),
         ({"max_evals": 0}, "max_evals"),
         ({"x0": [9.0, 0, 0, 0]}, "outside the bounds"),
@@ -372,3 +400,83 @@ def test_bas_without_position_evaluates_only_the_antennae():
     assert res.fun < 1e-4
     with pytest.raises(ConfigError, match="evaluate_position"):
         minimize(sphere, [(-1, 1)] * 2, "bas", options={"evaluate_position": "no"})
+
+
+# -- status, success and the two entry points ---------------------------------------------------
+
+
+def test_minimize_returns_one_result_and_has_no_runs_argument() -> None:
+    r = minimize(sphere, B4, "bas", seed=0, options={"n_iter": 20})
+    assert isinstance(r, OptimizeResult)
+    with pytest.raises(TypeError):
+        minimize(sphere, B4, "bas", seed=0, runs=2)  # type: ignore[call-arg]
+
+
+@pytest.mark.parametrize("method", ["bas", "ga", "de", "cmaes"])
+def test_minimize_runs_is_bit_identical_to_single_runs(method: str) -> None:
+    opts, evals = SMALL[method]
+    batch = minimize_runs(sphere, B4, method, seed=4, runs=2, max_evals=evals, options=opts)
+    for r, res in enumerate(batch):
+        one = minimize(sphere, B4, method, seed=4 + r, max_evals=evals, options=opts)
+        assert np.array_equal(res.x, one.x) and res.fun == one.fun
+        assert np.array_equal(res.history, one.history) and res.status == one.status
+
+
+def test_de_with_a_tiny_budget_far_from_the_optimum_is_not_success() -> None:
+    r = minimize(sphere, B4, "de", seed=0, max_evals=20)
+    assert r.fun > 1.0  # far from the optimum (0)
+    assert r.status == 1 and not r.success
+    assert r.message == "evaluation budget of 20 spent"
+
+
+def test_de_converges_by_its_own_criterion_when_given_a_tolerance() -> None:
+    r = minimize(sphere, B4, "de", seed=0, max_evals=20_000, options={"tol": 0.01})
+    assert r.status == 0 and r.success and r.message.startswith("converged")
+    assert r.nfev < 20_000 and r.fun < 1e-2
+
+
+@pytest.mark.parametrize("method", ["lm", "trf", "bas+lm"])
+def test_least_squares_converge_by_scipy_criteria(method: str) -> None:
+    r = minimize(None, B4, method, seed=0, max_evals=2000, residuals=sphere_res)
+    assert r.success and r.status == 0 and r.fun < 1e-20
+    short = minimize(None, B4, method, seed=0, max_evals=3, residuals=sphere_res)
+    assert not short.success and short.status == 1
+
+
+def test_beetle_schedule_converges_only_when_its_last_step_is_below_xtol() -> None:
+    done = minimize(sphere, B4, "vsbas", seed=0)  # the paper's schedule: last step 1.7e-10
+    assert done.success and done.status == 0 and "last step" in done.message
+    short = minimize(sphere, B4, "vsbas", seed=0, options={"n_iter": 50})
+    assert short.status == 4 and not short.success
+    assert short.message.startswith(STATUS_MESSAGES[4])
+    ibas = minimize(sphere, B4, "ibas", seed=0, options={"n_iter": 100})
+    assert ibas.status == 4  # the step never falls below step_min
+    rws = minimize(sphere, B4, "rwsavsbas", seed=0, options={"n_outer": 3, "n_inner": 5})
+    assert rws.status == 4
+    rws = minimize(
+        sphere, B4, "rwsavsbas", seed=0, options={"n_outer": 3, "n_inner": 5, "xtol": 0.1}
+    )
+    assert rws.status == 0 and rws.success
+
+
+def test_ga_converges_by_stall_and_otherwise_spends_its_budget() -> None:
+    r = minimize(sphere, B4, "ga", seed=0, max_evals=300)
+    assert r.status == 1 and not r.success
+    r = minimize(sphere, B4, "ga", seed=0, options={"n_gen": 3})
+    assert r.status == 4
+    r = minimize(sphere, B4, "ga", seed=0, max_evals=100_000, options={"stall": 20, "ftol": 1e-3})
+    assert r.status == 0 and r.success and r.nfev < 100_000
+    batch = minimize_runs(sphere, B4, "ga", seed=0, runs=2, options={"stall": 10, "n_gen": 200})
+    one = minimize(sphere, B4, "ga", seed=1, options={"stall": 10, "n_gen": 200})
+    assert batch[1].fun == one.fun and batch[1].nfev == one.nfev
+
+
+def test_residuals_given_to_a_method_that_ignores_them_warn_at_the_caller() -> None:
+    with pytest.warns(IgnoredArgumentWarning, match="does not use `residuals`") as rec:
+        minimize(sphere, B4, "bas", seed=0, options={"n_iter": 5}, residuals=sphere_res)
+    assert rec[0].filename == __file__
+    with pytest.warns(IgnoredArgumentWarning) as rec:
+        minimize_runs(
+            sphere, B4, "bas", runs=2, seed=0, options={"n_iter": 5}, residuals=sphere_res
+        )
+    assert rec[0].filename == __file__

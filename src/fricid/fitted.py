@@ -2,7 +2,10 @@
 
 It is what ``identify.fit`` returns and what the JSON model file holds; reports, exports and
 ``fricid predict`` start from it. The JSON is plain (numbers, strings, lists), versioned by
-``schema_version``, with SI units recorded per parameter.
+``schema_version``, with SI units recorded per parameter. Prediction is dispatched by model
+(:func:`fricid.models.get_predictor`): analytic models take the parameter vector, the RBF
+network its stored ``state``. :meth:`FittedModel.report` prints a fit report after lmfit's
+``fit_report`` from what the file stores.
 """
 
 from __future__ import annotations
@@ -18,9 +21,12 @@ import numpy as np
 
 from . import __version__
 from .errors import ConfigError, DataError
-from .models import get_model
+from .models import get_model, get_predictor
 
-__all__ = ["SCHEMA_VERSION", "FittedModel"]
+__all__ = ["MIN_CORREL", "SCHEMA_VERSION", "FittedModel"]
+
+#: Correlations at or below this magnitude are left out of the fit report (lmfit's default).
+MIN_CORREL = 0.1
 
 #: Version of the JSON model file this fricid writes and reads.
 SCHEMA_VERSION = 1
@@ -97,13 +103,21 @@ class FittedModel:
     units : unit of each parameter.
     fixed : names of the parameters held fixed during the fit.
     stderr : standard error of each free parameter from the Jacobian at the optimum
-        (``cov = s^2 (J^T J)^-1``, ``s^2 = SSE / (n - p)``); NaN where not available.
+        (``cov = s^2 (J^T J)^+``, an SVD pseudo-inverse as scipy's ``curve_fit``,
+        ``s^2 = SSE / (n - p)``); NaN where not determined.
     ci95 : half-width of the 95 % confidence interval (Student t, n - p degrees of freedom).
     at_bound : free parameters that ended on a bound of the search box (their
         uncertainty is not meaningful).
     correlation : correlation matrix of the free parameters (list of lists), or None.
     metrics : fit metrics on the identification data (``fricid.metrics.metrics``).
     method, seed, nfev : how it was found; ``history`` is (nfev, best SSE) pairs.
+    status, message : why the optimiser stopped (``fricid.optim.OptimizeResult.status``: 0
+        converged, 1 budget spent, 2 stopped by the callback, 4 iteration limit); None and ""
+        when not recorded (files from before they were).
+    init : starting value of each free parameter.
+    statistics : fit statistics after lmfit: ``ndata``, ``nvarys``, ``nfree``, ``chisqr``
+        (the SSE), ``redchi``, ``aic``, ``bic``, ``rsquared``
+        (:func:`fricid.metrics.fit_statistics`).
     bounds : the search box of each free parameter.
     operating_range : min and max of velocity, load and temperature in the data.
     provenance : data source, sample count, fricid version, creation time.
@@ -127,11 +141,16 @@ class FittedModel:
     operating_range: dict[str, list[float]] = field(default_factory=dict)
     provenance: dict[str, Any] = field(default_factory=dict)
     state: dict[str, Any] | None = None
+    status: int | None = None
+    message: str = ""
+    init: dict[str, float] = field(default_factory=dict)
+    statistics: dict[str, float] = field(default_factory=dict)
 
     # -- prediction ----------------------------------------------------------------------
     @property
     def kind(self) -> str:
-        return "rbf" if self.model == "rbf" else "analytic"
+        """``"rbf"`` for a stateful model (the RBF network), else ``"analytic"``."""
+        return "rbf" if get_predictor(self.model).stateful else "analytic"
 
     def friction_model(self):
         """The analytic :class:`~fricid.models.FrictionModel` behind this fit."""
@@ -142,12 +161,13 @@ class FittedModel:
         return self.friction_model().param_vector(self.params)
 
     def predict(self, X) -> np.ndarray:
-        """Friction [N m] at inputs ``X`` (n, 3): velocity [rad/s], load [N m], temp [degC]."""
-        if self.kind == "rbf":
-            from .models.rbf import predict_state
+        """Friction [N m] at inputs ``X`` (n, 3): velocity [rad/s], load [N m], temp [degC].
 
-            return predict_state(self.state, X)
-        return self.friction_model().predict(self.theta(), X)
+        Dispatched by model: the registered model's ``predict`` gets the stored state
+        (stateful models: the RBF network) or the parameter vector (analytic models).
+        """
+        model = get_predictor(self.model)
+        return model.predict(self.state if model.stateful else self.theta(), X)
 
     def predict_point(self, velocity, load=0.0, temperature=25.0) -> np.ndarray:
         """Friction [N m] at broadcastable velocity [rad/s], load [N m], temperature [degC]."""
@@ -158,45 +178,92 @@ class FittedModel:
         return self.predict(X).reshape(v.shape)
 
     # -- text ----------------------------------------------------------------------------
-    def report(self) -> str:
-        """A plain-text fit report (after lmfit's ``fit_report``)."""
-        lines = [
-            f"[[Model]] {self.model}   [[Method]] {self.method} (seed {self.seed}, "
-            f"{self.nfev} evaluations)"
-        ]
-        m = self.metrics
-        if m:
-            lines.append(
-                "[[Fit statistics]] "
-                + ", ".join(
-                    f"{k} = {m[k]:.6g}"
-                    for k in ("n", "fitness", "sse", "rmse", "rmspe", "mae", "max_abs_error")
-                    if k in m
-                )
-            )
-        if self.kind == "rbf" and self.state:
-            st = self.state
-            lines.append(
-                f"[[Network]] {len(st.get('centers', []))} Gaussian units (eq. 14), linear output "
-                f"(eq. 15){' with bias' if st.get('fit_bias') else ''}; inputs "
-                f"{', '.join(st.get('inputs', []))}; trainer {st.get('trainer')}"
-                + (f", encoding {st['encoding']}" if st.get("encoding") else "")
-                + (f", {st['n_epochs']} epochs" if st.get("n_epochs") else "")
-            )
+    def report(self, min_correl: float = MIN_CORREL) -> str:
+        """A plain-text fit report after lmfit's ``fit_report``, from what the file stores.
+
+        Parameters
+        ----------
+        min_correl : float, default 0.1
+            Correlations of at most this magnitude are left out.
+
+        Returns
+        -------
+        str
+            ``[[Model]]``; ``[[Fit Statistics]]`` (method, evaluations, status, data points,
+            variables, chi-square, reduced chi-square, AIC, BIC, R-squared); ``[[Variables]]``
+            (value +/- standard error (relative), 95 % CI, start, and the flags "fixed", "at
+            boundary", "at initial value", "not determined"), or ``[[Network]]`` for the RBF
+            network; ``[[Correlations]]`` above ``min_correl``, largest first.
+        """
+        lines = ["[[Model]]", f"    {self.model}", "[[Fit Statistics]]"]
+        lines.append(f"    # fitting method   = {self.method} (seed {self.seed})")
+        lines.append(f"    # function evals   = {self.nfev}")
+        if self.status is not None:
+            lines.append(f"    # status           = {self.status}: {self.message}")
+        st = self.statistics
+        n = st.get("ndata", self.metrics.get("n"))
+        if n is not None:
+            lines.append(f"    # data points      = {int(n)}")
+        if st.get("nvarys") is not None:
+            lines.append(f"    # variables        = {int(st['nvarys'])}")
+        rows = (
+            ("chi-square", st.get("chisqr", self.metrics.get("sse"))),
+            ("reduced chi-square", st.get("redchi")),
+            ("Akaike info crit", st.get("aic")),
+            ("Bayesian info crit", st.get("bic")),
+            ("R-squared", st.get("rsquared", self.metrics.get("fitness"))),
+        )
+        lines += [f"    {k:<18} = {_num(v):.8g}" for k, v in rows if v is not None]
+        model = get_predictor(self.model)
+        if model.stateful:
+            lines += ["[[Network]]", f"    {model.describe(self.state)}"]
             return "\n".join(lines)
-        lines.append("[[Parameters]]")
+        lines.append("[[Variables]]")
+        width = max((len(name) for name in self.params), default=0) + 1
         for name, value in self.params.items():
-            unit = self.units.get(name, "")
-            if name in self.fixed:
-                note = "(fixed)"
-            else:
-                se = self.stderr.get(name, float("nan"))
-                ci = self.ci95.get(name, float("nan"))
-                note = f"+/- {se:.3g} (95 % CI +/- {ci:.3g})" if np.isfinite(se) else ""
-                if name in self.at_bound:
-                    note += " at a bound"
-            lines.append(f"    {name:>10} = {value: .6g} {unit:<12} {note}")
+            lines.append(f"    {name + ':':<{width}} {value: .8g} {self.units.get(name, '')}")
+            lines[-1] = lines[-1].rstrip() + self._variable_note(name, value)
+        lines += self._correlation_lines(min_correl)
         return "\n".join(lines)
+
+    def _variable_note(self, name: str, value: float) -> str:
+        if name in self.fixed:
+            return " (fixed)"
+        se = _num(self.stderr.get(name))
+        note = ""
+        if np.isfinite(se):
+            rel = f" ({abs(se / value):.2%})" if value != 0 else ""
+            note += f" +/- {se:.3g}{rel} (95 % CI +/- {_num(self.ci95.get(name)):.3g})"
+        if name in self.init:
+            note += f" (init = {self.init[name]:.8g})"
+        flags = []
+        if name in self.at_bound:
+            flags.append("at boundary")
+        if name in self.init and value == self.init[name]:
+            flags.append("at initial value")
+        if not np.isfinite(se):
+            flags.append("not determined")
+        return note + "".join(f" [{f}]" for f in flags)
+
+    def _correlation_lines(self, min_correl: float) -> list[str]:
+        """``C(a, b) = r`` for the pairs above ``min_correl``, largest magnitude first."""
+        if not self.correlation:
+            return []
+        names = list(self.stderr)
+        corr = np.asarray(self.correlation, dtype=float)
+        if corr.shape != (len(names), len(names)):
+            return []
+        pairs = [
+            (float(corr[i, j]), names[i], names[j])
+            for i in range(len(names))
+            for j in range(i + 1, len(names))
+            if np.isfinite(corr[i, j]) and abs(corr[i, j]) > min_correl
+        ]
+        if not pairs:
+            return []
+        pairs.sort(key=lambda p: -abs(p[0]))
+        head = f"[[Correlations]] (unreported correlations are <= {min_correl:.3f})"
+        return [head] + [f"    C({a}, {b}) = {r:+.4f}" for r, a, b in pairs]
 
     # -- JSON ----------------------------------------------------------------------------
     def to_dict(self) -> dict[str, Any]:
@@ -222,11 +289,15 @@ class FittedModel:
         kwargs = {k: v for k, v in d.items() if k in known}
         if "model" not in kwargs or "params" not in kwargs:
             raise DataError("model file lacks 'model' or 'params'", file=source)
-        for key in ("params", "stderr", "ci95"):
+        for key in ("params", "stderr", "ci95", "init", "statistics"):
             if key in kwargs:
                 kwargs[key] = {k: _num(v) for k, v in kwargs[key].items()}
         out = cls(**kwargs)
-        if out.kind == "analytic":
+        try:
+            stateful = get_predictor(out.model).stateful
+        except ConfigError as exc:
+            raise DataError(str(exc), file=source) from None
+        if not stateful:
             try:
                 out.theta()
             except ConfigError as exc:  # unknown model, or parameter names that do not match

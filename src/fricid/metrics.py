@@ -10,7 +10,16 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["fitness", "mae", "max_abs_error", "metrics", "rmse", "rmspe", "sse"]
+__all__ = [
+    "fit_statistics",
+    "fitness",
+    "mae",
+    "max_abs_error",
+    "metrics",
+    "rmse",
+    "rmspe",
+    "sse",
+]
 
 
 def _pair(y, y_hat) -> tuple[np.ndarray, np.ndarray]:
@@ -75,4 +84,45 @@ def metrics(y, y_hat) -> dict[str, float]:
         "mae": mae(y, y_hat),
         "max_abs_error": max_abs_error(y, y_hat),
         "n": float(np.asarray(y).size),
+    }
+
+
+def fit_statistics(y, y_hat, nvarys: int, weights=None) -> dict[str, float]:
+    """Fit statistics of a least-squares fit, as lmfit's ``fit_report`` prints them.
+
+    Parameters
+    ----------
+    y, y_hat : array_like (n,)
+        Measured and fitted values.
+    nvarys : int
+        Number of fitted (free) parameters.
+    weights : array_like (n,), optional
+        Weights of the squared errors (chi-square is their weighted sum).
+
+    Returns
+    -------
+    dict
+        ``ndata``; ``nvarys``; ``nfree = ndata - nvarys``; ``chisqr``, the (weighted) sum of
+        squared errors; ``redchi = chisqr / nfree`` (NaN without spare data);
+        ``aic = ndata ln(chisqr / ndata) + 2 nvarys`` and
+        ``bic = ndata ln(chisqr / ndata) + ln(ndata) nvarys`` (lmfit's definitions, up to
+        the constant they share; chisqr is floored at the smallest positive float so a
+        perfect fit gives a finite value); ``rsquared`` (:func:`fitness`).
+    """
+    y, y_hat = _pair(y, y_hat)
+    r = y - y_hat
+    w = np.ones_like(r) if weights is None else np.asarray(weights, dtype=float)
+    chisqr = float(np.sum(w * r * r))
+    n = int(y.size)
+    nfree = n - int(nvarys)
+    neg2loglik = n * np.log(max(chisqr, np.finfo(float).tiny) / n) if n else float("nan")
+    return {
+        "ndata": float(n),
+        "nvarys": float(nvarys),
+        "nfree": float(nfree),
+        "chisqr": chisqr,
+        "redchi": chisqr / nfree if nfree > 0 else float("nan"),
+        "aic": float(neg2loglik + 2 * nvarys),
+        "bic": float(neg2loglik + np.log(n) * nvarys) if n else float("nan"),
+        "rsquared": fitness(y, y_hat),
     }

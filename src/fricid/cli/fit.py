@@ -97,49 +97,50 @@ def fit_command(
 ) -> None:
     """Identify a friction model from samples and write it as a JSON model file.
 
-    Prints the fit report: parameters with standard errors and 95 % confidence intervals,
-    fitness (R^2), SSE, RMSE [N m], RMSPE, mean and max absolute error [N m].
+    Prints the fit report (after lmfit's): method, evaluations and convergence status; data
+    points, variables, chi-square (SSE [N m^2]), reduced chi-square, AIC, BIC, R^2; each
+    parameter with its standard error, 95 % confidence interval and start, flagged at a
+    boundary, at its initial value or not determined; correlations above 0.1. The RBF network
+    (--model rbf) goes through the same identification and prints its network instead.
     """
     from ..identify import fit
     from ..io import read_samples
     from ..pipeline import select_direction
 
     data = select_direction(read_samples(samples), direction)
-    if model.strip().lower() == "rbf":
-        fitted = _fit_rbf(data, method, centers, inputs, seed)
-    else:
-        fitted = fit(
-            data,
-            model,
-            method,
-            fixed=parse_assignments(fix, "--fix"),
-            bounds=parse_ranges(bound, "--bound"),
-            seed=seed,
-            max_evals=max_evals,
-        )
+    rbf = model.strip().lower() == "rbf"
+    fitted = fit(
+        data,
+        model,
+        _rbf_trainer(method) if rbf else method,
+        fixed=parse_assignments(fix, "--fix"),
+        bounds=parse_ranges(bound, "--bound"),
+        seed=seed,
+        max_evals=max_evals,
+        **(_rbf_network(centers, inputs) if rbf else {}),
+    )
     out = out or Path(f"{samples.stem}.{fitted.model}.json")
     fitted.save(out)
     console.print(fitted.report(), markup=False, highlight=False, soft_wrap=True)
     err_console.print(f"wrote {escape(str(out))}")
 
 
-def _fit_rbf(samples, method: str, centers: int, inputs: str, seed: int):
-    """The RBF network: lsq (k-means, widths, ridge weights), bas (BAS-RBFNN) or ga."""
+def _rbf_trainer(method: str) -> str:
+    """The RBF network's trainer: lsq (k-means, widths, ridge weights; the default --method
+    lm means it), bas (BAS-RBFNN) or ga (GA-RBFNN)."""
     from ..errors import ConfigError
-    from ..models.rbf import fit_rbf
 
     trainer = "lsq" if method == "lm" else method
     if trainer not in ("lsq", "bas", "ga"):
         raise ConfigError(f"--model rbf trains with --method lsq, bas or ga; got '{method}'")
+    return trainer
+
+
+def _rbf_network(centers: int, inputs: str) -> dict:
+    """``identify.fit``'s network arguments from --centers and --inputs."""
     names = [name.strip() for name in inputs.split(",") if name.strip()]
-    return fit_rbf(
-        samples,
-        names,
-        n_centers=centers,
-        trainer=trainer,
-        random_state=seed,
-        velocity_scale=0.035 if "velocity" in names else None,
-    )
+    network = {"n_centers": centers, "velocity_scale": 0.035 if "velocity" in names else None}
+    return {"network": network, "inputs": names}
 
 
 @app.command("methods")

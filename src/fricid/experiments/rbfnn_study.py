@@ -39,8 +39,8 @@ import pandas as pd
 
 from ..errors import ConfigError
 from ..identify import fit as identify_fit
+from ..identify.rbf import RBFNetRegressor
 from ..metrics import mae, max_abs_error, rmse
-from ..models.rbf import RBFNetRegressor
 from ..samples import FrictionSamples
 from .paper_numbers import BAS_RBFNN as _NUMBERS
 

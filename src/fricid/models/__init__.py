@@ -1,6 +1,10 @@
-"""Friction models: the analytic models of both papers (and, later, the RBF network).
+"""Friction models as mathematics: the analytic models of both papers and the RBF network.
 
-Use :func:`get_model` to look one up by name; ``"<name>_asym"`` gives the per-direction variant.
+Use :func:`get_model` to look an analytic model up by name (``"<name>_asym"`` gives the
+per-direction variant), and :func:`get_predictor` for any model a model file may name, the RBF
+network included: every one predicts with ``predict(theta_or_state, X)``, and its ``stateful``
+flag says whether it takes a parameter vector (analytic models) or a stored state (the RBF
+network, :mod:`fricid.models.rbf`). Training the network is :mod:`fricid.identify.rbf`'s job.
 """
 
 from __future__ import annotations
@@ -9,30 +13,24 @@ from ..errors import ConfigError
 from ._analytic import CoulombViscous, LoadDependent, Stribeck, VelocityLoadTemperature
 from ._asymmetric import Asymmetric
 from ._base import INPUTS, FrictionModel, Parameter, data_scales
+from .rbf import NETWORK, RBFNetwork
 
 __all__ = [
     "INPUTS",
     "MODELS",
+    "STATEFUL",
     "Asymmetric",
     "CoulombViscous",
     "FrictionModel",
     "LoadDependent",
     "Parameter",
-    "RBFNetRegressor",
+    "RBFNetwork",
     "Stribeck",
     "VelocityLoadTemperature",
     "data_scales",
     "get_model",
+    "get_predictor",
 ]
-
-
-def __getattr__(name: str):
-    # the RBF network needs scikit-learn; import it only when asked for (fast CLI start-up)
-    if name == "RBFNetRegressor":
-        from .rbf import RBFNetRegressor
-
-        return RBFNetRegressor
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 #: The analytic models by registry name, in the order of the BAS-RBFNN paper's Table 1.
@@ -59,3 +57,18 @@ def get_model(name: str | FrictionModel, asymmetric: bool = False) -> FrictionMo
     if asymmetric and not model.is_asymmetric:
         model = Asymmetric(model)
     return model
+
+
+#: Models that predict from a stored state rather than a parameter vector, by registry name.
+STATEFUL: dict[str, RBFNetwork] = {NETWORK.name: NETWORK}
+
+
+def get_predictor(name: str | FrictionModel) -> FrictionModel | RBFNetwork:
+    """The model a model file names: an analytic model (:func:`get_model`) or a stateful one
+    (:data:`STATEFUL`: ``"rbf"``).
+
+    Either predicts with ``predict(theta_or_state, X)``; ``stateful`` tells which argument.
+    """
+    if isinstance(name, str) and name.strip().lower() in STATEFUL:
+        return STATEFUL[name.strip().lower()]
+    return get_model(name)

@@ -71,6 +71,8 @@ class FrictionModel(ABC):
     equation: str = ""
     inputs: tuple[str, ...] = ("velocity",)
     parameters: tuple[Parameter, ...] = ()
+    #: Predicts from a parameter vector (False), not a stored state (the RBF network).
+    stateful: bool = False
 
     # -- description ---------------------------------------------------------------------
     @property

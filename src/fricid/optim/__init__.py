@@ -11,8 +11,10 @@ Methods (``METHODS[name].summary`` has the one-line description):
   ``cmaes`` (the ``cma`` package);
 * ``bas+lm``: a beetle global phase polished by Levenberg-Marquardt.
 
-``minimize(..., runs=N)`` makes N independent runs (seeds ``seed .. seed + N - 1``), batched
-into one objective call per iteration for bas, vsbas, ibas, rwsavsbas and ga.
+``minimize`` makes one run and returns one :class:`OptimizeResult`, whose ``status`` (see
+:data:`STATUS_MESSAGES`) says why it ended and whose ``success`` means converged.
+``minimize_runs(..., runs=N)`` makes N independent runs (seeds ``seed .. seed + N - 1``),
+batched into one objective call per iteration for bas, vsbas, ibas, rwsavsbas and ga.
 :class:`JitObjective` pairs an objective with a numba kernel for RWSAVSBAS's compiled path.
 Conventions (unit box, clipping, NaN, history, budgets): :mod:`fricid.optim._api`.
 """
@@ -30,10 +32,12 @@ from . import (  # noqa: F401  (each registers its methods)
     _scipy_global,
     _vsbas,
 )
-from ._api import METHODS, JitObjective, OptimizeResult, check_bounds, minimize, minimize_runs
+from ._api import METHODS, STATUS_MESSAGES, JitObjective, OptimizeResult, check_bounds
+from ._minimize import minimize, minimize_runs
 
 __all__ = [
     "METHODS",
+    "STATUS_MESSAGES",
     "JitObjective",
     "OptimizeResult",
     "check_bounds",

@@ -1,8 +1,11 @@
 """The optimiser API, shaped after ``scipy.optimize.minimize`` (DESIGN.md, "Optimiser API").
 
 ``minimize(fun, bounds, method=..., seed=..., max_evals=..., options=..., callback=...)``
-dispatches to one solver class per method through :data:`METHODS`, and returns an
-:class:`OptimizeResult` (or a list of them with ``runs=N``).
+(:mod:`fricid.optim._minimize`) dispatches to one solver class per method through
+:data:`METHODS`, and returns one :class:`OptimizeResult`; ``minimize_runs`` makes independent
+runs (batched where the method allows) and returns a list of them. This module holds what the
+solvers share: the result, the status codes, the counted objective, the solver base class,
+the registry and the option checks.
 
 Conventions every method honours:
 
@@ -21,7 +24,19 @@ Conventions every method honours:
   monotone (``nfev`` increasing, ``fun`` non-increasing).
 * Randomness comes only from ``seed`` (int or ``numpy.random.Generator``) through
   ``numpy.random.default_rng``; the integer seed used is recorded in the result.
-* ``runs=N`` makes N independent runs with seeds ``seed .. seed + N - 1``. Methods marked
+* ``status`` says why a run ended (:data:`STATUS_MESSAGES`): ``0`` converged (the method's
+  own convergence criterion, stated in its docstring, was met), ``1`` evaluation budget spent,
+  ``2`` stopped by the callback, ``4`` the method's iteration limit or schedule ended without
+  meeting its criterion; ``3`` (no finite value) is the status of a run whose objective
+  returned no finite value, which :func:`minimize` raises as :class:`ConfigError`.
+  ``success`` is ``status == 0``: converged, not merely finished. Per method: ``lm``/``trf``
+  converge when scipy's ``least_squares`` met ``ftol``, ``xtol`` or ``gtol`` in the start that
+  found the best point; ``de`` and ``dual_annealing`` when scipy reports success (DE only
+  with a ``tol`` or ``atol`` option above its default 0); the beetle family when its step
+  schedule ran to the end with a last step of at most ``xtol`` (unit-box units); ``ga`` when
+  its stall criterion (option ``stall``) fired; ``cmaes`` (without restarts) when cma stopped
+  on ``tolfun``, ``tolx`` or ``tolfunhist``; ``bas+lm`` when its ``lm`` polish converged.
+* ``minimize_runs`` makes N independent runs with seeds ``seed .. seed + N - 1``. Methods marked
   ``batched`` advance all runs in lockstep and evaluate their candidates in one call of
   ``fun`` per iteration; each run's result is still bit-identical to running it alone with
   its seed, provided ``fun`` evaluates each row independently of the others (true of
@@ -44,7 +59,13 @@ import numpy as np
 from ..errors import ConfigError
 
 __all__ = [
+    "BUDGET",
+    "CALLBACK",
+    "CONVERGED",
+    "ITERATIONS",
     "METHODS",
+    "NO_FINITE",
+    "STATUS_MESSAGES",
     "Budget",
     "JitObjective",
     "Objective",
@@ -52,10 +73,31 @@ __all__ = [
     "Solver",
     "check_bounds",
     "choice_option",
-    "minimize",
     "positive_option",
     "register",
 ]
+
+
+#: ``OptimizeResult.status``: the method's convergence criterion was met.
+CONVERGED = 0
+#: ``OptimizeResult.status``: the evaluation budget (``max_evals``) was spent.
+BUDGET = 1
+#: ``OptimizeResult.status``: the callback stopped the run.
+CALLBACK = 2
+#: Status of a run whose objective returned no finite value (raised as :class:`ConfigError`).
+NO_FINITE = 3
+#: ``OptimizeResult.status``: the method's iteration limit or schedule ended unconverged.
+ITERATIONS = 4
+
+#: The standard message of each status (``OptimizeResult.message`` starts with it, or, for
+#: the budget, names the budget).
+STATUS_MESSAGES: dict[int, str] = {
+    CONVERGED: "converged",
+    BUDGET: "evaluation budget spent",
+    CALLBACK: "stopped by the callback",
+    NO_FINITE: "no finite objective value",
+    ITERATIONS: "iteration limit reached without convergence",
+}
 
 
 def clip01(U: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
@@ -68,8 +110,10 @@ class OptimizeResult(dict):
     """The result of :func:`minimize`: a dict with attribute access (like scipy's).
 
     Keys: ``x`` (best point, in bounds), ``fun`` (its value), ``nfev``, ``nit``,
-    ``history`` ((m, 2): nfev, best-so-far fun), ``message``, ``success``, ``method``,
-    ``seed`` (the integer seed used, or None when a Generator was passed); methods may add more.
+    ``history`` ((m, 2): nfev, best-so-far fun), ``status`` (int, see
+    :data:`STATUS_MESSAGES`), ``message`` (starting with the status's standard message, or
+    naming the budget), ``success`` (``status == 0``: converged), ``method``, ``seed`` (the
+    integer seed used, or None when a Generator was passed); methods may add more.
     """
 
     def __getattr__(self, name: str) -> Any:
@@ -82,7 +126,7 @@ class OptimizeResult(dict):
     __delattr__ = dict.__delitem__  # type: ignore[assignment]
 
     def __repr__(self) -> str:
-        keys = ("method", "fun", "x", "nfev", "nit", "success", "message")
+        keys = ("method", "fun", "x", "nfev", "nit", "status", "success", "message")
         body = ", ".join(f"{k}={self[k]!r}" for k in keys if k in self)
         return f"OptimizeResult({body})"
 
@@ -279,8 +323,9 @@ class Solver:
     ``batched`` (True when :meth:`run` advances ``objective.runs`` runs in lockstep, drawing
     run ``r``'s random numbers from ``rngs[r]`` only), and implement :meth:`run`, which calls
     ``self.objective`` on unit-box batches until the budget raises :class:`Budget` or the
-    method ends by itself; it returns ``(nit, message)``. ``self.nit`` is kept current so an
-    interrupted run still reports its iterations.
+    method ends by itself; it returns ``(nit, message)`` and sets ``self.converged`` to True
+    when its stated convergence criterion was met (the result's ``status`` 0; otherwise 4).
+    ``self.nit`` is kept current so an interrupted run still reports its iterations.
     """
 
     name: str = ""
@@ -309,6 +354,7 @@ class Solver:
         self.x0 = x0
         self.residuals = residuals
         self.nit = 0
+        self.converged = False
         self.objective: Objective
         self.rngs: list[np.random.Generator] = []
         self.validate()
@@ -353,31 +399,6 @@ def register(cls: type[Solver]) -> type[Solver]:
     return cls
 
 
-def _check_seed_int(seed) -> int:
-    if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or seed < 0:
-        raise ConfigError(f"seed must be a non-negative int or a numpy Generator; got {seed!r}")
-    return int(seed)
-
-
-def _seeds(seed, runs: int | None) -> tuple[list[np.random.Generator], list[int | None]]:
-    """One generator per run, and the integer seed each was made from."""
-    if runs is None:
-        if isinstance(seed, np.random.Generator):
-            return [seed], [None]
-        if seed is None:
-            seed = int(np.random.SeedSequence().entropy % (2**32))
-        s = _check_seed_int(seed)
-        return [np.random.default_rng(s)], [s]
-    if isinstance(seed, np.random.Generator):
-        base = int(seed.integers(2**31))
-    elif seed is None:
-        base = int(np.random.SeedSequence().entropy % (2**31))
-    else:
-        base = _check_seed_int(seed)
-    seeds = [base + r for r in range(runs)]
-    return [np.random.default_rng(s) for s in seeds], list(seeds)
-
-
 def positive_option(
     opts: dict[str, Any],
     name: str,
@@ -416,166 +437,3 @@ def choice_option(opts: dict[str, Any], name: str, method: str, choices: Sequenc
     if not any(v is c or (type(v) is type(c) and v == c) for c in choices):
         shown = ", ".join(repr(c) for c in choices)
         raise ConfigError(f"option '{name}' of method '{method}' must be one of {shown}; got {v!r}")
-
-
-def _result(objective: Objective, r: int, nit: int, message: str, key: str, seed) -> OptimizeResult:
-    best_f = float(objective.best_f[r])
-    finite = np.isfinite(best_f)
-    x = objective.to_x(objective.best_u[r]) if finite else np.full(objective.dim, np.nan)
-    return OptimizeResult(
-        x=x,
-        fun=best_f,
-        nfev=objective.nfev,
-        nit=nit,
-        history=objective.history(r),
-        message=message,
-        success=bool(finite),
-        method=key,
-        seed=seed,
-    )
-
-
-def _solve(solver: Solver, objective: Objective) -> tuple[int, str]:
-    try:
-        nit, message = solver.run()
-    except Budget:
-        nit = solver.nit
-        if objective.stopped_by_callback:
-            message = "stopped by the callback"
-        else:
-            message = f"evaluation budget of {objective.max_evals} spent"
-    if not np.isfinite(objective.best_f).any():
-        raise ConfigError(
-            f"the objective returned NaN or inf for every one of the {objective.nfev} "
-            "candidates evaluated; check it and the bounds"
-        )
-    return nit, message
-
-
-def minimize(
-    fun: Callable[[np.ndarray], np.ndarray] | None,
-    bounds,
-    method: str = "rwsavsbas",
-    *,
-    seed: int | np.random.Generator | None = None,
-    max_evals: int | None = None,
-    options: dict[str, Any] | None = None,
-    callback: Callable[[OptimizeResult], Any] | None = None,
-    x0=None,
-    residuals: Callable[[np.ndarray], np.ndarray] | None = None,
-    runs: int | None = None,
-) -> OptimizeResult | list[OptimizeResult]:
-    """Minimise ``fun`` over the box ``bounds`` with ``method``.
-
-    Parameters
-    ----------
-    fun : callable ``(k, d) -> (k,)``, or None when ``residuals`` is given (then ``fun`` is
-        the sum of squared residuals).
-    bounds : sequence of ``(lower, upper)``, one pair per parameter.
-    method : a key of :data:`METHODS` (case-insensitive).
-    seed : int or ``numpy.random.Generator``; the same seed gives the same result bit for bit.
-    max_evals : budget in candidate evaluations per run (method's default when None).
-    options : method options; unknown names raise :class:`ConfigError` listing the known ones.
-    callback : called with an intermediate :class:`OptimizeResult` (``x``, ``fun``, ``nfev``,
-        ``nit``, and ``run`` with ``runs``) after each iteration; returning True or raising
-        ``StopIteration`` stops the run (every run of a lockstep batch).
-    x0 : optional starting point (methods that use one; every run starts there).
-    residuals : callable ``(k, d) -> (k, n)`` for least-squares methods.
-    runs : None for one run (returns an :class:`OptimizeResult`), or N >= 1 independent runs
-        with seeds ``seed .. seed + N - 1`` (returns a list of N results, each identical to
-        ``minimize(..., seed=seed + r)``). A Generator ``seed`` gives the base seed by one draw.
-
-    Returns
-    -------
-    OptimizeResult, or a list of them with ``runs``.
-    """
-    key = str(method).strip().lower()
-    if key not in METHODS:
-        raise ConfigError(
-            f"unknown method '{method}'; choose one of: "
-            + "; ".join(f"{k} ({c.summary})" for k, c in METHODS.items())
-        )
-    cls = METHODS[key]
-    b = check_bounds(bounds)
-    if fun is None and residuals is None:
-        raise ConfigError("give an objective `fun`, or `residuals` for least squares")
-    if cls.uses_residuals and residuals is None:
-        raise ConfigError(f"method '{key}' ({cls.summary}) needs `residuals`")
-    if fun is None:
-        res_fun = residuals
-
-        def fun(X: np.ndarray) -> np.ndarray:
-            r = np.asarray(res_fun(X), dtype=float)
-            if r.ndim != 2 or r.shape[0] != X.shape[0]:
-                raise ConfigError(
-                    f"the residual function must return shape ({X.shape[0]}, n) for a batch of "
-                    f"{X.shape[0]} points; got {r.shape}"
-                )
-            return np.einsum("kn,kn->k", r, r)
-
-    if runs is not None and (
-        isinstance(runs, bool) or not isinstance(runs, int | np.integer) or runs < 1
-    ):
-        raise ConfigError(f"runs must be a positive integer or None; got {runs!r}")
-    if max_evals is not None and (
-        isinstance(max_evals, bool) or not isinstance(max_evals, int | np.integer) or max_evals < 1
-    ):
-        raise ConfigError(f"max_evals must be a positive integer; got {max_evals!r}")
-    if x0 is not None:
-        x0 = np.asarray(x0, dtype=float)
-        if x0.shape != (b.shape[0],):
-            raise ConfigError(f"x0 has shape {x0.shape}; the bounds give {b.shape[0]} parameters")
-        if not np.isfinite(x0).all() or np.any(x0 < b[:, 0]) or np.any(x0 > b[:, 1]):
-            raise ConfigError("x0 lies outside the bounds")
-    opts = dict(options or {})
-    solver = cls(opts, dim=b.shape[0], x0=x0, residuals=residuals)
-    budget = int(max_evals) if max_evals is not None else solver.default_budget()
-    rngs, seeds = _seeds(seed, None if runs is None else int(runs))
-    n = len(rngs)
-
-    results: list[OptimizeResult] = []
-    if cls.batched:
-        objective = Objective(fun, b, budget, callback, runs=n)
-        nit, message = _solve(solver.bind(objective, rngs), objective)
-        results = [_result(objective, r, nit, message, key, seeds[r]) for r in range(n)]
-    else:
-        for r in range(n):
-            one = solver if r == 0 else cls(opts, dim=b.shape[0], x0=x0, residuals=residuals)
-            objective = Objective(fun, b, budget, callback, runs=1)
-            nit, message = _solve(one.bind(objective, [rngs[r]]), objective)
-            results.append(_result(objective, 0, nit, message, key, seeds[r]))
-    return results[0] if runs is None else results
-
-
-def minimize_runs(
-    fun: Callable[[np.ndarray], np.ndarray] | None,
-    bounds,
-    method: str = "rwsavsbas",
-    *,
-    runs: int,
-    seed: int | np.random.Generator | None = None,
-    max_evals: int | None = None,
-    options: dict[str, Any] | None = None,
-    callback: Callable[[OptimizeResult], Any] | None = None,
-    x0=None,
-    residuals: Callable[[np.ndarray], np.ndarray] | None = None,
-) -> list[OptimizeResult]:
-    """``runs`` independent runs of :func:`minimize`, batched where the method allows.
-
-    Run ``r`` uses seed ``seed + r`` and equals ``minimize(..., seed=seed + r)`` bit for bit.
-    Returns a list of ``runs`` :class:`OptimizeResult`.
-    """
-    if isinstance(runs, bool) or not isinstance(runs, int | np.integer) or runs < 1:
-        raise ConfigError(f"runs must be a positive integer; got {runs!r}")
-    return minimize(
-        fun,
-        bounds,
-        method,
-        seed=seed,
-        max_evals=max_evals,
-        options=options,
-        callback=callback,
-        x0=x0,
-        residuals=residuals,
-        runs=int(runs),
-    )

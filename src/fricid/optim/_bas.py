@@ -53,10 +53,16 @@ class BeetleSolver(Solver):
     ``2 n_iter + 1`` without the position).
     Subclasses give the schedule ``(d_t, delta_t)`` through :meth:`schedule`. The result is the
     best point evaluated.
+
+    Convergence: the schedule always runs to its end (budgets compare fairly); the run has
+    converged (``status`` 0) when its last step ``delta_{n-1}`` was at most the option
+    ``xtol`` (unit-box units, default 1e-6), i.e. the beetle no longer moved by more than
+    that. A schedule whose step stays longer (IBAS's ``step_min``, a short ``n_iter``) ends
+    with status 4, "iteration limit reached without convergence".
     """
 
     batched = True
-    options: ClassVar[dict[str, Any]] = {"n_iter": 1000}
+    options: ClassVar[dict[str, Any]] = {"n_iter": 1000, "xtol": 1e-6}
 
     def per_iteration(self) -> int:
         return 3 if self.opts.get("evaluate_position", True) else 2
@@ -66,6 +72,7 @@ class BeetleSolver(Solver):
 
     def validate(self) -> None:
         positive_option(self.opts, "n_iter", self.name, integer=True)
+        positive_option(self.opts, "xtol", self.name, allow_zero=True)
         flag = self.opts.get("evaluate_position", True)
         if not isinstance(flag, bool | np.bool_):
             raise ConfigError(
@@ -99,7 +106,12 @@ class BeetleSolver(Solver):
             self.nit = t + 1
             obj.notify(self.nit)
         obj(x[:, None, :])
-        return n_iter, f"{n_iter} iterations done"
+        last = float(step[-1])
+        self.converged = last <= float(self.opts["xtol"])
+        return (
+            n_iter,
+            f"{n_iter} iterations done, last step {last:.3g} (xtol {self.opts['xtol']:g})",
+        )
 
 
 @register
@@ -119,6 +131,7 @@ class BAS(BeetleSolver):
     eta_d, d_inc, eta_step : the constants of eq. 21 (0.95, 0.01, 0.95).
     evaluate_position : also evaluate the position each iteration, as [J]'s code (True), or
         only the two antennae, as eq. 18-21 (False; 2 evaluations per iteration).
+    xtol : converged when the last step is at most this (1e-6; see :class:`BeetleSolver`).
     """
 
     name = "bas"
@@ -131,6 +144,7 @@ class BAS(BeetleSolver):
         "d_inc": 0.01,
         "eta_step": 0.95,
         "evaluate_position": True,
+        "xtol": 1e-6,
     }
 
     def validate(self) -> None:

@@ -18,6 +18,9 @@ from ._scipy_global import WORST
 
 __all__ = ["CMAES"]
 
+#: cma's termination criteria that mean convergence (the others are limits).
+_CONVERGED_STOPS = {"tolfun", "tolx", "tolfunhist"}
+
 
 @register
 class CMAES(Solver):
@@ -29,7 +32,9 @@ class CMAES(Solver):
     cma's ``BoundTransform`` onto [0, 1] (candidates never leave the box). When cma's own
     termination criteria fire before the budget is spent, it restarts from a new uniform
     point (``restarts=True``), so budgets compare fairly with the other methods. cma's
-    warnings are silenced; NaN/inf values reach it as ``1e150``.
+    warnings are silenced; NaN/inf values reach it as ``1e150``. With restarts it runs to the
+    budget (status 1); without, it has converged (status 0) when cma stopped on ``tolfun``,
+    ``tolx`` or ``tolfunhist``.
 
     Options
     -------
@@ -82,6 +87,7 @@ class CMAES(Solver):
                     obj.notify(self.nit)
             stops.append(", ".join(es.stop()))
             if not self.opts["restarts"]:
+                self.converged = bool(_CONVERGED_STOPS & set(es.stop()))
                 break
             x0 = rng.random(obj.dim)
         return self.nit, f"cma stopped: {stops[-1]}"

@@ -37,6 +37,12 @@ class GA(Solver):
     pop_size : 40.  n_elite : 2.  tournament : 2.
     p_cross, eta_c : 0.9, 15 (SBX).  p_mut, eta_m : None (= 1 / d), 20 (polynomial mutation).
     n_gen : generations, or None to run until the budget is spent (default budget 4000).
+    stall, ftol : the convergence criterion, off by default (``stall=None``): the run stops,
+        converged (status 0), when the best value improved by at most ``ftol`` times its
+        magnitude over the last ``stall`` generations (ftol 1e-8). Without it the GA ends at
+        ``n_gen`` (status 4) or the budget (status 1), never "converged". With ``stall`` the
+        runs of :func:`~fricid.optim.minimize_runs` are made one after another (each stops on
+        its own), not in lockstep.
     """
 
     name = "ga"
@@ -52,6 +58,8 @@ class GA(Solver):
         "p_mut": None,
         "eta_m": 20.0,
         "n_gen": None,
+        "stall": None,
+        "ftol": 1e-8,
     }
 
     def validate(self) -> None:
@@ -73,6 +81,10 @@ class GA(Solver):
                 )
         if o["n_gen"] is not None:
             positive_option(o, "n_gen", self.name, integer=True)
+        if o["stall"] is not None:
+            positive_option(o, "stall", self.name, integer=True)
+            self.batched = False  # each run stops on its own
+        positive_option(o, "ftol", self.name, allow_zero=True)
 
     def run(self) -> tuple[int, str]:
         obj = self.objective
@@ -90,6 +102,8 @@ class GA(Solver):
             pop[:, 0] = obj.to_u(self.x0)
         fit = obj(pop)
         n_gen = o["n_gen"]
+        stall = None if o["stall"] is None else int(o["stall"])
+        best = [float(np.min(fit))]
         gen = 0
         while n_gen is None or gen < int(n_gen):
             draws = [
@@ -137,4 +151,11 @@ class GA(Solver):
             gen += 1
             self.nit = gen
             obj.notify(gen)
+            if stall is not None:
+                best.append(float(np.min(fit)))
+                if gen >= stall and best[-stall - 1] - best[-1] <= float(o["ftol"]) * abs(
+                    best[-stall - 1]
+                ):
+                    self.converged = True
+                    return gen, f"best value stalled for {stall} generations after {gen}"
         return gen, f"{gen} generations done"

@@ -30,7 +30,8 @@ class BeetleLM(Solver):
     The global phase starts at ``x0`` or at a uniform point of the box (the run's first
     random draw, so ``lm`` alone with ``x0`` at that point starts where this does). All
     evaluations, the Jacobian's finite differences included, count against one budget; the
-    result is the best point evaluated by either phase.
+    result is the best point evaluated by either phase. The run has converged (status 0) when
+    the ``lm`` polish did (see :mod:`~fricid.optim._least_squares`).
 
     Options
     -------
@@ -91,5 +92,6 @@ class BeetleLM(Solver):
         polish = self._polish.bind(obj, self.rngs)
         polish.x0 = obj.to_x(obj.best_u[0])
         _, message = polish.run()
+        self.converged = polish.converged
         self.nit += polish.nit
         return self.nit, f"global phase {self.opts['global_method']} then lm: {message}"

@@ -34,6 +34,8 @@ class IBAS(BeetleSolver):
     -------
     n_iter : iterations (1000); ``3 n_iter + 1`` evaluations.
     step_min, step_max, eta, c : 0.1, 0.3, 0.98, 3.
+    xtol : converged when the last step is at most this (1e-6): never with
+        ``step_min > xtol``, since the step never falls below ``step_min``.
     """
 
     name = "ibas"
@@ -44,6 +46,7 @@ class IBAS(BeetleSolver):
         "step_max": 0.3,
         "eta": 0.98,
         "c": 3.0,
+        "xtol": 1e-6,
     }
 
     def validate(self) -> None:

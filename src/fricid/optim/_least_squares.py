@@ -7,8 +7,12 @@ scipy, so it runs in an unconstrained variable ``z`` with ``u = (sin z + 1) / 2`
 transformation lmfit uses), which keeps every candidate inside the box.
 
 Starts: the first at ``x0`` (or the box centre), the others uniform in the box from ``seed``;
-``n_starts`` of them, each given an equal share of the remaining budget, unless ``tol_stop``
-says the best start is good enough.
+``n_starts`` of them, each given an equal share of the remaining budget.
+
+Convergence: a run has converged (status 0) when the start that found the best point ended
+by scipy's own criterion (``ftol``, ``xtol`` or ``gtol``; scipy's ``status > 0``), not by its
+share of the budget; a later start that runs out of the budget then ends the run without
+changing that (the message says so). Otherwise the status is that of the budget.
 """
 
 from __future__ import annotations
@@ -74,7 +78,9 @@ class _LeastSquares(Solver):
         starts = self._starts()
         fun = self._residual_fun()
         messages = []
+        self.converged = False
         for i, u0 in enumerate(starts):
+            before = float(obj.best_f[0])
             share = max(obj.remaining // (len(starts) - i), 1)
             if obj.remaining < 1:
                 break
@@ -91,9 +97,18 @@ class _LeastSquares(Solver):
                     x_scale=1.0,
                 )
                 messages.append(sol.message)
+                if float(sol.fun @ sol.fun) <= float(obj.best_f[0]):  # its end is the best
+                    self.converged = sol.status > 0
             except Budget:
                 self.nit = i + 1
-                raise
+                if float(obj.best_f[0]) < before:  # the best is this unfinished start's
+                    self.converged = False
+                if obj.stopped_by_callback or not self.converged:
+                    raise
+                return self.nit, (
+                    f"the best start converged; the budget of {obj.max_evals} was spent in "
+                    f"start {i + 1} of {len(starts)}"
+                )
             except ValueError as exc:  # scipy's own input checks (e.g. fewer residuals than d)
                 raise ConfigError(f"method '{self.name}': {exc}") from None
             self.nit = i + 1

@@ -92,6 +92,9 @@ class RWSAVSBAS(Solver):
     h_inner, h_outer : 100, 1000 ([R] 4.1).
     wander, phase, best_update : the readings above.
     jit : "auto" (compiled when the objective has a kernel and numba is installed), True, False.
+    xtol : the run has converged (status 0) when its last step ``step0 eta^(n_outer - 1)`` is
+        at most this (1e-6, unit-box units; the paper's schedule ends at 1.7e-10); the
+        schedule always runs to its end.
     """
 
     name = "rwsavsbas"
@@ -114,6 +117,7 @@ class RWSAVSBAS(Solver):
         "phase": "counter",
         "best_update": "inner",
         "jit": "auto",
+        "xtol": 1e-6,
     }
 
     def default_budget(self) -> int:
@@ -132,6 +136,7 @@ class RWSAVSBAS(Solver):
         choice_option(o, "phase", self.name, ("counter", "random"))
         choice_option(o, "best_update", self.name, ("inner", "outer"))
         choice_option(o, "jit", self.name, ("auto", True, False))
+        positive_option(o, "xtol", self.name, allow_zero=True)
 
     # -- the two paths -----------------------------------------------------------------------
     def _use_jit(self) -> bool:
@@ -175,7 +180,9 @@ class RWSAVSBAS(Solver):
             self.T *= float(o["cooling"])
             self.nit = k
             obj.notify(k)
-        return K, f"{K} outer iterations done"
+        last = float(o["step0"]) * float(o["eta"]) ** (K - 1)
+        self.converged = last <= float(o["xtol"])
+        return K, f"{K} outer iterations done, last step {last:.3g} (xtol {o['xtol']:g})"
 
     def _draws(self, k: int, blk: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The phases ``S (R, Q + 1)`` of the wandering steps and the Metropolis thresholds

@@ -50,13 +50,15 @@ class DifferentialEvolution(Solver):
 
     ``vectorized=True`` makes scipy pass the population as ``(d, S)``; we transpose it into
     our ``(S, d)`` batch. ``updating="deferred"`` (required by vectorised evaluation),
-    ``polish=False`` (polish with ``bas+lm`` or ``lm`` instead) and ``tol=0``: it runs until
-    the budget is spent.
+    ``polish=False`` (polish with ``bas+lm`` or ``lm`` instead) and by default ``tol=0``,
+    ``atol=0``: it runs until the budget is spent (status 1). With ``tol`` or ``atol`` above 0
+    scipy's own criterion (population spread ``std(f) <= atol + tol |mean(f)|``; scipy's
+    default ``tol`` is 0.01) may stop it first: then it has converged (status 0).
 
     Options
     -------
     popsize : population = popsize * d (15).  mutation : (0.5, 1).  recombination : 0.7.
-    strategy : "best1bin".  init : "latinhypercube".
+    strategy : "best1bin".  init : "latinhypercube".  tol, atol : 0, 0.
     """
 
     name = "de"
@@ -68,10 +70,14 @@ class DifferentialEvolution(Solver):
         "recombination": 0.7,
         "strategy": "best1bin",
         "init": "latinhypercube",
+        "tol": 0.0,
+        "atol": 0.0,
     }
 
     def validate(self) -> None:
         positive_option(self.opts, "popsize", self.name, integer=True)
+        positive_option(self.opts, "tol", self.name, allow_zero=True)
+        positive_option(self.opts, "atol", self.name, allow_zero=True)
         positive_option(self.opts, "recombination", self.name)
         choice_option(self.opts, "init", self.name, ("latinhypercube", "sobol", "halton", "random"))
 
@@ -91,6 +97,7 @@ class DifferentialEvolution(Solver):
             res = self._de(f, count, d)
         except _Passthrough as exc:
             raise exc.error from None
+        self.converged = bool(res.success)
         return self.nit, str(res.message)
 
     def _de(self, f, count, d):
@@ -103,8 +110,8 @@ class DifferentialEvolution(Solver):
             strategy=self.opts["strategy"],
             maxiter=maxiter,
             popsize=int(self.opts["popsize"]),
-            tol=0.0,
-            atol=0.0,
+            tol=float(self.opts["tol"]),
+            atol=float(self.opts["atol"]),
             mutation=self.opts["mutation"],
             recombination=float(self.opts["recombination"]),
             rng=self.rng,
@@ -123,7 +130,9 @@ class DualAnnealing(Solver):
 
     scipy evaluates one point per call; its local search (L-BFGS-B with finite-difference
     gradients) is counted too. ``maxfun`` is set to the budget (scipy treats it as a soft
-    limit; our wrapper makes it exact).
+    limit; our wrapper makes it exact). Dual annealing has no convergence criterion (scipy's
+    ``success`` only says its iteration limit, here 1e9, was reached): it runs to the budget
+    and never reports "converged".
 
     Options
     -------

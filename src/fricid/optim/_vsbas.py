@@ -31,11 +31,19 @@ class VSBAS(BeetleSolver):
     -------
     n_iter : iterations (1000); ``3 n_iter + 1`` evaluations.
     step0, eta, c : initial step (0.1), step factor (0.98), step / antenna-length ratio (3).
+    xtol : converged when the last step is at most this (1e-6; the paper's schedule ends at
+        1.7e-10).
     """
 
     name = "vsbas"
     summary = "variable-step BAS (RWSAVSBAS paper 3.1.3, 4.1): step *= eta, antenna = step / c"
-    options: ClassVar[dict[str, Any]] = {"n_iter": 1000, "step0": 0.1, "eta": 0.98, "c": 3.0}
+    options: ClassVar[dict[str, Any]] = {
+        "n_iter": 1000,
+        "step0": 0.1,
+        "eta": 0.98,
+        "c": 3.0,
+        "xtol": 1e-6,
+    }
 
     def validate(self) -> None:
         super().validate()

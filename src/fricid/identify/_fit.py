@@ -1,0 +1,255 @@
+"""``fit`` and ``evaluate``: samples + model + optimiser -> :class:`~fricid.fitted.FittedModel`.
+
+``fit`` states the problem (:class:`~fricid.identify.problem.IdentificationProblem`: the sum of
+squared errors between the model and the measured friction, the RWSAVSBAS paper's objective,
+eq. 11 there), minimises it with any method of :mod:`fricid.optim`, then estimates the
+parameters' uncertainty from the Jacobian at the optimum (:mod:`fricid.identify.uncertainty`).
+The RBF network (``model="rbf"``) is trained by :func:`fricid.identify.rbf.fit_rbf`.
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Callable, Mapping, Sequence
+from datetime import UTC, datetime
+from typing import Any
+
+import numpy as np
+from scipy import stats
+
+from .. import __version__
+from ..errors import ConfigError, ConvergenceWarning, IdentifiabilityWarning, IgnoredArgumentWarning
+from ..fitted import FittedModel
+from ..metrics import fit_statistics, metrics
+from ..models import INPUTS, STATEFUL, FrictionModel, get_model
+from ..optim import METHODS, OptimizeResult, minimize
+from ..samples import FrictionSamples, samples_hash
+from .problem import IdentificationProblem
+from .uncertainty import jacobian_uncertainty
+
+__all__ = ["evaluate", "fit"]
+
+
+def _provenance(samples: FrictionSamples) -> dict[str, Any]:
+    return {
+        "source": samples.source,
+        "n_samples": len(samples),
+        "samples_sha256_16": samples_hash(samples),
+        "directions": list(samples.directions()),
+        "fricid_version": __version__,
+        "created": datetime.now(UTC).isoformat(timespec="seconds"),
+    }
+
+
+def fit(
+    samples: FrictionSamples,
+    model: str | FrictionModel,
+    method: str = "lm",
+    *,
+    fixed: Mapping[str, float] | None = None,
+    bounds: Mapping[str, tuple[float, float]] | None = None,
+    seed: int | np.random.Generator | None = 0,
+    max_evals: int | None = None,
+    options: dict[str, Any] | None = None,
+    x0: Mapping[str, float] | None = None,
+    callback: Callable[[OptimizeResult], Any] | None = None,
+    network: Mapping[str, Any] | None = None,
+    inputs: Sequence[str] = INPUTS,
+) -> FittedModel:
+    """Identify ``model`` from ``samples`` by least squares with ``method``.
+
+    Parameters
+    ----------
+    samples : FrictionSamples
+        The measured friction.
+    model : str or FrictionModel
+        A model name (``fricid.models.MODELS``, ``*_asym`` for per-direction), an instance,
+        or ``"rbf"`` for the RBF network (:mod:`fricid.identify.rbf`).
+    method : str, default "lm"
+        Any method of ``fricid.optim.METHODS`` (``"lm"``: Levenberg-Marquardt with
+        multi-start). For ``"rbf"``: ``"lsq"`` (k-means, widths, ridge least squares) or an
+        optimiser trainer (``"bas"`` for BAS-RBFNN, ``"ga"`` for GA-RBFNN, ...); the default
+        ``"lm"`` means ``"lsq"`` there.
+    fixed : mapping of str to float, optional
+        Parameters held at a value, e.g. ``{"delta": 1.0}`` for the RWSAVSBAS paper's
+        Stribeck model.
+    bounds : mapping of str to (float, float), optional
+        Per-parameter search bounds overriding the model's data-scaled defaults.
+    seed : int or numpy.random.Generator, optional
+        Makes the fit reproducible (default 0); the RBF network's ``random_state``.
+    max_evals : int, optional
+        Budget in evaluations (the RBF network: ``max_epochs = ceil(max_evals /
+        evals_per_epoch)``).
+    options : dict, optional
+        Options of the method (the RBF network's ``method_options``).
+    x0 : mapping of str to float, optional
+        Starting values of free parameters (default: the model's data-scaled defaults).
+    callback : callable, optional
+        Passed to ``fricid.optim.minimize`` (analytic models only).
+    network : mapping, optional
+        ``"rbf"`` only: parameters of :class:`~fricid.identify.rbf.RBFNetRegressor`
+        (``n_centers``, ``velocity_scale``, ``encoding``, ...).
+    inputs : sequence of str, default ("velocity", "load", "temperature")
+        ``"rbf"`` only: the network's input columns.
+
+    Returns
+    -------
+    FittedModel
+        With ``status`` and ``message`` from the optimiser, fit statistics, standard errors
+        (SVD pseudo-inverse, see :mod:`~fricid.identify.uncertainty`) and correlations.
+
+    Raises
+    ------
+    ConfigError
+        Unknown model, method, parameter or option; bad bounds; too few samples; arguments
+        of an analytic fit given for ``"rbf"`` (``fixed``, ``bounds``, ``x0``).
+
+    Warns
+    -----
+    ConvergenceWarning
+        The optimiser did not converge (budget spent, iteration limit, stopped).
+    IdentifiabilityWarning
+        The data do not determine some parameter (its standard error is NaN).
+    IgnoredArgumentWarning
+        An argument the chosen model does not use (``network``, ``inputs`` for analytic
+        models; ``callback`` for ``"rbf"``).
+    """
+    if isinstance(model, str) and model.strip().lower() in STATEFUL:
+        return _fit_network(
+            samples,
+            method,
+            seed,
+            max_evals,
+            options,
+            network,
+            inputs,
+            callback,
+            fixed=fixed,
+            bounds=bounds,
+            x0=x0,
+        )
+    if network is not None or tuple(inputs) != INPUTS:
+        warnings.warn(
+            "`network` and `inputs` apply to model 'rbf' only; ignored",
+            IgnoredArgumentWarning,
+            stacklevel=2,
+        )
+    model = get_model(model)
+    problem = IdentificationProblem(model, samples, loss="sse", bounds=bounds, fixed=fixed)
+    X, y = problem.X, problem.y
+    if problem.n_obs < problem.n_free:
+        raise ConfigError(
+            f"{problem.n_obs} samples cannot identify {problem.n_free} free parameters of "
+            f"'{model.name}'"
+        )
+    key = str(method).strip().lower()
+    start = problem.start(x0) if key in METHODS else None
+    uses_residuals = key in METHODS and METHODS[key].uses_residuals
+    result = minimize(
+        problem.evaluate,
+        problem.bounds,
+        method=method,
+        seed=seed,
+        max_evals=max_evals,
+        options=options,
+        callback=callback,
+        x0=start,
+        residuals=problem.residuals if uses_residuals else None,
+    )
+    if not result.success:
+        warnings.warn(
+            f"fitting '{model.name}' with '{result.method}' did not converge: {result.message}",
+            ConvergenceWarning,
+            stacklevel=2,
+        )
+    theta = problem.expand(result.x)[0]
+    stderr, cov = jacobian_uncertainty(problem.residuals, result.x, problem.n_obs)
+    names, free_names = problem.names, problem.free_names
+    if not np.isfinite(stderr).all():
+        unknown = [n for n, s in zip(free_names, stderr, strict=True) if not np.isfinite(s)]
+        warnings.warn(
+            f"the data do not determine {', '.join(unknown)} of '{model.name}' (singular "
+            "Jacobian or no spare samples): no standard error",
+            IdentifiabilityWarning,
+            stacklevel=2,
+        )
+    dof = max(problem.n_obs - problem.n_free, 1)
+    t95 = float(stats.t.ppf(0.975, dof))
+    corr = None
+    if cov is not None:
+        d = np.sqrt(np.diag(cov))
+        with np.errstate(invalid="ignore", divide="ignore"):
+            corr = (cov / np.outer(d, d)).tolist()
+    y_hat = model.predict(theta, X)
+    return FittedModel(
+        model=model.name,
+        params={n: float(v) for n, v in zip(names, theta, strict=True)},
+        units=model.units,
+        fixed=sorted(problem.fixed),
+        stderr={n: float(s) for n, s in zip(free_names, stderr, strict=True)},
+        ci95={n: float(s) * t95 for n, s in zip(free_names, stderr, strict=True)},
+        at_bound=problem.at_bound(result.x),
+        correlation=corr,
+        metrics=metrics(y, y_hat),
+        method=result.method,
+        seed=result.seed,
+        nfev=int(result.nfev),
+        history=np.asarray(result.history).tolist(),
+        bounds={
+            n: [float(lo), float(hi)]
+            for n, (lo, hi) in zip(free_names, problem.bounds, strict=True)
+        },
+        operating_range={
+            name: [float(X[:, j].min()), float(X[:, j].max())] for j, name in enumerate(INPUTS)
+        },
+        provenance=_provenance(samples),
+        status=int(result.status),
+        message=str(result.message),
+        init={} if start is None else dict(zip(free_names, map(float, start), strict=True)),
+        statistics=fit_statistics(y, y_hat, problem.n_free),
+    )
+
+
+def _fit_network(
+    samples: FrictionSamples,
+    method: str,
+    seed: int | np.random.Generator | None,
+    max_evals: int | None,
+    options: dict[str, Any] | None,
+    network: Mapping[str, Any] | None,
+    inputs: Sequence[str],
+    callback: Callable[[OptimizeResult], Any] | None,
+    **analytic: Any,
+) -> FittedModel:
+    """``fit(samples, "rbf", ...)``: :func:`fricid.identify.rbf.fit_rbf` with fit's arguments
+    translated (``method`` -> ``trainer``, ``seed`` -> ``random_state``, ``options`` ->
+    ``method_options``, ``max_evals`` -> ``max_epochs``)."""
+    from .rbf import RBFNetRegressor, fit_rbf
+
+    given = [name for name, value in analytic.items() if value]
+    if given:
+        raise ConfigError(
+            f"model 'rbf' has no named parameters: {', '.join(given)} do(es) not apply "
+            "(set the network with `network=`)"
+        )
+    if callback is not None:
+        warnings.warn(
+            "model 'rbf' does not take a callback; ignored", IgnoredArgumentWarning, stacklevel=3
+        )
+    params = dict(network or {})
+    key = str(method).strip().lower()
+    params["trainer"] = "lsq" if key == "lm" else key
+    if isinstance(seed, np.random.Generator):
+        seed = int(seed.integers(2**31))
+    params["random_state"] = seed
+    if options is not None:
+        params["method_options"] = dict(options)
+    if max_evals is not None:
+        per_epoch = int(params.get("evals_per_epoch", RBFNetRegressor().evals_per_epoch))
+        params["max_epochs"] = max(1, -(-int(max_evals) // per_epoch))
+    return fit_rbf(samples, inputs, **params)
+
+
+def evaluate(model: FittedModel, samples: FrictionSamples) -> dict[str, float]:
+    """Metrics of a fitted model on (other) samples (``fricid.metrics.metrics``)."""
+    return metrics(samples.y, model.predict(samples.X))

@@ -1,0 +1,338 @@
+"""The scikit-learn estimator of the RBF network, :class:`RBFNetRegressor` (BAS-RBFNN paper,
+eq. 14-21): the ``lsq`` recipe here, the optimiser trainers in :mod:`fricid.identify._rbf_search`.
+Public home and the reading of the paper: :mod:`fricid.identify.rbf`.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from numbers import Integral, Real
+from typing import Any, ClassVar
+
+import numpy as np
+from sklearn.base import BaseEstimator, RegressorMixin
+from sklearn.cluster import KMeans
+from sklearn.exceptions import ConvergenceWarning as SklearnConvergenceWarning
+from sklearn.utils import check_random_state
+from sklearn.utils._param_validation import Interval, InvalidParameterError, StrOptions
+from sklearn.utils.validation import check_is_fitted, validate_data
+
+from ..errors import ConfigError, DataError, IgnoredArgumentWarning
+from ..models import _rbf_core as core
+from ..models.rbf import mse_z, predict_z
+from ..optim import METHODS
+from ._rbf_search import search_network
+
+__all__ = ["LSQ_IGNORES", "TRAINERS", "RBFNetRegressor"]
+
+#: The trainers of the paper: ``lsq`` (RBFNN), ``bas`` (BAS-RBFNN), ``ga`` (GA-RBFNN); every
+#: other method of :data:`fricid.optim.METHODS` is accepted too.
+TRAINERS = ("lsq", "bas", "ga")
+
+#: Parameters of :class:`RBFNetRegressor` that only an optimiser trainer uses, with their
+#: defaults: set to anything else with ``trainer="lsq"`` they are ignored, with an
+#: :class:`~fricid.errors.IgnoredArgumentWarning`.
+LSQ_IGNORES: dict[str, Any] = {
+    "encoding": "hybrid",
+    "init": "kmeans",
+    "max_epochs": 500,
+    "evals_per_epoch": 30,
+    "method_options": None,
+}
+
+#: k-means places the centres using at most ``max(_KMEANS_MIN, _KMEANS_PER_CENTRE * m)``
+#: samples (a random subset of larger sets): centres need a representative sample, not all.
+_KMEANS_MIN = 2000
+_KMEANS_PER_CENTRE = 25
+
+
+class RBFNetRegressor(RegressorMixin, BaseEstimator):
+    """Gaussian radial basis function network (BAS-RBFNN paper, eq. 14-15), scikit-learn style.
+
+    ``y(x) = sum_i w_i exp(-||z(x) - c_i||^2 / (2 sigma_i^2)) + b`` with ``z(x)`` the
+    standardised input (after an optional asinh warp of the first column, the velocity).
+
+    Parameters
+    ----------
+    n_centers : int, default 20
+        Number of hidden units m (Gaussian centres). At most the number of training samples.
+    trainer : str, default "lsq"
+        ``"lsq"``: k-means centres (on at most ``max(2000, 25 m)`` samples, a random subset
+        of larger sets), nearest-neighbour widths, ridge least-squares weights (the paper's
+        "RBFNN"). ``"bas"`` (BAS-RBFNN), ``"ga"`` (GA-RBFNN) or any other method
+        of :data:`fricid.optim.METHODS`: search the network's parameters with that optimiser.
+    encoding : {"hybrid", "full"}, default "hybrid"
+        Search vector of an optimiser trainer: ``"full"`` = centres, log-widths, output weights
+        and bias (the paper's section 3.3); ``"hybrid"`` = centres and log-widths, with the
+        output weights solved by ridge least squares for each candidate. Ignored by ``lsq``
+        (like ``init``, ``max_epochs``, ``evals_per_epoch`` and ``method_options``: set to
+        anything but their defaults with ``lsq``, ``fit`` warns with
+        :class:`~fricid.errors.IgnoredArgumentWarning`).
+    init : {"kmeans", "random"}, default "kmeans"
+        Start of the search: ``"kmeans"`` starts from the ``lsq`` network (passed to the
+        optimiser as ``x0``; the result is never worse than it); ``"random"`` leaves the
+        start to the optimiser (uniform in the search box). Ignored by ``lsq``.
+    width_factor : float, default 1.0
+        Multiplies the width heuristic ``sigma_i = RMS distance from c_i to its two nearest
+        centres`` [MD]. Wider Gaussians give smoother fits (and worse conditioning).
+    alpha : float, default 1e-10
+        Ridge penalty on the output weights: minimise ``mean(e^2) + alpha ||w||^2`` on the
+        scaled target (``0``: plain least squares, with the SVD's rank cut-off). Hybrid
+        candidates are scored with at least 1e-12.
+    fit_bias : bool, default True
+        Add a bias to the linear output (eq. 15 has none).
+    velocity_scale : float or None, default None
+        If given [rad/s], the first input column (fricid's velocity) is replaced by
+        ``asinh(v / velocity_scale)`` before standardisation: logarithmic for
+        ``|v| >> velocity_scale``, linear and odd through zero. It spreads the Stribeck region
+        (the paper samples low velocities densely for the same reason, section 2.2) so fewer
+        Gaussians fit it. None: plain standardisation, as the paper.
+    target_mse : float or None, default 1e-4
+        Stop an optimiser trainer once the training MSE of the target mapped onto [-1, 1]
+        reaches this value (the paper's 0.0001; see :mod:`fricid.identify.rbf`). None: use the whole
+        budget.
+    max_epochs : int, default 500
+        Budget of an optimiser trainer, in epochs.
+    evals_per_epoch : int, default 30
+        Candidate evaluations per epoch (a GA generation; see :mod:`fricid.identify.rbf`).
+    method_options : dict or None, default None
+        Options for the optimiser (``fricid.optim.minimize(..., options=...)``).
+    random_state : int, RandomState instance or None, default None
+        Seeds k-means and the optimiser; an int makes ``fit`` reproducible bit for bit.
+        None draws fresh entropy from the OS (numpy's global random state is never used).
+
+    Attributes
+    ----------
+    centers_ : ndarray (m, n_features_in_)
+        Centres c_i in standardised input units.
+    widths_ : ndarray (m,)
+        Widths sigma_i in standardised input units.
+    weights_ : ndarray (m,)
+        Output weights w_i, in units of y.
+    bias_ : float
+        Output bias, units of y (0 when ``fit_bias=False``).
+    input_shift_, input_scale_ : ndarray (n_features_in_,)
+        Standardisation ``z = (warp(x) - input_shift_) / input_scale_``.
+    target_scale_ : float
+        Half the range of the training target: MSEs on the [-1, 1] scale times
+        ``target_scale_ ** 2`` are in units of y squared.
+    train_mse_ : float
+        Final training MSE on the [-1, 1] scale.
+    initial_mse_ : float
+        Training MSE of the ``lsq`` network the search started from (NaN for
+        ``init="random"``; equal to ``train_mse_`` for ``lsq``).
+    mse_history_ : ndarray (n_epochs_,)
+        Best training MSE ([-1, 1] scale) after each epoch (empty for ``lsq``; NaN for an
+        epoch that ended before the optimiser's first batch of evaluations did).
+    n_epochs_ : int
+        Epochs run (0 for ``lsq``).
+    n_evals_ : int
+        Candidate networks evaluated (0 for ``lsq``).
+    status_, message_ : int or None, str
+        The optimiser's ``status`` and ``message`` (``fricid.optim.OptimizeResult``; 2,
+        "stopped by the callback", when the target MSE was reached); None and "" for ``lsq``
+        or a start that already met the target.
+    epochs_to_target_ : int or None
+        First epoch whose best MSE reached ``target_mse`` (0 if the start already did);
+        None if it was not reached or there was no target.
+    n_features_in_ : int
+    feature_names_in_ : ndarray of str (only when X had string column names)
+
+    Examples
+    --------
+    >>> from fricid.identify.rbf import RBFNetRegressor
+    >>> net = RBFNetRegressor(n_centers=40, random_state=0)
+    >>> net.fit(samples.X, samples.y).predict(samples.X)  # doctest: +SKIP
+    >>> cross_val_score(RBFNetRegressor(), samples.X, samples.y, cv=5)  # doctest: +SKIP
+    """
+
+    _parameter_constraints: ClassVar[dict[str, list[Any]]] = {
+        "n_centers": [Interval(Integral, 1, None, closed="left")],
+        "trainer": [str],
+        "encoding": [StrOptions({"hybrid", "full"})],
+        "init": [StrOptions({"kmeans", "random"})],
+        "width_factor": [Interval(Real, 0, None, closed="neither")],
+        "alpha": [Interval(Real, 0, None, closed="left")],
+        "fit_bias": ["boolean"],
+        "velocity_scale": [Interval(Real, 0, None, closed="neither"), None],
+        "target_mse": [Interval(Real, 0, None, closed="neither"), None],
+        "max_epochs": [Interval(Integral, 1, None, closed="left")],
+        "evals_per_epoch": [Interval(Integral, 1, None, closed="left")],
+        "method_options": [dict, None],
+        "random_state": ["random_state"],
+    }
+
+    def __init__(
+        self,
+        n_centers: int = 20,
+        *,
+        trainer: str = "lsq",
+        encoding: str = "hybrid",
+        init: str = "kmeans",
+        width_factor: float = 1.0,
+        alpha: float = 1e-10,
+        fit_bias: bool = True,
+        velocity_scale: float | None = None,
+        target_mse: float | None = 1e-4,
+        max_epochs: int = 500,
+        evals_per_epoch: int = 30,
+        method_options: dict[str, Any] | None = None,
+        random_state: int | np.random.RandomState | None = None,
+    ) -> None:
+        self.n_centers = n_centers
+        self.trainer = trainer
+        self.encoding = encoding
+        self.init = init
+        self.width_factor = width_factor
+        self.alpha = alpha
+        self.fit_bias = fit_bias
+        self.velocity_scale = velocity_scale
+        self.target_mse = target_mse
+        self.max_epochs = max_epochs
+        self.evals_per_epoch = evals_per_epoch
+        self.method_options = method_options
+        self.random_state = random_state
+
+    # -- validation ----------------------------------------------------------------------
+    def _check_params(self) -> str:
+        """Validate the parameters (sklearn's constraints, raised as :class:`ConfigError`);
+        return the trainer's name, lower-cased."""
+        try:
+            self._validate_params()
+        except InvalidParameterError as exc:
+            raise ConfigError(str(exc)) from None
+        trainer = self.trainer.strip().lower()
+        if trainer == "lsq":
+            ignored = [
+                name for name, default in LSQ_IGNORES.items() if getattr(self, name) != default
+            ]
+            if ignored:
+                warnings.warn(
+                    f"RBFNetRegressor(trainer='lsq') ignores {', '.join(ignored)}: they set up "
+                    "an optimiser trainer (bas, ga, ...)",
+                    IgnoredArgumentWarning,
+                    stacklevel=3,
+                )
+        else:
+            if trainer not in METHODS:
+                raise ConfigError(
+                    f"The 'trainer' parameter of RBFNetRegressor must be 'lsq' or a method of "
+                    f"fricid.optim ({', '.join(METHODS)}). Got {self.trainer!r} instead."
+                )
+        return trainer
+
+    def _warp(self, X: np.ndarray) -> np.ndarray:
+        if self.velocity_scale is None:
+            return X
+        X = X.copy()
+        X[:, 0] = np.arcsinh(X[:, 0] / self.velocity_scale)
+        return X
+
+    def _standardise(self, X: np.ndarray) -> np.ndarray:
+        return (self._warp(X) - self.input_shift_) / self.input_scale_
+
+    # -- fitting -------------------------------------------------------------------------
+    def fit(self, X, y) -> RBFNetRegressor:
+        """Train the network on inputs ``X (n, d)`` and targets ``y (n,)``.
+
+        Raises
+        ------
+        ConfigError
+            A parameter is invalid, or ``n_centers`` exceeds the number of samples.
+        DataError
+            An input column has zero variance (it cannot be standardised).
+        ValueError
+            ``X`` or ``y`` is empty, has NaN or infinity, or has the wrong shape (sklearn's
+            ``validate_data``).
+        """
+        trainer = self._check_params()
+        X, y = validate_data(self, X, y, y_numeric=True, ensure_min_samples=2, dtype=np.float64)
+        n, d = X.shape
+        m = int(self.n_centers)
+        if m > n:
+            raise ConfigError(
+                f"n_centers={m} exceeds the number of training samples ({n}); an RBF network "
+                "needs at most one centre per sample"
+            )
+        Xw = self._warp(X)
+        shift = Xw.mean(axis=0)
+        scale = Xw.std(axis=0)
+        flat = np.flatnonzero(~(scale > 1e-12 * np.maximum(1.0, np.abs(shift))))
+        if flat.size:
+            j = int(flat[0])
+            name = str(self.feature_names_in_[j]) if hasattr(self, "feature_names_in_") else f"{j}"
+            raise DataError(
+                f"the input has zero variance (every value {X[0, j]!r}): it carries no "
+                "information and cannot be standardised; drop the column",
+                column=name,
+            )
+        self.input_shift_, self.input_scale_ = shift, scale
+        Z = (Xw - shift) / scale
+
+        # the target on [-1, 1] (mapminmax), or scaled only when there is no bias to absorb
+        # the shift
+        if self.fit_bias:
+            mid = 0.5 * (float(y.max()) + float(y.min()))
+            half = 0.5 * (float(y.max()) - float(y.min()))
+        else:
+            mid, half = 0.0, float(np.max(np.abs(y)))
+        if not half > 0:
+            half = 1.0
+        t = (y - mid) / half
+        self.target_scale_ = half
+
+        # None: fresh OS entropy, never numpy's global RandomState (DESIGN.md, "Randomness")
+        rs = (
+            np.random.RandomState()
+            if self.random_state is None
+            else check_random_state(self.random_state)
+        )
+        kmeans_seed = int(rs.randint(np.iinfo(np.int32).max))
+        search_seed = int(rs.randint(np.iinfo(np.int32).max))
+        spread = math.sqrt(d)
+        n_kmeans = max(_KMEANS_MIN, _KMEANS_PER_CENTRE * m)
+        Zk = Z if n <= n_kmeans else Z[rs.permutation(n)[:n_kmeans]]
+
+        with warnings.catch_warnings():
+            # duplicate points: fewer distinct clusters than centres; the width floor and
+            # the ridge penalty cope, the user learns of it through the fit's accuracy
+            warnings.simplefilter("ignore", SklearnConvergenceWarning)
+            km = KMeans(n_clusters=m, n_init=1, random_state=kmeans_seed)
+            C0 = km.fit(Zk).cluster_centers_
+        s0 = core.nn_widths(C0, float(self.width_factor), spread)
+        w0, b0 = core.lstsq_weights(
+            core.design(Z, C0, s0), t, float(self.alpha), bool(self.fit_bias)
+        )
+        mse0 = mse_z(Z, t, C0, s0, w0, b0)
+
+        self.n_epochs_ = 0
+        self.n_evals_ = 0
+        self.status_, self.message_ = None, ""
+        self.mse_history_ = np.empty(0)
+        self.initial_mse_ = mse0
+        if trainer == "lsq":
+            C, s, w, b, mse = C0, s0, w0, b0, mse0
+            self.epochs_to_target_ = (
+                0 if self.target_mse is not None and mse0 <= self.target_mse else None
+            )
+        else:
+            C, s, w, b, mse = search_network(
+                self, trainer, Z, t, (C0, s0, w0, b0, mse0), search_seed
+            )
+
+        self.centers_ = C
+        self.widths_ = s
+        self.weights_ = w * half
+        self.bias_ = float(b * half + mid)
+        self.train_mse_ = float(mse)
+        return self
+
+    # -- prediction ----------------------------------------------------------------------
+    def predict(self, X) -> np.ndarray:
+        """Network output (eq. 14-15) at inputs ``X (n, n_features_in_)``."""
+        check_is_fitted(self)
+        X = validate_data(self, X, reset=False, dtype=np.float64)
+        return predict_z(
+            self._standardise(X), self.centers_, self.widths_, self.weights_, self.bias_
+        )

@@ -1,0 +1,272 @@
+"""``IdentificationProblem``: what is identified, from which data, by which loss (after pymoo's
+``Problem``; STYLE.md, "Problems, algorithms, termination").
+
+A problem knows the model, the data and the objective; it knows nothing of the optimiser. It
+evaluates a whole batch of candidate parameter vectors ``T (k, p)`` at once (DESIGN.md,
+"Vectorised"): :meth:`IdentificationProblem.residuals` gives ``(k, n)`` weighted residuals and
+:meth:`IdentificationProblem.evaluate` the loss ``(k,)``, the one place where fricid's
+identification objective is written (``identify.fit``, the RBF trainer and, next, the studies
+all use it).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any, Protocol
+
+import numpy as np
+
+from ..errors import ConfigError
+from ..samples import FrictionSamples
+
+__all__ = ["LOSSES", "IdentificationProblem", "Predictor"]
+
+#: The losses: ``sse``, the sum of (weighted) squared errors (the RWSAVSBAS paper's fitness,
+#: eq. 11 there); ``mse``, that sum over the number of samples (the BAS-RBFNN paper's training
+#: error, eq. 16-17 up to the factor 2).
+LOSSES = ("sse", "mse")
+
+
+def _check_directions(samples: FrictionSamples, model: Any) -> None:
+    """A model with parameters per direction needs samples of each direction, not combined."""
+    dirs = set(samples.directions())
+    if 0 in dirs:
+        raise ConfigError(
+            f"model '{model.name}' has parameters per direction, but the samples combine "
+            "both directions (eq. 11); extract per-direction samples or fit the symmetric "
+            "model"
+        )
+    if not {-1, 1} <= dirs:
+        only = "positive" if 1 in dirs else "negative"
+        raise ConfigError(
+            f"model '{model.name}' has parameters per direction, but the samples hold the "
+            f"{only} direction only"
+        )
+
+
+class Predictor(Protocol):
+    """What a problem needs of a model: a batch prediction ``(k, p), X -> (k, n)``."""
+
+    def predict(self, theta: Any, X: Any) -> np.ndarray: ...  # pragma: no cover
+
+
+class IdentificationProblem:
+    """A model to identify from data, with its loss, bounds and fixed parameters.
+
+    Parameters
+    ----------
+    model : FrictionModel or Predictor
+        An analytic model of :mod:`fricid.models` (parameters named, with data-scaled default
+        values and bounds), or any object with a batch ``predict(T (k, p), X) -> (k, n)``
+        (then ``bounds`` must be the ``(p, 2)`` array and nothing can be fixed).
+    samples : FrictionSamples or tuple of (ndarray, ndarray)
+        The data: velocity, load, temperature, friction and direction from
+        :class:`~fricid.samples.FrictionSamples` (a model with parameters per direction
+        needs samples of both directions, each apart: RWSAVSBAS paper eq. 11), or ``(X, y)``
+        arrays for a generic model.
+    loss : {"sse", "mse"}, default "sse"
+        See :data:`LOSSES`.
+    bounds : mapping of str to (float, float), or array_like (p, 2), optional
+        Named models: search bounds of some parameters (the others keep the model's
+        data-scaled bounds). Generic models: the bounds of every parameter (required).
+    fixed : mapping of str to float, optional
+        Parameters held at a value (named models only), e.g. ``{"delta": 1.0}``.
+    weights : array_like (n,), optional
+        Non-negative weights of the squared errors (weighted least squares); residuals are
+        scaled by their square roots.
+
+    Attributes
+    ----------
+    X : ndarray (n, 3)
+        Inputs: velocity [rad/s], load [N m], temperature [degC] (generic models: any ``X``).
+    y : ndarray (n,)
+        Measured friction [N m].
+    names : tuple of str
+        Every parameter's name (generic models: ``p0, p1, ...``).
+    free : list of int
+        Indices of the free parameters in ``names``.
+    free_names : list of str
+    base : ndarray (p_all,)
+        The full parameter vector: the model's data-scaled defaults, fixed values set.
+    bounds : ndarray (p, 2)
+        Search bounds of the free parameters.
+    fixed : dict of str to float
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from fricid.identify.problem import IdentificationProblem
+    >>> from fricid.models import get_model
+    >>> from fricid.samples import FrictionSamples
+    >>> model = get_model("coulomb_viscous")
+    >>> v = np.linspace(0.1, 1.0, 5)
+    >>> samples = FrictionSamples(velocity=v, load=0.0, temperature=25.0, friction=0.3 + 0.1 * v)
+    >>> problem = IdentificationProblem(model, samples, loss="sse")
+    >>> problem.free_names
+    ['f_c', 'beta']
+    >>> problem.evaluate(np.array([[0.3, 0.1], [0.3, 0.0]])).round(4)
+    array([0.    , 0.0202])
+    """
+
+    def __init__(
+        self,
+        model: Any,
+        samples: FrictionSamples | tuple[Any, Any],
+        *,
+        loss: str = "sse",
+        bounds: Mapping[str, tuple[float, float]] | Any | None = None,
+        fixed: Mapping[str, float] | None = None,
+        weights: Any | None = None,
+    ) -> None:
+        self.model = model
+        if isinstance(samples, FrictionSamples):
+            self.samples: FrictionSamples | None = samples
+            X, y = samples.X, samples.y
+            if getattr(model, "is_asymmetric", False):
+                _check_directions(samples, model)
+        else:
+            self.samples = None
+            X, y = samples
+        self.X = np.asarray(X, dtype=float)
+        self.y = np.asarray(y, dtype=float)
+        if self.y.ndim != 1 or self.X.shape[0] != self.y.shape[0]:
+            raise ConfigError(
+                f"the data need X (n, ...) and y (n,) of one length; got {self.X.shape} and "
+                f"{self.y.shape}"
+            )
+        key = str(loss).strip().lower()
+        if key not in LOSSES:
+            raise ConfigError(f"unknown loss '{loss}'; choose one of: {', '.join(LOSSES)}")
+        self.loss = key
+        self.weights = None if weights is None else self._check_weights(weights)
+        self._sqrt_w = None if self.weights is None else np.sqrt(self.weights)
+        self.fixed = {str(k): float(v) for k, v in (fixed or {}).items()}
+        if hasattr(model, "param_names"):
+            self._init_named(bounds)
+        else:
+            self._init_generic(bounds)
+
+    # -- set-up ---------------------------------------------------------------------------
+    def _check_weights(self, weights: Any) -> np.ndarray:
+        w = np.asarray(weights, dtype=float)
+        if w.shape != self.y.shape or not np.isfinite(w).all() or (w < 0).any():
+            raise ConfigError(
+                f"weights must be {self.y.size} finite numbers >= 0, one per sample; got an "
+                f"array of shape {w.shape}"
+            )
+        return w
+
+    def _init_named(self, bounds: Mapping[str, tuple[float, float]] | None) -> None:
+        model = self.model
+        self.names = tuple(model.param_names)
+        unknown = [k for k in self.fixed if k not in self.names]
+        if unknown:
+            raise ConfigError(
+                f"cannot fix unknown parameter(s) {', '.join(unknown)} of model '{model.name}'; "
+                f"its parameters: {', '.join(self.names)}"
+            )
+        self.free = [i for i, n in enumerate(self.names) if n not in self.fixed]
+        if not self.free:
+            raise ConfigError("every parameter is fixed; nothing to identify")
+        full = model.bounds(self.X, self.y)
+        for name, pair in dict(bounds or {}).items():
+            if name not in self.names:
+                raise ConfigError(
+                    f"bounds given for unknown parameter '{name}' of model '{model.name}'; "
+                    f"its parameters: {', '.join(self.names)}"
+                )
+            lo, hi = (float(v) for v in pair)
+            if not lo < hi:
+                raise ConfigError(f"bounds for '{name}' need lower < upper; got ({lo}, {hi})")
+            full[self.names.index(name)] = (lo, hi)
+        self.base = model.defaults(self.X, self.y)
+        for name, value in self.fixed.items():
+            self.base[self.names.index(name)] = value
+        self.bounds = full[self.free]
+
+    def _init_generic(self, bounds: Any) -> None:
+        if bounds is None or isinstance(bounds, Mapping):
+            raise ConfigError(
+                "a model without named parameters needs bounds as a (p, 2) array of "
+                "(lower, upper) pairs"
+            )
+        if self.fixed:
+            raise ConfigError("only a model with named parameters can have fixed parameters")
+        b = np.asarray(bounds, dtype=float)
+        if b.ndim != 2 or b.shape[1] != 2 or b.shape[0] == 0:
+            raise ConfigError(f"bounds must have shape (p, 2); got {b.shape}")
+        self.names = tuple(f"p{i}" for i in range(b.shape[0]))
+        self.free = list(range(b.shape[0]))
+        self.base = np.zeros(b.shape[0])
+        self.bounds = b
+
+    # -- sizes ----------------------------------------------------------------------------
+    @property
+    def free_names(self) -> list[str]:
+        return [self.names[i] for i in self.free]
+
+    @property
+    def n_obs(self) -> int:
+        """Number of samples (residuals per candidate)."""
+        return int(self.y.size)
+
+    @property
+    def n_free(self) -> int:
+        """Number of free parameters (the search dimension)."""
+        return len(self.free)
+
+    # -- evaluation -----------------------------------------------------------------------
+    def expand(self, T: Any) -> np.ndarray:
+        """Full parameter vectors ``(k, p_all)`` of free-parameter candidates ``T (k, p)``."""
+        T = np.atleast_2d(np.asarray(T, dtype=float))
+        if len(self.free) == self.base.size:
+            return T
+        full = np.broadcast_to(self.base, (T.shape[0], self.base.size)).copy()
+        full[:, self.free] = T
+        return full
+
+    def predict(self, T: Any) -> np.ndarray:
+        """The model's friction ``(k, n)`` for candidates ``T (k, p)``."""
+        return np.atleast_2d(self.model.predict(self.expand(T), self.X))
+
+    def residuals(self, T: Any) -> np.ndarray:
+        """Weighted residuals ``sqrt(w) (model - y)``, shape ``(k, n)``, for ``T (k, p)``."""
+        r = self.predict(T) - self.y
+        return r if self._sqrt_w is None else r * self._sqrt_w
+
+    def loss_of(self, R: np.ndarray) -> np.ndarray:
+        """The loss ``(k,)`` of weighted residuals ``R (k, n)``: the objective, written once."""
+        sse = np.einsum("kn,kn->k", R, R)
+        return sse / self.n_obs if self.loss == "mse" else sse
+
+    def evaluate(self, T: Any) -> np.ndarray:
+        """The loss of each candidate, ``(k, p) -> (k,)``: what optimisers minimise.
+
+        A model may offer ``fused_mse(T, X, y) -> (k,)``, the unweighted mean squared error
+        computed without forming the residuals (the RBF trainer's ridge scorer); it is used
+        when there are no weights, and is the same quantity.
+        """
+        T = np.atleast_2d(np.asarray(T, dtype=float))
+        fused = getattr(self.model, "fused_mse", None)
+        if fused is not None and self._sqrt_w is None:
+            mse = fused(self.expand(T), self.X, self.y)
+            return mse if self.loss == "mse" else mse * self.n_obs
+        return self.loss_of(self.residuals(T))
+
+    __call__ = evaluate
+
+    def start(self, x0: Mapping[str, float] | None = None) -> np.ndarray:
+        """A starting point ``(p,)``: the defaults clipped into the bounds, with ``x0``'s
+        values (by name) for the free parameters it names."""
+        start = np.clip(self.base[self.free], self.bounds[:, 0], self.bounds[:, 1])
+        for name, value in (x0 or {}).items():
+            if name not in self.names or name in self.fixed:
+                raise ConfigError(f"x0 names '{name}', which is not a free parameter")
+            start[self.free.index(self.names.index(name))] = float(value)
+        return start
+
+    def at_bound(self, x: np.ndarray, rtol: float = 1e-6) -> list[str]:
+        """Free parameters of ``x (p,)`` within ``rtol`` of the box width of a bound."""
+        lo, hi = self.bounds[:, 0], self.bounds[:, 1]
+        gap = np.minimum(x - lo, hi - x)
+        return [n for n, g, s in zip(self.free_names, gap, hi - lo, strict=True) if g <= rtol * s]
