@@ -38,7 +38,7 @@ from fricid.fleet import (
 )
 from fricid.io import write_rawlog
 from fricid.models import Stribeck
-from fricid.pipeline import run_joint
+from fricid.workflow import run_joint
 from fricid.sim import ModelLaw, preset, simulate
 
 runner = CliRunner()

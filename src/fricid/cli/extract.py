@@ -174,7 +174,7 @@ def extract_command(
     as the load (eq. 12). Writes samples with velocity [rad/s], load [N m], temperature [degC],
     friction [N m], direction, count, std [N m]."""
     from ..io import write_samples
-    from ..pipeline import load_joint
+    from ..workflow import load_joint
     from ..units import to_si
 
     pos = parse_positions(positions, position_unit)

@@ -5,7 +5,7 @@
 ...                                                               # doctest: +SKIP
 >>> run.table.head(), run.failures                                # doctest: +SKIP
 
-Each joint runs :func:`fricid.pipeline.run_joint` (the same extraction and fit as
+Each joint runs :func:`fricid.workflow.run_joint` (the same extraction and fit as
 ``fricid extract`` and ``fricid fit``). Modules: :mod:`.manifest` (the manifest),
 :mod:`.job` (one joint, as a worker runs it), :mod:`.executors` and :mod:`._dask` (where the
 joints run), :mod:`.store` (the output folder, resumable), :mod:`.table` (the results table),

@@ -33,7 +33,8 @@ from typing import Any
 import numpy as np
 
 from ..errors import ConfigError, DataError
-from ..pipeline import DIRECTIONS, READER_OPTIONS, READERS, SAMPLE_SETS
+from ..io.registry import READER_OPTIONS, READERS
+from ..workflow import DIRECTIONS, SAMPLE_SETS
 from ..units import UNITS, to_si
 
 __all__ = ["FIELDS", "Field", "JointSpec", "Manifest", "read_manifest"]
@@ -289,10 +290,10 @@ class JointSpec:
     log_text : the path as the manifest writes it.
     row : the manifest line of the joint, for messages.
     date : measurement date (ISO), or None for the run's date.
-    reader, reader_options : see :func:`fricid.pipeline.load_joint` (SI units).
+    reader, reader_options : see :func:`fricid.workflow.load_joint` (SI units).
     extract_options : options of :func:`fricid.extract.extract` (SI units).
     models, method, seed, max_evals, samples, direction, fixed, bounds : see
-        :func:`fricid.pipeline.run_joint`.
+        :func:`fricid.workflow.run_joint`.
     chunk_rows : rows read at a time (memory, not results).
     """
 
@@ -340,7 +341,7 @@ class JointSpec:
         }
 
     def run_kwargs(self) -> dict[str, Any]:
-        """Keyword arguments of :func:`fricid.pipeline.run_joint` for this joint."""
+        """Keyword arguments of :func:`fricid.workflow.run_joint` for this joint."""
         return {
             "reader": self.reader,
             "reader_options": self.reader_options,
