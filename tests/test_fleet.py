@@ -38,8 +38,8 @@ from fricid.fleet import (
 )
 from fricid.io import write_rawlog
 from fricid.models import Stribeck
-from fricid.workflow import run_joint
 from fricid.sim import ModelLaw, preset, simulate
+from fricid.workflow import run_joint
 
 runner = CliRunner()
 

@@ -68,6 +68,7 @@ DIRECTIONS: dict[str, list[int] | None] = {
     "neg": [-1],
 }
 
+
 @dataclass(frozen=True, eq=False)
 class JointData:
     """The friction samples of one joint's log.

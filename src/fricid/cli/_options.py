@@ -113,9 +113,7 @@ TorqueConstantOption = Annotated[
 #: ``--temperature``: a constant temperature [degC] for a log that records none.
 TemperatureOption = Annotated[
     float,
-    typer.Option(
-        "--temperature", help="The temperature [degC] to record when the log has none."
-    ),
+    typer.Option("--temperature", help="The temperature [degC] to record when the log has none."),
 ]
 
 

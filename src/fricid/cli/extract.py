@@ -157,8 +157,8 @@ def extract_command(
     as the load (eq. 12). Writes samples with velocity [rad/s], load [N m], temperature [degC],
     friction [N m], direction, count, std [N m]."""
     from ..io import write_samples
-    from ..workflow import load_joint
     from ..units import to_si
+    from ..workflow import load_joint
 
     pos = parse_positions(positions, position_unit)
     half = None if bin_halfwidth is None else float(to_si(bin_halfwidth, position_unit, "position"))
