@@ -3,6 +3,7 @@ the command line and the fleet manifest: properties, refusals, and that both pla
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import pytest
@@ -100,7 +101,7 @@ def test_grid_includes_start_and_stop_on_the_grid(start, span, step):
     points = parse_grid(f"{start!r}:{start + span!r}:{step!r}")
     assert points[0] == start
     assert len(points) == math.floor(((start + span) - start) / step + 1e-9) + 1
-    assert all(b > a for a, b in zip(points, points[1:], strict=False))
+    assert all(b > a for a, b in itertools.pairwise(points))
     assert points[-1] <= start + span + 1e-9 * max(1.0, abs(start + span))
 
 

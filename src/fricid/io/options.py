@@ -201,7 +201,8 @@ def parse_grid(value: Any) -> list[float]:
         try:
             start, stop, step = (parse_number(p) for p in parts)
         except ConfigError as exc:
-            raise ConfigError(f"expected START:STOP:STEP or a list, got '{value}' ({exc})") from None
+            message = f"expected START:STOP:STEP or a list, got '{value}' ({exc})"
+            raise ConfigError(message) from None
         if not (step > 0 and stop >= start):
             raise ConfigError(f"START:STOP:STEP needs step > 0 and stop >= start, got '{value}'")
         count = math.floor((stop - start) / step + 1e-9) + 1
