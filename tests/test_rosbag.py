@@ -241,7 +241,7 @@ def test_degrees_are_converted(tmp_path, mcap_bag):
 def test_registry_opens_a_bag_and_asks_for_the_joint(mcap_bag):
     from fricid.io import open_log
 
-    with pytest.raises(ConfigError, match=r"needs the joint's name; .* has joints: shoulder, elbow"):
+    with pytest.raises(ConfigError, match=r"joint.s name; .* has joints: shoulder, elbow"):
         open_log(mcap_bag, "rosbag", {})
     options = {"joint": "elbow", "temperature": 25.0}
     chunks = list(open_log(mcap_bag, "rosbag", options, chunk_rows=100))
