@@ -75,11 +75,14 @@ class JointData:
 
     Attributes
     ----------
-    samples : the combined samples (direction 0, eq. 11 of the BAS-RBFNN paper); for a folder
-        of steady-state EPOS recordings, the per-direction operating points as recorded.
-    by_direction : the per-direction samples (+1 and -1).
-    extraction : what :func:`fricid.extract.extract` returned (diagnostics, gravity fit), or
-        None when the reader gave samples directly.
+    samples : FrictionSamples
+        The combined samples (direction 0, eq. 11 of the BAS-RBFNN paper); for a folder of
+        steady-state EPOS recordings, the per-direction operating points as recorded.
+    by_direction : FrictionSamples
+        The per-direction samples (+1 and -1).
+    extraction : ExtractionResult or None
+        What :func:`fricid.extract.extract` returned (diagnostics, gravity fit), or None when
+        the reader gave samples directly.
     """
 
     samples: FrictionSamples
@@ -93,12 +96,18 @@ class JointRun:
 
     Attributes
     ----------
-    data : the extracted samples.
-    fits : model name -> fitted model, for the models whose fit succeeded.
-    errors : model name -> the error of a model whose fit failed.
-    used : model name -> the samples that model was fitted to.
-    extract_seconds : wall time of reading and extraction [s].
-    fit_seconds : model name -> wall time of its fit [s].
+    data : JointData
+        The extracted samples.
+    fits : dict of str to FittedModel
+        Model name -> fitted model, for the models whose fit succeeded.
+    errors : dict of str to FricidError
+        Model name -> the error of a model whose fit failed.
+    used : dict of str to FrictionSamples
+        Model name -> the samples that model was fitted to.
+    extract_seconds : float
+        Wall time of reading and extraction [s].
+    fit_seconds : dict of str to float
+        Model name -> wall time of its fit [s].
     """
 
     data: JointData
@@ -168,16 +177,23 @@ def load_joint(
 
     Parameters
     ----------
-    path : the log: a fricid raw log (``table``), any CSV/Parquet table (``generic``), an EPOS
-        recorder CSV or a folder of steady-state EPOS recordings (``epos``).
-    reader : one of :data:`fricid.io.READERS`.
-    reader_options : the reader's options (:data:`fricid.io.READER_OPTIONS`, SI units), e.g. for
+    path : str or path-like
+        The log: a fricid raw log (``table``), any CSV/Parquet table (``generic``), a ROS 2
+        bag or MCAP file (``rosbag``), an EPOS recorder CSV or a folder of steady-state EPOS
+        recordings (``epos``); opened by :func:`fricid.io.open_log`.
+    reader : str
+        One of :data:`fricid.io.READERS`.
+    reader_options : Mapping, optional
+        The reader's options (:data:`fricid.io.READER_OPTIONS`, SI units), e.g. for
         ``generic`` ``{"columns": {"time": "t", "velocity": "dq", "torque": "tau"},
         "units": {"velocity": "deg/s"}, "temperature": 25.0}``.
-    extract_options : options of :func:`fricid.extract.extract` (:data:`EXTRACT_OPTIONS`).
-        Unset position bins and gravity mode come from the design a simulated log records.
-    chunk_rows : rows read at a time from a ``table`` log (bounded memory).
-    on_chunk : called once per chunk read (progress).
+    extract_options : Mapping, optional
+        Options of :func:`fricid.extract.extract` (:data:`EXTRACT_OPTIONS`). Unset position
+        bins and gravity mode come from the design a simulated log records.
+    chunk_rows : int
+        Rows read at a time from a ``table`` log or a bag (bounded memory).
+    on_chunk : callable, optional
+        Called once per chunk read (progress).
 
     Returns
     -------
@@ -185,8 +201,10 @@ def load_joint(
 
     Raises
     ------
-    ConfigError : an unknown reader or option.
-    DataError : unreadable or unusable data (naming file, row and column where known).
+    ConfigError
+        An unknown reader or option.
+    DataError
+        Unreadable or unusable data (naming file, row and column where known).
     """
     path = Path(path)
     ropts = dict(reader_options or {})
@@ -258,13 +276,18 @@ def run_joint(
 
     Parameters
     ----------
-    path, reader, reader_options, extract_options, chunk_rows : see :func:`load_joint`.
-    models : model names (``fricid.models.MODELS``, ``*_asym`` for per-direction parameters).
-    method, seed, max_evals : passed to :func:`fricid.identify.fit`; every model is fitted with
-        the same ``seed``, so the run is reproducible bit for bit.
-    samples, direction : which samples each model is fitted to (:func:`select_samples`).
-    fixed, bounds : parameters held fixed / search ranges (SI), applied to every model that
-        has the parameter named.
+    path, reader, reader_options, extract_options, chunk_rows
+        See :func:`load_joint`.
+    models : sequence of str
+        Model names (``fricid.models.MODELS``, ``*_asym`` for per-direction parameters).
+    method, seed, max_evals : str, int, int or None
+        Passed to :func:`fricid.identify.fit`; every model is fitted with the same ``seed``,
+        so the run is reproducible bit for bit.
+    samples, direction : str
+        Which samples each model is fitted to (:func:`select_samples`).
+    fixed, bounds : Mapping, optional
+        Parameters held fixed / search ranges (SI), applied to every model that has the
+        parameter named.
 
     Returns
     -------
@@ -274,7 +297,8 @@ def run_joint(
 
     Raises
     ------
-    FricidError : the log cannot be read or extracted (nothing can be fitted then).
+    FricidError
+        The log cannot be read or extracted (nothing can be fitted then).
     """
     from .identify import fit
     from .models import get_model

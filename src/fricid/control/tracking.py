@@ -336,11 +336,18 @@ def compensation_study(
 
     Parameters
     ----------
-    fitted : the identified model (the feed-forward).
-    config : the experiment (default :class:`TrackingConfig`). A ``truth`` with an inertia
+    fitted : FittedModel
+        The identified model (the feed-forward).
+    config : TrackingConfig, optional
+        The experiment (default :class:`TrackingConfig`). A ``truth`` with an inertia
         replaces ``config.inertia``.
-    truth : the plant's friction (:class:`Truth`); None: the model itself (``"model"``).
-    smoothing : :class:`fricid.export.Smoothing` of the feed-forward near zero velocity.
+    truth : Truth, optional
+        The plant's friction, given by the caller (the CLI builds a simulation preset's, a
+        test its own law); None: the model itself, named ``"model"``. This module imports
+        no simulation code.
+    smoothing : Smoothing, optional
+        Smoothing of the feed-forward near zero velocity (``Smoothing`` of
+        :mod:`fricid.export.smoothing`, moving to :mod:`fricid.models.smoothing`).
 
     Returns
     -------

@@ -74,16 +74,24 @@ class JointSpec:
 
     Attributes
     ----------
-    robot, joint : its names (``key`` is ``"robot/joint"``).
-    log : absolute path of the log (the manifest's relative path resolved).
-    log_text : the path as the manifest writes it.
-    row : the manifest line of the joint, for messages.
-    date : measurement date (ISO), or None for the run's date.
-    reader, reader_options : see :func:`fricid.workflow.load_joint` (SI units).
-    extract_options : options of :func:`fricid.extract.extract` (SI units).
-    models, method, seed, max_evals, samples, direction, fixed, bounds : see
-        :func:`fricid.workflow.run_joint`.
-    chunk_rows : rows read at a time (memory, not results).
+    robot, joint : str
+        Its names (``key`` is ``"robot/joint"``).
+    log : Path
+        Absolute path of the log (the manifest's relative path resolved).
+    log_text : str
+        The path as the manifest writes it.
+    row : int or None
+        The manifest line of the joint, for messages.
+    date : str or None
+        Measurement date (ISO), or None for the run's date.
+    reader, reader_options : str, dict
+        See :func:`fricid.workflow.load_joint` (SI units).
+    extract_options : dict
+        Options of :func:`fricid.extract.extract` (SI units).
+    models, method, seed, max_evals, samples, direction, fixed, bounds
+        See :func:`fricid.workflow.run_joint`.
+    chunk_rows : int
+        Rows read at a time (memory, not results).
     """
 
     robot: str
