@@ -20,7 +20,7 @@ PROPERTIES = SCHEMA["$defs"]["fields"]["properties"]
 
 
 def test_schema_is_valid_and_shipped_as_package_data():
-    text = resources.files("fricid.schemas").joinpath("manifest.schema.json").read_text("utf-8")
+    text = resources.files("fricid").joinpath("schemas", "manifest.schema.json").read_text("utf-8")
     schema = json.loads(text)
     Draft202012Validator.check_schema(schema)
     assert schema == SCHEMA

@@ -55,7 +55,7 @@ _BOOLEANS.update({"false": False, "no": False, "0": False, "off": False})
 
 @functools.cache
 def _schema() -> dict[str, Any]:
-    text = resources.files("fricid.schemas").joinpath("manifest.schema.json").read_text("utf-8")
+    text = resources.files("fricid").joinpath("schemas", "manifest.schema.json").read_text("utf-8")
     return json.loads(text)
 
 
