@@ -207,3 +207,16 @@ def test_extract_positions_use_the_same_grid(tmp_path):
     )
     with pytest.raises(ConfigError, match="--positions takes START:STOP:STEP"):
         parse_positions("0:1:1e-9", "deg")
+
+
+def test_extract_column_map_uses_the_pair_parser():
+    from fricid.cli.extract import parse_column_map
+
+    assert parse_column_map(["time=t:ms", "velocity=dq [deg/s]", "torque=a:b:N m"]) == (
+        {"time": "t", "velocity": "dq [deg/s]", "torque": "a:b"},
+        {"time": "ms", "torque": "N m"},
+    )
+    with pytest.raises(ConfigError, match=r"--map takes QUANTITY=COLUMN.*'time' is given twice"):
+        parse_column_map(["time=t", "time=u"])
+    with pytest.raises(ConfigError, match=r"--map takes QUANTITY=COLUMN\[:UNIT\]"):
+        parse_column_map(["velocity"])
