@@ -11,6 +11,7 @@ from typer.testing import CliRunner
 from fricid.cli import app
 from fricid.control import (
     TrackingConfig,
+    Truth,
     compensation_study,
     default_config,
     fitted_law,
@@ -33,6 +34,12 @@ def cv(f_c: float = 0.1, beta: float = 0.05) -> FittedModel:
         params={"f_c": f_c, "beta": beta},
         operating_range={"velocity": [0.01, 1.0], "load": [0, 0], "temperature": [25, 25]},
     )
+
+
+def preset_truth(name: str) -> Truth:
+    """The virtual joint of a simulation preset as the plant's truth (law and inertia)."""
+    joint = preset(name, "quick").joint
+    return Truth(joint.law, name, joint.inertia)
 
 
 def paper2() -> FittedModel:
@@ -80,8 +87,8 @@ def test_joint_sticks_at_reversals():
 def test_virtual_joint_truth_and_the_model_agree_for_the_same_law():
     """paper2's true law is the Stribeck model with its Table 2 values: same result."""
     config = TrackingConfig(**FAST)
-    a = compensation_study(paper2(), config, truth="model")
-    b = compensation_study(paper2(), config, truth="paper2")
+    a = compensation_study(paper2(), config)
+    b = compensation_study(paper2(), config, truth=preset_truth("paper2"))
     np.testing.assert_allclose(b.rms["with"], a.rms["with"], rtol=1e-9)
     assert b.rms["with"] < b.rms["without"]
 
@@ -89,7 +96,7 @@ def test_virtual_joint_truth_and_the_model_agree_for_the_same_law():
 def test_mismatched_model_against_the_virtual_joint():
     """A plain Coulomb-viscous model still helps on the paper1 joint (gravity compensated)."""
     config = default_config(cv(0.2, 0.2), **FAST, load=0.18, temperature=25.0)
-    r = compensation_study(cv(0.2, 0.2), config, truth="paper1")
+    r = compensation_study(cv(0.2, 0.2), config, truth=preset_truth("paper1"))
     assert r.rms["with"] < r.rms["without"]
 
 
@@ -116,8 +123,35 @@ def test_bad_configuration():
         TrackingConfig(dt=0.0)
     with pytest.raises(ConfigError, match="too many"):
         TrackingConfig(dt=1e-7, periods=10)
-    with pytest.raises(ConfigError, match="unknown truth 'lugre'"):
-        compensation_study(cv(), TrackingConfig(**FAST), truth="lugre")
+    with pytest.raises(ConfigError, match="'law' must be callable"):
+        Truth("lugre")
+    with pytest.raises(ConfigError, match="'inertia' must be a number > 0"):
+        Truth(fitted_law(cv()), "cv", inertia=0.0)
+
+
+def test_truth_comes_from_the_caller():
+    """A law given by the caller is the plant: here friction twice the model's."""
+    config = TrackingConfig(**FAST)
+    law = fitted_law(cv())
+    doubled = Truth(lambda v, load, t: 2.0 * law(v, load, t), "double", inertia=0.02)
+    r = compensation_study(cv(), config, truth=doubled)
+    exact = compensation_study(cv(), config)
+    assert r.truth == "double" and r.config.inertia == 0.02
+    assert any("inertia 0.02 kg m^2 from the 'double' joint" in n for n in r.notes)
+    assert r.rms["with"] > exact.rms["with"]
+
+
+def test_control_does_not_import_sim():
+    """The simulation presets are the caller's business (DESIGN.md layers)."""
+    import ast
+    from pathlib import Path
+
+    import fricid.control
+
+    for path in Path(fricid.control.__file__).parent.glob("*.py"):
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.ImportFrom):
+                assert not (node.module or "").startswith(("sim", "fricid.sim")), path
 
 
 def test_default_config_stays_in_the_operating_range():

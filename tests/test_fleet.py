@@ -38,8 +38,8 @@ from fricid.fleet import (
 )
 from fricid.io import write_rawlog
 from fricid.models import Stribeck
-from fricid.pipeline import run_joint
 from fricid.sim import ModelLaw, preset, simulate
+from fricid.workflow import run_joint
 
 runner = CliRunner()
 
@@ -557,3 +557,49 @@ def test_dask_worker_killed_mid_run_loses_nothing(fleet, dask_local, tmp_path):
     )
     client.wait_for_workers(2, timeout=30)
     assert killed[0] not in set(client.run(os.getpid).values())  # the nanny started a new one
+
+
+# --------------------------------------------------------------------------- results table
+
+
+def _rows(tau_c: float) -> list[dict]:
+    return [
+        {
+            "rows": [
+                {"robot": r, "joint": j, "date": "2026-01-02", "model": "stribeck", "status": "ok"}
+                | {"param_tau_c": tau_c + i}
+                for i, (r, j) in enumerate((("r0", "a"), ("r1", "b"), ("r0", "c")))
+            ]
+        }
+    ]
+
+
+def test_results_partitions_are_written_atomically(tmp_path, monkeypatch):
+    """Each Parquet file goes through fricid.io.atomic; a failure keeps the old table."""
+    import pyarrow.parquet as pq
+
+    from fricid.fleet import results_table, write_results
+
+    dataset, _ = write_results(results_table(_rows(1.0)), tmp_path)
+    parts = sorted(p.relative_to(dataset).as_posix() for p in dataset.rglob("*.parquet"))
+    assert parts == [f"robot={r}/date=2026-01-02/part-0.parquet" for r in ("r0", "r1")]
+    before = read_results(tmp_path)
+    assert before["param_tau_c"].tolist() == [1.0, 3.0, 2.0]  # sorted by robot, joint
+
+    calls = []
+    real = pq.write_table
+
+    def fail_second(table, where, *a, **kw):
+        calls.append(where)
+        if len(calls) == 2:
+            raise OSError("disk full")
+        return real(table, where, *a, **kw)
+
+    monkeypatch.setattr(pq, "write_table", fail_second)
+    with pytest.raises(OSError, match="disk full"):
+        write_results(results_table(_rows(10.0)), tmp_path)
+    monkeypatch.undo()
+    assert all(Path(c).name.endswith(".tmp") for c in calls)  # written beside, then renamed
+    pd.testing.assert_frame_equal(read_results(tmp_path / "results"), before)
+    leftovers = [p.name for p in tmp_path.rglob("*") if p.name.startswith(".")]
+    assert leftovers == []

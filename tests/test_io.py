@@ -576,3 +576,55 @@ def test_generic_log_errors(tmp_path):
     labelled = _write(tmp_path / "l.csv", "t,dq [deg/s],tau\n0,1,1\n")
     with pytest.raises(ConfigError, match="says its unit is 'deg/s'"):
         read_table_log(labelled, {**cols, "velocity": "dq [deg/s]"}, units, temperature=25.0)
+
+
+# --------------------------------------------------------------------------- reader registry
+
+
+def test_registry_is_in_io_and_pipeline_is_gone():
+    import importlib
+
+    from fricid import io as fio
+
+    assert fio.READERS == ("table", "generic", "rosbag", "epos")
+    assert set(fio.READER_OPTIONS) == set(fio.READERS)
+    with pytest.raises(ModuleNotFoundError):
+        importlib.import_module("fricid.pipeline")
+
+
+def test_open_log_table_streams_chunks(tmp_path):
+    from fricid.io import open_log
+
+    path = write_rawlog(_log(10), tmp_path / "log.parquet")
+    chunks = list(open_log(path, "table", chunk_rows=4))
+    assert [len(c.time) for c in chunks] == [4, 4, 2]
+    _assert_same_log(RawLog.concatenate(chunks), read_rawlog(path))
+
+
+def test_open_log_generic_is_one_chunk(tmp_path):
+    from fricid.io import open_log
+
+    path = _write(tmp_path / "g.csv", "t,dq,tau\n0,1,0.1\n0.001,1,0.1\n0.002,1,0.1\n")
+    columns = {"time": "t", "velocity": "dq", "torque": "tau"}
+    units = {"time": "ms", "velocity": "deg/s", "torque": "N m"}
+    options = {"columns": columns, "units": units, "temperature": 25.0}
+    (only,) = list(open_log(path, "generic", options))
+    _assert_same_log(only, read_table_log(path, columns, units, temperature=25.0))
+
+
+@pytest.mark.parametrize(
+    ("reader", "options", "message"),
+    [
+        ("nope", {}, "unknown reader 'nope'; choose one of: table, generic, rosbag, epos"),
+        ("table", {"joint": "a"}, "unknown option of reader 'table' 'joint'; allowed: none"),
+        ("generic", {"topic": "/x"}, "allowed: columns, units, torque_constant, temperature"),
+        ("epos", {"pattern": "*.csv"}, "'pattern' applies to a folder of EPOS recordings"),
+    ],
+)
+def test_open_log_refuses_bad_readers_and_options(tmp_path, reader, options, message):
+    from fricid.io import open_log
+
+    path = write_rawlog(_log(4), tmp_path / "log.csv")
+    with pytest.raises(ConfigError) as info:
+        open_log(path, reader, options)
+    assert message in str(info.value)

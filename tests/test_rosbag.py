@@ -236,3 +236,14 @@ def test_degrees_are_converted(tmp_path, mcap_bag):
     shutil.copytree(mcap_bag, copy)
     log = read_rosbag(copy, "elbow", temperature=25.0, position_unit="deg", velocity_unit="deg/s")
     np.testing.assert_allclose(log.velocity, np.deg2rad(truth(np.arange(N))["velocity"]))
+
+
+def test_registry_opens_a_bag_and_asks_for_the_joint(mcap_bag):
+    from fricid.io import open_log
+
+    with pytest.raises(ConfigError, match=r"joint.s name; .* has joints: shoulder, elbow"):
+        open_log(mcap_bag, "rosbag", {})
+    options = {"joint": "elbow", "temperature": 25.0}
+    chunks = list(open_log(mcap_bag, "rosbag", options, chunk_rows=100))
+    whole = read_rosbag(mcap_bag, **options)
+    np.testing.assert_array_equal(np.concatenate([c.velocity for c in chunks]), whole.velocity)

@@ -1,45 +1,167 @@
-"""Parsing helpers shared by sub-commands: NAME=VALUE pairs and LOW:HIGH ranges."""
+"""What sub-commands share: option definitions, and flag values parsed by :mod:`fricid.io.options`.
+
+Option definitions are ``Annotated`` types, used as a parameter's annotation::
+
+    def export_command(model: ModelFile, smooth: SmoothKind = "none", zone: SmoothZone = 0.0,
+                       out: Annotated[Path | None, out_option("File to write.")] = None): ...
+
+The parsers of ``NAME=VALUE`` and ``NAME=LOW:HIGH`` live in :mod:`fricid.io.options` (the
+fleet manifest uses them too); here they only turn its :class:`~fricid.errors.ConfigError`
+into a :class:`typer.BadParameter` naming the flag (exit status 2).
+"""
 
 from __future__ import annotations
 
+from collections.abc import Callable, Iterable
+from pathlib import Path
+from typing import Annotated, Any, TypeVar
+
 import typer
 
-__all__ = ["parse_assignments", "parse_ranges"]
+from ..errors import ConfigError
+from ..io import options as _parse
+
+__all__ = [
+    "BoundOption",
+    "DirectionOption",
+    "FixOption",
+    "MaxEvalsOption",
+    "ModelFile",
+    "SeedOption",
+    "SmoothKind",
+    "SmoothZone",
+    "TemperatureOption",
+    "TorqueConstantOption",
+    "out_option",
+    "parse_assignments",
+    "parse_grid",
+    "parse_ranges",
+]
+
+T = TypeVar("T")
+
+#: A model file argument (JSON written by ``fricid fit``), which must exist.
+ModelFile = Annotated[
+    Path,
+    typer.Argument(help="Model file (JSON, from `fricid fit`).", exists=True, dir_okay=False),
+]
+
+#: ``--fix NAME=VALUE`` (repeatable), parsed by :func:`parse_assignments`.
+FixOption = Annotated[
+    list[str] | None,
+    typer.Option(
+        "--fix",
+        help="Hold a parameter at a value, NAME=VALUE (SI units), e.g. --fix delta=1. Repeatable.",
+    ),
+]
+
+#: ``--bound NAME=LOW:HIGH`` (repeatable), parsed by :func:`parse_ranges`.
+BoundOption = Annotated[
+    list[str] | None,
+    typer.Option(
+        "--bound",
+        help=(
+            "Search range of a parameter, NAME=LOW:HIGH (SI units). Repeatable. Default ranges "
+            "scale with the data."
+        ),
+    ),
+]
+
+#: ``--seed``: the random seed of a stochastic computation.
+SeedOption = Annotated[int, typer.Option("--seed", help="Random seed (same seed, same result).")]
+
+#: ``--max-evals``: an optimiser's budget.
+MaxEvalsOption = Annotated[
+    int | None, typer.Option("--max-evals", help="Budget in model evaluations.")
+]
+
+#: ``--direction``: which samples a fit uses (:data:`fricid.workflow.DIRECTIONS`).
+DirectionOption = Annotated[
+    str,
+    typer.Option(
+        "--direction",
+        help="Which samples to use: all, combined (direction 0), both (+1 and -1), pos, neg.",
+    ),
+]
+
+#: ``--smooth``: smoothing of sign(v) near zero velocity (as the C export does).
+SmoothKind = Annotated[
+    str,
+    typer.Option(
+        "--smooth",
+        help=(
+            "Smoothing near zero velocity: none (the model as identified), tanh (sign(v) -> "
+            "tanh(v/zone), analytic models), linear (straight line between the model's values "
+            "at -zone and +zone, every model)."
+        ),
+    ),
+]
+
+#: ``--zone``: half-width of the smoothing zone [rad/s].
+SmoothZone = Annotated[
+    float, typer.Option("--zone", help="Half-width of the smoothing zone [rad/s].")
+]
+
+#: ``--torque-constant``: K of tau = K I when the effort is a motor current.
+TorqueConstantOption = Annotated[
+    float | None,
+    typer.Option(
+        "--torque-constant", help="K [N m/A] of tau = K I (eq. 13), when effort is current."
+    ),
+]
+
+#: ``--temperature``: a constant temperature [degC] for a log that records none.
+TemperatureOption = Annotated[
+    float,
+    typer.Option("--temperature", help="The temperature [degC] to record when the log has none."),
+]
 
 
-def _split(item: str, flag: str) -> tuple[str, str]:
-    name, sep, value = item.partition("=")
-    if not sep or not name.strip() or not value.strip():
-        raise typer.BadParameter(f"expected NAME=VALUE, got '{item}'", param_hint=flag)
-    return name.strip(), value.strip()
+def out_option(help: str, **kwargs: Any) -> Any:
+    """The ``--out``/``-o`` option with its command's own help text."""
+    return typer.Option("--out", "-o", help=help, **kwargs)
 
 
-def parse_assignments(items: list[str] | None, flag: str) -> dict[str, float]:
-    """``["delta=1", "xi=2"]`` -> ``{"delta": 1.0, "xi": 2.0}``."""
-    out: dict[str, float] = {}
-    for item in items or []:
-        name, value = _split(item, flag)
-        try:
-            out[name] = float(value)
-        except ValueError:
-            raise typer.BadParameter(
-                f"'{value}' is not a number (in '{item}')", param_hint=flag
-            ) from None
-    return out
+def _flag(parse: Callable[[Any], T], value: Any, flag: str) -> T:
+    try:
+        return parse(value)
+    except ConfigError as exc:
+        raise typer.BadParameter(str(exc), param_hint=flag) from None
 
 
-def parse_ranges(items: list[str] | None, flag: str) -> dict[str, tuple[float, float]]:
-    """``["w_s=0.001:1"]`` -> ``{"w_s": (0.001, 1.0)}``."""
-    out: dict[str, tuple[float, float]] = {}
-    for item in items or []:
-        name, value = _split(item, flag)
-        lo, sep, hi = value.partition(":")
-        try:
-            out[name] = (float(lo), float(hi))
-        except ValueError:
-            raise typer.BadParameter(
-                f"expected NAME=LOW:HIGH, got '{item}'", param_hint=flag
-            ) from None
-        if not sep:
-            raise typer.BadParameter(f"expected NAME=LOW:HIGH, got '{item}'", param_hint=flag)
-    return out
+def parse_assignments(items: Iterable[str] | None, flag: str) -> dict[str, float]:
+    """``["delta=1", "xi=2"]`` -> ``{"delta": 1.0, "xi": 2.0}`` (:mod:`fricid.io.options`).
+
+    Raises
+    ------
+    typer.BadParameter
+        Naming ``flag``: an item that is not NAME=VALUE with a finite number, or a name
+        given twice.
+    """
+    return _flag(_parse.parse_assignments, list(items or []), flag)
+
+
+def parse_ranges(items: Iterable[str] | None, flag: str) -> dict[str, tuple[float, float]]:
+    """``["w_s=0.001:1"]`` -> ``{"w_s": (0.001, 1.0)}`` (:mod:`fricid.io.options`).
+
+    Raises
+    ------
+    typer.BadParameter
+        Naming ``flag``: an item that is not NAME=LOW:HIGH with finite LOW < HIGH, or a name
+        given twice.
+    """
+    return _flag(_parse.parse_ranges, list(items or []), flag)
+
+
+def parse_grid(text: str, flag: str) -> list[float]:
+    """``"-60:-20:2"`` (START:STOP:STEP, stop included) or ``"-60,-40,-20"`` -> points.
+
+    Raises
+    ------
+    ConfigError
+        ``"<flag> takes START:STOP:STEP (step > 0) or a list: ..."``, with the reason.
+    """
+    try:
+        return _parse.parse_grid(text)
+    except ConfigError as exc:
+        raise ConfigError(f"{flag} takes START:STOP:STEP (step > 0) or a list: {exc}") from None

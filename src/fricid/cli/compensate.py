@@ -11,15 +11,36 @@ from rich.markup import escape
 from rich.table import Table
 
 from ._app import app, console, err_console, handle_errors
+from ._options import ModelFile, SmoothKind, SmoothZone
+
+
+def truth_names() -> tuple[str, ...]:
+    """``--truth`` choices: ``model``, then every simulation preset."""
+    from ..sim import PRESETS
+
+    return ("model", *PRESETS)
+
+
+def resolve_truth(name: str):
+    """The plant's friction for ``--truth``: None for the model itself, else the virtual
+    joint of that simulation preset (:func:`fricid.sim.preset`, its law and inertia)."""
+    from ..control import Truth
+    from ..errors import ConfigError
+    from ..sim import preset
+
+    key = str(name).strip().lower()
+    if key not in truth_names():
+        raise ConfigError(f"unknown truth '{name}'; choose one of: {', '.join(truth_names())}")
+    if key == "model":
+        return None
+    joint = preset(key, "quick").joint
+    return Truth(joint.law, key, joint.inertia)
 
 
 @app.command("compensate")
 @handle_errors
 def compensate_command(
-    model: Annotated[
-        Path,
-        typer.Argument(help="Model file (JSON, from `fricid fit`).", exists=True, dir_okay=False),
-    ],
+    model: ModelFile,
     truth: Annotated[
         str,
         typer.Option(
@@ -62,16 +83,8 @@ def compensate_command(
         typer.Option(help=("Temperature [degC]. Default: middle of the identified range.")),
     ] = None,
     dt: Annotated[float, typer.Option(help="Integration step [s].")] = 2e-4,
-    smooth: Annotated[
-        str,
-        typer.Option(
-            help=(
-                "Smoothing of the feed-forward near zero velocity: none, tanh, linear (as the C "
-                "export)."
-            )
-        ),
-    ] = "none",
-    zone: Annotated[float, typer.Option(help="Half-width of the smoothing zone [rad/s].")] = 0.0,
+    smooth: SmoothKind = "none",
+    zone: SmoothZone = 0.0,
     plot: Annotated[
         Path | None,
         typer.Option(
@@ -107,7 +120,9 @@ def compensate_command(
         temperature=temperature,
         dt=dt,
     )
-    result = compensation_study(fitted, config, truth=truth, smoothing=Smoothing(smooth, zone))
+    result = compensation_study(
+        fitted, config, truth=resolve_truth(truth), smoothing=Smoothing(smooth, zone)
+    )
     if not no_plot:
         plot_path = plot or Path(f"{model.stem}.compensation.png")
         plot_compensation(result, plot_path)

@@ -11,6 +11,7 @@ from rich.markup import escape
 
 from ..errors import ConfigError
 from ._app import app, console, err_console, handle_errors
+from ._options import TemperatureOption, TorqueConstantOption, out_option, parse_grid
 from ._progress import progress_bar
 
 
@@ -20,38 +21,30 @@ def parse_positions(text: str | None, unit: str) -> np.ndarray | None:
 
     if text is None:
         return None
-    try:
-        if ":" in text:
-            start, stop, step = (float(p) for p in text.split(":"))
-            if step <= 0 or stop < start:
-                raise ValueError
-            values = start + step * np.arange(int(np.floor((stop - start) / step + 1e-9)) + 1)
-        else:
-            values = np.array([float(p) for p in text.split(",")])
-    except ValueError:
-        raise ConfigError(
-            f"--positions takes START:STOP:STEP (step > 0) or a comma list; got '{text}'"
-        ) from None
+    values = np.asarray(parse_grid(text, "--positions"), dtype=float)
     return np.asarray(to_si(values, unit, "position"), dtype=float)
 
 
 def parse_column_map(items: list[str] | None) -> tuple[dict[str, str], dict[str, str]]:
     """``["time=t:ms", "velocity=dq"]`` -> ``({"time": "t", "velocity": "dq"}, {"time": "ms"})``."""
+    from ..io.options import parse_pairs
+
     if not items:
         raise ConfigError(
             "--format generic needs --map QUANTITY=COLUMN[:UNIT] for time, velocity and torque "
             "or current (e.g. --map time=t:s --map velocity=dq:deg/s --map torque=tau:Nm)"
         )
+    try:
+        pairs = parse_pairs(items, form="QUANTITY=COLUMN[:UNIT]")
+    except ConfigError as exc:
+        raise ConfigError(f"--map takes QUANTITY=COLUMN[:UNIT]; {exc}") from None
     columns: dict[str, str] = {}
     units: dict[str, str] = {}
-    for item in items:
-        quantity, sep, rest = item.partition("=")
-        if not sep or not quantity.strip() or not rest.strip():
-            raise ConfigError(f"--map takes QUANTITY=COLUMN[:UNIT]; got '{item}'")
+    for quantity, rest in pairs.items():
         column, _, unit = rest.rpartition(":") if ":" in rest else (rest, "", "")
-        columns[quantity.strip()] = column.strip()
+        columns[quantity] = column.strip()
         if unit.strip():
-            units[quantity.strip()] = unit.strip()
+            units[quantity] = unit.strip()
     return columns, units
 
 
@@ -68,12 +61,7 @@ def extract_command(
         ),
     ],
     out: Annotated[
-        Path,
-        typer.Option(
-            "--out",
-            "-o",
-            help="Samples to write (.csv or .parquet): direction 0, combined by eq. 11.",
-        ),
+        Path, out_option("Samples to write (.csv or .parquet): direction 0, combined by eq. 11.")
     ] = Path("samples.csv"),
     by_direction: Annotated[
         Path | None, typer.Option(help="Also write the per-direction samples (+1 and -1) here.")
@@ -116,9 +104,7 @@ def extract_command(
             "[N m] or current [A] (then give --torque-constant)."
         ),
     ] = "torque",
-    torque_constant: Annotated[
-        float | None, typer.Option(help="K [N m/A] of tau = K I (eq. 13), when effort is current.")
-    ] = None,
+    torque_constant: TorqueConstantOption = None,
     velocity_unit: Annotated[
         str, typer.Option(help="rosbag: unit of JointState.velocity.")
     ] = "rad/s",
@@ -160,10 +146,7 @@ def extract_command(
         float,
         typer.Option(help="EPOS: the motor's nominal torque [mN m], reference of the % channel."),
     ] = 9.84,
-    temperature: Annotated[
-        float,
-        typer.Option(help="EPOS, rosbag: the temperature [degC] to record when the log has none."),
-    ] = 25.0,
+    temperature: TemperatureOption = 25.0,
     chunk_rows: Annotated[
         int, typer.Option(help="Rows read at a time (bounded memory).")
     ] = 1_000_000,
@@ -174,8 +157,8 @@ def extract_command(
     as the load (eq. 12). Writes samples with velocity [rad/s], load [N m], temperature [degC],
     friction [N m], direction, count, std [N m]."""
     from ..io import write_samples
-    from ..pipeline import load_joint
     from ..units import to_si
+    from ..workflow import load_joint
 
     pos = parse_positions(positions, position_unit)
     half = None if bin_halfwidth is None else float(to_si(bin_halfwidth, position_unit, "position"))

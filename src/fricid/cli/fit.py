@@ -105,7 +105,7 @@ def fit_command(
     """
     from ..identify import fit
     from ..io import read_samples
-    from ..pipeline import select_direction
+    from ..workflow import select_direction
 
     data = select_direction(read_samples(samples), direction)
     rbf = model.strip().lower() == "rbf"

@@ -10,6 +10,7 @@ from rich.markup import escape
 from rich.table import Table
 
 from ._app import app, console, err_console, handle_errors
+from ._options import out_option
 from ._progress import progress_bar
 
 _MAX_LISTED = 20
@@ -77,9 +78,10 @@ def fleet_command(
         typer.Argument(
             help=(
                 "Manifest, .csv or .yaml: one row per joint with robot, joint, log (relative to "
-                "the manifest) and optionally date, reader (table, generic, epos), model (several: "
-                "'msk;vlt'), method, seed, fix, bound, positions [deg], gravity, ... (see "
-                "fricid.fleet.manifest)."
+                "the manifest) and optionally date, reader (table, generic, rosbag, epos), model "
+                "(several: 'msk;vlt'), method, seed, fix (NAME=VALUE;...), bound "
+                "(NAME=LOW:HIGH;...), positions [deg], gravity, ... (the JSON Schema "
+                "fricid/schemas/manifest.schema.json lists every column)."
             ),
             exists=True,
             dir_okay=False,
@@ -87,14 +89,10 @@ def fleet_command(
     ],
     out: Annotated[
         Path | None,
-        typer.Option(
-            "--out",
-            "-o",
-            help=(
-                "Output folder: records/, models/ (one model JSON per joint and model), results/ "
-                "(Parquet, partitioned by robot and date), results.csv, drift files. Default: "
-                "<manifest name>-results in the current directory."
-            ),
+        out_option(
+            "Output folder: records/, models/ (one model JSON per joint and model), results/ "
+            "(Parquet, partitioned by robot and date), results.csv, drift files. Default: "
+            "<manifest name>-results in the current directory."
         ),
     ] = None,
     workers: Annotated[

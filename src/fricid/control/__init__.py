@@ -2,7 +2,8 @@
 with the identified model as torque feed-forward.
 
 >>> from fricid.control import compensation_study, plot_compensation      # doctest: +SKIP
->>> result = compensation_study(fitted, truth="paper2")
+>>> joint = fricid.sim.preset("paper2", "quick").joint                       # the caller's truth
+>>> result = compensation_study(fitted, truth=Truth(joint.law, "paper2", joint.inertia))
 >>> result.rms, result.max                                                  # rad
 >>> plot_compensation(result, "compensation.png")
 """
@@ -11,9 +12,9 @@ from __future__ import annotations
 
 from .plot import plot_compensation
 from .tracking import (
-    TRUTHS,
     CompensationResult,
     TrackingConfig,
+    Truth,
     compensation_study,
     default_config,
     fitted_law,
@@ -21,9 +22,9 @@ from .tracking import (
 )
 
 __all__ = [
-    "TRUTHS",
     "CompensationResult",
     "TrackingConfig",
+    "Truth",
     "compensation_study",
     "default_config",
     "fitted_law",

@@ -5,10 +5,11 @@ goes into the controller as torque feed-forward).
 
 The plant
     ``J q'' = u - F(q', load, T)``: a rigid joint of inertia ``J`` [kg m^2] with friction
-    ``F`` from a true law. The true law is the model itself (``truth="model"``: what the
-    controller would gain if the model were exact), or the virtual joint's law of a
-    simulation preset (``truth="paper1"`` or ``"paper2"``, :func:`fricid.sim.preset`; its
-    inertia too): then the model is judged against friction it only approximates. Load and
+    ``F`` from a true law, which the caller gives (:class:`Truth`): by default the model
+    itself (what the controller would gain if the model were exact), or, for example, the
+    virtual joint's law of a simulation preset and its inertia (``fricid compensate --truth
+    paper2`` builds it from :func:`fricid.sim.preset`): then the model is judged against
+    friction it only approximates. Load and
     temperature are constant; the load enters the friction law only (its own torque is
     taken as compensated, e.g. gravity compensation, in both runs, so the comparison
     isolates friction).
@@ -44,22 +45,47 @@ from ..errors import ConfigError
 from ..fitted import FittedModel
 
 __all__ = [
-    "TRUTHS",
     "CompensationResult",
     "TrackingConfig",
+    "Truth",
     "compensation_study",
     "default_config",
     "fitted_law",
     "simulate_tracking",
 ]
 
-#: True friction laws the study can use.
-TRUTHS = ("model", "paper1", "paper2")
-
 #: Velocity [rad/s] just off zero where the break-away friction is evaluated.
 _OFF_ZERO = 1e-9
 
 Law = Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray]
+
+
+@dataclass(frozen=True)
+class Truth:
+    """The plant's true friction, given by the caller of :func:`compensation_study`.
+
+    Attributes
+    ----------
+    law : callable
+        ``law(velocity, load, temperature)`` [N m] on arrays that broadcast, e.g.
+        :func:`fitted_law` of a model, or a virtual joint's law (``fricid.sim``'s
+        ``preset(name).joint.law``).
+    name : str
+        What the law is, for reports (``"model"``, ``"paper2"``, ...).
+    inertia : float or None
+        The true joint's inertia [kg m^2], replacing the experiment's when given.
+    """
+
+    law: Law
+    name: str = "custom"
+    inertia: float | None = None
+
+    def __post_init__(self) -> None:
+        if not callable(self.law):
+            raise ConfigError(f"Truth: 'law' must be callable, got {type(self.law).__name__}")
+        inertia = self.inertia
+        if inertia is not None and not (math.isfinite(inertia) and inertia > 0):
+            raise ConfigError(f"Truth: 'inertia' must be a number > 0, got {inertia!r}")
 
 
 @dataclass(frozen=True)
@@ -279,19 +305,6 @@ class CompensationResult:
         }
 
 
-def _truth_law(truth: str, fitted: FittedModel) -> tuple[Law, float | None]:
-    """The plant's law and, for a preset, its inertia."""
-    key = str(truth).strip().lower()
-    if key == "model":
-        return fitted_law(fitted), None
-    if key not in TRUTHS:
-        raise ConfigError(f"unknown truth '{truth}'; choose one of: {', '.join(TRUTHS)}")
-    from ..sim import preset
-
-    joint = preset(key, "quick").joint
-    return joint.law, joint.inertia
-
-
 def _extrapolation_notes(fitted: FittedModel, v_r: np.ndarray, ff: np.ndarray, smoothing) -> list:
     """A note when the reference runs below the identified speeds, where the feed-forward is
     extrapolated (a fitted Stribeck peak can grow far beyond the data there)."""
@@ -316,19 +329,25 @@ def compensation_study(
     fitted: FittedModel,
     config: TrackingConfig | None = None,
     *,
-    truth: str = "model",
+    truth: Truth | None = None,
     smoothing=None,
 ) -> CompensationResult:
     """Track the reference without and with ``fitted`` as friction feed-forward.
 
     Parameters
     ----------
-    fitted : the identified model (the feed-forward).
-    config : the experiment (default :class:`TrackingConfig`). With ``truth`` a preset, the
-        preset joint's inertia replaces ``config.inertia``.
-    truth : the plant's friction: ``"model"`` (the model itself) or a simulation preset
-        (``"paper1"``, ``"paper2"``: the virtual joint's true law).
-    smoothing : :class:`fricid.models.smoothing.Smoothing` of the feed-forward near zero velocity.
+    fitted : FittedModel
+        The identified model (the feed-forward).
+    config : TrackingConfig, optional
+        The experiment (default :class:`TrackingConfig`). A ``truth`` with an inertia
+        replaces ``config.inertia``.
+    truth : Truth, optional
+        The plant's friction, given by the caller (the CLI builds a simulation preset's, a
+        test its own law); None: the model itself, named ``"model"``. This module imports
+        no simulation code.
+    smoothing : Smoothing, optional
+        Smoothing of the feed-forward near zero velocity
+        (:class:`fricid.models.smoothing.Smoothing`).
 
     Returns
     -------
@@ -340,22 +359,22 @@ def compensation_study(
     from ..models.smoothing import smooth_predict
 
     config = config or TrackingConfig()
-    law, inertia = _truth_law(truth, fitted)
+    truth = truth or Truth(fitted_law(fitted), "model")
     notes = []
-    if inertia is not None and inertia != config.inertia:
-        config = replace(config, inertia=inertia)
-        notes.append(f"inertia {inertia} kg m^2 from the '{truth}' preset joint")
+    if truth.inertia is not None and truth.inertia != config.inertia:
+        config = replace(config, inertia=truth.inertia)
+        notes.append(f"inertia {truth.inertia} kg m^2 from the '{truth.name}' joint")
     _, _, v_r, _ = config.reference()
     X = np.column_stack(
         [v_r, np.full_like(v_r, config.load), np.full_like(v_r, config.temperature)]
     )
     ff = smooth_predict(fitted, X, smoothing)
     notes += _extrapolation_notes(fitted, v_r, ff, smoothing)
-    runs = simulate_tracking(law, np.vstack([np.zeros_like(ff), ff]), config)
+    runs = simulate_tracking(truth.law, np.vstack([np.zeros_like(ff), ff]), config)
     err = np.abs(runs["error"])
     return CompensationResult(
         config=config,
-        truth=str(truth).strip().lower(),
+        truth=truth.name,
         model=fitted.model,
         rms={
             "without": float(np.sqrt(np.mean(err[0] ** 2))),

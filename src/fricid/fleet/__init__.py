@@ -5,11 +5,12 @@
 ...                                                               # doctest: +SKIP
 >>> run.table.head(), run.failures                                # doctest: +SKIP
 
-Each joint runs :func:`fricid.pipeline.run_joint` (the same extraction and fit as
-``fricid extract`` and ``fricid fit``). Modules: :mod:`.manifest` (the manifest),
-:mod:`.job` (one joint, as a worker runs it), :mod:`.executors` and :mod:`._dask` (where the
-joints run), :mod:`.store` (the output folder, resumable), :mod:`.table` (the results table),
-:mod:`.drift` (comparison with a previous identification), :mod:`.runner` (:func:`run_fleet`).
+Each joint runs :func:`fricid.workflow.run_joint` (the same extraction and fit as
+``fricid extract`` and ``fricid fit``). Modules: :mod:`.manifest` (the manifest, validated
+with its JSON Schema through :mod:`._manifest_schema`), :mod:`.job` (one joint, as a worker
+runs it), :mod:`.executors` and :mod:`._dask` (where the joints run), :mod:`.store` (the
+output folder, resumable), :mod:`.table` (the results table), :mod:`.drift` (comparison with
+a previous identification), :mod:`.runner` (:func:`run_fleet`).
 
 The names below are imported on first use, so a worker process that only runs
 :func:`run_job` does not import pandas, matplotlib or Dask.

@@ -1,4 +1,5 @@
-"""The work of one joint, as a worker runs it: hash the log, then :func:`fricid.pipeline.run_joint`.
+"""The work of one joint, as a worker runs it: hash the log, then
+:func:`fricid.workflow.run_joint`.
 
 :func:`run_job` never raises for a bad joint: an unreadable log, a failed extraction or a
 failed fit comes back as a :class:`JointOutcome` with the stage and the error (and, for an
@@ -156,7 +157,7 @@ def failed_outcome(
 
 
 def _compute(spec: JointSpec, digest: str) -> JointOutcome:
-    from ..pipeline import run_joint
+    from ..workflow import run_joint
 
     run = run_joint(spec.log, **spec.run_kwargs())
     rows, models = [], {}

@@ -15,256 +15,46 @@ Every dimensional value names its unit in the column name, as fricid's tables do
 ``positions [deg]``, ``bin_halfwidth [deg]``, ``settle_time [s]``, ``temperature [degC]``,
 ``torque_constant [N m/A]``, ``nominal_torque [mN m]``, ``load [N m]``. Log paths are relative
 to the manifest's folder. Every error names the manifest, the row (its line) and the column.
+
+How a manifest is read
+    The columns, their types, ranges and choices, and the document's shape are the JSON
+    Schema ``fricid/schemas/manifest.schema.json`` (:data:`SCHEMA`; :data:`FIELDS` is built
+    from it in :mod:`._manifest_schema`). A column label is split into its name and
+    ``[unit]``; a text cell is read as the value it writes (the schema's ``x-text``: a
+    number, ``NAME=VALUE`` items, ... through :mod:`fricid.io.options`, the parsers the
+    command line uses too); then the joint is validated against the schema, and the first
+    error becomes one :class:`~fricid.errors.DataError`. Code does only what a schema cannot:
+    units (:func:`fricid.units.to_si`), model and method names (their registries), options
+    of another reader (:data:`fricid.io.READER_OPTIONS`), a joint listed twice, and paths
+    relative to the manifest.
 """
 
 from __future__ import annotations
 
 import csv
-import datetime as _dt
 import io
-import math
 import os
-import re
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from ..errors import ConfigError, DataError
-from ..pipeline import DIRECTIONS, READER_OPTIONS, READERS, SAMPLE_SETS
-from ..units import UNITS, to_si
+from ..io.registry import READER_OPTIONS
+from ._manifest_schema import (
+    FIELDS,
+    SCHEMA,
+    Entry,
+    Field,
+    read_entry,
+    resolve_key,
+    to_values,
+    validate,
+    validator,
+)
 
-__all__ = ["FIELDS", "Field", "JointSpec", "Manifest", "read_manifest"]
+__all__ = ["FIELDS", "SCHEMA", "Field", "JointSpec", "Manifest", "read_manifest"]
 
-_ID = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]*$")
-_LABEL = re.compile(r"^\s*(?P<name>[^\[\]]*?)\s*(?:\[(?P<unit>[^\[\]]*)\])?\s*$")
-_TRUE = ("true", "yes", "1", "on")
-_FALSE = ("false", "no", "0", "off")
-
-
-# --------------------------------------------------------------------------- value parsers
-
-
-def _text(value: Any) -> str:
-    if isinstance(value, bool | int | float | str):
-        return str(value).strip()
-    raise ValueError(f"expected a single value, got {type(value).__name__}")
-
-
-def _items(value: Any, spaces: bool = False) -> list[Any]:
-    """A YAML list as is; a text cell split on ';' (or ',', and spaces if ``spaces``)."""
-    if isinstance(value, list | tuple):
-        return list(value)
-    pattern = r"[;,\s]+" if spaces else r"[;,]"
-    return [p.strip() for p in re.split(pattern, _text(value)) if p.strip()]
-
-
-def _pairs(value: Any) -> dict[str, Any]:
-    """``{"a": 1}`` (YAML) or ``"a=1; b=2"`` (a cell) -> dict."""
-    if isinstance(value, Mapping):
-        return {str(k).strip(): v for k, v in value.items()}
-    out: dict[str, Any] = {}
-    for part in _text(value).split(";"):
-        if not part.strip():
-            continue
-        name, sep, rest = part.partition("=")
-        if not sep or not name.strip() or not rest.strip():
-            raise ValueError(f"expected NAME=VALUE items separated by ';', got '{part.strip()}'")
-        out[name.strip()] = rest.strip()
-    return out
-
-
-def _float(value: Any) -> float:
-    try:
-        x = float(value) if not isinstance(value, bool) else math.nan
-    except (TypeError, ValueError):
-        raise ValueError(f"'{value}' is not a number") from None
-    if not math.isfinite(x):
-        raise ValueError(f"'{value}' is not a finite number")
-    return x
-
-
-def _positive(value: Any) -> float:
-    x = _float(value)
-    if x <= 0:
-        raise ValueError(f"must be > 0, got {value!r}")
-    return x
-
-
-def _int(value: Any, low: int) -> int:
-    if isinstance(value, bool):
-        raise ValueError(f"'{value}' is not an integer")
-    try:
-        x = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"'{value}' is not an integer") from None
-    if not x.is_integer() or x < low:
-        raise ValueError(f"must be an integer >= {low}, got {value!r}")
-    return int(x)
-
-
-def _bool(value: Any) -> bool:
-    if isinstance(value, bool):
-        return value
-    text = _text(value).lower()
-    if text in _TRUE:
-        return True
-    if text in _FALSE:
-        return False
-    raise ValueError(f"expected true or false, got '{value}'")
-
-
-def _choice(choices: tuple[str, ...]) -> Callable[[Any], str]:
-    def parse(value: Any) -> str:
-        text = _text(value).lower()
-        if text not in choices:
-            raise ValueError(f"must be one of: {', '.join(choices)}; got '{value}'")
-        return text
-
-    return parse
-
-
-def _identifier(value: Any) -> str:
-    text = _text(value)
-    if not _ID.match(text):
-        raise ValueError(
-            f"'{text}' is not a usable name: letters, digits, '.', '_' and '-' only, "
-            "starting with a letter or digit (it names files)"
-        )
-    return text
-
-
-def _date(value: Any) -> str:
-    if isinstance(value, _dt.date):
-        return value.isoformat()[:10]
-    try:
-        return _dt.date.fromisoformat(_text(value)).isoformat()
-    except ValueError:
-        raise ValueError(f"'{value}' is not a date YYYY-MM-DD") from None
-
-
-def _models(value: Any) -> tuple[str, ...]:
-    from ..models import get_model
-
-    names = [str(n).strip().lower() for n in _items(value, spaces=True)]
-    if not names:
-        raise ValueError("names no model")
-    for name in names:
-        get_model(name)  # ConfigError lists the models
-    return tuple(dict.fromkeys(names))
-
-
-def _method(value: Any) -> str:
-    from ..optim import METHODS
-
-    text = _text(value).lower()
-    if text not in METHODS:
-        raise ValueError(f"unknown method '{value}'; choose one of: {', '.join(METHODS)}")
-    return text
-
-
-def _assignments(value: Any) -> dict[str, float]:
-    return {name: _float(v) for name, v in _pairs(value).items()}
-
-
-def _ranges(value: Any) -> dict[str, list[float]]:
-    out: dict[str, list[float]] = {}
-    for name, v in _pairs(value).items():
-        parts = v if isinstance(v, list | tuple) else str(v).split(":")
-        if len(parts) != 2:
-            raise ValueError(f"expected NAME=LOW:HIGH, got '{name}={v}'")
-        lo, hi = _float(parts[0]), _float(parts[1])
-        if not lo < hi:
-            raise ValueError(f"'{name}' needs LOW < HIGH, got {lo} and {hi}")
-        out[name] = [lo, hi]
-    return out
-
-
-def _mapping(value: Any) -> dict[str, str]:
-    out = {name: _text(v) for name, v in _pairs(value).items()}
-    if not out:
-        raise ValueError("is empty")
-    return out
-
-
-def _positions(value: Any) -> list[float]:
-    """``"-60:-20:4"`` (start:stop:step, stop included), a ';' list, or a YAML list."""
-    if isinstance(value, str) and ":" in value:
-        try:
-            start, stop, step = (float(p) for p in value.split(":"))
-        except ValueError:
-            raise ValueError(f"expected START:STOP:STEP or a list, got '{value}'") from None
-        if not (step > 0 and stop >= start):
-            raise ValueError(f"START:STOP:STEP needs step > 0 and stop >= start, got '{value}'")
-        n = math.floor((stop - start) / step + 1e-9) + 1
-        return [start + step * i for i in range(n)]
-    values = [_float(v) for v in _items(value, spaces=True)]
-    if not values:
-        raise ValueError("names no position")
-    return values
-
-
-# --------------------------------------------------------------------------- the fields
-
-
-@dataclass(frozen=True)
-class Field:
-    """A manifest column: how to parse it, where it goes, and the quantity of its unit."""
-
-    name: str
-    parse: Callable[[Any], Any]
-    group: str  # "core", "fit", "extract" or "reader"
-    help: str
-    quantity: str | None = None  # a unit is required in the column name
-
-
-def _f(name: str, parse: Callable[[Any], Any], group: str, doc: str, quantity: str | None = None):
-    return Field(name, parse, group, doc, quantity)
-
-
-#: Every manifest column, by name.
-FIELDS: dict[str, Field] = {
-    f.name: f
-    for f in (
-        _f("robot", _identifier, "core", "robot id (required)"),
-        _f("joint", _identifier, "core", "joint name (required)"),
-        _f("log", _text, "core", "log path, relative to the manifest (required)"),
-        _f("date", _date, "core", "measurement date YYYY-MM-DD (default: the run's date)"),
-        _f("reader", _choice(READERS), "core", "table (default), generic or epos"),
-        _f("model", _models, "fit", "model name(s) (default stribeck)"),
-        _f("method", _method, "fit", "optimiser (default lm)"),
-        _f("seed", lambda v: _int(v, 0), "fit", "random seed (default 0)"),
-        _f("max_evals", lambda v: _int(v, 1), "fit", "budget in model evaluations"),
-        _f("direction", _choice(tuple(DIRECTIONS)), "fit", "samples kept (default all)"),
-        _f("samples", _choice(SAMPLE_SETS), "fit", "auto, combined or by_direction"),
-        _f("fix", _assignments, "fit", "NAME=VALUE (SI) held fixed"),
-        _f("bound", _ranges, "fit", "NAME=LOW:HIGH (SI) search ranges"),
-        _f("chunk_rows", lambda v: _int(v, 1), "core", "rows read at a time"),
-        _f("positions", _positions, "extract", "position bin centres", "position"),
-        _f("bin_halfwidth", _positive, "extract", "half width of a bin", "position"),
-        _f("median_window", lambda v: _int(v, 1), "extract", "odd running-median window"),
-        _f("gravity", _choice(("fit", "none")), "extract", "fit or none"),
-        _f("velocity_tolerance", _positive, "extract", "relative steady band"),
-        _f("settle_time", _float, "extract", "time trimmed at each end", "time"),
-        _f("min_samples", lambda v: _int(v, 1), "extract", "shortest steady part"),
-        _f("velocity_rtol", _positive, "extract", "relative set-point gap"),
-        _f("temperature_atol", _positive, "extract", "set-point gap [degC, a difference]"),
-        _f("columns", _mapping, "reader", "generic: quantity=column"),
-        _f("units", _mapping, "reader", "generic: quantity=unit"),
-        _f("torque_constant", _positive, "reader", "K for a current", "torque_constant"),
-        _f("temperature", _float, "reader", "constant temperature", "temperature"),
-        _f("flip_sign", _bool, "reader", "epos: negate motion and effort"),
-        _f("nominal_torque", _positive, "reader", "epos: reference of %", "torque"),
-        _f("counts_per_turn", _positive, "reader", "epos: encoder counts"),
-        _f("pattern", _text, "reader", "epos folder: file pattern"),
-        _f("load", _float, "reader", "epos folder: constant load", "torque"),
-    )
-}
-
-_ALIASES = {"models": "model", "robot_id": "robot", "log_path": "log", "path": "log"}
-_REQUIRED = ("robot", "joint", "log")
 _DEFAULTS: dict[str, Any] = {
     "reader": "table",
     "model": ("stribeck",),
@@ -284,16 +74,24 @@ class JointSpec:
 
     Attributes
     ----------
-    robot, joint : its names (``key`` is ``"robot/joint"``).
-    log : absolute path of the log (the manifest's relative path resolved).
-    log_text : the path as the manifest writes it.
-    row : the manifest line of the joint, for messages.
-    date : measurement date (ISO), or None for the run's date.
-    reader, reader_options : see :func:`fricid.pipeline.load_joint` (SI units).
-    extract_options : options of :func:`fricid.extract.extract` (SI units).
-    models, method, seed, max_evals, samples, direction, fixed, bounds : see
-        :func:`fricid.pipeline.run_joint`.
-    chunk_rows : rows read at a time (memory, not results).
+    robot, joint : str
+        Its names (``key`` is ``"robot/joint"``).
+    log : Path
+        Absolute path of the log (the manifest's relative path resolved).
+    log_text : str
+        The path as the manifest writes it.
+    row : int or None
+        The manifest line of the joint, for messages.
+    date : str or None
+        Measurement date (ISO), or None for the run's date.
+    reader, reader_options : str, dict
+        See :func:`fricid.workflow.load_joint` (SI units).
+    extract_options : dict
+        Options of :func:`fricid.extract.extract` (SI units).
+    models, method, seed, max_evals, samples, direction, fixed, bounds
+        See :func:`fricid.workflow.run_joint`.
+    chunk_rows : int
+        Rows read at a time (memory, not results).
     """
 
     robot: str
@@ -340,7 +138,7 @@ class JointSpec:
         }
 
     def run_kwargs(self) -> dict[str, Any]:
-        """Keyword arguments of :func:`fricid.pipeline.run_joint` for this joint."""
+        """Keyword arguments of :func:`fricid.workflow.run_joint` for this joint."""
         return {
             "reader": self.reader,
             "reader_options": self.reader_options,
@@ -371,84 +169,13 @@ class Manifest:
         return iter(self.joints)
 
 
-# --------------------------------------------------------------------------- parsing
+# --------------------------------------------------------------------------- reading
 
 
-def _resolve_key(label: Any, file: Path, row: int | None) -> tuple[Field, str | None, str]:
-    """A column label -> (field, unit, label); DataError for unknown names and bad units."""
-    text = str(label)
-    m = _LABEL.match(text)
-    name = (m.group("name") if m else text).strip().lower()
-    unit = m.group("unit").strip() if m and m.group("unit") is not None else None
-    name = _ALIASES.get(name, name)
-    if name not in FIELDS:
-        raise DataError(
-            f"unknown manifest column; known columns: {', '.join(FIELDS)}",
-            file=file,
-            row=row,
-            column=text,
-        )
-    fld = FIELDS[name]
-    if fld.quantity is None and unit is not None:
-        raise DataError(f"'{name}' takes no unit, got [{unit}]", file=file, row=row, column=text)
-    if fld.quantity is not None:
-        allowed = ", ".join(UNITS[fld.quantity])
-        if unit is None:
-            raise DataError(
-                f"'{name}' needs its unit in the column name, e.g. '{name} "
-                f"[{next(iter(UNITS[fld.quantity]))}]' (units: {allowed})",
-                file=file,
-                row=row,
-                column=text,
-            )
-        if unit not in UNITS[fld.quantity]:
-            raise DataError(
-                f"unknown {fld.quantity} unit '{unit}'; use one of: {allowed}",
-                file=file,
-                row=row,
-                column=text,
-            )
-    return fld, unit, text
-
-
-def _value(fld: Field, unit: str | None, raw: Any, file: Path, row: int | None, label: str):
-    try:
-        value = fld.parse(raw)
-        if unit is not None:
-            converted = to_si(np.asarray(value, dtype=float), unit, fld.quantity)
-            value = np.asarray(converted, dtype=float).tolist()
-    except (ValueError, ConfigError) as exc:
-        raise DataError(str(exc), file=file, row=row, column=label) from None
-    return value
-
-
-def _parse_entry(
-    entry: Mapping[Any, Any], file: Path, row: int | None, into: dict[str, Any]
-) -> dict[str, Any]:
-    """Parse one mapping of column labels to raw values into ``into`` (name -> value)."""
-    seen: dict[str, str] = {}
-    for label, raw in entry.items():
-        if raw is None or (isinstance(raw, str) and not raw.strip()):
-            continue
-        fld, unit, text = _resolve_key(label, file, row)
-        if fld.name in seen:
-            raise DataError(
-                f"'{fld.name}' is given twice ('{seen[fld.name]}' and '{text}')",
-                file=file,
-                row=row,
-                column=text,
-            )
-        seen[fld.name] = text
-        into[fld.name] = (_value(fld, unit, raw, file, row, text), text)
-    return into
-
-
-def _spec(values: dict[str, tuple[Any, str]], file: Path, row: int | None) -> JointSpec:
-    for name in _REQUIRED:
-        if name not in values:
-            raise DataError(f"missing required value '{name}'", file=file, row=row, column=name)
-    got = {name: v for name, (v, _) in values.items()}
-    label = {name: text for name, (_, text) in values.items()}
+def _spec(entry: Entry, file: Path) -> JointSpec:
+    """A validated joint entry (defaults merged) -> its :class:`JointSpec`."""
+    validate(entry, "joint", file)
+    got = to_values(entry, file)
     reader = got.get("reader", _DEFAULTS["reader"])
     reader_options: dict[str, Any] = {}
     extract_options: dict[str, Any] = {}
@@ -461,21 +188,13 @@ def _spec(values: dict[str, tuple[Any, str]], file: Path, row: int | None) -> Jo
                     f"'{name}' is an option of reader {' or '.join(users)}; this joint's "
                     f"reader is '{reader}'",
                     file=file,
-                    row=row,
-                    column=label[name],
+                    row=entry.row,
+                    column=entry.labels[name],
                 )
             reader_options[name] = value
         elif group == "extract":
             extract_options[name] = value
-    if reader == "generic" and "columns" not in reader_options:
-        raise DataError(
-            "reader 'generic' needs 'columns' (quantity=column name, e.g. "
-            "'time=t;velocity=dq;torque=tau')",
-            file=file,
-            row=row,
-            column="columns",
-        )
-    log_text = str(got["log"])
+    log_text = got["log"]
     log = Path(log_text).expanduser()
     if not log.is_absolute():
         log = file.parent / log
@@ -484,7 +203,7 @@ def _spec(values: dict[str, tuple[Any, str]], file: Path, row: int | None) -> Jo
         joint=got["joint"],
         log=Path(os.path.abspath(log)),
         log_text=log_text,
-        row=row,
+        row=entry.row,
         date=got.get("date"),
         reader=reader,
         reader_options=reader_options,
@@ -526,7 +245,7 @@ def _csv_entries(path: Path, text: str) -> list[tuple[int, dict[str, Any]]]:
             if header is None:
                 header, header_line = [c.strip() for c in cells], line
                 for label in header:
-                    _resolve_key(label, path, line)
+                    resolve_key(label, path, line)
                 blank = [i for i, c in enumerate(header) if not c]
                 if blank:
                     raise DataError(f"column {blank[0] + 1} has no name", file=path, row=line)
@@ -565,7 +284,26 @@ def _yaml_lines(text: str, key_path: list[Any]) -> list[int] | None:
     return [item.start_mark.line + 1 for item in node.value]
 
 
-def _yaml_entries(path: Path, text: str) -> tuple[dict[str, Any], list[tuple[int, Any]]]:
+def _document_error(doc: Any, path: Path, lines: list[int | None]) -> DataError | None:
+    """The first error of the document's shape (joints, defaults), as a DataError."""
+    error = next(iter(validator().iter_errors(doc)), None)
+    if error is None:
+        return None
+    where = list(error.path)
+    spec = error.schema
+    messages = spec.get("x-message") if isinstance(spec.get("x-message"), Mapping) else {}
+    if error.validator == "additionalProperties":
+        key = next(k for k in doc if k not in SCHEMA["properties"])
+        return DataError(messages["additionalProperties"].format(key=key), file=path)
+    if isinstance(spec.get("x-message"), str):
+        message = spec["x-message"]
+    else:
+        message = messages.get(error.validator, error.message)
+    row = lines[where[1]] if len(where) == 2 and where[1] < len(lines) else None
+    return DataError(message, file=path, row=row)
+
+
+def _yaml_entries(path: Path, text: str) -> tuple[dict[str, Any], list[tuple[int | None, Any]]]:
     import yaml
 
     try:
@@ -575,25 +313,19 @@ def _yaml_entries(path: Path, text: str) -> tuple[dict[str, Any], list[tuple[int
         row = None if mark is None else mark.line + 1
         problem = getattr(exc, "problem", None) or str(exc)
         raise DataError(f"not valid YAML: {problem}", file=path, row=row) from None
-    defaults: Any = {}
-    if isinstance(doc, Mapping):
-        unknown = [k for k in doc if k not in ("joints", "defaults")]
-        if unknown:
-            raise DataError(
-                f"unknown top-level key '{unknown[0]}'; a manifest has 'joints' and "
-                "optionally 'defaults'",
-                file=path,
-            )
-        defaults = doc.get("defaults") or {}
-        joints, where = doc.get("joints"), ["joints"]
-    else:
-        joints, where = doc, []
-    if not isinstance(defaults, Mapping):
-        raise DataError("'defaults' must be a mapping of column to value", file=path)
-    if not isinstance(joints, list) or not joints:
-        raise DataError("the manifest lists no joints (a 'joints:' list of mappings)", file=path)
-    lines = _yaml_lines(text, where) or [None] * len(joints)
-    return dict(defaults), list(zip(lines, joints, strict=True))
+    where = ["joints"] if isinstance(doc, Mapping) else []
+    if not isinstance(doc, Mapping):
+        doc = {"joints": doc}
+    if doc.get("defaults") is None:
+        doc = {**doc, "defaults": {}}
+    joints = doc.get("joints")
+    lines: list[int | None] = []
+    if isinstance(joints, list):
+        lines = _yaml_lines(text, where) or [None] * len(joints)
+    error = _document_error(doc, path, lines)
+    if error is not None:
+        raise error
+    return dict(doc["defaults"]), list(zip(lines, doc["joints"], strict=True))
 
 
 def read_manifest(path: str | os.PathLike[str]) -> Manifest:
@@ -601,7 +333,8 @@ def read_manifest(path: str | os.PathLike[str]) -> Manifest:
 
     Parameters
     ----------
-    path : the manifest. Log paths in it are relative to its folder.
+    path : str or path-like
+        The manifest. Log paths in it are relative to its folder.
 
     Returns
     -------
@@ -614,6 +347,8 @@ def read_manifest(path: str | os.PathLike[str]) -> Manifest:
         Naming the manifest, the row (line) and the column: an unknown column, a missing unit,
         a bad value (unknown model, method or reader, a non-number, ...), a missing required
         value (robot, joint, log), an option of another reader, a joint listed twice.
+    ConfigError
+        A file whose suffix is not ``.csv``, ``.yaml`` or ``.yml``.
     """
     path = Path(path)
     suffix = path.suffix.lower()
@@ -622,23 +357,21 @@ def read_manifest(path: str | os.PathLike[str]) -> Manifest:
             f"cannot tell the manifest format of '{path}' from its suffix; use .csv, .yaml or .yml"
         )
     text = _read_text(path)
+    defaults = Entry(None)
     if suffix == ".csv":
-        defaults: dict[str, tuple[Any, str]] = {}
         entries: list[tuple[int | None, Any]] = list(_csv_entries(path, text))
     else:
         raw_defaults, entries = _yaml_entries(path, text)
-        defaults = _parse_entry(raw_defaults, path, None, {})
-        for name in ("robot", "joint", "log"):
-            if name in defaults:
-                raise DataError(f"'{name}' cannot have a default", file=path, column=name)
+        read_entry(raw_defaults, path, None, defaults)
+        validate(defaults, "defaults", path)
     if not entries:
         raise DataError("the manifest lists no joints", file=path)
     joints: list[JointSpec] = []
     first_row: dict[str, int | None] = {}
-    for row, entry in entries:
-        if not isinstance(entry, Mapping):
-            raise DataError("a joint must be a mapping of column to value", file=path, row=row)
-        spec = _spec(_parse_entry(entry, path, row, dict(defaults)), path, row)
+    for row, mapping in entries:
+        entry = Entry(row, dict(defaults.values), dict(defaults.raw), dict(defaults.labels))
+        entry.units = dict(defaults.units)
+        spec = _spec(read_entry(mapping, path, row, entry), path)
         if spec.key in first_row:
             raise DataError(
                 f"joint {spec.key} is listed twice (also at row {first_row[spec.key]})",

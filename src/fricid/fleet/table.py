@@ -16,8 +16,9 @@ Columns (SI units; each parameter's unit in ``units``):
 
 Every column but the run columns (:data:`RUN_COLUMNS`) is the same, bit for bit, whichever
 executor computed the rows. The Parquet dataset (``results/``) is partitioned by robot and
-date (hive style, ``robot=<r>/date=<d>/``); it is written into a temporary folder and swapped
-in, and the CSV is written atomically, so a reader never sees a half-written table.
+date (hive style, ``robot=<r>/date=<d>/part-0.parquet``): each file is written atomically
+(:mod:`fricid.io.atomic`) into a temporary folder, which is then swapped in; the CSV is
+written atomically too, so a reader never sees a half-written table.
 """
 
 from __future__ import annotations
@@ -28,6 +29,7 @@ import uuid
 from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
+from urllib.parse import quote
 
 import pandas as pd
 import pyarrow as pa
@@ -35,7 +37,7 @@ import pyarrow.dataset as ds
 import pyarrow.parquet as pq
 
 from ..errors import DataError
-from ..io import atomic_write
+from ..io.atomic import atomic_path, atomic_write
 
 __all__ = [
     "PARTITIONS",
@@ -154,6 +156,28 @@ def _swap_in(tmp: Path, final: Path) -> None:
         shutil.rmtree(old, ignore_errors=True)
 
 
+def _partition_dir(value: Any) -> str:
+    """A hive partition folder's value, encoded as pyarrow's reader decodes it."""
+    return "__HIVE_DEFAULT_PARTITION__" if value is None else quote(str(value), safe="")
+
+
+def _write_partitions(table: pa.Table, folder: Path) -> None:
+    """Write ``table`` under ``folder`` as a hive-partitioned dataset (:data:`PARTITIONS`),
+    one ``part-0.parquet`` per partition, each through :func:`fricid.io.atomic.atomic_path`,
+    rows in table order."""
+    if not table.num_rows:
+        return
+    keys = list(zip(*(table.column(p).to_pylist() for p in PARTITIONS), strict=True))
+    data = table.drop_columns(list(PARTITIONS))
+    for key in dict.fromkeys(keys):
+        rows = data.filter(pa.array([k == key for k in keys]))
+        where = folder.joinpath(
+            *(f"{p}={_partition_dir(v)}" for p, v in zip(PARTITIONS, key, strict=True))
+        )
+        with atomic_path(where / "part-0.parquet") as part:
+            pq.write_table(rows, part)
+
+
 def write_results(table: pa.Table, root: str | os.PathLike[str]) -> tuple[Path, Path]:
     """Write ``table`` as ``root/results/`` (Parquet, partitioned by robot and date) and
     ``root/results.csv``. Returns both paths."""
@@ -163,14 +187,7 @@ def write_results(table: pa.Table, root: str | os.PathLike[str]) -> tuple[Path, 
     tmp = root / f".results-new-{os.getpid()}-{uuid.uuid4().hex[:8]}"
     tmp.mkdir()  # (not mkdtemp: the folder gets the usual permissions)
     try:
-        if table.num_rows:
-            pq.write_to_dataset(
-                table,
-                root_path=tmp,
-                partition_cols=list(PARTITIONS),
-                basename_template="part-{i}.parquet",
-                existing_data_behavior="error",
-            )
+        _write_partitions(table, tmp)
         _swap_in(tmp, dataset)
     except BaseException:
         shutil.rmtree(tmp, ignore_errors=True)

@@ -3,11 +3,12 @@
 The single-joint commands and ``fricid fleet`` run these functions, so a joint identified in a
 fleet is identified exactly as it would be by hand (DESIGN.md, "The flow of data"):
 
->>> from fricid.pipeline import run_joint
+>>> from fricid.workflow import run_joint
 >>> run = run_joint("log.parquet", models=("stribeck", "vlt"), seed=0)  # doctest: +SKIP
 >>> run.fits["vlt"].report()                                             # doctest: +SKIP
 
-:func:`load_joint` reads a log with one of :data:`READERS` and extracts its friction samples;
+:func:`load_joint` reads a log with one of the readers of :mod:`fricid.io.registry`
+(:data:`~fricid.io.READERS`) and extracts its friction samples;
 :func:`select_samples` picks the rows a model is fitted to; :func:`run_joint` does both and
 fits every model, isolating a model whose fit fails from the others.
 """
@@ -26,13 +27,12 @@ import numpy as np
 from .errors import ConfigError, DataError, FricidError
 from .extract import ExtractionResult, extract
 from .fitted import FittedModel
+from .io.registry import check_keys, check_reader, open_log
 from .samples import FrictionSamples, RawLog
 
 __all__ = [
     "DIRECTIONS",
     "EXTRACT_OPTIONS",
-    "READERS",
-    "READER_OPTIONS",
     "SAMPLE_SETS",
     "JointData",
     "JointRun",
@@ -41,40 +41,6 @@ __all__ = [
     "select_direction",
     "select_samples",
 ]
-
-#: Readers of a joint's log: ``table`` (fricid's raw-log CSV/Parquet, as ``fricid simulate``
-#: writes), ``generic`` (any CSV/Parquet through a column mapping and units,
-#: :func:`fricid.io.read_table_log`), ``rosbag`` (a ROS 2 bag or MCAP file with
-#: ``sensor_msgs/msg/JointState``, :func:`fricid.io.iter_rosbag`) and ``epos`` (a Maxon EPOS
-#: recorder CSV, or a folder of steady-state recordings, one operating point per file).
-READERS: tuple[str, ...] = ("table", "generic", "rosbag", "epos")
-
-#: Options each reader accepts (SI units), passed to its :mod:`fricid.io` function.
-READER_OPTIONS: dict[str, tuple[str, ...]] = {
-    "table": (),
-    "generic": ("columns", "units", "torque_constant", "temperature"),
-    "rosbag": (
-        "joint",
-        "topic",
-        "temperature_topic",
-        "temperature",
-        "effort",
-        "effort_unit",
-        "torque_constant",
-        "position_unit",
-        "velocity_unit",
-        "time_source",
-    ),
-    "epos": (
-        "nominal_torque",
-        "flip_sign",
-        "temperature",
-        "torque_constant",
-        "counts_per_turn",
-        "pattern",
-        "load",
-    ),
-}
 
 #: Keyword options of :func:`fricid.extract.extract` a caller may set (SI units).
 EXTRACT_OPTIONS: tuple[str, ...] = (
@@ -102,8 +68,6 @@ DIRECTIONS: dict[str, list[int] | None] = {
     "neg": [-1],
 }
 
-_EPOS_FOLDER_ONLY = ("pattern", "load")
-
 
 @dataclass(frozen=True, eq=False)
 class JointData:
@@ -111,11 +75,14 @@ class JointData:
 
     Attributes
     ----------
-    samples : the combined samples (direction 0, eq. 11 of the BAS-RBFNN paper); for a folder
-        of steady-state EPOS recordings, the per-direction operating points as recorded.
-    by_direction : the per-direction samples (+1 and -1).
-    extraction : what :func:`fricid.extract.extract` returned (diagnostics, gravity fit), or
-        None when the reader gave samples directly.
+    samples : FrictionSamples
+        The combined samples (direction 0, eq. 11 of the BAS-RBFNN paper); for a folder of
+        steady-state EPOS recordings, the per-direction operating points as recorded.
+    by_direction : FrictionSamples
+        The per-direction samples (+1 and -1).
+    extraction : ExtractionResult or None
+        What :func:`fricid.extract.extract` returned (diagnostics, gravity fit), or None when
+        the reader gave samples directly.
     """
 
     samples: FrictionSamples
@@ -129,12 +96,18 @@ class JointRun:
 
     Attributes
     ----------
-    data : the extracted samples.
-    fits : model name -> fitted model, for the models whose fit succeeded.
-    errors : model name -> the error of a model whose fit failed.
-    used : model name -> the samples that model was fitted to.
-    extract_seconds : wall time of reading and extraction [s].
-    fit_seconds : model name -> wall time of its fit [s].
+    data : JointData
+        The extracted samples.
+    fits : dict of str to FittedModel
+        Model name -> fitted model, for the models whose fit succeeded.
+    errors : dict of str to FricidError
+        Model name -> the error of a model whose fit failed.
+    used : dict of str to FrictionSamples
+        Model name -> the samples that model was fitted to.
+    extract_seconds : float
+        Wall time of reading and extraction [s].
+    fit_seconds : dict of str to float
+        Model name -> wall time of its fit [s].
     """
 
     data: JointData
@@ -143,19 +116,6 @@ class JointRun:
     used: dict[str, FrictionSamples] = field(default_factory=dict)
     extract_seconds: float = 0.0
     fit_seconds: dict[str, float] = field(default_factory=dict)
-
-
-def _check_keys(given: Mapping[str, Any], allowed: Sequence[str], what: str) -> None:
-    unknown = [k for k in given if k not in allowed]
-    if unknown:
-        choices = ", ".join(allowed) if allowed else "none"
-        raise ConfigError(f"unknown {what} '{unknown[0]}'; allowed: {choices}")
-
-
-def _check_reader(reader: str, options: Mapping[str, Any]) -> None:
-    if reader not in READERS:
-        raise ConfigError(f"unknown reader '{reader}'; choose one of: {', '.join(READERS)}")
-    _check_keys(options, READER_OPTIONS[reader], f"option of reader '{reader}'")
 
 
 def _design_hints(log: RawLog) -> dict[str, Any]:
@@ -217,16 +177,23 @@ def load_joint(
 
     Parameters
     ----------
-    path : the log: a fricid raw log (``table``), any CSV/Parquet table (``generic``), an EPOS
-        recorder CSV or a folder of steady-state EPOS recordings (``epos``).
-    reader : one of :data:`READERS`.
-    reader_options : the reader's options (:data:`READER_OPTIONS`, SI units), e.g. for
+    path : str or path-like
+        The log: a fricid raw log (``table``), any CSV/Parquet table (``generic``), a ROS 2
+        bag or MCAP file (``rosbag``), an EPOS recorder CSV or a folder of steady-state EPOS
+        recordings (``epos``); opened by :func:`fricid.io.open_log`.
+    reader : str
+        One of :data:`fricid.io.READERS`.
+    reader_options : Mapping, optional
+        The reader's options (:data:`fricid.io.READER_OPTIONS`, SI units), e.g. for
         ``generic`` ``{"columns": {"time": "t", "velocity": "dq", "torque": "tau"},
         "units": {"velocity": "deg/s"}, "temperature": 25.0}``.
-    extract_options : options of :func:`fricid.extract.extract` (:data:`EXTRACT_OPTIONS`).
-        Unset position bins and gravity mode come from the design a simulated log records.
-    chunk_rows : rows read at a time from a ``table`` log (bounded memory).
-    on_chunk : called once per chunk read (progress).
+    extract_options : Mapping, optional
+        Options of :func:`fricid.extract.extract` (:data:`EXTRACT_OPTIONS`). Unset position
+        bins and gravity mode come from the design a simulated log records.
+    chunk_rows : int
+        Rows read at a time from a ``table`` log or a bag (bounded memory).
+    on_chunk : callable, optional
+        Called once per chunk read (progress).
 
     Returns
     -------
@@ -234,49 +201,28 @@ def load_joint(
 
     Raises
     ------
-    ConfigError : an unknown reader or option.
-    DataError : unreadable or unusable data (naming file, row and column where known).
+    ConfigError
+        An unknown reader or option.
+    DataError
+        Unreadable or unusable data (naming file, row and column where known).
     """
-    from .io import epos_steady_samples, iter_rawlog, iter_rosbag, read_epos, read_table_log
-
     path = Path(path)
     ropts = dict(reader_options or {})
     eopts = {k: v for k, v in dict(extract_options or {}).items() if v is not None}
-    _check_reader(reader, ropts)
-    _check_keys(eopts, EXTRACT_OPTIONS, "extraction option")
-    if reader == "epos" and path.is_dir():
-        if eopts:
-            raise ConfigError(
-                "a folder of steady-state EPOS recordings gives one operating point per file; "
-                f"extraction options ({', '.join(eopts)}) do not apply"
-            )
-        samples = epos_steady_samples(path, **ropts)
-        return JointData(samples, samples, None)
-    if reader == "epos":
-        extra = [k for k in _EPOS_FOLDER_ONLY if k in ropts]
-        if extra:
-            raise ConfigError(f"reader option '{extra[0]}' applies to a folder of EPOS recordings")
-        log = read_epos(path, **ropts)
-        return _extract_stream([], log, eopts, on_chunk)
-    if reader == "generic":
-        log = read_table_log(path, **ropts)
-        return _extract_stream([], log, eopts, on_chunk)
-    if reader == "rosbag":
-        if "joint" not in ropts:
-            from .io import rosbag_joints
-
-            topic = ropts.get("topic", "/joint_states")
-            raise ConfigError(
-                f"reading a bag needs the joint's name; {path} has joints: "
-                f"{', '.join(rosbag_joints(path, topic=topic))}"
-            )
-        chunks = iter_rosbag(path, chunk_rows=chunk_rows, **ropts)
-    else:
-        chunks = iter_rawlog(path, chunk_rows=chunk_rows)
-    first = next(chunks, None)
+    check_reader(reader, ropts)
+    check_keys(eopts, EXTRACT_OPTIONS, "extraction option")
+    if reader == "epos" and path.is_dir() and eopts:
+        raise ConfigError(
+            "a folder of steady-state EPOS recordings gives one operating point per file; "
+            f"extraction options ({', '.join(eopts)}) do not apply"
+        )
+    opened = open_log(path, reader, ropts, chunk_rows=chunk_rows)
+    if isinstance(opened, FrictionSamples):
+        return JointData(opened, opened, None)
+    first = next(opened, None)
     if first is None:  # pragma: no cover - iter_rawlog raises on an empty log
         raise DataError("the log has no rows", file=path)
-    return _extract_stream(chunks, first, eopts, on_chunk)
+    return _extract_stream(opened, first, eopts, on_chunk)
 
 
 def select_direction(samples: FrictionSamples, direction: str = "all") -> FrictionSamples:
@@ -330,13 +276,18 @@ def run_joint(
 
     Parameters
     ----------
-    path, reader, reader_options, extract_options, chunk_rows : see :func:`load_joint`.
-    models : model names (``fricid.models.MODELS``, ``*_asym`` for per-direction parameters).
-    method, seed, max_evals : passed to :func:`fricid.identify.fit`; every model is fitted with
-        the same ``seed``, so the run is reproducible bit for bit.
-    samples, direction : which samples each model is fitted to (:func:`select_samples`).
-    fixed, bounds : parameters held fixed / search ranges (SI), applied to every model that
-        has the parameter named.
+    path, reader, reader_options, extract_options, chunk_rows
+        See :func:`load_joint`.
+    models : sequence of str
+        Model names (``fricid.models.MODELS``, ``*_asym`` for per-direction parameters).
+    method, seed, max_evals : str, int, int or None
+        Passed to :func:`fricid.identify.fit`; every model is fitted with the same ``seed``,
+        so the run is reproducible bit for bit.
+    samples, direction : str
+        Which samples each model is fitted to (:func:`select_samples`).
+    fixed, bounds : Mapping, optional
+        Parameters held fixed / search ranges (SI), applied to every model that has the
+        parameter named.
 
     Returns
     -------
@@ -346,7 +297,8 @@ def run_joint(
 
     Raises
     ------
-    FricidError : the log cannot be read or extracted (nothing can be fitted then).
+    FricidError
+        The log cannot be read or extracted (nothing can be fitted then).
     """
     from .identify import fit
     from .models import get_model

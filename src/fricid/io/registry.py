@@ -1,0 +1,166 @@
+"""The registry of joint-log readers and their options, and one entry that opens a log by name.
+
+``fricid extract --format``, the fleet manifest's ``reader`` column and
+:func:`fricid.workflow.load_joint` all name a reader from :data:`READERS` and pass it options
+from :data:`READER_OPTIONS` (SI units); :func:`open_log` checks both and calls the reader.
+
+>>> from fricid.io import open_log
+>>> opened = open_log("run.csv", "generic", {"columns": {"time": "t", "velocity": "dq",
+...                   "torque": "tau"}})                                 # doctest: +SKIP
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Iterator, Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+from ..errors import ConfigError
+from ..samples import FrictionSamples, RawLog
+
+__all__ = [
+    "EPOS_FOLDER_ONLY",
+    "READERS",
+    "READER_OPTIONS",
+    "check_keys",
+    "check_reader",
+    "open_log",
+]
+
+#: Readers of a joint's log: ``table`` (fricid's raw-log CSV/Parquet, as ``fricid simulate``
+#: writes), ``generic`` (any CSV/Parquet through a column mapping and units,
+#: :func:`fricid.io.read_table_log`), ``rosbag`` (a ROS 2 bag or MCAP file with
+#: ``sensor_msgs/msg/JointState``, :func:`fricid.io.iter_rosbag`) and ``epos`` (a Maxon EPOS
+#: recorder CSV, or a folder of steady-state recordings, one operating point per file).
+READERS: tuple[str, ...] = ("table", "generic", "rosbag", "epos")
+
+#: Options each reader accepts (SI units), passed to its :mod:`fricid.io` function.
+READER_OPTIONS: dict[str, tuple[str, ...]] = {
+    "table": (),
+    "generic": ("columns", "units", "torque_constant", "temperature"),
+    "rosbag": (
+        "joint",
+        "topic",
+        "temperature_topic",
+        "temperature",
+        "effort",
+        "effort_unit",
+        "torque_constant",
+        "position_unit",
+        "velocity_unit",
+        "time_source",
+    ),
+    "epos": (
+        "nominal_torque",
+        "flip_sign",
+        "temperature",
+        "torque_constant",
+        "counts_per_turn",
+        "pattern",
+        "load",
+    ),
+}
+
+#: Options of reader ``epos`` that apply to a folder of steady-state recordings only.
+EPOS_FOLDER_ONLY: tuple[str, ...] = ("pattern", "load")
+
+
+def check_keys(given: Mapping[str, Any], allowed: Sequence[str], what: str) -> None:
+    """Refuse a key of ``given`` that is not in ``allowed``.
+
+    Parameters
+    ----------
+    given : Mapping
+        The options given.
+    allowed : sequence of str
+        The options accepted.
+    what : str
+        What an option is, for the message (e.g. ``"option of reader 'table'"``).
+
+    Raises
+    ------
+    ConfigError
+        Naming the first unknown key and listing the allowed ones.
+    """
+    unknown = [k for k in given if k not in allowed]
+    if unknown:
+        choices = ", ".join(allowed) if allowed else "none"
+        raise ConfigError(f"unknown {what} '{unknown[0]}'; allowed: {choices}")
+
+
+def check_reader(reader: str, options: Mapping[str, Any]) -> None:
+    """Refuse an unknown reader, or an option that ``reader`` does not take.
+
+    Raises
+    ------
+    ConfigError
+        Listing the readers, or the reader's options.
+    """
+    if reader not in READERS:
+        raise ConfigError(f"unknown reader '{reader}'; choose one of: {', '.join(READERS)}")
+    check_keys(options, READER_OPTIONS[reader], f"option of reader '{reader}'")
+
+
+def open_log(
+    path: str | os.PathLike[str],
+    reader: str = "table",
+    options: Mapping[str, Any] | None = None,
+    *,
+    chunk_rows: int = 1_000_000,
+) -> FrictionSamples | Iterator[RawLog]:
+    """Open a joint's log with a reader of :data:`READERS`.
+
+    Parameters
+    ----------
+    path : path-like
+        The log: a fricid raw log (``table``), any CSV/Parquet table (``generic``), a ROS 2
+        bag or MCAP file (``rosbag``), an EPOS recorder CSV or a folder of steady-state EPOS
+        recordings (``epos``).
+    reader : str
+        One of :data:`READERS`.
+    options : Mapping, optional
+        The reader's options (:data:`READER_OPTIONS`, SI units).
+    chunk_rows : int
+        Rows read at a time from a ``table`` log or a bag (bounded memory).
+
+    Returns
+    -------
+    FrictionSamples or iterator of RawLog
+        Samples for a folder of steady-state EPOS recordings (one operating point per file),
+        else the log as a stream of chunks (one chunk for ``generic`` and an EPOS file).
+
+    Raises
+    ------
+    ConfigError
+        An unknown reader or option; a folder-only EPOS option given for one file; a bag
+        read without the joint's name (the message lists the bag's joints).
+    DataError
+        Unreadable data, naming file, row and column where known.
+    """
+    from .epos import epos_steady_samples, read_epos
+    from .generic import read_table_log
+    from .rosbag import iter_rosbag, rosbag_joints
+    from .tables import iter_rawlog
+
+    path = Path(path)
+    opts = dict(options or {})
+    check_reader(reader, opts)
+    if reader == "epos" and path.is_dir():
+        return epos_steady_samples(path, **opts)
+    if reader == "epos":
+        extra = [k for k in EPOS_FOLDER_ONLY if k in opts]
+        if extra:
+            raise ConfigError(f"reader option '{extra[0]}' applies to a folder of EPOS recordings")
+        return iter([read_epos(path, **opts)])
+    if reader == "generic":
+        return iter([read_table_log(path, **opts)])
+    if reader == "rosbag":
+        if "joint" not in opts:
+            topic = opts.get("topic", "/joint_states")
+            raise ConfigError(
+                f"reading a bag needs the joint's name; {path} has joints: "
+                f"{', '.join(rosbag_joints(path, topic=topic))}"
+            )
+        return iter_rosbag(path, chunk_rows=chunk_rows, **opts)
+    return iter_rawlog(path, chunk_rows=chunk_rows)
