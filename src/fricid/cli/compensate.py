@@ -103,7 +103,7 @@ def compensate_command(
     velocity. See `fricid.control.tracking` for every detail.
     """
     from ..control import compensation_study, default_config, plot_compensation
-    from ..export import Smoothing
+    from ..models.smoothing import Smoothing
     from ..fitted import FittedModel
 
     fitted = FittedModel.load(model)
