@@ -43,12 +43,17 @@ class Preamble:
 
     Attributes
     ----------
-    path : the file.
-    comments : ``{name: (unit or None, value text)}`` from leading ``# name [unit]: value``
-        lines, names lower-cased.
-    labels : the column labels of the header line, as written.
-    header_line : 1-based line number of the header.
-    header_offset : byte offset of the header line.
+    path : pathlib.Path
+        The file.
+    labels : list of str
+        The column labels of the header line, as written.
+    header_line : int
+        1-based line number of the header.
+    header_offset : int
+        Byte offset of the header line.
+    comments : dict of str to tuple of (str or None, str)
+        ``{name: (unit or None, value text)}`` from leading ``# name [unit]: value`` lines,
+        names lower-cased.
     """
 
     path: Path
@@ -59,6 +64,7 @@ class Preamble:
 
 
 def _decode(raw: bytes, path: Path, line: int) -> str:
+    """One line as UTF-8 text; anything else is a :class:`DataError` naming the line."""
     try:
         return raw.decode("utf-8")
     except UnicodeDecodeError as exc:
@@ -66,10 +72,24 @@ def _decode(raw: bytes, path: Path, line: int) -> str:
 
 
 def read_preamble(path: str | os.PathLike[str]) -> Preamble:
-    """Read leading ``#`` comment lines and the header line of a CSV file.
+    """Read the leading ``#`` comment lines and the header line of a CSV file.
 
-    Blank lines before the header are skipped. Raises :class:`DataError` for an empty file or
-    one with no header line.
+    Blank lines before the header are skipped; a UTF-8 byte-order mark is ignored.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The CSV file.
+
+    Returns
+    -------
+    Preamble
+        The comments, the header's labels and where the header is.
+
+    Raises
+    ------
+    DataError
+        An empty file, no header line, or text that is not UTF-8 (the line named).
     """
     path = Path(path)
     comments: dict[str, tuple[str | None, str]] = {}
@@ -98,6 +118,7 @@ def read_preamble(path: str | os.PathLike[str]) -> Preamble:
 
 
 def _convert_options(labels: list[str]) -> pacsv.ConvertOptions:
+    """pyarrow's options to read ``labels`` as float64 with no null values."""
     return pacsv.ConvertOptions(
         column_types={label: pa.float64() for label in labels},
         include_columns=labels,
@@ -119,10 +140,22 @@ def _parse_float(text: str) -> float | None:
 
 
 def locate_bad_value(pre: Preamble, labels: list[str], start: int = 0) -> DataError | None:
-    """The first malformed row, non-numeric or non-finite value in ``labels``, or None.
+    """Find the first malformed row, non-numeric or non-finite value in some columns.
 
-    Records before ``start`` (0-based) are known to be good and only counted. The error names
-    the file, the 1-based line number and the column label.
+    Parameters
+    ----------
+    pre : Preamble
+        The file's preamble.
+    labels : list of str
+        The columns to check.
+    start : int, default 0
+        Records (0-based) before this one are known to be good and are only counted.
+
+    Returns
+    -------
+    DataError or None
+        The error, naming the file, the 1-based line number and the column label; None when
+        every value is a finite number.
     """
     index = {label: pre.labels.index(label) for label in labels}
     wanted = sorted(index.items(), key=lambda item: item[1])
@@ -164,7 +197,20 @@ def locate_bad_value(pre: Preamble, labels: list[str], start: int = 0) -> DataEr
 
 
 def record_line(pre: Preamble, record: int) -> int | None:
-    """The 1-based line number of data record ``record`` (0-based), or None past the end."""
+    """The line a data record is on.
+
+    Parameters
+    ----------
+    pre : Preamble
+        The file's preamble.
+    record : int
+        0-based index of a data record (blank lines do not count).
+
+    Returns
+    -------
+    int or None
+        Its 1-based line number in the file, or None past the end.
+    """
     with open(pre.path, encoding="utf-8", errors="replace", newline="") as fh:
         for _ in range(pre.header_line):
             fh.readline()
@@ -179,6 +225,7 @@ def record_line(pre: Preamble, record: int) -> int | None:
 
 
 def _fail(pre: Preamble, labels: list[str], exc: Exception, start: int = 0) -> DataError:
+    """The error to raise for a failed read: the located bad value, else ``exc`` as text."""
     located = locate_bad_value(pre, labels, start)
     if located is not None:
         return located
@@ -188,13 +235,32 @@ def _fail(pre: Preamble, labels: list[str], exc: Exception, start: int = 0) -> D
 def _check_finite(
     pre: Preamble, labels: list[str], columns: dict[str, np.ndarray], start: int = 0
 ) -> None:
+    """Raise the located :class:`DataError` if any value in ``columns`` is not finite."""
     if all(np.isfinite(values).all() for values in columns.values()):
         return
     raise _fail(pre, labels, ValueError("non-finite value"), start)
 
 
 def read_numeric(pre: Preamble, labels: list[str]) -> dict[str, np.ndarray]:
-    """All rows of the columns ``labels`` as float64 arrays (finite, else DataError)."""
+    """Read whole columns of a CSV file.
+
+    Parameters
+    ----------
+    pre : Preamble
+        The file's preamble.
+    labels : list of str
+        The columns to read, as labelled in the header.
+
+    Returns
+    -------
+    dict of str to ndarray
+        Label -> float64 array of every row.
+
+    Raises
+    ------
+    DataError
+        A malformed row, a non-numeric or non-finite value (line and column named).
+    """
     try:
         with pa.OSFile(str(pre.path)) as fh:
             fh.seek(pre.header_offset)
@@ -207,7 +273,20 @@ def read_numeric(pre: Preamble, labels: list[str]) -> dict[str, np.ndarray]:
 
 
 def rechunk(batches: Iterable[pa.RecordBatch], rows: int) -> Iterator[pa.Table]:
-    """Regroup record batches into tables of exactly ``rows`` rows (the last may be shorter)."""
+    """Regroup record batches into tables of a fixed number of rows.
+
+    Parameters
+    ----------
+    batches : iterable of pyarrow.RecordBatch
+        Batches of any sizes, with the same schema.
+    rows : int
+        Rows per table.
+
+    Yields
+    ------
+    pyarrow.Table
+        Tables of exactly ``rows`` rows; the last may be shorter.
+    """
     buffer: list[pa.RecordBatch] = []
     held = 0
     for batch in batches:
@@ -227,9 +306,30 @@ def rechunk(batches: Iterable[pa.RecordBatch], rows: int) -> Iterator[pa.Table]:
 def iter_numeric(
     pre: Preamble, labels: list[str], chunk_rows: int
 ) -> Iterator[tuple[int, dict[str, np.ndarray]]]:
-    """Stream ``(first record index, {label: float64 array})`` chunks of ``chunk_rows`` rows.
+    """Stream columns of a CSV file in chunks.
 
     Memory is bounded by a few chunks whatever the file size.
+
+    Parameters
+    ----------
+    pre : Preamble
+        The file's preamble.
+    labels : list of str
+        The columns to read.
+    chunk_rows : int
+        Rows per chunk.
+
+    Yields
+    ------
+    start : int
+        0-based index of the chunk's first record.
+    columns : dict of str to ndarray
+        Label -> float64 array of the chunk's rows.
+
+    Raises
+    ------
+    DataError
+        A malformed row, a non-numeric or non-finite value (line and column named).
     """
 
     def batches() -> Iterator[pa.RecordBatch]:

@@ -22,7 +22,25 @@ META_KEY = b"fricid"
 
 
 def open_parquet(path: str | os.PathLike[str]) -> pq.ParquetFile:
-    """Open a Parquet file; a damaged or truncated file is a :class:`DataError`."""
+    """Open a Parquet file.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file.
+
+    Returns
+    -------
+    pyarrow.parquet.ParquetFile
+        The open file (no read-ahead: memory stays bounded when streaming).
+
+    Raises
+    ------
+    FileNotFoundError
+        No such file.
+    DataError
+        A damaged or truncated file.
+    """
     try:
         # no pre-buffering: it reads ahead whole row groups, unbounded for iter_batches
         return pq.ParquetFile(path, pre_buffer=False)
@@ -33,7 +51,26 @@ def open_parquet(path: str | os.PathLike[str]) -> pq.ParquetFile:
 
 
 def schema_meta(pf: pq.ParquetFile, path: str | os.PathLike[str]) -> dict[str, Any]:
-    """fricid's metadata document of a Parquet file (empty when another tool wrote it)."""
+    """fricid's metadata document of a Parquet file.
+
+    Parameters
+    ----------
+    pf : pyarrow.parquet.ParquetFile
+        The open file.
+    path : str or os.PathLike
+        Its path (for messages).
+
+    Returns
+    -------
+    dict
+        The JSON object under :data:`META_KEY` in the schema metadata; empty when another
+        tool wrote the file.
+
+    Raises
+    ------
+    DataError
+        Metadata that is not a JSON object.
+    """
     raw = (pf.schema_arrow.metadata or {}).get(META_KEY)
     if raw is None:
         return {}
@@ -47,6 +84,8 @@ def schema_meta(pf: pq.ParquetFile, path: str | os.PathLike[str]) -> dict[str, A
 
 
 def _to_float(table: pa.Table, labels: list[str], path: Path, first: int) -> dict[str, np.ndarray]:
+    """Columns as finite float64 arrays; null, non-numeric or non-finite is a DataError naming
+    the record (``first`` is the 0-based index of the table's first record)."""
     columns = {}
     for label in labels:
         col = table.column(label)
@@ -71,7 +110,28 @@ def _to_float(table: pa.Table, labels: list[str], path: Path, first: int) -> dic
 
 
 def read_columns(pf: pq.ParquetFile, labels: list[str], path: Path) -> dict[str, np.ndarray]:
-    """All rows of ``labels`` as finite float64 arrays (rows in errors are 0-based records)."""
+    """Read whole columns of a Parquet file.
+
+    Parameters
+    ----------
+    pf : pyarrow.parquet.ParquetFile
+        The open file.
+    labels : list of str
+        The columns to read.
+    path : pathlib.Path
+        Its path (for messages).
+
+    Returns
+    -------
+    dict of str to ndarray
+        Label -> float64 array of every row.
+
+    Raises
+    ------
+    DataError
+        Unreadable data, a null, non-numeric or non-finite value (rows in messages are
+        0-based records).
+    """
     try:
         table = pf.read(columns=labels)
     except (pa.ArrowException, OSError) as exc:
@@ -82,7 +142,31 @@ def read_columns(pf: pq.ParquetFile, labels: list[str], path: Path) -> dict[str,
 def iter_columns(
     pf: pq.ParquetFile, labels: list[str], path: Path, chunk_rows: int
 ) -> Iterator[tuple[int, dict[str, np.ndarray]]]:
-    """Stream ``(first record index, {label: array})`` chunks of ``chunk_rows`` rows."""
+    """Stream columns of a Parquet file in chunks.
+
+    Parameters
+    ----------
+    pf : pyarrow.parquet.ParquetFile
+        The open file.
+    labels : list of str
+        The columns to read.
+    path : pathlib.Path
+        Its path (for messages).
+    chunk_rows : int
+        Rows per chunk.
+
+    Yields
+    ------
+    start : int
+        0-based index of the chunk's first record.
+    columns : dict of str to ndarray
+        Label -> float64 array of the chunk's rows.
+
+    Raises
+    ------
+    DataError
+        As :func:`read_columns`.
+    """
     batches = pf.iter_batches(batch_size=min(chunk_rows, 1 << 20), columns=labels)
     stream = rechunk(batches, chunk_rows)
     start = 0
