@@ -1,4 +1,5 @@
-"""CSV machinery shared by the readers: the preamble, fast numeric reading, error location.
+"""CSV machinery shared by the readers and writers: the preamble, fast numeric reading, error
+location, streamed atomic writing.
 
 The normal path is pyarrow's multi-threaded CSV reader (no Python loop per row). Only when it
 fails, or finds a NaN or infinity, does :func:`locate_bad_value` walk the file with the
@@ -10,25 +11,32 @@ from __future__ import annotations
 import csv
 import math
 import os
-from collections.abc import Iterable, Iterator
+from collections.abc import Iterable, Iterator, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pyarrow as pa
 import pyarrow.csv as pacsv
 
 from ..errors import DataError
+from ..units import SI_UNITS
 from ._columns import split_label
+from ._meta import dumps_meta, encode_text
+from .atomic import atomic_write
 
 __all__ = [
     "Preamble",
+    "csv_preamble",
     "iter_numeric",
     "locate_bad_value",
+    "preamble_fields",
     "read_numeric",
     "read_preamble",
     "rechunk",
     "record_line",
+    "write_csv",
 ]
 
 #: Bytes pyarrow parses at a time when streaming (about 13 k rows of a raw log). With its
@@ -355,3 +363,89 @@ def iter_numeric(
         _check_finite(pre, labels, columns, start)
         yield start, columns
         start += table.num_rows
+
+
+# --------------------------------------------------------------------------- writing
+
+
+def preamble_fields(
+    fmt: str,
+    source: str | None,
+    joint: str | None,
+    torque_constant: float | None,
+    meta: Mapping[str, Any],
+) -> list[tuple[str, str]]:
+    """The ``# key: value`` comment lines of a fricid table file.
+
+    Parameters
+    ----------
+    fmt : str
+        The format tag, e.g. ``"fricid-rawlog/1"``.
+    source, joint : str or None
+        Written through :func:`~fricid.io._meta.encode_text` when given.
+    torque_constant : float or None
+        K [N m/A], written with its unit when given.
+    meta : mapping
+        Free-form metadata, written as one line of JSON.
+
+    Returns
+    -------
+    list of tuple of (str, str)
+        ``(key, value text)`` in the order written.
+    """
+    fields = [("format", fmt)]
+    if source is not None:
+        fields.append(("source", encode_text(str(source))))
+    if joint is not None:
+        fields.append(("joint", encode_text(str(joint))))
+    if torque_constant is not None:
+        key = f"torque_constant [{SI_UNITS['torque_constant']}]"
+        fields.append((key, repr(float(torque_constant))))
+    fields.append(("meta", dumps_meta(meta)))
+    return fields
+
+
+def csv_preamble(fields: list[tuple[str, str]], units: Mapping[str, str]) -> bytes:
+    """The comment lines and the header line of a CSV file.
+
+    Parameters
+    ----------
+    fields : list of tuple of (str, str)
+        ``(key, value text)`` comment lines (:func:`preamble_fields`).
+    units : mapping of str to str
+        Column -> unit, in column order; unit ``"1"`` means dimensionless (no brackets).
+
+    Returns
+    -------
+    bytes
+        UTF-8 text ending in a newline, e.g. ``# format: ...`` then ``time [s],...``.
+    """
+    lines = [f"# {key}: {value}" for key, value in fields]
+    lines.append(
+        ",".join(name if unit == "1" else f"{name} [{unit}]" for name, unit in units.items())
+    )
+    return ("\n".join(lines) + "\n").encode("utf-8")
+
+
+def write_csv(path: Path, preamble: bytes, tables: Iterable[pa.Table]) -> None:
+    """Write a CSV file atomically, table by table.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The file; nothing is left there if writing fails part-way.
+    preamble : bytes
+        The comment and header lines (:func:`csv_preamble`).
+    tables : iterable of pyarrow.Table
+        The rows, in order, all with the same columns (streamed: one in memory at a time).
+    """
+    options = pacsv.WriteOptions(include_header=False)
+    with atomic_write(path, "wb") as fh:
+        fh.write(preamble)
+        writer = None
+        for table in tables:
+            if writer is None:
+                writer = pacsv.CSVWriter(fh, table.schema, write_options=options)
+            writer.write_table(table)
+        if writer is not None:
+            writer.close()

@@ -1,10 +1,11 @@
-"""Parquet machinery shared by the readers: schema metadata, column reads, batch streaming."""
+"""Parquet machinery shared by the readers and writers: schema metadata, column reads, batch
+streaming, streamed atomic writing."""
 
 from __future__ import annotations
 
 import json
 import os
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator, Mapping
 from pathlib import Path
 from typing import Any
 
@@ -13,12 +14,28 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from ..errors import DataError
+from ..units import SI_UNITS
 from ._csv import rechunk
+from ._meta import dumps_meta
+from .atomic import atomic_path
 
-__all__ = ["META_KEY", "iter_columns", "open_parquet", "read_columns", "schema_meta"]
+__all__ = [
+    "META_KEY",
+    "ROW_GROUP_ROWS",
+    "iter_columns",
+    "open_parquet",
+    "parquet_doc",
+    "read_columns",
+    "schema_meta",
+    "write_parquet",
+]
 
 #: Key of fricid's JSON document in the Parquet schema metadata.
 META_KEY = b"fricid"
+
+#: Largest Parquet row group written: bounds the memory a streaming reader needs per group
+#: (5 float64 columns x 256 Ki rows = 10 MB).
+ROW_GROUP_ROWS = 1 << 18
 
 
 def open_parquet(path: str | os.PathLike[str]) -> pq.ParquetFile:
@@ -179,3 +196,72 @@ def iter_columns(
             raise DataError(f"cannot read Parquet data ({exc})", file=path) from None
         yield start, _to_float(table, labels, path, start)
         start += table.num_rows
+
+
+# --------------------------------------------------------------------------- writing
+
+
+def parquet_doc(
+    fmt: str,
+    units: Mapping[str, str],
+    source: str | None,
+    joint: str | None,
+    torque_constant: float | None,
+    meta: Mapping[str, Any],
+) -> bytes:
+    """fricid's metadata document for the schema of a Parquet file.
+
+    Parameters
+    ----------
+    fmt : str
+        The format tag, e.g. ``"fricid-samples/1"``.
+    units : mapping of str to str
+        Column -> unit.
+    source, joint : str or None
+        Recorded when given.
+    torque_constant : float or None
+        K [N m/A], recorded with its unit when given.
+    meta : mapping
+        Free-form metadata (JSON-serialisable).
+
+    Returns
+    -------
+    bytes
+        ASCII JSON, stored under :data:`META_KEY`.
+    """
+    doc: dict[str, Any] = {"format": fmt, "units": dict(units)}
+    if torque_constant is not None:
+        doc["units"]["torque_constant"] = SI_UNITS["torque_constant"]
+        doc["torque_constant"] = float(torque_constant)
+    if source is not None:
+        doc["source"] = str(source)
+    if joint is not None:
+        doc["joint"] = str(joint)
+    doc["meta"] = json.loads(dumps_meta(meta))
+    return json.dumps(doc, ensure_ascii=True).encode("ascii")
+
+
+def write_parquet(path: Path, doc: bytes, tables: Iterable[pa.Table]) -> None:
+    """Write a Parquet file atomically, table by table.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The file; nothing is left there if writing fails part-way.
+    doc : bytes
+        The metadata document (:func:`parquet_doc`).
+    tables : iterable of pyarrow.Table
+        The rows, in order, all with the same schema; streamed, in row groups of at most
+        :data:`ROW_GROUP_ROWS` rows.
+    """
+    with atomic_path(path) as tmp:
+        writer = None
+        try:
+            for table in tables:
+                if writer is None:
+                    schema = table.schema.with_metadata({META_KEY: doc})
+                    writer = pq.ParquetWriter(tmp, schema)
+                writer.write_table(table, row_group_size=ROW_GROUP_ROWS)
+        finally:
+            if writer is not None:
+                writer.close()
