@@ -18,8 +18,6 @@ from fricid.io import (
     read_epos_dir,
 )
 
-REAL = Path("/work/shared/data/real/epos-leadscrew")
-needs_real = pytest.mark.skipif(not REAL.is_dir(), reason="real EPOS recordings not present")
 RPM = 2 * math.pi / 60
 
 HEADER = (
@@ -53,9 +51,8 @@ def _digest(folder: Path) -> str:
 # --------------------------------------------------------------------------- real data
 
 
-@needs_real
-def test_real_file_header_units_and_position():
-    log = read_epos(REAL / "2.csv")
+def test_real_file_header_units_and_position(leadscrew_dir):
+    log = read_epos(leadscrew_dir / "2.csv")
     assert len(log) == 500
     assert log.meta["header"]["Sampling period"] == "128.000"
     assert log.meta["header"]["Recorded samples"] == "500"
@@ -73,11 +70,10 @@ def test_real_file_header_units_and_position():
     np.testing.assert_allclose(log.position[-1], np.trapezoid(log.velocity, log.time))
 
 
-@needs_real
-def test_real_folder_steady_samples_and_asymmetry():
-    before = _digest(REAL)
-    s = epos_steady_samples(REAL)
-    assert _digest(REAL) == before  # inputs never modified
+def test_real_folder_steady_samples_and_asymmetry(leadscrew_dir):
+    before = _digest(leadscrew_dir)
+    s = epos_steady_samples(leadscrew_dir)
+    assert _digest(leadscrew_dir) == before  # inputs never modified
     assert len(s) == 32
     assert (s.direction == 1).sum() == 16 and (s.direction == -1).sum() == 16
     assert np.all(np.diff(s.velocity) > 0)  # sorted by set-point
@@ -97,9 +93,8 @@ def test_real_folder_steady_samples_and_asymmetry():
     assert mnm[pos].min() < mnm[pos][0] and mnm[pos][-1] > mnm[pos].min() + 0.5
 
 
-@needs_real
-def test_real_folder_flipped_matches_file_names():
-    s = epos_steady_samples(REAL, flip_sign=True)
+def test_real_folder_flipped_matches_file_names(leadscrew_dir):
+    s = epos_steady_samples(leadscrew_dir, flip_sign=True)
     for name, v in zip(s.meta["files"], s.velocity / RPM, strict=True):
         setpoint = -float(name[1:-4]) if name.startswith("n") else float(name[:-4])
         assert v == pytest.approx(setpoint, rel=0.01, abs=0.15), name  # N.csv is +N rpm
@@ -109,9 +104,8 @@ def test_real_folder_flipped_matches_file_names():
     assert s.friction[n_two] * 1e3 == pytest.approx(-3.555, abs=0.01)
 
 
-@needs_real
-def test_read_epos_dir_sorted_and_options_passed():
-    logs = read_epos_dir(REAL, nominal_torque=0.01, temperature=30.0)
+def test_read_epos_dir_sorted_and_options_passed(leadscrew_dir):
+    logs = read_epos_dir(leadscrew_dir, nominal_torque=0.01, temperature=30.0)
     assert len(logs) == 32
     means = [float(np.mean(log.velocity)) for log in logs]
     assert means == sorted(means)

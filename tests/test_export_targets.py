@@ -290,7 +290,6 @@ def test_predict_refuses_mixed_units_and_missing_inputs(tmp_path, model_file):
 
 
 def test_rbf_network_projects_and_predicts(tmp_path):
-    pytest.importorskip("fricid.models.rbf")
     from test_export import rbf_fitted
 
     fitted = rbf_fitted(("velocity", "load"), 0.02)

@@ -230,9 +230,6 @@ def test_run_joint_isolates_a_failing_model(fleet):
         run_joint(log, fixed={"nope": 1.0})
 
 
-EPOS = Path("/work/shared/data/real/epos-leadscrew")
-
-
 def test_generic_reader_with_column_mapping_and_units(fleet, tmp_path):
     """A CSV with its own column names and deg/s, read through the manifest's mapping."""
     from fricid.io import read_rawlog
@@ -262,10 +259,9 @@ def test_generic_reader_with_column_mapping_and_units(fleet, tmp_path):
     assert got["param_tau_c"] == pytest.approx(want["param_tau_c"], rel=1e-6)
 
 
-@pytest.mark.skipif(not EPOS.is_dir(), reason="real EPOS recordings not present")
-def test_epos_folder_as_in_the_single_joint_commands(tmp_path):
+def test_epos_folder_as_in_the_single_joint_commands(tmp_path, leadscrew_dir):
     (tmp_path / "m.yaml").write_text(
-        f"joints:\n  - robot: leadscrew\n    joint: axis\n    log: {EPOS}\n"
+        f"joints:\n  - robot: leadscrew\n    joint: axis\n    log: {leadscrew_dir}\n"
         "    reader: epos\n    flip_sign: true\n    nominal_torque [mN m]: 9.84\n"
         "    model: [stribeck, stribeck_asym]\n",
         encoding="utf-8",
@@ -274,7 +270,7 @@ def test_epos_folder_as_in_the_single_joint_commands(tmp_path):
     assert run.failed == 0 and run.table["directions"].tolist() == ["-1;1", "-1;1"]
     samples = tmp_path / "s.parquet"
     res = runner.invoke(
-        app, ["extract", str(EPOS), "--format", "epos", "--flip-sign", "-o", str(samples)]
+        app, ["extract", str(leadscrew_dir), "--format", "epos", "--flip-sign", "-o", str(samples)]
     )
     assert res.exit_code == 0, res.output
     model = tmp_path / "m.json"

@@ -9,8 +9,6 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 
@@ -19,7 +17,6 @@ from fricid.identify import fit
 from fricid.io import epos_steady_samples
 from fricid.sim import preset, simulate
 
-LEADSCREW = Path(__file__).resolve().parents[2] / "shared" / "data" / "real" / "epos-leadscrew"
 PAPER2_TRUTH = {"tau_c": 0.084, "tau_s": 0.641, "w_s": 0.066, "tau_v": 0.0026}
 
 
@@ -54,9 +51,8 @@ def test_paper1_models_order_as_table1():
     assert fitness["vlt"] > 0.95
 
 
-@pytest.mark.skipif(not LEADSCREW.is_dir(), reason="real recordings not beside the repo")
-def test_leadscrew_stribeck_per_direction_is_plausible():
-    samples = epos_steady_samples(LEADSCREW)
+def test_leadscrew_stribeck_per_direction_is_plausible(leadscrew_dir):
+    samples = epos_steady_samples(leadscrew_dir)
     assert len(samples) == 32
     assert samples.directions() == (-1, 1)
     f = fit(samples, "stribeck_asym", "lm")

@@ -6,6 +6,7 @@ Budgets are small so the file runs in well under a minute on 2 cores.
 
 from __future__ import annotations
 
+import numba
 import numpy as np
 import pytest
 
@@ -238,8 +239,6 @@ def test_runs_with_a_generator_seed_records_the_seeds() -> None:
 
 
 # -- the compiled path of RWSAVSBAS ------------------------------------------------------------
-
-numba = pytest.importorskip("numba")
 
 
 @numba.njit(cache=True)

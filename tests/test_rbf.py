@@ -360,7 +360,8 @@ def test_bad_inputs_give_clear_errors():
 
 
 def test_zero_variance_named_by_feature_name():
-    pd = pytest.importorskip("pandas")
+    import pandas as pd
+
     X = pd.DataFrame({"velocity": np.linspace(0.1, 1, 20), "temperature": 25.0})
     with pytest.raises(DataError, match="column 'temperature'"):
         RBFNetRegressor(3).fit(X, np.arange(20.0))

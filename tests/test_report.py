@@ -19,9 +19,6 @@ from fricid.report import Document, Figure, Table, model_report, write_document
 from fricid.report.render import render_html, render_markdown
 from fricid.sim import preset, simulate
 
-# CI clones main with shared/ beside it
-LEADSCREW = Path(__file__).resolve().parents[2] / "shared" / "data" / "real" / "epos-leadscrew"
-
 FAMILIES = ("coulomb_viscous", "stribeck", "msk", "vlt")
 
 
@@ -65,10 +62,8 @@ def paper1_samples():
 
 
 @pytest.fixture(scope="module")
-def leadscrew():
-    if not LEADSCREW.is_dir():
-        pytest.skip("lead-screw recordings not available")
-    return epos_steady_samples(LEADSCREW)
+def leadscrew(leadscrew_dir):
+    return epos_steady_samples(leadscrew_dir)
 
 
 @pytest.mark.parametrize("family", FAMILIES)

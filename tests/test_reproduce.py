@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import io
 import json
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -15,8 +14,6 @@ from fricid.cli import app
 from fricid.errors import ConfigError
 from fricid.experiments.paper_numbers import BAS_RBFNN, RWSAVSBAS
 from fricid.experiments.reproduce import PAPERS, paper_steps, reproduce
-
-LEADSCREW = Path(__file__).resolve().parents[2] / "shared" / "data" / "real" / "epos-leadscrew"
 
 
 def png_stats(data: bytes) -> tuple[tuple[int, int], float]:
@@ -180,9 +177,7 @@ def test_rwsavsbas_quick_has_every_item(rwsavsbas):
     assert "lead screw" in res.output
 
 
-def test_rwsavsbas_runs_on_the_leadscrew_per_direction(rwsavsbas):
-    if not LEADSCREW.is_dir():
-        pytest.skip("lead-screw recordings not available")
+def test_rwsavsbas_runs_on_the_leadscrew_per_direction(rwsavsbas, leadscrew_dir):
     out, _ = rwsavsbas
     _, files = check_folder(out)
     for tag in ("leadscrew_pos", "leadscrew_neg"):

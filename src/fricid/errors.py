@@ -22,18 +22,50 @@ __all__ = [
 
 
 class FricidError(Exception):
-    """Base class of every error fricid raises on purpose."""
+    """Base class of every error fricid raises on purpose.
+
+    Catch this to handle any bad input or bad option; anything else escaping fricid is a
+    bug. The command line turns it into one line on stderr and exit status 2.
+    """
 
 
 class ConfigError(FricidError, ValueError):
-    """An option, parameter or setting is invalid (not the data)."""
+    """An option, parameter or setting is invalid (not the data).
+
+    The message names the option, the values it accepts and the value received.
+    """
 
 
 class DataError(FricidError, ValueError):
-    """Input data is invalid. Names the file, the row and the column where they are known.
+    """Input data is invalid; the message names the file, the row and the column.
 
-    ``row`` is the 1-based line number in the file where the file has lines (a CSV), else the
-    0-based index of the record.
+    Parameters
+    ----------
+    message : str
+        What is wrong, without the location (that is added from the other arguments).
+    file : str or os.PathLike, optional
+        The file the data came from.
+    row : int, optional
+        The 1-based line number in the file where the file has lines (a CSV), else the
+        0-based index of the record (a Parquet row, a bag's message).
+    column : str, optional
+        The column or field.
+
+    Attributes
+    ----------
+    message : str
+        ``message`` as given.
+    file : str or None
+        ``file`` as a string.
+    row : int or None
+        ``row`` as given.
+    column : str or None
+        ``column`` as given.
+
+    Examples
+    --------
+    >>> str(DataError("not a number: 'x'", file="log.csv", row=7, column="velocity"))
+    "log.csv, row 7, column 'velocity': not a number: 'x'"
     """
 
     def __init__(
@@ -51,6 +83,7 @@ class DataError(FricidError, ValueError):
         super().__init__(self._render())
 
     def _render(self) -> str:
+        """The message prefixed with the known parts of the location."""
         where = []
         if self.file is not None:
             where.append(self.file)
@@ -62,7 +95,12 @@ class DataError(FricidError, ValueError):
 
 
 class FricidWarning(UserWarning):
-    """Base class of the caveats fricid attaches to an answer that stands (DESIGN.md, "Errors")."""
+    """Base class of the caveats fricid attaches to an answer that stands (DESIGN.md, "Errors").
+
+    Raised with ``stacklevel`` pointing at the caller's line; filter the whole family with
+    ``warnings.simplefilter("ignore", FricidWarning)``. The command line prints each as one
+    line on stderr and saves it with the result.
+    """
 
 
 class ConvergenceWarning(FricidWarning):

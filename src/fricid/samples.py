@@ -39,7 +39,14 @@ RAWLOG_COLUMNS: dict[str, str] = {
 }
 
 
-def _as_column(name: str, values, n: int | None, source: str | None) -> np.ndarray:
+def _as_column(name: str, values: Any, n: int | None, source: str | None) -> np.ndarray:
+    """``values`` as a finite float column of ``n`` rows (a scalar is broadcast).
+
+    Raises
+    ------
+    DataError
+        Not one-dimensional, the wrong length, or a non-finite value (its row named).
+    """
     arr = np.asarray(values, dtype=float)
     if arr.ndim == 0:
         arr = np.full(n if n is not None else 1, float(arr))
@@ -58,18 +65,50 @@ def _as_column(name: str, values, n: int | None, source: str | None) -> np.ndarr
 class RawLog:
     """A joint's raw log: one row per sample, SI units.
 
-    Attributes
+    The columns are converted to float arrays and checked on construction; the object is
+    frozen, so a ``RawLog`` is always valid.
+
+    Parameters
     ----------
-    time : (n,) s, strictly increasing.
-    position : (n,) rad.
-    velocity : (n,) rad/s.
-    temperature : (n,) degC (a scalar is broadcast).
-    torque : (n,) N m, motor torque, or None when only the current was logged.
-    current : (n,) A, motor current, or None when the torque was logged.
-    torque_constant : N m/A, the K of eq. 13 (BAS-RBFNN paper), tau = K I. Needed when only
-        the current was logged.
-    joint, source : names, for messages and provenance.
-    meta : anything else worth keeping (free-form).
+    time : array_like, shape (n,)
+        Time [s], strictly increasing.
+    position : array_like, shape (n,)
+        Joint position [rad].
+    velocity : array_like, shape (n,)
+        Joint velocity [rad/s].
+    temperature : array_like, shape (n,) or scalar
+        Temperature [degC]; a scalar is broadcast to every row.
+    torque : array_like, shape (n,), optional
+        Motor torque [N m]; None when only the current was logged.
+    current : array_like, shape (n,), optional
+        Motor current [A]; None when the torque was logged.
+    torque_constant : float, optional
+        K [N m/A] of eq. 13 (BAS-RBFNN paper), tau = K I. Needed when only the current was
+        logged.
+    joint : str, default "joint"
+        The joint's name, for messages and provenance.
+    source : str, optional
+        Where the log came from (a file name), for messages and provenance.
+    meta : mapping, optional
+        Anything else worth keeping (free-form).
+
+    Raises
+    ------
+    DataError
+        A column of the wrong shape or length, a non-finite value, time not strictly
+        increasing (the row named), neither torque nor current, or current without a positive
+        torque constant.
+
+    See Also
+    --------
+    fricid.io.read_rawlog, fricid.io.write_rawlog : the log as a CSV or Parquet table.
+
+    Examples
+    --------
+    >>> log = RawLog(time=[0.0, 0.1], position=[0.0, 0.01], velocity=0.1, temperature=25.0,
+    ...              torque=[0.2, 0.21])
+    >>> len(log), float(log.motor_torque[1])
+    (2, 0.21)
     """
 
     time: np.ndarray
@@ -121,13 +160,25 @@ class RawLog:
 
     @property
     def motor_torque(self) -> np.ndarray:
-        """Motor torque [N m]: the logged torque, else K times the current (eq. 13)."""
+        """ndarray, shape (n,): motor torque [N m], the logged torque, else K times the
+        current (eq. 13 of the BAS-RBFNN paper)."""
         if self.torque is not None:
             return self.torque
         return self.current * float(self.torque_constant)
 
     def slice(self, start: int, stop: int) -> RawLog:
-        """Rows ``start:stop`` as a new log (views, no copy)."""
+        """Rows ``start:stop`` as a new log.
+
+        Parameters
+        ----------
+        start, stop : int
+            The rows, as in ``array[start:stop]``.
+
+        Returns
+        -------
+        RawLog
+            The rows, as views of this log's columns (no copy).
+        """
         s = np.s_[start:stop]
         return replace(
             self,
@@ -141,7 +192,24 @@ class RawLog:
 
     @staticmethod
     def concatenate(logs: list[RawLog]) -> RawLog:
-        """Join logs end to end (same joint, same kind of effort column)."""
+        """Join logs end to end.
+
+        Parameters
+        ----------
+        logs : list of RawLog
+            Logs of the same joint in time order; a torque (or current) column is kept only
+            if every log has one.
+
+        Returns
+        -------
+        RawLog
+            The rows of all logs; names, torque constant and ``meta`` from the first.
+
+        Raises
+        ------
+        DataError
+            No logs, or time that does not increase across a junction.
+        """
         if not logs:
             raise DataError("no logs to concatenate")
         first = logs[0]
@@ -167,13 +235,49 @@ class RawLog:
 class FrictionSamples:
     """Friction at operating points: one row per (velocity, load, temperature, direction).
 
-    ``direction`` is +1 or -1 for a sample measured in one direction of motion (velocity and
-    friction then carry that sign), or 0 when both directions were combined by eq. 11 of the
-    BAS-RBFNN paper (velocity and friction are then the positive-direction values).
-    ``count`` is the number of raw samples averaged and ``std`` their standard deviation [N m].
-
     The model input matrix is :attr:`X`, columns (velocity, load, temperature); the target is
-    :attr:`friction`.
+    :attr:`friction`. The columns are checked on construction and the object is frozen.
+
+    Parameters
+    ----------
+    velocity : array_like, shape (n,)
+        Joint velocity [rad/s], n >= 1.
+    load : array_like, shape (n,) or scalar
+        Load torque [N m] (eq. 7 of the BAS-RBFNN paper: the gravity torque of the link).
+    temperature : array_like, shape (n,) or scalar
+        Temperature [degC].
+    friction : array_like, shape (n,)
+        Friction torque [N m].
+    direction : array_like of {-1, 0, 1}, shape (n,), optional
+        +1 or -1 for a sample measured in one direction of motion (velocity and friction
+        then carry that sign), 0 when both directions were combined by eq. 11 of the
+        BAS-RBFNN paper (velocity and friction are then the positive-direction values).
+        Default: the sign of ``velocity``.
+    count : array_like of int, shape (n,), optional
+        The number of raw samples averaged into each row, >= 1 (default 1).
+    std : array_like, shape (n,), optional
+        Their standard deviation [N m], >= 0 (default 0).
+    source : str, optional
+        Where the samples came from (a file name), for messages and provenance.
+    meta : mapping, optional
+        Anything else worth keeping (copied).
+
+    Raises
+    ------
+    DataError
+        No rows, a column of the wrong shape or length, a non-finite value, a direction
+        other than -1, 0, +1, a count below 1 or a negative std (the row and column named).
+
+    See Also
+    --------
+    fricid.io.read_samples, fricid.io.write_samples : samples as a CSV or Parquet table.
+
+    Examples
+    --------
+    >>> s = FrictionSamples(velocity=[-0.1, 0.1], load=0.0, temperature=25.0,
+    ...                     friction=[-0.3, 0.3])
+    >>> s.directions(), s.X.shape
+    ((-1, 1), (2, 3))
     """
 
     velocity: np.ndarray
@@ -230,16 +334,33 @@ class FrictionSamples:
 
     @property
     def X(self) -> np.ndarray:
-        """Model inputs, shape (n, 3): velocity [rad/s], load [N m], temperature [degC]."""
+        """ndarray, shape (n, 3): the model inputs, columns velocity [rad/s], load [N m],
+        temperature [degC]."""
         return np.column_stack([self.velocity, self.load, self.temperature])
 
     @property
     def y(self) -> np.ndarray:
-        """Model target: friction [N m]."""
+        """ndarray, shape (n,): the model target, friction [N m]."""
         return self.friction
 
-    def subset(self, mask) -> FrictionSamples:
-        """The rows selected by a boolean mask or an index array."""
+    def subset(self, mask: Any) -> FrictionSamples:
+        """The rows selected by a boolean mask or an index array.
+
+        Parameters
+        ----------
+        mask : array_like of bool or int
+            A boolean mask of length n, or row indices.
+
+        Returns
+        -------
+        FrictionSamples
+            The selected rows; ``source`` and ``meta`` kept.
+
+        Raises
+        ------
+        DataError
+            The selection is empty.
+        """
         idx = np.asarray(mask)
         return replace(
             self,
@@ -253,18 +374,46 @@ class FrictionSamples:
         )
 
     def directions(self) -> tuple[int, ...]:
-        """The distinct directions present, sorted."""
+        """The distinct directions present.
+
+        Returns
+        -------
+        tuple of int
+            Sorted, a subset of ``(-1, 0, 1)``.
+        """
         return tuple(int(d) for d in np.unique(self.direction))
 
-    def to_frame(self):
-        """A pandas DataFrame with the columns of :data:`SAMPLE_COLUMNS`."""
+    def to_frame(self) -> Any:
+        """The samples as a table.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One column per key of :data:`SAMPLE_COLUMNS`, SI units.
+        """
         import pandas as pd
 
         return pd.DataFrame({name: getattr(self, name) for name in SAMPLE_COLUMNS})
 
     @classmethod
     def concatenate(cls, parts: list[FrictionSamples]) -> FrictionSamples:
-        """Stack sample tables (metadata from the first)."""
+        """Stack sample tables.
+
+        Parameters
+        ----------
+        parts : list of FrictionSamples
+            The tables, stacked in order.
+
+        Returns
+        -------
+        FrictionSamples
+            All rows; ``source`` and ``meta`` from the first table.
+
+        Raises
+        ------
+        DataError
+            No tables.
+        """
         if not parts:
             raise DataError("no samples to concatenate")
         cols = {name: np.concatenate([getattr(p, name) for p in parts]) for name in SAMPLE_COLUMNS}
@@ -272,7 +421,19 @@ class FrictionSamples:
 
 
 def samples_hash(samples: FrictionSamples) -> str:
-    """A short content hash of the samples (for provenance and caching)."""
+    """A short content hash of the samples, for provenance and caching.
+
+    Parameters
+    ----------
+    samples : FrictionSamples
+        The samples.
+
+    Returns
+    -------
+    str
+        16 hexadecimal digits of the SHA-256 of velocity, load, temperature, friction and
+        direction (not count, std, source or meta).
+    """
     h = hashlib.sha256()
     for a in (
         samples.velocity,

@@ -22,21 +22,60 @@ _DIMENSIONLESS = ("", "1", "-")
 
 @dataclass(frozen=True)
 class Column:
-    """A column found in a file: its label as written, its unit and its quantity."""
+    """A column found in a file.
+
+    Parameters
+    ----------
+    label : str
+        The label as written in the file, e.g. ``"velocity [deg/s]"``.
+    unit : str or None
+        Its unit, None for a dimensionless column.
+    quantity : str or None
+        Its quantity (a key of :data:`fricid.units.UNITS`), None for a dimensionless column.
+    """
 
     label: str
     unit: str | None
     quantity: str | None  # None: dimensionless
 
     def to_si(self, values: np.ndarray) -> np.ndarray:
-        """``values`` converted from this column's unit to SI."""
+        """Convert values from this column's unit to SI.
+
+        Parameters
+        ----------
+        values : ndarray
+            The column as read.
+
+        Returns
+        -------
+        ndarray
+            The values in SI units; ``values`` itself for a dimensionless column.
+        """
         if self.quantity is None or self.unit is None:
             return values
         return np.asarray(to_si(values, self.unit, self.quantity), dtype=float)
 
 
 def split_label(label: str) -> tuple[str, str | None]:
-    """``"velocity [deg/s]"`` -> ``("velocity", "deg/s")``; ``"count"`` -> ``("count", None)``."""
+    """Split a column label into its name and its unit.
+
+    Parameters
+    ----------
+    label : str
+        A label such as ``"velocity [deg/s]"`` or ``"count"``.
+
+    Returns
+    -------
+    name : str
+        The name, stripped.
+    unit : str or None
+        The unit in brackets, stripped; None when there are no brackets.
+
+    Examples
+    --------
+    >>> split_label("velocity [deg/s]"), split_label("count")
+    (('velocity', 'deg/s'), ('count', None))
+    """
     m = _LABEL.match(label)
     if m is None:
         return label.strip(), None
@@ -47,7 +86,24 @@ def split_label(label: str) -> tuple[str, str | None]:
 def check_unit(
     unit: str, quantity: str, *, file: str | os.PathLike[str] | None, column: str
 ) -> None:
-    """Raise :class:`DataError` unless ``unit`` is a known spelling for ``quantity``."""
+    """Check that a column's unit is a known spelling for its quantity.
+
+    Parameters
+    ----------
+    unit : str
+        The unit as written.
+    quantity : str
+        A key of :data:`fricid.units.UNITS`.
+    file : str or os.PathLike or None
+        The file (for messages).
+    column : str
+        The column's label (for messages).
+
+    Raises
+    ------
+    DataError
+        An unknown unit; the message lists the accepted spellings.
+    """
     if unit.strip() not in UNITS[quantity]:
         raise DataError(
             f"unknown {quantity} unit '{unit}'; use one of: {', '.join(UNITS[quantity])}",
@@ -64,12 +120,35 @@ def resolve_columns(
     file: str | os.PathLike[str],
     units: Mapping[str, str] | None = None,
 ) -> dict[str, Column]:
-    """Match file columns to a schema ``{name: quantity or None}`` and check their units.
+    """Match a file's columns to a schema and check their units.
 
     Columns may come in any order; names are case-insensitive; columns not in the schema are
     ignored. A unit comes from the label (``"velocity [deg/s]"``) or, failing that, from
-    ``units`` (Parquet schema metadata). Raises :class:`DataError` naming the file and column
-    for a missing required column, a duplicate, a missing or unknown unit.
+    ``units`` (Parquet schema metadata).
+
+    Parameters
+    ----------
+    labels : list of str
+        The file's column labels, in file order.
+    schema : mapping of str to str or None
+        Column name -> its quantity, None for a dimensionless column.
+    required : tuple of str
+        The names that must be present.
+    file : str or os.PathLike
+        The file (for messages).
+    units : mapping of str to str, optional
+        Column name -> unit, for labels without one.
+
+    Returns
+    -------
+    dict of str to Column
+        The columns found, by lower-case name.
+
+    Raises
+    ------
+    DataError
+        A missing required column, a duplicate, a unit on a dimensionless column, a missing
+        or unknown unit; the file and column named.
     """
     found: dict[str, Column] = {}
     for label in labels:

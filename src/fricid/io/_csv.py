@@ -1,4 +1,5 @@
-"""CSV machinery shared by the readers: the preamble, fast numeric reading, error location.
+"""CSV machinery shared by the readers and writers: the preamble, fast numeric reading, error
+location, streamed atomic writing.
 
 The normal path is pyarrow's multi-threaded CSV reader (no Python loop per row). Only when it
 fails, or finds a NaN or infinity, does :func:`locate_bad_value` walk the file with the
@@ -10,25 +11,32 @@ from __future__ import annotations
 import csv
 import math
 import os
-from collections.abc import Iterable, Iterator
+from collections.abc import Iterable, Iterator, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pyarrow as pa
 import pyarrow.csv as pacsv
 
 from ..errors import DataError
+from ..units import SI_UNITS
 from ._columns import split_label
+from ._meta import dumps_meta, encode_text
+from .atomic import atomic_write
 
 __all__ = [
     "Preamble",
+    "csv_preamble",
     "iter_numeric",
     "locate_bad_value",
+    "preamble_fields",
     "read_numeric",
     "read_preamble",
     "rechunk",
     "record_line",
+    "write_csv",
 ]
 
 #: Bytes pyarrow parses at a time when streaming (about 13 k rows of a raw log). With its
@@ -43,12 +51,17 @@ class Preamble:
 
     Attributes
     ----------
-    path : the file.
-    comments : ``{name: (unit or None, value text)}`` from leading ``# name [unit]: value``
-        lines, names lower-cased.
-    labels : the column labels of the header line, as written.
-    header_line : 1-based line number of the header.
-    header_offset : byte offset of the header line.
+    path : pathlib.Path
+        The file.
+    labels : list of str
+        The column labels of the header line, as written.
+    header_line : int
+        1-based line number of the header.
+    header_offset : int
+        Byte offset of the header line.
+    comments : dict of str to tuple of (str or None, str)
+        ``{name: (unit or None, value text)}`` from leading ``# name [unit]: value`` lines,
+        names lower-cased.
     """
 
     path: Path
@@ -59,6 +72,7 @@ class Preamble:
 
 
 def _decode(raw: bytes, path: Path, line: int) -> str:
+    """One line as UTF-8 text; anything else is a :class:`DataError` naming the line."""
     try:
         return raw.decode("utf-8")
     except UnicodeDecodeError as exc:
@@ -66,10 +80,24 @@ def _decode(raw: bytes, path: Path, line: int) -> str:
 
 
 def read_preamble(path: str | os.PathLike[str]) -> Preamble:
-    """Read leading ``#`` comment lines and the header line of a CSV file.
+    """Read the leading ``#`` comment lines and the header line of a CSV file.
 
-    Blank lines before the header are skipped. Raises :class:`DataError` for an empty file or
-    one with no header line.
+    Blank lines before the header are skipped; a UTF-8 byte-order mark is ignored.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The CSV file.
+
+    Returns
+    -------
+    Preamble
+        The comments, the header's labels and where the header is.
+
+    Raises
+    ------
+    DataError
+        An empty file, no header line, or text that is not UTF-8 (the line named).
     """
     path = Path(path)
     comments: dict[str, tuple[str | None, str]] = {}
@@ -98,6 +126,7 @@ def read_preamble(path: str | os.PathLike[str]) -> Preamble:
 
 
 def _convert_options(labels: list[str]) -> pacsv.ConvertOptions:
+    """pyarrow's options to read ``labels`` as float64 with no null values."""
     return pacsv.ConvertOptions(
         column_types={label: pa.float64() for label in labels},
         include_columns=labels,
@@ -119,10 +148,22 @@ def _parse_float(text: str) -> float | None:
 
 
 def locate_bad_value(pre: Preamble, labels: list[str], start: int = 0) -> DataError | None:
-    """The first malformed row, non-numeric or non-finite value in ``labels``, or None.
+    """Find the first malformed row, non-numeric or non-finite value in some columns.
 
-    Records before ``start`` (0-based) are known to be good and only counted. The error names
-    the file, the 1-based line number and the column label.
+    Parameters
+    ----------
+    pre : Preamble
+        The file's preamble.
+    labels : list of str
+        The columns to check.
+    start : int, default 0
+        Records (0-based) before this one are known to be good and are only counted.
+
+    Returns
+    -------
+    DataError or None
+        The error, naming the file, the 1-based line number and the column label; None when
+        every value is a finite number.
     """
     index = {label: pre.labels.index(label) for label in labels}
     wanted = sorted(index.items(), key=lambda item: item[1])
@@ -164,7 +205,20 @@ def locate_bad_value(pre: Preamble, labels: list[str], start: int = 0) -> DataEr
 
 
 def record_line(pre: Preamble, record: int) -> int | None:
-    """The 1-based line number of data record ``record`` (0-based), or None past the end."""
+    """The line a data record is on.
+
+    Parameters
+    ----------
+    pre : Preamble
+        The file's preamble.
+    record : int
+        0-based index of a data record (blank lines do not count).
+
+    Returns
+    -------
+    int or None
+        Its 1-based line number in the file, or None past the end.
+    """
     with open(pre.path, encoding="utf-8", errors="replace", newline="") as fh:
         for _ in range(pre.header_line):
             fh.readline()
@@ -179,6 +233,7 @@ def record_line(pre: Preamble, record: int) -> int | None:
 
 
 def _fail(pre: Preamble, labels: list[str], exc: Exception, start: int = 0) -> DataError:
+    """The error to raise for a failed read: the located bad value, else ``exc`` as text."""
     located = locate_bad_value(pre, labels, start)
     if located is not None:
         return located
@@ -188,13 +243,32 @@ def _fail(pre: Preamble, labels: list[str], exc: Exception, start: int = 0) -> D
 def _check_finite(
     pre: Preamble, labels: list[str], columns: dict[str, np.ndarray], start: int = 0
 ) -> None:
+    """Raise the located :class:`DataError` if any value in ``columns`` is not finite."""
     if all(np.isfinite(values).all() for values in columns.values()):
         return
     raise _fail(pre, labels, ValueError("non-finite value"), start)
 
 
 def read_numeric(pre: Preamble, labels: list[str]) -> dict[str, np.ndarray]:
-    """All rows of the columns ``labels`` as float64 arrays (finite, else DataError)."""
+    """Read whole columns of a CSV file.
+
+    Parameters
+    ----------
+    pre : Preamble
+        The file's preamble.
+    labels : list of str
+        The columns to read, as labelled in the header.
+
+    Returns
+    -------
+    dict of str to ndarray
+        Label -> float64 array of every row.
+
+    Raises
+    ------
+    DataError
+        A malformed row, a non-numeric or non-finite value (line and column named).
+    """
     try:
         with pa.OSFile(str(pre.path)) as fh:
             fh.seek(pre.header_offset)
@@ -207,7 +281,20 @@ def read_numeric(pre: Preamble, labels: list[str]) -> dict[str, np.ndarray]:
 
 
 def rechunk(batches: Iterable[pa.RecordBatch], rows: int) -> Iterator[pa.Table]:
-    """Regroup record batches into tables of exactly ``rows`` rows (the last may be shorter)."""
+    """Regroup record batches into tables of a fixed number of rows.
+
+    Parameters
+    ----------
+    batches : iterable of pyarrow.RecordBatch
+        Batches of any sizes, with the same schema.
+    rows : int
+        Rows per table.
+
+    Yields
+    ------
+    pyarrow.Table
+        Tables of exactly ``rows`` rows; the last may be shorter.
+    """
     buffer: list[pa.RecordBatch] = []
     held = 0
     for batch in batches:
@@ -227,9 +314,30 @@ def rechunk(batches: Iterable[pa.RecordBatch], rows: int) -> Iterator[pa.Table]:
 def iter_numeric(
     pre: Preamble, labels: list[str], chunk_rows: int
 ) -> Iterator[tuple[int, dict[str, np.ndarray]]]:
-    """Stream ``(first record index, {label: float64 array})`` chunks of ``chunk_rows`` rows.
+    """Stream columns of a CSV file in chunks.
 
     Memory is bounded by a few chunks whatever the file size.
+
+    Parameters
+    ----------
+    pre : Preamble
+        The file's preamble.
+    labels : list of str
+        The columns to read.
+    chunk_rows : int
+        Rows per chunk.
+
+    Yields
+    ------
+    start : int
+        0-based index of the chunk's first record.
+    columns : dict of str to ndarray
+        Label -> float64 array of the chunk's rows.
+
+    Raises
+    ------
+    DataError
+        A malformed row, a non-numeric or non-finite value (line and column named).
     """
 
     def batches() -> Iterator[pa.RecordBatch]:
@@ -255,3 +363,89 @@ def iter_numeric(
         _check_finite(pre, labels, columns, start)
         yield start, columns
         start += table.num_rows
+
+
+# --------------------------------------------------------------------------- writing
+
+
+def preamble_fields(
+    fmt: str,
+    source: str | None,
+    joint: str | None,
+    torque_constant: float | None,
+    meta: Mapping[str, Any],
+) -> list[tuple[str, str]]:
+    """The ``# key: value`` comment lines of a fricid table file.
+
+    Parameters
+    ----------
+    fmt : str
+        The format tag, e.g. ``"fricid-rawlog/1"``.
+    source, joint : str or None
+        Written through :func:`~fricid.io._meta.encode_text` when given.
+    torque_constant : float or None
+        K [N m/A], written with its unit when given.
+    meta : mapping
+        Free-form metadata, written as one line of JSON.
+
+    Returns
+    -------
+    list of tuple of (str, str)
+        ``(key, value text)`` in the order written.
+    """
+    fields = [("format", fmt)]
+    if source is not None:
+        fields.append(("source", encode_text(str(source))))
+    if joint is not None:
+        fields.append(("joint", encode_text(str(joint))))
+    if torque_constant is not None:
+        key = f"torque_constant [{SI_UNITS['torque_constant']}]"
+        fields.append((key, repr(float(torque_constant))))
+    fields.append(("meta", dumps_meta(meta)))
+    return fields
+
+
+def csv_preamble(fields: list[tuple[str, str]], units: Mapping[str, str]) -> bytes:
+    """The comment lines and the header line of a CSV file.
+
+    Parameters
+    ----------
+    fields : list of tuple of (str, str)
+        ``(key, value text)`` comment lines (:func:`preamble_fields`).
+    units : mapping of str to str
+        Column -> unit, in column order; unit ``"1"`` means dimensionless (no brackets).
+
+    Returns
+    -------
+    bytes
+        UTF-8 text ending in a newline, e.g. ``# format: ...`` then ``time [s],...``.
+    """
+    lines = [f"# {key}: {value}" for key, value in fields]
+    lines.append(
+        ",".join(name if unit == "1" else f"{name} [{unit}]" for name, unit in units.items())
+    )
+    return ("\n".join(lines) + "\n").encode("utf-8")
+
+
+def write_csv(path: Path, preamble: bytes, tables: Iterable[pa.Table]) -> None:
+    """Write a CSV file atomically, table by table.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The file; nothing is left there if writing fails part-way.
+    preamble : bytes
+        The comment and header lines (:func:`csv_preamble`).
+    tables : iterable of pyarrow.Table
+        The rows, in order, all with the same columns (streamed: one in memory at a time).
+    """
+    options = pacsv.WriteOptions(include_header=False)
+    with atomic_write(path, "wb") as fh:
+        fh.write(preamble)
+        writer = None
+        for table in tables:
+            if writer is None:
+                writer = pacsv.CSVWriter(fh, table.schema, write_options=options)
+            writer.write_table(table)
+        if writer is not None:
+            writer.close()

@@ -21,7 +21,24 @@ __all__ = ["decode_text", "dumps_meta", "encode_text", "loads_meta"]
 
 
 def encode_text(value: str) -> str:
-    """A comment value: ``value`` itself when unambiguous, else a JSON string literal."""
+    """A string as the value of a ``# key: value`` comment line.
+
+    Parameters
+    ----------
+    value : str
+        Any string.
+
+    Returns
+    -------
+    str
+        ``value`` itself when unambiguous (non-empty, printable, no surrounding blanks, not
+        starting with a double quote), else its JSON string literal (ASCII only).
+
+    Examples
+    --------
+    >>> encode_text("paper1"), encode_text("two\\nlines")
+    ('paper1', '"two\\\\nlines"')
+    """
     plain = (
         value != "" and value == value.strip() and value.isprintable() and not value.startswith('"')
     )
@@ -29,7 +46,27 @@ def encode_text(value: str) -> str:
 
 
 def decode_text(text: str, *, file: str | os.PathLike[str], key: str) -> str:
-    """Inverse of :func:`encode_text` (``text`` already stripped of surrounding blanks)."""
+    """The string a comment value stands for: the inverse of :func:`encode_text`.
+
+    Parameters
+    ----------
+    text : str
+        The value, already stripped of surrounding blanks.
+    file : str or os.PathLike
+        The file it was read from (for messages).
+    key : str
+        The metadata key (for messages).
+
+    Returns
+    -------
+    str
+        ``text`` itself, or the string its JSON literal encodes when it starts with ``"``.
+
+    Raises
+    ------
+    DataError
+        A quoted value that is not a valid JSON string.
+    """
     if not text.startswith('"'):
         return text
     try:
@@ -44,6 +81,7 @@ def decode_text(text: str, *, file: str | os.PathLike[str], key: str) -> str:
 
 
 def _default(obj: Any) -> Any:
+    """JSON for what :mod:`json` does not know: numpy scalars and arrays, paths."""
     if isinstance(obj, np.generic):
         return obj.item()
     if isinstance(obj, np.ndarray):
@@ -54,7 +92,24 @@ def _default(obj: Any) -> Any:
 
 
 def dumps_meta(meta: Mapping[str, Any]) -> str:
-    """Free-form metadata as one line of JSON (numpy values become plain numbers)."""
+    """Free-form metadata as one line of JSON.
+
+    Parameters
+    ----------
+    meta : mapping
+        JSON-serialisable values; numpy scalars and arrays become plain numbers and lists,
+        paths become strings.
+
+    Returns
+    -------
+    str
+        One line: readable unicode where every character is printable, else ASCII escapes.
+
+    Raises
+    ------
+    ConfigError
+        A value that cannot be written as JSON.
+    """
     try:
         text = json.dumps(dict(meta), ensure_ascii=False, default=_default)
     except (TypeError, ValueError) as exc:
@@ -66,7 +121,25 @@ def dumps_meta(meta: Mapping[str, Any]) -> str:
 
 
 def loads_meta(text: str, *, file: str | os.PathLike[str]) -> dict[str, Any]:
-    """Parse the free-form metadata written by :func:`dumps_meta`."""
+    """Parse the free-form metadata written by :func:`dumps_meta`.
+
+    Parameters
+    ----------
+    text : str
+        One line of JSON.
+    file : str or os.PathLike
+        The file it was read from (for messages).
+
+    Returns
+    -------
+    dict
+        The metadata.
+
+    Raises
+    ------
+    DataError
+        Invalid JSON, or JSON that is not an object.
+    """
     try:
         meta = json.loads(text)
     except json.JSONDecodeError as exc:

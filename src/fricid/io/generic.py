@@ -24,6 +24,8 @@ _QUANTITIES = ("time", "position", "velocity", "torque", "current", "temperature
 def _check_mapping(
     columns: Mapping[str, str], units: Mapping[str, str], temperature: float | None
 ) -> None:
+    """Check that the mapping names known quantities, the required ones, and one source of
+    temperature; a :class:`ConfigError` otherwise."""
     unknown = [q for q in columns if q not in _QUANTITIES]
     if unknown:
         raise ConfigError(
@@ -66,6 +68,7 @@ def _unit(quantity: str, label: str, units: Mapping[str, str]) -> str:
 
 
 def _integrate(time: np.ndarray, velocity: np.ndarray) -> np.ndarray:
+    """Position [rad] as the trapezoidal integral of velocity, starting at 0."""
     steps = 0.5 * (velocity[1:] + velocity[:-1]) * np.diff(time)
     return np.concatenate([[0.0], np.cumsum(steps)])
 
@@ -83,16 +86,22 @@ def read_table_log(
 
     Parameters
     ----------
-    path : ``.csv`` (comma-separated, header line, optional leading ``#`` lines) or
-        ``.parquet`` / ``.pq``.
-    columns : quantity -> column name in the file. Quantities: time and velocity (required),
+    path : str or os.PathLike
+        A ``.csv`` file (comma-separated, a header line, optional leading ``#`` lines) or a
+        ``.parquet`` / ``.pq`` file.
+    columns : mapping of str to str
+        Quantity -> column name in the file. Quantities: time and velocity (required),
         torque or current (one required), position and temperature (optional), e.g.
         ``{"time": "t", "position": "q", "velocity": "dq", "torque": "tau"}``.
-    units : quantity -> unit, e.g. ``{"velocity": "deg/s"}``. A unit may instead be written in
+    units : mapping of str to str, optional
+        Quantity -> unit, e.g. ``{"velocity": "deg/s"}``. A unit may instead be written in
         the column name (``"dq [deg/s]"``); every mapped column needs one or the other.
-    torque_constant : K [N m/A] for a current column (tau = K I, eq. 13 of the BAS-RBFNN paper).
-    temperature : constant temperature [degC] when the file has no temperature column.
-    joint : name for the log.
+    torque_constant : float, optional
+        K [N m/A] for a current column (tau = K I, eq. 13 of the BAS-RBFNN paper).
+    temperature : float, optional
+        Constant temperature [degC] when the file has no temperature column.
+    joint : str, default "joint"
+        The joint's name in the log.
 
     Returns
     -------
@@ -108,6 +117,19 @@ def read_table_log(
     DataError
         A mapped column missing from the file (listing the file's columns), a non-numeric or
         non-finite value (file, line, column), time not increasing.
+
+    See Also
+    --------
+    fricid.io.read_rawlog : fricid's own raw-log tables, whose columns need no mapping.
+
+    Examples
+    --------
+    >>> log = read_table_log(  # doctest: +SKIP
+    ...     "vendor.csv",
+    ...     {"time": "t", "velocity": "dq", "torque": "tau"},
+    ...     {"time": "ms", "velocity": "deg/s", "torque": "N m"},
+    ...     temperature=25.0,
+    ... )
     """
     path = Path(path)
     columns = dict(columns)

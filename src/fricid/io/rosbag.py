@@ -25,9 +25,8 @@ Large bags are read in chunks with :func:`iter_rosbag` (memory bounded by ``chun
 from __future__ import annotations
 
 import os
-import struct
 from collections.abc import Iterator
-from contextlib import contextmanager
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -36,6 +35,16 @@ import numpy as np
 from ..errors import ConfigError, DataError
 from ..samples import RawLog
 from ..units import SI_UNITS, UNITS, to_si
+from ._bag import (
+    JOINT_STATE,
+    TEMPERATURE,
+    interp_temperature,
+    messages,
+    open_bag,
+    stamp_ns,
+    temperature_series,
+    topic_connections,
+)
 
 __all__ = [
     "JOINT_STATE",
@@ -46,155 +55,78 @@ __all__ = [
     "rosbag_topics",
 ]
 
-#: The message types read.
-JOINT_STATE = "sensor_msgs/msg/JointState"
-TEMPERATURE = "sensor_msgs/msg/Temperature"
 
 _TIME_SOURCES = ("auto", "header", "receive")
 _EFFORTS = {"torque": "torque", "current": "current"}
 
 
-def _bag_errors() -> tuple[type[BaseException], ...]:
-    """Exceptions that mean the bag itself is unreadable, truncated or corrupt."""
-    from rosbags.highlevel import AnyReaderError
-    from rosbags.rosbag1 import ReaderError as ReaderError1
-    from rosbags.rosbag2 import ReaderError as ReaderError2
-    from rosbags.serde import SerdeError
-
-    errors: list[type[BaseException]] = [
-        AnyReaderError,
-        ReaderError1,
-        ReaderError2,
-        SerdeError,
-        struct.error,
-        EOFError,
-        OverflowError,
-        UnicodeError,
-    ]
-    try:
-        import apsw  # the SQLite driver of rosbags (.db3 storage)
-
-        errors.append(apsw.Error)
-    except ImportError:  # pragma: no cover - a rosbags without SQLite support
-        pass
-    return tuple(errors)
-
-
-@contextmanager
-def _open(path: Path) -> Iterator[Any]:
-    """An open ``AnyReader``; an unreadable bag is a :class:`DataError` naming it."""
-    from rosbags.highlevel import AnyReader
-    from rosbags.typesys import Stores, get_typestore
-
-    if not path.exists():
-        raise DataError("no such bag (a rosbag2 directory, .mcap, .db3 or .bag file)", file=path)
-    errors = _bag_errors()
-    try:
-        reader = AnyReader([path], default_typestore=get_typestore(Stores.LATEST))
-        reader.open()
-    except errors as exc:
-        raise DataError(_unreadable(exc), file=path) from None
-    try:
-        yield reader
-    finally:
-        reader.close()
-
-
-def _unreadable(exc: BaseException) -> str:
-    detail = " ".join(str(exc).split()) or type(exc).__name__
-    return (
-        f"unreadable or truncated bag ({detail}); a recording that was cut off can often be "
-        "repaired with `ros2 bag reindex`"
-    )
-
-
-def _messages(reader: Any, connections: list[Any], path: Path) -> Iterator[tuple[int, Any]]:
-    """``(receive time [ns], message)`` of ``connections``, corrupt data as DataError."""
-    errors = _bag_errors()
-    stream = reader.messages(connections=connections)
-    while True:
-        try:
-            item = next(stream, None)
-            if item is None:
-                return
-            connection, stamp, raw = item
-            msg = reader.deserialize(raw, connection.msgtype)
-        except errors as exc:
-            raise DataError(_unreadable(exc), file=path) from None
-        yield stamp, msg
-
-
-def _topic_connections(reader: Any, topic: str, msgtype: str, path: Path, what: str) -> list:
-    conns = [c for c in reader.connections if c.topic == topic]
-    if not conns:
-        present = ", ".join(
-            f"{c.topic} ({c.msgtype})" for c in sorted(reader.connections, key=lambda c: c.topic)
-        )
-        raise DataError(
-            f"no {what} topic '{topic}' in the bag; its topics: {present or 'none'}", file=path
-        )
-    wrong = {c.msgtype for c in conns if c.msgtype != msgtype}
-    if wrong:
-        raise DataError(
-            f"topic '{topic}' carries {', '.join(sorted(wrong))}, not {msgtype}", file=path
-        )
-    return conns
-
-
 def rosbag_topics(path: str | os.PathLike[str]) -> dict[str, str]:
-    """Topics of a bag and their message types."""
+    """List the topics of a bag.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        A rosbag2 directory, an ``.mcap`` or ``.db3`` file, or a ROS 1 ``.bag``.
+
+    Returns
+    -------
+    dict of str to str
+        Topic -> message type, e.g. ``{"/joint_states": "sensor_msgs/msg/JointState"}``.
+
+    Raises
+    ------
+    DataError
+        A missing, unreadable or truncated bag.
+    """
     path = Path(path)
-    with _open(path) as reader:
+    with open_bag(path) as reader:
         return {c.topic: c.msgtype for c in reader.connections}
 
 
 def rosbag_joints(path: str | os.PathLike[str], topic: str = "/joint_states") -> list[str]:
-    """The joint names found on a ``JointState`` topic, in order of first appearance."""
+    """List the joints named on a ``JointState`` topic.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        A rosbag2 directory, an ``.mcap`` or ``.db3`` file, or a ROS 1 ``.bag``.
+    topic : str, default "/joint_states"
+        A ``sensor_msgs/msg/JointState`` topic.
+
+    Returns
+    -------
+    list of str
+        The joint names, in order of first appearance.
+
+    Raises
+    ------
+    DataError
+        A missing, unreadable or corrupt bag; no such topic, or one of another type.
+    """
     path = Path(path)
     seen: dict[str, None] = {}
-    with _open(path) as reader:
-        conns = _topic_connections(reader, topic, JOINT_STATE, path, "joint-state")
-        for _stamp, msg in _messages(reader, conns, path):
+    with open_bag(path) as reader:
+        conns = topic_connections(reader, topic, JOINT_STATE, path, "joint-state")
+        for _stamp, msg in messages(reader, conns, path):
             seen.update(dict.fromkeys(msg.name))
     return list(seen)
 
 
-def _stamp_ns(msg: Any) -> int:
-    return int(msg.header.stamp.sec) * 1_000_000_000 + int(msg.header.stamp.nanosec)
+@dataclass(frozen=True)
+class _Options:
+    """The reading options of :func:`iter_rosbag`, checked (``unit``: the effort's unit)."""
 
-
-def _temperature_series(reader: Any, topic: str, path: Path) -> dict[str, np.ndarray]:
-    """Readings of a temperature topic: header stamps and receive times [ns], values [degC]."""
-    conns = _topic_connections(reader, topic, TEMPERATURE, path, "temperature")
-    header, receive, values = [], [], []
-    for stamp, msg in _messages(reader, conns, path):
-        header.append(_stamp_ns(msg))
-        receive.append(stamp)
-        values.append(float(msg.temperature))
-    if not values:
-        raise DataError(f"temperature topic '{topic}' has no messages", file=path)
-    v = np.asarray(values, dtype=float)
-    bad = np.flatnonzero(~np.isfinite(v))
-    if bad.size:
-        raise DataError(
-            f"temperature message {int(bad[0])} on '{topic}' is not finite ({v[bad[0]]!r})",
-            file=path,
-            row=int(bad[0]),
-            column="temperature",
-        )
-    return {
-        "header": np.asarray(header, dtype=np.int64),
-        "receive": np.asarray(receive, dtype=np.int64),
-        "value": v,
-    }
-
-
-def _interp_temperature(
-    series: dict[str, np.ndarray], key: str, t_ns: np.ndarray, origin: int
-) -> np.ndarray:
-    order = np.argsort(series[key], kind="stable")
-    t = (series[key][order] - origin) * 1e-9
-    return np.interp((t_ns - origin) * 1e-9, t, series["value"][order])
+    joint: str
+    topic: str
+    temperature_topic: str | None
+    temperature: float | None
+    effort: str
+    unit: str
+    torque_constant: float | None
+    position_unit: str
+    velocity_unit: str
+    time_source: str
+    chunk_rows: int
 
 
 def _check_options(
@@ -206,7 +138,7 @@ def _check_options(
     temperature: float | None,
     chunk_rows: int,
 ) -> str:
-    """Validate the options; return the effort unit."""
+    """Check the options (a :class:`ConfigError` naming the bad one); return the effort unit."""
     if effort not in _EFFORTS:
         raise ConfigError(f"effort must be one of: {', '.join(_EFFORTS)}; got '{effort}'")
     quantity = _EFFORTS[effort]
@@ -250,6 +182,7 @@ class _Chunk:
         self.n = 0
 
     def add(self, t: int, position: float, velocity: float, effort: float, index: int) -> None:
+        """Append one row: time [ns], position, velocity, effort, message index."""
         k = self.n
         self.time_ns[k] = t
         self.values[0, k] = position
@@ -260,6 +193,8 @@ class _Chunk:
 
 
 def _component(msg: Any, field: str, idx: int, joint: str, index: int, path: Path) -> float:
+    """The joint's value in one array of a ``JointState`` message (a DataError naming the
+    message if the array is empty or does not match ``name``)."""
     values = getattr(msg, field)
     if len(values) == 0:
         what = "effort (torque or current)" if field == "effort" else field
@@ -300,19 +235,31 @@ def iter_rosbag(
 
     Parameters
     ----------
-    path : a rosbag2 directory, an ``.mcap`` or ``.db3`` file, or a ROS 1 ``.bag``.
-    joint : the joint's name in ``JointState.name``.
-    topic : the ``sensor_msgs/msg/JointState`` topic.
-    temperature_topic : a ``sensor_msgs/msg/Temperature`` topic [degC], or None.
-    temperature : constant temperature [degC] when there is no temperature topic.
-    effort : ``"torque"`` (motor torque) or ``"current"`` (motor current, needs
-        ``torque_constant``).
-    effort_unit : unit of the effort values (default N m for torque, A for current).
-    torque_constant : K [N m/A] for ``effort="current"``.
-    position_unit, velocity_unit : units of position and velocity (ROS uses rad and rad/s,
-        REP 103; a driver that publishes degrees needs ``"deg"`` and ``"deg/s"``).
-    time_source : ``"auto"``, ``"header"`` or ``"receive"`` (module docstring).
-    chunk_rows : rows per chunk; memory is bounded by it whatever the bag's size.
+    path : str or os.PathLike
+        A rosbag2 directory, an ``.mcap`` or ``.db3`` file, or a ROS 1 ``.bag``.
+    joint : str
+        The joint's name in ``JointState.name``.
+    topic : str, default "/joint_states"
+        The ``sensor_msgs/msg/JointState`` topic.
+    temperature_topic : str, optional
+        A ``sensor_msgs/msg/Temperature`` topic [degC], interpolated to the joint's sample
+        times. Give it or ``temperature``, not both.
+    temperature : float, optional
+        Constant temperature [degC] when there is no temperature topic.
+    effort : {"torque", "current"}, default "torque"
+        What ``JointState.effort`` holds: the motor torque, or the motor current (which
+        needs ``torque_constant``).
+    effort_unit : str, optional
+        Unit of the effort values (default N m for torque, A for current).
+    torque_constant : float, optional
+        K [N m/A] for ``effort="current"`` (tau = K I, eq. 13 of the BAS-RBFNN paper).
+    position_unit, velocity_unit : str, default "rad", "rad/s"
+        Units of position and velocity (ROS uses rad and rad/s, REP 103; a driver that
+        publishes degrees needs ``"deg"`` and ``"deg/s"``).
+    time_source : {"auto", "header", "receive"}, default "auto"
+        Which time to use (module docstring).
+    chunk_rows : int, default 1000000
+        Rows per chunk; memory is bounded by it whatever the bag's size.
 
     Yields
     ------
@@ -346,48 +293,35 @@ def iter_rosbag(
             raise ConfigError(
                 f"unknown {quantity} unit '{u}'; use one of: {', '.join(UNITS[quantity])}"
             )
-    with _open(path) as reader:
-        conns = _topic_connections(reader, topic, JOINT_STATE, path, "joint-state")
-        yield from _read_chunks(
-            reader,
-            conns,
-            path,
-            joint,
-            topic,
-            temperature_topic,
-            temperature,
-            effort,
-            unit,
-            torque_constant,
-            position_unit,
-            velocity_unit,
-            time_source,
-            int(chunk_rows),
-        )
+    options = _Options(
+        joint=joint,
+        topic=topic,
+        temperature_topic=temperature_topic,
+        temperature=temperature,
+        effort=effort,
+        unit=unit,
+        torque_constant=torque_constant,
+        position_unit=position_unit,
+        velocity_unit=velocity_unit,
+        time_source=time_source,
+        chunk_rows=int(chunk_rows),
+    )
+    with open_bag(path) as reader:
+        conns = topic_connections(reader, topic, JOINT_STATE, path, "joint-state")
+        yield from _read_chunks(reader, conns, path, options)
 
 
-def _read_chunks(
-    reader,
-    conns,
-    path,
-    joint,
-    topic,
-    temperature_topic,
-    temperature,
-    effort,
-    unit,
-    torque_constant,
-    position_unit,
-    velocity_unit,
-    time_source,
-    chunk_rows,
-) -> Iterator[RawLog]:
+def _read_chunks(reader: Any, conns: list[Any], path: Path, opt: _Options) -> Iterator[RawLog]:
+    """The chunks of one joint's rows (see :func:`iter_rosbag`)."""
+    joint, topic, effort, unit = opt.joint, opt.topic, opt.effort, opt.unit
+    temperature_topic, temperature = opt.temperature_topic, opt.temperature
+    time_source, chunk_rows = opt.time_source, opt.chunk_rows
     names_seen: dict[str, None] = {}
     last_names: tuple[str, ...] | None = None
     idx: int | None = None
     use_header: bool | None = None if time_source == "auto" else time_source == "header"
     temps = (
-        None if temperature_topic is None else _temperature_series(reader, temperature_topic, path)
+        None if temperature_topic is None else temperature_series(reader, temperature_topic, path)
     )
     origin: int | None = None
     last_time: int | None = None
@@ -425,18 +359,18 @@ def _read_chunks(
         if temps is None:
             temp = np.full(chunk.n, float(temperature))
         else:
-            temp = _interp_temperature(temps, "header" if use_header else "receive", t_ns, origin)
+            temp = interp_temperature(temps, "header" if use_header else "receive", t_ns, origin)
         values = chunk.values[:, : chunk.n].copy()  # the buffer is reused for the next chunk
         eff = np.asarray(to_si(values[2], unit, _EFFORTS[effort]), dtype=float)
         try:
             log = RawLog(
                 time=time,
-                position=np.asarray(to_si(values[0], position_unit, "position"), dtype=float),
-                velocity=np.asarray(to_si(values[1], velocity_unit, "velocity"), dtype=float),
+                position=np.asarray(to_si(values[0], opt.position_unit, "position"), dtype=float),
+                velocity=np.asarray(to_si(values[1], opt.velocity_unit, "velocity"), dtype=float),
                 temperature=temp,
                 torque=eff if effort == "torque" else None,
                 current=eff if effort == "current" else None,
-                torque_constant=torque_constant,
+                torque_constant=opt.torque_constant,
                 joint=joint,
                 source=str(path),
                 meta={
@@ -451,7 +385,7 @@ def _read_chunks(
         return log
 
     index = -1
-    for stamp, msg in _messages(reader, conns, path):
+    for stamp, msg in messages(reader, conns, path):
         index += 1
         names = tuple(msg.name)
         if names != last_names:
@@ -461,8 +395,8 @@ def _read_chunks(
         if idx is None:
             continue
         if use_header is None:
-            use_header = _stamp_ns(msg) != 0
-        t = _stamp_ns(msg) if use_header else int(stamp)
+            use_header = stamp_ns(msg) != 0
+        t = stamp_ns(msg) if use_header else int(stamp)
         if origin is None:
             origin = t
         chunk.add(
@@ -488,10 +422,33 @@ def _read_chunks(
 
 
 def read_rosbag(path: str | os.PathLike[str], joint: str, **options: Any) -> RawLog:
-    """Read one joint of a bag as a whole :class:`RawLog` (options as :func:`iter_rosbag`).
+    """Read one joint of a bag as a whole :class:`RawLog`.
 
-    Example
+    Parameters
+    ----------
+    path : str or os.PathLike
+        A rosbag2 directory, an ``.mcap`` or ``.db3`` file, or a ROS 1 ``.bag``.
+    joint : str
+        The joint's name in ``JointState.name``.
+    **options
+        The keyword options of :func:`iter_rosbag`.
+
+    Returns
     -------
+    RawLog
+        The whole log, SI units.
+
+    Raises
+    ------
+    DataError, ConfigError
+        As :func:`iter_rosbag`.
+
+    See Also
+    --------
+    iter_rosbag : the same log in chunks, for bags larger than memory.
+
+    Examples
+    --------
     >>> log = read_rosbag("run1/", "elbow", temperature=25.0)  # doctest: +SKIP
     """
     chunks = list(iter_rosbag(path, joint, **options))

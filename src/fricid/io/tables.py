@@ -18,26 +18,18 @@ line number in a CSV, the 0-based record in Parquet) and the column. Writes are 
 from __future__ import annotations
 
 import itertools
-import json
 import os
-from collections.abc import Callable, Iterable, Iterator
-from dataclasses import dataclass, field
+from collections.abc import Iterable, Iterator
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 import pyarrow as pa
-import pyarrow.csv as pacsv
-import pyarrow.parquet as pq
 
 from ..errors import ConfigError, DataError
 from ..samples import RAWLOG_COLUMNS, SAMPLE_COLUMNS, FrictionSamples, RawLog
-from ..units import SI_UNITS, to_si
-from ._columns import Column, check_unit, resolve_columns
-from ._csv import iter_numeric, read_numeric, read_preamble, record_line
-from ._meta import decode_text, dumps_meta, encode_text, loads_meta
-from ._parquet import META_KEY, iter_columns, open_parquet, read_columns, schema_meta
-from .atomic import atomic_path, atomic_write
+from ._csv import csv_preamble, preamble_fields, write_csv
+from ._parquet import parquet_doc, write_parquet
+from ._tablefile import Opened, open_table, relocate, source_of, table_format
 
 __all__ = ["iter_rawlog", "read_rawlog", "read_samples", "write_rawlog", "write_samples"]
 
@@ -46,10 +38,6 @@ PathLike = str | os.PathLike[str]
 #: Format tags written to every file (CSV ``# format:`` line, Parquet metadata).
 SAMPLES_FORMAT = "fricid-samples/1"
 RAWLOG_FORMAT = "fricid-rawlog/1"
-
-#: Largest Parquet row group written: bounds the memory :func:`iter_rawlog` needs per group
-#: (5 float64 columns x 256 Ki rows = 10 MB).
-ROW_GROUP_ROWS = 1 << 18
 
 # column -> physical quantity for unit conversion (None: dimensionless)
 _SAMPLES_SCHEMA: dict[str, str | None] = {
@@ -66,151 +54,7 @@ _RAWLOG_SCHEMA: dict[str, str | None] = {name: name for name in RAWLOG_COLUMNS}
 _RAWLOG_REQUIRED = ("time", "position", "velocity", "temperature")
 
 
-def _format(path: PathLike) -> str:
-    suffix = Path(path).suffix.lower()
-    if suffix == ".csv":
-        return "csv"
-    if suffix in (".parquet", ".pq"):
-        return "parquet"
-    raise ConfigError(
-        f"cannot tell the file format of '{path}' from its suffix '{suffix}'; "
-        "use one of: .csv, .parquet, .pq"
-    )
-
-
 # --------------------------------------------------------------------------- reading
-
-
-@dataclass
-class _Info:
-    """Metadata found in a file."""
-
-    format: str | None = None
-    source: str | None = None
-    joint: str | None = None
-    torque_constant: float | None = None
-    meta: dict[str, Any] = field(default_factory=dict)
-
-
-@dataclass
-class _Opened:
-    """A table file opened for reading: resolved columns, metadata and data accessors."""
-
-    path: Path
-    columns: dict[str, Column]
-    info: _Info
-    read_all: Callable[[], dict[str, np.ndarray]]
-    iterate: Callable[[int], Iterator[tuple[int, dict[str, np.ndarray]]]]
-    to_row: Callable[[int], int | None]  # record index -> row number for messages
-
-    def si(self, raw: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
-        """File columns (keyed by label) to SI arrays keyed by column name."""
-        return {name: col.to_si(raw[col.label]) for name, col in self.columns.items()}
-
-
-def _csv_info(comments: dict[str, tuple[str | None, str]], path: Path) -> _Info:
-    info = _Info()
-    for key in ("format", "source", "joint"):
-        if key in comments:
-            setattr(info, key, decode_text(comments[key][1], file=path, key=key))
-    if "torque_constant" in comments:
-        unit, text = comments["torque_constant"]
-        unit = unit or SI_UNITS["torque_constant"]
-        check_unit(unit, "torque_constant", file=path, column="torque_constant")
-        try:
-            value = float(text)
-        except ValueError:
-            raise DataError(
-                f"metadata 'torque_constant' is not a number: {text!r}", file=path
-            ) from None
-        info.torque_constant = float(to_si(value, unit, "torque_constant"))
-    if "meta" in comments:
-        info.meta = loads_meta(comments["meta"][1], file=path)
-    return info
-
-
-def _parquet_info(doc: dict[str, Any], path: Path) -> _Info:
-    info = _Info(format=doc.get("format"), source=doc.get("source"), joint=doc.get("joint"))
-    k = doc.get("torque_constant")
-    if k is not None:
-        unit = doc.get("units", {}).get("torque_constant", SI_UNITS["torque_constant"])
-        check_unit(unit, "torque_constant", file=path, column="torque_constant")
-        info.torque_constant = float(to_si(float(k), unit, "torque_constant"))
-    meta = doc.get("meta", {})
-    if not isinstance(meta, dict):
-        raise DataError(f"metadata 'meta' must be a JSON object, got {meta!r}", file=path)
-    info.meta = meta
-    return info
-
-
-def _check_format(found: str | None, expected: str, path: Path) -> None:
-    if found is None or found == expected:
-        return
-    kind = found.split("/")[0]
-    if kind == expected.split("/")[0]:
-        raise DataError(
-            f"file format '{found}' is not supported by this fricid (reads '{expected}')",
-            file=path,
-        )
-    reader = {"fricid-samples": "read_samples", "fricid-rawlog": "read_rawlog"}.get(
-        kind, "another reader"
-    )
-    raise DataError(f"this is a '{found}' file, not '{expected}'; read it with {reader}", file=path)
-
-
-def _open(
-    path: PathLike, schema: dict[str, str | None], required: tuple[str, ...], expected: str
-) -> _Opened:
-    """Open a table file, check its format tag, resolve its columns against ``schema``."""
-    path = Path(path)
-    if _format(path) == "csv":
-        pre = read_preamble(path)
-        info = _csv_info(pre.comments, path)
-        _check_format(info.format, expected, path)
-        columns = resolve_columns(pre.labels, schema, required, file=path)
-        labels = [c.label for c in columns.values()]
-        return _Opened(
-            path,
-            columns,
-            info,
-            read_all=lambda: read_numeric(pre, labels),
-            iterate=lambda n: iter_numeric(pre, labels, n),
-            to_row=lambda record: record_line(pre, record),
-        )
-    pf = open_parquet(path)
-    doc = schema_meta(pf, path)
-    info = _parquet_info(doc, path)
-    _check_format(info.format, expected, path)
-    units = doc.get("units")
-    columns = resolve_columns(
-        pf.schema_arrow.names,
-        schema,
-        required,
-        file=path,
-        units=units if isinstance(units, dict) else None,
-    )
-    labels = [c.label for c in columns.values()]
-    return _Opened(
-        path,
-        columns,
-        info,
-        read_all=lambda: read_columns(pf, labels, path),
-        iterate=lambda n: iter_columns(pf, labels, path, n),
-        to_row=lambda record: record,
-    )
-
-
-def _source(info: _Info, path: Path) -> str:
-    """The source recorded in the file, else the file itself."""
-    return info.source if info.source is not None else str(path)
-
-
-def _relocate(err: DataError, opened: _Opened, first_record: int) -> DataError:
-    """Re-issue a validation error of the data types with this file's row and column."""
-    row = None if err.row is None else opened.to_row(first_record + err.row)
-    col = opened.columns.get(err.column) if err.column else None
-    column = col.label if col is not None else err.column
-    return DataError(err.message, file=opened.path, row=row, column=column)
 
 
 def read_samples(path: PathLike) -> FrictionSamples:
@@ -218,7 +62,8 @@ def read_samples(path: PathLike) -> FrictionSamples:
 
     Parameters
     ----------
-    path : ``.csv``, ``.parquet`` or ``.pq`` file written by :func:`write_samples`, or any
+    path : str or os.PathLike
+        A ``.csv``, ``.parquet`` or ``.pq`` file written by :func:`write_samples`, or any
         table with the columns velocity, load, temperature, friction (and optionally
         direction, count, std) and explicit units.
 
@@ -226,26 +71,45 @@ def read_samples(path: PathLike) -> FrictionSamples:
     -------
     FrictionSamples
         In SI units. ``source`` is the source recorded in the file, else ``path``.
+
+    Raises
+    ------
+    ConfigError
+        A suffix other than ``.csv``, ``.parquet``, ``.pq``.
+    DataError
+        A missing column or unit, an unknown unit, a non-numeric or non-finite value, a
+        fractional count, a file of another format (file, row and column named).
+
+    See Also
+    --------
+    write_samples : the inverse.
+
+    Examples
+    --------
+    >>> samples = read_samples("samples.csv")  # doctest: +SKIP
+    >>> samples.X.shape  # doctest: +SKIP
+    (60, 3)
     """
-    opened = _open(path, _SAMPLES_SCHEMA, _SAMPLES_REQUIRED, SAMPLES_FORMAT)
+    opened = open_table(path, _SAMPLES_SCHEMA, _SAMPLES_REQUIRED, SAMPLES_FORMAT)
     cols = opened.si(opened.read_all())
     count = cols.get("count")
     if count is not None and (count != np.round(count)).any():
         row = int(np.flatnonzero(count != np.round(count))[0])
-        raise _relocate(
+        raise relocate(
             DataError(f"count must be a whole number, got {count[row]!r}", row=row, column="count"),
             opened,
             0,
         )
     info = opened.info
     try:
-        return FrictionSamples(**cols, source=_source(info, opened.path), meta=info.meta)
+        return FrictionSamples(**cols, source=source_of(info, opened.path), meta=info.meta)
     except DataError as err:
-        raise _relocate(err, opened, 0) from None
+        raise relocate(err, opened, 0) from None
 
 
-def _open_rawlog(path: PathLike) -> _Opened:
-    opened = _open(path, _RAWLOG_SCHEMA, _RAWLOG_REQUIRED, RAWLOG_FORMAT)
+def _open_rawlog(path: PathLike) -> Opened:
+    """Open a raw-log table; a DataError if it has neither a torque nor a current column."""
+    opened = open_table(path, _RAWLOG_SCHEMA, _RAWLOG_REQUIRED, RAWLOG_FORMAT)
     if "torque" not in opened.columns and "current" not in opened.columns:
         raise DataError(
             "missing required column 'torque' (e.g. 'torque [N m]') or 'current' "
@@ -256,7 +120,8 @@ def _open_rawlog(path: PathLike) -> _Opened:
     return opened
 
 
-def _rawlog(opened: _Opened, cols: dict[str, np.ndarray], first_record: int) -> RawLog:
+def _rawlog(opened: Opened, cols: dict[str, np.ndarray], first_record: int) -> RawLog:
+    """A :class:`RawLog` of SI columns; its validation errors located in the file."""
     info = opened.info
     try:
         return RawLog(
@@ -268,18 +133,40 @@ def _rawlog(opened: _Opened, cols: dict[str, np.ndarray], first_record: int) -> 
             current=cols.get("current"),
             torque_constant=info.torque_constant,
             joint=info.joint if info.joint is not None else "joint",
-            source=_source(info, opened.path),
+            source=source_of(info, opened.path),
             meta=dict(info.meta),  # one copy per chunk
         )
     except DataError as err:
-        raise _relocate(err, opened, first_record) from None
+        raise relocate(err, opened, first_record) from None
 
 
 def read_rawlog(path: PathLike) -> RawLog:
-    """Read a whole raw joint log from a CSV or Parquet file (SI units).
+    """Read a whole raw joint log from a CSV or Parquet file.
 
-    For files too large for memory, use :func:`iter_rawlog`. A file with no data rows is a
-    :class:`~fricid.errors.DataError`.
+    Parameters
+    ----------
+    path : str or os.PathLike
+        A ``.csv``, ``.parquet`` or ``.pq`` file written by :func:`write_rawlog`, or any
+        table with the columns time, position, velocity, temperature and torque or current,
+        with explicit units.
+
+    Returns
+    -------
+    RawLog
+        In SI units; joint, source, torque constant and ``meta`` as recorded in the file.
+
+    Raises
+    ------
+    ConfigError
+        A suffix other than ``.csv``, ``.parquet``, ``.pq``.
+    DataError
+        No data rows, a missing column or unit, an unknown unit, a non-numeric or
+        non-finite value, time not strictly increasing (file, row and column named).
+
+    See Also
+    --------
+    iter_rawlog : the same log in chunks, for files too large for memory.
+    write_rawlog : the inverse.
     """
     opened = _open_rawlog(path)
     log = _rawlog(opened, opened.si(opened.read_all()), 0)
@@ -289,12 +176,35 @@ def read_rawlog(path: PathLike) -> RawLog:
 
 
 def iter_rawlog(path: PathLike, chunk_rows: int = 1_000_000) -> Iterator[RawLog]:
-    """Read a raw log in chunks of ``chunk_rows`` rows (the last may be shorter).
+    """Read a raw log in chunks.
 
     Memory stays bounded by a few chunks whatever the file size: Parquet is read batch by
-    batch (one row group at a time), CSV block by block. The chunks concatenate to
-    :func:`read_rawlog`'s log; time must also increase across chunk boundaries. The file is
-    opened and its columns checked at the call; data errors surface at the chunk holding them.
+    batch (one row group at a time), CSV block by block. The file is opened and its columns
+    checked at the call; data errors surface at the chunk holding them.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        A raw-log table, as for :func:`read_rawlog`.
+    chunk_rows : int, default 1000000
+        Rows per chunk; the last may be shorter.
+
+    Returns
+    -------
+    iterator of RawLog
+        The chunks; they concatenate to :func:`read_rawlog`'s log (time must also increase
+        across chunk boundaries).
+
+    Raises
+    ------
+    ConfigError
+        ``chunk_rows`` not a positive integer; a suffix fricid cannot read.
+    DataError
+        As :func:`read_rawlog`, at the call for the columns, from the iterator for the data.
+
+    Examples
+    --------
+    >>> n = sum(len(chunk) for chunk in iter_rawlog("log.parquet"))  # doctest: +SKIP
     """
     if isinstance(chunk_rows, bool) or not isinstance(chunk_rows, int | np.integer):
         raise ConfigError(f"chunk_rows must be a positive integer, got {chunk_rows!r}")
@@ -303,7 +213,8 @@ def iter_rawlog(path: PathLike, chunk_rows: int = 1_000_000) -> Iterator[RawLog]
     return _iter_rawlog(_open_rawlog(path), int(chunk_rows))
 
 
-def _iter_rawlog(opened: _Opened, chunk_rows: int) -> Iterator[RawLog]:
+def _iter_rawlog(opened: Opened, chunk_rows: int) -> Iterator[RawLog]:
+    """The chunks of an opened raw log, time checked across their boundaries."""
     last_time: float | None = None
     for start, raw in opened.iterate(chunk_rows):
         log = _rawlog(opened, opened.si(raw), start)
@@ -323,90 +234,50 @@ def _iter_rawlog(opened: _Opened, chunk_rows: int) -> Iterator[RawLog]:
 # --------------------------------------------------------------------------- writing
 
 
-def _label(name: str, unit: str) -> str:
-    return name if unit == "1" else f"{name} [{unit}]"
-
-
-def _csv_preamble(fields: list[tuple[str, str]], units: dict[str, str]) -> bytes:
-    lines = [f"# {key}: {value}" for key, value in fields]
-    lines.append(",".join(_label(name, unit) for name, unit in units.items()))
-    return ("\n".join(lines) + "\n").encode("utf-8")
-
-
-def _info_fields(fmt: str, source: str | None, joint: str | None, k: float | None, meta) -> list:
-    fields = [("format", fmt)]
-    if source is not None:
-        fields.append(("source", encode_text(str(source))))
-    if joint is not None:
-        fields.append(("joint", encode_text(str(joint))))
-    if k is not None:
-        fields.append((f"torque_constant [{SI_UNITS['torque_constant']}]", repr(float(k))))
-    fields.append(("meta", dumps_meta(meta)))
-    return fields
-
-
-def _parquet_doc(fmt: str, units: dict[str, str], source, joint, k, meta) -> bytes:
-    doc: dict[str, Any] = {"format": fmt, "units": dict(units)}
-    if k is not None:
-        doc["units"]["torque_constant"] = SI_UNITS["torque_constant"]
-        doc["torque_constant"] = float(k)
-    if source is not None:
-        doc["source"] = str(source)
-    if joint is not None:
-        doc["joint"] = str(joint)
-    doc["meta"] = json.loads(dumps_meta(meta))
-    return json.dumps(doc, ensure_ascii=True).encode("ascii")
-
-
-def _write_csv(path: Path, preamble: bytes, tables: Iterable[pa.Table]) -> None:
-    options = pacsv.WriteOptions(include_header=False)
-    with atomic_write(path, "wb") as fh:
-        fh.write(preamble)
-        writer = None
-        for table in tables:
-            if writer is None:
-                writer = pacsv.CSVWriter(fh, table.schema, write_options=options)
-            writer.write_table(table)
-        if writer is not None:
-            writer.close()
-
-
-def _write_parquet(path: Path, doc: bytes, tables: Iterable[pa.Table]) -> None:
-    with atomic_path(path) as tmp:
-        writer = None
-        try:
-            for table in tables:
-                if writer is None:
-                    schema = table.schema.with_metadata({META_KEY: doc})
-                    writer = pq.ParquetWriter(tmp, schema)
-                writer.write_table(table, row_group_size=ROW_GROUP_ROWS)
-        finally:
-            if writer is not None:
-                writer.close()
-
-
 def write_samples(samples: FrictionSamples, path: PathLike) -> Path:
-    """Write friction samples to ``path`` (CSV or Parquet by suffix), atomically.
+    """Write friction samples to a CSV or Parquet file, atomically.
 
-    Returns the path written. Units are SI and stated in the file.
+    Parameters
+    ----------
+    samples : FrictionSamples
+        The samples.
+    path : str or os.PathLike
+        The file; ``.csv`` or ``.parquet`` / ``.pq`` chooses the format.
+
+    Returns
+    -------
+    pathlib.Path
+        The path written. Units are SI and stated in the file (CSV header, Parquet schema
+        metadata), with the source and ``meta``.
+
+    Raises
+    ------
+    ConfigError
+        Not a :class:`FrictionSamples`, an unknown suffix, or ``meta`` that is not
+        JSON-serialisable.
+
+    See Also
+    --------
+    read_samples : the inverse.
     """
     if not isinstance(samples, FrictionSamples):
         raise ConfigError(
             f"write_samples(samples, path) needs a FrictionSamples, got {type(samples).__name__}"
         )
     path = Path(path)
-    fmt = _format(path)
+    fmt = table_format(path)
     table = pa.table({name: np.asarray(getattr(samples, name)) for name in SAMPLE_COLUMNS})
     if fmt == "csv":
-        fields = _info_fields(SAMPLES_FORMAT, samples.source, None, None, samples.meta)
-        _write_csv(path, _csv_preamble(fields, SAMPLE_COLUMNS), [table])
+        fields = preamble_fields(SAMPLES_FORMAT, samples.source, None, None, samples.meta)
+        write_csv(path, csv_preamble(fields, SAMPLE_COLUMNS), [table])
     else:
-        doc = _parquet_doc(SAMPLES_FORMAT, SAMPLE_COLUMNS, samples.source, None, None, samples.meta)
-        _write_parquet(path, doc, [table])
+        doc = parquet_doc(SAMPLES_FORMAT, SAMPLE_COLUMNS, samples.source, None, None, samples.meta)
+        write_parquet(path, doc, [table])
     return path
 
 
 def _rawlog_units(log: RawLog) -> dict[str, str]:
+    """The columns a log writes and their units (torque, current: only those present)."""
     return {
         name: unit
         for name, unit in RAWLOG_COLUMNS.items()
@@ -442,14 +313,38 @@ def write_rawlog(log_or_chunks: RawLog | Iterable[RawLog], path: PathLike) -> Pa
 
     Chunks are streamed: a Parquet file gets one row group per chunk (pyarrow
     ``ParquetWriter``), a CSV file grows chunk by chunk, so a log larger than memory can be
-    converted with ``write_rawlog(iter_rawlog(src), dst)``. Metadata (joint, source, torque
-    constant, meta) comes from the first chunk. If the chunks raise part-way, nothing is
-    left at ``path``. Returns the path written.
+    converted with ``write_rawlog(iter_rawlog(src), dst)``. If the chunks raise part-way,
+    nothing is left at ``path``.
+
+    Parameters
+    ----------
+    log_or_chunks : RawLog or iterable of RawLog
+        The log, or its chunks in time order, all with the same effort columns. Metadata
+        (joint, source, torque constant, meta) comes from the first chunk.
+    path : str or os.PathLike
+        The file; ``.csv`` or ``.parquet`` / ``.pq`` chooses the format.
+
+    Returns
+    -------
+    pathlib.Path
+        The path written.
+
+    Raises
+    ------
+    ConfigError
+        Arguments in the wrong order, no chunks, a chunk that is not a :class:`RawLog` or
+        has other columns than the first, an unknown suffix.
+    DataError
+        A chunk that does not continue the previous one in time.
+
+    See Also
+    --------
+    read_rawlog, iter_rawlog : the inverse.
     """
     if isinstance(log_or_chunks, str | os.PathLike):
         raise ConfigError("write_rawlog(log_or_chunks, path): the log comes first, then the path")
     path = Path(path)
-    fmt = _format(path)
+    fmt = table_format(path)
     chunks = iter([log_or_chunks] if isinstance(log_or_chunks, RawLog) else log_or_chunks)
     first = next(chunks, None)
     if first is None:
@@ -460,7 +355,7 @@ def write_rawlog(log_or_chunks: RawLog | Iterable[RawLog], path: PathLike) -> Pa
     tables = _rawlog_tables(first, chunks)
     info = (first.source, first.joint, first.torque_constant, first.meta)
     if fmt == "csv":
-        _write_csv(path, _csv_preamble(_info_fields(RAWLOG_FORMAT, *info), units), tables)
+        write_csv(path, csv_preamble(preamble_fields(RAWLOG_FORMAT, *info), units), tables)
     else:
-        _write_parquet(path, _parquet_doc(RAWLOG_FORMAT, units, *info), tables)
+        write_parquet(path, parquet_doc(RAWLOG_FORMAT, units, *info), tables)
     return path
