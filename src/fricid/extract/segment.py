@@ -35,16 +35,28 @@ class Segment:
 
     ``row`` is the global 0-based index of the segment's first sample in the stream; ``plateau``
     the run's median velocity [rad/s] (signed); ``direction`` +1 or -1; ``log`` the samples.
+    ``run_samples`` and ``run_duration`` [s] describe the whole run the segment was cut from;
+    ``band_fraction`` is the share of the steady part's samples inside the velocity band (near
+    1 at constant velocity, small for a move without a plateau, such as a return move).
     """
 
     row: int
     plateau: float
     direction: int
     log: RawLog
+    run_samples: int = 0
+    band_fraction: float = 1.0
+    run_duration: float = 0.0
 
     @property
     def speed(self) -> float:
+        """rad/s, the plateau's magnitude."""
         return abs(self.plateau)
+
+    @property
+    def trimmed(self) -> int:
+        """Samples of the run outside the steady part (ramps and settle margins)."""
+        return max(self.run_samples - len(self.log), 0)
 
 
 @dataclass
@@ -58,6 +70,7 @@ class SegmentCounts:
     dropped_short_run: int = 0
     dropped_no_plateau: int = 0
     dropped_short_steady: int = 0
+    dropped_samples: int = 0  # samples of dropped runs and at exactly zero velocity
 
 
 def as_log_stream(logs: RawLog | Iterable[RawLog]) -> Iterator[RawLog]:
@@ -81,11 +94,13 @@ def _steady(
     settle_time: float,
     min_samples: int,
     counts: SegmentCounts,
-) -> tuple[int, int, float] | None:
-    """Steady part (start, stop, plateau) of the run ``start:stop`` of ``log``, or None."""
+) -> tuple[int, int, float, int, float, float] | None:
+    """Steady part of the run ``start:stop`` of ``log``, or None: (start, stop, plateau, run
+    samples, band fraction, run duration)."""
     counts.runs += 1
     if stop - start < min_samples:
         counts.dropped_short_run += 1
+        counts.dropped_samples += stop - start
         return None
     v = log.velocity[start:stop]
     plateau = float(np.median(v))
@@ -96,6 +111,7 @@ def _steady(
         inside = np.flatnonzero(np.abs(v - plateau) <= velocity_tolerance * abs(plateau))
     if plateau == 0.0 or inside.size == 0:
         counts.dropped_no_plateau += 1
+        counts.dropped_samples += stop - start
         return None
     a, b = start + int(inside[0]), start + int(inside[-1]) + 1
     t = log.time[a:b]
@@ -103,9 +119,13 @@ def _steady(
     b2 = a + int(np.searchsorted(t, t[-1] - settle_time, side="right"))
     if b2 - a2 < min_samples:
         counts.dropped_short_steady += 1
+        counts.dropped_samples += stop - start
         return None
     counts.kept += 1
-    return a2, b2, plateau
+    v2 = log.velocity[a2:b2]
+    band = float(np.mean(np.abs(v2 - plateau) <= velocity_tolerance * abs(plateau)))
+    duration = float(log.time[stop - 1] - log.time[start])
+    return a2, b2, plateau, stop - start, band, duration
 
 
 def iter_segments(
@@ -160,6 +180,7 @@ def iter_segments(
         stops = np.concatenate((edges, [len(buf)]))
         for start, stop in zip(starts[:-1], stops[:-1], strict=True):
             if sign[start] == 0:
+                counts.dropped_samples += int(stop - start)
                 continue
             found = _steady(buf, int(start), int(stop), *options)
             if found is not None:
@@ -171,15 +192,29 @@ def iter_segments(
         found = _steady(carry, 0, len(carry), *options)
         if found is not None:
             yield _segment(carry, carry_row, *found)
+    elif carry is not None:
+        counts.dropped_samples += len(carry)
     logger.debug("segmentation: %s", counts)
 
 
-def _segment(log: RawLog, row0: int, start: int, stop: int, plateau: float) -> Segment:
+def _segment(
+    log: RawLog,
+    row0: int,
+    start: int,
+    stop: int,
+    plateau: float,
+    run_samples: int,
+    band: float,
+    duration: float,
+) -> Segment:
     return Segment(
         row=row0 + start,
         plateau=plateau,
         direction=1 if plateau > 0 else -1,
         log=log.slice(start, stop),
+        run_samples=run_samples,
+        band_fraction=band,
+        run_duration=duration,
     )
 
 
