@@ -1,6 +1,7 @@
 """Find the constant-velocity portions of a (streamed) raw log.
 
-A *run* is a maximal stretch of samples whose measured velocity has one sign. Its *plateau* is
+A *run* is a maximal stretch of samples whose measured velocity has one sign (a velocity
+within :data:`REST_RESIDUE` of zero counts as zero). Its *plateau* is
 the median velocity of the run (refined once: the median of the samples within the band); its
 *steady part* runs from the first to the last sample within ``velocity_tolerance`` of the
 plateau (which drops the acceleration and deceleration ramps), minus ``settle_time`` at each
@@ -24,7 +25,22 @@ import numpy as np
 from ..errors import ConfigError
 from ..samples import RawLog
 
-__all__ = ["Segment", "SegmentCounts", "as_log_stream", "cluster", "iter_segments"]
+__all__ = [
+    "REST_RESIDUE",
+    "Segment",
+    "SegmentCounts",
+    "as_log_stream",
+    "cluster",
+    "iter_segments",
+]
+
+#: rad/s; a velocity of at most this magnitude is numerically zero (float residue of a velocity
+#: estimate at standstill, typically 1e-15) and separates runs like an exact zero does, so a
+#: rest whose residue has the sign of the next move is not merged into that move's run. It is
+#: 0.2 deg per 100 hours, far below any speed an encoder can measure. Whether a slower run is
+#: rest is decided later, relative to the log's own velocity scale and encoder step
+#: (:func:`fricid.extract.steady.rest_threshold`).
+REST_RESIDUE = 1e-9
 
 logger = logging.getLogger(__name__)
 
@@ -175,6 +191,7 @@ def iter_segments(
         else:
             buf, buf_row = RawLog.concatenate([carry, chunk]), carry_row
         sign = np.sign(buf.velocity)
+        sign[np.abs(buf.velocity) <= REST_RESIDUE] = 0.0  # float residue: not moving
         edges = np.flatnonzero(sign[1:] != sign[:-1]) + 1
         starts = np.concatenate(([0], edges))
         stops = np.concatenate((edges, [len(buf)]))
@@ -188,7 +205,7 @@ def iter_segments(
         last = int(starts[-1])
         carry = buf.slice(last, len(buf))
         carry_row = buf_row + last
-    if carry is not None and len(carry) and carry.velocity[0] != 0:
+    if carry is not None and len(carry) and abs(carry.velocity[0]) > REST_RESIDUE:
         found = _steady(carry, 0, len(carry), *options)
         if found is not None:
             yield _segment(carry, carry_row, *found)

@@ -149,21 +149,23 @@ class Faults:
 
     @property
     def fault_run_up(self) -> float:
-        """s of extra cruise at each end of a traverse: the creep plus eight settling time
-        constants (the transients have decayed to 3e-4 of their amplitude by then)."""
+        """s of extra cruise at each end of a traverse: the creep plus four settling time
+        constants (the transients have decayed to 2 % of their amplitude by then, so the
+        measured range is crossed at settled velocity and torque, but an average over the
+        whole traverse still includes them)."""
         t = 0.0
         if self.ramp_fraction:
             t += self.ramp_time
         if self.settle_torque or self.overshoot:
-            t += 8.0 * self.settle_tau
+            t += 4.0 * self.settle_tau
         return t
 
     @classmethod
     def typical(cls, kinds=FAULT_KINDS, *, max_speed: float, max_current: float) -> Faults:
         """Faults of the given kinds (:data:`FAULT_KINDS`) at typical magnitudes for a design
         whose fastest set-point is ``max_speed`` rad/s and whose largest steady current is
-        ``max_current`` A: 1.5 s of rest, a 30 mN m torque transient and 3 % velocity overshoot
-        decaying in 0.1 s, 3 % creeps over 0.5 s, return moves peaking at 1.5x the fastest
+        ``max_current`` A: 1.5 s of rest, a 50 mN m torque transient and 3 % velocity overshoot
+        decaying in 0.15 s, 3 % creeps over 0.5 s, return moves peaking at 1.5x the fastest
         set-point, one 6-sample burst of 3 A every other traverse, and a current range of
         ``1.6 max_current`` (it clips the bursts, not the steady state)."""
         unknown = [k for k in kinds if k not in FAULT_KINDS]
@@ -174,8 +176,9 @@ class Faults:
         on = set(kinds)
         return cls(
             rest_time=1.5 if "rest" in on else 0.0,
-            settle_torque=0.03 if "settling" in on else 0.0,
+            settle_torque=0.05 if "settling" in on else 0.0,
             overshoot=0.03 if "settling" in on else 0.0,
+            settle_tau=0.15,
             ramp_fraction=0.03 if "ramps" in on else 0.0,
             return_speed=1.5 * max_speed if "returns" in on else 0.0,
             burst_rate=0.5 if "spikes" in on else 0.0,
