@@ -7,9 +7,10 @@ segment (the steady part of one run, :mod:`.segment`) and uses the segment's own
 scale, so it adapts to any drive and sampling rate:
 
 * :func:`settled` trims leading and trailing stretches where the velocity **or** the torque
-  has not settled (ramps, overshoot, a current controller winding down), judged on block means
-  against a robust quadratic trend (which absorbs slow changes such as gravity along the
-  traverse, eq. 7) at :data:`SETTLE_SIGMAS` robust standard deviations.
+  has not settled (ramps, overshoot, a current controller winding down), judged on block means:
+  velocity against its settled level (the mode of the block means), torque against a robust
+  quadratic trend (which absorbs slow changes such as gravity along the traverse, eq. 7), at
+  :data:`SETTLE_SIGMAS` robust standard deviations.
 * :func:`outliers` flags torque samples more than :data:`OUTLIER_SIGMAS` robust standard
   deviations (1.4826 MAD) from a running median of :data:`OUTLIER_WINDOW` samples: spike
   bursts that outlast the median filter.
@@ -80,54 +81,106 @@ def _noise_scale(x: np.ndarray) -> float:
     return robust_scale(np.diff(x)) / np.sqrt(2.0)
 
 
-def _unsettled_ends(means: np.ndarray, floor: float, sigmas: float) -> tuple[int, int]:
-    """Leading and trailing blocks whose means stray from a robust quadratic trend.
+#: Once an end is found unsettled (beyond ``SETTLE_SIGMAS``), trimming goes on while blocks
+#: stay beyond this many robust standard deviations (hysteresis: the tail of a transient is
+#: trimmed too, not only its loud start).
+SETTLE_RELEASE = 2.0
 
-    The trend is fitted by least squares, then refitted without the blocks beyond ``sigmas``
-    robust standard deviations (three rounds); the scale is the larger of 1.4826 MAD of the
-    kept residuals and ``floor`` (the noise a block mean must carry).
+
+def _ends(z: np.ndarray, sigmas: float) -> tuple[int, int]:
+    """Blocks to trim at the start and at the end, given the blocks' deviations ``z`` in
+    robust standard deviations: nothing unless the end block is beyond ``sigmas``, then up to
+    the first block within :data:`SETTLE_RELEASE`."""
+
+    def run(z: np.ndarray) -> int:
+        if z.size == 0 or z[0] <= sigmas:
+            return 0
+        within = np.flatnonzero(z <= min(SETTLE_RELEASE, sigmas))
+        return int(within[0]) if within.size else z.size
+
+    return run(z), run(z[::-1])
+
+
+def _torque_ends(means: np.ndarray, floor: float, sigmas: float) -> tuple[int, int]:
+    """Leading and trailing blocks whose torque strays from the run's robust quadratic trend.
+
+    The trend (quadratic in block index: it absorbs slow changes such as gravity along the
+    traverse, eq. 7) is first fitted to the central 60 % of the blocks, then refitted to every
+    block not flagged so far (three rounds), so a transient at an end cannot bend the trend
+    towards itself. The scale is the larger of 1.4826 MAD of the fitted blocks' residuals
+    (corrected for the three fitted parameters) and ``floor`` (the noise a block mean must
+    carry), widened at each block by the trend's own uncertainty there (its leverage), so an
+    extrapolated trend is not over-trusted.
     """
     k = means.size
     x = np.linspace(-1.0, 1.0, k)
     A = np.column_stack([np.ones(k), x, x * x])
-    use = np.ones(k, dtype=bool)
+    use = np.abs(x) <= 0.6
+    lead = trail = 0
     for _ in range(3):
-        coef, *_ = np.linalg.lstsq(A[use], means[use], rcond=None)
+        Au = A[use]
+        coef, *_ = np.linalg.lstsq(Au, means[use], rcond=None)
         resid = means - A @ coef
-        scale = max(robust_scale(resid[use]), floor)
-        new = np.abs(resid) <= sigmas * scale
+        m = int(use.sum())
+        scale = max(robust_scale(resid[use]) * np.sqrt(m / max(m - 3, 1)), floor)
+        # a block's deviation against the trend's own uncertainty there (its leverage)
+        leverage = np.einsum("ij,jk,ik->i", A, np.linalg.pinv(Au.T @ Au), A)
+        lead, trail = _ends(np.abs(resid) / (scale * np.sqrt(1.0 + leverage)), sigmas)
+        new = np.ones(k, dtype=bool)
+        new[:lead] = False
+        new[k - trail :] = False
         if new.sum() < 4 or np.array_equal(new, use):
             break
         use = new
-    bad = np.abs(resid) > sigmas * scale
-    lead = int(np.argmin(bad)) if not bad.all() else k
-    trail = int(np.argmin(bad[::-1])) if not bad.all() else k
     return lead, trail
+
+
+def _velocity_ends(means: np.ndarray, floor: float, sigmas: float) -> tuple[int, int]:
+    """Leading and trailing blocks whose velocity is off the run's settled level.
+
+    At constant velocity the block means are flat, so the settled level is their *mode*: the
+    median of the largest cluster of block means within ``2 floor`` of one another (a creeping
+    ramp or a ringing overshoot spreads its blocks over many levels; the settled stretch piles
+    them on one). Blocks further than ``sigmas`` times the scale (the larger of 1.4826 MAD of
+    the cluster and ``floor``) from it are unsettled.
+    """
+    near = np.abs(means[:, None] - means[None, :]) <= 2.0 * floor
+    centre = int(np.argmax(near.sum(axis=1)))
+    cluster = means[near[centre]]
+    level = float(np.median(cluster))
+    scale = max(robust_scale(cluster), floor)
+    return _ends(np.abs(means - level) / scale, sigmas)
 
 
 def settled(
     time: np.ndarray,
     velocity: np.ndarray,
     torque: np.ndarray,
+    raw: np.ndarray | None = None,
     *,
     block: float = SETTLE_BLOCK,
     sigmas: float = SETTLE_SIGMAS,
 ) -> tuple[int, int]:
     """The settled part ``[start, stop)`` of a steady segment.
 
-    The segment is cut into blocks of ``block`` seconds (at least 3 samples); the block means of
-    velocity and of torque are compared with a robust quadratic trend over the segment. Leading
-    blocks are trimmed up to the first block where **both** are within ``sigmas`` robust
-    standard deviations, trailing ones likewise, plus one more block at each trimmed end (the
-    block where a transient fades in is only partly clean). The scale has a floor of the block
-    mean's own noise (the sample noise from first differences over the square root of the block
-    length), so a noiseless or quantised trend is not mistaken for a transient. Segments with
-    fewer than 8 blocks are returned whole (too short to tell a trend from a transient).
+    The segment is cut into blocks of ``block`` seconds (at least 3 samples). Velocity has
+    settled where its block means sit at the run's settled level (their mode,
+    :func:`_velocity_ends`); torque where its block means follow the run's robust quadratic
+    trend (:func:`_torque_ends`), both within ``sigmas`` robust standard deviations. Leading
+    blocks are trimmed up to the first block where **both** have settled, trailing ones
+    likewise, plus one more block at each trimmed end (the block where a transient fades out
+    is only partly clean). Each scale has a floor: the block mean's own noise, the
+    sample-to-sample noise (from first differences of ``raw``, the unfiltered torque, default
+    ``torque``; of the velocity) over the square root of the block length, so a noiseless or
+    quantised trend is not mistaken for a transient. Segments of fewer than 8 blocks are
+    returned whole (too short to tell a trend from a transient).
 
     Parameters
     ----------
     time, velocity, torque : numpy.ndarray
         The segment's samples (s, rad/s, N m; the torque median-filtered).
+    raw : numpy.ndarray, optional
+        N m, the unfiltered torque (sets the torque's noise floor).
     block : float
         s, block length.
     sigmas : float
@@ -146,14 +199,15 @@ def settled(
     k = n // w
     if k < 8:
         return 0, n
-    lead = trail = 0
-    for x in (velocity, torque):
+    raw = torque if raw is None else raw
+    ends = []
+    for x, noisy, find in ((velocity, velocity, _velocity_ends), (torque, raw, _torque_ends)):
         means = x[: k * w].reshape(k, w).mean(axis=1)
-        floor = _noise_scale(x) / np.sqrt(w)
-        floor = max(floor, 1e-12 * float(np.max(np.abs(means))))
-        a, b = _unsettled_ends(means, floor, sigmas)
-        lead, trail = max(lead, a), max(trail, b)
-    if lead >= k or lead + trail >= k:
+        floor = max(_noise_scale(noisy) / np.sqrt(w), 1e-12 * float(np.max(np.abs(means))))
+        ends.append(find(means, floor, sigmas))
+    lead = max(e[0] for e in ends)
+    trail = max(e[1] for e in ends)
+    if lead + trail >= k:
         return 0, 0
     start = (lead + (lead > 0)) * w
     stop = n - (trail + (trail > 0)) * w if trail else n
