@@ -109,7 +109,9 @@ class Accumulator:
         keep = np.ones(n, dtype=bool)
         a, b = 0, n
         if self.settle_sigmas is not None:
-            a, b = settled(log.time, log.velocity, tau, raw, sigmas=self.settle_sigmas)
+            a, b = settled(
+                log.time, log.position, log.velocity, tau, raw, sigmas=self.settle_sigmas
+            )
         keep[:a] = keep[b:] = False
         sat = saturated(raw) & keep
         keep &= ~sat

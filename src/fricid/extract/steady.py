@@ -9,7 +9,8 @@ scale, so it adapts to any drive and sampling rate:
 * :func:`settled` trims leading and trailing stretches where the velocity **or** the torque
   has not settled (ramps, overshoot, a current controller winding down), judged on block means:
   velocity against its settled level (the mode of the block means), torque against a robust
-  quadratic trend (which absorbs slow changes such as gravity along the traverse, eq. 7), at
+  trend (eq. 7's constant, cos and sin of position: gravity and slow changes along the
+  traverse), at
   :data:`SETTLE_SIGMAS` robust standard deviations.
 * :func:`outliers` flags torque samples more than :data:`OUTLIER_SIGMAS` robust standard
   deviations (1.4826 MAD) from a running median of :data:`OUTLIER_WINDOW` samples: spike
@@ -101,35 +102,49 @@ def _ends(z: np.ndarray, sigmas: float) -> tuple[int, int]:
     return run(z), run(z[::-1])
 
 
-def _torque_ends(means: np.ndarray, floor: float, sigmas: float) -> tuple[int, int]:
-    """Leading and trailing blocks whose torque strays from the run's robust quadratic trend.
+#: Relative resolution of the torque trend: SVD directions weaker than this share of the
+#: strongest are dropped (they would only extrapolate noise), and the trend is trusted to this
+#: share of the block means' spread (what a noiseless log needs).
+TREND_RESOLUTION = 1e-6
 
-    The trend (quadratic in block index: it absorbs slow changes such as gravity along the
-    traverse, eq. 7) is first fitted to the central 60 % of the blocks, then refitted to every
-    block not flagged so far (three rounds), so a transient at an end cannot bend the trend
-    towards itself. The scale is the larger of 1.4826 MAD of the fitted blocks' residuals
-    (corrected for the three fitted parameters) and ``floor`` (the noise a block mean must
-    carry), widened at each block by the trend's own uncertainty there (its leverage), so an
-    extrapolated trend is not over-trusted.
+
+def _torque_ends(
+    means: np.ndarray, position: np.ndarray, floor: float, sigmas: float
+) -> tuple[int, int]:
+    """Leading and trailing blocks whose torque strays from the run's robust trend.
+
+    The trend is ``c0 + c1 cos(theta) + c2 sin(theta)`` in the block's mean position
+    ``theta``: eq. 7's gravity plus a friction linear in the load (eq. 12) is exactly of this
+    form at constant velocity, and over a short traverse it is a quadratic in position (any
+    slow change); over many turns (a lead screw's motor) a once-per-turn ripple. It is fitted
+    through the SVD, directions weaker than :data:`TREND_RESOLUTION` dropped, first to the
+    central 60 % of the blocks, then to every block not flagged so far (three rounds), so a
+    transient at an end cannot bend the trend towards itself. The scale is the largest of
+    1.4826 MAD of the fitted blocks' residuals (corrected for the fitted parameters), ``floor``
+    (the noise a block mean must carry) and :data:`TREND_RESOLUTION` times the spread of the
+    block means, widened at each block by the trend's own uncertainty there (its leverage), so
+    an extrapolated trend is not over-trusted.
     """
     k = means.size
     x = np.linspace(-1.0, 1.0, k)
-    A = np.column_stack([np.ones(k), x, x * x])
+    A = np.column_stack([np.ones(k), np.cos(position), np.sin(position)])
     use = np.abs(x) <= 0.6
     lead = trail = 0
     for _ in range(3):
-        Au = A[use]
-        coef, *_ = np.linalg.lstsq(Au, means[use], rcond=None)
-        resid = means - A @ coef
+        U, sv, Vt = np.linalg.svd(A[use], full_matrices=False)
+        r = int(np.sum(sv > TREND_RESOLUTION * sv[0]))
+        proj = A @ Vt[:r].T / sv[:r]  # rows: A_i V_r S_r^-1
+        resid = means - proj @ (U[:, :r].T @ means[use])
+        leverage = np.sum(proj * proj, axis=1)
         m = int(use.sum())
-        scale = max(robust_scale(resid[use]) * np.sqrt(m / max(m - 3, 1)), floor)
-        # a block's deviation against the trend's own uncertainty there (its leverage)
-        leverage = np.einsum("ij,jk,ik->i", A, np.linalg.pinv(Au.T @ Au), A)
+        # the floor also covers the trend's resolution (directions dropped by the SVD)
+        spread = float(np.ptp(means)) * TREND_RESOLUTION
+        scale = max(robust_scale(resid[use]) * np.sqrt(m / max(m - r, 1)), floor, spread)
         lead, trail = _ends(np.abs(resid) / (scale * np.sqrt(1.0 + leverage)), sigmas)
         new = np.ones(k, dtype=bool)
         new[:lead] = False
         new[k - trail :] = False
-        if new.sum() < 4 or np.array_equal(new, use):
+        if new.sum() < 6 or np.array_equal(new, use):
             break
         use = new
     return lead, trail
@@ -154,6 +169,7 @@ def _velocity_ends(means: np.ndarray, floor: float, sigmas: float) -> tuple[int,
 
 def settled(
     time: np.ndarray,
+    position: np.ndarray,
     velocity: np.ndarray,
     torque: np.ndarray,
     raw: np.ndarray | None = None,
@@ -165,20 +181,21 @@ def settled(
 
     The segment is cut into blocks of ``block`` seconds (at least 3 samples). Velocity has
     settled where its block means sit at the run's settled level (their mode,
-    :func:`_velocity_ends`); torque where its block means follow the run's robust quadratic
-    trend (:func:`_torque_ends`), both within ``sigmas`` robust standard deviations. Leading
-    blocks are trimmed up to the first block where **both** have settled, trailing ones
-    likewise, plus one more block at each trimmed end (the block where a transient fades out
-    is only partly clean). Each scale has a floor: the block mean's own noise, the
-    sample-to-sample noise (from first differences of ``raw``, the unfiltered torque, default
-    ``torque``; of the velocity) over the square root of the block length, so a noiseless or
-    quantised trend is not mistaken for a transient. Segments of fewer than 8 blocks are
-    returned whole (too short to tell a trend from a transient).
+    :func:`_velocity_ends`); torque where its block means follow the run's robust trend
+    (eq. 7's constant, cos and sin of position, :func:`_torque_ends`). An end
+    whose first block is beyond ``sigmas`` robust standard deviations is trimmed up to the
+    first block back within :data:`SETTLE_RELEASE` (the tail of the transient goes too), for
+    both signals, plus one more block (where the transient fades out, only partly clean).
+    Each scale has a floor, the block mean's own noise: the sample-to-sample noise (from first
+    differences of ``raw``, the unfiltered torque, default ``torque``; of the velocity) over
+    the square root of the block length, so a noiseless or quantised trend is not mistaken
+    for a transient. Segments of fewer than 8 blocks are returned whole (too short to tell a
+    trend from a transient).
 
     Parameters
     ----------
-    time, velocity, torque : numpy.ndarray
-        The segment's samples (s, rad/s, N m; the torque median-filtered).
+    time, position, velocity, torque : numpy.ndarray
+        The segment's samples (s, rad, rad/s, N m; the torque median-filtered).
     raw : numpy.ndarray, optional
         N m, the unfiltered torque (sets the torque's noise floor).
     block : float
@@ -200,11 +217,19 @@ def settled(
     if k < 8:
         return 0, n
     raw = torque if raw is None else raw
-    ends = []
-    for x, noisy, find in ((velocity, velocity, _velocity_ends), (torque, raw, _torque_ends)):
+
+    def blocks(x: np.ndarray, noisy: np.ndarray) -> tuple[np.ndarray, float]:
         means = x[: k * w].reshape(k, w).mean(axis=1)
         floor = max(_noise_scale(noisy) / np.sqrt(w), 1e-12 * float(np.max(np.abs(means))))
-        ends.append(find(means, floor, sigmas))
+        return means, floor
+
+    v_means, v_floor = blocks(velocity, velocity)
+    t_means, t_floor = blocks(torque, raw)
+    theta = position[: k * w].reshape(k, w).mean(axis=1)
+    ends = [
+        _velocity_ends(v_means, v_floor, sigmas),
+        _torque_ends(t_means, theta, t_floor, sigmas),
+    ]
     lead = max(e[0] for e in ends)
     trail = max(e[1] for e in ends)
     if lead + trail >= k:
