@@ -186,11 +186,13 @@ class Accumulator:
         t_set: np.ndarray,
         v_set: np.ndarray,
         cells: CellTable,
-        between: int,
+        between: tuple[int, int],
     ) -> QualityTable:
         """The per-set-point quality table: one row per (temperature, velocity, direction) of
         the kept records, in the samples' order, then one per direction of rest and unsteady
-        records, then the samples between runs (``between``)."""
+        records, then the samples ``between`` = (at rest between runs, in runs dropped at
+        segmentation for want of a plateau), as an ``unsteady`` and a ``between`` row of
+        direction 0."""
         nb = self.bins.n_bins
         nv = v_set.size
         keep = kinds == "setpoint"
@@ -250,9 +252,14 @@ class Accumulator:
                 )
                 row[column] = sum(r.samples for r in members)
                 rows.append(row)
-        if between:
-            row = dict.fromkeys(QUALITY_COLUMNS, 0)
-            row.update(kind="between", label="", temperature=np.nan, velocity=0.0)
-            row.update(dropped_rest=int(between), scatter=np.nan, flagged=False)
-            rows.append(row)
+        for kind, column, n in (
+            ("unsteady", "dropped_transient", between[1]),
+            ("between", "dropped_rest", between[0]),
+        ):
+            if n:
+                row = dict.fromkeys(QUALITY_COLUMNS, 0)
+                row.update(kind=kind, label="", temperature=np.nan, velocity=0.0)
+                row.update(scatter=np.nan, flagged=False)
+                row[column] = int(n)
+                rows.append(row)
         return QualityTable.from_rows(rows)

@@ -301,7 +301,15 @@ def extract(
         "settle_sigmas": settle_sigmas,
     }
     quality = flag_scatter(
-        acc.quality(kinds, t_label, v_label, t_set, v_set, cells, counts.dropped_samples)
+        acc.quality(
+            kinds,
+            t_label,
+            v_label,
+            t_set,
+            v_set,
+            cells,
+            (counts.dropped_samples, counts.unsteady_samples),
+        )
     )
     meta = {"extract": options, "quality": quality.rows()}
     samples, by_direction, fit, sem, direction_sem, position = _assemble(

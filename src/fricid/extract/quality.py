@@ -81,7 +81,8 @@ class QualityTable:
         extends beyond the bins).
     dropped_rest, dropped_transient, dropped_outlier, dropped_saturated : numpy.ndarray
         samples dropped: standstill (and samples between runs); ramps, settling and return
-        moves; outliers (:func:`fricid.extract.steady.outliers`); pinned at a rail
+        moves (and a rest or drift merged into a move's run by its sign, trimmed with the
+        ramp); outliers (:func:`fricid.extract.steady.outliers`); pinned at a rail
         (:func:`fricid.extract.steady.saturated`).
     scatter : numpy.ndarray
         N m, standard deviation of the kept samples' torque about their cell means (NaN

@@ -1,8 +1,10 @@
 """Find the constant-velocity portions of a (streamed) raw log.
 
 A *run* is a maximal stretch of samples whose measured velocity has one sign (a velocity
-within :data:`REST_RESIDUE` of zero counts as zero). Its *plateau* is
-the median velocity of the run (refined once: the median of the samples within the band); its
+within :data:`REST_RESIDUE` of zero counts as zero). Its *plateau* is the median velocity of
+the run's faster half (samples above half its 99th-percentile speed, so a rest or drift with
+the move's sign does not pull it down), refined once: the median of the samples within the
+band; its
 *steady part* runs from the first to the last sample within ``velocity_tolerance`` of the
 plateau (which drops the acceleration and deceleration ramps), minus ``settle_time`` at each
 end (what is left of a ramp, and the drive settling). Runs whose steady part is shorter than
@@ -86,7 +88,8 @@ class SegmentCounts:
     dropped_short_run: int = 0
     dropped_no_plateau: int = 0
     dropped_short_steady: int = 0
-    dropped_samples: int = 0  # samples of dropped runs and at exactly zero velocity
+    dropped_samples: int = 0  # samples at rest: zero velocity, runs too short to be moves
+    unsteady_samples: int = 0  # samples of runs without a (long enough) plateau
 
 
 def as_log_stream(logs: RawLog | Iterable[RawLog]) -> Iterator[RawLog]:
@@ -119,7 +122,10 @@ def _steady(
         counts.dropped_samples += stop - start
         return None
     v = log.velocity[start:stop]
-    plateau = float(np.median(v))
+    # the median of the faster half: a rest (or slow drift) at either end of the run, with the
+    # sign of the move, must not pull the plateau towards zero
+    speed = np.abs(v)
+    plateau = float(np.median(v[speed >= 0.5 * np.percentile(speed, 99)]))
     inside = np.flatnonzero(np.abs(v - plateau) <= velocity_tolerance * abs(plateau))
     if inside.size:
         # refine: the run's median is pulled towards the ramps; the band's median is not
@@ -127,7 +133,7 @@ def _steady(
         inside = np.flatnonzero(np.abs(v - plateau) <= velocity_tolerance * abs(plateau))
     if plateau == 0.0 or inside.size == 0:
         counts.dropped_no_plateau += 1
-        counts.dropped_samples += stop - start
+        counts.unsteady_samples += stop - start
         return None
     a, b = start + int(inside[0]), start + int(inside[-1]) + 1
     t = log.time[a:b]
@@ -135,7 +141,7 @@ def _steady(
     b2 = a + int(np.searchsorted(t, t[-1] - settle_time, side="right"))
     if b2 - a2 < min_samples:
         counts.dropped_short_steady += 1
-        counts.dropped_samples += stop - start
+        counts.unsteady_samples += stop - start
         return None
     counts.kept += 1
     v2 = log.velocity[a2:b2]
