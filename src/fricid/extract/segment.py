@@ -1,7 +1,8 @@
 """Find the constant-velocity portions of a (streamed) raw log.
 
 A *run* is a maximal stretch of samples whose measured velocity has one sign (a velocity
-within :data:`REST_RESIDUE` of zero counts as zero). Its *plateau* is the median velocity of
+within :data:`REST_RESIDUE` of zero counts as zero) without a gap in time
+(:data:`GAP_FACTOR`). Its *plateau* is the median velocity of
 the run's faster half (samples above half its 99th-percentile speed, so a rest or drift with
 the move's sign does not pull it down), refined once: the median of the samples within the
 band; its
@@ -28,6 +29,7 @@ from ..errors import ConfigError
 from ..samples import RawLog
 
 __all__ = [
+    "GAP_FACTOR",
     "REST_RESIDUE",
     "Segment",
     "SegmentCounts",
@@ -43,6 +45,10 @@ __all__ = [
 #: rest is decided later, relative to the log's own velocity scale and encoder step
 #: (:func:`fricid.extract.steady.rest_threshold`).
 REST_RESIDUE = 1e-9
+
+#: A step in time longer than this many median sample periods is a gap in the recording (rows
+#: missing, or logs of separate moves joined) and ends a run like a change of sign does.
+GAP_FACTOR = 10.0
 
 logger = logging.getLogger(__name__)
 
@@ -199,6 +205,10 @@ def iter_segments(
         sign = np.sign(buf.velocity)
         sign[np.abs(buf.velocity) <= REST_RESIDUE] = 0.0  # float residue: not moving
         edges = np.flatnonzero(sign[1:] != sign[:-1]) + 1
+        if len(buf) > 2:  # a gap in the recording ends a run too
+            dt = np.diff(buf.time)
+            gaps = np.flatnonzero(dt > GAP_FACTOR * float(np.median(dt))) + 1
+            edges = np.union1d(edges, gaps)
         starts = np.concatenate(([0], edges))
         stops = np.concatenate((edges, [len(buf)]))
         for start, stop in zip(starts[:-1], stops[:-1], strict=True):

@@ -186,11 +186,13 @@ def settled(
     whose first block is beyond ``sigmas`` robust standard deviations is trimmed up to the
     first block back within :data:`SETTLE_RELEASE` (the tail of the transient goes too), for
     both signals, plus one more block (where the transient fades out, only partly clean).
-    Each scale has a floor, the block mean's own noise: the sample-to-sample noise (from first
-    differences of ``raw``, the unfiltered torque, default ``torque``; of the velocity) over
-    the square root of the block length, so a noiseless or quantised trend is not mistaken
-    for a transient. Segments of fewer than 8 blocks are returned whole (too short to tell a
-    trend from a transient).
+    Each scale has a floor, the block mean's own noise: the larger of the sample-to-sample
+    noise (from first differences of ``raw``, the unfiltered torque, default ``torque``; of the
+    velocity) over the square root of the block length, and the block-to-block noise (from
+    first differences of the block means, which sees correlated noise, as in a drive's
+    averaged channels, and ignores a steady slope), so a noiseless or quantised trend is not
+    mistaken for a transient and neither is coloured noise. Segments of fewer than 8 blocks
+    are returned whole (too short to tell a trend from a transient).
 
     Parameters
     ----------
@@ -220,7 +222,11 @@ def settled(
 
     def blocks(x: np.ndarray, noisy: np.ndarray) -> tuple[np.ndarray, float]:
         means = x[: k * w].reshape(k, w).mean(axis=1)
-        floor = max(_noise_scale(noisy) / np.sqrt(w), 1e-12 * float(np.max(np.abs(means))))
+        floor = max(
+            _noise_scale(noisy) / np.sqrt(w),  # white noise averaged over a block
+            _noise_scale(means),  # block to block: correlated noise, insensitive to a slope
+            1e-12 * float(np.max(np.abs(means))),
+        )
         return means, floor
 
     v_means, v_floor = blocks(velocity, velocity)
