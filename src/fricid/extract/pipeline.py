@@ -41,20 +41,29 @@ class Diagnostics:
 
     Attributes
     ----------
-    rows, chunks : raw samples and log chunks read.
-    runs : runs of one velocity sign examined (including the flicker of a noisy velocity at rest).
-    segments : constant-velocity segments kept.
-    dropped : runs dropped, by reason: ``short_run`` (fewer than ``min_samples``),
-        ``no_plateau`` (no sample near the median velocity), ``short_steady`` (too short after
-        removing ramps and settle margins), ``rest`` (standstill), ``unsteady`` (no steady
-        plateau: return moves).
-    spikes : samples the median filter changed by more than ``SPIKE_SIGMAS`` robust sigmas.
-    binned, outside_bins : steady samples inside / outside every position bin.
-    velocity_setpoints : rad/s, the speeds found (cluster medians).
-    temperature_setpoints : degC, the temperatures found.
-    passes_min, passes_max : fewest and most passes averaged into one sample.
-    samples : samples kept and dropped over the whole log, by reason (``kept``,
-        ``dropped_rest``, ``dropped_transient``, ``dropped_outlier``, ``dropped_saturated``).
+    rows, chunks : int
+        Raw samples and log chunks read.
+    runs : int
+        Runs of one velocity sign examined (including the flicker of a noisy velocity at rest).
+    segments : int
+        Constant-velocity segments kept as set-point passes.
+    dropped : dict of str to int
+        Runs dropped, by reason: ``short_run`` (fewer than ``min_samples``), ``no_plateau`` (no
+        sample near the plateau), ``short_steady`` (too short after removing ramps and settle
+        margins), ``rest`` (standstill), ``unsteady`` (no steady plateau: return moves).
+    spikes : int
+        Samples the median filter changed by more than ``SPIKE_SIGMAS`` robust sigmas.
+    binned, outside_bins : int
+        Kept samples inside / outside every position bin.
+    velocity_setpoints : numpy.ndarray
+        rad/s, the speeds found (cluster medians).
+    temperature_setpoints : numpy.ndarray
+        degC, the temperatures found.
+    passes_min, passes_max : int
+        Fewest and most passes averaged into one sample.
+    samples : dict of str to int
+        Samples kept and dropped over the whole log, by reason (``kept``, ``dropped_rest``,
+        ``dropped_transient``, ``dropped_outlier``, ``dropped_saturated``).
     """
 
     rows: int
@@ -78,20 +87,28 @@ class ExtractionResult:
 
     Attributes
     ----------
-    samples : combined samples, direction 0 (eq. 11): one row per (temperature, velocity,
-        position bin), sorted in that order; velocity and friction of the positive direction.
-    by_direction : the same operating points per direction (+1/-1, velocity and friction
-        signed; rows ordered as ``samples`` with -1 before +1): ``tau_f+- = tau+- + tau_g``
-        with the fitted gravity, which keeps a drive's asymmetry.
-    gravity : the eq. 7 fit, or None with ``gravity="none"``.
-    diagnostics : see :class:`Diagnostics`.
-    sem, direction_sem : N m, standard error of each row's friction from the scatter of the
-        repetitions (the noise floor; use it for weighting or tolerances).
-    position : rad, mean position of each combined row's samples.
-    options : the extraction options used (also in ``samples.meta["extract"]``).
-    quality : per set-point and direction, samples kept and dropped (rest, transient, outlier,
-        saturated) and the scatter (:class:`~fricid.extract.quality.QualityTable`; also in
-        ``samples.meta["quality"]``).
+    samples : FrictionSamples
+        Combined samples, direction 0 (eq. 11): one row per (temperature, velocity, position
+        bin), sorted in that order; velocity and friction of the positive direction.
+    by_direction : FrictionSamples
+        The same operating points per direction (+1/-1, velocity and friction signed; rows
+        ordered as ``samples`` with -1 before +1): ``tau_f+- = tau+- + tau_g`` with the fitted
+        gravity, which keeps a drive's asymmetry.
+    gravity : GravityFit or None
+        The eq. 7 fit, or None with ``gravity="none"``.
+    diagnostics : Diagnostics
+        What was read, kept and dropped.
+    sem, direction_sem : numpy.ndarray
+        N m, standard error of each row's friction from the scatter of the repetitions (the
+        noise floor; use it for weighting or tolerances).
+    position : numpy.ndarray
+        rad, mean position of each combined row's samples.
+    options : dict
+        The extraction options used (also in ``samples.meta["extract"]``).
+    quality : QualityTable or None
+        Per set-point and direction, samples kept and dropped (rest, transient, outlier,
+        saturated) and their scatter (also in ``samples.meta["quality"]``, so it is written
+        with the samples).
     """
 
     samples: FrictionSamples
@@ -181,26 +198,38 @@ def extract(
 
     Parameters
     ----------
-    logs : one :class:`RawLog` or an iterable of consecutive chunks of one (streamed; memory
-        is bounded by a chunk plus one run). The torque is the logged torque or ``K I``.
-    positions : rad, centres of the position bins; None (default) makes each steady segment one
-        bin (right for a horizontal joint or a steady-state file; needs ``gravity="none"``).
-    bin_halfwidth : rad; default half the smallest spacing of ``positions``.
-    median_window : samples of the running median applied to the torque within each segment
-        (odd; 1 disables it). It removes current spikes.
-    gravity : "fit" (a joint with gravity: eq. 11 needs both directions at every operating
-        point, eq. 7 is fitted and gives the loads) or "none" (a horizontal joint: the torque is
+    logs : RawLog or iterable of RawLog
+        One log or consecutive chunks of one (streamed; memory is bounded by a chunk plus one
+        run). The torque is the logged torque or ``K I`` (eq. 13).
+    positions : array_like, optional
+        rad, centres of the position bins; None (default) makes each steady segment one bin
+        (right for a horizontal joint or a steady-state file; needs ``gravity="none"``).
+    bin_halfwidth : float, optional
+        rad; default half the smallest spacing of ``positions``.
+    median_window : int
+        Samples of the running median applied to the torque within each segment (odd; 1
+        disables it). It removes current spikes (section 2.2: "further filtered by median
+        filtering").
+    gravity : {"fit", "none"}
+        "fit": a joint with gravity; eq. 11 needs both directions at every operating point,
+        eq. 7 is fitted and gives the loads (eq. 12). "none": a horizontal joint; the torque is
         the friction, load 0; eq. 11 combines the directions where both exist, a single
-        direction is used as measured).
-    velocity_tolerance : relative band around a run's median velocity that counts as steady.
-    settle_time : s trimmed from each end of a steady part.
-    min_samples : shortest steady part kept (also after the checks below).
-    velocity_rtol : relative gap separating two velocity set-points.
-    temperature_atol : degC gap separating two temperature set-points.
-    outlier_sigmas : robust standard deviations beyond which a torque sample is an outlier
-        and dropped (:func:`fricid.extract.steady.outliers`, default 8); None disables the
-        screen.
-    settle_sigmas : robust standard deviations of the settling test on velocity and torque
+        direction is used as measured.
+    velocity_tolerance : float
+        Relative band around a run's plateau velocity that counts as steady.
+    settle_time : float
+        s trimmed from each end of a steady part.
+    min_samples : int
+        Shortest steady part kept (also after the checks below).
+    velocity_rtol : float
+        Relative gap separating two velocity set-points.
+    temperature_atol : float
+        degC gap separating two temperature set-points.
+    outlier_sigmas : float or None
+        Robust standard deviations beyond which a torque sample is an outlier and dropped
+        (:func:`fricid.extract.steady.outliers`, default 8); None disables the screen.
+    settle_sigmas : float or None
+        Robust standard deviations of the settling test on velocity and torque
         (:func:`fricid.extract.steady.settled`, default 5); None keeps the whole steady part.
 
     Returns
@@ -227,10 +256,12 @@ def extract(
 
     Raises
     ------
-    DataError : no constant-velocity segment; one direction only where eq. 11 needs two (the
-        message lists the set-points and the missing direction); a gravity fit without two
-        distinct positions.
-    ConfigError : bad options, among them ``gravity="fit"`` without ``positions``.
+    DataError
+        No constant-velocity segment (the message counts the runs dropped, by reason); one
+        direction only where eq. 11 needs two (it lists the set-points and the missing
+        direction); a gravity fit without two distinct positions.
+    ConfigError
+        Bad options, among them ``gravity="fit"`` without ``positions``.
     """
     _check_options(median_window, gravity, velocity_rtol, temperature_atol)
     bins = PositionBins(positions, bin_halfwidth)

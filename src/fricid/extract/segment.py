@@ -85,7 +85,9 @@ class Segment:
 
 @dataclass
 class SegmentCounts:
-    """What segmentation saw: rows read, runs found, runs kept and dropped (by reason)."""
+    """What segmentation saw: rows read, runs found, runs kept and dropped (by reason), and
+    the samples of dropped runs: ``dropped_samples`` at rest (zero velocity, runs shorter than
+    ``min_samples``), ``unsteady_samples`` in runs without a (long enough) plateau."""
 
     rows: int = 0
     chunks: int = 0
@@ -168,12 +170,23 @@ def iter_segments(
 
     Parameters
     ----------
-    logs : one RawLog or an iterable of consecutive chunks (memory is bounded by one chunk plus
-        one run).
-    velocity_tolerance : relative band around the plateau velocity that counts as steady.
-    settle_time : s trimmed from each end of the steady part.
-    min_samples : shortest steady part kept.
-    counts : filled with what was found and dropped.
+    logs : RawLog or iterable of RawLog
+        One log or consecutive chunks of one (memory is bounded by one chunk plus one run).
+    velocity_tolerance : float
+        Relative band around the plateau velocity that counts as steady.
+    settle_time : float
+        s trimmed from each end of the steady part.
+    min_samples : int
+        Shortest steady part kept.
+    counts : SegmentCounts, optional
+        Filled with what was found and dropped (runs by reason, samples by fate).
+
+    Yields
+    ------
+    Segment
+        The steady part of each run with a plateau, with its run's size, duration and band
+        fraction (whether it is a set-point, rest or unsteady is decided by the caller,
+        :class:`fricid.extract.accumulate.Accumulator`).
     """
     if not (0 < velocity_tolerance < 1):
         raise ConfigError(f"velocity_tolerance must be in (0, 1), got {velocity_tolerance!r}")
