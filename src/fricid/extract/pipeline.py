@@ -134,11 +134,13 @@ class ExtractionResult:
         ]
         if d.samples:
             n = d.samples
+            rest = d.dropped.get("rest", 0) + d.dropped.get("short_run", 0)
+            unsteady = sum(d.dropped.get(k, 0) for k in ("unsteady", "no_plateau", "short_steady"))
             lines.append(
                 f"samples kept {n['kept']}, dropped: rest {n['dropped_rest']}, transient "
                 f"{n['dropped_transient']}, outlier {n['dropped_outlier']}, saturated "
-                f"{n['dropped_saturated']}; runs rejected: {d.dropped.get('rest', 0)} at rest, "
-                f"{d.dropped.get('unsteady', 0)} unsteady"
+                f"{n['dropped_saturated']}; runs rejected: {rest} at rest or too short, "
+                f"{unsteady} without a steady plateau (return moves, aborted moves)"
             )
         if self.gravity is not None:
             g = self.gravity
