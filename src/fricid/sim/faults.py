@@ -167,7 +167,26 @@ class Faults:
         ``max_current`` A: 1.5 s of rest, a 50 mN m torque transient and 3 % velocity overshoot
         decaying in 0.15 s, 3 % creeps over 0.5 s, return moves peaking at 1.5x the fastest
         set-point, one 6-sample burst of 3 A every other traverse, and a current range of
-        ``1.6 max_current`` (it clips the bursts, not the steady state)."""
+        ``1.6 max_current`` (it clips the bursts, not the steady state).
+
+        Parameters
+        ----------
+        kinds : iterable of str
+            Fault kinds to switch on, from :data:`FAULT_KINDS`.
+        max_speed : float
+            rad/s, the design's fastest set-point.
+        max_current : float
+            A, the design's largest steady motor current.
+
+        Returns
+        -------
+        Faults
+
+        Raises
+        ------
+        ConfigError
+            An unknown kind (the message lists the known ones).
+        """
         unknown = [k for k in kinds if k not in FAULT_KINDS]
         if unknown:
             raise ConfigError(
