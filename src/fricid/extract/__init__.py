@@ -4,8 +4,10 @@
 >>> result = extract(logs, positions=centres, gravity="fit")     # doctest: +SKIP
 >>> result.samples, result.by_direction, result.gravity          # doctest: +SKIP
 
-Modules: :mod:`.segment` (constant-velocity segments, set-point clustering), :mod:`.bins`
-(position bins, repetition averaging), :mod:`.gravity` (eq. 7 and 11), :mod:`.pipeline`
+Modules: :mod:`.segment` (constant-velocity segments, set-point clustering), :mod:`.steady`
+(settling, outliers, saturation, rest), :mod:`.accumulate` (per-segment checks and statistics),
+:mod:`.bins` (position bins, repetition averaging), :mod:`.gravity` (eq. 7 and 11),
+:mod:`.quality` (the per-set-point quality table and its warnings), :mod:`.pipeline`
 (:func:`extract`).
 """
 
@@ -14,10 +16,16 @@ from __future__ import annotations
 from .bins import Cells, CellTable, Pooled, PositionBins, pool_cells
 from .gravity import GravityFit, fit_gravity, separate
 from .pipeline import GRAVITY_MODES, SPIKE_SIGMAS, Diagnostics, ExtractionResult, extract
+from .quality import QUALITY_COLUMNS, SCATTER_RATIO, QualityTable, flag_scatter, warn_quality
 from .segment import Segment, SegmentCounts, cluster, iter_segments
+from .steady import OUTLIER_SIGMAS, SETTLE_SIGMAS, outliers, saturated, settled
 
 __all__ = [
     "GRAVITY_MODES",
+    "OUTLIER_SIGMAS",
+    "QUALITY_COLUMNS",
+    "SCATTER_RATIO",
+    "SETTLE_SIGMAS",
     "SPIKE_SIGMAS",
     "CellTable",
     "Cells",
@@ -26,12 +34,18 @@ __all__ = [
     "GravityFit",
     "Pooled",
     "PositionBins",
+    "QualityTable",
     "Segment",
     "SegmentCounts",
     "cluster",
     "extract",
     "fit_gravity",
+    "flag_scatter",
     "iter_segments",
+    "outliers",
     "pool_cells",
+    "saturated",
     "separate",
+    "settled",
+    "warn_quality",
 ]

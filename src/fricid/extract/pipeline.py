@@ -17,13 +17,15 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from scipy.ndimage import median_filter
 
 from ..errors import ConfigError, DataError
 from ..samples import FrictionSamples, RawLog
-from .bins import Cells, CellTable, PositionBins, pool_cells
+from .accumulate import SPIKE_SIGMAS, Accumulator
+from .bins import PositionBins, pool_cells
 from .gravity import GravityFit, fit_gravity, separate
-from .segment import Segment, SegmentCounts, as_log_stream, cluster, iter_segments
+from .quality import QualityTable, flag_scatter, warn_quality
+from .segment import SegmentCounts, as_log_stream, cluster, iter_segments
+from .steady import OUTLIER_SIGMAS, SETTLE_SIGMAS
 
 __all__ = ["GRAVITY_MODES", "SPIKE_SIGMAS", "Diagnostics", "ExtractionResult", "extract"]
 
@@ -32,10 +34,6 @@ logger = logging.getLogger(__name__)
 #: Values of ``extract(..., gravity=...)``.
 GRAVITY_MODES = ("fit", "none")
 
-#: A filtered sample differing from the raw one by more than this many robust standard
-#: deviations (1.4826 MAD of the differences) is counted as a spike in the diagnostics.
-SPIKE_SIGMAS = 8.0
-
 
 @dataclass(frozen=True, eq=False)
 class Diagnostics:
@@ -43,17 +41,29 @@ class Diagnostics:
 
     Attributes
     ----------
-    rows, chunks : raw samples and log chunks read.
-    runs : runs of one velocity sign examined (including the flicker of a noisy velocity at rest).
-    segments : constant-velocity segments kept.
-    dropped : runs dropped, by reason: ``short_run`` (fewer than ``min_samples``),
-        ``no_plateau`` (no sample near the median velocity), ``short_steady`` (too short after
-        removing ramps and settle margins).
-    spikes : samples the median filter changed by more than ``SPIKE_SIGMAS`` robust sigmas.
-    binned, outside_bins : steady samples inside / outside every position bin.
-    velocity_setpoints : rad/s, the speeds found (cluster medians).
-    temperature_setpoints : degC, the temperatures found.
-    passes_min, passes_max : fewest and most passes averaged into one sample.
+    rows, chunks : int
+        Raw samples and log chunks read.
+    runs : int
+        Runs of one velocity sign examined (including the flicker of a noisy velocity at rest).
+    segments : int
+        Constant-velocity segments kept as set-point passes.
+    dropped : dict of str to int
+        Runs dropped, by reason: ``short_run`` (fewer than ``min_samples``), ``no_plateau`` (no
+        sample near the plateau), ``short_steady`` (too short after removing ramps and settle
+        margins), ``rest`` (standstill), ``unsteady`` (no steady plateau: return moves).
+    spikes : int
+        Samples the median filter changed by more than ``SPIKE_SIGMAS`` robust sigmas.
+    binned, outside_bins : int
+        Kept samples inside / outside every position bin.
+    velocity_setpoints : numpy.ndarray
+        rad/s, the speeds found (cluster medians).
+    temperature_setpoints : numpy.ndarray
+        degC, the temperatures found.
+    passes_min, passes_max : int
+        Fewest and most passes averaged into one sample.
+    samples : dict of str to int
+        Samples kept and dropped over the whole log, by reason (``kept``, ``dropped_rest``,
+        ``dropped_transient``, ``dropped_outlier``, ``dropped_saturated``).
     """
 
     rows: int
@@ -68,6 +78,7 @@ class Diagnostics:
     temperature_setpoints: np.ndarray
     passes_min: int
     passes_max: int
+    samples: dict[str, int] = field(default_factory=dict)
 
 
 @dataclass(frozen=True, eq=False)
@@ -76,17 +87,28 @@ class ExtractionResult:
 
     Attributes
     ----------
-    samples : combined samples, direction 0 (eq. 11): one row per (temperature, velocity,
-        position bin), sorted in that order; velocity and friction of the positive direction.
-    by_direction : the same operating points per direction (+1/-1, velocity and friction
-        signed; rows ordered as ``samples`` with -1 before +1): ``tau_f+- = tau+- + tau_g``
-        with the fitted gravity, which keeps a drive's asymmetry.
-    gravity : the eq. 7 fit, or None with ``gravity="none"``.
-    diagnostics : see :class:`Diagnostics`.
-    sem, direction_sem : N m, standard error of each row's friction from the scatter of the
-        repetitions (the noise floor; use it for weighting or tolerances).
-    position : rad, mean position of each combined row's samples.
-    options : the extraction options used (also in ``samples.meta["extract"]``).
+    samples : FrictionSamples
+        Combined samples, direction 0 (eq. 11): one row per (temperature, velocity, position
+        bin), sorted in that order; velocity and friction of the positive direction.
+    by_direction : FrictionSamples
+        The same operating points per direction (+1/-1, velocity and friction signed; rows
+        ordered as ``samples`` with -1 before +1): ``tau_f+- = tau+- + tau_g`` with the fitted
+        gravity, which keeps a drive's asymmetry.
+    gravity : GravityFit or None
+        The eq. 7 fit, or None with ``gravity="none"``.
+    diagnostics : Diagnostics
+        What was read, kept and dropped.
+    sem, direction_sem : numpy.ndarray
+        N m, standard error of each row's friction from the scatter of the repetitions (the
+        noise floor; use it for weighting or tolerances).
+    position : numpy.ndarray
+        rad, mean position of each combined row's samples.
+    options : dict
+        The extraction options used (also in ``samples.meta["extract"]``).
+    quality : QualityTable or None
+        Per set-point and direction, samples kept and dropped (rest, transient, outlier,
+        saturated) and their scatter (also in ``samples.meta["quality"]``, so it is written
+        with the samples).
     """
 
     samples: FrictionSamples
@@ -97,6 +119,7 @@ class ExtractionResult:
     direction_sem: np.ndarray
     position: np.ndarray
     options: dict[str, Any] = field(default_factory=dict)
+    quality: QualityTable | None = None
 
     def summary(self) -> str:
         """A few lines describing the result (for a report or the CLI)."""
@@ -109,12 +132,25 @@ class ExtractionResult:
             f"{d.temperature_setpoints.size} temperatures, "
             f"{d.passes_min}-{d.passes_max} passes per sample",
         ]
+        if d.samples:
+            n = d.samples
+            rest = d.dropped.get("rest", 0) + d.dropped.get("short_run", 0)
+            unsteady = sum(d.dropped.get(k, 0) for k in ("unsteady", "no_plateau", "short_steady"))
+            lines.append(
+                f"samples kept {n['kept']}, dropped: rest {n['dropped_rest']}, transient "
+                f"{n['dropped_transient']}, outlier {n['dropped_outlier']}, saturated "
+                f"{n['dropped_saturated']}; runs rejected: {rest} at rest or too short, "
+                f"{unsteady} without a steady plateau (return moves, aborted moves)"
+            )
         if self.gravity is not None:
             g = self.gravity
             lines.append(
                 f"gravity (eq. 7): p_x = {g.p_x:.5g} +- {g.p_x_se:.2g}, "
                 f"p_y = {g.p_y:.5g} +- {g.p_y_se:.2g} N m, residual {g.residual_rms:.2g} N m"
             )
+        if self.quality is not None and self.quality.flagged.any():
+            lines.append("set-points flagged (scatter far above their neighbours):")
+            lines.append(self.quality.subset(self.quality.flagged).describe())
         return "\n".join(lines)
 
 
@@ -130,19 +166,6 @@ class _Source:
             if self.name is None:
                 self.name = log.source
             yield log
-
-
-def _count_spikes(raw: np.ndarray, filtered: np.ndarray) -> int:
-    """Samples the filter moved by more than SPIKE_SIGMAS robust sigmas (1.4826 MAD of the
-    changes; for quantised or noiseless data with MAD 0, the median nonzero change)."""
-    r = np.abs(raw - filtered)
-    scale = 1.4826 * float(np.median(r))
-    if scale == 0.0:
-        nonzero = r[r > 0]
-        if nonzero.size == 0:
-            return 0
-        scale = float(np.median(nonzero))
-    return int(np.count_nonzero(r > SPIKE_SIGMAS * scale))
 
 
 def _check_options(median_window, gravity, velocity_rtol, temperature_atol) -> None:
@@ -170,38 +193,77 @@ def extract(
     min_samples: int = 20,
     velocity_rtol: float = 0.05,
     temperature_atol: float = 1.0,
+    outlier_sigmas: float | None = OUTLIER_SIGMAS,
+    settle_sigmas: float | None = SETTLE_SIGMAS,
 ) -> ExtractionResult:
     """Friction samples from raw constant-velocity sweeps (BAS-RBFNN paper, eq. 7-13).
 
     Parameters
     ----------
-    logs : one :class:`RawLog` or an iterable of consecutive chunks of one (streamed; memory
-        is bounded by a chunk plus one run). The torque is the logged torque or ``K I``.
-    positions : rad, centres of the position bins; None (default) makes each steady segment one
-        bin (right for a horizontal joint or a steady-state file; needs ``gravity="none"``).
-    bin_halfwidth : rad; default half the smallest spacing of ``positions``.
-    median_window : samples of the running median applied to the torque within each segment
-        (odd; 1 disables it). It removes current spikes.
-    gravity : "fit" (a joint with gravity: eq. 11 needs both directions at every operating
-        point, eq. 7 is fitted and gives the loads) or "none" (a horizontal joint: the torque is
+    logs : RawLog or iterable of RawLog
+        One log or consecutive chunks of one (streamed; memory is bounded by a chunk plus one
+        run). The torque is the logged torque or ``K I`` (eq. 13).
+    positions : array_like, optional
+        rad, centres of the position bins; None (default) makes each steady segment one bin
+        (right for a horizontal joint or a steady-state file; needs ``gravity="none"``).
+    bin_halfwidth : float, optional
+        rad; default half the smallest spacing of ``positions``.
+    median_window : int
+        Samples of the running median applied to the torque within each segment (odd; 1
+        disables it). It removes current spikes (section 2.2: "further filtered by median
+        filtering").
+    gravity : {"fit", "none"}
+        "fit": a joint with gravity; eq. 11 needs both directions at every operating point,
+        eq. 7 is fitted and gives the loads (eq. 12). "none": a horizontal joint; the torque is
         the friction, load 0; eq. 11 combines the directions where both exist, a single
-        direction is used as measured).
-    velocity_tolerance : relative band around a run's median velocity that counts as steady.
-    settle_time : s trimmed from each end of a steady part.
-    min_samples : shortest steady part kept.
-    velocity_rtol : relative gap separating two velocity set-points.
-    temperature_atol : degC gap separating two temperature set-points.
+        direction is used as measured.
+    velocity_tolerance : float
+        Relative band around a run's plateau velocity that counts as steady.
+    settle_time : float
+        s trimmed from each end of a steady part.
+    min_samples : int
+        Shortest steady part kept (also after the checks below).
+    velocity_rtol : float
+        Relative gap separating two velocity set-points.
+    temperature_atol : float
+        degC gap separating two temperature set-points.
+    outlier_sigmas : float or None
+        Robust standard deviations beyond which a torque sample is an outlier and dropped
+        (:func:`fricid.extract.steady.outliers`, default 8); None disables the screen.
+    settle_sigmas : float or None
+        Robust standard deviations of the settling test on velocity and torque
+        (:func:`fricid.extract.steady.settled`, default 5); None keeps the whole steady part.
 
     Returns
     -------
     ExtractionResult
+        With a per-set-point :class:`~fricid.extract.quality.QualityTable` (also in
+        ``samples.meta["quality"]``, so it is written with the samples).
+
+    Warns
+    -----
+    DataQualityWarning
+        When samples were dropped as outliers or pinned at a rail, or a set-point's scatter is
+        far above its neighbours' (:func:`fricid.extract.quality.warn_quality`).
+
+    Notes
+    -----
+    What is averaged (issue 11): a run is *rest*, not a set-point, when its speed is below
+    1e-3 of the fastest run's or it moved less than one encoder step (float residue of a held
+    joint); a run whose steady part is mostly outside the velocity band (a return move, a move
+    without a plateau) is *unsteady*; within a set-point's segment, leading and trailing
+    stretches where velocity or torque have not settled are trimmed, samples pinned at the
+    segment's extreme (a clipped sensor) and torque outliers are dropped. The quality table
+    counts every sample's fate.
 
     Raises
     ------
-    DataError : no constant-velocity segment; one direction only where eq. 11 needs two (the
-        message lists the set-points and the missing direction); a gravity fit without two
-        distinct positions.
-    ConfigError : bad options, among them ``gravity="fit"`` without ``positions``.
+    DataError
+        No constant-velocity segment (the message counts the runs dropped, by reason); one
+        direction only where eq. 11 needs two (it lists the set-points and the missing
+        direction); a gravity fit without two distinct positions.
+    ConfigError
+        Bad options, among them ``gravity="fit"`` without ``positions``.
     """
     _check_options(median_window, gravity, velocity_rtol, temperature_atol)
     bins = PositionBins(positions, bin_halfwidth)
@@ -220,27 +282,41 @@ def extract(
         min_samples=min_samples,
         counts=counts,
     )
-    acc = _Accumulator(bins, int(median_window))
+    acc = Accumulator(
+        bins,
+        int(median_window),
+        outlier_sigmas=outlier_sigmas,
+        settle_sigmas=settle_sigmas,
+        min_samples=int(min_samples),
+    )
     for seg in segments:
         acc.add(seg)
     source = stream.name
-    if not acc.cells:
+    kinds = acc.classify()
+    keep = kinds == "setpoint"
+    if not keep.any():
         raise DataError(
             f"no constant-velocity segment found in {counts.rows} rows: {counts.runs} runs of one "
             f"velocity sign, {counts.dropped_short_run} shorter than min_samples={min_samples}, "
             f"{counts.dropped_no_plateau} without a velocity plateau, "
-            f"{counts.dropped_short_steady} too short after trimming {settle_time} s of settling",
+            f"{counts.dropped_short_steady} too short after trimming {settle_time} s of settling, "
+            f"{int((kinds == 'rest').sum())} at rest (float residue or drift of a held joint), "
+            f"{int((kinds == 'unsteady').sum())} without a steady plateau",
             file=source,
         )
+    kept = [r for r, k in zip(acc.records, keep, strict=True) if k]
 
     # set-points: velocity by relative gaps, temperature by absolute gaps
-    v_label, v_set = cluster(np.array(acc.speeds), velocity_rtol, relative=True)
-    t_label, t_set = cluster(np.array(acc.temperatures), temperature_atol, relative=False)
+    v_label, v_set = cluster(np.array([r.speed for r in kept]), velocity_rtol, relative=True)
+    t_label, t_set = cluster(
+        np.array([r.temperature for r in kept]), temperature_atol, relative=False
+    )
     shape = (t_set.size, v_set.size, bins.n_bins)
-    pooled = pool_cells(acc.table(t_label, v_label, shape), int(np.prod(shape)) * 2)
+    cells = acc.table(keep, t_label, v_label, shape)
+    pooled = pool_cells(cells, int(np.prod(shape)) * 2)
     if not (pooled.count > 0).any():
         raise DataError(
-            f"{len(acc.cells)} constant-velocity segments found, but none has samples inside the "
+            f"{len(kept)} constant-velocity segments found, but none has samples inside the "
             "position bins; check positions and bin_halfwidth (radians)",
             file=source,
         )
@@ -254,77 +330,52 @@ def extract(
         "min_samples": int(min_samples),
         "velocity_rtol": velocity_rtol,
         "temperature_atol": temperature_atol,
+        "outlier_sigmas": outlier_sigmas,
+        "settle_sigmas": settle_sigmas,
     }
+    quality = flag_scatter(
+        acc.quality(
+            kinds,
+            t_label,
+            v_label,
+            t_set,
+            v_set,
+            cells,
+            (counts.dropped_samples, counts.unsteady_samples),
+        )
+    )
+    meta = {"extract": options, "quality": quality.rows()}
     samples, by_direction, fit, sem, direction_sem, position = _assemble(
-        pooled, shape, t_set, v_set, gravity, source, {"extract": options}
+        pooled, shape, t_set, v_set, gravity, source, meta
     )
     passes = pooled.passes[pooled.count > 0]
+    binned = int(sum(r.cells.count.sum() for r in kept))
     diagnostics = Diagnostics(
         rows=counts.rows,
         chunks=counts.chunks,
         runs=counts.runs,
-        segments=counts.kept,
+        segments=len(kept),
         dropped={
             "short_run": counts.dropped_short_run,
             "no_plateau": counts.dropped_no_plateau,
             "short_steady": counts.dropped_short_steady,
+            "rest": int((kinds == "rest").sum()),
+            "unsteady": int((kinds == "unsteady").sum()),
         },
-        spikes=acc.spikes,
-        binned=acc.binned,
-        outside_bins=acc.outside,
+        spikes=sum(r.spikes for r in kept),
+        binned=binned,
+        outside_bins=sum(r.kept for r in kept) - binned,
         velocity_setpoints=v_set,
         temperature_setpoints=t_set,
         passes_min=int(passes.min()),
         passes_max=int(passes.max()),
+        samples=quality.totals(),
     )
-    logger.info("extracted %d samples from %d segments", len(samples), counts.kept)
+    warn_quality(quality, source, stacklevel=2)
+    logger.info("extracted %d samples from %d segments", len(samples), len(kept))
     return ExtractionResult(
-        samples, by_direction, fit, diagnostics, sem, direction_sem, position, options
+        samples, by_direction, fit, diagnostics, sem, direction_sem, position, options, quality
     )
-
-
-class _Accumulator:
-    """Per-segment work: median filter (step 2), position bins (step 3), cell statistics."""
-
-    def __init__(self, bins: PositionBins, window: int) -> None:
-        self.bins = bins
-        self.window = window
-        self.speeds: list[float] = []
-        self.directions: list[int] = []
-        self.temperatures: list[float] = []
-        self.cells: list[Cells] = []
-        self.spikes = self.binned = self.outside = 0
-
-    def add(self, seg: Segment) -> None:
-        log = seg.log
-        raw = log.motor_torque  # eq. 13
-        if self.window > 1:
-            tau = median_filter(raw, size=self.window, mode="nearest")
-            self.spikes += _count_spikes(raw, tau)
-        else:
-            tau = raw
-        idx = self.bins.assign(log.position)
-        c = Cells.of(idx, tau, log.position, log.velocity, log.temperature, self.bins.n_bins)
-        n_in = int(c.count.sum())
-        self.binned += n_in
-        self.outside += len(log) - n_in
-        self.speeds.append(seg.speed)
-        self.directions.append(seg.direction)
-        self.temperatures.append(float(np.mean(log.temperature)))
-        self.cells.append(c)
-
-    def table(self, t_label: np.ndarray, v_label: np.ndarray, shape) -> CellTable:
-        """All cells, each labelled with its group (temperature, velocity, direction, bin)."""
-        _, nv, nb = shape
-        forward = (np.array(self.directions) > 0).astype(np.intp)  # 0: backward, 1: forward
-        first = ((t_label * nv + v_label) * 2 + forward) * nb
-        return CellTable(
-            group=(first[:, None] + np.arange(nb)[None, :]).ravel(),
-            **{
-                name: np.concatenate([getattr(c, name) for c in self.cells])
-                for name in ("count", "torque", "m2", "position", "velocity", "temperature")
-            },
-        )
 
 
 def _missing_message(has: np.ndarray, t_set, v_set) -> str:

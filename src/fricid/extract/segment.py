@@ -1,7 +1,11 @@
 """Find the constant-velocity portions of a (streamed) raw log.
 
-A *run* is a maximal stretch of samples whose measured velocity has one sign. Its *plateau* is
-the median velocity of the run (refined once: the median of the samples within the band); its
+A *run* is a maximal stretch of samples whose measured velocity has one sign (a velocity
+within :data:`REST_RESIDUE` of zero counts as zero) without a gap in time
+(:data:`GAP_FACTOR`). Its *plateau* is the median velocity of
+the run's faster half (samples above half its 99th-percentile speed, so a rest or drift with
+the move's sign does not pull it down), refined once: the median of the samples within the
+band; its
 *steady part* runs from the first to the last sample within ``velocity_tolerance`` of the
 plateau (which drops the acceleration and deceleration ramps), minus ``settle_time`` at each
 end (what is left of a ramp, and the drive settling). Runs whose steady part is shorter than
@@ -24,7 +28,27 @@ import numpy as np
 from ..errors import ConfigError
 from ..samples import RawLog
 
-__all__ = ["Segment", "SegmentCounts", "as_log_stream", "cluster", "iter_segments"]
+__all__ = [
+    "GAP_FACTOR",
+    "REST_RESIDUE",
+    "Segment",
+    "SegmentCounts",
+    "as_log_stream",
+    "cluster",
+    "iter_segments",
+]
+
+#: rad/s; a velocity of at most this magnitude is numerically zero (float residue of a velocity
+#: estimate at standstill, typically 1e-15) and separates runs like an exact zero does, so a
+#: rest whose residue has the sign of the next move is not merged into that move's run. It is
+#: 0.2 deg per 100 hours, far below any speed an encoder can measure. Whether a slower run is
+#: rest is decided later, relative to the log's own velocity scale and encoder step
+#: (:func:`fricid.extract.steady.rest_threshold`).
+REST_RESIDUE = 1e-9
+
+#: A step in time longer than this many median sample periods is a gap in the recording (rows
+#: missing, or logs of separate moves joined) and ends a run like a change of sign does.
+GAP_FACTOR = 10.0
 
 logger = logging.getLogger(__name__)
 
@@ -35,21 +59,35 @@ class Segment:
 
     ``row`` is the global 0-based index of the segment's first sample in the stream; ``plateau``
     the run's median velocity [rad/s] (signed); ``direction`` +1 or -1; ``log`` the samples.
+    ``run_samples`` and ``run_duration`` [s] describe the whole run the segment was cut from;
+    ``band_fraction`` is the share of the steady part's samples inside the velocity band (near
+    1 at constant velocity, small for a move without a plateau, such as a return move).
     """
 
     row: int
     plateau: float
     direction: int
     log: RawLog
+    run_samples: int = 0
+    band_fraction: float = 1.0
+    run_duration: float = 0.0
 
     @property
     def speed(self) -> float:
+        """rad/s, the plateau's magnitude."""
         return abs(self.plateau)
+
+    @property
+    def trimmed(self) -> int:
+        """Samples of the run outside the steady part (ramps and settle margins)."""
+        return max(self.run_samples - len(self.log), 0)
 
 
 @dataclass
 class SegmentCounts:
-    """What segmentation saw: rows read, runs found, runs kept and dropped (by reason)."""
+    """What segmentation saw: rows read, runs found, runs kept and dropped (by reason), and
+    the samples of dropped runs: ``dropped_samples`` at rest (zero velocity, runs shorter than
+    ``min_samples``), ``unsteady_samples`` in runs without a (long enough) plateau."""
 
     rows: int = 0
     chunks: int = 0
@@ -58,6 +96,8 @@ class SegmentCounts:
     dropped_short_run: int = 0
     dropped_no_plateau: int = 0
     dropped_short_steady: int = 0
+    dropped_samples: int = 0  # samples at rest: zero velocity, runs too short to be moves
+    unsteady_samples: int = 0  # samples of runs without a (long enough) plateau
 
 
 def as_log_stream(logs: RawLog | Iterable[RawLog]) -> Iterator[RawLog]:
@@ -81,14 +121,19 @@ def _steady(
     settle_time: float,
     min_samples: int,
     counts: SegmentCounts,
-) -> tuple[int, int, float] | None:
-    """Steady part (start, stop, plateau) of the run ``start:stop`` of ``log``, or None."""
+) -> tuple[int, int, float, int, float, float] | None:
+    """Steady part of the run ``start:stop`` of ``log``, or None: (start, stop, plateau, run
+    samples, band fraction, run duration)."""
     counts.runs += 1
     if stop - start < min_samples:
         counts.dropped_short_run += 1
+        counts.dropped_samples += stop - start
         return None
     v = log.velocity[start:stop]
-    plateau = float(np.median(v))
+    # the median of the faster half: a rest (or slow drift) at either end of the run, with the
+    # sign of the move, must not pull the plateau towards zero
+    speed = np.abs(v)
+    plateau = float(np.median(v[speed >= 0.5 * np.percentile(speed, 99)]))
     inside = np.flatnonzero(np.abs(v - plateau) <= velocity_tolerance * abs(plateau))
     if inside.size:
         # refine: the run's median is pulled towards the ramps; the band's median is not
@@ -96,6 +141,7 @@ def _steady(
         inside = np.flatnonzero(np.abs(v - plateau) <= velocity_tolerance * abs(plateau))
     if plateau == 0.0 or inside.size == 0:
         counts.dropped_no_plateau += 1
+        counts.unsteady_samples += stop - start
         return None
     a, b = start + int(inside[0]), start + int(inside[-1]) + 1
     t = log.time[a:b]
@@ -103,9 +149,13 @@ def _steady(
     b2 = a + int(np.searchsorted(t, t[-1] - settle_time, side="right"))
     if b2 - a2 < min_samples:
         counts.dropped_short_steady += 1
+        counts.unsteady_samples += stop - start
         return None
     counts.kept += 1
-    return a2, b2, plateau
+    v2 = log.velocity[a2:b2]
+    band = float(np.mean(np.abs(v2 - plateau) <= velocity_tolerance * abs(plateau)))
+    duration = float(log.time[stop - 1] - log.time[start])
+    return a2, b2, plateau, stop - start, band, duration
 
 
 def iter_segments(
@@ -120,12 +170,23 @@ def iter_segments(
 
     Parameters
     ----------
-    logs : one RawLog or an iterable of consecutive chunks (memory is bounded by one chunk plus
-        one run).
-    velocity_tolerance : relative band around the plateau velocity that counts as steady.
-    settle_time : s trimmed from each end of the steady part.
-    min_samples : shortest steady part kept.
-    counts : filled with what was found and dropped.
+    logs : RawLog or iterable of RawLog
+        One log or consecutive chunks of one (memory is bounded by one chunk plus one run).
+    velocity_tolerance : float
+        Relative band around the plateau velocity that counts as steady.
+    settle_time : float
+        s trimmed from each end of the steady part.
+    min_samples : int
+        Shortest steady part kept.
+    counts : SegmentCounts, optional
+        Filled with what was found and dropped (runs by reason, samples by fate).
+
+    Yields
+    ------
+    Segment
+        The steady part of each run with a plateau, with its run's size, duration and band
+        fraction (whether it is a set-point, rest or unsteady is decided by the caller,
+        :class:`fricid.extract.accumulate.Accumulator`).
     """
     if not (0 < velocity_tolerance < 1):
         raise ConfigError(f"velocity_tolerance must be in (0, 1), got {velocity_tolerance!r}")
@@ -155,11 +216,17 @@ def iter_segments(
         else:
             buf, buf_row = RawLog.concatenate([carry, chunk]), carry_row
         sign = np.sign(buf.velocity)
+        sign[np.abs(buf.velocity) <= REST_RESIDUE] = 0.0  # float residue: not moving
         edges = np.flatnonzero(sign[1:] != sign[:-1]) + 1
+        if len(buf) > 2:  # a gap in the recording ends a run too
+            dt = np.diff(buf.time)
+            gaps = np.flatnonzero(dt > GAP_FACTOR * float(np.median(dt))) + 1
+            edges = np.union1d(edges, gaps)
         starts = np.concatenate(([0], edges))
         stops = np.concatenate((edges, [len(buf)]))
         for start, stop in zip(starts[:-1], stops[:-1], strict=True):
             if sign[start] == 0:
+                counts.dropped_samples += int(stop - start)
                 continue
             found = _steady(buf, int(start), int(stop), *options)
             if found is not None:
@@ -167,19 +234,33 @@ def iter_segments(
         last = int(starts[-1])
         carry = buf.slice(last, len(buf))
         carry_row = buf_row + last
-    if carry is not None and len(carry) and carry.velocity[0] != 0:
+    if carry is not None and len(carry) and abs(carry.velocity[0]) > REST_RESIDUE:
         found = _steady(carry, 0, len(carry), *options)
         if found is not None:
             yield _segment(carry, carry_row, *found)
+    elif carry is not None:
+        counts.dropped_samples += len(carry)
     logger.debug("segmentation: %s", counts)
 
 
-def _segment(log: RawLog, row0: int, start: int, stop: int, plateau: float) -> Segment:
+def _segment(
+    log: RawLog,
+    row0: int,
+    start: int,
+    stop: int,
+    plateau: float,
+    run_samples: int,
+    band: float,
+    duration: float,
+) -> Segment:
     return Segment(
         row=row0 + start,
         plateau=plateau,
         direction=1 if plateau > 0 else -1,
         log=log.slice(start, stop),
+        run_samples=run_samples,
+        band_fraction=band,
+        run_duration=duration,
     )
 
 

@@ -14,7 +14,12 @@ The format, as EPOS Studio 3.x writes it (``;``-separated, CRLF line ends)::
 
 :func:`read_epos` turns one file into a :class:`~fricid.samples.RawLog` in SI units;
 :func:`read_epos_dir` reads a folder of them; :func:`epos_steady_samples` turns a folder of
-steady-state recordings (one constant velocity per file) into friction samples.
+steady-state recordings (one constant velocity per file) into friction samples, dropping
+outlier rows and warning about them (the robust statistics are in :mod:`._steady`).
+
+The module is slightly over 500 lines: one format's parser, reader and steady-state averaging,
+most of it docstrings that name every unit and error; splitting the parser from its two users
+would scatter the format's rules.
 """
 
 from __future__ import annotations
@@ -34,9 +39,19 @@ import pandas as pd
 from ..errors import ConfigError, DataError
 from ..samples import FrictionSamples, RawLog
 from ..units import UNITS, to_si
+from ._steady import (
+    OUTLIER_SIGMAS,
+    SCATTER_RATIO,
+    high_scatter,
+    outlier_rows,
+    quality_rows,
+    warn_steady,
+)
 
 __all__ = [
     "DEFAULT_NOMINAL_TORQUE",
+    "OUTLIER_SIGMAS",
+    "SCATTER_RATIO",
     "epos_steady_samples",
     "read_epos",
     "read_epos_dir",
@@ -290,6 +305,28 @@ def read_epos(
         channel, a number-like but malformed value, a short row, time not increasing.
         A text line in or after the data block (a typed comment) is skipped with a warning.
     """
+    return _read(
+        path,
+        nominal_torque=nominal_torque,
+        flip_sign=flip_sign,
+        temperature=temperature,
+        torque_constant=torque_constant,
+        counts_per_turn=counts_per_turn,
+        joint=joint,
+    )[0]
+
+
+def _read(
+    path: str | os.PathLike[str],
+    *,
+    nominal_torque: float = DEFAULT_NOMINAL_TORQUE,
+    flip_sign: bool = False,
+    temperature: float = 25.0,
+    torque_constant: float | None = None,
+    counts_per_turn: float | None = None,
+    joint: str = "joint",
+) -> tuple[RawLog, np.ndarray]:
+    """:func:`read_epos`, also returning the 1-based line number of each data row."""
     path = Path(path)
     _positive("nominal_torque", nominal_torque)
     _positive("counts_per_turn", counts_per_turn)
@@ -326,7 +363,7 @@ def read_epos(
         "position_source": "channel" if position is not None else "integrated velocity",
         "temperature_source": "constant parameter (no channel)",
     }
-    return RawLog(
+    log = RawLog(
         time=time,
         position=_integrate(time, values["velocity"]) if position is None else position,
         velocity=values["velocity"],
@@ -338,6 +375,7 @@ def read_epos(
         source=str(path),
         meta=meta,
     )
+    return log, rec.lines
 
 
 def _files(folder: str | os.PathLike[str], pattern: str) -> list[Path]:
@@ -358,8 +396,13 @@ def read_epos_dir(
     The logs are sorted by set-point, taken as each file's mean velocity (signed, after
     ``flip_sign``); file names are not interpreted. ``options`` go to :func:`read_epos`.
     """
-    logs = [read_epos(path, **options) for path in _files(folder, pattern)]
-    return sorted(logs, key=lambda log: float(np.mean(log.velocity)))
+    return [log for log, _ in _read_dir(folder, pattern, **options)]
+
+
+def _read_dir(folder, pattern: str, **options: Any) -> list[tuple[RawLog, np.ndarray]]:
+    """(log, data line numbers) of every file, sorted by mean velocity."""
+    read = [_read(path, **options) for path in _files(folder, pattern)]
+    return sorted(read, key=lambda item: float(np.mean(item[0].velocity)))
 
 
 def epos_steady_samples(
@@ -371,19 +414,49 @@ def epos_steady_samples(
     temperature: float = 25.0,
     load: float = 0.0,
     torque_constant: float | None = None,
+    outlier_sigmas: float | None = OUTLIER_SIGMAS,
 ) -> FrictionSamples:
     """Friction samples from a folder of steady-state EPOS recordings, one point per file.
 
     Each file is taken as one constant-velocity operating point already in steady state
-    (as in the lead-screw recordings): friction is the mean motor torque over the file,
-    velocity the mean velocity, direction the sign of the mean velocity, count the number
-    of rows and std the torque's sample standard deviation. Load and temperature are the
-    given constants (the recorder logs neither).
+    (as in the lead-screw recordings): friction is the mean motor torque over the file's rows
+    that are not outliers, velocity the mean velocity over the same rows, direction the sign of
+    the mean velocity, count the rows averaged and std their torque's sample standard
+    deviation. Load and temperature are the given constants (the recorder logs neither).
+
+    Parameters
+    ----------
+    folder : str or os.PathLike
+        The folder of recordings (never modified).
+    pattern : str
+        Glob of the files to read.
+    nominal_torque, flip_sign, temperature, torque_constant
+        As for :func:`read_epos`.
+    load : float
+        N m, the load recorded with every sample.
+    outlier_sigmas : float or None
+        Rows whose torque is further than this many robust standard deviations (1.4826 MAD)
+        from the file's median are dropped (default :data:`OUTLIER_SIGMAS`, 8); None keeps
+        every row.
+
+    Returns
+    -------
+    FrictionSamples
+        ``meta["quality"]`` holds one row per file (the columns of
+        :data:`fricid.extract.QUALITY_COLUMNS`: rows kept, outliers dropped, scatter, and
+        whether the scatter is far above the neighbours'); ``meta["outlier_lines"]`` the
+        1-based line numbers of the dropped rows, per file.
 
     Raises
     ------
     DataError
         For a file whose mean velocity is zero (no direction of motion).
+
+    Warns
+    -----
+    DataQualityWarning
+        Naming the file, the set-point and the lines, when rows were dropped as outliers or a
+        file's scatter is more than :data:`SCATTER_RATIO` times its neighbours'.
 
     Notes
     -----
@@ -392,22 +465,44 @@ def epos_steady_samples(
     and -2.77 mNm at -2.07 rpm (``2.csv``). With ``flip_sign=True`` (the authors' convention,
     ``N.csv`` is +N rpm) the same two points read +2.77 mNm at +2.07 rpm and -3.56 mNm at
     -2.14 rpm: which direction has the larger friction depends on the sign convention chosen.
+    No row of it is an outlier.
     """
-    logs = read_epos_dir(
+    if outlier_sigmas is not None and not (np.isfinite(outlier_sigmas) and outlier_sigmas > 0):
+        raise ConfigError(
+            f"outlier_sigmas must be a positive number or None, got {outlier_sigmas!r}"
+        )
+    read = _read_dir(
         folder,
-        pattern=pattern,
+        pattern,
         nominal_torque=nominal_torque,
         flip_sign=flip_sign,
         temperature=temperature,
         torque_constant=torque_constant,
     )
-    velocity = np.array([np.mean(log.velocity) for log in logs])
+    logs = [log for log, _ in read]
+    keep = [
+        ~outlier_rows(log.motor_torque, outlier_sigmas)
+        if outlier_sigmas is not None
+        else np.ones(len(log), dtype=bool)
+        for log in logs
+    ]
+    velocity = np.array([np.mean(log.velocity[k]) for log, k in zip(logs, keep, strict=True)])
     zero = np.flatnonzero(velocity == 0)
     if zero.size:
         raise DataError(
             "mean velocity is zero: not a constant-velocity recording", file=logs[zero[0]].source
         )
-    torque = [log.motor_torque for log in logs]
+    torque = [log.motor_torque[k] for log, k in zip(logs, keep, strict=True)]
+    std = np.array([np.std(t, ddof=1) if len(t) > 1 else 0.0 for t in torque])
+    flagged = high_scatter(velocity, std, SCATTER_RATIO)
+    names = [Path(log.source).name for log in logs]
+    dropped_lines = {
+        name: [int(x) for x in lines[~k]]
+        for name, (_, lines), k in zip(names, read, keep, strict=True)
+        if not k.all()
+    }
+    quality = quality_rows(names, velocity, keep, std, flagged, temperature)
+    warn_steady(str(folder), quality, dropped_lines)
     return FrictionSamples(
         velocity=velocity,
         load=load,
@@ -415,13 +510,16 @@ def epos_steady_samples(
         friction=np.array([np.mean(t) for t in torque]),
         direction=np.sign(velocity),
         count=np.array([len(t) for t in torque]),
-        std=np.array([np.std(t, ddof=1) if len(t) > 1 else 0.0 for t in torque]),
+        std=std,
         source=str(folder),
         meta={
             "format": FORMAT,
-            "method": "steady state: per-file mean torque and velocity",
-            "files": [Path(log.source).name for log in logs],
+            "method": "steady state: per-file mean torque and velocity, outlier rows dropped",
+            "files": names,
             "flip_sign": bool(flip_sign),
             "nominal_torque [N m]": float(nominal_torque),
+            "outlier_sigmas": outlier_sigmas,
+            "outlier_lines": dropped_lines,
+            "quality": quality,
         },
     )

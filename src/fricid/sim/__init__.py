@@ -9,12 +9,14 @@ It is fricid's embedded default data and the test oracle:
 
 Modules: :mod:`.laws` (true friction laws), :mod:`.design` (experiment designs, trapezoidal
 traverses), :mod:`.joint` (dynamics, noise, scenarios), :mod:`.simulate`, :mod:`.presets`,
-:mod:`.oracle`.
+:mod:`.oracle`, :mod:`.faults` (rest, settling, ramps, return moves, spike bursts, saturation;
+off by default, ``preset("paper1+faults")`` switches them on).
 """
 
 from __future__ import annotations
 
 from .design import Design, Profile, Traverse
+from .faults import FAULT_KINDS, Faults
 from .joint import Joint, Noise, Scenario, gravity_torque
 from .laws import FrictionLaw, LoadTemperatureLaw, ModelLaw
 from .oracle import (
@@ -29,10 +31,12 @@ from .simulate import CHUNKS, SeedLike, root_entropy, simulate, simulate_log
 
 __all__ = [
     "CHUNKS",
+    "FAULT_KINDS",
     "MEDIAN_EFFICIENCY",
     "PRESETS",
     "SIZES",
     "Design",
+    "Faults",
     "FrictionLaw",
     "Joint",
     "LoadTemperatureLaw",

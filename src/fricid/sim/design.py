@@ -15,10 +15,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ConfigError
+from ..units import DEG
 
 __all__ = ["Design", "Profile", "Traverse"]
-
-_DEG = math.pi / 180.0
 
 
 def _positive_array(name: str, values) -> np.ndarray:
@@ -57,7 +56,7 @@ class Design:
     bin_halfwidth: float
     repetitions: int = 10
     sample_rate: float = 250.0
-    acceleration: float = 200.0 * _DEG
+    acceleration: float = 200.0 * DEG
     settle_time: float = 0.2
     dwell_time: float = 0.2
     experiment_gap: float = 60.0

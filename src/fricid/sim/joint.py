@@ -15,6 +15,7 @@ import numpy as np
 
 from ..errors import ConfigError
 from .design import Design
+from .faults import Faults
 from .laws import FrictionLaw
 
 __all__ = ["Joint", "Noise", "Scenario", "gravity_torque"]
@@ -124,7 +125,8 @@ class Scenario:
 
     ``gravity`` is "fit" for a joint with gravity (the extractor separates it by eq. 11 and
     fits eq. 7) and "none" for a horizontal joint. :meth:`extract_options` gives the matching
-    keyword arguments of :func:`fricid.extract.extract`.
+    keyword arguments of :func:`fricid.extract.extract`. ``faults`` (None: a clean campaign)
+    injects the faults of a real campaign (:class:`~fricid.sim.faults.Faults`).
     """
 
     name: str
@@ -134,10 +136,13 @@ class Scenario:
     noise: Noise
     gravity: str = "fit"
     description: str = ""
+    faults: Faults | None = None
 
     def __post_init__(self) -> None:
         if self.gravity not in ("fit", "none"):
             raise ConfigError(f"Scenario: 'gravity' must be 'fit' or 'none', got {self.gravity!r}")
+        if self.faults is not None and not isinstance(self.faults, Faults):
+            raise ConfigError("Scenario: 'faults' must be a fricid.sim.Faults or None")
 
     def extract_options(self) -> dict[str, Any]:
         """Keyword arguments for :func:`fricid.extract.extract` matching this design: the
@@ -149,6 +154,17 @@ class Scenario:
             "bin_halfwidth": self.design.bin_halfwidth,
             "gravity": "fit",
         }
+
+    def with_faults(self, faults: Faults | None) -> Scenario:
+        """The same scenario with faults injected (None: a clean campaign)."""
+        return replace(self, faults=faults)
+
+    def period_length(self, iv: int) -> int:
+        """Samples in one period of velocity set-point ``iv`` (faults included)."""
+        traverse = self.design.traverse(self.design.velocities[iv])
+        if self.faults is not None and self.faults.active:
+            return self.faults.period_length(traverse)
+        return traverse.n_period
 
     def with_noise(self, noise: Noise) -> Scenario:
         """The same scenario with another noise model (``Noise.none()`` for exact data)."""

@@ -16,17 +16,15 @@ References
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 from typing import Protocol, runtime_checkable
 
 import numpy as np
 
 from ..models import FrictionModel
+from ..units import DEG
 
 __all__ = ["FrictionLaw", "LoadTemperatureLaw", "ModelLaw"]
-
-_DEG = math.pi / 180.0
 
 
 @runtime_checkable
@@ -69,7 +67,7 @@ class LoadTemperatureLaw:
     f_cl: float = 0.6  # Coulomb increase per N m of |load|
     f_s: float = 0.08  # N m, Stribeck excess at zero load
     f_sl: float = 0.3  # Stribeck excess increase per N m of |load|
-    v_s: float = 2.0 * _DEG  # rad/s, Stribeck velocity
+    v_s: float = 2.0 * DEG  # rad/s, Stribeck velocity
     alpha: float = 1.5  # Stribeck exponent
     beta: float = 0.2  # N m s/rad, viscous coefficient at t_ref
     t_ref: float = 25.0  # degC

@@ -7,26 +7,27 @@ all sizes share the joint and its noise, only the design shrinks.
 
 from __future__ import annotations
 
-import math
+from dataclasses import replace
 
 import numpy as np
 
 from ..errors import ConfigError
 from ..models import Stribeck
+from ..units import DEG
 from .design import Design
+from .faults import FAULT_KINDS, Faults
 from .joint import Joint, Noise, Scenario
 from .laws import LoadTemperatureLaw, ModelLaw
 
 __all__ = ["PRESETS", "SIZES", "preset"]
 
-_DEG = math.pi / 180.0
 
 #: Sizes of every preset, largest first.
 SIZES: tuple[str, ...] = ("full", "reduced", "quick")
 
 
 def _deg(values) -> np.ndarray:
-    return np.asarray(values, dtype=float) * _DEG
+    return np.asarray(values, dtype=float) * DEG
 
 
 # -- paper1: the BAS-RBFNN paper ----------------------------------------------------------------
@@ -61,9 +62,9 @@ _PAPER1_DESIGNS = {
 
 def _paper1(size: str) -> Scenario:
     design = Design(
-        bin_halfwidth=1.0 * _DEG,
+        bin_halfwidth=1.0 * DEG,
         sample_rate=250.0,
-        acceleration=200.0 * _DEG,
+        acceleration=200.0 * DEG,
         settle_time=0.2,
         dwell_time=0.2,
         **_PAPER1_DESIGNS[size],
@@ -177,16 +178,48 @@ errors are about 2 % (tau_c), 0.4 % (tau_s), 1.3 % (w_s) and 35 % (tau_v: its 10
 PRESETS = {"paper1": _paper1, "paper2": _paper2}
 
 
-def preset(name: str, size: str = "full") -> Scenario:
-    """The scenario ``name`` ("paper1" or "paper2") at ``size`` ("full", "reduced", "quick").
+def _max_current(scenario: Scenario) -> float:
+    """The largest steady motor current [A] of a design (both directions, every bin and
+    temperature): the scale of the saturation fault."""
+    d, joint = scenario.design, scenario.joint
+    t, v, p = np.meshgrid(d.temperatures, d.velocities, d.positions, indexing="ij")
+    tau = [joint.motor_torque(p, s * v, 0.0, t) for s in (-1.0, 1.0)]
+    return float(max(np.abs(x).max() for x in tau)) / joint.torque_constant
 
-    ``paper1``: the BAS-RBFNN paper's experiment (joint with gravity; velocity-, load- and
-    temperature-dependent friction). ``paper2``: the RWSAVSBAS paper's (horizontal joint; the
-    Stribeck law of its Table 2). See each scenario's ``description`` for every number.
+
+def preset(name: str, size: str = "full") -> Scenario:
+    """The scenario ``name`` at ``size`` ("full", "reduced", "quick").
+
+    Parameters
+    ----------
+    name : str
+        ``paper1``: the BAS-RBFNN paper's experiment (joint with gravity; velocity-, load- and
+        temperature-dependent friction). ``paper2``: the RWSAVSBAS paper's (horizontal joint;
+        the Stribeck law of its Table 2). A suffix adds faults of a real campaign at typical
+        magnitudes (:meth:`fricid.sim.Faults.typical`): ``"paper1+faults"`` all of them,
+        ``"paper2+rest+spikes"`` the ones named (:data:`fricid.sim.FAULT_KINDS`).
+    size : str
+        One of :data:`SIZES`.
+
+    Returns
+    -------
+    Scenario
+        See its ``description`` for every number.
     """
-    key = str(name).strip().lower()
+    key, *kinds = (part.strip() for part in str(name).strip().lower().split("+"))
     if key not in PRESETS:
         raise ConfigError(f"unknown preset '{name}'; choose one of: {', '.join(PRESETS)}")
     if size not in SIZES:
         raise ConfigError(f"unknown preset size '{size}'; choose one of: {', '.join(SIZES)}")
-    return PRESETS[key](size)
+    scenario = PRESETS[key](size)
+    if not kinds:
+        return scenario
+    if "faults" in kinds:
+        kinds = [k for k in kinds if k != "faults"] + list(FAULT_KINDS)
+    faults = Faults.typical(
+        kinds,
+        max_speed=float(scenario.design.velocities.max()),
+        max_current=_max_current(scenario),
+    )
+    described = f"{scenario.description}\nFaults injected: {faults}."
+    return replace(scenario, faults=faults, description=described)

@@ -4,7 +4,9 @@ For each temperature (one experiment), each velocity set-point and each repetiti
 is simulated: dwell, forward traverse, dwell, backward traverse (:class:`~.design.Traverse`),
 sampled at the design's rate. The log carries the motor current ``I = tau_m / K`` (eq. 8, 13)
 with sensor noise, ADC quantisation and spikes, the measured velocity, the encoder position and
-the temperature channel.
+the temperature channel. A scenario with :class:`~.faults.Faults` adds the faults of a real
+campaign (rest with float-residue velocity, settling transients, creeping ramps, return moves,
+spike bursts, sensor saturation); without them the log is exactly the clean one.
 
 Randomness: each period draws from its own generator,
 ``SeedSequence(entropy, spawn_key=(temperature index, velocity index, repetition))``, so the
@@ -21,6 +23,7 @@ import numpy as np
 
 from ..errors import ConfigError
 from ..samples import RawLog
+from . import faults as _faults
 from .joint import Scenario
 
 __all__ = ["CHUNKS", "SeedLike", "root_entropy", "simulate", "simulate_log"]
@@ -60,28 +63,48 @@ def _period(
 ) -> int:
     """Simulate one period into ``out[...][at:at+n]``; return n."""
     design, joint, noise = scenario.design, scenario.joint, scenario.noise
+    faults = scenario.faults if scenario.faults is not None and scenario.faults.active else None
     temperature = float(design.temperatures[it])
     traverse = design.traverse(design.velocities[iv])
-    n = traverse.n_period
-    k = np.arange(n)
-    prof = traverse.profile(k / design.sample_rate)
     rng = np.random.default_rng(np.random.SeedSequence(entropy, spawn_key=(it, iv, rep)))
+    if faults is None:
+        n = traverse.n_period
+        k = np.arange(n)
+        prof = traverse.profile(k / design.sample_rate)
+    else:
+        # faults draw from their own stream: the clean draws below stay as they were
+        frng = np.random.default_rng(np.random.SeedSequence(entropy, spawn_key=(it, iv, rep, 1)))
+        faulty = _faults.period(faults, traverse, frng)
+        prof = faulty.profile
+        n = prof.position.size
+        k = np.arange(n)
 
     # draws in a fixed order: pass offsets, current noise, spikes, velocity, temperature
     offsets = rng.normal(0.0, noise.pass_offset_std, 2)
     tau = joint.motor_torque(
         prof.position, prof.velocity, prof.acceleration, temperature, offsets[prof.pass_index]
     )
+    if faults is not None:
+        tau = tau + faulty.extra_torque + _holding(scenario, faulty, prof, temperature, frng)
     current = tau / joint.torque_constant + rng.normal(0.0, noise.current_std, n)
     n_spikes = rng.binomial(n, noise.spike_rate)
     where = rng.integers(0, n, n_spikes)
     size = rng.uniform(noise.spike_min, noise.spike_max, n_spikes)
     sign = np.where(rng.random(n_spikes) < 0.5, -1.0, 1.0)
     current[where] += sign * size
+    if faults is not None:
+        current += _faults.bursts(faults, n, frng)
     if noise.current_lsb > 0:
         current = np.round(current / noise.current_lsb) * noise.current_lsb
+    if faults is not None and faults.current_range > 0:
+        current = np.clip(current, -faults.current_range, faults.current_range)
     velocity_std = noise.velocity_rel_std * np.abs(prof.velocity) + noise.velocity_abs_std
     velocity = prof.velocity + velocity_std * rng.standard_normal(n)
+    if faults is not None and faults.rest_time > 0:
+        # at rest the velocity estimate is float residue, not sensor noise
+        velocity = np.where(
+            faulty.rest, _faults.rest_velocity(faults, faulty.rest_id, frng), velocity
+        )
     position = prof.position
     if noise.position_lsb > 0:
         position = np.round(position / noise.position_lsb) * noise.position_lsb
@@ -94,6 +117,18 @@ def _period(
     out["current"][s] = current
     out["temperature"][s] = temp
     return n
+
+
+def _holding(scenario: Scenario, faulty, prof, temperature: float, rng) -> np.ndarray:
+    """Torque [N m] the joint holds at rest (rest-time fault): a random fraction in (-1, 1),
+    one per rest stretch, of the break-away friction; zero while moving. The clean model
+    (eq. 6) gives 0 friction at rest, only gravity."""
+    if scenario.faults.rest_time <= 0:
+        return np.zeros(prof.position.size)
+    load = scenario.joint.gravity(prof.position)
+    breakaway = np.abs(scenario.joint.law(np.full(load.shape, 1e-12), load, temperature))
+    share = rng.uniform(-1.0, 1.0, 2)[np.maximum(faulty.rest_id, 0)]
+    return np.where(faulty.rest, share * breakaway, 0.0)
 
 
 def simulate(
@@ -121,7 +156,7 @@ def simulate(
     design = scenario.design
     n_t, n_v, _ = design.shape
     reps = design.repetitions
-    per_period = [design.traverse(v).n_period for v in design.velocities]
+    per_period = [scenario.period_length(iv) for iv in range(n_v)]
     gap = round(design.experiment_gap * design.sample_rate)
 
     def plan() -> Iterator[list[tuple[int, int, int, int]]]:

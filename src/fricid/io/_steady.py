@@ -1,0 +1,106 @@
+"""Robust statistics of steady-state recordings (one constant velocity per file), for the
+readers that average whole files (:func:`fricid.io.epos_steady_samples`): outlier rows by
+median/MAD, scatter far above the neighbours', and the warning that names them (issue 11,
+defect 4). The segment-level checks of a raw log live in :mod:`fricid.extract.steady`.
+"""
+
+from __future__ import annotations
+
+import warnings
+from typing import Any
+
+import numpy as np
+
+from ..errors import DataQualityWarning
+
+__all__ = [
+    "OUTLIER_SIGMAS",
+    "SCATTER_RATIO",
+    "high_scatter",
+    "outlier_rows",
+    "quality_rows",
+    "warn_steady",
+]
+
+#: A row whose torque is further than this many robust standard deviations (1.4826 MAD) from
+#: its file's median is an outlier and dropped (same threshold as
+#: :data:`fricid.extract.OUTLIER_SIGMAS`). The lead-screw recordings' largest deviation is
+#: 5.9 sigma; one row at 12x the nominal torque sits at hundreds.
+OUTLIER_SIGMAS = 8.0
+
+#: A file whose torque scatter exceeds this multiple of the median scatter of its neighbours
+#: (same direction, up to two set-points on each side) is flagged and warned about (as
+#: :data:`fricid.extract.SCATTER_RATIO`).
+SCATTER_RATIO = 4.0
+
+
+def outlier_rows(torque: np.ndarray, sigmas: float) -> np.ndarray:
+    """Rows further than ``sigmas`` robust standard deviations from the median (1.4826 MAD;
+    the median nonzero deviation when the MAD is 0; nothing when every row is equal)."""
+    dev = np.abs(torque - np.median(torque))
+    scale = 1.4826 * float(np.median(dev))
+    if scale == 0.0:
+        nonzero = dev[dev > 0]
+        if nonzero.size == 0:
+            return np.zeros(torque.shape, dtype=bool)
+        scale = float(np.median(nonzero))
+    return dev > sigmas * scale
+
+
+def high_scatter(velocity: np.ndarray, scatter: np.ndarray, ratio: float) -> np.ndarray:
+    """Files whose scatter exceeds ``ratio`` times the median of their neighbours' (same sign
+    of velocity, ordered by speed, up to two on each side)."""
+    flagged = np.zeros(velocity.size, dtype=bool)
+    for sign in (-1.0, 1.0):
+        group = np.flatnonzero(np.sign(velocity) == sign)
+        group = group[np.argsort(np.abs(velocity[group]))]
+        s = scatter[group]
+        for j, row in enumerate(group):
+            others = np.concatenate([s[max(j - 2, 0) : j], s[j + 1 : j + 3]])
+            if others.size and s[j] > max(ratio * float(np.median(others)), 1e-12):
+                flagged[row] = True
+    return flagged
+
+
+def warn_steady(folder: str, quality: list[dict[str, Any]], lines: dict[str, list[int]]) -> None:
+    """One DataQualityWarning for the outliers dropped and the files flagged, naming them."""
+    parts = []
+    for row in quality:
+        where = f"{row['label']} ({row['velocity']:+.4g} rad/s)"
+        if row["dropped_outlier"]:
+            shown = ", ".join(str(x) for x in lines[row["label"]][:5])
+            parts.append(
+                f"{where}: dropped {row['dropped_outlier']} outlier row(s) (line {shown}), "
+                f"more than {OUTLIER_SIGMAS:g} robust sigmas from the file's median torque"
+            )
+        if row["flagged"]:
+            parts.append(
+                f"{where}: torque scatter {row['scatter']:.3g} N m is more than "
+                f"{SCATTER_RATIO:g}x its neighbours'; check that recording"
+            )
+    if parts:
+        warnings.warn(f"{folder}: " + "; ".join(parts), DataQualityWarning, stacklevel=3)
+
+
+def quality_rows(names, velocity, keep, std, flagged, temperature: float) -> list[dict[str, Any]]:
+    """One quality-table row per file (the columns of :data:`fricid.extract.QUALITY_COLUMNS`;
+    :mod:`fricid.io` sits below :mod:`fricid.extract`, so the names are spelled here)."""
+    return [
+        {
+            "kind": "setpoint",
+            "label": name,
+            "temperature": float(temperature),
+            "velocity": float(v),
+            "direction": int(np.sign(v)),
+            "runs": 1,
+            "kept": int(k.sum()),
+            "outside_bins": 0,
+            "dropped_rest": 0,
+            "dropped_transient": 0,
+            "dropped_outlier": int((~k).sum()),
+            "dropped_saturated": 0,
+            "scatter": float(sd),
+            "flagged": bool(f),
+        }
+        for name, v, k, sd, f in zip(names, velocity, keep, std, flagged, strict=True)
+    ]
