@@ -8,7 +8,6 @@ then estimates the parameters' uncertainty from the Jacobian at the optimum.
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
-from datetime import UTC, datetime
 from typing import Any
 
 import numpy as np
@@ -17,6 +16,7 @@ from scipy import stats
 from .. import __version__
 from ..errors import ConfigError
 from ..fitted import FittedModel
+from ..io.atomic import created_timestamp
 from ..metrics import metrics
 from ..models import FrictionModel, get_model
 from ..optim import METHODS, OptimizeResult, minimize
@@ -212,7 +212,7 @@ def fit(
             "samples_sha256_16": samples_hash(samples),
             "directions": list(samples.directions()),
             "fricid_version": __version__,
-            "created": datetime.now(UTC).isoformat(timespec="seconds"),
+            "created": created_timestamp(),
         },
     )
 
