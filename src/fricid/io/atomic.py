@@ -297,6 +297,21 @@ def atomic_dir(path: str | os.PathLike[str]) -> Iterator[Path]:
     place, then the old one is deleted. If the body raises, the new folder is removed and
     ``path`` is left as it was. A killed run leaves only marked folders, which
     :func:`remove_stale` removes later.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The folder to (re)write. Missing parents are created.
+
+    Yields
+    ------
+    Path
+        The temporary folder to fill.
+
+    Notes
+    -----
+    The two renames are not one atomic step: a process killed between them leaves no
+    ``path``, and the previous folder under a marked name beside it.
     """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -306,7 +321,11 @@ def atomic_dir(path: str | os.PathLike[str]) -> Iterator[Path]:
     try:
         os.chmod(tmp, 0o777 & ~_umask())  # mkdtemp makes it 0o700
         yield tmp
-        old = None
+    except BaseException:
+        _discard(tmp)
+        raise
+    old = None
+    try:
         if path.exists():
             old = Path(
                 tempfile.mkdtemp(prefix=temp_prefix(path.name), suffix=".tmp", dir=path.parent)
@@ -314,9 +333,13 @@ def atomic_dir(path: str | os.PathLike[str]) -> Iterator[Path]:
             _live.add(os.path.abspath(old))
             os.replace(path, old)  # (replaces the empty folder made just now)
         os.replace(tmp, path)
-        _live.discard(os.path.abspath(tmp))
+    except BaseException:  # put the previous folder back before anything is removed
+        if old is not None and not path.exists() and any(old.iterdir()):
+            os.replace(old, path)
         if old is not None:
             _discard(old)
-    except BaseException:
         _discard(tmp)
         raise
+    _live.discard(os.path.abspath(tmp))
+    if old is not None:
+        _discard(old)
