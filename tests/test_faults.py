@@ -54,7 +54,7 @@ def _env(**extra: str) -> dict[str, str]:
     return {**os.environ, "PYTHONPATH": path, **extra}
 
 
-def _start(args: list[str], cwd: Path, **env: str) -> subprocess.Popen:
+def _start(args: list[str], cwd: Path, *, session: bool = False, **env: str) -> subprocess.Popen:
     """Run ``fricid ARGS``; stderr goes to a file (``proc.stderr_path``): a pipe would stay
     open as long as any orphaned grandchild holds it, and reading it would block."""
     fd, name = tempfile.mkstemp(prefix="fricid-test-stderr-", suffix=".txt")
@@ -67,6 +67,7 @@ def _start(args: list[str], cwd: Path, **env: str) -> subprocess.Popen:
             stdin=subprocess.DEVNULL,
             stdout=subprocess.DEVNULL,
             stderr=fh,
+            start_new_session=session,  # its own process group, as a shell job has
         )
     proc.stderr_path = err  # type: ignore[attr-defined]
     return proc
@@ -266,9 +267,11 @@ def test_simulate_killed_mid_write_then_rerun(tmp_path, sig):
 
 @pytest.fixture
 def busy_fleet(data, tmp_path) -> Iterator[tuple[subprocess.Popen, list, Path]]:
-    """``fricid fleet`` on two worker processes, once both exist and have started."""
+    """``fricid fleet`` on two worker processes (a process group of its own), once both
+    workers exist and have started."""
     out = tmp_path / "out"
-    proc = _start(["fleet", str(data / "fleet.csv"), "--out", str(out), "--workers", "2"], data)
+    args = ["fleet", str(data / "fleet.csv"), "--out", str(out), "--workers", "2"]
+    proc = _start(args, data, session=True)
     parent = psutil.Process(proc.pid)
     children: list = []
     try:
@@ -294,6 +297,20 @@ def test_fleet_sigterm_tears_the_pool_down(busy_fleet):
     line = _one_line(err)
     assert line.startswith("terminated (SIGTERM); kept ") and f"of {N_JOINTS} joints" in line
     assert "run the same command again" in line and str(out / "records") in line
+    _gone, alive = psutil.wait_procs(children, timeout=5)
+    assert _alive(alive) == []
+    assert list(out.rglob("*.tmp")) == []
+
+
+def test_fleet_ctrl_c_in_a_terminal(busy_fleet):
+    """Ctrl-C reaches the whole process group: the workers ignore it, the driver stops them
+    and says in one line what it kept."""
+    proc, children, out = busy_fleet
+    os.killpg(proc.pid, signal.SIGINT)
+    code, err = _finish(proc, 20)
+    assert code == 130
+    line = _one_line(err)
+    assert line.startswith("interrupted; kept ") and "run the same command again" in line
     _gone, alive = psutil.wait_procs(children, timeout=5)
     assert _alive(alive) == []
     assert list(out.rglob("*.tmp")) == []

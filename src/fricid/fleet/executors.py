@@ -122,6 +122,11 @@ def _tear_down(pool: ProcessPoolExecutor) -> None:
             if proc.is_alive():
                 proc.kill()
                 proc.join(1.0)
+    # With its workers gone, the pool's manager thread winds down; wait for it, or it races
+    # the interpreter's exit hook (``OSError: Bad file descriptor`` printed at exit).
+    manager = getattr(pool, "_executor_manager_thread", None)
+    if manager is not None and manager is not threading.current_thread():
+        manager.join(_TERMINATE_GRACE)
 
 
 class Executor(Protocol):
