@@ -136,9 +136,12 @@ def _finish(proc: subprocess.Popen, timeout: float) -> tuple[int, str]:
 
 
 def _one_line(err: str) -> str:
+    """The one line an interrupt ends with (after whatever progress the command printed)."""
     lines = [line for line in err.splitlines() if line.strip()]
-    assert "Traceback" not in err and len(lines) == 1, err
-    return lines[0]
+    assert "Traceback" not in err and lines, err
+    endings = [line for line in lines if line.startswith(("interrupted", "terminated"))]
+    assert endings == lines[-1:], err
+    return lines[-1]
 
 
 @pytest.fixture(scope="module")
