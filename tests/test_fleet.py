@@ -37,6 +37,7 @@ from fricid.fleet import (
     write_drift,
 )
 from fricid.io import write_rawlog
+from fricid.io.atomic import HOST_TAG
 from fricid.models import Stribeck
 from fricid.sim import ModelLaw, preset, simulate
 from fricid.workflow import run_joint
@@ -370,12 +371,16 @@ def test_killed_run_leaves_no_partial_output_and_resumes(fleet, tmp_path):
                   date="2026-03-01", progress=progress)
         """
     )
-    proc = subprocess.run([sys.executable, "-c", script], capture_output=True, timeout=120)
-    assert proc.returncode == -signal.SIGKILL, proc.stderr.decode()
+    proc = subprocess.Popen(
+        [sys.executable, "-c", script], stdout=subprocess.PIPE, stderr=subprocess.PIPE
+    )
+    _out, err = proc.communicate(timeout=120)
+    assert proc.returncode == -signal.SIGKILL, err.decode()
     records = sorted(out.rglob("records/*/*.json"))
     assert len(records) == 2 and all(json.loads(p.read_text())["rows"] for p in records)
     assert not (out / "results").exists() and not (out / "results.csv").exists()
-    (out / "records" / "r0" / ".j9.json.x1y2.tmp").write_text("{half")  # a torn write
+    torn = out / "records" / "r0" / f".j9.json.fricid-{HOST_TAG}-{proc.pid}-x1y2.tmp"
+    torn.write_text("{half")  # a torn write of the killed driver
     resumed = run_fleet(manifest, out, executor=SerialExecutor(), date="2026-03-01")
     assert resumed.skipped == 2 and resumed.computed == N_GOOD
     assert list(out.rglob("*.tmp")) == []

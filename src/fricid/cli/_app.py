@@ -3,13 +3,25 @@
 Sub-commands live one per module and register themselves on :data:`app`. Results go to
 stdout, diagnostics and progress to stderr; a :class:`~fricid.errors.FricidError` becomes one
 line on stderr and exit status 2, never a traceback (DESIGN.md, "Errors").
+
+Interrupts end the same way wherever they land (importing, parsing, compiling, writing):
+one line on stderr and exit status 130 for Ctrl-C (SIGINT), 143 for SIGTERM. SIGTERM is
+turned into :class:`Terminated`, a ``KeyboardInterrupt``, so every cleanup path an interrupt
+takes runs for it too (temporary files removed, worker pools torn down). An exception chained
+from an interrupt, or raised while one is being handled (numba's ``RuntimeError: no compiled
+object yet`` after Ctrl-C during compilation), counts as that interrupt.
 """
 
 from __future__ import annotations
 
+import contextlib
+import os
+import signal
 import sys
-from collections.abc import Callable
+import threading
+from collections.abc import Callable, Iterator
 from functools import wraps
+from types import FrameType
 from typing import Any
 
 import typer
@@ -18,7 +30,17 @@ from rich.markup import escape
 
 from ..errors import FricidError
 
-__all__ = ["app", "bench_app", "console", "err_console", "handle_errors"]
+__all__ = [
+    "Terminated",
+    "app",
+    "bench_app",
+    "console",
+    "err_console",
+    "handle_errors",
+    "interrupt_exit",
+    "main",
+    "signal_handlers",
+]
 
 app = typer.Typer(
     name="fricid",
@@ -42,21 +64,183 @@ app.add_typer(bench_app, name="bench")
 console = Console()
 err_console = Console(stderr=True)
 
+#: Exit status of a command stopped by a signal: 128 + the signal number, as a shell reports.
+EXIT_INTERRUPTED = 130
+EXIT_TERMINATED = 143
+
+#: What every interrupted command can say: outputs are written atomically (fricid.io.atomic).
+_DEFAULT_DETAIL = "no file was left half-written"
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM arrived; raised in the main thread by the handler of :func:`signal_handlers`."""
+
+
+class _State:
+    """The signal seen by the current command (reset when the outermost guard is entered)."""
+
+    depth = 0
+    signal: int | None = None
+    reported = False
+
+
+def _on_signal(signum: int, frame: FrameType | None) -> None:
+    _State.signal = signum
+    if signum == signal.SIGTERM:
+        raise Terminated("terminated")
+    raise KeyboardInterrupt
+
+
+@contextlib.contextmanager
+def signal_handlers() -> Iterator[None]:
+    """SIGINT and SIGTERM raise (``KeyboardInterrupt``, :class:`Terminated`) for the body.
+
+    Only in the main thread (the only one that may set handlers), and not for a signal that
+    is ignored (``nohup``, a background job): that stays ignored. The previous handlers are
+    restored after the body.
+    """
+    outer = _State.depth == 0
+    if outer:
+        _State.signal, _State.reported = None, False
+    _State.depth += 1
+    previous: dict[int, Any] = {}
+    try:
+        if threading.current_thread() is threading.main_thread():
+            for signum in (signal.SIGINT, signal.SIGTERM):
+                old = signal.getsignal(signum)
+                if old is not signal.SIG_IGN:
+                    previous[signum] = old
+                    signal.signal(signum, _on_signal)
+        yield
+    finally:
+        _State.depth -= 1
+        for signum, old in previous.items():
+            signal.signal(signum, old if old is not None else signal.SIG_DFL)
+
+
+def _chain(exc: BaseException) -> Iterator[BaseException]:
+    seen: set[int] = set()
+    todo: list[BaseException] = [exc]
+    while todo:
+        item = todo.pop(0)
+        if id(item) in seen:
+            continue
+        seen.add(id(item))
+        yield item
+        todo.extend(e for e in (item.__cause__, item.__context__) if e is not None)
+
+
+def interrupt_exit(exc: BaseException) -> tuple[int, str] | None:
+    """The exit status and the line to print if ``exc`` ends an interrupted command.
+
+    Parameters
+    ----------
+    exc : BaseException
+        What the command raised.
+
+    Returns
+    -------
+    (int, str) or None
+        ``(130, "interrupted; ...")`` or ``(143, "terminated (SIGTERM); ...")`` when ``exc``
+        is a ``KeyboardInterrupt``, has one in its chain (``__cause__``, ``__context__``), or
+        is an ``Exception`` raised after SIGINT or SIGTERM arrived; None otherwise. The
+        detail after the semicolon is the message of an interrupt in the chain that has
+        one (a fleet says what it kept and how to resume), else that no file was left
+        half-written.
+    """
+    chain = list(_chain(exc))
+    interrupts = [e for e in chain if isinstance(e, KeyboardInterrupt)]
+    if not interrupts and not (_State.signal is not None and isinstance(exc, Exception)):
+        return None
+    terminated = _State.signal == signal.SIGTERM or any(
+        isinstance(e, Terminated) for e in interrupts
+    )
+    details = [str(e) for e in interrupts if not isinstance(e, Terminated) and str(e).strip()]
+    detail = " ".join(details[0].split()) if details else _DEFAULT_DETAIL
+    if terminated:
+        return EXIT_TERMINATED, f"terminated (SIGTERM); {detail}"
+    return EXIT_INTERRUPTED, f"interrupted; {detail}"
+
+
+def _report_interrupt(code: int, line: str) -> None:
+    if not _State.reported:
+        _State.reported = True
+        with contextlib.suppress(Exception):
+            err_console.print(escape(line), highlight=False, soft_wrap=True)
+    sys.exit(code)
+
 
 def handle_errors(func: Callable[..., Any]) -> Callable[..., Any]:
-    """Turn fricid's own errors into one line on stderr and exit status 2."""
+    """Turn fricid's own errors into one line on stderr and exit status 2, and an interrupt
+    (anywhere in the command) into one line and exit status 130 or 143."""
 
     @wraps(func)
     def wrapper(*args: Any, **kwargs: Any) -> Any:
-        try:
-            return func(*args, **kwargs)
-        except FricidError as exc:
-            err_console.print(
-                f"[bold red]error:[/] {escape(str(exc))}", highlight=False, soft_wrap=True
-            )
-            raise typer.Exit(code=2) from None
-        except KeyboardInterrupt:
-            err_console.print("interrupted; no partial output was written")
-            sys.exit(130)
+        with signal_handlers():
+            try:
+                return func(*args, **kwargs)
+            except BaseException as exc:
+                stop = interrupt_exit(exc)
+                if stop is not None:
+                    _report_interrupt(*stop)
+                if isinstance(exc, FricidError):
+                    err_console.print(
+                        f"[bold red]error:[/] {escape(str(exc))}", highlight=False, soft_wrap=True
+                    )
+                    raise typer.Exit(code=2) from None
+                raise
 
     return wrapper
+
+
+def main(args: list[str] | None = None) -> None:
+    """Run the ``fricid`` command line (the console script's entry, via :mod:`fricid.cli`).
+
+    Everything runs under :func:`signal_handlers`, from importing the sub-commands to the
+    exit, so an interrupt that lands outside a command (while importing, or while the
+    arguments are parsed) also ends in one line and status 130 or 143.
+    """
+    with signal_handlers():
+        try:
+            from . import _commands  # noqa: F401  (registers the sub-commands)
+
+            app(args=args)
+        except SystemExit as exc:
+            # typer turns a KeyboardInterrupt outside a command into a silent exit 130
+            if exc.code in (EXIT_INTERRUPTED, EXIT_TERMINATED) and _State.signal is not None:
+                code = EXIT_TERMINATED if _State.signal == signal.SIGTERM else EXIT_INTERRUPTED
+                _report_interrupt(*(interrupt_exit(exc) or (code, "interrupted")))
+            raise
+        except BaseException as exc:
+            stop = interrupt_exit(exc)
+            if stop is None:
+                raise
+            _report_interrupt(*stop)
+
+
+def _restore_source_date(previous: str | None) -> None:
+    if previous is None:
+        os.environ.pop("SOURCE_DATE_EPOCH", None)
+    else:
+        os.environ["SOURCE_DATE_EPOCH"] = previous
+
+
+@app.callback()
+def _root(
+    ctx: typer.Context,
+    reproducible: bool = typer.Option(
+        False,
+        "--reproducible",
+        help=(
+            "Byte-identical output files for identical inputs: stamp files with "
+            "SOURCE_DATE_EPOCH (seconds since 1970 UTC) when it is set, else with "
+            "1970-01-01T00:00:00+00:00, instead of the current time. Setting "
+            "SOURCE_DATE_EPOCH alone has the same effect."
+        ),
+    ),
+) -> None:
+    """Identify the friction of robot joints."""
+    if reproducible and not os.environ.get("SOURCE_DATE_EPOCH", "").strip():
+        previous = os.environ.get("SOURCE_DATE_EPOCH")
+        os.environ["SOURCE_DATE_EPOCH"] = "0"  # read by fricid.io.atomic.created_timestamp
+        ctx.call_on_close(lambda: _restore_source_date(previous))

@@ -17,10 +17,19 @@ from ..errors import ConfigError
 
 __all__ = ["DaskExecutor"]
 
+logger = logging.getLogger(__name__)
+
 T = TypeVar("T")
 
 #: Where a LocalCluster listens: loopback only (scheduler, nannies and workers).
 LOOPBACK = "127.0.0.1"
+
+
+async def _quiet_shutdown() -> None:
+    """Run on each worker of a cluster being torn down after an interrupt: its heartbeats
+    to the closing scheduler fail, and each failure would log a traceback. (A coroutine:
+    ``Client.run(..., wait=False)`` takes only those.)"""
+    logging.getLogger("distributed").setLevel(logging.CRITICAL)
 
 
 class DaskExecutor:
@@ -121,7 +130,13 @@ class DaskExecutor:
                     result = exc
                 fut.release()
                 yield index[fut.key], result
-        except BaseException:
+        except BaseException:  # interrupted: stop the tasks, quietly (the caller closes)
+            if self.cluster is not None:  # only a cluster we started: not a shared one
+                try:
+                    self.client.run(_quiet_shutdown, wait=False)
+                    logging.getLogger("distributed").setLevel(logging.CRITICAL)
+                except Exception as exc:  # the cluster may be gone already
+                    logger.debug("could not quieten the Dask workers: %s", exc)
             self.client.cancel(futures)
             raise
 

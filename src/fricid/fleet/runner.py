@@ -3,7 +3,10 @@
 For each joint the driver decides whether it must run (new, changed log, changed settings,
 failed before, or ``force``), sends the jobs to an executor, writes each joint's record and
 model files as its result arrives, and finally writes the results table. A joint that fails
-is reported in the table and in :attr:`FleetRun.failures`; the others complete.
+is reported in the table and in :attr:`FleetRun.failures`; the others complete. An
+interrupted run (Ctrl-C, or SIGTERM turned into an exception by the CLI) keeps every joint
+finished so far and raises :class:`FleetInterrupted`, which says what was kept and how to
+resume.
 """
 
 from __future__ import annotations
@@ -27,9 +30,37 @@ from .manifest import JointSpec, Manifest, read_manifest
 from .store import FleetStore
 from .table import results_table, write_results
 
-__all__ = ["FleetRun", "JointEvent", "run_fleet"]
+__all__ = ["FleetInterrupted", "FleetRun", "JointEvent", "run_fleet"]
 
 logger = logging.getLogger(__name__)
+
+
+class FleetInterrupted(KeyboardInterrupt):
+    """A fleet run was interrupted; the joints finished so far are kept.
+
+    Raised from the original ``KeyboardInterrupt`` (or the CLI's SIGTERM exception, a
+    subclass of it), so ``except KeyboardInterrupt`` still catches it.
+
+    Parameters
+    ----------
+    out : Path
+        The output folder.
+    kept : int
+        Joints whose record is on disk (finished now or unchanged since the last run).
+    failed : int
+        Of those, the joints that failed (they run again next time).
+    total : int
+        Joints in the manifest.
+    """
+
+    def __init__(self, out: Path, kept: int, failed: int, total: int) -> None:
+        self.out, self.kept, self.failed, self.total = Path(out), kept, failed, total
+        failed_text = f" ({failed} of them failed and will run again)" if failed else ""
+        super().__init__(
+            f"kept {kept} of {total} joints finished{failed_text} in "
+            f"{self.out / 'records'} (no results table yet); run the same command again "
+            "to resume: finished joints are skipped"
+        )
 
 
 @dataclass(frozen=True, eq=False)
@@ -196,6 +227,10 @@ def run_fleet(
             done = [r for r in records if r is not None]
             table = results_table(done)
             results, csv_path = write_results(table, store.root)
+    except KeyboardInterrupt as exc:
+        kept = [r for r in records if r is not None]
+        failed = sum(1 for r in kept if r.get("status") != "ok")
+        raise FleetInterrupted(Path(out), len(kept), failed, len(manifest)) from exc
     finally:
         if owned:
             runner.close()

@@ -10,8 +10,11 @@ Layout::
 Every file is replaced atomically (temporary file, then rename), and each joint's record is
 written as soon as its result arrives, so an interrupted run keeps every finished joint and
 the next run resumes from there. A run holds a lock on ``OUT/.lock``: two runs cannot write
-the same folder at once. Temporary files a killed run left behind are removed when the next
-run opens the folder.
+the same folder at once. Temporary files and folders a killed run left behind are removed when
+the next run opens the folder, and only those: a file is removed only if its name carries
+fricid's mark and its writer's process is gone (:func:`fricid.io.atomic.remove_stale`), or it
+is a results folder being swapped in by a fricid process that is gone
+(:func:`_is_stale_results`). A user's ``notes.tmp`` or ``.results-2025`` stays.
 """
 
 from __future__ import annotations
@@ -21,6 +24,7 @@ import json
 import logging
 import math
 import os
+import re
 import shutil
 from pathlib import Path
 from typing import Any
@@ -28,6 +32,7 @@ from typing import Any
 from .. import __version__
 from ..errors import ConfigError
 from ..io import atomic_write
+from ..io.atomic import pid_alive, remove_stale
 from .hashing import RECORD_FORMAT
 from .job import JointOutcome
 from .manifest import JointSpec
@@ -35,6 +40,35 @@ from .manifest import JointSpec
 __all__ = ["FleetStore"]
 
 logger = logging.getLogger(__name__)
+
+#: The folders :func:`fricid.fleet.table.write_results` swaps the results table through.
+_RESULTS_SWAP = re.compile(r"\.results-(?:new-(?P<new>[0-9]+)-[0-9a-f]{8}|old-(?P<old>[0-9]+))\Z")
+
+#: What such a folder holds: Parquet parts under robot=/date= partitions, nothing else.
+_RESULTS_PART = re.compile(r"robot=[^/]*/date=[^/]*/part-[0-9]+\.parquet\Z")
+
+
+def _is_stale_results(folder: Path) -> bool:
+    """Whether ``folder`` is a results folder of a fricid process that is gone.
+
+    Its name must be one ``write_results`` gives (with the writer's pid), that pid must be
+    gone (as for :func:`~fricid.io.atomic.is_stale_temp`), and it must hold only the
+    partitioned Parquet parts fricid writes there: a user's folder of the same name survives.
+    """
+    match = _RESULTS_SWAP.match(folder.name)
+    if match is None or not folder.is_dir() or folder.is_symlink():
+        return False
+    pid = int(match.group("new") or match.group("old"))
+    if pid == os.getpid() or pid_alive(pid):
+        return False
+    try:
+        entries = list(folder.rglob("*"))
+    except OSError:
+        return False
+    files = [p for p in entries if not p.is_dir()]
+    return all(
+        not p.is_symlink() and _RESULTS_PART.match(p.relative_to(folder).as_posix()) for p in files
+    )
 
 
 def _clean(value: Any) -> Any:
@@ -85,12 +119,12 @@ class FleetStore:
         self._lock = fh
 
     def _remove_leftovers(self) -> None:
-        """Temporary files and folders a killed run left (never a finished output)."""
-        for tmp in self.root.rglob(".*.tmp"):
-            with contextlib.suppress(OSError):
-                tmp.unlink()
+        """Temporary files and folders a killed fricid run left (never a finished output,
+        never a file fricid did not write)."""
+        remove_stale(self.root, recursive=True)
         for tmp in self.root.glob(".results-*"):
-            shutil.rmtree(tmp, ignore_errors=True)
+            if _is_stale_results(tmp):
+                shutil.rmtree(tmp, ignore_errors=True)
 
     # -- paths ---------------------------------------------------------------------------
     def record_path(self, robot: str, joint: str) -> Path:

@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import warnings
 from collections.abc import Callable, Mapping, Sequence
-from datetime import UTC, datetime
 from typing import Any
 
 import numpy as np
@@ -20,6 +19,7 @@ from scipy import stats
 from .. import __version__
 from ..errors import ConfigError, ConvergenceWarning, IdentifiabilityWarning, IgnoredArgumentWarning
 from ..fitted import FittedModel
+from ..io.atomic import created_timestamp
 from ..metrics import fit_statistics, metrics
 from ..models import INPUTS, STATEFUL, FrictionModel, get_model
 from ..optim import METHODS, OptimizeResult, minimize
@@ -37,7 +37,7 @@ def _provenance(samples: FrictionSamples) -> dict[str, Any]:
         "samples_sha256_16": samples_hash(samples),
         "directions": list(samples.directions()),
         "fricid_version": __version__,
-        "created": datetime.now(UTC).isoformat(timespec="seconds"),
+        "created": created_timestamp(),
     }
 
 

@@ -67,7 +67,6 @@ References
 from __future__ import annotations
 
 from collections.abc import Sequence
-from datetime import UTC, datetime
 from numbers import Integral
 from typing import Any
 
@@ -77,6 +76,7 @@ from sklearn.utils.validation import check_is_fitted
 from .. import __version__
 from ..errors import ConfigError
 from ..fitted import FittedModel
+from ..io.atomic import created_timestamp
 from ..metrics import fit_statistics, metrics
 from ..models import INPUTS
 from ..models.rbf import STATE_KIND, check_inputs, predict_state
@@ -165,7 +165,7 @@ def to_fitted_model(
             "samples_sha256_16": samples_hash(samples),
             "directions": list(samples.directions()),
             "fricid_version": __version__,
-            "created": datetime.now(UTC).isoformat(timespec="seconds"),
+            "created": created_timestamp(),
             "estimator": "fricid.identify.rbf.RBFNetRegressor",
             "estimator_params": {
                 k: v
