@@ -221,3 +221,17 @@ def test_fit_rbf_network_and_predict(demo_dir, tmp_path):
     assert json.loads(res.stdout)["fitness"] > 0.9
     res = run("fit", demo_dir / "samples.csv", "--model", "rbf", "--method", "de", "--out", out)
     assert res.exit_code == 2 and "lsq, bas or ga" in res.output
+
+
+def test_a_warning_is_one_line_on_stderr(demo_dir, tmp_path):
+    """DESIGN.md, "Errors": a caveat on an answer that stands is one line on stderr."""
+    out = tmp_path / "bas.json"
+    res = run(
+        "fit", demo_dir / "samples.csv", "--model", "stribeck", "--method", "bas",
+        "--max-evals", "40", "--out", out,
+    )  # fmt: skip
+    assert res.exit_code == 0, res.output
+    lines = [ln for ln in res.stderr.splitlines() if "warning (convergence)" in ln]
+    assert len(lines) == 1, res.stderr
+    assert "did not converge" in lines[0]
+    assert "Traceback" not in res.stderr and "warnings.warn" not in res.stderr

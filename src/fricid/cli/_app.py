@@ -19,6 +19,7 @@ import os
 import signal
 import sys
 import threading
+import warnings
 from collections.abc import Callable, Iterator
 from functools import wraps
 from types import FrameType
@@ -28,7 +29,7 @@ import typer
 from rich.console import Console
 from rich.markup import escape
 
-from ..errors import FricidError
+from ..errors import FricidError, FricidWarning
 
 __all__ = [
     "Terminated",
@@ -170,13 +171,38 @@ def _report_interrupt(code: int, line: str) -> None:
     sys.exit(code)
 
 
+def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:
+    """``warnings.showwarning`` for the CLI: one line on stderr, no source line."""
+    text = " ".join(str(message).split())
+    if issubclass(category, FricidWarning):
+        label = category.__name__.removesuffix("Warning").lower() or "warning"
+        label = {"fricid": "warning", "dataquality": "data quality"}.get(label, label)
+        line_out = f"[bold yellow]warning ({label}):[/] {escape(text)}"
+    else:
+        line_out = f"[bold yellow]warning:[/] {escape(text)} ({category.__name__})"
+    with contextlib.suppress(Exception):
+        err_console.print(line_out, highlight=False, soft_wrap=True)
+
+
+@contextlib.contextmanager
+def one_line_warnings() -> Iterator[None]:
+    """Show every warning raised during a command as one line on stderr (DESIGN.md, "Errors").
+
+    Only the display changes: which warnings are shown (the warning filters) stays as Python,
+    ``-W`` or the test runner set it.
+    """
+    with warnings.catch_warnings():
+        warnings.showwarning = _show_warning
+        yield
+
+
 def handle_errors(func: Callable[..., Any]) -> Callable[..., Any]:
     """Turn fricid's own errors into one line on stderr and exit status 2, and an interrupt
     (anywhere in the command) into one line and exit status 130 or 143."""
 
     @wraps(func)
     def wrapper(*args: Any, **kwargs: Any) -> Any:
-        with signal_handlers():
+        with signal_handlers(), one_line_warnings():
             try:
                 return func(*args, **kwargs)
             except BaseException as exc:
