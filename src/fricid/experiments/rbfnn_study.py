@@ -206,9 +206,25 @@ def run_study(
 ) -> StudyResult:
     """Run the study (see the module docstring) and return its tables and curves.
 
-    ``data``: ``(samples, true friction at their rows, noise floor [N m])`` already at hand
-    (e.g. from a reproduction that simulated the joint itself); by default
-    :func:`paper1_data` makes them from ``cfg``. ``progress`` is called with a line per step.
+    Parameters
+    ----------
+    cfg : StudyConfig, optional
+        The settings (default :func:`study_config`).
+    data : tuple, optional
+        ``(samples, true friction at their rows, noise floor [N m])`` already at hand (e.g.
+        from a reproduction that simulated the joint itself); by default
+        :func:`paper1_data` makes them from ``cfg``.
+    progress : callable, optional
+        Called with a line per step.
+
+    Returns
+    -------
+    StudyResult
+
+    Raises
+    ------
+    ConfigError
+        If the true friction's shape differs from the samples'.
     """
     cfg = cfg or study_config()
     say = progress or (lambda _msg: None)

@@ -78,7 +78,30 @@ class MethodSpec:
 
 @dataclass
 class StudyResult:
-    """What :func:`run_study` returns (tables as pandas DataFrames)."""
+    """What :func:`run_study` returns.
+
+    Attributes
+    ----------
+    table : pandas.DataFrame
+        [R] Table 1 and the baselines: one row per method (average, max, min SSE, the
+        paper's, ratios to the optimum, runs at the optimum, evaluations, seconds per run).
+    readings : pandas.DataFrame
+        The readings of RWSAVSBAS where [R] is unclear, same columns.
+    hybrid : pandas.DataFrame
+        bas+lm against lm alone from the same random starts, run by run.
+    convergence : pandas.DataFrame
+        [R] Fig. 6: mean best-so-far SSE against evaluations per method.
+    performance : dict
+        Timings and the overhead ratios.
+    optimum : dict
+        The exact optimum (variable projection): parameters and ``sse``.
+    claims : dict
+        From :func:`reproduced`: per [R] Table 1 row, whether ours is within a factor 2.
+    config : dict
+        The settings of the run.
+    results : dict
+        Every run (:class:`~fricid.optim.OptimizeResult`) by label.
+    """
 
     table: pd.DataFrame
     readings: pd.DataFrame
@@ -205,16 +228,32 @@ def run_study(
 
     Parameters
     ----------
-    seed : base seed of the optimiser runs (run ``r`` uses ``seed + r``).
-    runs : runs per method ([R]: 8).
-    quick : reduced budgets (RWSAVSBAS 100 x 100 with its schedule compressed ten-fold,
+    seed : int
+        Base seed of the optimiser runs (run ``r`` uses ``seed + r``).
+    runs : int
+        Runs per method ([R]: 8).
+    quick : bool
+        Reduced budgets (RWSAVSBAS 100 x 100 with its schedule compressed ten-fold,
         baselines 3000 evaluations) for a fast check.
-    data_seed : seed of the simulated measurement.
-    progress : called with a short message before each stage (for a progress display).
-    time_numpy : also time RWSAVSBAS on its numpy path (the generic one) for the overhead
-        ratios.
-    repeats : the overhead timings (compiled RWSAVSBAS runs against batched evaluation) are
+    data_seed : int
+        Seed of the simulated measurement.
+    progress : callable, optional
+        Called with a short message before each stage (for a progress display).
+    time_numpy : bool
+        Also time RWSAVSBAS on its numpy path (the generic one) for the overhead ratios.
+    repeats : int
+        The overhead timings (compiled RWSAVSBAS runs against batched evaluation) are
         interleaved and repeated this many times; the best of each is reported.
+
+    Returns
+    -------
+    StudyResult
+        Tables, convergence data, performance numbers, the exact optimum and claims.
+
+    Raises
+    ------
+    ConfigError
+        If ``runs`` is not a positive integer.
     """
     if isinstance(runs, bool) or not isinstance(runs, int | np.integer) or runs < 1:
         raise ConfigError(f"runs must be a positive integer; got {runs!r}")

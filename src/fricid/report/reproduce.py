@@ -81,11 +81,25 @@ def reproduce(
 
     Parameters
     ----------
-    paper : which paper (:data:`PAPERS`).
-    out : output folder (default :func:`default_out`); written all or nothing.
-    quick : reduced designs and budgets (under 2 minutes on 2 cores, used by the tests).
-    seed : seeds every stochastic step; same seed, same report.
-    progress : called with each step's label as it starts (see :func:`paper_steps`).
+    paper : str
+        Which paper (:data:`PAPERS`).
+    out : path-like, optional
+        Output folder (default :func:`default_out`); written all or nothing.
+    quick : bool
+        Reduced designs and budgets (under 2 minutes on 2 cores, used by the tests).
+    seed : int
+        Seeds every stochastic step; same seed, same report.
+    progress : callable, optional
+        Called with each step's label as it starts (see :func:`paper_steps`).
+
+    Returns
+    -------
+    ReproduceResult
+
+    Raises
+    ------
+    ConfigError
+        If ``paper`` is unknown.
     """
     key, _, build = _module(paper)
     out = Path(out) if out is not None else default_out(key)
