@@ -12,9 +12,9 @@ import pandas as pd
 
 from ...experiments.paper_numbers import BAS_RBFNN as PAPER
 from ...experiments.rbfnn_study import BAS_PAPER
-from .. import paper_plots as pp
 from ..document import Figure, Table
 from ._bas_rbfnn_common import T4_PAPER, epochs, quick_setting
+from .rbfnn import FIG9_MODELS, fig9_png
 
 __all__ = ["fig9_items", "table4_items"]
 
@@ -162,19 +162,11 @@ def fig9_items(res, quick: bool) -> list:
     """[B] Fig. 9: the training MSE curves of GA-RBFNN and BAS-RBFNN (and every variant)."""
     cfg = res.config
     curves = res.curves
-    main = {m: curves[m] for m in ("GA-RBFNN", "BAS-RBFNN") if m in curves}
-    paper_epochs = {m: PAPER["fig9"]["epochs"][T4_PAPER[m]] for m in main}
+    main = {m: curves[m] for m in FIG9_MODELS if m in curves}
     runs = res.tables["table4_runs"]
     first = runs[runs["model"].isin(list(main))]["initial_mse"]
     start = float(np.nanmedian(first)) / cfg.target_mse
-    png = pp.mse_curves(
-        main,
-        cfg.target_mse,
-        paper_epochs=paper_epochs,
-        title="Fig. 9: training MSE of GA-RBFNN and BAS-RBFNN",
-        ncols=2,
-        log_epochs=True,
-    )
+    png = fig9_png(res)
     caption = (
         f"Paper: {PAPER['figures']['fig9']} Ours: the best MSE so far after each epoch, "
         f"{cfg.seeds} runs per method (thin lines) and their median (thick), the target "
@@ -204,13 +196,7 @@ def fig9_items(res, quick: bool) -> list:
             Figure(
                 "fig9_variants",
                 "Fig. 9, all variants of Table 4",
-                pp.mse_curves(
-                    curves,
-                    cfg.target_mse,
-                    title="Training MSE of every Table 4 variant",
-                    ncols=4,
-                    sharey=False,
-                ),
+                fig9_png(res, variants=True),
                 caption="Not in the paper: the training MSE of each row of Table 4, drawn as "
                 "Fig. 9 (one panel per variant, each with its own MSE axis).",
             )

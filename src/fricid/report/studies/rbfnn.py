@@ -21,7 +21,18 @@ from ...io.atomic import atomic_write
 from ...units import DEG
 from .. import paper_plots as pp
 
-__all__ = ["fig9_png", "fig10_png", "study_notes", "summary_markdown", "write_outputs"]
+__all__ = [
+    "FIG9_MODELS",
+    "FIG10_MODELS",
+    "fig9_png",
+    "fig10_png",
+    "study_notes",
+    "summary_markdown",
+    "write_outputs",
+]
+
+#: The methods of [B] Fig. 9, in order.
+FIG9_MODELS = ("GA-RBFNN", "BAS-RBFNN")
 
 #: The models drawn in Fig. 10, in order (those the study computed).
 FIG10_MODELS = ("BAS-RBFNN", "RBFNN", "VLT model", "MLP", "GP")
@@ -149,7 +160,7 @@ def fig9_png(result: StudyResult, *, variants: bool = False) -> bytes:
             ncols=4,
             sharey=False,
         )
-    main = {k: v for k, v in curves.items() if k in ("GA-RBFNN", "BAS-RBFNN")}
+    main = {m: curves[m] for m in FIG9_MODELS if m in curves}
     return pp.mse_curves(
         main,
         result.config.target_mse,
@@ -200,7 +211,7 @@ def write_outputs(result: StudyResult, out: str | Path) -> list[Path]:
             df.to_csv(fh, index=False)
         paths.append(path)
     figures = [("fig9_mse.png", fig9_png(result))]
-    if len(result.curves) > 2:
+    if set(result.curves) - set(FIG9_MODELS):
         figures.append(("fig9_variants.png", fig9_png(result, variants=True)))
     figures.append(("fig10_unseen.png", fig10_png(result)))
     for name, data in figures:
