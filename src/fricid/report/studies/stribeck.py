@@ -151,8 +151,8 @@ def report_text(result: StudyResult) -> str:
 
 
 def convergence_png(result: StudyResult) -> bytes:
-    """[R] Fig. 6: mean best-so-far SSE against evaluations of every method (and bas+lm), the
-    min-max range over the runs shaded, log axes, the exact optimum as a reference line.
+    """[R] Fig. 6: mean best-so-far SSE against evaluations of every method (and bas+lm), log
+    axes, the exact optimum as a reference line (no min-max bands: eleven methods).
 
     Evaluations rather than [R]'s iterations: an RWSAVSBAS iteration costs about 300 of them,
     a VSBAS or IBAS iteration 3.
@@ -169,6 +169,7 @@ def convergence_png(result: StudyResult) -> bytes:
         title=f"Average convergence over {runs} runs (RWSAVSBAS paper, Fig. 6)",
         reference={f"global optimum, SSE {result.optimum['sse']:.3g}": result.optimum["sse"]},
         log_x=True,
+        band=False,
     )
 
 
