@@ -275,12 +275,8 @@ def _fitted_from(theta: np.ndarray, samples: FrictionSamples, method: str) -> Fi
 
     model = get_model("stribeck")
     X, y = samples.X, samples.friction
-
-    def residuals(T: np.ndarray) -> np.ndarray:
-        T = np.atleast_2d(T)
-        return model.predict(np.column_stack([T, np.ones(len(T))]), X) - y
-
-    se, _ = jacobian_uncertainty(residuals, theta, len(y))
+    problem = study.StribeckProblem(samples.velocity, y, bounds=scaled_bounds(samples))
+    se, _ = jacobian_uncertainty(problem.residuals, theta, len(y))
     t95 = float(stats.t.ppf(0.975, max(len(y) - len(theta), 1)))
     params = {**dict(zip(PARAMS, map(float, theta), strict=True)), **FIXED}
     return FittedModel(
