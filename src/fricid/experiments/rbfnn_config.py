@@ -83,19 +83,44 @@ GA_TUNED: dict[str, Any] = {"eta_m": 5.0}
 class StudyConfig:
     """Settings of the study (see :func:`study_config` for the full and quick presets).
 
-    Network: ``n_centers`` Gaussians, ``width_factor``, ridge ``alpha``, asinh velocity warp
-    ``velocity_scale`` [rad/s] (None: plain standardisation, as the paper). Search:
-    ``max_epochs`` of ``evals_per_epoch`` evaluations, ``target_mse`` on the [-1, 1]
-    target scale, optimiser options ``bas_options`` and ``ga_options``. Study: preset
-    ``size``, ``seed``, ``folds`` for cross-validation, ``seeds`` runs of Table 4,
-    ``large_centers`` and ``large_width_factor`` for the larger ``lsq`` network (0: none),
-    ``variants``: add to Table 4 GA and BAS from a harder start (the lsq network with widths
-    ``narrow_width_factor`` instead of ``width_factor``, about 8 times the target MSE), BAS
-    with eq. 21's printed constants, and BAS with the full encoding (from the lsq start and
-    from a random start); ``gp_subset`` points for the GP's hyperparameters,
-    ``timing_repeats`` (best of, per seed; see :func:`timing`), ``data``: ``"simulate"``
-    (simulate and extract, eq. 9-13) or ``"oracle"`` (true friction plus Gaussian noise of
-    the expected size; fast, for tests).
+    Attributes
+    ----------
+    size : str
+        Preset size of ``paper1`` (``full``: [B]'s 6615 operating points).
+    seed : int
+        Seed of the data, folds and networks.
+    data : str
+        ``"simulate"`` (simulate and extract, eq. 9-13) or ``"oracle"`` (true friction plus
+        Gaussian noise of the expected size; fast, for tests).
+    folds : int
+        Folds of the cross-validation of Table 3.
+    seeds : int
+        Runs per method of Table 4 (and seeds of the timings).
+    n_centers, large_centers : int
+        Gaussians of the network (eq. 14), and of the larger ``lsq`` network (0: none).
+    width_factor, large_width_factor : float
+        Widths as multiples of the nearest-neighbour distance of the centres.
+    alpha : float
+        Ridge of the output weights.
+    velocity_scale : float or None
+        asinh velocity warp [rad/s] (None: plain standardisation, as the paper).
+    target_mse : float
+        Target MSE on the [-1, 1] target scale ([B] section 4.3: 1e-4).
+    max_epochs, evals_per_epoch : int
+        The search's budget: epochs of that many evaluations.
+    bas_options, ga_options : dict
+        Optimiser options (:data:`BAS_TUNED`, :data:`GA_TUNED`).
+    variants : bool
+        Add to Table 4 GA and BAS from a harder start (widths ``narrow_width_factor``
+        instead of ``width_factor``, about 8 times the target MSE), BAS with eq. 21's
+        printed constants, and BAS with the full encoding (from the lsq start and from a
+        random start).
+    narrow_width_factor : float
+        Widths of the harder start.
+    gp_subset : int
+        Points for the Gaussian process's hyperparameters.
+    timing_repeats : int
+        Fits per seed in the timings (best of; see :func:`~.rbfnn_tables.timing`).
     """
 
     size: str = "full"
