@@ -5,7 +5,8 @@ Usage: ``python benchmarks/bench_rbfnn.py [--quick] [--seed 0] [--seeds 5] [--fo
 mN m, the paper's numbers beside ours) and the performance targets, and writes CSVs,
 ``fig9_mse.png``, ``fig10_unseen.png`` and ``summary.md`` to ``--out`` (default
 ``benchmarks/out/rbfnn``). The study itself is
-:func:`fricid.experiments.rbfnn_study.run_study`; ``fricid bench rbfnn`` runs the same.
+:func:`fricid.experiments.rbfnn_study.run_study` (rendered by
+:mod:`fricid.report.studies.rbfnn`); ``fricid bench rbfnn`` runs the same.
 
 ``--timing-only`` makes the data and runs only the training-time comparison on all of it
 (:func:`fricid.experiments.rbfnn_study.timing`: RBFNN, hybrid BAS-RBFNN, the MLP and the
@@ -19,14 +20,8 @@ import argparse
 import sys
 import time
 
-from fricid.experiments.rbfnn_study import (
-    paper1_data,
-    run_study,
-    study_config,
-    summary_markdown,
-    timing,
-    write_outputs,
-)
+from fricid.experiments.rbfnn_study import paper1_data, run_study, study_config, timing
+from fricid.report.studies.rbfnn import summary_markdown, write_outputs
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -3,7 +3,8 @@
 Usage: ``python benchmarks/bench_stribeck.py [--quick] [--runs 8] [--seed 0] [--out DIR]``.
 Prints the tables and the performance ratios; with ``--out DIR`` also writes the CSVs and
 ``fig6_convergence.png`` there. The study itself is
-:func:`fricid.experiments.stribeck_study.run_study`.
+:func:`fricid.experiments.stribeck_study.run_study`; its text and files are
+:mod:`fricid.report.studies.stribeck`'s.
 """
 
 from __future__ import annotations
@@ -12,7 +13,8 @@ import argparse
 import sys
 import time
 
-from fricid.experiments.stribeck_study import report_text, run_study, write_outputs
+from fricid.experiments.stribeck_study import run_study
+from fricid.report.studies.stribeck import report_text, write_outputs
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -7,6 +7,7 @@ import pytest
 from scipy.optimize import least_squares
 
 from fricid.experiments import stribeck_study as study
+from fricid.report.studies import stribeck as render
 
 
 @pytest.fixture(scope="module")
@@ -44,9 +45,9 @@ def test_study_runs_and_writes_its_outputs(tmp_path) -> None:
     assert result.table.loc["RWSAVSBAS", "max_ratio"] < 1.001
     assert result.table.loc["VSBAS", "paper_mean"] == 0.60
     assert bool(result.hybrid["bas+lm_found"].all())
-    text = study.report_text(result)
+    text = render.report_text(result)
     assert "RWSAVSBAS" in text and "ratio" in text
-    paths = study.write_outputs(result, tmp_path / "out")
+    paths = render.write_outputs(result, tmp_path / "out")
     assert all(p.exists() and p.stat().st_size > 0 for p in paths)
     assert paths[-1].read_bytes()[:4] == b"\x89PNG"
 

@@ -14,10 +14,9 @@ from fricid.experiments.rbfnn_study import (
     paper1_data,
     run_study,
     study_config,
-    summary_markdown,
     unseen_region,
-    write_outputs,
 )
+from fricid.report.studies.rbfnn import summary_markdown, write_outputs
 
 DEG = math.pi / 180.0
 

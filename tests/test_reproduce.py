@@ -13,7 +13,7 @@ from typer.testing import CliRunner
 from fricid.cli import app
 from fricid.errors import ConfigError
 from fricid.experiments.paper_numbers import BAS_RBFNN, RWSAVSBAS
-from fricid.experiments.reproduce import PAPERS, paper_steps, reproduce
+from fricid.report.reproduce import PAPERS, paper_steps, reproduce
 
 
 def png_stats(data: bytes) -> tuple[tuple[int, int], float]:

@@ -9,7 +9,8 @@ from typing import Annotated
 import typer
 from rich.markup import escape
 
-from ._app import bench_app, console, err_console, handle_errors
+from ._app import bench_app, console, handle_errors
+from ._study_options import out_option, print_written, quick_option, seed_option, study_progress
 
 
 @bench_app.command(
@@ -20,28 +21,21 @@ def stribeck_command(
     runs: Annotated[int, typer.Option(min=1, help="Runs per method (the paper: 8).")] = 8,
     out: Annotated[
         Path | None,
-        typer.Option(
-            "--out",
-            "-o",
-            help=(
-                "Folder for the tables (CSV) and the convergence plot (PNG); created if missing. "
-                "Default: print only."
-            ),
-            file_okay=False,
+        out_option(
+            "Folder for the tables (CSV) and the convergence plot (PNG); created if missing. "
+            "Default: print only.",
+            folder=True,
         ),
     ] = None,
     quick: Annotated[
         bool,
-        typer.Option(
-            "--quick",
-            help=(
-                "Reduced budgets (RWSAVSBAS 100 x 100 with its schedule compressed ten-fold, "
-                "baselines 3000 evaluations): a check in seconds, not the paper's settings."
-            ),
+        quick_option(
+            "Reduced budgets (RWSAVSBAS 100 x 100 with its schedule compressed ten-fold, "
+            "baselines 3000 evaluations): a check in seconds, not the paper's settings."
         ),
     ] = False,
     seed: Annotated[
-        int, typer.Option(min=0, help=("Base seed of the runs (run r uses seed + r)."))
+        int, seed_option("Base seed of the runs (run r uses seed + r).", non_negative=True)
     ] = 0,
 ) -> None:
     """Reproduce the RWSAVSBAS paper's Table 1 and Fig. 6 on the simulated paper2 preset.
@@ -54,24 +48,15 @@ def stribeck_command(
     optimiser's overhead against evaluating as many candidates in large batches. Progress
     goes to stderr. Takes about two minutes on 2 cores (--quick: about 15 s).
     """
-    from ..experiments.stribeck_study import report_text, run_study, write_outputs
+    from ..experiments.stribeck_study import run_study
+    from ..report.studies.stribeck import report_text, write_outputs
 
     t0 = time.perf_counter()
-    with err_console.status("starting", spinner="dots") as status:
-
-        def progress(msg: str) -> None:
-            status.update(escape(msg))
-            if not err_console.is_terminal:
-                err_console.print(
-                    f"[{time.perf_counter() - t0:6.1f} s] {escape(msg)}", highlight=False
-                )
-
+    written = None
+    with study_progress(t0) as (progress, status):
         result = run_study(seed=seed, runs=runs, quick=quick, progress=progress)
         if out is not None:
             status.update(f"writing {escape(str(out))}")
             written = write_outputs(result, out)
     console.print(escape(report_text(result)), highlight=False, soft_wrap=True)
-    if out is not None:
-        for path in written:
-            err_console.print(f"wrote {escape(str(path))}", highlight=False)
-    err_console.print(f"done in {time.perf_counter() - t0:.1f} s", highlight=False)
+    print_written(written, t0)

@@ -9,7 +9,8 @@ from typing import Annotated
 import typer
 from rich.markup import escape
 
-from ._app import bench_app, console, err_console, handle_errors
+from ._app import bench_app, console, handle_errors
+from ._study_options import out_option, print_written, quick_option, seed_option, study_progress
 
 
 @bench_app.command("rbfnn")
@@ -17,29 +18,22 @@ from ._app import bench_app, console, err_console, handle_errors
 def rbfnn_command(
     out: Annotated[
         Path | None,
-        typer.Option(
-            "--out",
-            "-o",
-            help=(
-                "Folder for the tables (CSV), Fig. 9 and Fig. 10 (PNG) and summary.md; "
-                "created if missing. Default: print only."
-            ),
-            file_okay=False,
+        out_option(
+            "Folder for the tables (CSV), Fig. 9 and Fig. 10 (PNG) and summary.md; "
+            "created if missing. Default: print only.",
+            folder=True,
         ),
     ] = None,
     quick: Annotated[
         bool,
-        typer.Option(
-            "--quick",
-            help=(
-                "The reduced paper1 design (330 samples), smaller networks and budgets, "
-                "3 folds, no Table 4 variants: a check in under a minute, not the paper's "
-                "settings (at this size neither GA nor BAS reaches the target MSE)."
-            ),
+        quick_option(
+            "The reduced paper1 design (330 samples), smaller networks and budgets, "
+            "3 folds, no Table 4 variants: a check in under a minute, not the paper's "
+            "settings (at this size neither GA nor BAS reaches the target MSE)."
         ),
     ] = False,
     seed: Annotated[
-        int, typer.Option(min=0, help="Seed of the simulation, folds and networks.")
+        int, seed_option("Seed of the simulation, folds and networks.", non_negative=True)
     ] = 0,
     seeds: Annotated[
         int | None,
@@ -64,12 +58,8 @@ def rbfnn_command(
     each with the paper's number beside ours. Errors are in mN m. Progress goes to stderr.
     Takes 5-10 minutes on 2 cores (--quick: about 15 s).
     """
-    from ..experiments.rbfnn_study import (
-        run_study,
-        study_config,
-        summary_markdown,
-        write_outputs,
-    )
+    from ..experiments.rbfnn_study import run_study, study_config
+    from ..report.studies.rbfnn import summary_markdown, write_outputs
 
     changes = {}
     if seeds is not None:
@@ -80,21 +70,11 @@ def rbfnn_command(
         changes["max_epochs"] = epochs
     cfg = study_config(quick, seed=seed, **changes)
     t0 = time.perf_counter()
-    with err_console.status("starting", spinner="dots") as status:
-
-        def progress(msg: str) -> None:
-            status.update(escape(msg))
-            if not err_console.is_terminal:
-                err_console.print(
-                    f"[{time.perf_counter() - t0:6.1f} s] {escape(msg)}", highlight=False
-                )
-
+    written = None
+    with study_progress(t0) as (progress, status):
         result = run_study(cfg, progress=progress)
         if out is not None:
             status.update(f"writing {escape(str(out))}")
             written = write_outputs(result, out)
     console.print(escape(summary_markdown(result)), highlight=False, soft_wrap=True)
-    if out is not None:
-        for path in written:
-            err_console.print(f"wrote {escape(str(path))}", highlight=False)
-    err_console.print(f"done in {time.perf_counter() - t0:.1f} s", highlight=False)
+    print_written(written, t0)

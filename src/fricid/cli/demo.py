@@ -12,14 +12,15 @@ from rich.markup import escape
 from rich.table import Table
 
 from ._app import app, console, err_console, handle_errors
+from ._study_options import out_option, seed_option
 
 
 @app.command("demo")
 @handle_errors
 def demo_command(
-    out: Annotated[
-        Path, typer.Option("--out", "-o", help="Folder for samples, models and the summary.")
-    ] = Path("fricid-demo"),
+    out: Annotated[Path, out_option("Folder for samples, models and the summary.")] = Path(
+        "fricid-demo"
+    ),
     size: Annotated[
         str,
         typer.Option(
@@ -28,7 +29,7 @@ def demo_command(
             "minutes)."
         ),
     ] = "reduced",
-    seed: Annotated[int, typer.Option(help="Random seed.")] = 0,
+    seed: Annotated[int, seed_option("Random seed.")] = 0,
     method: Annotated[str, typer.Option(help="Optimiser for the fits.")] = "lm",
 ) -> None:
     """Simulate the BAS-RBFNN paper's experiment on the virtual joint, extract the friction
@@ -36,15 +37,16 @@ def demo_command(
     (fitness = R^2, RMSE, RMSPE per model). Writes samples.csv, samples_by_direction.csv, one
     JSON model file per model, table1.csv and summary.md into --out."""
     from ..experiments.demo import run_demo
+    from ..report.studies.demo import write_demo
 
     t0 = time.perf_counter()
     res = run_demo(
-        out,
         size=size,
         seed=seed,
         method=method,
         progress=lambda msg: err_console.print(f"[dim]{msg}[/]"),
     )
+    written = write_demo(res, out)
     console.print(res.extraction.summary(), markup=False, highlight=False)
     px, py = res.true_gravity
     console.print(f"true gravity:    p_x = {px:.5g}, p_y = {py:.5g} N m", highlight=False)
@@ -69,4 +71,4 @@ def demo_command(
         "[dim]The paper's RMSE has no stated unit (its scale does not match its "
         "Table 3 in N m): compare fitness, RMSPE and the ordering.[/]"
     )
-    console.print(f"wrote {res.out}/ in {time.perf_counter() - t0:.1f} s")
+    console.print(f"wrote {written}/ in {time.perf_counter() - t0:.1f} s")

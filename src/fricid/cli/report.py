@@ -8,6 +8,7 @@ from typing import Annotated
 import typer
 
 from ._app import app, console, err_console, handle_errors
+from ._study_options import out_option, seed_option
 
 
 @app.command("report")
@@ -22,13 +23,9 @@ def report_command(
     ],
     out: Annotated[
         Path | None,
-        typer.Option(
-            "--out",
-            "-o",
-            help=(
-                "Folder to write (created; files of an earlier report there are replaced). "
-                "Default: <model>-report/ in the current directory."
-            ),
+        out_option(
+            "Folder to write (created; files of an earlier report there are replaced). "
+            "Default: <model>-report/ in the current directory."
         ),
     ] = None,
     velocity_unit: Annotated[
@@ -40,7 +37,7 @@ def report_command(
             help="Bootstrap resamples for the RBF network's confidence intervals.", min=10
         ),
     ] = 200,
-    seed: Annotated[int, typer.Option(help="Seed of the bootstrap.")] = 0,
+    seed: Annotated[int, seed_option("Seed of the bootstrap.")] = 0,
 ) -> None:
     """Write a report of MODEL on SAMPLES: parameters with 95 % confidence intervals, fit
     metrics, measured against predicted friction over velocity, residuals against each input

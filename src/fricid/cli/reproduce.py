@@ -8,6 +8,7 @@ from typing import Annotated
 import typer
 
 from ._app import app, console, err_console, handle_errors
+from ._study_options import out_option, quick_option, seed_option
 
 
 @app.command("reproduce")
@@ -15,16 +16,12 @@ from ._app import app, console, err_console, handle_errors
 def reproduce_command(
     paper: Annotated[str, typer.Argument(help="Which paper: bas-rbfnn or rwsavsbas.")],
     out: Annotated[
-        Path | None,
-        typer.Option(
-            "--out", "-o", help=("Folder to write. Default: ./fricid-reproduce/<paper>/.")
-        ),
+        Path | None, out_option("Folder to write. Default: ./fricid-reproduce/<paper>/.")
     ] = None,
     quick: Annotated[
-        bool,
-        typer.Option("--quick", help=("Reduced designs and budgets: under 2 minutes on 2 cores.")),
+        bool, quick_option("Reduced designs and budgets: under 2 minutes on 2 cores.")
     ] = False,
-    seed: Annotated[int, typer.Option(help="Random seed (same seed, same report).")] = 0,
+    seed: Annotated[int, seed_option("Random seed (same seed, same report).")] = 0,
 ) -> None:
     """Regenerate every table and figure of a seed paper on the virtual joint (and, for
     rwsavsbas, on the real lead-screw recordings), with the paper's numbers beside ours.
@@ -34,7 +31,7 @@ def reproduce_command(
     """
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
-    from ..experiments.reproduce import paper_steps, reproduce
+    from ..report.reproduce import paper_steps, reproduce
 
     steps = paper_steps(paper)
     with Progress(

@@ -3,6 +3,7 @@
 Simulate the BAS-RBFNN paper's experiment (``paper1`` preset, reduced design), extract the
 friction samples (eq. 9-13), fit the four analytic models (eq. 1-4) and tabulate them as the
 paper's Table 1 does (fitness = R^2, RMSE, RMSPE), with the paper's numbers beside ours.
+:func:`run_demo` computes; :func:`fricid.report.studies.demo.write_demo` writes the files.
 """
 
 from __future__ import annotations
@@ -10,7 +11,6 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, replace
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -18,7 +18,7 @@ import pandas as pd
 from ..extract import ExtractionResult, extract
 from ..fitted import FittedModel
 from ..identify import fit
-from ..io import atomic_write, write_samples
+from ..samples import FrictionSamples
 from ..sim import preset, simulate, true_gravity
 
 __all__ = ["DEMO_MODELS", "PAPER_TABLE1", "DemoResult", "run_demo"]
@@ -37,27 +37,42 @@ PAPER_TABLE1 = {
 
 @dataclass
 class DemoResult:
-    """What the demo produced: the table, the fitted models, the extraction and timings."""
+    """What the demo produced: the table, the fitted models, the extraction, the true gravity
+    coefficients (eq. 7), timings and the samples the models were fitted to."""
 
     table: pd.DataFrame
     models: dict[str, FittedModel]
     extraction: ExtractionResult
     true_gravity: tuple[float, float]
     seconds: dict[str, float]
-    out: Path
+    samples: FrictionSamples
 
 
 def run_demo(
-    out: str | Path = "fricid-demo",
     *,
     size: str = "reduced",
     seed: int = 0,
     method: str = "lm",
     progress: Callable[[str], None] | None = None,
 ) -> DemoResult:
-    """Run the chain and write samples, models and a summary into ``out``."""
+    """Run the chain: simulate, extract, fit :data:`DEMO_MODELS`, tabulate.
+
+    Parameters
+    ----------
+    size : str
+        Preset size of ``paper1`` (``reduced``, ``quick`` or ``full``).
+    seed : int
+        Seed of the simulation and the fits.
+    method : str
+        Optimiser of the fits.
+    progress : callable, optional
+        Called with a line per step.
+
+    Returns
+    -------
+    DemoResult
+    """
     say = progress or (lambda _msg: None)
-    out = Path(out)
     scenario = preset("paper1", size)
     seconds: dict[str, float] = {}
 
@@ -92,55 +107,4 @@ def run_demo(
         )
     table = pd.DataFrame(rows)
 
-    out.mkdir(parents=True, exist_ok=True)
-    write_samples(samples, out / "samples.csv")
-    write_samples(result.by_direction, out / "samples_by_direction.csv")
-    for name, fitted in models.items():
-        fitted.save(out / f"{name}.json")
-    with atomic_write(out / "table1.csv", "w") as fh:
-        table.to_csv(fh, index=False)
-    truth = true_gravity(scenario)
-    with atomic_write(out / "summary.md", "w") as fh:
-        fh.write(summary_markdown(table, result, truth, seconds))
-    return DemoResult(table, models, result, truth, seconds, out)
-
-
-def summary_markdown(
-    table: pd.DataFrame,
-    result: ExtractionResult,
-    truth: tuple[float, float],
-    seconds: dict[str, float],
-) -> str:
-    """The demo's summary as Markdown."""
-    lines = ["# fricid demo: virtual joint, paper1 preset", "", "## Extraction", ""]
-    lines += [f"    {line}" for line in result.summary().splitlines()]
-    lines += [
-        "",
-        f"True gravity coefficients: p_x = {truth[0]:.5g}, p_y = {truth[1]:.5g} N m.",
-        "",
-        "## Table 1 (BAS-RBFNN paper), ours beside the paper's",
-        "",
-    ]
-    lines.append(
-        table.to_markdown(index=False, floatfmt=".4g")
-        if _has_tabulate()
-        else "```\n" + table.to_string(index=False) + "\n```"
-    )
-    lines += [
-        "",
-        "The paper's RMSE has no stated unit and a scale unlike its Table 3 (N m); "
-        "compare fitness and RMSPE, and the ordering.",
-        "",
-        "## Time",
-        "",
-    ]
-    lines += [f"- {k}: {v:.2f} s" for k, v in seconds.items()]
-    return "\n".join(lines) + "\n"
-
-
-def _has_tabulate() -> bool:
-    try:
-        import tabulate  # noqa: F401
-    except ImportError:
-        return False
-    return True
+    return DemoResult(table, models, result, true_gravity(scenario), seconds, samples)

@@ -1,6 +1,6 @@
 """The two seed papers' published numbers and figure captions, as data, in one place.
 
-Reproductions (:mod:`fricid.experiments.reproduce`) put these beside ours; nothing else in
+Reproductions (:mod:`fricid.report.reproduce`) put these beside ours; nothing else in
 fricid should hard-code a paper's result.
 
 References

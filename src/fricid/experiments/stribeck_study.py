@@ -10,37 +10,32 @@ Fig. 6 the average convergence curves.
 whose truth is [R]'s Table 2), adds BAS, GA, the scipy/cma baselines and ``bas+lm``, finds
 the exact global optimum by variable projection, checks the readings of RWSAVSBAS that [R]
 leaves open, and measures the optimiser's overhead against plain batched evaluation. It
-returns tables (pandas DataFrames) and the convergence data; the benchmark script
-(``benchmarks/bench_stribeck.py``) and ``fricid bench stribeck`` only print and plot them.
-
-The search box (:data:`BOUNDS`) is ours ([R] does not give one): tau_c and tau_s in
-[0, 2] N m, w_s in [0.001, 1] rad/s, tau_v in [0, 0.1] N m s/rad. The beetle methods step in
-the unit box mapped onto it, so a step of 0.1 moves tau_s by 0.2 N m but w_s by 0.1 rad/s:
-the box sets what [R]'s step sizes mean.
+returns tables (pandas DataFrames), the convergence data and computed claims; the text,
+figure and files are :mod:`fricid.report.studies.stribeck`'s (``fricid bench stribeck`` and
+``benchmarks/bench_stribeck.py`` print and write them). The problem itself (data, objective,
+box, exact optimum) is :mod:`.stribeck_problem`.
 """
 
 from __future__ import annotations
 
-import os
-import tempfile
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pandas as pd
-from scipy.optimize import least_squares, lsq_linear
 
 from ..errors import ConfigError
-from ..models import Stribeck
-from ..optim import JitObjective, OptimizeResult, minimize
-
-try:  # the compiled twin of the objective (optional: the numpy path is always there)
-    from numba import njit
-except ImportError:  # pragma: no cover - numba is a dependency
-    njit = None
+from ..optim import OptimizeResult, minimize, minimize_runs
+from .stribeck_problem import (
+    BOUNDS,
+    FREE,
+    StribeckProblem,
+    global_optimum,
+    paper2_samples,
+    sse_objective,
+)
 
 __all__ = [
     "BOUNDS",
@@ -51,18 +46,12 @@ __all__ = [
     "StribeckProblem",
     "StudyResult",
     "global_optimum",
+    "method_specs",
     "paper2_samples",
-    "plot_convergence",
-    "report_text",
+    "reproduced",
     "run_study",
-    "write_outputs",
+    "sse_objective",
 ]
-
-#: The free parameters (delta fixed to 1, [R] 2.3).
-FREE = ("tau_c", "tau_s", "w_s", "tau_v")
-
-#: Search bounds of the benchmark, one row per free parameter (see the module docstring).
-BOUNDS = np.array([[0.0, 2.0], [0.0, 2.0], [1e-3, 1.0], [0.0, 0.1]])
 
 #: [R] Table 1: average, largest and smallest final SSE of 8 runs.
 PAPER_TABLE1 = {
@@ -73,122 +62,6 @@ PAPER_TABLE1 = {
 
 #: A run "finds the optimum" when its SSE is within this relative distance of it.
 SUCCESS_RTOL = 1e-3
-
-
-def paper2_samples(seed: int = 0, size: str = "full") -> tuple[np.ndarray, np.ndarray]:
-    """The 17 friction samples of the ``paper2`` preset: velocity [rad/s], friction [N m].
-
-    Simulates the virtual joint (:func:`fricid.sim.simulate`) and extracts it with
-    ``gravity="none"`` (a horizontal joint, [R] 2.1); the direction-combined samples (eq. 11
-    of the BAS-RBFNN paper) are the 17 points of [R]. The one place the study gets its data.
-    """
-    from ..extract import extract
-    from ..sim import preset, simulate
-
-    result = extract(simulate(preset("paper2", size), seed=seed), gravity="none")
-    s = result.samples
-    return np.asarray(s.X[:, 0], dtype=float), np.asarray(s.y, dtype=float)
-
-
-if njit is not None:
-
-    @njit(cache=True)
-    def _sse_kernel(X, out, data):  # pragma: no cover - compiled
-        """SSE of the Stribeck model (delta = 1) for each row (tau_c, tau_s, w_s, tau_v)."""
-        v, y = data
-        for k in range(X.shape[0]):
-            tc, ts, ws, tv = X[k, 0], X[k, 1], X[k, 2], X[k, 3]
-            ws = max(abs(ws), 1e-12)
-            s = 0.0
-            for i in range(v.shape[0]):
-                a = abs(v[i])
-                sg = 0.0 if v[i] == 0.0 else (1.0 if v[i] > 0.0 else -1.0)
-                r = sg * (tc + (ts - tc) * np.exp(-a / ws)) + tv * v[i] - y[i]
-                s += r * r
-            out[k] = s
-
-else:  # pragma: no cover
-    _sse_kernel = None
-
-
-@dataclass
-class StribeckProblem:
-    """The SSE of [R] eq. 11 for the Stribeck model of fricid (delta fixed to 1)."""
-
-    velocity: np.ndarray
-    friction: np.ndarray
-    bounds: np.ndarray = field(default_factory=lambda: BOUNDS.copy())
-
-    def __post_init__(self) -> None:
-        self.velocity = np.ascontiguousarray(self.velocity, dtype=float)
-        self.friction = np.ascontiguousarray(self.friction, dtype=float)
-        self._model = Stribeck()
-        self._X = self._model.check_inputs(self.velocity)
-
-    def predict(self, theta: np.ndarray) -> np.ndarray:
-        """Friction ``(k, n)`` for free parameters ``theta (k, 4)``."""
-        theta = np.atleast_2d(theta)
-        full = np.column_stack([theta, np.ones(theta.shape[0])])
-        return self._model.predict(full, self._X)
-
-    def residuals(self, theta: np.ndarray) -> np.ndarray:
-        return self.predict(theta) - self.friction
-
-    def sse(self, theta: np.ndarray) -> np.ndarray:
-        r = self.residuals(theta)
-        return np.einsum("kn,kn->k", r, r)
-
-    def objective(self, jit: bool = True):
-        """The objective for :func:`fricid.optim.minimize`: with ``jit``, a
-        :class:`~fricid.optim.JitObjective` carrying the compiled kernel."""
-        if jit and _sse_kernel is not None:
-            return JitObjective(self.sse, _sse_kernel, (self.velocity, self.friction))
-        return self.sse
-
-
-def global_optimum(problem: StribeckProblem, n_grid: int = 4001) -> tuple[np.ndarray, float]:
-    """The exact global optimum by variable projection.
-
-    For fixed w_s the model is linear in (tau_c, tau_s, tau_v): ``f = (1 - e) tau_c + e tau_s +
-    v tau_v`` with ``e = exp(-v / w_s)`` (v > 0). A dense log-spaced grid of ``n_grid`` values
-    of w_s over its bounds, each with the bounded linear least-squares solution
-    (``scipy.optimize.lsq_linear``), gives the best w_s to grid resolution; a bounded
-    least-squares polish of all four parameters from the best few grid points finishes it.
-    """
-    v, y, b = problem.velocity, problem.friction, problem.bounds
-    av, sg = np.abs(v), np.sign(v)
-    grid = np.geomspace(b[2, 0], b[2, 1], n_grid)
-    lin_bounds = (b[[0, 1, 3], 0], b[[0, 1, 3], 1])
-    sse = np.empty(n_grid)
-    coef = np.empty((n_grid, 3))
-    for i, ws in enumerate(grid):
-        e = np.exp(-av / ws)
-        A = np.column_stack([sg * (1.0 - e), sg * e, v])
-        c, *_ = np.linalg.lstsq(A, y, rcond=None)
-        if np.any(c < lin_bounds[0]) or np.any(c > lin_bounds[1]):
-            c = lsq_linear(A, y, bounds=lin_bounds, method="bvls").x
-        coef[i] = c
-        r = A @ c - y
-        sse[i] = r @ r
-    best_theta, best_sse = None, np.inf
-    for i in np.argsort(sse)[:5]:
-        start = np.array([coef[i, 0], coef[i, 1], grid[i], coef[i, 2]])
-        start = np.clip(start, b[:, 0] + 1e-12 * (b[:, 1] - b[:, 0]), b[:, 1])
-        sol = least_squares(
-            lambda t: problem.residuals(t[None])[0],
-            start,
-            bounds=(b[:, 0], b[:, 1]),
-            method="trf",
-            xtol=1e-15,
-            ftol=1e-15,
-            gtol=1e-15,
-            max_nfev=2000,
-        )
-        for cand in (sol.x, start):
-            s = float(problem.sse(cand[None])[0])
-            if s < best_sse:
-                best_theta, best_sse = cand.copy(), s
-    return best_theta, best_sse
 
 
 @dataclass
@@ -205,7 +78,30 @@ class MethodSpec:
 
 @dataclass
 class StudyResult:
-    """What :func:`run_study` returns (tables as pandas DataFrames)."""
+    """What :func:`run_study` returns.
+
+    Attributes
+    ----------
+    table : pandas.DataFrame
+        [R] Table 1 and the baselines: one row per method (average, max, min SSE, the
+        paper's, ratios to the optimum, runs at the optimum, evaluations, seconds per run).
+    readings : pandas.DataFrame
+        The readings of RWSAVSBAS where [R] is unclear, same columns.
+    hybrid : pandas.DataFrame
+        bas+lm against lm alone from the same random starts, run by run.
+    convergence : pandas.DataFrame
+        [R] Fig. 6: mean best-so-far SSE against evaluations per method.
+    performance : dict
+        Timings and the overhead ratios.
+    optimum : dict
+        The exact optimum (variable projection): parameters and ``sse``.
+    claims : dict
+        From :func:`reproduced`: per [R] Table 1 row, whether ours is within a factor 2.
+    config : dict
+        The settings of the run.
+    results : dict
+        Every run (:class:`~fricid.optim.OptimizeResult`) by label.
+    """
 
     table: pd.DataFrame
     readings: pd.DataFrame
@@ -213,7 +109,7 @@ class StudyResult:
     convergence: pd.DataFrame
     performance: dict[str, float]
     optimum: dict[str, float]
-    notes: list[str]
+    claims: dict[str, bool]
     config: dict[str, Any]
     results: dict[str, list[OptimizeResult]] = field(repr=False, default_factory=dict)
 
@@ -332,16 +228,32 @@ def run_study(
 
     Parameters
     ----------
-    seed : base seed of the optimiser runs (run ``r`` uses ``seed + r``).
-    runs : runs per method ([R]: 8).
-    quick : reduced budgets (RWSAVSBAS 100 x 100 with its schedule compressed ten-fold,
+    seed : int
+        Base seed of the optimiser runs (run ``r`` uses ``seed + r``).
+    runs : int
+        Runs per method ([R]: 8).
+    quick : bool
+        Reduced budgets (RWSAVSBAS 100 x 100 with its schedule compressed ten-fold,
         baselines 3000 evaluations) for a fast check.
-    data_seed : seed of the simulated measurement.
-    progress : called with a short message before each stage (for a progress display).
-    time_numpy : also time RWSAVSBAS on its numpy path (the generic one) for the overhead
-        ratios.
-    repeats : the overhead timings (compiled RWSAVSBAS runs against batched evaluation) are
+    data_seed : int
+        Seed of the simulated measurement.
+    progress : callable, optional
+        Called with a short message before each stage (for a progress display).
+    time_numpy : bool
+        Also time RWSAVSBAS on its numpy path (the generic one) for the overhead ratios.
+    repeats : int
+        The overhead timings (compiled RWSAVSBAS runs against batched evaluation) are
         interleaved and repeated this many times; the best of each is reported.
+
+    Returns
+    -------
+    StudyResult
+        Tables, convergence data, performance numbers, the exact optimum and claims.
+
+    Raises
+    ------
+    ConfigError
+        If ``runs`` is not a positive integer.
     """
     if isinstance(runs, bool) or not isinstance(runs, int | np.integer) or runs < 1:
         raise ConfigError(f"runs must be a positive integer; got {runs!r}")
@@ -355,8 +267,8 @@ def run_study(
     problem = StribeckProblem(v, y)
     say("global optimum by variable projection")
     theta_opt, f_opt = global_optimum(problem)
-    fast = problem.objective(jit=True)
-    plain = problem.objective(jit=False)
+    fast = sse_objective(problem, jit=True)
+    plain = sse_objective(problem, jit=False)
     bounds = problem.bounds
     results: dict[str, list[OptimizeResult]] = {}
     rows = []
@@ -366,7 +278,7 @@ def run_study(
     if fast is not plain:
         say("compiling the RWSAVSBAS fast path (numba; cached after the first time)")
         t = time.perf_counter()
-        minimize(fast, bounds, "rwsavsbas", seed=seed, runs=runs, options={"n_outer": 1})
+        minimize_runs(fast, bounds, "rwsavsbas", seed=seed, runs=runs, options={"n_outer": 1})
         perf["compile_seconds"] = time.perf_counter() - t
 
     specs = _specs(quick)
@@ -374,7 +286,7 @@ def run_study(
         say(f"{spec.label}: {runs} runs")
         fun = fast if spec.method == "rwsavsbas" else plain
         t = time.perf_counter()
-        res = minimize(
+        res = minimize_runs(
             fun,
             bounds,
             spec.method,
@@ -405,7 +317,7 @@ def run_study(
         res = (
             results["RWSAVSBAS"]
             if not extra
-            else minimize(
+            else minimize_runs(
                 fast, bounds, "rwsavsbas", seed=seed, runs=runs, options={**rws_opts, **extra}
             )
         )
@@ -437,7 +349,7 @@ def run_study(
             kernel_call(X[:10])
             times["batch_kernel"].append(_time_batches(kernel_call, X, n_batches))
             t = time.perf_counter()
-            minimize(fast, bounds, "rwsavsbas", seed=seed, runs=runs, options=rws_opts)
+            minimize_runs(fast, bounds, "rwsavsbas", seed=seed, runs=runs, options=rws_opts)
             times["rws_jit"].append(time.perf_counter() - t)
     perf["batch_numpy_seconds"] = min(times["batch_numpy"])
     if fast is not plain:
@@ -450,7 +362,7 @@ def run_study(
     if time_numpy:
         say("RWSAVSBAS on the generic numpy path (same runs, for the overhead ratio)")
         t = time.perf_counter()
-        res_np = minimize(plain, bounds, "rwsavsbas", seed=seed, runs=runs, options=rws_opts)
+        res_np = minimize_runs(plain, bounds, "rwsavsbas", seed=seed, runs=runs, options=rws_opts)
         perf["rws_numpy_seconds"] = time.perf_counter() - t
         perf["ratio_numpy_vs_numpy_batches"] = (
             perf["rws_numpy_seconds"] / perf["batch_numpy_seconds"]
@@ -463,7 +375,7 @@ def run_study(
     # bas+lm and lm alone from the same random starts
     say(f"bas+lm and lm from the same random starts: {runs} runs each")
     t = time.perf_counter()
-    hyb = minimize(None, bounds, "bas+lm", seed=seed, runs=runs, residuals=problem.residuals)
+    hyb = minimize_runs(None, bounds, "bas+lm", seed=seed, runs=runs, residuals=problem.residuals)
     t_hyb = time.perf_counter() - t
     lm_res = []
     for r in range(runs):
@@ -510,7 +422,7 @@ def run_study(
 
     optimum = dict(zip(FREE, map(float, theta_opt), strict=True))
     optimum["sse"] = f_opt
-    notes = _notes(table, f_opt, quick)
+    claims = reproduced(table)
     config = {
         "seed": seed,
         "runs": runs,
@@ -520,200 +432,25 @@ def run_study(
         "success_rtol": SUCCESS_RTOL,
         "jit": fast is not plain,
     }
-    return StudyResult(table, readings, hybrid, convergence, perf, optimum, notes, config, results)
+    return StudyResult(table, readings, hybrid, convergence, perf, optimum, claims, config, results)
 
 
-def _notes(table: pd.DataFrame, f_opt: float, quick: bool) -> list[str]:
-    """One line per paper row whose number we do not reproduce, with the reason."""
-    notes = []
-    why = {
-        "VSBAS": (
-            "the same failure mode as the paper's: the step 0.1 * 0.98^t lets the beetle travel "
-            "at most 5 box widths and then freezes it wherever it is (runs range "
-            "{lo:.2g} .. {hi:.2g}); the level depends on the search box, which [R] does not give"
-        ),
-        "IBAS": (
-            "with steps of 0.1-0.3 of our box it reaches the optimum's region but cannot refine "
-            "it; [R]'s steps are presumably in raw units, 0.1-0.3 against w_s = 0.066 rad/s and "
-            "tau_v = 0.0026 N m s/rad, hence its far larger SSE"
-        ),
-    }
-    for label, reason in why.items():
-        ours = table.loc[label, "mean_sse"]
-        paper = PAPER_TABLE1[label][0]
-        if not 0.5 < ours / paper < 2.0:
-            text = reason.format(lo=table.loc[label, "min_sse"], hi=table.loc[label, "max_sse"])
-            notes.append(
-                f"{label}: average SSE {ours:.3g} against the paper's {paper:.3g}: {text}."
-            )
-    rws = table.loc["RWSAVSBAS", "mean_sse"]
-    if not 0.5 < rws / PAPER_TABLE1["RWSAVSBAS"][0] < 2.0:
-        notes.append(
-            f"RWSAVSBAS: ours {rws:.3g} against the paper's 1.3e-4: the simulated noise gives an "
-            f"optimum of {f_opt:.3g}; compare the ratio to the optimum, not the SSE."
-        )
-    if quick:
-        notes.append("quick mode: reduced budgets, not the paper's settings.")
-    if not notes:
-        notes.append("none: every paper row is reproduced within a factor of 2.")
-    return notes
+def reproduced(table: pd.DataFrame) -> dict[str, bool]:
+    """For each of [R]'s Table 1 rows: is our average SSE within a factor 2 of the paper's?
 
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        :attr:`StudyResult.table` (index: method labels, column ``mean_sse``).
 
-def _fmt(x: float) -> str:
-    return "-" if not np.isfinite(x) else f"{x:.3g}"
-
-
-def report_text(result: StudyResult) -> str:
-    """The study as plain text: Table 1 beside the paper's, readings, bas+lm, performance."""
-    t, p, o = result.table, result.performance, result.optimum
-    runs = result.config["runs"]
-    lines = [
-        "RWSAVSBAS paper, Table 1, on the paper2 preset (simulated; 17 samples, delta = 1)",
-        f"global optimum (variable projection): SSE {o['sse']:.6g} at "
-        + ", ".join(f"{n} {o[n]:.5g}" for n in FREE),
-        f"'found' = final SSE within {SUCCESS_RTOL:.1%} of the optimum; {runs} runs each",
-        "",
-        f"{'method':<24}{'avg SSE':>10}{'max':>10}{'min':>10}{'paper avg':>10}{'max':>8}"
-        f"{'min':>9}{'avg/opt':>10}{'max/opt':>10}{'found':>7}{'evals':>9}{'s/run':>8}  setting",
-    ]
-    for label, r in t.iterrows():
-        lines.append(
-            f"{label:<24}{_fmt(r.mean_sse):>10}{_fmt(r.max_sse):>10}{_fmt(r.min_sse):>10}"
-            f"{_fmt(r.paper_mean):>10}{_fmt(r.paper_max):>8}{_fmt(r.paper_min):>9}"
-            f"{r.mean_ratio:>10.4g}{r.max_ratio:>10.4g}{int(r.found):>4}/{int(r.runs):<2}"
-            f"{int(r.evals):>9}{r.seconds_per_run:>8.3g}  {r.setting}"
-        )
-    lines += ["", "why ours differ from the paper:"] + [f"  {n}" for n in result.notes]
-    lines += ["", "RWSAVSBAS readings (where [R] is unclear), settings of the RWSAVSBAS row:"]
-    for label, r in result.readings.iterrows():
-        lines.append(
-            f"  {label:<54} avg/opt {r.mean_ratio:<10.5g} max/opt {r.max_ratio:<10.5g} "
-            f"found {int(r.found)}/{int(r.runs)}"
-        )
-    h = result.hybrid
-    lines += [
-        "",
-        "bas+lm against lm alone, from the same random starts:",
-        f"  bas+lm: found {int(h['bas+lm_found'].sum())}/{len(h)}, at most "
-        f"{int(h['bas+lm_evals'].max())} evaluations "
-        f"({p['hybrid_max_evals_fraction_of_rws']:.2%} of RWSAVSBAS's "
-        f"{int(p['rws_evals_per_run'])}), max SSE/opt {h['bas+lm_sse'].max() / o['sse']:.6g}",
-        f"  lm alone: found {int(h['lm_found'].sum())}/{len(h)}, "
-        f"{int(h['lm_evals'].median())} evaluations (median), "
-        f"max SSE/opt {h['lm_sse'].max() / o['sse']:.4g}",
-        "",
-        "performance (wall time of all runs, same process):",
-        f"  RWSAVSBAS, {runs} runs batched, compiled path: {p['rws_jit_seconds']:.3f} s"
-        f" (best of {int(p['repeats'])})"
-        + (f" (compile, once: {p['compile_seconds']:.2f} s)" if "compile_seconds" in p else ""),
-    ]
-    if "rws_numpy_seconds" in p:
-        lines.append(
-            f"  RWSAVSBAS, {runs} runs batched, numpy path:    {p['rws_numpy_seconds']:.3f} s "
-            f"(final SSE within {p['numpy_vs_jit_max_rel_diff']:.1e} of the compiled path)"
-        )
-    n_total = int(p["rws_evals_per_run"]) * runs
-    lines.append(
-        f"  {n_total} evaluations in {int(p['batches'])} batches (best of {int(p['repeats'])}): "
-        "numpy objective "
-        f"{p['batch_numpy_seconds']:.3f} s"
-        + (
-            f", compiled kernel {p['batch_kernel_seconds']:.3f} s"
-            if "batch_kernel_seconds" in p
-            else ""
-        )
-    )
-    if "ratio_jit_vs_kernel_batches" in p:
-        lines.append(
-            f"  ratio compiled runs / kernel batches: {p['ratio_jit_vs_kernel_batches']:.2f} "
-            f"(target <= 2); compiled runs / numpy batches: "
-            f"{p['ratio_jit_vs_numpy_batches']:.2f}"
-        )
-    if "ratio_numpy_vs_numpy_batches" in p:
-        lines.append(
-            f"  ratio numpy-path runs / numpy batches: {p['ratio_numpy_vs_numpy_batches']:.2f}"
-        )
-    return "\n".join(lines)
-
-
-def _atomic_write(path: Path, write: Callable[[str], None]) -> None:
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=path.suffix)
-    os.close(fd)
-    try:
-        write(tmp)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-
-
-def plot_convergence(
-    convergence: pd.DataFrame,
-    path: str | os.PathLike[str],
-    runs: int = 8,
-    optimum: float | None = None,
-) -> Path:
-    """The average convergence curves ([R] Fig. 6) as a PNG: mean best-so-far SSE against
-    evaluations, both axes logarithmic (the paper plots against iterations; evaluations
-    compare methods whose iterations cost 3 or 301 evaluations)."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    path = Path(path)
-    fig, ax = plt.subplots(figsize=(8, 5), dpi=120)
-    colors = plt.get_cmap("tab20").colors
-    for i, (label, df) in enumerate(convergence.groupby("label", sort=False)):
-        paper = str(label) in PAPER_TABLE1
-        ax.plot(
-            df["nfev"],
-            df["mean_sse"],
-            label=str(label),
-            color="black" if label == "bas+lm" else colors[(2 * i) % 20 if i < 10 else 2 * i - 19],
-            lw=2.2 if paper else 1.2,
-            ls="-" if paper else (":" if label == "bas+lm" else "--"),
-        )
-    if optimum is not None:
-        ax.axhline(optimum, color="grey", lw=0.8, ls="-.", label="global optimum")
-    ax.set_xscale("log")
-    ax.set_yscale("log")
-    ax.set_xlabel("objective evaluations per run [-]")
-    ax.set_ylabel("mean best SSE [N$^2$ m$^2$]")
-    ax.set_title(f"Average convergence over {runs} runs (RWSAVSBAS paper, Fig. 6)")
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=8, loc="upper right")
-    fig.tight_layout()
-    _atomic_write(path, lambda tmp: fig.savefig(tmp, format="png"))
-    plt.close(fig)
-    return path
-
-
-def write_outputs(result: StudyResult, folder: str | os.PathLike[str]) -> list[Path]:
-    """Write the tables as CSV and Fig. 6 as PNG into ``folder`` (created); atomically."""
-    folder = Path(folder)
-    folder.mkdir(parents=True, exist_ok=True)
-    written = []
-    perf = pd.DataFrame(
-        {"value": list(result.performance.values())}, index=list(result.performance)
-    )
-    perf.index.name = "quantity"
-    for name, df in (
-        ("table1.csv", result.table),
-        ("readings.csv", result.readings),
-        ("bas_lm.csv", result.hybrid),
-        ("convergence.csv", result.convergence),
-        ("performance.csv", perf),
-    ):
-        path = folder / name
-        _atomic_write(path, lambda tmp, df=df: df.to_csv(tmp))
-        written.append(path)
-    written.append(
-        plot_convergence(
-            result.convergence,
-            folder / "fig6_convergence.png",
-            result.config["runs"],
-            result.optimum["sse"],
-        )
-    )
-    return written
+    Returns
+    -------
+    dict
+        ``{"VSBAS": bool, "IBAS": bool, "RWSAVSBAS": bool}``: true when
+        ``0.5 < ours / paper < 2``.
+    """
+    out = {}
+    for label, (paper, _, _) in PAPER_TABLE1.items():
+        ratio = float(table.loc[label, "mean_sse"]) / paper
+        out[label] = bool(0.5 < ratio < 2.0)
+    return out

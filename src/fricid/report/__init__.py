@@ -5,8 +5,11 @@
 >>> write_document(doc, "report/")                  # doctest: +SKIP
 
 :mod:`.document` (the format-free content), :mod:`.render` (HTML, Markdown), :mod:`.writer`
-(the folder, written all or nothing), :mod:`.style` and :mod:`.plots` (matplotlib, Agg only),
-:mod:`.model` (the report of one identified model), :mod:`.rbf` (the RBF network's part).
+(the folder, written all or nothing), :mod:`.style`, :mod:`.plots` and :mod:`.paper_plots`
+(matplotlib figures created directly, Agg canvas, no pyplot), :mod:`.model` (the report of one
+identified model), :mod:`.rbf` (the RBF network's part), :mod:`.studies` (the papers' studies
+from :mod:`fricid.experiments`, as text, files and documents) and :mod:`.reproduce`
+(``fricid reproduce``).
 """
 
 from __future__ import annotations

@@ -1,7 +1,7 @@
 """The content of a report, independent of its format: sections of text, tables and figures.
 
 A :class:`Document` is built by :func:`fricid.report.model_report` (one fitted model on one data
-set) and by the paper reproductions (:mod:`fricid.experiments.reproduce`); it is rendered to
+set) and by the paper reproductions (:mod:`fricid.report.reproduce`); it is rendered to
 HTML and Markdown by :mod:`fricid.report.render` and written to a folder, every table also as
 CSV and every figure as PNG, by :func:`fricid.report.write_document`.
 """

@@ -322,6 +322,7 @@ def convergence(
     Each value of ``histories`` is one ``(m, 2)`` array (nfev, best) or a list of them (runs):
     the mean over runs is drawn on a common evaluation grid, with the min-max range shaded
     when ``band``. ``reference`` draws horizontal lines (e.g. the paper's final values).
+    Methods beyond the palette's colours are told apart by their line style.
     """
     with styled():
         fig, axes = new_figure(width=7.0, height=4.2)
@@ -335,10 +336,11 @@ def convergence(
             if not runs_list:
                 continue
             color = COLORS[k % len(COLORS)]
+            style = ("-", "--", "-.", ":")[(k // len(COLORS)) % 4]  # past the palette
             grid, curves = _common_grid(runs_list, log=log_x)
             mean = curves.mean(axis=0)
             label = name if len(runs_list) == 1 else f"{name} (mean of {len(runs_list)} runs)"
-            ax.plot(grid, mean, color=color, label=label, drawstyle="steps-post")
+            ax.plot(grid, mean, color=color, ls=style, label=label, drawstyle="steps-post")
             if band and len(runs_list) > 1:
                 ax.fill_between(
                     grid,

@@ -1,8 +1,10 @@
 """``fricid reproduce PAPER``: regenerate every table and figure of a seed paper into a folder.
 
-Papers (:data:`PAPERS`): ``bas-rbfnn`` (:mod:`.bas_rbfnn_paper`) and ``rwsavsbas``
-(:mod:`.rwsavsbas_paper`). Each builds a :class:`~fricid.report.Document` with the paper's
-numbers beside ours (:mod:`.paper_numbers`), written by :func:`fricid.report.write_document` as
+Papers (:data:`PAPERS`): ``bas-rbfnn`` (computed by :mod:`fricid.experiments.bas_rbfnn_paper`,
+composed by :mod:`fricid.report.studies.bas_rbfnn`) and ``rwsavsbas``
+(:mod:`fricid.experiments.rwsavsbas_paper`, :mod:`fricid.report.studies.rwsavsbas`). Each
+builds a :class:`~fricid.report.Document` with the paper's numbers beside ours
+(:mod:`fricid.experiments.paper_numbers`), written by :func:`fricid.report.write_document` as
 ``report.html`` (self-contained), ``report.md``, one CSV per table and one PNG per figure, all
 or nothing.
 """
@@ -17,16 +19,17 @@ from os import PathLike
 from pathlib import Path
 
 from ..errors import ConfigError
-from ..report import Document, write_document
+from .document import Document
+from .writer import write_document
 
 __all__ = ["PAPERS", "ReproduceResult", "default_out", "paper_steps", "reproduce"]
 
 logger = logging.getLogger(__name__)
 
-#: The reproducible papers: name -> (module, builder function, steps constant).
+#: The reproducible papers: name -> (module of :mod:`fricid.report.studies`, builder function).
 PAPERS: dict[str, tuple[str, str]] = {
-    "bas-rbfnn": ("bas_rbfnn_paper", "build_bas_rbfnn"),
-    "rwsavsbas": ("rwsavsbas_paper", "build_rwsavsbas"),
+    "bas-rbfnn": ("bas_rbfnn", "build_bas_rbfnn"),
+    "rwsavsbas": ("rwsavsbas", "build_rwsavsbas"),
 }
 
 
@@ -51,7 +54,7 @@ def _module(paper: str):
     if key not in PAPERS:
         raise ConfigError(f"unknown paper '{paper}'; choose one of: {', '.join(PAPERS)}")
     module, builder = PAPERS[key]
-    mod = importlib.import_module(f"{__package__}.{module}")
+    mod = importlib.import_module(f"{__package__}.studies.{module}")
     return key, mod, getattr(mod, builder)
 
 
@@ -78,11 +81,25 @@ def reproduce(
 
     Parameters
     ----------
-    paper : which paper (:data:`PAPERS`).
-    out : output folder (default :func:`default_out`); written all or nothing.
-    quick : reduced designs and budgets (under 2 minutes on 2 cores, used by the tests).
-    seed : seeds every stochastic step; same seed, same report.
-    progress : called with each step's label as it starts (see :func:`paper_steps`).
+    paper : str
+        Which paper (:data:`PAPERS`).
+    out : path-like, optional
+        Output folder (default :func:`default_out`); written all or nothing.
+    quick : bool
+        Reduced designs and budgets (under 2 minutes on 2 cores, used by the tests).
+    seed : int
+        Seeds every stochastic step; same seed, same report.
+    progress : callable, optional
+        Called with each step's label as it starts (see :func:`paper_steps`).
+
+    Returns
+    -------
+    ReproduceResult
+
+    Raises
+    ------
+    ConfigError
+        If ``paper`` is unknown.
     """
     key, _, build = _module(paper)
     out = Path(out) if out is not None else default_out(key)
