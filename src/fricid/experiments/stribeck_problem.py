@@ -20,8 +20,10 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.optimize import least_squares, lsq_linear
 
+from ..identify.problem import IdentificationProblem
 from ..models import Stribeck
 from ..optim import JitObjective
+from ..samples import FrictionSamples
 
 try:  # the compiled twin of the objective (optional: the numpy path is always there)
     from numba import njit
@@ -82,7 +84,11 @@ else:  # pragma: no cover
 
 @dataclass
 class StribeckProblem:
-    """The SSE of [R] eq. 11 for the Stribeck model of fricid (delta fixed to 1)."""
+    """The SSE of [R] eq. 11 for the Stribeck model of fricid (delta fixed to 1).
+
+    A thin view of an :class:`~fricid.identify.problem.IdentificationProblem` (the one place
+    fricid's objective is written) with the study's box :data:`BOUNDS`.
+    """
 
     velocity: np.ndarray
     friction: np.ndarray
@@ -91,21 +97,28 @@ class StribeckProblem:
     def __post_init__(self) -> None:
         self.velocity = np.ascontiguousarray(self.velocity, dtype=float)
         self.friction = np.ascontiguousarray(self.friction, dtype=float)
-        self._model = Stribeck()
-        self._X = self._model.check_inputs(self.velocity)
+        model = Stribeck()
+        samples = FrictionSamples(
+            velocity=self.velocity, load=0.0, temperature=25.0, friction=self.friction
+        )
+        names = [n for n in model.param_names if n != "delta"]
+        self.identification = IdentificationProblem(
+            model,
+            samples,
+            loss="sse",
+            bounds={n: tuple(b) for n, b in zip(names, self.bounds, strict=True)},
+            fixed={"delta": 1.0},
+        )
 
     def predict(self, theta: np.ndarray) -> np.ndarray:
         """Friction ``(k, n)`` for free parameters ``theta (k, 4)``."""
-        theta = np.atleast_2d(theta)
-        full = np.column_stack([theta, np.ones(theta.shape[0])])
-        return self._model.predict(full, self._X)
+        return self.identification.predict(theta)
 
     def residuals(self, theta: np.ndarray) -> np.ndarray:
-        return self.predict(theta) - self.friction
+        return self.identification.residuals(theta)
 
     def sse(self, theta: np.ndarray) -> np.ndarray:
-        r = self.residuals(theta)
-        return np.einsum("kn,kn->k", r, r)
+        return self.identification.evaluate(theta)
 
     def objective(self, jit: bool = True):
         """The objective for :func:`fricid.optim.minimize`; see :func:`sse_objective`."""
@@ -176,8 +189,9 @@ def sse_objective(problem: StribeckProblem, *, jit: bool = True):
 
     Notes
     -----
-    The one place the study builds its objective (to become an
-    ``IdentificationProblem`` of :mod:`fricid.identify`).
+    The one place the study builds its objective: the numpy path is the
+    :class:`~fricid.identify.problem.IdentificationProblem`'s; the compiled kernel computes
+    the same SSE (a test checks they agree).
     """
     if jit and _sse_kernel is not None:
         return JitObjective(problem.sse, _sse_kernel, (problem.velocity, problem.friction))
