@@ -9,6 +9,7 @@ from typing import Annotated
 import typer
 
 from ._app import app, err_console, handle_errors
+from ._options import ModelFile, SmoothZone, out_option
 
 
 def _targets_help() -> str:
@@ -20,20 +21,13 @@ def _targets_help() -> str:
 @app.command("export")
 @handle_errors
 def export_command(
-    model: Annotated[
-        Path,
-        typer.Argument(help="Model file (JSON, from `fricid fit`).", exists=True, dir_okay=False),
-    ],
+    model: ModelFile,
     to: Annotated[str, typer.Option("--to", help=_targets_help())],
     out: Annotated[
         Path | None,
-        typer.Option(
-            "--out",
-            "-o",
-            help=(
-                "For c: the directory to write <prefix>_friction.h and .c into (default: the "
-                "current directory). For urdf, mjcf, yaml: the file to write (default: stdout)."
-            ),
+        out_option(
+            "For c: the directory to write <prefix>_friction.h and .c into (default: the "
+            "current directory). For urdf, mjcf, yaml: the file to write (default: stdout)."
         ),
     ] = None,
     smooth: Annotated[
@@ -46,7 +40,7 @@ def export_command(
             )
         ),
     ] = "none",
-    zone: Annotated[float, typer.Option(help="Half-width of the smoothing zone [rad/s].")] = 0.0,
+    zone: SmoothZone = 0.0,
     prefix: Annotated[
         str,
         typer.Option(

@@ -24,8 +24,6 @@ written atomically too, so a reader never sees a half-written table.
 from __future__ import annotations
 
 import os
-import shutil
-import uuid
 from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
@@ -37,7 +35,7 @@ import pyarrow.dataset as ds
 import pyarrow.parquet as pq
 
 from ..errors import DataError
-from ..io.atomic import atomic_path, atomic_write
+from ..io.atomic import atomic_dir, atomic_path, atomic_write
 
 __all__ = [
     "PARTITIONS",
@@ -144,18 +142,6 @@ def results_table(records: Iterable[dict[str, Any]]) -> pa.Table:
     return pa.Table.from_pylist([{n: row.get(n) for n in names} for row in rows], schema=schema)
 
 
-def _swap_in(tmp: Path, final: Path) -> None:
-    """Replace the folder ``final`` by ``tmp`` (two renames; the old one is deleted after)."""
-    old = None
-    if final.exists():
-        old = final.with_name(f".results-old-{os.getpid()}")
-        shutil.rmtree(old, ignore_errors=True)
-        os.replace(final, old)
-    os.replace(tmp, final)
-    if old is not None:
-        shutil.rmtree(old, ignore_errors=True)
-
-
 def _partition_dir(value: Any) -> str:
     """A hive partition folder's value, encoded as pyarrow's reader decodes it."""
     return "__HIVE_DEFAULT_PARTITION__" if value is None else quote(str(value), safe="")
@@ -184,14 +170,8 @@ def write_results(table: pa.Table, root: str | os.PathLike[str]) -> tuple[Path, 
     root = Path(root)
     root.mkdir(parents=True, exist_ok=True)
     dataset = root / "results"
-    tmp = root / f".results-new-{os.getpid()}-{uuid.uuid4().hex[:8]}"
-    tmp.mkdir()  # (not mkdtemp: the folder gets the usual permissions)
-    try:
+    with atomic_dir(dataset) as tmp:
         _write_partitions(table, tmp)
-        _swap_in(tmp, dataset)
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
     csv_path = root / "results.csv"
     with atomic_write(csv_path, "w") as fh:
         table.to_pandas().to_csv(fh, index=False)

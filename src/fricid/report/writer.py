@@ -23,7 +23,7 @@ from os import PathLike
 from pathlib import Path
 
 from ..errors import ConfigError
-from ..io.atomic import atomic_write
+from ..io.atomic import atomic_write, remove_stale, temp_prefix
 from .document import Document
 from .render import render_html, render_markdown
 
@@ -84,7 +84,8 @@ def write_document(doc: Document, out: str | PathLike[str]) -> Path:
     if out.exists() and not out.is_dir():
         raise ConfigError(f"--out must be a folder; {out} is a file")
     out.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".tmp", dir=out.parent))
+    remove_stale(out.parent, name=out.name)  # what a killed run of fricid left
+    tmp = Path(tempfile.mkdtemp(prefix=temp_prefix(out.name), suffix=".tmp", dir=out.parent))
     try:
         names = _build(doc, tmp)
         if not out.exists() or not any(out.iterdir()):
