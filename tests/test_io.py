@@ -25,7 +25,7 @@ from fricid.io import (
     write_rawlog,
     write_samples,
 )
-from fricid.samples import SAMPLE_COLUMNS, FrictionSamples, RawLog
+from fricid.samples import LIMITS, SAMPLE_COLUMNS, FrictionSamples, RawLog
 
 SAMPLES_HEADER = (
     "velocity [rad/s],load [N m],temperature [degC],friction [N m],direction,count,std [N m]"
@@ -126,6 +126,18 @@ metas = st.dictionaries(
     st.none() | st.booleans() | st.integers(-(10**12), 10**12) | finite | texts,
     max_size=4,
 )
+
+
+def physical(name: str) -> st.SearchStrategy[float]:
+    """Any value in the column's physically possible range (samples.LIMITS)."""
+    low, high, _unit = LIMITS[name]
+    return st.floats(low, high)
+
+
+def column(name: str, n: int) -> st.SearchStrategy[np.ndarray]:
+    return st.lists(physical(name), min_size=n, max_size=n).map(np.array)
+
+
 ROUND_TRIP = settings(
     max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
 )
@@ -134,15 +146,14 @@ ROUND_TRIP = settings(
 @st.composite
 def samples_strategy(draw):
     n = draw(st.integers(1, 20))
-    col = st.lists(finite, min_size=n, max_size=n).map(np.array)
     return FrictionSamples(
-        velocity=draw(col),
-        load=draw(col),
-        temperature=draw(col),
-        friction=draw(col),
+        velocity=draw(column("velocity", n)),
+        load=draw(column("load", n)),
+        temperature=draw(column("temperature", n)),
+        friction=draw(column("friction", n)),
         direction=np.array(draw(st.lists(st.sampled_from([-1, 0, 1]), min_size=n, max_size=n))),
         count=np.array(draw(st.lists(st.integers(1, 2**53), min_size=n, max_size=n))),
-        std=np.abs(draw(col)),
+        std=draw(column("std", n)),
         source=draw(st.none() | texts),
         meta=draw(metas),
     )
@@ -151,17 +162,16 @@ def samples_strategy(draw):
 @st.composite
 def rawlog_strategy(draw):
     n = draw(st.integers(1, 20))
-    col = st.lists(finite, min_size=n, max_size=n).map(np.array)
     steps = st.lists(st.floats(1e-6, 1e3), min_size=n, max_size=n)
     time = draw(st.floats(-1e6, 1e6)) + np.cumsum(draw(steps))
     effort = draw(st.sampled_from(["torque", "current", "both"]))
     return RawLog(
         time=time,
-        position=draw(col),
-        velocity=draw(col),
-        temperature=draw(col),
-        torque=None if effort == "current" else draw(col),
-        current=None if effort == "torque" else draw(col),
+        position=draw(column("position", n)),
+        velocity=draw(column("velocity", n)),
+        temperature=draw(column("temperature", n)),
+        torque=None if effort == "current" else draw(column("torque", n)),
+        current=None if effort == "torque" else draw(column("current", n)),
         torque_constant=draw(st.none() | st.floats(1e-6, 10.0)) if effort != "current" else 0.05,
         joint=draw(texts),
         source=draw(st.none() | texts),

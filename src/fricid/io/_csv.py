@@ -58,6 +58,11 @@ class Preamble:
     comments: dict[str, tuple[str | None, str]] = field(default_factory=dict)
 
 
+def one_line(exc: BaseException) -> str:
+    """An exception's message on one line (pyarrow's span several)."""
+    return " ".join(str(exc).split()) or type(exc).__name__
+
+
 def _decode(raw: bytes, path: Path, line: int) -> str:
     try:
         return raw.decode("utf-8")
@@ -75,7 +80,11 @@ def read_preamble(path: str | os.PathLike[str]) -> Preamble:
     comments: dict[str, tuple[str | None, str]] = {}
     offset = 0
     line = 0
-    with open(path, "rb") as fh:
+    try:
+        fh = open(path, "rb")  # noqa: SIM115 - closed below
+    except IsADirectoryError:
+        raise DataError("is a folder, not a CSV file", file=path) from None
+    with fh:
         while True:
             raw = fh.readline()
             if not raw:
@@ -182,7 +191,7 @@ def _fail(pre: Preamble, labels: list[str], exc: Exception, start: int = 0) -> D
     located = locate_bad_value(pre, labels, start)
     if located is not None:
         return located
-    return DataError(f"cannot read CSV data: {exc}", file=pre.path)
+    return DataError(f"cannot read CSV data: {one_line(exc)}", file=pre.path)
 
 
 def _check_finite(

@@ -66,8 +66,9 @@ def _unit(quantity: str, label: str, units: Mapping[str, str]) -> str:
 
 
 def _integrate(time: np.ndarray, velocity: np.ndarray) -> np.ndarray:
-    steps = 0.5 * (velocity[1:] + velocity[:-1]) * np.diff(time)
-    return np.concatenate([[0.0], np.cumsum(steps)])
+    with np.errstate(over="ignore", invalid="ignore"):  # RawLog reports absurd velocities
+        steps = 0.5 * (velocity[1:] + velocity[:-1]) * np.diff(time)
+        return np.concatenate([[0.0], np.cumsum(steps)])
 
 
 def read_table_log(

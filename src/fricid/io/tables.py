@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import itertools
 import json
+import math
 import os
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, field
@@ -117,25 +118,48 @@ def _csv_info(comments: dict[str, tuple[str | None, str]], path: Path) -> _Info:
         unit, text = comments["torque_constant"]
         unit = unit or SI_UNITS["torque_constant"]
         check_unit(unit, "torque_constant", file=path, column="torque_constant")
-        try:
-            value = float(text)
-        except ValueError:
-            raise DataError(
-                f"metadata 'torque_constant' is not a number: {text!r}", file=path
-            ) from None
-        info.torque_constant = float(to_si(value, unit, "torque_constant"))
+        info.torque_constant = _torque_constant(text, unit, path)
     if "meta" in comments:
         info.meta = loads_meta(comments["meta"][1], file=path)
     return info
 
 
+def _torque_constant(value: Any, unit: str, path: Path) -> float:
+    """K [N m/A] from file metadata: a finite, positive number in a known unit."""
+    check_unit(unit, "torque_constant", file=path, column="torque_constant")
+    number = None
+    if isinstance(value, str):
+        try:
+            number = float(value)
+        except ValueError:
+            pass
+    elif isinstance(value, int | float) and not isinstance(value, bool):
+        number = float(value)
+    if number is None or not math.isfinite(number) or number <= 0:
+        raise DataError(
+            f"metadata 'torque_constant' must be a positive number [{unit}], got {value!r}",
+            file=path,
+        )
+    return float(to_si(number, unit, "torque_constant"))
+
+
 def _parquet_info(doc: dict[str, Any], path: Path) -> _Info:
+    for key in ("format", "source", "joint"):
+        if not isinstance(doc.get(key, ""), str):
+            raise DataError(
+                f"schema metadata '{key}' must be a string, got {doc[key]!r}", file=path
+            )
+    units = doc.get("units", {})
+    if not isinstance(units, dict) or not all(isinstance(u, str) for u in units.values()):
+        raise DataError(
+            f"schema metadata 'units' must map column names to unit strings, got {units!r}",
+            file=path,
+        )
     info = _Info(format=doc.get("format"), source=doc.get("source"), joint=doc.get("joint"))
     k = doc.get("torque_constant")
     if k is not None:
-        unit = doc.get("units", {}).get("torque_constant", SI_UNITS["torque_constant"])
-        check_unit(unit, "torque_constant", file=path, column="torque_constant")
-        info.torque_constant = float(to_si(float(k), unit, "torque_constant"))
+        unit = units.get("torque_constant", SI_UNITS["torque_constant"])
+        info.torque_constant = _torque_constant(k, unit, path)
     meta = doc.get("meta", {})
     if not isinstance(meta, dict):
         raise DataError(f"metadata 'meta' must be a JSON object, got {meta!r}", file=path)
@@ -181,13 +205,8 @@ def _open(
     doc = schema_meta(pf, path)
     info = _parquet_info(doc, path)
     _check_format(info.format, expected, path)
-    units = doc.get("units")
     columns = resolve_columns(
-        pf.schema_arrow.names,
-        schema,
-        required,
-        file=path,
-        units=units if isinstance(units, dict) else None,
+        pf.schema_arrow.names, schema, required, file=path, units=doc.get("units")
     )
     labels = [c.label for c in columns.values()]
     return _Opened(
