@@ -36,6 +36,7 @@ import numpy as np
 from ..errors import ConfigError, DataError
 from ..samples import RawLog
 from ..units import SI_UNITS, UNITS, to_si
+from ._mcap import check_mcap
 
 __all__ = [
     "JOINT_STATE",
@@ -88,6 +89,8 @@ def _open(path: Path) -> Iterator[Any]:
 
     if not path.exists():
         raise DataError("no such bag (a rosbag2 directory, .mcap, .db3 or .bag file)", file=path)
+    for mcap in [path] if path.is_file() else sorted(path.glob("*.mcap")):
+        check_mcap(mcap)
     errors = _bag_errors()
     try:
         reader = AnyReader([path], default_typestore=get_typestore(Stores.LATEST))
