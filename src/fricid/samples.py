@@ -274,7 +274,10 @@ class FrictionSamples:
         if (count != np.round(count)).any():
             row = int(np.flatnonzero(count != np.round(count))[0])
             raise DataError(
-                f"count must be a whole number, got {count[row]!r}", file=src, row=row, column="count"
+                f"count must be a whole number, got {count[row]!r}",
+                file=src,
+                row=row,
+                column="count",
             )
         set_(self, "count", count.astype(np.int64))
         std = np.zeros(n) if self.std is None else _as_column("std", self.std, n, src)

@@ -11,6 +11,7 @@ from rich.markup import escape
 from rich.table import Table
 
 from ._app import app, console, err_console, handle_errors
+from ._paths import check_paths
 
 
 @app.command("compensate")
@@ -18,7 +19,7 @@ from ._app import app, console, err_console, handle_errors
 def compensate_command(
     model: Annotated[
         Path,
-        typer.Argument(help="Model file (JSON, from `fricid fit`).", exists=True, dir_okay=False),
+        typer.Argument(help="Model file (JSON, from `fricid fit`)."),
     ],
     truth: Annotated[
         str,
@@ -93,6 +94,7 @@ def compensate_command(
     from ..export import Smoothing
     from ..fitted import FittedModel
 
+    check_paths(inputs={"MODEL": model})
     fitted = FittedModel.load(model)
     config = default_config(
         fitted,

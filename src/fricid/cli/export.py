@@ -9,6 +9,7 @@ from typing import Annotated
 import typer
 
 from ._app import app, err_console, handle_errors
+from ._paths import check_paths
 
 
 def _targets_help() -> str:
@@ -22,7 +23,7 @@ def _targets_help() -> str:
 def export_command(
     model: Annotated[
         Path,
-        typer.Argument(help="Model file (JSON, from `fricid fit`).", exists=True, dir_okay=False),
+        typer.Argument(help="Model file (JSON, from `fricid fit`)."),
     ],
     to: Annotated[str, typer.Option("--to", help=_targets_help())],
     out: Annotated[
@@ -78,6 +79,9 @@ def export_command(
     from ..fitted import FittedModel
 
     target = to.strip().lower()
+    check_paths(
+        inputs={"MODEL": model}, **{"out_dirs" if target == "c" else "out_files": {"--out": out}}
+    )
     if target not in TARGETS:
         raise ConfigError(f"unknown export target '{to}'; choose one of: {', '.join(TARGETS)}")
     fitted = FittedModel.load(model)

@@ -10,6 +10,7 @@ from rich.markup import escape
 from rich.table import Table
 
 from ._app import app, console, err_console, handle_errors
+from ._paths import check_paths
 from ._progress import progress_bar
 
 _MAX_LISTED = 20
@@ -81,8 +82,6 @@ def fleet_command(
                 "'msk;vlt'), method, seed, fix, bound, positions [deg], gravity, ... (see "
                 "fricid.fleet.manifest)."
             ),
-            exists=True,
-            dir_okay=False,
         ),
     ],
     out: Annotated[
@@ -124,7 +123,6 @@ def fleet_command(
                 "change of predicted friction; writes drift_joints.csv, drift_params.csv, "
                 "drift.png."
             ),
-            exists=True,
         ),
     ] = None,
     min_change: Annotated[
@@ -162,6 +160,11 @@ def fleet_command(
     from ..fleet import compare, make_executor, read_manifest, read_results, run_fleet
     from ..fleet import write_drift as write_drift_files
 
+    check_paths(
+        inputs={"MANIFEST": manifest, "--baseline": baseline},
+        folders={"--baseline"},
+        out_dirs={"--out": out},
+    )
     spec = read_manifest(manifest)
     out = out or Path(f"{manifest.stem}-results")
     before = read_results(baseline) if baseline is not None else None

@@ -8,6 +8,7 @@ from typing import Annotated
 import typer
 
 from ._app import app, console, err_console, handle_errors
+from ._paths import check_paths
 
 
 @app.command("report")
@@ -15,11 +16,9 @@ from ._app import app, console, err_console, handle_errors
 def report_command(
     model: Annotated[
         Path,
-        typer.Argument(help="Model file (JSON, from `fricid fit`).", exists=True, dir_okay=False),
+        typer.Argument(help="Model file (JSON, from `fricid fit`)."),
     ],
-    samples: Annotated[
-        Path, typer.Argument(help="Friction samples, CSV or Parquet.", exists=True, dir_okay=False)
-    ],
+    samples: Annotated[Path, typer.Argument(help="Friction samples, CSV or Parquet.")],
     out: Annotated[
         Path | None,
         typer.Option(
@@ -59,6 +58,7 @@ def report_command(
         raise ConfigError(
             f"--velocity-unit must be one of: {', '.join(UNITS['velocity'])}; got '{velocity_unit}'"
         )
+    check_paths(inputs={"MODEL": model, "SAMPLES": samples}, out_dirs={"--out": out})
     fitted = FittedModel.load(model)
     data = read_samples(samples)
     out = out or Path(f"{model.stem}-report")

@@ -40,7 +40,9 @@ def schema_meta(pf: pq.ParquetFile, path: str | os.PathLike[str]) -> dict[str, A
     try:
         doc = json.loads(raw)
     except (json.JSONDecodeError, UnicodeDecodeError, RecursionError) as exc:
-        raise DataError(f"schema metadata 'fricid' is not valid JSON: {one_line(exc)}", file=path) from None
+        raise DataError(
+            f"schema metadata 'fricid' is not valid JSON: {one_line(exc)}", file=path
+        ) from None
     if not isinstance(doc, dict):
         raise DataError("schema metadata 'fricid' must be a JSON object", file=path)
     return doc
@@ -56,7 +58,9 @@ def _to_float(table: pa.Table, labels: list[str], path: Path, first: int) -> dic
         try:
             values = col.cast(pa.float64()).to_numpy()
         except (pa.ArrowInvalid, pa.ArrowNotImplementedError) as exc:
-            raise DataError(f"not numeric ({col.type}): {one_line(exc)}", file=path, column=label) from None
+            raise DataError(
+                f"not numeric ({col.type}): {one_line(exc)}", file=path, column=label
+            ) from None
         bad = ~np.isfinite(values)
         if bad.any():
             row = int(np.flatnonzero(bad)[0])

@@ -89,6 +89,12 @@ def _open(path: Path) -> Iterator[Any]:
 
     if not path.exists():
         raise DataError("no such bag (a rosbag2 directory, .mcap, .db3 or .bag file)", file=path)
+    if path.is_dir() and not (path / "metadata.yaml").is_file():
+        raise DataError(
+            "a folder without metadata.yaml is not a rosbag2 bag (give the bag's folder, or its "
+            ".mcap or .db3 file)",
+            file=path,
+        )
     for mcap in [path] if path.is_file() else sorted(path.glob("*.mcap")):
         check_mcap(mcap)
     errors = _bag_errors()

@@ -17,6 +17,7 @@ line number in a CSV, the 0-based record in Parquet) and the column. Writes are 
 
 from __future__ import annotations
 
+import contextlib
 import itertools
 import json
 import math
@@ -129,10 +130,8 @@ def _torque_constant(value: Any, unit: str, path: Path) -> float:
     check_unit(unit, "torque_constant", file=path, column="torque_constant")
     number = None
     if isinstance(value, str):
-        try:
+        with contextlib.suppress(ValueError):
             number = float(value)
-        except ValueError:
-            pass
     elif isinstance(value, int | float) and not isinstance(value, bool):
         number = float(value)
     if number is None or not math.isfinite(number) or number <= 0:
