@@ -101,7 +101,10 @@ def read_preamble(path: str | os.PathLike[str]) -> Preamble:
                     name, unit = split_label(key)
                     comments[name.lower()] = (unit, value.strip())
             elif stripped:
-                labels = next(csv.reader([text.rstrip("\r\n")]))
+                try:
+                    labels = next(csv.reader([text.rstrip("\r\n")]))
+                except csv.Error as exc:
+                    raise DataError(f"malformed header line: {exc}", file=path, row=line) from None
                 return Preamble(path, labels, line, offset, comments)
             offset += len(raw)
 

@@ -140,6 +140,8 @@ def read_table_log(
         q: np.asarray(to_si(raw[label], unit_of[q], q), dtype=float) for q, label in columns.items()
     }
     time, velocity = si["time"], si["velocity"]
+    if len(time) == 0:
+        raise DataError("no data rows after the header", file=path)
     try:
         return RawLog(
             time=time,
