@@ -24,14 +24,15 @@ def parse_positions(text: str | None, unit: str) -> np.ndarray | None:
     try:
         if ":" in text:
             start, stop, step = (float(p) for p in text.split(":"))
-            if step <= 0 or stop < start:
+            if not (step > 0 and stop >= start and (stop - start) / step <= 10_000):
                 raise ValueError
             values = start + step * np.arange(int(np.floor((stop - start) / step + 1e-9)) + 1)
         else:
             values = np.array([float(p) for p in text.split(",")])
     except ValueError:
         raise ConfigError(
-            f"--positions takes START:STOP:STEP (step > 0) or a comma list; got '{text}'"
+            f"--positions takes START:STOP:STEP (step > 0, at most 10000 positions) or a comma "
+            f"list; got '{text}'"
         ) from None
     return np.asarray(to_si(values, unit, "position"), dtype=float)
 

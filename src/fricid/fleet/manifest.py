@@ -198,8 +198,10 @@ def _positions(value: Any) -> list[float]:
             raise ValueError(f"expected START:STOP:STEP or a list, got '{value}'") from None
         if not (step > 0 and stop >= start):
             raise ValueError(f"START:STOP:STEP needs step > 0 and stop >= start, got '{value}'")
-        n = math.floor((stop - start) / step + 1e-9) + 1
-        return [start + step * i for i in range(n)]
+        n = (stop - start) / step + 1e-9 + 1
+        if not n <= 10_000:  # checked before allocating (NaN and inf included)
+            raise ValueError(f"START:STOP:STEP gives more than 10000 positions, got '{value}'")
+        return [start + step * i for i in range(math.floor(n))]
     values = [_float(v) for v in _items(value, spaces=True)]
     if not values:
         raise ValueError("names no position")

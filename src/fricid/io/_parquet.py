@@ -26,7 +26,7 @@ def open_parquet(path: str | os.PathLike[str]) -> pq.ParquetFile:
     try:
         # no pre-buffering: it reads ahead whole row groups, unbounded for iter_batches
         return pq.ParquetFile(path, pre_buffer=False)
-    except (pa.ArrowException, OSError) as exc:
+    except (pa.ArrowException, OSError, UnicodeError) as exc:
         if isinstance(exc, FileNotFoundError):
             raise
         raise DataError(f"not a readable Parquet file ({one_line(exc)})", file=path) from None
@@ -78,7 +78,7 @@ def read_columns(pf: pq.ParquetFile, labels: list[str], path: Path) -> dict[str,
     """All rows of ``labels`` as finite float64 arrays (rows in errors are 0-based records)."""
     try:
         table = pf.read(columns=labels)
-    except (pa.ArrowException, OSError) as exc:
+    except (pa.ArrowException, OSError, UnicodeError) as exc:
         raise DataError(f"cannot read Parquet data ({one_line(exc)})", file=path) from None
     return _to_float(table, labels, path, 0)
 
@@ -95,7 +95,7 @@ def iter_columns(
             table = next(stream)
         except StopIteration:
             return
-        except (pa.ArrowException, OSError) as exc:
+        except (pa.ArrowException, OSError, UnicodeError) as exc:
             raise DataError(f"cannot read Parquet data ({one_line(exc)})", file=path) from None
         yield start, _to_float(table, labels, path, start)
         start += table.num_rows

@@ -71,6 +71,12 @@ def _bag_errors() -> tuple[type[BaseException], ...]:
         EOFError,
         OverflowError,
         UnicodeError,
+        # what rosbags raises on some corrupt records (a QoS profile that is not a mapping,
+        # a missing key): caught only around its calls, as a corrupt bag
+        KeyError,
+        IndexError,
+        TypeError,
+        ValueError,
     ]
     try:
         import apsw  # the SQLite driver of rosbags (.db3 storage)
