@@ -30,7 +30,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 
-from fuzzing import READERS, RngChooser, Workspace  # noqa: E402
+from fuzzing import READERS, RngChooser, Workspace
 
 
 def main() -> int:

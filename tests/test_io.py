@@ -179,6 +179,13 @@ def rawlog_strategy(draw):
     )
 
 
+def _with_recorded(data, path) -> dict:
+    """The meta a reader returns: the written meta, plus the source recorded in the file."""
+    if data.source is None or data.source == str(path):
+        return dict(data.meta)
+    return {**data.meta, "recorded_source": data.source}
+
+
 @pytest.mark.parametrize("suffix", [".csv", ".parquet"])
 @ROUND_TRIP
 @given(samples=samples_strategy())
@@ -188,8 +195,8 @@ def test_samples_round_trip(tmp_path, suffix, samples):
     back = read_samples(path)
     for name in SAMPLE_COLUMNS:
         np.testing.assert_array_equal(getattr(back, name), getattr(samples, name), err_msg=name)
-    assert back.source == (samples.source if samples.source is not None else str(path))
-    assert back.meta == samples.meta
+    assert back.source == str(path)  # messages name the file read (issue 12)
+    assert back.meta == _with_recorded(samples, path)
 
 
 @pytest.mark.parametrize("suffix", [".csv", ".pq"])
@@ -202,8 +209,8 @@ def test_rawlog_round_trip(tmp_path, suffix, log):
     _assert_same_log(back, log)
     assert back.torque_constant == log.torque_constant
     assert back.joint == log.joint
-    assert back.source == (log.source if log.source is not None else str(path))
-    assert back.meta == log.meta
+    assert back.source == str(path)
+    assert back.meta == _with_recorded(log, path)
 
 
 def test_csv_is_readable_with_units_in_header(tmp_path):

@@ -218,9 +218,13 @@ def _open(
     )
 
 
-def _source(info: _Info, path: Path) -> str:
-    """The source recorded in the file, else the file itself."""
-    return info.source if info.source is not None else str(path)
+def _meta(info: _Info, path: Path) -> dict[str, Any]:
+    """The file's meta, plus the source recorded in it (``recorded_source``) when that is not
+    the file itself: ``source`` is the file read, which messages must name (issue 12)."""
+    meta = dict(info.meta)  # one copy per chunk
+    if info.source is not None and info.source != str(path):
+        meta["recorded_source"] = info.source
+    return meta
 
 
 def _relocate(err: DataError, opened: _Opened, first_record: int) -> DataError:
@@ -243,7 +247,8 @@ def read_samples(path: PathLike) -> FrictionSamples:
     Returns
     -------
     FrictionSamples
-        In SI units. ``source`` is the source recorded in the file, else ``path``.
+        In SI units. ``source`` is ``path``; a different source recorded in the file is
+        kept as ``meta["recorded_source"]``.
     """
     opened = _open(path, _SAMPLES_SCHEMA, _SAMPLES_REQUIRED, SAMPLES_FORMAT)
     cols = opened.si(opened.read_all())
@@ -257,7 +262,7 @@ def read_samples(path: PathLike) -> FrictionSamples:
         )
     info = opened.info
     try:
-        return FrictionSamples(**cols, source=_source(info, opened.path), meta=info.meta)
+        return FrictionSamples(**cols, source=str(opened.path), meta=_meta(info, opened.path))
     except DataError as err:
         raise _relocate(err, opened, 0) from None
 
@@ -286,8 +291,8 @@ def _rawlog(opened: _Opened, cols: dict[str, np.ndarray], first_record: int) -> 
             current=cols.get("current"),
             torque_constant=info.torque_constant,
             joint=info.joint if info.joint is not None else "joint",
-            source=_source(info, opened.path),
-            meta=dict(info.meta),  # one copy per chunk
+            source=str(opened.path),
+            meta=_meta(info, opened.path),
         )
     except DataError as err:
         raise _relocate(err, opened, first_record) from None
