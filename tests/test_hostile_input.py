@@ -301,7 +301,7 @@ def files(tmp_path_factory):
         (["fit", "{f}/missing.csv"], ["SAMPLES: no such file", "missing.csv"]),
         (["fit", "{f}/a_folder"], ["SAMPLES", "is a folder"]),
         (["fit", "{f}/s.csv", "--out", "{f}/a_folder"], ["--out", "existing folder"]),
-        (["fit", "{f}/s.csv", "--out", "{f}/nowhere/m.json"], ["its folder", "does not exist"]),
+        (["fit", "{f}/s.csv", "--out", "{f}/s.csv/m.json"], ["is a file, not a folder"]),
         (["predict", "{f}/m.json", "-v", "1", "--out", "{f}/a_folder"], ["--out", "folder"]),
         (["predict", "{f}/missing.json", "-v", "1"], ["MODEL: no such file"]),
         (["export", "{f}/m.json", "--to", "urdf", "--out", "{f}/a_folder"], ["existing folder"]),

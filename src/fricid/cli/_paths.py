@@ -34,9 +34,10 @@ def _out_file(name: str, path: Path) -> None:
             f"{name}: '{path}' is an existing folder; give the name of a file to write"
         )
     parent = path.parent
+    while not parent.exists() and parent != parent.parent:
+        parent = parent.parent  # writers create missing folders
     if not parent.is_dir():
-        what = "is a file" if parent.exists() else "does not exist"
-        raise ConfigError(f"{name}: cannot write '{path}': its folder '{parent}' {what}")
+        raise ConfigError(f"{name}: cannot write '{path}': '{parent}' is a file, not a folder")
 
 
 def _out_dir(name: str, path: Path) -> None:
@@ -62,7 +63,7 @@ def check_paths(
         Whether the inputs may be folders (a folder of EPOS recordings, a rosbag2 folder),
         or the names of those that may; by default each must be a file.
     out_files : Mapping[str, Path or None]
-        Files to write: each must not be an existing folder, and its folder must exist.
+        Files to write: each must not be an existing folder, nor lie below a file.
     out_dirs : Mapping[str, Path or None]
         Folders to write into: each must not be an existing file.
 
