@@ -80,9 +80,11 @@ def _walk(fh: BinaryIO, size: int) -> None:
     if _read(fh, 8, 0) != MAGIC:
         return  # not MCAP: the bag library says so in its own words
     pos = 8
+    starts = {0}  # 0: no summary section
     while True:
         if pos + 9 > size:
             raise _Bad("truncated: no footer record", pos)
+        starts.add(pos)
         op, length = struct.unpack("<BQ", _read(fh, 9, pos))
         if length > size - pos - 9:
             raise _Bad(f"record length {length} runs past the end of the file", pos)
@@ -92,8 +94,8 @@ def _walk(fh: BinaryIO, size: int) -> None:
             data = _read(fh, length, pos)  # bounded by the file size, checked above
             if op == _FOOTER:
                 summary, offsets = _unpack("<QQ", data, 0, pos)
-                if summary > size or offsets > size:
-                    raise _Bad("footer points past the end of the file", pos)
+                if summary not in starts or offsets not in starts:
+                    raise _Bad("footer points outside the file's records", pos)
                 return
             _check_chunk_index(data, size, pos)
         pos += 9 + length
