@@ -25,7 +25,7 @@ from fricid.io import (
     write_rawlog,
     write_samples,
 )
-from fricid.samples import SAMPLE_COLUMNS, FrictionSamples, RawLog
+from fricid.samples import LIMITS, SAMPLE_COLUMNS, FrictionSamples, RawLog
 
 SAMPLES_HEADER = (
     "velocity [rad/s],load [N m],temperature [degC],friction [N m],direction,count,std [N m]"
@@ -126,6 +126,18 @@ metas = st.dictionaries(
     st.none() | st.booleans() | st.integers(-(10**12), 10**12) | finite | texts,
     max_size=4,
 )
+
+
+def physical(name: str) -> st.SearchStrategy[float]:
+    """Any value in the column's physically possible range (samples.LIMITS)."""
+    low, high, _unit = LIMITS[name]
+    return st.floats(low, high)
+
+
+def column(name: str, n: int) -> st.SearchStrategy[np.ndarray]:
+    return st.lists(physical(name), min_size=n, max_size=n).map(np.array)
+
+
 ROUND_TRIP = settings(
     max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
 )
@@ -134,15 +146,14 @@ ROUND_TRIP = settings(
 @st.composite
 def samples_strategy(draw):
     n = draw(st.integers(1, 20))
-    col = st.lists(finite, min_size=n, max_size=n).map(np.array)
     return FrictionSamples(
-        velocity=draw(col),
-        load=draw(col),
-        temperature=draw(col),
-        friction=draw(col),
+        velocity=draw(column("velocity", n)),
+        load=draw(column("load", n)),
+        temperature=draw(column("temperature", n)),
+        friction=draw(column("friction", n)),
         direction=np.array(draw(st.lists(st.sampled_from([-1, 0, 1]), min_size=n, max_size=n))),
         count=np.array(draw(st.lists(st.integers(1, 2**53), min_size=n, max_size=n))),
-        std=np.abs(draw(col)),
+        std=draw(column("std", n)),
         source=draw(st.none() | texts),
         meta=draw(metas),
     )
@@ -151,22 +162,28 @@ def samples_strategy(draw):
 @st.composite
 def rawlog_strategy(draw):
     n = draw(st.integers(1, 20))
-    col = st.lists(finite, min_size=n, max_size=n).map(np.array)
     steps = st.lists(st.floats(1e-6, 1e3), min_size=n, max_size=n)
     time = draw(st.floats(-1e6, 1e6)) + np.cumsum(draw(steps))
     effort = draw(st.sampled_from(["torque", "current", "both"]))
     return RawLog(
         time=time,
-        position=draw(col),
-        velocity=draw(col),
-        temperature=draw(col),
-        torque=None if effort == "current" else draw(col),
-        current=None if effort == "torque" else draw(col),
+        position=draw(column("position", n)),
+        velocity=draw(column("velocity", n)),
+        temperature=draw(column("temperature", n)),
+        torque=None if effort == "current" else draw(column("torque", n)),
+        current=None if effort == "torque" else draw(column("current", n)),
         torque_constant=draw(st.none() | st.floats(1e-6, 10.0)) if effort != "current" else 0.05,
         joint=draw(texts),
         source=draw(st.none() | texts),
         meta=draw(metas),
     )
+
+
+def _with_recorded(data, path) -> dict:
+    """The meta a reader returns: the written meta, plus the source recorded in the file."""
+    if data.source is None or data.source == str(path):
+        return dict(data.meta)
+    return {**data.meta, "recorded_source": data.source}
 
 
 @pytest.mark.parametrize("suffix", [".csv", ".parquet"])
@@ -178,8 +195,8 @@ def test_samples_round_trip(tmp_path, suffix, samples):
     back = read_samples(path)
     for name in SAMPLE_COLUMNS:
         np.testing.assert_array_equal(getattr(back, name), getattr(samples, name), err_msg=name)
-    assert back.source == (samples.source if samples.source is not None else str(path))
-    assert back.meta == samples.meta
+    assert back.source == str(path)  # messages name the file read (issue 12)
+    assert back.meta == _with_recorded(samples, path)
 
 
 @pytest.mark.parametrize("suffix", [".csv", ".pq"])
@@ -192,8 +209,8 @@ def test_rawlog_round_trip(tmp_path, suffix, log):
     _assert_same_log(back, log)
     assert back.torque_constant == log.torque_constant
     assert back.joint == log.joint
-    assert back.source == (log.source if log.source is not None else str(path))
-    assert back.meta == log.meta
+    assert back.source == str(path)
+    assert back.meta == _with_recorded(log, path)
 
 
 def test_csv_is_readable_with_units_in_header(tmp_path):

@@ -91,7 +91,8 @@ class DataError(FricidError, ValueError):
             where.append(f"row {self.row}")
         if self.column is not None:
             where.append(f"column '{self.column}'")
-        return f"{', '.join(where)}: {self.message}" if where else self.message
+        text = f"{', '.join(where)}: {self.message}" if where else self.message
+        return " ".join(text.splitlines())  # one line, whatever text the file put in it
 
 
 class FricidWarning(UserWarning):

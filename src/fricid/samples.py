@@ -15,7 +15,7 @@ import numpy as np
 
 from .errors import DataError
 
-__all__ = ["RAWLOG_COLUMNS", "SAMPLE_COLUMNS", "FrictionSamples", "RawLog"]
+__all__ = ["LIMITS", "RAWLOG_COLUMNS", "SAMPLE_COLUMNS", "FrictionSamples", "RawLog"]
 
 #: Columns of a :class:`FrictionSamples` table and their units.
 SAMPLE_COLUMNS: dict[str, str] = {
@@ -39,6 +39,42 @@ RAWLOG_COLUMNS: dict[str, str] = {
 }
 
 
+#: Physically possible range of each column, ``(low, high, unit)`` in SI. Values outside it
+#: are not measurements (a unit mistake, a corrupt file, an overflow): absolute zero below,
+#: and above, bounds no joint reaches (1e6 rad/s is about 10 million rpm) that still leave
+#: products such as friction x velocity far from floating-point overflow.
+LIMITS: dict[str, tuple[float, float, str]] = {
+    "time": (-1e10, 1e10, "s"),
+    "position": (-1e12, 1e12, "rad"),
+    "velocity": (-1e6, 1e6, "rad/s"),
+    "torque": (-1e9, 1e9, "N m"),
+    "current": (-1e6, 1e6, "A"),
+    "temperature": (-273.15, 1e4, "degC"),
+    "load": (-1e9, 1e9, "N m"),
+    "friction": (-1e9, 1e9, "N m"),
+    "count": (1.0, 2.0**53, "1"),
+    "std": (0.0, 1e9, "N m"),
+    "torque_constant": (0.0, 1e6, "N m/A"),
+}
+
+
+def _check_range(name: str, arr: np.ndarray, source: str | None) -> None:
+    """Raise :class:`DataError` for the first value of column ``name`` outside :data:`LIMITS`."""
+    low, high, unit = LIMITS[name]
+    u = "" if unit == "1" else f" {unit}"
+    bad = (arr < low) | (arr > high)
+    if bad.any():
+        row = int(np.flatnonzero(bad)[0])
+        what = "below absolute zero" if name == "temperature" and arr[row] < low else "impossible"
+        raise DataError(
+            f"{what} value {float(arr[row])!r}{u}; {name} must lie in [{low:g}, {high:g}]{u} "
+            "(a unit mistake or a corrupt file?)",
+            file=source,
+            row=row,
+            column=name,
+        )
+
+
 def _as_column(name: str, values: Any, n: int | None, source: str | None) -> np.ndarray:
     """``values`` as a finite float column of ``n`` rows (a scalar is broadcast).
 
@@ -58,6 +94,8 @@ def _as_column(name: str, values: Any, n: int | None, source: str | None) -> np.
     if bad.any():
         row = int(np.flatnonzero(bad)[0])
         raise DataError(f"non-finite value {arr[row]!r}", file=source, row=row, column=name)
+    if name in LIMITS and name not in ("count", "std"):  # checked after their own rules
+        _check_range(name, arr, source)
     return arr
 
 
@@ -128,21 +166,36 @@ class RawLog:
         n = time.shape[0]
         set_ = object.__setattr__
         set_(self, "time", time)
-        for name in ("position", "velocity", "temperature"):
+        # velocity before position: readers may integrate position from it
+        for name in ("velocity", "position", "temperature"):
             set_(self, name, _as_column(name, getattr(self, name), n, src))
         if self.torque is None and self.current is None:
             raise DataError("the log has neither a torque nor a current column", file=src)
         for name in ("torque", "current"):
             if getattr(self, name) is not None:
                 set_(self, name, _as_column(name, getattr(self, name), n, src))
-        if self.torque is None:
-            k = self.torque_constant
-            if k is None or not np.isfinite(k) or k <= 0:
+        k = self.torque_constant
+        if self.torque is None and k is None:
+            raise DataError(
+                "only current was logged, so a positive torque constant K [N m/A] is "
+                f"needed (tau = K I, eq. 13); got {k!r}",
+                file=src,
+            )
+        if k is not None:
+            try:
+                k = float(k)
+            except (TypeError, ValueError):
                 raise DataError(
-                    "only current was logged, so a positive torque constant K [N m/A] is "
-                    f"needed (tau = K I, eq. 13); got {k!r}",
+                    f"the torque constant K must be a number [N m/A], got {k!r}", file=src
+                ) from None
+            high = LIMITS["torque_constant"][1]
+            if not (np.isfinite(k) and 0 < k <= high):
+                raise DataError(
+                    f"the torque constant K (tau = K I, eq. 13) must lie in (0, {high:g}] "
+                    f"N m/A; got {k!r}",
                     file=src,
                 )
+            set_(self, "torque_constant", k)
         if n > 1:
             dt = np.diff(time)
             bad = np.flatnonzero(dt <= 0)
@@ -321,11 +374,21 @@ class FrictionSamples:
             raise DataError(
                 f"count must be >= 1, got {count[row]!r}", file=src, row=row, column="count"
             )
+        _check_range("count", count, src)
+        if (count != np.round(count)).any():
+            row = int(np.flatnonzero(count != np.round(count))[0])
+            raise DataError(
+                f"count must be a whole number, got {count[row]!r}",
+                file=src,
+                row=row,
+                column="count",
+            )
         set_(self, "count", count.astype(np.int64))
         std = np.zeros(n) if self.std is None else _as_column("std", self.std, n, src)
         if (std < 0).any():
             row = int(np.flatnonzero(std < 0)[0])
             raise DataError(f"std must be >= 0, got {std[row]!r}", file=src, row=row, column="std")
+        _check_range("std", std, src)
         set_(self, "std", std)
         set_(self, "meta", dict(self.meta))
 

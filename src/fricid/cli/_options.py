@@ -43,7 +43,7 @@ T = TypeVar("T")
 #: A model file argument (JSON written by ``fricid fit``), which must exist.
 ModelFile = Annotated[
     Path,
-    typer.Argument(help="Model file (JSON, from `fricid fit`).", exists=True, dir_okay=False),
+    typer.Argument(help="Model file (JSON, from `fricid fit`); checked by `check_paths`."),
 ]
 
 #: ``--fix NAME=VALUE`` (repeatable), parsed by :func:`parse_assignments`.

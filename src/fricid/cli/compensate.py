@@ -12,6 +12,7 @@ from rich.table import Table
 
 from ._app import app, console, err_console, handle_errors
 from ._options import ModelFile, SmoothKind, SmoothZone
+from ._paths import check_paths
 
 
 def truth_names() -> tuple[str, ...]:
@@ -103,9 +104,10 @@ def compensate_command(
     velocity. See `fricid.control.tracking` for every detail.
     """
     from ..control import compensation_study, default_config, plot_compensation
-    from ..models.smoothing import Smoothing
     from ..fitted import FittedModel
+    from ..models.smoothing import Smoothing
 
+    check_paths(inputs={"MODEL": model})
     fitted = FittedModel.load(model)
     config = default_config(
         fitted,

@@ -10,6 +10,7 @@ import typer
 from rich.table import Table
 
 from ._app import app, console, handle_errors
+from ._paths import check_paths
 
 
 @app.command("evaluate")
@@ -17,11 +18,9 @@ from ._app import app, console, handle_errors
 def evaluate_command(
     model: Annotated[
         Path,
-        typer.Argument(help="Model file (JSON, from `fricid fit`).", exists=True, dir_okay=False),
+        typer.Argument(help="Model file (JSON, from `fricid fit`)."),
     ],
-    samples: Annotated[
-        Path, typer.Argument(help="Friction samples, CSV or Parquet.", exists=True, dir_okay=False)
-    ],
+    samples: Annotated[Path, typer.Argument(help="Friction samples, CSV or Parquet.")],
     as_json: Annotated[bool, typer.Option("--json", help="Print the metrics as JSON.")] = False,
 ) -> None:
     """Evaluate a model file on samples: fitness (R^2), SSE [N m^2], RMSE [N m], RMSPE,
@@ -30,6 +29,7 @@ def evaluate_command(
     from ..identify import evaluate
     from ..io import read_samples
 
+    check_paths(inputs={"MODEL": model, "SAMPLES": samples})
     fitted = FittedModel.load(model)
     result = evaluate(fitted, read_samples(samples))
     if as_json:

@@ -10,6 +10,7 @@ import typer
 
 from ._app import app, err_console, handle_errors
 from ._options import ModelFile, SmoothZone, out_option
+from ._paths import check_paths
 
 
 def _targets_help() -> str:
@@ -93,6 +94,9 @@ def export_command(
     from ..fitted import FittedModel
 
     target = to.strip().lower()
+    check_paths(
+        inputs={"MODEL": model}, **{"out_dirs" if target == "c" else "out_files": {"--out": out}}
+    )
     if target not in TARGETS:
         raise ConfigError(f"unknown export target '{to}'; choose one of: {', '.join(TARGETS)}")
     fitted = FittedModel.load(model)

@@ -12,6 +12,7 @@ from rich.markup import escape
 from ..errors import ConfigError
 from ._app import app, console, err_console, handle_errors
 from ._options import TemperatureOption, TorqueConstantOption, out_option, parse_grid
+from ._paths import check_paths
 from ._progress import progress_bar
 
 
@@ -57,7 +58,6 @@ def extract_command(
             help="Raw log (.parquet or .csv from `fricid "
             "simulate` or a converted recording), or a folder of "
             "steady-state EPOS recordings with --format epos.",
-            exists=True,
         ),
     ],
     out: Annotated[
@@ -160,6 +160,11 @@ def extract_command(
     from ..units import to_si
     from ..workflow import load_joint
 
+    check_paths(
+        inputs={"LOG": log},
+        folders=fmt in ("epos", "rosbag"),
+        out_files={"--out": out, "--by-direction": by_direction},
+    )
     pos = parse_positions(positions, position_unit)
     half = None if bin_halfwidth is None else float(to_si(bin_halfwidth, position_unit, "position"))
     extract_options = {

@@ -10,6 +10,7 @@ from rich.markup import escape
 
 from ._app import app, console, err_console, handle_errors
 from ._options import parse_assignments, parse_ranges
+from ._paths import check_paths
 
 
 def _method_help() -> str:
@@ -25,8 +26,6 @@ def fit_command(
         Path,
         typer.Argument(
             help="Friction samples, CSV or Parquet (from `fricid extract`).",
-            exists=True,
-            dir_okay=False,
         ),
     ],
     model: Annotated[
@@ -107,6 +106,7 @@ def fit_command(
     from ..io import read_samples
     from ..workflow import select_direction
 
+    check_paths(inputs={"SAMPLES": samples}, out_files={"--out": out})
     data = select_direction(read_samples(samples), direction)
     rbf = model.strip().lower() == "rbf"
     fitted = fit(

@@ -11,6 +11,7 @@ from rich.table import Table
 
 from ._app import app, console, err_console, handle_errors
 from ._options import out_option
+from ._paths import check_paths
 from ._progress import progress_bar
 
 _MAX_LISTED = 20
@@ -83,8 +84,6 @@ def fleet_command(
                 "(NAME=LOW:HIGH;...), positions [deg], gravity, ... (the JSON Schema "
                 "fricid/schemas/manifest.schema.json lists every column)."
             ),
-            exists=True,
-            dir_okay=False,
         ),
     ],
     out: Annotated[
@@ -122,7 +121,6 @@ def fleet_command(
                 "change of predicted friction; writes drift_joints.csv, drift_params.csv, "
                 "drift.png."
             ),
-            exists=True,
         ),
     ] = None,
     min_change: Annotated[
@@ -160,6 +158,11 @@ def fleet_command(
     from ..fleet import compare, make_executor, read_manifest, read_results, run_fleet
     from ..fleet import write_drift as write_drift_files
 
+    check_paths(
+        inputs={"MANIFEST": manifest, "--baseline": baseline},
+        folders={"--baseline"},
+        out_dirs={"--out": out},
+    )
     spec = read_manifest(manifest)
     out = out or Path(f"{manifest.stem}-results")
     before = read_results(baseline) if baseline is not None else None

@@ -9,6 +9,7 @@ from typing import Annotated
 import typer
 
 from ._app import app, err_console, handle_errors
+from ._paths import check_paths
 
 
 def _unit_help(quantity: str) -> str:
@@ -22,7 +23,7 @@ def _unit_help(quantity: str) -> str:
 def predict_command(
     model: Annotated[
         Path,
-        typer.Argument(help="Model file (JSON, from `fricid fit`).", exists=True, dir_okay=False),
+        typer.Argument(help="Model file (JSON, from `fricid fit`)."),
     ],
     velocity: Annotated[
         list[float] | None,
@@ -47,8 +48,6 @@ def predict_command(
         typer.Option(
             "--input",
             "-i",
-            exists=True,
-            dir_okay=False,
             help="File of points (CSV or Parquet) with a 'velocity' column and optional 'load' and "
             "'temperature' columns; units in the column names ('velocity [deg/s]') or from the "
             "unit flags. Missing columns take --load / --temperature.",
@@ -91,6 +90,7 @@ def predict_command(
     from ..fitted import FittedModel
     from ..units import to_si
 
+    check_paths(inputs={"MODEL": model, "--input": input_file}, out_files={"--out": out})
     fitted = FittedModel.load(model)
     flags = {"velocity": velocity_unit, "load": load_unit, "temperature": temperature_unit}
     quantity = {"velocity": "velocity", "load": "torque", "temperature": "temperature"}

@@ -8,6 +8,7 @@ from typing import Annotated
 import typer
 
 from ._app import app, console, err_console, handle_errors
+from ._paths import check_paths
 from ._study_options import out_option, seed_option
 
 
@@ -16,11 +17,9 @@ from ._study_options import out_option, seed_option
 def report_command(
     model: Annotated[
         Path,
-        typer.Argument(help="Model file (JSON, from `fricid fit`).", exists=True, dir_okay=False),
+        typer.Argument(help="Model file (JSON, from `fricid fit`)."),
     ],
-    samples: Annotated[
-        Path, typer.Argument(help="Friction samples, CSV or Parquet.", exists=True, dir_okay=False)
-    ],
+    samples: Annotated[Path, typer.Argument(help="Friction samples, CSV or Parquet.")],
     out: Annotated[
         Path | None,
         out_option(
@@ -56,6 +55,7 @@ def report_command(
         raise ConfigError(
             f"--velocity-unit must be one of: {', '.join(UNITS['velocity'])}; got '{velocity_unit}'"
         )
+    check_paths(inputs={"MODEL": model, "SAMPLES": samples}, out_dirs={"--out": out})
     fitted = FittedModel.load(model)
     data = read_samples(samples)
     out = out or Path(f"{model.stem}-report")

@@ -311,7 +311,7 @@ def _yaml_entries(path: Path, text: str) -> tuple[dict[str, Any], list[tuple[int
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         row = None if mark is None else mark.line + 1
-        problem = getattr(exc, "problem", None) or str(exc)
+        problem = " ".join(str(getattr(exc, "problem", None) or exc).split())  # one line
         raise DataError(f"not valid YAML: {problem}", file=path, row=row) from None
     where = ["joints"] if isinstance(doc, Mapping) else []
     if not isinstance(doc, Mapping):

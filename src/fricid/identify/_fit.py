@@ -24,6 +24,7 @@ from ..metrics import fit_statistics, metrics
 from ..models import INPUTS, STATEFUL, FrictionModel, get_model
 from ..optim import METHODS, OptimizeResult, minimize
 from ..samples import FrictionSamples, samples_hash
+from .checks import check_identifiable
 from .problem import IdentificationProblem
 from .uncertainty import jacobian_uncertainty
 
@@ -109,7 +110,10 @@ def fit(
     ConvergenceWarning
         The optimiser did not converge (budget spent, iteration limit, stopped).
     IdentifiabilityWarning
-        The data do not determine some parameter (its standard error is NaN).
+        The data do not determine some parameter: too few velocity levels, no load or
+        temperature variation for a model that uses them (checked before fitting,
+        :func:`~fricid.identify.checks.check_identifiable`), or a singular Jacobian at the
+        optimum (its standard error is NaN).
     IgnoredArgumentWarning
         An argument the chosen model does not use (``network``, ``inputs`` for analytic
         models; ``callback`` for ``"rbf"``).
@@ -136,6 +140,7 @@ def fit(
         )
     model = get_model(model)
     problem = IdentificationProblem(model, samples, loss="sse", bounds=bounds, fixed=fixed)
+    check_identifiable(samples, model, fixed=problem.fixed, stacklevel=3)
     X, y = problem.X, problem.y
     if problem.n_obs < problem.n_free:
         raise ConfigError(

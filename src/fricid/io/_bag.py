@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import DataError
+from ._mcap import check_mcap
 
 __all__ = [
     "JOINT_STATE",
@@ -50,6 +51,12 @@ def bag_errors() -> tuple[type[BaseException], ...]:
         EOFError,
         OverflowError,
         UnicodeError,
+        # what rosbags raises on some corrupt records (a QoS profile that is not a mapping,
+        # a missing key): caught only around its calls, as a corrupt bag
+        KeyError,
+        IndexError,
+        TypeError,
+        ValueError,
     ]
     try:
         import apsw  # the SQLite driver of rosbags (.db3 storage)
@@ -68,6 +75,14 @@ def open_bag(path: Path) -> Iterator[Any]:
 
     if not path.exists():
         raise DataError("no such bag (a rosbag2 directory, .mcap, .db3 or .bag file)", file=path)
+    if path.is_dir() and not (path / "metadata.yaml").is_file():
+        raise DataError(
+            "a folder without metadata.yaml is not a rosbag2 bag (give the bag's folder, or its "
+            ".mcap or .db3 file)",
+            file=path,
+        )
+    for mcap in [path] if path.is_file() else sorted(path.glob("*.mcap")):
+        check_mcap(mcap)
     errors = bag_errors()
     try:
         reader = AnyReader([path], default_typestore=get_typestore(Stores.LATEST))

@@ -71,6 +71,11 @@ class Preamble:
     comments: dict[str, tuple[str | None, str]] = field(default_factory=dict)
 
 
+def one_line(exc: BaseException) -> str:
+    """An exception's message on one line (pyarrow's span several)."""
+    return " ".join(str(exc).split()) or type(exc).__name__
+
+
 def _decode(raw: bytes, path: Path, line: int) -> str:
     """One line as UTF-8 text; anything else is a :class:`DataError` naming the line."""
     try:
@@ -103,7 +108,11 @@ def read_preamble(path: str | os.PathLike[str]) -> Preamble:
     comments: dict[str, tuple[str | None, str]] = {}
     offset = 0
     line = 0
-    with open(path, "rb") as fh:
+    try:
+        fh = open(path, "rb")  # noqa: SIM115 - closed below
+    except IsADirectoryError:
+        raise DataError("is a folder, not a CSV file", file=path) from None
+    with fh:
         while True:
             raw = fh.readline()
             if not raw:
@@ -120,7 +129,10 @@ def read_preamble(path: str | os.PathLike[str]) -> Preamble:
                     name, unit = split_label(key)
                     comments[name.lower()] = (unit, value.strip())
             elif stripped:
-                labels = next(csv.reader([text.rstrip("\r\n")]))
+                try:
+                    labels = next(csv.reader([text.rstrip("\r\n")]))
+                except csv.Error as exc:
+                    raise DataError(f"malformed header line: {exc}", file=path, row=line) from None
                 return Preamble(path, labels, line, offset, comments)
             offset += len(raw)
 
@@ -237,7 +249,7 @@ def _fail(pre: Preamble, labels: list[str], exc: Exception, start: int = 0) -> D
     located = locate_bad_value(pre, labels, start)
     if located is not None:
         return located
-    return DataError(f"cannot read CSV data: {exc}", file=pre.path)
+    return DataError(f"cannot read CSV data: {one_line(exc)}", file=pre.path)
 
 
 def _check_finite(

@@ -71,7 +71,7 @@ def decode_text(text: str, *, file: str | os.PathLike[str], key: str) -> str:
         return text
     try:
         value = json.loads(text)
-    except json.JSONDecodeError as exc:
+    except (json.JSONDecodeError, RecursionError) as exc:
         raise DataError(
             f"metadata '{key}' is not a valid quoted string: {exc}", file=file
         ) from None
@@ -142,7 +142,7 @@ def loads_meta(text: str, *, file: str | os.PathLike[str]) -> dict[str, Any]:
     """
     try:
         meta = json.loads(text)
-    except json.JSONDecodeError as exc:
+    except (json.JSONDecodeError, RecursionError) as exc:
         raise DataError(f"metadata 'meta' is not valid JSON: {exc}", file=file) from None
     if not isinstance(meta, dict):
         raise DataError(f"metadata 'meta' must be a JSON object, got {meta!r}", file=file)

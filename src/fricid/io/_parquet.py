@@ -15,7 +15,7 @@ import pyarrow.parquet as pq
 
 from ..errors import DataError
 from ..units import SI_UNITS
-from ._csv import rechunk
+from ._csv import one_line, rechunk
 from ._meta import dumps_meta
 from .atomic import atomic_path
 
@@ -61,10 +61,10 @@ def open_parquet(path: str | os.PathLike[str]) -> pq.ParquetFile:
     try:
         # no pre-buffering: it reads ahead whole row groups, unbounded for iter_batches
         return pq.ParquetFile(path, pre_buffer=False)
-    except (pa.ArrowException, OSError) as exc:
+    except (pa.ArrowException, OSError, UnicodeError) as exc:
         if isinstance(exc, FileNotFoundError):
             raise
-        raise DataError(f"not a readable Parquet file ({exc})", file=path) from None
+        raise DataError(f"not a readable Parquet file ({one_line(exc)})", file=path) from None
 
 
 def schema_meta(pf: pq.ParquetFile, path: str | os.PathLike[str]) -> dict[str, Any]:
@@ -93,8 +93,10 @@ def schema_meta(pf: pq.ParquetFile, path: str | os.PathLike[str]) -> dict[str, A
         return {}
     try:
         doc = json.loads(raw)
-    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
-        raise DataError(f"schema metadata 'fricid' is not valid JSON: {exc}", file=path) from None
+    except (json.JSONDecodeError, UnicodeDecodeError, RecursionError) as exc:
+        raise DataError(
+            f"schema metadata 'fricid' is not valid JSON: {one_line(exc)}", file=path
+        ) from None
     if not isinstance(doc, dict):
         raise DataError("schema metadata 'fricid' must be a JSON object", file=path)
     return doc
@@ -112,7 +114,9 @@ def _to_float(table: pa.Table, labels: list[str], path: Path, first: int) -> dic
         try:
             values = col.cast(pa.float64()).to_numpy()
         except (pa.ArrowInvalid, pa.ArrowNotImplementedError) as exc:
-            raise DataError(f"not numeric ({col.type}): {exc}", file=path, column=label) from None
+            raise DataError(
+                f"not numeric ({col.type}): {one_line(exc)}", file=path, column=label
+            ) from None
         bad = ~np.isfinite(values)
         if bad.any():
             row = int(np.flatnonzero(bad)[0])
@@ -151,8 +155,8 @@ def read_columns(pf: pq.ParquetFile, labels: list[str], path: Path) -> dict[str,
     """
     try:
         table = pf.read(columns=labels)
-    except (pa.ArrowException, OSError) as exc:
-        raise DataError(f"cannot read Parquet data ({exc})", file=path) from None
+    except (pa.ArrowException, OSError, UnicodeError) as exc:
+        raise DataError(f"cannot read Parquet data ({one_line(exc)})", file=path) from None
     return _to_float(table, labels, path, 0)
 
 
@@ -192,8 +196,8 @@ def iter_columns(
             table = next(stream)
         except StopIteration:
             return
-        except (pa.ArrowException, OSError) as exc:
-            raise DataError(f"cannot read Parquet data ({exc})", file=path) from None
+        except (pa.ArrowException, OSError, UnicodeError) as exc:
+            raise DataError(f"cannot read Parquet data ({one_line(exc)})", file=path) from None
         yield start, _to_float(table, labels, path, start)
         start += table.num_rows
 

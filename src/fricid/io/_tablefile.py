@@ -8,6 +8,8 @@ into a validation error of the data types.
 
 from __future__ import annotations
 
+import contextlib
+import math
 import os
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
@@ -23,7 +25,7 @@ from ._csv import iter_numeric, read_numeric, read_preamble, record_line
 from ._meta import decode_text, loads_meta
 from ._parquet import iter_columns, open_parquet, read_columns, schema_meta
 
-__all__ = ["Info", "Opened", "open_table", "relocate", "source_of", "table_format"]
+__all__ = ["Info", "Opened", "meta_of", "open_table", "relocate", "table_format"]
 
 PathLike = str | os.PathLike[str]
 
@@ -77,27 +79,46 @@ def _csv_info(comments: dict[str, tuple[str | None, str]], path: Path) -> Info:
     if "torque_constant" in comments:
         unit, text = comments["torque_constant"]
         unit = unit or SI_UNITS["torque_constant"]
-        check_unit(unit, "torque_constant", file=path, column="torque_constant")
-        try:
-            value = float(text)
-        except ValueError:
-            raise DataError(
-                f"metadata 'torque_constant' is not a number: {text!r}", file=path
-            ) from None
-        info.torque_constant = float(to_si(value, unit, "torque_constant"))
+        info.torque_constant = _torque_constant(text, unit, path)
     if "meta" in comments:
         info.meta = loads_meta(comments["meta"][1], file=path)
     return info
 
 
+def _torque_constant(value: Any, unit: str, path: Path) -> float:
+    """K [N m/A] from file metadata: a finite, positive number in a known unit."""
+    check_unit(unit, "torque_constant", file=path, column="torque_constant")
+    number = None
+    if isinstance(value, str):
+        with contextlib.suppress(ValueError):
+            number = float(value)
+    elif isinstance(value, int | float) and not isinstance(value, bool):
+        number = float(value)
+    if number is None or not math.isfinite(number) or number <= 0:
+        raise DataError(
+            f"metadata 'torque_constant' must be a positive number [{unit}], got {value!r}",
+            file=path,
+        )
+    return float(to_si(number, unit, "torque_constant"))
+
+
 def _parquet_info(doc: dict[str, Any], path: Path) -> Info:
-    """The metadata of a Parquet file's schema document (torque constant in SI)."""
+    for key in ("format", "source", "joint"):
+        if not isinstance(doc.get(key, ""), str):
+            raise DataError(
+                f"schema metadata '{key}' must be a string, got {doc[key]!r}", file=path
+            )
+    units = doc.get("units", {})
+    if not isinstance(units, dict) or not all(isinstance(u, str) for u in units.values()):
+        raise DataError(
+            f"schema metadata 'units' must map column names to unit strings, got {units!r}",
+            file=path,
+        )
     info = Info(format=doc.get("format"), source=doc.get("source"), joint=doc.get("joint"))
     k = doc.get("torque_constant")
     if k is not None:
-        unit = doc.get("units", {}).get("torque_constant", SI_UNITS["torque_constant"])
-        check_unit(unit, "torque_constant", file=path, column="torque_constant")
-        info.torque_constant = float(to_si(float(k), unit, "torque_constant"))
+        unit = units.get("torque_constant", SI_UNITS["torque_constant"])
+        info.torque_constant = _torque_constant(k, unit, path)
     meta = doc.get("meta", {})
     if not isinstance(meta, dict):
         raise DataError(f"metadata 'meta' must be a JSON object, got {meta!r}", file=path)
@@ -163,9 +184,13 @@ def open_table(
     )
 
 
-def source_of(info: Info, path: Path) -> str:
-    """The source recorded in the file, else the file itself."""
-    return info.source if info.source is not None else str(path)
+def meta_of(info: Info, path: Path) -> dict[str, Any]:
+    """The file's meta, plus the source recorded in it (``recorded_source``) when that is not
+    the file itself: a reader's ``source`` is the file read, which messages must name."""
+    meta = dict(info.meta)  # one copy per chunk
+    if info.source is not None and info.source != str(path):
+        meta["recorded_source"] = info.source
+    return meta
 
 
 def relocate(err: DataError, opened: Opened, first_record: int) -> DataError:

@@ -108,11 +108,27 @@ def _fields(line: str) -> list[str]:
     return fields
 
 
+#: Skipped lines quoted in the one warning per file.
+_SKIPPED_SHOWN = 3
+
+
+def _warn_skipped(path: Path, what: str, skipped: list[tuple[int, str]]) -> None:
+    """One warning line for all the lines of one kind skipped in a file: count, first ones."""
+    if not skipped:
+        return
+    shown = "; ".join(f"line {n}: {text[:60]!r}" for n, text in skipped[:_SKIPPED_SHOWN])
+    more = f"; and {len(skipped) - _SKIPPED_SHOWN} more" if len(skipped) > _SKIPPED_SHOWN else ""
+    plural = "s" if len(skipped) > 1 else ""
+    logger.warning("%s: skipped %d %s line%s (%s%s)", path, len(skipped), what, plural, shown, more)
+
+
 def _parse_header(lines: list[str], path: Path) -> tuple[dict[str, Any], int]:
     """The ``Key:;value`` block as a dict, and the index of the channel line."""
     header: dict[str, Any] = {}
+    skipped: list[tuple[int, str]] = []
     for i, line in enumerate(lines):
         if line.startswith(";"):
+            _warn_skipped(path, "unrecognised header", skipped)
             return header, i
         m = _HEADER.match(line.strip())
         if m and m.group("key").strip():
@@ -123,7 +139,7 @@ def _parse_header(lines: list[str], path: Path) -> tuple[dict[str, Any], int]:
             else:
                 header[key] = value
         elif line.strip():
-            logger.warning("%s, line %d: skipped unrecognised header line %r", path, i + 1, line)
+            skipped.append((i + 1, line))
     raise DataError(
         "no channel line (';<channel name>;...', naming the recorded channels) found; "
         "is this an EPOS Studio data-recorder export?",
@@ -136,8 +152,7 @@ def _parse_data(lines: list[str], start: int, channels: list[str], path: Path):
     body = pd.Series(lines[start:], index=np.arange(start + 1, len(lines) + 1), dtype=object)
     body = body[body.str.strip() != ""].str.strip().str.rstrip(";").str.strip()
     is_row = body.str.match(_NUMBER_START)
-    for line_no, text in body[~is_row].items():
-        logger.warning("%s, line %d: skipped non-numeric line %r", path, line_no, text)
+    _warn_skipped(path, "non-numeric", list(body[~is_row].items()))
     rows = body[is_row]
     if rows.empty:
         raise DataError("no data rows after the units line", file=path)
@@ -256,8 +271,9 @@ def _convert(
 
 def _integrate(time: np.ndarray, velocity: np.ndarray) -> np.ndarray:
     """Position [rad] from velocity by the trapezoidal rule, starting at 0."""
-    steps = 0.5 * (velocity[1:] + velocity[:-1]) * np.diff(time)
-    return np.concatenate([[0.0], np.cumsum(steps)])
+    with np.errstate(over="ignore", invalid="ignore"):  # RawLog reports absurd velocities
+        steps = 0.5 * (velocity[1:] + velocity[:-1]) * np.diff(time)
+        return np.concatenate([[0.0], np.cumsum(steps)])
 
 
 def _positive(name: str, value: float | None) -> None:

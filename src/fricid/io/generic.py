@@ -68,9 +68,9 @@ def _unit(quantity: str, label: str, units: Mapping[str, str]) -> str:
 
 
 def _integrate(time: np.ndarray, velocity: np.ndarray) -> np.ndarray:
-    """Position [rad] as the trapezoidal integral of velocity, starting at 0."""
-    steps = 0.5 * (velocity[1:] + velocity[:-1]) * np.diff(time)
-    return np.concatenate([[0.0], np.cumsum(steps)])
+    with np.errstate(over="ignore", invalid="ignore"):  # RawLog reports absurd velocities
+        steps = 0.5 * (velocity[1:] + velocity[:-1]) * np.diff(time)
+        return np.concatenate([[0.0], np.cumsum(steps)])
 
 
 def read_table_log(
@@ -161,6 +161,8 @@ def read_table_log(
         q: np.asarray(to_si(raw[label], unit_of[q], q), dtype=float) for q, label in columns.items()
     }
     time, velocity = si["time"], si["velocity"]
+    if len(time) == 0:
+        raise DataError("no data rows after the header", file=path)
     try:
         return RawLog(
             time=time,

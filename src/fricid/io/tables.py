@@ -29,7 +29,7 @@ from ..errors import ConfigError, DataError
 from ..samples import RAWLOG_COLUMNS, SAMPLE_COLUMNS, FrictionSamples, RawLog
 from ._csv import csv_preamble, preamble_fields, write_csv
 from ._parquet import parquet_doc, write_parquet
-from ._tablefile import Opened, open_table, relocate, source_of, table_format
+from ._tablefile import Opened, meta_of, open_table, relocate, table_format
 
 __all__ = ["iter_rawlog", "read_rawlog", "read_samples", "write_rawlog", "write_samples"]
 
@@ -70,7 +70,8 @@ def read_samples(path: PathLike) -> FrictionSamples:
     Returns
     -------
     FrictionSamples
-        In SI units. ``source`` is the source recorded in the file, else ``path``.
+        In SI units. ``source`` is ``path``; a different source recorded in the file is
+        kept as ``meta["recorded_source"]``.
 
     Raises
     ------
@@ -102,7 +103,7 @@ def read_samples(path: PathLike) -> FrictionSamples:
         )
     info = opened.info
     try:
-        return FrictionSamples(**cols, source=source_of(info, opened.path), meta=info.meta)
+        return FrictionSamples(**cols, source=str(opened.path), meta=meta_of(info, opened.path))
     except DataError as err:
         raise relocate(err, opened, 0) from None
 
@@ -133,8 +134,8 @@ def _rawlog(opened: Opened, cols: dict[str, np.ndarray], first_record: int) -> R
             current=cols.get("current"),
             torque_constant=info.torque_constant,
             joint=info.joint if info.joint is not None else "joint",
-            source=source_of(info, opened.path),
-            meta=dict(info.meta),  # one copy per chunk
+            source=str(opened.path),
+            meta=meta_of(info, opened.path),
         )
     except DataError as err:
         raise relocate(err, opened, first_record) from None
