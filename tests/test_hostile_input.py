@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from fricid.pipeline import select_direction
+from fricid.workflow import select_direction
 from typer.testing import CliRunner
 
 from fricid.cli import app
