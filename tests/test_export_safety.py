@@ -579,7 +579,7 @@ def test_out_that_is_a_directory_is_refused_without_a_traceback(tmp_path):
     folder = tmp_path / "folder"
     folder.mkdir()
     res = runner.invoke(app, ["export", str(path), "--to", "urdf", "--out", str(folder)])
-    assert res.exit_code == 2 and "is a directory" in res.output
+    assert res.exit_code == 2 and "is an existing folder" in res.output
     (tmp_path / "c" / "fricid_friction.h").mkdir(parents=True)
     res = runner.invoke(app, ["export", str(path), "--to", "c", "--out", str(tmp_path / "c")])
     assert res.exit_code == 2 and "is a directory" in res.output

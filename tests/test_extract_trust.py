@@ -37,7 +37,6 @@ from fricid.sim import (
 )
 
 Z = 5.0  # tolerance in standard deviations of the noise (see test_extract.py)
-REAL = Path("/work/shared/data/real/epos-leadscrew")
 RPM = 2 * math.pi / 60
 
 
@@ -415,11 +414,10 @@ def test_cli_extract_epos_folder_with_spike(tmp_path):
     assert samples.meta["quality"][samples.meta["files"].index("n40.csv")]["dropped_outlier"] == 1
 
 
-@pytest.mark.skipif(not REAL.is_dir(), reason="real EPOS recordings not present")
-def test_real_leadscrew_nothing_dropped():
+def test_real_leadscrew_nothing_dropped(leadscrew_dir):
     with warnings.catch_warnings():
         warnings.simplefilter("error", DataQualityWarning)
-        s = epos_steady_samples(REAL)
+        s = epos_steady_samples(leadscrew_dir)
     q = s.meta["quality"]
     assert len(q) == 32
     assert all(row["dropped_outlier"] == 0 and not row["flagged"] for row in q)

@@ -13,7 +13,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from fricid.workflow import select_direction
 from typer.testing import CliRunner
 
 from fricid.cli import app
@@ -30,6 +29,7 @@ from fricid.io import (
     write_samples,
 )
 from fricid.samples import FrictionSamples, RawLog
+from fricid.workflow import select_direction
 from fuzzing import EPOS, _mcap, mutate
 
 SAMPLES_HEADER = (
@@ -267,14 +267,14 @@ def test_the_check_agrees_with_what_a_fit_can_do():
 def test_unbounded_position_ranges_are_refused(tmp_path):
     path = tmp_path / "m.csv"
     path.write_text("robot,joint,log,positions [deg]\nr,j,x.csv,-60:1e300:1\n")
-    with pytest.raises(DataError, match="more than 10000 positions"):
+    with pytest.raises(DataError, match="points; at most 100000"):
         read_manifest(path)
     path.write_text("robot,joint,log,positions [deg]\nr,j,x.csv,-60:inf:1\n")
-    with pytest.raises(DataError, match="more than 10000 positions"):
+    with pytest.raises(DataError, match="not a finite number"):
         read_manifest(path)
     from fricid.cli.extract import parse_positions
 
-    with pytest.raises(ConfigError, match="at most 10000 positions"):
+    with pytest.raises(ConfigError, match="points; at most 100000"):
         parse_positions("-60:1e300:1", "deg")
 
 

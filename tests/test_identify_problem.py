@@ -13,7 +13,7 @@ import fricid.models
 from fricid.errors import (
     ConfigError,
     ConvergenceWarning,
-    IdentifiabilityWarning,
+    DataError,
     IgnoredArgumentWarning,
 )
 from fricid.fitted import FittedModel
@@ -117,13 +117,13 @@ def test_unidentifiable_parameter_has_no_stderr_and_warns():
     stderr, cov = jacobian_uncertainty(res, np.array([0.1, 0.2, 0.1]), v.size)
     assert np.isnan(cov[0]).all() and np.isfinite(cov[2, 2])
     assert np.isnan(stderr[:2]).all() and np.isfinite(stderr[2]) and stderr[2] > 0
-    # one velocity only: Coulomb and viscous friction cannot be told apart
+    # one velocity only: Coulomb and viscous friction cannot be told apart, and fit refuses
+    # before fitting, naming them (issue 12: no model file from data that cannot determine it)
     s = FrictionSamples(
         velocity=[0.5] * 5, load=0, temperature=25, friction=[0.3, 0.31, 0.29, 0.3, 0.305]
     )
-    with pytest.warns(IdentifiabilityWarning, match="do not determine f_c, beta"):
-        f = fit(s, "coulomb_viscous")
-    assert np.isnan(f.stderr["f_c"]) and "[not determined]" in f.report()
+    with pytest.raises(DataError, match=r"single velocity level .* f_c, beta"):
+        fit(s, "coulomb_viscous")
 
 
 # -- fit report --------------------------------------------------------------------------------

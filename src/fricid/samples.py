@@ -2,6 +2,10 @@
 
 Both hold SI units only (DESIGN.md, "Units") and validate themselves on construction, so a
 value of either type is always safe to use. Reading and writing them is :mod:`fricid.io`'s job.
+
+The module is longer than 500 lines because it holds both types with their validation (shapes,
+finite values, the physically possible ranges of :data:`LIMITS`, each error naming its row and
+column): the checks are the types' contract and belong beside them.
 """
 
 from __future__ import annotations

@@ -140,13 +140,13 @@ def fit(
         )
     model = get_model(model)
     problem = IdentificationProblem(model, samples, loss="sse", bounds=bounds, fixed=fixed)
-    check_identifiable(samples, model, fixed=problem.fixed, stacklevel=3)
     X, y = problem.X, problem.y
     if problem.n_obs < problem.n_free:
         raise ConfigError(
             f"{problem.n_obs} samples cannot identify {problem.n_free} free parameters of "
             f"'{model.name}'"
         )
+    check_identifiable(samples, model, fixed=problem.fixed, stacklevel=3)
     key = str(method).strip().lower()
     start = problem.start(x0) if key in METHODS else None
     uses_residuals = key in METHODS and METHODS[key].uses_residuals

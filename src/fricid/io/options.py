@@ -207,7 +207,7 @@ def parse_grid(value: Any) -> list[float]:
             raise ConfigError(f"START:STOP:STEP needs step > 0 and stop >= start, got '{value}'")
         count = math.floor((stop - start) / step + 1e-9) + 1
         if count > MAX_GRID:
-            raise ConfigError(f"'{value}' gives {count} points; at most {MAX_GRID}")
+            raise ConfigError(f"'{value}' gives {count:.3g} points; at most {MAX_GRID}")
         return [start + step * i for i in range(count)]
     points = [parse_number(v) for v in split_list(value, spaces=True)]
     if not points:
