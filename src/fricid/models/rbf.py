@@ -333,6 +333,18 @@ def _describe_net(st: Mapping[str, Any]) -> str:
         f"{', '.join(st.get('inputs', []))}; trainer {st.get('trainer')}"
         + (f", encoding {st['encoding']}" if st.get("encoding") else "")
         + (f", {st['n_epochs']} epochs" if st.get("n_epochs") else "")
+        + (
+            f"; {st['n_centers_selection'].get('chosen')} centres chosen by "
+            f"{st['n_centers_selection'].get('folds')}-fold cross-validation"
+            if isinstance(st.get("n_centers_selection"), Mapping)
+            else ""
+        )
+        + (
+            "; dropped (constant): "
+            + ", ".join(f"{k} = {v:.6g}" for k, v in st["dropped_inputs"].items())
+            if isinstance(st.get("dropped_inputs"), Mapping) and st["dropped_inputs"]
+            else ""
+        )
     )
 
 
