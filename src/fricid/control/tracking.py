@@ -199,7 +199,7 @@ def fitted_law(fitted: FittedModel) -> Law:
         def rbf_law(velocity, load, temperature):
             v, lo, t = np.broadcast_arrays(velocity, load, temperature)
             X = np.column_stack([v.ravel(), lo.ravel(), t.ravel()]).astype(float)
-            return fitted.predict(X).reshape(v.shape)
+            return fitted.predict(X, warn=False).reshape(v.shape)  # range: checked by the study
 
         return rbf_law
     model = fitted.friction_model()
