@@ -26,6 +26,13 @@ It is trained by one of
 both from :class:`~fricid.samples.FrictionSamples` (as ``fricid.identify.fit(samples, "rbf")``
 does).
 
+Friction opposes motion (issue 11, defect 1): :func:`fit_rbf` trains the network on ``|v|``
+and stores it as ``F = sign(v) g(|v|, load, T)`` for combined samples (the paper's eq. 11 data,
+``v > 0`` only, which a network on signed velocity extrapolated to the wrong sign at ``v < 0``),
+one network per direction for samples of both directions, and one for a single direction
+(``state["symmetry"]``, :mod:`fricid.models.rbf`). The estimator itself stays a plain
+regressor on the ``X`` it is given, so the paper's study (``v > 0`` data) is unchanged.
+
 Reading of the paper (where it is unclear, DESIGN.md "Faithful and honest")
 --------------------------------------------------------------------------
 * **Target MSE.** The paper trains to "MSE 0.0001" (section 4.3) and reports mean absolute
@@ -296,9 +303,9 @@ def _train_side(
         params["n_centers"], notes["n_centers_selection"] = choose_n_centers(X, t, params)
     else:
         check_centres(int(params["n_centers"]), len(t), where)
-    est = RBFNetRegressor(**params).fit(X, t)
-    if est.velocity_scale is not None and kept[0] != "velocity":
+    if params.get("velocity_scale") is not None and kept[0] != "velocity":
         raise ConfigError("velocity_scale warps the first input, which must be 'velocity'")
+    est = RBFNetRegressor(**params).fit(X, t)
     return est, {**_state(est, kept), **notes}
 
 
