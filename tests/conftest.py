@@ -38,3 +38,66 @@ def real_data() -> Path:
 def leadscrew_dir(real_data: Path) -> Path:
     """The Maxon EPOS lead-screw recordings, ``../shared/data/real/epos-leadscrew/``."""
     return _folder_or_skip(real_data / "epos-leadscrew")
+
+
+# -- every model the suite fits and saves, for tests/test_friction_sign.py ---------------------
+
+#: ``(model dict, samples or None)`` of every model file a test wrote through
+#: ``FittedModel.save``; the samples are those the model was fitted on, found by the content
+#: hash its provenance records (None when the fit is not known).
+SAVED_MODELS: list[tuple[dict, object]] = []
+
+_SAMPLES_BY_HASH: dict[str, object] = {}
+
+
+def pytest_configure(config):
+    config.addinivalue_line(
+        "markers", "after_all: run after every other test (checks what the suite produced)"
+    )
+
+
+def pytest_collection_modifyitems(session, config, items):
+    """Tests marked ``after_all`` run last, so they see every model file the suite wrote."""
+    items.sort(key=lambda item: item.get_closest_marker("after_all") is not None)
+
+
+@pytest.fixture(autouse=True, scope="session")
+def _record_saved_models():
+    """Record every model file written and the samples it was fitted on (see SAVED_MODELS)."""
+    import sys
+
+    import fricid.identify
+    import fricid.identify.rbf
+    import fricid.samples
+    import fricid.workflow
+    from fricid.fitted import FittedModel
+
+    original_hash = fricid.samples.samples_hash
+
+    def recording_hash(samples):
+        digest = original_hash(samples)
+        _SAMPLES_BY_HASH[digest] = samples
+        return digest
+
+    patched = [
+        module
+        for name, module in list(sys.modules.items())
+        if name.startswith("fricid") and getattr(module, "samples_hash", None) is original_hash
+    ]
+    original_save = FittedModel.save
+
+    def recording_save(self, path):
+        out = original_save(self, path)
+        digest = (self.provenance or {}).get("samples_sha256_16")
+        SAVED_MODELS.append((self.to_dict(), _SAMPLES_BY_HASH.get(digest)))
+        return out
+
+    for module in patched:
+        module.samples_hash = recording_hash
+    FittedModel.save = recording_save
+    try:
+        yield
+    finally:
+        FittedModel.save = original_save
+        for module in patched:
+            module.samples_hash = original_hash

@@ -262,15 +262,20 @@ def sum_scale(fitted: FittedModel, X: np.ndarray) -> np.ndarray:
     network crosses zero, so this is the scale of its rounding error (the sum's condition)."""
     from fricid.models.rbf import predict_state
 
+    def absolute(net: dict) -> dict:
+        return {**net, "weights": np.abs(net["weights"]).tolist(), "bias": abs(net["bias"])}
+
     state = dict(fitted.state)
-    state["weights"] = np.abs(state["weights"]).tolist()
-    state["bias"] = abs(state["bias"])
-    return predict_state(state, X)
+    if state.get("symmetry") == "per_direction":
+        state.update(pos=absolute(state["pos"]), neg=absolute(state["neg"]))
+    else:
+        state = absolute(state)
+    return np.abs(predict_state(state, X))  # sign(v) g(|v|): the scale is that of g
 
 
 def test_rbf_tanh_is_refused(tmp_path):
     rbf = FittedModel(model="rbf", params={}, state={"centers": [[0.0]]})
-    with pytest.raises(ExportError, match="RBF network has no sign term"):
+    with pytest.raises(ExportError, match="stored on signed velocity and has no sign term"):
         export_c(rbf, tmp_path, Smoothing("tanh", 0.01))
     assert not any(tmp_path.iterdir())
 

@@ -207,7 +207,9 @@ def test_identify_fit_rbf_equals_fit_rbf():
     d = fit_rbf(s, n_centers=6, trainer="bas", random_state=3, max_epochs=2, target_mse=None)
     assert c.method == "bas/hybrid" and c.state == d.state and c.nfev == d.nfev == 60
     assert c.status == 1 and "budget" in c.message and a.status is None
-    assert c.statistics["ndata"] == 120 and c.statistics["nvarys"] == 6 * 3 + 6 + 6 + 1
+    # the samples hold both directions: one network per direction (issue 11, defect 1)
+    assert c.state["symmetry"] == "per_direction"
+    assert c.statistics["ndata"] == 120 and c.statistics["nvarys"] == 2 * (6 * 3 + 6 + 6 + 1)
 
 
 def test_identify_fit_rbf_rejects_named_parameter_arguments():

@@ -11,6 +11,7 @@ network its stored ``state``. :meth:`FittedModel.report` prints a fit report aft
 from __future__ import annotations
 
 import json
+import warnings
 from dataclasses import asdict, dataclass, field
 from functools import lru_cache
 from os import PathLike
@@ -20,10 +21,12 @@ from typing import Any
 import numpy as np
 
 from . import __version__
-from .errors import ConfigError, DataError
-from .models import get_model, get_predictor
+from .errors import ConfigError, DataError, ExtrapolationWarning
+from .models import INPUTS, get_model, get_predictor
+from .models._range import RANGE_TOLERANCE, RangeViolation, range_violations
+from .models.rbf import legacy_symmetry
 
-__all__ = ["MIN_CORREL", "SCHEMA_VERSION", "FittedModel"]
+__all__ = ["MIN_CORREL", "RANGE_TOLERANCE", "SCHEMA_VERSION", "FittedModel", "RangeViolation"]
 
 #: Correlations at or below this magnitude are left out of the fit report (lmfit's default).
 MIN_CORREL = 0.1
@@ -160,22 +163,82 @@ class FittedModel:
         """The full parameter vector, in the model's order."""
         return self.friction_model().param_vector(self.params)
 
-    def predict(self, X) -> np.ndarray:
+    def predict(self, X, *, warn: bool = True) -> np.ndarray:
         """Friction [N m] at inputs ``X`` (n, 3): velocity [rad/s], load [N m], temp [degC].
 
         Dispatched by model: the registered model's ``predict`` gets the stored state
         (stateful models: the RBF network) or the parameter vector (analytic models).
+
+        Parameters
+        ----------
+        X : array_like, shape (n, 3)
+            The inputs.
+        warn : bool, default True
+            Warn (:class:`~fricid.errors.ExtrapolationWarning`, one per quantity) when inputs
+            lie outside the operating range (:meth:`range_check`): above the identified
+            speeds, on a side a one-direction model was not identified on, or outside the
+            load or temperature range. Speeds below the smallest identified one are
+            reported by :meth:`range_check` but not warned about here (every reversal passes
+            through them).
         """
         model = get_predictor(self.model)
-        return model.predict(self.state if model.stateful else self.theta(), X)
+        out = model.predict(self.state if model.stateful else self.theta(), X)
+        if warn:
+            self._warn_range(X)
+        return out
+
+    def _warn_range(self, X, stacklevel: int = 3) -> None:
+        for bad in self.range_check(X):
+            if bad.kind != "below":
+                warnings.warn(bad.message, ExtrapolationWarning, stacklevel=stacklevel)
 
     def predict_point(self, velocity, load=0.0, temperature=25.0) -> np.ndarray:
-        """Friction [N m] at broadcastable velocity [rad/s], load [N m], temperature [degC]."""
+        """Friction [N m] at broadcastable velocity [rad/s], load [N m], temperature [degC];
+        warns as :meth:`predict` does."""
         v, lo, t = np.broadcast_arrays(
             np.asarray(velocity, float), np.asarray(load, float), np.asarray(temperature, float)
         )
         X = np.column_stack([v.ravel(), lo.ravel(), t.ravel()])
-        return self.predict(X).reshape(v.shape)
+        out = self.predict(X, warn=False).reshape(v.shape)
+        self._warn_range(X)
+        return out
+
+    def inputs_used(self) -> tuple[str, ...]:
+        """The inputs the model uses: the RBF network's (those its state names, and inputs it
+        dropped for not varying), an analytic model's ``inputs``."""
+        if self.kind != "rbf":
+            return tuple(self.friction_model().inputs)
+        state = self.state if isinstance(self.state, dict) else {}
+        names: set[str] = set()
+        for net in (state, state.get("pos"), state.get("neg")):
+            if isinstance(net, dict):
+                names.update(n for n in net.get("inputs") or () if n in INPUTS)
+                names.update(n for n in net.get("dropped_inputs") or {} if n in INPUTS)
+        return tuple(n for n in INPUTS if n in names) or INPUTS
+
+    def range_check(self, X) -> list[RangeViolation]:
+        """The inputs of ``X`` outside the operating range the model was identified on
+        (issue 11, defect 8).
+
+        Each input the model uses is compared with ``operating_range`` (inputs without a
+        recorded range are not checked), allowing :data:`RANGE_TOLERANCE` of the span at the
+        edges. Velocity: a model of combined samples (direction 0, odd in velocity) is
+        compared by speed ``|v|`` (``"above"``, ``"below"``); a one-direction model by speed
+        and side (``"side"``); a range spanning both directions by value (``"outside"``).
+        ``v = 0`` is never out of range (``sign(0) = 0``).
+
+        Parameters
+        ----------
+        X : array_like, shape (n, 3)
+            Velocity [rad/s], load [N m], temperature [degC].
+
+        Returns
+        -------
+        list of RangeViolation
+            One per quantity and kind found, empty when every input is inside.
+        """
+        dirs = (self.provenance or {}).get("directions") if self.provenance else None
+        return range_violations(X, self.operating_range, self.inputs_used(), dirs)
 
     # -- text ----------------------------------------------------------------------------
     def report(self, min_correl: float = MIN_CORREL) -> str:
@@ -273,6 +336,14 @@ class FittedModel:
 
     @classmethod
     def from_dict(cls, d: dict[str, Any], source: str | None = None) -> FittedModel:
+        """A model from the JSON object of a model file (``source`` names it in errors).
+
+        An RBF network from before ``state["symmetry"]`` was recorded is read with
+        :func:`fricid.models.rbf.legacy_symmetry`: trained on combined samples (provenance
+        directions ``[0]``, so on ``v > 0`` only) it is read as odd, ``F = sign(v) g(|v|)``,
+        which repairs the wrong sign such files gave at ``v < 0``; any other stays "signed"
+        (the network as trained).
+        """
         if not isinstance(d, dict):
             raise DataError("a model file must hold a JSON object", file=source)
         version = d.get("schema_version")
@@ -297,6 +368,11 @@ class FittedModel:
             stateful = get_predictor(out.model).stateful
         except ConfigError as exc:
             raise DataError(str(exc), file=source) from None
+        if stateful and isinstance(out.state, dict) and "symmetry" not in out.state:
+            # a network written before the symmetry was recorded: one on combined samples
+            # (v > 0) is read as odd, which repairs its sign at v < 0 (issue 11, defect 1)
+            directions = (out.provenance or {}).get("directions")
+            out.state = {**out.state, "symmetry": legacy_symmetry(directions)}
         if not stateful:
             try:
                 out.theta()

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import warnings
 from pathlib import Path
 from typing import Annotated
 
@@ -102,8 +103,13 @@ def compensate_command(
     The plant sticks at zero velocity until the applied torque exceeds the break-away
     friction (fixed-step Karnopp scheme); the feed-forward is the model at the reference
     velocity. See `fricid.control.tracking` for every detail.
+
+    "RMS error N x smaller" is printed only when the feed-forward shrank the error; when it
+    made tracking worse, a warning line on stderr says so and by how much. A reference that
+    leaves the model's operating range is warned about on stderr too.
     """
     from ..control import compensation_study, default_config, plot_compensation
+    from ..errors import FricidWarning
     from ..fitted import FittedModel
     from ..models.smoothing import Smoothing
 
@@ -122,9 +128,18 @@ def compensate_command(
         temperature=temperature,
         dt=dt,
     )
-    result = compensation_study(
-        fitted, config, truth=resolve_truth(truth), smoothing=Smoothing(smooth, zone)
-    )
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", FricidWarning)
+        result = compensation_study(
+            fitted, config, truth=resolve_truth(truth), smoothing=Smoothing(smooth, zone)
+        )
+    for w in caught:  # one line each on stderr (DESIGN.md); also in the result's notes
+        if issubclass(w.category, FricidWarning):
+            err_console.print(
+                f"warning: {w.message}", markup=False, highlight=False, soft_wrap=True
+            )
+        else:
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
     if not no_plot:
         plot_path = plot or Path(f"{model.stem}.compensation.png")
         plot_compensation(result, plot_path)
@@ -152,11 +167,15 @@ def compensate_command(
         f"{1e3 * result.max['with']:.4g}",
     )
     console.print(table)
+    settings = (
+        f"K_p {k_p:.4g} N m/rad, K_d {k_d:.4g} N m s/rad, J {cfg.inertia:g} kg m^2, "
+        f"load {cfg.load:.4g} N m, temperature {cfg.temperature:.4g} degC, dt {cfg.dt:g} s"
+    )
+    # "x smaller" only when measured (issue 11, defect 1); worse: the warning line on stderr
+    head = result.verdict() if result.improved else "Settings"
     console.print(
-        f"RMS error {result.improvement:.3g}x smaller with feed-forward "
-        f"(K_p {k_p:.4g} N m/rad, K_d {k_d:.4g} N m s/rad, J {cfg.inertia:g} kg m^2, "
-        f"load {cfg.load:.4g} N m, temperature {cfg.temperature:.4g} degC, dt {cfg.dt:g} s)",
-        highlight=False,
+        f"{head} ({settings})" if result.improved else f"{head}: {settings}", highlight=False
     )
     for note in result.notes:
-        console.print(f"note: {note}", highlight=False)
+        if not note.startswith("the reference goes outside"):  # warned on stderr above
+            console.print(f"note: {note}", highlight=False)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import sys
+import warnings
 from pathlib import Path
 from typing import Annotated
 
@@ -81,10 +82,15 @@ def predict_command(
     """Friction of a model at operating points: CSV with velocity, load, temperature and
     friction columns, each labelled with its unit.
 
+    Points outside the operating range the model was identified on (above the identified
+    speeds, below the smallest one, on a side a one-direction model was not identified on,
+    outside the load or temperature range) are still predicted, with one warning line per
+    quantity on stderr.
+
     Examples: `fricid predict m.json --velocity 0.1 --velocity 0.5 --load 0.2 --temperature 30`;
     `fricid predict m.json --input points.csv --velocity-unit deg/s --out friction.csv`.
     """
-    from ..errors import ConfigError
+    from ..errors import ConfigError, ExtrapolationWarning
     from ..export import Smoothing, smooth_predict, write_text
     from ..export.points import points_matrix, points_table, read_points
     from ..fitted import FittedModel
@@ -119,7 +125,16 @@ def predict_command(
             raise ConfigError("give the points: --velocity (repeatable), or --input FILE")
         X = points_matrix(fitted, si["velocity"], si["load"], si["temperature"])
     zone_si = float(to_si(zone, velocity_unit or "rad/s", "velocity"))
-    friction = smooth_predict(fitted, X, Smoothing(smooth, zone_si))
+    for bad in fitted.range_check(X):  # one line each on stderr (issue 11, defect 8)
+        err_console.print(
+            f"warning: {bad.message} ({bad.count} of {len(X)} points)",
+            markup=False,
+            highlight=False,
+            soft_wrap=True,
+        )
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ExtrapolationWarning)  # said above, once per quantity
+        friction = smooth_predict(fitted, X, Smoothing(smooth, zone_si))
     units["friction"] = friction_unit
     text = points_table(X, friction, units)
     if out is None:

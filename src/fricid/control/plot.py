@@ -65,7 +65,7 @@ def plot_compensation(result: CompensationResult, path: str | os.PathLike[str]) 
     kp, kd = result.config.gains
     title = f"Friction compensation: model '{result.model}', true friction '{result.truth}'"
     if np.isfinite(result.improvement):
-        title += f": RMS error {result.improvement:.3g}x smaller with feed-forward"
+        title += f": {result.verdict().split(' (')[0]}"  # only what was measured
     fig.suptitle(f"{title}\n(K_p {kp:.3g} N m/rad, K_d {kd:.3g} N m s/rad)")
     path = Path(path)
     with atomic_path(path) as tmp:

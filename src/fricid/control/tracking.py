@@ -35,13 +35,14 @@ Integration
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
-from ..errors import ConfigError
+from ..errors import ConfigError, ExtrapolationWarning, FricidWarning
 from ..fitted import FittedModel
 
 __all__ = [
@@ -198,7 +199,7 @@ def fitted_law(fitted: FittedModel) -> Law:
         def rbf_law(velocity, load, temperature):
             v, lo, t = np.broadcast_arrays(velocity, load, temperature)
             X = np.column_stack([v.ravel(), lo.ravel(), t.ravel()]).astype(float)
-            return fitted.predict(X).reshape(v.shape)
+            return fitted.predict(X, warn=False).reshape(v.shape)  # range: checked by the study
 
         return rbf_law
     model = fitted.friction_model()
@@ -286,8 +287,27 @@ class CompensationResult:
 
     @property
     def improvement(self) -> float:
-        """RMS error without over RMS error with feed-forward."""
+        """RMS error without over RMS error with feed-forward (below 1: worse with it)."""
         return self.rms["without"] / self.rms["with"] if self.rms["with"] > 0 else math.inf
+
+    @property
+    def improved(self) -> bool:
+        """True only when the feed-forward measurably shrank the RMS tracking error."""
+        return self.rms["with"] < self.rms["without"]
+
+    def verdict(self) -> str:
+        """One line on what the feed-forward did, as measured: "RMS error N x smaller with
+        feed-forward" only when it shrank; else how much worse (or that nothing changed)."""
+        with_, without = self.rms["with"], self.rms["without"]
+        if self.improved:
+            return f"RMS error {self.improvement:.3g}x smaller with feed-forward"
+        if with_ > without:
+            ratio = with_ / without if without > 0 else math.inf
+            return (
+                f"the feed-forward made tracking worse: RMS error {ratio:.3g}x larger with it "
+                f"({1e3 * with_:.4g} mrad against {1e3 * without:.4g} mrad without)"
+            )
+        return "the feed-forward did not change the RMS tracking error"
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready summary (errors in rad)."""
@@ -298,6 +318,8 @@ class CompensationResult:
             "rms_error_rad": dict(self.rms),
             "max_error_rad": dict(self.max),
             "rms_improvement": self.improvement,
+            "improved": self.improved,
+            "verdict": self.verdict(),
             "kp": kp,
             "kd": kd,
             "config": {k: getattr(self.config, k) for k in self.config.__dataclass_fields__},
@@ -352,7 +374,16 @@ def compensation_study(
     Returns
     -------
     CompensationResult
-        RMS and max tracking error of both runs, and the signals.
+        RMS and max tracking error of both runs, and the signals; ``notes`` name where the
+        reference leaves the model's operating range.
+
+    Warns
+    -----
+    ExtrapolationWarning
+        The reference (velocity above the identified speeds, load, temperature) leaves the
+        operating range (:meth:`fricid.fitted.FittedModel.range_check`).
+    FricidWarning
+        The feed-forward made the tracking worse (:meth:`CompensationResult.verdict`).
     """
     from dataclasses import replace
 
@@ -368,11 +399,19 @@ def compensation_study(
     X = np.column_stack(
         [v_r, np.full_like(v_r, config.load), np.full_like(v_r, config.temperature)]
     )
-    ff = smooth_predict(fitted, X, smoothing)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ExtrapolationWarning)  # checked once below
+        ff = smooth_predict(fitted, X, smoothing)
     notes += _extrapolation_notes(fitted, v_r, ff, smoothing)
+    for bad in fitted.range_check(X):
+        if bad.kind == "below":  # reversals always pass through; noted above
+            continue
+        note = f"the reference goes outside the identified operating range: {bad.message}"
+        notes.append(note)
+        warnings.warn(note, ExtrapolationWarning, stacklevel=2)
     runs = simulate_tracking(truth.law, np.vstack([np.zeros_like(ff), ff]), config)
     err = np.abs(runs["error"])
-    return CompensationResult(
+    result = CompensationResult(
         config=config,
         truth=truth.name,
         model=fitted.model,
@@ -385,3 +424,6 @@ def compensation_study(
         feedforward=ff,
         notes=notes,
     )
+    if result.rms["with"] > result.rms["without"]:
+        warnings.warn(result.verdict(), FricidWarning, stacklevel=2)
+    return result

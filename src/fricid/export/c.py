@@ -205,13 +205,11 @@ def _array(name: str, values: np.ndarray, what: str) -> str:
     )
 
 
-def _rbf_parts(fitted: FittedModel) -> tuple[list[str], list[str]]:
-    """Constants and the model function of the RBF network, mirroring
-    ``fricid.models.rbf.predict_state`` (and ``fricid.models._rbf_core``) step by step."""
-    from ..models import rbf
-
-    state = fitted.state
-    rbf.predict_state(state, np.zeros((1, 3)))  # validates the state (DataError if malformed)
+def _rbf_network(state: dict, side: str) -> tuple[list[str], str]:
+    """Constants and the function ``net_<side>`` of one stored network, mirroring
+    ``fricid.models.rbf`` (and ``fricid.models._rbf_core``) step by step."""
+    pre = "rbf_" if side == "all" else f"rbf_{side}_"
+    where = "state" if side == "all" else f"state.{side}"
     inputs = [str(name) for name in state["inputs"]]  # validated: velocity, load, temperature
     shift = np.asarray(state["input_shift"], dtype=float)
     scale = np.asarray(state["input_scale"], dtype=float)
@@ -225,49 +223,99 @@ def _rbf_parts(fitted: FittedModel) -> tuple[list[str], list[str]]:
     cc = np.einsum("md,md->m", centers, centers)
     inv = 0.5 / np.square(widths)
     consts = [
-        _array("rbf_shift", shift, f"input shift, inputs {', '.join(inputs)}"),
-        _array("rbf_scale", scale, "input scale"),
-        _array("rbf_centers", centers, "centres (standardised inputs)"),
-        _array("rbf_cc", cc, "squared norm of each centre"),
-        _array("rbf_inv", inv, "0.5 / sigma^2 of each neuron"),
-        _array("rbf_weights", weights, "output weights [N m]"),
-        f"static const double rbf_bias = {fmt_float(bias, 'state.bias')};  /* output bias [N m] */",
+        _array(f"{pre}shift", shift, f"input shift, inputs {', '.join(inputs)}"),
+        _array(f"{pre}scale", scale, "input scale"),
+        _array(f"{pre}centers", centers, "centres (standardised inputs)"),
+        _array(f"{pre}cc", cc, "squared norm of each centre"),
+        _array(f"{pre}inv", inv, "0.5 / sigma^2 of each neuron"),
+        _array(f"{pre}weights", weights, "output weights [N m]"),
+        f"static const double {pre}bias = {fmt_float(bias, f'{where}.bias')};"
+        "  /* output bias [N m] */",
     ]
     if vscale is not None:
         consts.append(
-            "static const double rbf_velocity_scale = "
-            f"{fmt_float(float(vscale), 'state.velocity_scale')};"
+            f"static const double {pre}velocity_scale = "
+            f"{fmt_float(float(vscale), f'{where}.velocity_scale')};"
             "  /* [rad/s] velocity warped by asinh(v / scale) */"
         )
-    raw = {"velocity": "velocity", "load": "load", "temperature": "temperature"}
-    x0 = "asinh(velocity / rbf_velocity_scale)" if vscale is not None else None
-    picks = [x0 if (k == 0 and x0) else raw[name] for k, name in enumerate(inputs)]
+    x0 = f"asinh(velocity / {pre}velocity_scale)" if vscale is not None else None
+    picks = [x0 if (k == 0 and x0) else name for k, name in enumerate(inputs)]
     unused = [name for name in ("velocity", "load", "temperature") if name not in inputs]
-    dot = " + ".join(f"z[{i}] * rbf_centers[j][{i}]" for i in range(d))
+    dot = " + ".join(f"z[{i}] * {pre}centers[j][{i}]" for i in range(d))
     zz = " + ".join(f"z[{i}] * z[{i}]" for i in range(d))
+    what = {"all": "", "pos": ", v > 0", "neg": ", v < 0"}[side]
     body = (
-        "/* The RBF network (BAS-RBFNN paper, eq. 14-15): standardised inputs z, Gaussian\n"
-        " * units exp(-||z - c_j||^2 / (2 sigma_j^2)) with ||z - c_j||^2 computed as\n"
+        f"/* The RBF network{what} (BAS-RBFNN paper, eq. 14-15): standardised inputs z,\n"
+        " * Gaussian units exp(-||z - c_j||^2 / (2 sigma_j^2)) with ||z - c_j||^2 computed as\n"
         " * max(||z||^2 + ||c_j||^2 - 2 z.c_j, 0) as in Python, linear output plus bias. */\n"
-        "static double model(double velocity, double load, double temperature)\n{\n"
+        f"static double net_{side}(double velocity, double load, double temperature)\n{{\n"
         + "".join(f"    (void){name};\n" for name in unused)
         + f"    double z[{d}];\n"
         "    double zz, acc = 0.0;\n"
         "    int j;\n"
         + "".join(
-            f"    z[{i}] = ({pick} - rbf_shift[{i}]) / rbf_scale[{i}];\n"
+            f"    z[{i}] = ({pick} - {pre}shift[{i}]) / {pre}scale[{i}];\n"
             for i, pick in enumerate(picks)
         )
         + f"    zz = {zz};\n"
         f"    for (j = 0; j < {m}; ++j) {{\n"
         f"        const double dot = {dot};\n"
-        "        const double d2 = fmax(zz + rbf_cc[j] - 2.0 * dot, 0.0);\n"
-        "        acc += exp(-d2 * rbf_inv[j]) * rbf_weights[j];\n"
+        f"        const double d2 = fmax(zz + {pre}cc[j] - 2.0 * dot, 0.0);\n"
+        f"        acc += exp(-d2 * {pre}inv[j]) * {pre}weights[j];\n"
         "    }\n"
-        "    return acc + rbf_bias;\n"
+        f"    return acc + {pre}bias;\n"
         "}\n"
     )
-    return consts, [body]
+    return consts, body
+
+
+def _rbf_parts(fitted: FittedModel, smoothing: Smoothing) -> tuple[list[str], list[str]]:
+    """Constants and functions of the RBF network, with its sign as ``state["symmetry"]``
+    says (:mod:`fricid.models.rbf`): ``sign(v) g(|v|)`` (odd or one direction), two constant
+    sets and ``g_pos``/``g_neg`` per direction, or the network on signed velocity (legacy)."""
+    from ..models import rbf
+
+    state = fitted.state
+    rbf.predict_state(state, np.zeros((1, 3)))  # validates the state (DataError if malformed)
+    symmetry = rbf.symmetry_of(state)
+    consts: list[str] = []
+    funcs: list[str] = []
+    for side, net in rbf.sub_networks(state).items():
+        c, f = _rbf_network(dict(net), side)
+        consts += c
+        funcs.append(f)
+    if symmetry == "signed":
+        core = [
+            "/* The model: the network on signed velocity (stored without a sign of its own) */",
+            "static double model(double velocity, double load, double temperature)\n{",
+            "    return net_all(velocity, load, temperature);",
+        ]
+    else:
+        sign = (
+            f"tanh(velocity / {fmt_float(smoothing.zone, 'zone')})"
+            if smoothing.kind == "tanh"
+            else "(double)((velocity > 0.0) - (velocity < 0.0))"
+        )
+        core = [
+            "/* The model: friction opposes motion, F = s g(|v|, load, T), s = "
+            + ("tanh(v / zone)" if smoothing.kind == "tanh" else "sign(v)")
+            + (", g = g_pos for v > 0, g_neg for v < 0" if symmetry == "per_direction" else "")
+            + " */",
+            "static double model(double velocity, double load, double temperature)\n{",
+            f"    const double s = {sign};",
+            "    const double av = fabs(velocity);",
+        ]
+        if symmetry == "per_direction":
+            core += [
+                "    if (velocity > 0.0) return s * net_pos(av, load, temperature);",
+                "    if (velocity < 0.0) return s * net_neg(av, load, temperature);",
+                "    return 0.0;",
+            ]
+        else:
+            core.append("    return s * net_all(av, load, temperature);")
+    core.append("}\n")
+    funcs.append("\n".join(core))
+    return consts, funcs
 
 
 # -- assembly ------------------------------------------------------------------------------------
@@ -326,20 +374,28 @@ def c_code(
     Raises
     ------
     ExportError
-        A model family without a C template, tanh smoothing of the RBF network, a bad prefix,
+        A model family without a C template, tanh smoothing of an RBF network stored on
+        signed velocity, a bad prefix,
         ``clamp`` without a recorded operating range.
     DataError
         A non-finite number in the model (named), a malformed RBF state or operating range.
     """
     smoothing = smoothing or Smoothing()
     check_identifier(prefix)
-    if smoothing.kind == "tanh" and fitted.kind == "rbf":
+    if (
+        smoothing.kind == "tanh"
+        and fitted.kind == "rbf"
+        and (fitted.state or {}).get("symmetry", "signed") == "signed"
+    ):
         raise ExportError(
-            "tanh smoothing replaces sign(v) in an analytic model; the RBF network has no sign "
-            "term (it is continuous already): use --smooth linear, or none"
+            "tanh smoothing replaces sign(v) in a model of the form sign(v) G(|v|); this RBF "
+            "network was stored on signed velocity and has no sign term: use --smooth "
+            "linear, or none, or refit it"
         )
     consts, funcs = (
-        _rbf_parts(fitted) if fitted.kind == "rbf" else _analytic_parts(fitted, smoothing)
+        _rbf_parts(fitted, smoothing)
+        if fitted.kind == "rbf"
+        else _analytic_parts(fitted, smoothing)
     )
     function = f"{prefix}_friction"
     guard = f"{prefix.upper()}_FRICTION_H"

@@ -26,6 +26,13 @@ It is trained by one of
 both from :class:`~fricid.samples.FrictionSamples` (as ``fricid.identify.fit(samples, "rbf")``
 does).
 
+Friction opposes motion (issue 11, defect 1): :func:`fit_rbf` trains the network on ``|v|``
+and stores it as ``F = sign(v) g(|v|, load, T)`` for combined samples (the paper's eq. 11 data,
+``v > 0`` only, which a network on signed velocity extrapolated to the wrong sign at ``v < 0``),
+one network per direction for samples of both directions, and one for a single direction
+(``state["symmetry"]``, :mod:`fricid.models.rbf`). The estimator itself stays a plain
+regressor on the ``X`` it is given, so the paper's study (``v > 0`` data) is unchanged.
+
 Reading of the paper (where it is unclear, DESIGN.md "Faithful and honest")
 --------------------------------------------------------------------------
 * **Target MSE.** The paper trains to "MSE 0.0001" (section 4.3) and reports mean absolute
@@ -82,8 +89,17 @@ from ..models import INPUTS
 from ..models.rbf import STATE_KIND, check_inputs, predict_state
 from ..samples import FrictionSamples, samples_hash
 from ._rbf_estimator import LSQ_IGNORES, TRAINERS, RBFNetRegressor
+from ._rbf_select import check_centres, choose_n_centers, drop_constant_inputs
 
-__all__ = ["LSQ_IGNORES", "TRAINERS", "RBFNetRegressor", "fit_rbf", "to_fitted_model"]
+__all__ = [
+    "LSQ_IGNORES",
+    "TRAINERS",
+    "RBFNetRegressor",
+    "fit_rbf",
+    "side_data",
+    "symmetry_for",
+    "to_fitted_model",
+]
 
 
 def _state(est: RBFNetRegressor, inputs: Sequence[str]) -> dict[str, Any]:
@@ -114,47 +130,86 @@ def _n_numbers(est: RBFNetRegressor) -> int:
     return int(est.centers_.size + est.widths_.size + est.weights_.size + bool(est.fit_bias))
 
 
-def to_fitted_model(
-    estimator: RBFNetRegressor, samples: FrictionSamples, inputs: Sequence[str] = INPUTS
-) -> FittedModel:
-    """A :class:`~fricid.fitted.FittedModel` (``model="rbf"``) of an estimator fitted on
-    ``samples.X[:, inputs]``, with metrics on ``samples`` and provenance as ``identify.fit``
-    records them; ``state`` holds the network as plain lists (see :func:`predict_state`).
+def symmetry_for(samples: FrictionSamples) -> str:
+    """The symmetry (:data:`fricid.models.rbf.SYMMETRIES`) a network of ``samples`` gets.
 
-    ``history`` is the per-epoch best SSE [N m^2] against evaluations, for optimiser trainers.
+    ``"odd"`` for combined samples (direction 0), ``"per_direction"`` for both directions
+    apart, ``"pos"`` / ``"neg"`` for one direction.
+
+    Raises
+    ------
+    ConfigError
+        Samples that mix combined and per-direction rows.
     """
-    names = check_inputs(inputs)
-    check_is_fitted(estimator)
-    if estimator.n_features_in_ != len(names):
+    dirs = set(samples.directions())
+    if dirs == {0}:
+        return "odd"
+    if 0 in dirs:
         raise ConfigError(
-            f"the estimator was fitted on {estimator.n_features_in_} input "
-            f"columns, but inputs names {len(names)}: {', '.join(names)}"
+            "the samples mix combined (direction 0, eq. 11) and per-direction rows; fit the "
+            "RBF network on one kind (fricid fit --direction combined, or both)"
         )
-    if estimator.velocity_scale is not None and names[0] != "velocity":
-        raise ConfigError("velocity_scale warps the first input, which must be 'velocity'")
-    state = _state(estimator, names)
+    return "per_direction" if dirs == {-1, 1} else ("pos" if dirs == {1} else "neg")
+
+
+def side_data(samples: FrictionSamples) -> tuple[np.ndarray, np.ndarray]:
+    """Inputs with ``|v|`` and the target ``s F`` (``s = -1`` where ``v < 0``, else 1): what a
+    network with a sign of its own (``F = sign(v) g(|v|, ...)``) is trained on. For combined
+    samples (``v > 0``) these are the samples as they are."""
+    X = samples.X.copy()
+    s = np.where(X[:, 0] < 0, -1.0, 1.0)
+    X[:, 0] = np.abs(X[:, 0])
+    return X, s * samples.y
+
+
+def _history(ests: Sequence[RBFNetRegressor], n: int) -> list[list[float]] | None:
+    """Per-epoch best SSE [N m^2] against evaluations, summed over the networks."""
+    rows = []
+    for est in ests:
+        if not est.mse_history_.size:
+            return None
+        per_epoch = int(est.evals_per_epoch)
+        evals = per_epoch * np.arange(1, est.mse_history_.size + 1)
+        rows.append(np.column_stack([evals, est.mse_history_ * est.target_scale_**2 * n]))
+    if not rows:
+        return None
+    k = max(len(r) for r in rows)
+    padded = [np.vstack([r, np.repeat(r[-1:], k - len(r), axis=0)]) for r in rows]
+    return np.sum(padded, axis=0).tolist()
+
+
+def _model(
+    ests: Sequence[RBFNetRegressor],
+    state: dict[str, Any],
+    samples: FrictionSamples,
+) -> FittedModel:
+    """The :class:`FittedModel` of trained networks whose state is ``state``."""
     X = samples.X
     y_hat = predict_state(state, X)
-    trainer = state["trainer"]
+    est = ests[0]
+    trainer = str(est.trainer).lower()
     n = len(samples)
-    history = None
-    if estimator.mse_history_.size:
-        per_epoch = int(estimator.evals_per_epoch)
-        evals = per_epoch * np.arange(1, estimator.mse_history_.size + 1)
-        sse = estimator.mse_history_ * estimator.target_scale_**2 * n
-        history = np.column_stack([evals, sse]).tolist()
-    rs = estimator.random_state
+    rs = est.random_state
+    statuses = [e.status_ for e in ests]
+    bad = [st for st in statuses if st not in (None, 0, 2)]
+    status = bad[0] if bad else statuses[0]
+    sides = ("v > 0", "v < 0") if len(ests) == 2 else ("",)
+    message = "; ".join(
+        f"{side}: {e.message_}" if side else e.message_
+        for side, e in zip(sides, ests, strict=True)
+        if e.message_
+    )
     return FittedModel(
         model="rbf",
         params={},
         metrics=metrics(samples.y, y_hat),
-        statistics=fit_statistics(samples.y, y_hat, _n_numbers(estimator)),
-        method=trainer if trainer == "lsq" else f"{trainer}/{estimator.encoding}",
+        statistics=fit_statistics(samples.y, y_hat, sum(_n_numbers(e) for e in ests)),
+        method=trainer if trainer == "lsq" else f"{trainer}/{est.encoding}",
         seed=int(rs) if isinstance(rs, Integral) else None,
-        nfev=int(estimator.n_evals_),
-        status=estimator.status_,
-        message=estimator.message_,
-        history=history,
+        nfev=int(sum(e.n_evals_ for e in ests)),
+        status=status,
+        message=message,
+        history=_history(ests, n),
         operating_range={
             name: [float(X[:, INPUTS.index(name)].min()), float(X[:, INPUTS.index(name)].max())]
             for name in INPUTS
@@ -169,7 +224,7 @@ def to_fitted_model(
             "estimator": "fricid.identify.rbf.RBFNetRegressor",
             "estimator_params": {
                 k: v
-                for k, v in estimator.get_params().items()
+                for k, v in est.get_params().items()
                 if k != "random_state" or isinstance(v, Integral | None)
             },
         },
@@ -177,14 +232,144 @@ def to_fitted_model(
     )
 
 
-def fit_rbf(samples: FrictionSamples, inputs: Sequence[str] = INPUTS, **params: Any) -> FittedModel:
-    """Train an :class:`RBFNetRegressor` (keyword ``params``) on ``samples`` and return it as
-    a :class:`~fricid.fitted.FittedModel` (see :func:`to_fitted_model`).
+def to_fitted_model(
+    estimator: RBFNetRegressor,
+    samples: FrictionSamples,
+    inputs: Sequence[str] = INPUTS,
+    *,
+    symmetry: str | None = None,
+) -> FittedModel:
+    """A :class:`~fricid.fitted.FittedModel` (``model="rbf"``) of an estimator fitted on
+    ``samples``, with metrics on ``samples`` and provenance as ``identify.fit`` records them;
+    ``state`` holds the network as plain lists (see :func:`predict_state`).
 
-    ``inputs`` selects the columns (any subset of velocity, load, temperature, in that
-    order or another).
+    Parameters
+    ----------
+    estimator : RBFNetRegressor
+        Fitted on the columns ``inputs`` of :func:`side_data` of ``samples`` (``|v|`` and
+        ``sign(v) F``; for combined samples, ``v > 0``, that is ``samples.X`` and
+        ``samples.y`` as they are).
+    samples : FrictionSamples
+        Its training samples.
+    inputs : sequence of str
+        The estimator's input columns, in order.
+    symmetry : str, optional
+        ``"odd"``, ``"pos"``, ``"neg"`` or ``"signed"`` (:data:`fricid.models.rbf.SYMMETRIES`;
+        ``"signed"``: an estimator trained on signed velocity, with no sign of its own).
+        Default: :func:`symmetry_for` the samples; both directions apart need two networks,
+        which :func:`fit_rbf` trains.
+
+    Returns
+    -------
+    FittedModel
+        ``history`` is the per-epoch best SSE [N m^2] against evaluations, for optimiser
+        trainers.
     """
     names = check_inputs(inputs)
-    X = samples.X[:, [INPUTS.index(name) for name in names]]
-    est = RBFNetRegressor(**params).fit(X, samples.y)
-    return to_fitted_model(est, samples, names)
+    check_is_fitted(estimator)
+    if estimator.n_features_in_ != len(names):
+        raise ConfigError(
+            f"the estimator was fitted on {estimator.n_features_in_} input "
+            f"columns, but inputs names {len(names)}: {', '.join(names)}"
+        )
+    if estimator.velocity_scale is not None and names[0] != "velocity":
+        raise ConfigError("velocity_scale warps the first input, which must be 'velocity'")
+    symmetry = symmetry or symmetry_for(samples)
+    if symmetry not in ("odd", "pos", "neg", "signed"):
+        raise ConfigError(
+            f"one estimator makes a network of symmetry odd, pos, neg or signed, not "
+            f"{symmetry!r}; fit_rbf trains one network per direction"
+        )
+    state = {**_state(estimator, names), "symmetry": symmetry}
+    return _model([estimator], state, samples)
+
+
+def _train_side(
+    samples: FrictionSamples, names: list[str], params: dict[str, Any], where: str
+) -> tuple[RBFNetRegressor, dict[str, Any]]:
+    """Train one network on ``samples`` (|v|, sign-corrected target): constant inputs
+    dropped, the number of centres chosen by cross-validation when not given."""
+    X, t = side_data(samples)
+    X = X[:, [INPUTS.index(name) for name in names]]
+    kept, dropped = drop_constant_inputs(X, names, where)
+    X = X[:, [names.index(name) for name in kept]]
+    params = dict(params)
+    if "velocity" in dropped:
+        params["velocity_scale"] = None
+    notes: dict[str, Any] = {}
+    if dropped:
+        notes["dropped_inputs"] = dropped
+    if params.get("n_centers") is None:
+        params["n_centers"], notes["n_centers_selection"] = choose_n_centers(X, t, params)
+    else:
+        check_centres(int(params["n_centers"]), len(t), where)
+    if params.get("velocity_scale") is not None and kept[0] != "velocity":
+        raise ConfigError("velocity_scale warps the first input, which must be 'velocity'")
+    est = RBFNetRegressor(**params).fit(X, t)
+    return est, {**_state(est, kept), **notes}
+
+
+def fit_rbf(samples: FrictionSamples, inputs: Sequence[str] = INPUTS, **params: Any) -> FittedModel:
+    """Train the RBF network on ``samples`` and return it as a
+    :class:`~fricid.fitted.FittedModel` (see :func:`to_fitted_model`).
+
+    Friction opposes motion (issue 11, defect 1): the network learns ``g(|v|, load, T)``
+    and predicts ``sign(v) g(|v|, ...)``. Combined samples (direction 0) give one network
+    (symmetry ``"odd"``); samples of both directions give one network per direction
+    (``"per_direction"``: ``+g_pos`` for ``v > 0``, ``-g_neg`` for ``v < 0``; seeds
+    ``random_state`` and ``random_state + 1``, and half of ``max_epochs`` each, so that the
+    budget is the fit's); one direction gives one network (``"pos"`` or
+    ``"neg"``), whose other side is an extrapolation that ``FittedModel.predict`` warns about.
+    :class:`RBFNetRegressor` itself is a plain regressor on whatever ``X`` it is given.
+
+    Parameters
+    ----------
+    samples : FrictionSamples
+        The data.
+    inputs : sequence of str
+        The columns (any subset of velocity, load, temperature, in that order or another).
+        One that does not vary in the data is dropped with a
+        :class:`~fricid.errors.DataQualityWarning` and noted in ``state["dropped_inputs"]``.
+    **params
+        :class:`RBFNetRegressor` parameters. Without ``n_centers`` (or with None) the number
+        of centres is chosen by 5-fold cross-validation of the ``lsq`` trainer over
+        5..min(60, n/3) (``state["n_centers_selection"]``); a given number above half the
+        samples warns (:class:`~fricid.errors.IdentifiabilityWarning`).
+
+    Returns
+    -------
+    FittedModel
+        ``model="rbf"``, its network(s) in ``state``.
+    """
+    names = check_inputs(inputs)
+    symmetry = symmetry_for(samples)
+    if symmetry != "per_direction":
+        est, state = _train_side(samples, names, params, "")
+        return _model([est], {**state, "symmetry": symmetry}, samples)
+    ests, states = [], {}
+    rs = params.get("random_state")
+    shared = dict(params)
+    if str(params.get("trainer", "lsq")).strip().lower() != "lsq":
+        # one budget for the fit: each network gets half of the epochs
+        epochs = int(params.get("max_epochs", LSQ_IGNORES["max_epochs"]))
+        shared["max_epochs"] = max(1, -(-epochs // 2))
+    for k, (side, d) in enumerate((("pos", 1), ("neg", -1))):
+        side_params = dict(shared)
+        if isinstance(rs, Integral):
+            side_params["random_state"] = int(rs) + k
+        where = f" for {'v > 0' if d > 0 else 'v < 0'}"
+        est, states[side] = _train_side(
+            samples.subset(samples.direction == d), names, side_params, where
+        )
+        ests.append(est)
+    first = states["pos"]
+    state = {
+        "kind": STATE_KIND,
+        "symmetry": "per_direction",
+        "inputs": names,
+        "fit_bias": first["fit_bias"],
+        "trainer": first["trainer"],
+        "encoding": first["encoding"],
+        **states,
+    }
+    return _model(ests, state, samples)

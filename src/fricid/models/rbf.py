@@ -13,6 +13,26 @@ A state (``FittedModel.state`` of a model ``"rbf"``) holds ``kind`` (``"gaussian
 warp of the first input), ``input_shift``, ``input_scale``, ``centers (m, d)``,
 ``widths (m,)``, ``weights (m,)`` and ``bias``, plus training notes that prediction ignores.
 
+Friction opposes motion: ``symmetry`` says how the network gives the sign (issue 11, defect 1).
+
+``"odd"``
+    Combined samples (direction 0, eq. 11 of the BAS-RBFNN paper): the network is
+    ``g(|v|, load, T)`` and the friction ``F = sign(v) g(|v|, load, T)`` (``F(0) = 0``).
+``"pos"``, ``"neg"``
+    Samples of one direction only: one network on ``|v|`` as for ``"odd"``; the other side
+    is the mirror image, an extrapolation (``FittedModel.range_check`` says so).
+``"per_direction"``
+    Samples of both directions apart: ``state["pos"]`` and ``state["neg"]`` are two networks
+    (each a state as above) on ``|v|``; ``F = +g_pos(|v|)`` for ``v > 0``, ``-g_neg(|v|)``
+    for ``v < 0`` and 0 at ``v = 0``.
+``"signed"``
+    The network on signed velocity as given, with no sign of its own: what files written
+    before the symmetry was recorded hold. ``FittedModel.from_dict`` reads such a file whose
+    samples were combined (direction 0, hence ``v > 0`` only) as ``"odd"``, which is the model
+    it was meant to be and repairs its sign at ``v < 0`` (:func:`legacy_symmetry`).
+
+A state without the key is ``"signed"``.
+
 References
 ----------
 [B] "An Optimized RBF Neural Network Based on Beetle Antennae Search Algorithm for Modeling the
@@ -32,16 +52,96 @@ from ._base import INPUTS
 
 __all__ = [
     "NETWORK",
+    "SIGN_FORM",
     "STATE_KIND",
+    "SYMMETRIES",
     "RBFNetwork",
     "check_inputs",
+    "legacy_symmetry",
     "mse_z",
     "predict_state",
     "predict_z",
+    "sub_networks",
+    "symmetry_of",
 ]
 
 #: ``state["kind"]`` of an RBF network in a model file.
 STATE_KIND = "gaussian_rbf"
+
+#: ``state["symmetry"]`` values, with a line on each (module notes).
+SYMMETRIES: dict[str, str] = {
+    "odd": "F = sign(v) g(|v|, load, T), from combined samples (eq. 11)",
+    "pos": "F = sign(v) g(|v|, load, T), identified for v > 0 only",
+    "neg": "F = sign(v) g(|v|, load, T), identified for v < 0 only",
+    "per_direction": "F = g_pos(|v|) for v > 0, -g_neg(|v|) for v < 0, two networks",
+    "signed": "the network on signed velocity (files from before the symmetry was recorded)",
+}
+
+#: The symmetries whose friction is ``s(v) G(|v|, ...)`` with ``s = sign(v)``, so that tanh
+#: smoothing can replace ``sign(v)`` (:mod:`fricid.models.smoothing`).
+SIGN_FORM = ("odd", "pos", "neg", "per_direction")
+
+
+def legacy_symmetry(directions) -> str:
+    """The symmetry of a stored network without ``state["symmetry"]``.
+
+    Parameters
+    ----------
+    directions : sequence of int or None
+        ``provenance["directions"]`` of the model file.
+
+    Returns
+    -------
+    str
+        ``"odd"`` when the samples were combined only (``[0]``: trained on ``v > 0``, so
+        ``sign(v) g(|v|)`` is the intended model and gives the right sign at ``v < 0``);
+        else ``"signed"`` (the network as it was trained).
+    """
+    try:
+        dirs = sorted({int(d) for d in directions or ()})
+    except (TypeError, ValueError):
+        return "signed"
+    return "odd" if dirs == [0] else "signed"
+
+
+def symmetry_of(state: Mapping[str, Any]) -> str:
+    """``state["symmetry"]`` checked against :data:`SYMMETRIES` (``"signed"`` when absent).
+
+    Raises
+    ------
+    DataError
+        An unknown symmetry.
+    """
+    sym = state.get("symmetry") or "signed"
+    if sym not in SYMMETRIES:
+        raise DataError(
+            f"unknown RBF symmetry {sym!r}; expected one of {', '.join(SYMMETRIES)}",
+            column="state.symmetry",
+        )
+    return str(sym)
+
+
+def sub_networks(state: Mapping[str, Any]) -> dict[str, Mapping[str, Any]]:
+    """The networks of a state by side: ``{"pos": ..., "neg": ...}`` for ``per_direction``,
+    else ``{"all": state}``.
+
+    Raises
+    ------
+    DataError
+        A ``per_direction`` state without its ``pos`` and ``neg`` objects.
+    """
+    if symmetry_of(state) != "per_direction":
+        return {"all": state}
+    nets = {}
+    for side in ("pos", "neg"):
+        sub = state.get(side)
+        if not isinstance(sub, Mapping):
+            raise DataError(
+                f"a per-direction RBF state needs the network '{side}' (an object)",
+                column=f"state.{side}",
+            )
+        nets[side] = sub
+    return nets
 
 
 def predict_z(Z: np.ndarray, C: np.ndarray, s: np.ndarray, w: np.ndarray, b: float) -> np.ndarray:
@@ -118,23 +218,12 @@ def _state_array(state: Mapping[str, Any], key: str, shape: tuple[int | None, ..
     return arr
 
 
-def predict_state(state: Mapping[str, Any] | None, X) -> np.ndarray:
-    """Friction [N m] of a stored RBF network at ``X (n, 3)``: velocity [rad/s], load [N m],
-    temperature [degC] (``FrictionSamples.X``); eq. 14-15.
-
-    ``state`` is ``FittedModel.state`` as ``fricid.identify.rbf.to_fitted_model`` writes it.
-
-    Raises
-    ------
-    DataError
-        A malformed state, or ``X`` without three columns.
-    """
-    if not isinstance(state, Mapping):
-        raise DataError("an RBF model needs its network in 'state' (an object)")
+def _network(state: Mapping[str, Any], X: np.ndarray, where: str = "state") -> np.ndarray:
+    """One stored network's output at ``X (n, 3)`` (its inputs picked, warped, standardised)."""
     if state.get("kind", STATE_KIND) != STATE_KIND:
         raise DataError(
             f"unknown RBF state kind {state.get('kind')!r}; expected '{STATE_KIND}'",
-            column="state.kind",
+            column=f"{where}.kind",
         )
     inputs = state.get("inputs")
     if (
@@ -147,7 +236,7 @@ def predict_state(state: Mapping[str, Any] | None, X) -> np.ndarray:
         raise DataError(
             f"RBF model state 'inputs' must be distinct names among "
             f"{', '.join(INPUTS)}; got {inputs!r}",
-            column="state.inputs",
+            column=f"{where}.inputs",
         )
     d = len(inputs)
     shift = _state_array(state, "input_shift", (d,))
@@ -158,24 +247,54 @@ def predict_state(state: Mapping[str, Any] | None, X) -> np.ndarray:
     weights = _state_array(state, "weights", (m,))
     bias = float(_state_array(state, "bias", ()))
     if (scale <= 0).any() or (widths <= 0).any():
-        raise DataError("RBF model state has non-positive input scales or widths", column="state")
-    vscale = state.get("velocity_scale")
-    X = np.asarray(X, dtype=float)
-    if X.ndim != 2 or X.shape[1] != len(INPUTS):
         raise DataError(
-            f"inputs must have shape (n, 3): velocity, load, temperature; got {X.shape}"
+            "RBF model state has non-positive input scales or widths", column=f"{where}"
         )
+    vscale = state.get("velocity_scale")
     Xs = X[:, [INPUTS.index(name) for name in inputs]]
     if vscale is not None:
         if inputs[0] != "velocity" or not float(vscale) > 0:
             raise DataError(
                 "RBF model state 'velocity_scale' needs velocity as the first "
                 "input and a positive value",
-                column="state.velocity_scale",
+                column=f"{where}.velocity_scale",
             )
         Xs = Xs.copy()
         Xs[:, 0] = np.arcsinh(Xs[:, 0] / float(vscale))
     return predict_z((Xs - shift) / scale, centers, widths, weights, bias)
+
+
+def predict_state(state: Mapping[str, Any] | None, X) -> np.ndarray:
+    """Friction [N m] of a stored RBF network at ``X (n, 3)``: velocity [rad/s], load [N m],
+    temperature [degC] (``FrictionSamples.X``); eq. 14-15, with the sign of motion as
+    ``state["symmetry"]`` says (module notes).
+
+    ``state`` is ``FittedModel.state`` as ``fricid.identify.rbf.to_fitted_model`` writes it.
+
+    Raises
+    ------
+    DataError
+        A malformed state, or ``X`` without three columns.
+    """
+    if not isinstance(state, Mapping):
+        raise DataError("an RBF model needs its network in 'state' (an object)")
+    sym = symmetry_of(state)
+    X = np.asarray(X, dtype=float)
+    if X.ndim != 2 or X.shape[1] != len(INPUTS):
+        raise DataError(
+            f"inputs must have shape (n, 3): velocity, load, temperature; got {X.shape}"
+        )
+    if sym == "signed":
+        return _network(state, X)
+    v = X[:, 0]
+    Xa = X.copy()
+    Xa[:, 0] = np.abs(v)
+    if sym != "per_direction":
+        return np.sign(v) * _network(state, Xa)
+    nets = sub_networks(state)
+    g_pos = _network(nets["pos"], Xa, "state.pos")
+    g_neg = _network(nets["neg"], Xa, "state.neg")
+    return np.where(v > 0, g_pos, np.where(v < 0, -g_neg, 0.0))
 
 
 class RBFNetwork:
@@ -198,13 +317,35 @@ class RBFNetwork:
     def describe(self, state: Mapping[str, Any] | None) -> str:
         """One line on a stored network, for fit reports."""
         st = dict(state or {})
-        return (
-            f"{len(st.get('centers', []))} Gaussian units (eq. 14), linear output "
-            f"(eq. 15){' with bias' if st.get('fit_bias') else ''}; inputs "
-            f"{', '.join(st.get('inputs', []))}; trainer {st.get('trainer')}"
-            + (f", encoding {st['encoding']}" if st.get("encoding") else "")
-            + (f", {st['n_epochs']} epochs" if st.get("n_epochs") else "")
+        sym = st.get("symmetry") or "signed"
+        if sym == "per_direction" and all(isinstance(st.get(k), Mapping) for k in ("pos", "neg")):
+            return (
+                f"two networks on |v|: v > 0 {_describe_net(st['pos'])}; v < 0 "
+                f"{_describe_net(st['neg'])}; {SYMMETRIES[sym]}"
+            )
+        return _describe_net(st) + (f"; {SYMMETRIES[sym]}" if sym in SYMMETRIES else "")
+
+
+def _describe_net(st: Mapping[str, Any]) -> str:
+    return (
+        f"{len(st.get('centers', []))} Gaussian units (eq. 14), linear output "
+        f"(eq. 15){' with bias' if st.get('fit_bias') else ''}; inputs "
+        f"{', '.join(st.get('inputs', []))}; trainer {st.get('trainer')}"
+        + (f", encoding {st['encoding']}" if st.get("encoding") else "")
+        + (f", {st['n_epochs']} epochs" if st.get("n_epochs") else "")
+        + (
+            f"; {st['n_centers_selection'].get('chosen')} centres chosen by "
+            f"{st['n_centers_selection'].get('folds')}-fold cross-validation"
+            if isinstance(st.get("n_centers_selection"), Mapping)
+            else ""
         )
+        + (
+            "; dropped (constant): "
+            + ", ".join(f"{k} = {v:.6g}" for k, v in st["dropped_inputs"].items())
+            if isinstance(st.get("dropped_inputs"), Mapping) and st["dropped_inputs"]
+            else ""
+        )
+    )
 
 
 #: The one instance the model registry hands out.

@@ -15,7 +15,9 @@ Two smoothings are offered, each with a zone half-width ``zone`` [rad/s]; the C 
     ``F_s = tanh(v / zone) G(|v|, load, T) + c v``; a per-direction model uses the ``_pos``
     parameters for ``v >= 0`` and the ``_neg`` ones below (continuous at 0, where both sides
     give 0). Outside about 3 zones the difference from the model is below 0.5 % of ``G``.
-    Not for the RBF network, which has no sign term (it is continuous already).
+    The RBF network is ``sign(v) g(|v|, load, T)`` too (per direction: ``g_pos``, ``g_neg``;
+    :mod:`fricid.models.rbf`), smoothed as ``tanh(v / zone) g(|v|, load, T)``; only a network
+    stored on signed velocity (symmetry ``"signed"``) has no sign term and refuses tanh.
 ``linear``
     Inside ``|v| < zone`` the friction follows the straight line between the model's values at
     ``-zone`` and ``+zone`` (at the same load and temperature); outside, the model is exact.
@@ -67,7 +69,7 @@ class FittedLike(Protocol):
 #: The smoothing kinds, with a line on each.
 SMOOTHINGS: dict[str, str] = {
     "none": "the model as identified (sign(0) = 0)",
-    "tanh": "sign(v) replaced by tanh(v / zone); viscous term unchanged (analytic models)",
+    "tanh": "sign(v) replaced by tanh(v / zone); viscous term unchanged",
     "linear": "straight line between the model's values at -zone and +zone (every model)",
 }
 
@@ -218,9 +220,25 @@ def _linear(predict: Callable[[np.ndarray], np.ndarray], X: np.ndarray, zone: fl
 
 
 _RBF_TANH = (
-    "tanh smoothing replaces sign(v) in an analytic model; the RBF network has no sign "
-    "term (it is continuous already): use --smooth linear, or none"
+    "tanh smoothing replaces sign(v) in a model of the form sign(v) G(|v|); this RBF network "
+    "was stored on signed velocity (symmetry 'signed') and has no sign term: use --smooth "
+    "linear, or none, or refit it"
 )
+
+
+def _sign_form(fitted: FittedLike) -> bool:
+    """True for an RBF network with a sign of its own (``F = sign(v) g(|v|)``)."""
+    from .rbf import SIGN_FORM
+
+    state = getattr(fitted, "state", None)
+    return isinstance(state, Mapping) and state.get("symmetry") in SIGN_FORM
+
+
+def _tanh_sign_form(predict: Callable[[np.ndarray], np.ndarray], X, zone: float) -> np.ndarray:
+    """``tanh(v / zone) g(|v|)`` of a model ``F = sign(v) g(|v|)``: ``sign(v) F`` is ``g``."""
+    X = np.atleast_2d(np.asarray(X, dtype=float))
+    v = X[:, 0]
+    return np.tanh(v / zone) * np.sign(v) * np.asarray(predict(X), dtype=float)
 
 
 def smooth_values(
@@ -288,7 +306,8 @@ def smooth_predict(fitted: FittedLike, X, smoothing: Smoothing | None = None) ->
     Raises
     ------
     ConfigError
-        tanh smoothing of a model without a sign term (the RBF network).
+        tanh smoothing of a model without a sign term (an RBF network stored on signed
+        velocity).
     """
     smoothing = smoothing or Smoothing()
     model = theta = None
@@ -296,4 +315,6 @@ def smooth_predict(fitted: FittedLike, X, smoothing: Smoothing | None = None) ->
         analytic = _analytic(fitted)
         if analytic is not None:
             model, theta = analytic
+        elif _sign_form(fitted):
+            return _tanh_sign_form(fitted.predict, X, smoothing.zone)
     return smooth_values(fitted.predict, X, smoothing, model=model, theta=theta)
