@@ -59,6 +59,7 @@ READER_OPTIONS: dict[str, tuple[str, ...]] = {
         "counts_per_turn",
         "pattern",
         "load",
+        "skip_bad_rows",
     ),
 }
 
