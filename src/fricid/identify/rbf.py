@@ -158,6 +158,7 @@ def to_fitted_model(
         operating_range={
             name: [float(X[:, INPUTS.index(name)].min()), float(X[:, INPUTS.index(name)].max())]
             for name in INPUTS
+            if name in samples.measured
         },
         provenance={
             "source": samples.source,
@@ -185,6 +186,7 @@ def fit_rbf(samples: FrictionSamples, inputs: Sequence[str] = INPUTS, **params: 
     order or another).
     """
     names = check_inputs(inputs)
+    samples.require(names, "model 'rbf' (inputs=)")
     X = samples.X[:, [INPUTS.index(name) for name in names]]
     est = RBFNetRegressor(**params).fit(X, samples.y)
     return to_fitted_model(est, samples, names)
