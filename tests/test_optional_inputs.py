@@ -19,7 +19,7 @@ def _two_column(path):
     half = np.array([0.05, 0.1, 0.2, 0.3, 0.5, 0.8, 1.2, 2.0])
     v = np.concatenate([-half[::-1], half])
     f = np.sign(v) * (0.3 + 0.2 * np.exp(-np.abs(v) / 0.2)) + 0.05 * v
-    lines = ["velocity [rad/s],friction [N m]"] + [f"{a:.6g},{b:.6g}" for a, b in zip(v, f)]
+    lines = ["velocity [rad/s],friction [N m]"] + [f"{a:.6g},{b:.6g}" for a, b in zip(v, f, strict=True)]
     path.write_text("\n".join(lines) + "\n")
     return path
 
@@ -29,7 +29,7 @@ def test_two_column_table_reads_with_load_and_temperature_not_measured(tmp_path)
     assert samples.measured == ("velocity",)
     assert np.isnan(samples.load).all() and np.isnan(samples.temperature).all()
     out = write_samples(samples, tmp_path / "again.csv")
-    header = [line for line in out.read_text().splitlines() if not line.startswith("#")][0]
+    header = next(line for line in out.read_text().splitlines() if not line.startswith("#"))
     assert "load" not in header and "temperature" not in header
     assert read_samples(out).measured == ("velocity",)
 

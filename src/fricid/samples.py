@@ -283,7 +283,8 @@ class FrictionSamples:
     ------
     DataError
         No rows, a column of the wrong shape or length, a non-finite value (in load or
-        temperature: some but not all), a direction other than -1, 0, +1, a count below 1 or a negative std (the row and column named).
+        temperature: some but not all), a direction other than -1, 0, +1, a count below 1
+        or a negative std (the row and column named).
 
     See Also
     --------
@@ -354,9 +355,8 @@ class FrictionSamples:
     def measured(self) -> tuple[str, ...]:
         """tuple of str: the model inputs measured, among velocity, load and temperature (an
         input given as None, or all NaN, was not measured)."""
-        return ("velocity",) + tuple(
-            name for name in OPTIONAL_INPUTS if np.isfinite(getattr(self, name)).all()
-        )
+        found = [name for name in OPTIONAL_INPUTS if np.isfinite(getattr(self, name)).all()]
+        return ("velocity", *found)
 
     def require(self, inputs: tuple[str, ...] | list[str], user: str) -> None:
         """Refuse samples that lack an input ``user`` needs.
