@@ -19,7 +19,9 @@ def _two_column(path):
     half = np.array([0.05, 0.1, 0.2, 0.3, 0.5, 0.8, 1.2, 2.0])
     v = np.concatenate([-half[::-1], half])
     f = np.sign(v) * (0.3 + 0.2 * np.exp(-np.abs(v) / 0.2)) + 0.05 * v
-    lines = ["velocity [rad/s],friction [N m]"] + [f"{a:.6g},{b:.6g}" for a, b in zip(v, f, strict=True)]
+    lines = ["velocity [rad/s],friction [N m]"] + [
+        f"{a:.6g},{b:.6g}" for a, b in zip(v, f, strict=True)
+    ]
     path.write_text("\n".join(lines) + "\n")
     return path
 
