@@ -7,7 +7,9 @@ identity in the file name::
     run_pos1_80.t   run_vel1_80.t   run_tau1_80.t
 
 One pattern per quantity names the files; ``{field}`` matches a part of the name (any
-characters but ``/``), ``*`` and ``?`` are globs, anything else is literal::
+characters but ``/``, as few as the rest of the pattern allows), ``*`` and ``?`` are globs,
+anything else is literal; put a literal between a field and a ``*`` (``{speed}_*.t``, not
+``{speed}*.t``, which cannot tell where the field ends)::
 
     torque={name}_tau{joint}_{speed}.t     velocity={name}_vel{joint}_{speed}.t
 
