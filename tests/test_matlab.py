@@ -64,7 +64,7 @@ def test_mean_tables_read_straight_into_samples(tmp_path, write):
 @pytest.mark.parametrize("write", [_v5, _v73])
 def test_errors_name_the_variable(tmp_path, write):
     path = write(tmp_path / "means.mat")
-    with pytest.raises(ConfigError, match="3 columns .* --joint 1..3"):
+    with pytest.raises(ConfigError, match=r"3 columns .* --joint 1\.\.3"):
         read_mat(path, VARS, UNITS)
     with pytest.raises(DataError, match="struct 'fwd' has 'tau', 'v'") as err:
         read_mat(path, {**VARS, "velocity": "fwd.qd"}, UNITS, joint="1")

@@ -17,9 +17,10 @@ The format, as EPOS Studio 3.x writes it (``;``-separated, CRLF line ends)::
 steady-state recordings (one constant velocity per file) into friction samples, dropping
 outlier rows and warning about them (the robust statistics are in :mod:`._steady`).
 
-The module is about 600 lines: one format's parser (with a spreadsheet's re-save and
-``skip_bad_rows``), reader and steady-state averaging, most of it docstrings that name every
-unit and error; splitting the parser from its two users would scatter the format's rules.
+The module is longer than 500 lines because it holds one format's parser (with a
+spreadsheet's re-save and ``skip_bad_rows``), reader and steady-state averaging, most of it
+docstrings that name every unit and error; splitting the parser from its two users would
+scatter the format's rules.
 """
 
 from __future__ import annotations
