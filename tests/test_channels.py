@@ -143,3 +143,10 @@ def test_cli_extracts_a_folder_of_channel_files(tmp_path):
     samples = read_samples(out)
     assert sorted(np.round(np.rad2deg(samples.velocity)).astype(int)) == list(SPEEDS)
     np.testing.assert_allclose(samples.friction, _friction(samples.velocity), rtol=1e-6)
+
+
+def test_open_log_without_patterns_says_what_is_needed(tmp_path):
+    from fricid.io import open_log
+
+    with pytest.raises(ConfigError, match="needs a pattern per quantity"):
+        open_log(_folder(tmp_path), "channels")

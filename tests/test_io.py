@@ -586,7 +586,7 @@ def test_registry_is_in_io_and_pipeline_is_gone():
 
     from fricid import io as fio
 
-    assert fio.READERS == ("table", "generic", "rosbag", "epos")
+    assert fio.READERS == ("table", "generic", "rosbag", "epos", "channels", "mat")
     assert set(fio.READER_OPTIONS) == set(fio.READERS)
     with pytest.raises(ModuleNotFoundError):
         importlib.import_module("fricid.pipeline")

@@ -122,3 +122,19 @@ def test_cli_reads_mean_tables_and_refuses_extraction_flags(tmp_path):
     res = CliRunner().invoke(app, [*args, "--median-window", "7"])
     assert res.exit_code == 2
     assert "--median-window does not apply to --format mat here" in res.output
+
+
+def test_open_log_without_variables_lists_the_file_s(tmp_path):
+    from fricid.io import open_log
+
+    with pytest.raises(ConfigError, match=r"needs its variables by name.*bwd\.tau, bwd\.v"):
+        open_log(_v5(tmp_path / "m.mat"), "mat")
+    with pytest.raises(ConfigError, match="extraction options \\(median_window\\) do not apply"):
+        from fricid.workflow import load_joint
+
+        load_joint(
+            tmp_path / "m.mat",
+            "mat",
+            reader_options={"variables": VARS, "units": UNITS, "joint": "1"},
+            extract_options={"median_window": 7},
+        )

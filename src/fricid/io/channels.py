@@ -212,7 +212,7 @@ def _runs(
 
 def read_channels(
     folder: str | os.PathLike[str],
-    channels: Mapping[str, str],
+    channels: Mapping[str, str] | None = None,
     units: Mapping[str, str] | None = None,
     *,
     joint: str | None = None,
@@ -267,6 +267,11 @@ def read_channels(
     folder = Path(folder)
     if not folder.is_dir():
         raise DataError("not a folder (--format channels reads a folder of files)", file=folder)
+    if not channels:
+        raise ConfigError(
+            "reading per-channel files needs a pattern per quantity (--channels "
+            "QUANTITY=PATTERN:UNIT, channels= in Python)"
+        )
     patterns = dict(channels)
     units = dict(units or {})
     unknown = [q for q in patterns if q not in CHANNEL_QUANTITIES]

@@ -169,7 +169,7 @@ def _unit(quantity: str, units: Mapping[str, str]) -> str:
 
 def read_mat(
     path: str | os.PathLike[str],
-    variables: Mapping[str, str],
+    variables: Mapping[str, str] | None = None,
     units: Mapping[str, str] | None = None,
     *,
     joint: str | None = None,
@@ -214,6 +214,11 @@ def read_mat(
         a zero velocity; file, row and variable named.
     """
     path = Path(path)
+    if not variables:
+        raise ConfigError(
+            "reading a MATLAB file needs its variables by name (--var QUANTITY=NAME:UNIT, "
+            "variables= in Python); the file has: " + ", ".join(mat_variables(path))
+        )
     variables = dict(variables)
     units = dict(units or {})
     as_samples = "friction" in variables
