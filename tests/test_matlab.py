@@ -138,3 +138,29 @@ def test_open_log_without_variables_lists_the_file_s(tmp_path):
             reader_options={"variables": VARS, "units": UNITS, "joint": "1"},
             extract_options={"median_window": 7},
         )
+
+
+def test_real_means_published_as_mat_tables_read_back_unchanged(leadscrew_dir, tmp_path):
+    """The lead-screw recordings' per-direction means, published as a lab would (one struct
+    per direction, v5 and v7.3), read straight into the same samples."""
+    from fricid.io import epos_steady_samples
+
+    ref = epos_steady_samples(leadscrew_dir, flip_sign=True)
+    fwd, bwd = ref.direction > 0, ref.direction < 0
+    tables = {
+        "fwd": {"v": ref.velocity[fwd], "tau": ref.friction[fwd] * 1e3},
+        "bwd": {"v": ref.velocity[bwd], "tau": ref.friction[bwd] * 1e3},
+    }
+    v5 = tmp_path / "v5.mat"
+    scipy.io.savemat(v5, tables)
+    v73 = tmp_path / "v73.mat"
+    with h5py.File(v73, "w") as f:
+        for name, struct in tables.items():
+            for field, value in struct.items():
+                f.create_dataset(f"{name}/{field}", data=np.atleast_2d(value))
+    order = np.concatenate([np.flatnonzero(fwd), np.flatnonzero(bwd)])
+    for path in (v5, v73):
+        got = read_mat(path, VARS, {"velocity": "rad/s", "friction": "mNm"})
+        np.testing.assert_allclose(got.velocity, ref.velocity[order], rtol=1e-12)
+        np.testing.assert_allclose(got.friction, ref.friction[order], rtol=1e-12)
+        np.testing.assert_array_equal(got.direction, ref.direction[order])
