@@ -155,3 +155,11 @@ def test_generic_map_finds_column_with_unit_in_header_from_the_cli(tmp_path):
         out,
     )
     assert res.exit_code == 2 and "'s'" in res.output and "'ms'" in res.output
+
+
+def test_chunk_rows_with_a_reader_that_does_not_chunk_is_refused(leadscrew_dir, tmp_path):
+    res = run(
+        "extract", leadscrew_dir, "--format", "epos", "--chunk-rows", "10", "-o", tmp_path / "s.csv"
+    )
+    assert res.exit_code == 2
+    assert "--chunk-rows does not apply to --format epos" in res.output

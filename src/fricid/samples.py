@@ -385,7 +385,7 @@ class FrictionSamples:
     @property
     def X(self) -> np.ndarray:
         """ndarray, shape (n, 3): the model inputs, columns velocity [rad/s], load [N m],
-        temperature [degC]."""
+        temperature [degC]; an input not measured is a column of NaN."""
         return np.column_stack([self.velocity, self.load, self.temperature])
 
     @property

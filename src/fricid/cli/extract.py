@@ -108,7 +108,7 @@ def check_flags(ctx: typer.Context, fmt: str, log: Path, variables: list[str] | 
         An unknown format; a reader flag whose option the reader lacks (naming the formats
         that take it); an extraction flag with a reader that gives samples directly.
     """
-    from ..io.registry import READER_OPTIONS, READERS, gives_samples
+    from ..io.registry import CHUNKED_READERS, READER_OPTIONS, READERS, gives_samples
 
     if fmt not in READERS:
         raise ConfigError(f"--format must be one of {', '.join(READERS)}; got '{fmt}'")
@@ -119,6 +119,11 @@ def check_flags(ctx: typer.Context, fmt: str, log: Path, variables: list[str] | 
                 f"{flag} does not apply to --format {fmt}: it is an option of --format "
                 f"{' and '.join(takers)}"
             )
+    if _given(ctx, "chunk_rows") and fmt not in CHUNKED_READERS:
+        raise ConfigError(
+            f"--chunk-rows does not apply to --format {fmt}: only --format "
+            f"{' and '.join(CHUNKED_READERS)} read a log in chunks"
+        )
     probe = {"variables": parse_column_map(variables, "--var", "NAME")[0]} if variables else {}
     if gives_samples(fmt, log, probe):
         what = (

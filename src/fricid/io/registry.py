@@ -20,6 +20,7 @@ from ..errors import ConfigError
 from ..samples import FrictionSamples, RawLog
 
 __all__ = [
+    "CHUNKED_READERS",
     "EPOS_FOLDER_ONLY",
     "READERS",
     "READER_EXAMPLES",
@@ -78,6 +79,9 @@ READER_OPTIONS: dict[str, tuple[str, ...]] = {
     ),
     "mat": ("variables", "units", "joint", "temperature", "torque_constant"),
 }
+
+#: Readers that read a log a chunk of rows at a time (``chunk_rows`` of :func:`open_log`).
+CHUNKED_READERS: tuple[str, ...] = ("table", "rosbag")
 
 #: One-line examples of ``fricid extract`` per reader (its ``--help`` lists them).
 READER_EXAMPLES: dict[str, str] = {
