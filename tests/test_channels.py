@@ -9,7 +9,7 @@ import pytest
 from typer.testing import CliRunner
 
 from fricid.cli import app
-from fricid.errors import ConfigError, DataError
+from fricid.errors import ConfigError, DataError, DataQualityWarning
 from fricid.io import read_channels, read_samples
 from fricid.io.channels import compile_pattern
 
@@ -82,7 +82,8 @@ def test_join_exact_nearest_and_linear(tmp_path):
     assert err.value.file.endswith("run_tau1_20.t") and err.value.row == 1
     near = read_channels(folder, PATTERNS, UNITS, join="nearest", temperature=25.0)[0]
     np.testing.assert_allclose(near.torque, _friction(near.velocity))
-    lin = read_channels(folder, PATTERNS, UNITS, join="linear", temperature=25.0)[0]
+    with pytest.warns(DataQualityWarning, match="1 of 3000 velocity time stamps"):
+        lin = read_channels(folder, PATTERNS, UNITS, join="linear", temperature=25.0)[0]
     assert lin.meta["rows_dropped"] == 1  # the first time stamp precedes every torque sample
     assert "linear interpolation" in lin.meta["join"]
     with pytest.raises(DataError, match="fewer than two"):
@@ -100,14 +101,15 @@ def test_joint_field_selects_a_joint(tmp_path):
 def test_bad_cell_missing_channel_and_units(tmp_path):
     folder = _folder(tmp_path)
     path = folder / "run_tau1_40.t"
-    lines = path.read_text().splitlines()
+    original = path.read_text()
+    lines = original.splitlines()
     lines[6] = "0.012000 spike?"
     path.write_text("\n".join(lines) + "\n")
     with pytest.raises(DataError) as err:
         read_channels(folder, PATTERNS, UNITS, temperature=25.0)
     assert (err.value.file, err.value.row, err.value.column) == (str(path), 7, "torque")
     (folder / "run_vel1_80.t").unlink()
-    path.write_text("\n".join(lines[:6]) + "\n")
+    path.write_text(original)
     with pytest.raises(DataError, match=r"run \{.*'80'\} has no velocity file"):
         read_channels(folder, PATTERNS, UNITS, temperature=25.0)
     with pytest.raises(ConfigError, match="no unit for the torque channel"):

@@ -22,7 +22,8 @@ Joining on time (``join=``), onto the time stamps of the velocity file (else the
 
 * ``"exact"``: every channel has the same time stamps, else an error naming file and row;
 * ``"nearest"`` (default): each time stamp takes the other channel's nearest sample within
-  ``tolerance`` (default half the median sample period); rows with none are dropped;
+  ``tolerance`` (default half the median sample period); rows with none are dropped (with a
+  :class:`~fricid.errors.DataQualityWarning` counting them);
 * ``"linear"``: the other channels are linearly interpolated at the time stamps; rows outside
   a channel's time span are dropped.
 
@@ -33,13 +34,14 @@ from __future__ import annotations
 
 import os
 import re
+import warnings
 from collections.abc import Mapping
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
-from ..errors import ConfigError, DataError
+from ..errors import ConfigError, DataError, DataQualityWarning
 from ..samples import RawLog
 from ..units import UNITS, to_si
 
@@ -376,6 +378,14 @@ def _read_run(
             f"the channels of run {run} share fewer than two time stamps (join='{join}', "
             f"tolerance {tol:g} s)",
             file=files[ref],
+        )
+    if not keep.all():
+        warnings.warn(
+            f"{files[ref].parent}: run {run}: {int((~keep).sum())} of {len(keep)} {ref} time "
+            f"stamps have no sample of every channel (join='{join}', tolerance {tol:g} s); "
+            "those rows are dropped",
+            DataQualityWarning,
+            stacklevel=3,
         )
     t_ref = t_ref[keep]
     values = {q: v[keep] for q, v in values.items()}
