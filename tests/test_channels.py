@@ -152,3 +152,33 @@ def test_open_log_without_patterns_says_what_is_needed(tmp_path):
 
     with pytest.raises(ConfigError, match="needs a pattern per quantity"):
         open_log(_folder(tmp_path), "channels")
+
+
+def test_real_recordings_split_into_channel_files_read_as_recorded(leadscrew_dir, tmp_path):
+    """Two lead-screw recordings written as a lab's per-channel files (time in ms, velocity in
+    rpm, torque in mNm, the set-point in the name) read back as the EPOS reader reads them."""
+    from fricid.io import read_epos
+
+    folder = tmp_path / "split"
+    folder.mkdir()
+    refs = {}
+    for name in ("20", "n20"):
+        ref = read_epos(leadscrew_dir / f"{name}.csv")
+        refs[name] = ref
+        t_ms = ref.time * 1e3
+        _write(folder / f"ls_vel1_{name}.t", t_ms, ref.velocity * 60 / (2 * np.pi))
+        _write(folder / f"ls_tau1_{name}.t", t_ms, ref.torque * 1e3)
+    logs = read_channels(
+        folder,
+        {"velocity": "{name}_vel{joint}_{speed}.t", "torque": "{name}_tau{joint}_{speed}.t"},
+        {"velocity": "rpm", "torque": "mNm"},
+        time_unit="ms",
+        join="exact",
+        temperature=25.0,
+    )
+    assert [log.meta["run"]["speed"] for log in logs] == ["20", "n20"]
+    for log in logs:
+        ref = refs[log.meta["run"]["speed"]]
+        np.testing.assert_allclose(log.time, ref.time, rtol=1e-9, atol=1e-12)
+        np.testing.assert_allclose(log.velocity, ref.velocity, rtol=1e-8)
+        np.testing.assert_allclose(log.torque, ref.torque, rtol=1e-8)
