@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from fricid.errors import ConfigError, DataError
+from fricid.errors import ConfigError, DataError, DataQualityWarning
 from fricid.io import (
     DEFAULT_NOMINAL_TORQUE,
     epos_steady_samples,
@@ -245,3 +245,72 @@ def test_steady_samples_synthetic(tmp_path):
     assert err.value.file.endswith("z.csv")
     with pytest.raises(DataError, match="no files"):
         epos_steady_samples(tmp_path, pattern="*.dat")
+
+
+# --------------------------------------------------------------------------- spreadsheet re-saves
+
+
+def _resaved(path: Path, rows: list[str], pad: str = ",,") -> Path:
+    """An EPOS export as a spreadsheet re-saves it: every line ends in empty fields."""
+    text = HEADER + CHANNELS + "ms;rpm;%\r\n" + "\r\n".join(rows) + "\r\n"
+    lines = [line + pad for line in text.split("\r\n") if line]
+    path.write_bytes(("\r\n".join(lines) + "\r\n").encode())
+    return path
+
+
+def test_spreadsheet_resave_with_trailing_empty_fields_reads_as_the_original(tmp_path):
+    rows = _rows(6, v=-10.0, tau=-1200.0)
+    original = read_epos(_epos(tmp_path / "a.csv", rows))
+    resaved = read_epos(_resaved(tmp_path / "b.csv", rows))
+    np.testing.assert_array_equal(resaved.torque, original.torque)
+    np.testing.assert_array_equal(resaved.velocity, original.velocity)
+    assert resaved.meta["channels"]["torque"] == "Torque actual value averaged"
+    # a re-save with ',' as the separator too
+    comma = tmp_path / "c.csv"
+    comma.write_bytes(_resaved(tmp_path / "c0.csv", rows).read_bytes().replace(b";", b","))
+    np.testing.assert_array_equal(read_epos(comma).torque, original.torque)
+
+
+def test_stray_note_in_a_cell_names_file_line_and_column_and_can_be_skipped(tmp_path):
+    rows = _rows(6, tau=-1200.0)
+    rows[2] = "20.000;-10;see lab book"
+    rows[4] = "40.000;-10"
+    path = _resaved(tmp_path / "a.csv", rows)
+    with pytest.raises(DataError) as err:
+        read_epos(path)
+    assert (err.value.file, err.value.row) == (str(path), 14)  # the short row comes first
+    rows[4] = "40.000;-10;-1200.0"
+    path = _resaved(tmp_path / "b.csv", rows)
+    with pytest.raises(DataError) as err:
+        read_epos(path)
+    assert (err.value.row, err.value.column) == (12, "Torque actual value averaged")
+    assert "'see lab book'" in str(err.value)
+    rows[4] = "40.000;-10"
+    path = _resaved(tmp_path / "c.csv", rows)
+    with pytest.warns(DataQualityWarning, match=r"skipped 2 bad rows.*line 12.*see lab book"):
+        log = read_epos(path, skip_bad_rows=True)
+    assert len(log) == 4
+    assert [s["line"] for s in log.meta["skipped_rows"]] == [12, 14]
+
+
+def test_skip_bad_rows_in_a_folder_lists_the_rows_per_file(tmp_path):
+    folder = tmp_path / "runs"
+    folder.mkdir()
+    rows = _rows(6, v=-10.0, tau=-30.0)
+    rows[1] = "10.000;-10;n/a"
+    _resaved(folder / "n10.csv", rows)
+    _resaved(folder / "10.csv", _rows(6, v=10.0, tau=30.0))
+    with pytest.warns(DataQualityWarning, match="skipped 1 bad row"):
+        samples = epos_steady_samples(folder, skip_bad_rows=True)
+    assert samples.meta["skipped_rows"] == {
+        "n10.csv": [{"line": 11, "column": "Torque actual value averaged", "text": "n/a"}]
+    }
+    np.testing.assert_array_equal(samples.count, [5, 6])
+
+
+def test_real_recording_resaved_by_a_spreadsheet_reads_as_recorded(leadscrew_dir, tmp_path):
+    src = leadscrew_dir / "20.csv"
+    lines = src.read_bytes().decode().split("\r\n")
+    copy = tmp_path / "20.csv"
+    copy.write_bytes("\r\n".join(line + ",," if line else line for line in lines).encode())
+    np.testing.assert_array_equal(read_epos(copy).torque, read_epos(src).torque)

@@ -603,7 +603,7 @@ def test_registry_is_in_io_and_pipeline_is_gone():
 
     from fricid import io as fio
 
-    assert fio.READERS == ("table", "generic", "rosbag", "epos")
+    assert fio.READERS == ("table", "generic", "rosbag", "epos", "channels", "mat")
     assert set(fio.READER_OPTIONS) == set(fio.READERS)
     with pytest.raises(ModuleNotFoundError):
         importlib.import_module("fricid.pipeline")
@@ -645,3 +645,35 @@ def test_open_log_refuses_bad_readers_and_options(tmp_path, reader, options, mes
     with pytest.raises(ConfigError) as info:
         open_log(path, reader, options)
     assert message in str(info.value)
+
+
+def test_generic_map_finds_a_column_by_name_and_takes_its_unit_from_the_bracket(tmp_path):
+    path = _write(tmp_path / "lab.csv", "t [ms],dq [deg/s],tau [Nm]\n0,90,1\n500,90,2\n")
+    log = read_table_log(
+        path, columns={"time": "t", "velocity": "dq", "torque": "tau"}, temperature=25.0
+    )
+    np.testing.assert_allclose(log.time, [0.0, 0.5])
+    np.testing.assert_allclose(log.velocity, [math.pi / 2] * 2)
+    # the same unit spelt another way agrees; a different unit is an error naming both
+    same = read_table_log(
+        path,
+        columns={"time": "t", "velocity": "dq", "torque": "tau"},
+        units={"torque": "N m"},
+        temperature=25.0,
+    )
+    np.testing.assert_allclose(same.torque, [1.0, 2.0])
+    with pytest.raises(ConfigError, match=r"'ms'.*'s' for time"):
+        read_table_log(
+            path,
+            columns={"time": "t", "velocity": "dq", "torque": "tau"},
+            units={"time": "s"},
+            temperature=25.0,
+        )
+
+
+def test_generic_map_name_shared_by_two_columns_is_refused(tmp_path):
+    path = _write(tmp_path / "two.csv", "t [s],dq [deg/s],dq [rad/s],tau [Nm]\n0,1,1,1\n1,1,1,1\n")
+    with pytest.raises(DataError, match="names 2 columns"):
+        read_table_log(
+            path, columns={"time": "t", "velocity": "dq", "torque": "tau"}, temperature=25.0
+        )

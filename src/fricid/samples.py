@@ -17,9 +17,19 @@ from typing import Any
 
 import numpy as np
 
-from .errors import DataError
+from .errors import ConfigError, DataError
 
-__all__ = ["LIMITS", "RAWLOG_COLUMNS", "SAMPLE_COLUMNS", "FrictionSamples", "RawLog"]
+__all__ = [
+    "LIMITS",
+    "OPTIONAL_INPUTS",
+    "RAWLOG_COLUMNS",
+    "SAMPLE_COLUMNS",
+    "FrictionSamples",
+    "RawLog",
+]
+
+#: Model inputs a :class:`FrictionSamples` may lack (not measured: all NaN).
+OPTIONAL_INPUTS: tuple[str, ...] = ("load", "temperature")
 
 #: Columns of a :class:`FrictionSamples` table and their units.
 SAMPLE_COLUMNS: dict[str, str] = {
@@ -101,6 +111,18 @@ def _as_column(name: str, values: Any, n: int | None, source: str | None) -> np.
     if name in LIMITS and name not in ("count", "std"):  # checked after their own rules
         _check_range(name, arr, source)
     return arr
+
+
+def _optional_column(name: str, values: Any, n: int, source: str | None) -> np.ndarray:
+    """An optional input of :class:`FrictionSamples`: None or all NaN -> all NaN (not
+    measured), else a finite column (:func:`_as_column`)."""
+    if values is None:
+        return np.full(n, np.nan)
+    arr = np.asarray(values, dtype=float)
+    if arr.size and np.isnan(arr).all():
+        shape_checked = _as_column(name, np.zeros_like(arr), n, source)
+        return np.full_like(shape_checked, np.nan)
+    return _as_column(name, values, n, source)
 
 
 @dataclass(frozen=True, eq=False)
@@ -299,10 +321,12 @@ class FrictionSamples:
     ----------
     velocity : array_like, shape (n,)
         Joint velocity [rad/s], n >= 1.
-    load : array_like, shape (n,) or scalar
+    load : array_like, shape (n,) or scalar, or None
         Load torque [N m] (eq. 7 of the BAS-RBFNN paper: the gravity torque of the link).
-    temperature : array_like, shape (n,) or scalar
-        Temperature [degC].
+        None (or all NaN) when not measured: the column is then all NaN, :attr:`measured`
+        leaves it out, and a model that needs it is refused (:meth:`require`).
+    temperature : array_like, shape (n,) or scalar, or None
+        Temperature [degC]; None (or all NaN) when not measured, as for ``load``.
     friction : array_like, shape (n,)
         Friction torque [N m].
     direction : array_like of {-1, 0, 1}, shape (n,), optional
@@ -322,8 +346,9 @@ class FrictionSamples:
     Raises
     ------
     DataError
-        No rows, a column of the wrong shape or length, a non-finite value, a direction
-        other than -1, 0, +1, a count below 1 or a negative std (the row and column named).
+        No rows, a column of the wrong shape or length, a non-finite value (in load or
+        temperature: some but not all), a direction other than -1, 0, +1, a count below 1
+        or a negative std (the row and column named).
 
     See Also
     --------
@@ -338,8 +363,8 @@ class FrictionSamples:
     """
 
     velocity: np.ndarray
-    load: np.ndarray
-    temperature: np.ndarray
+    load: np.ndarray | None
+    temperature: np.ndarray | None
     friction: np.ndarray
     direction: np.ndarray | None = None
     count: np.ndarray | None = None
@@ -355,8 +380,9 @@ class FrictionSamples:
         if n == 0:
             raise DataError("no friction samples", file=src)
         set_(self, "velocity", velocity)
-        for name in ("load", "temperature", "friction"):
-            set_(self, name, _as_column(name, getattr(self, name), n, src))
+        for name in ("load", "temperature"):  # optional: None or all NaN is not measured
+            set_(self, name, _optional_column(name, getattr(self, name), n, src))
+        set_(self, "friction", _as_column("friction", self.friction, n, src))
         direction = (
             np.sign(velocity)
             if self.direction is None
@@ -400,9 +426,40 @@ class FrictionSamples:
         return int(self.velocity.shape[0])
 
     @property
+    def measured(self) -> tuple[str, ...]:
+        """tuple of str: the model inputs measured, among velocity, load and temperature (an
+        input given as None, or all NaN, was not measured)."""
+        found = [name for name in OPTIONAL_INPUTS if np.isfinite(getattr(self, name)).all()]
+        return ("velocity", *found)
+
+    def require(self, inputs: tuple[str, ...] | list[str], user: str) -> None:
+        """Refuse samples that lack an input ``user`` needs.
+
+        Parameters
+        ----------
+        inputs : sequence of str
+            The inputs needed, among velocity, load and temperature.
+        user : str
+            Who needs them, for the message (e.g. ``"model 'vlt'"``).
+
+        Raises
+        ------
+        ConfigError
+            Naming the first input that was not measured.
+        """
+        missing = [name for name in inputs if name not in self.measured]
+        if missing:
+            raise ConfigError(
+                f"{user} needs {', '.join(inputs)}, but the samples"
+                + (f" ({self.source})" if self.source else "")
+                + f" have no {missing[0]} (not measured); choose a model of velocity only "
+                "or give samples with that column"
+            )
+
+    @property
     def X(self) -> np.ndarray:
         """ndarray, shape (n, 3): the model inputs, columns velocity [rad/s], load [N m],
-        temperature [degC]."""
+        temperature [degC]; an input not measured is a column of NaN."""
         return np.column_stack([self.velocity, self.load, self.temperature])
 
     @property

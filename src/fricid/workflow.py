@@ -27,7 +27,7 @@ import numpy as np
 from .errors import ConfigError, DataError, FricidError
 from .extract import ExtractionResult, extract
 from .fitted import FittedModel
-from .io.registry import check_keys, check_reader, open_log
+from .io.registry import check_keys, check_reader, gives_samples, open_log
 from .samples import FrictionSamples, RawLog
 
 __all__ = [
@@ -76,8 +76,9 @@ class JointData:
     Attributes
     ----------
     samples : FrictionSamples
-        The combined samples (direction 0, eq. 11 of the BAS-RBFNN paper); for a folder of
-        steady-state EPOS recordings, the per-direction operating points as recorded.
+        The combined samples (direction 0, eq. 11 of the BAS-RBFNN paper); for a reader that
+        gives samples directly (a folder of steady-state EPOS recordings, a MATLAB table of
+        means), the per-direction operating points as recorded.
     by_direction : FrictionSamples
         The per-direction samples (+1 and -1).
     extraction : ExtractionResult or None
@@ -180,7 +181,8 @@ def load_joint(
     path : str or path-like
         The log: a fricid raw log (``table``), any CSV/Parquet table (``generic``), a ROS 2
         bag or MCAP file (``rosbag``), an EPOS recorder CSV or a folder of steady-state EPOS
-        recordings (``epos``); opened by :func:`fricid.io.open_log`.
+        recordings (``epos``), a folder of per-channel files (``channels``), a MATLAB file
+        (``mat``); opened by :func:`fricid.io.open_log`.
     reader : str
         One of :data:`fricid.io.READERS`.
     reader_options : Mapping, optional
@@ -211,11 +213,13 @@ def load_joint(
     eopts = {k: v for k, v in dict(extract_options or {}).items() if v is not None}
     check_reader(reader, ropts)
     check_keys(eopts, EXTRACT_OPTIONS, "extraction option")
-    if reader == "epos" and path.is_dir() and eopts:
-        raise ConfigError(
-            "a folder of steady-state EPOS recordings gives one operating point per file; "
-            f"extraction options ({', '.join(eopts)}) do not apply"
+    if gives_samples(reader, path, ropts) and eopts:
+        what = (
+            "a folder of steady-state EPOS recordings gives one operating point per file"
+            if reader == "epos"
+            else f"reader '{reader}' gives friction samples directly"
         )
+        raise ConfigError(f"{what}; extraction options ({', '.join(eopts)}) do not apply")
     opened = open_log(path, reader, ropts, chunk_rows=chunk_rows)
     if isinstance(opened, FrictionSamples):
         return JointData(opened, opened, None)

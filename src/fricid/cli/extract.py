@@ -26,19 +26,22 @@ def parse_positions(text: str | None, unit: str) -> np.ndarray | None:
     return np.asarray(to_si(values, unit, "position"), dtype=float)
 
 
-def parse_column_map(items: list[str] | None) -> tuple[dict[str, str], dict[str, str]]:
-    """``["time=t:ms", "velocity=dq"]`` -> ``({"time": "t", "velocity": "dq"}, {"time": "ms"})``."""
+def parse_column_map(
+    items: list[str] | None, flag: str = "--map", what: str = "COLUMN"
+) -> tuple[dict[str, str], dict[str, str]]:
+    """``["time=t:ms", "velocity=dq"]`` -> ``({"time": "t", "velocity": "dq"}, {"time": "ms"})``.
+
+    ``flag`` (``--map``, ``--channels``, ``--var``) and ``what`` (what stands right of ``=``)
+    name the flag in messages.
+    """
     from ..io.options import parse_pairs
 
     if not items:
-        raise ConfigError(
-            "--format generic needs --map QUANTITY=COLUMN[:UNIT] for time, velocity and torque "
-            "or current (e.g. --map time=t:s --map velocity=dq:deg/s --map torque=tau:Nm)"
-        )
+        raise ConfigError(_NEEDS[flag])
     try:
-        pairs = parse_pairs(items, form="QUANTITY=COLUMN[:UNIT]")
+        pairs = parse_pairs(items, form=f"QUANTITY={what}[:UNIT]")
     except ConfigError as exc:
-        raise ConfigError(f"--map takes QUANTITY=COLUMN[:UNIT]; {exc}") from None
+        raise ConfigError(f"{flag} takes QUANTITY={what}[:UNIT]; {exc}") from None
     columns: dict[str, str] = {}
     units: dict[str, str] = {}
     for quantity, rest in pairs.items():
@@ -49,19 +52,122 @@ def parse_column_map(items: list[str] | None) -> tuple[dict[str, str], dict[str,
     return columns, units
 
 
-@app.command("extract")
+#: What a format needs of its mapping flag, when the flag is missing.
+_NEEDS = {
+    "--map": "--format generic needs --map QUANTITY=COLUMN[:UNIT] for time, velocity and torque "
+    "or current (e.g. --map time=t:s --map velocity=dq:deg/s --map torque=tau:Nm)",
+    "--channels": "--format channels needs --channels QUANTITY=PATTERN:UNIT for velocity (or "
+    "position) and torque (or current), e.g. --channels 'torque={name}_tau{joint}_{speed}.t:Nm'",
+    "--var": "--format mat needs --var QUANTITY=NAME:UNIT: time, velocity and torque (a log) or "
+    "velocity and friction (a table of means), e.g. --var velocity=qd:rad/s",
+}
+
+#: Flag -> (parameter, the reader option it sets). A flag given with a format whose reader
+#: lacks that option (:data:`fricid.io.READER_OPTIONS`) is refused, never silently dropped.
+READER_FLAGS: dict[str, tuple[str, str]] = {
+    "--map": ("column_map", "columns"),
+    "--joint": ("joint", "joint"),
+    "--topic": ("topic", "topic"),
+    "--temperature-topic": ("temperature_topic", "temperature_topic"),
+    "--effort": ("effort", "effort"),
+    "--torque-constant": ("torque_constant", "torque_constant"),
+    "--velocity-unit": ("velocity_unit", "velocity_unit"),
+    "--flip-sign": ("flip_sign", "flip_sign"),
+    "--nominal-torque": ("nominal_torque", "nominal_torque"),
+    "--temperature": ("temperature", "temperature"),
+    "--skip-bad-rows": ("skip_bad_rows", "skip_bad_rows"),
+    "--channels": ("channel_patterns", "channels"),
+    "--var": ("variables", "variables"),
+    "--join": ("join", "join"),
+    "--join-tolerance": ("join_tolerance", "tolerance"),
+    "--time-unit": ("time_unit", "time_unit"),
+}
+
+#: Flags of the extraction (:func:`fricid.extract.extract`): refused for a reader that gives
+#: samples directly (:func:`fricid.io.registry.gives_samples`).
+EXTRACT_FLAGS: dict[str, str] = {
+    "--positions": "positions",
+    "--position-unit": "position_unit",
+    "--bin-halfwidth": "bin_halfwidth",
+    "--median-window": "median_window",
+    "--gravity": "gravity",
+}
+
+
+def _given(ctx: typer.Context, param: str) -> bool:
+    """Whether ``param`` was set on the command line (not left at its default)."""
+    source = ctx.get_parameter_source(param)  # an enum of click's (typer may vendor click)
+    return source is not None and source.name not in ("DEFAULT", "DEFAULT_MAP")
+
+
+def check_flags(ctx: typer.Context, fmt: str, log: Path, variables: list[str] | None) -> None:
+    """Refuse a flag that ``fmt`` does not use, saying why (table-driven from the registry).
+
+    Raises
+    ------
+    ConfigError
+        An unknown format; a reader flag whose option the reader lacks (naming the formats
+        that take it); an extraction flag with a reader that gives samples directly.
+    """
+    from ..io.registry import CHUNKED_READERS, READER_OPTIONS, READERS, gives_samples
+
+    if fmt not in READERS:
+        raise ConfigError(f"--format must be one of {', '.join(READERS)}; got '{fmt}'")
+    for flag, (param, option) in READER_FLAGS.items():
+        if _given(ctx, param) and option not in READER_OPTIONS[fmt]:
+            takers = [r for r in READERS if option in READER_OPTIONS[r]]
+            raise ConfigError(
+                f"{flag} does not apply to --format {fmt}: it is an option of --format "
+                f"{' and '.join(takers)}"
+            )
+    if _given(ctx, "chunk_rows") and fmt not in CHUNKED_READERS:
+        raise ConfigError(
+            f"--chunk-rows does not apply to --format {fmt}: only --format "
+            f"{' and '.join(CHUNKED_READERS)} read a log in chunks"
+        )
+    probe = {"variables": parse_column_map(variables, "--var", "NAME")[0]} if variables else {}
+    if gives_samples(fmt, log, probe):
+        what = (
+            "a folder of steady-state EPOS recordings gives one operating point per file"
+            if fmt == "epos"
+            else "a MATLAB table of means (--var friction=...) is read straight into samples"
+        )
+        for flag, param in EXTRACT_FLAGS.items():
+            if _given(ctx, param):
+                raise ConfigError(
+                    f"{flag} does not apply to --format {fmt} here: {what}, so there is "
+                    "nothing to extract"
+                )
+
+
+def _format_help() -> str:
+    from ..io.registry import READER_EXAMPLES
+
+    return "\b\nFormats (--format), one example each:\n" + "\n".join(
+        f"  {name}: {example}" for name, example in READER_EXAMPLES.items()
+    )
+
+
+@app.command("extract", epilog=_format_help())
 @handle_errors
 def extract_command(
+    ctx: typer.Context,
     log: Annotated[
         Path,
         typer.Argument(
-            help="Raw log (.parquet or .csv from `fricid "
-            "simulate` or a converted recording), or a folder of "
-            "steady-state EPOS recordings with --format epos.",
+            help="Raw log (.parquet or .csv from `fricid simulate` or a converted recording), "
+            "a folder of steady-state EPOS recordings (--format epos), a folder of per-channel "
+            "files (--format channels) or a MATLAB file (--format mat).",
         ),
     ],
     out: Annotated[
-        Path, out_option("Samples to write (.csv or .parquet): direction 0, combined by eq. 11.")
+        Path,
+        out_option(
+            "Samples to write (.csv or .parquet): direction 0, combined by eq. 11, for a log "
+            "that is extracted; the operating points as recorded (+1 and -1 rows) for a "
+            "format that gives samples directly (a folder of EPOS recordings, a MATLAB table "
+            "of means)."
+        ),
     ] = Path("samples.csv"),
     by_direction: Annotated[
         Path | None, typer.Option(help="Also write the per-direction samples (+1 and -1) here.")
@@ -70,11 +176,12 @@ def extract_command(
         str,
         typer.Option(
             "--format",
-            help="table (fricid's CSV/Parquet raw log), "
-            "rosbag (a ROS 2 bag folder or .mcap/.db3 file with "
-            "sensor_msgs/msg/JointState; needs --joint) or epos (a "
-            "folder of Maxon EPOS recorder CSVs, one steady velocity "
-            "per file) or generic (any CSV/Parquet table, with --map).",
+            help="table (fricid's CSV/Parquet raw log), generic (any CSV/Parquet table, with "
+            "--map), rosbag (a ROS 2 bag folder or .mcap/.db3 file with "
+            "sensor_msgs/msg/JointState; needs --joint), epos (a Maxon EPOS recorder CSV, or a "
+            "folder of them, one steady velocity per file), channels (a folder of headerless "
+            "'time value' files, one per channel and run, with --channels) or mat (a MATLAB "
+            "v5/v7.3 file, with --var). Examples below.",
         ),
     ] = "table",
     column_map: Annotated[
@@ -84,11 +191,53 @@ def extract_command(
             help="generic: QUANTITY=COLUMN[:UNIT], repeatable, e.g. --map time=t:ms --map "
             "velocity=dq:deg/s --map current=i:A --map position=q:deg --map "
             "temperature=T:degC. time, velocity and torque or current are required; a unit "
-            "may instead stand in the column name, as 'dq [deg/s]'.",
+            "may instead stand in the column name, as 'dq [deg/s]' (then --map velocity=dq "
+            "finds it).",
         ),
     ] = None,
+    channel_patterns: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--channels",
+            help="channels: QUANTITY=PATTERN:UNIT, repeatable, one per quantity (velocity or "
+            "position, torque or current, optionally temperature). In PATTERN, {field} matches "
+            "part of a file name and * any text: --channels "
+            "'torque={name}_tau{joint}_{speed}.t:Nm'. A run is one value of the fields.",
+        ),
+    ] = None,
+    variables: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--var",
+            help="mat: QUANTITY=NAME:UNIT, repeatable; a struct field as a.b, variables "
+            "joined end to end as a,b. A log: time, velocity, torque or current (position, "
+            "temperature optional). A table of means: velocity and friction (load, "
+            "temperature optional).",
+        ),
+    ] = None,
+    join: Annotated[
+        str,
+        typer.Option(
+            help="channels: join channels on the velocity (else position) time stamps: exact, "
+            "nearest (the nearest sample within --join-tolerance) or linear (interpolated)."
+        ),
+    ] = "nearest",
+    join_tolerance: Annotated[
+        float | None,
+        typer.Option(
+            help="channels: largest time difference [s] of --join nearest (default "
+            "half the median sample period)."
+        ),
+    ] = None,
+    time_unit: Annotated[
+        str, typer.Option(help="channels: unit of the time column of every file.")
+    ] = "s",
     joint: Annotated[
-        str | None, typer.Option(help="rosbag: the joint's name in JointState.name.")
+        str | None,
+        typer.Option(
+            help="rosbag: the joint's name in JointState.name; channels: the value of the "
+            "{joint} field; mat: the 1-based column of variables with one column per joint."
+        ),
     ] = None,
     topic: Annotated[str, typer.Option(help="rosbag: the JointState topic.")] = "/joint_states",
     temperature_topic: Annotated[
@@ -146,6 +295,13 @@ def extract_command(
         float,
         typer.Option(help="EPOS: the motor's nominal torque [mN m], reference of the % channel."),
     ] = 9.84,
+    skip_bad_rows: Annotated[
+        bool,
+        typer.Option(
+            help="EPOS: drop a data row with a malformed cell (a typed note) instead of "
+            "stopping; the rows dropped are counted and listed (file, line, column)."
+        ),
+    ] = False,
     temperature: TemperatureOption = 25.0,
     chunk_rows: Annotated[
         int, typer.Option(help="Rows read at a time (bounded memory).")
@@ -155,8 +311,10 @@ def extract_command(
     filter the current, torque = K I (eq. 13), average the repetitions per position bin,
     separate friction and gravity (eq. 9-11), fit p_x, p_y (eq. 7) and take the gravity torque
     as the load (eq. 12). Writes samples with velocity [rad/s], load [N m], temperature [degC],
-    friction [N m], direction, count, std [N m]."""
+    friction [N m], direction, count, std [N m]. A flag that the format does not use is an
+    error."""
     from ..io import write_samples
+    from ..io.registry import gives_samples
     from ..units import to_si
     from ..workflow import load_joint
 
@@ -165,6 +323,7 @@ def extract_command(
         folders=fmt in ("epos", "rosbag"),
         out_files={"--out": out, "--by-direction": by_direction},
     )
+    check_flags(ctx, fmt, log, variables)
     pos = parse_positions(positions, position_unit)
     half = None if bin_halfwidth is None else float(to_si(bin_halfwidth, position_unit, "position"))
     extract_options = {
@@ -173,12 +332,13 @@ def extract_command(
         "median_window": median_window,
         "gravity": gravity,
     }
+    given = {option for _, (param, option) in READER_FLAGS.items() if _given(ctx, param)}
     if fmt == "table":
-        reader_options = {}
+        reader_options: dict = {}
     elif fmt == "generic":
         columns, units = parse_column_map(column_map)
         reader_options = {"columns": columns, "units": units, "torque_constant": torque_constant}
-        if "temperature" not in columns:
+        if "temperature" not in columns or "temperature" in given:
             reader_options["temperature"] = temperature
     elif fmt == "rosbag":
         reader_options = {
@@ -198,11 +358,35 @@ def extract_command(
             "flip_sign": flip_sign,
             "temperature": temperature,
             "nominal_torque": nominal_torque * 1e-3,
+            "torque_constant": torque_constant,
+            "skip_bad_rows": skip_bad_rows,
         }
-        if log.is_dir():
-            extract_options = {}
-    else:
-        raise ConfigError(f"--format must be table, generic, rosbag or epos; got '{fmt}'")
+    elif fmt == "channels":
+        patterns, units = parse_column_map(channel_patterns, "--channels", "PATTERN")
+        reader_options = {
+            "channels": patterns,
+            "units": units,
+            "joint": joint,
+            "join": join,
+            "tolerance": join_tolerance,
+            "time_unit": time_unit,
+            "torque_constant": torque_constant,
+        }
+        if "temperature" not in patterns or "temperature" in given:
+            reader_options["temperature"] = temperature
+    else:  # mat (check_flags refused any other format)
+        names, units = parse_column_map(variables, "--var", "NAME")
+        reader_options = {
+            "variables": names,
+            "units": units,
+            "joint": joint,
+            "torque_constant": torque_constant,
+        }
+        table_of_means = "friction" in names
+        if "temperature" in given or ("temperature" not in names and not table_of_means):
+            reader_options["temperature"] = temperature
+    if gives_samples(fmt, log, reader_options):
+        extract_options = {}
 
     with progress_bar("extracting", total=None) as advance:
         data = load_joint(
@@ -221,9 +405,23 @@ def extract_command(
         if pos is None and data.extraction.options.get("positions") is not None:
             err_console.print("used the position bins recorded with the log")
     else:
+        skipped = data.samples.meta.get("skipped_rows") or {}
+        n_bad = sum(len(rows) for rows in skipped.values())
         err_console.print(
-            f"{len(data.samples)} steady operating points (directions {data.samples.directions()})"
+            f"{len(data.samples)} steady operating points (directions "
+            f"{data.samples.directions()})"
+            + (f"; {n_bad} bad rows skipped in {len(skipped)} files" if n_bad else ""),
+            markup=False,
+            highlight=False,
         )
+    if fmt == "channels":
+        how = {
+            "exact": "on identical time stamps",
+            "nearest": "by the nearest sample within "
+            + (f"{join_tolerance:g} s" if join_tolerance else "half the median sample period"),
+            "linear": "by linear interpolation",
+        }.get(join, join)
+        err_console.print(f"channels joined {how}, onto the velocity (else position) time stamps")
     err_console.print(
         f"wrote {escape(str(out))} ({len(data.samples)} samples)"
         + (f" and {escape(str(by_direction))}" if by_direction else "")

@@ -139,6 +139,7 @@ def fit(
             stacklevel=2,
         )
     model = get_model(model)
+    samples.require(model.inputs, f"model '{model.name}'")
     problem = IdentificationProblem(model, samples, loss="sse", bounds=bounds, fixed=fixed)
     X, y = problem.X, problem.y
     if problem.n_obs < problem.n_free:
@@ -205,7 +206,9 @@ def fit(
             for n, (lo, hi) in zip(free_names, problem.bounds, strict=True)
         },
         operating_range={
-            name: [float(X[:, j].min()), float(X[:, j].max())] for j, name in enumerate(INPUTS)
+            name: [float(X[:, j].min()), float(X[:, j].max())]
+            for j, name in enumerate(INPUTS)
+            if name in samples.measured
         },
         provenance=_provenance(samples),
         status=int(result.status),

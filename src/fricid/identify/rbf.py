@@ -213,6 +213,7 @@ def _model(
         operating_range={
             name: [float(X[:, INPUTS.index(name)].min()), float(X[:, INPUTS.index(name)].max())]
             for name in INPUTS
+            if name in samples.measured
         },
         provenance={
             "source": samples.source,
@@ -342,6 +343,7 @@ def fit_rbf(samples: FrictionSamples, inputs: Sequence[str] = INPUTS, **params: 
         ``model="rbf"``, its network(s) in ``state``.
     """
     names = check_inputs(inputs)
+    samples.require(names, "model 'rbf' (inputs=)")
     symmetry = symmetry_for(samples)
     if symmetry != "per_direction":
         est, state = _train_side(samples, names, params, "")

@@ -1,7 +1,8 @@
 """Readers and writers: fricid's CSV and Parquet tables, Maxon EPOS recorder CSV, ROS 2 bags
-and MCAP, generic column-mapped logs; the registry of readers and their options
-(:mod:`.registry`: :data:`READERS`, :data:`READER_OPTIONS`, :func:`open_log`); the parsers of
-option values written as text (:mod:`.options`); atomic writes (:mod:`.atomic`).
+and MCAP, generic column-mapped logs, per-channel ``time value`` files, MATLAB files; the
+registry of readers and their options (:mod:`.registry`: :data:`READERS`,
+:data:`READER_OPTIONS`, :func:`open_log`); the parsers of option values written as text
+(:mod:`.options`); atomic writes (:mod:`.atomic`).
 
 Every reader converts to SI once, at the edge, and names the file, row and column of bad
 input (:class:`~fricid.errors.DataError`); every writer is atomic (DESIGN.md, "Files").
@@ -19,6 +20,7 @@ from typing import Any
 from .atomic import atomic_path as atomic_path
 from .atomic import atomic_write as atomic_write
 from .registry import EPOS_FOLDER_ONLY as EPOS_FOLDER_ONLY
+from .registry import READER_EXAMPLES as READER_EXAMPLES
 from .registry import READER_OPTIONS as READER_OPTIONS
 from .registry import READERS as READERS
 from .registry import check_reader as check_reader
@@ -31,6 +33,9 @@ _WHERE = {
     "read_epos": "epos",
     "read_epos_dir": "epos",
     "read_table_log": "generic",
+    "read_channels": "channels",
+    "read_mat": "matlab",
+    "mat_variables": "matlab",
     "iter_rosbag": "rosbag",
     "read_rosbag": "rosbag",
     "rosbag_joints": "rosbag",
@@ -47,6 +52,7 @@ __all__ = sorted(
         *_WHERE,
         "EPOS_FOLDER_ONLY",
         "READERS",
+        "READER_EXAMPLES",
         "READER_OPTIONS",
         "atomic_path",
         "atomic_write",

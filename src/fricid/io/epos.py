@@ -17,9 +17,10 @@ The format, as EPOS Studio 3.x writes it (``;``-separated, CRLF line ends)::
 steady-state recordings (one constant velocity per file) into friction samples, dropping
 outlier rows and warning about them (the robust statistics are in :mod:`._steady`).
 
-The module is longer than 500 lines because it holds one format's parser, reader and
-steady-state averaging, most of it docstrings that name every unit and error; splitting the
-parser from its two users would scatter the format's rules.
+The module is longer than 500 lines because it holds one format's parser (with a
+spreadsheet's re-save and ``skip_bad_rows``), reader and steady-state averaging, most of it
+docstrings that name every unit and error; splitting the parser from its two users would
+scatter the format's rules.
 """
 
 from __future__ import annotations
@@ -28,6 +29,7 @@ import logging
 import math
 import os
 import re
+import warnings
 from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
@@ -36,7 +38,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from ..errors import ConfigError, DataError
+from ..errors import ConfigError, DataError, DataQualityWarning
 from ..samples import FrictionSamples, RawLog
 from ..units import UNITS, to_si
 from ._steady import (
@@ -85,6 +87,7 @@ class _Recording:
     units_line: int
     data: np.ndarray  # (n, channels)
     lines: np.ndarray  # (n,) 1-based line number of each data row
+    skipped: list[dict[str, Any]]  # bad rows dropped by skip_bad_rows
 
 
 def _read_text(path: Path) -> list[str]:
@@ -97,7 +100,23 @@ def _read_text(path: Path) -> list[str]:
             continue
     else:  # pragma: no cover - cp1252 fails only on five undefined bytes
         text = raw.decode("latin-1")
-    return [line.rstrip("\r") for line in text.split("\n")]
+    return _unpad([line.rstrip("\r") for line in text.split("\n")])
+
+
+_PADDING = re.compile(r"(?:\s*[;,])+\s*$")
+
+
+def _unpad(lines: list[str]) -> list[str]:
+    """Undo a spreadsheet's re-save: ``,`` as the only separator becomes ``;``, and when the
+    channel line ends in empty fields (``...averaged,,``) every line loses its trailing empty
+    fields (``-1200,,`` -> ``-1200``). A comma inside a value (``12,5``) is kept, and so
+    reported as a malformed number."""
+    if not any(";" in line for line in lines) and any(line.startswith(",") for line in lines):
+        lines = [line.replace(",", ";") for line in lines]
+    channel = next((line for line in lines if line.startswith(";")), "")
+    if channel.rstrip().endswith(","):
+        lines = [_PADDING.sub("", line) for line in lines]
+    return lines
 
 
 def _fields(line: str) -> list[str]:
@@ -147,8 +166,15 @@ def _parse_header(lines: list[str], path: Path) -> tuple[dict[str, Any], int]:
     )
 
 
-def _parse_data(lines: list[str], start: int, channels: list[str], path: Path):
-    """Numeric rows from ``lines[start:]``; text lines are skipped with a warning."""
+def _parse_data(
+    lines: list[str], start: int, channels: list[str], path: Path, skip_bad_rows: bool
+) -> tuple[np.ndarray, np.ndarray, list[dict[str, Any]]]:
+    """Numeric rows from ``lines[start:]``, their line numbers, and the bad rows skipped.
+
+    Text lines are skipped with a warning. A row of the wrong width or with a malformed cell
+    is an error naming its line and column, or with ``skip_bad_rows`` dropped and listed as
+    ``{"line", "column", "text"}``.
+    """
     body = pd.Series(lines[start:], index=np.arange(start + 1, len(lines) + 1), dtype=object)
     body = body[body.str.strip() != ""].str.strip().str.rstrip(";").str.strip()
     is_row = body.str.match(_NUMBER_START)
@@ -157,20 +183,25 @@ def _parse_data(lines: list[str], start: int, channels: list[str], path: Path):
     if rows.empty:
         raise DataError("no data rows after the units line", file=path)
     k = len(channels)
+    skipped: list[dict[str, Any]] = []
     widths = rows.str.count(";").to_numpy() + 1
     if (widths != k).any():
         i = int(np.flatnonzero(widths != k)[0])
-        raise DataError(
-            f"row has {widths[i]} fields, expected {k} ({', '.join(channels)})",
-            file=path,
-            row=int(rows.index[i]),
-        )
+        if not skip_bad_rows:
+            raise DataError(
+                f"row has {widths[i]} fields, expected {k} ({', '.join(channels)})",
+                file=path,
+                row=int(rows.index[i]),
+            )
+        for line_no, text in rows[widths != k].items():
+            skipped.append({"line": int(line_no), "column": None, "text": str(text)})
+        rows = rows[widths == k]
     text = rows.str.split(";", expand=True)
     data = np.empty((len(rows), k))
     for j in range(k):
         data[:, j] = pd.to_numeric(text[j].str.strip(), errors="coerce").to_numpy(float)
     bad = ~np.isfinite(data)
-    if bad.any():
+    if bad.any() and not skip_bad_rows:
         i = int(np.flatnonzero(bad.any(axis=1))[0])
         j = int(np.flatnonzero(bad[i])[0])
         raise DataError(
@@ -179,10 +210,37 @@ def _parse_data(lines: list[str], start: int, channels: list[str], path: Path):
             row=int(rows.index[i]),
             column=channels[j],
         )
-    return data, rows.index.to_numpy()
+    for i in np.flatnonzero(bad.any(axis=1)):
+        j = int(np.flatnonzero(bad[i])[0])
+        skipped.append(
+            {"line": int(rows.index[i]), "column": channels[j], "text": str(text.iat[i, j])}
+        )
+    good = ~bad.any(axis=1)
+    if not good.any():
+        raise DataError("no readable data rows after the units line", file=path)
+    skipped.sort(key=lambda item: item["line"])
+    return data[good], rows.index.to_numpy()[good], skipped
 
 
-def _parse(path: Path) -> _Recording:
+def _warn_skipped(path: Path, skipped: list[dict[str, Any]]) -> None:
+    """One :class:`~fricid.errors.DataQualityWarning` counting and listing skipped rows."""
+    if not skipped:
+        return
+    listed = "; ".join(
+        f"line {s['line']}"
+        + (f", column '{s['column']}'" if s["column"] else "")
+        + f": {s['text']!r}"
+        for s in skipped
+    )
+    warnings.warn(
+        f"{path}: skipped {len(skipped)} bad row{'s' if len(skipped) > 1 else ''} "
+        f"(--skip-bad-rows): {listed}",
+        DataQualityWarning,
+        stacklevel=4,
+    )
+
+
+def _parse(path: Path, skip_bad_rows: bool = False) -> _Recording:
     lines = _read_text(path)
     if not any(line.strip() for line in lines):
         raise DataError("empty file", file=path)
@@ -204,8 +262,8 @@ def _parse(path: Path) -> _Recording:
             file=path,
             row=at + 2,
         )
-    data, line_numbers = _parse_data(lines, at + 2, channels, path)
-    return _Recording(header, channels, units[: len(channels)], at + 2, data, line_numbers)
+    data, line_numbers, skipped = _parse_data(lines, at + 2, channels, path, skip_bad_rows)
+    return _Recording(header, channels, units[: len(channels)], at + 2, data, line_numbers, skipped)
 
 
 def _pick_channels(channels: list[str]) -> dict[str, int]:
@@ -290,6 +348,7 @@ def read_epos(
     torque_constant: float | None = None,
     counts_per_turn: float | None = None,
     joint: str = "joint",
+    skip_bad_rows: bool = False,
 ) -> RawLog:
     """Read one EPOS Studio data-recorder CSV export as a raw log in SI units.
 
@@ -305,6 +364,9 @@ def read_epos(
     torque_constant : K [N m/A], needed when only a current channel was recorded.
     counts_per_turn : encoder counts per revolution, needed for a position channel in counts.
     joint : name for the log.
+    skip_bad_rows : drop a data row with a malformed cell or the wrong number of fields
+        (``--skip-bad-rows``) instead of refusing the file; the rows dropped are counted and
+        listed in a :class:`~fricid.errors.DataQualityWarning` and in ``meta["skipped_rows"]``.
 
     Returns
     -------
@@ -320,6 +382,8 @@ def read_epos(
         Naming file, line and column: no channel or units line, an unknown unit of a used
         channel, a number-like but malformed value, a short row, time not increasing.
         A text line in or after the data block (a typed comment) is skipped with a warning.
+        A spreadsheet's re-save (trailing empty fields ``-1200,,`` on every line, or ``,``
+        as the separator) is read as the original.
     """
     return _read(
         path,
@@ -329,6 +393,7 @@ def read_epos(
         torque_constant=torque_constant,
         counts_per_turn=counts_per_turn,
         joint=joint,
+        skip_bad_rows=skip_bad_rows,
     )[0]
 
 
@@ -341,12 +406,14 @@ def _read(
     torque_constant: float | None = None,
     counts_per_turn: float | None = None,
     joint: str = "joint",
+    skip_bad_rows: bool = False,
 ) -> tuple[RawLog, np.ndarray]:
     """:func:`read_epos`, also returning the 1-based line number of each data row."""
     path = Path(path)
     _positive("nominal_torque", nominal_torque)
     _positive("counts_per_turn", counts_per_turn)
-    rec = _parse(path)
+    rec = _parse(path, skip_bad_rows)
+    _warn_skipped(path, rec.skipped)
     picked = _pick_channels(rec.channels)
     if "velocity" not in picked:
         raise DataError(f"no velocity channel among {rec.channels[1:]}", file=path)
@@ -378,6 +445,7 @@ def _read(
         "nominal_torque [N m]": float(nominal_torque),
         "position_source": "channel" if position is not None else "integrated velocity",
         "temperature_source": "constant parameter (no channel)",
+        "skipped_rows": rec.skipped,
     }
     log = RawLog(
         time=time,
@@ -431,6 +499,7 @@ def epos_steady_samples(
     load: float = 0.0,
     torque_constant: float | None = None,
     outlier_sigmas: float | None = OUTLIER_SIGMAS,
+    skip_bad_rows: bool = False,
 ) -> FrictionSamples:
     """Friction samples from a folder of steady-state EPOS recordings, one point per file.
 
@@ -454,6 +523,8 @@ def epos_steady_samples(
         Rows whose torque is further than this many robust standard deviations (1.4826 MAD)
         from the file's median are dropped (default :data:`OUTLIER_SIGMAS`, 8); None keeps
         every row.
+    skip_bad_rows : bool
+        As for :func:`read_epos`; ``meta["skipped_rows"]`` lists the rows dropped, per file.
 
     Returns
     -------
@@ -494,6 +565,7 @@ def epos_steady_samples(
         flip_sign=flip_sign,
         temperature=temperature,
         torque_constant=torque_constant,
+        skip_bad_rows=skip_bad_rows,
     )
     logs = [log for log, _ in read]
     keep = [
@@ -536,6 +608,11 @@ def epos_steady_samples(
             "nominal_torque [N m]": float(nominal_torque),
             "outlier_sigmas": outlier_sigmas,
             "outlier_lines": dropped_lines,
+            "skipped_rows": {
+                name: log.meta["skipped_rows"]
+                for name, log in zip(names, logs, strict=True)
+                if log.meta["skipped_rows"]
+            },
             "quality": quality,
         },
     )

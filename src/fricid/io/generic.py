@@ -46,15 +46,23 @@ def _check_mapping(
         )
 
 
+def _same_unit(quantity: str, a: str, b: str) -> bool:
+    """Whether two spellings of a unit convert alike (``Nm`` and ``N m`` do)."""
+    table = UNITS[quantity]
+    return a.strip() == b.strip() or (
+        a.strip() in table and b.strip() in table and table[a.strip()] == table[b.strip()]
+    )
+
+
 def _unit(quantity: str, label: str, units: Mapping[str, str]) -> str:
     """The unit of a mapped column: from ``units``, else from its label ``"dq [deg/s]"``."""
     given = units.get(quantity)
     in_label = split_label(label)[1]
     allowed = ", ".join(UNITS[quantity])
-    if given is not None and in_label is not None and given.strip() != in_label:
+    if given is not None and in_label is not None and not _same_unit(quantity, given, in_label):
         raise ConfigError(
-            f"column '{label}' says its unit is '{in_label}', but units= says '{given}' "
-            f"for {quantity}; give one unit (allowed: {allowed})"
+            f"column '{label}' says its unit is '{in_label}', but units= (--map) says "
+            f"'{given}' for {quantity}; give one unit (allowed: {allowed})"
         )
     unit = given if given is not None else in_label
     if unit is None:
@@ -65,6 +73,41 @@ def _unit(quantity: str, label: str, units: Mapping[str, str]) -> str:
     if unit.strip() not in UNITS[quantity]:
         raise ConfigError(f"unknown {quantity} unit '{unit}'; allowed units: {allowed}")
     return unit.strip()
+
+
+def _find_column(label: str, quantity: str, available: list[str], path: Path) -> str:
+    """The file's column that ``label`` names: the label itself (blanks around it tolerated),
+    else the one column whose name without its bracketed unit is ``label`` (``t`` finds
+    ``t [s]``, whose unit then comes from the bracket).
+
+    Raises
+    ------
+    DataError
+        No such column (listing the file's columns), or two columns of that name.
+    """
+    if label in available:
+        return label
+    by_name = {a.strip(): a for a in reversed(available)}  # tolerate blanks around names
+    if label.strip() in by_name:
+        return by_name[label.strip()]
+    if split_label(label)[1] is None:
+        named = [a for a in available if split_label(a)[0] == label.strip()]
+        if len(named) == 1:
+            return named[0]
+        if len(named) > 1:
+            raise DataError(
+                f"'{label}' (mapped to {quantity}) names {len(named)} columns: "
+                + ", ".join(repr(a) for a in named)
+                + "; map one of them by its full label",
+                file=path,
+                column=label,
+            )
+    raise DataError(
+        f"no column '{label}' (mapped to {quantity}); the file has: "
+        + ", ".join(repr(a) for a in available),
+        file=path,
+        column=label,
+    )
 
 
 def _integrate(time: np.ndarray, velocity: np.ndarray) -> np.ndarray:
@@ -144,16 +187,8 @@ def read_table_log(
         available = pf.schema_arrow.names
     else:
         raise ConfigError(f"cannot read '{path}': use a .csv, .parquet or .pq file")
-    by_name = {a.strip(): a for a in reversed(available)}  # tolerate blanks around names
     for quantity, label in columns.items():
-        if label not in available and label.strip() not in by_name:
-            raise DataError(
-                f"no column '{label}' (mapped to {quantity}); the file has: "
-                + ", ".join(repr(a) for a in available),
-                file=path,
-                column=label,
-            )
-        columns[quantity] = label if label in available else by_name[label.strip()]
+        columns[quantity] = _find_column(label, quantity, available, path)
     unit_of = {q: _unit(q, label, units) for q, label in columns.items()}
     labels = list(dict.fromkeys(columns.values()))
     raw = read_numeric(pre, labels) if suffix == ".csv" else read_columns(pf, labels, path)

@@ -20,11 +20,14 @@ from ..errors import ConfigError
 from ..samples import FrictionSamples, RawLog
 
 __all__ = [
+    "CHUNKED_READERS",
     "EPOS_FOLDER_ONLY",
     "READERS",
+    "READER_EXAMPLES",
     "READER_OPTIONS",
     "check_keys",
     "check_reader",
+    "gives_samples",
     "open_log",
 ]
 
@@ -33,7 +36,10 @@ __all__ = [
 #: :func:`fricid.io.read_table_log`), ``rosbag`` (a ROS 2 bag or MCAP file with
 #: ``sensor_msgs/msg/JointState``, :func:`fricid.io.iter_rosbag`) and ``epos`` (a Maxon EPOS
 #: recorder CSV, or a folder of steady-state recordings, one operating point per file).
-READERS: tuple[str, ...] = ("table", "generic", "rosbag", "epos")
+#: ``channels`` (a folder of headerless ``time value`` files, one per channel and run, by
+#: file-name patterns, :func:`fricid.io.channels.read_channels`) and ``mat`` (a MATLAB v5 or
+#: v7.3 file, variables by name, :func:`fricid.io.matlab.read_mat`).
+READERS: tuple[str, ...] = ("table", "generic", "rosbag", "epos", "channels", "mat")
 
 #: Options each reader accepts (SI units), passed to its :mod:`fricid.io` function.
 READER_OPTIONS: dict[str, tuple[str, ...]] = {
@@ -59,8 +65,53 @@ READER_OPTIONS: dict[str, tuple[str, ...]] = {
         "counts_per_turn",
         "pattern",
         "load",
+        "skip_bad_rows",
     ),
+    "channels": (
+        "channels",
+        "units",
+        "joint",
+        "join",
+        "tolerance",
+        "time_unit",
+        "temperature",
+        "torque_constant",
+    ),
+    "mat": ("variables", "units", "joint", "temperature", "torque_constant"),
 }
+
+#: Readers that read a log a chunk of rows at a time (``chunk_rows`` of :func:`open_log`).
+CHUNKED_READERS: tuple[str, ...] = ("table", "rosbag")
+
+#: One-line examples of ``fricid extract`` per reader (its ``--help`` lists them).
+READER_EXAMPLES: dict[str, str] = {
+    "table": "fricid extract log.parquet -o samples.csv",
+    "generic": "fricid extract run.csv --format generic --map time=t:ms --map velocity=dq:deg/s "
+    "--map torque=tau:Nm",
+    "rosbag": "fricid extract bag/ --format rosbag --joint elbow --effort current "
+    "--torque-constant 0.1",
+    "epos": "fricid extract recordings/ --format epos --flip-sign (one steady point per file)",
+    "channels": "fricid extract runs/ --format channels "
+    "--channels 'torque={name}_tau{joint}_{speed}.t:Nm' "
+    "--channels 'velocity={name}_vel{joint}_{speed}.t:rad/s' --joint 1",
+    "mat": "fricid extract means.mat --format mat --var velocity=fwd.v,bwd.v:rad/s "
+    "--var friction=fwd.tau,bwd.tau:Nm --joint 2 (or --var time=t:s ... for a log)",
+}
+
+
+def gives_samples(reader: str, path: str | os.PathLike[str], options: Mapping[str, Any]) -> bool:
+    """Whether ``reader`` gives friction samples directly (no extraction to apply).
+
+    True for a folder of steady-state EPOS recordings (one operating point per file) and a
+    MATLAB table of means (a ``friction`` variable); every other log is extracted by
+    :func:`fricid.extract.extract`, so extraction options apply to it.
+    """
+    if reader == "epos":
+        return Path(path).is_dir()
+    if reader == "mat":
+        return "friction" in dict(options.get("variables") or {})
+    return False
+
 
 #: Options of reader ``epos`` that apply to a folder of steady-state recordings only.
 EPOS_FOLDER_ONLY: tuple[str, ...] = ("pattern", "load")
@@ -116,7 +167,8 @@ def open_log(
     path : path-like
         The log: a fricid raw log (``table``), any CSV/Parquet table (``generic``), a ROS 2
         bag or MCAP file (``rosbag``), an EPOS recorder CSV or a folder of steady-state EPOS
-        recordings (``epos``).
+        recordings (``epos``), a folder of per-channel files (``channels``), a MATLAB file
+        (``mat``).
     reader : str
         One of :data:`READERS`.
     options : Mapping, optional
@@ -127,8 +179,10 @@ def open_log(
     Returns
     -------
     FrictionSamples or iterator of RawLog
-        Samples for a folder of steady-state EPOS recordings (one operating point per file),
-        else the log as a stream of chunks (one chunk for ``generic`` and an EPOS file).
+        Samples for a folder of steady-state EPOS recordings (one operating point per file)
+        and a MATLAB table of means (:func:`gives_samples`), else the log as a stream of
+        chunks (one chunk for ``generic``, an EPOS file and a MATLAB log; one per run for
+        ``channels``, each run's time starting again).
 
     Raises
     ------
@@ -138,8 +192,10 @@ def open_log(
     DataError
         Unreadable data, naming file, row and column where known.
     """
+    from .channels import read_channels
     from .epos import epos_steady_samples, read_epos
     from .generic import read_table_log
+    from .matlab import read_mat
     from .rosbag import iter_rosbag, rosbag_joints
     from .tables import iter_rawlog
 
@@ -155,6 +211,11 @@ def open_log(
         return iter([read_epos(path, **opts)])
     if reader == "generic":
         return iter([read_table_log(path, **opts)])
+    if reader == "channels":
+        return iter(read_channels(path, **opts))
+    if reader == "mat":
+        got = read_mat(path, **opts)
+        return got if isinstance(got, FrictionSamples) else iter([got])
     if reader == "rosbag":
         if "joint" not in opts:
             topic = opts.get("topic", "/joint_states")

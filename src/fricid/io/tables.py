@@ -26,7 +26,7 @@ import numpy as np
 import pyarrow as pa
 
 from ..errors import ConfigError, DataError
-from ..samples import RAWLOG_COLUMNS, SAMPLE_COLUMNS, FrictionSamples, RawLog
+from ..samples import OPTIONAL_INPUTS, RAWLOG_COLUMNS, SAMPLE_COLUMNS, FrictionSamples, RawLog
 from ._csv import csv_preamble, preamble_fields, write_csv
 from ._parquet import parquet_doc, write_parquet
 from ._tablefile import Opened, meta_of, open_table, relocate, table_format
@@ -49,7 +49,7 @@ _SAMPLES_SCHEMA: dict[str, str | None] = {
     "count": None,
     "std": "torque",
 }
-_SAMPLES_REQUIRED = ("velocity", "load", "temperature", "friction")
+_SAMPLES_REQUIRED = ("velocity", "friction")  # load, temperature: absent is not measured
 _RAWLOG_SCHEMA: dict[str, str | None] = {name: name for name in RAWLOG_COLUMNS}
 _RAWLOG_REQUIRED = ("time", "position", "velocity", "temperature")
 
@@ -64,8 +64,10 @@ def read_samples(path: PathLike) -> FrictionSamples:
     ----------
     path : str or os.PathLike
         A ``.csv``, ``.parquet`` or ``.pq`` file written by :func:`write_samples`, or any
-        table with the columns velocity, load, temperature, friction (and optionally
-        direction, count, std) and explicit units.
+        table with the columns velocity and friction (and optionally load, temperature,
+        direction, count, std) and explicit units. A table without load or temperature
+        gives samples that did not measure it (all NaN, see
+        :attr:`FrictionSamples.measured <fricid.samples.FrictionSamples.measured>`).
 
     Returns
     -------
@@ -102,6 +104,8 @@ def read_samples(path: PathLike) -> FrictionSamples:
             0,
         )
     info = opened.info
+    for name in OPTIONAL_INPUTS:
+        cols.setdefault(name, None)
     try:
         return FrictionSamples(**cols, source=str(opened.path), meta=meta_of(info, opened.path))
     except DataError as err:
@@ -249,7 +253,8 @@ def write_samples(samples: FrictionSamples, path: PathLike) -> Path:
     -------
     pathlib.Path
         The path written. Units are SI and stated in the file (CSV header, Parquet schema
-        metadata), with the source and ``meta``.
+        metadata), with the source and ``meta``. An input not measured (load, temperature)
+        is left out.
 
     Raises
     ------
@@ -267,12 +272,14 @@ def write_samples(samples: FrictionSamples, path: PathLike) -> Path:
         )
     path = Path(path)
     fmt = table_format(path)
-    table = pa.table({name: np.asarray(getattr(samples, name)) for name in SAMPLE_COLUMNS})
+    measured = samples.measured
+    units = {k: u for k, u in SAMPLE_COLUMNS.items() if k not in OPTIONAL_INPUTS or k in measured}
+    table = pa.table({name: np.asarray(getattr(samples, name)) for name in units})
     if fmt == "csv":
         fields = preamble_fields(SAMPLES_FORMAT, samples.source, None, None, samples.meta)
-        write_csv(path, csv_preamble(fields, SAMPLE_COLUMNS), [table])
+        write_csv(path, csv_preamble(fields, units), [table])
     else:
-        doc = parquet_doc(SAMPLES_FORMAT, SAMPLE_COLUMNS, samples.source, None, None, samples.meta)
+        doc = parquet_doc(SAMPLES_FORMAT, units, samples.source, None, None, samples.meta)
         write_parquet(path, doc, [table])
     return path
 
