@@ -320,7 +320,7 @@ def extract_command(
 
     check_paths(
         inputs={"LOG": log},
-        folders=fmt in ("epos", "rosbag"),
+        folders=fmt in ("epos", "rosbag", "channels"),
         out_files={"--out": out, "--by-direction": by_direction},
     )
     check_flags(ctx, fmt, log, variables)

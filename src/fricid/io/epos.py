@@ -222,7 +222,7 @@ def _parse_data(
     return data[good], rows.index.to_numpy()[good], skipped
 
 
-def _warn_skipped(path: Path, skipped: list[dict[str, Any]]) -> None:
+def _warn_bad_rows(path: Path, skipped: list[dict[str, Any]]) -> None:
     """One :class:`~fricid.errors.DataQualityWarning` counting and listing skipped rows."""
     if not skipped:
         return
@@ -413,7 +413,7 @@ def _read(
     _positive("nominal_torque", nominal_torque)
     _positive("counts_per_turn", counts_per_turn)
     rec = _parse(path, skip_bad_rows)
-    _warn_skipped(path, rec.skipped)
+    _warn_bad_rows(path, rec.skipped)
     picked = _pick_channels(rec.channels)
     if "velocity" not in picked:
         raise DataError(f"no velocity channel among {rec.channels[1:]}", file=path)
