@@ -97,9 +97,9 @@ def certify(problem: IdentificationProblem, result: OptimizeResult) -> dict[str,
         return block
     method = str(result.method)
     block["reason"] = (
-        f"method '{method}' stopped ({result.message}) after {result.nfev} evaluations at SSE "
-        f"{sse:.4g}; a local least-squares polish from there reaches {best:.4g} "
-        f"({sse / best:.3g}x lower)"
+        f"method '{method}' ended after {result.nfev} of {block['max_evals']} evaluations "
+        f"(status {int(result.status)}: {result.message}) at SSE {sse:.4g}, but a local "
+        f"least-squares polish from there reaches {best:.4g} ({sse / best:.3g}x lower)"
     )
     block["advice"] = advice(method)
     return block

@@ -2,11 +2,12 @@
 
 ``fit`` states the problem (:class:`~fricid.identify.problem.IdentificationProblem`: the sum of
 squared errors between the model and the measured friction, the RWSAVSBAS paper's objective,
-eq. 11 there), minimises it with any method of :mod:`fricid.optim`, certifies convergence by a short local
-polish (:mod:`fricid.identify._convergence`), then gives the parameters' uncertainty only when
-it means something: standard errors from the Jacobian and profile-likelihood intervals inside
-the search box (:mod:`fricid.identify.uncertainty`, :mod:`fricid.identify.profile`).
-The RBF network (``model="rbf"``) is trained by :func:`fricid.identify.rbf.fit_rbf`.
+eq. 11 there), minimises it with any method of :mod:`fricid.optim`, certifies convergence by a
+short local polish (:mod:`fricid.identify._convergence`), then gives the parameters'
+uncertainty only where it means something: standard errors from the Jacobian and
+profile-likelihood intervals inside the search box (:mod:`fricid.identify.uncertainty`,
+:mod:`fricid.identify.profile`). The RBF network (``model="rbf"``) is trained by
+:func:`fricid.identify.rbf.fit_rbf`.
 """
 
 from __future__ import annotations
@@ -105,7 +106,8 @@ def fit(
     -------
     FittedModel
         With ``status`` and ``message`` from the optimiser, the ``convergence`` block (the
-        optimiser's status and a local polish's verdict, :func:`~fricid.identify._convergence.certify`),
+        optimiser's status and a local polish's verdict,
+        :func:`~fricid.identify._convergence.certify`),
         fit statistics, standard errors (SVD pseudo-inverse), 95 % intervals
         (``ci95_low``, ``ci95_high``, ``ci_open``, ``ci_method``), the reason where a parameter
         has none (``uncertainty_note``) and correlations.

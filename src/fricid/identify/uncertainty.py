@@ -251,7 +251,9 @@ def assess(
     nan = np.full(p, np.nan)
     none = Uncertainty(nan.copy(), nan.copy(), nan.copy(), nan.copy(), np.zeros((p, 2), bool))
     if not converged:
-        why = "no interval: the fit did not converge" + (" (see the convergence block)" if reason else "")
+        why = "no interval: the fit did not converge" + (
+            " (see the convergence block)" if reason else ""
+        )
         none.notes = dict.fromkeys(names, why)
         return none
     dof = problem.n_obs - p
@@ -311,7 +313,11 @@ def _name_open_sides(out: Uncertainty, problem, x, names: list[str], units) -> N
         if not sides:
             continue
         corr = _strongest(out.cov, j, names)
-        at = " (the estimate is at the bound)" if min(x[j] - lo, hi - x[j]) <= 1e-9 * (hi - lo) else ""
+        at = (
+            " (the estimate is at the bound)"
+            if min(x[j] - lo, hi - x[j]) <= 1e-9 * (hi - lo)
+            else ""
+        )
         if len(sides) == 2:
             note = (
                 f"not identified: the 95 % interval spans the whole search range "
