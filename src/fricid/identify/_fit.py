@@ -70,10 +70,11 @@ def fit(
         A model name (``fricid.models.MODELS``, ``*_asym`` for per-direction), an instance,
         or ``"rbf"`` for the RBF network (:mod:`fricid.identify.rbf`).
     method : str, default "lm"
-        Any method of ``fricid.optim.METHODS`` (``"lm"``: Levenberg-Marquardt with
-        multi-start). For ``"rbf"``: ``"lsq"`` (k-means, widths, ridge least squares) or an
-        optimiser trainer (``"bas"`` for BAS-RBFNN, ``"ga"`` for GA-RBFNN, ...); the default
-        ``"lm"`` means ``"lsq"`` there.
+        Any method of ``fricid.optim.METHODS`` (``"lm"``: the default least-squares method,
+        scipy's bounded trust-region reflective solver, a Levenberg-Marquardt-type method, with
+        multi-start; :mod:`fricid.optim._least_squares`). For ``"rbf"``: ``"lsq"`` (k-means,
+        widths, ridge least squares) or an optimiser trainer (``"bas"`` for BAS-RBFNN,
+        ``"ga"`` for GA-RBFNN, ...); the default ``"lm"`` means ``"lsq"`` there.
     fixed : mapping of str to float, optional
         Parameters held at a value, e.g. ``{"delta": 1.0}`` for the RWSAVSBAS paper's
         Stribeck model.
