@@ -107,7 +107,9 @@ class _Refit:
 
         def fun(u: np.ndarray) -> np.ndarray:
             self.nfev += 1
-            return self.problem.residuals(self._theta(u[None, :], value, x))[0]
+            r = self.problem.residuals(self._theta(u[None, :], value, x))[0]
+            # scipy cannot step on non-finite residuals; a large finite one steers it away
+            return r if np.isfinite(r).all() else np.full(r.shape, 1e50)
 
         def jac(u: np.ndarray) -> np.ndarray:
             h = np.where(u + _FD <= 1.0, _FD, -_FD)
