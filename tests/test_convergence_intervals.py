@@ -301,3 +301,19 @@ def test_profile_intervals_cover_the_truth_on_the_virtual_joint():
         assert f.converged and f.ci_method == "profile"
         covered += sum(f.ci95_low[k] <= v <= f.ci95_high[k] for k, v in PAPER2_TRUTH.items())
     assert covered >= 70, covered
+
+
+def test_a_file_without_the_new_fields_loads_and_reports_as_before(paper2, tmp_path):
+    """Old model files (no convergence block, no interval ends) still load and print their
+    half-width intervals."""
+    f = quiet_fit(paper2, "stribeck", "lm", fixed={"delta": 1.0})
+    d = f.to_dict()
+    for key in ("convergence", "ci95_low", "ci95_high", "ci_open", "ci_method", "uncertainty_note"):
+        d.pop(key)
+    path = tmp_path / "old.json"
+    path.write_text(json.dumps(d))
+    g = FittedModel.load(path)
+    assert g.convergence is None and g.converged is None and g.ci95_low == {}
+    text = g.report()
+    assert "NOT CONVERGED" not in text and "# convergence" not in text
+    assert f"95 % CI +/- {g.ci95['tau_c']:.3g}" in text

@@ -225,11 +225,15 @@ class FittedModel:
         Returns
         -------
         str
-            ``[[Model]]``; ``[[Fit Statistics]]`` (method, evaluations, status, data points,
-            variables, chi-square, reduced chi-square, AIC, BIC, R-squared); ``[[Variables]]``
-            (value +/- standard error (relative), 95 % CI, start, and the flags "fixed", "at
-            boundary", "at initial value", "not determined"), or ``[[Network]]`` for the RBF
-            network; ``[[Correlations]]`` above ``min_correl``, largest first.
+            First, for a fit that did not converge, a line ``NOT CONVERGED: <reason>; <what
+            to do>``. ``[[Model]]``; ``[[Fit Statistics]]`` (method, evaluations, status,
+            convergence as certified, data points, variables, chi-square, reduced chi-square,
+            AIC, BIC, R-squared); ``[[Variables]]`` (value +/- standard error (relative), the
+            95 % interval ``[low, high]`` and how it was found, start, and the flags "fixed",
+            "at boundary", "at initial value", "not determined", and the reason a parameter
+            has no interval or a side reaches a bound), or ``[[Network]]`` for the RBF
+            network; ``[[Correlations]]`` above ``min_correl``, largest first. Files from
+            before the intervals were stored print ``95 % CI +/- half-width`` as they did.
         """
         lines = []
         conv = self.convergence
