@@ -62,6 +62,7 @@ SMALL = {
     "bas+lm": ({"global_evals": 150, "global_options": {"n_iter": 40}}, 400),
     "lm": ({"n_starts": 3}, 300),
     "trf": ({"n_starts": 3}, 300),
+    "lm_minpack": ({"n_starts": 3}, 300),
     "de": ({}, 300),
     "dual_annealing": ({}, 300),
     "cmaes": ({}, 300),

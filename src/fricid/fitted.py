@@ -68,6 +68,18 @@ def _num(value: Any) -> float:
     return float("nan") if value is None else float(value)
 
 
+def _convergence_line(conv: dict[str, Any]) -> str:
+    """The fit report's convergence line, from the model file's convergence block."""
+    ratio = _num(conv.get("polish_sse_ratio"))
+    polish = f"local polish SSE ratio {ratio:.6g}" if np.isfinite(ratio) else "no polish"
+    if conv.get("converged"):
+        by = {"optimizer": "optimiser's own test", "polish": "local polish"}.get(
+            str(conv.get("certified_by")), "recorded"
+        )
+        return f"converged (certified by the {by}; {polish})"
+    return f"NOT CONVERGED ({polish}; {conv.get('nfev')} of {conv.get('max_evals')} evaluations)"
+
+
 @lru_cache(maxsize=1)
 def _schema_validator():
     """The validator of the model file's JSON Schema (``fricid/schemas/model.schema.json``)."""
@@ -107,8 +119,21 @@ class FittedModel:
     fixed : names of the parameters held fixed during the fit.
     stderr : standard error of each free parameter from the Jacobian at the optimum
         (``cov = s^2 (J^T J)^+``, an SVD pseudo-inverse as scipy's ``curve_fit``,
-        ``s^2 = SSE / (n - p)``); NaN where not determined.
-    ci95 : half-width of the 95 % confidence interval (Student t, n - p degrees of freedom).
+        ``s^2 = SSE / (n - p)``); NaN where not determined, and for every parameter of a fit
+        that did not converge or whose optimum is degenerate (``uncertainty_note`` says why).
+    ci95 : half-width of the linearised 95 % interval ``t(0.975, n - p) * stderr`` (NaN where
+        ``stderr`` is); the interval to use is ``ci95_low`` .. ``ci95_high``.
+    ci95_low, ci95_high : ends of the 95 % interval, inside the search box (profile
+        likelihood, or the linearised interval cut at the box: ``ci_method``); NaN where there
+        is none. Empty in files written before they were.
+    ci_open : per free parameter, ``[lower, upper]``: that side of the interval reaches the
+        search bound (the data do not bound the parameter there).
+    ci_method : ``"profile"``, ``"jacobian"`` or ``""`` (no intervals).
+    uncertainty_note : why a parameter has no interval, or why a side is open.
+    convergence : the convergence block (``fricid.identify._convergence.certify``):
+        ``converged``, ``status``, ``message``, ``nfev``, ``max_evals``, ``polish_sse_ratio``,
+        ``polish_nfev``, ``certified_by`` and, when not converged, ``reason`` and ``advice``;
+        None when not recorded.
     at_bound : free parameters that ended on a bound of the search box (their
         uncertainty is not meaningful).
     correlation : correlation matrix of the free parameters (list of lists), or None.
@@ -148,6 +173,17 @@ class FittedModel:
     message: str = ""
     init: dict[str, float] = field(default_factory=dict)
     statistics: dict[str, float] = field(default_factory=dict)
+    ci95_low: dict[str, float] = field(default_factory=dict)
+    ci95_high: dict[str, float] = field(default_factory=dict)
+    ci_open: dict[str, list[bool]] = field(default_factory=dict)
+    ci_method: str = ""
+    uncertainty_note: dict[str, str] = field(default_factory=dict)
+    convergence: dict[str, Any] | None = None
+
+    @property
+    def converged(self) -> bool | None:
+        """Whether the fit converged (the ``convergence`` block; None when not recorded)."""
+        return None if self.convergence is None else bool(self.convergence.get("converged"))
 
     # -- prediction ----------------------------------------------------------------------
     @property
@@ -252,17 +288,30 @@ class FittedModel:
         Returns
         -------
         str
-            ``[[Model]]``; ``[[Fit Statistics]]`` (method, evaluations, status, data points,
-            variables, chi-square, reduced chi-square, AIC, BIC, R-squared); ``[[Variables]]``
-            (value +/- standard error (relative), 95 % CI, start, and the flags "fixed", "at
-            boundary", "at initial value", "not determined"), or ``[[Network]]`` for the RBF
-            network; ``[[Correlations]]`` above ``min_correl``, largest first.
+            First, for a fit that did not converge, a line ``NOT CONVERGED: <reason>; <what
+            to do>``. ``[[Model]]``; ``[[Fit Statistics]]`` (method, evaluations, status,
+            convergence as certified, data points, variables, chi-square, reduced chi-square,
+            AIC, BIC, R-squared); ``[[Variables]]`` (value +/- standard error (relative), the
+            95 % interval ``[low, high]`` and how it was found, start, and the flags "fixed",
+            "at boundary", "at initial value", "not determined", and the reason a parameter
+            has no interval or a side reaches a bound), or ``[[Network]]`` for the RBF
+            network; ``[[Correlations]]`` above ``min_correl``, largest first. Files from
+            before the intervals were stored print ``95 % CI +/- half-width`` as they did.
         """
-        lines = ["[[Model]]", f"    {self.model}", "[[Fit Statistics]]"]
+        lines = []
+        conv = self.convergence
+        if conv is not None and not conv.get("converged"):
+            lines.append(
+                f"NOT CONVERGED: {conv.get('reason', conv.get('message', ''))}; "
+                f"{conv.get('advice', '')}. No confidence intervals."
+            )
+        lines += ["[[Model]]", f"    {self.model}", "[[Fit Statistics]]"]
         lines.append(f"    # fitting method   = {self.method} (seed {self.seed})")
         lines.append(f"    # function evals   = {self.nfev}")
         if self.status is not None:
             lines.append(f"    # status           = {self.status}: {self.message}")
+        if conv is not None:
+            lines.append(f"    # convergence      = {_convergence_line(conv)}")
         st = self.statistics
         n = st.get("ndata", self.metrics.get("n"))
         if n is not None:
@@ -296,16 +345,24 @@ class FittedModel:
         note = ""
         if np.isfinite(se):
             rel = f" ({abs(se / value):.2%})" if value != 0 else ""
-            note += f" +/- {se:.3g}{rel} (95 % CI +/- {_num(self.ci95.get(name)):.3g})"
+            note += f" +/- {se:.3g}{rel}"
+            low, high = _num(self.ci95_low.get(name)), _num(self.ci95_high.get(name))
+            if np.isfinite(low) and np.isfinite(high):
+                note += f" (95 % CI [{low:.4g}, {high:.4g}], {self.ci_method or 'jacobian'})"
+            elif np.isfinite(_num(self.ci95.get(name))):
+                note += f" (95 % CI +/- {_num(self.ci95.get(name)):.3g})"
         if name in self.init:
             note += f" (init = {self.init[name]:.8g})"
+        why = self.uncertainty_note.get(name, "")
         flags = []
         if name in self.at_bound:
             flags.append("at boundary")
         if name in self.init and value == self.init[name]:
             flags.append("at initial value")
-        if not np.isfinite(se):
+        if not np.isfinite(se) and (not why or why.startswith("not determined")):
             flags.append("not determined")
+        if why:
+            flags.append(why.removeprefix("not determined: "))
         return note + "".join(f" [{f}]" for f in flags)
 
     def _correlation_lines(self, min_correl: float) -> list[str]:
@@ -360,7 +417,7 @@ class FittedModel:
         kwargs = {k: v for k, v in d.items() if k in known}
         if "model" not in kwargs or "params" not in kwargs:
             raise DataError("model file lacks 'model' or 'params'", file=source)
-        for key in ("params", "stderr", "ci95", "init", "statistics"):
+        for key in ("params", "stderr", "ci95", "ci95_low", "ci95_high", "init", "statistics"):
             if key in kwargs:
                 kwargs[key] = {k: _num(v) for k, v in kwargs[key].items()}
         out = cls(**kwargs)

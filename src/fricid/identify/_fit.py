@@ -2,9 +2,12 @@
 
 ``fit`` states the problem (:class:`~fricid.identify.problem.IdentificationProblem`: the sum of
 squared errors between the model and the measured friction, the RWSAVSBAS paper's objective,
-eq. 11 there), minimises it with any method of :mod:`fricid.optim`, then estimates the
-parameters' uncertainty from the Jacobian at the optimum (:mod:`fricid.identify.uncertainty`).
-The RBF network (``model="rbf"``) is trained by :func:`fricid.identify.rbf.fit_rbf`.
+eq. 11 there), minimises it with any method of :mod:`fricid.optim`, certifies convergence by a
+short local polish (:mod:`fricid.identify._convergence`), then gives the parameters'
+uncertainty only where it means something: standard errors from the Jacobian and
+profile-likelihood intervals inside the search box (:mod:`fricid.identify.uncertainty`,
+:mod:`fricid.identify.profile`). The RBF network (``model="rbf"``) is trained by
+:func:`fricid.identify.rbf.fit_rbf`.
 """
 
 from __future__ import annotations
@@ -14,7 +17,6 @@ from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 import numpy as np
-from scipy import stats
 
 from .. import __version__
 from ..errors import ConfigError, ConvergenceWarning, IdentifiabilityWarning, IgnoredArgumentWarning
@@ -24,9 +26,10 @@ from ..metrics import fit_statistics, metrics
 from ..models import INPUTS, STATEFUL, FrictionModel, get_model
 from ..optim import METHODS, OptimizeResult, minimize
 from ..samples import FrictionSamples, samples_hash
+from ._convergence import certify
 from .checks import check_identifiable
 from .problem import IdentificationProblem
-from .uncertainty import jacobian_uncertainty
+from .uncertainty import INTERVALS, assess
 
 __all__ = ["evaluate", "fit"]
 
@@ -56,6 +59,7 @@ def fit(
     callback: Callable[[OptimizeResult], Any] | None = None,
     network: Mapping[str, Any] | None = None,
     inputs: Sequence[str] = INPUTS,
+    intervals: str = "auto",
 ) -> FittedModel:
     """Identify ``model`` from ``samples`` by least squares with ``method``.
 
@@ -67,10 +71,11 @@ def fit(
         A model name (``fricid.models.MODELS``, ``*_asym`` for per-direction), an instance,
         or ``"rbf"`` for the RBF network (:mod:`fricid.identify.rbf`).
     method : str, default "lm"
-        Any method of ``fricid.optim.METHODS`` (``"lm"``: Levenberg-Marquardt with
-        multi-start). For ``"rbf"``: ``"lsq"`` (k-means, widths, ridge least squares) or an
-        optimiser trainer (``"bas"`` for BAS-RBFNN, ``"ga"`` for GA-RBFNN, ...); the default
-        ``"lm"`` means ``"lsq"`` there.
+        Any method of ``fricid.optim.METHODS`` (``"lm"``: the default least-squares method,
+        scipy's bounded trust-region reflective solver, a Levenberg-Marquardt-type method, with
+        multi-start; :mod:`fricid.optim._least_squares`). For ``"rbf"``: ``"lsq"`` (k-means,
+        widths, ridge least squares) or an optimiser trainer (``"bas"`` for BAS-RBFNN,
+        ``"ga"`` for GA-RBFNN, ...); the default ``"lm"`` means ``"lsq"`` there.
     fixed : mapping of str to float, optional
         Parameters held at a value, e.g. ``{"delta": 1.0}`` for the RWSAVSBAS paper's
         Stribeck model.
@@ -92,12 +97,22 @@ def fit(
         (``n_centers``, ``velocity_scale``, ``encoding``, ...).
     inputs : sequence of str, default ("velocity", "load", "temperature")
         ``"rbf"`` only: the network's input columns.
+    intervals : {"auto", "profile", "jacobian", "none"}, default "auto"
+        95 % intervals of the parameters: profile likelihood inside the search box
+        (:mod:`fricid.identify.profile`; ``"auto"`` uses it for at most
+        :data:`~fricid.identify.uncertainty.PROFILE_AUTO_MAX` free parameters), the Jacobian's
+        ``value +/- t se`` cut at the box, or none. A fit that did not converge, or whose
+        optimum is degenerate (rank-deficient Jacobian), gets none whatever is asked.
 
     Returns
     -------
     FittedModel
-        With ``status`` and ``message`` from the optimiser, fit statistics, standard errors
-        (SVD pseudo-inverse, see :mod:`~fricid.identify.uncertainty`) and correlations.
+        With ``status`` and ``message`` from the optimiser, the ``convergence`` block (the
+        optimiser's status and a local polish's verdict,
+        :func:`~fricid.identify._convergence.certify`),
+        fit statistics, standard errors (SVD pseudo-inverse), 95 % intervals
+        (``ci95_low``, ``ci95_high``, ``ci_open``, ``ci_method``), the reason where a parameter
+        has none (``uncertainty_note``) and correlations.
 
     Raises
     ------
@@ -108,12 +123,14 @@ def fit(
     Warns
     -----
     ConvergenceWarning
-        The optimiser did not converge (budget spent, iteration limit, stopped).
+        The fit did not converge: a local least-squares polish from its result lowers the
+        SSE (the message says by how much and what to do); its intervals are withheld.
     IdentifiabilityWarning
         The data do not determine some parameter: too few velocity levels, no load or
         temperature variation for a model that uses them (checked before fitting,
-        :func:`~fricid.identify.checks.check_identifiable`), or a singular Jacobian at the
-        optimum (its standard error is NaN).
+        :func:`~fricid.identify.checks.check_identifiable`); a rank-deficient Jacobian at the
+        optimum (which combination is free); or an interval that reaches a bound of the
+        search box other than 0 (which bound, and its strongest correlation).
     IgnoredArgumentWarning
         An argument the chosen model does not use (``network``, ``inputs`` for analytic
         models; ``callback`` for ``"rbf"``).
@@ -162,38 +179,64 @@ def fit(
         x0=start,
         residuals=problem.residuals if uses_residuals else None,
     )
-    if not result.success:
+    key_i = str(intervals).strip().lower()
+    if key_i not in INTERVALS:
+        raise ConfigError(f"intervals must be one of {', '.join(INTERVALS)}; got {intervals!r}")
+    convergence = certify(problem, result)
+    if not convergence["converged"]:
         warnings.warn(
-            f"fitting '{model.name}' with '{result.method}' did not converge: {result.message}",
+            f"fitting '{model.name}' did not converge: {convergence['reason']}; "
+            f"{convergence['advice']}",
             ConvergenceWarning,
             stacklevel=2,
         )
     theta = problem.expand(result.x)[0]
-    stderr, cov = jacobian_uncertainty(problem.residuals, result.x, problem.n_obs)
     names, free_names = problem.names, problem.free_names
-    if not np.isfinite(stderr).all():
-        unknown = [n for n, s in zip(free_names, stderr, strict=True) if not np.isfinite(s)]
+    unc = assess(
+        problem,
+        result.x,
+        converged=convergence["converged"],
+        reason=convergence.get("reason", ""),
+        intervals=key_i,
+        units=model.units,
+    )
+    if unc.identifiability:
         warnings.warn(
-            f"the data do not determine {', '.join(unknown)} of '{model.name}' (singular "
-            "Jacobian or no spare samples): no standard error",
+            f"fitting '{model.name}': the data " + "; the data ".join(unc.identifiability),
             IdentifiabilityWarning,
             stacklevel=2,
         )
-    dof = max(problem.n_obs - problem.n_free, 1)
-    t95 = float(stats.t.ppf(0.975, dof))
+    if unc.lower_sse < float(result.fun) * (1 - 1e-6):
+        warnings.warn(
+            f"fitting '{model.name}': a profile re-fit found SSE {unc.lower_sse:.6g} below the "
+            f"fit's {float(result.fun):.6g}; the fit is a local optimum (use more starts)",
+            ConvergenceWarning,
+            stacklevel=2,
+        )
+    cov = unc.cov
     corr = None
     if cov is not None:
         d = np.sqrt(np.diag(cov))
         with np.errstate(invalid="ignore", divide="ignore"):
             corr = (cov / np.outer(d, d)).tolist()
+
+    def per_free(values) -> dict[str, float]:
+        return {n: float(v) for n, v in zip(free_names, values, strict=True)}
+
     y_hat = model.predict(theta, X)
     return FittedModel(
         model=model.name,
         params={n: float(v) for n, v in zip(names, theta, strict=True)},
         units=model.units,
         fixed=sorted(problem.fixed),
-        stderr={n: float(s) for n, s in zip(free_names, stderr, strict=True)},
-        ci95={n: float(s) * t95 for n, s in zip(free_names, stderr, strict=True)},
+        stderr=per_free(unc.stderr),
+        ci95=per_free(unc.ci95),
+        ci95_low=per_free(unc.low),
+        ci95_high=per_free(unc.high),
+        ci_open={n: [bool(a), bool(b)] for n, (a, b) in zip(free_names, unc.open, strict=True)},
+        ci_method=unc.method,
+        uncertainty_note=dict(unc.notes),
+        convergence=convergence,
         at_bound=problem.at_bound(result.x),
         correlation=corr,
         metrics=metrics(y, y_hat),

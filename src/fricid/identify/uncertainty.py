@@ -11,15 +11,47 @@ A parameter is *not determined* (standard error NaN) when its direction is not w
 span of the singular vectors whose singular values exceed :data:`DETERMINED_RCOND` times the
 largest: a finite-difference Jacobian is accurate to about 1e-9 relative, so a direction the
 data cannot see shows a singular value of that size rather than one below scipy's cut-off.
+:func:`null_directions` says which combination of parameters is free.
+
+:func:`assess` is what ``fit`` reports (issue 11, defects 5 and 7): no interval at all for a
+fit that did not converge or for a degenerate optimum (a rank-deficient Jacobian: the
+linearised intervals there, such as ``Coulomb 2e-10 +- 210 N m``, mean nothing); otherwise
+profile-likelihood intervals inside the search box (:mod:`fricid.identify.profile`) for up
+to :data:`PROFILE_AUTO_MAX` free parameters (or when asked), else the Jacobian's Wald
+intervals cut at the box with the cut sides flagged; each side that reaches a bound other than
+zero is named in an :class:`~fricid.errors.IdentifiabilityWarning`, with the parameter's
+strongest correlation.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import dataclass, field
 
 import numpy as np
+from scipy import stats
 
-__all__ = ["covariance_svd", "jacobian", "jacobian_uncertainty"]
+__all__ = [
+    "INTERVALS",
+    "PROFILE_AUTO_MAX",
+    "Uncertainty",
+    "assess",
+    "covariance_svd",
+    "jacobian",
+    "jacobian_uncertainty",
+    "null_directions",
+]
+
+#: The interval methods of :func:`assess`: ``auto`` (profile for at most
+#: :data:`PROFILE_AUTO_MAX` free parameters, else Jacobian), ``profile``, ``jacobian``, ``none``.
+INTERVALS = ("auto", "profile", "jacobian", "none")
+
+#: ``intervals="auto"`` profiles fits with at most this many free parameters (about 0.2 s for
+#: the Stribeck model's five on 30 samples; eight parameters of ``vlt`` take seconds).
+PROFILE_AUTO_MAX = 5
+
+#: A correlation at least this strong is named as the reason a parameter is not bounded.
+STRONG_CORREL = 0.9
 
 #: A parameter counts as determined when at least ``1 - DETERMINED_TOL`` of its unit vector's
 #: squared length lies in the span of the right singular vectors (of the column-scaled
@@ -106,3 +138,193 @@ def jacobian_uncertainty(
     if not determined.any():
         return nan, None
     return np.where(determined, np.sqrt(np.clip(np.diag(cov), 0.0, None)), np.nan), cov
+
+
+def null_directions(J: np.ndarray, names: list[str]) -> list[str]:
+    """The parameter combinations a Jacobian ``(n, p)`` cannot see, in words.
+
+    A zero column is "``name`` has no effect"; another direction of a singular value below
+    :data:`DETERMINED_RCOND` times the largest (columns scaled to unit length) is listed by its
+    components above 0.1, e.g. "``tau_s`` (+0.71) and ``delta`` (-0.70) trade off".
+    """
+    if not np.isfinite(J).all():
+        return ["the Jacobian is not finite"]
+    norms = np.linalg.norm(J, axis=0)
+    out = [f"{n} has no effect" for n, c in zip(names, norms, strict=True) if c == 0]
+    live = norms > 0
+    if live.sum() == 0:
+        return out
+    sub = [n for n, keep in zip(names, live, strict=True) if keep]
+    _, s, VT = np.linalg.svd(J[:, live] / norms[live], full_matrices=False)
+    for k in np.flatnonzero(s <= DETERMINED_RCOND * s[0]):
+        v = VT[k] * np.sign(VT[k][np.argmax(np.abs(VT[k]))])
+        parts = [f"{n} ({c:+.2f})" for n, c in zip(sub, v, strict=True) if abs(c) > 0.1]
+        out.append(" and ".join(parts) + " trade off (a free combination)")
+    return out
+
+
+@dataclass
+class Uncertainty:
+    """What :func:`assess` found, per free parameter (arrays in free-parameter order).
+
+    Attributes
+    ----------
+    stderr : ndarray (p,)
+        Standard errors (Jacobian); NaN where there is no meaningful one.
+    ci95 : ndarray (p,)
+        The Jacobian's 95 % half-width ``t se``; NaN where there is no interval.
+    low, high : ndarray (p,)
+        The 95 % interval's ends, inside the search box; NaN where there is no interval.
+    open : ndarray of bool (p, 2)
+        Lower and upper side reach the bound (the data do not bound that side).
+    cov : ndarray (p, p) or None
+    method : str
+        ``"profile"``, ``"jacobian"`` or ``""`` (no intervals).
+    notes : dict of str to str
+        Why a parameter has no interval, or why a side is open.
+    identifiability : list of str
+        One clause per parameter the data do not determine or bound ("do not determine ...",
+        "do not bound ..."), for the warning.
+    lower_sse : float
+        The lowest SSE a profile re-fit found (below the fit's: not at the optimum), or NaN.
+    """
+
+    stderr: np.ndarray
+    ci95: np.ndarray
+    low: np.ndarray
+    high: np.ndarray
+    open: np.ndarray
+    cov: np.ndarray | None = None
+    method: str = ""
+    notes: dict[str, str] = field(default_factory=dict)
+    identifiability: list[str] = field(default_factory=list)
+    lower_sse: float = float("nan")
+
+
+def _strongest(cov: np.ndarray | None, j: int, names: list[str]) -> str:
+    if cov is None:
+        return ""
+    d = np.sqrt(np.clip(np.diag(cov), 1e-300, None))
+    r = cov[j] / (d[j] * d)
+    r[j] = 0.0
+    r = np.where(np.isfinite(r), r, 0.0)
+    k = int(np.argmax(np.abs(r)))
+    if abs(r[k]) < STRONG_CORREL:
+        return ""
+    return f"; correlated with {names[k]} ({r[k]:+.3f})"
+
+
+def assess(
+    problem,
+    x: np.ndarray,
+    *,
+    converged: bool,
+    reason: str = "",
+    intervals: str = "auto",
+    units: dict[str, str] | None = None,
+) -> Uncertainty:
+    """Standard errors and 95 % intervals of a least-squares fit, or why there are none.
+
+    Parameters
+    ----------
+    problem : IdentificationProblem
+        The problem fitted (loss ``sse``).
+    x : ndarray (p,)
+        The fit's free parameters.
+    converged : bool
+        False: no standard error and no interval, the note says ``reason``.
+    reason : str
+        Why the fit did not converge (for the notes).
+    intervals : {"auto", "profile", "jacobian", "none"}
+        See :data:`INTERVALS`.
+    units : dict, optional
+        Parameter units, for the messages.
+
+    Returns
+    -------
+    Uncertainty
+    """
+    from .profile import profile_intervals
+
+    names = problem.free_names
+    p = len(names)
+    nan = np.full(p, np.nan)
+    none = Uncertainty(nan.copy(), nan.copy(), nan.copy(), nan.copy(), np.zeros((p, 2), bool))
+    if not converged:
+        why = "no interval: the fit did not converge" + (
+            " (see the convergence block)" if reason else ""
+        )
+        none.notes = dict.fromkeys(names, why)
+        return none
+    dof = problem.n_obs - p
+    if dof <= 0:
+        none.notes = dict.fromkeys(names, "not determined: no spare samples (n <= p)")
+        none.identifiability = [f"do not determine {', '.join(names)} (no spare samples: n <= p)"]
+        return none
+    J, r0 = jacobian(problem.residuals, x)
+    cov, determined = covariance_svd(J, float(r0 @ r0) / dof)
+    if not determined.all():
+        why = "; ".join(null_directions(J, names)) or "singular Jacobian"
+        free = [n for n, ok in zip(names, determined, strict=True) if not ok]
+        none.notes = {
+            n: (f"not determined: {why}" if not ok else f"no interval: degenerate optimum ({why})")
+            for n, ok in zip(names, determined, strict=True)
+        }
+        none.identifiability = [
+            f"do not determine {', '.join(free)} (degenerate optimum: {why}; no interval)"
+        ]
+        return none
+    se = np.sqrt(np.clip(np.diag(cov), 0.0, None))
+    half = se * float(stats.t.ppf(0.975, dof))
+    lo_b, hi_b = problem.bounds[:, 0], problem.bounds[:, 1]
+    out = Uncertainty(se, half, nan.copy(), nan.copy(), np.zeros((p, 2), bool), cov=cov)
+    key = str(intervals).strip().lower()
+    if key == "none":
+        return out
+    if key == "profile" or (key == "auto" and p <= PROFILE_AUTO_MAX):
+        prof = profile_intervals(problem, x)
+        for j, n in enumerate(names):
+            iv = prof[n]
+            out.low[j], out.high[j] = iv.low, iv.high
+            out.open[j] = iv.low_open, iv.high_open
+        out.method = "profile"
+        out.lower_sse = min(iv.lower_sse for iv in prof.values())
+    else:
+        out.low, out.high = np.maximum(x - half, lo_b), np.minimum(x + half, hi_b)
+        out.open = np.column_stack([x - half <= lo_b, x + half >= hi_b])
+        out.method = "jacobian"
+    _name_open_sides(out, problem, x, names, units or {})
+    return out
+
+
+def _name_open_sides(out: Uncertainty, problem, x, names: list[str], units) -> None:
+    """Notes and identifiability clauses for the sides that reach a bound. A side open at a
+    bound of 0 (friction amplitudes are not negative) means "consistent with zero" and is
+    noted; any other open side (the data-scaled search box) means the data do not bound it."""
+    for j, n in enumerate(names):
+        lo, hi = problem.bounds[j]
+        unit = units.get(n, "")
+        unit = f" {unit}" if unit not in ("", "1") else ""
+        sides = []
+        if out.open[j, 0]:
+            sides.append((lo, f"{n} >= {lo:.4g}{unit}"))
+        if out.open[j, 1]:
+            sides.append((hi, f"{n} <= {hi:.4g}{unit}"))
+        if not sides:
+            continue
+        corr = _strongest(out.cov, j, names)
+        at = (
+            " (the estimate is at the bound)"
+            if min(x[j] - lo, hi - x[j]) <= 1e-9 * (hi - lo)
+            else ""
+        )
+        if len(sides) == 2:
+            note = (
+                f"not identified: the 95 % interval spans the whole search range "
+                f"[{lo:.4g}, {hi:.4g}]{unit}{corr}"
+            )
+        else:
+            note = f"reaches the bound {sides[0][1]}{at}{corr}"
+        out.notes[n] = note
+        if any(b != 0 for b, _ in sides):
+            out.identifiability.append(f"do not bound {n} ({note})")

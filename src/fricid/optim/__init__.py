@@ -7,9 +7,11 @@ Methods (``METHODS[name].summary`` has the one-line description):
 
 * beetle antennae search family: ``bas``, ``vsbas``, ``ibas``, ``rwsavsbas``;
 * ``ga``, a real-coded genetic algorithm;
-* baselines: ``lm``, ``trf`` (scipy least squares), ``de``, ``dual_annealing`` (scipy),
+* baselines: ``lm`` (the default least-squares method: scipy's bounded trust-region
+  reflective solver with a batched Jacobian), ``trf`` (the same with scipy's own Jacobian),
+  ``lm_minpack`` (MINPACK in sin coordinates, legacy), ``de``, ``dual_annealing`` (scipy),
   ``cmaes`` (the ``cma`` package);
-* ``bas+lm``: a beetle global phase polished by Levenberg-Marquardt.
+* ``bas+lm``: a beetle global phase polished by ``lm``.
 
 ``minimize`` makes one run and returns one :class:`OptimizeResult`, whose ``status`` (see
 :data:`STATUS_MESSAGES`) says why it ended and whose ``success`` means converged.
@@ -55,6 +57,7 @@ _ORDER = (
     "bas+lm",
     "lm",
     "trf",
+    "lm_minpack",
     "de",
     "dual_annealing",
     "cmaes",

@@ -113,7 +113,8 @@ class OptimizeResult(dict):
     ``history`` ((m, 2): nfev, best-so-far fun), ``status`` (int, see
     :data:`STATUS_MESSAGES`), ``message`` (starting with the status's standard message, or
     naming the budget), ``success`` (``status == 0``: converged), ``method``, ``seed`` (the
-    integer seed used, or None when a Generator was passed); methods may add more.
+    integer seed used, or None when a Generator was passed), ``max_evals`` (the budget the run
+    had); methods may add more.
     """
 
     def __getattr__(self, name: str) -> Any:

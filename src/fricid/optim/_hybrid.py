@@ -1,8 +1,10 @@
-"""``bas+lm``: a beetle global phase polished by Levenberg-Marquardt.
+"""``bas+lm``: a beetle global phase polished by least squares (``lm``).
 
 What a practitioner should use on a least-squares problem such as the Stribeck fit: a cheap
-global phase finds the basin of the optimum, and Levenberg-Marquardt (quadratic convergence on
-a smooth least-squares problem) finishes it in a few dozen evaluations.
+global phase finds the basin of the optimum, and the default least-squares method ``lm``
+(:mod:`~fricid.optim._least_squares`: scipy's bounded trust-region reflective solver, a
+Levenberg-Marquardt-type method, fast local convergence on a smooth least-squares problem)
+finishes it in a few dozen evaluations.
 """
 
 from __future__ import annotations
@@ -24,7 +26,7 @@ GLOBAL = ("bas", "vsbas", "ibas", "rwsavsbas")
 @register
 class BeetleLM(Solver):
     """A BAS-family global phase (``global_method``, default ``vsbas``) with its own budget
-    ``global_evals``, then ``lm`` (Levenberg-Marquardt, :mod:`~fricid.optim._least_squares`)
+    ``global_evals``, then ``lm`` (bounded trust region, :mod:`~fricid.optim._least_squares`)
     from the best point found, using what is left of ``max_evals`` (default 3000 in all).
 
     The global phase starts at ``x0`` or at a uniform point of the box (the run's first
@@ -42,7 +44,7 @@ class BeetleLM(Solver):
     """
 
     name = "bas+lm"
-    summary = "BAS-family global phase (default vsbas) polished by Levenberg-Marquardt"
+    summary = "BAS-family global phase (default vsbas) polished by least squares (lm)"
     uses_residuals = True
     default_evals = 3000
     options: ClassVar[dict[str, Any]] = {

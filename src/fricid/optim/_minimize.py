@@ -73,6 +73,7 @@ def _result(
         success=status == CONVERGED,
         method=key,
         seed=seed,
+        max_evals=objective.max_evals,
     )
 
 
