@@ -232,11 +232,7 @@ def fit(
         loss={
             "loss": "l2" if problem.loss == "sse" else problem.loss,
             "f_scale": problem.f_scale,
-            "weights": "none"
-            if _no_weights(weights)
-            else str(weights).lower()
-            if isinstance(weights, str)
-            else "given",
+            "weights": _weights_name(weights),
             "scatter": scatter.to_dict(),
         },
     )
@@ -244,6 +240,13 @@ def fit(
 
 def _no_weights(weights: Any) -> bool:
     return weights is None or (isinstance(weights, str) and weights.strip().lower() == "none")
+
+
+def _weights_name(weights: Any) -> str:
+    """What the model file records: ``none``, ``std`` or ``given`` (an array)."""
+    if _no_weights(weights):
+        return "none"
+    return weights.strip().lower() if isinstance(weights, str) else "given"
 
 
 def _fit_network(
