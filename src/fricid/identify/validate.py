@@ -36,10 +36,12 @@ from ._scatter import (
 )
 
 __all__ = [
+    "ASYMMETRY_SCATTERS",
     "SCHEMES",
     "WEIGHTS",
     "Scatter",
     "Validation",
+    "asymmetry_note",
     "fold_labels",
     "level_labels",
     "measurement_scatter",
@@ -283,4 +285,49 @@ def validate(
         folds=folds,
         predictions=pred,
         not_converged=not_converged,
+    )
+
+
+#: Per-direction magnitudes further apart than this many scatters call for an ``_asym`` model.
+ASYMMETRY_SCATTERS = 3.0
+
+
+def asymmetry_note(samples: FrictionSamples, model: str, scatter: Scatter | None = None) -> str:
+    """A note when a symmetric model is fitted to samples whose directions differ.
+
+    Parameters
+    ----------
+    samples : FrictionSamples
+    model : str
+        The fitted model's name.
+    scatter : Scatter, optional
+        Default: :func:`measurement_scatter` of ``samples``.
+
+    Returns
+    -------
+    str
+        ``"direction asymmetry not modelled: |F| differs by 7.9e-04 N m between directions
+        (52x the scatter); try stribeck_asym"``, when the model is symmetric, both
+        directions are present at common speeds and the mean difference of ``|F|`` over those
+        speeds exceeds :data:`ASYMMETRY_SCATTERS` scatters; else ``""``.
+    """
+    name = str(model)
+    if name.endswith("_asym") or name == "rbf" or not {-1, 1} <= set(samples.directions()):
+        return ""
+    sc = scatter if scatter is not None else measurement_scatter(samples)
+    levels = level_labels(samples)
+    diffs = []
+    for lv in np.unique(levels):
+        k = levels == lv
+        pos, neg = k & (samples.direction > 0), k & (samples.direction < 0)
+        if pos.any() and neg.any():
+            diffs.append(np.abs(samples.y[pos]).mean() - np.abs(samples.y[neg]).mean())
+    if not diffs or not np.isfinite(sc.value) or sc.value <= 0:
+        return ""
+    gap = float(np.mean(diffs))
+    if abs(gap) <= ASYMMETRY_SCATTERS * sc.value:
+        return ""
+    return (
+        f"direction asymmetry not modelled: |F| differs by {abs(gap):.2g} N m between "
+        f"directions ({abs(gap) / sc.value:.3g}x the scatter); try {name}_asym"
     )
