@@ -169,8 +169,8 @@ def fit_command(
     fitted.save(out)
     console.print(fitted.report(), markup=False, highlight=False, soft_wrap=True)
     console.print(goodness_text(fitted, data), markup=False, highlight=False, soft_wrap=True)
-    for line in lines:
-        err_console.print(f"warning: {escape(line)}", highlight=False, soft_wrap=True)
+    for w in caught:  # shown as the CLI shows every warning (one line on stderr)
+        warnings.showwarning(w.message, w.category, w.filename, w.lineno)
     err_console.print(f"wrote {escape(str(out))}")
 
 

@@ -23,6 +23,7 @@ The rules (issue 11, "Validation built in"):
 from __future__ import annotations
 
 import functools
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -36,21 +37,56 @@ from . import _fit
 from ._scatter import Scatter, level_labels, measurement_scatter
 from .validate import validate
 
-__all__ = ["FAMILIES", "PREFER_SIMPLER", "candidates", "fit", "select"]
+__all__ = ["FAMILIES", "PREFER_SIMPLER", "Candidate", "candidates", "fit", "select"]
 
-#: Analytic families tried by ``"auto"``, simplest first (their ``_asym`` variants follow).
-FAMILIES = ("coulomb_viscous", "stribeck", "msk", "vlt")
+#: Analytic families tried by ``"auto"``, simplest first (their ``_asym`` variants follow), with
+#: parameters held fixed: Stribeck with ``delta = 1`` is the RWSAVSBAS paper's eq. 7 as it
+#: identifies it, one parameter fewer than the free shape, which extrapolates poorly from few
+#: velocity levels.
+FAMILIES: tuple[tuple[str, dict[str, float]], ...] = (
+    ("coulomb_viscous", {}),
+    ("stribeck", {"delta": 1.0}),
+    ("stribeck", {}),
+    ("msk", {}),
+    ("vlt", {}),
+)
 
 #: A simpler model within this fraction of the best held-out RMSE is preferred.
 PREFER_SIMPLER = 0.05
+
+
+@dataclass(frozen=True)
+class Candidate:
+    """A model ``"auto"`` may fit.
+
+    Attributes
+    ----------
+    label : str
+        ``model`` with its fixed parameters, e.g. ``"stribeck (delta=1)"``.
+    model : str
+        Registry name.
+    fixed : dict of str to float
+        Parameters held fixed (``*_asym``: in both directions).
+    n_params : int
+        Free parameters.
+    note : str
+        Why the data cannot support it; ``""`` when they can.
+    """
+
+    label: str
+    model: str
+    fixed: dict[str, float]
+    n_params: int
+    note: str = ""
 
 
 def _varies(x: np.ndarray, atol: float) -> bool:
     return bool(np.ptp(x) > atol)
 
 
-def candidates(samples: FrictionSamples) -> list[tuple[str, str]]:
-    """Every family with ``""`` when the data can support it, else the reason it cannot.
+def candidates(samples: FrictionSamples) -> list[Candidate]:
+    """The families of :data:`FAMILIES` and their ``_asym`` variants, simplest first, each
+    with the reason the data cannot support it (module docstring), or ``""``.
 
     Parameters
     ----------
@@ -58,9 +94,7 @@ def candidates(samples: FrictionSamples) -> list[tuple[str, str]]:
 
     Returns
     -------
-    list of (str, str)
-        ``(model name, reason excluded)`` for the families of :data:`FAMILIES` and their
-        ``_asym`` variants, simplest first.
+    list of Candidate
     """
     dirs = set(samples.directions())
     levels = level_labels(samples)
@@ -70,11 +104,11 @@ def candidates(samples: FrictionSamples) -> list[tuple[str, str]]:
         np.column_stack([levels, np.round(samples.load, 6), np.round(samples.temperature, 1)]),
         axis=0,
     ).shape[0]
-    out: list[tuple[str, str]] = []
+    out: list[Candidate] = []
     for asym in (False, True):
-        for family in FAMILIES:
+        for family, fixed in FAMILIES:
             name = f"{family}_asym" if asym else family
-            p = len(get_model(family).param_names)
+            p = len(get_model(family).param_names) - len(fixed)
             reason = ""
             if family == "msk" and not load_varies:
                 reason = "the load does not vary"
@@ -95,7 +129,11 @@ def candidates(samples: FrictionSamples) -> list[tuple[str, str]]:
                     have, what = points, "operating points"
                 if have <= p:
                     reason = f"{have} {what} for {p} parameters"
-            out.append((name, reason))
+            held = {f"{k}_{d}": v for k, v in fixed.items() for d in ("pos", "neg")} if asym else {}
+            label = name + (
+                f" ({', '.join(f'{k}={v:g}' for k, v in fixed.items())})" if fixed else ""
+            )
+            out.append(Candidate(label, name, held or dict(fixed), p * (2 if asym else 1), reason))
     return out
 
 
@@ -144,13 +182,16 @@ def select(
     sc = scatter if scatter is not None else measurement_scatter(samples)
     table: list[dict[str, Any]] = []
     runs = {}
-    for name, reason in candidates(samples):
-        row: dict[str, Any] = {"model": name, "n_params": len(get_model(name).param_names)}
-        if reason:
-            table.append({**row, "heldout_rmse": None, "ratio": None, "note": reason})
+    found = {c.label: c for c in candidates(samples)}
+    for c in found.values():
+        row: dict[str, Any] = {"model": c.label, "n_params": c.n_params}
+        if c.note:
+            table.append({**row, "heldout_rmse": None, "ratio": None, "note": c.note})
             continue
-        v = validate(samples, name, scheme, method, scatter=sc, seed=seed, **fit_options)
-        runs[name] = v
+        v = validate(
+            samples, c.model, scheme, method, scatter=sc, seed=seed, fixed=c.fixed, **fit_options
+        )
+        runs[c.label] = v
         ok = np.isfinite(v.rmse) and v.failed == 0
         table.append(
             {
@@ -170,9 +211,10 @@ def select(
     limit = best["heldout_rmse"] * (1.0 + PREFER_SIMPLER)
     noise = NOISE_RATIO * sc.value if np.isfinite(sc.value) else 0.0
     ok = [r for r in scored if r["heldout_rmse"] <= max(limit, noise)]
-    chosen = min(ok, key=lambda r: (r["n_params"], r["model"].endswith("_asym")))
+    chosen = min(ok, key=lambda r: (r["n_params"], "_asym" in r["model"]))
     reason = _reason(chosen, best, sc, scheme, noise)
-    fitted = _fit.fit(samples, chosen["model"], method, seed=seed, **fit_options)
+    pick = found[chosen["model"]]
+    fitted = _fit.fit(samples, pick.model, method, seed=seed, fixed=pick.fixed, **fit_options)
     fitted.selection = {
         "scheme": scheme,
         "chosen": chosen["model"],
