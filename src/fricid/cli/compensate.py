@@ -103,8 +103,8 @@ def compensate_command(
     velocity. See `fricid.control.tracking` for every detail.
     """
     from ..control import compensation_study, default_config, plot_compensation
-    from ..fitted import FittedModel
     from ..models.smoothing import Smoothing
+    from ..fitted import FittedModel
 
     fitted = FittedModel.load(model)
     config = default_config(
