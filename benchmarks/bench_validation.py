@@ -84,7 +84,7 @@ def row(label: str, samples, scheme: str, scatters: dict) -> list[list[str]]:
         out.append(
             [
                 label,
-                fitted.model,
+                fitted.selection["chosen"],
                 f"{rmse:.3g}",
                 f"{sc.value:.3g}",
                 name,

@@ -334,6 +334,12 @@ def test_cli_fit_validate_auto_robust(tmp_path):
     assert res.exit_code == 0, res.output
     d = json.loads(out.read_text())
     assert d["loss"]["loss"] == "soft_l1" and d["loss"]["weights"] == "std"
+    lin = tmp_path / "lin.csv"
+    write_samples(directional("coulomb_viscous", [0.1, 0.05], levels=5), lin)
+    res = runner.invoke(app, ["fit", str(lin), "--model", "auto", "--out", str(out)])
+    assert res.exit_code == 0, res.output
+    assert "[[Model selection]]" in res.stdout and "chosen: coulomb_viscous" in res.stdout
+    assert json.loads(out.read_text())["selection"]["chosen"] == "coulomb_viscous"
     res = runner.invoke(app, ["fit", str(path), "--validate", "loo"])
     assert res.exit_code == 2 and "unknown validation" in res.output
     res = runner.invoke(app, ["evaluate", str(out), str(path)])

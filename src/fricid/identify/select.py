@@ -179,6 +179,8 @@ def select(
             f"model 'auto' tries several families: {', '.join(named)} cannot name their "
             "parameters; fit a named model instead"
         )
+    for key in ("fixed", "bounds", "x0"):
+        fit_options.pop(key, None)  # empty: nothing named
     sc = scatter if scatter is not None else measurement_scatter(samples)
     table: list[dict[str, Any]] = []
     runs = {}
