@@ -28,6 +28,7 @@ __all__ = [
     "metrics",
     "rmse",
     "rmspe",
+    "sem_autocorrelated",
     "sse",
     "verdict",
 ]
@@ -193,6 +194,45 @@ def metrics(y, y_hat, direction=None, scatter: float | None = None) -> dict[str,
         out["scatter"] = float(scatter)
         out["rmse_over_scatter"] = out["rmse"] / scatter if scatter > 0 else float("inf")
     return out
+
+
+def sem_autocorrelated(x) -> float:
+    """Standard error of the mean of a steady, autocorrelated series.
+
+    It lives here, at the bottom of the layer table, so that readers and the extraction can
+    store it with the samples (``meta["sem"]``, which
+    :func:`fricid.identify.validate.measurement_scatter` prefers).
+
+    Parameters
+    ----------
+    x : array_like (n,)
+        Raw samples of one set-point's steady part (torque [N m]), in time order.
+
+    Returns
+    -------
+    float
+        The larger of two estimates: ``std / sqrt(n_eff)`` with the effective sample size of
+        an AR(1) process, ``n_eff = n (1 - r1) / (1 + r1)`` (``r1`` the lag-1
+        autocorrelation, floored at 0), and the batch-means standard error (``floor(sqrt n)``
+        batches). The first misses slow drifts, the second is noisy with few batches; the
+        larger is the cautious choice. NaN for fewer than 4 samples.
+    """
+    x = np.asarray(x, dtype=float)
+    n = x.size
+    if n < 4:
+        return float("nan")
+    d = x - x.mean()
+    var = float(d @ d) / n
+    if var == 0.0:
+        return 0.0
+    r1 = float(np.clip(d[:-1] @ d[1:] / n / var, 0.0, 0.99))
+    n_eff = n * (1.0 - r1) / (1.0 + r1)
+    ar1 = np.sqrt(var * n / (n - 1) / n_eff)
+    b = int(np.sqrt(n))
+    m = n // b
+    means = x[: b * m].reshape(b, m).mean(axis=1)
+    batch = float(np.std(means, ddof=1) / np.sqrt(b))
+    return float(max(ar1, batch))
 
 
 def fit_statistics(y, y_hat, nvarys: int, weights=None) -> dict[str, float]:

@@ -28,6 +28,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import ConfigError
+from ..metrics import sem_autocorrelated
 from ..samples import FrictionSamples
 
 __all__ = [
@@ -78,41 +79,6 @@ class Scatter:
             return f"unknown ({self.caveat})"
         note = f"; {self.caveat}" if self.caveat else ""
         return f"{self.value:.3g} N m ({self.method}{note})"
-
-
-def sem_autocorrelated(x: Any) -> float:
-    """Standard error of the mean of a steady, autocorrelated series.
-
-    Parameters
-    ----------
-    x : array_like (n,)
-        Raw samples of one set-point's steady part (torque [N m]), in time order.
-
-    Returns
-    -------
-    float
-        The larger of two estimates: ``std / sqrt(n_eff)`` with the effective sample size of
-        an AR(1) process, ``n_eff = n (1 - r1) / (1 + r1)`` (``r1`` the lag-1
-        autocorrelation, floored at 0), and the batch-means standard error (``floor(sqrt n)``
-        batches). The first misses slow drifts, the second is noisy with few batches; the
-        larger is the cautious choice. NaN for fewer than 4 samples.
-    """
-    x = np.asarray(x, dtype=float)
-    n = x.size
-    if n < 4:
-        return float("nan")
-    d = x - x.mean()
-    var = float(d @ d) / n
-    if var == 0.0:
-        return 0.0
-    r1 = float(np.clip(d[:-1] @ d[1:] / n / var, 0.0, 0.99))
-    n_eff = n * (1.0 - r1) / (1.0 + r1)
-    ar1 = np.sqrt(var * n / (n - 1) / n_eff)
-    b = int(np.sqrt(n))
-    m = n // b
-    means = x[: b * m].reshape(b, m).mean(axis=1)
-    batch = float(np.std(means, ddof=1) / np.sqrt(b))
-    return float(max(ar1, batch))
 
 
 def level_labels(samples: FrictionSamples, rtol: float = LEVEL_RTOL) -> np.ndarray:
