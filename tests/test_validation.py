@@ -118,6 +118,15 @@ def test_scatter_methods():
     assert sc.method == "given" and sc.value == pytest.approx(0.01)
     bare = FrictionSamples(velocity=[0.1, 0.2], load=0.0, temperature=25.0, friction=[1, 2])
     assert np.isnan(measurement_scatter(bare).value)
+    carried = FrictionSamples(
+        velocity=[0.1, 0.2],
+        load=0.0,
+        temperature=25.0,
+        friction=[1, 2],
+        meta={"sem": [0.03, 0.04]},
+    )
+    sc = measurement_scatter(carried)
+    assert sc.method == "given" and sc.value == pytest.approx(np.sqrt((0.03**2 + 0.04**2) / 2))
 
 
 def test_autocorrelated_scatter_is_larger_than_naive():
