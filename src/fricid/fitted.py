@@ -150,6 +150,13 @@ class FittedModel:
     operating_range : min and max of velocity, load and temperature in the data.
     provenance : data source, sample count, fricid version, creation time.
     state : model-specific arrays for non-analytic models (the RBF network).
+    loss : how the fit weighed its residuals: ``loss`` (l2, soft_l1, huber), ``f_scale``
+        [N m] of a robust loss, ``weights`` (none, std, given) and the measurement
+        ``scatter`` (value [N m], method, caveat; :mod:`fricid.identify.validate`).
+    validation : held-out validation (:func:`fricid.identify.validate.validate`): scheme,
+        held-out RMSE, scatter, ratio, verdict, folds; None when not validated.
+    selection : ``fit(samples, "auto")``'s comparison of candidate models
+        (:mod:`fricid.identify.select`): the table, the choice and why; None otherwise.
     """
 
     model: str
@@ -184,6 +191,10 @@ class FittedModel:
     def converged(self) -> bool | None:
         """Whether the fit converged (the ``convergence`` block; None when not recorded)."""
         return None if self.convergence is None else bool(self.convergence.get("converged"))
+
+    loss: dict[str, Any] = field(default_factory=dict)
+    validation: dict[str, Any] | None = None
+    selection: dict[str, Any] | None = None
 
     # -- prediction ----------------------------------------------------------------------
     @property

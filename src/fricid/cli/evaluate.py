@@ -10,28 +10,30 @@ import typer
 from rich.table import Table
 
 from ._app import app, console, handle_errors
+from ._options import ModelFile
 from ._paths import check_paths
 
 
 @app.command("evaluate")
 @handle_errors
 def evaluate_command(
-    model: Annotated[
-        Path,
-        typer.Argument(help="Model file (JSON, from `fricid fit`)."),
-    ],
+    model: ModelFile,
     samples: Annotated[Path, typer.Argument(help="Friction samples, CSV or Parquet.")],
     as_json: Annotated[bool, typer.Option("--json", help="Print the metrics as JSON.")] = False,
 ) -> None:
-    """Evaluate a model file on samples: fitness (R^2), SSE [N m^2], RMSE [N m], RMSPE,
-    mean and max absolute error [N m]."""
+    """Evaluate a model file on samples: RMSE [N m] beside the samples' measurement scatter
+    (with a verdict), RMSE and R^2 of the friction's magnitude per direction, SSE [N m^2],
+    RMSPE, mean and max absolute error [N m], and the BAS-RBFNN paper's Table 1 fitness (R^2 of
+    the signed friction, "fitness": it flatters per-direction samples)."""
     from ..fitted import FittedModel
-    from ..identify import evaluate
+    from ..identify import evaluate, measurement_scatter
     from ..io import read_samples
+    from ..metrics import verdict
 
     check_paths(inputs={"MODEL": model, "SAMPLES": samples})
     fitted = FittedModel.load(model)
-    result = evaluate(fitted, read_samples(samples))
+    data = read_samples(samples)
+    result = evaluate(fitted, data)
     if as_json:
         console.print_json(json.dumps(result))
         return
@@ -39,5 +41,15 @@ def evaluate_command(
     table.add_column("metric")
     table.add_column("value", justify="right")
     for key, value in result.items():
-        table.add_row(key, f"{value:.6g}")
+        label = "fitness (paper Table 1, signed)" if key == "fitness" else key
+        table.add_row(label, f"{value:.6g}")
     console.print(table)
+    if "rmse_over_scatter" in result:
+        scatter = measurement_scatter(data)
+        console.print(
+            f"RMSE {result['rmse']:.4g} N m, scatter {scatter.describe()}: "
+            f"{verdict(result['rmse_over_scatter'])}",
+            highlight=False,
+            markup=False,
+            soft_wrap=True,
+        )

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 from typing import Annotated
 
@@ -9,7 +10,16 @@ import typer
 from rich.markup import escape
 
 from ._app import app, console, err_console, handle_errors
-from ._options import parse_assignments, parse_ranges
+from ._options import (
+    BoundOption,
+    DirectionOption,
+    FixOption,
+    MaxEvalsOption,
+    SeedOption,
+    out_option,
+    parse_assignments,
+    parse_ranges,
+)
 from ._paths import check_paths
 
 
@@ -36,8 +46,9 @@ def fit_command(
             help=(
                 "Model: coulomb_viscous (eq. 1), stribeck (eq. 2 / RWSAVSBAS eq. 7), msk (eq. 3, "
                 "load), vlt (eq. 4, load and temperature); append _asym for parameters per "
-                "direction; or rbf, the RBF neural network (eq. 14-15; --method lsq, bas for "
-                "BAS-RBFNN or ga for GA-RBFNN)."
+                "direction; rbf, the RBF neural network (eq. 14-15; --method lsq, bas for "
+                "BAS-RBFNN or ga for GA-RBFNN); or auto: every family the data can support, "
+                "chosen by held-out error (leave one velocity level out, or --validate)."
             ),
         ),
     ] = "stribeck",
@@ -48,49 +59,56 @@ def fit_command(
             "vsbas, ibas, rwsavsbas, ga, de, cmaes, bas+lm, ..."
         ),
     ] = "lm",
-    fix: Annotated[
-        list[str] | None,
-        typer.Option(
-            "--fix",
-            help=(
-                "Hold a parameter at a value, NAME=VALUE (SI units), e.g. --fix delta=1. "
-                "Repeatable."
-            ),
-        ),
-    ] = None,
-    bound: Annotated[
-        list[str] | None,
-        typer.Option(
-            "--bound",
-            help=(
-                "Search range of a parameter, NAME=LOW:HIGH (SI units). Repeatable. Default ranges "
-                "scale with the data."
-            ),
-        ),
-    ] = None,
-    seed: Annotated[int, typer.Option(help="Random seed (same seed, same result).")] = 0,
-    max_evals: Annotated[int | None, typer.Option(help="Budget in model evaluations.")] = None,
+    fix: FixOption = None,
+    bound: BoundOption = None,
+    seed: SeedOption = 0,
+    max_evals: MaxEvalsOption = None,
     centers: Annotated[
         int, typer.Option(help="rbf: number of Gaussian units (hidden layer).")
     ] = 40,
     inputs: Annotated[
         str, typer.Option(help="rbf: input columns, a comma list of velocity, load, temperature.")
     ] = "velocity,load,temperature",
-    direction: Annotated[
+    direction: DirectionOption = "all",
+    validate: Annotated[
+        str | None,
+        typer.Option(
+            "--validate",
+            help=(
+                "Held-out validation: lovo (leave one velocity level out, both directions "
+                "together) or kfold[:K] (default K 5). Prints the held-out RMSE beside the "
+                "measurement scatter with a verdict, and saves it in the model file."
+            ),
+        ),
+    ] = None,
+    loss: Annotated[
         str,
         typer.Option(
-            help=("Which samples to use: all, combined (direction 0), both (+1 and -1), pos, neg.")
+            "--loss",
+            help=(
+                "l2 (least squares), or soft_l1 or huber: robust losses for samples with "
+                "spikes, whose scale is the measurement scatter (or --f-scale)."
+            ),
         ),
-    ] = "all",
+    ] = "l2",
+    f_scale: Annotated[
+        float | None,
+        typer.Option("--f-scale", help="Scale of the robust loss [N m] (default: the scatter)."),
+    ] = None,
+    weights: Annotated[
+        str,
+        typer.Option(
+            "--weights",
+            help=(
+                "none, or std: weighted least squares with 1/se^2 from the samples' own "
+                "standard errors (std / sqrt(count), or repeated runs)."
+            ),
+        ),
+    ] = "none",
     out: Annotated[
         Path | None,
-        typer.Option(
-            "--out",
-            "-o",
-            help=(
-                "Model file to write (JSON). Default: <samples>.<model>.json in the current "
-                "directory."
-            ),
+        out_option(
+            "Model file to write (JSON). Default: <samples>.<model>.json in the current directory."
         ),
     ] = None,
 ) -> None:
@@ -101,28 +119,132 @@ def fit_command(
     parameter with its standard error, 95 % confidence interval and start, flagged at a
     boundary, at its initial value or not determined; correlations above 0.1. The RBF network
     (--model rbf) goes through the same identification and prints its network instead.
+    Then the goodness of fit a user can compare: RMSE beside the measurement scatter, R^2 of
+    the friction's magnitude per direction (the R-squared above is the BAS-RBFNN paper's
+    Table 1 fitness, of the signed friction, which flatters per-direction data); with
+    --validate or --model auto, the held-out RMSE and a verdict; with auto, the candidates
+    compared. Warnings print as one line each on stderr and are saved in the model file
+    (provenance "warnings").
     """
     from ..identify import fit
+    from ..identify import validate as validate_model
     from ..io import read_samples
     from ..workflow import select_direction
 
     check_paths(inputs={"SAMPLES": samples}, out_files={"--out": out})
     data = select_direction(read_samples(samples), direction)
-    rbf = model.strip().lower() == "rbf"
-    fitted = fit(
-        data,
-        model,
-        _rbf_trainer(method) if rbf else method,
-        fixed=parse_assignments(fix, "--fix"),
-        bounds=parse_ranges(bound, "--bound"),
-        seed=seed,
-        max_evals=max_evals,
-        **(_rbf_network(centers, inputs) if rbf else {}),
-    )
+    key = model.strip().lower()
+    rbf = key == "rbf"
+    options = {"loss": loss, "f_scale": f_scale, "weights": weights}
+    options.update(_rbf_network(centers, inputs) if rbf else {})
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        fitted = fit(
+            data,
+            model,
+            _rbf_trainer(method) if rbf else method,
+            fixed=parse_assignments(fix, "--fix"),
+            bounds=parse_ranges(bound, "--bound"),
+            seed=seed,
+            max_evals=max_evals,
+            **options,
+            **({"scheme": validate} if key == "auto" and validate else {}),
+        )
+        if validate and key != "auto":
+            fitted.validation = validate_model(
+                data,
+                fitted.model,
+                validate,
+                _rbf_trainer(method) if rbf else method,
+                seed=seed,
+                fixed=parse_assignments(fix, "--fix"),
+                bounds=parse_ranges(bound, "--bound"),
+                max_evals=max_evals,
+                **options,
+            ).to_dict()
+    lines = [f"{w.category.__name__}: {w.message}" for w in caught]
+    if lines:
+        fitted.provenance["warnings"] = lines
     out = out or Path(f"{samples.stem}.{fitted.model}.json")
     fitted.save(out)
     console.print(fitted.report(), markup=False, highlight=False, soft_wrap=True)
+    console.print(goodness_text(fitted, data), markup=False, highlight=False, soft_wrap=True)
+    for w in caught:  # shown as the CLI shows every warning (one line on stderr)
+        warnings.showwarning(w.message, w.category, w.filename, w.lineno)
     err_console.print(f"wrote {escape(str(out))}")
+
+
+def goodness_text(fitted, samples=None) -> str:
+    """The ``[[Goodness of fit]]`` block of ``fricid fit`` (and ``[[Validation]]``,
+    ``[[Model selection]]`` when the model file holds them).
+
+    RMSE beside the measurement scatter, with the verdict; RMSE and R^2 of the friction's
+    magnitude per direction (issue 11, defect 9); the paper's Table 1 fitness, labelled; with
+    ``samples``, a note when a symmetric model misses a direction asymmetry.
+    """
+    from ..identify.validate import asymmetry_note
+    from ..metrics import verdict
+
+    m = fitted.metrics
+    scatter = fitted.loss.get("scatter") or {}
+    lines = ["[[Goodness of fit]]"]
+    rmse = m.get("rmse")
+    if rmse is not None:
+        lines.append(f"    RMSE               = {rmse:.4g} N m")
+    if scatter.get("value") is not None:
+        caveat = f"; {scatter['caveat']}" if scatter.get("caveat") else ""
+        lines.append(
+            f"    scatter            = {scatter['value']:.4g} N m ({scatter['method']}{caveat})"
+        )
+        if m.get("rmse_over_scatter") is not None:
+            lines.append(
+                f"    RMSE / scatter     = {m['rmse_over_scatter']:.3g}: "
+                f"{verdict(m['rmse_over_scatter'])} (in-sample)"
+            )
+    for d, label in (("pos", "v > 0"), ("neg", "v < 0"), ("comb", "combined")):
+        if m.get(f"r2_magnitude_{d}") is not None:
+            lines.append(
+                f"    {label:<9} RMSE {m[f'rmse_{d}']:.4g} N m, R^2 of |F| "
+                f"{m[f'r2_magnitude_{d}']:.4f}"
+            )
+    note = asymmetry_note(samples, fitted.model) if samples is not None else ""
+    if note:
+        lines.append(f"    note: {note}")
+    if m.get("fitness") is not None:
+        lines.append(
+            f"    paper fitness      = {m['fitness']:.4f} (BAS-RBFNN paper Table 1: R^2 of the "
+            "signed friction; compare only with the paper)"
+        )
+    if fitted.loss.get("loss") not in (None, "l2") or fitted.loss.get("weights") not in (
+        None,
+        "none",
+    ):
+        scale = fitted.loss.get("f_scale")
+        lines.append(
+            f"    loss               = {fitted.loss.get('loss')}"
+            + (f" (scale {scale:.3g} N m)" if scale else "")
+            + f", weights {fitted.loss.get('weights')}"
+        )
+    v = fitted.validation
+    if v:
+        sc = f"{v['scatter']:.3g} N m" if v.get("scatter") is not None else "unknown"
+        rm = f"{v['rmse']:.4g} N m" if v.get("rmse") is not None else "n/a"
+        lines += [
+            "[[Validation]]",
+            f"    held-out RMSE ({v['scheme']}) = {rm}, scatter {sc}: {v['verdict']}",
+        ]
+        if v.get("failed"):
+            lines.append(f"    {v['failed']} of {len(v['folds'])} folds could not be fitted")
+        if v.get("not_converged"):
+            lines.append(f"    {v['not_converged']} fold fits did not converge")
+    sel = fitted.selection
+    if sel:
+        lines += ["[[Model selection]]", f"    chosen: {sel['reason']}"]
+        for r in sel["table"]:
+            err = r.get("heldout_rmse")
+            cell = f"{err:.4g} N m" if err is not None else "-"
+            lines.append(f"    {r['model']:<22} {r['n_params']:>3} par  {cell:>14}  {r['note']}")
+    return "\n".join(lines)
 
 
 def _rbf_trainer(method: str) -> str:

@@ -27,8 +27,9 @@ from ..models import INPUTS, STATEFUL, FrictionModel, get_model
 from ..optim import METHODS, OptimizeResult, minimize
 from ..samples import FrictionSamples, samples_hash
 from ._convergence import certify
+from ._scatter import measurement_scatter, sample_weights
 from .checks import check_identifiable
-from .problem import IdentificationProblem
+from .problem import ROBUST_LOSSES, IdentificationProblem
 from .uncertainty import INTERVALS, assess
 
 __all__ = ["evaluate", "fit"]
@@ -60,6 +61,9 @@ def fit(
     network: Mapping[str, Any] | None = None,
     inputs: Sequence[str] = INPUTS,
     intervals: str = "auto",
+    loss: str = "l2",
+    f_scale: float | None = None,
+    weights: str | Any = "none",
 ) -> FittedModel:
     """Identify ``model`` from ``samples`` by least squares with ``method``.
 
@@ -103,6 +107,15 @@ def fit(
         :data:`~fricid.identify.uncertainty.PROFILE_AUTO_MAX` free parameters), the Jacobian's
         ``value +/- t se`` cut at the box, or none. A fit that did not converge, or whose
         optimum is degenerate (rank-deficient Jacobian), gets none whatever is asked.
+    loss : {"l2", "soft_l1", "huber"}, default "l2"
+        Least squares, or a robust loss for logs with spikes
+        (:data:`fricid.identify.problem.ROBUST_LOSSES`).
+    f_scale : float, optional
+        N m, the robust loss's scale; default: the measurement scatter
+        (:func:`fricid.identify.validate.measurement_scatter`).
+    weights : {"none", "std"} or array_like (n,), default "none"
+        ``"std"``: weighted least squares with ``1 / se^2`` from the samples' own standard
+        errors (:func:`fricid.identify.validate.sample_weights`), or the weights themselves.
 
     Returns
     -------
@@ -136,6 +149,8 @@ def fit(
         models; ``callback`` for ``"rbf"``).
     """
     if isinstance(model, str) and model.strip().lower() in STATEFUL:
+        if str(loss).lower() not in ("l2", "sse") or not _no_weights(weights):
+            raise ConfigError("model 'rbf' trains by least squares: no robust loss or weights")
         return _fit_network(
             samples,
             method,
@@ -157,7 +172,14 @@ def fit(
         )
     model = get_model(model)
     samples.require(model.inputs, f"model '{model.name}'")
-    problem = IdentificationProblem(model, samples, loss="sse", bounds=bounds, fixed=fixed)
+    scatter = measurement_scatter(samples)
+    w = sample_weights(samples, weights, scatter) if isinstance(weights, str) else weights
+    loss_key = str(loss).strip().lower()
+    if loss_key in ROBUST_LOSSES and f_scale is None:
+        f_scale = scatter.value if np.isfinite(scatter.value) and scatter.value > 0 else None
+    problem = IdentificationProblem(
+        model, samples, loss=loss_key, bounds=bounds, fixed=fixed, weights=w, f_scale=f_scale
+    )
     X, y = problem.X, problem.y
     if problem.n_obs < problem.n_free:
         raise ConfigError(
@@ -239,7 +261,7 @@ def fit(
         convergence=convergence,
         at_bound=problem.at_bound(result.x),
         correlation=corr,
-        metrics=metrics(y, y_hat),
+        metrics=metrics(y, y_hat, samples.direction, scatter.value),
         method=result.method,
         seed=result.seed,
         nfev=int(result.nfev),
@@ -257,8 +279,25 @@ def fit(
         status=int(result.status),
         message=str(result.message),
         init={} if start is None else dict(zip(free_names, map(float, start), strict=True)),
-        statistics=fit_statistics(y, y_hat, problem.n_free),
+        statistics=fit_statistics(y, y_hat, problem.n_free, w),
+        loss={
+            "loss": "l2" if problem.loss == "sse" else problem.loss,
+            "f_scale": problem.f_scale,
+            "weights": _weights_name(weights),
+            "scatter": scatter.to_dict(),
+        },
     )
+
+
+def _no_weights(weights: Any) -> bool:
+    return weights is None or (isinstance(weights, str) and weights.strip().lower() == "none")
+
+
+def _weights_name(weights: Any) -> str:
+    """What the model file records: ``none``, ``std`` or ``given`` (an array)."""
+    if _no_weights(weights):
+        return "none"
+    return weights.strip().lower() if isinstance(weights, str) else "given"
 
 
 def _fit_network(
@@ -302,5 +341,7 @@ def _fit_network(
 
 
 def evaluate(model: FittedModel, samples: FrictionSamples) -> dict[str, float]:
-    """Metrics of a fitted model on (other) samples (``fricid.metrics.metrics``)."""
-    return metrics(samples.y, model.predict(samples.X))
+    """Metrics of a fitted model on (other) samples (``fricid.metrics.metrics``), with RMSE and
+    R^2 of the magnitude per direction and the RMSE over the samples' measurement scatter."""
+    scatter = measurement_scatter(samples)
+    return metrics(samples.y, model.predict(samples.X), samples.direction, scatter.value)

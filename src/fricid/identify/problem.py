@@ -7,6 +7,11 @@ evaluates a whole batch of candidate parameter vectors ``T (k, p)`` at once (DES
 :meth:`IdentificationProblem.evaluate` the loss ``(k,)``, the one place where fricid's
 identification objective is written (``identify.fit``, the RBF trainer and, next, the studies
 all use it).
+
+Robust losses (``soft_l1``, ``huber``) for logs with spikes are written as a least-squares
+problem on transformed residuals, ``r' = sign(r) c sqrt(rho((r / c)^2))``, so that
+``sum r'^2 = c^2 sum rho((r / c)^2)`` is scipy's ``least_squares`` robust cost and every
+optimiser, Levenberg-Marquardt included, minimises it unchanged.
 """
 
 from __future__ import annotations
@@ -19,12 +24,47 @@ import numpy as np
 from ..errors import ConfigError
 from ..samples import FrictionSamples
 
-__all__ = ["LOSSES", "IdentificationProblem", "Predictor"]
+__all__ = ["LOSSES", "ROBUST_LOSSES", "IdentificationProblem", "Predictor", "robust_residuals"]
 
 #: The losses: ``sse``, the sum of (weighted) squared errors (the RWSAVSBAS paper's fitness,
-#: eq. 11 there); ``mse``, that sum over the number of samples (the BAS-RBFNN paper's training
-#: error, eq. 16-17 up to the factor 2).
-LOSSES = ("sse", "mse")
+#: eq. 11 there), also called ``l2``; ``mse``, that sum over the number of samples (the
+#: BAS-RBFNN paper's training error, eq. 16-17 up to the factor 2); the robust ``soft_l1``
+#: and ``huber`` (:data:`ROBUST_LOSSES`, summed as ``sse``).
+LOSSES = ("sse", "mse", "l2", "soft_l1", "huber")
+
+#: Robust losses, ``rho(z)`` of the squared scaled residual ``z = (r / c)^2`` (scipy's
+#: ``least_squares``): ``soft_l1`` ``2 (sqrt(1 + z) - 1)``; ``huber`` ``z`` for ``z <= 1``,
+#: else ``2 sqrt(z) - 1``. Both are quadratic for residuals well below the scale ``c`` and
+#: grow linearly beyond it, so a spike pulls the fit with bounded force.
+ROBUST_LOSSES = ("soft_l1", "huber")
+
+
+def robust_residuals(R: np.ndarray, loss: str, scale: float) -> np.ndarray:
+    """Residuals whose squares sum to a robust loss: ``sign(r) c sqrt(rho((r / c)^2))``.
+
+    Parameters
+    ----------
+    R : numpy.ndarray
+        Residuals, any shape.
+    loss : {"soft_l1", "huber"}
+        See :data:`ROBUST_LOSSES`.
+    scale : float
+        ``c`` > 0, in the units of ``R``: residuals well below it count as in least squares.
+
+    Returns
+    -------
+    numpy.ndarray
+        Same shape as ``R``; equal to ``R`` where ``|R| << c`` (and for ``huber``, wherever
+        ``|R| <= c``).
+    """
+    z = (R / scale) ** 2
+    if loss == "soft_l1":
+        rho = 2.0 * (np.sqrt(1.0 + z) - 1.0)
+    elif loss == "huber":
+        rho = np.where(z <= 1.0, z, 2.0 * np.sqrt(np.maximum(z, 1.0)) - 1.0)
+    else:
+        raise ConfigError(f"unknown robust loss '{loss}'; choose one of: soft_l1, huber")
+    return np.sign(R) * scale * np.sqrt(rho)
 
 
 def _check_directions(samples: FrictionSamples, model: Any) -> None:
@@ -64,8 +104,8 @@ class IdentificationProblem:
         :class:`~fricid.samples.FrictionSamples` (a model with parameters per direction
         needs samples of both directions, each apart: RWSAVSBAS paper eq. 11), or ``(X, y)``
         arrays for a generic model.
-    loss : {"sse", "mse"}, default "sse"
-        See :data:`LOSSES`.
+    loss : {"sse", "l2", "mse", "soft_l1", "huber"}, default "sse"
+        See :data:`LOSSES`; ``l2`` is ``sse``.
     bounds : mapping of str to (float, float), or array_like (p, 2), optional
         Named models: search bounds of some parameters (the others keep the model's
         data-scaled bounds). Generic models: the bounds of every parameter (required).
@@ -73,7 +113,11 @@ class IdentificationProblem:
         Parameters held at a value (named models only), e.g. ``{"delta": 1.0}``.
     weights : array_like (n,), optional
         Non-negative weights of the squared errors (weighted least squares); residuals are
-        scaled by their square roots.
+        scaled by their square roots (:func:`fricid.identify.validate.sample_weights` gives
+        ``1 / se^2`` from the samples' own standard errors).
+    f_scale : float, optional
+        The scale ``c`` [N m] of a robust loss (required with ``soft_l1`` and ``huber``, where
+        it applies to the weighted residuals; ignored otherwise).
 
     Attributes
     ----------
@@ -117,6 +161,7 @@ class IdentificationProblem:
         bounds: Mapping[str, tuple[float, float]] | Any | None = None,
         fixed: Mapping[str, float] | None = None,
         weights: Any | None = None,
+        f_scale: float | None = None,
     ) -> None:
         self.model = model
         if isinstance(samples, FrictionSamples):
@@ -137,7 +182,15 @@ class IdentificationProblem:
         key = str(loss).strip().lower()
         if key not in LOSSES:
             raise ConfigError(f"unknown loss '{loss}'; choose one of: {', '.join(LOSSES)}")
-        self.loss = key
+        self.loss = "sse" if key == "l2" else key
+        self.f_scale = None
+        if self.loss in ROBUST_LOSSES:
+            if f_scale is None or not np.isfinite(f_scale) or f_scale <= 0:
+                raise ConfigError(
+                    f"loss '{key}' needs a scale f_scale > 0 [N m] (the measurement scatter); "
+                    f"got {f_scale!r}"
+                )
+            self.f_scale = float(f_scale)
         self.weights = None if weights is None else self._check_weights(weights)
         self._sqrt_w = None if self.weights is None else np.sqrt(self.weights)
         self.fixed = {str(k): float(v) for k, v in (fixed or {}).items()}
@@ -230,9 +283,11 @@ class IdentificationProblem:
         return np.atleast_2d(self.model.predict(self.expand(T), self.X))
 
     def residuals(self, T: Any) -> np.ndarray:
-        """Weighted residuals ``sqrt(w) (model - y)``, shape ``(k, n)``, for ``T (k, p)``."""
+        """Weighted residuals ``sqrt(w) (model - y)``, shape ``(k, n)``, for ``T (k, p)``;
+        with a robust loss, transformed by :func:`robust_residuals`."""
         r = self.predict(T) - self.y
-        return r if self._sqrt_w is None else r * self._sqrt_w
+        r = r if self._sqrt_w is None else r * self._sqrt_w
+        return r if self.f_scale is None else robust_residuals(r, self.loss, self.f_scale)
 
     def loss_of(self, R: np.ndarray) -> np.ndarray:
         """The loss ``(k,)`` of weighted residuals ``R (k, n)``: the objective, written once."""
@@ -244,11 +299,11 @@ class IdentificationProblem:
 
         A model may offer ``fused_mse(T, X, y) -> (k,)``, the unweighted mean squared error
         computed without forming the residuals (the RBF trainer's ridge scorer); it is used
-        when there are no weights, and is the same quantity.
+        when there are no weights and the loss is not robust, and is the same quantity.
         """
         T = np.atleast_2d(np.asarray(T, dtype=float))
         fused = getattr(self.model, "fused_mse", None)
-        if fused is not None and self._sqrt_w is None:
+        if fused is not None and self._sqrt_w is None and self.f_scale is None:
             mse = fused(self.expand(T), self.X, self.y)
             return mse if self.loss == "mse" else mse * self.n_obs
         return self.loss_of(self.residuals(T))

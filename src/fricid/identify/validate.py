@@ -1,0 +1,333 @@
+"""Held-out validation: does a model predict friction it was not fitted to, within the noise?
+
+:func:`validate` refits a model with one fold of the samples held out at a time and compares
+the pooled held-out RMSE with the measurement scatter estimated from the data
+(:func:`measurement_scatter`, from :mod:`fricid.identify._scatter`), ending in a one-line
+verdict (:func:`fricid.metrics.verdict`: "within noise (1.05x)" or "misses by 3.2x"). Folds
+(issue 11, "Validation built in"):
+
+* ``lovo``: leave one velocity level out, both directions of that speed (and every load and
+  temperature at it) held out together, so a per-direction model cannot lean on the other
+  direction's point. Holding out the slowest or fastest level asks the model to extrapolate,
+  which a model with the right shape does and an over-flexible one does not;
+* ``kfold`` or ``kfold:K`` (default K = 5): K folds of samples dealt at random (``seed``).
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from ..errors import ConfigError, ConvergenceWarning, FricidError
+from ..metrics import rmse, verdict
+from ..samples import FrictionSamples
+from ._fit import fit
+from ._scatter import (
+    WEIGHTS,
+    Scatter,
+    level_labels,
+    measurement_scatter,
+    sample_weights,
+    sem_autocorrelated,
+)
+
+__all__ = [
+    "ASYMMETRY_SCATTERS",
+    "SCHEMES",
+    "WEIGHTS",
+    "Scatter",
+    "Validation",
+    "asymmetry_note",
+    "fold_labels",
+    "level_labels",
+    "measurement_scatter",
+    "parse_scheme",
+    "sample_weights",
+    "sem_autocorrelated",
+    "validate",
+]
+
+#: Validation schemes (``kfold`` takes ``:K``).
+SCHEMES = ("lovo", "kfold")
+
+#: Folds of ``kfold`` without ``:K``.
+DEFAULT_K = 5
+
+
+def parse_scheme(scheme: str) -> tuple[str, int | None]:
+    """``"lovo"`` -> ``("lovo", None)``; ``"kfold:10"`` -> ``("kfold", 10)``.
+
+    Raises
+    ------
+    ConfigError
+        An unknown scheme, or K that is not an integer >= 2.
+    """
+    text = str(scheme).strip().lower()
+    name, _, k = text.partition(":")
+    if name not in SCHEMES or (name == "lovo" and k):
+        raise ConfigError(f"unknown validation '{scheme}'; choose lovo, kfold or kfold:K")
+    if name == "lovo":
+        return name, None
+    try:
+        n = int(k) if k else DEFAULT_K
+    except ValueError:
+        n = 0
+    if n < 2:
+        raise ConfigError(f"kfold:K needs an integer K >= 2; got '{scheme}'")
+    return name, n
+
+
+def fold_labels(samples: FrictionSamples, scheme: str = "lovo", seed: Any = 0) -> np.ndarray:
+    """The fold of each sample.
+
+    Parameters
+    ----------
+    samples : FrictionSamples
+    scheme : str
+        ``lovo``, ``kfold`` or ``kfold:K`` (module docstring).
+    seed : int or numpy.random.Generator
+        Deals the ``kfold`` folds.
+
+    Returns
+    -------
+    numpy.ndarray of int (n,)
+        Fold index per sample (``lovo``: the velocity level, slowest first).
+
+    Raises
+    ------
+    ConfigError
+        A bad scheme, or fewer folds than two.
+    """
+    name, k = parse_scheme(scheme)
+    if name == "lovo":
+        labels = level_labels(samples)
+    else:
+        n = len(samples)
+        if k > n:
+            raise ConfigError(f"kfold:{k} needs at least {k} samples; there are {n}")
+        rng = np.random.default_rng(seed)
+        labels = np.empty(n, dtype=int)
+        labels[rng.permutation(n)] = np.arange(n) % k
+    if np.unique(labels).size < 2:
+        raise ConfigError(f"validation '{scheme}' needs at least two folds; the samples give one")
+    return labels
+
+
+@dataclass
+class Validation:
+    """The outcome of :func:`validate`.
+
+    Attributes
+    ----------
+    model : str
+    scheme : str
+    rmse : float
+        N m, held-out RMSE over every held-out prediction (NaN when no fold could be fitted).
+    scatter : Scatter
+        The measurement scatter it is compared with.
+    ratio : float
+        ``rmse / scatter.value``.
+    verdict : str
+        :func:`fricid.metrics.verdict` of ``ratio``.
+    folds : list of dict
+        Per fold: ``fold``, ``speed`` (rad/s, mean held-out ``|v|``), ``n``, ``rmse`` [N m]
+        (None when the fold could not be fitted), ``note``.
+    predictions : numpy.ndarray (n,)
+        The held-out prediction of each sample (NaN where its fold failed).
+    not_converged : int
+        Folds whose fit did not converge (their predictions are kept).
+    """
+
+    model: str
+    scheme: str
+    rmse: float
+    scatter: Scatter
+    ratio: float
+    verdict: str
+    folds: list[dict[str, Any]] = field(default_factory=list)
+    predictions: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
+    not_converged: int = 0
+
+    @property
+    def failed(self) -> int:
+        """Folds that could not be fitted."""
+        return sum(1 for f in self.folds if f["rmse"] is None)
+
+    def line(self) -> str:
+        """``"held-out RMSE (lovo) 2.1e-05 N m, scatter 1.5e-05 N m: misses by 1.37x"``."""
+        extra = []
+        if self.failed:
+            extra.append(f"{self.failed} of {len(self.folds)} folds could not be fitted")
+        if self.not_converged:
+            extra.append(f"{self.not_converged} fold fits did not converge")
+        tail = f" ({'; '.join(extra)})" if extra else ""
+        sc = f"{self.scatter.value:.3g} N m" if np.isfinite(self.scatter.value) else "unknown"
+        return (
+            f"held-out RMSE ({self.scheme}) {self.rmse:.3g} N m, scatter {sc}: {self.verdict}{tail}"
+        )
+
+    def to_dict(self) -> dict[str, Any]:
+        """For the model file (``validation``; JSON Schema ``model.schema.json``)."""
+        return {
+            "scheme": self.scheme,
+            "rmse": _finite(self.rmse),
+            "scatter": _finite(self.scatter.value),
+            "scatter_method": self.scatter.method,
+            "scatter_caveat": self.scatter.caveat,
+            "ratio": _finite(self.ratio),
+            "verdict": self.verdict,
+            "failed": self.failed,
+            "not_converged": self.not_converged,
+            "folds": self.folds,
+        }
+
+
+def _finite(x: float) -> float | None:
+    return float(x) if np.isfinite(x) else None
+
+
+def validate(
+    samples: FrictionSamples,
+    model: str,
+    scheme: str = "lovo",
+    method: str = "lm",
+    *,
+    scatter: Scatter | None = None,
+    seed: int | np.random.Generator | None = 0,
+    fixed: Mapping[str, float] | None = None,
+    bounds: Mapping[str, tuple[float, float]] | None = None,
+    **fit_options: Any,
+) -> Validation:
+    """Held-out RMSE of ``model`` on ``samples`` beside the measurement scatter.
+
+    Parameters
+    ----------
+    samples : FrictionSamples
+    model : str
+        A model name, as :func:`fricid.identify.fit` takes it (not ``"auto"``).
+    scheme : str, default "lovo"
+        ``lovo``, ``kfold`` or ``kfold:K`` (module docstring).
+    method : str, default "lm"
+        The optimiser of each fold's fit.
+    scatter : Scatter, optional
+        Default: :func:`measurement_scatter` of ``samples``.
+    seed : int or numpy.random.Generator, optional
+        The folds of ``kfold`` and each fold's fit.
+    fixed, bounds : mapping, optional
+        As :func:`fricid.identify.fit` takes them.
+    **fit_options
+        Passed to :func:`fricid.identify.fit` (``max_evals``, ``loss``, ``weights``, ...).
+        Weights given as ``"std"`` are computed per training fold.
+
+    Returns
+    -------
+    Validation
+
+    Notes
+    -----
+    The warnings of the fold fits are not repeated: a fold whose fit fails (too few
+    samples left, one direction missing) is counted in ``Validation.failed`` and noted in its
+    row; one that does not converge in ``Validation.not_converged``.
+    """
+    if str(model).strip().lower() == "auto":
+        raise ConfigError("validate a named model; model 'auto' validates its candidates itself")
+    labels = fold_labels(samples, scheme, seed)
+    scheme = scheme.strip().lower()
+    sc = scatter if scatter is not None else measurement_scatter(samples)
+    pred = np.full(len(samples), np.nan)
+    folds: list[dict[str, Any]] = []
+    not_converged = 0
+    for fold in np.unique(labels):
+        held = labels == fold
+        row: dict[str, Any] = {
+            "fold": int(fold),
+            "speed": float(np.mean(np.abs(samples.velocity[held]))),
+            "n": int(held.sum()),
+            "rmse": None,
+            "note": "",
+        }
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            try:
+                fitted = fit(
+                    samples.subset(~held),
+                    model,
+                    method,
+                    seed=seed,
+                    fixed=fixed,
+                    bounds=bounds,
+                    **fit_options,
+                )
+            except FricidError as exc:
+                row["note"] = f"not fitted: {exc}"
+                folds.append(row)
+                continue
+        if any(issubclass(w.category, ConvergenceWarning) for w in caught):
+            not_converged += 1
+            row["note"] = "did not converge"
+        pred[held] = fitted.predict(samples.X[held])
+        row["rmse"] = rmse(samples.y[held], pred[held])
+        folds.append(row)
+    ok = np.isfinite(pred)
+    err = rmse(samples.y[ok], pred[ok]) if ok.any() else float("nan")
+    ratio = err / sc.value if np.isfinite(sc.value) and sc.value > 0 else float("nan")
+    return Validation(
+        model=str(model),
+        scheme=scheme,
+        rmse=err,
+        scatter=sc,
+        ratio=ratio,
+        verdict=verdict(ratio) if np.isfinite(err) else "no fold could be fitted",
+        folds=folds,
+        predictions=pred,
+        not_converged=not_converged,
+    )
+
+
+#: Per-direction magnitudes further apart than this many scatters call for an ``_asym`` model.
+ASYMMETRY_SCATTERS = 3.0
+
+
+def asymmetry_note(samples: FrictionSamples, model: str, scatter: Scatter | None = None) -> str:
+    """A note when a symmetric model is fitted to samples whose directions differ.
+
+    Parameters
+    ----------
+    samples : FrictionSamples
+    model : str
+        The fitted model's name.
+    scatter : Scatter, optional
+        Default: :func:`measurement_scatter` of ``samples``.
+
+    Returns
+    -------
+    str
+        ``"direction asymmetry not modelled: |F| differs by 7.9e-04 N m between directions
+        (52x the scatter); try stribeck_asym"``, when the model is symmetric, both
+        directions are present at common speeds and the mean difference of ``|F|`` over those
+        speeds exceeds :data:`ASYMMETRY_SCATTERS` scatters; else ``""``.
+    """
+    name = str(model)
+    if name.endswith("_asym") or name == "rbf" or not {-1, 1} <= set(samples.directions()):
+        return ""
+    sc = scatter if scatter is not None else measurement_scatter(samples)
+    levels = level_labels(samples)
+    diffs = []
+    for lv in np.unique(levels):
+        k = levels == lv
+        pos, neg = k & (samples.direction > 0), k & (samples.direction < 0)
+        if pos.any() and neg.any():
+            diffs.append(np.abs(samples.y[pos]).mean() - np.abs(samples.y[neg]).mean())
+    if not diffs or not np.isfinite(sc.value) or sc.value <= 0:
+        return ""
+    gap = float(np.mean(diffs))
+    if abs(gap) <= ASYMMETRY_SCATTERS * sc.value:
+        return ""
+    return (
+        f"direction asymmetry not modelled: |F| differs by {abs(gap):.2g} N m between "
+        f"directions ({abs(gap) / sc.value:.3g}x the scatter); try {name}_asym"
+    )
