@@ -87,6 +87,14 @@ def _schema_validator():
     return Draft202012Validator(json.loads(text))
 
 
+#: Messages for the size limits of the schema (jsonschema's would print the whole value).
+_LIMITS = {
+    "maxLength": "text longer than {} characters",
+    "maxItems": "more than {} items",
+    "maxProperties": "more than {} properties",
+}
+
+
 def _validate_schema(d: dict[str, Any], source: str | None) -> None:
     """Raise a :class:`DataError` naming the file and the first failing field."""
     from jsonschema.exceptions import best_match
@@ -96,8 +104,10 @@ def _validate_schema(d: dict[str, Any], source: str | None) -> None:
     if error is None:
         return
     where = one_line("/".join(str(p) for p in error.absolute_path) or "(top level)")[:120]
-    message = one_line(error.message)
-    message = message if len(message) <= 200 else message[:197] + "..."
+    message = _LIMITS.get(error.validator, "").format(error.validator_value)
+    if not message:
+        message = one_line(error.message)
+        message = message if len(message) <= 200 else message[:197] + "..."
     raise DataError(
         f"field '{where}' does not match the model file schema (version {SCHEMA_VERSION}): "
         f"{message}",
@@ -334,6 +344,9 @@ class FittedModel:
                 out.theta()
             except ConfigError as exc:  # unknown model, or parameter names that do not match
                 raise DataError(one_line(str(exc)), file=source) from None
+        rows = out.correlation or []
+        if any(len(row) != len(rows) for row in rows):
+            raise DataError("field 'correlation': not a square matrix", file=source)
         for key in ("operating_range", "bounds"):
             for name, (low, high) in getattr(out, key).items():
                 if low > high:
