@@ -144,6 +144,11 @@ def test_files_that_are_not_model_json_are_refused(folder, name, content, words)
     refused(write(folder, name, content), *words)
 
 
+def test_a_folder_or_a_missing_file_is_refused(folder):
+    refused(folder, "cannot read the model file")
+    refused(folder / "missing.json", "cannot read the model file", "No such file")
+
+
 def test_brackets_inside_strings_do_not_count_as_nesting(folder, valid):
     d = doc(valid)
     d["method"] = "[" * 500
