@@ -316,3 +316,41 @@ def test_fuzzed_model_files_through_the_cli(folder, valid, family, kind, command
     out = Path(tempfile.mkdtemp(dir=folder)) / "out"
     outcome, detail = mf.classify_cli(path, command, out)
     assert outcome in ("error", "valid"), f"{family}/{kind}/{command}: {outcome}: {detail}"
+
+
+def _subschemas(node, path=()):
+    """Every subschema of the model schema, with its path."""
+    if isinstance(node, dict):
+        yield path, node
+        for key, value in node.items():
+            if key in ("properties", "$defs"):
+                for name, sub in value.items():
+                    yield from _subschemas(sub, (*path, key, name))
+            elif key in ("items", "additionalProperties", "propertyNames", "then", "if"):
+                yield from _subschemas(value, (*path, key))
+            elif key in ("allOf", "oneOf", "anyOf"):
+                for i, sub in enumerate(value):
+                    yield from _subschemas(sub, (*path, key, i))
+
+
+def test_every_number_array_string_and_object_of_the_schema_is_bounded():
+    bounds = {
+        "number": ("maximum",),
+        "integer": ("maximum",),
+        "array": ("maxItems",),
+        "string": ("maxLength", "enum", "const"),
+        "object": ("maxProperties",),
+    }
+    low = ("minimum", "exclusiveMinimum")
+    loose = []
+    for path, node in _subschemas(model_schema()):
+        if "if" in path or "$ref" in node or "enum" in node or "const" in node:
+            continue
+        types = node.get("type", [])
+        for kind in [types] if isinstance(types, str) else types:
+            unbounded = kind in bounds and not any(b in node for b in bounds[kind])
+            if kind in ("number", "integer") and not any(b in node for b in low):
+                unbounded = True
+            if unbounded:
+                loose.append(f"{'/'.join(map(str, path))}: {kind}")
+    assert not loose, loose
