@@ -288,7 +288,7 @@ def test_every_command_that_loads_a_model_exits_2_with_one_line(
 # -- fuzzing ----------------------------------------------------------------------------
 
 
-@settings(max_examples=100, **FUZZ)
+@settings(max_examples=200, **FUZZ)
 @given(
     family=st.sampled_from(mf.FAMILIES),
     kind=st.sampled_from(mf.KINDS),
@@ -303,7 +303,7 @@ def test_fuzzed_model_files_load_cleanly_or_predict_finite_friction(
     assert outcome in ("error", "valid"), f"{family}/{kind}: {outcome}: {detail}"
 
 
-@settings(max_examples=25, **FUZZ)
+@settings(max_examples=40, **FUZZ)
 @given(
     family=st.sampled_from(mf.FAMILIES),
     kind=st.sampled_from(mf.KINDS),
