@@ -6,10 +6,19 @@ It is what ``identify.fit`` returns and what the JSON model file holds; reports,
 (:func:`fricid.models.get_predictor`): analytic models take the parameter vector, the RBF
 network its stored ``state``. :meth:`FittedModel.report` prints a fit report after lmfit's
 ``fit_report`` from what the file stores.
+
+A model file may come from a stranger, so loading is strict (issue 12): the file is read by
+:func:`fricid.io._jsonfile.read_json` (at most 64 MiB, UTF-8, nesting at most 64 deep, no
+NaN, Infinity or overflowing numbers, no repeated keys), checked against the JSON Schema
+(finite numbers, bounded sizes, identifier names, the RBF network's typed arrays), and
+:meth:`FittedModel.from_dict` refuses ranges whose minimum exceeds their maximum and a model
+that cannot be evaluated, or predicts a non-finite friction, on its operating range. Every
+failure is one :class:`~fricid.errors.DataError` line naming the file given.
 """
 
 from __future__ import annotations
 
+import itertools
 import json
 import warnings
 from dataclasses import asdict, dataclass, field
@@ -21,7 +30,8 @@ from typing import Any
 import numpy as np
 
 from . import __version__
-from .errors import ConfigError, DataError, ExtrapolationWarning
+from .errors import ConfigError, DataError, ExtrapolationWarning, FricidError
+from .io._jsonfile import check_document, one_line, read_json
 from .models import INPUTS, get_model, get_predictor
 from .models._range import RANGE_TOLERANCE, RangeViolation, range_violations
 from .models.rbf import legacy_symmetry
@@ -91,15 +101,27 @@ def _schema_validator():
     return Draft202012Validator(json.loads(text))
 
 
+#: Messages for the size limits of the schema (jsonschema's would print the whole value).
+_LIMITS = {
+    "maxLength": "text longer than {} characters",
+    "maxItems": "more than {} items",
+    "maxProperties": "more than {} properties",
+}
+
+
 def _validate_schema(d: dict[str, Any], source: str | None) -> None:
     """Raise a :class:`DataError` naming the file and the first failing field."""
     from jsonschema.exceptions import best_match
 
-    error = best_match(_schema_validator().iter_errors(d))
+    # the first errors suffice to name one; a hostile file may have millions
+    error = best_match(itertools.islice(_schema_validator().iter_errors(d), 1000))
     if error is None:
         return
-    where = "/".join(str(p) for p in error.absolute_path) or "(top level)"
-    message = error.message if len(error.message) <= 200 else error.message[:197] + "..."
+    where = one_line("/".join(str(p) for p in error.absolute_path) or "(top level)")[:120]
+    message = _LIMITS.get(error.validator, "").format(error.validator_value)
+    if not message:
+        message = one_line(error.message)
+        message = message if len(message) <= 200 else message[:197] + "..."
     raise DataError(
         f"field '{where}' does not match the model file schema (version {SCHEMA_VERSION}): "
         f"{message}",
@@ -404,8 +426,26 @@ class FittedModel:
 
     @classmethod
     def from_dict(cls, d: dict[str, Any], source: str | None = None) -> FittedModel:
-        """A model from the JSON object of a model file (``source`` names it in errors).
+        """The model a parsed model file describes, checked as strictly as :meth:`load`.
 
+        Parameters
+        ----------
+        d : dict
+            The parsed JSON document.
+        source : str, optional
+            The file it came from, named in every error.
+
+        Raises
+        ------
+        DataError
+            The document is not a model file of a version this fricid reads, does not match
+            the schema (``fricid/schemas/model.schema.json``: finite numbers of at most 1e300
+            in magnitude, bounded sizes), names an unknown model or parameters, has a range or
+            bound whose minimum exceeds its maximum, or gives a model that cannot be
+            evaluated, or predicts a non-finite friction, on its operating range.
+
+        Notes
+        -----
         An RBF network from before ``state["symmetry"]`` was recorded is read with
         :func:`fricid.models.rbf.legacy_symmetry`: trained on combined samples (provenance
         directions ``[0]``, so on ``v > 0`` only) it is read as odd, ``F = sign(v) g(|v|)``,
@@ -414,6 +454,7 @@ class FittedModel:
         """
         if not isinstance(d, dict):
             raise DataError("a model file must hold a JSON object", file=source)
+        check_document(d, source)
         version = d.get("schema_version")
         if not isinstance(version, int):
             raise DataError("not a fricid model file (no integer 'schema_version')", file=source)
@@ -435,7 +476,7 @@ class FittedModel:
         try:
             stateful = get_predictor(out.model).stateful
         except ConfigError as exc:
-            raise DataError(str(exc), file=source) from None
+            raise DataError(one_line(str(exc)), file=source) from None
         if stateful and isinstance(out.state, dict) and "symmetry" not in out.state:
             # a network written before the symmetry was recorded: one on combined samples
             # (v > 0) is read as odd, which repairs its sign at v < 0 (issue 11, defect 1)
@@ -445,8 +486,52 @@ class FittedModel:
             try:
                 out.theta()
             except ConfigError as exc:  # unknown model, or parameter names that do not match
-                raise DataError(str(exc), file=source) from None
+                raise DataError(one_line(str(exc)), file=source) from None
+        rows = out.correlation or []
+        if any(len(row) != len(rows) for row in rows):
+            raise DataError("field 'correlation': not a square matrix", file=source)
+        for key in ("operating_range", "bounds"):
+            for name, (low, high) in getattr(out, key).items():
+                if low > high:
+                    raise DataError(
+                        f"field '{key}/{name}': the minimum {low!r} exceeds the maximum {high!r}",
+                        file=source,
+                    )
+        out._check_predictions(source)
         return out
+
+    def _check_predictions(self, source: str | None) -> None:
+        """Evaluate the model on a grid over its operating range; a model that cannot be
+        evaluated, or predicts a non-finite friction, there gives a :class:`DataError`.
+
+        The grid takes each input's minimum, middle and maximum, and zero where the range
+        spans it (sign(v) and the viscous terms change there); an input without a recorded
+        range takes velocities +-0.01 and +-1 rad/s and zero, load 0 N m and 25 degC.
+        """
+        X = _probe_inputs(self.operating_range)
+        model = get_predictor(self.model)
+        with warnings.catch_warnings(), np.errstate(all="ignore"):
+            warnings.simplefilter("ignore")  # extrapolation and the like: not the question here
+            try:
+                y = np.asarray(model.predict(self.state if model.stateful else self.theta(), X))
+            except FricidError as exc:
+                column = getattr(exc, "column", None)
+                where = f"field '{column.replace('.', '/')}': " if column else ""
+                message = one_line(getattr(exc, "message", str(exc)))
+                raise DataError(where + message, file=source) from None
+            except (TypeError, ValueError, IndexError, KeyError, ArithmeticError) as exc:
+                # the trust boundary: whatever the file holds, loading it ends in a DataError
+                raise DataError(
+                    f"the model cannot be evaluated: {one_line(str(exc))[:200]}", file=source
+                ) from None
+        bad = ~np.isfinite(y.astype(float, copy=False))
+        if y.shape != (len(X),) or bad.any():
+            at = X[int(np.argmax(bad))] if y.shape == (len(X),) else X[0]
+            raise DataError(
+                f"the model predicts a non-finite friction on its operating range (at velocity "
+                f"{at[0]:g} rad/s, load {at[1]:g} N m, temperature {at[2]:g} degC)",
+                file=source,
+            )
 
     def save(self, path: str | PathLike[str]) -> Path:
         """Write the model as JSON, atomically."""
@@ -460,14 +545,37 @@ class FittedModel:
 
     @classmethod
     def load(cls, path: str | PathLike[str]) -> FittedModel:
-        """Read a JSON model file; a bad or newer file gives a :class:`DataError`."""
-        path = Path(path)
-        try:
-            text = path.read_text(encoding="utf-8")
-        except OSError as exc:
-            raise DataError(f"cannot read the model file: {exc.strerror}", file=path) from None
-        try:
-            d = json.loads(text)
-        except json.JSONDecodeError as exc:
-            raise DataError(f"not valid JSON: {exc.msg}", file=path, row=exc.lineno) from None
+        """Read a JSON model file strictly (see the module notes and :meth:`from_dict`).
+
+        Raises
+        ------
+        DataError
+            One line naming ``path`` as given: the file cannot be read, is over 64 MiB, not
+            UTF-8, not JSON, nested over 64 deep, holds NaN, Infinity or a number beyond
+            1e300, is of a newer version, does not match the schema, or gives a model that
+            does not predict finite friction on its operating range.
+        """
+        d = read_json(path, what="model file")
         return cls.from_dict(d, source=str(path))
+
+
+#: Velocities probed where a model file records no velocity range [rad/s].
+_PROBE_VELOCITY = (-1.0, -0.01, 0.0, 0.01, 1.0)
+#: Load [N m] and temperature [degC] probed where a model file records no range.
+_PROBE_DEFAULT = {"load": (0.0,), "temperature": (25.0,)}
+
+
+def _probe_inputs(operating_range: dict[str, list[float]]) -> np.ndarray:
+    """Inputs (n, 3) on which loading evaluates a model: see ``_check_predictions``."""
+    axes = []
+    for name in INPUTS:
+        span = operating_range.get(name)
+        if span is None:
+            axes.append(_PROBE_VELOCITY if name == "velocity" else _PROBE_DEFAULT[name])
+            continue
+        low, high = float(span[0]), float(span[1])
+        points = {low, high, low / 2 + high / 2}
+        if low < 0 < high:
+            points.add(0.0)
+        axes.append(sorted(points))
+    return np.array(list(itertools.product(*axes)), dtype=float)
