@@ -129,10 +129,11 @@ def extract_command(
     gravity: Annotated[
         str | None,
         typer.Option(
-            help="fit (joint with gravity: eq. 7, 11, 12) "
-            "or none (horizontal joint: torque is "
-            "friction). Default: from the log's design, "
-            "else fit with positions, none without."
+            help="fit (joint with gravity: eq. 7, 11, 12; where the two directions do not "
+            "cover the same positions it falls back to joint, with a note), joint (eq. 7 and "
+            "one friction per set-point and direction by least squares over all steady "
+            "samples, no pairing: e.g. --gravity joint) or none (horizontal joint: torque is "
+            "friction). Default: from the log's design, else fit with positions, none without."
         ),
     ] = None,
     flip_sign: Annotated[

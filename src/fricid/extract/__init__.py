@@ -7,6 +7,9 @@
 Modules: :mod:`.segment` (constant-velocity segments, set-point clustering), :mod:`.steady`
 (settling, outliers, saturation, rest), :mod:`.accumulate` (per-segment checks and statistics),
 :mod:`.bins` (position bins, repetition averaging), :mod:`.gravity` (eq. 7 and 11),
+:mod:`.joint_gravity` (eq. 7 with per-set-point friction, no pairing), :mod:`.separation`
+(step 4: friction, gravity and the sample tables), :mod:`.torque_constant` (K of eq. 13 from
+current and a torque sensor),
 :mod:`.quality` (the per-set-point quality table and its warnings), :mod:`.pipeline`
 (:func:`extract`).
 """
@@ -15,6 +18,7 @@ from __future__ import annotations
 
 from .bins import Cells, CellTable, Pooled, PositionBins, pool_cells
 from .gravity import GravityFit, fit_gravity, separate
+from .joint_gravity import JointGravityFit, fit_gravity_joint, moments
 from .pipeline import GRAVITY_MODES, SPIKE_SIGMAS, Diagnostics, ExtractionResult, extract
 from .quality import QUALITY_COLUMNS, SCATTER_RATIO, QualityTable, flag_scatter, warn_quality
 from .segment import Segment, SegmentCounts, cluster, iter_segments
@@ -32,6 +36,7 @@ __all__ = [
     "Diagnostics",
     "ExtractionResult",
     "GravityFit",
+    "JointGravityFit",
     "Pooled",
     "PositionBins",
     "QualityTable",
@@ -40,8 +45,10 @@ __all__ = [
     "cluster",
     "extract",
     "fit_gravity",
+    "fit_gravity_joint",
     "flag_scatter",
     "iter_segments",
+    "moments",
     "outliers",
     "pool_cells",
     "saturated",
