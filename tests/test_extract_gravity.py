@@ -125,3 +125,28 @@ def test_joint_fit_recovers_a_known_line_exactly():
     fit = fit_gravity_joint(stats, group, direction)
     np.testing.assert_allclose([fit.p_x, fit.p_y], p, atol=1e-9)
     np.testing.assert_allclose(fit.load_friction, q, atol=1e-9)
+
+
+def test_cli_simulate_split_then_extract_joint(tmp_path):
+    from typer.testing import CliRunner
+
+    from fricid.cli import app
+
+    runner = CliRunner()
+    log = tmp_path / "split.parquet"
+    res = runner.invoke(
+        app, ["simulate", "--size", "quick", "--coverage", "split", "-o", str(log), "--seed", "2"]
+    )
+    assert res.exit_code == 0, res.output
+    res = runner.invoke(app, ["extract", str(log), "-o", str(tmp_path / "a.csv")])
+    assert res.exit_code == 0, res.output
+    text = " ".join(res.output.split())
+    assert "note: eq. 11 separates" in text and "gravity='joint'" in text
+    res = runner.invoke(
+        app, ["extract", str(log), "-o", str(tmp_path / "b.csv"), "--gravity", "joint"]
+    )
+    assert res.exit_code == 0, res.output
+    assert "joint fit with 12 set-point frictions, no pairing" in " ".join(res.output.split())
+    assert "note:" not in res.output
+    bad = runner.invoke(app, ["simulate", "--coverage", "half", "-o", str(tmp_path / "x.csv")])
+    assert bad.exit_code == 2 and "coverage" in bad.output
