@@ -71,6 +71,7 @@ def test_one_sided_coverage_falls_back_to_the_joint_fit(split1):
     assert r.options["gravity"] == "joint" and r.options["gravity_requested"] == "fit"
     assert len(r.notes) == 1 and "lack one" in r.notes[0] and "gravity='joint'" in r.notes[0]
     assert "note: eq. 11" in r.summary() and "no pairing" in r.summary()
+    assert r.summary().count(" rad/s ") >= 12  # every set-point friction, with its error
     g = r.gravity
     p_x, p_y = true_gravity(split1)
     assert abs(g.p_x - p_x) <= Z * g.p_x_se and abs(g.p_y - p_y) <= Z * g.p_y_se

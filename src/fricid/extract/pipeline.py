@@ -160,11 +160,26 @@ class ExtractionResult:
                 f"gravity (eq. 7{how}): p_x = {g.p_x:.5g} +- {g.p_x_se:.2g}, "
                 f"p_y = {g.p_y:.5g} +- {g.p_y_se:.2g} N m, residual {g.residual_rms:.2g} N m"
             )
+        if isinstance(self.gravity, JointGravityFit):
+            lines.append(self._joint_frictions())
         lines.extend(f"note: {n}" for n in self.notes)
         if self.quality is not None and self.quality.flagged.any():
             lines.append("set-points flagged (scatter far above their neighbours):")
             lines.append(self.quality.subset(self.quality.flagged).describe())
         return "\n".join(lines)
+
+    def _joint_frictions(self) -> str:
+        """The joint fit's friction per set-point and direction, with standard errors."""
+        g, d = self.gravity, self.diagnostics
+        nv = d.velocity_setpoints.size
+        parts = []
+        for label, f, se in zip(g.group, g.friction, g.friction_se, strict=True):
+            it, rem = divmod(int(label), 2 * nv)
+            iv, fwd = divmod(rem, 2)
+            v = d.velocity_setpoints[iv] * (1 if fwd else -1)
+            temperature = d.temperature_setpoints[it]
+            parts.append(f"{temperature:.4g} degC {v:+.4g} rad/s {f:+.4g}+-{se:.2g}")
+        return "set-point friction [N m] (joint fit): " + "; ".join(parts)
 
 
 class _Source:
