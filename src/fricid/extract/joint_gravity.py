@@ -58,6 +58,7 @@ MOMENT_SIZE = 10
 
 # index pairs of the co-moment entries, in the order stored
 _PAIRS = ((0, 0), (0, 1), (1, 1), (0, 2), (1, 2), (2, 2))
+_ROWS, _COLS = (np.array(k) for k in zip(*_PAIRS, strict=True))
 
 
 def moments(theta, tau) -> np.ndarray:
@@ -77,12 +78,22 @@ def moments(theta, tau) -> np.ndarray:
         their sums of cross-products about those means (two-pass, so exact in floating point).
     """
     theta = np.asarray(theta, dtype=float)
-    x = np.stack([-np.cos(theta), np.sin(theta), np.asarray(tau, dtype=float)])
-    n = x.shape[1]
+    n = theta.size
     out = np.zeros(MOMENT_SIZE)
     out[0] = n
     if n == 0:
         return out
+    x = np.empty((3, n))
+    np.cos(theta, out=x[0])
+    np.negative(x[0], out=x[0])
+    np.sin(theta, out=x[1])
+    x[2] = tau
+    mean = x.mean(axis=1)
+    x -= mean[:, None]
+    c = x @ x.T
+    out[1:4] = mean
+    out[4:] = c[_ROWS, _COLS]
+    return out
     mean = x.mean(axis=1)
     d = x - mean[:, None]
     out[1:4] = mean
