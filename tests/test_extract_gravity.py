@@ -58,6 +58,10 @@ def test_joint_and_eq11_agree_on_the_virtual_joint(quick1, full_log):
         assert abs(a - b) <= 2 * se, (name, a, b, se)
     p_x, p_y = true_gravity(quick1)
     assert abs(joint.p_x - p_x) <= Z * joint.p_x_se and abs(joint.p_y - p_y) <= Z * joint.p_y_se
+    # the joint fit uses every steady sample, inside the position bins or not: no bins needed
+    unbinned = extract(full_log, gravity="joint")
+    assert (unbinned.gravity.p_x, unbinned.gravity.p_y) == (joint.p_x, joint.p_y)
+    assert len(unbinned.samples) == 3 * 2  # one row per velocity and temperature
     # one friction per set-point and direction, with its standard error
     assert joint.friction.size == 2 * 3 * 2 and np.all(joint.friction_se > 0)
     assert np.all(np.sign(joint.friction) == np.where(joint.group % 2 == 1, 1, -1))
