@@ -23,6 +23,7 @@ from .pipeline import GRAVITY_MODES, SPIKE_SIGMAS, Diagnostics, ExtractionResult
 from .quality import QUALITY_COLUMNS, SCATTER_RATIO, QualityTable, flag_scatter, warn_quality
 from .segment import Segment, SegmentCounts, cluster, iter_segments
 from .steady import OUTLIER_SIGMAS, SETTLE_SIGMAS, outliers, saturated, settled
+from .torque_constant import TorqueConstantFit, fit_torque_constant, torque_constant_from_gravity
 
 __all__ = [
     "GRAVITY_MODES",
@@ -41,11 +42,13 @@ __all__ = [
     "PositionBins",
     "QualityTable",
     "Segment",
+    "TorqueConstantFit",
     "SegmentCounts",
     "cluster",
     "extract",
     "fit_gravity",
     "fit_gravity_joint",
+    "fit_torque_constant",
     "flag_scatter",
     "iter_segments",
     "moments",
@@ -54,5 +57,6 @@ __all__ = [
     "saturated",
     "separate",
     "settled",
+    "torque_constant_from_gravity",
     "warn_quality",
 ]
