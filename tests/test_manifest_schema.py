@@ -41,8 +41,8 @@ def test_schema_mirrors_the_registries():
     assert PROPERTIES["direction"]["enum"] == list(DIRECTIONS)
     assert PROPERTIES["samples"]["enum"] == list(SAMPLE_SETS)
     options = {o for opts in READER_OPTIONS.values() for o in opts}
-    reader_fields = {n for n, f in FIELDS.items() if f.group == "reader"}
-    assert reader_fields <= options  # every reader column is some reader's option
+    reader_fields = {f.option for f in FIELDS.values() if f.group == "reader"}
+    assert reader_fields <= options  # every reader column fills some reader's option
 
 
 def test_a_document_validates_against_the_schema():

@@ -148,6 +148,20 @@ def _format_help() -> str:
     )
 
 
+def _print_torque_constant(log: Path, fmt: str, reader_options: dict, chunk_rows: int) -> None:
+    """``--identify-torque-constant``: K (and the efficiency) from current and torque."""
+    from ..extract.torque_constant import fit_torque_constant
+    from ..io import open_log
+
+    opened = open_log(log, fmt, reader_options, chunk_rows=chunk_rows)
+    if not hasattr(opened, "__next__"):
+        raise ConfigError(
+            "--identify-torque-constant needs a log of samples over time with both a current "
+            "and a torque column, not a folder of steady-state recordings"
+        )
+    console.print(fit_torque_constant(opened).summary(), markup=False, highlight=False)
+
+
 @app.command("extract", epilog=_format_help())
 @handle_errors
 def extract_command(
@@ -278,10 +292,11 @@ def extract_command(
     gravity: Annotated[
         str | None,
         typer.Option(
-            help="fit (joint with gravity: eq. 7, 11, 12) "
-            "or none (horizontal joint: torque is "
-            "friction). Default: from the log's design, "
-            "else fit with positions, none without."
+            help="fit (joint with gravity: eq. 7, 11, 12; where the two directions do not "
+            "cover the same positions it falls back to joint, with a note), joint (eq. 7 and "
+            "one friction per set-point and direction by least squares over all steady "
+            "samples, no pairing: e.g. --gravity joint) or none (horizontal joint: torque is "
+            "friction). Default: from the log's design, else fit with positions, none without."
         ),
     ] = None,
     flip_sign: Annotated[
@@ -306,6 +321,16 @@ def extract_command(
     chunk_rows: Annotated[
         int, typer.Option(help="Rows read at a time (bounded memory).")
     ] = 1_000_000,
+    identify_torque_constant: Annotated[
+        bool,
+        typer.Option(
+            "--identify-torque-constant",
+            help="Also identify K of tau = K I (eq. 13) from a log with both motor current and "
+            "a joint torque sensor (e.g. --map current=i:A --map torque=tau_j:Nm), with its "
+            "95 % interval and, when both power flows were logged, the gear efficiency; "
+            "printed before the samples are written (reads the log a second time).",
+        ),
+    ] = False,
 ) -> None:
     """Extract friction samples from a raw log: segment the constant-velocity traverses, median
     filter the current, torque = K I (eq. 13), average the repetitions per position bin,
@@ -397,6 +422,8 @@ def extract_command(
             chunk_rows=chunk_rows,
             on_chunk=advance,
         )
+    if identify_torque_constant:
+        _print_torque_constant(log, fmt, reader_options, chunk_rows)
     write_samples(data.samples, out)
     if by_direction is not None:
         write_samples(data.by_direction, by_direction)

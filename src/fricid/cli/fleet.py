@@ -71,7 +71,13 @@ def _drift_table(drift) -> Table:
     return table
 
 
-@app.command("fleet")
+def _manifest_help() -> str:
+    from ..fleet._manifest_schema import describe_columns
+
+    return describe_columns()
+
+
+@app.command("fleet", epilog=_manifest_help())
 @handle_errors
 def fleet_command(
     manifest: Annotated[
@@ -79,10 +85,10 @@ def fleet_command(
         typer.Argument(
             help=(
                 "Manifest, .csv or .yaml: one row per joint with robot, joint, log (relative to "
-                "the manifest) and optionally date, reader (table, generic, rosbag, epos), model "
-                "(several: 'msk;vlt'), method, seed, fix (NAME=VALUE;...), bound "
-                "(NAME=LOW:HIGH;...), positions [deg], gravity, ... (the JSON Schema "
-                "fricid/schemas/manifest.schema.json lists every column)."
+                "the manifest: a file, an EPOS folder or a ROS 2 bag folder or .mcap file) and "
+                "any column below (every reader and reader option of `fricid extract`); a "
+                "dimensional column names its unit ('positions [deg]'). The JSON Schema "
+                "fricid/schemas/manifest.schema.json defines every column."
             ),
         ),
     ],

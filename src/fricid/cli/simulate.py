@@ -49,6 +49,14 @@ def simulate_command(
         ),
     ] = "reduced",
     seed: Annotated[int, typer.Option(help="Random seed (same seed, same log).")] = 0,
+    coverage: Annotated[
+        str,
+        typer.Option(
+            help="both (each direction over the whole range) or split (forward runs logged on "
+            "the lower half of the range, backward runs on the upper half: eq. 11 cannot pair "
+            "them, extract identifies gravity jointly)."
+        ),
+    ] = "both",
 ) -> None:
     """Simulate a bidirectional constant-velocity campaign on the virtual joint and write its
     raw log: time [s], position [rad], velocity [rad/s], motor current [A] (torque = K I),
@@ -58,6 +66,7 @@ def simulate_command(
     from ..sim import simulate
 
     scenario = get_preset(preset, size)
+    scenario = replace(scenario, design=replace(scenario.design, coverage=coverage))
     hints = design_hints(scenario)
     n_t, n_v, _ = scenario.design.shape
 

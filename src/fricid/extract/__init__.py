@@ -7,6 +7,9 @@
 Modules: :mod:`.segment` (constant-velocity segments, set-point clustering), :mod:`.steady`
 (settling, outliers, saturation, rest), :mod:`.accumulate` (per-segment checks and statistics),
 :mod:`.bins` (position bins, repetition averaging), :mod:`.gravity` (eq. 7 and 11),
+:mod:`.joint_gravity` (eq. 7 with per-set-point friction, no pairing), :mod:`.separation`
+(step 4: friction, gravity and the sample tables), :mod:`.torque_constant` (K of eq. 13 from
+current and a torque sensor),
 :mod:`.quality` (the per-set-point quality table and its warnings), :mod:`.pipeline`
 (:func:`extract`).
 """
@@ -15,10 +18,12 @@ from __future__ import annotations
 
 from .bins import Cells, CellTable, Pooled, PositionBins, pool_cells
 from .gravity import GravityFit, fit_gravity, separate
+from .joint_gravity import JointGravityFit, fit_gravity_joint, moments
 from .pipeline import GRAVITY_MODES, SPIKE_SIGMAS, Diagnostics, ExtractionResult, extract
 from .quality import QUALITY_COLUMNS, SCATTER_RATIO, QualityTable, flag_scatter, warn_quality
 from .segment import Segment, SegmentCounts, cluster, iter_segments
 from .steady import OUTLIER_SIGMAS, SETTLE_SIGMAS, outliers, saturated, settled
+from .torque_constant import TorqueConstantFit, fit_torque_constant, torque_constant_from_gravity
 
 __all__ = [
     "GRAVITY_MODES",
@@ -32,20 +37,26 @@ __all__ = [
     "Diagnostics",
     "ExtractionResult",
     "GravityFit",
+    "JointGravityFit",
     "Pooled",
     "PositionBins",
     "QualityTable",
     "Segment",
     "SegmentCounts",
+    "TorqueConstantFit",
     "cluster",
     "extract",
     "fit_gravity",
+    "fit_gravity_joint",
+    "fit_torque_constant",
     "flag_scatter",
     "iter_segments",
+    "moments",
     "outliers",
     "pool_cells",
     "saturated",
     "separate",
     "settled",
+    "torque_constant_from_gravity",
     "warn_quality",
 ]

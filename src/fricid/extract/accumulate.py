@@ -16,6 +16,7 @@ import numpy as np
 from scipy.ndimage import median_filter
 
 from .bins import Cells, CellTable, PositionBins
+from .joint_gravity import moments
 from .quality import QUALITY_COLUMNS, QualityTable
 from .segment import Segment
 from .steady import OUTLIER_SIGMAS, SETTLE_SIGMAS, outliers, rest_threshold, saturated, settled
@@ -60,6 +61,7 @@ class Record:
     kept: int  # kept samples (inside or outside the position bins)
     cells: Cells
     spikes: int
+    moments: np.ndarray | None = None  # :func:`.joint_gravity.moments` of the kept samples
 
 
 class Accumulator:
@@ -77,6 +79,8 @@ class Accumulator:
         Threshold of :func:`~.steady.settled` (None: no settling detection).
     min_samples : int
         Fewest samples a segment must keep after the checks.
+    moments : bool
+        Also keep each segment's :func:`~.joint_gravity.moments` (for ``gravity="joint"``).
     """
 
     def __init__(
@@ -87,7 +91,9 @@ class Accumulator:
         outlier_sigmas: float | None = OUTLIER_SIGMAS,
         settle_sigmas: float | None = SETTLE_SIGMAS,
         min_samples: int = 20,
+        moments: bool = False,
     ) -> None:
+        self.moments = moments
         self.bins = bins
         self.window = window
         self.outlier_sigmas = outlier_sigmas
@@ -141,6 +147,7 @@ class Accumulator:
                 kept=int(keep.sum()),
                 cells=cells,
                 spikes=spikes,
+                moments=moments(log.position[keep], tau[keep]) if self.moments else None,
             )
         )
 

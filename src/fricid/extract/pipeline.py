@@ -5,7 +5,9 @@
 2. Median-filter the motor torque ``tau = K I`` (eq. 13) within each segment.
 3. Bin by position and average over the repetitions (:mod:`.bins`).
 4. Separate friction and gravity by eq. 11, fit eq. 7 and take the fitted gravity torque at
-   each bin as its load (eq. 12) (:mod:`.gravity`); or, for a horizontal joint
+   each bin as its load (eq. 12) (:mod:`.gravity`); or, where the two directions do not cover
+   the same positions, identify eq. 7 and each set-point's friction jointly
+   (``gravity="joint"``, :mod:`.joint_gravity`); or, for a horizontal joint
    (``gravity="none"``, RWSAVSBAS paper section 2.1), take the torque as the friction.
 """
 
@@ -22,9 +24,11 @@ from ..errors import ConfigError, DataError
 from ..samples import FrictionSamples, RawLog
 from .accumulate import SPIKE_SIGMAS, Accumulator
 from .bins import PositionBins, pool_cells
-from .gravity import GravityFit, fit_gravity, separate
+from .gravity import GravityFit
+from .joint_gravity import JointGravityFit, fit_gravity_joint
 from .quality import QualityTable, flag_scatter, warn_quality
 from .segment import SegmentCounts, as_log_stream, cluster, iter_segments
+from .separation import assemble
 from .steady import OUTLIER_SIGMAS, SETTLE_SIGMAS
 
 __all__ = ["GRAVITY_MODES", "SPIKE_SIGMAS", "Diagnostics", "ExtractionResult", "extract"]
@@ -32,7 +36,7 @@ __all__ = ["GRAVITY_MODES", "SPIKE_SIGMAS", "Diagnostics", "ExtractionResult", "
 logger = logging.getLogger(__name__)
 
 #: Values of ``extract(..., gravity=...)``.
-GRAVITY_MODES = ("fit", "none")
+GRAVITY_MODES = ("fit", "joint", "none")
 
 
 @dataclass(frozen=True, eq=False)
@@ -94,8 +98,9 @@ class ExtractionResult:
         The same operating points per direction (+1/-1, velocity and friction signed; rows
         ordered as ``samples`` with -1 before +1): ``tau_f+- = tau+- + tau_g`` with the fitted
         gravity, which keeps a drive's asymmetry.
-    gravity : GravityFit or None
-        The eq. 7 fit, or None with ``gravity="none"``.
+    gravity : GravityFit, JointGravityFit or None
+        The eq. 7 fit (eq. 11 pairing, or the joint fit with its per-set-point frictions), or
+        None with ``gravity="none"``.
     diagnostics : Diagnostics
         What was read, kept and dropped.
     sem, direction_sem : numpy.ndarray
@@ -109,17 +114,21 @@ class ExtractionResult:
         Per set-point and direction, samples kept and dropped (rest, transient, outlier,
         saturated) and their scatter (also in ``samples.meta["quality"]``, so it is written
         with the samples).
+    notes : tuple of str
+        What the user should know about how the result was obtained (e.g. eq. 11 pairing
+        impossible, gravity identified jointly instead).
     """
 
     samples: FrictionSamples
     by_direction: FrictionSamples
-    gravity: GravityFit | None
+    gravity: GravityFit | JointGravityFit | None
     diagnostics: Diagnostics
     sem: np.ndarray
     direction_sem: np.ndarray
     position: np.ndarray
     options: dict[str, Any] = field(default_factory=dict)
     quality: QualityTable | None = None
+    notes: tuple[str, ...] = ()
 
     def summary(self) -> str:
         """A few lines describing the result (for a report or the CLI)."""
@@ -144,14 +153,33 @@ class ExtractionResult:
             )
         if self.gravity is not None:
             g = self.gravity
+            how = ""
+            if isinstance(g, JointGravityFit):
+                how = f", joint fit with {g.friction.size} set-point frictions, no pairing"
             lines.append(
-                f"gravity (eq. 7): p_x = {g.p_x:.5g} +- {g.p_x_se:.2g}, "
+                f"gravity (eq. 7{how}): p_x = {g.p_x:.5g} +- {g.p_x_se:.2g}, "
                 f"p_y = {g.p_y:.5g} +- {g.p_y_se:.2g} N m, residual {g.residual_rms:.2g} N m"
             )
+        if isinstance(self.gravity, JointGravityFit):
+            lines.append(self._joint_frictions())
+        lines.extend(f"note: {n}" for n in self.notes)
         if self.quality is not None and self.quality.flagged.any():
             lines.append("set-points flagged (scatter far above their neighbours):")
             lines.append(self.quality.subset(self.quality.flagged).describe())
         return "\n".join(lines)
+
+    def _joint_frictions(self) -> str:
+        """The joint fit's friction per set-point and direction, with standard errors."""
+        g, d = self.gravity, self.diagnostics
+        nv = d.velocity_setpoints.size
+        parts = []
+        for label, f, se in zip(g.group, g.friction, g.friction_se, strict=True):
+            it, rem = divmod(int(label), 2 * nv)
+            iv, fwd = divmod(rem, 2)
+            v = d.velocity_setpoints[iv] * (1 if fwd else -1)
+            temperature = d.temperature_setpoints[it]
+            parts.append(f"{temperature:.4g} degC {v:+.4g} rad/s {f:+.4g}+-{se:.2g}")
+        return "set-point friction [N m] (joint fit): " + "; ".join(parts)
 
 
 class _Source:
@@ -212,11 +240,16 @@ def extract(
         Samples of the running median applied to the torque within each segment (odd; 1
         disables it). It removes current spikes (section 2.2: "further filtered by median
         filtering").
-    gravity : {"fit", "none"}
-        "fit": a joint with gravity; eq. 11 needs both directions at every operating point,
-        eq. 7 is fitted and gives the loads (eq. 12). "none": a horizontal joint; the torque is
-        the friction, load 0; eq. 11 combines the directions where both exist, a single
-        direction is used as measured.
+    gravity : {"fit", "joint", "none"}
+        "fit": a joint with gravity, the paper's method; eq. 11 pairs both directions at every
+        operating point, eq. 7 is fitted and gives the loads (eq. 12). Where a set-point lacks
+        one direction in some bin, pairing is impossible and "joint" is used instead (with a
+        note in ``notes``). "joint": eq. 7 and one friction per set-point and direction
+        identified together by linear least squares over all steady samples
+        (:func:`~.joint_gravity.fit_gravity_joint`); needs no pairing, nor position bins; a
+        row with one direction is that direction's friction with gravity removed. "none": a
+        horizontal joint; the torque is the friction, load 0; eq. 11 combines the directions
+        where both exist, a single direction is used as measured.
     velocity_tolerance : float
         Relative band around a run's plateau velocity that counts as steady.
     settle_time : float
@@ -261,7 +294,8 @@ def extract(
     DataError
         No constant-velocity segment (the message counts the runs dropped, by reason); one
         direction only where eq. 11 needs two (it lists the set-points and the missing
-        direction); a gravity fit without two distinct positions.
+        direction) when the joint fit cannot stand in either; a gravity fit without two
+        distinct positions.
     ConfigError
         Bad options, among them ``gravity="fit"`` without ``positions``.
     """
@@ -288,6 +322,7 @@ def extract(
         outlier_sigmas=outlier_sigmas,
         settle_sigmas=settle_sigmas,
         min_samples=int(min_samples),
+        moments=gravity != "none",
     )
     for seg in segments:
         acc.add(seg)
@@ -345,9 +380,22 @@ def extract(
         )
     )
     meta = {"extract": options, "quality": quality.rows()}
-    samples, by_direction, fit, sem, direction_sem, position = _assemble(
-        pooled, shape, t_set, v_set, gravity, source, meta
+
+    def joint_fit() -> JointGravityFit:
+        forward = np.array([r.direction > 0 for r in kept], dtype=np.intp)
+        group = (t_label * v_set.size + v_label) * 2 + forward
+        stats = np.array([r.moments for r in kept])
+        return fit_gravity_joint(stats, group, 2 * forward - 1, source=source)
+
+    notes: list[str] = []
+    samples, by_direction, fit, sem, direction_sem, position = assemble(
+        pooled, shape, t_set, v_set, gravity, source, meta, joint_fit, notes
     )
+    if notes:
+        options["gravity_requested"] = gravity
+        options["gravity"] = "joint"
+        for note in notes:
+            logger.info("%s", note)
     passes = pooled.passes[pooled.count > 0]
     binned = int(sum(r.cells.count.sum() for r in kept))
     diagnostics = Diagnostics(
@@ -374,107 +422,14 @@ def extract(
     warn_quality(quality, source, stacklevel=2)
     logger.info("extracted %d samples from %d segments", len(samples), len(kept))
     return ExtractionResult(
-        samples, by_direction, fit, diagnostics, sem, direction_sem, position, options, quality
+        samples,
+        by_direction,
+        fit,
+        diagnostics,
+        sem,
+        direction_sem,
+        position,
+        options,
+        quality,
+        tuple(notes),
     )
-
-
-def _missing_message(has: np.ndarray, t_set, v_set) -> str:
-    """Describe the (temperature, velocity) set-points where one direction is missing;
-    ``has`` is (temperature, velocity, direction, bin)."""
-    lines = []
-    for it, iv in zip(*np.nonzero((has[:, :, 0] ^ has[:, :, 1]).any(axis=-1)), strict=True):
-        back, fwd = has[it, iv, 0], has[it, iv, 1]
-        parts = []
-        for name, mine, other in (("negative", back, fwd), ("positive", fwd, back)):
-            lacking = int((other & ~mine).sum())
-            if lacking:
-                parts.append(f"no {name}-direction data in {lacking} of {int(other.sum())} bins")
-        v = v_set[iv]
-        lines.append(
-            f"{t_set[it]:.4g} degC, {v:.4g} rad/s ({np.degrees(v):.4g} deg/s): " + ", ".join(parts)
-        )
-    more = f"; and {len(lines) - 5} more" if len(lines) > 5 else ""
-    return (
-        "eq. 11 separates friction from gravity with both directions of motion at every "
-        f"operating point, but {len(lines)} set-point(s) lack one: "
-        + "; ".join(lines[:5])
-        + more
-        + " (for a horizontal joint use gravity='none')"
-    )
-
-
-def _assemble(pooled, shape, t_set, v_set, gravity, source, meta):
-    """Step 4: eq. 11 per operating point, the eq. 7 fit, loads (eq. 12), sample tables."""
-    nt, nv, nb = shape
-
-    def grid(x: np.ndarray) -> np.ndarray:
-        return x.reshape(nt, nv, 2, nb).transpose(0, 1, 3, 2)  # (t, v, bin, direction)
-
-    count, tau, std, sem = (grid(getattr(pooled, k)) for k in ("count", "torque", "std", "sem"))
-    pos, vel, temp = (grid(getattr(pooled, k)) for k in ("position", "velocity", "temperature"))
-    has = count > 0
-    both = has[..., 0] & has[..., 1]
-    any_ = has[..., 0] | has[..., 1]
-    if gravity == "fit" and (any_ & ~both).any():
-        raise DataError(_missing_message(has.transpose(0, 1, 3, 2), t_set, v_set), file=source)
-
-    fit = None
-    if gravity == "fit":
-        _, tau_g = separate(tau[both][:, 1], tau[both][:, 0])
-        theta = 0.5 * (pos[both][:, 0] + pos[both][:, 1])
-        fit = fit_gravity(theta, tau_g, source=source)
-
-    rows = np.argwhere(any_)  # (t, v, bin), C order = sorted
-    sel = tuple(rows.T)
-    # per row, columns (backward, forward): count, torque, std, sem, position, velocity, temp
-    c_, t_, s_, e_, p_, v_, T_ = (a[sel] for a in (count, tau, std, sem, pos, vel, temp))
-    h = has[sel]
-    b2 = h[:, 0] & h[:, 1]
-    n_tot = c_.sum(axis=1)
-    with np.errstate(invalid="ignore"):
-        # combined (direction 0): eq. 11 where both directions exist, else the one measured
-        friction = np.where(b2, 0.5 * (t_[:, 1] - t_[:, 0]), np.where(h[:, 1], t_[:, 1], -t_[:, 0]))
-        velocity = np.where(b2, 0.5 * (v_[:, 1] - v_[:, 0]), np.where(h[:, 1], v_[:, 1], -v_[:, 0]))
-        position = np.nansum(np.where(h, p_ * c_, 0.0), axis=1) / n_tot
-        temperature = np.nansum(np.where(h, T_ * c_, 0.0), axis=1) / n_tot
-        m2 = np.where(h, s_**2 * np.maximum(c_ - 1, 0), 0.0).sum(axis=1)
-        std_c = np.sqrt(m2 / np.maximum(n_tot - h.sum(axis=1), 1))
-        sem_c = np.where(
-            b2,
-            0.5 * np.sqrt(e_[:, 0] ** 2 + e_[:, 1] ** 2),
-            np.nanmax(np.where(h, e_, np.nan), axis=1),
-        )
-    if fit is not None:
-        load = fit.torque(position)
-        friction_dir = t_ + fit.torque(p_)
-        load_dir = fit.torque(p_)
-    else:
-        load = np.zeros_like(position)
-        friction_dir = t_
-        load_dir = np.zeros_like(p_)
-    meta = {**meta, "gravity": None if fit is None else vars(fit)}
-    samples = FrictionSamples(
-        velocity=velocity,
-        load=load,
-        temperature=temperature,
-        friction=friction,
-        direction=np.zeros_like(friction),
-        count=n_tot,
-        std=std_c,
-        source=source,
-        meta=meta,
-    )
-    dsel = h.ravel()  # (row, direction) pairs present, -1 before +1
-    sign = np.tile([-1.0, 1.0], len(rows))
-    by_direction = FrictionSamples(
-        velocity=v_.ravel()[dsel],
-        load=load_dir.ravel()[dsel],
-        temperature=T_.ravel()[dsel],
-        friction=friction_dir.ravel()[dsel],
-        direction=sign[dsel],
-        count=c_.ravel()[dsel],
-        std=s_.ravel()[dsel],
-        source=source,
-        meta=meta,
-    )
-    return samples, by_direction, fit, sem_c, e_.ravel()[dsel], position

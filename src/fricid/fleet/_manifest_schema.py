@@ -3,7 +3,9 @@
 ``fricid/schemas/manifest.schema.json`` (:data:`SCHEMA`) is the one description of the
 manifest: every column (:data:`FIELDS`), its type, range or choices, its group (``core``,
 ``fit``, ``extract``, ``reader``), the quantity of its unit (``x-quantity``), how a text cell
-is read (``x-text``) and the message of a bad value (``x-message``); and the document's shape.
+is read (``x-text``), the reader option a ``reader`` column fills (``x-option``, default its
+name; every option of :data:`fricid.io.READER_OPTIONS` has its column, which a test checks)
+and the message of a bad value (``x-message``); and the document's shape.
 This module reads a cell into the JSON value it writes (through :mod:`fricid.io.options`,
 the parsers the command line uses), validates a joint with ``jsonschema`` and turns the first
 error into one :class:`~fricid.errors.DataError` naming the manifest, the row and the column.
@@ -41,6 +43,7 @@ __all__ = [
     "SCHEMA",
     "Entry",
     "Field",
+    "describe_columns",
     "read_entry",
     "resolve_key",
     "to_values",
@@ -82,6 +85,7 @@ class Field:
     quantity: str | None = None  # a unit is required in the column name
     text: str | None = None  # how a text cell is read (the schema's x-text)
     choices: tuple[str, ...] = ()
+    option: str = ""  # the reader option it fills (the schema's x-option; default its name)
 
 
 #: Every manifest column, by name (built from :data:`SCHEMA`).
@@ -93,9 +97,36 @@ FIELDS: dict[str, Field] = {
         spec.get("x-quantity"),
         spec.get("x-text"),
         tuple(spec.get("enum", ())),
+        spec.get("x-option", name),
     )
     for name, spec in SCHEMA["$defs"]["fields"]["properties"].items()
 }
+
+_GROUPS = {
+    "core": "the joint",
+    "fit": "fitting (fricid fit)",
+    "extract": "extraction (fricid extract)",
+    "reader": "reader options (fricid extract --format ...)",
+}
+
+
+def describe_columns() -> str:
+    """The manifest's columns as text, one paragraph per group, from :data:`SCHEMA`: each
+    column's name, its unit quantity (a unit in the column label) and its description. It is
+    the ``fricid fleet --help`` text, so the help cannot drift from the schema."""
+    paragraphs = []
+    for group, title in _GROUPS.items():
+        items = []
+        for fld in FIELDS.values():
+            if fld.group != group:
+                continue
+            unit = ""
+            if fld.quantity:
+                unit = f" [{fld.quantity} unit, e.g. {next(iter(UNITS[fld.quantity]))}]"
+            items.append(f"{fld.name}{unit}: {fld.help}")
+        paragraphs.append(f"Columns, {title}: " + "; ".join(items) + ".")
+    return "\n\n".join(paragraphs)
+
 
 _ALIASES = {"models": "model", "robot_id": "robot", "log_path": "log", "path": "log"}
 
@@ -277,7 +308,7 @@ def to_values(entry: Entry, file: Path) -> dict[str, Any]:
     for name in ("seed", "max_evals", "chunk_rows", "median_window", "min_samples"):
         if name in got:
             got[name] = int(got[name])
-    for name in ("robot", "joint", "log"):
+    for name in ("robot", "joint", "log", "log_joint"):
         if name in got:
             got[name] = str(got[name])
     return got

@@ -25,13 +25,16 @@ _BLOCK = 1 << 20
 
 
 def input_files(path: Path, reader: str, reader_options: dict[str, Any]) -> list[Path]:
-    """The files a joint's log consists of: the file, or an EPOS folder's recordings.
+    """The files a joint's log consists of: the file, an EPOS folder's recordings, or every
+    file of another folder (a ROS 2 bag: its metadata and storage files).
 
     Raises :class:`OSError` when the log is missing.
     """
     if reader == "epos" and path.is_dir():
         pattern = str(reader_options.get("pattern", "*.csv"))
         return sorted(p for p in path.glob(pattern) if p.is_file())
+    if path.is_dir():
+        return sorted(p for p in path.rglob("*") if p.is_file())
     if not path.exists():
         raise FileNotFoundError(2, "No such file or directory", str(path))
     return [path]
@@ -43,7 +46,8 @@ def input_hash(path: Path, reader: str, reader_options: dict[str, Any]) -> str:
     files = input_files(path, reader, reader_options)
     for f in files:
         if len(files) > 1 or f != path:
-            h.update(f.name.encode("utf-8") + b"\0")
+            name = f.relative_to(path).as_posix() if f != path and path.is_dir() else f.name
+            h.update(name.encode("utf-8") + b"\0")
         with open(f, "rb") as fh:
             while block := fh.read(_BLOCK):
                 h.update(block)

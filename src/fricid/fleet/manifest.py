@@ -11,6 +11,12 @@ YAML
     ``defaults:`` (a mapping applied to every joint), or just the list. Lists and mappings
     are written natively.
 
+A ROS 2 bag (``reader`` ``rosbag``: a bag folder, or an ``.mcap`` or ``.db3`` file) is read
+for the joint named by the ``joint`` column, or by ``log_joint`` when the bag names it
+otherwise; ``topic``, ``temperature_topic``, ``effort`` (torque or current),
+``effort_unit``, ``position_unit``, ``velocity_unit`` and ``time_source`` are its reader's
+options, as for ``fricid extract --format rosbag``.
+
 Every dimensional value names its unit in the column name, as fricid's tables do:
 ``positions [deg]``, ``bin_halfwidth [deg]``, ``settle_time [s]``, ``temperature [degC]``,
 ``torque_constant [N m/A]``, ``nominal_torque [mN m]``, ``load [N m]``. Log paths are relative
@@ -182,8 +188,9 @@ def _spec(entry: Entry, file: Path) -> JointSpec:
     for name, value in got.items():
         group = FIELDS[name].group
         if group == "reader":
-            if name not in READER_OPTIONS[reader]:
-                users = [r for r, opts in READER_OPTIONS.items() if name in opts]
+            option = FIELDS[name].option
+            if option not in READER_OPTIONS[reader]:
+                users = [r for r, opts in READER_OPTIONS.items() if option in opts]
                 raise DataError(
                     f"'{name}' is an option of reader {' or '.join(users)}; this joint's "
                     f"reader is '{reader}'",
@@ -191,9 +198,11 @@ def _spec(entry: Entry, file: Path) -> JointSpec:
                     row=entry.row,
                     column=entry.labels[name],
                 )
-            reader_options[name] = value
+            reader_options[option] = value
         elif group == "extract":
             extract_options[name] = value
+    if "joint" in READER_OPTIONS[reader] and "joint" not in reader_options:
+        reader_options["joint"] = got["joint"]  # a bag's joint: the joint column by default
     log_text = got["log"]
     log = Path(log_text).expanduser()
     if not log.is_absolute():

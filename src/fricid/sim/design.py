@@ -17,7 +17,10 @@ import numpy as np
 from ..errors import ConfigError
 from ..units import DEG
 
-__all__ = ["Design", "Profile", "Traverse"]
+__all__ = ["COVERAGES", "Design", "Profile", "Traverse"]
+
+#: Values of :attr:`Design.coverage`.
+COVERAGES = ("both", "split")
 
 
 def _positive_array(name: str, values) -> np.ndarray:
@@ -48,6 +51,11 @@ class Design:
         long after the acceleration still sees every bin at constant velocity.
     dwell_time : s at rest at each end of the traverse.
     experiment_gap : s between two experiments (temperatures) in the time column.
+    coverage : "both" (default) records both directions over the whole measured range;
+        "split" records forward traverses only below the middle of the measured range and
+        backward traverses only above it (one-sided coverage: the two directions never share
+        a position, so eq. 11 cannot pair them; the samples outside are not logged, leaving a
+        gap in the time column).
     """
 
     velocities: np.ndarray
@@ -60,9 +68,14 @@ class Design:
     settle_time: float = 0.2
     dwell_time: float = 0.2
     experiment_gap: float = 60.0
+    coverage: str = "both"
 
     def __post_init__(self) -> None:
         set_ = object.__setattr__
+        if self.coverage not in COVERAGES:
+            raise ConfigError(
+                f"Design: 'coverage' must be one of {', '.join(COVERAGES)}, got {self.coverage!r}"
+            )
         velocities = _positive_array("velocities", self.velocities)
         if (velocities <= 0).any():
             raise ConfigError("Design: velocity set-points must be positive (both directions run)")
@@ -117,6 +130,15 @@ class Design:
             dwell=self.dwell_time,
             sample_rate=self.sample_rate,
         )
+
+    def recorded(self, position: np.ndarray, velocity: np.ndarray) -> np.ndarray:
+        """Which samples of a profile (true ``position`` [rad] and ``velocity`` [rad/s]) are
+        logged: all of them, or with ``coverage="split"`` none of a forward move above the
+        middle of the measured range nor of a backward move below it."""
+        if self.coverage == "both":
+            return np.ones(np.shape(position), dtype=bool)
+        middle = 0.5 * sum(self.measured_range)
+        return ~(((velocity > 0) & (position > middle)) | ((velocity < 0) & (position < middle)))
 
     def samples_per_setpoint(self) -> np.ndarray:
         """(n_v,) raw samples logged per velocity set-point and temperature."""

@@ -61,7 +61,8 @@ def root_entropy(seed: SeedLike) -> int:
 def _period(
     scenario: Scenario, it: int, iv: int, rep: int, k0: int, entropy: int, out: dict, at: int
 ) -> int:
-    """Simulate one period into ``out[...][at:at+n]``; return n."""
+    """Simulate one period into ``out[...][at:at+n]``; return n (the samples the design
+    records: fewer than the period's with ``coverage="split"``)."""
     design, joint, noise = scenario.design, scenario.joint, scenario.noise
     faults = scenario.faults if scenario.faults is not None and scenario.faults.active else None
     temperature = float(design.temperatures[it])
@@ -110,12 +111,14 @@ def _period(
         position = np.round(position / noise.position_lsb) * noise.position_lsb
     temp = temperature + rng.normal(0.0, noise.temperature_std, n)
 
+    keep = design.recorded(prof.position, prof.velocity)  # all, unless coverage="split"
+    n = int(keep.sum())
     s = np.s_[at : at + n]
-    out["time"][s] = (k0 + k) / design.sample_rate
-    out["position"][s] = position
-    out["velocity"][s] = velocity
-    out["current"][s] = current
-    out["temperature"][s] = temp
+    out["time"][s] = ((k0 + k) / design.sample_rate)[keep]
+    out["position"][s] = position[keep]
+    out["velocity"][s] = velocity[keep]
+    out["current"][s] = current[keep]
+    out["temperature"][s] = temp[keep]
     return n
 
 
@@ -185,6 +188,7 @@ def simulate(
         at = 0
         for it, iv, rep, k0 in periods:
             at += _period(scenario, it, iv, rep, k0, entropy, out, at)
+        out = {name: column[:at] for name, column in out.items()}
         it0, iv0 = periods[0][0], periods[0][1]
         yield RawLog(
             time=out["time"],

@@ -1,0 +1,141 @@
+"""Step 4 of :func:`fricid.extract.extract`: friction and gravity separated per operating point
+(BAS-RBFNN paper eq. 9-12), and the sample tables (combined and per direction).
+
+The gravity torque comes from eq. 11 pairing and the eq. 7 fit (:mod:`.gravity`), or, when the
+two directions do not cover the same positions, from the joint fit of :mod:`.joint_gravity`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import DataError
+from ..samples import FrictionSamples
+from .gravity import GravityFit, fit_gravity, separate
+from .joint_gravity import JointGravityFit
+
+__all__ = ["assemble", "missing_message"]
+
+
+def missing_message(has: np.ndarray, t_set, v_set) -> str:
+    """Describe the (temperature, velocity) set-points where one direction is missing;
+    ``has`` is (temperature, velocity, direction, bin)."""
+    lines = []
+    for it, iv in zip(*np.nonzero((has[:, :, 0] ^ has[:, :, 1]).any(axis=-1)), strict=True):
+        back, fwd = has[it, iv, 0], has[it, iv, 1]
+        parts = []
+        for name, mine, other in (("negative", back, fwd), ("positive", fwd, back)):
+            lacking = int((other & ~mine).sum())
+            if lacking:
+                parts.append(f"no {name}-direction data in {lacking} of {int(other.sum())} bins")
+        v = v_set[iv]
+        lines.append(
+            f"{t_set[it]:.4g} degC, {v:.4g} rad/s ({np.degrees(v):.4g} deg/s): " + ", ".join(parts)
+        )
+    more = f"; and {len(lines) - 5} more" if len(lines) > 5 else ""
+    return (
+        "eq. 11 separates friction from gravity with both directions of motion at every "
+        f"operating point, but {len(lines)} set-point(s) lack one: "
+        + "; ".join(lines[:5])
+        + more
+        + " (for a horizontal joint use gravity='none')"
+    )
+
+
+def assemble(pooled, shape, t_set, v_set, gravity, source, meta, joint_fit, notes):
+    """Step 4: eq. 11 per operating point, the eq. 7 fit (or the joint fit, ``joint_fit()``,
+    also when eq. 11 pairing is impossible: then a note is appended to ``notes``), loads
+    (eq. 12), sample tables."""
+    nt, nv, nb = shape
+
+    def grid(x: np.ndarray) -> np.ndarray:
+        return x.reshape(nt, nv, 2, nb).transpose(0, 1, 3, 2)  # (t, v, bin, direction)
+
+    count, tau, std, sem = (grid(getattr(pooled, k)) for k in ("count", "torque", "std", "sem"))
+    pos, vel, temp = (grid(getattr(pooled, k)) for k in ("position", "velocity", "temperature"))
+    has = count > 0
+    both = has[..., 0] & has[..., 1]
+    any_ = has[..., 0] | has[..., 1]
+    fit: GravityFit | JointGravityFit | None = None
+    if gravity == "fit" and (any_ & ~both).any():
+        missing = missing_message(has.transpose(0, 1, 3, 2), t_set, v_set)
+        try:
+            fit = joint_fit()
+        except DataError as exc:
+            raise DataError(
+                f"{missing}; nor can gravity='joint' stand in: {exc.message}", file=source
+            ) from None
+        notes.append(
+            f"{missing.split(' (for a horizontal')[0]}; so gravity and friction were "
+            "identified jointly without pairing (gravity='joint')"
+        )
+    elif gravity == "fit":
+        _, tau_g = separate(tau[both][:, 1], tau[both][:, 0])
+        theta = 0.5 * (pos[both][:, 0] + pos[both][:, 1])
+        fit = fit_gravity(theta, tau_g, source=source)
+    elif gravity == "joint":
+        fit = joint_fit()
+
+    rows = np.argwhere(any_)  # (t, v, bin), C order = sorted
+    sel = tuple(rows.T)
+    # per row, columns (backward, forward): count, torque, std, sem, position, velocity, temp
+    c_, t_, s_, e_, p_, v_, T_ = (a[sel] for a in (count, tau, std, sem, pos, vel, temp))
+    h = has[sel]
+    b2 = h[:, 0] & h[:, 1]
+    n_tot = c_.sum(axis=1)
+    with np.errstate(invalid="ignore"):
+        # combined (direction 0): eq. 11 where both directions exist, else the one measured
+        friction = np.where(b2, 0.5 * (t_[:, 1] - t_[:, 0]), np.where(h[:, 1], t_[:, 1], -t_[:, 0]))
+        velocity = np.where(b2, 0.5 * (v_[:, 1] - v_[:, 0]), np.where(h[:, 1], v_[:, 1], -v_[:, 0]))
+        position = np.nansum(np.where(h, p_ * c_, 0.0), axis=1) / n_tot
+        temperature = np.nansum(np.where(h, T_ * c_, 0.0), axis=1) / n_tot
+        m2 = np.where(h, s_**2 * np.maximum(c_ - 1, 0), 0.0).sum(axis=1)
+        std_c = np.sqrt(m2 / np.maximum(n_tot - h.sum(axis=1), 1))
+        sem_c = np.where(
+            b2,
+            0.5 * np.sqrt(e_[:, 0] ** 2 + e_[:, 1] ** 2),
+            np.nanmax(np.where(h, e_, np.nan), axis=1),
+        )
+    if fit is not None:
+        load = fit.torque(position)
+        friction_dir = t_ + fit.torque(p_)
+        load_dir = fit.torque(p_)
+        # a row measured in one direction: its friction with the fitted gravity removed
+        friction = np.where(
+            b2, friction, np.where(h[:, 1], friction_dir[:, 1], -friction_dir[:, 0])
+        )
+    else:
+        load = np.zeros_like(position)
+        friction_dir = t_
+        load_dir = np.zeros_like(p_)
+    meta = {
+        **meta,
+        "gravity": None
+        if fit is None
+        else (fit.as_meta() if isinstance(fit, JointGravityFit) else vars(fit)),
+    }
+    samples = FrictionSamples(
+        velocity=velocity,
+        load=load,
+        temperature=temperature,
+        friction=friction,
+        direction=np.zeros_like(friction),
+        count=n_tot,
+        std=std_c,
+        source=source,
+        meta=meta,
+    )
+    dsel = h.ravel()  # (row, direction) pairs present, -1 before +1
+    sign = np.tile([-1.0, 1.0], len(rows))
+    by_direction = FrictionSamples(
+        velocity=v_.ravel()[dsel],
+        load=load_dir.ravel()[dsel],
+        temperature=T_.ravel()[dsel],
+        friction=friction_dir.ravel()[dsel],
+        direction=sign[dsel],
+        count=c_.ravel()[dsel],
+        std=s_.ravel()[dsel],
+        source=source,
+        meta=meta,
+    )
+    return samples, by_direction, fit, sem_c, e_.ravel()[dsel], position
