@@ -18,115 +18,35 @@ failure is one :class:`~fricid.errors.DataError` line naming the file given.
 
 from __future__ import annotations
 
-import itertools
 import json
 import warnings
 from dataclasses import asdict, dataclass, field
-from functools import lru_cache
 from os import PathLike
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from . import __version__
-from .errors import ConfigError, DataError, ExtrapolationWarning, FricidError
-from .io._jsonfile import check_document, one_line, read_json
-from .models import INPUTS, get_model, get_predictor
-from .models._range import RANGE_TOLERANCE, RangeViolation, range_violations
-from .models.rbf import legacy_symmetry
+from .. import __version__
+from ..errors import ConfigError, DataError, ExtrapolationWarning, FricidError
+from ..io._jsonfile import check_document, one_line, read_json
+from ..models import INPUTS, get_model, get_predictor
+from ..models._range import RANGE_TOLERANCE, RangeViolation, range_violations
+from ..models.rbf import legacy_symmetry
+from ._file import (
+    SCHEMA_VERSION,
+    _clean,
+    _convergence_line,
+    _downsample,
+    _num,
+    _probe_inputs,
+    _validate_schema,
+)
 
 __all__ = ["MIN_CORREL", "RANGE_TOLERANCE", "SCHEMA_VERSION", "FittedModel", "RangeViolation"]
 
 #: Correlations at or below this magnitude are left out of the fit report (lmfit's default).
 MIN_CORREL = 0.1
-
-#: Version of the JSON model file this fricid writes and reads.
-SCHEMA_VERSION = 1
-
-#: Longest convergence history kept in a model file (downsampled evenly, last point kept).
-MAX_HISTORY = 2000
-
-
-def _downsample(history: np.ndarray | None) -> list[list[float]] | None:
-    if history is None or len(history) == 0:
-        return None
-    h = np.asarray(history, dtype=float)
-    if len(h) > MAX_HISTORY:
-        idx = np.unique(np.linspace(0, len(h) - 1, MAX_HISTORY).round().astype(int))
-        h = h[idx]
-    return h.tolist()
-
-
-def _clean(value: Any) -> Any:
-    """JSON-ready: numpy to Python, non-finite floats to None."""
-    if isinstance(value, dict):
-        return {str(k): _clean(v) for k, v in value.items()}
-    if isinstance(value, list | tuple):
-        return [_clean(v) for v in value]
-    if isinstance(value, np.ndarray):
-        return _clean(value.tolist())
-    if isinstance(value, np.integer):
-        return int(value)
-    if isinstance(value, float | np.floating):
-        f = float(value)
-        return f if np.isfinite(f) else None
-    return value
-
-
-def _num(value: Any) -> float:
-    return float("nan") if value is None else float(value)
-
-
-def _convergence_line(conv: dict[str, Any]) -> str:
-    """The fit report's convergence line, from the model file's convergence block."""
-    ratio = _num(conv.get("polish_sse_ratio"))
-    polish = f"local polish SSE ratio {ratio:.6g}" if np.isfinite(ratio) else "no polish"
-    if conv.get("converged"):
-        by = {"optimizer": "optimiser's own test", "polish": "local polish"}.get(
-            str(conv.get("certified_by")), "recorded"
-        )
-        return f"converged (certified by the {by}; {polish})"
-    return f"NOT CONVERGED ({polish}; {conv.get('nfev')} of {conv.get('max_evals')} evaluations)"
-
-
-@lru_cache(maxsize=1)
-def _schema_validator():
-    """The validator of the model file's JSON Schema (``fricid/schemas/model.schema.json``)."""
-    from importlib.resources import files
-
-    from jsonschema import Draft202012Validator
-
-    text = files("fricid").joinpath("schemas", "model.schema.json").read_text(encoding="utf-8")
-    return Draft202012Validator(json.loads(text))
-
-
-#: Messages for the size limits of the schema (jsonschema's would print the whole value).
-_LIMITS = {
-    "maxLength": "text longer than {} characters",
-    "maxItems": "more than {} items",
-    "maxProperties": "more than {} properties",
-}
-
-
-def _validate_schema(d: dict[str, Any], source: str | None) -> None:
-    """Raise a :class:`DataError` naming the file and the first failing field."""
-    from jsonschema.exceptions import best_match
-
-    # the first errors suffice to name one; a hostile file may have millions
-    error = best_match(itertools.islice(_schema_validator().iter_errors(d), 1000))
-    if error is None:
-        return
-    where = one_line("/".join(str(p) for p in error.absolute_path) or "(top level)")[:120]
-    message = _LIMITS.get(error.validator, "").format(error.validator_value)
-    if not message:
-        message = one_line(error.message)
-        message = message if len(message) <= 200 else message[:197] + "..."
-    raise DataError(
-        f"field '{where}' does not match the model file schema (version {SCHEMA_VERSION}): "
-        f"{message}",
-        file=source,
-    )
 
 
 @dataclass
@@ -535,7 +455,7 @@ class FittedModel:
 
     def save(self, path: str | PathLike[str]) -> Path:
         """Write the model as JSON, atomically."""
-        from .io.atomic import atomic_write
+        from ..io.atomic import atomic_write
 
         path = Path(path)
         with atomic_write(path, "w") as fh:
@@ -557,25 +477,3 @@ class FittedModel:
         """
         d = read_json(path, what="model file")
         return cls.from_dict(d, source=str(path))
-
-
-#: Velocities probed where a model file records no velocity range [rad/s].
-_PROBE_VELOCITY = (-1.0, -0.01, 0.0, 0.01, 1.0)
-#: Load [N m] and temperature [degC] probed where a model file records no range.
-_PROBE_DEFAULT = {"load": (0.0,), "temperature": (25.0,)}
-
-
-def _probe_inputs(operating_range: dict[str, list[float]]) -> np.ndarray:
-    """Inputs (n, 3) on which loading evaluates a model: see ``_check_predictions``."""
-    axes = []
-    for name in INPUTS:
-        span = operating_range.get(name)
-        if span is None:
-            axes.append(_PROBE_VELOCITY if name == "velocity" else _PROBE_DEFAULT[name])
-            continue
-        low, high = float(span[0]), float(span[1])
-        points = {low, high, low / 2 + high / 2}
-        if low < 0 < high:
-            points.add(0.0)
-        axes.append(sorted(points))
-    return np.array(list(itertools.product(*axes)), dtype=float)
