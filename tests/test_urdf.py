@@ -97,7 +97,8 @@ def virtual_joint_urdf(tmp_path, p_x, p_y, mass=1.5):
         tmp_path,
         f"""<robot name="virtual">
   <link name="world"/><link name="base"/>
-  <link name="arm"><inertial><origin xyz="{x!r} 0.05 {z!r}"/><mass value="{mass!r}"/></inertial></link>
+  <link name="arm"><inertial><origin xyz="{x!r} 0.05 {z!r}"/>
+    <mass value="{mass!r}"/></inertial></link>
   <joint name="fix" type="fixed"><parent link="world"/><child link="base"/>
     <origin xyz="0 0 0.8"/></joint>
   <joint name="elbow" type="continuous"><parent link="base"/><child link="arm"/>
