@@ -164,12 +164,13 @@ def current_only_log(tmp_path_factory):
     return s, float(log.torque_constant), path
 
 
-def test_cli_k_from_a_urdf(current_only_log, tmp_path):
+@pytest.mark.parametrize("gravity", [BINS, ["--gravity", "joint"]], ids=["fit", "joint"])
+def test_cli_k_from_a_urdf(current_only_log, tmp_path, gravity):
     s, k_true, path = current_only_log
     urdf = _urdf(tmp_path, *true_gravity(s))
     out = tmp_path / "s.csv"
     args = ["extract", str(path), "-o", str(out), "--urdf", str(urdf), "--urdf-joint", "elbow"]
-    res = CliRunner().invoke(app, [*args, *BINS])
+    res = CliRunner().invoke(app, [*args, *gravity])
     assert res.exit_code == 0, res.output
     text = " ".join(res.output.split())
     assert (
