@@ -145,6 +145,14 @@ def test_bad_files_one_line(tmp_path, text, match):
     assert str(info.value).startswith(str(path)) and "\n" not in str(info.value)
 
 
+def test_an_expanded_xacro_with_its_namespace_loads(tmp_path):
+    text = TWO_LINK.format(rpy="0 0 0", axis="0 1 0", com="0.1 0 0.02").replace(
+        '<robot name="arm">', '<robot name="arm" xmlns:xacro="http://www.ros.org/wiki/xacro">'
+    )
+    got = urdf_gravity(_write(tmp_path, text), "shoulder")
+    assert got.p_x == pytest.approx(G * 0.7, abs=1e-12)
+
+
 def test_size_cap(tmp_path, monkeypatch):
     import fricid.io.urdf as urdf
 

@@ -287,8 +287,13 @@ def read_urdf(path: str | os.PathLike[str]) -> Robot:
         root = ET.fromstring(data)
     except ET.ParseError as exc:
         raise DataError(f"not XML: {exc}", file=src) from None
-    if any(el.tag.startswith("{") or ":" in el.tag for el in root.iter()) or b"xacro:" in data:
-        raise DataError("xacro macros are not expanded here; run xacro first", file=src)
+    macro = next((el.tag for el in root.iter() if el.tag.startswith("{")), None)
+    if macro is not None:  # xacro:macro, xacro:include ... (namespaced elements)
+        raise DataError(
+            f"<{macro.rpartition('}')[2][:40]}> is a namespaced (xacro) element; xacro macros "
+            "are not expanded here: run xacro first",
+            file=src,
+        )
     if root.tag != "robot":
         raise DataError(f"the root element is <{root.tag[:40]}>, not <robot>", file=src)
     reader = _Reader(src)
