@@ -133,3 +133,123 @@ def test_cli_identify_torque_constant(sensor_log, tmp_path):
     assert m, text
     assert abs(float(m.group(1)) - K) <= Z * float(m.group(2))
     assert "gear efficiency eta = 0.90" in text
+
+
+def _urdf(tmp_path, p_x, p_y, mass=2.0):
+    """A URDF of the virtual joint: one link on a y axis with eq. 7's p_x, p_y
+    (fricid.io.urdf's conventions: x = p_x / (m g), z = -p_y / (m g))."""
+    from fricid.io.urdf import STANDARD_GRAVITY as G
+
+    path = tmp_path / "joint.urdf"
+    path.write_text(
+        f"""<robot name="virtual"><link name="base"/>
+  <link name="arm"><inertial><origin xyz="{p_x / (mass * G)!r} 0 {-p_y / (mass * G)!r}"/>
+    <mass value="{mass!r}"/></inertial></link>
+  <joint name="elbow" type="revolute"><parent link="base"/><child link="arm"/>
+    <axis xyz="0 1 0"/></joint></robot>"""
+    )
+    return path
+
+
+BINS = ["--positions", "-60:-20:10", "--bin-halfwidth", "1"]  # the quick design's bins
+
+
+@pytest.fixture(scope="module")
+def current_only_log(tmp_path_factory):
+    """The paper1 virtual joint's log as simulated: current only, with known K = 0.5."""
+    s = preset("paper1", "quick")
+    log = simulate_log(s, seed=11)
+    assert log.torque is None and log.current is not None
+    path = write_rawlog(log, tmp_path_factory.mktemp("kurdf") / "log.parquet")
+    return s, float(log.torque_constant), path
+
+
+@pytest.mark.parametrize("gravity", [BINS, ["--gravity", "joint"]], ids=["fit", "joint"])
+def test_cli_k_from_a_urdf(current_only_log, tmp_path, gravity):
+    s, k_true, path = current_only_log
+    urdf = _urdf(tmp_path, *true_gravity(s))
+    out = tmp_path / "s.csv"
+    args = ["extract", str(path), "-o", str(out), "--urdf", str(urdf), "--urdf-joint", "elbow"]
+    res = CliRunner().invoke(app, [*args, *gravity])
+    assert res.exit_code == 0, res.output
+    text = " ".join(res.output.split())
+    assert (
+        "gravity load of joint 'elbow' from the URDF (eq. 7): p_x = 0.2011, p_y = 0.06175" in text
+    )
+    m = re.search(
+        r"from the gravity load\): K = (\S+) \+- (\S+) N m/A \(95 % CI (\S+) to (\S+);", text
+    )
+    assert m, text
+    k, se, lo, hi = (float(x) for x in m.groups())
+    assert lo <= k_true <= hi and abs(k - k_true) <= Z * se and se < 0.02 * k_true
+    assert out.exists()
+
+
+def test_cli_k_from_a_wrong_urdf_misses(current_only_log, tmp_path):
+    """The interval is not so wide that any geometry passes: a link 20 % heavier misses K."""
+    s, k_true, path = current_only_log
+    p_x, p_y = true_gravity(s)
+    urdf = _urdf(tmp_path, 1.2 * p_x, 1.2 * p_y)
+    args = ["extract", str(path), "-o", str(tmp_path / "s.csv"), "--urdf", str(urdf)]
+    res = CliRunner().invoke(app, [*args, "--urdf-joint", "elbow", *BINS])
+    m = re.search(r"95 % CI (\S+) to (\S+);", " ".join(res.output.split()))
+    assert res.exit_code == 0 and m, res.output
+    assert float(m.group(1)) > k_true
+
+
+@pytest.mark.parametrize(
+    ("extra", "match"),
+    [
+        (["--urdf-joint", "elbow"], "--urdf and --urdf-joint go together"),
+        (["--urdf", "URDF", "--urdf-joint", "wrist"], "no joint 'wrist'"),
+        (["--urdf", "URDF", "--urdf-joint", "elbow", "--gravity", "none"], "--gravity none"),
+        (["--urdf", "URDF", "--urdf-joint", "elbow", "--urdf-position", "x"], "--urdf-position"),
+    ],
+)
+def test_cli_urdf_refusals(current_only_log, tmp_path, extra, match):
+    s, _, path = current_only_log
+    urdf = str(_urdf(tmp_path, *true_gravity(s)))
+    args = ["extract", str(path), "-o", str(tmp_path / "s.csv")]
+    res = CliRunner().invoke(app, args + [urdf if a == "URDF" else a for a in extra] + BINS)
+    assert res.exit_code == 2
+    assert match in " ".join(res.output.split())
+
+
+def test_cli_urdf_generic_csv_without_k(current_only_log, tmp_path):
+    """A CSV with current and no K cannot be extracted alone; with --urdf the samples come
+    out in N m with the identified K (the same samples as the true K's, scaled)."""
+    import pandas as pd
+
+    from fricid.io import read_rawlog, read_samples
+
+    s, k_true, path = current_only_log
+    log = read_rawlog(path)
+    csv = tmp_path / "run.csv"
+    frame = {"t": log.time, "q": log.position, "dq": log.velocity, "i": log.current}
+    pd.DataFrame({**frame, "T": log.temperature}).to_csv(csv, index=False)
+    maps = ["time=t:s", "position=q:rad", "velocity=dq:rad/s", "current=i:A", "temperature=T:degC"]
+    args = ["extract", str(csv), "--format", "generic", *BINS]
+    args += [x for m in maps for x in ("--map", m)]
+    alone = CliRunner().invoke(app, [*args, "-o", str(tmp_path / "a.csv")])
+    assert alone.exit_code == 2 and "torque constant" in alone.output
+    out = tmp_path / "s.csv"
+    urdf = _urdf(tmp_path, *true_gravity(s))
+    res = CliRunner().invoke(
+        app, [*args, "-o", str(out), "--urdf", str(urdf), "--urdf-joint", "elbow"]
+    )
+    assert res.exit_code == 0, res.output
+    text = " ".join(res.output.split())
+    m = re.search(r"from the gravity load\): K = (\S+) \+- (\S+) N m/A", text)
+    k, se = float(m.group(1)), float(m.group(2))
+    assert (
+        abs(k - k_true) <= Z * se
+        and f"samples converted with the identified K = {m.group(1)}" in text
+    )
+    truth = extract(
+        log,
+        positions=np.deg2rad(np.arange(-60.0, -19.0, 10.0)),
+        bin_halfwidth=np.deg2rad(1.0),
+        gravity="fit",
+    ).samples
+    got = read_samples(out)
+    np.testing.assert_allclose(got.friction, truth.friction * k / k_true, rtol=1e-3, atol=1e-6)

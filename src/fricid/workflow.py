@@ -173,6 +173,7 @@ def load_joint(
     extract_options: Mapping[str, Any] | None = None,
     chunk_rows: int = 1_000_000,
     on_chunk: Callable[[], None] | None = None,
+    chunk_map: Callable[[RawLog], RawLog] | None = None,
 ) -> JointData:
     """Read a joint's log and extract its friction samples.
 
@@ -196,6 +197,9 @@ def load_joint(
         Rows read at a time from a ``table`` log or a bag (bounded memory).
     on_chunk : callable, optional
         Called once per chunk read (progress).
+    chunk_map : callable, optional
+        Applied to every chunk read before extraction (e.g.
+        :func:`fricid.extract.torque_constant.current_as_torque`, to extract in amperes).
 
     Returns
     -------
@@ -223,6 +227,8 @@ def load_joint(
     opened = open_log(path, reader, ropts, chunk_rows=chunk_rows)
     if isinstance(opened, FrictionSamples):
         return JointData(opened, opened, None)
+    if chunk_map is not None:
+        opened = map(chunk_map, opened)
     first = next(opened, None)
     if first is None:  # pragma: no cover - iter_rawlog raises on an empty log
         raise DataError("the log has no rows", file=path)

@@ -14,6 +14,13 @@ from ._app import app, console, err_console, handle_errors
 from ._options import TemperatureOption, TorqueConstantOption, out_option, parse_grid
 from ._paths import check_paths
 from ._progress import progress_bar
+from ._torque_constant import (
+    UrdfJointOption,
+    UrdfOption,
+    UrdfPositionOption,
+    identify_from_urdf,
+    print_torque_constant,
+)
 
 
 def parse_positions(text: str | None, unit: str) -> np.ndarray | None:
@@ -146,20 +153,6 @@ def _format_help() -> str:
     return "\b\nFormats (--format), one example each:\n" + "\n".join(
         f"  {name}: {example}" for name, example in READER_EXAMPLES.items()
     )
-
-
-def _print_torque_constant(log: Path, fmt: str, reader_options: dict, chunk_rows: int) -> None:
-    """``--identify-torque-constant``: K (and the efficiency) from current and torque."""
-    from ..extract.torque_constant import fit_torque_constant
-    from ..io import open_log
-
-    opened = open_log(log, fmt, reader_options, chunk_rows=chunk_rows)
-    if not hasattr(opened, "__next__"):
-        raise ConfigError(
-            "--identify-torque-constant needs a log of samples over time with both a current "
-            "and a torque column, not a folder of steady-state recordings"
-        )
-    console.print(fit_torque_constant(opened).summary(), markup=False, highlight=False)
 
 
 @app.command("extract", epilog=_format_help())
@@ -331,6 +324,9 @@ def extract_command(
             "printed before the samples are written (reads the log a second time).",
         ),
     ] = False,
+    urdf: UrdfOption = None,
+    urdf_joint: UrdfJointOption = None,
+    urdf_position: UrdfPositionOption = None,
 ) -> None:
     """Extract friction samples from a raw log: segment the constant-velocity traverses, median
     filter the current, torque = K I (eq. 13), average the repetitions per position bin,
@@ -412,6 +408,23 @@ def extract_command(
             reader_options["temperature"] = temperature
     if gives_samples(fmt, log, reader_options):
         extract_options = {}
+    if urdf is not None or urdf_joint is not None or urdf_position:
+        check_paths(inputs={"--urdf": urdf})
+        k_fit = identify_from_urdf(
+            log,
+            fmt,
+            reader_options,
+            extract_options,
+            chunk_rows,
+            urdf=urdf,
+            joint=urdf_joint,
+            positions=urdf_position,
+        )
+        if torque_constant is None and "torque_constant" in reader_options:
+            reader_options["torque_constant"] = k_fit.K
+            err_console.print(f"samples converted with the identified K = {k_fit.K:.6g} N m/A")
+        else:
+            err_console.print("samples converted with the given (or the log's own) K, not this one")
 
     with progress_bar("extracting", total=None) as advance:
         data = load_joint(
@@ -423,7 +436,7 @@ def extract_command(
             on_chunk=advance,
         )
     if identify_torque_constant:
-        _print_torque_constant(log, fmt, reader_options, chunk_rows)
+        print_torque_constant(log, fmt, reader_options, chunk_rows)
     write_samples(data.samples, out)
     if by_direction is not None:
         write_samples(data.by_direction, by_direction)

@@ -9,7 +9,7 @@ Modules: :mod:`.segment` (constant-velocity segments, set-point clustering), :mo
 :mod:`.bins` (position bins, repetition averaging), :mod:`.gravity` (eq. 7 and 11),
 :mod:`.joint_gravity` (eq. 7 with per-set-point friction, no pairing), :mod:`.separation`
 (step 4: friction, gravity and the sample tables), :mod:`.torque_constant` (K of eq. 13 from
-current and a torque sensor),
+current and a torque sensor, or from a gravity load known from a URDF),
 :mod:`.quality` (the per-set-point quality table and its warnings), :mod:`.pipeline`
 (:func:`extract`).
 """
@@ -23,7 +23,12 @@ from .pipeline import GRAVITY_MODES, SPIKE_SIGMAS, Diagnostics, ExtractionResult
 from .quality import QUALITY_COLUMNS, SCATTER_RATIO, QualityTable, flag_scatter, warn_quality
 from .segment import Segment, SegmentCounts, cluster, iter_segments
 from .steady import OUTLIER_SIGMAS, SETTLE_SIGMAS, outliers, saturated, settled
-from .torque_constant import TorqueConstantFit, fit_torque_constant, torque_constant_from_gravity
+from .torque_constant import (
+    TorqueConstantFit,
+    current_as_torque,
+    fit_torque_constant,
+    torque_constant_from_gravity,
+)
 
 __all__ = [
     "GRAVITY_MODES",
@@ -45,6 +50,7 @@ __all__ = [
     "SegmentCounts",
     "TorqueConstantFit",
     "cluster",
+    "current_as_torque",
     "extract",
     "fit_gravity",
     "fit_gravity_joint",

@@ -33,7 +33,12 @@ from ..errors import DataError
 from ..samples import RawLog
 from .segment import as_log_stream
 
-__all__ = ["TorqueConstantFit", "fit_torque_constant", "torque_constant_from_gravity"]
+__all__ = [
+    "TorqueConstantFit",
+    "current_as_torque",
+    "fit_torque_constant",
+    "torque_constant_from_gravity",
+]
 
 _CLASSES = ("all", "motoring", "generating")
 
@@ -79,10 +84,14 @@ class TorqueConstantFit:
     def summary(self) -> str:
         """One or two lines for the CLI or a report."""
         lo, hi = self.ci95
+        basis = (
+            "from eq. 7's p_x, p_y on the current"
+            if self.method == "gravity load"
+            else f"{self.n} samples in {self.blocks} blocks"
+        )
         lines = [
             f"torque constant (eq. 13, from the {self.method}): K = {self.K:.6g} +- "
-            f"{self.K_se:.2g} N m/A (95 % CI {lo:.6g} to {hi:.6g}; {self.n} samples in "
-            f"{self.blocks} blocks)"
+            f"{self.K_se:.2g} N m/A (95 % CI {lo:.6g} to {hi:.6g}; {basis})"
         ]
         if self.efficiency is not None:
             lines.append(
@@ -210,6 +219,36 @@ def fit_torque_constant(
     )
 
 
+def current_as_torque(log: RawLog) -> RawLog:
+    """The log with its motor current [A] as its torque (``K = 1``, any torque column dropped).
+
+    Extracting it gives eq. 7's ``p_x, p_y`` in amperes, for
+    :func:`torque_constant_from_gravity` (``chunk_map`` of :func:`fricid.workflow.load_joint`).
+
+    Raises
+    ------
+    DataError
+        The log has no current column.
+    """
+    if log.current is None:
+        raise DataError(
+            "identifying K from a gravity load needs the motor current; the log has none (a "
+            "bag: --effort current; a table: --map current=COLUMN:A)",
+            file=log.source,
+        )
+    return RawLog(
+        time=log.time,
+        position=log.position,
+        velocity=log.velocity,
+        temperature=log.temperature,
+        current=log.current,
+        torque_constant=1.0,
+        joint=log.joint,
+        source=log.source,
+        meta=log.meta,
+    )
+
+
 def torque_constant_from_gravity(
     p_current, p_current_se, p_known, *, source: str | None = None
 ) -> TorqueConstantFit:
@@ -223,7 +262,8 @@ def torque_constant_from_gravity(
     p_known : array_like
         ``(p_x, p_y)`` [N m] from the link's mass ``m`` and centre of mass (for a link whose
         centre of mass is at distance ``r`` and angle ``phi`` from the joint axis in the
-        plane of motion, ``p_x = m g r cos(phi)``, ``p_y = m g r sin(phi)``).
+        plane of motion, ``p_x = m g r cos(phi)``, ``p_y = m g r sin(phi)``); from a URDF by
+        :func:`fricid.io.urdf.urdf_gravity`.
 
     Returns
     -------
@@ -231,7 +271,8 @@ def torque_constant_from_gravity(
         ``K = (p_known . p_current) / (p_current . p_current)``; its error from the current
         fit's errors (delta method, the known load taken as exact); the interval uses the
         normal quantile (the errors come from a gravity fit over many points); ``n`` and
-        ``blocks`` are 2, the coefficients.
+        ``blocks`` are 2, the coefficients. The gear efficiency is not identified: the
+        gravity load alone does not separate the two power flows.
     """
     a = np.asarray(p_current, dtype=float)
     a_se = np.asarray(p_current_se, dtype=float)
