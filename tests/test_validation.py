@@ -178,6 +178,18 @@ def test_validate_right_model_within_noise_wrong_model_misses():
     assert d["scheme"] == "lovo" and d["rmse"] == pytest.approx(good.rmse)
 
 
+def test_lovo_predicts_held_out_end_levels_without_an_extrapolation_warning():
+    """Holding out the fastest level is an extrapolation by design, not the user's: no
+    ExtrapolationWarning (the CLI would print it after every validated fit)."""
+    from fricid.errors import ExtrapolationWarning
+
+    s = directional("coulomb_viscous", np.array([0.3, 0.1]), levels=5)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", ExtrapolationWarning)
+        v = validate(s, "coulomb_viscous", "lovo", **FAST)
+    assert v.failed == 0 and len(v.folds) == 5
+
+
 # -- model selection ------------------------------------------------------------------------
 
 
