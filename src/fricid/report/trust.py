@@ -13,7 +13,8 @@ module reads them (and, where given, the samples) into one :class:`Trust`:
   "consistent with zero" and is not a caveat;
 - held-out error against the measurement scatter: the file's ``validation``; else, for an
   analytic model given its samples, :func:`fricid.identify.validate` with ``lovo`` when that is
-  expected to take at most :data:`VALIDATE_SECONDS`; else the fit's in-sample
+  expected to take at most :data:`VALIDATE_SECONDS` and the samples have at least
+  :data:`MIN_LEVELS` velocity levels; else the fit's in-sample
   ``rmse_over_scatter``, labelled as such;
 - the operating range, outside which predictions are extrapolated.
 
@@ -40,6 +41,7 @@ from ..metrics import NOISE_RATIO, verdict
 from ..samples import FrictionSamples
 
 __all__ = [
+    "MIN_LEVELS",
     "MISS_RATIO",
     "VALIDATE_SECONDS",
     "Trust",
@@ -55,6 +57,10 @@ MISS_RATIO = 3.0
 
 #: Longest expected run of the report's own leave-one-velocity-out validation [s].
 VALIDATE_SECONDS = 3.0
+
+#: The report runs its own leave-one-velocity-out validation only with at least this many
+#: velocity levels (with fewer, each held-out level is an extrapolation from a handful).
+MIN_LEVELS = 5
 
 _UNITS = {"velocity": "rad/s", "load": "N m", "temperature": "degC"}
 
@@ -242,8 +248,11 @@ def _run_validation(
     if fitted.kind == "rbf":
         return None, "not run for the RBF network (each fold retrains it); in-sample only"
     folds = int(np.unique(level_labels(samples)).size)
-    if folds < 2:
-        return None, "one velocity level: nothing to hold out; in-sample only"
+    if folds < MIN_LEVELS:
+        return None, (
+            f"not run here: {folds} velocity level(s), and holding one out of so few asks "
+            "the model to extrapolate; in-sample only"
+        )
     fixed = {n: fitted.params[n] for n in fitted.fixed if n in fitted.params}
     options: dict[str, Any] = {"intervals": "none"}
     if isinstance(fitted.loss.get("loss"), str):
