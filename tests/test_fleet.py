@@ -308,6 +308,44 @@ def test_outputs_and_failure_isolation(fleet):
     assert list(run.out.rglob("*.tmp")) == []
 
 
+def test_results_table_has_per_joint_verdict_columns(fleet):
+    from fricid.fleet.table import VERDICT_COLUMNS
+
+    _manifest, run = fleet
+    table = read_results(run.out)
+    assert set(VERDICT_COLUMNS) <= set(table.columns)
+    cols = list(table.columns)
+    assert cols.index("trust") < cols.index("log")  # beside the outcome, not at the end
+    ok = table[table["status"] == "ok"]
+    assert ok["converged"].all() and str(ok["converged"].dtype) == "boolean"
+    assert (ok["n_not_determined"] == 0).all()
+    # no validation in the fleet: the fit's in-sample RMSE over the scatter, labelled so
+    assert (ok["heldout_source"] == "in-sample").all()
+    for row in ok.itertuples():
+        saved = json.loads((run.out / row.model_file).read_text())
+        assert row.heldout_ratio == pytest.approx(saved["metrics"]["rmse_over_scatter"])
+        assert row.verdict.startswith(("within noise", "misses by"))
+        assert row.trust in ("yes", "with caveats")
+        lo, hi = saved["operating_range"]["velocity"]
+        assert row.extrapolation_free_range.startswith(f"speed {lo:.4g} to {hi:.4g} rad/s")
+    failed = table[table["status"] == "failed"]
+    assert failed["trust"].isna().all() and failed["converged"].isna().all()
+
+
+def test_verdict_columns_of_an_unconverged_fit():
+    from fricid.errors import ConvergenceWarning
+    from fricid.fleet.job import verdict_columns
+    from fricid.identify import fit
+    from fricid.sim import true_samples
+
+    samples = true_samples(scenario())
+    with pytest.warns(ConvergenceWarning):
+        fitted = fit(samples, "stribeck", "bas", max_evals=100)
+    cols = verdict_columns(fitted, samples)
+    assert cols["converged"] is False and cols["trust"] == "no"
+    assert cols["extrapolation_free_range"].startswith("speed 0.01 to 2 rad/s")
+
+
 def test_rerun_skips_unchanged_and_redoes_what_changed(fleet, tmp_path):
     manifest, first = fleet
     out = tmp_path / "out"
@@ -434,6 +472,7 @@ def test_cli_fleet_with_baseline(fleet, tmp_path):
     assert res.exit_code == 1, res.output  # two joints failed: reported, the rest completed
     assert "failed joints (2)" in res.stdout and "No such file" in res.stdout
     assert "none of 6 joint fits drifted" in res.stdout
+    assert "fits trusted: yes / with caveats / no" in res.stdout
     for name in ("results.csv", "drift_joints.csv", "drift_params.csv", "drift.png"):
         assert (out / name).stat().st_size > 0
     res = runner.invoke(app, ["fleet", str(manifest), "-o", str(out), "--cluster", "udp://x"])

@@ -113,6 +113,7 @@ def test_cli_report(leadscrew, tmp_path):
     )
     assert res.exit_code == 0, res.output
     assert (tmp_path / "r" / "report.html").is_file()
+    assert "Trust: yes, because the fit converged" in res.output
     res = CliRunner().invoke(
         app,
         [
@@ -194,5 +195,104 @@ def test_report_for_the_rbf_network_with_bootstrap(paper1_samples, tmp_path):
         {"network", "parameters", "prediction_ci", "metrics"},
     )
     ci = __import__("pandas").read_csv(tmp_path / "rep" / "prediction_ci.csv")
+    assert (ci["95% CI low [N m]"] <= ci["predicted [N m]"] + 1e-12).all()
+    assert (ci["95% CI high [N m]"] >= ci["predicted [N m]"] - 1e-12).all()
+
+
+# -- "Can I trust this?" (issue 11, "Where it shows") -------------------------------------------
+
+
+def _trust_section(doc: Document):
+    sec = doc.sections[0]
+    assert sec.title == "Can I trust this?"
+    return sec, sec.items[0].text
+
+
+def test_trust_yes_for_a_converged_fit_within_noise(leadscrew, tmp_path):
+    fitted = fit(leadscrew, "stribeck_asym")
+    assert fitted.converged and fitted.validation is None
+    doc = model_report(fitted, leadscrew)
+    sec, line = _trust_section(doc)
+    assert line.startswith("Trust: yes, because the fit converged")
+    assert doc.meta["trust"] == line and next(iter(doc.meta)) == "trust"
+    # the report ran lovo itself, and says so; the quality table of the EPOS reader is shown
+    assert "held-out RMSE (lovo)" in sec.text and "run by this report" in sec.text
+    assert "32 set-points" in sec.text
+    names = {getattr(i, "name", None) for i in sec.items}
+    assert {"quality", "heldout"} <= names
+    write_document(doc, tmp_path / "rep")
+    md = (tmp_path / "rep" / "report.md").read_text()
+    assert md.index("Can I trust this?") < md.index("## Parameters")
+    params = __import__("pandas").read_csv(tmp_path / "rep" / "parameters.csv")
+    assert params["95% interval"].str.match(r"^\[.+, .+\]$").all()
+    assert (params["95% CI low"] <= params["value"]).all()
+    assert (params["value"] <= params["95% CI high"]).all()
+
+
+def test_trust_no_for_a_bas_fit_with_a_tiny_budget(leadscrew):
+    from fricid.errors import ConvergenceWarning
+
+    with pytest.warns(ConvergenceWarning):
+        fitted = fit(leadscrew, "stribeck", "bas", max_evals=200)
+    assert fitted.converged is False
+    doc = model_report(fitted, leadscrew)
+    sec, line = _trust_section(doc)
+    assert line.startswith("Trust: no, because the fit did NOT converge")
+    assert "--method bas+lm" in line
+    assert "NOT converged: method 'bas' ended after 200 of 200 evaluations" in sec.text
+    table = next(i for i in doc.sections[1].items if getattr(i, "name", "") == "parameters")
+    assert (table.frame["95% interval"] == "–").all()
+    assert table.frame["status"].str.contains("did not converge").all()
+
+
+def test_trust_names_open_sides_and_undetermined_parameters():
+    from fricid.fitted import FittedModel
+    from fricid.report.trust import assess_trust
+
+    fitted = FittedModel(
+        model="stribeck",
+        params={"tau_c": 1.0, "tau_s": 1.5, "w_s": 0.1, "tau_v": 0.2, "delta": 2.0},
+        stderr={"tau_c": 0.01, "tau_s": 0.01, "w_s": float("nan"), "tau_v": 0.01, "delta": 0.3},
+        bounds={"tau_v": [0.0, 5.0], "delta": [0.5, 10.0]},
+        ci_open={"tau_v": [True, False], "delta": [False, True]},
+        uncertainty_note={
+            "w_s": "not determined: w_s and delta trade off",
+            "delta": "reaches the bound delta <= 10",
+        },
+        convergence={"converged": True, "certified_by": "optimizer"},
+        metrics={"rmse": 0.02, "scatter": 0.01, "rmse_over_scatter": 2.0},
+        operating_range={"velocity": [0.1, 2.0]},
+        provenance={"directions": [0]},
+    )
+    trust = assess_trust(fitted)
+    assert trust.level == "with caveats"
+    assert trust.not_determined == ["w_s"]
+    assert list(trust.open_sides) == ["delta"]  # tau_v is open at 0 only: consistent with zero
+    assert "misses by 2x" in trust.line() and "in-sample" in trust.line()
+    assert trust.range == "speed 0.1 to 2 rad/s (either direction)"
+
+
+def test_report_of_a_per_direction_rbf_network(leadscrew, tmp_path):
+    from fricid.fitted import FittedModel
+    from fricid.report.rbf import coefficient_names, hidden_layer
+
+    fitted = FittedModel.load(fit(leadscrew, "rbf").save(tmp_path / "rbf.json"))
+    assert fitted.state["symmetry"] == "per_direction"
+    # the design matrix reproduces the two networks' prediction, sign of motion included
+    A = hidden_layer(fitted, leadscrew.X)
+    names = coefficient_names(fitted.state)
+    assert A.shape == (len(leadscrew), len(names))
+    assert any(n.startswith("pos ") for n in names) and any(n.startswith("neg ") for n in names)
+    doc = model_report(fitted, leadscrew, bootstrap=50)
+    write_document(doc, tmp_path / "rep")
+    titles = [s.title for s in doc.sections]
+    assert titles[0] == "Can I trust this?" and titles[1] == "Parameters"
+    main = {getattr(i, "name", None) for i in doc.sections[1].items}
+    assert "prediction_ci" in main and "parameters" not in main  # the weights: an appendix
+    assert any(t.startswith("Appendix") for t in titles)
+    ci = __import__("pandas").read_csv(tmp_path / "rep" / "prediction_ci.csv")
+    assert (ci["velocity [rad/s]"] < 0).any() and (ci["velocity [rad/s]"] > 0).any()
+    pred = np.sign(ci["predicted [N m]"])
+    assert (pred == np.sign(ci["velocity [rad/s]"])).all()
     assert (ci["95% CI low [N m]"] <= ci["predicted [N m]"] + 1e-12).all()
     assert (ci["95% CI high [N m]"] >= ci["predicted [N m]"] - 1e-12).all()

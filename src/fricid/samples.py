@@ -478,7 +478,8 @@ class FrictionSamples:
         Returns
         -------
         FrictionSamples
-            The selected rows; ``source`` and ``meta`` kept.
+            The selected rows; ``source`` and ``meta`` kept (the per-row standard errors
+            ``meta["sem"]`` selected with the rows).
 
         Raises
         ------
@@ -486,8 +487,13 @@ class FrictionSamples:
             The selection is empty.
         """
         idx = np.asarray(mask)
+        meta = self.meta
+        sem = meta.get("sem")
+        if isinstance(sem, list | tuple) and len(sem) == len(self):
+            meta = {**meta, "sem": [sem[i] for i in np.arange(len(self))[idx]]}
         return replace(
             self,
+            meta=meta,
             velocity=self.velocity[idx],
             load=self.load[idx],
             temperature=self.temperature[idx],

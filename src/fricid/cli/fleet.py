@@ -36,6 +36,13 @@ def _summary(run, manifest_path: Path) -> Table:
     table.add_row(
         "failed (see the table below)", str(run.failed), style="red" if run.failed else None
     )
+    trust = getattr(run, "table", None)
+    if trust is not None and "trust" in trust:
+        counts = trust["trust"].value_counts()
+        table.add_row(
+            "fits trusted: yes / with caveats / no (column trust)",
+            " / ".join(str(int(counts.get(k, 0))) for k in ("yes", "with caveats", "no")),
+        )
     if run.computed and run.seconds > 0:
         table.add_row("processed per minute", f"{60.0 * run.computed / run.seconds:.1f}")
     return table

@@ -37,10 +37,20 @@ def report_command(
         ),
     ] = 200,
     seed: Annotated[int, seed_option("Seed of the bootstrap.")] = 0,
+    validate: Annotated[
+        bool,
+        typer.Option(
+            "--validate/--no-validate",
+            help="Run leave-one-velocity-out validation for the trust section when the model "
+            "file has none (analytic models, when it takes a few seconds at most).",
+        ),
+    ] = True,
 ) -> None:
-    """Write a report of MODEL on SAMPLES: parameters with 95 % confidence intervals, fit
+    """Write a report of MODEL on SAMPLES: first "Can I trust this?" (a one-line verdict, data
+    quality per set-point, convergence, identifiability, held-out error against the
+    measurement scatter, operating range), then parameters with their 95 % intervals, fit
     metrics, measured against predicted friction over velocity, residuals against each input
-    and the optimiser's convergence.
+    and the optimiser's convergence. The verdict line is printed on stderr too.
 
     Outputs in the folder: report.html (self-contained), report.md, one CSV per table and one
     PNG per figure, written all or nothing.
@@ -67,9 +77,11 @@ def report_command(
             bootstrap=bootstrap,
             seed=seed,
             samples_label=samples.name,
+            validate=validate,
         )
         path = write_document(doc, out)
     console.print(str(path), highlight=False, soft_wrap=True)
+    err_console.print(str(doc.meta["trust"]), markup=False, highlight=False, soft_wrap=True)
     err_console.print(
         f"wrote {len(doc.tables())} tables and {len(doc.figures())} figures into {out}/"
     )

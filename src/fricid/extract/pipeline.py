@@ -105,7 +105,8 @@ class ExtractionResult:
         What was read, kept and dropped.
     sem, direction_sem : numpy.ndarray
         N m, standard error of each row's friction from the scatter of the repetitions (the
-        noise floor; use it for weighting or tolerances).
+        noise floor; use it for weighting or tolerances); also in ``samples.meta["sem"]`` and
+        ``by_direction.meta["sem"]``, so it is written with the samples.
     position : numpy.ndarray
         rad, mean position of each combined row's samples.
     options : dict

@@ -14,7 +14,21 @@ from ..samples import FrictionSamples
 from .gravity import GravityFit, fit_gravity, separate
 from .joint_gravity import JointGravityFit
 
-__all__ = ["assemble", "missing_message"]
+__all__ = ["SEM_CAVEAT", "SEM_METHOD", "assemble", "missing_message", "sem_meta"]
+
+#: How the extraction estimates each row's standard error (``samples.meta["sem_method"]``).
+SEM_METHOD = "between passes (scatter of the per-pass means)"
+
+#: What that estimate leaves out (``samples.meta["sem_caveat"]``).
+SEM_CAVEAT = "a row measured in a single pass falls back to std/sqrt(count)"
+
+
+def sem_meta(sem: np.ndarray) -> dict:
+    """The samples' ``meta`` entries of the per-row standard errors [N m] (``sem``, None where
+    not finite; ``sem_method``, ``sem_caveat``), which
+    :func:`fricid.identify.validate.measurement_scatter` prefers to its own estimates."""
+    values = [float(x) if np.isfinite(x) else None for x in np.asarray(sem, dtype=float)]
+    return {"sem": values, "sem_method": SEM_METHOD, "sem_caveat": SEM_CAVEAT}
 
 
 def missing_message(has: np.ndarray, t_set, v_set) -> str:
@@ -114,6 +128,7 @@ def assemble(pooled, shape, t_set, v_set, gravity, source, meta, joint_fit, note
         if fit is None
         else (fit.as_meta() if isinstance(fit, JointGravityFit) else vars(fit)),
     }
+    by_sem = e_.ravel()[h.ravel()]
     samples = FrictionSamples(
         velocity=velocity,
         load=load,
@@ -123,7 +138,7 @@ def assemble(pooled, shape, t_set, v_set, gravity, source, meta, joint_fit, note
         count=n_tot,
         std=std_c,
         source=source,
-        meta=meta,
+        meta={**meta, **sem_meta(sem_c)},
     )
     dsel = h.ravel()  # (row, direction) pairs present, -1 before +1
     sign = np.tile([-1.0, 1.0], len(rows))
@@ -136,6 +151,6 @@ def assemble(pooled, shape, t_set, v_set, gravity, source, meta, joint_fit, note
         count=c_.ravel()[dsel],
         std=s_.ravel()[dsel],
         source=source,
-        meta=meta,
+        meta={**meta, **sem_meta(by_sem)},
     )
-    return samples, by_direction, fit, sem_c, e_.ravel()[dsel], position
+    return samples, by_direction, fit, sem_c, by_sem, position

@@ -18,13 +18,22 @@ import traceback
 from dataclasses import dataclass, field
 from typing import Any
 
+import numpy as np
+
 from ..errors import FricidError
 from ..fitted import FittedModel
 from ..samples import FrictionSamples
 from .hashing import input_hash
 from .manifest import JointSpec
 
-__all__ = ["JointJob", "JointOutcome", "failed_outcome", "fit_row", "run_job"]
+__all__ = [
+    "JointJob",
+    "JointOutcome",
+    "failed_outcome",
+    "fit_row",
+    "run_job",
+    "verdict_columns",
+]
 
 
 @dataclass(frozen=True, eq=False)
@@ -108,7 +117,8 @@ def fit_row(
 
     Parameters are ``param_<name>``, their standard errors ``stderr_<name>`` and the
     half-widths of their 95 % confidence intervals ``ci95_<name>`` (SI units, listed in
-    ``units``); a failed fit has ``status`` ``"failed"`` and its ``error``.
+    ``units``); the verdict columns of :func:`verdict_columns`; a failed fit has ``status``
+    ``"failed"`` and its ``error``.
     """
     row: dict[str, Any] = {
         "robot": spec.robot,
@@ -133,6 +143,7 @@ def fit_row(
         return row
     for key in ("fitness", "sse", "rmse", "rmspe", "mae", "max_abs_error"):
         row[key] = fitted.metrics.get(key)
+    row.update(verdict_columns(fitted, used))
     row["nfev"] = fitted.nfev
     row["at_bound"] = ";".join(fitted.at_bound) or None
     row["fixed"] = ";".join(fitted.fixed) or None
@@ -144,6 +155,32 @@ def fit_row(
     for name in fitted.params:
         row[f"ci95_{name}"] = fitted.ci95.get(name)
     return row
+
+
+def verdict_columns(fitted: FittedModel, used: FrictionSamples | None) -> dict[str, Any]:
+    """The per-joint verdict columns of a fit (issue 11, "Where it shows").
+
+    From :func:`fricid.report.trust.assess_trust` of the model and the samples it was fitted
+    on (no validation is run here): ``trust`` (``yes``, ``with caveats``, ``no``),
+    ``converged`` (None when not recorded), ``heldout_ratio`` (held-out RMSE over the
+    measurement scatter from the model's validation, else the fit's in-sample
+    ``rmse_over_scatter``; ``heldout_source`` says which), ``verdict`` (within noise, or
+    misses by a factor), ``n_not_determined`` (free parameters the data do not determine)
+    and ``extrapolation_free_range`` (the operating range as text).
+    """
+    from ..report.trust import assess_trust
+
+    trust = assess_trust(fitted, used, run_validation=False)
+    ratio = trust.heldout_ratio
+    return {
+        "trust": trust.level,
+        "converged": trust.converged,
+        "heldout_ratio": float(ratio) if np.isfinite(ratio) else None,
+        "heldout_source": trust.heldout_source or None,
+        "verdict": trust.verdict,
+        "n_not_determined": len(trust.not_determined),
+        "extrapolation_free_range": trust.range or None,
+    }
 
 
 def failed_outcome(

@@ -8,6 +8,11 @@ Columns (SI units; each parameter's unit in ``units``):
   ``settings_hash``, ``n_samples``, ``directions``, the operating range ``speed_min``,
   ``speed_max`` [rad/s], ``load_min``, ``load_max`` [N m], ``temperature_min``,
   ``temperature_max`` [degC];
+- verdict (issue 11; :func:`fricid.fleet.job.verdict_columns`): ``trust`` (``yes``,
+  ``with caveats``, ``no``), ``converged``, ``heldout_ratio`` (RMSE over the measurement
+  scatter, held out where the model was validated, else in-sample: ``heldout_source``),
+  ``verdict`` (within noise, or misses by a factor), ``n_not_determined``,
+  ``extrapolation_free_range`` (the operating range, as text);
 - fit: ``fitness`` (R^2), ``sse`` [N m^2], ``rmse``, ``mae``, ``max_abs_error`` [N m],
   ``rmspe`` (a fraction), ``nfev``, ``at_bound``, ``fixed``, ``units``, ``model_file``;
   ``param_<name>``, ``stderr_<name>``, ``ci95_<name>`` (half-width of the 95 % CI);
@@ -40,6 +45,7 @@ from ..io.atomic import atomic_dir, atomic_path, atomic_write
 __all__ = [
     "PARTITIONS",
     "RUN_COLUMNS",
+    "VERDICT_COLUMNS",
     "read_results",
     "results_table",
     "write_results",
@@ -68,8 +74,23 @@ _STRINGS = (
     "model_file",
     "worker",
     "fricid_version",
+    "trust",
+    "heldout_source",
+    "verdict",
+    "extrapolation_free_range",
 )
-_INTS = ("seed", "n_samples", "nfev")
+_INTS = ("seed", "n_samples", "nfev", "n_not_determined")
+_BOOLS = ("converged",)
+#: The verdict columns, after the identity and outcome columns.
+VERDICT_COLUMNS = (
+    "trust",
+    "converged",
+    "heldout_ratio",
+    "heldout_source",
+    "verdict",
+    "n_not_determined",
+    "extrapolation_free_range",
+)
 _FLOATS = (
     "speed_min",
     "speed_max",
@@ -94,6 +115,7 @@ _ORDER = (
     "status",
     "stage",
     "error",
+    *VERDICT_COLUMNS,
     "log",
     "reader",
     "method",
@@ -117,6 +139,8 @@ def _type(name: str) -> pa.DataType:
         return pa.string()
     if name in _INTS:
         return pa.int64()
+    if name in _BOOLS:
+        return pa.bool_()
     return pa.float64()
 
 
@@ -184,6 +208,9 @@ def _read_csv(path: Path) -> pd.DataFrame:
     for name in _INTS:
         if name in frame:
             frame[name] = frame[name].astype("Int64")
+    for name in _BOOLS:
+        if name in frame:
+            frame[name] = frame[name].astype("boolean")
     return frame
 
 
@@ -223,6 +250,9 @@ def read_results(path: str | os.PathLike[str]) -> pd.DataFrame:
         for name in _INTS:
             if name in frame:
                 frame[name] = frame[name].astype("Int64")
+        for name in _BOOLS:
+            if name in frame:
+                frame[name] = frame[name].astype("boolean")
     for name in ("robot", "joint", "model"):
         if name not in frame:
             raise DataError(f"not a fleet results table: no column '{name}'", file=path)

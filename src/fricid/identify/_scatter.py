@@ -6,7 +6,8 @@ this order of preference (issue 11, "Validation built in"):
 
 1. standard errors given by the caller (``sem=``, e.g. the scatter of repeated passes that
    :func:`fricid.extract.extract` computes as ``ExtractionResult.direction_sem``), or carried
-   by the samples as ``meta["sem"]``;
+   by the samples as ``meta["sem"]`` (method ``meta["sem_method"]`` where the extraction or
+   reader recorded it, else "given");
 2. the raw steady samples of each set-point (``raw=``): within-run, with the autocorrelation
    taken into account (an effective sample size from the lag-1 autocorrelation, and batch
    means; the larger standard error of the two);
@@ -151,6 +152,9 @@ def measurement_scatter(
     if sem is None and "sem" in samples.meta:
         given = np.asarray(samples.meta["sem"], dtype=float)
         if given.shape == (n,):
+            how = samples.meta.get("sem_method")
+            if isinstance(how, str) and how:  # the reader or extraction says how
+                return _scatter(given, how, str(samples.meta.get("sem_caveat") or ""))
             sem = given
     if sem is not None:
         se = np.asarray(sem, dtype=float)

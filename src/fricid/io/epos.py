@@ -39,6 +39,7 @@ import numpy as np
 import pandas as pd
 
 from ..errors import ConfigError, DataError, DataQualityWarning
+from ..metrics import sem_autocorrelated
 from ..samples import FrictionSamples, RawLog
 from ..units import UNITS, to_si
 from ._steady import (
@@ -54,6 +55,8 @@ __all__ = [
     "DEFAULT_NOMINAL_TORQUE",
     "OUTLIER_SIGMAS",
     "SCATTER_RATIO",
+    "SEM_CAVEAT",
+    "SEM_METHOD",
     "epos_steady_samples",
     "read_epos",
     "read_epos_dir",
@@ -483,6 +486,13 @@ def read_epos_dir(
     return [log for log, _ in _read_dir(folder, pattern, **options)]
 
 
+#: How ``epos_steady_samples`` estimates each file's standard error (``meta["sem_method"]``).
+SEM_METHOD = "within-run, autocorrelation-corrected"
+
+#: What that estimate leaves out (``meta["sem_caveat"]``).
+SEM_CAVEAT = "one run per set-point: offsets between runs are not in it"
+
+
 def _read_dir(folder, pattern: str, **options: Any) -> list[tuple[RawLog, np.ndarray]]:
     """(log, data line numbers) of every file, sorted by mean velocity."""
     read = [_read(path, **options) for path in _files(folder, pattern)]
@@ -532,7 +542,11 @@ def epos_steady_samples(
         ``meta["quality"]`` holds one row per file (the columns of
         :data:`fricid.extract.QUALITY_COLUMNS`: rows kept, outliers dropped, scatter, and
         whether the scatter is far above the neighbours'); ``meta["outlier_lines"]`` the
-        1-based line numbers of the dropped rows, per file.
+        1-based line numbers of the dropped rows, per file; ``meta["sem"]`` each file's
+        standard error of the mean torque [N m] (:func:`fricid.metrics.sem_autocorrelated` of
+        its kept rows, in time order; None for fewer than 4 rows), with ``meta["sem_method"]``
+        and ``meta["sem_caveat"]`` saying how it was estimated
+        (:func:`fricid.identify.validate.measurement_scatter` prefers it).
 
     Raises
     ------
@@ -591,6 +605,7 @@ def epos_steady_samples(
     }
     quality = quality_rows(names, velocity, keep, std, flagged, temperature)
     warn_steady(str(folder), quality, dropped_lines)
+    sem = [sem_autocorrelated(t) for t in torque]
     return FrictionSamples(
         velocity=velocity,
         load=load,
@@ -614,5 +629,8 @@ def epos_steady_samples(
                 if log.meta["skipped_rows"]
             },
             "quality": quality,
+            "sem": [float(x) if np.isfinite(x) else None for x in sem],
+            "sem_method": SEM_METHOD,
+            "sem_caveat": SEM_CAVEAT,
         },
     )

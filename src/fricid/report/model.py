@@ -1,10 +1,14 @@
 """The report for one identified model on one data set (``fricid report MODEL.json SAMPLES``).
 
-Contents: the model and its parameters with 95 % confidence intervals (from the Jacobian at the
-optimum, :attr:`FittedModel.ci95`; for the RBF network a bootstrap of its predictions), fit
-metrics on the identification data and on the given samples, measured against predicted
-friction over velocity (one curve per temperature and load band), residuals against each
-input, predicted against measured, and the optimiser's convergence history where there is one.
+Contents, in order: "Can I trust this?" first (:mod:`.trust`: a one-line verdict, data quality
+per set-point, convergence, identifiability, held-out error against the measurement scatter,
+operating range); the model and its parameters with their 95 % intervals ``[low, high]``
+(profile likelihood inside the search box where the model file has them, open sides marked;
+for the RBF network, predicted friction with bootstrap intervals over the operating range, its
+weights in an appendix); fit metrics on the identification data and on the given samples,
+measured against predicted friction over velocity (one curve per temperature and load band),
+residuals against each input, predicted against measured, and the optimiser's convergence
+history where there is one.
 """
 
 from __future__ import annotations
@@ -19,6 +23,7 @@ from ..identify import evaluate
 from ..samples import FrictionSamples
 from . import plots
 from .document import Document, Figure, Note, Table
+from .trust import Trust, assess_trust, not_determined, quality_frame, trust_text
 
 __all__ = ["METRIC_LABELS", "metrics_table", "model_report", "parameter_table"]
 
@@ -40,31 +45,60 @@ def _metric_value(key: str, value: float) -> float:
     return 100.0 * value if key == "rmspe" else value
 
 
+def _interval(fitted: FittedModel, name: str, value: float) -> tuple[float, float, str, str]:
+    """(low, high, text, method) of a free parameter's 95 % interval; NaNs and "" for none."""
+    low = _num(fitted.ci95_low.get(name))
+    high = _num(fitted.ci95_high.get(name))
+    method = fitted.ci_method or "jacobian"
+    if not (np.isfinite(low) and np.isfinite(high)):
+        half = _num(fitted.ci95.get(name))
+        if not np.isfinite(half) or fitted.converged is False:
+            return np.nan, np.nan, "", ""
+        low, high, method = value - half, value + half, "jacobian (value ± half-width)"
+    sides = fitted.ci_open.get(name) or [False, False]
+    lo_t = f"{low:.4g}" + (" (open)" if sides[0] else "")
+    hi_t = f"{high:.4g}" + (" (open)" if sides[1] else "")
+    return low, high, f"[{lo_t}, {hi_t}]", method
+
+
+def _num(value) -> float:
+    return float("nan") if value is None else float(value)
+
+
 def parameter_table(fitted: FittedModel) -> pd.DataFrame:
-    """One row per parameter: value, unit, standard error, 95 % CI bounds, relative half-width
-    and status (free, fixed, at a bound, not identifiable)."""
+    """One row per parameter: value, unit, the 95 % interval ``[low, high]`` (profile
+    likelihood where the file has it; a side that reaches the search bound marked "(open)"),
+    how it was found, and the status (fixed, not determined, no interval and why, at a bound,
+    not bounded by the data, free)."""
     rows = []
+    undetermined = set(not_determined(fitted))
     for name, value in fitted.params.items():
-        se = fitted.stderr.get(name, np.nan)
-        ci = fitted.ci95.get(name, np.nan)
+        note = fitted.uncertainty_note.get(name, "")
         if name in fitted.fixed:
-            status, se, ci = "fixed", np.nan, np.nan
-        elif name in fitted.at_bound:
-            status = "at a bound of the search box"
-        elif not np.isfinite(ci):
-            status = "no CI (Jacobian rank-deficient)"
+            low, high, text, method, status = np.nan, np.nan, "", "", "fixed"
         else:
-            status = "free"
-        rel = 100.0 * ci / abs(value) if np.isfinite(ci) and value != 0 else np.nan
+            low, high, text, method = _interval(fitted, name, value)
+            if name in undetermined:
+                status = note or "not determined (Jacobian rank-deficient)"
+            elif fitted.converged is False:
+                status = "no interval: the fit did not converge"
+            elif note:
+                status = note
+            elif name in fitted.at_bound:
+                status = "at a bound of the search box"
+            elif not text:
+                status = "no interval"
+            else:
+                status = "free"
         rows.append(
             {
                 "parameter": name,
                 "value": value,
                 "unit": fitted.units.get(name, ""),
-                "std. error": se,
-                "95% CI low": value - ci if np.isfinite(ci) else np.nan,
-                "95% CI high": value + ci if np.isfinite(ci) else np.nan,
-                "± [% of value]": rel,
+                "95% interval": text or "–",
+                "95% CI low": low,
+                "95% CI high": high,
+                "interval method": method or "–",
                 "status": status,
             }
         )
@@ -151,6 +185,7 @@ def model_report(
     samples_label: str | None = None,
     bootstrap: int = 200,
     seed: int = 0,
+    validate: bool = True,
 ) -> Document:
     """Build the report of ``fitted`` on ``samples``.
 
@@ -163,6 +198,9 @@ def model_report(
     bootstrap : resamples for the RBF network's prediction interval (ignored for analytic
         models, whose CIs come from the Jacobian at the optimum).
     seed : seed of the bootstrap.
+    validate : run a leave-one-velocity-out validation for the trust section when the model
+        file has none, the model is analytic and it takes at most a few seconds
+        (:func:`fricid.report.trust.assess_trust`).
 
     Returns
     -------
@@ -191,22 +229,30 @@ def model_report(
         },
     )
 
+    trust = assess_trust(fitted, samples, run_validation=validate)
+    doc.meta = {"trust": trust.line(), **doc.meta}
+    _trust_section(doc, trust)
+
+    appendix: list = []
     sec = doc.section("Parameters", _param_text(fitted))
     if fitted.kind == "rbf":
         from .rbf import rbf_parameter_items
 
-        for item in rbf_parameter_items(fitted, samples, n_boot=bootstrap, seed=seed):
+        main, appendix = rbf_parameter_items(fitted, samples, n_boot=bootstrap, seed=seed)
+        for item in main:
             sec.add(item)
     else:
         sec.add(
             Table(
                 "parameters",
-                "Identified parameters with 95 % confidence intervals",
+                "Identified parameters with 95 % intervals",
                 parameter_table(fitted),
                 caption=(
-                    "95 % CI: value ± t(0.975, n − p) × standard error, from the "
-                    "Jacobian at the optimum (cov = s² (JᵀJ)⁻¹, s² = SSE / (n − p)). "
-                    "Parameters at a bound of the search box have no meaningful CI."
+                    "95 % interval [low, high]: profile likelihood inside the search box "
+                    "where the model file has it (the parameter's values whose re-fitted SSE "
+                    "stays within the F-test threshold), else the Jacobian's linearised "
+                    "interval; a side marked (open) reaches the search bound: the data do "
+                    "not bound the parameter there. A fit that did not converge has none."
                 ),
             )
         )
@@ -279,6 +325,11 @@ def model_report(
         )
     )
 
+    if appendix:
+        sec = doc.section("Appendix: the network's output weights")
+        for item in appendix:
+            sec.add(item)
+
     history = np.asarray(fitted.history, dtype=float) if fitted.history else None
     if history is not None and history.ndim == 2 and len(history) > 1:
         sec = doc.section("Convergence")
@@ -295,6 +346,40 @@ def model_report(
             )
         )
     return doc
+
+
+def _trust_section(doc: Document, trust: Trust) -> None:
+    """The "Can I trust this?" section (first): the verdict, then the diagnostics."""
+    sec = doc.section("Can I trust this?", trust_text(trust))
+    sec.items.insert(0, Note(trust.line(), kind="text" if trust.level == "yes" else "warning"))
+    if trust.quality:
+        sec.add(
+            Table(
+                "quality",
+                "Data quality per set-point",
+                quality_frame(trust.quality),
+                caption="Samples averaged into each set-point's friction and those dropped, "
+                "by reason; HIGH marks a scatter far above the neighbouring set-points'.",
+            )
+        )
+    v = trust.validation
+    if v and v.get("folds"):
+        sec.add(
+            Table(
+                "heldout",
+                f"Held-out error per fold ({v.get('scheme', '')})",
+                pd.DataFrame(
+                    {
+                        "fold": [f["fold"] for f in v["folds"]],
+                        "speed [rad/s]": [f["speed"] for f in v["folds"]],
+                        "samples": [f["n"] for f in v["folds"]],
+                        "held-out RMSE [N m]": [f["rmse"] for f in v["folds"]],
+                        "note": [f.get("note", "") for f in v["folds"]],
+                    }
+                ),
+                caption="Each fold's samples predicted by the model fitted without them.",
+            )
+        )
 
 
 def _param_text(fitted: FittedModel) -> str:

@@ -1,44 +1,98 @@
-"""The RBF network's part of a model report: its structure and bootstrap confidence intervals.
+"""The RBF network's part of a model report: predicted friction with bootstrap intervals over the
+operating range, the network's structure, and its output weights (for an appendix).
 
 An RBF network (BAS-RBFNN paper, eq. 14-15) has no small set of physical parameters whose
 Jacobian CIs mean much, so the report gives a residual bootstrap instead: the hidden layer
 (centres and widths) is held at its trained values, the residuals are resampled with
 replacement, and the linear output layer (weights and bias) is re-solved by least squares for
-each resample. That yields 95 % percentile intervals of the output weights and of the
-predicted friction at representative operating points. It is conditional on the hidden layer,
-so it understates the uncertainty of a network whose centres were searched (BAS, GA).
+each resample. That yields 95 % percentile intervals of the predicted friction over the
+operating range (what a user of the model needs) and of the output weights (an appendix). It
+is conditional on the hidden layer, so it understates the uncertainty of a network whose
+centres were searched (BAS, GA).
+
+The output is linear in every output weight and bias of every network the state holds (one,
+or ``pos`` and ``neg`` for a ``per_direction`` state: :func:`fricid.models.rbf.sub_networks`),
+sign of motion included, so each column of the design matrix is the model's own prediction
+with that one coefficient set to 1 and all others to 0 (:func:`hidden_layer`).
 """
 
 from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
 
 import numpy as np
 import pandas as pd
 
 from ..fitted import FittedModel
+from ..models import get_predictor
+from ..models.rbf import sub_networks
 from ..samples import FrictionSamples
 from .document import Note, Table
 
-__all__ = ["hidden_layer", "rbf_bootstrap", "rbf_parameter_items"]
+__all__ = ["coefficient_names", "hidden_layer", "rbf_bootstrap", "rbf_parameter_items"]
+
+#: Speeds per direction at which the report predicts friction with its interval.
+N_SPEEDS = 8
+
+
+def _slots(state: Mapping[str, Any]) -> list[tuple[str, str, int]]:
+    """(side, "w" or "b", unit index) of every output coefficient, side ``"all"`` for a
+    single network."""
+    out = []
+    for side, net in sub_networks(state).items():
+        out += [(side, "w", i) for i in range(len(net.get("weights") or ()))]
+        if net.get("fit_bias", True):
+            out.append((side, "b", -1))
+    return out
+
+
+def coefficient_names(state: Mapping[str, Any]) -> list[str]:
+    """``w_1 .. w_m, bias`` for one network; ``pos w_1 .. pos bias, neg w_1 ..`` for two."""
+    names = []
+    for side, what, i in _slots(state):
+        base = f"w_{i + 1}" if what == "w" else "bias"
+        names.append(base if side == "all" else f"{side} {base}")
+    return names
+
+
+def _unit_state(state: Mapping[str, Any], slot: tuple[str, str, int]) -> dict[str, Any]:
+    """``state`` with every output weight and bias 0 except the one of ``slot`` (1)."""
+    side, what, i = slot
+    out = dict(state)
+    for s, net in sub_networks(state).items():
+        zero = {**net, "weights": [0.0] * len(net.get("weights") or ()), "bias": 0.0}
+        if s == side:
+            if what == "w":
+                zero["weights"][i] = 1.0
+            else:
+                zero["bias"] = 1.0
+        if s == "all":
+            out.update(zero)
+        else:
+            out[s] = zero
+    return out
+
+
+def _coefficients(state: Mapping[str, Any]) -> np.ndarray:
+    values = []
+    for side, what, i in _slots(state):
+        net = sub_networks(state)[side]
+        values.append(float(net["weights"][i]) if what == "w" else float(net.get("bias", 0.0)))
+    return np.asarray(values)
 
 
 def hidden_layer(fitted: FittedModel, X: np.ndarray) -> np.ndarray:
-    """The hidden-layer outputs ``Phi (n, m)`` of the stored network at inputs ``X (n, 3)``.
+    """The design matrix ``A (n, k)`` of the stored network's output coefficients at ``X``.
 
-    The network is linear in its output weights, so column i is the prediction with weight
-    vector e_i and zero bias (eq. 15); computed through the model's own ``predict``.
+    ``fitted.predict(X) == A @ c`` with ``c`` the coefficients named by
+    :func:`coefficient_names` (every network's weights, then its bias where it has one);
+    column j is the model's prediction with coefficient j set to 1 and all others to 0.
     """
     state = dict(fitted.state or {})
-    m = len(state["weights"])
-    cols = []
-    for i in range(m):
-        w = np.zeros(m)
-        w[i] = 1.0
-        cols.append(
-            FittedModel(
-                model="rbf", params={}, state={**state, "weights": w.tolist(), "bias": 0.0}
-            ).predict(X)
-        )
-    return np.column_stack(cols)
+    model = get_predictor("rbf")
+    cols = [model.predict(_unit_state(state, slot), X) for slot in _slots(state)]
+    return np.column_stack(cols) if cols else np.zeros((len(X), 0))
 
 
 def rbf_bootstrap(
@@ -51,112 +105,75 @@ def rbf_bootstrap(
 ) -> dict[str, np.ndarray]:
     """Residual bootstrap of the output layer (see the module notes).
 
-    Returns a dict with ``weights`` (n_boot, m), ``bias`` (n_boot,) and ``predictions``
-    (n_boot, len(Xq)).
+    Returns a dict with ``coefficients`` (n_boot, k) in the order of
+    :func:`coefficient_names` and ``predictions`` (n_boot, len(Xq)).
     """
     rng = np.random.default_rng(seed)
-    phi = hidden_layer(fitted, samples.X)
-    phi_q = hidden_layer(fitted, Xq)
-    fit_bias = bool((fitted.state or {}).get("fit_bias", True))
-    A = np.column_stack([phi, np.ones(len(phi))]) if fit_bias else phi
-    Aq = np.column_stack([phi_q, np.ones(len(phi_q))]) if fit_bias else phi_q
-    y_hat = fitted.predict(samples.X)
+    A = hidden_layer(fitted, samples.X)
+    Aq = hidden_layer(fitted, Xq)
+    y_hat = fitted.predict(samples.X, warn=False)
     resid = samples.friction - y_hat
     idx = rng.integers(0, resid.size, size=(n_boot, resid.size))
     Y = y_hat[None, :] + resid[idx]  # (n_boot, n)
-    coef, *_ = np.linalg.lstsq(A, Y.T, rcond=None)  # (m[+1], n_boot)
+    coef, *_ = np.linalg.lstsq(A, Y.T, rcond=None)  # (k, n_boot)
     coef = coef.T
-    m = phi.shape[1]
-    return {
-        "weights": coef[:, :m],
-        "bias": coef[:, m] if fit_bias else np.zeros(n_boot),
-        "predictions": coef @ Aq.T,
-    }
+    return {"coefficients": coef, "predictions": coef @ Aq.T}
 
 
-def _query_points(samples: FrictionSamples, n: int = 6) -> np.ndarray:
-    speeds = np.unique(np.abs(samples.velocity))
-    pick = np.unique(np.quantile(speeds, np.linspace(0, 1, n), method="nearest"))
-    sign = 1.0 if (samples.velocity > 0).any() else -1.0
+def _query_points(fitted: FittedModel, samples: FrictionSamples) -> np.ndarray:
+    """:data:`N_SPEEDS` speeds spread over the measured ones, on each side of motion the
+    samples have (both for combined samples), at their median load and temperature."""
+    speeds = np.abs(samples.velocity[samples.velocity != 0])
+    if not speeds.size:
+        speeds = np.abs(samples.velocity)
+    pick = np.unique(np.quantile(speeds, np.linspace(0, 1, N_SPEEDS), method="nearest"))
+    dirs = set(samples.directions())
+    signs = [s for s in (-1.0, 1.0) if 0 in dirs or int(s) in dirs]
+    v = np.concatenate([s * pick for s in signs])
     return np.column_stack(
         [
-            sign * pick,
-            np.full_like(pick, np.median(samples.load)),
-            np.full_like(pick, np.median(samples.temperature)),
+            v,
+            np.full_like(v, np.median(samples.load)),
+            np.full_like(v, np.median(samples.temperature)),
         ]
+    )
+
+
+def _facts(fitted: FittedModel) -> pd.DataFrame:
+    state = fitted.state or {}
+    rows: dict[str, Any] = {"symmetry": state.get("symmetry") or "signed", "trainer": fitted.method}
+    for side, net in sub_networks(state).items():
+        tag = "" if side == "all" else f" ({side})"
+        widths = np.asarray(net.get("widths", []), dtype=float)
+        rows[f"inputs{tag}"] = ", ".join(net.get("inputs", []))
+        rows[f"hidden units (centres){tag}"] = len(net.get("weights") or ())
+        rows[f"velocity warp asinh(v / scale) [rad/s]{tag}"] = net.get("velocity_scale")
+        rows[f"widths (standardised units){tag}"] = (
+            f"{widths.min():.3g}–{widths.max():.3g}" if widths.size else "–"
+        )
+        rows[f"epochs run{tag}"] = net.get("n_epochs")
+        rows[f"final training MSE (target scaled to [-1, 1]){tag}"] = net.get("train_mse_scaled")
+    return pd.DataFrame(
+        {"property": list(rows), "value": [("–" if v is None else v) for v in rows.values()]}
     )
 
 
 def rbf_parameter_items(
     fitted: FittedModel, samples: FrictionSamples, *, n_boot: int = 200, seed: int = 0
-) -> list:
-    """Tables for an RBF model: the network, its output weights with bootstrap 95 % CIs and
-    predicted friction with bootstrap 95 % CIs at representative operating points."""
-    state = fitted.state or {}
-    widths = np.asarray(state.get("widths", []), dtype=float)
-    facts = {
-        "inputs": ", ".join(state.get("inputs", [])),
-        "hidden units (centres)": len(state.get("weights", [])),
-        "trainer": fitted.method,
-        "velocity warp asinh(v / scale) [rad/s]": state.get("velocity_scale"),
-        "widths (standardised units)": f"{widths.min():.3g}–{widths.max():.3g}"
-        if widths.size
-        else "–",
-        "epochs run": state.get("n_epochs"),
-        "epoch reaching the target MSE": state.get("epochs_to_target"),
-        "target MSE (target scaled to [-1, 1])": state.get("target_mse"),
-        "final training MSE (same scale)": state.get("train_mse_scaled"),
-    }
-    items: list = [
-        Table(
-            "network",
-            "The RBF network",
-            pd.DataFrame(
-                {
-                    "property": list(facts),
-                    "value": [("–" if v is None else v) for v in facts.values()],
-                }
-            ),
-            caption="Gaussian hidden units (eq. 14) and a linear output layer (eq. 15).",
-        )
-    ]
-    Xq = _query_points(samples)
+) -> tuple[list, list]:
+    """The RBF network's report items: (main, appendix).
+
+    Main: predicted friction with bootstrap 95 % intervals over the operating range and the
+    network's structure; appendix: every output weight and bias with its interval.
+    """
+    Xq = _query_points(fitted, samples)
     boot = rbf_bootstrap(fitted, samples, Xq, n_boot=n_boot, seed=seed)
-    weights = np.asarray(state.get("weights", []), dtype=float)
-    lo_w, hi_w = np.percentile(boot["weights"], [2.5, 97.5], axis=0)
-    rows = [
-        {"parameter": f"w_{i + 1}", "value": w, "unit": "N m", "95% CI low": lo, "95% CI high": hi}
-        for i, (w, lo, hi) in enumerate(zip(weights, lo_w, hi_w, strict=True))
-    ]
-    if state.get("fit_bias", True):
-        lo_b, hi_b = np.percentile(boot["bias"], [2.5, 97.5])
-        rows.append(
-            {
-                "parameter": "bias",
-                "value": float(state.get("bias", 0.0)),
-                "unit": "N m",
-                "95% CI low": lo_b,
-                "95% CI high": hi_b,
-            }
-        )
-    items.append(
-        Table(
-            "parameters",
-            "Output weights with bootstrap 95 % confidence intervals",
-            pd.DataFrame(rows),
-            caption=(
-                f"Residual bootstrap, {n_boot} resamples, hidden layer held fixed "
-                "(percentile intervals). Individual weights of overlapping Gaussians "
-                "are poorly determined; the predictions below are what matters."
-            ),
-        )
-    )
-    pred = fitted.predict(Xq)
+    pred = fitted.predict(Xq, warn=False)
     lo_p, hi_p = np.percentile(boot["predictions"], [2.5, 97.5], axis=0)
-    items.append(
+    main: list = [
         Table(
             "prediction_ci",
-            "Predicted friction with bootstrap 95 % confidence intervals",
+            "Predicted friction with bootstrap 95 % intervals over the operating range",
             pd.DataFrame(
                 {
                     "velocity [rad/s]": Xq[:, 0],
@@ -165,18 +182,46 @@ def rbf_parameter_items(
                     "predicted [N m]": pred,
                     "95% CI low [N m]": lo_p,
                     "95% CI high [N m]": hi_p,
-                    "± [N m]": 0.5 * (hi_p - lo_p),
                 }
             ),
-            caption="At speeds spread over the measured range, median load and "
-            "temperature of the samples.",
-        )
-    )
-    items.append(
+            caption=(
+                f"At {N_SPEEDS} speeds spread over the measured ones, on each side of motion, "
+                f"median load and temperature of the samples. Residual bootstrap, {n_boot} "
+                "resamples, hidden layer held fixed (percentile intervals): it understates "
+                "the uncertainty of searched centres. The weights are in the appendix."
+            ),
+        ),
+        Table(
+            "network",
+            "The RBF network",
+            _facts(fitted),
+            caption="Gaussian hidden units (eq. 14) and a linear output layer (eq. 15).",
+        ),
+    ]
+    coef = _coefficients(fitted.state or {})
+    lo_w, hi_w = np.percentile(boot["coefficients"], [2.5, 97.5], axis=0)
+    appendix: list = [
+        Table(
+            "parameters",
+            "Output weights with bootstrap 95 % intervals",
+            pd.DataFrame(
+                {
+                    "parameter": coefficient_names(fitted.state or {}),
+                    "value": coef,
+                    "unit": "N m",
+                    "95% CI low": lo_w,
+                    "95% CI high": hi_w,
+                }
+            ),
+            caption=(
+                f"Residual bootstrap, {n_boot} resamples, hidden layer held fixed. Individual "
+                "weights of overlapping Gaussians are poorly determined; the predictions in "
+                "the parameters section are what matters."
+            ),
+        ),
         Note(
-            "Confidence intervals of an RBF network come from the bootstrap above, "
-            "not from a Jacobian: the network's parameters are many and strongly "
-            "coupled."
-        )
-    )
-    return items
+            "Confidence intervals of an RBF network come from the bootstrap, not from a "
+            "Jacobian: the network's parameters are many and strongly coupled."
+        ),
+    ]
+    return main, appendix
