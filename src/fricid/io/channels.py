@@ -44,6 +44,7 @@ import pandas as pd
 from ..errors import ConfigError, DataError, DataQualityWarning
 from ..samples import RawLog
 from ..units import UNITS, to_si
+from .generic import integrate_velocity
 
 __all__ = ["CHANNEL_QUANTITIES", "JOINS", "compile_pattern", "read_channels"]
 
@@ -399,8 +400,7 @@ def _read_run(
         velocity = np.gradient(values["position"], t_ref)
     position = values.get("position")
     if position is None:
-        steps = 0.5 * (velocity[1:] + velocity[:-1]) * np.diff(t_ref)
-        position = np.concatenate([[0.0], np.cumsum(steps)])
+        position = integrate_velocity(t_ref, velocity)
     return RawLog(
         time=t_ref,
         position=position,

@@ -50,6 +50,7 @@ from ._steady import (
     quality_rows,
     warn_steady,
 )
+from .generic import integrate_velocity
 
 __all__ = [
     "DEFAULT_NOMINAL_TORQUE",
@@ -330,13 +331,6 @@ def _convert(
     return np.asarray(to_si(values, unit, quantity), dtype=float)
 
 
-def _integrate(time: np.ndarray, velocity: np.ndarray) -> np.ndarray:
-    """Position [rad] from velocity by the trapezoidal rule, starting at 0."""
-    with np.errstate(over="ignore", invalid="ignore"):  # RawLog reports absurd velocities
-        steps = 0.5 * (velocity[1:] + velocity[:-1]) * np.diff(time)
-        return np.concatenate([[0.0], np.cumsum(steps)])
-
-
 def _positive(name: str, value: float | None) -> None:
     if value is not None and not (np.isfinite(value) and value > 0):
         raise ConfigError(f"{name} must be a positive number, got {value!r}")
@@ -452,7 +446,7 @@ def _read(
     }
     log = RawLog(
         time=time,
-        position=_integrate(time, values["velocity"]) if position is None else position,
+        position=integrate_velocity(time, values["velocity"]) if position is None else position,
         velocity=values["velocity"],
         temperature=temperature,
         torque=values.get("torque"),

@@ -110,7 +110,9 @@ def _find_column(label: str, quantity: str, available: list[str], path: Path) ->
     )
 
 
-def _integrate(time: np.ndarray, velocity: np.ndarray) -> np.ndarray:
+def integrate_velocity(time: np.ndarray, velocity: np.ndarray) -> np.ndarray:
+    """Position [rad] as the trapezoidal integral of velocity, starting at 0 (for logs that
+    record no position: the readers of generic tables, per-channel files and MATLAB files)."""
     with np.errstate(over="ignore", invalid="ignore"):  # RawLog reports absurd velocities
         steps = 0.5 * (velocity[1:] + velocity[:-1]) * np.diff(time)
         return np.concatenate([[0.0], np.cumsum(steps)])
@@ -201,7 +203,7 @@ def read_table_log(
     try:
         return RawLog(
             time=time,
-            position=si["position"] if "position" in si else _integrate(time, velocity),
+            position=si["position"] if "position" in si else integrate_velocity(time, velocity),
             velocity=velocity,
             temperature=si.get("temperature", temperature),
             torque=si.get("torque"),

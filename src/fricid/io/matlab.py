@@ -26,6 +26,7 @@ import numpy as np
 from ..errors import ConfigError, DataError
 from ..samples import FrictionSamples, RawLog
 from ..units import UNITS, to_si
+from .generic import integrate_velocity
 
 __all__ = ["LOG_VARIABLES", "SAMPLE_VARIABLES", "mat_variables", "read_mat"]
 
@@ -287,8 +288,7 @@ def read_mat(
         raise ConfigError("give the temperature as --var temperature=NAME:UNIT or --temperature")
     position = si.get("position")
     if position is None:
-        steps = 0.5 * (velocity[1:] + velocity[:-1]) * np.diff(time)
-        position = np.concatenate([[0.0], np.cumsum(steps)])
+        position = integrate_velocity(time, velocity)
     return RawLog(
         time=time,
         position=position,
