@@ -20,9 +20,14 @@ from fricid.export.mujoco_check import one_joint_xml, run_torque
 from fricid.fitted import FittedModel
 from fricid.models import lugre
 
-mujoco = pytest.importorskip(
-    "mujoco", reason="the MuJoCo checks need the optional mujoco package (pip install mujoco)"
-)
+
+@pytest.fixture
+def mujoco():
+    """The optional mujoco package; the tests that run MuJoCo skip without it."""
+    return pytest.importorskip(
+        "mujoco", reason="the MuJoCo checks need the optional mujoco package (pip install mujoco)"
+    )
+
 
 runner = CliRunner()
 J = 0.01
@@ -49,7 +54,7 @@ def rms(a: np.ndarray, b: np.ndarray) -> float:
     return float(np.sqrt(np.mean((a - b) ** 2)))
 
 
-def test_cli_export_runs_in_mujoco_and_tracks_the_karnopp_joint(tmp_path):
+def test_cli_export_runs_in_mujoco_and_tracks_the_karnopp_joint(tmp_path, mujoco):
     """Coulomb-viscous truth, exported exactly: MuJoCo's trajectory follows the Python joint's;
     frictionloss is a soft constraint, and a stiffer solreffriction follows it closer."""
     cv = FittedModel(
@@ -80,7 +85,7 @@ def test_cli_export_runs_in_mujoco_and_tracks_the_karnopp_joint(tmp_path):
     assert rms(free["position"], ref["position"]) > 0.1 * span
 
 
-def test_dcmotor_lugre_steady_state_has_exponent_two():
+def test_dcmotor_lugre_steady_state_has_exponent_two(mujoco):
     """Held at constant velocity, MuJoCo's bristle state settles to g(v) / sigma_0 with a
     Stribeck exponent of 2 (the basis of MUJOCO_STRIBECK_EXPONENT)."""
     fragment = mjcf_text(lugre_model(), joint="j")
@@ -98,7 +103,7 @@ def test_dcmotor_lugre_steady_state_has_exponent_two():
     assert MUJOCO_STRIBECK_EXPONENT == 2.0
 
 
-def test_lugre_export_in_mujoco_tracks_the_python_lugre_joint():
+def test_lugre_export_in_mujoco_tracks_the_python_lugre_joint(mujoco):
     fragment = mjcf_text(lugre_model(), joint="elbow")
     root = ET.fromstring(f"<r>{fragment}</r>")
     motor = root.find("actuator/dcmotor")
@@ -134,3 +139,21 @@ def test_fragment_checks():
     bad = '<joint name="a"/><actuator><dcmotor joint="b" lugre="1 0 1 1 1"/></actuator>'
     with pytest.raises(ConfigError, match="not on"):
         one_joint_xml(bad)
+
+
+def test_cli_export_of_a_lugre_model_states_the_mapping(tmp_path, monkeypatch):
+    """`fricid export --to mjcf` of a LuGre model file: the dcmotor in the file, and what the
+    exponent mapping and the static fallback cost on stderr. (Loading a 'lugre' file needs
+    the model registered; here the loader is stubbed.)"""
+    path = tmp_path / "lugre.json"
+    path.write_text("{}")
+    monkeypatch.setattr(FittedModel, "load", classmethod(lambda cls, p: lugre_model(delta=1.0)))
+    out = tmp_path / "lugre.mjcf"
+    res = runner.invoke(app, ["export", str(path), "--to", "mjcf", "-o", str(out)])
+    assert res.exit_code == 0, res.output
+    assert "<dcmotor" in out.read_text()
+    notes = " ".join(res.stderr.split())
+    assert "note: MuJoCo's Stribeck exponent is 2, this model's 1" in notes
+    assert "without dcmotor (MuJoCo < 4.0)" in notes
+    res = runner.invoke(app, ["export", str(path), "--to", "mjcf", "--max-loss", "0.001"])
+    assert res.exit_code == 2 and "cannot represent this model's exponent" in res.output

@@ -11,7 +11,11 @@ Static models
     ``frictionloss`` does not hold the joint exactly still but lets it creep, and the
     constraint reacts over about the ``solref`` time constant. :data:`FRICTIONLOSS_LINES` say
     so in the exported comment; ``benchmarks/bench_mujoco.py`` measures what it costs against
-    a stick-slip (Karnopp) joint, with the default and a stiffer ``solreffriction``.
+    a stick-slip (Karnopp) joint, with the default and a stiffer ``solreffriction``. Its run
+    with mujoco 4.0.0 (Coulomb 0.3 N m, viscous 0.1 N m s/rad, J 0.01 kg m^2, 2 s of a
+    0.6 N m sine torque, 1 ms steps): RMS position error 0.45 % of the span with the default
+    ``solref``, 0.05 % with ``solreffriction="0.002 1"`` (the Python joint's own at 1 ms:
+    0.09 %); at 0.1 ms steps 0.52 % and 0.007 %.
 LuGre (dynamic) models
     MuJoCo 4.0 added the ``dcmotor`` actuator (XML reference, actuator/dcmotor) with optional
     LuGre friction: ``lugre="stiffness damping coulomb static stribeck"`` = sigma_0 [N m/rad],
