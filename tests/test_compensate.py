@@ -224,7 +224,7 @@ def test_extrapolated_feedforward_is_noted():
 
 from fricid.control import LuGreTruth, lugre_compensation_study, lugre_parameters  # noqa: E402
 from fricid.control.dynamic import RUNS, crossing_mask  # noqa: E402
-from fricid.control.plant import drive  # noqa: E402
+from fricid.control.plant import drive, lugre_step  # noqa: E402
 from fricid.errors import FricidWarning  # noqa: E402
 from fricid.models import lugre  # noqa: E402
 
@@ -310,3 +310,15 @@ def test_cli_compensate_lugre_truth(tmp_path):
     assert res.exit_code == 0, res.output
     assert plot.stat().st_size > 10_000
     assert "LuGre observer's RMS error is" in " ".join(res.stdout.split())
+
+
+def test_lugre_step_batches_runs_like_the_compiled_drive():
+    """plant.lugre_step over (k,) runs, stepped from Python, matches drive's compiled loop."""
+    dt, u = 1e-4, 0.45 * np.sin(np.linspace(0, 6, 300))
+    ref = drive(u, dt, 0.01, lugre_theta=LUGRE)
+    z, v = np.zeros(2), np.zeros(2)
+    theta = np.vstack([LUGRE, LUGRE])
+    for i in range(u.size):
+        np.testing.assert_allclose(v, ref["velocity"][i], rtol=1e-12, atol=1e-15)
+        z, v, f = lugre_step(theta, z, v, np.full(2, u[i]), 0.01, dt)
+        np.testing.assert_allclose(f, ref["friction"][i], rtol=1e-12, atol=1e-15)

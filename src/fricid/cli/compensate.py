@@ -68,7 +68,10 @@ def compensate_command(
             help=(
                 "True friction of the simulated joint: model (the model itself, i.e. the gain "
                 "if it were exact), paper1 or paper2 (the virtual joint's law of that "
-                "simulation preset, and its inertia)."
+                "simulation preset, and its inertia), or lugre (dynamic LuGre friction: "
+                "sigma_0 1000 N m/rad, sigma_1 0.5, sigma_2 0.1 N m s/rad, tau_c 0.3, tau_s "
+                "0.5 N m, w_s 0.05 rad/s, delta 2, J 0.01 kg m^2; adds the LuGre observer, "
+                "see --lugre)."
             )
         ),
     ] = "model",

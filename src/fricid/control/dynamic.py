@@ -14,7 +14,8 @@ Three runs advance together, each with the controller
     ``F_ff = sign(v_r) g(v_r) + sigma_2 v_r`` (:func:`fricid.models.lugre.steady_state`: the
     static Stribeck law, what a model identified from constant-velocity sweeps gives).
 ``LuGre observer``
-    The friction observer of [CW95] section 4 with zero observer gain: the bristle state
+    The observer-based compensation of [CW95] (there the estimate is also corrected by the
+    tracking error through a gain; here that gain is zero): the bristle state
     ``z_hat`` is estimated from the measured joint velocity ``v`` with the model's own update
     (:func:`fricid.models.lugre.simulate`, one sample per control step, exact for a velocity
     held over the step), and ``F_ff = sigma_0 z_hat + sigma_1 dz_hat/dt + sigma_2 v``. It is
@@ -43,7 +44,6 @@ import numpy as np
 from ..errors import ConfigError, FricidWarning
 from ..fitted import FittedModel
 from ..models import lugre
-from .plant import lugre_step
 from .tracking import TrackingConfig
 
 __all__ = [
@@ -208,27 +208,33 @@ class DynamicCompensationResult:
 
 
 def _simulate(truth: np.ndarray, model: np.ndarray, config: TrackingConfig) -> dict:
+    """The three runs, compiled (:func:`fricid.control._kernels.track_lugre`)."""
+    from ._kernels import track_lugre
+
     t, q_r, v_r, a_r = config.reference()
-    n, k = t.size, len(RUNS)
     kp, kd = config.gains
-    J, dt = config.inertia, config.dt
-    static_ff = lugre.steady_state(model, v_r)
     # the joint starts on the reference, sliding: bristles at their steady deflection
-    q, v = np.zeros(k), np.full(k, v_r[0])
-    z = np.full(k, np.sign(v_r[0]) * lugre.stribeck_curve(truth, v_r[:1])[0] / truth[0])
-    z_hat = float(np.sign(v_r[0]) * lugre.stribeck_curve(model, v_r[:1])[0] / model[0])
+    z0, z0_hat = (
+        float(np.sign(v_r[0]) * lugre.stribeck_curve(th, v_r[:1])[0] / th[0])
+        for th in (truth, model)
+    )
     names = ("position", "velocity", "torque", "friction", "feedforward")
-    out = {name: np.empty((k, n)) for name in names}
-    ff = np.zeros(k)
-    for i in range(n):
-        f_hat, z_now = lugre.simulate(model, v[2:3], dt, z_hat)  # the observer's update
-        z_hat = float(z_now[0])
-        ff[1], ff[2] = static_ff[i], f_hat[0]
-        u = J * a_r[i] + kp * (q_r[i] - q) + kd * (v_r[i] - v) + ff
-        out["position"][:, i], out["velocity"][:, i] = q, v
-        out["torque"][:, i], out["feedforward"][:, i] = u, ff
-        z, v, out["friction"][:, i] = lugre_step(truth, z, v, u, J, dt)
-        q = q + v * dt
+    out = {name: np.empty((len(RUNS), t.size)) for name in names}
+    track_lugre(
+        np.ascontiguousarray(truth, dtype=float),
+        np.ascontiguousarray(model, dtype=float)[None, :],
+        q_r,
+        v_r,
+        a_r,
+        lugre.steady_state(model, v_r),
+        kp,
+        kd,
+        float(config.inertia),
+        float(config.dt),
+        z0,
+        z0_hat,
+        *(out[name] for name in names),
+    )
     out["error"] = q_r[None, :] - out["position"]
     out.update(time=t, reference=q_r, reference_velocity=v_r)
     return out

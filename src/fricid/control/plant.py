@@ -78,29 +78,26 @@ def lugre_step(
 
     Parameters
     ----------
-    theta : (7,) or (k, 7) LuGre parameters in the order of :data:`fricid.models.lugre.PARAM_NAMES`.
-    z, v, u : (k,) bristle state [rad], velocity [rad/s] and applied torque [N m].
+    theta : array_like
+        (7,) LuGre parameters (:data:`fricid.models.lugre.PARAM_NAMES`), or (k, 7): one row
+        per run.
+    z, v, u : ndarray
+        (k,) bristle state [rad], velocity [rad/s] and applied torque [N m].
 
     Returns
     -------
-    z_new, v_new, friction : (k,) arrays; ``friction`` is the LuGre force over the step.
+    z_new, v_new, friction : ndarray
+        (k,) arrays; ``friction`` is the LuGre force over the step. The step is compiled
+        (:func:`fricid.control._kernels.lugre_plant_step`, also used by the study's loop).
     """
-    th = np.atleast_2d(np.asarray(theta, dtype=float))
-    s0, s1, s2 = th[:, 0], th[:, 1], th[:, 2]
-    a = s0 * np.abs(v) / _g(th, v)
-    c = 1.0 / (1.0 + a * dt)
-    k = (s0 - s1 * a) * c  # friction = k z + (k dt + s1 + s2) v'
-    v_new = (inertia * v / dt + u - k * z) / (inertia / dt + k * dt + s1 + s2)
-    z_new = c * (z + dt * v_new)
-    friction = k * z + (k * dt + s1 + s2) * v_new
-    return z_new, v_new, friction
+    from ._kernels import lugre_plant_step
 
-
-def _g(th: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """``g(v)`` of [CW95] eq. 3 (:func:`fricid.models.lugre.stribeck_curve`), run by run:
-    row ``i`` of ``th`` (or its only row) at ``v[i]``."""
-    tau_c, tau_s, w_s, delta = th[:, 3], th[:, 4], th[:, 5], th[:, 6]
-    return tau_c + (tau_s - tau_c) * np.exp(-((np.abs(v) / np.maximum(w_s, 1e-12)) ** delta))
+    z, v, u = (np.atleast_1d(np.asarray(a, dtype=float)) for a in (z, v, u))
+    th = np.broadcast_to(np.atleast_2d(np.asarray(theta, dtype=float)), (z.size, 7))
+    out = np.array(
+        [lugre_plant_step(th[j], z[j], v[j], u[j], inertia, dt) for j in range(z.size)]
+    ).reshape(z.size, 3)
+    return out[:, 0], out[:, 1], out[:, 2]
 
 
 def drive(
@@ -132,16 +129,26 @@ def drive(
         raise ConfigError("drive: the torque must be finite")
     n = torque.size
     out = {name: np.empty(n) for name in ("position", "velocity", "friction")}
-    q, v, z = np.zeros(1), np.zeros(1), np.zeros(1)
+    out["time"] = np.arange(n) * dt
+    if lugre_theta is not None:
+        from ._kernels import drive_lugre
+
+        th = np.ascontiguousarray(_checked(lugre_theta))
+        drive_lugre(th, torque, float(dt), float(inertia), *(out[k] for k in list(out)[:3]))
+        return out
+    q, v = np.zeros(1), np.zeros(1)
     lo, te = np.full(1, float(load)), np.full(1, float(temperature))
     for i in range(n):
         out["position"][i], out["velocity"][i] = q[0], v[0]
-        u = torque[i : i + 1]
-        if law is not None:
-            v, f = static_step(law, v, u, inertia, dt, lo, te)
-        else:
-            z, v, f = lugre_step(lugre_theta, z, v, u, inertia, dt)
+        v, f = static_step(law, v, torque[i : i + 1], inertia, dt, lo, te)
         out["friction"][i] = f[0]
         q = q + v * dt
-    out["time"] = np.arange(n) * dt
     return out
+
+
+def _checked(theta) -> np.ndarray:
+    """7 finite LuGre parameters, as floats (:class:`ConfigError` otherwise)."""
+    th = np.asarray(theta, dtype=float)
+    if th.shape != (7,) or not np.all(np.isfinite(th)):
+        raise ConfigError(f"LuGre takes 7 finite parameters, got {theta!r}")
+    return th
