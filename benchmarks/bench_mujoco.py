@@ -1,6 +1,6 @@
 """The MJCF export in MuJoCo, and LuGre compensation (issue 16, "In a real simulator").
 
-Usage: ``python benchmarks/bench_mujoco.py`` (needs ``mujoco``; about a minute on 2 cores).
+Usage: ``python benchmarks/bench_mujoco.py`` (needs ``mujoco``; about 30 s on 2 shared cores).
 
 Table 1, MuJoCo trajectory error. One joint (J = 0.01 kg m^2, no gravity) at rest is driven
 open loop by ``u = A sin(2 pi t)`` for 2 s, A above the break-away friction so it sticks and
@@ -27,7 +27,8 @@ the ``exported`` row is also the "true model" row.
 Table 2, compensation at zero-velocity crossings (:mod:`fricid.control.dynamic`): the joint
 of ``fricid compensate --truth lugre`` (LuGre truth) tracks 0.2 Hz for 2 periods under PD
 control at 10 Hz bandwidth; PD only, static feed-forward (the model's steady state) and the
-LuGre observer, with the model's bristle parameters right and off by 2x and 10x.
+LuGre observer, with the model's bristle parameters right and off by 2x and 10x, and with
+white noise on the measured velocity (D term and observer input; seed 0).
 """
 
 from __future__ import annotations
@@ -146,16 +147,18 @@ def table_compensation() -> None:
     head = f"{'model bristles':28s} {'run':22s} {'RMS':>8s} {'max':>8s} {'RMS x':>8s} {'max x':>8s}"
     print(head)
     print("-" * len(head))
-    for label, s0, s1 in (
-        ("right (1e3, 0.5)", 1e3, 0.5),
-        ("sigma_0 x2 (2e3, 0.5)", 2e3, 0.5),
-        ("sigma_0 /2 (5e2, 0.5)", 5e2, 0.5),
-        ("sigma_0 x10 (1e4, 0.5)", 1e4, 0.5),
-        ("sigma_1 /10 (1e3, 0.05)", 1e3, 0.05),
+    for label, s0, s1, noise in (
+        ("right (1e3, 0.5)", 1e3, 0.5, 0.0),
+        ("sigma_0 x2 (2e3, 0.5)", 2e3, 0.5, 0.0),
+        ("sigma_0 /2 (5e2, 0.5)", 5e2, 0.5, 0.0),
+        ("sigma_0 x10 (1e4, 0.5)", 1e4, 0.5, 0.0),
+        ("sigma_1 /10 (1e3, 0.05)", 1e3, 0.05, 0.0),
+        ("right, v noise 0.01 rad/s", 1e3, 0.5, 0.01),
+        ("right, v noise 0.05 rad/s", 1e3, 0.5, 0.05),
     ):
         theta = theta_of({**LUGRE, "sigma_0": s0, "sigma_1": s1})
         start = time.perf_counter()
-        r = lugre_compensation_study(theta, config, truth=truth)
+        r = lugre_compensation_study(theta, config, truth=truth, velocity_noise=noise, seed=0)
         took = time.perf_counter() - start
         for name in RUNS:
             print(

@@ -322,3 +322,14 @@ def test_lugre_step_batches_runs_like_the_compiled_drive():
         np.testing.assert_allclose(v, ref["velocity"][i], rtol=1e-12, atol=1e-15)
         z, v, f = lugre_step(theta, z, v, np.full(2, u[i]), 0.01, dt)
         np.testing.assert_allclose(f, ref["friction"][i], rtol=1e-12, atol=1e-15)
+
+
+def test_velocity_noise_is_seeded_and_reaches_the_observer():
+    config, truth = TrackingConfig(**FAST), LuGreTruth(LUGRE)
+    a = lugre_compensation_study(LUGRE, config, truth=truth, velocity_noise=0.02, seed=1)
+    b = lugre_compensation_study(LUGRE, config, truth=truth, velocity_noise=0.02, seed=1)
+    clean = lugre_compensation_study(LUGRE, config, truth=truth)
+    assert a.rms == b.rms and "white noise" in a.notes[-1]
+    assert a.rms_crossing[RUNS[2]] > 2 * clean.rms_crossing[RUNS[2]]
+    with pytest.raises(ConfigError, match="velocity_noise"):
+        lugre_compensation_study(LUGRE, config, truth=truth, velocity_noise=-1.0)

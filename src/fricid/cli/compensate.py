@@ -136,6 +136,15 @@ def compensate_command(
             )
         ),
     ] = 0.05,
+    velocity_noise: Annotated[
+        float,
+        typer.Option(
+            help=(
+                "With --truth lugre: RMS white noise [rad/s] on the measured velocity (the D "
+                "term's and the observer's input; seed 0). Default 0: measured exactly."
+            )
+        ),
+    ] = 0.0,
     no_plot: Annotated[bool, typer.Option("--no-plot", help="Write no figure.")] = False,
     as_json: Annotated[bool, typer.Option("--json", help="Print the result as JSON.")] = False,
 ) -> None:
@@ -181,7 +190,10 @@ def compensate_command(
     )
     plant = resolve_truth(truth)
     if isinstance(plant, LuGreTruth):
-        _dynamic(fitted, config, plant, lugre, crossing_window, model, plot, no_plot, as_json)
+        if smooth != "none":
+            err_console.print("note: --smooth applies to static feed-forward; ignored with lugre")
+        window = (crossing_window, velocity_noise)
+        _dynamic(fitted, config, plant, lugre, window, model, plot, no_plot, as_json)
         return
     if lugre is not None:
         raise ConfigError("--lugre applies with --truth lugre (a plant with LuGre friction)")
@@ -259,8 +271,9 @@ def _sigmas(text: str | None) -> tuple[float | None, float | None]:
         ) from None
 
 
-def _dynamic(fitted, config, plant, lugre, window, model, plot, no_plot, as_json) -> None:
-    """``--truth lugre``: the study of :mod:`fricid.control.dynamic`, its table and plot."""
+def _dynamic(fitted, config, plant, lugre, options, model, plot, no_plot, as_json) -> None:
+    """``--truth lugre``: the study of :mod:`fricid.control.dynamic`, its table and plot;
+    ``options`` is (crossing window, velocity noise)."""
     from ..control import lugre_compensation_study, lugre_parameters, plot_lugre_compensation
     from ..control.dynamic import RUNS
     from ..errors import FricidWarning
@@ -268,8 +281,15 @@ def _dynamic(fitted, config, plant, lugre, window, model, plot, no_plot, as_json
     theta = lugre_parameters(fitted, *_sigmas(lugre))
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", FricidWarning)
+        window, noise = options
         result = lugre_compensation_study(
-            theta, config, truth=plant, model=fitted.model, crossing_window=window
+            theta,
+            config,
+            truth=plant,
+            model=fitted.model,
+            crossing_window=window,
+            velocity_noise=noise,
+            seed=0,
         )
     _relay(caught)
     if not no_plot:

@@ -47,12 +47,13 @@ def drive_lugre(th, torque, dt, inertia, Q, V, F):  # pragma: no cover - compile
 
 @njit(cache=True)
 def track_lugre(
-    truth, model, q_r, v_r, a_r, static_ff, kp, kd, inertia, dt, z0, z0_hat, Q, V, U, FR, FF
+    truth, model, q_r, v_r, a_r, static_ff, kp, kd, inertia, dt, z0, z0_hat, noise, Q, V, U, FR, FF
 ):  # pragma: no cover - compiled
     """The three runs of :func:`fricid.control.dynamic.lugre_compensation_study` (row 0 PD
     only, 1 static feed-forward, 2 LuGre observer on row 2's measured velocity).
 
-    ``model`` is (1, 7); ``Q``, ``V``, ``U``, ``FR``, ``FF`` (3, n) receive position,
+    ``model`` is (1, 7); ``noise`` (n,) is added to the measured velocity (the D term and
+    the observer's input); ``Q``, ``V``, ``U``, ``FR``, ``FF`` (3, n) receive position, true
     velocity, command, true friction and feed-forward at each step's start.
     """
     k, n = Q.shape
@@ -66,13 +67,14 @@ def track_lugre(
     z_obs = np.empty((1, 1))
     ff = np.zeros(k)
     for i in range(n):
-        v_obs[0] = v[2]
+        v_obs[0] = v[2] + noise[i]
         lugre_run(model, v_obs, dt_obs, z_hat, f_obs, z_obs)  # the model's own update
         z_hat[0] = z_obs[0, 0]
         ff[1] = static_ff[i]
         ff[2] = f_obs[0, 0]
         for j in range(k):
-            u = inertia * a_r[i] + kp * (q_r[i] - q[j]) + kd * (v_r[i] - v[j]) + ff[j]
+            v_meas = v[j] + noise[i]
+            u = inertia * a_r[i] + kp * (q_r[i] - q[j]) + kd * (v_r[i] - v_meas) + ff[j]
             Q[j, i] = q[j]
             V[j, i] = v[j]
             U[j, i] = u

@@ -20,7 +20,8 @@ Three runs advance together, each with the controller
     (:func:`fricid.models.lugre.simulate`, one sample per control step, exact for a velocity
     held over the step), and ``F_ff = sigma_0 z_hat + sigma_1 dz_hat/dt + sigma_2 v``. It is
     computed from the state measured at the start of the step, so it acts with the
-    controller's one-step delay, as on a real drive.
+    controller's one-step delay, as on a real drive. The measured velocity is exact unless
+    ``velocity_noise`` adds white noise to it (the D term's and the observer's input).
 
 The model's parameters (7, :data:`fricid.models.lugre.PARAM_NAMES`) come from the caller:
 :func:`lugre_parameters` builds them from a fitted ``lugre`` model, or from a static
@@ -207,7 +208,9 @@ class DynamicCompensationResult:
         }
 
 
-def _simulate(truth: np.ndarray, model: np.ndarray, config: TrackingConfig) -> dict:
+def _simulate(
+    truth: np.ndarray, model: np.ndarray, config: TrackingConfig, noise: np.ndarray
+) -> dict:
     """The three runs, compiled (:func:`fricid.control._kernels.track_lugre`)."""
     from ._kernels import track_lugre
 
@@ -233,6 +236,7 @@ def _simulate(truth: np.ndarray, model: np.ndarray, config: TrackingConfig) -> d
         float(config.dt),
         z0,
         z0_hat,
+        noise,
         *(out[name] for name in names),
     )
     out["error"] = q_r[None, :] - out["position"]
@@ -247,6 +251,8 @@ def lugre_compensation_study(
     truth: LuGreTruth,
     model: str = "lugre",
     crossing_window: float = 0.05,
+    velocity_noise: float = 0.0,
+    seed=None,
 ) -> DynamicCompensationResult:
     """Track the reference with PD only, static feed-forward and the LuGre observer.
 
@@ -264,6 +270,11 @@ def lugre_compensation_study(
         The model's name, for reports.
     crossing_window : float
         Half-width [periods] of the window around each zero-velocity crossing.
+    velocity_noise : float
+        Standard deviation [rad/s] of white Gaussian noise on the measured velocity, which
+        the D term and the observer use (the same draw in every run); 0: measured exactly.
+    seed : int or numpy.random.Generator, optional
+        Of the noise.
 
     Returns
     -------
@@ -289,7 +300,13 @@ def lugre_compensation_study(
             )
             warnings.warn(notes[-1], FricidWarning, stacklevel=2)
     mask = crossing_mask(config, crossing_window)
-    runs = _simulate(np.asarray(truth.theta), th, config)
+    if not (math.isfinite(velocity_noise) and velocity_noise >= 0):
+        raise ConfigError(f"velocity_noise must be >= 0 rad/s, got {velocity_noise!r}")
+    noise = np.zeros(mask.size)
+    if velocity_noise > 0:
+        noise = np.random.default_rng(seed).normal(0.0, velocity_noise, mask.size)
+        notes.append(f"measured velocity with {velocity_noise:g} rad/s RMS white noise")
+    runs = _simulate(np.asarray(truth.theta), th, config, noise)
     err = np.abs(runs["error"])
 
     def stat(values: np.ndarray, fn) -> dict[str, float]:
