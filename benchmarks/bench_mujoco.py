@@ -29,6 +29,25 @@ of ``fricid compensate --truth lugre`` (LuGre truth) tracks 0.2 Hz for 2 periods
 control at 10 Hz bandwidth; PD only, static feed-forward (the model's steady state) and the
 LuGre observer, with the model's bristle parameters right and off by 2x and 10x, and with
 white noise on the measured velocity (D term and observer input; seed 0).
+
+What it showed (mujoco 4.0.0, run on 2 shared cores):
+
+* Coulomb-viscous, exported exactly: MuJoCo's default ``frictionloss`` softness costs 0.45 %
+  of the position span (RMS) at 1 ms steps and 0.52 % at 0.1 ms (the joint creeps under
+  torques below ``frictionloss``); with ``solreffriction`` at two steps MuJoCo is at the
+  Python joint's own discretisation error (0.05 % against 0.09 % at 1 ms, 0.007 % at
+  0.1 ms).
+* Stribeck truth: the exported projection (``frictionloss``/``damping``) loses the break-away
+  peak, 7.1 % of the span; the same law as a stiff-bristle dcmotor LuGre gives 3.3 % at 1 ms
+  and 0.33 % at 0.1 ms.
+* LuGre truth, exponent 2: the exported dcmotor is the true model: 1.1 % at 1 ms (the Python
+  joint 1.3 %), 0.18 % at 0.1 ms (0.12 %); the static fallback for MuJoCo < 4.0, 4.9 %.
+  Exponent 1 (w_s refit): 1.8 % and 0.73 %.
+* Compensation: with the right bristles the LuGre observer's RMS error at the crossings is
+  36x smaller than static feed-forward's (0.040 against 1.44 mrad); sigma_0 2x or 10x too
+  high 5.3x and 4.1x, sigma_1 10x too low 18x; sigma_0 2x too LOW makes it slightly worse
+  than static (1.51 against 1.44 mrad). Velocity noise of 0.01 rad/s leaves 5.5x; at
+  0.05 rad/s the observer ties static feed-forward (1.37 against 1.36 mrad).
 """
 
 from __future__ import annotations
