@@ -157,3 +157,14 @@ def test_cli_export_of_a_lugre_model_states_the_mapping(tmp_path, monkeypatch):
     assert "without dcmotor (MuJoCo < 4.0)" in notes
     res = runner.invoke(app, ["export", str(path), "--to", "mjcf", "--max-loss", "0.001"])
     assert res.exit_code == 2 and "cannot represent this model's exponent" in res.output
+
+
+def test_lugre_export_refuses_bad_names_and_values():
+    from fricid.export import ExportError
+
+    with pytest.raises(ExportError):
+        mjcf_text(lugre_model(), joint='a"b><x')
+    with pytest.raises(ExportError, match="finite"):
+        mjcf_text(lugre_model(sigma_0=float("nan")))
+    with pytest.raises(ExportError, match="needs the parameters"):
+        mjcf_text(FittedModel(model="lugre", params={"sigma_0": 1.0}))
