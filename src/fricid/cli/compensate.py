@@ -15,19 +15,36 @@ from ._app import app, console, err_console, handle_errors
 from ._options import ModelFile, SmoothKind, SmoothZone
 from ._paths import check_paths
 
+#: ``--truth lugre``: a LuGre joint (Canudas de Wit et al. 1995) with the Stribeck exponent
+#: MuJoCo's dcmotor uses (2), passive (sigma_1 0.5 <= 4 sigma_2 tau_c / (tau_s - tau_c) = 0.6),
+#: bristles at 50 Hz on the 0.01 kg m^2 joint.
+LUGRE_TRUTH = {
+    "sigma_0": 1e3,
+    "sigma_1": 0.5,
+    "sigma_2": 0.1,
+    "tau_c": 0.3,
+    "tau_s": 0.5,
+    "w_s": 0.05,
+    "delta": 2.0,
+}
+LUGRE_INERTIA = 0.01
+
 
 def truth_names() -> tuple[str, ...]:
-    """``--truth`` choices: ``model``, then every simulation preset."""
+    """``--truth`` choices: ``model``, every simulation preset, then ``lugre``."""
     from ..sim import PRESETS
 
-    return ("model", *PRESETS)
+    return ("model", *PRESETS, "lugre")
 
 
 def resolve_truth(name: str):
-    """The plant's friction for ``--truth``: None for the model itself, else the virtual
-    joint of that simulation preset (:func:`fricid.sim.preset`, its law and inertia)."""
-    from ..control import Truth
+    """The plant's friction for ``--truth``: None for the model itself, a
+    :class:`~fricid.control.LuGreTruth` of :data:`LUGRE_TRUTH` for ``lugre``, else the
+    virtual joint of that simulation preset (:func:`fricid.sim.preset`, its law and
+    inertia)."""
+    from ..control import LuGreTruth, Truth
     from ..errors import ConfigError
+    from ..models.lugre import PARAM_NAMES
     from ..sim import preset
 
     key = str(name).strip().lower()
@@ -35,6 +52,8 @@ def resolve_truth(name: str):
         raise ConfigError(f"unknown truth '{name}'; choose one of: {', '.join(truth_names())}")
     if key == "model":
         return None
+    if key == "lugre":
+        return LuGreTruth(tuple(LUGRE_TRUTH[k] for k in PARAM_NAMES), "lugre", LUGRE_INERTIA)
     joint = preset(key, "quick").joint
     return Truth(joint.law, key, joint.inertia)
 
@@ -49,7 +68,10 @@ def compensate_command(
             help=(
                 "True friction of the simulated joint: model (the model itself, i.e. the gain "
                 "if it were exact), paper1 or paper2 (the virtual joint's law of that "
-                "simulation preset, and its inertia)."
+                "simulation preset, and its inertia), or lugre (dynamic LuGre friction: "
+                "sigma_0 1000 N m/rad, sigma_1 0.5, sigma_2 0.1 N m s/rad, tau_c 0.3, tau_s "
+                "0.5 N m, w_s 0.05 rad/s, delta 2, J 0.01 kg m^2; adds the LuGre observer, "
+                "see --lugre)."
             )
         ),
     ] = "model",
@@ -93,6 +115,36 @@ def compensate_command(
             help=("PNG to write. Default: <model>.compensation.png in the current directory.")
         ),
     ] = None,
+    lugre: Annotated[
+        str | None,
+        typer.Option(
+            "--lugre",
+            metavar="SIGMA_0,SIGMA_1",
+            help=(
+                "With --truth lugre: the model's bristle stiffness [N m/rad] and damping "
+                "[N m s/rad], added to a stribeck or coulomb_viscous model's static part for "
+                "the LuGre observer (a lugre model file has its own; these override them)."
+            ),
+        ),
+    ] = None,
+    crossing_window: Annotated[
+        float,
+        typer.Option(
+            help=(
+                "With --truth lugre: half-width [reference periods] of the window around each "
+                "zero-velocity crossing where the error is also summarised."
+            )
+        ),
+    ] = 0.05,
+    velocity_noise: Annotated[
+        float,
+        typer.Option(
+            help=(
+                "With --truth lugre: RMS white noise [rad/s] on the measured velocity (the D "
+                "term's and the observer's input; seed 0). Default 0: measured exactly."
+            )
+        ),
+    ] = 0.0,
     no_plot: Annotated[bool, typer.Option("--no-plot", help="Write no figure.")] = False,
     as_json: Annotated[bool, typer.Option("--json", help="Print the result as JSON.")] = False,
 ) -> None:
@@ -104,12 +156,20 @@ def compensate_command(
     friction (fixed-step Karnopp scheme); the feed-forward is the model at the reference
     velocity. See `fricid.control.tracking` for every detail.
 
+    With --truth lugre the joint's friction is dynamic (LuGre, bristles in pre-sliding at the
+    reversals), and three runs are shown: PD only, static feed-forward (the model's
+    steady state at the reference velocity) and a LuGre friction observer (the bristle state
+    estimated from the measured velocity with the model's own update); the error is given
+    over the run and at the zero-velocity crossings. The model is a lugre file, or a
+    stribeck / coulomb_viscous one with --lugre SIGMA_0,SIGMA_1. See
+    `fricid.control.dynamic`.
+
     "RMS error N x smaller" is printed only when the feed-forward shrank the error; when it
     made tracking worse, a warning line on stderr says so and by how much. A reference that
     leaves the model's operating range is warned about on stderr too.
     """
-    from ..control import compensation_study, default_config, plot_compensation
-    from ..errors import FricidWarning
+    from ..control import LuGreTruth, compensation_study, default_config, plot_compensation
+    from ..errors import ConfigError, FricidWarning
     from ..fitted import FittedModel
     from ..models.smoothing import Smoothing
 
@@ -128,18 +188,19 @@ def compensate_command(
         temperature=temperature,
         dt=dt,
     )
+    plant = resolve_truth(truth)
+    if isinstance(plant, LuGreTruth):
+        if smooth != "none":
+            err_console.print("note: --smooth applies to static feed-forward; ignored with lugre")
+        window = (crossing_window, velocity_noise)
+        _dynamic(fitted, config, plant, lugre, window, model, plot, no_plot, as_json)
+        return
+    if lugre is not None:
+        raise ConfigError("--lugre applies with --truth lugre (a plant with LuGre friction)")
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", FricidWarning)
-        result = compensation_study(
-            fitted, config, truth=resolve_truth(truth), smoothing=Smoothing(smooth, zone)
-        )
-    for w in caught:  # one line each on stderr (DESIGN.md); also in the result's notes
-        if issubclass(w.category, FricidWarning):
-            err_console.print(
-                f"warning: {w.message}", markup=False, highlight=False, soft_wrap=True
-            )
-        else:
-            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+        result = compensation_study(fitted, config, truth=plant, smoothing=Smoothing(smooth, zone))
+    _relay(caught)
     if not no_plot:
         plot_path = plot or Path(f"{model.stem}.compensation.png")
         plot_compensation(result, plot_path)
@@ -179,3 +240,86 @@ def compensate_command(
     for note in result.notes:
         if not note.startswith("the reference goes outside"):  # warned on stderr above
             console.print(f"note: {note}", highlight=False)
+
+
+def _relay(caught) -> None:
+    """Caught warnings: fricid's one line each on stderr (DESIGN.md), others re-raised."""
+    from ..errors import FricidWarning
+
+    for w in caught:
+        if issubclass(w.category, FricidWarning):
+            err_console.print(
+                f"warning: {w.message}", markup=False, highlight=False, soft_wrap=True
+            )
+        else:
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+
+
+def _sigmas(text: str | None) -> tuple[float | None, float | None]:
+    from ..errors import ConfigError
+
+    if text is None:
+        return None, None
+    parts = [p.strip() for p in str(text).split(",")]
+    try:
+        if len(parts) != 2:
+            raise ValueError
+        return float(parts[0]), float(parts[1])
+    except ValueError:
+        raise ConfigError(
+            f"--lugre takes SIGMA_0,SIGMA_1 (two numbers, e.g. 1000,0.5), got {text!r}"
+        ) from None
+
+
+def _dynamic(fitted, config, plant, lugre, options, model, plot, no_plot, as_json) -> None:
+    """``--truth lugre``: the study of :mod:`fricid.control.dynamic`, its table and plot;
+    ``options`` is (crossing window, velocity noise)."""
+    from ..control import lugre_compensation_study, lugre_parameters, plot_lugre_compensation
+    from ..control.dynamic import RUNS
+    from ..errors import FricidWarning
+
+    theta = lugre_parameters(fitted, *_sigmas(lugre))
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", FricidWarning)
+        window, noise = options
+        result = lugre_compensation_study(
+            theta,
+            config,
+            truth=plant,
+            model=fitted.model,
+            crossing_window=window,
+            velocity_noise=noise,
+            seed=0,
+        )
+    _relay(caught)
+    if not no_plot:
+        plot_path = plot or Path(f"{model.stem}.compensation.png")
+        plot_lugre_compensation(result, plot_path)
+        err_console.print(f"wrote {plot_path}")
+    if as_json:
+        console.print_json(json.dumps(result.to_dict()))
+        return
+    cfg = result.config
+    table = Table(
+        title=(
+            f"Tracking {cfg.amplitude:.3g} rad sin(2 pi {cfg.frequency:g} Hz t), model "
+            f"'{fitted.model}' as LuGre, true friction '{result.truth}' (LuGre)"
+        )
+    )
+    table.add_column("controller")
+    for head in ("RMS [mrad]", "max [mrad]", "RMS at crossings [mrad]", "max at crossings [mrad]"):
+        table.add_column(escape(head), justify="right")
+    for name in RUNS:
+        values = (result.rms, result.max, result.rms_crossing, result.max_crossing)
+        table.add_row(name, *(f"{1e3 * v[name]:.4g}" for v in values))
+    console.print(table)
+    k_p, k_d = cfg.gains
+    console.print(result.verdict(), highlight=False)
+    console.print(
+        f"Settings: K_p {k_p:.4g} N m/rad, K_d {k_d:.4g} N m s/rad, J {cfg.inertia:g} kg m^2, "
+        f"dt {cfg.dt:g} s; crossings: within {window:g} periods of each velocity reversal "
+        f"({100 * result.crossing.mean():.3g} % of the run)",
+        highlight=False,
+    )
+    for note in result.notes:
+        console.print(f"note: {note}", highlight=False)

@@ -91,6 +91,7 @@ def export_command(
 
     from ..errors import ConfigError, DataError
     from ..export import TARGETS, Smoothing, description_text, export_c, file_sha256, write_text
+    from ..export.mjcf import is_lugre, lugre_mapping
     from ..fitted import FittedModel
 
     target = to.strip().lower()
@@ -134,6 +135,9 @@ def export_command(
         if exc.file is not None:
             raise
         raise DataError(exc.message, file=model, row=exc.row, column=exc.column) from None
+    if target == "mjcf" and is_lugre(fitted):  # what the mapping to MuJoCo costs, said here too
+        for line in lugre_mapping(fitted).summary()[2:]:
+            err_console.print(f"note: {line}", markup=False, highlight=False, soft_wrap=True)
     if out is None:
         sys.stdout.write(text)
         sys.stdout.flush()

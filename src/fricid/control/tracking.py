@@ -17,8 +17,10 @@ Stiction
     At zero velocity the joint sticks while the applied torque stays within the break-away
     friction (the law just off zero, in the direction of the torque), and slips once it
     exceeds it; a step that would carry the velocity through zero stops it at zero (the
-    Karnopp scheme, adapted to a fixed step). So the stick-slip at velocity reversals, where
-    PD control without friction compensation lags, is simulated rather than smoothed away.
+    Karnopp scheme, adapted to a fixed step: :func:`fricid.control.plant.static_step`). So the
+    stick-slip at velocity reversals, where PD control without friction compensation lags, is
+    simulated rather than smoothed away. A LuGre truth (dynamic friction) is simulated by
+    :mod:`fricid.control.dynamic`.
 The controller
     ``u = J q_r'' + K_p (q_r - q) + K_d (q_r' - q')`` plus, in the second run, the feed-forward
     ``F_hat(q_r', load, T)``: the model evaluated at the reference velocity (optionally
@@ -44,6 +46,7 @@ import numpy as np
 
 from ..errors import ConfigError, ExtrapolationWarning, FricidWarning
 from ..fitted import FittedModel
+from .plant import static_step
 
 __all__ = [
     "CompensationResult",
@@ -54,9 +57,6 @@ __all__ = [
     "fitted_law",
     "simulate_tracking",
 ]
-
-#: Velocity [rad/s] just off zero where the break-away friction is evaluated.
-_OFF_ZERO = 1e-9
 
 Law = Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray]
 
@@ -248,18 +248,10 @@ def simulate_tracking(
     base = J * a_r[None, :] + ff
     for i in range(n):
         u = base[:, i] + kp * (q_r[i] - q) + kd * (v_r[i] - v)
-        moving = v != 0.0
-        v_eval = np.where(moving, v, np.where(u >= 0.0, _OFF_ZERO, -_OFF_ZERO))
-        f = law(v_eval, load, temp)
-        stuck = ~moving & (np.abs(u) <= np.abs(f))
-        f = np.where(stuck, u, f)  # static friction balances the applied torque
         out["position"][:, i] = q
         out["velocity"][:, i] = v
         out["torque"][:, i] = u
-        out["friction"][:, i] = f
-        v_new = v + (u - f) / J * dt
-        v_new = np.where(moving & (np.sign(v_new) != np.sign(v)), 0.0, v_new)
-        v = np.where(stuck, 0.0, v_new)
+        v, out["friction"][:, i] = static_step(law, v, u, J, dt, load, temp)
         q = q + v * dt
     out["error"] = q_r[None, :] - out["position"]
     out["time"] = t

@@ -70,6 +70,7 @@ __all__ = [
 TARGETS: dict[str, str] = {
     "c": "C99 header and source, double fricid_friction(velocity, load, temperature)",
     "urdf": "URDF <dynamics damping= friction=/> (Coulomb-viscous projection)",
-    "mjcf": "MJCF <joint frictionloss= damping=/> (Coulomb-viscous projection)",
+    "mjcf": "MJCF <joint frictionloss= damping=/> (Coulomb-viscous projection; a LuGre model: "
+    "MuJoCo 4's dcmotor with lugre friction)",
     "yaml": "ros2_control-style parameters, Coulomb and viscous per direction (projection)",
 }

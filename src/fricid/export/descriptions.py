@@ -6,6 +6,9 @@ what is lost stated in a comment of the file. When the projection misses the mod
 than ``max_loss`` (RMS error relative to the RMS friction, default 50 %), the export is
 refused with an :class:`ExportError` that says what would be lost; pass a larger
 ``max_loss`` (``--max-loss``) to write it anyway, or export to C for the full model.
+
+MJCF is checked in MuJoCo itself (:mod:`fricid.export.mujoco_check`, ``tests/test_mujoco.py``),
+and a LuGre model goes to MuJoCo 4's ``dcmotor`` LuGre friction (:mod:`fricid.export.mjcf`).
 """
 
 from __future__ import annotations
@@ -28,6 +31,7 @@ from ._common import (
     summary_lines,
     write_lines_checked,
 )
+from .mjcf import FRICTIONLOSS_LINES, is_lugre, mjcf_lugre_elements
 from .projection import Projection, project
 
 __all__ = [
@@ -82,20 +86,15 @@ def _checked(
     return proj
 
 
-def _xml(lines: list[str], element: ET.Element) -> str:
-    """An XML comment of ``lines``, then ``element``, both serialised by ElementTree.
+def _xml(lines: list[str], *elements: ET.Element) -> str:
+    """An XML comment of ``lines``, then ``elements``, all serialised by ElementTree.
 
     ``lines`` hold fixed text, numbers and :func:`~fricid.export._common.plain` text only;
     the check refuses ``--`` (which would end or invalidate the comment) as a last guard.
     """
     write_lines_checked(lines, ("--",))
     comment = ET.Comment("\n" + "".join(f"     {line}\n" for line in lines))
-    return (
-        ET.tostring(comment, encoding="unicode")
-        + "\n"
-        + ET.tostring(element, encoding="unicode")
-        + "\n"
-    )
+    return "".join(ET.tostring(part, encoding="unicode") + "\n" for part in (comment, *elements))
 
 
 def urdf_text(
@@ -144,14 +143,33 @@ def mjcf_text(
     """An MJCF ``<joint frictionloss= damping=/>`` element, with a comment.
 
     MuJoCo's ``frictionloss`` is the Coulomb (dry) friction [N m] and ``damping`` the viscous
-    coefficient [N m s/rad]; copy both attributes onto the joint of your model. Other
-    arguments as for :func:`urdf_text`.
+    coefficient [N m s/rad]; copy both attributes onto the joint of your model. The comment
+    says how MuJoCo applies ``frictionloss`` (a soft constraint:
+    :data:`fricid.export.mjcf.FRICTIONLOSS_LINES`). Other arguments as for
+    :func:`urdf_text`.
+
+    A LuGre model (``model == "lugre"``) exports instead to a ``<joint damping=/>`` and an
+    ``<actuator>`` holding MuJoCo's passive ``dcmotor`` with ``lugre`` friction (MuJoCo >=
+    4.0), its comment giving the static projection for older MuJoCo with its error
+    (:mod:`fricid.export.mjcf`); ``max_loss`` then bounds the error of mapping the Stribeck
+    exponent to MuJoCo's 2. Of ``ranges`` only ``velocity_range`` applies.
     """
     name = _check_joint(joint)
+    if is_lugre(fitted):
+        lines, elements = mjcf_lugre_elements(
+            fitted,
+            name,
+            max_loss=max_loss,
+            source=source,
+            sha256=sha256,
+            velocity_range=ranges.get("velocity_range"),
+        )
+        return _xml(lines, *elements)
     proj = _checked(fitted, "MJCF frictionloss/damping", False, max_loss, ranges)
     lines = [
         *summary_lines(fitted, source, sha256),
         *proj.summary(),
+        *FRICTIONLOSS_LINES,
         "copy frictionloss [N m] and damping [N m s/rad] onto your <joint>",
     ]
     element = ET.Element(
