@@ -1,0 +1,343 @@
+"""``method="varpro"``: the exact least-squares optimum by variable projection.
+
+Most friction models are linear in most of their parameters: for fixed values of the others
+(the Stribeck velocity and exponent, ...) the prediction is a linear combination of a few
+basis functions, ``f(theta) = f_0(nu) + A(nu) c``, where ``c`` are the parameters a model
+declares in ``linear_params`` and ``nu`` the rest. Separable (variable-projection) least
+squares (Golub and Pereyra 1973; Golub and Pereyra 2003, "Separable nonlinear least squares:
+the variable projection method and its applications", Inverse Problems 19 R1) minimises the
+projected functional ``min_c ||W^(1/2) (f_0(nu) + A(nu) c - y)||^2`` over ``nu`` alone, the
+inner problem solved in closed form for each ``nu``.
+
+What :func:`varpro` does
+    1. The basis ``A(nu)`` and offset ``f_0(nu)`` come from the model itself: its prediction
+       with the free linear parameters set to 0 and to each unit vector (so fixed parameters,
+       linear or not, stay at their values, and nothing but the declaration is asked of a
+       model).
+    2. The nonlinear parameters (1 or 2 for the Stribeck model, 3 for ``vlt``, none for
+       Coulomb-viscous) are searched on a grid over their whole search box: log-spaced where
+       the box is positive, linear otherwise (:data:`GRID_POINTS` points per axis). At each
+       grid point the linear parameters are the bounded linear least-squares solution inside
+       their box (unconstrained by a batched pseudo-inverse; where that leaves the box,
+       ``scipy.optimize.lsq_linear`` with BVLS, Stark and Parker 1995), so non-negativity and
+       the other bounds hold exactly. The unconstrained SSE bounds the constrained one from
+       below, so only grid points that could rank among the best are solved with BVLS.
+    3. The best grid points of distinct basins (:data:`N_POLISH` of them) are polished by the
+       default least-squares method (``lm``, one start each) on the full problem, and the
+       lowest wins.
+
+    The search box is covered whatever the start, so the result does not depend on ``x0``
+    (recorded as the fit's ``init``, not used to search). For a model with parameters per
+    direction (``*_asym``) each direction's parameters are searched on its own samples (the
+    problem separates), then polished together.
+
+Losses and weights
+    Weights (``weights="std"`` or given) enter as row scaling, exactly. ``mse`` is ``sse`` over
+    ``n`` (the same minimiser). A robust loss (``soft_l1``, ``huber``) is not separable: the
+    grid then ranks the nonlinear parameters by the (weighted) l2 projection and the polish
+    minimises the robust loss over all free parameters from there, so with a robust loss
+    ``varpro`` is a well-started local method, not an exact one (the result's message says so).
+
+Cost: one batched model evaluation per grid point and linear parameter (plus one), counted as
+evaluations (``nfev``); the polish's evaluations are added.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from scipy.optimize import lsq_linear
+
+from ..errors import ConfigError
+from ..optim import OptimizeResult, minimize
+from .problem import IdentificationProblem
+
+__all__ = ["GRID_POINTS", "N_POLISH", "VARPRO_OPTIONS", "linear_split", "varpro"]
+
+#: Grid points per nonlinear axis, by the number of nonlinear parameters searched together.
+GRID_POINTS: dict[int, int] = {1: 256, 2: 48, 3: 16}
+
+#: Best grid points of distinct basins polished by ``lm``.
+N_POLISH = 3
+
+#: Options of ``method="varpro"`` (``fit(..., options=...)``): ``grid`` points per axis
+#: (default :data:`GRID_POINTS`), ``n_polish`` (:data:`N_POLISH`), ``polish_evals`` (the
+#: budget of each polish; default ``100 (p + 1)``, or ``max_evals`` shared out).
+VARPRO_OPTIONS = ("grid", "n_polish", "polish_evals")
+
+#: Model evaluations (rows of length n) per chunk of the grid: bounds the memory used.
+_CHUNK_VALUES = 4_000_000
+
+
+@dataclass
+class _Block:
+    """Free parameters searched together: nonlinear ``nl`` and linear ``lin`` (positions in the
+    free vector), on the samples ``rows``."""
+
+    nl: list[int]
+    lin: list[int]
+    rows: np.ndarray
+
+
+def linear_split(problem: IdentificationProblem) -> tuple[list[int], list[int]]:
+    """Positions in the free vector of the linear and the nonlinear free parameters.
+
+    Raises
+    ------
+    ConfigError
+        The model declares no ``linear_params`` (variable projection does not apply).
+    """
+    model = problem.model
+    declared = tuple(getattr(model, "linear_params", ()) or ())
+    if not declared or not hasattr(model, "param_names"):
+        name = getattr(model, "name", type(model).__name__)
+        raise ConfigError(
+            f"method 'varpro' needs a model that declares which parameters enter linearly; "
+            f"model '{name}' declares none (use --method lm)"
+        )
+    free = problem.free_names
+    lin = [i for i, n in enumerate(free) if n in declared]
+    nl = [i for i, n in enumerate(free) if n not in declared]
+    return lin, nl
+
+
+def _blocks(problem: IdentificationProblem, lin: list[int], nl: list[int]) -> list[_Block]:
+    """One block, or one per direction for a model with parameters per direction."""
+    n = problem.n_obs
+    if not getattr(problem.model, "is_asymmetric", False):
+        return [_Block(nl, lin, np.ones(n, dtype=bool))]
+    free = problem.free_names
+    v = problem.X[:, 0]
+    blocks = []
+    for suffix, rows in (("_pos", v >= 0), ("_neg", v < 0)):
+        pick = [i for i in nl if free[i].endswith(suffix)]
+        blocks.append(_Block(pick, [i for i in lin if free[i].endswith(suffix)], rows))
+    return blocks
+
+
+def _axes(bounds: np.ndarray, points: int) -> list[np.ndarray]:
+    """Grid axes: log-spaced over a positive box, linear otherwise."""
+    axes = []
+    for lo, hi in bounds:
+        if lo > 0 and hi / lo > 10:
+            axes.append(np.geomspace(lo, hi, points))
+        else:
+            axes.append(np.linspace(lo, hi, points))
+    return axes
+
+
+class _Projection:
+    """The projected least-squares problem of one block: basis, bounded linear solves."""
+
+    def __init__(self, problem: IdentificationProblem, block: _Block, start: np.ndarray):
+        self.problem, self.block, self.start = problem, block, start
+        rows = block.rows
+        w = problem._sqrt_w
+        self.sqrt_w = np.ones(int(rows.sum())) if w is None else w[rows]
+        self.y = problem.y[rows]
+        lo_hi = problem.bounds[block.lin]
+        self.lo, self.hi = lo_hi[:, 0], lo_hi[:, 1]
+        self.nfev = 0
+
+    def candidates(self, NU: np.ndarray, C: np.ndarray | None = None) -> np.ndarray:
+        """Free vectors ``(G, p)`` with the block's nonlinear values ``NU`` (and linear ``C``)."""
+        Z = np.repeat(self.start[None], NU.shape[0], axis=0)
+        Z[:, self.block.nl] = NU
+        if C is not None:
+            Z[:, self.block.lin] = C
+        return Z
+
+    def basis(self, NU: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Weighted basis ``(G, n, m)`` and weighted target ``(G, n)`` (y minus the offset)."""
+        m = len(self.block.lin)
+        G = NU.shape[0]
+        Z = np.repeat(self.candidates(NU, np.zeros((G, m))), m + 1, axis=0)
+        for j, pos in enumerate(self.block.lin):
+            Z[j + 1 :: m + 1, pos] = 1.0
+        P = self.problem.predict(Z)[:, self.block.rows].reshape(G, m + 1, -1)
+        self.nfev += Z.shape[0]
+        offset = P[:, 0]
+        A = (P[:, 1:] - offset[:, None]).transpose(0, 2, 1) * self.sqrt_w[None, :, None]
+        b = (self.y[None] - offset) * self.sqrt_w[None]
+        return A, b
+
+    def solve(self, NU: np.ndarray, keep: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Bounded linear solutions ``C (G, m)``, their SSE ``(G,)`` and whether each SSE is
+        exact (only the grid points that could rank among the ``keep`` best are made exact)."""
+        A, b = self.basis(NU)
+        G, m = NU.shape[0], len(self.block.lin)
+        if m == 0:
+            return np.zeros((G, 0)), np.einsum("gn,gn->g", b, b), np.ones(G, dtype=bool)
+        scale = np.sqrt(np.einsum("gnm,gnm->gm", A, A))
+        scale = np.where(scale > 0, scale, 1.0)
+        C = np.einsum("gmn,gn->gm", np.linalg.pinv(A / scale[:, None], rcond=1e-13), b) / scale
+        span = self.hi - self.lo
+        inside = np.all((self.lo - 1e-9 * span <= C) & (self.hi + 1e-9 * span >= C), axis=1)
+        C = np.where(inside[:, None], np.clip(C, self.lo, self.hi), C)
+        R = np.einsum("gnm,gm->gn", A, C) - b
+        sse = np.einsum("gn,gn->g", R, R)  # a lower bound where not inside
+        exact = inside.copy()
+        order = np.argsort(sse)
+        for g in order:
+            if exact[g]:
+                continue
+            known = np.sort(sse[exact])
+            if known.size >= keep and sse[g] >= known[keep - 1]:
+                break
+            c = lsq_linear(A[g], b[g], bounds=(self.lo, self.hi), method="bvls").x
+            C[g] = np.clip(c, self.lo, self.hi)
+            r = A[g] @ C[g] - b[g]
+            sse[g], exact[g] = float(r @ r), True
+        sse = np.where(exact, sse, np.inf)
+        return C, sse, exact
+
+
+def _search(proj: _Projection, bounds: np.ndarray, points: int, n_keep: int) -> list[np.ndarray]:
+    """The best grid points of distinct basins, as free vectors, best first."""
+    axes = _axes(bounds, points)
+    if axes:
+        index = np.stack(np.meshgrid(*[np.arange(a.size) for a in axes], indexing="ij"), -1)
+        index = index.reshape(-1, len(axes))
+    else:  # every free parameter is linear: one linear solve
+        index = np.zeros((1, 0), dtype=int)
+    NU = np.empty(index.shape)
+    for j, a in enumerate(axes):
+        NU[:, j] = a[index[:, j]]
+    per = max(1, _CHUNK_VALUES // max(1, (len(proj.block.lin) + 1) * proj.y.size))
+    C = np.empty((NU.shape[0], len(proj.block.lin)))
+    sse = np.empty(NU.shape[0])
+    for s in range(0, NU.shape[0], per):
+        C[s : s + per], sse[s : s + per], _ = proj.solve(NU[s : s + per], 5 * n_keep)
+    picked: list[int] = []
+    for g in np.argsort(sse):
+        if not np.isfinite(sse[g]) or len(picked) == n_keep:
+            break
+        if all(np.max(np.abs(index[g] - index[h])) > 2 for h in picked):
+            picked.append(int(g))
+    return [proj.candidates(NU[[g]], C[[g]])[0] for g in picked]
+
+
+def _option(options: dict[str, Any], name: str, default: int) -> int:
+    value = options.get(name, default)
+    if not isinstance(value, (int, np.integer)) or isinstance(value, bool) or value < 1:
+        raise ConfigError(
+            f"method 'varpro': option '{name}' must be an integer >= 1; got {value!r}"
+        )
+    return int(value)
+
+
+def varpro(
+    problem: IdentificationProblem,
+    *,
+    seed: int | np.random.Generator | None = 0,
+    max_evals: int | None = None,
+    options: dict[str, Any] | None = None,
+    callback: Callable[[OptimizeResult], Any] | None = None,
+) -> OptimizeResult:
+    """Minimise ``problem`` by variable projection (see the module docstring).
+
+    Parameters
+    ----------
+    problem : IdentificationProblem
+        A named model's problem; the model declares ``linear_params``.
+    seed : int or numpy.random.Generator, optional
+        Passed to the polish (one start each, so it does not change the result).
+    max_evals : int, optional
+        Budget of the polishes together (the grid's evaluations come on top).
+    options : dict, optional
+        :data:`VARPRO_OPTIONS`.
+    callback : callable, optional
+        Passed to each polish (``fricid.optim.minimize``).
+
+    Returns
+    -------
+    OptimizeResult
+        ``x`` (free parameters), ``fun`` (the problem's loss), ``nfev`` (grid and polish),
+        ``status`` (the winning polish's; 0 when the grid needed none), ``method`` "varpro",
+        and ``grid_points``, ``grid_nfev``.
+
+    Raises
+    ------
+    ConfigError
+        The model declares no linear parameters; an unknown or bad option.
+    """
+    opts = dict(options or {})
+    unknown = sorted(set(opts) - set(VARPRO_OPTIONS))
+    if unknown:
+        raise ConfigError(
+            f"method 'varpro' has no option(s) {', '.join(unknown)}; its options: "
+            f"{', '.join(VARPRO_OPTIONS)}"
+        )
+    lin, nl = linear_split(problem)
+    n_polish = _option(opts, "n_polish", N_POLISH)
+    start = problem.start()
+    per_block: list[list[np.ndarray]] = []
+    grid_nfev, grid_points = 0, 0
+    for block in _blocks(problem, lin, nl):
+        proj = _Projection(problem, block, start)
+        q = len(block.nl)
+        points = _option(opts, "grid", GRID_POINTS.get(q, 8)) if q else 1
+        per_block.append(_search(proj, problem.bounds[block.nl], points, n_polish))
+        grid_nfev += proj.nfev
+        grid_points += points**q
+    cands = []
+    for k in range(max(len(b) for b in per_block)):
+        x = start.copy()
+        for block, found in zip(_blocks(problem, lin, nl), per_block, strict=True):
+            pick = found[min(k, len(found) - 1)]
+            x[block.nl + block.lin] = pick[block.nl + block.lin]
+        cands.append(x)
+    grid_fun = problem.evaluate(np.array(cands))
+    best_x, best_fun = cands[int(np.argmin(grid_fun))], float(np.min(grid_fun))
+    history = [[grid_nfev, best_fun]]
+    exact_l2 = problem.f_scale is None
+    status, polish_msg, polish_nfev = 0, "", 0
+    if nl or not exact_l2:
+        p = problem.n_free
+        each = max_evals // len(cands) if max_evals else 100 * (p + 1)
+        each = _option(opts, "polish_evals", max(each, 1))
+        ranked = []
+        for x in cands:
+            res = minimize(
+                problem.evaluate,
+                problem.bounds,
+                method="lm",
+                x0=x,
+                options={"n_starts": 1},
+                max_evals=each,
+                residuals=problem.residuals,
+                seed=seed,
+                callback=callback,
+            )
+            polish_nfev += int(res.nfev)
+            ranked.append(res)
+        win = min(ranked, key=lambda r: float(r.fun))
+        status, polish_msg = int(win.status), str(win.message)
+        if float(win.fun) <= best_fun:
+            best_x, best_fun = np.asarray(win.x, dtype=float), float(win.fun)
+    nfev = grid_nfev + polish_nfev
+    history.append([nfev, best_fun])
+    what = "exact (l2)" if exact_l2 else "robust loss: l2-projected grid, then a local polish"
+    message = (
+        f"{'converged' if status == 0 else polish_msg}; variable projection, {what}: "
+        f"{grid_points} grid points over {', '.join(problem.free_names[i] for i in nl) or '-'}"
+        + (f", {len(cands)} polished by lm ({polish_msg})" if polish_msg else "")
+    )
+    return OptimizeResult(
+        x=best_x,
+        fun=best_fun,
+        nfev=nfev,
+        nit=len(cands),
+        history=np.array(history, dtype=float),
+        status=status,
+        message=message,
+        success=status == 0,
+        method="varpro",
+        seed=seed if isinstance(seed, int) else None,
+        max_evals=nfev if max_evals is None else int(max_evals) + grid_nfev,
+        grid_points=grid_points,
+        grid_nfev=grid_nfev,
+    )
