@@ -49,13 +49,20 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from scipy.optimize import lsq_linear
+from scipy.optimize import least_squares, lsq_linear
 
 from ..errors import ConfigError
 from ..optim import OptimizeResult, minimize
 from .problem import IdentificationProblem
 
-__all__ = ["GRID_POINTS", "N_POLISH", "VARPRO_OPTIONS", "linear_split", "varpro"]
+__all__ = ["GRID_POINTS", "N_POLISH", "SUMMARY", "VARPRO_OPTIONS", "linear_split", "varpro"]
+
+#: One line on the method, as ``fricid methods`` lists it.
+SUMMARY = (
+    "exact least-squares optimum by variable projection (Golub-Pereyra): the linear "
+    "parameters in closed form within their bounds, the others on a grid then polished; "
+    "models that declare linear_params (all analytic ones)"
+)
 
 #: Grid points per nonlinear axis, by the number of nonlinear parameters searched together.
 GRID_POINTS: dict[int, int] = {1: 256, 2: 48, 3: 16}
@@ -67,6 +74,10 @@ N_POLISH = 3
 #: (default :data:`GRID_POINTS`), ``n_polish`` (:data:`N_POLISH`), ``polish_evals`` (the
 #: budget of each polish; default ``100 (p + 1)``, or ``max_evals`` shared out).
 VARPRO_OPTIONS = ("grid", "n_polish", "polish_evals")
+
+#: Forward-difference step of the polish's Jacobian, in the unit box of the nonlinear
+#: parameters (as ``lm``'s).
+_FD_STEP = 1e-7
 
 #: Model evaluations (rows of length n) per chunk of the grid: bounds the memory used.
 _CHUNK_VALUES = 4_000_000
@@ -141,6 +152,7 @@ class _Projection:
         lo_hi = problem.bounds[block.lin]
         self.lo, self.hi = lo_hi[:, 0], lo_hi[:, 1]
         self.nfev = 0
+        self._active: tuple[np.ndarray, np.ndarray] | None = None
 
     def candidates(self, NU: np.ndarray, C: np.ndarray | None = None) -> np.ndarray:
         """Free vectors ``(G, p)`` with the block's nonlinear values ``NU`` (and linear ``C``)."""
@@ -164,13 +176,21 @@ class _Projection:
         b = (self.y[None] - offset) * self.sqrt_w[None]
         return A, b
 
-    def solve(self, NU: np.ndarray, keep: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Bounded linear solutions ``C (G, m)``, their SSE ``(G,)`` and whether each SSE is
-        exact (only the grid points that could rank among the ``keep`` best are made exact)."""
+    def solve(self, NU: np.ndarray, keep: int) -> tuple[np.ndarray, np.ndarray]:
+        """Bounded linear solutions ``C (G, m)`` at nonlinear values ``NU (G, q)`` and their
+        SSE ``(G,)``: exact for the grid points that could rank among the ``keep`` best,
+        ``inf`` for the others."""
         A, b = self.basis(NU)
-        G, m = NU.shape[0], len(self.block.lin)
+        C, sse, _ = self.solve_ab(A, b, keep)
+        return C, sse
+
+    def solve_ab(
+        self, A: np.ndarray, b: np.ndarray, keep: int
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """:meth:`solve` on a basis, also returning the weighted residuals ``(G, n)``."""
+        G, m = A.shape[0], A.shape[2]
         if m == 0:
-            return np.zeros((G, 0)), np.einsum("gn,gn->g", b, b), np.ones(G, dtype=bool)
+            return np.zeros((G, 0)), np.einsum("gn,gn->g", b, b), -b
         scale = np.sqrt(np.einsum("gnm,gnm->gm", A, A))
         scale = np.where(scale > 0, scale, 1.0)
         C = np.einsum("gmn,gn->gm", np.linalg.pinv(A / scale[:, None], rcond=1e-13), b) / scale
@@ -180,23 +200,95 @@ class _Projection:
         R = np.einsum("gnm,gm->gn", A, C) - b
         sse = np.einsum("gn,gn->g", R, R)  # a lower bound where not inside
         exact = inside.copy()
-        order = np.argsort(sse)
-        for g in order:
+        for g in np.argsort(sse):
             if exact[g]:
                 continue
             known = np.sort(sse[exact])
             if known.size >= keep and sse[g] >= known[keep - 1]:
                 break
-            c = lsq_linear(A[g], b[g], bounds=(self.lo, self.hi), method="bvls").x
-            C[g] = np.clip(c, self.lo, self.hi)
-            r = A[g] @ C[g] - b[g]
-            sse[g], exact[g] = float(r @ r), True
-        sse = np.where(exact, sse, np.inf)
-        return C, sse, exact
+            C[g] = self.bounded(A[g], b[g])
+            R[g] = A[g] @ C[g] - b[g]
+            sse[g], exact[g] = float(R[g] @ R[g]), True
+        return C, np.where(exact, sse, np.inf), R
+
+    def bounded(self, A: np.ndarray, b: np.ndarray) -> np.ndarray:
+        """``argmin ||A c - b||`` over the box of the linear parameters.
+
+        First the active set of the last solve (neighbouring grid points and polish steps
+        mostly share it), accepted if it satisfies the Karush-Kuhn-Tucker conditions (then it
+        is the optimum: the problem is convex); else BVLS (``scipy.optimize.lsq_linear``).
+        """
+        if self._active is not None:
+            c = self._on_active_set(A, b, *self._active)
+            if c is not None:
+                return c
+        c = np.clip(lsq_linear(A, b, bounds=(self.lo, self.hi), method="bvls").x, self.lo, self.hi)
+        tol = 1e-12 * (self.hi - self.lo)
+        self._active = (c <= self.lo + tol, c >= self.hi - tol)
+        return c
+
+    def _on_active_set(
+        self, A: np.ndarray, b: np.ndarray, lower: np.ndarray, upper: np.ndarray
+    ) -> np.ndarray | None:
+        free = ~(lower | upper)
+        c = np.where(lower, self.lo, np.where(upper, self.hi, 0.0))
+        if free.any():
+            rhs = b - A[:, ~free] @ c[~free]
+            c[free] = np.linalg.lstsq(A[:, free], rhs, rcond=None)[0]
+        span = self.hi - self.lo
+        if np.any(c < self.lo - 1e-9 * span) or np.any(c > self.hi + 1e-9 * span):
+            return None
+        c = np.clip(c, self.lo, self.hi)
+        r = A @ c - b
+        g = A.T @ r
+        gtol = 1e-9 * np.sqrt(np.einsum("nm,nm->m", A, A)) * max(float(np.linalg.norm(b)), 1e-300)
+        if np.any(g[lower] < -gtol[lower]) or np.any(g[upper] > gtol[upper]):
+            return None
+        return c
+
+    def polish(self, nu0: np.ndarray, bounds: np.ndarray, max_nfev: int) -> tuple[Any, ...]:
+        """Least squares over the nonlinear parameters alone, the linear ones projected out
+        (scipy's bounded trust-region reflective solver in the unit box of ``bounds``).
+
+        Returns ``(nu, c, sse, converged)``.
+        """
+        lo, width = bounds[:, 0], bounds[:, 1] - bounds[:, 0]
+
+        def residuals(U: np.ndarray) -> np.ndarray:
+            A, b = self.basis(lo + np.clip(U, 0.0, 1.0) * width)
+            return self.solve_ab(A, b, U.shape[0])[2]
+
+        def jacobian(u: np.ndarray) -> np.ndarray:
+            """Forward differences, every column in one batched call (inward at the upper
+            face), as ``lm``'s (:mod:`fricid.optim._least_squares`)."""
+            step = np.where(u + _FD_STEP <= 1.0, _FD_STEP, -_FD_STEP)
+            U = np.repeat(u[None], u.size + 1, axis=0)
+            U[1:] += np.diag(step)
+            R = residuals(U)
+            return ((R[1:] - R[0]) / step[:, None]).T
+
+        u0 = np.clip((nu0 - lo) / width, 1e-9, 1.0 - 1e-9)
+        sol = least_squares(
+            lambda u: residuals(u[None])[0],
+            u0,
+            jac=jacobian,
+            bounds=(0.0, 1.0),
+            method="trf",
+            ftol=1e-12,
+            xtol=1e-12,
+            gtol=1e-12,
+            max_nfev=max_nfev,
+        )
+        nu = lo + np.clip(sol.x, 0.0, 1.0) * width
+        A, b = self.basis(nu[None])
+        C, sse, _ = self.solve_ab(A, b, 1)
+        return nu, C[0], float(sse[0]), bool(sol.status > 0)
 
 
-def _search(proj: _Projection, bounds: np.ndarray, points: int, n_keep: int) -> list[np.ndarray]:
-    """The best grid points of distinct basins, as free vectors, best first."""
+def _search(
+    proj: _Projection, bounds: np.ndarray, points: int, n_keep: int
+) -> list[tuple[np.ndarray, np.ndarray, float]]:
+    """The best grid points of distinct basins, ``(nu, c, sse)``, best first."""
     axes = _axes(bounds, points)
     if axes:
         index = np.stack(np.meshgrid(*[np.arange(a.size) for a in axes], indexing="ij"), -1)
@@ -210,14 +302,14 @@ def _search(proj: _Projection, bounds: np.ndarray, points: int, n_keep: int) -> 
     C = np.empty((NU.shape[0], len(proj.block.lin)))
     sse = np.empty(NU.shape[0])
     for s in range(0, NU.shape[0], per):
-        C[s : s + per], sse[s : s + per], _ = proj.solve(NU[s : s + per], 5 * n_keep)
+        C[s : s + per], sse[s : s + per] = proj.solve(NU[s : s + per], 5 * n_keep)
     picked: list[int] = []
     for g in np.argsort(sse):
         if not np.isfinite(sse[g]) or len(picked) == n_keep:
             break
         if all(np.max(np.abs(index[g] - index[h])) > 2 for h in picked):
             picked.append(int(g))
-    return [proj.candidates(NU[[g]], C[[g]])[0] for g in picked]
+    return [(NU[g], C[g], float(sse[g])) for g in picked]
 
 
 def _option(options: dict[str, Any], name: str, default: int) -> int:
@@ -274,70 +366,63 @@ def varpro(
     lin, nl = linear_split(problem)
     n_polish = _option(opts, "n_polish", N_POLISH)
     start = problem.start()
-    per_block: list[list[np.ndarray]] = []
-    grid_nfev, grid_points = 0, 0
+    x = start.copy()
+    nfev, grid_points, converged = 0, 0, True
     for block in _blocks(problem, lin, nl):
         proj = _Projection(problem, block, start)
-        q = len(block.nl)
+        q, box = len(block.nl), problem.bounds[block.nl]
         points = _option(opts, "grid", GRID_POINTS.get(q, 8)) if q else 1
-        per_block.append(_search(proj, problem.bounds[block.nl], points, n_polish))
-        grid_nfev += proj.nfev
+        found = _search(proj, box, points, n_polish)
         grid_points += points**q
-    cands = []
-    for k in range(max(len(b) for b in per_block)):
-        x = start.copy()
-        for block, found in zip(_blocks(problem, lin, nl), per_block, strict=True):
-            pick = found[min(k, len(found) - 1)]
-            x[block.nl + block.lin] = pick[block.nl + block.lin]
-        cands.append(x)
-    grid_fun = problem.evaluate(np.array(cands))
-    best_x, best_fun = cands[int(np.argmin(grid_fun))], float(np.min(grid_fun))
-    history = [[grid_nfev, best_fun]]
+        best = found[0] + (True,)
+        if q:
+            budget = _option(opts, "polish_evals", 200 * (q + 1))
+            for nu0, _, _ in found:
+                polished = proj.polish(nu0, box, budget)
+                if polished[2] <= best[2]:
+                    best = polished
+            converged = converged and best[3]
+        x[block.nl], x[block.lin] = best[0], best[1]
+        nfev += proj.nfev
+    fun = float(problem.evaluate(x[None])[0])
+    history = [[nfev, fun]]
+    status = 0 if converged else 1
     exact_l2 = problem.f_scale is None
-    status, polish_msg, polish_nfev = 0, "", 0
-    if nl or not exact_l2:
-        p = problem.n_free
-        each = max_evals // len(cands) if max_evals else 100 * (p + 1)
-        each = _option(opts, "polish_evals", max(each, 1))
-        ranked = []
-        for x in cands:
-            res = minimize(
-                problem.evaluate,
-                problem.bounds,
-                method="lm",
-                x0=x,
-                options={"n_starts": 1},
-                max_evals=each,
-                residuals=problem.residuals,
-                seed=seed,
-                callback=callback,
-            )
-            polish_nfev += int(res.nfev)
-            ranked.append(res)
-        win = min(ranked, key=lambda r: float(r.fun))
-        status, polish_msg = int(win.status), str(win.message)
-        if float(win.fun) <= best_fun:
-            best_x, best_fun = np.asarray(win.x, dtype=float), float(win.fun)
-    nfev = grid_nfev + polish_nfev
-    history.append([nfev, best_fun])
-    what = "exact (l2)" if exact_l2 else "robust loss: l2-projected grid, then a local polish"
+    what = "exact (l2)" if exact_l2 else "robust loss: l2-projected grid, then an lm polish"
     message = (
-        f"{'converged' if status == 0 else polish_msg}; variable projection, {what}: "
+        f"{'converged' if converged else 'polish budget spent'}; variable projection, {what}: "
         f"{grid_points} grid points over {', '.join(problem.free_names[i] for i in nl) or '-'}"
-        + (f", {len(cands)} polished by lm ({polish_msg})" if polish_msg else "")
+        + (f", the best {n_polish} polished over them" if nl else "")
     )
+    if not exact_l2:
+        res = minimize(
+            problem.evaluate,
+            problem.bounds,
+            method="lm",
+            x0=x,
+            options={"n_starts": 1},
+            max_evals=max_evals,
+            residuals=problem.residuals,
+            seed=seed,
+            callback=callback,
+        )
+        nfev += int(res.nfev)
+        if float(res.fun) <= fun:
+            x, fun = np.asarray(res.x, dtype=float), float(res.fun)
+        status = int(res.status)
+        message += f" ({res.message})"
+        history.append([nfev, fun])
     return OptimizeResult(
-        x=best_x,
-        fun=best_fun,
+        x=x,
+        fun=fun,
         nfev=nfev,
-        nit=len(cands),
+        nit=grid_points,
         history=np.array(history, dtype=float),
         status=status,
         message=message,
         success=status == 0,
         method="varpro",
         seed=seed if isinstance(seed, int) else None,
-        max_evals=nfev if max_evals is None else int(max_evals) + grid_nfev,
+        max_evals=nfev if max_evals is None else max(int(max_evals), nfev),
         grid_points=grid_points,
-        grid_nfev=grid_nfev,
     )
