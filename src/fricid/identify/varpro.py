@@ -14,17 +14,21 @@ What :func:`varpro` does
        with the free linear parameters set to 0 and to each unit vector (so fixed parameters,
        linear or not, stay at their values, and nothing but the declaration is asked of a
        model).
-    2. The nonlinear parameters (1 or 2 for the Stribeck model, 3 for ``vlt``, none for
-       Coulomb-viscous) are searched on a grid over their whole search box: log-spaced where
-       the box is positive, linear otherwise (:data:`GRID_POINTS` points per axis). At each
-       grid point the linear parameters are the bounded linear least-squares solution inside
-       their box (unconstrained by a batched pseudo-inverse; where that leaves the box,
-       ``scipy.optimize.lsq_linear`` with BVLS, Stark and Parker 1995), so non-negativity and
-       the other bounds hold exactly. The unconstrained SSE bounds the constrained one from
+    2. The nonlinear parameters (1 or 2 for the Stribeck model, 2 for ``msk``, 3 for ``vlt``,
+       none for Coulomb-viscous) are searched on a grid over their whole search box:
+       log-spaced where the box is positive, linear otherwise (:data:`GRID_POINTS` points per
+       axis). At each grid point the linear parameters are the bounded linear least-squares
+       solution inside their box (unconstrained by a batched pseudo-inverse; where that leaves
+       the box, ``scipy.optimize.lsq_linear`` with BVLS, Stark and Parker 1995), so
+       non-negativity and the other bounds hold exactly. The unconstrained SSE bounds the constrained one from
        below, so only grid points that could rank among the best are solved with BVLS.
-    3. The best grid points of distinct basins (:data:`N_POLISH` of them) are polished by the
-       default least-squares method (``lm``, one start each) on the full problem, and the
-       lowest wins.
+    3. The best grid points of distinct basins (:data:`N_POLISH` of them, at least 3 grid
+       steps apart) are polished by least squares over the nonlinear parameters alone, the
+       linear ones projected out at every step (scipy's bounded trust-region reflective
+       solver in the unit box of the nonlinear parameters, a forward-difference Jacobian in
+       one batched model call, as ``lm``'s), and the lowest wins. Each bounded linear solve
+       first tries the previous solve's active set and keeps it when the Karush-Kuhn-Tucker
+       conditions hold (the inner problem is convex, so that is its optimum), else BVLS.
 
     The search box is covered whatever the start, so the result does not depend on ``x0``
     (recorded as the fit's ``init``, not used to search). For a model with parameters per
@@ -65,14 +69,15 @@ SUMMARY = (
 )
 
 #: Grid points per nonlinear axis, by the number of nonlinear parameters searched together.
-GRID_POINTS: dict[int, int] = {1: 256, 2: 48, 3: 16}
+GRID_POINTS: dict[int, int] = {1: 128, 2: 32, 3: 12}
 
 #: Best grid points of distinct basins polished by ``lm``.
 N_POLISH = 3
 
 #: Options of ``method="varpro"`` (``fit(..., options=...)``): ``grid`` points per axis
 #: (default :data:`GRID_POINTS`), ``n_polish`` (:data:`N_POLISH`), ``polish_evals`` (the
-#: budget of each polish; default ``100 (p + 1)``, or ``max_evals`` shared out).
+#: most residual vectors one polish over the nonlinear parameters asks for; default
+#: ``200 (q + 1)`` for ``q`` nonlinear parameters).
 VARPRO_OPTIONS = ("grid", "n_polish", "polish_evals")
 
 #: Forward-difference step of the polish's Jacobian, in the unit box of the nonlinear
@@ -336,20 +341,22 @@ def varpro(
     problem : IdentificationProblem
         A named model's problem; the model declares ``linear_params``.
     seed : int or numpy.random.Generator, optional
-        Passed to the polish (one start each, so it does not change the result).
+        Recorded; the search is deterministic (a robust loss's ``lm`` polish gets it).
     max_evals : int, optional
-        Budget of the polishes together (the grid's evaluations come on top).
+        The budget of a robust loss's ``lm`` polish (the projected polishes have the option
+        ``polish_evals``).
     options : dict, optional
         :data:`VARPRO_OPTIONS`.
     callback : callable, optional
-        Passed to each polish (``fricid.optim.minimize``).
+        Called once with the result (and at each step of a robust loss's ``lm`` polish).
 
     Returns
     -------
     OptimizeResult
         ``x`` (free parameters), ``fun`` (the problem's loss), ``nfev`` (grid and polish),
-        ``status`` (the winning polish's; 0 when the grid needed none), ``method`` "varpro",
-        and ``grid_points``, ``grid_nfev``.
+        ``status`` (0 when every projected polish converged by scipy's criterion, 1 when one
+        spent its budget; with a robust loss, its ``lm`` polish's), ``method`` "varpro", and
+        ``grid_points``.
 
     Raises
     ------
@@ -412,7 +419,7 @@ def varpro(
         status = int(res.status)
         message += f" ({res.message})"
         history.append([nfev, fun])
-    return OptimizeResult(
+    result = OptimizeResult(
         x=x,
         fun=fun,
         nfev=nfev,
@@ -426,3 +433,6 @@ def varpro(
         max_evals=nfev if max_evals is None else max(int(max_evals), nfev),
         grid_points=grid_points,
     )
+    if callback is not None and exact_l2:
+        callback(result)
+    return result
