@@ -20,8 +20,9 @@ What :func:`varpro` does
        axis). At each grid point the linear parameters are the bounded linear least-squares
        solution inside their box (unconstrained by a batched pseudo-inverse; where that leaves
        the box, ``scipy.optimize.lsq_linear`` with BVLS, Stark and Parker 1995), so
-       non-negativity and the other bounds hold exactly. The unconstrained SSE bounds the constrained one from
-       below, so only grid points that could rank among the best are solved with BVLS.
+       non-negativity and the other bounds hold exactly. The unconstrained SSE bounds the
+       constrained one from below, so only grid points that could rank among the best are
+       solved with BVLS.
     3. The best grid points of distinct basins (:data:`N_POLISH` of them, at least 3 grid
        steps apart) are polished by least squares over the nonlinear parameters alone, the
        linear ones projected out at every step (scipy's bounded trust-region reflective
