@@ -16,7 +16,7 @@ import pytest
 from typer.testing import CliRunner
 
 from fricid.cli import app
-from fricid.errors import ConfigError, FricidWarning
+from fricid.errors import ConfigError, FricidWarning, IgnoredArgumentWarning
 from fricid.experiments import stribeck_problem as sp
 from fricid.identify import fit
 from fricid.io import write_samples
@@ -106,7 +106,9 @@ def test_varpro_reaches_the_study_optimum_from_any_start(study):
         f = quiet(samples, "stribeck", "varpro", x0=x0, intervals="none", **kw)
         assert f.converged and f.method == "varpro"
         assert f.metrics["sse"] <= optimum * (1 + EXACT), (x0, f.metrics["sse"], optimum)
-        assert f.init == pytest.approx(x0)  # recorded, and the search does not depend on it
+        assert f.init == {}  # no start: the search covers the box
+    with pytest.warns(IgnoredArgumentWarning, match="x0 is not used"):
+        fit(samples, "stribeck", "varpro", x0={"w_s": 0.5}, intervals="none", **kw)
 
 
 @pytest.mark.parametrize(

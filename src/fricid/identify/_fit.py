@@ -191,9 +191,15 @@ def fit(
         )
     check_identifiable(samples, model, fixed=problem.fixed, stacklevel=3)
     key = str(method).strip().lower()
-    start = problem.start(x0) if key in METHODS or key == "varpro" else None
+    start = problem.start(x0) if key in METHODS else None
     uses_residuals = key in METHODS and METHODS[key].uses_residuals
-    if key == "varpro":  # separable least squares (identify/varpro.py); x0 is recorded only
+    if key == "varpro":  # separable least squares over the whole box (identify/varpro.py)
+        if x0:
+            warnings.warn(
+                "method 'varpro' searches the whole search box; x0 is not used",
+                IgnoredArgumentWarning,
+                stacklevel=2,
+            )
         result = varpro(problem, seed=seed, max_evals=max_evals, options=options, callback=callback)
     else:
         result = minimize(

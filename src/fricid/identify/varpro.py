@@ -31,10 +31,10 @@ What :func:`varpro` does
        first tries the previous solve's active set and keeps it when the Karush-Kuhn-Tucker
        conditions hold (the inner problem is convex, so that is its optimum), else BVLS.
 
-    The search box is covered whatever the start, so the result does not depend on ``x0``
-    (recorded as the fit's ``init``, not used to search). For a model with parameters per
-    direction (``*_asym``) each direction's parameters are searched on its own samples (the
-    problem separates), then polished together.
+    The search box is covered whatever the start, so there is none: ``fit(..., x0=...)`` warns
+    that it is not used (``IgnoredArgumentWarning``) and the model file records no ``init``.
+    For a model with parameters per direction (``*_asym``) each direction's parameters are
+    searched and polished on its own samples (the problem separates).
 
 Losses and weights
     Weights (``weights="std"`` or given) enter as row scaling, exactly. ``mse`` is ``sse`` over
