@@ -24,9 +24,11 @@ from ._paths import check_paths
 
 
 def _method_help() -> str:
+    from ..identify.varpro import SUMMARY
     from ..optim import METHODS
 
-    return "; ".join(f"{name}: {cls.summary}" for name, cls in METHODS.items())
+    items = [f"{name}: {cls.summary}" for name, cls in METHODS.items()]
+    return "; ".join([*items, f"varpro: {SUMMARY}"])
 
 
 @app.command("fit")
@@ -55,8 +57,8 @@ def fit_command(
     method: Annotated[
         str,
         typer.Option(
-            help="Optimiser (see `fricid methods`): lm, trf, bas, "
-            "vsbas, ibas, rwsavsbas, ga, de, cmaes, bas+lm, ..."
+            help="Optimiser (see `fricid methods`): lm, varpro (exact optimum by variable "
+            "projection), trf, bas, vsbas, ibas, rwsavsbas, ga, de, cmaes, bas+lm, ..."
         ),
     ] = "lm",
     fix: FixOption = None,
@@ -281,3 +283,6 @@ def methods_command() -> None:
     console.print("[bold]Methods[/]:")
     for name, cls in METHODS.items():
         console.print(f"  {name:<16} {cls.summary}", highlight=False)
+    from ..identify.varpro import SUMMARY
+
+    console.print(f"  {'varpro':<16} {SUMMARY}", highlight=False)

@@ -31,6 +31,7 @@ from ._scatter import measurement_scatter, sample_weights
 from .checks import check_identifiable
 from .problem import ROBUST_LOSSES, IdentificationProblem
 from .uncertainty import INTERVALS, assess
+from .varpro import varpro
 
 __all__ = ["evaluate", "fit"]
 
@@ -77,7 +78,9 @@ def fit(
     method : str, default "lm"
         Any method of ``fricid.optim.METHODS`` (``"lm"``: the default least-squares method,
         scipy's bounded trust-region reflective solver, a Levenberg-Marquardt-type method, with
-        multi-start; :mod:`fricid.optim._least_squares`). For ``"rbf"``: ``"lsq"`` (k-means,
+        multi-start; :mod:`fricid.optim._least_squares`), or ``"varpro"``: the exact
+        least-squares optimum by variable projection for models that declare
+        ``linear_params`` (:mod:`fricid.identify.varpro`). For ``"rbf"``: ``"lsq"`` (k-means,
         widths, ridge least squares) or an optimiser trainer (``"bas"`` for BAS-RBFNN,
         ``"ga"`` for GA-RBFNN, ...); the default ``"lm"`` means ``"lsq"`` there.
     fixed : mapping of str to float, optional
@@ -190,17 +193,26 @@ def fit(
     key = str(method).strip().lower()
     start = problem.start(x0) if key in METHODS else None
     uses_residuals = key in METHODS and METHODS[key].uses_residuals
-    result = minimize(
-        problem.evaluate,
-        problem.bounds,
-        method=method,
-        seed=seed,
-        max_evals=max_evals,
-        options=options,
-        callback=callback,
-        x0=start,
-        residuals=problem.residuals if uses_residuals else None,
-    )
+    if key == "varpro":  # separable least squares over the whole box (identify/varpro.py)
+        if x0:
+            warnings.warn(
+                "method 'varpro' searches the whole search box; x0 is not used",
+                IgnoredArgumentWarning,
+                stacklevel=2,
+            )
+        result = varpro(problem, seed=seed, max_evals=max_evals, options=options, callback=callback)
+    else:
+        result = minimize(
+            problem.evaluate,
+            problem.bounds,
+            method=method,
+            seed=seed,
+            max_evals=max_evals,
+            options=options,
+            callback=callback,
+            x0=start,
+            residuals=problem.residuals if uses_residuals else None,
+        )
     key_i = str(intervals).strip().lower()
     if key_i not in INTERVALS:
         raise ConfigError(f"intervals must be one of {', '.join(INTERVALS)}; got {intervals!r}")

@@ -28,6 +28,7 @@ class CoulombViscous(FrictionModel):
     """Coulomb plus viscous friction, [B] eq. 1: ``F = F_c sign(v) + beta v``."""
 
     name = "coulomb_viscous"
+    linear_params = ("f_c", "beta")
     title = "Coulomb-viscous"
     equation = "BAS-RBFNN paper, eq. 1"
     inputs = ("velocity",)
@@ -55,6 +56,7 @@ class Stribeck(FrictionModel):
     """
 
     name = "stribeck"
+    linear_params = ("tau_c", "tau_s", "tau_v")
     title = "Stribeck (velocity)"
     equation = "BAS-RBFNN paper eq. 2; RWSAVSBAS paper eq. 7"
     inputs = ("velocity",)
@@ -81,6 +83,7 @@ class LoadDependent(FrictionModel):
     """
 
     name = "msk"
+    linear_params = ("f_c", "f_s", "f_ck", "f_sk", "beta")
     title = "Load-dependent (Msk)"
     equation = "BAS-RBFNN paper, eq. 3"
     inputs = ("velocity", "load")
@@ -117,6 +120,7 @@ class VelocityLoadTemperature(FrictionModel):
     """
 
     name = "vlt"
+    linear_params = ("f_c", "f_ctl", "f_stl", "f_v0", "f_vT")
     title = "Velocity-load-temperature"
     equation = "BAS-RBFNN paper, eq. 4 (Table 2 parameters)"
     inputs = ("velocity", "load", "temperature")

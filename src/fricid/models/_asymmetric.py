@@ -41,6 +41,9 @@ class Asymmetric(FrictionModel):
             for suffix, word in (("_pos", "positive"), ("_neg", "negative"))
             for p in base.parameters
         )
+        self.linear_params = tuple(
+            f"{name}{suffix}" for suffix in ("_pos", "_neg") for name in base.linear_params
+        )
 
     @property
     def is_asymmetric(self) -> bool:

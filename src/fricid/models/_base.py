@@ -73,6 +73,9 @@ class FrictionModel(ABC):
     parameters: tuple[Parameter, ...] = ()
     #: Predicts from a parameter vector (False), not a stored state (the RBF network).
     stateful: bool = False
+    #: The parameters the prediction is a linear combination of, for fixed values of the
+    #: others (variable projection, :mod:`fricid.identify.varpro`); ``()`` when none is declared.
+    linear_params: tuple[str, ...] = ()
 
     # -- description ---------------------------------------------------------------------
     @property

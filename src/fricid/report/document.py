@@ -61,13 +61,16 @@ class Figure:
     """A figure as PNG bytes: embedded in the HTML, linked from the Markdown, ``<name>.png``.
 
     ``caption`` says what the figure shows; for a reproduced figure, what the paper showed and
-    where ours differ.
+    where ours differ. ``plotly``, when given, is the same figure as Plotly JSON
+    (:mod:`fricid.report.interactive`): the HTML shows it interactive (zoom, pan, hover) with
+    the PNG as its no-JavaScript fallback; the Markdown links the PNG.
     """
 
     name: str
     title: str
     png: bytes
     caption: str = ""
+    plotly: str | None = None
 
     def __post_init__(self) -> None:
         _check_name(self.name)

@@ -21,7 +21,7 @@ import pandas as pd
 from ..fitted import FittedModel
 from ..identify import evaluate
 from ..samples import FrictionSamples
-from . import plots
+from . import interactive, plots
 from .document import Document, Figure, Note, Table
 from .trust import Trust, assess_trust, not_determined, quality_frame, trust_text
 
@@ -302,8 +302,44 @@ def model_report(
                 title=f"{fitted.model}: friction against velocity",
             ),
             caption=_curves_caption(samples),
+            plotly=interactive.friction_figure(
+                samples,
+                fitted.predict,
+                velocity_unit=velocity_unit,
+                title=f"{fitted.model}: friction against velocity",
+            ),
         )
     )
+    if (samples.velocity != 0).any():
+        marks = interactive.stribeck_velocities(fitted.params)
+        moving = samples.subset(samples.velocity != 0)
+        sec.add(
+            Figure(
+                "stribeck_region",
+                "The Stribeck region: friction magnitude against speed, log axis",
+                plots.stribeck_region(
+                    moving,
+                    fitted.predict,
+                    marks,
+                    velocity_unit=velocity_unit,
+                    xlim=interactive.stribeck_range(moving.velocity, marks),
+                ),
+                caption="The low-speed end, where friction falls from its static level to the "
+                "Coulomb level, on a log speed axis, per direction (up to 20 times the "
+                "Stribeck velocity where that is inside the data; the interactive figure "
+                "zooms out on a double click)"
+                + (
+                    "; dotted lines mark the model's Stribeck velocities ("
+                    + ", ".join(marks)
+                    + ")."
+                    if marks
+                    else "."
+                ),
+                plotly=interactive.stribeck_figure(
+                    moving, fitted.predict, fitted.params, velocity_unit=velocity_unit
+                ),
+            )
+        )
     sec.add(
         Figure(
             "parity",
@@ -322,6 +358,7 @@ def model_report(
             caption="Measured minus predicted friction against each input that varies "
             "in the data; structure (a trend, a curve) means the model misses an "
             "effect, scatter within the dashed ±2 RMSE lines is noise.",
+            plotly=interactive.residual_figure(samples, residual, velocity_unit=velocity_unit),
         )
     )
 

@@ -26,6 +26,7 @@ __all__ = [
     "parity",
     "residual_panels",
     "set_velocity_axis",
+    "stribeck_region",
     "surface",
     "velocity_grid",
 ]
@@ -198,6 +199,77 @@ def friction_curves(
             fig.legend(handles, labels, loc="outside right center")
         else:
             axes[0, -1].legend(loc="best")
+        fig.suptitle(title, fontweight="bold")
+        return png(fig)
+
+
+def stribeck_region(
+    samples: FrictionSamples,
+    predict: Predict,
+    marks: Mapping[str, float],
+    *,
+    velocity_unit: str = "rad/s",
+    title: str = "The Stribeck region: |friction| against speed",
+    xlim: tuple[float, float] | None = None,
+) -> bytes:
+    """The friction magnitude against speed on a log axis, per direction, measured (markers)
+    and the model at the median load and temperature (lines), with dotted lines at the
+    velocities in ``marks`` [rad/s] (the model's Stribeck velocities); ``xlim`` [rad/s] limits
+    the speed axis."""
+    vf, vunit = velocity_scale(velocity_unit)
+    tf, tunit = torque_scale(samples.friction)
+    with styled():
+        fig, axes = new_figure(1, 1, width=7.5, height=4.4)
+        ax = axes[0, 0]
+        for k, d in enumerate((1, -1)):
+            sel = np.sign(samples.velocity) == d
+            if not sel.any():
+                continue
+            label, marker, dash = _DIRECTION[d]
+            v = samples.velocity[sel]
+            ax.plot(
+                np.abs(v) * vf,
+                np.abs(samples.friction[sel]) * tf,
+                marker,
+                color=COLORS[k],
+                ms=4.5,
+                alpha=0.6,
+                mfc=COLORS[k] if d > 0 else "white",
+                label=f"measured, {label}",
+            )
+            grid = velocity_grid(v, log=True)
+            X = np.column_stack(
+                [
+                    grid,
+                    np.full_like(grid, np.median(samples.load)),
+                    np.full_like(grid, np.median(samples.temperature)),
+                ]
+            )
+            ax.plot(
+                np.abs(grid) * vf,
+                d * predict(X) * tf,
+                dash,
+                color=COLORS[k],
+                label=f"model, {label}",
+            )
+        for k, (name, value) in enumerate(marks.items()):
+            ax.axvline(value * vf, color="0.35", lw=0.9, ls=":")
+            ax.annotate(
+                name,
+                (value * vf, 1.0),
+                xycoords=("data", "axes fraction"),
+                xytext=(0, 2 + 10 * k),
+                textcoords="offset points",
+                ha="center",
+                va="bottom",
+                fontsize=8,
+            )
+        ax.set_xscale("log")
+        if xlim is not None:
+            ax.set_xlim(xlim[0] * vf, xlim[1] * vf)
+        ax.set_xlabel(f"speed |velocity| [{vunit}], log scale")
+        ax.set_ylabel(f"|friction torque| [{tunit}]")
+        ax.legend(loc="best")
         fig.suptitle(title, fontweight="bold")
         return png(fig)
 

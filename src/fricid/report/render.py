@@ -1,7 +1,9 @@
 """Render a :class:`~fricid.report.document.Document` as self-contained HTML or as Markdown.
 
 The HTML embeds every figure as a base64 PNG and every table as an HTML table, with a small
-inline style sheet: one file that opens anywhere, offline. The Markdown links the PNG and CSV
+inline style sheet: one file that opens anywhere, offline. Figures that carry a Plotly version
+(:mod:`fricid.report.interactive`) are interactive there, plotly.js inlined once (not from a
+CDN), the PNG kept as the fallback without JavaScript. The Markdown links the PNG and CSV
 files written beside it. Text in sections and notes is plain text with a tiny markup: blank
 lines separate paragraphs, lines starting with ``- `` form a list, ```code``` and ``**bold**``.
 """
@@ -12,11 +14,12 @@ import base64
 import html
 import math
 import re
+from importlib import resources
 from numbers import Number
 
 from .document import Document, Figure, Note, Section, Table
 
-__all__ = ["format_value", "render_html", "render_markdown", "slug"]
+__all__ = ["format_value", "plotly_js", "render_html", "render_markdown", "slug"]
 
 _CSS = """
 body{font-family:-apple-system,"Segoe UI",Roboto,Helvetica,Arial,sans-serif;max-width:1100px;
@@ -34,6 +37,7 @@ figcaption,.caption{color:#444;font-size:.92em;margin-top:.3em}
 .note-warning{border-left:4px solid #d9822b;background:#fff6ec;padding:.5em .9em}
 code{background:#f1f4f9;padding:0 .25em;border-radius:3px}
 nav ul{columns:2;font-size:.92em}.files{color:#666;font-size:.85em}
+.plotly-figure{width:100%;min-height:480px;border:1px solid #e3e7ee}
 """
 
 
@@ -112,22 +116,40 @@ def _table_html(table: Table) -> str:
     )
 
 
-def _figure_html(fig: Figure) -> str:
+def plotly_js() -> str | None:
+    """plotly.js from the installed ``plotly`` package (inlined: no CDN, works offline), or
+    None without it (the figures are then shown as PNG)."""
+    try:
+        return (resources.files("plotly") / "package_data" / "plotly.min.js").read_text("utf-8")
+    except (ModuleNotFoundError, FileNotFoundError, OSError):  # pragma: no cover
+        return None
+
+
+def _figure_html(fig: Figure, interactive: bool = False) -> str:
     data = base64.b64encode(fig.png).decode("ascii")
     caption = _text_html(fig.caption) if fig.caption else ""
+    img = f'<img alt="{html.escape(fig.title)}" src="data:image/png;base64,{data}">'
+    if interactive and fig.plotly:
+        spec = fig.plotly.replace("</", "<\\/")  # never closes the script element
+        div_id = f"plotly-{fig.name}"
+        img = (
+            f'<div class="plotly-figure" id="{div_id}"></div>'
+            f"<script>(function(){{var s={spec};Plotly.newPlot({div_id!r},s.data,s.layout,"
+            "{responsive:true,displaylogo:false});})();</script>"
+            f"<noscript>{img}</noscript>"
+        )
     return (
-        f'<figure id="{slug(fig.title)}"><h3>{_inline_html(fig.title)}</h3>'
-        f'<img alt="{html.escape(fig.title)}" src="data:image/png;base64,{data}">'
+        f'<figure id="{slug(fig.title)}"><h3>{_inline_html(fig.title)}</h3>{img}'
         f"<figcaption>{caption}</figcaption>"
         f'<div class="files">{fig.name}.png</div></figure>'
     )
 
 
-def _item_html(item) -> str:
+def _item_html(item, interactive: bool = False) -> str:
     if isinstance(item, Table):
         return _table_html(item)
     if isinstance(item, Figure):
-        return _figure_html(item)
+        return _figure_html(item, interactive)
     if isinstance(item, Note):
         cls = "note-warning" if item.kind == "warning" else ""
         return f'<div class="{cls}">{_text_html(item.text)}</div>'
@@ -144,16 +166,19 @@ def _meta_html(meta: dict) -> str:
     return f'<table class="meta"><tbody>{rows}</tbody></table>'
 
 
-def _section_html(sec: Section) -> str:
+def _section_html(sec: Section, interactive: bool = False) -> str:
     body = [f'<h2 id="{slug(sec.title)}">{_inline_html(sec.title)}</h2>']
     if sec.text:
         body.append(_text_html(sec.text))
-    body.extend(_item_html(i) for i in sec.items)
+    body.extend(_item_html(i, interactive) for i in sec.items)
     return "<section>\n" + "\n".join(body) + "\n</section>"
 
 
 def render_html(doc: Document) -> str:
-    """The document as one self-contained HTML page (figures embedded as base64 PNG)."""
+    """The document as one self-contained HTML page: figures embedded as base64 PNG, those
+    with a Plotly version interactive (plotly.js inlined once, in the head; the PNG kept for
+    a browser without JavaScript)."""
+    js = plotly_js() if any(f.plotly for f in doc.figures()) else None
     toc = "".join(
         f'<li><a href="#{slug(s.title)}">{_inline_html(s.title)}</a></li>' for s in doc.sections
     )
@@ -161,12 +186,14 @@ def render_html(doc: Document) -> str:
         "<!DOCTYPE html>",
         '<html lang="en"><head><meta charset="utf-8">',
         '<meta name="viewport" content="width=device-width, initial-scale=1">',
-        f"<title>{html.escape(doc.title)}</title><style>{_CSS}</style></head><body>",
+        f"<title>{html.escape(doc.title)}</title><style>{_CSS}</style>",
+        f'<script type="text/javascript">{js}</script>' if js else "",
+        "</head><body>",
         f"<h1>{_inline_html(doc.title)}</h1>",
         _text_html(doc.summary, "summary") if doc.summary else "",
         _meta_html(doc.meta),
         f"<nav><ul>{toc}</ul></nav>" if len(doc.sections) > 2 else "",
-        *(_section_html(s) for s in doc.sections),
+        *(_section_html(s, js is not None) for s in doc.sections),
         "</body></html>",
     ]
     return "\n".join(p for p in parts if p) + "\n"
