@@ -208,6 +208,18 @@ def _trust_section(doc: Document):
     return sec, sec.items[0].text
 
 
+def test_report_validation_limit_is_a_size_not_a_time(leadscrew):
+    """Whether the report runs lovo itself depends on the problem's size only, never on how
+    busy the machine is (a measured time made the verdict flip under load)."""
+    from fricid.report.trust import assess_trust
+
+    fitted = fit(leadscrew, "stribeck_asym")
+    small = assess_trust(fitted, leadscrew, max_work=1)
+    assert small.validation is None
+    assert "over the report's 1; use fricid fit --validate lovo" in small.validation_note
+    assert assess_trust(fitted, leadscrew).validation is not None
+
+
 def test_trust_yes_for_a_converged_fit_within_noise(leadscrew, tmp_path):
     fitted = fit(leadscrew, "stribeck_asym")
     assert fitted.converged and fitted.validation is None
