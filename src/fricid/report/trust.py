@@ -56,7 +56,7 @@ MISS_RATIO = 3.0
 
 #: Largest leave-one-velocity-out validation the report runs itself, as folds x samples x
 #: parameters. A count, not a measured time, so the verdict does not depend on how busy the
-#: machine is (50 000 is a few seconds of ``lm`` on 2 cores; larger: ``fricid fit --validate``).
+#: machine is (larger problems: ``fricid fit --validate lovo``).
 VALIDATE_WORK = 50_000
 
 #: The report runs its own leave-one-velocity-out validation only with at least this many
