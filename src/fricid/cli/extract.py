@@ -13,7 +13,7 @@ from ..errors import ConfigError
 from ._app import app, console, err_console, handle_errors
 from ._options import TemperatureOption, TorqueConstantOption, out_option, parse_grid
 from ._paths import check_paths
-from ._progress import progress_bar
+from ._progress import QuietOption, progress_bar
 from ._torque_constant import (
     UrdfJointOption,
     UrdfOption,
@@ -327,6 +327,7 @@ def extract_command(
     urdf: UrdfOption = None,
     urdf_joint: UrdfJointOption = None,
     urdf_position: UrdfPositionOption = None,
+    quiet: QuietOption = False,
 ) -> None:
     """Extract friction samples from a raw log: segment the constant-velocity traverses, median
     filter the current, torque = K I (eq. 13), average the repetitions per position bin,
@@ -426,7 +427,9 @@ def extract_command(
         else:
             err_console.print("samples converted with the given (or the log's own) K, not this one")
 
-    with progress_bar("extracting", total=None) as advance:
+    with progress_bar(
+        f"extracting {log.name}", total=None, unit="chunks read", quiet=quiet
+    ) as advance:
         data = load_joint(
             log,
             fmt,

@@ -12,7 +12,7 @@ from rich.table import Table
 from ._app import app, console, err_console, handle_errors
 from ._options import out_option
 from ._paths import check_paths
-from ._progress import progress_bar
+from ._progress import QuietOption, progress_bar
 
 _MAX_LISTED = 20
 
@@ -160,14 +160,16 @@ def fleet_command(
             help=("Measurement date YYYY-MM-DD of joints whose row gives none (default: today).")
         ),
     ] = None,
+    quiet: QuietOption = False,
 ) -> None:
     """Identify every joint of many robots: extract then fit each joint of the manifest
     (exactly as `fricid extract` and `fricid fit` do), in parallel, and write one model file
     per joint and model plus a results table with parameters, 95 % confidence intervals,
     metrics, timing and the log's content hash. A joint that fails is reported (table and
     summary) and the rest completes; re-running skips unchanged joints, so an interrupted
-    run resumes. Exit status 0 when every joint succeeded, 1 when some failed, 2 for a bad
-    manifest or option."""
+    run resumes. Progress goes to stderr, piped too (a line per tenth of the joints with the
+    time left; --quiet: none). Exit status 0 when every joint succeeded, 1 when some failed,
+    2 for a bad manifest or option."""
     from ..fleet import compare, make_executor, read_manifest, read_results, run_fleet
     from ..fleet import write_drift as write_drift_files
 
@@ -181,7 +183,7 @@ def fleet_command(
     before = read_results(baseline) if baseline is not None else None
     with (
         make_executor(workers, cluster) as executor,
-        progress_bar("identifying joints", total=len(spec)) as advance,
+        progress_bar("identifying joints", total=len(spec), unit="joints", quiet=quiet) as advance,
     ):
         run = run_fleet(
             spec, out, executor=executor, force=force, date=date, progress=lambda event: advance()
