@@ -117,9 +117,20 @@ def test_tracker_estimate_and_lines(no_grace, capsys):
     err = capsys.readouterr().err
     assert "work: done (10/10 items)" in err
     with _progress.tracker("open-ended", None, unit="chunks read") as t:
+        assert t.line() == "open-ended"
         t.advance()
-        assert t.line() == "open-ended: running (1 chunks read so far)"
+        assert t.line() == "open-ended: 1 chunks read so far"
     assert _progress._seconds(125) == "2 min 5 s" and _progress._seconds(4000) == "1 h 6 min"
+
+
+def test_fit_budget_is_the_method_s_own_end():
+    """A scheduled method (BAS family, GA) ends at its schedule even with a larger budget."""
+    assert _progress.fit_budget("stribeck", "vsbas", {"delta": 1.0}, 200_000) == 3001
+    assert _progress.fit_budget("stribeck", "vsbas", None, 1000) == 1000
+    assert _progress.fit_budget("stribeck", "rwsavsbas", None, None) == 301_001
+    assert _progress.fit_budget("stribeck", "de", None, 50_000) == 50_000  # runs to the budget
+    assert _progress.fit_budget("stribeck", "lm", None, None) is None  # stops when converged
+    assert _progress.fit_budget("rbf", "bas", None, None) is None
 
 
 def test_fleet_piped_shows_progress(no_grace, tmp_path):

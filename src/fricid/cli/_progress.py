@@ -65,6 +65,10 @@ HEARTBEAT_S = 10.0
 #: Seconds at least between two plain lines of a step whose total is known.
 MIN_GAP_S = 1.0
 
+#: Options by which a population method ends on its own schedule (BAS family: iterations;
+#: RWSAVSBAS: outer loops; GA: generations), so that its total is at most its default budget.
+SCHEDULE_OPTIONS = ("n_iter", "n_outer", "n_gen")
+
 QuietOption = Annotated[
     bool,
     typer.Option(
@@ -145,7 +149,9 @@ class Tracker:
             left = self.estimate()
             tail = f", about {_seconds(left)} left" if left and self.done < self.total else ""
             return f"{self.label}: {count}{tail}"
-        return f"{self.label}: running" + (f" ({self.done:,.0f}{unit} so far)" if self.done else "")
+        if self.done:
+            return f"{self.label}: {self.done:,.0f}{unit} so far"
+        return f"{self.label}: still running" if self._printed else self.label
 
     def _emit(self, text: str) -> None:
         err_console.print(f"[{self.elapsed:7.1f} s] {escape(text)}", highlight=False, markup=True)
@@ -316,14 +322,18 @@ def fit_budget(
     key, meth = model.strip().lower(), method.strip().lower()
     if key in STATEFUL or key == "auto" or meth not in METHODS or METHODS[meth].uses_residuals:
         return None
-    if max_evals is not None:
-        return int(max_evals)
     try:
         names = get_model(key).param_names
         dim = max(1, sum(1 for n in names if n not in (fixed or {})))
-        return int(METHODS[meth]({}, dim=dim).default_budget())
+        solver = METHODS[meth]({}, dim=dim)
+        natural = int(solver.default_budget())
     except Exception:  # an unknown model: fit raises the clear error
         return None
+    if max_evals is None:
+        return natural
+    # a method with its own schedule (iterations, generations) ends there, budget or not
+    scheduled = any(k in solver.opts for k in SCHEDULE_OPTIONS)
+    return min(int(max_evals), natural) if scheduled else int(max_evals)
 
 
 @contextmanager
