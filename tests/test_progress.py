@@ -173,6 +173,13 @@ def test_extraction_summary_counts_read_right():
     assert _count(1234567, "row") == "1,234,567 rows"
 
 
+def test_cli_counts_are_plural_only_when_more_than_one():
+    from fricid.cli._app import plural
+
+    assert plural(1, "joint") == "1 joint" and plural(0, "joint") == "0 joints"
+    assert plural(2, "pass", "passes") == "2 passes"
+
+
 def test_evaluate_prints_rmspe_in_percent_and_sse_in_n2m2():
     assert metric_row("rmspe", 0.037) == ("RMSPE [%]", "3.7")
     assert metric_row("sse", 2.0)[0] == "SSE [N^2 m^2]"

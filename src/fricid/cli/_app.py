@@ -42,6 +42,7 @@ __all__ = [
     "handle_errors",
     "interrupt_exit",
     "main",
+    "plural",
     "signal_handlers",
 ]
 
@@ -96,6 +97,11 @@ EXIT_TERMINATED = 143
 
 #: What every interrupted command can say: outputs are written atomically (fricid.io.atomic).
 _DEFAULT_DETAIL = "no file was left half-written"
+
+
+def plural(n: int, noun: str, many: str | None = None) -> str:
+    """``1 joint``, ``3 joints``, ``2 passes`` (``many`` for an irregular plural)."""
+    return f"{n} " + (noun if n == 1 else many or f"{noun}s")
 
 
 class Terminated(KeyboardInterrupt):

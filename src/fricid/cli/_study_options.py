@@ -58,7 +58,7 @@ def study_progress(t0: float | None = None) -> Iterator[tuple[Callable[[str], No
     """
     from ._progress import tracker
 
-    with tracker("starting", None) as t:
+    with tracker("study", None) as t:
 
         def progress(msg: str) -> None:
             t.stage(msg, force=True)

@@ -10,7 +10,7 @@ import typer
 from rich.markup import escape
 
 from ..errors import ConfigError
-from ._app import app, console, err_console, handle_errors
+from ._app import app, console, err_console, handle_errors, plural
 from ._options import TemperatureOption, TorqueConstantOption, out_option, parse_grid
 from ._paths import check_paths
 from ._progress import QuietOption, progress_bar
@@ -466,6 +466,6 @@ def extract_command(
         }.get(join, join)
         err_console.print(f"channels joined {how}, onto the velocity (else position) time stamps")
     err_console.print(
-        f"wrote {escape(str(out))} ({len(data.samples)} samples)"
+        f"wrote {escape(str(out))} ({plural(len(data.samples), 'sample')})"
         + (f" and {escape(str(by_direction))}" if by_direction else "")
     )

@@ -9,7 +9,7 @@ import typer
 from rich.markup import escape
 from rich.table import Table
 
-from ._app import app, console, err_console, handle_errors
+from ._app import app, console, err_console, handle_errors, plural
 from ._options import out_option
 from ._paths import check_paths
 from ._progress import QuietOption, progress_bar
@@ -24,8 +24,8 @@ def _short(text: str, n: int = 110) -> str:
 
 def _summary(run, manifest_path: Path) -> Table:
     table = Table(
-        title=f"fricid fleet {escape(str(manifest_path))}: {len(run.records)} joints in "
-        f"{run.seconds:.1f} s ({run.executor}, {run.workers} worker(s))",
+        title=f"fricid fleet {escape(str(manifest_path))}: {plural(len(run.records), 'joint')} "
+        f"in {run.seconds:.1f} s ({run.executor}, {plural(run.workers, 'worker')})",
         title_justify="left",
     )
     table.add_column("joints")
