@@ -165,6 +165,8 @@ class Tracker:
             t = self.elapsed
             if t < GRACE_S and not force:
                 return
+            if self.total and self.done >= self.total and not force:
+                return  # the last line says "done"
             tenth = int(10 * self.done / self.total) if self.total else -1
             if force or not self._printed:
                 due = True
@@ -216,8 +218,8 @@ class Tracker:
         self._maybe_print()
 
     def finish(self) -> None:
-        """The last plain line, if any line was printed."""
-        if self.mode == "plain" and self._printed:
+        """The last plain line, when the step printed a line or outlasted the grace."""
+        if self.mode == "plain" and (self._printed or self.elapsed >= GRACE_S):
             unit = f" {self.unit}" if self.unit else ""
             count = (
                 f" ({self.done:,.0f}/{self.total:,.0f}{unit})"
