@@ -350,7 +350,7 @@ def fit_progress(
     """Progress of ``fricid fit``; yields ``(tracker, callback)``.
 
     ``callback`` is the optimiser callback to pass to :func:`fricid.identify.fit` (None for
-    models that take none: ``rbf``, ``auto``): it counts evaluations against the budget
+    models that take none, ``rbf`` and ``auto``, and with ``--quiet``): it counts evaluations against the budget
     (:func:`fit_budget`), and once the budget is spent names what the fit does next
     (certifying convergence by a local polish, the 95 % intervals).
     """
@@ -360,8 +360,8 @@ def fit_progress(
     label = f"fitting {key} ({method})"
     budget = fit_budget(model, method, fixed, max_evals)
     with tracker(label, budget, unit="evaluations", quiet=quiet) as t:
-        if key in STATEFUL or key == "auto":
-            yield t, None
+        if key in STATEFUL or key == "auto" or t.mode == "quiet":
+            yield t, None  # no callback at all when quiet: not even its small cost
             return
         inner = fit_callback(t, budget)
         spent = [False]
