@@ -350,9 +350,9 @@ def fit_progress(
     """Progress of ``fricid fit``; yields ``(tracker, callback)``.
 
     ``callback`` is the optimiser callback to pass to :func:`fricid.identify.fit` (None for
-    models that take none, ``rbf`` and ``auto``, and with ``--quiet``): it counts evaluations against the budget
-    (:func:`fit_budget`), and once the budget is spent names what the fit does next
-    (certifying convergence by a local polish, the 95 % intervals).
+    models that take none, ``rbf`` and ``auto``, and with ``--quiet``): it counts evaluations
+    against the budget (:func:`fit_budget`), and once the budget is spent names what the fit
+    does next (certifying convergence by a local polish, the 95 % intervals).
     """
     from ..models import STATEFUL
 
