@@ -62,6 +62,19 @@ def test_simulate_piped_prints_lines_with_elapsed_time_and_estimate(no_grace, tm
     assert res.stdout == ""  # progress never goes to stdout
 
 
+def test_extract_counts_chunks_of_a_parquet_log(no_grace, tmp_path):
+    import pyarrow.parquet as pq
+
+    log = tmp_path / "l.parquet"
+    assert run("simulate", "--preset", "paper2", "--size", "quick", "--out", log).exit_code == 0
+    n = -(-pq.ParquetFile(log).metadata.num_rows // 20_000)
+    res = run("extract", log, "--out", tmp_path / "s.csv", "--chunk-rows", "20000")
+    assert res.exit_code == 0, res.output
+    lines = progress_lines(res.stderr)
+    assert any(f"/{n} chunks read (" in ln for ln in lines), lines
+    assert lines[-1].endswith(f"extracting l.parquet: done ({n}/{n} chunks read)"), lines
+
+
 @pytest.mark.parametrize("where", ["command", "root"])
 def test_quiet_turns_progress_off(no_grace, tmp_path, where):
     args = ["simulate", "--preset", "paper2", "--size", "quick", "--out", tmp_path / "l.parquet"]

@@ -147,6 +147,20 @@ def check_flags(ctx: typer.Context, fmt: str, log: Path, variables: list[str] | 
                 )
 
 
+def chunks_expected(log: Path, fmt: str, chunk_rows: int) -> int | None:
+    """How many chunks of ``chunk_rows`` a log is read in, when its file says how many rows it
+    has (a Parquet table: its footer), for the progress estimate; None otherwise."""
+    if fmt != "table" or log.suffix.lower() != ".parquet" or chunk_rows < 1:
+        return None
+    try:
+        import pyarrow.parquet as pq
+
+        rows = int(pq.ParquetFile(log).metadata.num_rows)
+    except Exception:  # the reader reports a bad file properly
+        return None
+    return max(1, -(-rows // int(chunk_rows)))
+
+
 def _format_help() -> str:
     from ..io.registry import READER_EXAMPLES
 
@@ -428,7 +442,10 @@ def extract_command(
             err_console.print("samples converted with the given (or the log's own) K, not this one")
 
     with progress_bar(
-        f"extracting {log.name}", total=None, unit="chunks read", quiet=quiet
+        f"extracting {log.name}",
+        total=chunks_expected(log, fmt, chunk_rows),
+        unit="chunks read",
+        quiet=quiet,
     ) as advance:
         data = load_joint(
             log,
