@@ -95,7 +95,8 @@ def fleet_command(
                 "the manifest: a file, an EPOS folder or a ROS 2 bag folder or .mcap file) and "
                 "any column below (every reader and reader option of `fricid extract`); a "
                 "dimensional column names its unit ('positions [deg]'). The JSON Schema "
-                "fricid/schemas/manifest.schema.json defines every column."
+                "fricid/schemas/manifest.schema.json defines every column; docs/manifest.md "
+                "describes the format with examples and a table of the columns."
             ),
         ),
     ],
