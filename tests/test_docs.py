@@ -324,6 +324,7 @@ def test_manifest_doc_lists_every_column_of_the_schema():
         + manifest_columns()
     )
     assert "docs/manifest.md" in README.read_text(encoding="utf-8")
+    assert "docs/manifest.md" in runner.invoke(app, ["fleet", "--help"]).stdout
 
 
 def test_manifest_doc_examples_are_valid_manifests(tmp_path):
