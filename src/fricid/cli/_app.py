@@ -26,13 +26,15 @@ from types import FrameType
 from typing import Any
 
 import typer
-from rich.console import Console
+from rich.console import Console, ConsoleDimensions
 from rich.markup import escape
 
 from ..errors import FricidError, FricidWarning
 
 __all__ = [
+    "PIPE_WIDTH",
     "Terminated",
+    "WideConsole",
     "app",
     "bench_app",
     "console",
@@ -40,6 +42,7 @@ __all__ = [
     "handle_errors",
     "interrupt_exit",
     "main",
+    "plural",
     "signal_handlers",
 ]
 
@@ -62,8 +65,31 @@ bench_app = typer.Typer(
 )
 app.add_typer(bench_app, name="bench")
 
-console = Console()
-err_console = Console(stderr=True)
+#: Columns of a console whose output is not a terminal (a pipe, a file, CI) and whose width
+#: ``COLUMNS`` does not set: wide enough that tables keep whole model names.
+PIPE_WIDTH = 160
+
+
+class WideConsole(Console):
+    """A rich console that is :data:`PIPE_WIDTH` columns wide (or its terminal's width, if
+    wider) when its output is not a terminal and ``COLUMNS`` is unset, instead of rich's 80:
+    tables in a pipe then keep ``coulomb_viscous_asym`` whole instead of ``coulomb_visc…``
+    and lines are not broken mid-sentence. On a terminal, or with ``COLUMNS``, it is rich's."""
+
+    @property
+    def size(self) -> ConsoleDimensions:
+        size = Console.size.fget(self)  # type: ignore[attr-defined]
+        if self._width is None and not self.is_terminal and not os.environ.get("COLUMNS"):
+            return ConsoleDimensions(max(size.width, PIPE_WIDTH), size.height)
+        return size
+
+    @size.setter
+    def size(self, new_size: tuple[int, int]) -> None:
+        Console.size.fset(self, new_size)  # type: ignore[attr-defined]
+
+
+console = WideConsole()
+err_console = WideConsole(stderr=True)
 
 #: Exit status of a command stopped by a signal: 128 + the signal number, as a shell reports.
 EXIT_INTERRUPTED = 130
@@ -71,6 +97,11 @@ EXIT_TERMINATED = 143
 
 #: What every interrupted command can say: outputs are written atomically (fricid.io.atomic).
 _DEFAULT_DETAIL = "no file was left half-written"
+
+
+def plural(n: int, noun: str, many: str | None = None) -> str:
+    """``1 joint``, ``3 joints``, ``2 passes`` (``many`` for an irregular plural)."""
+    return f"{n} " + (noun if n == 1 else many or f"{noun}s")
 
 
 class Terminated(KeyboardInterrupt):
@@ -264,8 +295,20 @@ def _root(
             "SOURCE_DATE_EPOCH alone has the same effect."
         ),
     ),
+    quiet: bool = typer.Option(
+        False,
+        "--quiet",
+        "-q",
+        help=(
+            "No progress display on stderr for any command (as each long command's own "
+            "--quiet); results, warnings and errors still print."
+        ),
+    ),
 ) -> None:
     """Identify the friction of robot joints."""
+    from ._progress import set_quiet
+
+    set_quiet(quiet)
     if reproducible and not os.environ.get("SOURCE_DATE_EPOCH", "").strip():
         previous = os.environ.get("SOURCE_DATE_EPOCH")
         os.environ["SOURCE_DATE_EPOCH"] = "0"  # read by fricid.io.atomic.created_timestamp

@@ -48,23 +48,32 @@ def seed_option(help: str, *, non_negative: bool = False) -> Any:
 
 @contextlib.contextmanager
 def study_progress(t0: float | None = None) -> Iterator[tuple[Callable[[str], None], Any]]:
-    """A progress display on stderr for a long study.
+    """A progress display on stderr for a long study (:func:`fricid.cli._progress.tracker`).
 
-    Yields ``(progress, status)``: ``progress(message)`` updates the spinner and, when stderr
-    is not a terminal, prints the message with the seconds since ``t0`` (default: now);
-    ``status`` is the rich status, for a last message such as "writing ...".
+    Yields ``(progress, status)``: ``progress(message)`` names the stage under way (on a
+    terminal, the bar's label; otherwise a line with the seconds since the start, and a line at
+    least every 10 s while a stage runs); ``status.update(message)`` does the same for a last
+    message such as "writing ...". Nothing with ``fricid --quiet``. ``t0`` is accepted for the
+    callers' own total time (:func:`print_written`).
     """
-    start = time.perf_counter() if t0 is None else t0
-    with err_console.status("starting", spinner="dots") as status:
+    from ._progress import tracker
+
+    with tracker("study", None) as t:
 
         def progress(msg: str) -> None:
-            status.update(escape(msg))
-            if not err_console.is_terminal:
-                err_console.print(
-                    f"[{time.perf_counter() - start:6.1f} s] {escape(msg)}", highlight=False
-                )
+            t.stage(msg, force=True)
 
-        yield progress, status
+        yield progress, _Status(t)
+
+
+class _Status:
+    """``status.update(message)`` of :func:`study_progress`."""
+
+    def __init__(self, tracker: Any) -> None:
+        self._tracker = tracker
+
+    def update(self, message: str) -> None:
+        self._tracker.stage(message, force=True)
 
 
 def print_written(paths: Sequence[Path] | None, t0: float) -> None:

@@ -34,8 +34,9 @@ def demo_command(
 ) -> None:
     """Simulate the BAS-RBFNN paper's experiment on the virtual joint, extract the friction
     samples, fit the four analytic models and print a table like the paper's Table 1
-    (fitness = R^2, RMSE, RMSPE per model). Writes samples.csv, samples_by_direction.csv, one
-    JSON model file per model, table1.csv and summary.md into --out."""
+    (fitness = R^2, RMSE, RMSPE in percent per model). Writes samples.csv,
+    samples_by_direction.csv, one JSON model file per model, table1.csv and summary.md into
+    --out."""
     from ..experiments.demo import run_demo
     from ..report.studies.demo import write_demo
 
@@ -47,12 +48,12 @@ def demo_command(
         progress=lambda msg: err_console.print(f"[dim]{msg}[/]"),
     )
     written = write_demo(res, out)
-    console.print(res.extraction.summary(), markup=False, highlight=False)
+    console.print(res.extraction.summary(), markup=False, highlight=False, soft_wrap=True)
     px, py = res.true_gravity
     console.print(f"true gravity:    p_x = {px:.5g}, p_y = {py:.5g} N m", highlight=False)
 
     table = Table(title="Table 1: performance of the models (paper's values in brackets)")
-    for col in ("model", "fitness", "RMSE [mN m]", "RMSPE", "max |err| [mN m]"):
+    for col in ("model", "fitness", "RMSE [mN m]", "RMSPE [%]", "max |err| [mN m]"):
         table.add_column(escape(col), justify="left" if col == "model" else "right")
 
     def both(ours: float, paper: float, fmt: str) -> str:
@@ -63,7 +64,7 @@ def demo_command(
             row.model,
             both(row.fitness, row.paper_fitness, ".4f"),
             both(row.rmse_mNm, row.paper_rmse, ".4g"),
-            both(row.rmspe, row.paper_rmspe, ".4f"),
+            both(row.rmspe_percent, row.paper_rmspe_percent, ".2f"),
             f"{row.max_abs_error_mNm:.3g}",
         )
     console.print(table)

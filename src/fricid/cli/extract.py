@@ -10,10 +10,10 @@ import typer
 from rich.markup import escape
 
 from ..errors import ConfigError
-from ._app import app, console, err_console, handle_errors
+from ._app import app, console, err_console, handle_errors, plural
 from ._options import TemperatureOption, TorqueConstantOption, out_option, parse_grid
 from ._paths import check_paths
-from ._progress import progress_bar
+from ._progress import QuietOption, progress_bar
 from ._torque_constant import (
     UrdfJointOption,
     UrdfOption,
@@ -145,6 +145,20 @@ def check_flags(ctx: typer.Context, fmt: str, log: Path, variables: list[str] | 
                     f"{flag} does not apply to --format {fmt} here: {what}, so there is "
                     "nothing to extract"
                 )
+
+
+def chunks_expected(log: Path, fmt: str, chunk_rows: int) -> int | None:
+    """How many chunks of ``chunk_rows`` a log is read in, when its file says how many rows it
+    has (a Parquet table: its footer), for the progress estimate; None otherwise."""
+    if fmt != "table" or log.suffix.lower() != ".parquet" or chunk_rows < 1:
+        return None
+    try:
+        import pyarrow.parquet as pq
+
+        rows = int(pq.ParquetFile(log).metadata.num_rows)
+    except Exception:  # the reader reports a bad file properly
+        return None
+    return max(1, -(-rows // int(chunk_rows)))
 
 
 def _format_help() -> str:
@@ -327,6 +341,7 @@ def extract_command(
     urdf: UrdfOption = None,
     urdf_joint: UrdfJointOption = None,
     urdf_position: UrdfPositionOption = None,
+    quiet: QuietOption = False,
 ) -> None:
     """Extract friction samples from a raw log: segment the constant-velocity traverses, median
     filter the current, torque = K I (eq. 13), average the repetitions per position bin,
@@ -426,7 +441,12 @@ def extract_command(
         else:
             err_console.print("samples converted with the given (or the log's own) K, not this one")
 
-    with progress_bar("extracting", total=None) as advance:
+    with progress_bar(
+        f"extracting {log.name}",
+        total=chunks_expected(log, fmt, chunk_rows),
+        unit="chunks read",
+        quiet=quiet,
+    ) as advance:
         data = load_joint(
             log,
             fmt,
@@ -463,6 +483,6 @@ def extract_command(
         }.get(join, join)
         err_console.print(f"channels joined {how}, onto the velocity (else position) time stamps")
     err_console.print(
-        f"wrote {escape(str(out))} ({len(data.samples)} samples)"
+        f"wrote {escape(str(out))} ({plural(len(data.samples), 'sample')})"
         + (f" and {escape(str(by_direction))}" if by_direction else "")
     )

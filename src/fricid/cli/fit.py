@@ -21,6 +21,7 @@ from ._options import (
     parse_ranges,
 )
 from ._paths import check_paths
+from ._progress import QuietOption, fit_progress
 
 
 def _method_help() -> str:
@@ -113,11 +114,12 @@ def fit_command(
             "Model file to write (JSON). Default: <samples>.<model>.json in the current directory."
         ),
     ] = None,
+    quiet: QuietOption = False,
 ) -> None:
     """Identify a friction model from samples and write it as a JSON model file.
 
     Prints the fit report (after lmfit's): method, evaluations and convergence status; data
-    points, variables, chi-square (SSE [N m^2]), reduced chi-square, AIC, BIC, R^2; each
+    points, variables, chi-square (SSE [N^2 m^2]), reduced chi-square, AIC, BIC, R^2; each
     parameter with its standard error, 95 % confidence interval and start, flagged at a
     boundary, at its initial value or not determined; correlations above 0.1. The RBF network
     (--model rbf) goes through the same identification and prints its network instead.
@@ -126,7 +128,9 @@ def fit_command(
     Table 1 fitness, of the signed friction, which flatters per-direction data); with
     --validate or --model auto, the held-out RMSE and a verdict; with auto, the candidates
     compared. Warnings print as one line each on stderr and are saved in the model file
-    (provenance "warnings").
+    (provenance "warnings"). Progress goes to stderr: a bar on a terminal, otherwise a line
+    per tenth of the evaluation budget with the time left (population methods) or every few
+    seconds; --quiet: none.
     """
     from ..identify import fit
     from ..identify import validate as validate_model
@@ -139,8 +143,16 @@ def fit_command(
     rbf = key == "rbf"
     options = {"loss": loss, "f_scale": f_scale, "weights": weights}
     options.update(_rbf_network(centers, inputs) if rbf else {})
-    with warnings.catch_warnings(record=True) as caught:
+    fixed = parse_assignments(fix, "--fix")
+    with (
+        warnings.catch_warnings(record=True) as caught,
+        fit_progress(model, method, fixed=fixed, max_evals=max_evals, quiet=quiet) as (
+            track,
+            callback,
+        ),
+    ):
         warnings.simplefilter("always")
+        options.update({"callback": callback} if callback is not None else {})
         fitted = fit(
             data,
             model,
@@ -153,6 +165,8 @@ def fit_command(
             **({"scheme": validate} if key == "auto" and validate else {}),
         )
         if validate and key != "auto":
+            track.stage(f"validating {fitted.model} ({validate})", restart=True)
+            options.pop("callback", None)
             fitted.validation = validate_model(
                 data,
                 fitted.model,
@@ -269,8 +283,10 @@ def _rbf_network(centers: int, inputs: str) -> dict:
 
 @app.command("methods")
 def methods_command() -> None:
-    """List the optimisers and the models, with a line on each."""
-    from ..models import MODELS
+    """List the models (analytic, then those that predict from a stored state such as the RBF
+    network) and the optimisers, with a line on each."""
+    from ..identify.varpro import SUMMARY
+    from ..models import MODELS, STATEFUL
     from ..optim import METHODS
 
     console.print("[bold]Models[/] (append _asym for per-direction parameters):")
@@ -280,9 +296,31 @@ def methods_command() -> None:
             f"  {name:<16} {m.title}; {m.equation}; parameters {', '.join(m.param_names)}",
             highlight=False,
         )
+    for line in stateful_model_lines(STATEFUL):
+        console.print(line, highlight=False, markup=False)
+    console.print(
+        f"  {'auto':<16} the analytic family chosen by held-out error (--validate)",
+        highlight=False,
+    )
     console.print("[bold]Methods[/]:")
     for name, cls in METHODS.items():
         console.print(f"  {name:<16} {cls.summary}", highlight=False)
-    from ..identify.varpro import SUMMARY
-
     console.print(f"  {'varpro':<16} {SUMMARY}", highlight=False)
+
+
+def stateful_model_lines(stateful: dict) -> list[str]:
+    """One line per model of ``fricid.models.STATEFUL`` (the RBF network, and any model a
+    later registration adds), for ``fricid methods``: name, title, equation, inputs."""
+    lines = []
+    for name, m in stateful.items():
+        title = getattr(m, "title", "") or type(m).__name__
+        equation = getattr(m, "equation", "")
+        inputs = getattr(m, "inputs", None)
+        bits = [title] + ([equation] if equation else [])
+        bits.append("stored state, no named parameters")
+        if inputs:
+            bits.append("inputs " + ", ".join(inputs))
+        if name == "rbf":
+            bits.append("trained with --method lsq, bas (BAS-RBFNN) or ga (GA-RBFNN)")
+        lines.append(f"  {name:<16} " + "; ".join(bits))
+    return lines

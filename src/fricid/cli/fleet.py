@@ -9,10 +9,10 @@ import typer
 from rich.markup import escape
 from rich.table import Table
 
-from ._app import app, console, err_console, handle_errors
+from ._app import app, console, err_console, handle_errors, plural
 from ._options import out_option
 from ._paths import check_paths
-from ._progress import progress_bar
+from ._progress import QuietOption, progress_bar
 
 _MAX_LISTED = 20
 
@@ -24,8 +24,8 @@ def _short(text: str, n: int = 110) -> str:
 
 def _summary(run, manifest_path: Path) -> Table:
     table = Table(
-        title=f"fricid fleet {escape(str(manifest_path))}: {len(run.records)} joints in "
-        f"{run.seconds:.1f} s ({run.executor}, {run.workers} worker(s))",
+        title=f"fricid fleet {escape(str(manifest_path))}: {plural(len(run.records), 'joint')} "
+        f"in {run.seconds:.1f} s ({run.executor}, {plural(run.workers, 'worker')})",
         title_justify="left",
     )
     table.add_column("joints")
@@ -95,7 +95,8 @@ def fleet_command(
                 "the manifest: a file, an EPOS folder or a ROS 2 bag folder or .mcap file) and "
                 "any column below (every reader and reader option of `fricid extract`); a "
                 "dimensional column names its unit ('positions [deg]'). The JSON Schema "
-                "fricid/schemas/manifest.schema.json defines every column."
+                "fricid/schemas/manifest.schema.json defines every column; docs/manifest.md "
+                "describes the format with examples and a table of the columns."
             ),
         ),
     ],
@@ -160,14 +161,16 @@ def fleet_command(
             help=("Measurement date YYYY-MM-DD of joints whose row gives none (default: today).")
         ),
     ] = None,
+    quiet: QuietOption = False,
 ) -> None:
     """Identify every joint of many robots: extract then fit each joint of the manifest
     (exactly as `fricid extract` and `fricid fit` do), in parallel, and write one model file
     per joint and model plus a results table with parameters, 95 % confidence intervals,
     metrics, timing and the log's content hash. A joint that fails is reported (table and
     summary) and the rest completes; re-running skips unchanged joints, so an interrupted
-    run resumes. Exit status 0 when every joint succeeded, 1 when some failed, 2 for a bad
-    manifest or option."""
+    run resumes. Progress goes to stderr, piped too (a line per tenth of the joints with the
+    time left; --quiet: none). Exit status 0 when every joint succeeded, 1 when some failed,
+    2 for a bad manifest or option."""
     from ..fleet import compare, make_executor, read_manifest, read_results, run_fleet
     from ..fleet import write_drift as write_drift_files
 
@@ -181,7 +184,7 @@ def fleet_command(
     before = read_results(baseline) if baseline is not None else None
     with (
         make_executor(workers, cluster) as executor,
-        progress_bar("identifying joints", total=len(spec)) as advance,
+        progress_bar("identifying joints", total=len(spec), unit="joints", quiet=quiet) as advance,
     ):
         run = run_fleet(
             spec, out, executor=executor, force=force, date=date, progress=lambda event: advance()

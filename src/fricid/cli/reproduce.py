@@ -8,6 +8,7 @@ from typing import Annotated
 import typer
 
 from ._app import app, console, err_console, handle_errors
+from ._progress import QuietOption, tracker
 from ._study_options import out_option, quick_option, seed_option
 
 
@@ -22,41 +23,27 @@ def reproduce_command(
         bool, quick_option("Reduced designs and budgets: under 2 minutes on 2 cores.")
     ] = False,
     seed: Annotated[int, seed_option("Random seed (same seed, same report).")] = 0,
+    quiet: QuietOption = False,
 ) -> None:
     """Regenerate every table and figure of a seed paper on the virtual joint (and, for
     rwsavsbas, on the real lead-screw recordings), with the paper's numbers beside ours.
 
     Writes report.html (self-contained), report.md, one CSV per table and one PNG per figure
-    into the folder, all or nothing. Progress is shown on stderr.
+    into the folder, all or nothing. Progress is shown on stderr (a bar on a terminal,
+    otherwise a line per step and at least every 30 s, with the time left; --quiet: none).
     """
-    from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
-
     from ..report.reproduce import paper_steps, reproduce
 
     steps = paper_steps(paper)
-    with Progress(
-        TextColumn("[bold]{task.fields[paper]}[/]"),
-        BarColumn(),
-        TextColumn("{task.completed}/{task.total}"),
-        TimeElapsedColumn(),
-        TextColumn("{task.description}"),
-        console=err_console,
-        transient=False,
-        disable=not err_console.is_terminal,
-    ) as bar:
-        task = bar.add_task("starting", total=len(steps), paper=paper)
+    with tracker(paper, total=len(steps), unit="steps done", quiet=quiet) as bar:
         seen: list[str] = []
 
         def progress(label: str) -> None:
-            if seen:
-                bar.advance(task)
             seen.append(label)
-            bar.update(task, description=label)
-            if not err_console.is_terminal:
-                err_console.print(f"[{len(seen)}/{len(steps)}] {label}", highlight=False)
+            bar.stage(f"{paper} [{len(seen)}/{len(steps)}] {label}", done=len(seen) - 1, force=True)
 
         result = reproduce(paper, out, quick=quick, seed=seed, progress=progress)
-        bar.update(task, completed=len(steps), description="written")
+        bar.update(len(steps))
     console.print(str(result.html), highlight=False, soft_wrap=True)
     err_console.print(
         f"{len(result.document.tables())} tables and "

@@ -10,7 +10,7 @@ import typer
 from rich.markup import escape
 
 from ._app import app, err_console, handle_errors
-from ._progress import progress_bar
+from ._progress import QuietOption, progress_bar
 
 
 def design_hints(scenario) -> dict:
@@ -57,10 +57,12 @@ def simulate_command(
             "them, extract identifies gravity jointly)."
         ),
     ] = "both",
+    quiet: QuietOption = False,
 ) -> None:
     """Simulate a bidirectional constant-velocity campaign on the virtual joint and write its
     raw log: time [s], position [rad], velocity [rad/s], motor current [A] (torque = K I),
-    temperature [degC], with the torque constant K in the file's metadata."""
+    temperature [degC], with the torque constant K in the file's metadata. Progress goes to
+    stderr (a bar on a terminal, a line per tenth with the time left otherwise; --quiet: none)."""
     from ..io import write_rawlog
     from ..sim import preset as get_preset
     from ..sim import simulate
@@ -71,7 +73,12 @@ def simulate_command(
     n_t, n_v, _ = scenario.design.shape
 
     def chunks():
-        with progress_bar("simulating", total=n_t * n_v) as advance:
+        with progress_bar(
+            f"simulating {scenario.name} ({size})",
+            total=n_t * n_v,
+            unit="velocity-temperature runs",
+            quiet=quiet,
+        ) as advance:
             for log in simulate(scenario, seed=seed):
                 advance()
                 yield replace(log, meta={**log.meta, "design": hints})

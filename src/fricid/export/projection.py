@@ -124,7 +124,13 @@ def operating_grid(
     if b <= 0:
         raise ExportError("the velocity range is zero; there is no motion to project over")
     levels = {}
+    used = _inputs(fitted)
     for name, override in (("load", load_range), ("temperature", temperature_range)):
+        if override is None and name not in used and name not in (fitted.operating_range or {}):
+            # an input the model does not read (a Stribeck model fitted on velocity alone):
+            # one placeholder level, never used by the prediction
+            levels[name] = np.zeros(1)
+            continue
         lo, hi = _range(fitted, name, override)
         levels[name] = np.linspace(lo, hi, N_LEVELS) if hi > lo else np.array([lo])
     v = np.concatenate([neg, pos])

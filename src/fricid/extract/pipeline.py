@@ -135,12 +135,13 @@ class ExtractionResult:
         """A few lines describing the result (for a report or the CLI)."""
         d = self.diagnostics
         lines = [
-            f"{len(self.samples)} samples ({len(self.by_direction)} per direction) from "
-            f"{d.segments} segments of {d.rows} rows; {d.spikes} spikes filtered",
-            f"{d.velocity_setpoints.size} velocity set-points "
+            f"{_count(len(self.samples), 'sample')} (both directions combined; "
+            f"{_per_direction(self.by_direction)}) from {_count(d.segments, 'segment')} of "
+            f"{_count(d.rows, 'row')}; {_count(d.spikes, 'spike')} filtered",
+            f"{_count(d.velocity_setpoints.size, 'velocity set-point')} "
             f"({d.velocity_setpoints.min():.4g}-{d.velocity_setpoints.max():.4g} rad/s), "
-            f"{d.temperature_setpoints.size} temperatures, "
-            f"{d.passes_min}-{d.passes_max} passes per sample",
+            f"{_count(d.temperature_setpoints.size, 'temperature')}, "
+            f"{_passes(d.passes_min, d.passes_max)} per sample",
         ]
         if d.samples:
             n = d.samples
@@ -434,3 +435,26 @@ def extract(
         quality,
         tuple(notes),
     )
+
+
+def _count(n: int, noun: str, plural: str | None = None) -> str:
+    """``1 temperature``, ``5 temperatures``, ``1,211,640 rows`` (the summary's counts)."""
+    n = int(n)
+    return f"{n:,} " + (noun if n == 1 else plural or f"{noun}s")
+
+
+def _per_direction(by_direction: FrictionSamples) -> str:
+    """``330 + 330 per-direction samples`` (positive + negative), or the total when one-sided."""
+    d = np.asarray(by_direction.direction)
+    pos, neg = int((d > 0).sum()), int((d < 0).sum())
+    if pos and neg and pos + neg == len(d):
+        return f"{pos:,} + {neg:,} per-direction samples"
+    return f"{_count(len(d), 'per-direction sample')}"
+
+
+def _passes(lo: int, hi: int) -> str:
+    """``3 passes``, ``1 pass``, ``2-4 passes`` (repetitions averaged into each sample)."""
+    lo, hi = int(lo), int(hi)
+    if lo == hi:
+        return _count(lo, "pass", "passes")
+    return f"{lo}-{hi} passes"

@@ -13,8 +13,9 @@ Columns (SI units; each parameter's unit in ``units``):
   scatter, held out where the model was validated, else in-sample: ``heldout_source``),
   ``verdict`` (within noise, or misses by a factor), ``n_not_determined``,
   ``extrapolation_free_range`` (the operating range, as text);
-- fit: ``fitness`` (R^2), ``sse`` [N m^2], ``rmse``, ``mae``, ``max_abs_error`` [N m],
-  ``rmspe`` (a fraction), ``nfev``, ``at_bound``, ``fixed``, ``units``, ``model_file``;
+- fit: ``fitness`` (R^2), ``sse`` [N^2 m^2], ``rmse``, ``mae``, ``max_abs_error`` [N m],
+  ``rmspe`` (a fraction: 0.021 is 2.1 %, as in the model file; commands and reports print
+  it in percent), ``nfev``, ``at_bound``, ``fixed``, ``units``, ``model_file``;
   ``param_<name>``, ``stderr_<name>``, ``ci95_<name>`` (half-width of the 95 % CI);
 - run: ``time_extract_s``, ``time_fit_s``, ``time_total_s`` [s], ``worker``,
   ``peak_rss_mb`` [MB], ``fricid_version``.
