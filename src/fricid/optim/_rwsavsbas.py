@@ -257,7 +257,7 @@ class RWSAVSBAS(Solver):
 
     def _outer_jit(self, k: int, blk: np.ndarray, S: np.ndarray, thr: np.ndarray) -> None:
         """One outer iteration of every run in compiled code (same algorithm and numbers)."""
-        from ._rws_numba import outer_iteration
+        from ._rws_numba import function_of, outer_iteration
 
         B, W = self._directions(blk)
         obj = self.objective
@@ -271,10 +271,11 @@ class RWSAVSBAS(Solver):
                 np.empty((R, 3, d)),
                 np.empty(Q + 1, dtype=np.int64),
                 np.empty((Q + 1, R)),
+                function_of(obj.kernel, obj.kernel_data),
             )
-        X, out, P, hist_n, hist_f = self._buf
+        X, out, P, hist_n, hist_f, kernel = self._buf
         used, nh, hit = outer_iteration(
-            obj.kernel,
+            kernel,
             obj.kernel_data,
             obj.lower,
             obj.span,
