@@ -9,6 +9,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 SRC = Path(__file__).resolve().parents[1] / "src"
@@ -17,12 +18,13 @@ SRC = Path(__file__).resolve().parents[1] / "src"
 #: compiled outer iteration and of the kernel's function pointer.
 _CHILD = """
 import json, numpy as np
-from fricid.experiments.stribeck_problem import StribeckProblem, sse_objective
-from fricid.optim import minimize_runs
-from fricid.optim import _rws_numba
+from fricid.identify.problem import IdentificationProblem
+from fricid.models import get_model
+from fricid.optim import minimize_runs, _rws_numba
 v = np.linspace(-1.0, 1.0, 17)
-problem = StribeckProblem(v, np.sign(v) * 0.3 + 0.01 * v)
-minimize_runs(sse_objective(problem, jit=True), problem.bounds, "rwsavsbas", seed=0, runs=2,
+data = (np.column_stack([v, 0 * v, 0 * v]), np.sign(v) * 0.3 + 0.01 * v)
+problem = IdentificationProblem(get_model("stribeck"), data, fixed={"delta": 1.0})
+minimize_runs(problem.objective(), problem.bounds, "rwsavsbas", seed=0, runs=2,
               options={"n_outer": 1, "n_inner": 2})
 stats = _rws_numba.outer_iteration.stats
 print(json.dumps({"hits": sum(stats.cache_hits.values()),
@@ -45,3 +47,131 @@ def test_a_second_process_loads_the_compiled_path_from_the_cache():
     _child()
     second = _child()
     assert second == {"hits": 1, "misses": 0}
+
+
+# ------------------------------------------------------------------ compiled model kernels
+_MODELS = ("coulomb_viscous", "stribeck", "msk", "vlt")
+
+
+def _samples(rng: np.random.Generator):
+    from fricid.samples import FrictionSamples
+
+    v = np.concatenate([np.linspace(-2.0, -0.01, 9), [0.0], np.linspace(0.01, 2.0, 8)])
+    n = v.size
+    return FrictionSamples(
+        velocity=v,
+        load=rng.uniform(-3.0, 3.0, n),
+        temperature=rng.uniform(20.0, 50.0, n),
+        friction=np.sign(v) * 0.3 + 0.1 * v + 0.01 * rng.standard_normal(n),
+        direction=np.where(v < 0, -1, 1),
+    )
+
+
+@pytest.mark.parametrize("name", [*_MODELS, *(m + "_asym" for m in _MODELS)])
+def test_the_compiled_kernel_gives_the_numpy_loss(name):
+    """Every built-in model, loss, weighting and fixed parameter: the kernel's loss equals
+    IdentificationProblem.evaluate's to 1e-12 relative."""
+    pytest.importorskip("numba")
+    from fricid.identify.problem import IdentificationProblem
+    from fricid.models import get_model
+    from fricid.optim import JitObjective
+
+    rng = np.random.default_rng(3)
+    samples = _samples(rng)
+    model = get_model(name)
+    n = len(samples)
+    cases = [
+        ("sse", None, None, None),
+        ("mse", None, None, None),
+        ("l2", rng.uniform(0.5, 2.0, n), None, {model.param_names[1]: 0.2}),
+        ("soft_l1", None, 0.01, None),
+        ("huber", rng.uniform(0.5, 2.0, n), 0.01, {model.param_names[0]: 0.3}),
+    ]
+    for loss, weights, f_scale, fixed in cases:
+        problem = IdentificationProblem(
+            model, samples, loss=loss, weights=weights, f_scale=f_scale, fixed=fixed
+        )
+        objective = problem.objective()
+        assert isinstance(objective, JitObjective)
+        lo, hi = problem.bounds[:, 0], problem.bounds[:, 1]
+        T = lo + rng.random((40, problem.n_free)) * (hi - lo)
+        want = problem.evaluate(T)
+        np.testing.assert_allclose(objective(T), want, rtol=1e-12, atol=0)
+        out = np.empty(len(T))
+        objective.jit_kernel(T, out, objective.jit_data)
+        np.testing.assert_allclose(out, want, rtol=1e-12, atol=0)
+
+
+def test_a_model_without_a_kernel_keeps_the_numpy_path():
+    """A subclass may change the formula: it is evaluated by numpy, not by its parent's kernel."""
+    from fricid.identify.problem import IdentificationProblem
+    from fricid.models import Stribeck
+
+    class Shifted(Stribeck):
+        def _predict(self, theta, X):
+            return super()._predict(theta, X) + 1.0
+
+    problem = IdentificationProblem(Shifted(), _samples(np.random.default_rng(0)))
+    assert problem.objective() == problem.evaluate
+
+
+def test_fit_with_rwsavsbas_takes_the_compiled_path(monkeypatch):
+    """fit hands the optimiser the compiled objective: RWSAVSBAS runs its compiled outer
+    iteration, and finds what its numpy path finds."""
+    pytest.importorskip("numba")
+    from fricid.identify import fit
+    from fricid.optim import _rwsavsbas
+
+    calls = {"jit": 0}
+    original = _rwsavsbas.RWSAVSBAS._outer_jit
+
+    def counted(self, *args):
+        calls["jit"] += 1
+        return original(self, *args)
+
+    monkeypatch.setattr(_rwsavsbas.RWSAVSBAS, "_outer_jit", counted)
+    samples = _samples(np.random.default_rng(1))
+    kw = {"fixed": {"delta": 1.0}, "intervals": "none", "seed": 4}
+    fast = fit(samples, "stribeck", "rwsavsbas", options={"n_outer": 30}, **kw)
+    assert calls["jit"] == 30
+    slow = fit(samples, "stribeck", "rwsavsbas", options={"n_outer": 30, "jit": False}, **kw)
+    assert calls["jit"] == 30
+    for k, v in slow.params.items():
+        assert fast.params[k] == pytest.approx(v, rel=1e-9, abs=1e-12)
+
+
+# ------------------------------------------------------------------------------ GA clones
+def _duplicates(method_options: dict) -> tuple[float, object]:
+    from fricid.optim import minimize
+
+    seen: list[tuple] = []
+
+    def fun(X: np.ndarray) -> np.ndarray:
+        seen.extend(map(tuple, X))
+        return np.sum((X - 0.3) ** 2, axis=1)
+
+    res = minimize(fun, [(-1.0, 1.0)] * 4, "ga", seed=0, max_evals=4000, options=method_options)
+    assert res.nfev == len(seen)  # every evaluation counted, nothing counted twice
+    return 1.0 - len(set(seen)) / len(seen), res
+
+
+def test_ga_does_not_evaluate_clones_of_their_parents():
+    """A child that neither crossover nor mutation changed is its parent: with ``dedupe``
+    (the default) it is neither evaluated nor counted; without, ~6 % of the budget went there."""
+    before, _ = _duplicates({"dedupe": False})
+    after, res = _duplicates({})
+    assert before > 0.02
+    assert after < 0.2 * before
+    assert res.fun < 1e-4
+
+
+def test_ga_runs_with_dedupe_equal_single_runs():
+    from fricid.optim import minimize, minimize_runs
+
+    def fun(X: np.ndarray) -> np.ndarray:
+        return np.sum((X - 0.3) ** 2, axis=1)
+
+    runs = minimize_runs(fun, [(-1.0, 1.0)] * 3, "ga", seed=5, runs=2, max_evals=500)
+    for r, res in enumerate(runs):
+        one = minimize(fun, [(-1.0, 1.0)] * 3, "ga", seed=5 + r, max_evals=500)
+        assert res.fun == one.fun and res.nfev == one.nfev and res.nit == one.nit
