@@ -30,11 +30,13 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from fricid.experiments.stribeck_problem import paper2_samples
+from fricid.extract import extract
 from fricid.identify import fit
 from fricid.identify.problem import IdentificationProblem
 from fricid.models import get_model
 from fricid.optim import minimize
 from fricid.samples import FrictionSamples
+from fricid.sim import preset, simulate
 
 #: What a fresh process runs to compile the fast paths (time printed on its last line).
 _CHILD = """
@@ -45,6 +47,8 @@ from fricid.experiments.stribeck_problem import StribeckProblem, sse_objective
 from fricid.identify.problem import IdentificationProblem
 from fricid.models import get_model
 from fricid.optim import minimize_runs
+from fricid.optim import _rws_numba  # imports numba
+from fricid.models import _kernels
 t_import = time.perf_counter() - t
 v = np.linspace(-1.0, 1.0, 17)
 y = np.sign(v) * 0.3 + 0.01 * v
@@ -56,7 +60,9 @@ data = (np.column_stack([v, 0 * v, 0 * v]), y)
 problem = IdentificationProblem(get_model("stribeck"), data, fixed={"delta": 1.0})
 minimize_runs(problem.objective(), problem.bounds, "rwsavsbas", seed=0, runs=1,
               options={"n_outer": 1})
-print(t_import, time.perf_counter() - t)
+t_compile = time.perf_counter() - t
+stats = _rws_numba.outer_iteration.stats
+print(sum(stats.cache_hits.values()), sum(stats.cache_misses.values()), t_import, t_compile)
 """
 
 
@@ -99,7 +105,12 @@ def rwsavsbas_table(samples: FrictionSamples, problem: IdentificationProblem) ->
     print(f"largest parameter difference compiled vs numpy: {same:.2e}")
 
 
-def lm_table(problem: IdentificationProblem, repeats: int) -> None:
+def lm_table(
+    problem: IdentificationProblem,
+    repeats: int,
+    extracted: FrictionSamples,
+    bare: FrictionSamples,
+) -> None:
     x0 = problem.start()
     lo, hi = problem.bounds[:, 0], problem.bounds[:, 1]
 
@@ -136,17 +147,21 @@ def lm_table(problem: IdentificationProblem, repeats: int) -> None:
             f"{label:44s} {secs[label] * 1e3:8.2f} {secs[label] / secs[base]:8.2f} "
             f"{sse[label]:22.17g} {sse[label] / sse[base] - 1:16.2e}"
         )
-    t = time.perf_counter()
-    f = fit(
-        FrictionSamples(velocity=problem.X[:, 0], load=0.0, temperature=25.0, friction=problem.y),
-        "stribeck",
-        fixed={"delta": 1.0},
-        intervals="none",
-    )
+    t_raw = _best(lambda: problem.residuals(x0[None]), 200)
+    n = fricid_lm().nfev
+    per_call = secs["lm, default (one start unless doubtful)"] / n
     print(
-        f"whole fit() with lm (convergence certificate, standard errors, no intervals): "
-        f"{time.perf_counter() - t:.3f} s, {f.nfev} evaluations"
+        f"residual vector: {t_raw * 1e6:.1f} us called directly; lm spends "
+        f"{per_call * 1e6:.1f} us per residual vector evaluated (wrapper, Jacobian and scipy "
+        f"included; {n} vectors per fit)"
     )
+    for label, smp in (("extracted samples (scatter known)", extracted), ("bare arrays", bare)):
+        t = time.perf_counter()
+        f = fit(smp, "stribeck", fixed={"delta": 1.0}, intervals="none")
+        print(
+            f"whole fit() with lm on {label}: {time.perf_counter() - t:.3f} s, {f.nfev} "
+            f"evaluations ({f.message[:60]})"
+        )
 
 
 def compile_table() -> None:
@@ -154,7 +169,10 @@ def compile_table() -> None:
     src = Path(__file__).resolve().parents[1] / "src"
     env["PYTHONPATH"] = os.pathsep.join([str(src), env.get("PYTHONPATH", "")])
     print("\n3. compiling the fast paths (RWSAVSBAS outer iteration, study and model kernels)")
-    print(f"{'process (fresh numba cache)':44s} {'import s':>9s} {'compile s':>10s}")
+    print(
+        f"{'process (fresh numba cache)':44s} {'import s':>9s} {'compile s':>10s} "
+        f"{'cache hits':>10s} {'misses':>7s}"
+    )
     with tempfile.TemporaryDirectory() as cache:
         env["NUMBA_CACHE_DIR"] = cache
         seconds = []
@@ -165,9 +183,12 @@ def compile_table() -> None:
             if out.returncode:
                 print(out.stderr)
                 raise SystemExit(out.returncode)
-            t_import, t_compile = map(float, out.stdout.split()[-2:])
-            seconds.append(t_compile)
-            print(f"{label:44s} {t_import:9.2f} {t_compile:10.2f}")
+            hits, misses, t_import, t_compile = out.stdout.split()[-4:]
+            seconds.append(float(t_compile))
+            print(
+                f"{label:44s} {float(t_import):9.2f} {float(t_compile):10.2f} {hits:>10s} "
+                f"{misses:>7s}"
+            )
     print(f"second / first: {seconds[1] / seconds[0]:.3f}")
 
 
@@ -192,12 +213,13 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     t0 = time.perf_counter()
     warnings.simplefilter("ignore")
+    extracted = extract(simulate(preset("paper2"), seed=0), gravity="none").samples
     v, y = paper2_samples(0)
     samples = FrictionSamples(velocity=v, load=0.0, temperature=25.0, friction=y)
     problem = IdentificationProblem(get_model("stribeck"), samples, fixed={"delta": 1.0})
     print("fricid fit paths (issue 14); 2 shared cores: read the ratios")
     rwsavsbas_table(samples, problem)
-    lm_table(problem, args.repeats)
+    lm_table(problem, args.repeats, extracted, samples)
     compile_table()
     ga_table(problem)
     print(f"\ntotal {time.perf_counter() - t0:.1f} s", file=sys.stderr)

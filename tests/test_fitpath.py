@@ -175,3 +175,67 @@ def test_ga_runs_with_dedupe_equal_single_runs():
     for r, res in enumerate(runs):
         one = minimize(fun, [(-1.0, 1.0)] * 3, "ga", seed=5 + r, max_evals=500)
         assert res.fun == one.fun and res.nfev == one.nfev and res.nit == one.nit
+
+
+# ------------------------------------------------------------------- lm: restart if doubtful
+def _lm_problem():
+    from fricid.identify.problem import IdentificationProblem
+    from fricid.models import get_model
+
+    v = np.concatenate([np.linspace(-2.0, -0.05, 8), np.linspace(0.05, 2.0, 9)])
+    y = np.sign(v) * (0.1 + 0.5 * np.exp(-np.abs(v) / 0.07)) + 0.002 * v
+    y = y + 1e-3 * np.random.default_rng(0).standard_normal(v.size)
+    data = (np.column_stack([v, 0 * v, 0 * v]), y)
+    return IdentificationProblem(get_model("stribeck"), data, fixed={"delta": 1.0})
+
+
+def _lm(problem, x0=None, **options):
+    from fricid.optim import minimize
+
+    return minimize(
+        problem.evaluate,
+        problem.bounds,
+        "lm",
+        x0=problem.start() if x0 is None else x0,
+        residuals=problem.residuals,
+        seed=0,
+        options=options,
+    )
+
+
+def test_lm_starts_once_unless_the_fit_is_doubtful():
+    problem = _lm_problem()
+    one = _lm(problem)
+    assert one.nit == 1 and "not doubtful" in one.message and one.success
+    every = _lm(problem, restart="always")
+    assert every.nit == 8 and every.nfev > 4 * one.nfev
+    assert one.fun == pytest.approx(every.fun, rel=1e-9)
+    # an SSE above restart_above is doubtful: the other starts run
+    high = _lm(problem, restart_above=0.1 * one.fun)
+    assert high.nit == 8 and "restart_above" in high.message
+    assert _lm(problem, restart_above=10 * one.fun).nit == 1
+    # a start on a face of the box is doubtful
+    corner = _lm(problem, x0=problem.bounds[:, 0].copy())
+    assert corner.nit == 8 and "began on a bound" in corner.message
+
+
+def test_fit_judges_the_first_lm_start_against_the_measurement_scatter():
+    """fit sets restart_above at 3x the scatter's SSE; without a scatter every start runs."""
+    from fricid.identify import fit
+    from fricid.samples import FrictionSamples
+
+    problem = _lm_problem()
+    v, y = problem.X[:, 0], problem.y
+    n = v.size
+    kw = {"fixed": {"delta": 1.0}, "intervals": "none"}
+    known = FrictionSamples(
+        velocity=v, load=0.0, temperature=25.0, friction=y, std=np.full(n, 0.01), count=100
+    )
+    assert "not doubtful" in fit(known, "stribeck", **kw).message
+    # a scatter far below the residual (the model cannot fit): restart
+    tiny = FrictionSamples(
+        velocity=v, load=0.0, temperature=25.0, friction=y, std=np.full(n, 1e-7), count=100
+    )
+    assert "restart_above" in fit(tiny, "stribeck", **kw).message
+    bare = FrictionSamples(velocity=v, load=0.0, temperature=25.0, friction=y)
+    assert "8 start(s)" in fit(bare, "stribeck", **kw).message

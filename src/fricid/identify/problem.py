@@ -275,7 +275,8 @@ class IdentificationProblem:
         T = np.atleast_2d(np.asarray(T, dtype=float))
         if len(self.free) == self.base.size:
             return T
-        full = np.broadcast_to(self.base, (T.shape[0], self.base.size)).copy()
+        full = np.empty((T.shape[0], self.base.size))
+        full[...] = self.base  # (np.broadcast_to costs more on the small batches of hot loops)
         full[:, self.free] = T
         return full
 

@@ -184,6 +184,7 @@ class _LeastSquares(Solver):
         fun = self._residual_fun()
         jac = self._jacobian_fun() if self.batched_jacobian else "2-point"
         messages = []
+        restarted = ""
         self.converged = False
         for i, u0 in enumerate(starts):
             before = float(obj.best_f[0])
@@ -212,7 +213,7 @@ class _LeastSquares(Solver):
                         self.nit = 1
                         obj.notify(self.nit)
                         return 1, f"1 start, not doubtful (no restart): {sol.message}"
-                    messages[-1] = f"{why}; {sol.message}"
+                    restarted = f" (restarted: {why})"
             except Budget:
                 self.nit = i + 1
                 if float(obj.best_f[0]) < before:  # the best is this unfinished start's
@@ -227,7 +228,8 @@ class _LeastSquares(Solver):
                 raise ConfigError(f"method '{self.name}': {exc}") from None
             self.nit = i + 1
             obj.notify(self.nit)
-        return self.nit, f"{self.nit} start(s); last: {messages[-1] if messages else 'none'}"
+        last = messages[-1] if messages else "none"
+        return self.nit, f"{self.nit} start(s){restarted}; last: {last}"
 
 
 @register

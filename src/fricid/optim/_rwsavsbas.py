@@ -221,9 +221,13 @@ class RWSAVSBAS(Solver):
         B, W = self._directions(blk)
         SW = (S[:, :, None] * step) * W
         delta = np.zeros(R)
+        P = np.empty((R, 3, x.shape[1]))
         for p in range(blk.shape[1] - 1):
             b = B[:, p]
-            P = np.stack([x + dist * b, x - dist * b, G + SW[:, p]], axis=1)
+            db = dist * b
+            np.add(x, db, out=P[:, 0])
+            np.subtract(x, db, out=P[:, 1])
+            np.add(G, SW[:, p], out=P[:, 2])
             clip01(P, out=P)
             f = obj(P)
             fr, fl, fw = f[:, 0], f[:, 1], f[:, 2]
