@@ -28,7 +28,8 @@ minimize_runs(problem.objective(), problem.bounds, "rwsavsbas", seed=0, runs=2,
               options={"n_outer": 1, "n_inner": 2})
 stats = _rws_numba.outer_iteration.stats
 print(json.dumps({"hits": sum(stats.cache_hits.values()),
-                  "misses": sum(stats.cache_misses.values())}))
+                  "misses": sum(stats.cache_misses.values()),
+                  "path": stats.cache_path}))
 """
 
 
@@ -44,9 +45,12 @@ def test_a_second_process_loads_the_compiled_path_from_the_cache():
     """The first process may compile (cold cache); the second must only load: numba typed
     the kernel argument by its memory address before, so every process recompiled."""
     pytest.importorskip("numba")
-    _child()
+    first = _child()
+    files = sorted(Path(first["path"]).glob("*outer_iteration*"))
     second = _child()
-    assert second == {"hits": 1, "misses": 0}
+    assert (second["hits"], second["misses"]) == (1, 0)
+    # and the cache does not grow with every process
+    assert sorted(Path(second["path"]).glob("*outer_iteration*")) == files
 
 
 # ------------------------------------------------------------------ compiled model kernels
