@@ -261,7 +261,7 @@ class RWSAVSBAS(Solver):
 
     def _outer_jit(self, k: int, blk: np.ndarray, S: np.ndarray, thr: np.ndarray) -> None:
         """One outer iteration of every run in compiled code (same algorithm and numbers)."""
-        from ._rws_numba import function_of, outer_iteration
+        from ._rws_numba import first_call, function_of
 
         B, W = self._directions(blk)
         obj = self.objective
@@ -278,7 +278,7 @@ class RWSAVSBAS(Solver):
                 function_of(obj.kernel, obj.kernel_data),
             )
         X, out, P, hist_n, hist_f, kernel = self._buf
-        used, nh, hit = outer_iteration(
+        args = (
             kernel,
             obj.kernel_data,
             obj.lower,
@@ -288,15 +288,15 @@ class RWSAVSBAS(Solver):
             self.fG,
             self.ibu,
             self.ibf,
-            B,
+            np.ascontiguousarray(B),
             np.ascontiguousarray(W),
-            S,
-            thr,
-            self.step,
+            np.ascontiguousarray(S),
+            np.ascontiguousarray(thr),
+            float(self.step),
             float(o["c"]),
-            o["best_update"] == "inner",
-            obj.remaining,
-            obj.nfev,
+            bool(o["best_update"] == "inner"),
+            int(obj.remaining),
+            int(obj.nfev),
             obj.best_u,
             obj.best_f,
             X,
@@ -305,6 +305,12 @@ class RWSAVSBAS(Solver):
             hist_n,
             hist_f,
         )
+        # the arguments keep their types for the whole run: after the first call, the
+        # compiled entry point without numba's per-call type dispatch
+        if getattr(self, "_entry", None) is None:
+            (used, nh, hit), self._entry = first_call(args)
+        else:
+            used, nh, hit = self._entry(*args)
         obj.nfev += int(used)
         for i in range(int(nh)):
             obj._hist_n.append(int(hist_n[i]))
