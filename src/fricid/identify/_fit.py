@@ -193,6 +193,8 @@ def fit(
     key = str(method).strip().lower()
     start = problem.start(x0) if key in METHODS else None
     uses_residuals = key in METHODS and METHODS[key].uses_residuals
+    if key in METHODS and "restart_above" in METHODS[key].options:
+        options = _restart_above(dict(options or {}), problem, scatter.value)
     if key == "varpro":  # separable least squares over the whole box (identify/varpro.py)
         if x0:
             warnings.warn(
@@ -203,7 +205,7 @@ def fit(
         result = varpro(problem, seed=seed, max_evals=max_evals, options=options, callback=callback)
     else:
         result = minimize(
-            problem.evaluate,
+            problem.objective(),
             problem.bounds,
             method=method,
             seed=seed,
@@ -299,6 +301,28 @@ def fit(
             "scatter": scatter.to_dict(),
         },
     )
+
+
+#: ``lm`` restarts (multi-start) when its first start's RMS residual exceeds this many times
+#: the measurement scatter (issue 14: restart only when the fit is doubtful).
+RESTART_SCATTER_FACTOR = 3.0
+
+
+def _restart_above(options: dict[str, Any], problem: IdentificationProblem, scatter: float):
+    """``options`` with ``restart_above``: the loss of residuals of
+    :data:`RESTART_SCATTER_FACTOR` times the scatter at every sample (weighted as the problem
+    weighs them), unless given. When the scatter is unknown the residual cannot be judged, so
+    every start runs (``restart="always"``, unless given)."""
+    if "restart_above" in options:
+        return options
+    if not np.isfinite(scatter) or scatter <= 0:
+        options.setdefault("restart", "always")
+        return options
+    w = problem.weights
+    total = float(problem.n_obs if w is None else np.sum(w))
+    target = (RESTART_SCATTER_FACTOR * scatter) ** 2 * total
+    options["restart_above"] = target / problem.n_obs if problem.loss == "mse" else target
+    return options
 
 
 def _no_weights(weights: Any) -> bool:

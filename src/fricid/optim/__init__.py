@@ -16,7 +16,8 @@ Methods (``METHODS[name].summary`` has the one-line description):
 ``minimize`` makes one run and returns one :class:`OptimizeResult`, whose ``status`` (see
 :data:`STATUS_MESSAGES`) says why it ended and whose ``success`` means converged.
 ``minimize_runs(..., runs=N)`` makes N independent runs (seeds ``seed .. seed + N - 1``),
-batched into one objective call per iteration for bas, vsbas, ibas, rwsavsbas and ga.
+batched into one objective call per iteration for bas, vsbas, ibas, rwsavsbas and ga (with
+option ``dedupe=False``; by default GA skips its clones, each run counting its own).
 :class:`JitObjective` pairs an objective with a numba kernel for RWSAVSBAS's compiled path.
 Conventions (unit box, clipping, NaN, history, budgets): :mod:`fricid.optim._api`.
 """

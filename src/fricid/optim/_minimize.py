@@ -191,10 +191,11 @@ def minimize_runs(
     Returns
     -------
     list of OptimizeResult
-        One per run. Methods marked ``batched`` (bas, vsbas, ibas, rwsavsbas, ga) advance the
-        runs in lockstep with one objective call per iteration for all of them; each run's
-        result is still bit-identical to ``minimize(..., seed=seed + r)``, provided ``fun``
-        evaluates each row independently of the others (true of element-wise numpy code).
+        One per run. Methods marked ``batched`` (bas, vsbas, ibas, rwsavsbas; ga with
+        ``dedupe=False``) advance the runs in lockstep with one objective call per iteration
+        for all of them; each run's result is still bit-identical to ``minimize(...,
+        seed=seed + r)``, provided ``fun`` evaluates each row independently of the others
+        (true of element-wise numpy code).
         Other methods make the runs one after another.
     """
     if isinstance(runs, bool) or not isinstance(runs, int | np.integer) or runs < 1:

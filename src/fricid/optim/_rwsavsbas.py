@@ -221,9 +221,13 @@ class RWSAVSBAS(Solver):
         B, W = self._directions(blk)
         SW = (S[:, :, None] * step) * W
         delta = np.zeros(R)
+        P = np.empty((R, 3, x.shape[1]))
         for p in range(blk.shape[1] - 1):
             b = B[:, p]
-            P = np.stack([x + dist * b, x - dist * b, G + SW[:, p]], axis=1)
+            db = dist * b
+            np.add(x, db, out=P[:, 0])
+            np.subtract(x, db, out=P[:, 1])
+            np.add(G, SW[:, p], out=P[:, 2])
             clip01(P, out=P)
             f = obj(P)
             fr, fl, fw = f[:, 0], f[:, 1], f[:, 2]
@@ -257,7 +261,7 @@ class RWSAVSBAS(Solver):
 
     def _outer_jit(self, k: int, blk: np.ndarray, S: np.ndarray, thr: np.ndarray) -> None:
         """One outer iteration of every run in compiled code (same algorithm and numbers)."""
-        from ._rws_numba import outer_iteration
+        from ._rws_numba import first_call, function_of
 
         B, W = self._directions(blk)
         obj = self.objective
@@ -271,10 +275,11 @@ class RWSAVSBAS(Solver):
                 np.empty((R, 3, d)),
                 np.empty(Q + 1, dtype=np.int64),
                 np.empty((Q + 1, R)),
+                function_of(obj.kernel, obj.kernel_data),
             )
-        X, out, P, hist_n, hist_f = self._buf
-        used, nh, hit = outer_iteration(
-            obj.kernel,
+        X, out, P, hist_n, hist_f, kernel = self._buf
+        args = (
+            kernel,
             obj.kernel_data,
             obj.lower,
             obj.span,
@@ -283,15 +288,15 @@ class RWSAVSBAS(Solver):
             self.fG,
             self.ibu,
             self.ibf,
-            B,
+            np.ascontiguousarray(B),
             np.ascontiguousarray(W),
-            S,
-            thr,
-            self.step,
+            np.ascontiguousarray(S),
+            np.ascontiguousarray(thr),
+            float(self.step),
             float(o["c"]),
-            o["best_update"] == "inner",
-            obj.remaining,
-            obj.nfev,
+            bool(o["best_update"] == "inner"),
+            int(obj.remaining),
+            int(obj.nfev),
             obj.best_u,
             obj.best_f,
             X,
@@ -300,6 +305,12 @@ class RWSAVSBAS(Solver):
             hist_n,
             hist_f,
         )
+        # the arguments keep their types for the whole run: after the first call, the
+        # compiled entry point without numba's per-call type dispatch
+        if getattr(self, "_entry", None) is None:
+            (used, nh, hit), self._entry = first_call(args)
+        else:
+            used, nh, hit = self._entry(*args)
         obj.nfev += int(used)
         for i in range(int(nh)):
             obj._hist_n.append(int(hist_n[i]))
