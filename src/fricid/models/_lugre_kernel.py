@@ -84,7 +84,7 @@ def _linear_step(s0, s1, s2, a, inv_j, beta, z, v, h):  # pragma: no cover - com
 
 @njit(cache=True)
 def run_joint(
-    theta, phys, tau, qref, vref, gains, dt, n_sub, reset, q_meas, v_meas, x0, Q, V, Z, F, U
+    theta, phys, tau, qref, vref, gains, dt, n_sub, reset, q_meas, v_meas, a_meas, x0, Q, V, Z, F, U
 ):  # pragma: no cover - compiled
     """A joint with LuGre friction, ``J qdd = u + p_x cos q - p_y sin q - F``, for every row.
 
@@ -93,7 +93,10 @@ def run_joint(
     sub-steps, over each of which the bristle rate ``a = sigma_0 |v| / g(v)`` and the gravity
     torque are frozen at the predicted mid-point and the linear (z, v) system is solved
     exactly. Where ``reset`` is set,
-    position and velocity restart from the measured ones (the bristle state carries on).
+    position and velocity restart from the measured ones and the bristle state from the force
+    balance ``sigma_0 z = tau + tau_g(q) - J a - sigma_2 v`` (measured acceleration ``a``),
+    bounded by the steady deflection ``g(v) / sigma_0``: the equilibrium at rest, the steady
+    state when sliding steadily.
     """
     k = theta.shape[0]
     n = tau.shape[0]
@@ -117,6 +120,11 @@ def run_joint(
             if reset[i]:
                 q = q_meas[i]
                 v = v_meas[i]
+                av = abs(v)
+                g = max(tau_c + (tau_s - tau_c) * math.exp(-((av / w_s) ** delta)), 1e-12)
+                grav = p_x * math.cos(q) - p_y * math.sin(q)
+                z = (tau[i] + grav - inertia * a_meas[i] - s2 * v) / s0
+                z = min(max(z, -g / s0), g / s0)
             elif i > 0:
                 h = dt[i] / n_sub
                 for _ in range(n_sub):

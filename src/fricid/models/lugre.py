@@ -208,7 +208,9 @@ def simulate_joint(
     reset : array_like of bool, optional
         ``(n,)``: at these samples position and velocity restart from ``measured``.
     measured : tuple of array_like, optional
-        ``(q, v)`` measured, each ``(n,)``; needed with ``reset``.
+        ``(q, v)`` or ``(q, v, a)`` measured, each ``(n,)``; needed with ``reset``. At a reset
+        the bristle state starts from the force balance with the measured acceleration ``a``
+        (default 0), bounded by the steady deflection (see ``_lugre_kernel.run_joint``).
 
     Returns
     -------
@@ -241,9 +243,10 @@ def simulate_joint(
         raise ConfigError("LuGre joint simulation: 'reset' must have one flag per sample")
     if flags.any() and measured is None:
         raise ConfigError("LuGre joint simulation: 'reset' needs the measured (q, v)")
-    qm, vm = (zeros, zeros) if measured is None else measured
-    qm = np.ascontiguousarray(np.broadcast_to(np.asarray(qm, float), (n,)))
-    vm = np.ascontiguousarray(np.broadcast_to(np.asarray(vm, float), (n,)))
+    qm, vm, am = (zeros, zeros, zeros) if measured is None else (*measured, zeros)[:3]
+    qm, vm, am = (
+        np.ascontiguousarray(np.broadcast_to(np.asarray(x, float), (n,))) for x in (qm, vm, am)
+    )
     out = {name: np.empty((k, n)) for name in ("position", "velocity", "state", "friction")}
     out["torque"] = np.empty((k, n))
     from ._lugre_kernel import run_joint  # lazy: importing numba takes a while
@@ -260,6 +263,7 @@ def simulate_joint(
         np.ascontiguousarray(flags),
         qm,
         vm,
+        am,
         x0,
         out["position"],
         out["velocity"],

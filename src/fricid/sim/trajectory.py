@@ -120,9 +120,14 @@ def sine(duration=10.0, rate=1000.0, amplitude=0.5, frequency=0.5, kp=200.0, kd=
     t = _time(duration, rate)
     w = 2 * math.pi * frequency
     return _tracked(
-        "sine", t, amplitude * np.sin(w * t), amplitude * w * np.cos(w * t),
-        -amplitude * w**2 * np.sin(w * t), kp, kd,
-    )  # fmt: skip
+        "sine",
+        t,
+        amplitude * np.sin(w * t),
+        amplitude * w * np.cos(w * t),
+        -amplitude * w**2 * np.sin(w * t),
+        kp,
+        kd,
+    )
 
 
 def chirp(
@@ -171,8 +176,9 @@ def stick_slip(duration=10.0, rate=1000.0, stiffness=20.0, speed=0.05) -> Experi
     phase = np.mod(t, 2 * quarter)
     target = speed * np.where(phase < quarter, phase, 2 * quarter - phase)
     v = speed * np.where(phase < quarter, 1.0, -1.0)
-    return Experiment("stick_slip", t, target, v, np.zeros_like(t), np.zeros_like(t),
-                      stiffness, 0.0, False)  # fmt: skip
+    return Experiment(
+        "stick_slip", t, target, v, np.zeros_like(t), np.zeros_like(t), stiffness, 0.0, False
+    )
 
 
 def presliding(duration=4.0, rate=1000.0, torque=0.3, frequency=0.5) -> Experiment:
@@ -227,12 +233,21 @@ def simulate_trajectory(
         if e.feedforward:
             ff += lugre.steady_state(truth.theta, e.v_ref)
         sim = lugre.simulate_joint(
-            truth.theta, joint.inertia, joint.p_x, joint.p_y, np.diff(t, prepend=t[0]), ff,
-            q0=e.q_ref[0], v0=e.v_ref[0],
-            z0=np.sign(e.v_ref[0]) * lugre.stribeck_curve(truth.theta, e.v_ref[:1])[0]
+            truth.theta,
+            joint.inertia,
+            joint.p_x,
+            joint.p_y,
+            np.diff(t, prepend=t[0]),
+            ff,
+            q0=e.q_ref[0],
+            v0=e.v_ref[0],
+            z0=np.sign(e.v_ref[0])
+            * lugre.stribeck_curve(truth.theta, e.v_ref[:1])[0]
             / truth.theta[0],
-            reference=(e.q_ref, e.v_ref), gains=(e.kp, e.kd), n_sub=truth.n_sub,
-        )  # fmt: skip
+            reference=(e.q_ref, e.v_ref),
+            gains=(e.kp, e.kd),
+            n_sub=truth.n_sub,
+        )
         q, v, u = sim["position"], sim["velocity"], sim["torque"]
         truth_meta = {"model": "lugre", **truth.params()}
     elif callable(truth):
@@ -265,10 +280,16 @@ def simulate_trajectory(
         "seed": int(seed),
     }
     return RawLog(
-        time=t, position=q_meas, velocity=v_meas, temperature=temperature, current=current,
-        torque_constant=joint.torque_constant, joint="virtual", source=f"sim:{e.kind}",
+        time=t,
+        position=q_meas,
+        velocity=v_meas,
+        temperature=temperature,
+        current=current,
+        torque_constant=joint.torque_constant,
+        joint="virtual",
+        source=f"sim:{e.kind}",
         meta=meta,
-    )  # fmt: skip
+    )
 
 
 def with_temperature(experiment: Experiment, temperature: float) -> Experiment:
