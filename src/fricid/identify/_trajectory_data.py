@@ -82,9 +82,9 @@ class DerivativeFilter:
         """The settings, as recorded in provenance (window also in samples)."""
         d = asdict(self)
         keep = (
-            ("method", "window", "order")
+            ("method", "source", "window", "order")
             if self.method == "savgol"
-            else ("method", "cutoff", "butter_order")
+            else ("method", "source", "cutoff", "butter_order")
         )
         out = {k: d[k] for k in keep}
         if self.method == "savgol":

@@ -371,8 +371,7 @@ def fit_trajectory(
         ci95={n: float((h - lo) / 2) for n, lo, h in zip(param_names, low, high, strict=True)},
         ci95_low=dict(zip(param_names, low, strict=True)),
         ci95_high=dict(zip(param_names, high, strict=True)),
-        ci_method="cluster-robust jacobian"
-        + (" (two-step, Murphy-Topel)" if key == "lugre" else ""),
+        ci_method="cluster-robust" + (", two-step" if key == "lugre" else ""),
         metrics={
             **metrics(y, yhat),
             **{
