@@ -179,3 +179,43 @@ def test_cli_fits_lugre_from_a_ros2_bag(tmp_path):
 def test_cli_refuses_a_log_without_motion(tmp_path):
     result = CliRunner().invoke(app, ["fit", str(tmp_path / "missing.csv"), "--trajectory"])
     assert result.exit_code == 2
+
+
+def test_any_optimiser_and_static_part_from_sweeps():
+    log = tr.simulate_trajectory(tr.multisine(duration=6.0, seed=5), TRUTH, JOINT, seed=5)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        fitted = fit_trajectory(log, "lugre", "bas", max_evals=60, seed=1)
+    assert fitted.method == "bas" and fitted.convergence is not None
+    assert fitted.provenance["trajectory"]["routes"]["simulation"]["nfev"] <= 60
+    sweep = FittedModel(
+        model="stribeck",
+        params=dict(zip(Stribeck().param_names, STATIC, strict=True)),
+        stderr=dict.fromkeys(Stribeck().param_names, 0.001),
+        ci95_low=dict(zip(Stribeck().param_names, STATIC - 0.002, strict=True)),
+        ci95_high=dict(zip(Stribeck().param_names, STATIC + 0.002, strict=True)),
+    )
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        two = fit_trajectory(log, "lugre", static=sweep)
+    assert two.provenance["trajectory"]["static_from"] == "sweeps"
+    assert two.params["tau_s"] == 0.8 and two.ci95_low["tau_s"] == pytest.approx(0.798)
+    assert set(two.provenance["trajectory"]["routes"]["regression"]["parameters"]) == {
+        "inertia",
+        "p_x",
+        "p_y",
+    }
+
+
+def test_passivity_is_judged_at_the_estimate_and_the_worst_corner():
+    from fricid.identify.trajectory import _passivity
+
+    names = list(TRUTH.params())
+    values = TRUTH.theta
+    wide_high = values.copy()
+    wide_high[1] = 10.0  # sigma_1 up to 10 N m s/rad inside the interval: not passive there
+    p = _passivity(names, values, values * 0.99, wide_high)
+    assert p["passive"] and not p["passive_across_ci95"]
+    damped = values.copy()
+    damped[1] = 5.0
+    assert not _passivity(names, damped, damped, damped)["passive"]
