@@ -24,6 +24,7 @@ were free.
 from __future__ import annotations
 
 import argparse
+import os
 import time
 import warnings
 from dataclasses import replace
@@ -133,7 +134,10 @@ def main() -> None:
             f"{routes['simulation']['seconds']:>11.2f} {conv!s:>9}  {ok}"
         )
     worst = max(r[2] for r in rows)
-    print(f"\nslowest identification: {worst:.2f} s (target < 10 s for 60 s at 1 kHz with lm)")
+    print(
+        f"\nslowest identification: {worst:.2f} s (target < 10 s for 60 s at 1 kHz with lm); "
+        f"load average at the end {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores"
+    )
 
 
 if __name__ == "__main__":
