@@ -211,9 +211,12 @@ def test_unrepresentable_c_exports_say_so_and_write_nothing(tmp_path):
     with pytest.raises(ConfigError, match="needs a zone half-width"):
         export_c(fitted, tmp_path / "b", Smoothing("tanh", 0.0))
     unknown = make_fitted("stribeck", False)
-    unknown.model = "lugre"
-    with pytest.raises(Exception, match="unknown model 'lugre'"):
+    unknown.model = "gms"  # not registered ("lugre" is, since issue 16)
+    with pytest.raises(Exception, match="unknown model 'gms'"):
         export_c(unknown, tmp_path / "c")
+    unknown.model = "lugre"  # a registered dynamic model without a C template
+    with pytest.raises(Exception, match="no template for the model family 'lugre'"):
+        export_c(unknown, tmp_path / "d")
     assert not any(tmp_path.iterdir())
 
 

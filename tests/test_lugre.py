@@ -58,3 +58,39 @@ def test_wrong_shapes_and_periods_are_refused():
         lugre.simulate(THETA[:5], [0.1], 1e-3)
     with pytest.raises(ConfigError, match="periods"):
         lugre.simulate(THETA, [0.1, 0.2], [1e-3, -1.0])
+
+
+def test_joint_under_torque_slides_at_the_steady_state_or_sticks():
+    # above break-away the joint settles where steady friction balances the torque
+    r = lugre.simulate_joint(THETA, 0.01, 0.0, 0.0, 1e-3, np.full(4000, 0.9))
+    assert r["friction"][-1] == pytest.approx(0.9, rel=1e-6)
+    assert lugre.steady_state(THETA, r["velocity"][-1:])[0] == pytest.approx(0.9, rel=1e-6)
+    # below it the joint only deflects the bristles: micro-radians, then rest
+    r = lugre.simulate_joint(THETA, 0.01, 0.0, 0.0, 1e-3, np.full(4000, 0.3))
+    assert abs(r["velocity"][-1]) < 1e-9 and 0 < r["position"][-1] < 1e-3
+    assert r["friction"][-1] == pytest.approx(0.3, rel=1e-6)
+
+
+def test_joint_sub_steps_converge_and_batches_match():
+    t = np.arange(8000) * 1e-3
+    tau = np.sin(2 * np.pi * 0.5 * t)
+    fine = lugre.simulate_joint(THETA, 0.01, 0.1, 0.05, 1e-3, tau, n_sub=64)
+    errors = [
+        np.max(
+            np.abs(
+                lugre.simulate_joint(THETA, 0.01, 0.1, 0.05, 1e-3, tau, n_sub=m)["velocity"]
+                - fine["velocity"]
+            )
+        )
+        for m in (2, 8)
+    ]
+    assert errors[1] < errors[0] / 8 and errors[1] < 1e-3
+    other = THETA * np.array([3, 2, 1, 1, 1, 1, 1])
+    both = lugre.simulate_joint(np.vstack([THETA, other]), 0.01, 0.1, 0.05, 1e-3, tau)
+    one = lugre.simulate_joint(other, 0.01, 0.1, 0.05, 1e-3, tau)
+    np.testing.assert_allclose(both["position"][1], one["position"])
+
+
+def test_joint_reset_needs_measurements():
+    with pytest.raises(ConfigError, match="measured"):
+        lugre.simulate_joint(THETA, 0.01, 0, 0, 1e-3, np.zeros(5), reset=np.ones(5, bool))

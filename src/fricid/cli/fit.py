@@ -115,6 +115,21 @@ def fit_command(
         ),
     ] = None,
     quiet: QuietOption = False,
+    trajectory: Annotated[
+        bool,
+        typer.Option(
+            "--trajectory",
+            help="SAMPLES is a raw log of any motion: identify lugre (or stribeck, "
+            "coulomb_viscous) with J and gravity from it (fricid.identify.trajectory).",
+        ),
+    ] = False,
+    log_format: Annotated[
+        str, typer.Option("--format", help="--trajectory: the log's reader (fricid.io.READERS).")
+    ] = "table",
+    reader_option: Annotated[
+        list[str] | None,
+        typer.Option("--reader-option", help="--trajectory: a reader option KEY=VALUE."),
+    ] = None,
 ) -> None:
     """Identify a friction model from samples and write it as a JSON model file.
 
@@ -132,6 +147,22 @@ def fit_command(
     per tenth of the evaluation budget with the time left (population methods) or every few
     seconds; --quiet: none.
     """
+    if trajectory:  # delegated (cli/trajectory.py)
+        from .trajectory import parse_reader_options, run_trajectory
+
+        check_paths(inputs={"LOG": samples}, folders=True, out_files={"--out": out})
+        return run_trajectory(
+            samples,
+            model,
+            method,
+            reader=log_format,
+            reader_options=parse_reader_options(reader_option),
+            seed=seed,
+            max_evals=max_evals,
+            route="two_stage",
+            gravity="fit",
+            out=out,
+        )
     from ..identify import fit
     from ..identify import validate as validate_model
     from ..io import read_samples

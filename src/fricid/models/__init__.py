@@ -13,9 +13,12 @@ from ..errors import ConfigError
 from ._analytic import CoulombViscous, LoadDependent, Stribeck, VelocityLoadTemperature
 from ._asymmetric import Asymmetric
 from ._base import INPUTS, FrictionModel, Parameter, data_scales
+from .dahl import Dahl
+from .lugre import LuGre
 from .rbf import NETWORK, RBFNetwork
 
 __all__ = [
+    "DYNAMIC",
     "INPUTS",
     "MODELS",
     "STATEFUL",
@@ -39,6 +42,12 @@ MODELS: dict[str, type[FrictionModel]] = {
 }
 
 
+#: Dynamic models by registry name (their ``predict`` is the steady state; identified from
+#: trajectories by :mod:`fricid.identify.trajectory`); kept out of :data:`MODELS`, whose
+#: families are fitted to friction samples.
+DYNAMIC: dict[str, type[FrictionModel]] = {cls.name: cls for cls in (LuGre, Dahl)}
+
+
 def get_model(name: str | FrictionModel, asymmetric: bool = False) -> FrictionModel:
     """The model called ``name`` (see :data:`MODELS`); ``name_asym`` or ``asymmetric=True``
     gives its per-direction variant. A model instance is passed through."""
@@ -48,6 +57,8 @@ def get_model(name: str | FrictionModel, asymmetric: bool = False) -> FrictionMo
         key = name.strip().lower()
         if key.endswith("_asym"):
             key, asymmetric = key[: -len("_asym")], True
+        if key in DYNAMIC and not asymmetric:
+            return DYNAMIC[key]()
         if key not in MODELS:
             raise ConfigError(
                 f"unknown model '{name}'; choose one of: {', '.join(MODELS)} "

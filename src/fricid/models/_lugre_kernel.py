@@ -38,3 +38,116 @@ def run(theta, v, dt, z0, F, Z):  # pragma: no cover - compiled
             Z[j, i] = z
             F[j, i] = s0 * z + s1 * dz + s2 * vi
     return 0
+
+
+@njit(cache=True)
+def _linear_step(s0, s1, s2, a, inv_j, beta, z, v, h):  # pragma: no cover - compiled
+    """Exact step of ``z' = v - a z``, ``v' = beta - (s0 z + s1 (v - a z) + s2 v) / J`` over
+    ``h`` (``a`` and ``beta`` frozen): returns ``z, v`` at its end and the distance moved."""
+    p = -a
+    r = (s1 * a - s0) * inv_j
+    s = -(s1 + s2) * inv_j
+    det = p * s - r  # (a s2 + s0) / J > 0
+    tr = p + s
+    disc = 0.25 * (p - s) * (p - s) + r
+    half = math.exp(0.5 * tr * h)
+    if disc > 0.0:
+        root = math.sqrt(disc)
+        lam1 = 0.5 * tr - root  # the faster (more negative) eigenvalue
+        lam2 = det / lam1  # the slower one, without cancellation
+        e1 = math.exp(lam2 * h)
+        e2 = math.exp(lam1 * h)
+        c = 0.5 * (e1 + e2)
+        if root * h > 1e-6:
+            sh = (e1 - e2) / (lam2 - lam1)
+        else:
+            sh = half * h * (1.0 + (root * h) ** 2 / 6.0)
+    else:
+        w = math.sqrt(-disc)
+        c = half * math.cos(w * h)
+        sh = half * math.sin(w * h) / w if w * h > 1e-6 else half * h * (1.0 - (w * h) ** 2 / 6.0)
+    z_eq = beta / det
+    v_eq = a * z_eq
+    dz = z - z_eq
+    dv = v - v_eq
+    # M = c I + sh (A - tr/2 I)
+    m11 = c + sh * (p - 0.5 * tr)
+    m22 = c + sh * (s - 0.5 * tr)
+    m12 = sh
+    m21 = sh * r
+    nz = m11 * dz + m12 * dv
+    nv = m21 * dz + m22 * dv
+    # distance: v_eq h + [A^-1 (M - I) dx]_v, A^-1 = [[s, -1], [-r, p]] / det
+    moved = v_eq * h + (-r * (nz - dz) + p * (nv - dv)) / det
+    return z_eq + nz, v_eq + nv, moved
+
+
+@njit(cache=True)
+def run_joint(
+    theta, phys, tau, qref, vref, gains, dt, n_sub, reset, q_meas, v_meas, a_meas, x0, Q, V, Z, F, U
+):  # pragma: no cover - compiled
+    """A joint with LuGre friction, ``J qdd = u + p_x cos q - p_y sin q - F``, for every row.
+
+    ``u = tau + kp (qref - q) + kd (vref - v)`` is computed at each sample from the state
+    there and held until the next (zero-order hold); each sample period is cut into ``n_sub``
+    sub-steps, over each of which the bristle rate ``a = sigma_0 |v| / g(v)`` and the gravity
+    torque are frozen at the predicted mid-point and the linear (z, v) system is solved
+    exactly. Where ``reset`` is set,
+    position and velocity restart from the measured ones and the bristle state from the force
+    balance ``sigma_0 z = tau + tau_g(q) - J a - sigma_2 v`` (measured acceleration ``a``),
+    bounded by the steady deflection ``g(v) / sigma_0``: the equilibrium at rest, the steady
+    state when sliding steadily.
+    """
+    k = theta.shape[0]
+    n = tau.shape[0]
+    kp, kd = gains[0], gains[1]
+    for j in range(k):
+        s0, s1, s2 = theta[j, 0], theta[j, 1], theta[j, 2]
+        tau_c, tau_s, w_s, delta = theta[j, 3], theta[j, 4], theta[j, 5], theta[j, 6]
+        inertia, p_x, p_y = phys[j, 0], phys[j, 1], phys[j, 2]
+        if not (s0 > 0.0 and inertia > 0.0 and tau_c > 0.0 and w_s > 0.0):
+            for i in range(n):
+                Q[j, i] = math.nan
+                V[j, i] = math.nan
+                Z[j, i] = math.nan
+                F[j, i] = math.nan
+                U[j, i] = math.nan
+            continue
+        inv_j = 1.0 / inertia
+        q, v, z = x0[j, 0], x0[j, 1], x0[j, 2]
+        u = 0.0
+        for i in range(n):
+            if reset[i]:
+                q = q_meas[i]
+                v = v_meas[i]
+                av = abs(v)
+                g = max(tau_c + (tau_s - tau_c) * math.exp(-((av / w_s) ** delta)), 1e-12)
+                grav = p_x * math.cos(q) - p_y * math.sin(q)
+                z = (tau[i] + grav - inertia * a_meas[i] - s2 * v) / s0
+                z = min(max(z, -g / s0), g / s0)
+            elif i > 0:
+                h = dt[i] / n_sub
+                for _ in range(n_sub):
+                    # predictor with the rate at the start, corrector with the rate and the
+                    # gravity torque at the predicted mid-point (exponential mid-point rule)
+                    av = abs(v)
+                    g = max(tau_c + (tau_s - tau_c) * math.exp(-((av / w_s) ** delta)), 1e-12)
+                    a = s0 * av / g
+                    beta = (u + p_x * math.cos(q) - p_y * math.sin(q)) * inv_j
+                    _, vp, moved = _linear_step(s0, s1, s2, a, inv_j, beta, z, v, h)
+                    av = abs(0.5 * (v + vp))
+                    g = max(tau_c + (tau_s - tau_c) * math.exp(-((av / w_s) ** delta)), 1e-12)
+                    a = s0 * av / g
+                    qm = q + 0.5 * moved
+                    beta = (u + p_x * math.cos(qm) - p_y * math.sin(qm)) * inv_j
+                    z, v, moved = _linear_step(s0, s1, s2, a, inv_j, beta, z, v, h)
+                    q += moved
+            av = abs(v)
+            g = max(tau_c + (tau_s - tau_c) * math.exp(-((av / w_s) ** delta)), 1e-12)
+            Q[j, i] = q
+            V[j, i] = v
+            Z[j, i] = z
+            F[j, i] = s0 * z + s1 * (v - s0 * av / g * z) + s2 * v
+            u = tau[i] + kp * (qref[i] - q) + kd * (vref[i] - v)
+            U[j, i] = u
+    return 0

@@ -10,7 +10,8 @@ It is fricid's embedded default data and the test oracle:
 Modules: :mod:`.laws` (true friction laws), :mod:`.design` (experiment designs, trapezoidal
 traverses), :mod:`.joint` (dynamics, noise, scenarios), :mod:`.simulate`, :mod:`.presets`,
 :mod:`.oracle`, :mod:`.faults` (rest, settling, ramps, return moves, spike bursts, saturation;
-off by default, ``preset("paper1+faults")`` switches them on).
+off by default, ``preset("paper1+faults")`` switches them on), :mod:`.trajectory` (any motion:
+sines, chirps, multi-sines, stick-slip, pre-sliding; static or LuGre truth).
 """
 
 from __future__ import annotations

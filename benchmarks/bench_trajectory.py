@@ -1,0 +1,144 @@
+"""LuGre from a trajectory against the truth and against sweeps (issue 16, done-when).
+
+Usage: ``python benchmarks/bench_trajectory.py [--seeds 5] [--duration 60] [--method lm]``
+(about 2-3 minutes on 2 idle cores).
+
+For each seed, the virtual joint with a LuGre truth (:class:`fricid.sim.trajectory.
+LuGreTruth`: sigma_0 1e4 N m/rad, sigma_1 1 N m s/rad, sigma_2 0.2 N m s/rad, tau_c 0.5 N m,
+tau_s 0.8 N m, w_s 0.1 rad/s, delta 1; J 0.01 kg m^2, p_x 0.3 N m, p_y 0.1 N m) tracks a
+multi-sine (0.2, 0.5, 1.1, 2.3 Hz, 0.3 rad, random phases from the seed) for ``--duration``
+seconds at 1 kHz, logged with :data:`fricid.sim.trajectory.TRAJECTORY_NOISE`, and
+:func:`fricid.identify.trajectory.fit_trajectory` identifies it (two-stage route). The same
+joint's steady state (the static Stribeck law LuGre reduces to at constant velocity) is swept
+on the ``paper2`` ``reduced`` design (17 speeds 0.005-4 rad/s, 10 passes, horizontal), the
+sweeps extracted and fitted with ``stribeck`` by ``lm``.
+
+Tables: (1) per parameter: truth, sweep estimate with its 95 % interval (seed 0),
+trajectory estimate with its interval (seed 0), and the coverage of the trajectory intervals
+over the seeds; (2) per seed: identification time (the whole ``fit_trajectory`` call, numba
+compiled beforehand), each route's time, and whether each static parameter's trajectory and
+sweep intervals overlap. The machine may be shared: times are wall-clock on whatever cores
+were free.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import time
+import warnings
+from dataclasses import replace
+
+import numpy as np
+
+from fricid.extract import extract
+from fricid.identify import fit
+from fricid.identify.trajectory import fit_trajectory
+from fricid.models import Stribeck, lugre
+from fricid.sim import Joint, ModelLaw, preset, simulate
+from fricid.sim import trajectory as tr
+
+TRUTH = tr.LuGreTruth()
+JOINT = Joint(law=lambda v, load, temp: np.zeros_like(v), p_x=0.3, p_y=0.1, inertia=0.01)
+#: LuGre's static part in the stribeck model's order and names
+STATIC_NAMES = {
+    "tau_c": "tau_c",
+    "tau_s": "tau_s",
+    "w_s": "w_s",
+    "tau_v": "sigma_2",
+    "delta": "delta",
+}
+
+
+def sweeps(seed: int):
+    """The steady state swept on paper2's reduced design, fitted with stribeck."""
+    scenario = preset("paper2", "reduced")
+    p = TRUTH.params()
+    law = ModelLaw(
+        Stribeck(), np.array([p["tau_c"], p["tau_s"], p["w_s"], p["sigma_2"], p["delta"]])
+    )
+    scenario = replace(scenario, joint=replace(scenario.joint, law=law))
+    samples = extract(simulate(scenario, seed=seed), **scenario.extract_options()).samples
+    return fit(samples, "stribeck", "lm", seed=seed)
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--seeds", type=int, default=5)
+    ap.add_argument("--duration", type=float, default=60.0)
+    ap.add_argument("--method", default="lm")
+    args = ap.parse_args()
+    warnings.simplefilter("ignore")
+    # compile the kernels first so no timing below includes numba's compilation
+    fit_trajectory(tr.simulate_trajectory(tr.multisine(duration=4.0), TRUTH, JOINT), "lugre")
+    truth = TRUTH.params()
+    rows, sweep0, traj0 = [], None, None
+    cover = {n: 0 for n in truth}
+    for seed in range(args.seeds):
+        log = tr.simulate_trajectory(
+            tr.multisine(duration=args.duration, seed=seed), TRUTH, JOINT, seed=seed
+        )
+        t0 = time.perf_counter()
+        f = fit_trajectory(log, "lugre", args.method, seed=seed)
+        seconds = time.perf_counter() - t0
+        s = sweeps(seed)
+        for n, v in truth.items():
+            cover[n] += int(f.ci95_low[n] <= v <= f.ci95_high[n])
+        overlap = {
+            STATIC_NAMES[n]: bool(
+                max(f.ci95_low[STATIC_NAMES[n]], s.ci95_low[n])
+                <= min(f.ci95_high[STATIC_NAMES[n]], s.ci95_high[n])
+            )
+            for n in STATIC_NAMES
+        }
+        routes = f.provenance["trajectory"]["routes"]
+        rows.append((seed, len(log), seconds, routes, overlap, f.converged))
+        if seed == 0:
+            sweep0, traj0 = s, f
+    print(
+        f"LuGre truth; multi-sine {args.duration:g} s at 1 kHz; method {args.method}; "
+        f"{args.seeds} seeds\n"
+    )
+    print(
+        f"{'parameter':<9} {'truth':>9}  {'sweeps (seed 0) [95 % CI]':<32} "
+        f"{'trajectory (seed 0) [95 % CI]':<34} coverage"
+    )
+    inverse = {v: k for k, v in STATIC_NAMES.items()}
+    for n, v in truth.items():
+        if n in inverse:
+            k = inverse[n]
+            sw = f"{sweep0.params[k]:.4g} [{sweep0.ci95_low[k]:.4g}, {sweep0.ci95_high[k]:.4g}]"
+        else:
+            sw = "- (no effect at constant speed)"
+        tj = f"{traj0.params[n]:.4g} [{traj0.ci95_low[n]:.4g}, {traj0.ci95_high[n]:.4g}]"
+        print(f"{n:<9} {v:>9.4g}  {sw:<32} {tj:<34} {cover[n]}/{args.seeds}")
+    joint = traj0.provenance["trajectory"]["joint"]
+    for n, v in (("inertia", 0.01), ("p_x", 0.3), ("p_y", 0.1)):
+        r = joint[n]
+        tj = f"{r['value']:.4g} [{r['ci95_low']:.4g}, {r['ci95_high']:.4g}]"
+        print(f"{n:<9} {v:>9.4g}  {'-':<32} {tj}")
+    p = traj0.provenance["trajectory"]["passivity"]
+    print(
+        f"\npassivity (seed 0): margin {p['margin']:.3g}, passive {p['passive']}, "
+        f"across the 95 % box {p['passive_across_ci95']}; truth margin "
+        f"{float(lugre.passivity_margin(TRUTH.theta)):.3g}"
+    )
+    print(
+        f"\n{'seed':>4} {'samples':>8} {'time [s]':>9} {'regression':>11} {'simulation':>11} "
+        f"{'converged':>9}  static intervals overlap the sweeps'"
+    )
+    for seed, n, seconds, routes, overlap, conv in rows:
+        ok = ", ".join(f"{k} {'yes' if v else 'NO'}" for k, v in overlap.items())
+        print(
+            f"{seed:>4} {n:>8} {seconds:>9.2f} {routes['regression']['seconds']:>11.2f} "
+            f"{routes['simulation']['seconds']:>11.2f} {conv!s:>9}  {ok}"
+        )
+    worst = max(r[2] for r in rows)
+    print(
+        f"\nslowest identification: {worst:.2f} s (target < 10 s for 60 s at 1 kHz with lm); "
+        f"load average at the end {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores"
+    )
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,111 @@
+"""``fricid fit LOG --trajectory``: identify friction, inertia and gravity from any motion.
+
+A hook in :mod:`fricid.cli.fit` delegates here. The log is opened by any reader that gives
+a time series (:func:`fricid.io.open_log`: ``table``, ``generic``, ``rosbag``, ``channels``,
+``mat``, ``epos``; reader options as ``--reader-option KEY=VALUE``), its chunks joined, and
+identified by :func:`fricid.identify.trajectory.fit_trajectory`.
+"""
+
+from __future__ import annotations
+
+import json
+import warnings
+from pathlib import Path
+
+from rich.markup import escape
+
+from ..errors import ConfigError, DataError
+from ._app import console, err_console
+
+__all__ = ["parse_reader_options", "run_trajectory", "trajectory_text"]
+
+
+def parse_reader_options(items: list[str] | None) -> dict:
+    """``["joint=elbow", "torque_constant=0.5"]`` -> a dict; values read as JSON where they
+    parse (numbers, booleans, objects), else as text."""
+    out: dict = {}
+    for item in items or []:
+        key, sep, value = item.partition("=")
+        if not sep or not key.strip():
+            raise ConfigError(f"--reader-option takes KEY=VALUE, got '{item}'")
+        try:
+            out[key.strip()] = json.loads(value)
+        except json.JSONDecodeError:
+            out[key.strip()] = value
+    return out
+
+
+def trajectory_text(fitted) -> str:
+    """The trajectory block of the report: filter, routes, joint parameters, passivity."""
+    info = fitted.provenance.get("trajectory", {})
+    d = info.get("derivative", {})
+    lines = [
+        "[[Trajectory]]",
+        f"    route: {info.get('route')} (static part from {info.get('static_from')}); "
+        f"{info.get('seconds', float('nan')):.2f} s",
+        f"    derivatives: {d.get('method')} of the {d.get('source')}, "
+        + ", ".join(f"{k} {v}" for k, v in d.items() if k not in ("method", "source")),
+    ]
+    for name, row in info.get("joint", {}).items():
+        lines.append(
+            f"    {name}: {row['value']:.6g} +/- {row['stderr']:.2g} "
+            f"(95 % CI [{row['ci95_low']:.5g}, {row['ci95_high']:.5g}])"
+        )
+    for name, route in info.get("routes", {}).items():
+        rms = ", ".join(f"{k} {v:.3g}" for k, v in route.get("rms", {}).items())
+        lines.append(
+            f"    route {name}: {route.get('nfev')} evaluations, {route.get('seconds', 0):.2f} s, "
+            f"converged {route.get('converged')}, residual RMS {rms}"
+        )
+    p = info.get("passivity")
+    if p:
+        lines.append(
+            f"    passivity: {'passive' if p['passive'] else 'NOT passive'} (margin "
+            f"{p['margin']}; across the 95 % intervals: "
+            f"{'passive' if p['passive_across_ci95'] else 'not guaranteed'}); {p['condition']}"
+        )
+    return "\n".join(lines)
+
+
+def run_trajectory(
+    log_path: Path,
+    model: str,
+    method: str,
+    *,
+    reader: str,
+    reader_options: dict,
+    seed: int,
+    max_evals: int | None,
+    route: str,
+    gravity: str,
+    out: Path | None,
+) -> None:
+    """Open, identify, save and print (the ``--trajectory`` branch of ``fricid fit``)."""
+    from ..identify.trajectory import fit_trajectory
+    from ..io import open_log
+    from ..samples import RawLog
+
+    opened = open_log(log_path, reader, reader_options)
+    if not isinstance(opened, RawLog) and not hasattr(opened, "__next__"):
+        raise DataError(
+            "this reader gives friction samples (steady-state means), not a time series: a "
+            "trajectory needs time, position, velocity and torque",
+            file=str(log_path),
+        )
+    chunks = list(opened)
+    log = chunks[0] if len(chunks) == 1 else RawLog.concatenate(chunks)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        fitted = fit_trajectory(
+            log, model, method, route=route, gravity=gravity, seed=seed, max_evals=max_evals
+        )
+    lines = [f"{w.category.__name__}: {w.message}" for w in caught]
+    if lines:
+        fitted.provenance["warnings"] = lines
+    out = out or Path(f"{log_path.stem}.{fitted.model}.json")
+    fitted.save(out)
+    console.print(fitted.report(), markup=False, highlight=False, soft_wrap=True)
+    console.print(trajectory_text(fitted), markup=False, highlight=False, soft_wrap=True)
+    for w in caught:
+        warnings.showwarning(w.message, w.category, w.filename, w.lineno)
+    err_console.print(f"wrote {escape(str(out))}")

@@ -1,0 +1,347 @@
+"""The two routes of :mod:`fricid.identify.trajectory`: inverse-dynamics regression and
+simulation error (see that module's notes), each returning a :class:`_Stage` (estimate,
+cluster-robust covariance, 95 % intervals, the optimiser's result, timing)."""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ..errors import ConfigError, DataError
+from ..models import lugre
+from ..optim import METHODS, minimize
+from ._trajectory_data import Series, blocks, cluster_covariance, low_speed_windows
+from .uncertainty import jacobian
+
+__all__ = ["JOINT_PARAMS", "LSQ_STARTS"]
+
+#: Starts of the least-squares methods (the first at the given start: the static part's
+#: defaults, or the first stage's estimate; the second at random in the box).
+LSQ_STARTS = 2
+
+#: Starts of the least-squares methods on the simulation route: one, from the box centre
+#: (sigma_0 = 10^4.5 N m/rad, sigma_1 = 1 N m s/rad) or the two-stage estimate; on the virtual
+#: joint the simulation error was unimodal in log sigma_0 (scanned 1e3-1e5), and on the 5
+#: seeds of ``benchmarks/bench_trajectory.py`` a second, random start gave the same table
+#: at about twice the route's time.
+SIM_STARTS = 1
+
+#: Names of the joint's rigid-body parameters.
+JOINT_PARAMS = ("inertia", "p_x", "p_y")
+_JOINT_UNITS = {"inertia": "kg m^2", "p_x": "N m", "p_y": "N m"}
+
+
+@dataclass
+class _Stage:
+    """One route's estimate: names, values, standard errors, 95 % intervals, bookkeeping."""
+
+    names: list[str]
+    values: np.ndarray
+    stderr: np.ndarray
+    low: np.ndarray
+    high: np.ndarray
+    cov: np.ndarray
+    result: Any
+    seconds: float
+    clusters: int
+    rms: dict[str, float]
+    bounds: np.ndarray
+
+    def table(self) -> dict[str, dict[str, float]]:
+        return {
+            n: {
+                "value": float(v),
+                "stderr": float(s),
+                "ci95_low": float(lo),
+                "ci95_high": float(hi),
+            }
+            for n, v, s, lo, hi in zip(
+                self.names, self.values, self.stderr, self.low, self.high, strict=True
+            )
+        }
+
+
+def _t975(dof: int) -> float:
+    from scipy.stats import t
+
+    return float(t.ppf(0.975, max(dof, 1)))
+
+
+def _run(fun_res, bounds, method, x0, seed, max_evals, starts=None):
+    """``minimize`` with residuals for the least-squares methods (``starts`` of them, default
+    :data:`LSQ_STARTS`), their SSE for the others."""
+    key = method.strip().lower()
+    if key not in METHODS:
+        raise ConfigError(f"unknown method '{method}'; choose one of: {', '.join(METHODS)}")
+
+    def sse(U):
+        r = fun_res(U)
+        return np.einsum("ij,ij->i", r, r)
+
+    if METHODS[key].uses_residuals:
+        n = LSQ_STARTS if starts is None else starts
+        options = {"n_starts": n} if "n_starts" in METHODS[key].options else None
+        return minimize(
+            None,
+            bounds,
+            key,
+            seed=seed,
+            max_evals=max_evals,
+            x0=x0,
+            residuals=fun_res,
+            options=options,
+        )
+    return minimize(sse, bounds, key, seed=seed, max_evals=max_evals, x0=x0)
+
+
+def _regression(series, vf, acc, mask, model, gravity, method, seed, max_evals, cluster_n, fixed):
+    """The inverse-dynamics route (module notes); ``fixed`` holds the friction parameters."""
+    t0 = time.perf_counter()
+    y = series.torque[mask]
+    q = series.position[mask]
+    cols = [acc[mask]] + ([-np.cos(q), np.sin(q)] if gravity == "fit" else [])
+    Phi = np.column_stack(cols)
+    nd, d = Phi.shape[1], model.n_params
+    Qphi, _ = np.linalg.qr(Phi)
+    X = np.column_stack([vf[mask], np.zeros(mask.sum()), series.temperature[mask]])
+    rough = np.linalg.lstsq(np.column_stack([Phi, np.sign(X[:, 0]), X[:, 0]]), y, rcond=None)[0]
+    F_scale = y - Phi @ rough[:nd]
+    bounds = model.bounds(X, F_scale)
+    x0 = np.clip(model.defaults(X, F_scale), bounds[:, 0], bounds[:, 1])
+
+    def projected(P):
+        R = y[None, :] - model.predict(np.atleast_2d(P), X)
+        return R - (R @ Qphi) @ Qphi.T
+
+    result = None
+    if fixed is None:
+        result = _run(projected, bounds, method, x0, seed, max_evals)
+        theta = np.asarray(result.x, dtype=float)
+    else:
+        theta = np.asarray(fixed, dtype=float)
+    c = np.linalg.lstsq(Phi, y - model.predict(theta, X), rcond=None)[0]
+
+    def full(P):
+        P = np.atleast_2d(P)
+        return y[None, :] - model.predict(P[:, :d], X) - P[:, d:] @ Phi.T
+
+    names = list(JOINT_PARAMS[:nd])
+    box = np.column_stack([np.full(nd, -np.inf), np.full(nd, np.inf)])
+    if fixed is None:
+        p_hat, resid = np.concatenate([theta, c]), full
+        names = list(model.param_names) + names
+        box = np.vstack([bounds, box])
+    else:
+        p_hat = c
+
+        def resid(P):
+            P = np.atleast_2d(P)
+            return full(np.column_stack([np.broadcast_to(theta, (len(P), d)), P]))
+
+    Jm, r0 = jacobian(resid, p_hat)
+    labels = blocks(series.time.size, cluster_n)[mask]
+    cov, se, g = cluster_covariance(Jm, r0, labels)
+    tq = _t975(g - 1)
+    low = np.maximum(p_hat - tq * se, box[:, 0])
+    high = np.minimum(p_hat + tq * se, box[:, 1])
+    rms = {"torque": float(np.sqrt(np.mean(r0**2)))}
+    stage = _Stage(names, p_hat, se, low, high, cov, result, time.perf_counter() - t0, g, rms, box)
+    return stage, theta, c, r0
+
+
+@dataclass
+class _Windows:
+    """The simulation route's data: the samples of every window, concatenated."""
+
+    index: np.ndarray
+    reset: np.ndarray
+    labels: np.ndarray
+    tau: np.ndarray
+    q: np.ndarray
+    v: np.ndarray
+    a: np.ndarray
+    dt: float
+    count: int
+
+
+def _windows(series: Series, vf, acc, v_window, before, after, longest) -> _Windows:
+    spans = low_speed_windows(np.abs(vf), v_window, before, after, longest)
+    if not spans:
+        raise DataError(
+            f"the trajectory never comes below {v_window:g} rad/s: nothing determines the "
+            "dynamic friction (sigma_0, sigma_1); record reversals, sticking or pre-sliding",
+            file=None,
+        )
+    index = np.concatenate([np.arange(a, b) for a, b, _ in spans])
+    reset = np.zeros(index.size, dtype=bool)
+    labels = np.zeros(index.size, dtype=np.int64)
+    at = 0
+    for a, b, w in spans:
+        reset[at] = True
+        labels[at : at + b - a] = w
+        at += b - a
+    return _Windows(
+        index,
+        reset,
+        labels,
+        series.torque[index],
+        series.position[index],
+        series.velocity[index],
+        acc[index],
+        series.dt,
+        int(spans[-1][2]) + 1,
+    )
+
+
+#: Parameters of the simulation route searched on a log scale.
+_LOG = ("sigma_0", "sigma_1")
+
+
+class _SimProblem:
+    """Simulation-error residuals over the windows, for a chosen set of free parameters.
+
+    The full vector is LuGre's seven parameters then J, p_x, p_y; the optimiser moves
+    ``free`` of them (sigma_0, sigma_1 as log10).
+    """
+
+    def __init__(self, w: _Windows, base: np.ndarray, free: list[str], n_sub: int) -> None:
+        self.w, self.base, self.free, self.n_sub = w, base, free, n_sub
+        self.all_names = list(lugre.PARAM_NAMES) + list(JOINT_PARAMS)
+        self.pos = [self.all_names.index(n) for n in free]
+        self.log = np.array([n in _LOG for n in free])
+        self.keep = ~w.reset
+        self.scale = np.ones(2)
+
+    def to_u(self, values: np.ndarray) -> np.ndarray:
+        return np.where(self.log, np.log10(np.maximum(values, 1e-300)), values)
+
+    def to_values(self, U: np.ndarray) -> np.ndarray:
+        return np.where(self.log, 10.0**U, U)
+
+    def full(self, U, at=None) -> np.ndarray:
+        U = np.atleast_2d(U)
+        P = np.tile(self.base if at is None else at, (len(U), 1))
+        P[:, self.pos] = self.to_values(U)
+        return P
+
+    def simulate(self, P: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        w = self.w
+        sim = lugre.simulate_joint(
+            P[:, :7],
+            P[:, 7],
+            P[:, 8],
+            P[:, 9],
+            w.dt,
+            w.tau,
+            q0=w.q[0],
+            v0=w.v[0],
+            reset=w.reset,
+            measured=(w.q, w.v, w.a),
+            n_sub=self.n_sub,
+        )
+        return sim["position"], sim["velocity"]
+
+    def residuals_full(self, P: np.ndarray) -> np.ndarray:
+        Q, V = self.simulate(np.atleast_2d(P))
+        k = self.keep
+        r = np.hstack(
+            [(Q[:, k] - self.w.q[k]) / self.scale[0], (V[:, k] - self.w.v[k]) / self.scale[1]]
+        )
+        return np.where(np.isfinite(r), r, 1e6)
+
+    def residuals(self, U) -> np.ndarray:
+        return self.residuals_full(self.full(U))
+
+    def set_scale(self, P: np.ndarray) -> None:
+        Q, V = self.simulate(np.atleast_2d(P))
+        k = self.keep
+        rq = float(np.sqrt(np.mean((Q[0, k] - self.w.q[k]) ** 2)))
+        rv = float(np.sqrt(np.mean((V[0, k] - self.w.v[k]) ** 2)))
+        self.scale = np.array([rq if rq > 0 else 1.0, rv if rv > 0 else 1.0])
+
+    def labels(self) -> np.ndarray:
+        lab = self.w.labels[self.keep]
+        return np.concatenate([lab, lab])
+
+
+def _simulation(problem: _SimProblem, bounds_u, x0_u, method, seed, max_evals, first=None):
+    """The simulation-error route over ``problem.free``; ``first`` = (stage, names in the
+    full vector) carries the first stage's covariance into this one (Murphy-Topel)."""
+    t0 = time.perf_counter()
+    result = _run(problem.residuals, bounds_u, method, x0_u, seed, max_evals, SIM_STARTS)
+    u_hat = np.asarray(result.x, dtype=float)
+    Jm, r0 = jacobian(problem.residuals, u_hat)
+    cov, se, g = cluster_covariance(Jm, r0, problem.labels())
+    if first is not None:
+        stage, held = first
+        P_hat = problem.full(u_hat)[0]
+        sel = [i for i, n in enumerate(held) if n is not None and n not in problem.free]
+        if sel:
+            cols = [problem.all_names.index(held[i]) for i in sel]
+
+            def shifted(S):
+                S = np.atleast_2d(S)
+                P = np.tile(P_hat, (len(S), 1))
+                P[:, cols] = S
+                return problem.residuals_full(P)
+
+            J21, _ = jacobian(shifted, P_hat[cols])
+            V1 = np.nan_to_num(stage.cov[np.ix_(sel, sel)])
+            G = -np.linalg.pinv(Jm) @ J21
+            extra = G @ V1 @ G.T
+            with np.errstate(invalid="ignore"):
+                cov = cov + extra
+                se = np.sqrt(se**2 + np.clip(np.diag(extra), 0, None))
+    tq = _t975(g - 1)
+    lo_u = np.maximum(u_hat - tq * se, bounds_u[:, 0])
+    hi_u = np.minimum(u_hat + tq * se, bounds_u[:, 1])
+    values = problem.to_values(u_hat)
+    stderr = np.where(problem.log, values * np.log(10.0) * se, se)
+    rms = dict(
+        zip(
+            ("position", "velocity"),
+            problem.scale
+            * np.sqrt([np.mean(r0[: r0.size // 2] ** 2), np.mean(r0[r0.size // 2 :] ** 2)]),
+            strict=True,
+        )
+    )
+    return _Stage(
+        list(problem.free),
+        values,
+        stderr,
+        problem.to_values(lo_u),
+        problem.to_values(hi_u),
+        cov,
+        result,
+        time.perf_counter() - t0,
+        g,
+        {k: float(v) for k, v in rms.items()},
+        np.column_stack([problem.to_values(bounds_u[:, 0]), problem.to_values(bounds_u[:, 1])]),
+    )
+
+
+def _sim_bounds(problem: _SimProblem, stage1: _Stage, names_full: dict[str, str]) -> np.ndarray:
+    """Search box of the simulation route, in its coordinates (log10 for sigma_0, sigma_1)."""
+    out = []
+    by_name = {
+        names_full.get(n, n): (v, b)
+        for n, v, b in zip(stage1.names, stage1.values, stage1.bounds, strict=True)
+    }
+    for n in problem.free:
+        if n == "sigma_0":
+            out.append((2.0, 7.0))
+        elif n == "sigma_1":
+            out.append((-3.0, 3.0))
+        elif n == "inertia":
+            v = max(by_name[n][0], 1e-6)
+            out.append((0.2 * v, 5.0 * v))
+        elif n in ("p_x", "p_y"):
+            v = by_name[n][0]
+            half = max(0.5 * abs(v), 0.05 * float(np.max(np.abs(problem.w.tau))))
+            out.append((v - half, v + half))
+        else:
+            out.append(tuple(by_name[n][1]))
+    return np.array(out, dtype=float)

@@ -1,0 +1,221 @@
+"""Trajectory experiments on the virtual joint and identification from them (issue 16)."""
+
+from __future__ import annotations
+
+import json
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from fricid.cli import app
+from fricid.errors import ConfigError, DataError
+from fricid.fitted import FittedModel
+from fricid.identify.trajectory import DerivativeFilter, fit_trajectory
+from fricid.models import Stribeck
+from fricid.sim import Joint, ModelLaw
+from fricid.sim import trajectory as tr
+
+JOINT = Joint(law=lambda v, load, temp: np.zeros_like(v), p_x=0.3, p_y=0.1, inertia=0.01)
+STATIC = np.array([0.5, 0.8, 0.1, 0.2, 1.0])  # stribeck: tau_c, tau_s, w_s, tau_v, delta
+TRUTH = tr.LuGreTruth()
+
+
+def covered(fitted, truth: dict[str, float]) -> dict[str, bool]:
+    return {n: bool(fitted.ci95_low[n] <= v <= fitted.ci95_high[n]) for n, v in truth.items()}
+
+
+@pytest.mark.parametrize("kind", tr.KINDS)
+def test_every_experiment_gives_a_reader_like_log(kind):
+    e = getattr(tr, kind)(duration=2.0)
+    log = tr.simulate_trajectory(e, TRUTH, JOINT, seed=3)
+    assert log.current is not None and log.torque_constant == 0.5
+    assert log.meta["experiment"] == kind and log.meta["truth"]["sigma_0"] == 1e4
+    assert np.all(np.isfinite(log.motor_torque))
+    if kind == "presliding":  # below break-away: micro-radians only
+        assert np.ptp(log.position) < 1e-3
+    if kind in ("sine", "chirp", "multisine"):  # tracked, crossing zero velocity
+        assert np.max(np.abs(log.position - e.q_ref)) < 2e-3
+        assert np.any(np.diff(np.sign(e.v_ref)) != 0)
+
+
+def test_static_truth_is_the_inverse_dynamics_and_refuses_torque_drives():
+    law = ModelLaw(Stribeck(), STATIC)
+    e = tr.sine(duration=1.0)
+    log = tr.simulate_trajectory(e, law, JOINT, noise=tr.Noise.none())
+    expected = (
+        0.01 * e.a_ref + law(e.v_ref, 0, 25) - (0.3 * np.cos(e.q_ref) - 0.1 * np.sin(e.q_ref))
+    )
+    np.testing.assert_allclose(log.motor_torque, expected, atol=1e-9)
+    with pytest.raises(ConfigError, match="dynamic truth"):
+        tr.simulate_trajectory(tr.stick_slip(duration=1.0), law, JOINT)
+
+
+def test_static_model_from_a_trajectory_within_intervals():
+    law = ModelLaw(Stribeck(), STATIC)
+    log = tr.simulate_trajectory(tr.multisine(duration=10.0, seed=2), law, JOINT, seed=2)
+    fitted = fit_trajectory(log, "stribeck", "lm")
+    truth = dict(zip(Stribeck().param_names, STATIC, strict=True))
+    hits = covered(fitted, truth)
+    joint = fitted.provenance["trajectory"]["joint"]
+    hits.update(
+        {
+            n: joint[n]["ci95_low"] <= v <= joint[n]["ci95_high"]
+            for n, v in (("inertia", 0.01), ("p_x", 0.3), ("p_y", 0.1))
+        }
+    )
+    assert sum(hits.values()) >= len(hits) - 1, hits  # 95 % intervals: at most one miss of 8
+    assert fitted.provenance["trajectory"]["derivative"]["method"] == "savgol"
+
+
+def test_lugre_from_a_trajectory_covers_the_truth_on_two_seeds(tmp_path):
+    hits = {}
+    for seed in (0, 1):
+        log = tr.simulate_trajectory(
+            tr.multisine(duration=10.0, seed=seed), TRUTH, JOINT, seed=seed
+        )
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            fitted = fit_trajectory(log, "lugre", "lm", seed=seed)
+        for n, ok in covered(fitted, TRUTH.params()).items():
+            hits[(seed, n)] = ok
+        info = fitted.provenance["trajectory"]
+        assert set(info["routes"]) == {"regression", "simulation"}
+        assert info["passivity"]["condition"].startswith("sigma_1 <=")
+    # 14 intervals of 95 %: about 13 should hold; 12 is the honest floor (binomial, p 0.97)
+    assert sum(hits.values()) >= 12, {k: v for k, v in hits.items() if not v}
+    path = fitted.save(tmp_path / "lugre.json")
+    again = FittedModel.load(path)
+    assert again.model == "lugre" and again.params == pytest.approx(fitted.params)
+    assert again.predict_point(0.5) == pytest.approx(
+        fitted.params["tau_c"]
+        + (fitted.params["tau_s"] - fitted.params["tau_c"])
+        * np.exp(-((0.5 / fitted.params["w_s"]) ** fitted.params["delta"]))
+        + fitted.params["sigma_2"] * 0.5
+    )
+
+
+def test_single_sine_cannot_separate_inertia_from_gravity():
+    log = tr.simulate_trajectory(tr.sine(duration=6.0), TRUTH, JOINT, seed=1)
+    fitted_or_error = None
+    try:
+        fitted_or_error = fit_trajectory(log, "lugre")
+    except DataError as exc:
+        assert "collinear" in str(exc)
+        return
+    # if the noise happens to give a positive J, its interval must be wide
+    row = fitted_or_error.provenance["trajectory"]["joint"]["inertia"]
+    assert row["stderr"] > 0.05 * abs(row["value"])
+
+
+def test_options_are_checked():
+    log = tr.simulate_trajectory(tr.multisine(duration=2.0), TRUTH, JOINT)
+    with pytest.raises(ConfigError, match="trajectory identifies"):
+        fit_trajectory(log, "vlt")
+    with pytest.raises(ConfigError, match="simulation route"):
+        fit_trajectory(log, "lugre", route="regression")
+    with pytest.raises(ConfigError, match="derivative filter"):
+        DerivativeFilter(method="spline")
+
+
+def write_joint_bag(path: Path, log) -> Path:
+    from rosbags.rosbag2 import StoragePlugin, Writer
+    from rosbags.typesys import Stores, get_typestore
+
+    ts = get_typestore(Stores.ROS2_HUMBLE)
+    JointState = ts.types["sensor_msgs/msg/JointState"]
+    Header = ts.types["std_msgs/msg/Header"]
+    Time = ts.types["builtin_interfaces/msg/Time"]
+    t0 = 1_700_000_000_000_000_000
+    with Writer(path, version=9, storage_plugin=StoragePlugin.MCAP) as w:
+        conn = w.add_connection("/joint_states", JointState.__msgtype__, typestore=ts)
+        for t, q, v, u in zip(log.time, log.position, log.velocity, log.motor_torque, strict=True):
+            ns = t0 + round(t * 1e9)
+            msg = JointState(
+                header=Header(stamp=Time(sec=ns // 10**9, nanosec=ns % 10**9), frame_id=""),
+                name=["elbow"],
+                position=np.array([q]),
+                velocity=np.array([v]),
+                effort=np.array([u]),
+            )
+            w.write(conn, ns, ts.serialize_cdr(msg, JointState.__msgtype__))
+    return path
+
+
+def test_cli_fits_lugre_from_a_ros2_bag(tmp_path):
+    e = tr.multisine(duration=8.0, rate=500.0, seed=4)
+    log = tr.simulate_trajectory(e, TRUTH, JOINT, seed=4)
+    bag = write_joint_bag(tmp_path / "run", log)
+    out = tmp_path / "elbow.json"
+    result = CliRunner().invoke(
+        app,
+        [
+            "fit",
+            str(bag),
+            "--trajectory",
+            "--model",
+            "lugre",
+            "--format",
+            "rosbag",
+            "--reader-option",
+            "joint=elbow",
+            "--reader-option",
+            "temperature=25",
+            "--out",
+            str(out),
+        ],
+    )
+    assert result.exit_code == 0, result.output
+    assert "[[Trajectory]]" in result.output and "passivity" in result.output
+    fitted = FittedModel.load(out)
+    assert fitted.model == "lugre"
+    assert fitted.params["tau_c"] == pytest.approx(0.5, rel=0.05)
+    joint = json.loads(out.read_text())["provenance"]["trajectory"]["joint"]
+    assert joint["inertia"]["value"] == pytest.approx(0.01, rel=0.1)
+
+
+def test_cli_refuses_a_log_without_motion(tmp_path):
+    result = CliRunner().invoke(app, ["fit", str(tmp_path / "missing.csv"), "--trajectory"])
+    assert result.exit_code == 2
+
+
+def test_any_optimiser_and_static_part_from_sweeps():
+    log = tr.simulate_trajectory(tr.multisine(duration=6.0, seed=5), TRUTH, JOINT, seed=5)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        fitted = fit_trajectory(log, "lugre", "bas", max_evals=60, seed=1)
+    assert fitted.method == "bas" and fitted.convergence is not None
+    assert fitted.provenance["trajectory"]["routes"]["simulation"]["nfev"] <= 60
+    sweep = FittedModel(
+        model="stribeck",
+        params=dict(zip(Stribeck().param_names, STATIC, strict=True)),
+        stderr=dict.fromkeys(Stribeck().param_names, 0.001),
+        ci95_low=dict(zip(Stribeck().param_names, STATIC - 0.002, strict=True)),
+        ci95_high=dict(zip(Stribeck().param_names, STATIC + 0.002, strict=True)),
+    )
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        two = fit_trajectory(log, "lugre", static=sweep)
+    assert two.provenance["trajectory"]["static_from"] == "sweeps"
+    assert two.params["tau_s"] == 0.8 and two.ci95_low["tau_s"] == pytest.approx(0.798)
+    assert set(two.provenance["trajectory"]["routes"]["regression"]["parameters"]) == {
+        "inertia",
+        "p_x",
+        "p_y",
+    }
+
+
+def test_passivity_is_judged_at_the_estimate_and_the_worst_corner():
+    from fricid.identify.trajectory import _passivity
+
+    names = list(TRUTH.params())
+    values = TRUTH.theta
+    wide_high = values.copy()
+    wide_high[1] = 10.0  # sigma_1 up to 10 N m s/rad inside the interval: not passive there
+    p = _passivity(names, values, values * 0.99, wide_high)
+    assert p["passive"] and not p["passive_across_ci95"]
+    damped = values.copy()
+    damped[1] = 5.0
+    assert not _passivity(names, damped, damped, damped)["passive"]
