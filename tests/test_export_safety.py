@@ -148,6 +148,14 @@ def c_text(fitted: FittedModel, **options) -> str:
 # -- the escaper and the number formatter ---------------------------------------------------
 
 
+@pytest.mark.parametrize("name", ["a ", " a", " ", "x  "])
+def test_blanks_at_the_ends_survive_the_export(name):
+    """Exports strip trailing blanks from their lines: a file named "a " must not be written
+    as if it were "a" (found by the property test below)."""
+    assert plain(name) != plain(name.strip()) and plain(name).endswith(("%20", "a"))
+    assert c_text(stribeck(), source=name, sha256=SHA) == expected(c_text, "lm", "bench", name)
+
+
 @settings(max_examples=300, deadline=None)
 @given(hostile)
 def test_escaper_is_inert_and_reversible(text):

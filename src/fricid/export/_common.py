@@ -111,7 +111,9 @@ def plain(text: object, limit: int = PLAIN_LIMIT) -> str:
     -------
     str
         Only letters, digits, space, ``_.,:;=+()[]@/``, ``%XX`` escapes and single ``-``
-        characters that neither start nor end it.
+        characters that neither start nor end it. Spaces at either end are escaped too
+        (``%20``): exports strip trailing blanks from their lines, and "a " must not come out
+        as "a".
     """
     text = str(text)
     extra = len(text) - limit
@@ -120,7 +122,10 @@ def plain(text: object, limit: int = PLAIN_LIMIT) -> str:
     out: list[str] = []
     last = len(text) - 1
     for i, ch in enumerate(text):
-        if ch in _PLAIN or (ch == "-" and 0 < i < last and not out[-1].endswith("-")):
+        inner = 0 < i < last
+        if (ch in _PLAIN and (ch != " " or inner)) or (
+            ch == "-" and inner and not out[-1].endswith("-")
+        ):
             out.append(ch)
         else:
             out.append("".join(f"%{b:02X}" for b in ch.encode("utf-8", "surrogatepass")))
