@@ -160,6 +160,7 @@ def fit(
             network,
             inputs,
             callback,
+            model_name=model.strip().lower(),
             fixed=fixed,
             bounds=bounds,
             x0=x0,
@@ -316,6 +317,9 @@ def _fit_network(
     ``method_options``, ``max_evals`` -> ``max_epochs``)."""
     from .rbf import RBFNetRegressor, fit_rbf
 
+    fit_network = fit_rbf
+    if analytic.pop("model_name", "rbf") == "hybrid":  # issue 15: backbone + RBF residual
+        from .hybrid import fit_hybrid as fit_network
     given = [name for name, value in analytic.items() if value]
     if given:
         raise ConfigError(
@@ -337,7 +341,9 @@ def _fit_network(
     if max_evals is not None:
         per_epoch = int(params.get("evals_per_epoch", RBFNetRegressor().evals_per_epoch))
         params["max_epochs"] = max(1, -(-int(max_evals) // per_epoch))
-    return fit_rbf(samples, inputs, **params)
+    # the default inputs are the measured ones (a column not measured is no error here)
+    names = None if tuple(inputs) == INPUTS else inputs
+    return fit_network(samples, names, **params)
 
 
 def evaluate(model: FittedModel, samples: FrictionSamples) -> dict[str, float]:

@@ -13,6 +13,7 @@ from ..errors import ConfigError
 from ._analytic import CoulombViscous, LoadDependent, Stribeck, VelocityLoadTemperature
 from ._asymmetric import Asymmetric
 from ._base import INPUTS, FrictionModel, Parameter, data_scales
+from .hybrid import HYBRID, HybridModel
 from .rbf import NETWORK, RBFNetwork
 
 __all__ = [
@@ -60,12 +61,12 @@ def get_model(name: str | FrictionModel, asymmetric: bool = False) -> FrictionMo
 
 
 #: Models that predict from a stored state rather than a parameter vector, by registry name.
-STATEFUL: dict[str, RBFNetwork] = {NETWORK.name: NETWORK}
+STATEFUL: dict[str, RBFNetwork | HybridModel] = {NETWORK.name: NETWORK, HYBRID.name: HYBRID}
 
 
-def get_predictor(name: str | FrictionModel) -> FrictionModel | RBFNetwork:
+def get_predictor(name: str | FrictionModel) -> FrictionModel | RBFNetwork | HybridModel:
     """The model a model file names: an analytic model (:func:`get_model`) or a stateful one
-    (:data:`STATEFUL`: ``"rbf"``).
+    (:data:`STATEFUL`: ``"rbf"``, ``"hybrid"``).
 
     Either predicts with ``predict(theta_or_state, X)``; ``stateful`` tells which argument.
     """
