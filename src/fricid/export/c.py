@@ -35,8 +35,8 @@ import numpy as np
 from .. import __version__
 from ..fitted import FittedModel
 from ..models import Asymmetric
-from ..models.rbf import tail_terms
 from ..models.smoothing import VISCOUS_TERM, Smoothing
+from ._c_hybrid import hybrid_parts, tail_code
 from ._common import (
     ExportError,
     check_identifier,
@@ -239,17 +239,8 @@ def _rbf_network(state: dict, side: str, magnitude: bool = False) -> tuple[list[
             f"{fmt_float(float(vscale), f'{where}.velocity_scale')};"
             "  /* [rad/s] velocity warped by asinh(v / scale) */"
         )
-    linear = state.get("linear")
-    if linear is not None:
-        consts.append(
-            _array(f"{pre}linear", np.asarray(linear, dtype=float), "linear tail [N m per unit]")
-        )
-    if linear is not None and magnitude:
-        floor = max(float(state.get("magnitude_floor") or 0.0), 0.0)
-        consts.append(
-            f"static const double {pre}floor = {fmt_float(floor, f'{where}.magnitude_floor')};"
-            "  /* [N m] smallest magnitude of friction */"
-        )
+    tail_consts, tail_body = tail_code(state, pre, where, magnitude, _array)
+    consts += tail_consts
     x0 = f"asinh(velocity / {pre}velocity_scale)" if vscale is not None else None
     picks = [x0 if (k == 0 and x0) else name for k, name in enumerate(inputs)]
     unused = [name for name in ("velocity", "load", "temperature") if name not in inputs]
@@ -274,19 +265,7 @@ def _rbf_network(state: dict, side: str, magnitude: bool = False) -> tuple[list[
         f"        const double dot = {dot};\n"
         f"        const double d2 = fmax(zz + {pre}cc[j] - 2.0 * dot, 0.0);\n"
         f"        acc += exp(-d2 * {pre}inv[j]) * {pre}weights[j];\n"
-        "    }\n"
-        + "".join(
-            f"    acc += {pre}linear[{i}] * "
-            f"{' * '.join('fabs(load)' if x == 'load' else x for x in term.split('*'))};\n"
-            for i, term in enumerate(tail_terms(inputs))
-            if linear is not None
-        )
-        + (
-            f"    return fmax(acc + {pre}bias, {pre}floor);  /* a magnitude: opposes motion */\n"
-            if linear is not None and magnitude
-            else f"    return acc + {pre}bias;\n"
-        )
-        + "}\n"
+        "    }\n" + tail_body + "}\n"
     )
     return consts, body
 
@@ -415,15 +394,10 @@ def c_code(
             "linear, or none, or refit it"
         )
     if fitted.model == "hybrid":  # issue 15: analytic backbone + RBF residual
-        from ._c_hybrid import hybrid_parts
-
         consts, funcs = hybrid_parts(fitted, smoothing, _analytic_parts, _rbf_parts)
     else:
-        consts, funcs = (
-            _rbf_parts(fitted, smoothing)
-            if fitted.kind == "rbf"
-            else _analytic_parts(fitted, smoothing)
-        )
+        parts = _rbf_parts if fitted.kind == "rbf" else _analytic_parts
+        consts, funcs = parts(fitted, smoothing)
     function = f"{prefix}_friction"
     guard = f"{prefix.upper()}_FRICTION_H"
     header_name, source_name = f"{function}.h", f"{function}.c"
