@@ -48,16 +48,16 @@ import os
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 
-import argparse  # noqa: E402
-import time  # noqa: E402
-import warnings  # noqa: E402
+import argparse
+import time
+import warnings
 
-import numpy as np  # noqa: E402
+import numpy as np
 
-from fricid.identify import fit  # noqa: E402
-from fricid.identify.select import candidates  # noqa: E402
-from fricid.models import MODELS, STATEFUL  # noqa: E402
-from fricid.sim.heldout_laws import KINDS, REPORTING_SEEDS, draw  # noqa: E402
+from fricid.identify import fit
+from fricid.identify.select import candidates
+from fricid.models import MODELS, STATEFUL
+from fricid.sim.heldout_laws import KINDS, REPORTING_SEEDS, draw
 
 GOAL_RATIO = 1.10
 GOAL_TIME = 0.1
@@ -88,7 +88,7 @@ def _analytic(d):
     for name, fixed in names:
         try:
             m, dt = _timed(lambda name=name, fixed=fixed: fit(d.train, name, fixed=fixed or None))
-        except Exception:  # noqa: BLE001 - a family the data do not support
+        except Exception:
             continue
         seconds += dt
         ratio = _ratio(lambda X, m=m: m.predict(X, warn=False), d)
@@ -110,7 +110,7 @@ def _sklearn(d, which: str):
 
     pick = _sk_inputs(d.train)
     X = pick(d.train.X)
-    X = np.column_stack([X, np.sign(X[:, 0])]) if not d.train.directions() == (0,) else X
+    X = np.column_stack([X, np.sign(X[:, 0])]) if d.train.directions() != (0,) else X
     if which == "gp":
         k = X.shape[1]
         kernel = ConstantKernel() * RBF(np.ones(k), (1e-2, 1e3)) + WhiteKernel(1e-2, (1e-6, 1))
