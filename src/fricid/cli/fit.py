@@ -78,6 +78,14 @@ def fit_command(
             "default the measured ones."
         ),
     ] = None,
+    learned: Annotated[
+        bool,
+        typer.Option(
+            "--learned",
+            help="auto: try the learned families too (rbf, hybrid); slower, each is "
+            "retrained for every held-out fold.",
+        ),
+    ] = False,
     backbone: Annotated[
         str | None,
         typer.Option(
@@ -167,6 +175,7 @@ def fit_command(
             max_evals=max_evals,
             **options,
             **({"scheme": validate} if key == "auto" and validate else {}),
+            **({"learned": True} if key == "auto" and learned else {}),
         )
         if validate and key != "auto":
             fitted.validation = validate_model(

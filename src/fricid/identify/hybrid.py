@@ -51,12 +51,16 @@ def fit_backbone(
         The warnings of the chosen backbone's fit.
     """
     from . import _fit
-    from .select import candidates
+    from .select import LEARNED, candidates
 
     if backbone is not None:
         names = [(str(backbone).strip().lower(), {})]
     else:
-        names = [(c.model, dict(c.fixed)) for c in candidates(samples) if not c.note]
+        names = [
+            (c.model, dict(c.fixed))
+            for c in candidates(samples)
+            if not c.note and c.model not in LEARNED
+        ]
         if not names:
             raise ConfigError(
                 "no analytic backbone fits these samples (too few velocity levels for any "
