@@ -21,9 +21,13 @@ noise (1.0 = a model equal to the truth) and the training seconds, for
 * ``hybrid``: ``fit(samples, "hybrid")``, analytic backbone (by BIC) plus RBF residual;
 * ``gp``: ``fit(samples, "gp")`` when a family ``gp`` is registered, else "(not available)";
 * ``sklearn GP``: scikit-learn's ``GaussianProcessRegressor`` with an ARD RBF kernel plus
-  white noise on the standardised inputs (as issue 15's table; first reporting seed only,
-  as the training-time reference);
-* ``MLP``: scikit-learn's ``MLPRegressor((64, 64))`` on the standardised inputs.
+  white noise (as issue 15's table; first reporting seed only, as the training-time
+  reference);
+* ``MLP``: scikit-learn's ``MLPRegressor`` with two hidden layers of 64.
+
+Both scikit-learn models get the structure the fricid models get (the same for every model:
+fair): standardised inputs ``asinh(|v| / v_min)``, the other measured inputs and the direction
+(per-direction samples), target ``sign(v) F``, prediction ``sign(v) g``.
 
 Goals (issue 15): the default model <= 1.10 x noise on each kind; its training time <= 0.1 x
 the GP's (the registered ``gp`` when there is one, else the sklearn GP) on the same data.
@@ -76,8 +80,20 @@ def _ratio(predict, d) -> float:
 
 
 def _sk_inputs(samples):
+    """The structured inputs the scikit-learn models get: ``asinh(|v| / v_min)``, the other
+    measured inputs, and the direction for per-direction samples; their target is
+    ``sign(v) F`` (friction opposes motion), their prediction ``sign(v) g``."""
     cols = [["velocity", "load", "temperature"].index(n) for n in samples.measured]
-    return lambda X: np.asarray(X)[:, cols]
+    v_min = float(np.min(np.abs(samples.velocity[samples.velocity != 0])))
+    both = samples.directions() != (0,)
+
+    def pick(X):
+        Z = np.asarray(X, dtype=float)[:, cols].copy()
+        v = Z[:, 0].copy()
+        Z[:, 0] = np.arcsinh(np.abs(v) / v_min)
+        return np.column_stack([Z, np.sign(v)]) if both else Z
+
+    return pick
 
 
 def _analytic(d):
@@ -112,7 +128,7 @@ def _sklearn(d, which: str):
 
     pick = _sk_inputs(d.train)
     X = pick(d.train.X)
-    X = np.column_stack([X, np.sign(X[:, 0])]) if d.train.directions() != (0,) else X
+    t = np.sign(d.train.velocity) * d.train.y
     if which == "gp":
         k = X.shape[1]
         kernel = ConstantKernel() * RBF(np.ones(k), (1e-2, 1e3)) + WhiteKernel(1e-2, (1e-6, 1))
@@ -125,12 +141,10 @@ def _sklearn(d, which: str):
             StandardScaler(),
             MLPRegressor(hidden_layer_sizes=(64, 64), max_iter=2000, random_state=0),
         )
-    _, dt = _timed(lambda: est.fit(X, d.train.y))
+    _, dt = _timed(lambda: est.fit(X, t))
 
     def predict(Xq):
-        Z = pick(Xq)
-        Z = np.column_stack([Z, np.sign(Z[:, 0])]) if Z.shape[1] < X.shape[1] else Z
-        return est.predict(Z)
+        return np.sign(np.asarray(Xq)[:, 0]) * est.predict(pick(Xq))
 
     return _ratio(predict, d), dt
 

@@ -14,7 +14,7 @@ from fricid.errors import ConfigError, DataError
 from fricid.fitted import FittedModel
 from fricid.identify import fit
 from fricid.models import STATEFUL, get_predictor
-from fricid.models.rbf import interval_half_width, predict_state
+from fricid.models.rbf import interval_half_width, predict_state, tail_terms
 from fricid.sim.heldout_laws import KINDS, REPORTING_SEEDS, TUNING_SEEDS, draw, heldout_law
 
 
@@ -80,8 +80,10 @@ def test_default_rbf_is_structured_cross_validated_and_near_the_floor(asym):
     for side in ("pos", "neg"):
         net = m.state[side]
         assert net["state_version"] == 2 and net["inputs"] == ["velocity", "temperature"]
-        assert net["linear_terms"] == ["velocity", "temperature", "velocity*temperature"]
         sel = net["n_centers_selection"]
+        order = sel["chosen_tail_order"]
+        assert net["linear_terms"] == tail_terms(["velocity", "temperature"], order)
+        assert net["linear_terms"][:3] == ["velocity", "temperature", "velocity*temperature"]
         assert sel["chosen"] == len(net["centers"]) and sel["folds"] == 5
         assert {"chosen_width_factor", "chosen_stretch", "chosen_alpha"} <= set(sel)
     plain = fit(asym.train, "rbf", network={"linear_tail": False, "velocity_scale": None})

@@ -15,7 +15,6 @@ from collections.abc import Callable
 
 from ..fitted import FittedModel
 from ..models.hybrid import backbone_of
-from ..models.rbf import tail_terms
 from ..models.smoothing import Smoothing
 from ._common import fmt_float
 
@@ -40,7 +39,7 @@ def tail_code(
     body = "".join(
         f"    acc += {pre}linear[{i}] * "
         f"{' * '.join('fabs(load)' if x == 'load' else x for x in term.split('*'))};\n"
-        for i, term in enumerate(tail_terms(list(state["inputs"])))
+        for i, term in enumerate(state["linear_terms"])  # checked by predict_state
     )
     if not magnitude:
         return consts, body + f"    return acc + {pre}bias;\n"

@@ -91,6 +91,9 @@ class RBFNetRegressor(RegressorMixin, BaseEstimator):
         ``lsq`` solves weights and ``a`` together by ridge least squares (the columns
         standardised, so the penalty treats them alike; the bias is then always fitted); an
         optimiser trainer fits ``T(X) a + b`` first and searches the network on its residual.
+    tail_order : {1, 2}, default 1
+        2 adds the velocity times each other input squared to the linear tail
+        (:func:`fricid.models.rbf.tail_terms`).
     linear_magnitude : tuple of int, default ()
         Columns the linear tail takes as absolute values (``fit_rbf``: the load,
         :func:`fricid.models.rbf.magnitude_columns`).
@@ -179,6 +182,7 @@ class RBFNetRegressor(RegressorMixin, BaseEstimator):
         "linear_tail": ["boolean"],
         "velocity_stretch": [Interval(Real, 0, None, closed="neither")],
         "linear_magnitude": ["array-like"],
+        "tail_order": [Interval(Integral, 1, 2, closed="both")],
         "velocity_scale": [Interval(Real, 0, None, closed="neither"), None],
         "target_mse": [Interval(Real, 0, None, closed="neither"), None],
         "max_epochs": [Interval(Integral, 1, None, closed="left")],
@@ -199,6 +203,7 @@ class RBFNetRegressor(RegressorMixin, BaseEstimator):
         fit_bias: bool = True,
         linear_tail: bool = False,
         linear_magnitude: tuple[int, ...] = (),
+        tail_order: int = 1,
         velocity_stretch: float = 1.0,
         velocity_scale: float | None = None,
         target_mse: float | None = 1e-4,
@@ -216,6 +221,7 @@ class RBFNetRegressor(RegressorMixin, BaseEstimator):
         self.fit_bias = fit_bias
         self.linear_tail = linear_tail
         self.linear_magnitude = linear_magnitude
+        self.tail_order = tail_order
         self.velocity_stretch = velocity_stretch
         self.velocity_scale = velocity_scale
         self.target_mse = target_mse
@@ -334,7 +340,7 @@ class RBFNetRegressor(RegressorMixin, BaseEstimator):
             C0 = km.fit(Zk).cluster_centers_
         s0 = core.nn_widths(C0, float(self.width_factor), spread)
         L, lin_shift, lin_scale = (
-            _linear_columns(X, tuple(self.linear_magnitude))
+            _linear_columns(X, tuple(self.linear_magnitude), int(self.tail_order))
             if self.linear_tail
             else (None, None, None)
         )
@@ -394,15 +400,15 @@ class RBFNetRegressor(RegressorMixin, BaseEstimator):
         )
         if not np.any(self.linear_):
             return out
-        return out + tail_columns(X, self.linear_magnitude) @ self.linear_
+        return out + tail_columns(X, self.linear_magnitude, int(self.tail_order)) @ self.linear_
 
 
 def _linear_columns(
-    X: np.ndarray, magnitude: tuple[int, ...] = ()
+    X: np.ndarray, magnitude: tuple[int, ...] = (), order: int = 1
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The linear tail's columns (:func:`fricid.models.rbf.tail_columns`) standardised, their
     shift and scale."""
-    X = tail_columns(X, magnitude)
+    X = tail_columns(X, magnitude, order)
     shift = X.mean(axis=0)
     scale = X.std(axis=0)
     scale = np.where(scale > 0, scale, 1.0)

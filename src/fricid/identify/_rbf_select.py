@@ -122,6 +122,9 @@ ALPHAS = (1e-11, 1e-8, 1e-5)
 INTERVAL_LEVELS = (0.9, 0.95)
 
 
+#: Fewest distinct levels of the first input (the speed) for the quadratic tail.
+QUADRATIC_MIN_LEVELS = 6
+
 #: Velocity stretches (:class:`RBFNetRegressor` ``velocity_stretch``) it tries.
 STRETCHES = (1.0, 2.0, 4.0)
 
@@ -184,9 +187,11 @@ class _CrossValidation:
         self.Z = (Xw - Xw.mean(axis=0)) / Xw.std(axis=0)
         self.linear = bool(params.get("linear_tail"))
         self.fit_bias = bool(params.get("fit_bias", True)) or self.linear
-        F = tail_columns(X, tuple(params.get("linear_magnitude") or ()))
-        sd = F.std(axis=0)
-        self.L = (F - F.mean(axis=0)) / np.where(sd > 0, sd, 1.0)
+        self.L = {}
+        for order in (1, 2):
+            F = tail_columns(X, tuple(params.get("linear_magnitude") or ()), order)
+            sd = F.std(axis=0)
+            self.L[order] = (F - F.mean(axis=0)) / np.where(sd > 0, sd, 1.0)
         if self.fit_bias:
             mid, half = 0.5 * (t.max() + t.min()), 0.5 * (t.max() - t.min())
         else:
@@ -202,12 +207,14 @@ class _CrossValidation:
             else []
         )
         self._centres: dict[tuple[int, float], np.ndarray] = {}
-        self._memo: dict[tuple[int, float, float], tuple[int, float, np.ndarray]] = {}
+        self._memo: dict[tuple, tuple[int, float, np.ndarray]] = {}
 
-    def residuals(self, m: int, wf: float, stretch: float) -> tuple[int, float, np.ndarray]:
+    def residuals(
+        self, m: int, wf: float, stretch: float, order: int = 1
+    ) -> tuple[int, float, np.ndarray]:
         from ..models import _rbf_core as core
 
-        key = (m, wf, stretch)
+        key = (m, wf, stretch, order)
         if key in self._memo:
             return self._memo[key]
         Z = self.Z.copy()
@@ -217,7 +224,7 @@ class _CrossValidation:
         C = self._centres[(m, stretch)]
         A = core.design(Z, C, core.nn_widths(C, wf, float(np.sqrt(self.d))))
         if self.linear:
-            A = np.hstack([A, self.L])
+            A = np.hstack([A, self.L[order]])
         oof = np.full((len(self.alphas), len(self.ts)), np.nan)
         for train, test in self.splits:
             At, tt = A[train], self.ts[train]
@@ -255,13 +262,14 @@ def choose_structure(
 
     The search is coordinate-wise: the number of centres over :func:`structure_grid` (width
     factor 1.5, no stretch), then the width factor (:data:`WIDTH_FACTORS`), the velocity
-    stretch (:data:`STRETCHES`), and the number of centres once more; every candidate takes
-    its best penalty among :data:`ALPHAS`. Candidates share their hidden layers across folds:
-    the k-means centres are placed once per number of centres and stretch on all inputs (as
-    ``fit`` places them with the same ``random_state``; the targets are not used, so no
-    held-out target leaks into them), and for each fold the output layer (weights, the
-    linear tail when ``linear_tail``, bias) is solved by ridge least squares for every
-    penalty. One least-squares solve per candidate, fold and penalty: fast.
+    stretch (:data:`STRETCHES`), the linear tail's order (1 or 2, when ``linear_tail``; 2 only
+    with at least :data:`QUADRATIC_MIN_LEVELS` speed levels), and the number of centres once
+    more; every candidate takes its best penalty among :data:`ALPHAS`. Candidates share their
+    hidden layers across folds: the k-means centres are placed once per number of centres and
+    stretch on all inputs (as ``fit`` places them with the same ``random_state``; the targets
+    are not used, so no held-out target leaks into them), and for each fold the output layer
+    (weights, the linear tail when ``linear_tail``, bias) is solved by ridge least squares for
+    every penalty. One least-squares solve per candidate, fold and penalty: fast.
 
     Parameters
     ----------
@@ -319,17 +327,29 @@ def choose_structure(
         scores = [cv.residuals(*c)[1] for c in cands]
         return cands[int(np.argmin(scores))], scores
 
-    (m, _, _), _ = best_of([(g, wf, stretch) for g in grid])
-    (_, wf, _), _ = best_of([(m, w, stretch) for w in widths])
-    (_, _, stretch), _ = best_of([(m, wf, x) for x in stretches])
-    (m, _, _), per_m = best_of([(g, wf, stretch) for g in grid])
-    k, rmse, resid = cv.residuals(m, wf, stretch)
+    orders = (1,)
+    if params.get("linear_tail"):
+        # the quadratic tail only with the levels to resolve it (a few levels: overfitting)
+        # levels: distinct speeds to a tenth of a decade (measured speeds scatter about
+        # their set-points)
+        first = np.abs(X[:, 0])
+        levels = np.unique(np.round(np.log10(first[first > 0]), 1)).size
+        tried = (1, 2) if levels >= QUADRATIC_MIN_LEVELS else (1,)
+        orders = (int(params["tail_order"]),) if params.get("tail_order") else tried
+    order = orders[0]
+    (m, _, _, _), _ = best_of([(g, wf, stretch, order) for g in grid])
+    (_, wf, _, _), _ = best_of([(m, w, stretch, order) for w in widths])
+    (_, _, stretch, _), _ = best_of([(m, wf, x, order) for x in stretches])
+    (_, _, _, order), _ = best_of([(m, wf, stretch, o) for o in orders])
+    (m, _, _, _), per_m = best_of([(g, wf, stretch, order) for g in grid])
+    k, rmse, resid = cv.residuals(m, wf, stretch, order)
     note.update(
         cv_rmse=[r if np.isfinite(r) else None for r in per_m],
         chosen=m,
         chosen_width_factor=wf,
         chosen_stretch=stretch,
         chosen_alpha=alphas[k],
+        chosen_tail_order=order,
         cv_rmse_chosen=rmse,
         prediction_interval={
             "levels": list(INTERVAL_LEVELS),
@@ -338,7 +358,13 @@ def choose_structure(
             "residuals of the chosen candidate (CV+, Barber et al. 2021)",
         },
     )
-    chosen = {"n_centers": m, "width_factor": wf, "velocity_stretch": stretch, "alpha": alphas[k]}
+    chosen = {
+        "n_centers": m,
+        "width_factor": wf,
+        "velocity_stretch": stretch,
+        "alpha": alphas[k],
+        **({"tail_order": order} if params.get("linear_tail") else {}),
+    }
     return chosen, note
 
 

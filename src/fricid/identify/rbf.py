@@ -111,7 +111,7 @@ __all__ = [
 
 def _state(est: RBFNetRegressor, inputs: Sequence[str]) -> dict[str, Any]:
     linear = (
-        {"linear_terms": tail_terms(inputs), "linear": est.linear_.tolist()}
+        {"linear_terms": tail_terms(inputs, int(est.tail_order)), "linear": est.linear_.tolist()}
         if est.linear_tail
         else {}
     )

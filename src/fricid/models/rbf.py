@@ -84,6 +84,7 @@ __all__ = [
     "sub_networks",
     "symmetry_of",
     "tail_columns",
+    "tail_order",
     "tail_terms",
 ]
 
@@ -294,14 +295,15 @@ def _network(
     out = predict_z((Xs - shift) / scale, centers, widths, weights, bias)
     if state.get("linear") is not None:
         terms = state.get("linear_terms")
-        if terms != tail_terms(inputs):
+        order = tail_order(inputs, terms)
+        if order is None:
             raise DataError(
-                f"RBF model state 'linear_terms' must be {tail_terms(inputs)!r} for inputs "
-                f"{list(inputs)!r}; got {terms!r}",
+                f"RBF model state 'linear_terms' must be {tail_terms(inputs)!r} or "
+                f"{tail_terms(inputs, 2)!r} for inputs {list(inputs)!r}; got {terms!r}",
                 column=f"{where}.linear_terms",
             )
         out = out + tail_columns(
-            X[:, [INPUTS.index(n) for n in inputs]], magnitude_columns(inputs)
+            X[:, [INPUTS.index(n) for n in inputs]], magnitude_columns(inputs), order
         ) @ _state_array(state, "linear", (len(terms),))
         if magnitude:  # g is a magnitude: friction opposes motion
             floor = (
@@ -313,14 +315,25 @@ def _network(
     return out
 
 
-def tail_terms(inputs: Sequence[str]) -> list[str]:
+def tail_terms(inputs: Sequence[str], order: int = 1) -> list[str]:
     """Names of the linear tail's columns for a network on ``inputs``: the inputs (the load
     as ``|load|``, :func:`tail_columns`), then the first (the velocity) times each other one,
-    e.g. ``velocity*temperature`` (a viscous
-    coefficient linear in load and temperature). A quadratic term in each was tried on the
-    held-out laws' tuning seeds and made the held-out error worse."""
+    e.g. ``velocity*temperature`` (a viscous coefficient linear in load and temperature), and
+    with ``order=2`` times each other one squared, ``velocity*temperature*temperature`` (a
+    viscous coefficient quadratic in them: an Arrhenius-like coefficient to second order).
+    Cross-validation chooses the order (:mod:`fricid.identify._rbf_select`)."""
     names = list(inputs)
-    return names + [f"{names[0]}*{other}" for other in names[1:]]
+    first, others = names[0], names[1:]
+    out = names + [f"{first}*{o}" for o in others]
+    return out + [f"{first}*{o}*{o}" for o in others] if order == 2 else out
+
+
+def tail_order(inputs: Sequence[str], terms) -> int | None:
+    """The order (1 or 2) whose :func:`tail_terms` are ``terms``; None for neither."""
+    for order in (1, 2):
+        if terms == tail_terms(inputs, order):
+            return order
+    return None
 
 
 def magnitude_columns(inputs: Sequence[str]) -> tuple[int, ...]:
@@ -330,13 +343,18 @@ def magnitude_columns(inputs: Sequence[str]) -> tuple[int, ...]:
     return tuple(j for j, name in enumerate(inputs) if name == "load")
 
 
-def tail_columns(Xs: np.ndarray, magnitude: Sequence[int] = ()) -> np.ndarray:
-    """The linear tail's columns (:func:`tail_terms`) of a network's raw inputs ``(n, d)``,
-    the columns ``magnitude`` (:func:`magnitude_columns`) taken as absolute values."""
+def tail_columns(Xs: np.ndarray, magnitude: Sequence[int] = (), order: int = 1) -> np.ndarray:
+    """The linear tail's columns (:func:`tail_terms` of ``order``) of a network's raw inputs
+    ``(n, d)``, the columns ``magnitude`` (:func:`magnitude_columns`) taken as absolute
+    values."""
     Xs = np.array(Xs, dtype=float)
     for j in magnitude:
         Xs[:, j] = np.abs(Xs[:, j])
-    return np.column_stack([Xs] + [Xs[:, 0] * Xs[:, j] for j in range(1, Xs.shape[1])])
+    v, d = Xs[:, 0], Xs.shape[1]
+    cols = [Xs] + [v * Xs[:, j] for j in range(1, d)]
+    if order == 2:
+        cols += [v * Xs[:, j] ** 2 for j in range(1, d)]
+    return np.column_stack(cols)
 
 
 def predict_state(state: Mapping[str, Any] | None, X) -> np.ndarray:

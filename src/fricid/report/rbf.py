@@ -27,7 +27,13 @@ import pandas as pd
 from ..fitted import FittedModel
 from ..models import INPUTS, get_predictor
 from ..models.hybrid import backbone_of
-from ..models.rbf import interval_half_width, magnitude_columns, sub_networks, tail_columns
+from ..models.rbf import (
+    interval_half_width,
+    magnitude_columns,
+    sub_networks,
+    tail_columns,
+    tail_order,
+)
 from ..samples import FrictionSamples
 from .document import Note, Table
 
@@ -71,7 +77,9 @@ def _tail_column(state: Mapping[str, Any], slot: tuple[str, str, int], X) -> np.
     v = Xa[:, 0].copy()
     Xa[:, 0] = np.abs(v)
     names = list(net["inputs"])
-    col = tail_columns(Xa[:, [INPUTS.index(n) for n in names]], magnitude_columns(names))[:, i]
+    order = tail_order(names, net["linear_terms"]) or 1
+    Xs = Xa[:, [INPUTS.index(n) for n in names]]
+    col = tail_columns(Xs, magnitude_columns(names), order)[:, i]
     mask = {"all": np.ones(v.size, bool), "pos": v > 0, "neg": v < 0}[side]
     return np.where(mask, np.sign(v) * col, 0.0)
 
