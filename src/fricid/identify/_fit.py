@@ -73,7 +73,9 @@ def fit(
         The measured friction.
     model : str or FrictionModel
         A model name (``fricid.models.MODELS``, ``*_asym`` for per-direction), an instance,
-        or ``"rbf"`` for the RBF network (:mod:`fricid.identify.rbf`).
+        ``"rbf"`` for the RBF network (:mod:`fricid.identify.rbf`), or ``"hybrid"`` for an
+        analytic backbone plus an RBF residual (:mod:`fricid.identify.hybrid`; ``network``
+        may name its ``backbone``).
     method : str, default "lm"
         Any method of ``fricid.optim.METHODS`` (``"lm"``: the default least-squares method,
         scipy's bounded trust-region reflective solver, a Levenberg-Marquardt-type method, with

@@ -4,7 +4,9 @@ Use :func:`get_model` to look an analytic model up by name (``"<name>_asym"`` gi
 per-direction variant), and :func:`get_predictor` for any model a model file may name, the RBF
 network included: every one predicts with ``predict(theta_or_state, X)``, and its ``stateful``
 flag says whether it takes a parameter vector (analytic models) or a stored state (the RBF
-network, :mod:`fricid.models.rbf`). Training the network is :mod:`fricid.identify.rbf`'s job.
+network, :mod:`fricid.models.rbf`; the hybrid of an analytic backbone and an RBF residual,
+:mod:`fricid.models.hybrid`). Training them is :mod:`fricid.identify.rbf`'s and
+:mod:`fricid.identify.hybrid`'s job.
 """
 
 from __future__ import annotations
