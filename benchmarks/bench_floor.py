@@ -41,16 +41,16 @@ samples' noise (the RMS of :func:`fricid.sim.expected_noise_std`).
 
 What it showed (``python benchmarks/bench_floor.py``, 2026-11-22, the machine shared; 302 s):
 
-=============  ==========================  ===============  ===============
-family         grid                        asym_arrhenius   sigmoid
-=============  ==========================  ===============  ===============
-best analytic  16.66 (vlt)                 7.78 (stribeck_asym)  0.99 (msk_asym)
-rbf plain      135.96                      9.37             11.29
-rbf default    1.15 [5.1 s]                1.36 [0.4 s]     1.10 [0.7 s]
-hybrid         1.19                        2.07             0.99
-sklearn GP     1.51 [128.9 s]              1.10 [0.2 s]     1.13 [4.7 s]
-MLP            16.41                       16.73            9.53
-=============  ==========================  ===============  ===============
+==============  ==============  ====================  ================
+family          grid            asym_arrhenius        sigmoid
+==============  ==============  ====================  ================
+best analytic   16.66 (vlt)     7.78 (stribeck_asym)  0.99 (msk_asym)
+rbf plain       135.96          9.37                  11.29
+rbf default     1.15 [5.1 s]    1.36 [0.4 s]          1.10 [0.7 s]
+hybrid          1.19            2.07                  0.99
+sklearn GP      1.51 [128.9 s]  1.10 [0.2 s]          1.13 [4.7 s]
+MLP             16.41           16.73                 9.53
+==============  ==============  ====================  ================
 
 The default meets 1.10 on ``sigmoid`` and misses on ``grid`` (1.15) and ``asym_arrhenius``
 (1.36; 1.20-1.26 on tuning seeds 0-1); its training takes 0.04 x the GP's on the 1848-point
