@@ -222,15 +222,20 @@ def noisy(n=90, seed=0) -> FrictionSamples:
 
 
 def test_number_of_centres_chosen_by_held_out_error():
+    from fricid.identify._rbf_select import structure_grid
+
     s = noisy()
     with pytest.warns(DataQualityWarning, match=r"temperature \(every sample at 25\)"):
         fitted = fit_rbf(s, velocity_scale=0.035, random_state=0)
     sel = fitted.state["n_centers_selection"]
-    assert sel["grid"][0] == 5 and sel["grid"][-1] == 30 and sel["folds"] == 5
+    # issue 15: centres up to n / 4, chosen with the widths and the penalty
+    assert sel["grid"] == structure_grid(len(s)) and sel["grid"][0] == 5 and sel["folds"] == 5
+    assert sel["chosen_width_factor"] in sel["width_factors"]
     best = int(np.argmin(sel["cv_rmse"]))
     assert sel["chosen"] == sel["grid"][best] == len(fitted.state["centers"])
-    # interpolating the noise: the largest network has the worse held-out error
-    assert sel["cv_rmse"][-1] > min(sel["cv_rmse"])
+    # held-out error decides: the smallest network underfits (the largest no longer
+    # interpolates the noise: its ridge penalty is chosen by the same cross-validation)
+    assert sel["cv_rmse"][0] > min(sel["cv_rmse"])
     assert fitted.state["dropped_inputs"] == {"temperature": 25.0}
     assert fitted.state["inputs"] == ["velocity", "load"]
     assert "temperature" in fitted.inputs_used()

@@ -406,16 +406,14 @@ def test_fitted_model_round_trip(tmp_path, inputs):
     loaded = FittedModel.load(path)
     np.testing.assert_array_equal(loaded.predict(samples.X), fitted.predict(samples.X))
     assert loaded.predict_point(0.5, 0.2, 30.0).shape == ()
-    # the estimator and the stored state agree
+    # the estimator and the stored state agree (fit_rbf's structured defaults, the linear
+    # tail and the cross-validated widths, are recorded with the estimator's parameters)
     cols = [("velocity", "load", "temperature").index(n) for n in inputs]
-    est = RBFNetRegressor(
-        n_centers=20,
-        trainer="bas",
-        max_epochs=3,
-        target_mse=None,
-        velocity_scale=vs,
-        random_state=3,
-    ).fit(samples.X[:, cols], samples.y)
+    params = fitted.provenance["estimator_params"]
+    assert params["linear_tail"] is True and fitted.state["linear_terms"][: len(inputs)] == list(
+        inputs
+    )
+    est = RBFNetRegressor(**params).fit(samples.X[:, cols], samples.y)
     np.testing.assert_allclose(
         est.predict(samples.X[:, cols]), loaded.predict(samples.X), rtol=0, atol=1e-12
     )

@@ -50,7 +50,8 @@ def fit_command(
                 "Model: coulomb_viscous (eq. 1), stribeck (eq. 2 / RWSAVSBAS eq. 7), msk (eq. 3, "
                 "load), vlt (eq. 4, load and temperature); append _asym for parameters per "
                 "direction; rbf, the RBF neural network (eq. 14-15; --method lsq, bas for "
-                "BAS-RBFNN or ga for GA-RBFNN); or auto: every family the data can support, "
+                "BAS-RBFNN or ga for GA-RBFNN); hybrid, an analytic backbone plus an RBF "
+                "residual; or auto: every family the data can support, "
                 "chosen by held-out error (leave one velocity level out, or --validate)."
             ),
         ),
@@ -67,11 +68,34 @@ def fit_command(
     seed: SeedOption = 0,
     max_evals: MaxEvalsOption = None,
     centers: Annotated[
-        int, typer.Option(help="rbf: number of Gaussian units (hidden layer).")
-    ] = 40,
+        int | None,
+        typer.Option(
+            help="rbf, hybrid: number of Gaussian units (hidden layer); default chosen with "
+            "the widths and the ridge penalty by 5-fold cross-validation."
+        ),
+    ] = None,
     inputs: Annotated[
-        str, typer.Option(help="rbf: input columns, a comma list of velocity, load, temperature.")
-    ] = "velocity,load,temperature",
+        str | None,
+        typer.Option(
+            help="rbf, hybrid: input columns, a comma list of velocity, load, temperature; "
+            "default the measured ones."
+        ),
+    ] = None,
+    learned: Annotated[
+        bool,
+        typer.Option(
+            "--learned",
+            help="auto: try the learned families too (rbf, hybrid); slower, each is "
+            "retrained for every held-out fold.",
+        ),
+    ] = False,
+    backbone: Annotated[
+        str | None,
+        typer.Option(
+            help="hybrid: the analytic backbone (e.g. stribeck_asym); default the family the "
+            "data support with the smallest BIC."
+        ),
+    ] = None,
     direction: DirectionOption = "all",
     validate: Annotated[
         str | None,
@@ -171,9 +195,11 @@ def fit_command(
     check_paths(inputs={"SAMPLES": samples}, out_files={"--out": out})
     data = select_direction(read_samples(samples), direction)
     key = model.strip().lower()
-    rbf = key == "rbf"
+    rbf = key in ("rbf", "hybrid")
     options = {"loss": loss, "f_scale": f_scale, "weights": weights}
-    options.update(_rbf_network(centers, inputs) if rbf else {})
+    options.update(
+        _rbf_network(centers, inputs, backbone if key == "hybrid" else None) if rbf else {}
+    )
     fixed = parse_assignments(fix, "--fix")
     with (
         warnings.catch_warnings(record=True) as caught,
@@ -194,6 +220,7 @@ def fit_command(
             max_evals=max_evals,
             **options,
             **({"scheme": validate} if key == "auto" and validate else {}),
+            **({"learned": True} if key == "auto" and learned else {}),
         )
         if validate and key != "auto":
             track.stage(f"validating {fitted.model} ({validate})", restart=True)
@@ -301,15 +328,22 @@ def _rbf_trainer(method: str) -> str:
 
     trainer = "lsq" if method == "lm" else method
     if trainer not in ("lsq", "bas", "ga"):
-        raise ConfigError(f"--model rbf trains with --method lsq, bas or ga; got '{method}'")
+        raise ConfigError(
+            f"--model rbf and hybrid train with --method lsq, bas or ga; got '{method}'"
+        )
     return trainer
 
 
-def _rbf_network(centers: int, inputs: str) -> dict:
-    """``identify.fit``'s network arguments from --centers and --inputs."""
-    names = [name.strip() for name in inputs.split(",") if name.strip()]
-    network = {"n_centers": centers, "velocity_scale": 0.035 if "velocity" in names else None}
-    return {"network": network, "inputs": names}
+def _rbf_network(centers: int | None, inputs: str | None, backbone: str | None = None) -> dict:
+    """``identify.fit``'s network arguments from --centers, --inputs and --backbone (the
+    velocity warp, the widths and the penalty are fit's structured defaults)."""
+    network: dict = {"n_centers": centers}
+    if backbone:
+        network["backbone"] = backbone
+    out: dict = {"network": network}
+    if inputs:
+        out["inputs"] = [name.strip() for name in inputs.split(",") if name.strip()]
+    return out
 
 
 @app.command("methods")

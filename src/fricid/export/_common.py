@@ -170,8 +170,8 @@ def model_sha256(fitted: FittedModel) -> str:
 
 def model_name(fitted: FittedModel) -> str:
     """The model's registry name, taken from the registry (never the file's text)."""
-    if fitted.model == "rbf":
-        return "rbf"
+    if fitted.model in ("rbf", "hybrid"):  # stateful models (fricid.models.STATEFUL)
+        return fitted.model
     model = fitted.friction_model()  # ConfigError for a name the registry does not know
     return model.name
 

@@ -36,6 +36,7 @@ from .. import __version__
 from ..fitted import FittedModel
 from ..models import Asymmetric
 from ..models.smoothing import VISCOUS_TERM, Smoothing
+from ._c_hybrid import hybrid_parts, tail_code
 from ._common import (
     ExportError,
     check_identifier,
@@ -205,7 +206,7 @@ def _array(name: str, values: np.ndarray, what: str) -> str:
     )
 
 
-def _rbf_network(state: dict, side: str) -> tuple[list[str], str]:
+def _rbf_network(state: dict, side: str, magnitude: bool = False) -> tuple[list[str], str]:
     """Constants and the function ``net_<side>`` of one stored network, mirroring
     ``fricid.models.rbf`` (and ``fricid.models._rbf_core``) step by step."""
     pre = "rbf_" if side == "all" else f"rbf_{side}_"
@@ -238,6 +239,8 @@ def _rbf_network(state: dict, side: str) -> tuple[list[str], str]:
             f"{fmt_float(float(vscale), f'{where}.velocity_scale')};"
             "  /* [rad/s] velocity warped by asinh(v / scale) */"
         )
+    tail_consts, tail_body = tail_code(state, pre, where, magnitude, _array)
+    consts += tail_consts
     x0 = f"asinh(velocity / {pre}velocity_scale)" if vscale is not None else None
     picks = [x0 if (k == 0 and x0) else name for k, name in enumerate(inputs)]
     unused = [name for name in ("velocity", "load", "temperature") if name not in inputs]
@@ -262,9 +265,7 @@ def _rbf_network(state: dict, side: str) -> tuple[list[str], str]:
         f"        const double dot = {dot};\n"
         f"        const double d2 = fmax(zz + {pre}cc[j] - 2.0 * dot, 0.0);\n"
         f"        acc += exp(-d2 * {pre}inv[j]) * {pre}weights[j];\n"
-        "    }\n"
-        f"    return acc + {pre}bias;\n"
-        "}\n"
+        "    }\n" + tail_body + "}\n"
     )
     return consts, body
 
@@ -281,7 +282,7 @@ def _rbf_parts(fitted: FittedModel, smoothing: Smoothing) -> tuple[list[str], li
     consts: list[str] = []
     funcs: list[str] = []
     for side, net in rbf.sub_networks(state).items():
-        c, f = _rbf_network(dict(net), side)
+        c, f = _rbf_network(dict(net), side, magnitude=symmetry != "signed")
         consts += c
         funcs.append(f)
     if symmetry == "signed":
@@ -392,11 +393,11 @@ def c_code(
             "network was stored on signed velocity and has no sign term: use --smooth "
             "linear, or none, or refit it"
         )
-    consts, funcs = (
-        _rbf_parts(fitted, smoothing)
-        if fitted.kind == "rbf"
-        else _analytic_parts(fitted, smoothing)
-    )
+    if fitted.model == "hybrid":  # issue 15: analytic backbone + RBF residual
+        consts, funcs = hybrid_parts(fitted, smoothing, _analytic_parts, _rbf_parts)
+    else:
+        parts = _rbf_parts if fitted.kind == "rbf" else _analytic_parts
+        consts, funcs = parts(fitted, smoothing)
     function = f"{prefix}_friction"
     guard = f"{prefix.upper()}_FRICTION_H"
     header_name, source_name = f"{function}.h", f"{function}.c"

@@ -17,7 +17,8 @@
 * :func:`profile_intervals` (:mod:`fricid.identify.profile`): profile-likelihood 95 %
   intervals inside the search box;
 * :mod:`fricid.identify.rbf`: the RBF network's scikit-learn estimator and trainers
-  (imported on use: it needs scikit-learn).
+  (imported on use: it needs scikit-learn); :mod:`fricid.identify.hybrid`: an analytic
+  backbone plus an RBF residual (``fit(samples, "hybrid")``).
 """
 
 from __future__ import annotations

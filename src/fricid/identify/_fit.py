@@ -74,7 +74,9 @@ def fit(
         The measured friction.
     model : str or FrictionModel
         A model name (``fricid.models.MODELS``, ``*_asym`` for per-direction), an instance,
-        or ``"rbf"`` for the RBF network (:mod:`fricid.identify.rbf`).
+        ``"rbf"`` for the RBF network (:mod:`fricid.identify.rbf`), or ``"hybrid"`` for an
+        analytic backbone plus an RBF residual (:mod:`fricid.identify.hybrid`; ``network``
+        may name its ``backbone``).
     method : str, default "lm"
         Any method of ``fricid.optim.METHODS`` (``"lm"``: the default least-squares method,
         scipy's bounded trust-region reflective solver, a Levenberg-Marquardt-type method, with
@@ -163,6 +165,7 @@ def fit(
             network,
             inputs,
             callback,
+            model_name=model.strip().lower(),
             fixed=fixed,
             bounds=bounds,
             x0=x0,
@@ -352,6 +355,9 @@ def _fit_network(
     ``method_options``, ``max_evals`` -> ``max_epochs``)."""
     from .rbf import RBFNetRegressor, fit_rbf
 
+    fit_network = fit_rbf
+    if analytic.pop("model_name", "rbf") == "hybrid":  # issue 15: backbone + RBF residual
+        from .hybrid import fit_hybrid as fit_network
     given = [name for name, value in analytic.items() if value]
     if given:
         raise ConfigError(
@@ -373,7 +379,9 @@ def _fit_network(
     if max_evals is not None:
         per_epoch = int(params.get("evals_per_epoch", RBFNetRegressor().evals_per_epoch))
         params["max_epochs"] = max(1, -(-int(max_evals) // per_epoch))
-    return fit_rbf(samples, inputs, **params)
+    # the default inputs are the measured ones (a column not measured is no error here)
+    names = None if tuple(inputs) == INPUTS else inputs
+    return fit_network(samples, names, **params)
 
 
 def evaluate(model: FittedModel, samples: FrictionSamples) -> dict[str, float]:

@@ -20,7 +20,7 @@ from sklearn.utils.validation import check_is_fitted, validate_data
 
 from ..errors import ConfigError, DataError, IgnoredArgumentWarning
 from ..models import _rbf_core as core
-from ..models.rbf import mse_z, predict_z
+from ..models.rbf import mse_z, predict_z, tail_columns
 from ..optim import METHODS
 from ._rbf_search import search_network
 
@@ -82,6 +82,26 @@ class RBFNetRegressor(RegressorMixin, BaseEstimator):
         candidates are scored with at least 1e-12.
     fit_bias : bool, default True
         Add a bias to the linear output (eq. 15 has none).
+    linear_tail : bool, default False
+        Add a linear term on the raw (unwarped) inputs and the first input (the velocity)
+        times each other one: ``y = Phi w + T(X) a + b`` with ``T(X) = [x_1 .. x_d, x_1 x_2
+        .. x_1 x_d]`` (:func:`fricid.models.rbf.tail_columns`). Far from the centres the
+        Gaussians vanish and the network returns to ``T(X) a + b`` (for ``|v|``: Coulomb plus
+        viscous friction, both linear in load and temperature) instead of the bias alone.
+        ``lsq`` solves weights and ``a`` together by ridge least squares (the columns
+        standardised, so the penalty treats them alike; the bias is then always fitted); an
+        optimiser trainer fits ``T(X) a + b`` first and searches the network on its residual.
+    tail_order : {1, 2}, default 1
+        2 adds the velocity times each other input squared to the linear tail
+        (:func:`fricid.models.rbf.tail_terms`).
+    linear_magnitude : tuple of int, default ()
+        Columns the linear tail takes as absolute values (``fit_rbf``: the load,
+        :func:`fricid.models.rbf.magnitude_columns`).
+    velocity_stretch : float, default 1.0
+        Multiplies the first standardised input (the velocity): above 1 the Gaussians are
+        narrower in velocity than in load and temperature (anisotropic units, as an ARD
+        kernel's length scales), where friction changes fastest (the Stribeck region). Stored
+        in ``input_scale_`` (divided by it), so prediction needs nothing new.
     velocity_scale : float or None, default None
         If given [rad/s], the first input column (fricid's velocity) is replaced by
         ``asinh(v / velocity_scale)`` before standardisation: logarithmic for
@@ -111,7 +131,11 @@ class RBFNetRegressor(RegressorMixin, BaseEstimator):
     weights_ : ndarray (m,)
         Output weights w_i, in units of y.
     bias_ : float
-        Output bias, units of y (0 when ``fit_bias=False``).
+        Output bias, units of y (0 when ``fit_bias=False`` and no linear tail).
+    linear_ : ndarray (2 n_features_in_ - 1,) or (0,)
+        Coefficients ``a`` of the linear tail's columns
+        (:func:`fricid.models.rbf.tail_columns`), units of y per unit of the column (empty
+        without ``linear_tail``).
     input_shift_, input_scale_ : ndarray (n_features_in_,)
         Standardisation ``z = (warp(x) - input_shift_) / input_scale_``.
     target_scale_ : float
@@ -155,6 +179,10 @@ class RBFNetRegressor(RegressorMixin, BaseEstimator):
         "width_factor": [Interval(Real, 0, None, closed="neither")],
         "alpha": [Interval(Real, 0, None, closed="left")],
         "fit_bias": ["boolean"],
+        "linear_tail": ["boolean"],
+        "velocity_stretch": [Interval(Real, 0, None, closed="neither")],
+        "linear_magnitude": ["array-like"],
+        "tail_order": [Interval(Integral, 1, 2, closed="both")],
         "velocity_scale": [Interval(Real, 0, None, closed="neither"), None],
         "target_mse": [Interval(Real, 0, None, closed="neither"), None],
         "max_epochs": [Interval(Integral, 1, None, closed="left")],
@@ -173,6 +201,10 @@ class RBFNetRegressor(RegressorMixin, BaseEstimator):
         width_factor: float = 1.0,
         alpha: float = 1e-10,
         fit_bias: bool = True,
+        linear_tail: bool = False,
+        linear_magnitude: tuple[int, ...] = (),
+        tail_order: int = 1,
+        velocity_stretch: float = 1.0,
         velocity_scale: float | None = None,
         target_mse: float | None = 1e-4,
         max_epochs: int = 500,
@@ -187,6 +219,10 @@ class RBFNetRegressor(RegressorMixin, BaseEstimator):
         self.width_factor = width_factor
         self.alpha = alpha
         self.fit_bias = fit_bias
+        self.linear_tail = linear_tail
+        self.linear_magnitude = linear_magnitude
+        self.tail_order = tail_order
+        self.velocity_stretch = velocity_stretch
         self.velocity_scale = velocity_scale
         self.target_mse = target_mse
         self.max_epochs = max_epochs
@@ -267,6 +303,8 @@ class RBFNetRegressor(RegressorMixin, BaseEstimator):
                 "information and cannot be standardised; drop the column",
                 column=name,
             )
+        scale = scale.copy()
+        scale[0] /= float(self.velocity_stretch)
         self.input_shift_, self.input_scale_ = shift, scale
         Z = (Xw - shift) / scale
 
@@ -301,10 +339,29 @@ class RBFNetRegressor(RegressorMixin, BaseEstimator):
             km = KMeans(n_clusters=m, n_init=1, random_state=kmeans_seed)
             C0 = km.fit(Zk).cluster_centers_
         s0 = core.nn_widths(C0, float(self.width_factor), spread)
-        w0, b0 = core.lstsq_weights(
-            core.design(Z, C0, s0), t, float(self.alpha), bool(self.fit_bias)
+        L, lin_shift, lin_scale = (
+            _linear_columns(X, tuple(self.linear_magnitude), int(self.tail_order))
+            if self.linear_tail
+            else (None, None, None)
         )
-        mse0 = mse_z(Z, t, C0, s0, w0, b0)
+        a = np.zeros(L.shape[1] if L is not None else 0)
+        if L is not None and trainer == "lsq":
+            wa, b0 = core.lstsq_weights(
+                np.hstack([core.design(Z, C0, s0), L]), t, float(self.alpha), True
+            )
+            w0, a = wa[:m], wa[m:]
+        else:
+            if L is not None:  # optimiser trainers: the linear tail first, the network after
+                a, b_lin = core.lstsq_weights(L, t, 0.0, True)
+                t = t - (L @ a + b_lin)
+            w0, b0 = core.lstsq_weights(
+                core.design(Z, C0, s0), t, float(self.alpha), bool(self.fit_bias)
+            )
+            if L is not None:
+                b0 += b_lin
+                t = t + (L @ a + b_lin)
+        t_net = t - L @ a if L is not None else t
+        mse0 = mse_z(Z, t_net, C0, s0, w0, b0)
 
         self.n_epochs_ = 0
         self.n_evals_ = 0
@@ -318,13 +375,18 @@ class RBFNetRegressor(RegressorMixin, BaseEstimator):
             )
         else:
             C, s, w, b, mse = search_network(
-                self, trainer, Z, t, (C0, s0, w0, b0, mse0), search_seed
+                self, trainer, Z, t_net, (C0, s0, w0, b0, mse0), search_seed
             )
 
         self.centers_ = C
         self.widths_ = s
         self.weights_ = w * half
         self.bias_ = float(b * half + mid)
+        self.linear_ = np.zeros(L.shape[1] if L is not None else 0)
+        if L is not None:
+            # y = half (Phi w + b + ((x - shift) / scale) a) + mid: raw-input coefficients
+            self.linear_ = a * half / lin_scale
+            self.bias_ -= float(self.linear_ @ lin_shift)
         self.train_mse_ = float(mse)
         return self
 
@@ -333,6 +395,21 @@ class RBFNetRegressor(RegressorMixin, BaseEstimator):
         """Network output (eq. 14-15) at inputs ``X (n, n_features_in_)``."""
         check_is_fitted(self)
         X = validate_data(self, X, reset=False, dtype=np.float64)
-        return predict_z(
+        out = predict_z(
             self._standardise(X), self.centers_, self.widths_, self.weights_, self.bias_
         )
+        if not np.any(self.linear_):
+            return out
+        return out + tail_columns(X, self.linear_magnitude, int(self.tail_order)) @ self.linear_
+
+
+def _linear_columns(
+    X: np.ndarray, magnitude: tuple[int, ...] = (), order: int = 1
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The linear tail's columns (:func:`fricid.models.rbf.tail_columns`) standardised, their
+    shift and scale."""
+    X = tail_columns(X, magnitude, order)
+    shift = X.mean(axis=0)
+    scale = X.std(axis=0)
+    scale = np.where(scale > 0, scale, 1.0)
+    return (X - shift) / scale, shift, scale

@@ -13,16 +13,25 @@ from numbers import Integral
 from typing import Any
 
 import numpy as np
+import scipy.linalg
 
 from ..errors import DataError, DataQualityWarning, IdentifiabilityWarning
+from ..models.rbf import tail_columns
 from ._rbf_estimator import LSQ_IGNORES, RBFNetRegressor
 
 __all__ = [
+    "ALPHAS",
+    "INTERVAL_LEVELS",
     "MAX_AUTO_CENTERS",
+    "STRETCHES",
+    "WIDTH_FACTORS",
     "centre_grid",
     "check_centres",
     "choose_n_centers",
+    "choose_structure",
+    "conformal_half_widths",
     "drop_constant_inputs",
+    "structure_grid",
 ]
 
 #: The largest number of centres :func:`choose_n_centers` tries.
@@ -99,6 +108,263 @@ def choose_n_centers(
     best = int(np.argmin(rmse))
     chosen = grid[best] if np.isfinite(rmse[best]) else grid[0]
     note.update(cv_rmse=[r if np.isfinite(r) else None for r in rmse], chosen=chosen)
+    return chosen, note
+
+
+#: Width factors (:class:`RBFNetRegressor` ``width_factor``) :func:`choose_structure` tries
+#: when none is given.
+WIDTH_FACTORS = (1.0, 1.5, 2.2, 3.2)
+
+#: Ridge penalties (``alpha``, on the target scaled to [-1, 1]) it tries when none is given.
+ALPHAS = (1e-11, 1e-8, 1e-5)
+
+#: Levels of the prediction intervals saved with a network.
+INTERVAL_LEVELS = (0.9, 0.95)
+
+
+#: Fewest distinct levels of the first input (the speed) for the quadratic tail.
+QUADRATIC_MIN_LEVELS = 6
+
+#: Velocity stretches (:class:`RBFNetRegressor` ``velocity_stretch``) it tries.
+STRETCHES = (1.0, 2.0, 4.0)
+
+
+def structure_grid(n: int) -> list[int]:
+    """Candidate numbers of centres of :func:`choose_structure` for ``n`` samples: eight
+    values spaced geometrically from 5 to ``min(400, n / 4)``."""
+    hi = max(1, min(400, n // 4))
+    lo = min(5, hi)
+    return sorted({int(np.rint(x)) for x in np.geomspace(lo, hi, 8)})
+
+
+def _kmeans_centres(Z: np.ndarray, m: int, random_state: Any) -> np.ndarray:
+    """The centres :class:`RBFNetRegressor` ``.fit`` places with ``random_state`` (the same
+    draws in the same order, so the chosen candidate is the network fit trains)."""
+    from sklearn.cluster import KMeans
+    from sklearn.exceptions import ConvergenceWarning as SklearnConvergenceWarning
+    from sklearn.utils import check_random_state
+
+    from ._rbf_estimator import _KMEANS_MIN, _KMEANS_PER_CENTRE
+
+    rs = check_random_state(_seed(random_state))
+    kmeans_seed = int(rs.randint(np.iinfo(np.int32).max))
+    rs.randint(np.iinfo(np.int32).max)  # the search seed, drawn second by fit
+    n = Z.shape[0]
+    n_kmeans = max(_KMEANS_MIN, _KMEANS_PER_CENTRE * m)
+    Zk = Z if n <= n_kmeans else Z[rs.permutation(n)[:n_kmeans]]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", SklearnConvergenceWarning)
+        return KMeans(n_clusters=m, n_init=1, random_state=kmeans_seed).fit(Zk).cluster_centers_
+
+
+def conformal_half_widths(residuals: np.ndarray, levels=INTERVAL_LEVELS) -> list[float]:
+    """Half-widths of split-conformal prediction intervals from held-out residuals: the
+    ``ceil((n + 1) level)``-th smallest ``|r|`` (Vovk et al. 2005; with cross-validation
+    residuals, the CV+ reading of Barber et al. 2021, whose coverage is at least
+    ``2 level - 1``); the largest ``|r|`` when ``n`` is too small for the level."""
+    r = np.sort(np.abs(np.asarray(residuals, dtype=float)))
+    n = r.size
+    out = []
+    for level in levels:
+        k = int(np.ceil((n + 1) * float(level)))
+        out.append(float(r[min(k, n) - 1]))
+    return out
+
+
+class _CrossValidation:
+    """k-fold held-out residuals of ``lsq`` networks sharing their hidden layers (see
+    :func:`choose_structure`); ``residuals(m, wf, stretch)`` -> (alpha index, rmse [N m],
+    residuals [N m]) of the best penalty, memoised."""
+
+    def __init__(self, X: np.ndarray, t: np.ndarray, params: Mapping[str, Any], alphas) -> None:
+        from sklearn.model_selection import KFold
+
+        n, self.d = X.shape
+        vscale = params.get("velocity_scale")
+        Xw = X.copy()
+        if vscale is not None:
+            Xw[:, 0] = np.arcsinh(Xw[:, 0] / float(vscale))
+        self.Z = (Xw - Xw.mean(axis=0)) / Xw.std(axis=0)
+        self.linear = bool(params.get("linear_tail"))
+        self.fit_bias = bool(params.get("fit_bias", True)) or self.linear
+        self.L = {}
+        for order in (1, 2):
+            F = tail_columns(X, tuple(params.get("linear_magnitude") or ()), order)
+            sd = F.std(axis=0)
+            self.L[order] = (F - F.mean(axis=0)) / np.where(sd > 0, sd, 1.0)
+        if self.fit_bias:
+            mid, half = 0.5 * (t.max() + t.min()), 0.5 * (t.max() - t.min())
+        else:
+            mid, half = 0.0, float(np.max(np.abs(t)))
+        self.half = half if half > 0 else 1.0
+        self.ts = (t - mid) / self.half
+        self.seed = _seed(params.get("random_state"))
+        self.alphas = alphas
+        self.folds = min(FOLDS, n // 2)
+        self.splits = (
+            list(KFold(self.folds, shuffle=True, random_state=self.seed).split(X))
+            if self.folds >= 2
+            else []
+        )
+        self._centres: dict[tuple[int, float], np.ndarray] = {}
+        self._memo: dict[tuple, tuple[int, float, np.ndarray]] = {}
+
+    def residuals(
+        self, m: int, wf: float, stretch: float, order: int = 1
+    ) -> tuple[int, float, np.ndarray]:
+        from ..models import _rbf_core as core
+
+        key = (m, wf, stretch, order)
+        if key in self._memo:
+            return self._memo[key]
+        Z = self.Z.copy()
+        Z[:, 0] *= stretch
+        if (m, stretch) not in self._centres:
+            self._centres[(m, stretch)] = _kmeans_centres(Z, m, self.seed)
+        C = self._centres[(m, stretch)]
+        A = core.design(Z, C, core.nn_widths(C, wf, float(np.sqrt(self.d))))
+        if self.linear:
+            A = np.hstack([A, self.L[order]])
+        oof = np.full((len(self.alphas), len(self.ts)), np.nan)
+        for train, test in self.splits:
+            At, tt = A[train], self.ts[train]
+            mu = At.mean(axis=0) if self.fit_bias else np.zeros(A.shape[1])
+            tm = float(tt.mean()) if self.fit_bias else 0.0
+            Ac = At - mu
+            G = Ac.T @ Ac / len(train)
+            h = Ac.T @ (tt - tm) / len(train)
+            for k, alpha in enumerate(self.alphas):
+                Gk = G.copy()
+                Gk[np.diag_indices_from(Gk)] += alpha
+                try:
+                    w = scipy.linalg.cho_solve(
+                        scipy.linalg.cho_factor(Gk, check_finite=False, overwrite_a=True),
+                        h,
+                        check_finite=False,
+                    )
+                except (np.linalg.LinAlgError, scipy.linalg.LinAlgError):
+                    w = np.linalg.lstsq(G + alpha * np.eye(len(h)), h, rcond=None)[0]
+                oof[k, test] = (A[test] - mu) @ w + tm
+        rmse = np.sqrt(np.mean((oof - self.ts) ** 2, axis=1)) * self.half
+        rmse = np.where(np.isfinite(rmse), rmse, np.inf)
+        k = int(np.argmin(rmse))
+        out = (k, float(rmse[k]), (oof[k] - self.ts) * self.half)
+        self._memo[key] = out
+        return out
+
+
+def choose_structure(
+    X: np.ndarray, t: np.ndarray, params: Mapping[str, Any]
+) -> tuple[dict[str, Any], dict[str, Any]]:
+    """Number of centres, width factor, velocity stretch and ridge penalty of the ``lsq``
+    network by k-fold cross-validation (issue 15, "defaults chosen by held-out error"), and
+    prediction intervals from the chosen candidate's held-out residuals.
+
+    The search is coordinate-wise: the number of centres over :func:`structure_grid` (width
+    factor 1.5, no stretch), then the width factor (:data:`WIDTH_FACTORS`), the velocity
+    stretch (:data:`STRETCHES`), the linear tail's order (1 or 2, when ``linear_tail``; 2 only
+    with at least :data:`QUADRATIC_MIN_LEVELS` speed levels), and the number of centres once
+    more; every candidate takes its best penalty among :data:`ALPHAS`. Candidates share their
+    hidden layers across folds: the k-means centres are placed once per number of centres and
+    stretch on all inputs (as ``fit`` places them with the same ``random_state``; the targets
+    are not used, so no held-out target leaks into them), and for each fold the output layer
+    (weights, the linear tail when ``linear_tail``, bias) is solved by ridge least squares for
+    every penalty. One least-squares solve per candidate, fold and penalty: fast.
+
+    Parameters
+    ----------
+    X : ndarray, shape (n, d)
+        The network's inputs (velocity first when it is an input).
+    t : ndarray, shape (n,)
+        Targets [N m].
+    params : mapping
+        :class:`RBFNetRegressor` parameters; those given (not None) among ``n_centers``,
+        ``width_factor``, ``velocity_stretch``, ``alpha`` are held, the others chosen.
+
+    Returns
+    -------
+    dict
+        The chosen ``n_centers``, ``width_factor``, ``velocity_stretch``, ``alpha``.
+    dict
+        The note saved in the model file: ``grid`` (centres), ``width_factors``,
+        ``stretches``, ``alphas``, ``folds``, ``cv_rmse`` [N m] per number of centres (last
+        pass), ``chosen`` (centres), ``chosen_width_factor``, ``chosen_stretch``,
+        ``chosen_alpha``, ``cv_rmse_chosen`` and ``prediction_interval`` (levels, half-widths
+        [N m], method).
+    """
+    n = X.shape[0]
+
+    def held(key: str, default):
+        return (params[key],) if params.get(key) is not None else default
+
+    grid = [int(m) for m in held("n_centers", structure_grid(n)) if int(m) <= n] or [1]
+    widths = tuple(float(w) for w in held("width_factor", WIDTH_FACTORS))
+    stretches = (1.0,)
+    if params.get("velocity_scale") is not None or params.get("velocity_stretch") is not None:
+        stretches = tuple(float(x) for x in held("velocity_stretch", STRETCHES))
+    alphas = tuple(max(float(a), 1e-12) for a in held("alpha", ALPHAS))
+    cv = _CrossValidation(X, t, params, alphas)
+    note: dict[str, Any] = {
+        "grid": grid,
+        "width_factors": list(widths),
+        "stretches": list(stretches),
+        "alphas": list(alphas),
+        "folds": cv.folds,
+        "trainer": "lsq",
+    }
+    wf = 1.5 if 1.5 in widths else widths[0]
+    stretch = stretches[0]
+    if not cv.splits:  # too few samples to cross-validate: the largest candidate
+        note.update(cv_rmse=None, chosen=grid[-1], cv_rmse_chosen=None)
+        return {
+            "n_centers": grid[-1],
+            "width_factor": wf,
+            "velocity_stretch": stretch,
+            "alpha": alphas[0],
+        }, note
+
+    def best_of(cands):
+        scores = [cv.residuals(*c)[1] for c in cands]
+        return cands[int(np.argmin(scores))], scores
+
+    orders = (1,)
+    if params.get("linear_tail"):
+        # the quadratic tail only with the levels to resolve it (a few levels: overfitting)
+        # levels: distinct speeds to a tenth of a decade (measured speeds scatter about
+        # their set-points)
+        first = np.abs(X[:, 0])
+        levels = np.unique(np.round(np.log10(first[first > 0]), 1)).size
+        tried = (1, 2) if levels >= QUADRATIC_MIN_LEVELS else (1,)
+        orders = (int(params["tail_order"]),) if params.get("tail_order") else tried
+    order = orders[0]
+    (m, _, _, _), _ = best_of([(g, wf, stretch, order) for g in grid])
+    (_, wf, _, _), _ = best_of([(m, w, stretch, order) for w in widths])
+    (_, _, stretch, _), _ = best_of([(m, wf, x, order) for x in stretches])
+    (_, _, _, order), _ = best_of([(m, wf, stretch, o) for o in orders])
+    (m, _, _, _), per_m = best_of([(g, wf, stretch, order) for g in grid])
+    k, rmse, resid = cv.residuals(m, wf, stretch, order)
+    note.update(
+        cv_rmse=[r if np.isfinite(r) else None for r in per_m],
+        chosen=m,
+        chosen_width_factor=wf,
+        chosen_stretch=stretch,
+        chosen_alpha=alphas[k],
+        chosen_tail_order=order,
+        cv_rmse_chosen=rmse,
+        prediction_interval={
+            "levels": list(INTERVAL_LEVELS),
+            "half_width": conformal_half_widths(resid),
+            "method": f"conformal: quantiles of the {cv.folds}-fold cross-validation "
+            "residuals of the chosen candidate (CV+, Barber et al. 2021)",
+        },
+    )
+    chosen = {
+        "n_centers": m,
+        "width_factor": wf,
+        "velocity_stretch": stretch,
+        "alpha": alphas[k],
+        **({"tail_order": order} if params.get("linear_tail") else {}),
+    }
     return chosen, note
 
 

@@ -86,10 +86,17 @@ from ..fitted import FittedModel
 from ..io.atomic import created_timestamp
 from ..metrics import fit_statistics, metrics
 from ..models import INPUTS
-from ..models.rbf import STATE_KIND, check_inputs, predict_state
+from ..models.rbf import (
+    STATE_KIND,
+    STATE_VERSION,
+    check_inputs,
+    magnitude_columns,
+    predict_state,
+    tail_terms,
+)
 from ..samples import FrictionSamples, samples_hash
 from ._rbf_estimator import LSQ_IGNORES, TRAINERS, RBFNetRegressor
-from ._rbf_select import check_centres, choose_n_centers, drop_constant_inputs
+from ._rbf_select import check_centres, choose_structure, drop_constant_inputs
 
 __all__ = [
     "LSQ_IGNORES",
@@ -103,8 +110,15 @@ __all__ = [
 
 
 def _state(est: RBFNetRegressor, inputs: Sequence[str]) -> dict[str, Any]:
+    linear = (
+        {"linear_terms": tail_terms(inputs, int(est.tail_order)), "linear": est.linear_.tolist()}
+        if est.linear_tail
+        else {}
+    )
     return {
         "kind": STATE_KIND,
+        "state_version": STATE_VERSION,
+        **linear,
         "inputs": list(inputs),
         "velocity_scale": None if est.velocity_scale is None else float(est.velocity_scale),
         "input_shift": est.input_shift_.tolist(),
@@ -300,17 +314,37 @@ def _train_side(
     notes: dict[str, Any] = {}
     if dropped:
         notes["dropped_inputs"] = dropped
-    if params.get("n_centers") is None:
-        params["n_centers"], notes["n_centers_selection"] = choose_n_centers(X, t, params)
-    else:
-        check_centres(int(params["n_centers"]), len(t), where)
+    if "velocity_scale" not in params:  # the structured default: asinh warp of |v|
+        params["velocity_scale"] = _default_velocity_scale(X) if kept[0] == "velocity" else None
+    params.setdefault("linear_tail", True)
+    if params["linear_tail"]:
+        params.setdefault("linear_magnitude", magnitude_columns(kept))
     if params.get("velocity_scale") is not None and kept[0] != "velocity":
         raise ConfigError("velocity_scale warps the first input, which must be 'velocity'")
+    if params.get("n_centers") is not None:
+        check_centres(int(params["n_centers"]), len(t), where)
+    chosen, note = choose_structure(X, t, params)
+    params.update({k: v for k, v in chosen.items() if params.get(k) is None})
+    notes["n_centers_selection"] = note
+    if "prediction_interval" in note:
+        notes["prediction_interval"] = note["prediction_interval"]
     est = RBFNetRegressor(**params).fit(X, t)
+    if est.linear_tail:  # the floor of the magnitude g (models.rbf notes)
+        notes["magnitude_floor"] = 0.5 * max(float(np.min(est.predict(X))), 0.0)
     return est, {**_state(est, kept), **notes}
 
 
-def fit_rbf(samples: FrictionSamples, inputs: Sequence[str] = INPUTS, **params: Any) -> FittedModel:
+def _default_velocity_scale(X: np.ndarray) -> float | None:
+    """The asinh warp's scale [rad/s]: the smallest measured speed, so that the warp is
+    logarithmic over the measured speeds (a decade takes the same room everywhere)."""
+    speeds = np.abs(X[:, 0])
+    speeds = speeds[speeds > 0]
+    return float(speeds.min()) if speeds.size else None
+
+
+def fit_rbf(
+    samples: FrictionSamples, inputs: Sequence[str] | None = None, **params: Any
+) -> FittedModel:
     """Train the RBF network on ``samples`` and return it as a
     :class:`~fricid.fitted.FittedModel` (see :func:`to_fitted_model`).
 
@@ -327,22 +361,29 @@ def fit_rbf(samples: FrictionSamples, inputs: Sequence[str] = INPUTS, **params: 
     ----------
     samples : FrictionSamples
         The data.
-    inputs : sequence of str
-        The columns (any subset of velocity, load, temperature, in that order or another).
+    inputs : sequence of str, optional
+        The columns (any subset of velocity, load, temperature, in that order or another);
+        default the measured ones (``samples.measured``).
         One that does not vary in the data is dropped with a
         :class:`~fricid.errors.DataQualityWarning` and noted in ``state["dropped_inputs"]``.
     **params
-        :class:`RBFNetRegressor` parameters. Without ``n_centers`` (or with None) the number
-        of centres is chosen by 5-fold cross-validation of the ``lsq`` trainer over
-        5..min(60, n/3) (``state["n_centers_selection"]``); a given number above half the
-        samples warns (:class:`~fricid.errors.IdentifiabilityWarning`).
+        :class:`RBFNetRegressor` parameters. The structured defaults (issue 15): a linear
+        tail (``linear_tail=True``: far from the data the network returns to Coulomb plus
+        viscous friction, linear in load and temperature), the asinh velocity warp at the
+        smallest measured speed (``velocity_scale``), and the number of centres, width
+        factor, velocity stretch and ridge penalty not given (or None) chosen by 5-fold
+        cross-validation of the ``lsq`` trainer
+        (:func:`fricid.identify._rbf_select.choose_structure`; ``state["n_centers_selection"]``),
+        whose held-out residuals give conformal prediction intervals
+        (``state["prediction_interval"]``). A given number of centres above half the samples
+        warns (:class:`~fricid.errors.IdentifiabilityWarning`).
 
     Returns
     -------
     FittedModel
         ``model="rbf"``, its network(s) in ``state``.
     """
-    names = check_inputs(inputs)
+    names = check_inputs(samples.measured if inputs is None else inputs)
     samples.require(names, "model 'rbf' (inputs=)")
     symmetry = symmetry_for(samples)
     if symmetry != "per_direction":

@@ -12,6 +12,12 @@ The rules (issue 11, "Validation built in"):
   models count distinct operating points instead, since their extra parameters are
   determined by load and temperature); ``msk`` needs the load to vary, ``vlt`` the load and
   the temperature; ``*_asym`` needs samples of both directions, apart;
+* with ``learned=True`` (``fricid fit --model auto --learned``), the learned families
+  :data:`LEARNED` (``rbf``, ``hybrid``; issue 15) are candidates too, with at least
+  :data:`LEARNED_MIN_LEVELS` velocity levels per direction, at most
+  :data:`LEARNED_MAX_SAMPLES` samples (validation retrains them per fold) and the
+  least-squares loss without weights (how they train); they count as many parameters as
+  samples, so one is chosen only when clearly better than every analytic family;
 * the choice is the simplest candidate (fewest parameters, symmetric before ``_asym``) whose
   held-out RMSE is within :data:`PREFER_SIMPLER` (5 %) of the best, or within the noise
   (:data:`fricid.metrics.NOISE_RATIO` times the measurement scatter).
@@ -37,7 +43,15 @@ from . import _fit
 from ._scatter import Scatter, level_labels, measurement_scatter
 from .validate import validate
 
-__all__ = ["FAMILIES", "PREFER_SIMPLER", "Candidate", "candidates", "fit", "select"]
+__all__ = [
+    "FAMILIES",
+    "LEARNED",
+    "PREFER_SIMPLER",
+    "Candidate",
+    "candidates",
+    "fit",
+    "select",
+]
 
 #: Analytic families tried by ``"auto"``, simplest first (their ``_asym`` variants follow), with
 #: parameters held fixed: Stribeck with ``delta = 1`` is the RWSAVSBAS paper's eq. 7 as it
@@ -53,6 +67,15 @@ FAMILIES: tuple[tuple[str, dict[str, float]], ...] = (
 
 #: A simpler model within this fraction of the best held-out RMSE is preferred.
 PREFER_SIMPLER = 0.05
+
+#: Learned families ``"auto"`` also tries (issue 15), when the data suit them.
+LEARNED: tuple[str, ...] = ("rbf", "hybrid")
+
+#: Fewest velocity levels per direction for a learned candidate.
+LEARNED_MIN_LEVELS = 5
+
+#: Most samples for a learned candidate (each fold of its validation retrains it).
+LEARNED_MAX_SAMPLES = 600
 
 
 @dataclass(frozen=True)
@@ -84,13 +107,16 @@ def _varies(x: np.ndarray, atol: float) -> bool:
     return bool(np.ptp(x) > atol)
 
 
-def candidates(samples: FrictionSamples) -> list[Candidate]:
+def candidates(samples: FrictionSamples, learned: bool = False) -> list[Candidate]:
     """The families of :data:`FAMILIES` and their ``_asym`` variants, simplest first, each
-    with the reason the data cannot support it (module docstring), or ``""``.
+    with the reason the data cannot support it (module docstring), or ``""``; then, with
+    ``learned``, the learned families :data:`LEARNED`.
 
     Parameters
     ----------
     samples : FrictionSamples
+    learned : bool, default False
+        Add the learned families.
 
     Returns
     -------
@@ -134,7 +160,30 @@ def candidates(samples: FrictionSamples) -> list[Candidate]:
                 f" ({', '.join(f'{k}={v:g}' for k, v in fixed.items())})" if fixed else ""
             )
             out.append(Candidate(label, name, held or dict(fixed), p * (2 if asym else 1), reason))
-    return out
+    return out + (_learned(samples, levels) if learned else [])
+
+
+def _learned(samples: FrictionSamples, levels: np.ndarray) -> list[Candidate]:
+    """The learned families (issue 15): ``rbf`` (the structured network) and ``hybrid``
+    (analytic backbone plus RBF residual). Their ``n_params`` is the number of samples (an
+    upper bound: their size is chosen by cross-validation), so the rule "the simplest within
+    5 % of the best" picks one only when it is clearly better than every analytic family."""
+    n = len(samples)
+    dirs = [d for d in (-1, 0, 1) if d in set(samples.directions())]
+    have = min(np.unique(levels[samples.direction == d]).size for d in dirs)
+    reason = ""
+    if have < LEARNED_MIN_LEVELS:
+        reason = (
+            f"{have} velocity levels per direction (a learned model needs {LEARNED_MIN_LEVELS})"
+        )
+    elif n > LEARNED_MAX_SAMPLES:
+        reason = (
+            f"{n} samples: validating a learned model refits it per fold (slow over "
+            f"{LEARNED_MAX_SAMPLES}); fit 'rbf' or 'hybrid' by name"
+        )
+    elif 0 in dirs and len(dirs) > 1:
+        reason = "the samples mix combined and per-direction rows"
+    return [Candidate(name, name, {}, n, reason) for name in LEARNED]
 
 
 def select(
@@ -144,6 +193,7 @@ def select(
     scheme: str = "lovo",
     scatter: Scatter | None = None,
     seed: int | np.random.Generator | None = 0,
+    learned: bool = False,
     **fit_options: Any,
 ) -> FittedModel:
     """Fit the candidates, pick by held-out error, refit the choice on all the samples.
@@ -158,6 +208,10 @@ def select(
     scatter : Scatter, optional
         Default: :func:`~fricid.identify.validate.measurement_scatter` of ``samples``.
     seed : int or numpy.random.Generator, optional
+    learned : bool, default False
+        Try the learned families too (``rbf``, ``hybrid``; :func:`candidates`). Off by
+        default: validating one retrains it, its structure search included, for every fold
+        (about 20 times an analytic family's time).
     **fit_options
         Passed to every fit (``max_evals``, ``loss``, ``weights``, ...).
 
@@ -184,9 +238,14 @@ def select(
     sc = scatter if scatter is not None else measurement_scatter(samples)
     table: list[dict[str, Any]] = []
     runs = {}
-    found = {c.label: c for c in candidates(samples)}
+    found = {c.label: c for c in candidates(samples, learned)}
+    robust = str(fit_options.get("loss", "l2")).lower() not in ("l2", "sse") or (
+        fit_options.get("weights") not in (None, "none", "")
+    )
     for c in found.values():
         row: dict[str, Any] = {"model": c.label, "n_params": c.n_params}
+        if c.model in LEARNED and robust and not c.note:
+            c = Candidate(c.label, c.model, c.fixed, c.n_params, "trains by least squares only")
         if c.note:
             table.append({**row, "heldout_rmse": None, "ratio": None, "note": c.note})
             continue
@@ -216,7 +275,9 @@ def select(
     chosen = min(ok, key=lambda r: (r["n_params"], "_asym" in r["model"]))
     reason = _reason(chosen, best, sc, scheme, noise)
     pick = found[chosen["model"]]
-    fitted = _fit.fit(samples, pick.model, method, seed=seed, fixed=pick.fixed, **fit_options)
+    fitted = _fit.fit(
+        samples, pick.model, method, seed=seed, fixed=pick.fixed or None, **fit_options
+    )
     fitted.selection = {
         "scheme": scheme,
         "chosen": chosen["model"],

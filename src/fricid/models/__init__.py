@@ -4,7 +4,9 @@ Use :func:`get_model` to look an analytic model up by name (``"<name>_asym"`` gi
 per-direction variant), and :func:`get_predictor` for any model a model file may name, the RBF
 network included: every one predicts with ``predict(theta_or_state, X)``, and its ``stateful``
 flag says whether it takes a parameter vector (analytic models) or a stored state (the RBF
-network, :mod:`fricid.models.rbf`). Training the network is :mod:`fricid.identify.rbf`'s job.
+network, :mod:`fricid.models.rbf`; the hybrid of an analytic backbone and an RBF residual,
+:mod:`fricid.models.hybrid`). Training them is :mod:`fricid.identify.rbf`'s and
+:mod:`fricid.identify.hybrid`'s job.
 """
 
 from __future__ import annotations
@@ -14,6 +16,7 @@ from ._analytic import CoulombViscous, LoadDependent, Stribeck, VelocityLoadTemp
 from ._asymmetric import Asymmetric
 from ._base import INPUTS, FrictionModel, Parameter, data_scales
 from .dahl import Dahl
+from .hybrid import HYBRID, HybridModel
 from .lugre import LuGre
 from .rbf import NETWORK, RBFNetwork
 
@@ -71,12 +74,12 @@ def get_model(name: str | FrictionModel, asymmetric: bool = False) -> FrictionMo
 
 
 #: Models that predict from a stored state rather than a parameter vector, by registry name.
-STATEFUL: dict[str, RBFNetwork] = {NETWORK.name: NETWORK}
+STATEFUL: dict[str, RBFNetwork | HybridModel] = {NETWORK.name: NETWORK, HYBRID.name: HYBRID}
 
 
-def get_predictor(name: str | FrictionModel) -> FrictionModel | RBFNetwork:
+def get_predictor(name: str | FrictionModel) -> FrictionModel | RBFNetwork | HybridModel:
     """The model a model file names: an analytic model (:func:`get_model`) or a stateful one
-    (:data:`STATEFUL`: ``"rbf"``).
+    (:data:`STATEFUL`: ``"rbf"``, ``"hybrid"``).
 
     Either predicts with ``predict(theta_or_state, X)``; ``stateful`` tells which argument.
     """

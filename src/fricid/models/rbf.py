@@ -33,6 +33,23 @@ Friction opposes motion: ``symmetry`` says how the network gives the sign (issue
 
 A state without the key is ``"signed"``.
 
+Structure (issue 15): a network may carry a *linear tail*, coefficients ``state["linear"]``
+of the columns ``state["linear_terms"]`` (:func:`tail_terms`: the raw SI inputs, velocity
+unwarped, ``|v|`` under a sign-form symmetry, ``|load|``, then velocity times each other
+input), added to
+the output: ``g = sum_i w_i phi_i(z) + b + sum_j a_j x_j``. Far from the centres the Gaussians
+vanish and ``g`` returns to ``b + a_L |load| + a_T T + (a_v + a_vL |load| + a_vT T) |v|``: a
+Coulomb level and a viscous coefficient both linear in load and temperature, instead of
+falling back to the bias. A network with a tail and a sign of its own (``SIGN_FORM``) floors
+``g`` at ``state["magnitude_floor"]`` (half the smallest magnitude it fits on its training
+data; 0 when absent): friction opposes motion, so a linear extrapolation far outside the data
+(a load near zero, or of the other sign, from a narrow load range) cannot turn it into
+propulsion or zero. ``state["state_version"]`` is 2 for states that may hold these (absent
+or 1: the states of fricid before issue 15, which still load). The velocity warp
+``asinh(|v| / velocity_scale)`` is logarithmic above ``velocity_scale`` (fit chooses it as the
+smallest measured speed), so a decade of speed takes the same room in the network's input at
+every speed.
+
 References
 ----------
 [B] "An Optimized RBF Neural Network Based on Beetle Antennae Search Algorithm for Modeling the
@@ -54,19 +71,29 @@ __all__ = [
     "NETWORK",
     "SIGN_FORM",
     "STATE_KIND",
+    "STATE_VERSION",
     "SYMMETRIES",
     "RBFNetwork",
     "check_inputs",
+    "interval_half_width",
     "legacy_symmetry",
+    "magnitude_columns",
     "mse_z",
     "predict_state",
     "predict_z",
     "sub_networks",
     "symmetry_of",
+    "tail_columns",
+    "tail_order",
+    "tail_terms",
 ]
 
 #: ``state["kind"]`` of an RBF network in a model file.
 STATE_KIND = "gaussian_rbf"
+
+#: ``state["state_version"]`` fricid writes (2: the linear tail and prediction intervals of
+#: issue 15 may be present; files without the key are version 1 and read as before).
+STATE_VERSION = 2
 
 #: ``state["symmetry"]`` values, with a line on each (module notes).
 SYMMETRIES: dict[str, str] = {
@@ -218,8 +245,12 @@ def _state_array(state: Mapping[str, Any], key: str, shape: tuple[int | None, ..
     return arr
 
 
-def _network(state: Mapping[str, Any], X: np.ndarray, where: str = "state") -> np.ndarray:
-    """One stored network's output at ``X (n, 3)`` (its inputs picked, warped, standardised)."""
+def _network(
+    state: Mapping[str, Any], X: np.ndarray, where: str = "state", magnitude: bool = False
+) -> np.ndarray:
+    """One stored network's output at ``X (n, 3)`` (its inputs picked, warped, standardised);
+    ``magnitude``: the output is ``g`` of a sign-form symmetry (floored at 0 with a linear
+    tail)."""
     if state.get("kind", STATE_KIND) != STATE_KIND:
         raise DataError(
             f"unknown RBF state kind {state.get('kind')!r}; expected '{STATE_KIND}'",
@@ -261,7 +292,69 @@ def _network(state: Mapping[str, Any], X: np.ndarray, where: str = "state") -> n
             )
         Xs = Xs.copy()
         Xs[:, 0] = np.arcsinh(Xs[:, 0] / float(vscale))
-    return predict_z((Xs - shift) / scale, centers, widths, weights, bias)
+    out = predict_z((Xs - shift) / scale, centers, widths, weights, bias)
+    if state.get("linear") is not None:
+        terms = state.get("linear_terms")
+        order = tail_order(inputs, terms)
+        if order is None:
+            raise DataError(
+                f"RBF model state 'linear_terms' must be {tail_terms(inputs)!r} or "
+                f"{tail_terms(inputs, 2)!r} for inputs {list(inputs)!r}; got {terms!r}",
+                column=f"{where}.linear_terms",
+            )
+        out = out + tail_columns(
+            X[:, [INPUTS.index(n) for n in inputs]], magnitude_columns(inputs), order
+        ) @ _state_array(state, "linear", (len(terms),))
+        if magnitude:  # g is a magnitude: friction opposes motion
+            floor = (
+                float(_state_array(state, "magnitude_floor", ()))
+                if (state.get("magnitude_floor") is not None)
+                else 0.0
+            )
+            out = np.maximum(out, max(floor, 0.0))
+    return out
+
+
+def tail_terms(inputs: Sequence[str], order: int = 1) -> list[str]:
+    """Names of the linear tail's columns for a network on ``inputs``: the inputs (the load
+    as ``|load|``, :func:`tail_columns`), then the first (the velocity) times each other one,
+    e.g. ``velocity*temperature`` (a viscous coefficient linear in load and temperature), and
+    with ``order=2`` times each other one squared, ``velocity*temperature*temperature`` (a
+    viscous coefficient quadratic in them: an Arrhenius-like coefficient to second order).
+    Cross-validation chooses the order (:mod:`fricid.identify._rbf_select`)."""
+    names = list(inputs)
+    first, others = names[0], names[1:]
+    out = names + [f"{first}*{o}" for o in others]
+    return out + [f"{first}*{o}*{o}" for o in others] if order == 2 else out
+
+
+def tail_order(inputs: Sequence[str], terms) -> int | None:
+    """The order (1 or 2) whose :func:`tail_terms` are ``terms``; None for neither."""
+    for order in (1, 2):
+        if terms == tail_terms(inputs, order):
+            return order
+    return None
+
+
+def magnitude_columns(inputs: Sequence[str]) -> tuple[int, ...]:
+    """Indices of the inputs the linear tail takes in magnitude: the load (friction grows
+    with the magnitude of the load torque, Bittencourt and Gunnarsson 2012, so a load of the
+    other sign, outside the data, extrapolates as its mirror image)."""
+    return tuple(j for j, name in enumerate(inputs) if name == "load")
+
+
+def tail_columns(Xs: np.ndarray, magnitude: Sequence[int] = (), order: int = 1) -> np.ndarray:
+    """The linear tail's columns (:func:`tail_terms` of ``order``) of a network's raw inputs
+    ``(n, d)``, the columns ``magnitude`` (:func:`magnitude_columns`) taken as absolute
+    values."""
+    Xs = np.array(Xs, dtype=float)
+    for j in magnitude:
+        Xs[:, j] = np.abs(Xs[:, j])
+    v, d = Xs[:, 0], Xs.shape[1]
+    cols = [Xs] + [v * Xs[:, j] for j in range(1, d)]
+    if order == 2:
+        cols += [v * Xs[:, j] ** 2 for j in range(1, d)]
+    return np.column_stack(cols)
 
 
 def predict_state(state: Mapping[str, Any] | None, X) -> np.ndarray:
@@ -290,11 +383,52 @@ def predict_state(state: Mapping[str, Any] | None, X) -> np.ndarray:
     Xa = X.copy()
     Xa[:, 0] = np.abs(v)
     if sym != "per_direction":
-        return np.sign(v) * _network(state, Xa)
+        return np.sign(v) * _network(state, Xa, magnitude=True)
     nets = sub_networks(state)
-    g_pos = _network(nets["pos"], Xa, "state.pos")
-    g_neg = _network(nets["neg"], Xa, "state.neg")
+    g_pos = _network(nets["pos"], Xa, "state.pos", magnitude=True)
+    g_neg = _network(nets["neg"], Xa, "state.neg", magnitude=True)
     return np.where(v > 0, g_pos, np.where(v < 0, -g_neg, 0.0))
+
+
+def interval_half_width(state: Mapping[str, Any] | None, X, level: float = 0.9) -> np.ndarray:
+    """Half-width [N m] of the prediction interval at ``level`` stored with a learned model
+    (``state["prediction_interval"]`` of each network: conformal quantiles of its
+    cross-validation residuals, :func:`fricid.identify._rbf_select.conformal_half_widths`),
+    at each row of ``X (n, 3)``: the ``pos`` network's for ``v > 0`` and the ``neg`` one's
+    for ``v < 0`` of a per-direction state; a hybrid model's are its residual network's.
+
+    The interval of a prediction ``F(x)`` is ``F(x) -+ half_width``: it covers a new
+    averaged sample at ``x`` (measurement noise included) with probability about ``level``
+    inside the operating range; outside it says nothing.
+
+    Returns
+    -------
+    ndarray, shape (n,)
+        NaN where the state holds no interval at that level (files before issue 15).
+    """
+    X = np.asarray(X, dtype=float)
+    out = np.full(X.shape[0], np.nan)
+    if not isinstance(state, Mapping):
+        return out
+    if isinstance(state.get("residual"), Mapping):  # a hybrid model
+        state = state["residual"]
+    v = X[:, 0]
+    try:
+        nets = sub_networks(state)
+    except DataError:
+        return out
+    for side, net in nets.items():
+        pi = net.get("prediction_interval")
+        if not isinstance(pi, Mapping):
+            continue
+        levels = [float(x) for x in pi.get("levels") or ()]
+        widths = list(pi.get("half_width") or ())
+        hits = [k for k, x in enumerate(levels) if abs(x - float(level)) < 1e-9]
+        if not hits or hits[0] >= len(widths):
+            continue
+        mask = {"all": np.ones(v.size, bool), "pos": v > 0, "neg": v < 0}[side]
+        out[mask] = float(widths[hits[0]])
+    return out
 
 
 class RBFNetwork:
@@ -333,6 +467,7 @@ def _describe_net(st: Mapping[str, Any]) -> str:
         f"{', '.join(st.get('inputs', []))}; trainer {st.get('trainer')}"
         + (f", encoding {st['encoding']}" if st.get("encoding") else "")
         + (f", {st['n_epochs']} epochs" if st.get("n_epochs") else "")
+        + ("; linear tail on the raw inputs" if st.get("linear") is not None else "")
         + (
             f"; {st['n_centers_selection'].get('chosen')} centres chosen by "
             f"{st['n_centers_selection'].get('folds')}-fold cross-validation"

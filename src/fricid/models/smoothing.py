@@ -130,10 +130,12 @@ class Smoothing:
 
 
 def _analytic(fitted: FittedLike) -> tuple[FrictionModel, np.ndarray] | None:
-    """The analytic model and parameter vector of ``fitted``; None for the RBF network."""
-    if fitted.model == "rbf":
+    """The analytic model and parameter vector of ``fitted``; None for the RBF network (and
+    the other stateful models, the hybrid)."""
+    from . import STATEFUL, get_model
+
+    if fitted.model in STATEFUL:
         return None
-    from . import get_model
 
     model = get_model(fitted.model)
     return model, model.param_vector(dict(fitted.params))

@@ -25,8 +25,15 @@ import numpy as np
 import pandas as pd
 
 from ..fitted import FittedModel
-from ..models import get_predictor
-from ..models.rbf import sub_networks
+from ..models import INPUTS, get_predictor
+from ..models.hybrid import backbone_of
+from ..models.rbf import (
+    interval_half_width,
+    magnitude_columns,
+    sub_networks,
+    tail_columns,
+    tail_order,
+)
 from ..samples import FrictionSamples
 from .document import Note, Table
 
@@ -37,31 +44,58 @@ N_SPEEDS = 8
 
 
 def _slots(state: Mapping[str, Any]) -> list[tuple[str, str, int]]:
-    """(side, "w" or "b", unit index) of every output coefficient, side ``"all"`` for a
-    single network."""
+    """(side, "w", "b" or "a", index) of every output coefficient, side ``"all"`` for a
+    single network: unit weights, the bias, the linear tail's coefficients."""
     out = []
     for side, net in sub_networks(state).items():
         out += [(side, "w", i) for i in range(len(net.get("weights") or ()))]
-        if net.get("fit_bias", True):
+        if net.get("fit_bias", True) or net.get("linear") is not None:
             out.append((side, "b", -1))
+        out += [(side, "a", i) for i in range(len(net.get("linear") or ()))]
     return out
 
 
 def coefficient_names(state: Mapping[str, Any]) -> list[str]:
-    """``w_1 .. w_m, bias`` for one network; ``pos w_1 .. pos bias, neg w_1 ..`` for two."""
+    """``w_1 .. w_m, bias`` (then ``a_<term>`` of a linear tail) for one network;
+    ``pos w_1 .. pos bias, neg w_1 ..`` for two."""
     names = []
     for side, what, i in _slots(state):
-        base = f"w_{i + 1}" if what == "w" else "bias"
+        if what == "a":
+            net = sub_networks(state)[side]
+            base = f"a_{net['linear_terms'][i]}"
+        else:
+            base = f"w_{i + 1}" if what == "w" else "bias"
         names.append(base if side == "all" else f"{side} {base}")
     return names
 
 
+def _tail_column(state: Mapping[str, Any], slot: tuple[str, str, int], X) -> np.ndarray:
+    """The model's column of a linear-tail coefficient at ``X`` (sign of motion included)."""
+    side, _, i = slot
+    net = sub_networks(state)[side]
+    Xa = np.asarray(X, dtype=float).copy()
+    v = Xa[:, 0].copy()
+    Xa[:, 0] = np.abs(v)
+    names = list(net["inputs"])
+    order = tail_order(names, net["linear_terms"]) or 1
+    Xs = Xa[:, [INPUTS.index(n) for n in names]]
+    col = tail_columns(Xs, magnitude_columns(names), order)[:, i]
+    mask = {"all": np.ones(v.size, bool), "pos": v > 0, "neg": v < 0}[side]
+    return np.where(mask, np.sign(v) * col, 0.0)
+
+
 def _unit_state(state: Mapping[str, Any], slot: tuple[str, str, int]) -> dict[str, Any]:
-    """``state`` with every output weight and bias 0 except the one of ``slot`` (1)."""
+    """``state`` with every output weight and bias 0, and no linear tail, except the one of
+    ``slot`` (1)."""
     side, what, i = slot
     out = dict(state)
     for s, net in sub_networks(state).items():
         zero = {**net, "weights": [0.0] * len(net.get("weights") or ()), "bias": 0.0}
+        zero.pop("linear", None)
+        zero.pop("linear_terms", None)
+        if s == "all":
+            out.pop("linear", None)
+            out.pop("linear_terms", None)
         if s == side:
             if what == "w":
                 zero["weights"][i] = 1.0
@@ -78,7 +112,10 @@ def _coefficients(state: Mapping[str, Any]) -> np.ndarray:
     values = []
     for side, what, i in _slots(state):
         net = sub_networks(state)[side]
-        values.append(float(net["weights"][i]) if what == "w" else float(net.get("bias", 0.0)))
+        if what == "a":
+            values.append(float(net["linear"][i]))
+        else:
+            values.append(float(net["weights"][i]) if what == "w" else float(net.get("bias", 0.0)))
     return np.asarray(values)
 
 
@@ -91,7 +128,12 @@ def hidden_layer(fitted: FittedModel, X: np.ndarray) -> np.ndarray:
     """
     state = dict(fitted.state or {})
     model = get_predictor("rbf")
-    cols = [model.predict(_unit_state(state, slot), X) for slot in _slots(state)]
+    cols = [
+        _tail_column(state, slot, X)
+        if slot[1] == "a"
+        else model.predict(_unit_state(state, slot), X)
+        for slot in _slots(state)
+    ]
     return np.column_stack(cols) if cols else np.zeros((len(X), 0))
 
 
@@ -139,9 +181,38 @@ def _query_points(fitted: FittedModel, samples: FrictionSamples) -> np.ndarray:
     )
 
 
+def _residual_view(
+    fitted: FittedModel, samples: FrictionSamples, Xq: np.ndarray
+) -> tuple[FittedModel, FrictionSamples, np.ndarray | float]:
+    """What the bootstrap resamples: the network itself, or for a hybrid model its residual
+    network (an ``rbf`` model), the samples minus the backbone, and the backbone at ``Xq``
+    (added back to the bootstrap's predictions)."""
+    if fitted.model != "hybrid":
+        return fitted, samples, 0.0
+    from dataclasses import replace
+
+    model, theta = backbone_of(fitted.state or {})
+    view = FittedModel(
+        model="rbf",
+        params={},
+        method=fitted.method,
+        operating_range=fitted.operating_range,
+        provenance=fitted.provenance,
+        state=dict((fitted.state or {})["residual"]),
+    )
+    rest = replace(samples, friction=samples.friction - model.predict(theta, samples.X))
+    return view, rest, model.predict(theta, Xq)
+
+
 def _facts(fitted: FittedModel) -> pd.DataFrame:
     state = fitted.state or {}
     rows: dict[str, Any] = {"symmetry": state.get("symmetry") or "signed", "trainer": fitted.method}
+    if fitted.model == "hybrid":
+        bb = state.get("backbone") or {}
+        rows["analytic backbone"] = f"{bb.get('model')}: " + ", ".join(
+            f"{k} = {float(v):.6g}" for k, v in dict(bb.get("params") or {}).items()
+        )
+        state = state.get("residual") or {}
     for side, net in sub_networks(state).items():
         tag = "" if side == "all" else f" ({side})"
         widths = np.asarray(net.get("widths", []), dtype=float)
@@ -153,6 +224,14 @@ def _facts(fitted: FittedModel) -> pd.DataFrame:
         )
         rows[f"epochs run{tag}"] = net.get("n_epochs")
         rows[f"final training MSE (target scaled to [-1, 1]){tag}"] = net.get("train_mse_scaled")
+        if net.get("linear") is not None:
+            rows[f"linear tail{tag}"] = ", ".join(
+                f"{t}: {float(a):.4g}"
+                for t, a in zip(net["linear_terms"], net["linear"], strict=True)
+            )
+        sel = net.get("n_centers_selection")
+        if isinstance(sel, Mapping) and sel.get("cv_rmse_chosen") is not None:
+            rows[f"cross-validated RMSE [N m]{tag}"] = sel["cv_rmse_chosen"]
     return pd.DataFrame(
         {"property": list(rows), "value": [("–" if v is None else v) for v in rows.values()]}
     )
@@ -167,28 +246,42 @@ def rbf_parameter_items(
     network's structure; appendix: every output weight and bias with its interval.
     """
     Xq = _query_points(fitted, samples)
-    boot = rbf_bootstrap(fitted, samples, Xq, n_boot=n_boot, seed=seed)
+    view, vsamples, offset = _residual_view(fitted, samples, Xq)
+    boot = rbf_bootstrap(view, vsamples, Xq, n_boot=n_boot, seed=seed)
     pred = fitted.predict(Xq, warn=False)
-    lo_p, hi_p = np.percentile(boot["predictions"], [2.5, 97.5], axis=0)
+    lo_p, hi_p = np.percentile(boot["predictions"], [2.5, 97.5], axis=0) + offset
+    half = interval_half_width(fitted.state, Xq, 0.9)
+    table = {
+        "velocity [rad/s]": Xq[:, 0],
+        "load [N m]": Xq[:, 1],
+        "temperature [°C]": Xq[:, 2],
+        "predicted [N m]": pred,
+        "95% CI low [N m]": lo_p,
+        "95% CI high [N m]": hi_p,
+    }
+    note = ""
+    if np.isfinite(half).any():
+        table["90% prediction low [N m]"] = pred - half
+        table["90% prediction high [N m]"] = pred + half
+        note = (
+            " The 90 % prediction interval (saved in the model file) covers a new averaged "
+            "sample, noise included: conformal, from the cross-validation residuals of the "
+            "network's structure selection."
+        )
+    hybrid = fitted.model == "hybrid"
     main: list = [
         Table(
             "prediction_ci",
             "Predicted friction with bootstrap 95 % intervals over the operating range",
-            pd.DataFrame(
-                {
-                    "velocity [rad/s]": Xq[:, 0],
-                    "load [N m]": Xq[:, 1],
-                    "temperature [°C]": Xq[:, 2],
-                    "predicted [N m]": pred,
-                    "95% CI low [N m]": lo_p,
-                    "95% CI high [N m]": hi_p,
-                }
-            ),
+            pd.DataFrame(table),
             caption=(
                 f"At {N_SPEEDS} speeds spread over the measured ones, on each side of motion, "
                 f"median load and temperature of the samples. Residual bootstrap, {n_boot} "
                 "resamples, hidden layer held fixed (percentile intervals): it understates "
-                "the uncertainty of searched centres. The weights are in the appendix."
+                "the uncertainty of searched centres"
+                + (", and the backbone is held at its fit" if hybrid else "")
+                + ". The weights are in the appendix."
+                + note
             ),
         ),
         Table(
@@ -198,7 +291,7 @@ def rbf_parameter_items(
             caption="Gaussian hidden units (eq. 14) and a linear output layer (eq. 15).",
         ),
     ]
-    coef = _coefficients(fitted.state or {})
+    coef = _coefficients(view.state or {})
     lo_w, hi_w = np.percentile(boot["coefficients"], [2.5, 97.5], axis=0)
     appendix: list = [
         Table(
@@ -206,7 +299,7 @@ def rbf_parameter_items(
             "Output weights with bootstrap 95 % intervals",
             pd.DataFrame(
                 {
-                    "parameter": coefficient_names(fitted.state or {}),
+                    "parameter": coefficient_names(view.state or {}),
                     "value": coef,
                     "unit": "N m",
                     "95% CI low": lo_w,

@@ -1,0 +1,271 @@
+"""Held-out RMSE / noise of every model family on issue 15's held-out laws, the paper-1 preset's
+unseen region (BAS-RBFNN paper Fig. 10), and training times.
+
+Usage: ``python benchmarks/bench_floor.py [--seeds 3] [--no-gp]`` (a few minutes on 2 idle
+cores; BLAS is held to one thread, see below).
+
+Part 1, for each kind of :mod:`fricid.sim.heldout_laws` (``grid``, ``asym_arrhenius``,
+``sigmoid``) and each of its REPORTING seeds (1001-1003, never used to choose a default; the
+tuning seeds are 0-99): train on the noisy design grid, predict the held-out set (random points
+in the grid's box, with their own noise), and print the mean over seeds of held-out RMSE /
+noise (1.0 = a model equal to the truth) and the training seconds, for
+
+* ``best analytic``: the best held-out ratio among the analytic families the data support
+  (:func:`fricid.identify.select.candidates`, plus any ``*_temp`` family registered by name in
+  :data:`fricid.models.MODELS`): an oracle choice among them, flattering them;
+* ``rbf plain``: ``fit(samples, "rbf", network={"linear_tail": False, "velocity_scale":
+  None})``: no structure, the size, widths and penalty still cross-validated;
+* ``rbf default``: ``fit(samples, "rbf")``, the CLI default: structured (linear tail, asinh
+  velocity warp) with its structure chosen by cross-validation. This is THE DEFAULT MODEL the
+  goals refer to;
+* ``hybrid``: ``fit(samples, "hybrid")``, analytic backbone (by BIC) plus RBF residual;
+* ``gp``: ``fit(samples, "gp")`` when a family ``gp`` is registered, else "(not available)";
+* ``sklearn GP``: scikit-learn's ``GaussianProcessRegressor`` with an ARD RBF kernel plus
+  white noise (as issue 15's table; first reporting seed only, as the training-time
+  reference);
+* ``MLP``: scikit-learn's ``MLPRegressor`` with two hidden layers of 64.
+
+Both scikit-learn models get the structure the fricid models get (the same for every model:
+fair): standardised inputs ``asinh(|v| / v_min)``, the other measured inputs and the direction
+(per-direction samples), target ``sign(v) F``, prediction ``sign(v) g``.
+
+Goals (issue 15): the default model <= 1.10 x noise on each kind; its training time <= 0.1 x
+the GP's (the registered ``gp`` when there is one, else the sklearn GP) on the same data.
+
+Part 2: the paper-1 preset (``paper1``, full design, the oracle's Gaussian noise on the true
+friction, :func:`fricid.experiments.rbfnn_study.paper1_data`, seed 1001) against the true
+friction in Fig. 10's unseen region (52-60 deg/s, positions -22 to -10 deg, 45-55 degC:
+:func:`~fricid.experiments.rbfnn_study.unseen_region`): mean / max absolute error [mN m] of
+``vlt``, ``rbf default`` and ``hybrid``. Goal: the default's mean error <= 2 x the averaged
+samples' noise (the RMS of :func:`fricid.sim.expected_noise_std`).
+
+What it showed (``python benchmarks/bench_floor.py``, 2026-11-22, the machine shared; 302 s):
+
+==============  ==============  ====================  ================
+family          grid            asym_arrhenius        sigmoid
+==============  ==============  ====================  ================
+best analytic   16.66 (vlt)     7.78 (stribeck_asym)  0.99 (msk_asym)
+rbf plain       135.96          9.37                  11.29
+rbf default     1.15 [5.1 s]    1.36 [0.4 s]          1.10 [0.7 s]
+hybrid          1.19            2.07                  0.99
+sklearn GP      1.51 [128.9 s]  1.10 [0.2 s]          1.13 [4.7 s]
+MLP             16.41           16.73                 9.53
+==============  ==============  ====================  ================
+
+The default meets 1.10 on ``sigmoid`` and misses on ``grid`` (1.15) and ``asym_arrhenius``
+(1.36; 1.20-1.26 on tuning seeds 0-1); its training takes 0.04 x the GP's on the 1848-point
+grid (goal met) but more than 0.1 x on the small sets, where the GP itself takes 0.2-5 s. In
+the paper-1 unseen region the default's mean / max error is 2.28 / 4.60 mN m, 4.5 x the
+averaged samples' noise of 0.51 mN m (goal 2 x: missed; vlt 8.50 / 12.70, hybrid 3.90 / 7.54;
+the BAS-RBFNN paper 1.2 / 6.3). A registered ``gp`` family was not available on this branch.
+
+Timings: the machine this was written on was shared (2 cores, eight engineers): read the
+seconds as ratios within one run. OpenBLAS is held to one thread (``OPENBLAS_NUM_THREADS=1``
+set before numpy loads, unless already set): on a loaded machine its threads made a 400 x 400
+Cholesky factorisation 300 times slower.
+"""
+
+from __future__ import annotations
+
+import os
+
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+
+import argparse
+import time
+import warnings
+
+import numpy as np
+
+from fricid.identify import fit
+from fricid.identify.select import LEARNED, candidates
+from fricid.models import MODELS, STATEFUL
+from fricid.sim.heldout_laws import KINDS, REPORTING_SEEDS, draw
+
+GOAL_RATIO = 1.10
+GOAL_TIME = 0.1
+GOAL_UNSEEN = 2.0
+
+
+def _timed(fn):
+    t0 = time.perf_counter()
+    out = fn()
+    return out, time.perf_counter() - t0
+
+
+def _ratio(predict, d) -> float:
+    r = predict(d.test.X) - d.test.y
+    return float(np.sqrt(np.mean(r * r)) / d.noise)
+
+
+def _sk_inputs(samples):
+    """The structured inputs the scikit-learn models get: ``asinh(|v| / v_min)``, the other
+    measured inputs, and the direction for per-direction samples; their target is
+    ``sign(v) F`` (friction opposes motion), their prediction ``sign(v) g``."""
+    cols = [["velocity", "load", "temperature"].index(n) for n in samples.measured]
+    v_min = float(np.min(np.abs(samples.velocity[samples.velocity != 0])))
+    both = samples.directions() != (0,)
+
+    def pick(X):
+        Z = np.asarray(X, dtype=float)[:, cols].copy()
+        v = Z[:, 0].copy()
+        Z[:, 0] = np.arcsinh(np.abs(v) / v_min)
+        return np.column_stack([Z, np.sign(v)]) if both else Z
+
+    return pick
+
+
+def _analytic(d):
+    """Best held-out ratio among the analytic candidates, its name, and the seconds of all."""
+    names = [
+        (c.model, c.fixed) for c in candidates(d.train) if not c.note and c.model not in LEARNED
+    ]
+    names += [(n, {}) for n in MODELS if n.endswith("_temp")]
+    best, seconds = (np.inf, "-"), 0.0
+    for name, fixed in names:
+        try:
+            m, dt = _timed(lambda name=name, fixed=fixed: fit(d.train, name, fixed=fixed or None))
+        except Exception:
+            continue
+        seconds += dt
+        ratio = _ratio(lambda X, m=m: m.predict(X, warn=False), d)
+        best = min(best, (ratio, m.model))
+    return best[0], best[1], seconds
+
+
+def _fricid(d, name, **kw):
+    m, dt = _timed(lambda: fit(d.train, name, seed=0, **kw))
+    return _ratio(lambda X: m.predict(X, warn=False), d), dt
+
+
+def _sklearn(d, which: str):
+    from sklearn.gaussian_process import GaussianProcessRegressor
+    from sklearn.gaussian_process.kernels import RBF, ConstantKernel, WhiteKernel
+    from sklearn.neural_network import MLPRegressor
+    from sklearn.pipeline import make_pipeline
+    from sklearn.preprocessing import StandardScaler
+
+    pick = _sk_inputs(d.train)
+    X = pick(d.train.X)
+    t = np.sign(d.train.velocity) * d.train.y
+    if which == "gp":
+        k = X.shape[1]
+        kernel = ConstantKernel() * RBF(np.ones(k), (1e-2, 1e3)) + WhiteKernel(1e-2, (1e-6, 1))
+        est = make_pipeline(
+            StandardScaler(),
+            GaussianProcessRegressor(kernel, normalize_y=True, random_state=0),
+        )
+    else:
+        est = make_pipeline(
+            StandardScaler(),
+            MLPRegressor(hidden_layer_sizes=(64, 64), max_iter=2000, random_state=0),
+        )
+    _, dt = _timed(lambda: est.fit(X, t))
+
+    def predict(Xq):
+        return np.sign(np.asarray(Xq)[:, 0]) * est.predict(pick(Xq))
+
+    return _ratio(predict, d), dt
+
+
+FAMILIES = ("best analytic", "rbf plain", "rbf default", "hybrid", "gp", "sklearn GP", "MLP")
+
+
+def part1(seeds, with_gp: bool) -> None:
+    print("Held-out RMSE / noise (mean over reporting seeds), training seconds in brackets\n")
+    head = f"{'family':<16}" + "".join(f"{k:>26}" for k in KINDS)
+    print(head)
+    rows: dict[str, list[str]] = {f: [] for f in FAMILIES}
+    verdict = []
+    for kind in KINDS:
+        acc: dict[str, list[tuple[float, float]]] = {f: [] for f in FAMILIES}
+        best_names = set()
+        for k, seed in enumerate(seeds):
+            d = draw(kind, seed)
+            r, name, dt = _analytic(d)
+            acc["best analytic"].append((r, dt))
+            best_names.add(name)
+            acc["rbf plain"].append(
+                _fricid(d, "rbf", network={"linear_tail": False, "velocity_scale": None})
+            )
+            acc["rbf default"].append(_fricid(d, "rbf"))
+            acc["hybrid"].append(_fricid(d, "hybrid"))
+            if "gp" in STATEFUL or "gp" in MODELS:
+                acc["gp"].append(_fricid(d, "gp"))
+            if with_gp and k == 0:
+                acc["sklearn GP"].append(_sklearn(d, "gp"))
+            acc["MLP"].append(_sklearn(d, "mlp"))
+        for f in FAMILIES:
+            vals = acc[f]
+            if not vals:
+                cell = "(not available)" if f == "gp" else "-"
+            else:
+                r = np.mean([v[0] for v in vals])
+                t = np.mean([v[1] for v in vals])
+                cell = f"{r:.2f} [{t:.1f} s]"
+                if f == "best analytic":
+                    cell = f"{r:.2f} {'/'.join(sorted(best_names))[:11]} [{t:.1f}s]"
+            rows[f].append(cell)
+        default = np.mean([v[0] for v in acc["rbf default"]])
+        t_def = np.mean([v[1] for v in acc["rbf default"]])
+        ref = acc["gp"] or acc["sklearn GP"]
+        t_gp = np.mean([v[1] for v in ref]) if ref else np.nan
+        verdict.append(
+            f"{kind}: default {default:.2f} x noise "
+            f"({'meets' if default <= GOAL_RATIO else 'MISSES'} <= {GOAL_RATIO}); training "
+            + (
+                f"{t_def / t_gp:.3f} x the GP's "
+                f"({'meets' if t_def <= GOAL_TIME * t_gp else 'MISSES'} <= {GOAL_TIME})"
+                if np.isfinite(t_gp)
+                else "(no GP timed)"
+            )
+        )
+    for f in FAMILIES:
+        print(f"{f:<16}" + "".join(f"{c:>26}" for c in rows[f]))
+    print("\nGoals:")
+    for line in verdict:
+        print("  " + line)
+
+
+def part2(seed: int) -> None:
+    from fricid.experiments.rbfnn_study import paper1_data, unseen_region
+
+    samples, _, floor = paper1_data("full", seed=seed, data="oracle")
+    unseen = unseen_region("full")
+    print(
+        f"\nPaper-1 preset (full design, {len(samples)} samples, oracle noise, seed {seed}): "
+        f"unseen region (Fig. 10, {len(unseen)} points), |error| [mN m]; averaged samples' "
+        f"noise {1e3 * floor:.2f} mN m"
+    )
+    print(f"{'family':<14}{'mean':>8}{'max':>8}{'train s':>9}")
+    mean_default = np.nan
+    for label, name in (("vlt", "vlt"), ("rbf default", "rbf"), ("hybrid", "hybrid")):
+        m, dt = _timed(lambda name=name: fit(samples, name, seed=0))
+        err = np.abs(m.predict(unseen.X, warn=False) - unseen.friction) * 1e3
+        print(f"{label:<14}{err.mean():>8.2f}{err.max():>8.2f}{dt:>9.1f}")
+        if name == "rbf":
+            mean_default = float(err.mean())
+    ok = mean_default <= GOAL_UNSEEN * 1e3 * floor
+    print(
+        f"Goal: default mean {mean_default:.2f} mN m = {mean_default / (1e3 * floor):.2f} x the "
+        f"noise ({'meets' if ok else 'MISSES'} <= {GOAL_UNSEEN}); paper's BAS-RBFNN 1.2/6.3, "
+        "issue 15's GP 0.53/1.18"
+    )
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--seeds", type=int, default=len(REPORTING_SEEDS))
+    ap.add_argument("--no-gp", action="store_true", help="skip the sklearn GP reference")
+    args = ap.parse_args()
+    seeds = REPORTING_SEEDS[: args.seeds]
+    warnings.simplefilter("ignore")
+    t0 = time.perf_counter()
+    part1(seeds, not args.no_gp)
+    part2(REPORTING_SEEDS[0])
+    print(f"\n(total {time.perf_counter() - t0:.0f} s; machine shared, timings are ratios)")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,176 @@
+"""Identification of the hybrid model (issue 15): an analytic backbone identified first, then an
+RBF network trained on what it leaves, ``fit(samples, "hybrid")``.
+
+1. **Backbone.** Each analytic family the data support (:func:`fricid.identify.select.candidates`:
+   Stribeck, MSK, VLT, ..., their ``_asym`` variants for samples of both directions) is fitted
+   by :func:`fricid.identify.fit` (least squares); the one with the smallest BIC is kept
+   (``state["backbone_selection"]`` lists them). ``backbone=`` names one instead.
+2. **Residual.** The RBF network (:func:`fricid.identify.rbf.fit_rbf`) is trained on
+   ``F - F_backbone`` with its sign of motion, *without* bias or linear tail, so it vanishes
+   far from its centres and the model returns to the backbone outside the data; its size,
+   widths and penalty are chosen by cross-validation, and its trainer is least squares
+   (``lsq``), BAS or GA as the BAS-RBFNN paper's (``method=``).
+
+The prediction intervals saved with the model are the residual network's conformal intervals
+(cross-validation residuals of the residual fit, the backbone held; they do not include the
+backbone's own uncertainty, which is small beside them when the backbone has few parameters).
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from ..errors import ConfigError
+from ..fitted import FittedModel
+from ..metrics import fit_statistics, metrics
+from ..models import INPUTS, get_model
+from ..models.hybrid import STATE_KIND
+from ..models.rbf import STATE_VERSION
+from ..samples import FrictionSamples
+
+__all__ = ["fit_backbone", "fit_hybrid"]
+
+
+def fit_backbone(
+    samples: FrictionSamples, backbone: str | None = None
+) -> tuple[FittedModel, list[dict[str, Any]], list[warnings.WarningMessage]]:
+    """The analytic backbone: ``backbone`` fitted by least squares, or the candidate of
+    :func:`fricid.identify.select.candidates` with the smallest BIC.
+
+    Returns
+    -------
+    FittedModel
+        The backbone's fit.
+    list of dict
+        Per candidate: ``model``, ``bic`` and ``rmse`` [N m] (None when it failed).
+    list
+        The warnings of the chosen backbone's fit.
+    """
+    from . import _fit
+    from .select import LEARNED, candidates
+
+    if backbone is not None:
+        names = [(str(backbone).strip().lower(), {})]
+    else:
+        names = [
+            (c.model, dict(c.fixed))
+            for c in candidates(samples)
+            if not c.note and c.model not in LEARNED
+        ]
+        if not names:
+            raise ConfigError(
+                "no analytic backbone fits these samples (too few velocity levels for any "
+                "family); fit the RBF network instead (model 'rbf')"
+            )
+    table: list[dict[str, Any]] = []
+    best: tuple[float, FittedModel, list] | None = None
+    for name, fixed in names:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            try:
+                fitted = _fit.fit(samples, name, fixed=fixed or None)
+            except ConfigError:
+                if backbone is not None:
+                    raise
+                table.append({"model": name, "fixed": fixed, "bic": None, "rmse": None})
+                continue
+        bic = float(fitted.statistics.get("bic", np.inf))
+        table.append(
+            {"model": name, "fixed": fixed, "bic": bic, "rmse": float(fitted.metrics["rmse"])}
+        )
+        if best is None or bic < best[0]:
+            best = (bic, fitted, list(caught))
+    if best is None:
+        raise ConfigError("no analytic backbone could be fitted to these samples")
+    return best[1], table, best[2]
+
+
+def fit_hybrid(
+    samples: FrictionSamples,
+    inputs: Sequence[str] | None = None,
+    *,
+    backbone: str | None = None,
+    **network: Any,
+) -> FittedModel:
+    """Identify the hybrid model (module notes) on ``samples``.
+
+    Parameters
+    ----------
+    samples : FrictionSamples
+        The data.
+    inputs : sequence of str, optional
+        The residual network's inputs; default the samples' measured ones.
+    backbone : str, optional
+        The backbone's registry name (e.g. ``"stribeck_asym"``); default chosen by BIC.
+    **network
+        :class:`~fricid.identify.rbf.RBFNetRegressor` parameters of the residual network
+        (``trainer="bas"`` or ``"ga"`` for the paper's trainers); ``linear_tail`` and
+        ``fit_bias`` are off (the residual returns to zero outside the data).
+
+    Returns
+    -------
+    FittedModel
+        ``model="hybrid"``; ``state`` holds ``backbone`` and ``residual``
+        (:mod:`fricid.models.hybrid`).
+    """
+    from .rbf import fit_rbf
+
+    for key in ("linear_tail", "fit_bias"):
+        if network.get(key):
+            raise ConfigError(
+                f"the hybrid model's residual network has no {key.replace('_', ' ')}: it "
+                "must vanish outside the data, where the backbone takes over"
+            )
+    names = list(inputs) if inputs is not None else list(samples.measured)
+    base, table, caught = fit_backbone(samples, backbone)
+    for w in caught:
+        warnings.warn(f"hybrid backbone {base.model}: {w.message}", w.category, stacklevel=3)
+    model = get_model(base.model)
+    theta = base.theta()
+    resid = samples.friction - model.predict(theta, samples.X)
+    from dataclasses import replace
+
+    res_samples = replace(samples, friction=resid)
+    res = fit_rbf(res_samples, names, **{**network, "linear_tail": False, "fit_bias": False})
+    residual = dict(res.state or {})
+    used = set(names) | set(model.inputs)
+    state: dict[str, Any] = {
+        "kind": STATE_KIND,
+        "state_version": STATE_VERSION,
+        "symmetry": residual.get("symmetry"),
+        "inputs": [n for n in INPUTS if n in used],
+        "backbone": {"model": base.model, "params": {k: float(v) for k, v in base.params.items()}},
+        "residual": residual,
+        "backbone_selection": table,
+    }
+    nets = [residual.get(s) for s in ("pos", "neg")] if "pos" in residual else [residual]
+    intervals = [n.get("prediction_interval") for n in nets if isinstance(n, dict)]
+    if intervals and all(intervals):
+        state["prediction_interval"] = (
+            intervals[0]
+            if len(intervals) == 1
+            else {
+                "pos": intervals[0],
+                "neg": intervals[1],
+            }
+        )
+    y_hat = samples.friction - resid + res.predict(samples.X, warn=False)
+    n_numbers = int(res.statistics.get("nvarys", 0)) + len(base.params)
+    return FittedModel(
+        model="hybrid",
+        params={},
+        metrics=metrics(samples.y, y_hat),
+        statistics=fit_statistics(samples.y, y_hat, n_numbers),
+        method=f"{base.method} + {res.method}",
+        seed=res.seed,
+        nfev=int((base.nfev or 0) + (res.nfev or 0)),
+        status=res.status,
+        message=res.message,
+        operating_range=res.operating_range,
+        provenance={**res.provenance, "estimator": "fricid.identify.hybrid.fit_hybrid"},
+        state=state,
+    )
