@@ -1,10 +1,12 @@
-"""Friction models as mathematics: the analytic models of both papers and the RBF network.
+"""Friction models as mathematics: the analytic models of both papers and the learned ones.
 
 Use :func:`get_model` to look an analytic model up by name (``"<name>_asym"`` gives the
-per-direction variant), and :func:`get_predictor` for any model a model file may name, the RBF
-network included: every one predicts with ``predict(theta_or_state, X)``, and its ``stateful``
-flag says whether it takes a parameter vector (analytic models) or a stored state (the RBF
-network, :mod:`fricid.models.rbf`). Training the network is :mod:`fricid.identify.rbf`'s job.
+per-direction variant, ``"<name>_temp"`` the Arrhenius viscous term of
+:mod:`fricid.models._temperature`, ``"<name>_temp_asym"`` both), and :func:`get_predictor`
+for any model a model file may name, the learned ones included: every one predicts with
+``predict(theta_or_state, X)``, and its ``stateful`` flag says whether it takes a parameter
+vector (analytic models) or a stored state (the RBF network, :mod:`fricid.models.rbf`).
+Training the network is :mod:`fricid.identify.rbf`'s job.
 """
 
 from __future__ import annotations
@@ -13,12 +15,14 @@ from ..errors import ConfigError
 from ._analytic import CoulombViscous, LoadDependent, Stribeck, VelocityLoadTemperature
 from ._asymmetric import Asymmetric
 from ._base import INPUTS, FrictionModel, Parameter, data_scales
+from ._temperature import T_REF, WithTemperature
 from .rbf import NETWORK, RBFNetwork
 
 __all__ = [
     "INPUTS",
     "MODELS",
     "STATEFUL",
+    "T_REF",
     "Asymmetric",
     "CoulombViscous",
     "FrictionModel",
@@ -27,6 +31,7 @@ __all__ = [
     "RBFNetwork",
     "Stribeck",
     "VelocityLoadTemperature",
+    "WithTemperature",
     "data_scales",
     "get_model",
     "get_predictor",
@@ -41,20 +46,30 @@ MODELS: dict[str, type[FrictionModel]] = {
 
 def get_model(name: str | FrictionModel, asymmetric: bool = False) -> FrictionModel:
     """The model called ``name`` (see :data:`MODELS`); ``name_asym`` or ``asymmetric=True``
-    gives its per-direction variant. A model instance is passed through."""
+    gives its per-direction variant, ``name_temp`` its temperature-dependent viscous term
+    (:class:`WithTemperature`; ``name_temp_asym`` both, one activation temperature shared by
+    the directions). A model instance is passed through."""
     if isinstance(name, FrictionModel):
         model = name
     else:
         key = name.strip().lower()
         if key.endswith("_asym"):
             key, asymmetric = key[: -len("_asym")], True
+        temperature = key.endswith("_temp")
+        if temperature:
+            key = key[: -len("_temp")]
         if key not in MODELS:
             raise ConfigError(
                 f"unknown model '{name}'; choose one of: {', '.join(MODELS)} "
-                "(append _asym for separate parameters per direction)"
+                "(append _asym for separate parameters per direction, _temp for a "
+                "temperature-dependent viscous term, _temp_asym for both)"
             )
         model = MODELS[key]()
+        if temperature:
+            return WithTemperature(Asymmetric(model) if asymmetric else model)
     if asymmetric and not model.is_asymmetric:
+        if isinstance(model, WithTemperature):
+            return WithTemperature(Asymmetric(model.inner))
         model = Asymmetric(model)
     return model
 
