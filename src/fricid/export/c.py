@@ -34,8 +34,9 @@ import numpy as np
 
 from .. import __version__
 from ..fitted import FittedModel
-from ..models import Asymmetric
+from ..models import Asymmetric, WithTemperature
 from ..models.smoothing import VISCOUS_TERM, Smoothing
+from ._c_temperature import ARRHENIUS_C, temperature_const
 from ._common import (
     ExportError,
     check_identifier,
@@ -110,8 +111,10 @@ _FAMILIES: dict[str, tuple[Callable, tuple[str, ...]]] = {
 def _analytic_parts(fitted: FittedModel, smoothing: Smoothing) -> tuple[list[str], list[str]]:
     """(constant declarations, function definitions) of an analytic model."""
     model = fitted.friction_model()
-    asym = isinstance(model, Asymmetric)
-    base = model.base if asym else model
+    temp = isinstance(model, WithTemperature)  # the Arrhenius viscous term scales c by phi(T)
+    inner = model.inner if temp else model
+    asym = isinstance(inner, Asymmetric)
+    base = inner.base if asym else inner
     if base.name not in _FAMILIES or base.name not in VISCOUS_TERM:
         raise ExportError(
             f"the C export has no template for the model family '{base.name}' (it knows "
@@ -121,8 +124,8 @@ def _analytic_parts(fitted: FittedModel, smoothing: Smoothing) -> tuple[list[str
     viscous = VISCOUS_TERM[base.name]
     theta = fitted.theta()
     d = base.n_params
-    sides = [("pos", theta[:d]), ("neg", theta[d:])] if asym else [("sym", theta)]
-    consts: list[str] = []
+    sides = [("pos", theta[:d]), ("neg", theta[d : 2 * d])] if asym else [("sym", theta[:d])]
+    consts = [temperature_const(theta[-1])] if temp else []
     funcs: list[str] = []
     for side, values in sides:
         prefix = "" if side == "sym" else f"{side}_"
@@ -165,7 +168,8 @@ def _analytic_parts(fitted: FittedModel, smoothing: Smoothing) -> tuple[list[str
     def term(side: str) -> str:
         prefix = "" if side == "sym" else f"{side}_"
         call = f"s * g_{side}(av, load, temperature)"
-        return call if viscous is None else f"{call} + {prefix}{viscous} * velocity"
+        phi = " * phi" if temp else ""
+        return call if viscous is None else f"{call} + {prefix}{viscous}{phi} * velocity"
 
     core = [
         "/* The model: F = s G(|v|, load, T) + c v, s = "
@@ -174,6 +178,7 @@ def _analytic_parts(fitted: FittedModel, smoothing: Smoothing) -> tuple[list[str
         "static double model(double velocity, double load, double temperature)\n{",
         f"    const double s = {sign};",
         "    const double av = fabs(velocity);",
+        *([f"    const double phi = {ARRHENIUS_C};"] if temp else []),
     ]
     if asym:
         core += [
