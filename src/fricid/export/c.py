@@ -9,8 +9,9 @@ function as :func:`fricid.models.smoothing.smooth_predict` (``FittedModel.predic
 smoothing). The code needs only ``<math.h>`` (link with ``-lm``), allocates nothing, keeps no
 state and does no I/O; every parameter is a ``static const double`` written by
 :func:`fricid.export._common.fmt_float` (``repr``: reads back bit for bit; NaN and inf are
-refused). Every model family is supported: the analytic models (symmetric or per direction)
-and the RBF network.
+refused). Every model family is supported: the analytic models (symmetric or per direction,
+with or without the temperature term), the RBF network and the Gaussian process
+(:mod:`fricid.export._c_gp`).
 
 The expressions follow the Python models operation for operation, so the C function agrees
 with ``FittedModel.predict`` to a few units in the last place (tests check 1e-12 relative).
@@ -36,6 +37,7 @@ from .. import __version__
 from ..fitted import FittedModel
 from ..models import Asymmetric, WithTemperature
 from ..models.smoothing import VISCOUS_TERM, Smoothing
+from ._c_gp import gp_parts
 from ._c_temperature import ARRHENIUS_C, temperature_const
 from ._common import (
     ExportError,
@@ -398,7 +400,9 @@ def c_code(
             "linear, or none, or refit it"
         )
     consts, funcs = (
-        _rbf_parts(fitted, smoothing)
+        gp_parts(fitted, smoothing)
+        if fitted.model == "gp"
+        else _rbf_parts(fitted, smoothing)
         if fitted.kind == "rbf"
         else _analytic_parts(fitted, smoothing)
     )

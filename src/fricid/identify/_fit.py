@@ -148,6 +148,10 @@ def fit(
         An argument the chosen model does not use (``network``, ``inputs`` for analytic
         models; ``callback`` for ``"rbf"``).
     """
+    if isinstance(model, str) and model.strip().lower() == "gp":
+        from .gp import fit_gp  # the Gaussian process: its options through `options`
+
+        return fit_gp(samples, inputs=inputs, seed=seed, **(options or {}))
     if isinstance(model, str) and model.strip().lower() in STATEFUL:
         if str(loss).lower() not in ("l2", "sse") or not _no_weights(weights):
             raise ConfigError("model 'rbf' trains by least squares: no robust loss or weights")

@@ -16,6 +16,7 @@ from ._analytic import CoulombViscous, LoadDependent, Stribeck, VelocityLoadTemp
 from ._asymmetric import Asymmetric
 from ._base import INPUTS, FrictionModel, Parameter, data_scales
 from ._temperature import T_REF, WithTemperature
+from .gp import GP, GaussianProcess
 from .rbf import NETWORK, RBFNetwork
 
 __all__ = [
@@ -26,6 +27,7 @@ __all__ = [
     "Asymmetric",
     "CoulombViscous",
     "FrictionModel",
+    "GaussianProcess",
     "LoadDependent",
     "Parameter",
     "RBFNetwork",
@@ -75,12 +77,12 @@ def get_model(name: str | FrictionModel, asymmetric: bool = False) -> FrictionMo
 
 
 #: Models that predict from a stored state rather than a parameter vector, by registry name.
-STATEFUL: dict[str, RBFNetwork] = {NETWORK.name: NETWORK}
+STATEFUL: dict[str, RBFNetwork | GaussianProcess] = {NETWORK.name: NETWORK, GP.name: GP}
 
 
-def get_predictor(name: str | FrictionModel) -> FrictionModel | RBFNetwork:
+def get_predictor(name: str | FrictionModel) -> FrictionModel | RBFNetwork | GaussianProcess:
     """The model a model file names: an analytic model (:func:`get_model`) or a stateful one
-    (:data:`STATEFUL`: ``"rbf"``).
+    (:data:`STATEFUL`: ``"rbf"``, ``"gp"``).
 
     Either predicts with ``predict(theta_or_state, X)``; ``stateful`` tells which argument.
     """
