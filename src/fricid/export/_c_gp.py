@@ -1,8 +1,8 @@
 """The Gaussian-process model in C: its posterior mean as a kernel sum over the stored points.
 
 Mirrors :mod:`fricid.models.gp` step by step: the prior mean (linear in |v|, |load|, T and
-|v| T), the inputs warped (``asinh(|v| / velocity_scale)``), standardised and divided by the
-length scales, squared distances as ``max(||z||^2 + ||p||^2 - 2 z.p, 0)``, and
+|v| T), the inputs (|v|, |load|, T) warped (``asinh(|v| / velocity_scale)``), standardised
+and divided by the length scales, squared distances as ``max(||z||^2 + ||p||^2 - 2 z.p, 0)``, and
 ``mean + y_scale * sum_j s2 exp(-0.5 d2_j) alpha_j``. The points divided by the length scales
 and their squared norms are computed here once, in Python, with the operations the Python
 model uses, and written as constants. The standard deviation is not exported (a controller
@@ -65,13 +65,12 @@ def _side(st: Mapping[str, Any], side: str) -> tuple[list[str], str]:
         consts.append(
             f"static const double {pre}{short} = {fmt_float(float(st[key]), key)};  /* {key} */"
         )
-    raw = [_ARGS[name] for name in inputs]
-    absolute = ["fabs(load)" if name == "load" else _ARGS[name] for name in inputs]
+    raw = ["fabs(load)" if name == "load" else _ARGS[name] for name in inputs]
     warped = [f"asinh(av / {pre}vscale)", *raw[1:]]
-    mean = " + ".join(f"{a} * {pre}mean[{i + 1}]" for i, a in enumerate(absolute))
+    mean = " + ".join(f"{a} * {pre}mean[{i + 1}]" for i, a in enumerate(raw))
     if len(coef) == d + 2:
         mean += f") + {pre}mean[{d + 1}] * (av * temperature"
-    unused = [x for x in _ARGS.values() if x not in raw]
+    unused = [x for name, x in _ARGS.items() if name not in inputs]
     dot = " + ".join(f"z[{i}] * {pre}points[j][{i}]" for i in range(d))
     body = (
         f"/* The Gaussian process{_WHERE[side]}"

@@ -4,11 +4,13 @@
 where the samples have both, ``g(|v|, load, T)`` with ``F = sign(v) g``:
 
 1. the inputs: |v| warped by ``asinh(|v| / velocity_scale)`` with ``velocity_scale`` the
-   slowest measured speed (speeds spread as by log |v| above it, zero maps to zero), load and
-   temperature as measured; an input with a single value in the data is left out (noted in
+   slowest measured speed (speeds spread as by log |v| above it, zero maps to zero), |load|
+   (friction grows with the magnitude of the load, [B] eq. 3-4) and temperature as
+   measured; an input with a single value in the data is left out (noted in
    ``state["dropped_inputs"]``); all standardised (mean 0, standard deviation 1);
-2. the prior mean: ``c_0 + c_v |v| + c_l |load| + c_T T`` by least squares (Coulomb-viscous
-   with linear load and temperature terms, what the model returns to far from the data);
+2. the prior mean: ``c_0 + c_v |v| + c_l |load| + c_T T + c_vT |v| T`` by least squares
+   (Coulomb-viscous with linear load and temperature terms, what the model returns to far
+   from the data);
 3. the kernel: scikit-learn's ``ConstantKernel * RBF(length_scale per input) + WhiteKernel``
    (ARD squared exponential plus white noise), its hyperparameters by maximum marginal
    likelihood (``GaussianProcessRegressor``, L-BFGS-B with ``n_restarts`` random restarts
@@ -104,6 +106,8 @@ def _train_side(
     v = samples.velocity[moving]
     g = np.sign(v) * samples.friction[moving]
     R = np.column_stack([np.abs(v)] + [samples.X[moving, INPUTS.index(n)] for n in names[1:]])
+    if "load" in names:
+        R[:, names.index("load")] = np.abs(R[:, names.index("load")])
     kept = [0] + [j for j in range(1, len(names)) if np.ptp(R[:, j]) > 0]
     dropped = {names[j]: float(R[0, j]) for j in range(1, len(names)) if j not in kept}
     R = R[:, kept]
@@ -120,10 +124,7 @@ def _train_side(
     scale = W.std(axis=0)
     scale[scale <= 0] = 1.0
     Z = (W - shift) / scale
-    A = R.copy()
-    if "load" in used:
-        A[:, used.index("load")] = np.abs(A[:, used.index("load")])
-    A = np.column_stack([np.ones(n), A, *_interaction(A, used)])
+    A = np.column_stack([np.ones(n), R, *_interaction(R, used)])
     coef = np.linalg.lstsq(A, g, rcond=None)[0]
     r = g - A @ coef
     y_scale = float(np.std(r))

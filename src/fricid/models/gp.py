@@ -16,14 +16,16 @@ constant far from the data):
 
 ``g(x) = m(x) + y_scale * sum_j alpha_j k(z(x), p_j)``,
 
-``m(x) = c_0 + c_v |v| + c_l |load| + c_T T`` (the inputs the state names),
+``m(x) = c_0 + c_v |v| + c_l |load| + c_T T + c_vT |v| T`` (the inputs the state names; the
+last term, a viscous coefficient linear in temperature as in [B] eq. 4, when both are used),
 
 ``k(z, p) = s2 * exp(-0.5 * sum_i ((z_i - p_i) / l_i)^2)`` (an anisotropic, ARD, squared
 exponential kernel; Rasmussen & Williams 2006, eq. 5.1),
 
 on the warped, standardised inputs ``z = (w(x) - shift) / scale`` with
 ``w(|v|) = asinh(|v| / velocity_scale)`` (log-like above ``velocity_scale``, linear through
-zero) and load, temperature as measured. The points ``p_j`` are the training points or an
+zero), |load| (friction grows with the magnitude of the load, [B] eq. 3-4) and the
+temperature. The points ``p_j`` are the training points or an
 inducing subset of them. The posterior standard deviation of ``g`` (the latent friction,
 without the white measurement noise) is
 
@@ -44,6 +46,8 @@ A state (``FittedModel.state`` of a model ``"gp"``) holds ``kind`` (``"gaussian_
 
 References
 ----------
+[B] "An Optimized RBF Neural Network Based on Beetle Antennae Search Algorithm for Modeling
+    the Static Friction in a Robotic Manipulator Joint" (the BAS-RBFNN paper), eq. 3-4.
 C. E. Rasmussen and C. K. I. Williams, *Gaussian Processes for Machine Learning*, MIT Press,
 2006, eq. 2.25-2.26 and 5.1.
 J. Quinonero-Candela and C. E. Rasmussen, "A unifying view of sparse approximate Gaussian
@@ -169,8 +173,9 @@ class _Side:
             )
 
     def raw(self, Xa: np.ndarray) -> np.ndarray:
-        """The inputs the process uses, |v| first, from ``Xa (n, 3)`` with |v| in column 0."""
-        return Xa[:, self.columns]
+        """The inputs the process uses, |v| first and |load|, from ``Xa (n, 3)`` with |v| in
+        column 0."""
+        return np.abs(Xa[:, self.columns]) if 1 in self.columns else Xa[:, self.columns]
 
     def kernel(self, R: np.ndarray) -> np.ndarray:
         """``k(z(x), p_j)`` ``(n, m)`` at raw inputs ``R``; ``||a - b||^2`` computed as
@@ -186,11 +191,9 @@ class _Side:
 
     def mean(self, R: np.ndarray) -> np.ndarray:
         """The prior mean ``m(x)``: linear in |v|, |load| and T (module notes)."""
-        A = R.copy()
-        A[:, 1:] = np.where(np.asarray(self.columns[1:]) == 1, np.abs(A[:, 1:]), A[:, 1:])
-        out = self.mean_coef[0] + A @ self.mean_coef[1 : len(self.columns) + 1]
+        out = self.mean_coef[0] + R @ self.mean_coef[1 : len(self.columns) + 1]
         if self.vt:
-            out = out + self.mean_coef[-1] * (A[:, 0] * A[:, self.columns.index(2)])
+            out = out + self.mean_coef[-1] * (R[:, 0] * R[:, self.columns.index(2)])
         return out
 
     def predict(self, Xa: np.ndarray, return_std: bool) -> tuple[np.ndarray, np.ndarray | None]:
