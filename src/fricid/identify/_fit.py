@@ -151,6 +151,10 @@ def fit(
     if isinstance(model, str) and model.strip().lower() == "gp":
         from .gp import fit_gp  # the Gaussian process: its options through `options`
 
+        if str(loss).lower() not in ("l2", "sse") or not _no_weights(weights) or fixed or bounds:
+            raise ConfigError(
+                "model 'gp' learns by marginal likelihood: no robust loss, weights, fixed or bounds"
+            )
         return fit_gp(samples, inputs=inputs, seed=seed, **(options or {}))
     if isinstance(model, str) and model.strip().lower() in STATEFUL:
         if str(loss).lower() not in ("l2", "sse") or not _no_weights(weights):
