@@ -67,6 +67,18 @@ def test_gp_heldout_within_noise_and_band_covers_truth(gp_model):
     assert gp_model.predict(np.array([[0.0, 0.0, 30.0]]), return_std=True)[1][0] == 0.0
 
 
+def test_gp_band_widens_outside_the_data(gp_model):
+    # the uncertainty of the mean's coefficients (R&W eq. 2.42) grows with the distance
+    speeds = np.array([1.0, 8.0, 30.0])
+    X = np.column_stack([speeds, np.full(3, 0.5), np.full(3, 40.0)])
+    _, std = gp_model.predict(X, warn=False, return_std=True)
+    assert std[0] < std[1] < std[2]
+    state = {**gp_model.state, "pos": dict(gp_model.state["pos"])}
+    del state["pos"]["mean_gain"], state["pos"]["mean_cov"]  # optional in a state
+    narrow = get_predictor("gp").predict(state, X, return_std=True)[1]
+    assert np.all(narrow <= std) and narrow[2] < 0.5 * std[2]
+
+
 def test_gp_inducing_subset_uses_every_sample():
     samples = samples_of(300, seed=2)
     fitted = fit(samples, "gp", options={"max_points": 60, "n_restarts": 1})

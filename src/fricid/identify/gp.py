@@ -15,13 +15,14 @@ where the samples have both, ``g(|v|, load, T)`` with ``F = sign(v) g``:
    (ARD squared exponential plus white noise), its hyperparameters by maximum marginal
    likelihood (``GaussianProcessRegressor``, L-BFGS-B with ``n_restarts`` random restarts
    seeded by ``seed``) on the residuals of the mean, scaled to unit standard deviation;
-4. the posterior: exact (R&W eq. 2.25-2.26) on all samples up to ``max_points``; above that,
-   the hyperparameters are fitted on an inducing subset of ``max_points`` samples chosen by
-   farthest-point sampling in the standardised input space (deterministic, starting from the
-   sample farthest from the mean: it covers the measured region, edges first, as a grid
-   would), and the posterior uses every sample through the deterministic training
-   conditional on that subset (Quinonero-Candela & Rasmussen 2005, DTC), so prediction is
-   a kernel sum over at most ``max_points`` stored points.
+4. the posterior, with the mean's coefficients estimated with it (R&W section 2.7: their
+   uncertainty widens the band where the model extrapolates): exact (R&W eq. 2.25-2.26) on all
+   samples up to ``max_points``; above that, the hyperparameters are fitted on an inducing subset
+   of ``max_points`` samples chosen by farthest-point sampling in the standardised input space
+   (deterministic, starting from the sample farthest from the mean: it covers the measured
+   region, edges first, as a grid would), and the posterior uses every sample through the
+   deterministic training conditional on that subset (Quinonero-Candela & Rasmussen 2005,
+   DTC), so prediction is a kernel sum over at most ``max_points`` stored points.
 
 The state holds the points, the weights and the matrix of the posterior variance, so the
 predictive standard deviation travels with the model file (``FittedModel.predict(X,
@@ -98,6 +99,49 @@ def _interaction(A: np.ndarray, used: list[str]) -> list[np.ndarray]:
     return [A[:, 0] * A[:, used.index("temperature")]] if "temperature" in used else []
 
 
+def _posterior(
+    P: np.ndarray,
+    Z: np.ndarray,
+    t: np.ndarray,
+    A: np.ndarray,
+    lengths: np.ndarray,
+    s2: float,
+    noise: float,
+    exact: bool,
+) -> tuple[np.ndarray, ...]:
+    """The posterior on stored points ``P`` of targets ``t`` at ``Z`` with the mean's basis
+    ``A (n, q)`` estimated with it (R&W section 2.7, eq. 2.41-2.42, vague prior on the
+    coefficients): ``(alpha, B, G, C, dbeta)``.
+
+    ``dbeta`` corrects the least-squares mean, ``alpha`` weighs the points, and the variance
+    is ``s2 - k^T B k + (h - G k)^T C (h - G k)`` for a kernel vector ``k`` and basis ``h``.
+    Exact: ``K = K_nn + noise I`` (R&W eq. 2.25-2.26); else DTC on the points, with
+    ``K~^-1 = (Q_nn + noise I)^-1`` by the Woodbury identity (Quinonero-Candela & Rasmussen
+    2005, eq. 20-21).
+    """
+    m = len(P)
+    Kmm = _kernel_matrix(P, P, lengths, s2)
+    if exact:
+        factor = cho_factor(Kmm + (noise + 1e-10) * np.eye(m), lower=True)
+        M = cho_solve(factor, A)  # K^-1 H^T
+        gain = M.T  # H K^-1
+        B = cho_solve(factor, np.eye(m))
+        weights = lambda r: cho_solve(factor, r)  # noqa: E731
+    else:
+        Kmn = _kernel_matrix(P, Z, lengths, s2)
+        Kj = Kmm + _JITTER * s2 * np.eye(m)
+        Sigma = cho_factor(noise * Kj + Kmn @ Kmn.T, lower=True)
+        M = (A - Kmn.T @ cho_solve(Sigma, Kmn @ A)) / noise
+        gain = cho_solve(Sigma, Kmn @ A).T  # H K_nm (noise K_mm + K_mn K_nm)^-1
+        B = cho_solve(cho_factor(Kj, lower=True), np.eye(m)) - noise * cho_solve(Sigma, np.eye(m))
+        weights = lambda r: cho_solve(Sigma, Kmn @ r)  # noqa: E731
+    cov = np.linalg.inv(A.T @ M)
+    cov = 0.5 * (cov + cov.T)
+    dbeta = cov @ (M.T @ t)
+    alpha = weights(t - A @ dbeta)
+    return alpha, 0.5 * (B + B.T), gain, cov, dbeta
+
+
 def _train_side(
     samples: FrictionSamples, names: list[str], max_points: int, n_restarts: int, seed: int
 ) -> dict[str, Any]:
@@ -146,22 +190,14 @@ def _train_side(
     lengths = np.atleast_1d(np.asarray(k.k1.k2.length_scale, dtype=float)) * np.ones(d)
     noise = float(k.k2.noise_level)
     P = Z[sub]
-    Kmm = _kernel_matrix(P, P, lengths, s2)
-    if len(sub) == n:  # exact GP: K = Kf + noise I (R&W eq. 2.25-2.26)
-        factor = cho_factor(Kmm + (noise + 1e-10) * np.eye(n), lower=True)
-        alpha = cho_solve(factor, t)
-        Bm = cho_solve(factor, np.eye(n))
-        inducing = "all training points"
-    else:  # DTC on the inducing subset (Quinonero-Candela & Rasmussen 2005, eq. 20-21)
-        Kmn = _kernel_matrix(P, Z, lengths, s2)
-        Kj = Kmm + _JITTER * s2 * np.eye(len(sub))
-        Sigma = cho_factor(noise * Kj + Kmn @ Kmn.T, lower=True)
-        alpha = cho_solve(Sigma, Kmn @ t)
-        Bm = cho_solve(cho_factor(Kj, lower=True), np.eye(len(sub))) - noise * cho_solve(
-            Sigma, np.eye(len(sub))
-        )
-        inducing = f"farthest-point subset of {len(sub)} of {n} samples (DTC)"
-    Bm = 0.5 * (Bm + Bm.T)
+    exact = len(sub) == n
+    alpha, Bm, gain, cov, dbeta = _posterior(P, Z, t, A, lengths, s2, noise, exact)
+    coef = coef + y_scale * dbeta
+    inducing = (
+        "all training points"
+        if exact
+        else f"farthest-point subset of {len(sub)} of {n} samples (DTC)"
+    )
     state: dict[str, Any] = {
         "inputs": used,
         "velocity_scale": vscale,
@@ -176,6 +212,8 @@ def _train_side(
         "points": P.tolist(),
         "alpha": alpha.tolist(),
         "var_matrix": Bm.tolist(),
+        "mean_gain": gain.tolist(),
+        "mean_cov": cov.tolist(),
         "inducing": inducing,
         "n_train": n,
         "log_marginal_likelihood": float(gpr.log_marginal_likelihood_value_),

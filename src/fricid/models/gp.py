@@ -29,20 +29,23 @@ temperature. The points ``p_j`` are the training points or an
 inducing subset of them. The posterior standard deviation of ``g`` (the latent friction,
 without the white measurement noise) is
 
-``std(x) = y_scale * sqrt(max(s2 - k^T B k, 0))``,
+``std(x) = y_scale * sqrt(max(s2 - k^T B k + (h - G k)^T C (h - G k), 0))``,
 
 ``B`` the stored ``(m, m)`` matrix: ``K^-1`` of the exact GP (``K`` with the white noise
 on its diagonal, R&W eq. 2.26), ``K_mm^-1 - noise (noise K_mm + K_mn K_nm)^-1`` of the
 deterministic training conditional with inducing points (Quinonero-Candela & Rasmussen 2005,
-eq. 20-21).
+eq. 20-21); the last term, with the basis ``h(x)`` of the mean, ``G = H K^-1``
+(``mean_gain``) and ``C = (H K^-1 H^T)^-1`` (``mean_cov``), is the uncertainty of the mean's
+coefficients, estimated with the process (R&W eq. 2.41-2.42), optional in a state.
 
 A state (``FittedModel.state`` of a model ``"gp"``) holds ``kind`` (``"gaussian_process"``),
 ``symmetry`` (``"odd"``, ``"pos"``, ``"neg"`` or ``"per_direction"``, as for the RBF network:
 :data:`fricid.models.rbf.SYMMETRIES`) and, for one process or in each of ``state["pos"]`` and
 ``state["neg"]``: ``inputs`` (velocity first), ``velocity_scale``, ``input_shift``,
-``input_scale``, ``mean_coef`` (``c_0`` then one per input), ``length_scales``, ``signal_var``
-(``s2``), ``noise_var``, ``y_scale``, ``points (m, d)``, ``alpha (m,)`` and ``var_matrix``
-``(m, m)``, plus training notes that prediction ignores.
+``input_scale``, ``mean_coef`` (``c_0``, one per input, then ``c_vT``), ``length_scales``,
+``signal_var`` (``s2``), ``noise_var``, ``y_scale``, ``points (m, d)``, ``alpha (m,)``,
+``var_matrix (m, m)`` and, optionally, ``mean_gain (q, m)`` and ``mean_cov (q, q)``, plus training
+notes that prediction ignores.
 
 References
 ----------
@@ -164,6 +167,10 @@ class _Side:
         m = self.points.shape[0]
         self.alpha = _array(st, "alpha", (m,), where)
         self.B = _array(st, "var_matrix", (m, m), where)
+        q = len(self.mean_coef)  # the mean's coefficients' uncertainty: optional
+        has_gain = "mean_gain" in st or "mean_cov" in st
+        self.gain = _array(st, "mean_gain", (q, m), where) if has_gain else None
+        self.cov = _array(st, "mean_cov", (q, q), where) if has_gain else None
         positive = (self.vscale, self.s2, self.y_scale, *self.scale, *self.lengths)
         if m == 0 or min(positive) <= 0 or self.noise < 0:
             raise DataError(
@@ -196,6 +203,11 @@ class _Side:
             out = out + self.mean_coef[-1] * (R[:, 0] * R[:, self.columns.index(2)])
         return out
 
+    def basis(self, R: np.ndarray) -> np.ndarray:
+        """The mean's basis ``h(x)`` ``(n, q)``: 1, the inputs, and |v| T when used."""
+        extra = [R[:, 0] * R[:, self.columns.index(2)]] if self.vt else []
+        return np.column_stack([np.ones(len(R)), R, *extra])
+
     def predict(self, Xa: np.ndarray, return_std: bool) -> tuple[np.ndarray, np.ndarray | None]:
         R = self.raw(Xa)
         g = np.empty(len(R))
@@ -206,6 +218,9 @@ class _Side:
             g[rows] = self.mean(R[rows]) + self.y_scale * (K @ self.alpha)
             if sd is not None:
                 var = self.s2 - np.einsum("nm,nm->n", K @ self.B, K)
+                if self.gain is not None and self.cov is not None:
+                    Rb = self.basis(R[rows]) - K @ self.gain.T
+                    var = var + np.einsum("nq,nq->n", Rb @ self.cov, Rb)
                 sd[rows] = self.y_scale * np.sqrt(np.maximum(var, 0.0))
         return g, sd
 
