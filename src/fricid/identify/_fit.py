@@ -73,7 +73,9 @@ def fit(
         The measured friction.
     model : str or FrictionModel
         A model name (``fricid.models.MODELS``, ``*_asym`` for per-direction), an instance,
-        or ``"rbf"`` for the RBF network (:mod:`fricid.identify.rbf`).
+        ``*_temp`` / ``*_temp_asym`` with an Arrhenius viscous term, ``"rbf"`` for the RBF
+        network (:mod:`fricid.identify.rbf`) or ``"gp"`` for the Gaussian process
+        (:mod:`fricid.identify.gp`; its options, e.g. ``max_points``, through ``options``).
     method : str, default "lm"
         Any method of ``fricid.optim.METHODS`` (``"lm"``: the default least-squares method,
         scipy's bounded trust-region reflective solver, a Levenberg-Marquardt-type method, with

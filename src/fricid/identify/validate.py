@@ -361,7 +361,7 @@ def asymmetry_note(samples: FrictionSamples, model: str, scatter: Scatter | None
         speeds exceeds :data:`ASYMMETRY_SCATTERS` scatters; else ``""``.
     """
     name = str(model)
-    if name.endswith("_asym") or name == "rbf" or not {-1, 1} <= set(samples.directions()):
+    if name.endswith("_asym") or name in ("rbf", "gp") or not {-1, 1} <= set(samples.directions()):
         return ""
     sc = scatter if scatter is not None else measurement_scatter(samples)
     levels = level_labels(samples)
