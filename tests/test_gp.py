@@ -45,6 +45,11 @@ def gp_model() -> FittedModel:
     return fit(samples_of(200, seed=1), "gp")
 
 
+@pytest.fixture(scope="module")
+def small_gp() -> FittedModel:
+    return fit(samples_of(40, seed=5), "gp", options={"n_restarts": 0})
+
+
 def test_gp_is_registered_and_per_direction(gp_model):
     assert "gp" in STATEFUL and get_predictor("gp").stateful
     assert gp_model.model == "gp" and gp_model.state["symmetry"] == "per_direction"
@@ -156,3 +161,39 @@ def test_gp_c_export_matches_python(gp_model, tmp_path):
         # friction level of the model, not to each value
         level = np.full(len(X), np.max(np.abs(want)))
         assert relative_error(got, want, level) <= 1e-12, smoothing
+
+
+@pytest.mark.parametrize(
+    "key",
+    [
+        "inputs",
+        "velocity_scale",
+        "input_scale",
+        "mean_coef",
+        "length_scales",
+        "signal_var",
+        "noise_var",
+        "y_scale",
+        "points",
+        "alpha",
+        "var_matrix",
+        "mean_gain",
+        "mean_cov",
+    ],
+)
+def test_a_damaged_gp_file_is_a_data_error(small_gp, tmp_path, key):
+    """Whatever a damaged file holds, loading it ends in a DataError naming it, or in a model
+    that predicts finite friction."""
+    base = small_gp.to_dict()
+    for value in ("x", -1.0, [[1.0]], None):
+        doc = json.loads(json.dumps(base))
+        doc["state"]["neg"][key] = value
+        path = tmp_path / "damaged.json"
+        path.write_text(json.dumps(doc))
+        try:
+            back = FittedModel.load(path)
+        except DataError as exc:
+            assert "damaged.json" in str(exc)
+            continue
+        mean, std = back.predict(draw(50, seed=12), warn=False, return_std=True)
+        assert np.isfinite(mean).all() and np.isfinite(std).all(), (key, value)
