@@ -39,6 +39,7 @@ from pathlib import Path
 from .. import __version__
 from ..errors import ConfigError, DataError
 from ..fitted import FittedModel
+from ..models import STATEFUL
 
 __all__ = [
     "ExportError",
@@ -170,8 +171,8 @@ def model_sha256(fitted: FittedModel) -> str:
 
 def model_name(fitted: FittedModel) -> str:
     """The model's registry name, taken from the registry (never the file's text)."""
-    if fitted.model in ("rbf", "hybrid"):  # stateful models (fricid.models.STATEFUL)
-        return fitted.model
+    if fitted.model in STATEFUL:
+        return str(fitted.model)
     model = fitted.friction_model()  # ConfigError for a name the registry does not know
     return model.name
 

@@ -9,8 +9,9 @@ function as :func:`fricid.models.smoothing.smooth_predict` (``FittedModel.predic
 smoothing). The code needs only ``<math.h>`` (link with ``-lm``), allocates nothing, keeps no
 state and does no I/O; every parameter is a ``static const double`` written by
 :func:`fricid.export._common.fmt_float` (``repr``: reads back bit for bit; NaN and inf are
-refused). Every model family is supported: the analytic models (symmetric or per direction)
-and the RBF network.
+refused). Every model family is supported: the analytic models (symmetric or per direction,
+with or without the temperature term), the RBF network and the Gaussian process
+(:mod:`fricid.export._c_gp`).
 
 The expressions follow the Python models operation for operation, so the C function agrees
 with ``FittedModel.predict`` to a few units in the last place (tests check 1e-12 relative).
@@ -34,9 +35,11 @@ import numpy as np
 
 from .. import __version__
 from ..fitted import FittedModel
-from ..models import Asymmetric
+from ..models import Asymmetric, WithTemperature
 from ..models.smoothing import VISCOUS_TERM, Smoothing
+from ._c_gp import gp_parts
 from ._c_hybrid import hybrid_parts, tail_code
+from ._c_temperature import ARRHENIUS_C, temperature_const
 from ._common import (
     ExportError,
     check_identifier,
@@ -111,8 +114,10 @@ _FAMILIES: dict[str, tuple[Callable, tuple[str, ...]]] = {
 def _analytic_parts(fitted: FittedModel, smoothing: Smoothing) -> tuple[list[str], list[str]]:
     """(constant declarations, function definitions) of an analytic model."""
     model = fitted.friction_model()
-    asym = isinstance(model, Asymmetric)
-    base = model.base if asym else model
+    temp = isinstance(model, WithTemperature)  # the Arrhenius viscous term scales c by phi(T)
+    inner = model.inner if temp else model
+    asym = isinstance(inner, Asymmetric)
+    base = inner.base if asym else inner
     if base.name not in _FAMILIES or base.name not in VISCOUS_TERM:
         raise ExportError(
             f"the C export has no template for the model family '{base.name}' (it knows "
@@ -122,8 +127,8 @@ def _analytic_parts(fitted: FittedModel, smoothing: Smoothing) -> tuple[list[str
     viscous = VISCOUS_TERM[base.name]
     theta = fitted.theta()
     d = base.n_params
-    sides = [("pos", theta[:d]), ("neg", theta[d:])] if asym else [("sym", theta)]
-    consts: list[str] = []
+    sides = [("pos", theta[:d]), ("neg", theta[d : 2 * d])] if asym else [("sym", theta[:d])]
+    consts = [temperature_const(theta[-1])] if temp else []
     funcs: list[str] = []
     for side, values in sides:
         prefix = "" if side == "sym" else f"{side}_"
@@ -166,7 +171,8 @@ def _analytic_parts(fitted: FittedModel, smoothing: Smoothing) -> tuple[list[str
     def term(side: str) -> str:
         prefix = "" if side == "sym" else f"{side}_"
         call = f"s * g_{side}(av, load, temperature)"
-        return call if viscous is None else f"{call} + {prefix}{viscous} * velocity"
+        phi = " * phi" if temp else ""
+        return call if viscous is None else f"{call} + {prefix}{viscous}{phi} * velocity"
 
     core = [
         "/* The model: F = s G(|v|, load, T) + c v, s = "
@@ -175,6 +181,7 @@ def _analytic_parts(fitted: FittedModel, smoothing: Smoothing) -> tuple[list[str
         "static double model(double velocity, double load, double temperature)\n{",
         f"    const double s = {sign};",
         "    const double av = fabs(velocity);",
+        *([f"    const double phi = {ARRHENIUS_C};"] if temp else []),
     ]
     if asym:
         core += [
@@ -395,6 +402,8 @@ def c_code(
         )
     if fitted.model == "hybrid":  # issue 15: analytic backbone + RBF residual
         consts, funcs = hybrid_parts(fitted, smoothing, _analytic_parts, _rbf_parts)
+    elif fitted.model == "gp":
+        consts, funcs = gp_parts(fitted, smoothing)
     else:
         parts = _rbf_parts if fitted.kind == "rbf" else _analytic_parts
         consts, funcs = parts(fitted, smoothing)

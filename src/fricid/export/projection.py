@@ -168,7 +168,8 @@ def _lost(
     lost = []
     inputs = _inputs(fitted)
     if fitted.kind == "rbf":
-        lost.append("the RBF network's shape (only F_c and b remain)")
+        what = "RBF network" if fitted.model == "rbf" else "Gaussian process"
+        lost.append(f"the {what}'s shape (only F_c and b remain)")
     elif model_name(fitted).split("_asym")[0] != "coulomb_viscous":
         v = X[:, 0]
         slow = np.abs(v) == np.abs(v).min()

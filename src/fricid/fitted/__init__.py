@@ -152,7 +152,7 @@ class FittedModel:
         """The full parameter vector, in the model's order."""
         return self.friction_model().param_vector(self.params)
 
-    def predict(self, X, *, warn: bool = True) -> np.ndarray:
+    def predict(self, X, *, warn: bool = True, return_std: bool = False):
         """Friction [N m] at inputs ``X`` (n, 3): velocity [rad/s], load [N m], temp [degC].
 
         Dispatched by model: the registered model's ``predict`` gets the stored state
@@ -169,9 +169,15 @@ class FittedModel:
             load or temperature range. Speeds below the smallest identified one are
             reported by :meth:`range_check` but not warned about here (every reversal passes
             through them).
+        return_std : bool, default False
+            Also return the predictive standard deviation [N m] of the friction (models with
+            a posterior: ``"gp"``); a ``ConfigError`` for the others.
         """
         model = get_predictor(self.model)
-        out = model.predict(self.state if model.stateful else self.theta(), X)
+        if return_std and self.model != "gp":
+            raise ConfigError(f"model '{self.model}' has no predictive standard deviation")
+        arg = self.state if model.stateful else self.theta()
+        out = model.predict(arg, X, return_std=True) if return_std else model.predict(arg, X)
         if warn:
             self._warn_range(X)
         return out

@@ -74,9 +74,11 @@ def fit(
         The measured friction.
     model : str or FrictionModel
         A model name (``fricid.models.MODELS``, ``*_asym`` for per-direction), an instance,
-        ``"rbf"`` for the RBF network (:mod:`fricid.identify.rbf`), or ``"hybrid"`` for an
-        analytic backbone plus an RBF residual (:mod:`fricid.identify.hybrid`; ``network``
-        may name its ``backbone``).
+        ``*_temp`` / ``*_temp_asym`` with an Arrhenius viscous term, ``"rbf"`` for the RBF
+        network (:mod:`fricid.identify.rbf`), ``"hybrid"`` for an analytic backbone plus an RBF
+        residual (:mod:`fricid.identify.hybrid`; ``network`` may name its ``backbone``) or
+        ``"gp"`` for the Gaussian process (:mod:`fricid.identify.gp`; its options, e.g.
+        ``max_points``, through ``options``).
     method : str, default "lm"
         Any method of ``fricid.optim.METHODS`` (``"lm"``: the default least-squares method,
         scipy's bounded trust-region reflective solver, a Levenberg-Marquardt-type method, with
@@ -153,6 +155,14 @@ def fit(
         An argument the chosen model does not use (``network``, ``inputs`` for analytic
         models; ``callback`` for ``"rbf"``).
     """
+    if isinstance(model, str) and model.strip().lower() == "gp":
+        from .gp import fit_gp  # the Gaussian process: its options through `options`
+
+        if str(loss).lower() not in ("l2", "sse") or not _no_weights(weights) or fixed or bounds:
+            raise ConfigError(
+                "model 'gp' learns by marginal likelihood: no robust loss, weights, fixed or bounds"
+            )
+        return fit_gp(samples, inputs=inputs, seed=seed, **(options or {}))
     if isinstance(model, str) and model.strip().lower() in STATEFUL:
         if str(loss).lower() not in ("l2", "sse") or not _no_weights(weights):
             raise ConfigError("model 'rbf' trains by least squares: no robust loss or weights")

@@ -10,8 +10,8 @@ offer against what the model needs:
 - velocity: distinct speed levels |v| (per direction for a per-direction model) against the
   number of free parameters that shape the velocity curve;
 - load: for models with load coefficients ([B] eq. 3 and 4), at least two distinct |load|;
-- temperature: for models with temperature coefficients ([B] eq. 4), at least two distinct
-  temperatures.
+- temperature: for models with temperature coefficients ([B] eq. 4, the Arrhenius term of
+  ``*_temp`` models), at least two distinct temperatures.
 
 It raises :class:`~fricid.errors.DataError` when nothing useful can be fitted (no moving
 sample, a single speed, fewer moving samples than free parameters) and warns
@@ -37,7 +37,7 @@ LEVEL_RTOL = 1e-6
 
 #: Parameter kinds (``Parameter.kind``) that only act through the load or the temperature.
 _LOAD_KINDS = ("load_coef",)
-_TEMPERATURE_KINDS = ("temp_coef", "velocity_temp")
+_TEMPERATURE_KINDS = ("temp_coef", "velocity_temp", "activation")
 
 
 def _levels(values: np.ndarray) -> np.ndarray:

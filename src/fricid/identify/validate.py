@@ -363,7 +363,7 @@ def asymmetry_note(samples: FrictionSamples, model: str, scatter: Scatter | None
     name = str(model)
     if (
         name.endswith("_asym")
-        or name in ("rbf", "hybrid")
+        or name in ("rbf", "hybrid", "gp")
         or not {-1, 1} <= set(samples.directions())
     ):
         return ""

@@ -32,6 +32,7 @@ class CoulombViscous(FrictionModel):
     title = "Coulomb-viscous"
     equation = "BAS-RBFNN paper, eq. 1"
     inputs = ("velocity",)
+    viscous = "beta"
     parameters = (
         Parameter("f_c", "N m", "torque", 0.5, 0.0, 2.0, "Coulomb friction"),
         Parameter("beta", "N m s/rad", "viscous", 0.5, 0.0, 2.0, "viscous coefficient"),
@@ -60,6 +61,7 @@ class Stribeck(FrictionModel):
     title = "Stribeck (velocity)"
     equation = "BAS-RBFNN paper eq. 2; RWSAVSBAS paper eq. 7"
     inputs = ("velocity",)
+    viscous = "tau_v"
     parameters = (
         Parameter("tau_c", "N m", "torque", 0.5, 0.0, 2.0, "Coulomb friction"),
         Parameter("tau_s", "N m", "torque", 0.8, 0.0, 2.0, "static (break-away) friction"),
@@ -87,6 +89,7 @@ class LoadDependent(FrictionModel):
     title = "Load-dependent (Msk)"
     equation = "BAS-RBFNN paper, eq. 3"
     inputs = ("velocity", "load")
+    viscous = "beta"
     parameters = (
         Parameter("f_c", "N m", "torque", 0.4, 0.0, 2.0, "Coulomb friction at zero load"),
         Parameter("f_s", "N m", "torque", 0.6, 0.0, 2.0, "static friction at zero load"),

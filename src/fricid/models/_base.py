@@ -21,14 +21,30 @@ import numpy as np
 
 from ..errors import ConfigError, DataError
 
-__all__ = ["INPUTS", "FrictionModel", "Parameter", "data_scales"]
+__all__ = ["INPUTS", "KELVIN", "NOMINAL_ACTIVATION", "FrictionModel", "Parameter", "data_scales"]
 
 #: Input columns of X, in order.
 INPUTS: tuple[str, ...] = ("velocity", "load", "temperature")
 
 
 #: How a parameter's default and bounds scale with the data (see :func:`data_scales`).
-SCALE_KINDS = ("torque", "velocity", "viscous", "load_coef", "temp_coef", "velocity_temp", "one")
+SCALE_KINDS = (
+    "torque",
+    "velocity",
+    "viscous",
+    "load_coef",
+    "temp_coef",
+    "velocity_temp",
+    "activation",
+    "one",
+)
+
+#: The scale of an ``"activation"`` parameter [K] without data, or when the data hold a single
+#: temperature: ``1 / (1/293.15 - 1/333.15)``, the span 20-60 degC (:func:`data_scales`).
+NOMINAL_ACTIVATION = 1.0 / (1.0 / 293.15 - 1.0 / 333.15)
+
+#: Degrees Celsius to kelvin.
+KELVIN = 273.15
 
 
 @dataclass(frozen=True)
@@ -76,6 +92,10 @@ class FrictionModel(ABC):
     #: The parameters the prediction is a linear combination of, for fixed values of the
     #: others (variable projection, :mod:`fricid.identify.varpro`); ``()`` when none is declared.
     linear_params: tuple[str, ...] = ()
+    #: The viscous coefficient ``c`` of a model of the form ``sign(v) G(|v|, load, T) + c v``
+    #: (None when the model has no such term), which a temperature law may scale
+    #: (:class:`fricid.models.WithTemperature`).
+    viscous: str | None = None
 
     # -- description ---------------------------------------------------------------------
     @property
@@ -157,9 +177,15 @@ class FrictionModel(ABC):
 
 def data_scales(X=None, y=None) -> dict[str, float]:
     """Typical magnitudes of the data, by kind: largest |friction| F, |velocity| V, |load| L,
-    |temperature| T, and their ratios. Without data every scale is 1."""
+    |temperature| T, and their ratios. Without data every scale is 1.
+
+    ``"activation"`` [K] is the reciprocal of the span of ``1 / (T + 273.15)`` over the data,
+    so that ``E * (1/T_a - 1/T_b)`` of an Arrhenius law is the log of the viscosity ratio
+    across the measured temperatures; with a single temperature (or without data) it is
+    :data:`NOMINAL_ACTIVATION`.
+    """
     if X is None or y is None:
-        return dict.fromkeys(SCALE_KINDS, 1.0)
+        return {**dict.fromkeys(SCALE_KINDS, 1.0), "activation": NOMINAL_ACTIVATION}
     X = np.asarray(X, dtype=float)
     y = np.asarray(y, dtype=float)
 
@@ -175,8 +201,18 @@ def data_scales(X=None, y=None) -> dict[str, float]:
         "load_coef": F / L,
         "temp_coef": F / T,
         "velocity_temp": V / T,
+        "activation": _activation_scale(X[:, 2]),
         "one": 1.0,
     }
+
+
+def _activation_scale(temperature: np.ndarray) -> float:
+    """``1 / (1/T_min - 1/T_max)`` [K] of the temperatures (degC) given, or the nominal one."""
+    t = temperature[np.isfinite(temperature)] + KELVIN
+    if t.size == 0 or float(t.min()) <= 0.0:
+        return NOMINAL_ACTIVATION
+    span = 1.0 / float(t.min()) - 1.0 / float(t.max())
+    return 1.0 / span if span > 1e-9 else NOMINAL_ACTIVATION
 
 
 def columns(theta: np.ndarray) -> list[np.ndarray]:

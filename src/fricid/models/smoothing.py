@@ -11,7 +11,8 @@ Two smoothings are offered, each with a zone half-width ``zone`` [rad/s]; the C 
     ``sign(v)`` is replaced by ``tanh(v / zone)`` in the model's Coulomb and Stribeck terms; the
     viscous term ``c v`` is kept as is. Every analytic model has the form
     ``F = sign(v) G(|v|, load, T) + c v`` (``c`` is ``beta`` in coulomb_viscous and msk,
-    ``tau_v`` in stribeck, 0 in vlt), so the smoothed model is
+    ``tau_v`` in stribeck, 0 in vlt; ``c phi(T)`` in the ``*_temp`` models of
+    :mod:`fricid.models._temperature`), so the smoothed model is
     ``F_s = tanh(v / zone) G(|v|, load, T) + c v``; a per-direction model uses the ``_pos``
     parameters for ``v >= 0`` and the ``_neg`` ones below (continuous at 0, where both sides
     give 0). Outside about 3 zones the difference from the model is below 0.5 % of ``G``.
@@ -41,6 +42,7 @@ import numpy as np
 from ..errors import ConfigError
 from ._asymmetric import Asymmetric
 from ._base import FrictionModel
+from ._temperature import WithTemperature, arrhenius_factor
 
 __all__ = [
     "SMOOTHINGS",
@@ -130,8 +132,8 @@ class Smoothing:
 
 
 def _analytic(fitted: FittedLike) -> tuple[FrictionModel, np.ndarray] | None:
-    """The analytic model and parameter vector of ``fitted``; None for the RBF network (and
-    the other stateful models, the hybrid)."""
+    """The analytic model and parameter vector of ``fitted``; None for the stateful models
+    (the RBF network, the hybrid, the Gaussian process)."""
     from . import STATEFUL, get_model
 
     if fitted.model in STATEFUL:
@@ -189,6 +191,11 @@ def sign_split(model: FrictionModel, theta) -> list[tuple[np.ndarray, np.ndarray
 
 
 def _tanh(model: FrictionModel, theta, X: np.ndarray, zone: float) -> np.ndarray:
+    if isinstance(model, WithTemperature):  # its viscous term c phi(T) v, kept as is
+        inner, c, e_t = model.split(np.atleast_2d(np.asarray(theta, dtype=float)))
+        c_v = np.where(X[:, 0] >= 0, c[0, 0], c[0, -1])
+        g = _tanh(model.inner, inner[0], X, zone)
+        return g + c_v * arrhenius_factor(e_t[0, 0], X[:, 2]) * X[:, 0]
     sides = sign_split(model, theta)
     base = model.base if isinstance(model, Asymmetric) else model
     v = X[:, 0]

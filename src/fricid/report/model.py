@@ -168,6 +168,10 @@ def _strong_correlations(frame: pd.DataFrame, limit: float = 0.9) -> list[str]:
 
 
 def _model_description(fitted: FittedModel) -> str:
+    if fitted.model == "gp":
+        from ..models import get_predictor
+
+        return get_predictor("gp").describe(fitted.state) + "."
     if fitted.kind == "rbf":
         return (
             "RBF neural network (BAS-RBFNN paper, eq. 14-15): Gaussian basis functions of "
@@ -235,7 +239,23 @@ def model_report(
 
     appendix: list = []
     sec = doc.section("Parameters", _param_text(fitted))
-    if fitted.kind == "rbf":
+    if fitted.model == "gp":  # the Gaussian process: its posterior band at the samples
+        mean, std = fitted.predict(samples.X, warn=False, return_std=True)
+        band = {
+            "predicted [N m]": mean,
+            "95% low": mean - 1.96 * std,
+            "95% high": mean + 1.96 * std,
+        }
+        frame = pd.DataFrame({"velocity [rad/s]": samples.velocity, **band})
+        sec.add(
+            Table(
+                "prediction_band",
+                "Predicted friction with the GP's 95 % band",
+                frame,
+                caption="Posterior of the latent friction (without the white noise).",
+            )
+        )
+    elif fitted.kind == "rbf":
         from .rbf import rbf_parameter_items
 
         main, appendix = rbf_parameter_items(fitted, samples, n_boot=bootstrap, seed=seed)

@@ -1,0 +1,329 @@
+"""Training the Gaussian-process friction model (:mod:`fricid.models.gp`) with scikit-learn.
+
+:func:`fit_gp` (also ``fricid.identify.fit(samples, "gp")``) learns, per direction of motion
+where the samples have both, ``g(|v|, load, T)`` with ``F = sign(v) g``:
+
+1. the inputs: |v| warped by ``asinh(|v| / velocity_scale)`` with ``velocity_scale`` the
+   slowest measured speed (speeds spread as by log |v| above it, zero maps to zero), |load|
+   (friction grows with the magnitude of the load, [B] eq. 3-4) and temperature as
+   measured; an input with a single value in the data is left out (noted in
+   ``state["dropped_inputs"]``); all standardised (mean 0, standard deviation 1);
+2. the prior mean: ``c_0 + c_v |v| + c_l |load| + c_T T + c_vT |v| T`` by least squares
+   (Coulomb-viscous with linear load and temperature terms, what the model returns to far
+   from the data);
+3. the kernel: scikit-learn's ``ConstantKernel * RBF(length_scale per input) + WhiteKernel``
+   (ARD squared exponential plus white noise), its hyperparameters by maximum marginal
+   likelihood (``GaussianProcessRegressor``, L-BFGS-B with ``n_restarts`` random restarts
+   seeded by ``seed``) on the residuals of the mean, scaled to unit standard deviation;
+4. the posterior, with the mean's coefficients estimated with it (R&W section 2.7: their
+   uncertainty widens the band where the model extrapolates): exact (R&W eq. 2.25-2.26) on all
+   samples up to ``max_points``; above that, the hyperparameters are fitted on an inducing subset
+   of ``max_points`` samples chosen by farthest-point sampling in the standardised input space
+   (deterministic, starting from the sample farthest from the mean: it covers the measured
+   region, edges first, as a grid would), and the posterior uses every sample through the
+   deterministic training conditional on that subset (Quinonero-Candela & Rasmussen 2005,
+   DTC), so prediction is a kernel sum over at most ``max_points`` stored points.
+
+The state holds the points, the weights and the matrix of the posterior variance, so the
+predictive standard deviation travels with the model file (``FittedModel.predict(X,
+return_std=True)``).
+"""
+
+from __future__ import annotations
+
+import time
+import warnings
+from typing import Any
+
+import numpy as np
+from scipy.linalg import cho_factor, cho_solve
+from sklearn.exceptions import ConvergenceWarning as SklearnConvergenceWarning
+from sklearn.gaussian_process import GaussianProcessRegressor
+from sklearn.gaussian_process.kernels import RBF, ConstantKernel, WhiteKernel
+from threadpoolctl import threadpool_limits
+
+from .. import __version__
+from ..errors import ConfigError, DataError
+from ..fitted import FittedModel
+from ..io.atomic import created_timestamp
+from ..metrics import fit_statistics, metrics
+from ..models import INPUTS
+from ..models.gp import GP_KIND, predict_gp
+from ..samples import FrictionSamples, samples_hash
+
+__all__ = ["DEFAULT_MAX_POINTS", "farthest_points", "fit_gp"]
+
+#: Stored points above which the inducing subset is used (module notes, step 4).
+DEFAULT_MAX_POINTS = 400
+
+#: Relative jitter on the diagonal of the inducing points' kernel matrix.
+_JITTER = 1e-8
+
+
+def farthest_points(Z: np.ndarray, m: int) -> np.ndarray:
+    """Indices of ``m`` rows of ``Z (n, d)`` chosen by farthest-point sampling: first the row
+    farthest from the mean, then each time the row farthest from those chosen (ties: the
+    first). Deterministic; O(n m)."""
+    n = Z.shape[0]
+    if m >= n:
+        return np.arange(n)
+    chosen = np.empty(m, dtype=int)
+    chosen[0] = int(np.argmax(np.sum((Z - Z.mean(axis=0)) ** 2, axis=1)))
+    dist = np.sum((Z - Z[chosen[0]]) ** 2, axis=1)
+    for k in range(1, m):
+        chosen[k] = int(np.argmax(dist))
+        dist = np.minimum(dist, np.sum((Z - Z[chosen[k]]) ** 2, axis=1))
+    return np.sort(chosen)
+
+
+def _symmetry(samples: FrictionSamples) -> str:
+    dirs = set(samples.directions())
+    if 0 in dirs and len(dirs) > 1:
+        raise DataError(
+            "the samples mix combined (direction 0, eq. 11) and per-direction rows; fit the "
+            "GP on one kind",
+            file=samples.source,
+        )
+    if dirs == {0}:
+        return "odd"
+    return "per_direction" if dirs == {-1, 1} else ("pos" if dirs == {1} else "neg")
+
+
+def _kernel_matrix(A: np.ndarray, B: np.ndarray, lengths: np.ndarray, s2: float) -> np.ndarray:
+    d2 = np.sum(((A[:, None, :] - B[None, :, :]) / lengths) ** 2, axis=2)
+    return s2 * np.exp(-0.5 * d2)
+
+
+def _interaction(A: np.ndarray, used: list[str]) -> list[np.ndarray]:
+    """``|v| T`` when both are used: the viscous coefficient linear in temperature."""
+    return [A[:, 0] * A[:, used.index("temperature")]] if "temperature" in used else []
+
+
+def _posterior(
+    P: np.ndarray,
+    Z: np.ndarray,
+    t: np.ndarray,
+    A: np.ndarray,
+    lengths: np.ndarray,
+    s2: float,
+    noise: float,
+    exact: bool,
+) -> tuple[np.ndarray, ...]:
+    """The posterior on stored points ``P`` of targets ``t`` at ``Z`` with the mean's basis
+    ``A (n, q)`` estimated with it (R&W section 2.7, eq. 2.41-2.42, vague prior on the
+    coefficients): ``(alpha, B, G, C, dbeta)``.
+
+    ``dbeta`` corrects the least-squares mean, ``alpha`` weighs the points, and the variance
+    is ``s2 - k^T B k + (h - G k)^T C (h - G k)`` for a kernel vector ``k`` and basis ``h``.
+    Exact: ``K = K_nn + noise I`` (R&W eq. 2.25-2.26); else DTC on the points, with
+    ``K~^-1 = (Q_nn + noise I)^-1`` by the Woodbury identity (Quinonero-Candela & Rasmussen
+    2005, eq. 20-21).
+    """
+    m = len(P)
+    Kmm = _kernel_matrix(P, P, lengths, s2)
+    if exact:
+        factor = cho_factor(Kmm + (noise + 1e-10) * np.eye(m), lower=True)
+        M = cho_solve(factor, A)  # K^-1 H^T
+        gain = M.T  # H K^-1
+        B = cho_solve(factor, np.eye(m))
+        weights = lambda r: cho_solve(factor, r)  # noqa: E731
+    else:
+        Kmn = _kernel_matrix(P, Z, lengths, s2)
+        Kj = Kmm + _JITTER * s2 * np.eye(m)
+        Sigma = cho_factor(noise * Kj + Kmn @ Kmn.T, lower=True)
+        M = (A - Kmn.T @ cho_solve(Sigma, Kmn @ A)) / noise
+        gain = cho_solve(Sigma, Kmn @ A).T  # H K_nm (noise K_mm + K_mn K_nm)^-1
+        B = cho_solve(cho_factor(Kj, lower=True), np.eye(m)) - noise * cho_solve(Sigma, np.eye(m))
+        weights = lambda r: cho_solve(Sigma, Kmn @ r)  # noqa: E731
+    cov = np.linalg.inv(A.T @ M)
+    cov = 0.5 * (cov + cov.T)
+    dbeta = cov @ (M.T @ t)
+    alpha = weights(t - A @ dbeta)
+    return alpha, 0.5 * (B + B.T), gain, cov, dbeta
+
+
+def _train_side(
+    samples: FrictionSamples, names: list[str], max_points: int, n_restarts: int, seed: int
+) -> dict[str, Any]:
+    """The state of one process on ``samples`` (one direction, or combined)."""
+    moving = samples.velocity != 0
+    v = samples.velocity[moving]
+    g = np.sign(v) * samples.friction[moving]
+    R = np.column_stack([np.abs(v)] + [samples.X[moving, INPUTS.index(n)] for n in names[1:]])
+    if "load" in names:
+        R[:, names.index("load")] = np.abs(R[:, names.index("load")])
+    kept = [0] + [j for j in range(1, len(names)) if np.ptp(R[:, j]) > 0]
+    dropped = {names[j]: float(R[0, j]) for j in range(1, len(names)) if j not in kept}
+    R = R[:, kept]
+    used = [names[j] for j in kept]
+    n, d = R.shape
+    if n < d + 3:
+        raise DataError(
+            f"{n} moving samples are too few for a GP on {', '.join(used)}", file=samples.source
+        )
+    vscale = float(R[:, 0].min())
+    W = R.copy()
+    W[:, 0] = np.arcsinh(W[:, 0] / vscale)
+    shift = W.mean(axis=0)
+    scale = W.std(axis=0)
+    scale[scale <= 0] = 1.0
+    Z = (W - shift) / scale
+    A = np.column_stack([np.ones(n), R, *_interaction(R, used)])
+    coef = np.linalg.lstsq(A, g, rcond=None)[0]
+    r = g - A @ coef
+    y_scale = float(np.std(r))
+    if not y_scale > 0:
+        y_scale = max(float(np.max(np.abs(g))), 1.0) * 1e-6
+    t = r / y_scale
+    sub = farthest_points(Z, max_points)
+    kernel = ConstantKernel(1.0, (1e-4, 1e4)) * RBF(np.ones(d), (1e-2, 1e3)) + WhiteKernel(
+        1e-2, (1e-10, 10.0)
+    )
+    gpr = GaussianProcessRegressor(
+        kernel, alpha=1e-10, n_restarts_optimizer=n_restarts, random_state=seed
+    )
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", SklearnConvergenceWarning)
+        gpr.fit(Z[sub], t[sub])
+    k = gpr.kernel_
+    s2 = float(k.k1.k1.constant_value)
+    lengths = np.atleast_1d(np.asarray(k.k1.k2.length_scale, dtype=float)) * np.ones(d)
+    noise = float(k.k2.noise_level)
+    P = Z[sub]
+    exact = len(sub) == n
+    alpha, Bm, gain, cov, dbeta = _posterior(P, Z, t, A, lengths, s2, noise, exact)
+    coef = coef + y_scale * dbeta
+    inducing = (
+        "all training points"
+        if exact
+        else f"farthest-point subset of {len(sub)} of {n} samples (DTC)"
+    )
+    state: dict[str, Any] = {
+        "inputs": used,
+        "velocity_scale": vscale,
+        "input_shift": shift.tolist(),
+        "input_scale": scale.tolist(),
+        "mean_coef": coef.tolist(),
+        "length_scales": lengths.tolist(),
+        "signal_var": s2,
+        "noise_var": noise,
+        "noise_std": y_scale * float(np.sqrt(noise)),
+        "y_scale": y_scale,
+        "points": P.tolist(),
+        "alpha": alpha.tolist(),
+        "var_matrix": Bm.tolist(),
+        "mean_gain": gain.tolist(),
+        "mean_cov": cov.tolist(),
+        "inducing": inducing,
+        "n_train": n,
+        "log_marginal_likelihood": float(gpr.log_marginal_likelihood_value_),
+        "kernel": str(k),
+    }
+    if dropped:
+        state["dropped_inputs"] = dropped
+    notes = sorted({str(w.message).split(". ")[0] for w in caught})
+    if notes:
+        state["training_notes"] = notes
+    return state
+
+
+def fit_gp(
+    samples: FrictionSamples,
+    *,
+    inputs: list[str] | tuple[str, ...] = INPUTS,
+    max_points: int = DEFAULT_MAX_POINTS,
+    n_restarts: int = 2,
+    seed: int | None = 0,
+) -> FittedModel:
+    """Train the Gaussian-process model on ``samples`` (module notes).
+
+    Parameters
+    ----------
+    samples : FrictionSamples
+        The data; samples at zero velocity are left out (``sign(0) = 0``).
+    inputs : sequence of str
+        Among velocity (required), load and temperature; those the samples do not measure
+        are left out.
+    max_points : int, default 400
+        The most points stored (and the size of the exact GP); above it, the inducing subset.
+    n_restarts : int, default 2
+        Random restarts of the marginal-likelihood optimiser.
+    seed : int, optional
+        Seeds the restarts (the second direction's process gets ``seed + 1``).
+
+    Returns
+    -------
+    FittedModel
+        ``model="gp"``, the process(es) in ``state``.
+
+    Raises
+    ------
+    ConfigError
+        Bad ``inputs``, ``max_points`` or ``n_restarts``.
+    DataError
+        Mixed combined and per-direction samples, too few moving samples.
+    """
+    names = [str(n).strip().lower() for n in inputs]
+    if not names or names[0] != "velocity" or any(n not in INPUTS for n in names):
+        raise ConfigError(f"GP inputs must start with velocity, among {INPUTS}; got {inputs!r}")
+    names = [n for n in names if n == "velocity" or n in samples.measured]
+    if int(max_points) < 10 or int(n_restarts) < 0:
+        raise ConfigError(
+            f"max_points must be >= 10 and n_restarts >= 0; got {max_points}, {n_restarts}"
+        )
+    with threadpool_limits(limits=1, user_api="blas"):  # small matrices: threads only cost
+        return _fit(samples, names, int(max_points), int(n_restarts), seed)
+
+
+def _fit(
+    samples: FrictionSamples, names: list[str], max_points: int, n_restarts: int, seed: int | None
+) -> FittedModel:
+    start = time.perf_counter()
+    symmetry = _symmetry(samples)
+    seed0 = 0 if seed is None else int(seed)
+    args = (names, max_points, n_restarts)
+    if symmetry == "per_direction":
+        state: dict[str, Any] = {
+            side: _train_side(samples.subset(samples.direction == d), *args, seed0 + k)
+            for k, (side, d) in enumerate((("pos", 1), ("neg", -1)))
+        }
+    else:
+        state = _train_side(samples, *args, seed0)
+    state = {"kind": GP_KIND, "symmetry": symmetry, **state}
+    y_hat = predict_gp(state, samples.X)
+    X = samples.X
+    n_hyper = sum(
+        len(s["length_scales"]) + len(s["mean_coef"]) + 2
+        for s in ([state["pos"], state["neg"]] if symmetry == "per_direction" else [state])
+    )
+    return FittedModel(
+        model="gp",
+        params={},
+        metrics=metrics(samples.y, y_hat),
+        statistics=fit_statistics(samples.y, y_hat, n_hyper),
+        method="sklearn-gpr",
+        seed=seed,
+        nfev=0,
+        status=0,
+        message=f"trained in {time.perf_counter() - start:.3g} s",
+        operating_range={
+            name: [float(X[:, INPUTS.index(name)].min()), float(X[:, INPUTS.index(name)].max())]
+            for name in INPUTS
+            if name in samples.measured
+        },
+        provenance={
+            "source": samples.source,
+            "n_samples": len(samples),
+            "samples_sha256_16": samples_hash(samples),
+            "directions": list(samples.directions()),
+            "fricid_version": __version__,
+            "created": created_timestamp(),
+            "estimator": "fricid.identify.gp.fit_gp",
+            "estimator_params": {
+                "inputs": names,
+                "max_points": max_points,
+                "n_restarts": n_restarts,
+            },
+        },
+        state=state,
+    )
