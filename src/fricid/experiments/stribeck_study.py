@@ -13,7 +13,18 @@ leaves open, and measures the optimiser's overhead against plain batched evaluat
 returns tables (pandas DataFrames), the convergence data and computed claims; the text,
 figure and files are :mod:`fricid.report.studies.stribeck`'s (``fricid bench stribeck`` and
 ``benchmarks/bench_stribeck.py`` print and write them). The problem itself (data, objective,
-box, exact optimum) is :mod:`.stribeck_problem`.
+box, exact optimum) is :mod:`.stribeck_problem`, the rows (methods, budgets) :mod:`.stribeck_specs`.
+
+Fairness. Every timed method evaluates candidates with the same objective code, the compiled
+numba kernel of :func:`.stribeck_problem.sse_objective` (numpy only without numba): every
+method here takes batches (or single points, which the kernel serves as batches of one), so
+the kernel is the objective all of them can take, and the fastest; timing some on numpy and
+one on the kernel measured the objective, not the algorithm. RWSAVSBAS's table row runs its
+algorithm in Python like the others (``jit=False``); its compiled loop, algorithm and kernel
+fused, is timed apart in :attr:`StudyResult.performance`. The table's first rows give every
+method RWSAVSBAS's evaluation count (the headline: at equal work), then [R]'s budgets, then
+the baselines that cannot afford that count in the stated time. BLAS runs on one thread for
+every method (17 samples: threads only add overhead).
 """
 
 from __future__ import annotations
@@ -37,10 +48,14 @@ from .stribeck_problem import (
     paper2_samples,
     sse_objective,
 )
+from .stribeck_specs import GROUPS, MethodSpec, method_specs
+from .stribeck_specs import paper_options as _paper_options
+from .stribeck_specs import readings as _readings
 
 __all__ = [
     "BOUNDS",
     "FREE",
+    "GROUPS",
     "PAPER_TABLE1",
     "SUCCESS_RTOL",
     "MethodSpec",
@@ -62,19 +77,6 @@ PAPER_TABLE1 = {
 
 #: A run "finds the optimum" when its SSE is within this relative distance of it.
 SUCCESS_RTOL = 1e-3
-
-
-@dataclass
-class MethodSpec:
-    """One row of the study: a method, its options and budget per run."""
-
-    label: str
-    method: str
-    options: dict[str, Any]
-    max_evals: int | None = None
-    paper: str | None = None
-    setting: str = ""
-    group: str = "paper budget"
 
 
 @dataclass
@@ -113,96 +115,6 @@ class StudyResult:
     claims: dict[str, bool]
     config: dict[str, Any]
     results: dict[str, list[OptimizeResult]] = field(repr=False, default_factory=dict)
-
-
-#: The groups of :func:`method_specs`, in the table's order (the headline first).
-GROUPS = ("equal budget", "paper budget", "baseline")
-
-
-def _paper_options(quick: bool) -> dict[str, Any]:
-    """RWSAVSBAS at [R] 4.1 (quick: the same schedule compressed ten-fold)."""
-    if not quick:
-        return {}
-    return {"n_outer": 100, "eta": 0.98**10, "cooling": 0.95**10, "h_outer": 100.0}
-
-
-def _specs(quick: bool) -> list[MethodSpec]:
-    """The rows: every method at RWSAVSBAS's evaluation count first (the headline), then
-    [R]'s methods at [R]'s budgets, then the baselines that cannot afford that count here.
-
-    The equal-budget beetles stretch their schedule ``k``-fold (``k`` = 100, quick 10) to
-    spend the budget: each per-iteration decay factor to the power ``1 / k``, BAS's antenna
-    floor ``d_inc / (1 - eta_d)`` kept.
-    """
-    rws = _paper_options(quick)
-    k = 10 if quick else 100
-    n_rws = 1 + (100 if quick else 1000) * 301
-    eq_iter = -(-(n_rws - 1) // 3)  # cut at n_rws evaluations by the budget
-    eq_eta = 0.98 ** (1.0 / k)
-    bas_eta = 0.95 ** (1.0 / k)
-    base = 3000 if quick else 30_000
-    rws_setting = (
-        "1000 x 100, step0 0.1, eta 0.98, c 3, T0 1e4 x 0.95"
-        if not quick
-        else "quick: 100 x 100, schedule compressed x10"
-    )
-    eq = f"{eq_iter} it., eta 0.98^(1/{k})"
-    equal = "equal budget"
-    return [
-        MethodSpec(
-            "RWSAVSBAS", "rwsavsbas", {**rws, "jit": False}, None, "RWSAVSBAS", rws_setting, equal
-        ),
-        MethodSpec(
-            "VSBAS (equal evals)",
-            "vsbas",
-            {"n_iter": eq_iter, "eta": eq_eta},
-            n_rws,
-            None,
-            eq,
-            equal,
-        ),
-        MethodSpec(
-            "IBAS (equal evals)", "ibas", {"n_iter": eq_iter, "eta": eq_eta}, n_rws, None, eq, equal
-        ),
-        MethodSpec(
-            "BAS (equal evals)",
-            "bas",
-            {
-                "n_iter": eq_iter,
-                "eta_step": bas_eta,
-                "eta_d": bas_eta,
-                "d_inc": 0.01 * (1.0 - bas_eta) / 0.05,
-            },
-            n_rws,
-            None,
-            f"{eq_iter} it., eta 0.95^(1/{k}), d0 0.2, step0 0.5",
-            equal,
-        ),
-        MethodSpec("GA (equal evals)", "ga", {}, n_rws, None, "pop 40, SBX, poly. mutation", equal),
-        MethodSpec("DE (scipy, equal evals)", "de", {}, n_rws, None, "best1bin, pop 60", equal),
-        MethodSpec("VSBAS", "vsbas", {}, None, "VSBAS", "1000 it., step0 0.1, eta 0.98, c 3"),
-        MethodSpec("IBAS", "ibas", {}, None, "IBAS", "1000 it., step 0.3->0.1, eta 0.98, c 3"),
-        MethodSpec("BAS", "bas", {}, None, None, "eq. 18-21, 1000 it., d0 0.2, step0 0.5"),
-        MethodSpec(
-            "dual annealing (scipy)", "dual_annealing", {}, base, None, "defaults", "baseline"
-        ),
-        MethodSpec("CMA-ES (cma)", "cmaes", {}, base, None, "sigma0 0.3, restarts", "baseline"),
-    ]
-
-
-def method_specs(quick: bool = False) -> list[MethodSpec]:
-    """The methods the study compares, in the table's order (:data:`GROUPS`), full or quick."""
-    return _specs(quick)
-
-
-def _readings(quick: bool) -> list[tuple[str, dict[str, Any]]]:
-    return [
-        ("default: wander along b, P counts, G updated at once", {}),
-        ("wander: independent random direction", {"wander": "random"}),
-        ("wander: literal, same offset on every coordinate", {"wander": "diagonal"}),
-        ("P: uniform random phase", {"phase": "random"}),
-        ("G updated only after each inner loop (3.2 D)", {"best_update": "outer"}),
-    ]
 
 
 def _summary(label: str, res: list[OptimizeResult], f_opt: float, seconds: float) -> dict:
@@ -287,6 +199,24 @@ def run_study(
     """
     if isinstance(runs, bool) or not isinstance(runs, int | np.integer) or runs < 1:
         raise ConfigError(f"runs must be a positive integer; got {runs!r}")
+    from threadpoolctl import threadpool_limits
+
+    # 17 samples: BLAS threads only add overhead (scipy's L-BFGS-B inside dual annealing ran
+    # 3-7x slower with them on a loaded 2-core machine), so every method runs on one
+    with threadpool_limits(limits=1):
+        return _run(seed, runs, quick, data_seed, progress, time_numpy, repeats)
+
+
+def _run(
+    seed: int,
+    runs: int,
+    quick: bool,
+    data_seed: int,
+    progress: Callable[[str], None] | None,
+    time_numpy: bool,
+    repeats: int,
+) -> StudyResult:
+    """:func:`run_study`'s body, on one BLAS thread."""
 
     def say(msg: str) -> None:
         if progress is not None:
@@ -313,7 +243,7 @@ def run_study(
         minimize_runs(fast, bounds, "rwsavsbas", seed=seed, runs=runs, options={"n_outer": 1})
         perf["compile_seconds"] = time.perf_counter() - t
 
-    specs = _specs(quick)
+    specs = method_specs(quick)
     for spec in specs:
         say(f"{spec.label}: {runs} runs ({spec.group})")
         t = time.perf_counter()
