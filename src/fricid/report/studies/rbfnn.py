@@ -16,6 +16,7 @@ from pathlib import Path
 
 import pandas as pd
 
+from ...experiments.paper_numbers import table1_rmse_unit
 from ...experiments.rbfnn_study import PAPER, TUNING_SEED_OFFSET, StudyResult
 from ...io.atomic import atomic_write
 from ...units import DEG
@@ -160,8 +161,7 @@ def summary_markdown(result: StudyResult) -> str:
         "",
         _fmt(t["table1"]),
         "",
-        "The paper's RMSE has no stated unit and a scale unlike its Table 3; compare "
-        "fitness and RMSPE.",
+        table1_rmse_unit(),
         "",
         "## Tuning (on data and seeds not reported)",
         "",
