@@ -35,7 +35,7 @@ from .. import paper_plots as pp
 from .. import plots
 from ..document import Document, Figure, Note, Section, Table
 from ._fig6 import coincide, fig6_convergence
-from .stribeck import study_notes
+from .stribeck import headline, study_notes
 
 __all__ = ["STEPS", "build_rwsavsbas", "compose_rwsavsbas"]
 
@@ -50,6 +50,7 @@ _SYMBOLS = {
 def _table1(tag: str, comp: Comparison, *, paper_numbers: bool) -> Table:
     """[R] Table 1: final SSE of each method's runs, the paper's beside ours."""
     f_opt = comp.optimum[1]
+    groups = comp.study.table["group"] if comp.study is not None else {}
     rows = []
     for label, runs in comp.results.items():
         f = np.array([r.fun for r in runs])
@@ -58,6 +59,7 @@ def _table1(tag: str, comp: Comparison, *, paper_numbers: bool) -> Table:
         rows.append(
             {
                 "algorithm": label if in_paper else f"{label} (not in the paper)",
+                "budget": groups.get(label, "paper budget"),
                 "paper: average": p["mean"] if p else np.nan,
                 "ours: average": f.mean(),
                 "paper: max": p["max"] if p else np.nan,
@@ -74,7 +76,9 @@ def _table1(tag: str, comp: Comparison, *, paper_numbers: bool) -> Table:
         f"Fitness = SSE over the {len(comp.samples)} samples (eq. 11, N² m²), "
         f"{PAPER['runs']} runs per algorithm. The exact optimum (variable projection, "
         f"a baseline the paper did not have) is SSE {f_opt:.4g}: the ratio column says "
-        "how close each algorithm gets."
+        "how close each algorithm gets. Every method evaluates the same compiled objective; "
+        "the rows at RWSAVSBAS's evaluation count ('equal budget') come first: "
+        + (headline(comp.study) if comp.study is not None else "")
     )
     notes = study_notes(comp.study) if comp.study is not None else []
     if notes:
