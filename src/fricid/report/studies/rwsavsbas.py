@@ -322,7 +322,7 @@ def _table2(
     else:
         caption += (
             " The paper's values belong to its robot and are not comparable to this "
-            "lead screw (friction of a few mN m), so they are not repeated here."
+            "lead screw (its friction range: Table 1's caption), so they are not repeated here."
         )
     return Table(
         f"{tag}_table2_parameters",
@@ -392,8 +392,7 @@ def compose_rwsavsbas(result: RwsavsbasResult) -> Document:
             "Mablekos-Alexiou et al. (IEEE T-RO 2021), a Maxon motor on a simple lead screw, "
             "one steady velocity per recording (2-200 rpm, both directions); friction = the mean "
             "motor torque of each recording. The paper's eq. 7 has one parameter set, so it is "
-            "identified per direction; the drive is asymmetric (about 3.6 mN m forwards against "
-            "2.8 mN m backwards at 2 rpm). The search box scales with the data "
+            f"identified per direction{_asymmetry(result)}. The search box scales with the data "
             "(fricid.experiments.rwsavsbas_paper.scaled_bounds); the paper's numbers are for its "
             "robot and are not repeated."
         ),
@@ -401,6 +400,16 @@ def compose_rwsavsbas(result: RwsavsbasResult) -> Document:
     for direction, data in result.leadscrew.items():
         _dataset_section(doc, f"Lead screw, {direction} direction", data)
     return doc
+
+
+def _asymmetry(result: RwsavsbasResult) -> str:
+    """The lead screw's friction at its slowest recording per direction, computed."""
+    parts = []
+    for direction, data in result.leadscrew.items():
+        v, f = np.abs(data.samples.velocity), np.abs(data.samples.friction)
+        i = int(np.argmin(v))
+        parts.append(f"{1e3 * f[i]:.2g} mN m {direction} at {v[i] * 60 / (2 * np.pi):.3g} rpm")
+    return "; at the slowest recording: " + ", ".join(parts) if parts else ""
 
 
 def build_rwsavsbas(
