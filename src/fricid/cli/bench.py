@@ -31,22 +31,32 @@ def stribeck_command(
         bool,
         quick_option(
             "Reduced budgets (RWSAVSBAS 100 x 100 with its schedule compressed ten-fold, "
-            "baselines 3000 evaluations): a check in seconds, not the paper's settings."
+            "30,101 evaluations per run, the equal-budget rows alike; baselines 3,000): a "
+            "check, not the paper's settings."
         ),
     ] = False,
     seed: Annotated[
         int, seed_option("Base seed of the runs (run r uses seed + r).", non_negative=True)
     ] = 0,
 ) -> None:
-    """Reproduce the RWSAVSBAS paper's Table 1 and Fig. 6 on the simulated paper2 preset.
+    """Compare the optimisers of the RWSAVSBAS paper's Table 1 and Fig. 6 on the simulated
+    paper2 preset, at equal budgets first.
 
-    Fits the Stribeck model (delta = 1) to the preset's 17 samples with VSBAS, IBAS and
-    RWSAVSBAS at the paper's settings, plus BAS, GA, DE, dual annealing, CMA-ES and bas+lm,
-    and prints each method's average, max and min SSE beside the paper's, its ratio to the
-    exact global optimum (variable projection), evaluations and wall time; the readings of
-    RWSAVSBAS the paper leaves open; bas+lm against lm from the same random starts; and the
-    optimiser's overhead against evaluating as many candidates in large batches. Progress
-    goes to stderr. Takes about two minutes on 2 cores (--quick: about 15 s).
+    Fits the Stribeck model (delta = 1) to the preset's 17 samples. Every method evaluates
+    candidates with the same compiled objective. First every method at RWSAVSBAS's evaluation
+    count (the headline: VSBAS, IBAS, BAS, GA and DE with as many evaluations as RWSAVSBAS),
+    then VSBAS, IBAS and BAS at the paper's 1000 iterations, then dual annealing and CMA-ES
+    at a smaller budget; each row's average, max and min SSE beside the paper's, its ratio to
+    the exact global optimum (variable projection), evaluations and wall time. Then the
+    readings of RWSAVSBAS the paper leaves open, bas+lm against lm from the same random
+    starts, and RWSAVSBAS's compiled loop against evaluating as many candidates in batches.
+    Progress goes to stderr.
+
+    Budgets rather than times: 8 runs per method; RWSAVSBAS 1000 x 100 iterations (301,001
+    evaluations per run) and every equal-budget row as many; dual annealing and CMA-ES
+    10,000 (--quick: 30,101 and 3,000). Measured with benchmarks/bench_stribeck.py on 2
+    cores shared with other jobs: --quick 24 s and 235 s in two runs half an hour apart as the
+    load grew; the full settings 579 s (load average about 14; dual annealing 3 % of it).
     """
     from ..experiments.stribeck_study import run_study
     from ..report.studies.stribeck import report_text, write_outputs

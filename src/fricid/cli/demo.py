@@ -38,6 +38,7 @@ def demo_command(
     samples_by_direction.csv, one JSON model file per model, table1.csv and summary.md into
     --out."""
     from ..experiments.demo import run_demo
+    from ..experiments.paper_numbers import table1_rmse_unit
     from ..report.studies.demo import write_demo
 
     t0 = time.perf_counter()
@@ -68,8 +69,5 @@ def demo_command(
             f"{row.max_abs_error_mNm:.3g}",
         )
     console.print(table)
-    console.print(
-        "[dim]The paper's RMSE has no stated unit (its scale does not match its "
-        "Table 3 in N m): compare fitness, RMSPE and the ordering.[/]"
-    )
+    console.print(f"[dim]{table1_rmse_unit()} Compare fitness, RMSPE and the ordering.[/]")
     console.print(f"wrote {written}/ in {time.perf_counter() - t0:.1f} s")

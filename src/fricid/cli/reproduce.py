@@ -20,7 +20,13 @@ def reproduce_command(
         Path | None, out_option("Folder to write. Default: ./fricid-reproduce/<paper>/.")
     ] = None,
     quick: Annotated[
-        bool, quick_option("Reduced designs and budgets: under 2 minutes on 2 cores.")
+        bool,
+        quick_option(
+            "Reduced designs and budgets (RWSAVSBAS: its schedule compressed ten-fold; "
+            "BAS-RBFNN: the 330-sample design, smaller networks). Measured as the setup of "
+            "tests/test_reproduce.py (pytest --durations) on 2 cores shared with other jobs, "
+            "load average about 14: rwsavsbas 221 s, bas-rbfnn 175 s."
+        ),
     ] = False,
     seed: Annotated[int, seed_option("Random seed (same seed, same report).")] = 0,
     quiet: QuietOption = False,

@@ -178,7 +178,7 @@ def run_bas_rbfnn(
         The reduced ``paper1`` design (330 samples) and the RBF study's quick settings
         (:func:`~fricid.experiments.rbfnn_study.study_config`), for tests; otherwise the
         paper's full design (21 positions, 15 velocities, 21 temperatures) and the study's
-        full settings (with Table 4's variants; about 6 minutes on 2 cores).
+        full settings (with Table 4's variants and the tuning of :mod:`.rbfnn_tuning`).
     seed : int
         Seeds the simulator and every stochastic step.
     progress : callable, optional

@@ -27,7 +27,7 @@ __all__ = ["DEMO_MODELS", "PAPER_TABLE1", "DemoResult", "run_demo"]
 DEMO_MODELS = ("coulomb_viscous", "stribeck", "msk", "vlt")
 
 #: The BAS-RBFNN paper's Table 1 ("Velocity", "Velocity-load", "Velocity-temperature-load").
-#: Its RMSE has no stated unit and its scale does not match its Table 3 (N m); we print it as is.
+#: Its RMSE has no stated unit (see :func:`.paper_numbers.table1_rmse_unit`); printed as is.
 PAPER_TABLE1 = {
     "stribeck": {"fitness": 0.8732, "rmse": 35.25, "rmspe": 0.1792},
     "msk": {"fitness": 0.9418, "rmse": 24.16, "rmspe": 0.1077},

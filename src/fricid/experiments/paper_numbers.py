@@ -10,14 +10,15 @@ References
 [R] Kou, Huang, Wang, Ren, Zhang, Guo, "A New Parameter Identification Method for Industrial
     Robots with Friction", Machines 10(5) 349, 2022 (the RWSAVSBAS paper).
 
-Units are the papers' own: [B] gives torques in N m in Tables 3-4 but prints Table 1's RMSE
-and Table 2's torque parameters on a scale that matches neither (probably mN m or motor-side
-counts; the paper does not say). [R] gives no units; we read its numbers as N m and rad/s.
+Units are the papers' own: [B] gives torques in N m in Tables 3-4 but states no unit for
+Table 1's RMSE (described one way everywhere by :func:`table1_rmse_unit`) and prints Table 2's
+torque parameters on a scale unlike N m (the paper does not say). [R] gives no units; we read
+its numbers as N m and rad/s.
 """
 
 from __future__ import annotations
 
-__all__ = ["BAS_RBFNN", "RWSAVSBAS"]
+__all__ = ["BAS_RBFNN", "RWSAVSBAS", "table1_rmse_unit"]
 
 #: The BAS-RBFNN paper [B].
 BAS_RBFNN: dict = {
@@ -143,3 +144,18 @@ RWSAVSBAS: dict = {
         "the measured friction: the trend matches at low and high speed.",
     },
 }
+
+
+def table1_rmse_unit() -> str:
+    """How fricid reads [B] Table 1's RMSE, in one sentence used wherever it is shown.
+
+    The paper states no unit; its velocity-load-temperature RMSE is close to its Table 3 mean
+    error of the same model in mN m, and a thousand times its N m value, so we read it as mN m.
+    """
+    rmse = BAS_RBFNN["table1"]["vlt"]["rmse"]
+    mean_mnm = 1e3 * BAS_RBFNN["table3"]["vlt"]["mean"]
+    return (
+        "The paper states no unit for its Table 1 RMSE; we read it as mN m (its "
+        f"velocity-load-temperature RMSE {rmse:g} is close to its Table 3 mean error of "
+        f"{mean_mnm:.2g} mN m for that model, whose errors Table 3 gives in N m)."
+    )

@@ -18,7 +18,7 @@ import numpy as np
 from ..identify import fit as identify_fit
 from ..identify.rbf import RBFNetRegressor
 from ..samples import FrictionSamples
-from .rbfnn_config import StudyConfig
+from .rbfnn_config import MLP_BASE, StudyConfig
 
 __all__ = [
     "SubsetGP",
@@ -45,16 +45,18 @@ def _warp(velocity_scale: float | None):
     return FunctionTransformer(warp)
 
 
-def mlp_model(cfg: StudyConfig):
-    """scikit-learn's ``MLPRegressor`` at its defaults (100 ReLU units, Adam, early stop on
-    the training loss), on the same inputs as the RBF network (warped velocity,
+def mlp_model(cfg: StudyConfig, options: dict[str, Any] | None = None, seed: int | None = None):
+    """scikit-learn's ``MLPRegressor`` (ReLU, Adam) with early stopping on a validation split
+    (:data:`~.rbfnn_config.MLP_BASE`) and the hidden layers and penalty of ``options``
+    (default ``cfg.mlp_options``), on the same inputs as the RBF network (warped velocity,
     standardised) and a standardised target."""
     from sklearn.compose import TransformedTargetRegressor
     from sklearn.neural_network import MLPRegressor
     from sklearn.pipeline import make_pipeline
     from sklearn.preprocessing import StandardScaler
 
-    net = MLPRegressor(random_state=cfg.seed)
+    opts = {**MLP_BASE, **(cfg.mlp_options if options is None else options)}
+    net = MLPRegressor(random_state=cfg.seed if seed is None else seed, **opts)
     return TransformedTargetRegressor(
         regressor=make_pipeline(_warp(cfg.velocity_scale), StandardScaler(), net),
         transformer=StandardScaler(),
@@ -84,21 +86,19 @@ class SubsetGP:
         ) + WhiteKernel(1e-3, (1e-9, 1.0))
         rng = np.random.default_rng(self.seed)
         idx = rng.permutation(len(y))[: min(self.subset, len(y))]
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            hyper = make_pipeline(
-                _warp(self.velocity_scale),
-                StandardScaler(),
-                GaussianProcessRegressor(kernel, normalize_y=True, random_state=self.seed),
-            )
-            hyper.fit(X[idx], y[idx])
-            learned = hyper[-1].kernel_
-            self.model_ = make_pipeline(
-                _warp(self.velocity_scale),
-                StandardScaler(),
-                GaussianProcessRegressor(learned, normalize_y=True, optimizer=None),
-            )
-            self.model_.fit(X, y)
+        hyper = make_pipeline(
+            _warp(self.velocity_scale),
+            StandardScaler(),
+            GaussianProcessRegressor(kernel, normalize_y=True, random_state=self.seed),
+        )
+        hyper.fit(X[idx], y[idx])
+        learned = hyper[-1].kernel_
+        self.model_ = make_pipeline(
+            _warp(self.velocity_scale),
+            StandardScaler(),
+            GaussianProcessRegressor(learned, normalize_y=True, optimizer=None),
+        )
+        self.model_.fit(X, y)
         self.kernel_ = learned
         return self
 
@@ -149,14 +149,17 @@ def fit_learner(model: Any, samples: FrictionSamples) -> Any:
     """Fit one learner of :func:`learners` on ``samples`` and return it.
 
     The velocity-load-temperature model takes the samples themselves; the estimators take
-    ``(X, y)``, with their warnings (MLP convergence, GP bounds) silenced: their accuracy in
-    Table 3 reports them.
+    ``(X, y)``. Warnings raised while fitting (the MLP's convergence, the GP's bounds) are
+    recorded, not silenced: ``model.fit_warnings_`` lists their categories and first lines,
+    which the study counts and reports (Table 3's ``warnings`` column).
     """
-    if isinstance(model, _VLT):
-        return model.fit(samples)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")  # MLP convergence, GP bounds: reported by accuracy
-        return model.fit(samples.X, samples.y)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        fitted = model.fit(samples) if isinstance(model, _VLT) else model.fit(samples.X, samples.y)
+    fitted.fit_warnings_ = [
+        f"{w.category.__name__}: {str(w.message).splitlines()[0]}" for w in caught
+    ]
+    return fitted
 
 
 def describe(label: str, cfg: StudyConfig) -> str:
@@ -167,7 +170,10 @@ def describe(label: str, cfg: StudyConfig) -> str:
         "BAS-RBFNN": f"bas/hybrid from the lsq net, to MSE {cfg.target_mse:g}; {m} centres",
         "RBFNN, plain inputs": "as RBFNN, without the velocity warp (the paper's inputs)",
         "VLT model": "eq. 4, Levenberg-Marquardt (8 starts)",
-        "MLP": "sklearn MLPRegressor defaults (100 ReLU, Adam)",
+        "MLP": (
+            f"sklearn MLP {cfg.mlp_options.get('hidden_layer_sizes')}, "
+            f"alpha {cfg.mlp_options.get('alpha'):g}, early stopping"
+        ),
         "GP": f"sklearn GP, SE-ARD + white; hyperparameters on {cfg.gp_subset} points",
     }.get(label, f"lsq; {cfg.large_centers} centres, widths x{cfg.large_width_factor:g}")
 

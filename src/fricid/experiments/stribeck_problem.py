@@ -178,9 +178,10 @@ def sse_objective(problem: StribeckProblem, *, jit: bool = True):
     problem : StribeckProblem
         The data and box.
     jit : bool
-        With numba available, a :class:`~fricid.optim.JitObjective` carrying the compiled
-        kernel (the same SSE, evaluated without numpy temporaries); otherwise, or with
-        ``jit=False``, the batched numpy :meth:`StribeckProblem.sse`.
+        With numba available, a :class:`~fricid.optim.JitObjective` whose every call runs the
+        compiled kernel (so every method evaluates candidates with the same compiled code;
+        RWSAVSBAS can also run its whole inner loop compiled on the same kernel); otherwise,
+        or with ``jit=False``, the batched numpy :meth:`StribeckProblem.sse`.
 
     Returns
     -------
@@ -194,5 +195,13 @@ def sse_objective(problem: StribeckProblem, *, jit: bool = True):
     the same SSE (a test checks they agree).
     """
     if jit and _sse_kernel is not None:
-        return JitObjective(problem.sse, _sse_kernel, (problem.velocity, problem.friction))
+        data = (problem.velocity, problem.friction)
+
+        def compiled(X: np.ndarray) -> np.ndarray:
+            X = np.ascontiguousarray(np.atleast_2d(X), dtype=float)
+            out = np.empty(X.shape[0])
+            _sse_kernel(X, out, data)
+            return out
+
+        return JitObjective(compiled, _sse_kernel, data)
     return problem.sse

@@ -13,7 +13,18 @@ leaves open, and measures the optimiser's overhead against plain batched evaluat
 returns tables (pandas DataFrames), the convergence data and computed claims; the text,
 figure and files are :mod:`fricid.report.studies.stribeck`'s (``fricid bench stribeck`` and
 ``benchmarks/bench_stribeck.py`` print and write them). The problem itself (data, objective,
-box, exact optimum) is :mod:`.stribeck_problem`.
+box, exact optimum) is :mod:`.stribeck_problem`, the rows (methods, budgets) :mod:`.stribeck_specs`.
+
+Fairness. Every timed method evaluates candidates with the same objective code, the compiled
+numba kernel of :func:`.stribeck_problem.sse_objective` (numpy only without numba): every
+method here takes batches (or single points, which the kernel serves as batches of one), so
+the kernel is the objective all of them can take, and the fastest; timing some on numpy and
+one on the kernel measured the objective, not the algorithm. RWSAVSBAS's table row runs its
+algorithm in Python like the others (``jit=False``); its compiled loop, algorithm and kernel
+fused, is timed apart in :attr:`StudyResult.performance`. The table's first rows give every
+method RWSAVSBAS's evaluation count (the headline: at equal work), then [R]'s budgets, then
+the baselines that cannot afford that count in the stated time. BLAS runs on one thread for
+every method (17 samples: threads only add overhead).
 """
 
 from __future__ import annotations
@@ -28,6 +39,7 @@ import pandas as pd
 
 from ..errors import ConfigError
 from ..optim import OptimizeResult, minimize, minimize_runs
+from .paper_numbers import RWSAVSBAS as PAPER_NUMBERS
 from .stribeck_problem import (
     BOUNDS,
     FREE,
@@ -36,10 +48,14 @@ from .stribeck_problem import (
     paper2_samples,
     sse_objective,
 )
+from .stribeck_specs import GROUPS, MethodSpec, method_specs
+from .stribeck_specs import paper_options as _paper_options
+from .stribeck_specs import readings as _readings
 
 __all__ = [
     "BOUNDS",
     "FREE",
+    "GROUPS",
     "PAPER_TABLE1",
     "SUCCESS_RTOL",
     "MethodSpec",
@@ -53,27 +69,14 @@ __all__ = [
     "sse_objective",
 ]
 
-#: [R] Table 1: average, largest and smallest final SSE of 8 runs.
+#: [R] Table 1: average, largest and smallest final SSE of 8 runs (from
+#: :mod:`.paper_numbers`, the one place paper numbers live).
 PAPER_TABLE1 = {
-    "VSBAS": (0.60, 1.86, 0.10),
-    "IBAS": (0.42, 0.83, 0.09),
-    "RWSAVSBAS": (0.00013, 0.00014, 0.00013),
+    row["label"]: (row["mean"], row["max"], row["min"]) for row in PAPER_NUMBERS["table1"].values()
 }
 
 #: A run "finds the optimum" when its SSE is within this relative distance of it.
 SUCCESS_RTOL = 1e-3
-
-
-@dataclass
-class MethodSpec:
-    """One row of the study: a method, its options and budget per run."""
-
-    label: str
-    method: str
-    options: dict[str, Any]
-    max_evals: int | None = None
-    paper: str | None = None
-    setting: str = ""
 
 
 @dataclass
@@ -112,67 +115,6 @@ class StudyResult:
     claims: dict[str, bool]
     config: dict[str, Any]
     results: dict[str, list[OptimizeResult]] = field(repr=False, default_factory=dict)
-
-
-def _paper_options(quick: bool) -> dict[str, Any]:
-    """RWSAVSBAS at [R] 4.1 (quick: the same schedule compressed ten-fold)."""
-    if not quick:
-        return {}
-    return {"n_outer": 100, "eta": 0.98**10, "cooling": 0.95**10, "h_outer": 100.0}
-
-
-def _specs(quick: bool) -> list[MethodSpec]:
-    rws = _paper_options(quick)
-    n_rws = 1 + (100 if quick else 1000) * 301
-    eq_iter = (n_rws - 1) // 3
-    eq_eta = 0.98 ** (1.0 / 100.0) if not quick else 0.98 ** (1.0 / 10.0)
-    base = 3000 if quick else 30_000
-    rws_setting = (
-        "1000 x 100, step0 0.1, eta 0.98, c 3, T0 1e4 x 0.95"
-        if not quick
-        else "quick: 100 x 100, schedule compressed x10"
-    )
-    return [
-        MethodSpec("VSBAS", "vsbas", {}, None, "VSBAS", "1000 it., step0 0.1, eta 0.98, c 3"),
-        MethodSpec("IBAS", "ibas", {}, None, "IBAS", "1000 it., step 0.3->0.1, eta 0.98, c 3"),
-        MethodSpec("RWSAVSBAS", "rwsavsbas", rws, None, "RWSAVSBAS", rws_setting),
-        MethodSpec("BAS", "bas", {}, None, None, "eq. 18-21, 1000 it., d0 0.2, step0 0.5"),
-        MethodSpec(
-            "VSBAS (equal evals)",
-            "vsbas",
-            {"n_iter": eq_iter, "eta": eq_eta},
-            None,
-            None,
-            f"{eq_iter} it., eta 0.98^(1/{100 if not quick else 10})",
-        ),
-        MethodSpec(
-            "IBAS (equal evals)",
-            "ibas",
-            {"n_iter": eq_iter, "eta": eq_eta},
-            None,
-            None,
-            f"{eq_iter} it., eta 0.98^(1/{100 if not quick else 10})",
-        ),
-        MethodSpec("GA", "ga", {}, base, None, "pop 40, SBX, poly. mutation"),
-        MethodSpec("DE (scipy)", "de", {}, base, None, "best1bin, pop 60"),
-        MethodSpec("dual annealing (scipy)", "dual_annealing", {}, base, None, "defaults"),
-        MethodSpec("CMA-ES (cma)", "cmaes", {}, base, None, "sigma0 0.3, restarts"),
-    ]
-
-
-def method_specs(quick: bool = False) -> list[MethodSpec]:
-    """The methods the study compares, in order (the paper's three first), full or quick."""
-    return _specs(quick)
-
-
-def _readings(quick: bool) -> list[tuple[str, dict[str, Any]]]:
-    return [
-        ("default: wander along b, P counts, G updated at once", {}),
-        ("wander: independent random direction", {"wander": "random"}),
-        ("wander: literal, same offset on every coordinate", {"wander": "diagonal"}),
-        ("P: uniform random phase", {"phase": "random"}),
-        ("G updated only after each inner loop (3.2 D)", {"best_update": "outer"}),
-    ]
 
 
 def _summary(label: str, res: list[OptimizeResult], f_opt: float, seconds: float) -> dict:
@@ -257,6 +199,24 @@ def run_study(
     """
     if isinstance(runs, bool) or not isinstance(runs, int | np.integer) or runs < 1:
         raise ConfigError(f"runs must be a positive integer; got {runs!r}")
+    from threadpoolctl import threadpool_limits
+
+    # 17 samples: BLAS threads only add overhead (scipy's L-BFGS-B inside dual annealing ran
+    # 3-7x slower with them on a loaded 2-core machine), so every method runs on one
+    with threadpool_limits(limits=1):
+        return _run(seed, runs, quick, data_seed, progress, time_numpy, repeats)
+
+
+def _run(
+    seed: int,
+    runs: int,
+    quick: bool,
+    data_seed: int,
+    progress: Callable[[str], None] | None,
+    time_numpy: bool,
+    repeats: int,
+) -> StudyResult:
+    """:func:`run_study`'s body, on one BLAS thread."""
 
     def say(msg: str) -> None:
         if progress is not None:
@@ -269,25 +229,26 @@ def run_study(
     theta_opt, f_opt = global_optimum(problem)
     fast = sse_objective(problem, jit=True)
     plain = sse_objective(problem, jit=False)
+    objective_code = "compiled kernel" if fast is not plain else "numpy"
     bounds = problem.bounds
     results: dict[str, list[OptimizeResult]] = {}
     rows = []
     perf: dict[str, float] = {}
 
-    # compile the fast path once, outside every timing
+    # compile the kernel and RWSAVSBAS's compiled loop once, outside every timing
     if fast is not plain:
-        say("compiling the RWSAVSBAS fast path (numba; cached after the first time)")
+        say("compiling the objective kernel and RWSAVSBAS's loop (numba)")
         t = time.perf_counter()
+        fast(bounds[:, 0][None])
         minimize_runs(fast, bounds, "rwsavsbas", seed=seed, runs=runs, options={"n_outer": 1})
         perf["compile_seconds"] = time.perf_counter() - t
 
-    specs = _specs(quick)
+    specs = method_specs(quick)
     for spec in specs:
-        say(f"{spec.label}: {runs} runs")
-        fun = fast if spec.method == "rwsavsbas" else plain
+        say(f"{spec.label}: {runs} runs ({spec.group})")
         t = time.perf_counter()
         res = minimize_runs(
-            fun,
+            fast,
             bounds,
             spec.method,
             seed=seed,
@@ -298,13 +259,15 @@ def run_study(
         seconds = time.perf_counter() - t
         results[spec.label] = res
         row = _summary(spec.label, res, f_opt, seconds)
+        row["group"] = spec.group
         row["method"] = spec.method
         row["setting"] = spec.setting
+        row["objective"] = objective_code
         paper = PAPER_TABLE1.get(spec.paper) if spec.paper else None
         row["paper_mean"], row["paper_max"], row["paper_min"] = paper or (np.nan,) * 3
         rows.append(row)
-        if spec.method == "rwsavsbas":
-            perf["rws_jit_seconds"] = seconds
+        if spec.label == "RWSAVSBAS":
+            perf["rws_loop_seconds"] = seconds
             perf["rws_evals_per_run"] = float(res[0].nfev)
     table = pd.DataFrame(rows).set_index("label")
 
@@ -318,10 +281,15 @@ def run_study(
             results["RWSAVSBAS"]
             if not extra
             else minimize_runs(
-                fast, bounds, "rwsavsbas", seed=seed, runs=runs, options={**rws_opts, **extra}
+                fast,
+                bounds,
+                "rwsavsbas",
+                seed=seed,
+                runs=runs,
+                options={**rws_opts, **extra, "jit": False},
             )
         )
-        seconds = perf["rws_jit_seconds"] if not extra else time.perf_counter() - t
+        seconds = perf["rws_loop_seconds"] if not extra else time.perf_counter() - t
         results[f"reading: {label}"] = res
         reading_rows.append(_summary(label, res, f_opt, seconds))
     readings = pd.DataFrame(reading_rows).set_index("label")
@@ -353,7 +321,8 @@ def run_study(
             times["rws_jit"].append(time.perf_counter() - t)
     perf["batch_numpy_seconds"] = min(times["batch_numpy"])
     if fast is not plain:
-        perf["rws_jit_seconds"] = min(times["rws_jit"] + [perf["rws_jit_seconds"]])
+        perf["rws_jit_seconds"] = min(times["rws_jit"])
+        perf["ratio_loop_vs_jit"] = perf["rws_loop_seconds"] / perf["rws_jit_seconds"]
         perf["batch_kernel_seconds"] = min(times["batch_kernel"])
         perf["ratio_jit_vs_kernel_batches"] = perf["rws_jit_seconds"] / perf["batch_kernel_seconds"]
         perf["ratio_jit_vs_numpy_batches"] = perf["rws_jit_seconds"] / perf["batch_numpy_seconds"]

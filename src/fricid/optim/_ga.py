@@ -40,6 +40,9 @@ class GA(Solver):
     pop_size : 40.  n_elite : 2.  tournament : 2.
     p_cross, eta_c : 0.9, 15 (SBX).  p_mut, eta_m : None (= 1 / d), 20 (polynomial mutation).
     n_gen : generations, or None to run until the budget is spent (default budget 4000).
+    init_spread : None (the population uniform in the box, ``x0`` one member), or the standard
+        deviation (unit-box units) of a population drawn around ``x0`` (``x0`` itself one member;
+        the others ``x0 + init_spread * N(0, 1)``, clipped), the start a local method gets.
     stall, ftol : the convergence criterion, off by default (``stall=None``): the run stops,
         converged (status 0), when the best value improved by at most ``ftol`` times its
         magnitude over the last ``stall`` generations (ftol 1e-8). Without it the GA ends at
@@ -67,6 +70,7 @@ class GA(Solver):
         "stall": None,
         "ftol": 1e-8,
         "dedupe": True,
+        "init_spread": None,
     }
 
     def validate(self) -> None:
@@ -96,6 +100,8 @@ class GA(Solver):
         if o["dedupe"]:
             self.batched = False  # each run counts its own evaluations
         self.n_clones = 0
+        if o["init_spread"] is not None:
+            positive_option(o, "init_spread", self.name)
 
     def run(self) -> tuple[int, str]:
         obj = self.objective
@@ -110,7 +116,11 @@ class GA(Solver):
 
         pop = np.stack([g.random((P, d)) for g in self.rngs])
         if self.x0 is not None:
-            pop[:, 0] = obj.to_u(self.x0)
+            u0 = obj.to_u(self.x0)
+            if o["init_spread"] is not None:  # the population around x0, as a local start
+                noise = np.stack([g.standard_normal((P, d)) for g in self.rngs])
+                pop = np.clip(u0[..., None, :] + float(o["init_spread"]) * noise, 0.0, 1.0)
+            pop[:, 0] = u0
         fit = obj(pop)
         n_gen = o["n_gen"]
         stall = None if o["stall"] is None else int(o["stall"])

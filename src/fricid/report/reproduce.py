@@ -86,7 +86,7 @@ def reproduce(
     out : path-like, optional
         Output folder (default :func:`default_out`); written all or nothing.
     quick : bool
-        Reduced designs and budgets (under 2 minutes on 2 cores, used by the tests).
+        Reduced designs and budgets (used by the tests).
     seed : int
         Seeds every stochastic step; same seed, same report.
     progress : callable, optional

@@ -11,6 +11,7 @@ from pathlib import Path
 import pandas as pd
 
 from ...experiments.demo import DemoResult
+from ...experiments.paper_numbers import table1_rmse_unit
 from ...extract import ExtractionResult
 from ...io import atomic_write, write_samples
 
@@ -71,8 +72,7 @@ def summary_markdown(
     )
     lines += [
         "",
-        "The paper's RMSE has no stated unit and a scale unlike its Table 3 (N m); "
-        "compare fitness and RMSPE, and the ordering.",
+        table1_rmse_unit() + " Compare fitness, RMSPE and the ordering.",
         "",
         "## Time",
         "",
