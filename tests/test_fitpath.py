@@ -71,7 +71,10 @@ def _samples(rng: np.random.Generator):
     )
 
 
-@pytest.mark.parametrize("name", [*_MODELS, *(m + "_asym" for m in _MODELS)])
+_TEMP = ("coulomb_viscous_temp", "stribeck_temp", "msk_temp", "stribeck_temp_asym", "msk_temp_asym")
+
+
+@pytest.mark.parametrize("name", [*_MODELS, *(m + "_asym" for m in _MODELS), *_TEMP])
 def test_the_compiled_kernel_gives_the_numpy_loss(name):
     """Every built-in model, loss, weighting and fixed parameter: the kernel's loss equals
     IdentificationProblem.evaluate's to 1e-12 relative."""

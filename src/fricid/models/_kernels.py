@@ -3,18 +3,20 @@
 One kernel, :func:`loss_kernel`, evaluates the identification loss of a batch of candidates
 ``X (k, d)`` (the free parameters) on the samples in one compiled loop, for coulomb_viscous
 (BAS-RBFNN paper eq. 1), stribeck (eq. 2 there; RWSAVSBAS paper eq. 7), msk (eq. 3) and vlt
-(eq. 4, as read in :class:`~fricid.models.VelocityLoadTemperature`) and their per-direction
-``_asym`` variants. It computes exactly what
-:meth:`fricid.identify.problem.IdentificationProblem.evaluate` computes with numpy (the same
-formulas, weights, robust losses and ``mse`` divisor), up to rounding (the tests hold the two to
-1e-12 relative); it is written once for all models and branches on a model code, so numba
-compiles (and caches) one function for every model.
+(eq. 4, as read in :class:`~fricid.models.VelocityLoadTemperature`), their per-direction
+``_asym`` variants, and the ``_temp`` / ``_temp_asym`` variants of the first three (the viscous
+coefficient scaled by :func:`~fricid.models._temperature.arrhenius_factor`). It computes
+exactly what :meth:`fricid.identify.problem.IdentificationProblem.evaluate` computes with
+numpy (the same formulas, weights, robust losses and ``mse`` divisor), up to rounding (the
+tests hold the two to 1e-12 relative); it is written once for all models and branches on a
+model code, so numba compiles (and caches) one function for every model.
 
 ``data`` (:func:`kernel_data`) is a tuple of fixed types: inputs ``(n, 3)``, friction ``(n,)``,
 square roots of the weights ``(n,)`` (ones when unweighted), the full parameter vector with the
 fixed values ``(p_all,)``, the free parameters' indices ``(d,)`` (int64) and a configuration
 vector (model code, parameters per direction for ``_asym`` or 0, loss code, robust scale,
-divisor).
+divisor, and for a temperature model the viscous coefficient's index within a direction's
+parameters and the index of ``e_t``, else -1 and -1).
 
 A model without a kernel (:func:`kernel_for` returns None: subclasses, wrappers, new families)
 keeps the numpy path. numba is optional: without it :data:`HAVE_NUMBA` is False and nothing
@@ -27,6 +29,9 @@ import math
 from typing import Any
 
 import numpy as np
+
+from ._base import KELVIN
+from ._temperature import T_REF
 
 try:
     from numba import njit
@@ -57,27 +62,36 @@ def _exact_models() -> dict[type, str]:
     }
 
 
-def kernel_for(model: Any) -> tuple[int, int] | None:
-    """``(model code, parameters per direction or 0)`` when ``model`` has a compiled kernel.
+def kernel_for(model: Any) -> tuple[int, int, int, int] | None:
+    """``(model code, parameters per direction or 0, viscous index or -1, e_t index or -1)``
+    when ``model`` has a compiled kernel.
 
-    Only the built-in classes themselves (not subclasses, whose formula may differ) and
-    :class:`~fricid.models.Asymmetric` around one of them qualify; None otherwise, or without
+    Only the built-in classes themselves (not subclasses, whose formula may differ),
+    :class:`~fricid.models.Asymmetric` around one of them, and
+    :class:`~fricid.models.WithTemperature` around either qualify; None otherwise, or without
     numba.
     """
     if not HAVE_NUMBA:
         return None
     from ._asymmetric import Asymmetric
+    from ._temperature import WithTemperature
 
+    if type(model) is WithTemperature:
+        inner = kernel_for(model.inner)
+        if inner is None or inner[2] >= 0:
+            return None
+        base = model.inner.base if type(model.inner) is Asymmetric else model.inner
+        return (inner[0], inner[1], base.param_names.index(base.viscous), model.n_params - 1)
     exact = _exact_models()
     if type(model) is Asymmetric:
         name = exact.get(type(model.base))
-        return None if name is None else (MODEL_CODES[name], model.base.n_params)
+        return None if name is None else (MODEL_CODES[name], model.base.n_params, -1, -1)
     name = exact.get(type(model))
-    return None if name is None else (MODEL_CODES[name], 0)
+    return None if name is None else (MODEL_CODES[name], 0, -1, -1)
 
 
 def kernel_data(
-    code: tuple[int, int],
+    code: tuple[int, int, int, int],
     X: np.ndarray,
     y: np.ndarray,
     sqrt_w: np.ndarray | None,
@@ -95,6 +109,8 @@ def kernel_data(
             float(LOSS_CODES[loss]),
             float(f_scale) if f_scale is not None else 1.0,
             float(n) if loss == "mse" else 1.0,
+            float(code[2]),
+            float(code[3]),
         ]
     )
     return (
@@ -165,6 +181,8 @@ def _loss_kernel(X, out, data):  # pragma: no cover - compiled
     inputs, y, sw, base, free, cfg = data
     model, half, loss = int(cfg[0]), int(cfg[1]), int(cfg[2])
     c, divisor = cfg[3], cfg[4]
+    visc, e_t = int(cfg[5]), int(cfg[6])
+    inv_ref = 1.0 / (T_REF + KELVIN)
     th = base.copy()
     for k in range(X.shape[0]):
         for j in range(free.shape[0]):
@@ -173,7 +191,14 @@ def _loss_kernel(X, out, data):  # pragma: no cover - compiled
         for i in range(y.shape[0]):
             v = inputs[i, 0]
             o = half if (half > 0 and v < 0.0) else 0
-            f = _predict(model, th, o, v, inputs[i, 1], inputs[i, 2])
+            if visc >= 0:  # _temp: the viscous coefficient times the Arrhenius factor
+                cv = th[o + visc]
+                phi = math.exp(th[e_t] * (1.0 / (inputs[i, 2] + KELVIN) - inv_ref))
+                th[o + visc] = cv * phi
+                f = _predict(model, th, o, v, inputs[i, 1], inputs[i, 2])
+                th[o + visc] = cv
+            else:
+                f = _predict(model, th, o, v, inputs[i, 1], inputs[i, 2])
             s += _term((f - y[i]) * sw[i], loss, c)
         out[k] = s / divisor
 
