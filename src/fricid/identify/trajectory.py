@@ -93,6 +93,7 @@ from ..samples import RawLog
 from ._trajectory_data import DerivativeFilter, derivatives, dilate, uniform_series
 from ._trajectory_routes import (
     JOINT_PARAMS,
+    _refine_static,
     _regression,
     _sim_bounds,
     _SimProblem,
@@ -127,6 +128,10 @@ WINDOW_AFTER = 0.06
 #: and never recover; the bristle dynamics play out within a few milliseconds, well inside a
 #: segment.
 SEGMENT = 0.025
+
+#: Passes of the refinement (static part with LuGre's friction along the motion, then
+#: sigma_0 and sigma_1 again) after the two-stage estimate; 0 for the plain two-stage route.
+REFINE = 1
 
 
 class PassivityWarning(FricidWarning):
@@ -333,8 +338,45 @@ def fit_trajectory(
         stage2 = _simulation(
             problem, b2, b2.mean(axis=1), method, seed, max_evals, first=(stage1, held)
         )
-        stages["simulation"] = stage2
         results.append(stage2.result)
+        for k in range(REFINE if static is None else 0):
+            # the static part again with LuGre's friction along the motion, then sigma_0,
+            # sigma_1 again from there (module notes: "Refinement")
+            ref = _refine_static(
+                series,
+                vf,
+                acc,
+                mask,
+                stage2,
+                stage1,
+                gravity,
+                method,
+                seed,
+                max_evals,
+                cluster_n,
+            )
+            stages[f"refinement_{k + 1}"] = ref
+            results.append(ref.result)
+            static_tab = {rename.get(n, n): row for n, row in ref.table().items()}
+            final.update(static_tab)
+            joint_vals.update({n: static_tab[n]["value"] for n in JOINT_PARAMS if n in static_tab})
+            problem.base = np.array(
+                [*stage2.values]
+                + [static_tab[n]["value"] for n in lugre.PARAM_NAMES[2:]]
+                + [joint_vals["inertia"], joint_vals["p_x"], joint_vals["p_y"]]
+            )
+            held = [rename.get(n, n) for n in ref.names]
+            stage2 = _simulation(
+                problem,
+                b2,
+                problem.to_u(stage2.values),
+                method,
+                seed,
+                max_evals,
+                first=(ref, held),
+            )
+            results.append(stage2.result)
+        stages["simulation"] = stage2
         for n, row in stage2.table().items():
             final[n] = row
         bounds_out.update({n: list(b) for n, b in zip(stage2.names, stage2.bounds, strict=True)})
@@ -420,7 +462,10 @@ def fit_trajectory(
         for n, lo, h in zip(param_names, low, high, strict=True)
         if n in fitted.bounds
     }
-    joint_tab = {n: row for n, row in stage1.table().items() if n in JOINT_PARAMS}
+    last_regression = [st for name, st in stages.items() if name.startswith("refinement")]
+    joint_tab = {
+        n: row for n, row in (last_regression or [stage1])[-1].table().items() if n in JOINT_PARAMS
+    }
     if "simulation_joint" in stages:
         joint_tab.update(
             {n: r for n, r in stages["simulation_joint"].table().items() if n in JOINT_PARAMS}
