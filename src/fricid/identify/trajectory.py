@@ -51,12 +51,11 @@ filtered motion (:func:`fricid.models.lugre.simulate`, the regression's samples;
 uncertainty of sigma_0, sigma_1 carried in by Murphy-Topel), then sigma_0, sigma_1 again
 from there. Measured (20 s multi-sine, seed 0, noise-free, before segments carried z on):
 tau_s 0.774 [0.766, 0.782] -> 0.782 [0.759, 0.806] for 0.8, w_s 0.110 [0.107, 0.112] ->
-0.107 [0.101, 0.114] for 0.1: the
-bias shrinks and the intervals now cover. More passes moved no parameter beyond its third
-digit (the same run with sigma_1 = 8, 2 and 3 passes): a fixed point, so one pass is the
-default. It does not remove the whole bias (next paragraph). ``route="joint"`` then refines
-every parameter (and J, p_x, p_y) by
-the simulation error from the two-stage estimate (all jointly: the maximum-likelihood
+0.107 [0.101, 0.114] for 0.1: the bias shrinks and the intervals now cover. More passes
+moved no parameter beyond its third digit (the same run with sigma_1 = 8, 2 and 3 passes):
+a fixed point, so one pass is the default. It does not remove the whole bias (next
+paragraph). ``route="joint"`` then refines every parameter (and J, p_x, p_y) by the
+simulation error from the two-stage estimate (all jointly: the maximum-likelihood
 estimate when the noise is in the measured motion, at about five times the cost).
 ``static=`` takes the static part from a fit to constant-velocity sweeps instead (a
 ``stribeck`` :class:`~fricid.fitted.FittedModel`): only J, p_x, p_y are then regressed.
