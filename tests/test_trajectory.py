@@ -71,7 +71,7 @@ def test_static_model_from_a_trajectory_within_intervals():
 
 
 def test_lugre_from_a_trajectory_covers_the_truth_on_two_seeds(tmp_path):
-    hits = {}
+    hits, opened = {}, []
     for seed in (0, 1):
         log = tr.simulate_trajectory(
             tr.multisine(duration=10.0, seed=seed), TRUTH, JOINT, seed=seed
@@ -80,12 +80,17 @@ def test_lugre_from_a_trajectory_covers_the_truth_on_two_seeds(tmp_path):
             warnings.simplefilter("ignore")
             fitted = fit_trajectory(log, "lugre", "lm", seed=seed)
         for n, ok in covered(fitted, TRUTH.params()).items():
-            hits[(seed, n)] = ok
+            if any(fitted.ci_open[n]):  # not determined: counted apart, never as a hit
+                opened.append((seed, n))
+            else:
+                hits[(seed, n)] = ok
         info = fitted.provenance["trajectory"]
-        assert set(info["routes"]) == {"regression", "simulation"}
+        assert set(info["routes"]) == {"regression", "refinement_1", "simulation"}
         assert info["passivity"]["condition"].startswith("sigma_1 <=")
-    # 14 intervals of 95 %: about 13 should hold; 12 is the honest floor (binomial, p 0.97)
-    assert sum(hits.values()) >= 12, {k: v for k, v in hits.items() if not v}
+    # only sigma_1 (damping ratio 0.05) may be left undetermined by 10 s of multi-sine
+    assert {n for _, n in opened} <= {"sigma_1"}, opened
+    # up to 14 intervals of 95 %: at most 2 misses is the honest floor (binomial, p 0.97)
+    assert sum(hits.values()) >= len(hits) - 2, {k: v for k, v in hits.items() if not v}
     path = fitted.save(tmp_path / "lugre.json")
     again = FittedModel.load(path)
     assert again.model == "lugre" and again.params == pytest.approx(fitted.params)
@@ -219,3 +224,59 @@ def test_passivity_is_judged_at_the_estimate_and_the_worst_corner():
     damped = values.copy()
     damped[1] = 5.0
     assert not _passivity(names, damped, damped, damped)["passive"]
+
+
+def test_multiple_shooting_segments_carry_the_bristle_state():
+    from fricid.models import lugre
+
+    t = np.arange(200) * 1e-3
+    tau = 0.6 * np.sin(2 * np.pi * 3 * t)
+    run = lugre.simulate_joint(TRUTH.theta, 0.01, 0.0, 0.0, 1e-3, tau, n_sub=4)
+    reset = np.zeros(t.size, dtype=bool)
+    reset[[0, 80]] = True
+    measured = (run["position"], run["velocity"])
+    again = lugre.simulate_joint(
+        TRUTH.theta,
+        0.01,
+        0.0,
+        0.0,
+        1e-3,
+        tau,
+        n_sub=4,
+        reset=reset,
+        measured=measured,
+        carry=np.arange(t.size) == 80,
+    )
+    # restarting the motion from itself with z carried on changes nothing after sample 80
+    np.testing.assert_allclose(again["state"][80:], run["state"][80:], rtol=1e-9, atol=1e-15)
+    fresh = lugre.simulate_joint(
+        TRUTH.theta, 0.01, 0.0, 0.0, 1e-3, tau, n_sub=4, reset=reset, measured=measured
+    )
+    assert abs(fresh["state"][80] - run["state"][80]) > 1e-9  # force balance: another z
+
+
+def test_bristle_damping_determined_when_the_static_part_is_known():
+    """A well-damped bristle mode (damping ratio 0.4) with the static part from sweeps: the
+    simulation route determines sigma_1 (it did not before segments carried z on)."""
+    theta = TRUTH.theta.copy()
+    theta[1] = 8.0
+    log = tr.simulate_trajectory(
+        tr.multisine(duration=10.0, seed=0),
+        tr.LuGreTruth(theta=theta),
+        JOINT,
+        noise=tr.Noise.none(),
+    )
+    names = Stribeck().param_names
+    sweep = FittedModel(
+        model="stribeck",
+        params=dict(zip(names, STATIC, strict=True)),
+        stderr=dict.fromkeys(names, 1e-6),
+        ci95_low=dict(zip(names, STATIC, strict=True)),
+        ci95_high=dict(zip(names, STATIC, strict=True)),
+    )
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        fitted = fit_trajectory(log, "lugre", static=sweep)
+    assert not any(fitted.ci_open["sigma_1"])
+    assert fitted.params["sigma_1"] == pytest.approx(8.0, rel=0.05)
+    assert fitted.params["sigma_0"] == pytest.approx(1e4, rel=0.1)

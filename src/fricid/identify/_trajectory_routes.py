@@ -158,6 +158,7 @@ class _Windows:
 
     index: np.ndarray
     reset: np.ndarray
+    carry: np.ndarray
     labels: np.ndarray
     tau: np.ndarray
     q: np.ndarray
@@ -177,15 +178,19 @@ def _windows(series: Series, vf, acc, v_window, before, after, longest) -> _Wind
         )
     index = np.concatenate([np.arange(a, b) for a, b, _ in spans])
     reset = np.zeros(index.size, dtype=bool)
+    carry = np.zeros(index.size, dtype=bool)
     labels = np.zeros(index.size, dtype=np.int64)
-    at = 0
+    at, previous = 0, None
     for a, b, w in spans:
         reset[at] = True
+        carry[at] = previous == (a, w)  # a segment continuing the last: z carries on
+        previous = (b, w)
         labels[at : at + b - a] = w
         at += b - a
     return _Windows(
         index,
         reset,
+        carry,
         labels,
         series.torque[index],
         series.position[index],
@@ -239,6 +244,7 @@ class _SimProblem:
             q0=w.q[0],
             v0=w.v[0],
             reset=w.reset,
+            carry=w.carry,
             measured=(w.q, w.v, w.a),
             n_sub=self.n_sub,
         )
@@ -289,12 +295,7 @@ def _simulation(problem: _SimProblem, bounds_u, x0_u, method, seed, max_evals, f
                 return problem.residuals_full(P)
 
             J21, _ = jacobian(shifted, P_hat[cols])
-            V1 = np.nan_to_num(stage.cov[np.ix_(sel, sel)])
-            G = -np.linalg.pinv(Jm) @ J21
-            extra = G @ V1 @ G.T
-            with np.errstate(invalid="ignore"):
-                cov = cov + extra
-                se = np.sqrt(se**2 + np.clip(np.diag(extra), 0, None))
+            cov, se = _two_step(Jm, J21, stage.cov[np.ix_(sel, sel)], cov, se)
     tq = _t975(g - 1)
     lo_u = np.maximum(u_hat - tq * se, bounds_u[:, 0])
     hi_u = np.minimum(u_hat + tq * se, bounds_u[:, 1])
@@ -321,6 +322,87 @@ def _simulation(problem: _SimProblem, bounds_u, x0_u, method, seed, max_evals, f
         {k: float(v) for k, v in rms.items()},
         np.column_stack([problem.to_values(bounds_u[:, 0]), problem.to_values(bounds_u[:, 1])]),
     )
+
+
+def _two_step(Jm, J21, V1, cov, se):
+    """Murphy and Topel's (1985) two-step covariance: ``V2 + G V1 G^T``,
+    ``G = -(J2' J2)^-1 J2' J21`` (``J21``: sensitivity of this stage's residuals to the
+    held parameters of covariance ``V1``)."""
+    G = -np.linalg.pinv(Jm) @ J21
+    extra = G @ np.nan_to_num(V1) @ G.T
+    with np.errstate(invalid="ignore"):
+        return cov + extra, np.sqrt(se**2 + np.clip(np.diag(extra), 0, None))
+
+
+def _refine_static(
+    series, vf, acc, mask, dyn: _Stage, stage1: _Stage, gravity, method, seed, max_evals, cluster_n
+):
+    """The regression again, with LuGre's friction along the measured motion (module notes).
+
+    ``u - F_LuGre(vf; sigma_0, sigma_1, static) = J qdd - p_x cos q + p_y sin q`` on the
+    regression's samples, where ``F_LuGre`` is :func:`fricid.models.lugre.simulate` along the
+    filtered velocity from the steady state at the first sample, with sigma_0 and sigma_1
+    held at the simulation route's estimate ``dyn``; the static part (sigma_2 and the
+    Stribeck parameters) starts from ``stage1`` (in ``stribeck`` order and names, then J, p_x,
+    p_y). The uncertainty of sigma_0 and sigma_1 is carried in by :func:`_two_step`.
+    """
+    t0 = time.perf_counter()
+    y = series.torque[mask]
+    q = series.position[mask]
+    cols = [acc[mask]] + ([-np.cos(q), np.sin(q)] if gravity == "fit" else [])
+    Phi = np.column_stack(cols)
+    nd = Phi.shape[1]
+    Qphi, _ = np.linalg.qr(Phi)
+    v = np.ascontiguousarray(vf)
+    d = 5  # stribeck's tau_c, tau_s, w_s, tau_v, delta
+
+    def lugre_theta(P, du):
+        P = np.atleast_2d(P)
+        th = np.empty((len(P), 7))
+        th[:, 0:2] = 10.0 ** np.asarray(du, dtype=float)
+        th[:, 2:7] = P[:, [3, 0, 1, 2, 4]]  # sigma_2 = tau_v, then the Stribeck curve
+        return th
+
+    dyn_u = np.log10(dyn.values)
+
+    def friction(P, du=None):
+        th = lugre_theta(P, dyn_u if du is None else du)
+        z0 = np.sign(v[0]) * lugre.stribeck_curve(th, v[:1])[:, 0] / th[:, 0]
+        F, _ = lugre.simulate(th, v, series.dt, z0)
+        return np.atleast_2d(F)[:, mask]
+
+    def projected(P):
+        R = y[None, :] - friction(P)
+        return R - (R @ Qphi) @ Qphi.T
+
+    bounds = stage1.bounds[:d]
+    x0 = np.clip(stage1.values[:d], bounds[:, 0], bounds[:, 1])
+    result = _run(projected, bounds, method, x0, seed, max_evals, 1)
+    theta = np.asarray(result.x, dtype=float)
+    c = np.linalg.lstsq(Phi, y - friction(theta)[0], rcond=None)[0]
+
+    def full(P):
+        P = np.atleast_2d(P)
+        return y[None, :] - friction(P[:, :d]) - P[:, d:] @ Phi.T
+
+    p_hat = np.concatenate([theta, c])
+    Jm, r0 = jacobian(full, p_hat)
+    labels = blocks(series.time.size, cluster_n)[mask]
+    cov, se, g = cluster_covariance(Jm, r0, labels)
+
+    def shifted(U):
+        base = y - Phi @ p_hat[d:]
+        return np.vstack([base - friction(theta, u)[0] for u in np.atleast_2d(U)])
+
+    J21, _ = jacobian(shifted, dyn_u)
+    cov, se = _two_step(Jm, J21, dyn.cov, cov, se)
+    box = np.vstack([bounds, np.column_stack([np.full(nd, -np.inf), np.full(nd, np.inf)])])
+    tq = _t975(g - 1)
+    low = np.maximum(p_hat - tq * se, box[:, 0])
+    high = np.minimum(p_hat + tq * se, box[:, 1])
+    names = list(stage1.names[:d]) + list(JOINT_PARAMS[:nd])
+    rms = {"torque": float(np.sqrt(np.mean(r0**2)))}
+    return _Stage(names, p_hat, se, low, high, cov, result, time.perf_counter() - t0, g, rms, box)
 
 
 def _sim_bounds(problem: _SimProblem, stage1: _Stage, names_full: dict[str, str]) -> np.ndarray:

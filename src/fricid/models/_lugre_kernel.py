@@ -92,11 +92,14 @@ def run_joint(
     there and held until the next (zero-order hold); each sample period is cut into ``n_sub``
     sub-steps, over each of which the bristle rate ``a = sigma_0 |v| / g(v)`` and the gravity
     torque are frozen at the predicted mid-point and the linear (z, v) system is solved
-    exactly. Where ``reset`` is set,
+    exactly. Where ``reset`` is 1,
     position and velocity restart from the measured ones and the bristle state from the force
-    balance ``sigma_0 z = tau + tau_g(q) - J a - sigma_2 v`` (measured acceleration ``a``),
-    bounded by the steady deflection ``g(v) / sigma_0``: the equilibrium at rest, the steady
-    state when sliding steadily.
+    balance ``sigma_0 z + sigma_1 (v - sigma_0 |v| z / g) = tau + tau_g(q) - J a - sigma_2 v``
+    (measured acceleration ``a``; the steady deflection where ``sigma_1 |v| / g > 0.9`` makes
+    that ill-posed), bounded by the steady deflection ``g(v) / sigma_0``: the equilibrium at
+    rest, the steady state when sliding steadily. Where ``reset`` is 2, the sample is
+    simulated as usual, then position and velocity restart from the measured ones while the
+    bristle state carries on (the next segment of a multiple-shooting window).
     """
     k = theta.shape[0]
     n = tau.shape[0]
@@ -117,13 +120,20 @@ def run_joint(
         q, v, z = x0[j, 0], x0[j, 1], x0[j, 2]
         u = 0.0
         for i in range(n):
-            if reset[i]:
+            if reset[i] == 1:
                 q = q_meas[i]
                 v = v_meas[i]
                 av = abs(v)
                 g = max(tau_c + (tau_s - tau_c) * math.exp(-((av / w_s) ** delta)), 1e-12)
                 grav = p_x * math.cos(q) - p_y * math.sin(q)
-                z = (tau[i] + grav - inertia * a_meas[i] - s2 * v) / s0
+                # F = s0 z + s1 (v - s0 |v| / g z) + s2 v solved for z (the damping term
+                # included); where that is ill-posed (s1 |v| / g near or above 1) the
+                # steady deflection
+                lever = 1.0 - s1 * av / g
+                if lever > 0.1:
+                    z = (tau[i] + grav - inertia * a_meas[i] - (s1 + s2) * v) / (s0 * lever)
+                else:
+                    z = math.copysign(g / s0, v)
                 z = min(max(z, -g / s0), g / s0)
             elif i > 0:
                 h = dt[i] / n_sub
@@ -142,6 +152,9 @@ def run_joint(
                     beta = (u + p_x * math.cos(qm) - p_y * math.sin(qm)) * inv_j
                     z, v, moved = _linear_step(s0, s1, s2, a, inv_j, beta, z, v, h)
                     q += moved
+                if reset[i] == 2:  # the motion restarts from the measured, z carries on
+                    q = q_meas[i]
+                    v = v_meas[i]
             av = abs(v)
             g = max(tau_c + (tau_s - tau_c) * math.exp(-((av / w_s) ** delta)), 1e-12)
             Q[j, i] = q

@@ -183,6 +183,7 @@ def simulate_joint(
     n_sub: int = 4,
     reset=None,
     measured=None,
+    carry=None,
 ) -> dict[str, np.ndarray]:
     """A joint with LuGre friction driven by a torque (or tracking a reference), batched.
 
@@ -211,6 +212,10 @@ def simulate_joint(
         ``(q, v)`` or ``(q, v, a)`` measured, each ``(n,)``; needed with ``reset``. At a reset
         the bristle state starts from the force balance with the measured acceleration ``a``
         (default 0), bounded by the steady deflection (see ``_lugre_kernel.run_joint``).
+    carry : array_like of bool, optional
+        ``(n,)``: at the reset samples flagged here only position and velocity restart (after
+        the sample is simulated); the bristle state carries on from the simulation, as in a
+        multiple-shooting segment that continues the previous one.
 
     Returns
     -------
@@ -238,9 +243,15 @@ def simulate_joint(
     qref, vref = (zeros, zeros) if reference is None else reference
     qref = np.ascontiguousarray(np.broadcast_to(np.asarray(qref, float), (n,)))
     vref = np.ascontiguousarray(np.broadcast_to(np.asarray(vref, float), (n,)))
-    flags = np.zeros(n, dtype=np.bool_) if reset is None else np.asarray(reset, dtype=np.bool_)
+    flags = np.zeros(n, dtype=np.int8) if reset is None else np.asarray(reset, dtype=np.bool_)
     if flags.shape != (n,):
         raise ConfigError("LuGre joint simulation: 'reset' must have one flag per sample")
+    flags = flags.astype(np.int8)
+    if carry is not None:
+        keep = np.asarray(carry, dtype=np.bool_)
+        if keep.shape != (n,):
+            raise ConfigError("LuGre joint simulation: 'carry' must have one flag per sample")
+        flags[(flags == 1) & keep] = 2
     if flags.any() and measured is None:
         raise ConfigError("LuGre joint simulation: 'reset' needs the measured (q, v)")
     qm, vm, am = (zeros, zeros, zeros) if measured is None else (*measured, zeros)[:3]
