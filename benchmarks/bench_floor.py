@@ -10,16 +10,20 @@ tuning seeds are 0-99): train on the noisy design grid, predict the held-out set
 in the grid's box, with their own noise), and print the mean over seeds of held-out RMSE /
 noise (1.0 = a model equal to the truth) and the training seconds, for
 
-* ``best analytic``: the best held-out ratio among the analytic families the data support
-  (:func:`fricid.identify.select.candidates`, plus any ``*_temp`` family registered by name in
-  :data:`fricid.models.MODELS`): an oracle choice among them, flattering them;
+* ``best analytic``: the best held-out ratio among the analytic families the hybrid's backbone
+  selection tries (:func:`fricid.identify.hybrid.backbone_candidates`: those
+  :func:`fricid.identify.select.candidates` lists the data support, and their ``*_temp``
+  variants when the temperature varies): an oracle choice among them, flattering them;
 * ``rbf plain``: ``fit(samples, "rbf", network={"linear_tail": False, "velocity_scale":
   None})``: no structure, the size, widths and penalty still cross-validated;
-* ``rbf default``: ``fit(samples, "rbf")``, the CLI default: structured (linear tail, asinh
-  velocity warp) with its structure chosen by cross-validation. This is THE DEFAULT MODEL the
-  goals refer to;
-* ``hybrid``: ``fit(samples, "hybrid")``, analytic backbone (by BIC) plus RBF residual;
-* ``gp``: ``fit(samples, "gp")`` when a family ``gp`` is registered, else "(not available)";
+* ``rbf``: ``fit(samples, "rbf")``, ``fricid fit --model rbf``'s defaults: structured (linear
+  tail, asinh velocity warp) with its structure chosen by cross-validation;
+* ``hybrid``: ``fit(samples, "hybrid")``, ``fricid fit --model hybrid``'s defaults: the
+  analytic backbone with the smallest BIC (temperature variants included) plus an RBF
+  residual cross-validated as ``rbf``'s. This is THE DEFAULT learned model the goals refer
+  to (:data:`DEFAULT`; the CLI's help names it the learned model to start with);
+* ``gp``: ``fit(samples, "gp")``, fricid's Gaussian process (inducing subset of 400 points
+  above 400 samples);
 * ``sklearn GP``: scikit-learn's ``GaussianProcessRegressor`` with an ARD RBF kernel plus
   white noise (as issue 15's table; first reporting seed only, as the training-time
   reference);
@@ -30,34 +34,42 @@ fair): standardised inputs ``asinh(|v| / v_min)``, the other measured inputs and
 (per-direction samples), target ``sign(v) F``, prediction ``sign(v) g``.
 
 Goals (issue 15): the default model <= 1.10 x noise on each kind; its training time <= 0.1 x
-the GP's (the registered ``gp`` when there is one, else the sklearn GP) on the same data.
+the GP's (fricid's ``gp``) on the same data.
 
 Part 2: the paper-1 preset (``paper1``, full design, the oracle's Gaussian noise on the true
 friction, :func:`fricid.experiments.rbfnn_study.paper1_data`, seed 1001) against the true
 friction in Fig. 10's unseen region (52-60 deg/s, positions -22 to -10 deg, 45-55 degC:
-:func:`~fricid.experiments.rbfnn_study.unseen_region`): mean / max absolute error [mN m] of
-``vlt``, ``rbf default`` and ``hybrid``. Goal: the default's mean error <= 2 x the averaged
-samples' noise (the RMS of :func:`fricid.sim.expected_noise_std`).
+:func:`~fricid.experiments.rbfnn_study.unseen_region`): mean / max absolute error [mN m] and
+training seconds of ``vlt``, ``rbf``, ``hybrid`` and ``gp``. Goal: the default's mean error <= 2
+x the averaged samples' noise (the RMS of :func:`fricid.sim.expected_noise_std`).
 
-What it showed (``python benchmarks/bench_floor.py``, 2026-11-22, the machine shared; 302 s):
+What it showed (``python benchmarks/bench_floor.py``, 2026-11-22, the machine shared; 104 s;
+held-out RMSE / noise, mean over seeds 1001-1003, training seconds in brackets):
 
-==============  ==============  ====================  ================
-family          grid            asym_arrhenius        sigmoid
-==============  ==============  ====================  ================
-best analytic   16.66 (vlt)     7.78 (stribeck_asym)  0.99 (msk_asym)
-rbf plain       135.96          9.37                  11.29
-rbf default     1.15 [5.1 s]    1.36 [0.4 s]          1.10 [0.7 s]
-hybrid          1.19            2.07                  0.99
-sklearn GP      1.51 [128.9 s]  1.10 [0.2 s]          1.13 [4.7 s]
-MLP             16.41           16.73                 9.53
-==============  ==============  ====================  ================
+==============  ===================  ====================  ================
+family          grid                 asym_arrhenius        sigmoid
+==============  ===================  ====================  ================
+best analytic   10.52 (msk_temp)     0.98 (stribeck_temp_  0.99 (msk_asym)
+                                     asym)
+rbf plain       135.96               9.37                  11.29
+rbf             1.15 [1.0 s]         1.36 [0.1 s]          1.10 [0.1 s]
+hybrid          **1.08** [2.8 s]     **1.01** [1.6 s]      **0.99** [1.0 s]
+gp              1.24 [3.6 s]         1.13 [0.1 s]          0.99 [1.2 s]
+sklearn GP      1.51 [43.1 s]        1.10 [0.0 s]          1.13 [0.9 s]
+MLP             16.41                16.73                 9.53
+==============  ===================  ====================  ================
 
-The default meets 1.10 on ``sigmoid`` and misses on ``grid`` (1.15) and ``asym_arrhenius``
-(1.36; 1.20-1.26 on tuning seeds 0-1); its training takes 0.04 x the GP's on the 1848-point
-grid (goal met) but more than 0.1 x on the small sets, where the GP itself takes 0.2-5 s. In
-the paper-1 unseen region the default's mean / max error is 2.28 / 4.60 mN m, 4.5 x the
-averaged samples' noise of 0.51 mN m (goal 2 x: missed; vlt 8.50 / 12.70, hybrid 3.90 / 7.54;
-the BAS-RBFNN paper 1.2 / 6.3). A registered ``gp`` family was not available on this branch.
+The default learned model (``hybrid``: the backbone by BIC among the families and their
+temperature variants) meets 1.10 on every kind (before the temperature variants joined its
+backbones it chose ``vlt`` / ``stribeck_asym`` and reached 1.19 / 2.07 / 0.99). In the paper-1
+unseen region its mean / max error is 0.80 / 2.49 mN m with the ``msk_temp`` backbone, 1.55 x
+the averaged samples' noise of 0.51 mN m (goal 2 x: met; ``vlt`` 8.50 / 12.70, ``rbf`` 2.28 /
+4.60, ``gp`` 0.56 / 1.73, the BAS-RBFNN paper 1.2 / 6.3). The training-time goal is MISSED
+against fricid's own ``gp`` (0.77 x on the grid, 11 x on the 150-point Arrhenius set, 0.85 x
+on the sigmoid, 2.5 x on the paper-1 preset), which trains its hyperparameters on an inducing
+subset of 400 points and so is itself fast; against the exact scikit-learn GP of issue 15's
+table it is met on the 1848-point grid (2.8 s against 43.1 s: 0.065 x, the GP timed on the
+first seed only) and missed on the small sets, where that GP takes under a second.
 
 Timings: the machine this was written on was shared (2 cores, eight engineers): read the
 seconds as ratios within one run. OpenBLAS is held to one thread (``OPENBLAS_NUM_THREADS=1``
@@ -79,7 +91,7 @@ import warnings
 import numpy as np
 
 from fricid.identify import fit
-from fricid.identify.select import LEARNED, candidates
+from fricid.identify.hybrid import backbone_candidates
 from fricid.models import MODELS, STATEFUL
 from fricid.sim.heldout_laws import KINDS, REPORTING_SEEDS, draw
 
@@ -118,10 +130,7 @@ def _sk_inputs(samples):
 
 def _analytic(d):
     """Best held-out ratio among the analytic candidates, its name, and the seconds of all."""
-    names = [
-        (c.model, c.fixed) for c in candidates(d.train) if not c.note and c.model not in LEARNED
-    ]
-    names += [(n, {}) for n in MODELS if n.endswith("_temp")]
+    names = backbone_candidates(d.train)
     best, seconds = (np.inf, "-"), 0.0
     for name, fixed in names:
         try:
@@ -169,7 +178,10 @@ def _sklearn(d, which: str):
     return _ratio(predict, d), dt
 
 
-FAMILIES = ("best analytic", "rbf plain", "rbf default", "hybrid", "gp", "sklearn GP", "MLP")
+#: The default learned model the goals refer to (``fricid fit --model hybrid``).
+DEFAULT = "hybrid"
+
+FAMILIES = ("best analytic", "rbf plain", "rbf", "hybrid", "gp", "sklearn GP", "MLP")
 
 
 def part1(seeds, with_gp: bool) -> None:
@@ -189,7 +201,7 @@ def part1(seeds, with_gp: bool) -> None:
             acc["rbf plain"].append(
                 _fricid(d, "rbf", network={"linear_tail": False, "velocity_scale": None})
             )
-            acc["rbf default"].append(_fricid(d, "rbf"))
+            acc["rbf"].append(_fricid(d, "rbf"))
             acc["hybrid"].append(_fricid(d, "hybrid"))
             if "gp" in STATEFUL or "gp" in MODELS:
                 acc["gp"].append(_fricid(d, "gp"))
@@ -207,12 +219,12 @@ def part1(seeds, with_gp: bool) -> None:
                 if f == "best analytic":
                     cell = f"{r:.2f} {'/'.join(sorted(best_names))[:11]} [{t:.1f}s]"
             rows[f].append(cell)
-        default = np.mean([v[0] for v in acc["rbf default"]])
-        t_def = np.mean([v[1] for v in acc["rbf default"]])
+        default = np.mean([v[0] for v in acc[DEFAULT]])
+        t_def = np.mean([v[1] for v in acc[DEFAULT]])
         ref = acc["gp"] or acc["sklearn GP"]
         t_gp = np.mean([v[1] for v in ref]) if ref else np.nan
         verdict.append(
-            f"{kind}: default {default:.2f} x noise "
+            f"{kind}: default ({DEFAULT}) {default:.2f} x noise "
             f"({'meets' if default <= GOAL_RATIO else 'MISSES'} <= {GOAL_RATIO}); training "
             + (
                 f"{t_def / t_gp:.3f} x the GP's "
@@ -238,19 +250,24 @@ def part2(seed: int) -> None:
         f"unseen region (Fig. 10, {len(unseen)} points), |error| [mN m]; averaged samples' "
         f"noise {1e3 * floor:.2f} mN m"
     )
-    print(f"{'family':<14}{'mean':>8}{'max':>8}{'train s':>9}")
+    print(f"{'family':<22}{'mean':>8}{'max':>8}{'train s':>9}")
     mean_default = np.nan
-    for label, name in (("vlt", "vlt"), ("rbf default", "rbf"), ("hybrid", "hybrid")):
-        m, dt = _timed(lambda name=name: fit(samples, name, seed=0))
+    times = {}
+    for name in ("vlt", "rbf", "hybrid", "gp"):
+        m, times[name] = _timed(lambda name=name: fit(samples, name, seed=0))
         err = np.abs(m.predict(unseen.X, warn=False) - unseen.friction) * 1e3
-        print(f"{label:<14}{err.mean():>8.2f}{err.max():>8.2f}{dt:>9.1f}")
-        if name == "rbf":
+        label = name + (f" ({m.state['backbone']['model']})" if name == "hybrid" else "")
+        print(f"{label:<22}{err.mean():>8.2f}{err.max():>8.2f}{times[name]:>9.1f}")
+        if name == DEFAULT:
             mean_default = float(err.mean())
     ok = mean_default <= GOAL_UNSEEN * 1e3 * floor
+    ratio = times[DEFAULT] / times["gp"]
     print(
-        f"Goal: default mean {mean_default:.2f} mN m = {mean_default / (1e3 * floor):.2f} x the "
-        f"noise ({'meets' if ok else 'MISSES'} <= {GOAL_UNSEEN}); paper's BAS-RBFNN 1.2/6.3, "
-        "issue 15's GP 0.53/1.18"
+        f"Goal: default ({DEFAULT}) mean {mean_default:.2f} mN m = "
+        f"{mean_default / (1e3 * floor):.2f} x the noise ({'meets' if ok else 'MISSES'} <= "
+        f"{GOAL_UNSEEN}); training {ratio:.2f} x the gp's "
+        f"({'meets' if ratio <= GOAL_TIME else 'MISSES'} <= {GOAL_TIME}); paper's BAS-RBFNN "
+        "1.2/6.3, issue 15's GP 0.53/1.18"
     )
 
 

@@ -197,3 +197,21 @@ def test_a_damaged_gp_file_is_a_data_error(small_gp, tmp_path, key):
             continue
         mean, std = back.predict(draw(50, seed=12), warn=False, return_std=True)
         assert np.isfinite(mean).all() and np.isfinite(std).all(), (key, value)
+
+
+def test_inducing_posterior_survives_a_numerically_singular_kernel_matrix():
+    # close inducing points under long length scales: K_mm is singular to rounding, which made
+    # the held-out grid law of issue 15 (1848 samples) fail with "not positive definite"
+    from fricid.identify.gp import _cholesky, _posterior
+
+    with pytest.raises(np.linalg.LinAlgError):
+        np.linalg.cholesky(np.ones((3, 3)))
+    factor, jitter = _cholesky(np.ones((3, 3)), 1.0)
+    assert 0 < jitter <= 1e-2 and np.all(np.isfinite(factor[0]))
+    rng = np.random.default_rng(0)
+    Z = rng.uniform(-1, 1, (80, 2))
+    P = np.vstack([Z[:10], Z[:10] + 1e-9])  # duplicated inducing points
+    t = np.sin(Z[:, 0]) + 0.01 * rng.standard_normal(80)
+    A = np.column_stack([np.ones(80), Z[:, 0]])
+    alpha, B, gain, cov, dbeta = _posterior(P, Z, t, A, np.array([1e3, 1e3]), 1.0, 1e-6, False)
+    assert all(np.all(np.isfinite(x)) for x in (alpha, B, gain, cov, dbeta))

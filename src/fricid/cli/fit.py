@@ -51,7 +51,9 @@ def fit_command(
                 "load), vlt (eq. 4, load and temperature); append _asym for parameters per "
                 "direction; rbf, the RBF neural network (eq. 14-15; --method lsq, bas for "
                 "BAS-RBFNN or ga for GA-RBFNN); hybrid, an analytic backbone plus an RBF "
-                "residual; or auto: every family the data can support, "
+                "residual (the learned model to start with: nearest the noise floor on "
+                "held-out laws, physics outside the data); gp, a Gaussian process; or "
+                "auto: every family the data can support, "
                 "chosen by held-out error (leave one velocity level out, or --validate)."
             ),
         ),
@@ -93,7 +95,7 @@ def fit_command(
         str | None,
         typer.Option(
             help="hybrid: the analytic backbone (e.g. stribeck_asym); default the family the "
-            "data support with the smallest BIC."
+            "data support with the smallest BIC, temperature variants (*_temp) included."
         ),
     ] = None,
     direction: DirectionOption = "all",

@@ -59,6 +59,26 @@ DEFAULT_MAX_POINTS = 400
 #: Relative jitter on the diagonal of the inducing points' kernel matrix.
 _JITTER = 1e-8
 
+#: Most tenfold increases of the jitter :func:`_cholesky` tries.
+_JITTER_STEPS = 6
+
+
+def _cholesky(M: np.ndarray, scale: float) -> tuple[tuple[np.ndarray, bool], float]:
+    """``cho_factor`` of the symmetric ``M`` with ``jitter * I`` added, and that jitter:
+    ``_JITTER * scale``, raised tenfold (up to :data:`_JITTER_STEPS` times) while the
+    factorisation fails. Long length scales make the kernel matrix of close inducing points
+    numerically singular (its smallest eigenvalues fall below rounding); the jitter restores
+    it, as the nugget of R&W section 3.4.3 does."""
+    eye = np.eye(len(M))
+    for k in range(_JITTER_STEPS + 1):
+        jitter = _JITTER * scale * 10.0**k
+        try:
+            return cho_factor(M + jitter * eye, lower=True), jitter
+        except np.linalg.LinAlgError:
+            if k == _JITTER_STEPS:
+                raise
+    raise AssertionError("unreachable")  # pragma: no cover
+
 
 def farthest_points(Z: np.ndarray, m: int) -> np.ndarray:
     """Indices of ``m`` rows of ``Z (n, d)`` chosen by farthest-point sampling: first the row
@@ -129,11 +149,13 @@ def _posterior(
         weights = lambda r: cho_solve(factor, r)  # noqa: E731
     else:
         Kmn = _kernel_matrix(P, Z, lengths, s2)
-        Kj = Kmm + _JITTER * s2 * np.eye(m)
-        Sigma = cho_factor(noise * Kj + Kmn @ Kmn.T, lower=True)
+        Kj_factor, jitter = _cholesky(Kmm, s2)
+        Kj = Kmm + jitter * np.eye(m)
+        S = noise * Kj + Kmn @ Kmn.T
+        Sigma, _ = _cholesky(S, float(np.trace(S)) / m)
         M = (A - Kmn.T @ cho_solve(Sigma, Kmn @ A)) / noise
         gain = cho_solve(Sigma, Kmn @ A).T  # H K_nm (noise K_mm + K_mn K_nm)^-1
-        B = cho_solve(cho_factor(Kj, lower=True), np.eye(m)) - noise * cho_solve(Sigma, np.eye(m))
+        B = cho_solve(Kj_factor, np.eye(m)) - noise * cho_solve(Sigma, np.eye(m))
         weights = lambda r: cho_solve(Sigma, Kmn @ r)  # noqa: E731
     cov = np.linalg.inv(A.T @ M)
     cov = 0.5 * (cov + cov.T)
