@@ -114,6 +114,7 @@ class _State:
     depth = 0
     signal: int | None = None
     reported = False
+    unraisable_hook: Any = sys.__unraisablehook__
 
 
 def _on_signal(signum: int, frame: FrameType | None) -> None:
@@ -121,6 +122,24 @@ def _on_signal(signum: int, frame: FrameType | None) -> None:
     if signum == signal.SIGTERM:
         raise Terminated("terminated")
     raise KeyboardInterrupt
+
+
+def _on_alarm(signum: int, frame: FrameType | None) -> None:
+    """Raise again an interrupt that was swallowed (see :func:`_on_unraisable`)."""
+    if _State.signal is not None:
+        _on_signal(_State.signal, frame)
+
+
+def _on_unraisable(unraisable: Any) -> None:
+    """An interrupt raised where Python cannot propagate it (a ctypes callback: numba's LLVM
+    compiling calls back into Python) is printed as "Exception ignored" and lost, and the
+    command would run on as if never interrupted. Raise it again 50 ms later instead, and
+    again for as long as it keeps landing in such a callback. Anything else goes to the
+    previous hook."""
+    if isinstance(unraisable.exc_value, KeyboardInterrupt) and _State.signal is not None:
+        signal.setitimer(signal.ITIMER_REAL, 0.05)
+        return
+    _State.unraisable_hook(unraisable)
 
 
 @contextlib.contextmanager
@@ -143,9 +162,15 @@ def signal_handlers() -> Iterator[None]:
                 if old is not signal.SIG_IGN:
                     previous[signum] = old
                     signal.signal(signum, _on_signal)
+            if outer and previous:
+                previous[signal.SIGALRM] = signal.signal(signal.SIGALRM, _on_alarm)
+                _State.unraisable_hook, sys.unraisablehook = sys.unraisablehook, _on_unraisable
         yield
     finally:
         _State.depth -= 1
+        if signal.SIGALRM in previous:
+            signal.setitimer(signal.ITIMER_REAL, 0)
+            sys.unraisablehook = _State.unraisable_hook
         for signum, old in previous.items():
             signal.signal(signum, old if old is not None else signal.SIG_DFL)
 
