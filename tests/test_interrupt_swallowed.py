@@ -26,11 +26,3 @@ def test_a_swallowed_interrupt_is_raised_again(capsys):
         while time.monotonic() < deadline:  # the command going on after the callback
             time.sleep(0.01)
     assert "Exception ignored" not in capsys.readouterr().err
-
-
-@pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")
-def test_without_the_guard_ctypes_loses_it():
-    """The failure the guard is for: outside it, the callback's interrupt is simply lost."""
-    _swallowed_interrupt()
-    time.sleep(0.2)
-    _app._State.signal = None
