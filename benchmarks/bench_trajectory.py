@@ -1,10 +1,11 @@
 """LuGre from a trajectory against the truth and against sweeps (issue 16, done-when).
 
 Usage: ``python benchmarks/bench_trajectory.py [--seeds 5] [--duration 60] [--method lm]
-[--sigma1 1]`` (about 2-3 minutes on 2 idle cores). ``--sigma1`` sets the truth's bristle
-damping (default 1 N m s/rad: damping ratio ``sigma_1 / (2 sqrt(sigma_0 J))`` = 0.05 with
-the joint's J; 8 gives 0.4, a well-damped bristle mode, though not passive by [BO00] with
-this static part: the table prints the truth's margin).
+[--sigma1 1] [--experiment multisine]`` (about 2-3 minutes on 2 idle cores). ``--sigma1``
+sets the truth's bristle damping (default 1 N m s/rad: damping ratio
+``sigma_1 / (2 sqrt(sigma_0 J))`` = 0.05 with the joint's J; 8 gives 0.4, a well-damped
+bristle mode, though not passive by [BO00] with this static part: the table prints the
+truth's margin).
 
 For each seed, the virtual joint with a LuGre truth (:class:`fricid.sim.trajectory.
 LuGreTruth`: sigma_0 1e4 N m/rad, sigma_1 1 N m s/rad, sigma_2 0.2 N m s/rad, tau_c 0.5 N m,
@@ -15,6 +16,12 @@ seconds at 1 kHz, logged with :data:`fricid.sim.trajectory.TRAJECTORY_NOISE`, an
 joint's steady state (the static Stribeck law LuGre reduces to at constant velocity) is swept
 on the ``paper2`` ``reduced`` design (17 speeds 0.005-4 rad/s, 10 passes, horizontal), the
 sweeps extracted and fitted with ``stribeck`` by ``lm``.
+
+``--experiment slow_multisine`` runs :func:`fricid.sim.trajectory.slow_multisine` instead
+(the same duration: constant-speed plateaus at 0.03-0.3 rad/s both ways for the first half,
+the same multi-sine faded in for the second), a designed experiment for the Stribeck region;
+the default stays the plain multi-sine (the module notes of
+:mod:`fricid.identify.trajectory` say why).
 
 Tables: (1) per parameter: truth, sweep estimate with its 95 % interval (seed 0),
 trajectory estimate with its interval (seed 0), and the coverage of the trajectory intervals
@@ -81,6 +88,7 @@ def main() -> None:
     ap.add_argument("--duration", type=float, default=60.0)
     ap.add_argument("--method", default="lm")
     ap.add_argument("--sigma1", type=float, default=float(TRUTH.theta[1]))
+    ap.add_argument("--experiment", choices=("multisine", "slow_multisine"), default="multisine")
     args = ap.parse_args()
     theta = TRUTH.theta.copy()
     theta[1] = args.sigma1
@@ -94,7 +102,10 @@ def main() -> None:
     undetermined = {n: 0 for n in truth}
     for seed in range(args.seeds):
         log = tr.simulate_trajectory(
-            tr.multisine(duration=args.duration, seed=seed), truth_model, JOINT, seed=seed
+            getattr(tr, args.experiment)(duration=args.duration, seed=seed),
+            truth_model,
+            JOINT,
+            seed=seed,
         )
         t0 = time.perf_counter()
         f = fit_trajectory(log, "lugre", args.method, seed=seed)
@@ -117,7 +128,7 @@ def main() -> None:
         if seed == 0:
             sweep0, traj0 = s, f
     print(
-        f"LuGre truth; multi-sine {args.duration:g} s at 1 kHz; method {args.method}; "
+        f"LuGre truth; {args.experiment} {args.duration:g} s at 1 kHz; method {args.method}; "
         f"{args.seeds} seeds; truth damping ratio sigma_1 / (2 sqrt(sigma_0 J)) = "
         f"{theta[1] / (2 * np.sqrt(theta[0] * INERTIA)):.2g}\n"
     )

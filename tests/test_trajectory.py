@@ -36,7 +36,7 @@ def test_every_experiment_gives_a_reader_like_log(kind):
     assert np.all(np.isfinite(log.motor_torque))
     if kind == "presliding":  # below break-away: micro-radians only
         assert np.ptp(log.position) < 1e-3
-    if kind in ("sine", "chirp", "multisine"):  # tracked, crossing zero velocity
+    if kind in ("sine", "chirp", "multisine", "slow_multisine"):  # tracked, crossing zero velocity
         assert np.max(np.abs(log.position - e.q_ref)) < 2e-3
         assert np.any(np.diff(np.sign(e.v_ref)) != 0)
 
@@ -280,3 +280,19 @@ def test_bristle_damping_determined_when_the_static_part_is_known():
     assert not any(fitted.ci_open["sigma_1"])
     assert fitted.params["sigma_1"] == pytest.approx(8.0, rel=0.05)
     assert fitted.params["sigma_0"] == pytest.approx(1e4, rel=0.1)
+
+
+def test_slow_multisine_holds_each_speed_both_ways_then_the_multisine():
+    e = tr.slow_multisine(duration=20.0, seed=1)
+    half = e.time < 10.0
+    for s in (0.03, 0.05, 0.1, 0.2, 0.3):  # each plateau forwards and backwards, ~0.75 s
+        for sign in (1, -1):
+            held = np.isclose(e.v_ref[half], sign * s, rtol=0, atol=1e-12).sum()
+            assert 0.7 < held * 1e-3 < 0.8
+    assert abs(e.q_ref[half][-1]) < 1e-6  # the pairs are symmetric: back at the start
+    # one continuous reference: velocity is the position's derivative, no jumps
+    dv = np.gradient(e.q_ref, 1e-3) - e.v_ref
+    assert np.max(np.abs(dv[1:-1])) < 5e-4 and np.max(np.abs(np.diff(e.v_ref))) < 0.02
+    m = tr.multisine(duration=20.0, seed=1)
+    tail = e.time >= 11.0  # after the fade: the multi-sine itself, shifted to the start
+    np.testing.assert_allclose(e.v_ref[tail], m.v_ref[1000 : 1000 + tail.sum()], atol=1e-12)

@@ -8,6 +8,9 @@ with ``u`` the motor torque. Experiments (:class:`Experiment`, built by the func
 
 * ``sine``, ``chirp``, ``multisine``: a position reference crossing zero velocity; the joint
   tracks it under a PD controller with feed-forward ``J qdd_ref - tau_g(q_ref)``;
+* ``slow_multisine``: a designed experiment for the Stribeck region, tracked the same way:
+  constant-speed plateaus at slow speeds in both directions, then the multi-sine faded in
+  (one continuous reference);
 * ``stick_slip``: the motor acts as a spring of stiffness ``k`` (N m/rad) pulling the joint
   towards a point moving at a constant speed (the classic spring-load stick-slip rig);
 * ``presliding``: a slow torque oscillation below the break-away level: the joint never
@@ -30,6 +33,7 @@ temperature.
 
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import dataclass, field, replace
 
@@ -51,11 +55,12 @@ __all__ = [
     "presliding",
     "simulate_trajectory",
     "sine",
+    "slow_multisine",
     "stick_slip",
 ]
 
 #: Experiment kinds.
-KINDS = ("sine", "chirp", "multisine", "stick_slip", "presliding")
+KINDS = ("sine", "chirp", "multisine", "slow_multisine", "stick_slip", "presliding")
 
 #: Sensors of a trajectory experiment: no current spikes, a 24-bit position encoder.
 TRAJECTORY_NOISE = Noise(spike_rate=0.0, position_lsb=2.0 * math.pi / 2**24)
@@ -165,6 +170,81 @@ def multisine(
         v += share * w * np.cos(w * t + p)
         a -= share * w**2 * np.sin(w * t + p)
     return _tracked("multisine", t, q, v, a, kp, kd)
+
+
+def _plateaus(
+    t: np.ndarray, speeds: tuple[float, ...], hold: float, ramp: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Velocity plateaus ``+s, -s`` for each speed ``s`` (``hold`` seconds each), joined by
+    raised-cosine ramps of ``ramp`` seconds, from rest to rest; position by the trapezoid rule
+    (every pair is symmetric, so the position returns to its start)."""
+    levels = [0.0] + [x for s in speeds for x in (s, -s)] + [0.0]
+    v, a = np.zeros_like(t), np.zeros_like(t)
+    start = 0.0
+    for v0, v1 in itertools.pairwise(levels):
+        tau = t - start
+        inside = (tau >= 0) & (tau < ramp)
+        phase = math.pi * tau[inside] / ramp
+        v[inside] = v0 + (v1 - v0) * 0.5 * (1 - np.cos(phase))
+        a[inside] = (v1 - v0) * 0.5 * (math.pi / ramp) * np.sin(phase)
+        steady = (tau >= ramp) & (tau < ramp + hold)
+        v[steady] = v1
+        start += ramp + (hold if v1 != 0.0 or v0 == 0.0 else 0.0)
+    dt = np.diff(t)
+    q = np.concatenate(([0.0], np.cumsum(0.5 * (v[1:] + v[:-1]) * dt)))
+    return q, v, a
+
+
+def slow_multisine(
+    duration=60.0,
+    rate=1000.0,
+    amplitude=0.3,
+    frequencies=(0.2, 0.5, 1.1, 2.3),
+    seed: int = 0,
+    speeds=(0.03, 0.05, 0.1, 0.2, 0.3),
+    share=0.5,
+    hold=None,
+    ramp=0.25,
+    fade=1.0,
+    kp=200.0,
+    kd=5.0,
+) -> Experiment:
+    """Slow constant-speed plateaus, then a :func:`multisine`: one continuous reference.
+
+    The first ``share`` of ``duration`` holds each of ``speeds`` [rad/s] for ``hold`` seconds
+    (default: that time shared evenly), forwards then backwards, joined by raised-cosine ramps
+    of ``ramp`` seconds; the rest is the multi-sine of :func:`multisine`, faded in over
+    ``fade`` seconds by a raised-cosine window. A multi-sine alone slides slowly only briefly,
+    around its reversals, where a regression must leave samples out (the LuGre state is not
+    at its steady value there), so it sees the Stribeck region (``|qd|`` near ``w_s``) on few
+    samples; the plateaus give the steady state at those speeds for seconds at a time, as a
+    sweep does (the paper's design, [BAS-RBFNN] section 4), while the multi-sine excites the
+    dynamics (inertia, gravity, bristles). On the virtual joint it pins the static part
+    down but biases sigma_0 (the notes of :mod:`fricid.identify.trajectory`, measured by
+    ``benchmarks/bench_trajectory.py --experiment slow_multisine``).
+    """
+    t = _time(duration, rate)
+    half = share * t[-1] if t[-1] > 0 else 0.0
+    pairs = 2 * len(speeds)
+    if hold is None:
+        hold = max((half - (pairs + 1) * ramp) / pairs, 0.0)
+    slow = t < half
+    q, v, a = (np.zeros_like(t) for _ in range(3))
+    q[slow], v[slow], a[slow] = _plateaus(t[slow], tuple(speeds), float(hold), float(ramp))
+    m = multisine(duration, rate, amplitude, frequencies, seed)
+    tau = t[~slow] - t[~slow][0]
+    k = np.minimum(tau / fade, 1.0) if fade > 0 else np.ones_like(tau)
+    on = k < 1.0
+    w = 0.5 * (1 - np.cos(math.pi * k))
+    dw = np.where(on, 0.5 * math.pi / fade * np.sin(math.pi * k), 0.0)
+    ddw = np.where(on, 0.5 * (math.pi / fade) ** 2 * np.cos(math.pi * k), 0.0)
+    n = tau.size
+    qm, vm, am = m.q_ref[:n], m.v_ref[:n], m.a_ref[:n]
+    q0 = q[slow][-1] if slow.any() else 0.0
+    q[~slow] = q0 + w * qm
+    v[~slow] = dw * qm + w * vm
+    a[~slow] = ddw * qm + 2 * dw * vm + w * am
+    return _tracked("slow_multisine", t, q, v, a, kp, kd)
 
 
 def stick_slip(duration=10.0, rate=1000.0, stiffness=20.0, speed=0.05) -> Experiment:
