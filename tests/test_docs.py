@@ -220,6 +220,14 @@ def build_workspace(ws: Path, leadscrew: Path) -> None:
         ws / "means.mat", {"fwd": {"v": vel, "tau": tau3}, "bwd": {"v": -vel, "tau": -tau3}}
     )
 
+    # a trajectory of any motion (LuGre truth) and its identified model, as simulate/fit write
+    from fricid.cli.simulate import _trajectory_log
+    from fricid.identify.trajectory import fit_trajectory
+
+    traj = _trajectory_log("multisine", 10.0, 0)
+    write_rawlog(traj, ws / "traj.parquet")
+    fit_trajectory(traj, "lugre").save(ws / "lugre.json")
+
     # a fleet of two joints
     (ws / "manifest.csv").write_text(
         "robot,joint,log,model,fix\nr0,j0,log.parquet,stribeck,delta=1\n"

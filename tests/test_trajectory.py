@@ -296,3 +296,18 @@ def test_slow_multisine_holds_each_speed_both_ways_then_the_multisine():
     m = tr.multisine(duration=20.0, seed=1)
     tail = e.time >= 11.0  # after the fade: the multi-sine itself, shifted to the start
     np.testing.assert_allclose(e.v_ref[tail], m.v_ref[1000 : 1000 + tail.sum()], atol=1e-12)
+
+
+def test_simulate_trajectory_refuses_an_unknown_experiment_and_writes_nothing(tmp_path):
+    from typer.testing import CliRunner
+
+    from fricid.cli import app
+
+    out = tmp_path / "t.parquet"
+    res = CliRunner().invoke(app, ["simulate", "--trajectory", "spiral", "--out", str(out)])
+    assert res.exit_code == 2 and "--trajectory must be one of" in res.output
+    res = CliRunner().invoke(
+        app, ["simulate", "--trajectory", "sine", "--duration", "0", "--out", str(out)]
+    )
+    assert res.exit_code == 2 and "--duration must be between 1 and 3600 s" in res.output
+    assert not out.exists()

@@ -24,6 +24,28 @@ def design_hints(scenario) -> dict:
     return hints
 
 
+def _trajectory_log(kind: str, duration: float, seed: int):
+    """The log of one trajectory experiment on the documented joint (see simulate's help)."""
+    import inspect
+
+    import numpy as np
+
+    from ..errors import ConfigError
+    from ..sim import Joint
+    from ..sim import trajectory as tr
+
+    if kind not in tr.KINDS:
+        raise ConfigError(f"--trajectory must be one of {', '.join(tr.KINDS)}; got {kind!r}")
+    if not (np.isfinite(duration) and 1.0 <= duration <= 3600.0):
+        raise ConfigError(f"--duration must be between 1 and 3600 s; got {duration!r}")
+    make = getattr(tr, kind)
+    options = {"duration": duration}
+    if "seed" in inspect.signature(make).parameters:
+        options["seed"] = seed
+    joint = Joint(law=lambda v, load, temp: np.zeros_like(v), p_x=0.3, p_y=0.1, inertia=0.01)
+    return tr.simulate_trajectory(make(**options), tr.LuGreTruth(), joint, seed=seed)
+
+
 @app.command("simulate")
 @handle_errors
 def simulate_command(
@@ -57,13 +79,35 @@ def simulate_command(
             "them, extract identifies gravity jointly)."
         ),
     ] = "both",
+    trajectory: Annotated[
+        str | None,
+        typer.Option(
+            help="Instead of the campaign, one trajectory experiment on a joint with LuGre "
+            "friction (fricid.sim.trajectory; the truth's parameters in the log's metadata): "
+            "sine, chirp, multisine, slow_multisine, stick_slip or presliding. For "
+            "`fricid fit LOG --trajectory`; --preset, --size and --coverage do not apply.",
+        ),
+    ] = None,
+    duration: Annotated[
+        float, typer.Option(help="--trajectory: the experiment's length [s], sampled at 1 kHz.")
+    ] = 20.0,
     quiet: QuietOption = False,
 ) -> None:
     """Simulate a bidirectional constant-velocity campaign on the virtual joint and write its
     raw log: time [s], position [rad], velocity [rad/s], motor current [A] (torque = K I),
     temperature [degC], with the torque constant K in the file's metadata. Progress goes to
-    stderr (a bar on a terminal, a line per tenth with the time left otherwise; --quiet: none)."""
+    stderr (a bar on a terminal, a line per tenth with the time left otherwise; --quiet: none).
+    With --trajectory, one experiment of any motion instead (J 0.01 kg m^2, gravity p_x 0.3,
+    p_y 0.1 N m, LuGre friction with the defaults of fricid.sim.trajectory.LuGreTruth)."""
     from ..io import write_rawlog
+
+    if trajectory is not None:
+        write_rawlog(_trajectory_log(trajectory, duration, seed), out)
+        err_console.print(
+            f"wrote {escape(str(out))} (trajectory {escape(trajectory)}, {duration:g} s, "
+            f"seed {seed}, LuGre truth)"
+        )
+        return
     from ..sim import preset as get_preset
     from ..sim import simulate
 
