@@ -218,3 +218,18 @@ def _activation_scale(temperature: np.ndarray) -> float:
 def columns(theta: np.ndarray) -> list[np.ndarray]:
     """Split a (k, d) batch into d column vectors of shape (k, 1), ready to broadcast."""
     return [theta[:, j : j + 1] for j in range(theta.shape[1])]
+
+
+def parameter_batch(theta, names: tuple[str, ...], title: str) -> tuple[np.ndarray, bool]:
+    """``theta`` as a C-contiguous batch ``(k, d)`` and whether it was one vector ``(d,)``,
+    for the dynamic models' functions (``d = len(names)``); a wrong shape is a ConfigError
+    naming the model ``title`` and its parameters."""
+    theta = np.asarray(theta, dtype=float)
+    single = theta.ndim == 1
+    batch = np.ascontiguousarray(np.atleast_2d(theta))
+    if batch.ndim != 2 or batch.shape[1] != len(names):
+        raise ConfigError(
+            f"{title} takes {len(names)} parameters ({', '.join(names)}); "
+            f"got an array of shape {theta.shape}"
+        )
+    return batch, single

@@ -56,7 +56,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import ConfigError
-from ._base import FrictionModel, Parameter
+from ._base import FrictionModel, Parameter, parameter_batch
 
 __all__ = [
     "PARAMETERS",
@@ -88,15 +88,7 @@ _TINY = 1e-12
 
 
 def _batch(theta) -> tuple[np.ndarray, bool]:
-    theta = np.asarray(theta, dtype=float)
-    single = theta.ndim == 1
-    batch = np.ascontiguousarray(np.atleast_2d(theta))
-    if batch.ndim != 2 or batch.shape[1] != len(PARAMETERS):
-        raise ConfigError(
-            f"LuGre takes {len(PARAMETERS)} parameters ({', '.join(PARAM_NAMES)}); "
-            f"got an array of shape {theta.shape}"
-        )
-    return batch, single
+    return parameter_batch(theta, PARAM_NAMES, "LuGre")
 
 
 def stribeck_curve(theta, v) -> np.ndarray:
