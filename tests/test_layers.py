@@ -236,6 +236,33 @@ def test_no_import_cycle_between_units():
     assert not found, "\n".join(lines)
 
 
+def test_no_import_cycle_between_modules():
+    """No cycle between any two modules either (a package counts as its ``__init__``), lazy
+    imports included: a cycle inside a unit hides a module in the wrong place. An
+    ``importlib.import_module(f"{__package__}.{name}")`` (the CLI's command registry) imports
+    a submodule, not the package: :func:`imports` reads it as the package, so it is left out."""
+    graph: dict[str, set[str]] = defaultdict(set)
+    where: dict[tuple[str, str], list[str]] = defaultdict(list)
+    for module in modules():
+        lines = module.path.read_text(encoding="utf-8").splitlines()
+        for imp in imports(module):
+            submodule = (
+                module.name.startswith(imp.target + ".")
+                and "import_module(" in (lines[imp.line - 1])
+            )
+            if imp.target not in (module.name, ROOT) and not submodule:
+                graph[module.name].add(imp.target)
+                where[module.name, imp.target].append(describe(imp, module.rel))
+    found = cycles(graph)
+    lines = []
+    for component in found:
+        lines.append(f"cycle between {', '.join(component)}:")
+        for a in component:
+            for b in component:
+                lines += [f"  {line}" for line in where.get((a, b), ())]
+    assert not found, "\n".join(lines)
+
+
 @pytest.mark.parametrize(
     ("name", "other", "ok"),
     [

@@ -115,6 +115,18 @@ class _State:
     signal: int | None = None
     reported = False
     unraisable_hook: Any = sys.__unraisablehook__
+    #: ``--quiet`` given to ``fricid`` itself: no progress display (:mod:`fricid.cli._progress`).
+    quiet = False
+
+
+def set_quiet(quiet: bool) -> None:
+    """Turn progress off (``True``) or back on for the current command."""
+    _State.quiet = bool(quiet)
+
+
+def is_quiet() -> bool:
+    """Whether progress is off (``--quiet``)."""
+    return _State.quiet
 
 
 def _on_signal(signum: int, frame: FrameType | None) -> None:
@@ -331,8 +343,6 @@ def _root(
     ),
 ) -> None:
     """Identify the friction of robot joints."""
-    from ._progress import set_quiet
-
     set_quiet(quiet)
     if reproducible and not os.environ.get("SOURCE_DATE_EPOCH", "").strip():
         previous = os.environ.get("SOURCE_DATE_EPOCH")

@@ -41,7 +41,7 @@ from rich.progress import (
     TimeRemainingColumn,
 )
 
-from ._app import err_console
+from ._app import err_console, is_quiet, set_quiet
 
 __all__ = [
     "GRACE_S",
@@ -77,20 +77,6 @@ QuietOption = Annotated[
         help="No progress display on stderr (results, warnings and errors still print).",
     ),
 ]
-
-
-class _State:
-    quiet = False
-
-
-def set_quiet(quiet: bool) -> None:
-    """Turn progress off (``True``) or back on for the current command."""
-    _State.quiet = bool(quiet)
-
-
-def is_quiet() -> bool:
-    """Whether progress is off (``--quiet``)."""
-    return _State.quiet
 
 
 def _seconds(s: float) -> str:

@@ -83,7 +83,7 @@ def tune(
     ConfigError
         If the reported seeds would reach the tuning seeds.
     """
-    from .rbfnn_study import paper1_data
+    from .rbfnn_data import paper1_data
 
     if cfg.seeds >= TUNING_SEED_OFFSET:
         raise ConfigError(f"seeds must be below {TUNING_SEED_OFFSET} to stay apart from tuning")

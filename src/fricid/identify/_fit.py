@@ -23,7 +23,7 @@ from ..errors import ConfigError, ConvergenceWarning, IdentifiabilityWarning, Ig
 from ..fitted import FittedModel
 from ..io.atomic import created_timestamp
 from ..metrics import fit_statistics, metrics
-from ..models import INPUTS, STATEFUL, FrictionModel, get_model
+from ..models import INPUTS, FrictionModel, get_model
 from ..optim import METHODS, OptimizeResult, minimize
 from ..samples import FrictionSamples, samples_hash
 from ._convergence import certify
@@ -155,31 +155,6 @@ def fit(
         An argument the chosen model does not use (``network``, ``inputs`` for analytic
         models; ``callback`` for ``"rbf"``).
     """
-    if isinstance(model, str) and model.strip().lower() == "gp":
-        from .gp import fit_gp  # the Gaussian process: its options through `options`
-
-        if str(loss).lower() not in ("l2", "sse") or not _no_weights(weights) or fixed or bounds:
-            raise ConfigError(
-                "model 'gp' learns by marginal likelihood: no robust loss, weights, fixed or bounds"
-            )
-        return fit_gp(samples, inputs=inputs, seed=seed, **(options or {}))
-    if isinstance(model, str) and model.strip().lower() in STATEFUL:
-        if str(loss).lower() not in ("l2", "sse") or not _no_weights(weights):
-            raise ConfigError("model 'rbf' trains by least squares: no robust loss or weights")
-        return _fit_network(
-            samples,
-            method,
-            seed,
-            max_evals,
-            options,
-            network,
-            inputs,
-            callback,
-            model_name=model.strip().lower(),
-            fixed=fixed,
-            bounds=bounds,
-            x0=x0,
-        )
     if network is not None or tuple(inputs) != INPUTS:
         warnings.warn(
             "`network` and `inputs` apply to model 'rbf' only; ignored",
@@ -347,51 +322,6 @@ def _weights_name(weights: Any) -> str:
     if _no_weights(weights):
         return "none"
     return weights.strip().lower() if isinstance(weights, str) else "given"
-
-
-def _fit_network(
-    samples: FrictionSamples,
-    method: str,
-    seed: int | np.random.Generator | None,
-    max_evals: int | None,
-    options: dict[str, Any] | None,
-    network: Mapping[str, Any] | None,
-    inputs: Sequence[str],
-    callback: Callable[[OptimizeResult], Any] | None,
-    **analytic: Any,
-) -> FittedModel:
-    """``fit(samples, "rbf", ...)``: :func:`fricid.identify.rbf.fit_rbf` with fit's arguments
-    translated (``method`` -> ``trainer``, ``seed`` -> ``random_state``, ``options`` ->
-    ``method_options``, ``max_evals`` -> ``max_epochs``)."""
-    from .rbf import RBFNetRegressor, fit_rbf
-
-    fit_network = fit_rbf
-    if analytic.pop("model_name", "rbf") == "hybrid":  # issue 15: backbone + RBF residual
-        from .hybrid import fit_hybrid as fit_network
-    given = [name for name, value in analytic.items() if value]
-    if given:
-        raise ConfigError(
-            f"model 'rbf' has no named parameters: {', '.join(given)} do(es) not apply "
-            "(set the network with `network=`)"
-        )
-    if callback is not None:
-        warnings.warn(
-            "model 'rbf' does not take a callback; ignored", IgnoredArgumentWarning, stacklevel=3
-        )
-    params = dict(network or {})
-    key = str(method).strip().lower()
-    params["trainer"] = "lsq" if key == "lm" else key
-    if isinstance(seed, np.random.Generator):
-        seed = int(seed.integers(2**31))
-    params["random_state"] = seed
-    if options is not None:
-        params["method_options"] = dict(options)
-    if max_evals is not None:
-        per_epoch = int(params.get("evals_per_epoch", RBFNetRegressor().evals_per_epoch))
-        params["max_epochs"] = max(1, -(-int(max_evals) // per_epoch))
-    # the default inputs are the measured ones (a column not measured is no error here)
-    names = None if tuple(inputs) == INPUTS else inputs
-    return fit_network(samples, names, **params)
 
 
 def evaluate(model: FittedModel, samples: FrictionSamples) -> dict[str, float]:

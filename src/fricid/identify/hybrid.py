@@ -60,7 +60,7 @@ def backbone_candidates(samples: FrictionSamples) -> list[tuple[str, dict[str, f
     when the samples have at least :data:`TEMPERATURE_MIN_LEVELS` distinct temperatures, by
     its temperature variant if its family is in :data:`TEMPERATURE_FAMILIES`
     (``stribeck_asym`` -> ``stribeck_temp_asym``, the same parameters fixed)."""
-    from .select import LEARNED, candidates
+    from ._candidates import LEARNED, candidates
 
     temps = samples.temperature[np.isfinite(samples.temperature)]
     with_temp = np.unique(np.round(temps * 2.0)).size >= TEMPERATURE_MIN_LEVELS

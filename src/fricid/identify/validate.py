@@ -34,7 +34,7 @@ import numpy as np
 from ..errors import ConfigError, ConvergenceWarning, FricidError
 from ..metrics import rmse, verdict
 from ..samples import FrictionSamples
-from ._fit import fit
+from ._learned import fit
 from ._scatter import (
     WEIGHTS,
     Scatter,

@@ -25,6 +25,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from ..errors import ConfigError, DataError
+from ._catalog import get_model
 from .rbf import predict_state
 
 __all__ = ["HYBRID", "STATE_KIND", "HybridModel", "backbone_of", "predict_hybrid"]
@@ -42,8 +43,6 @@ def backbone_of(state: Mapping[str, Any]):
         A state without a well-formed ``backbone`` (an object naming a registered analytic
         model and all of its parameters as numbers).
     """
-    from . import get_model
-
     bb = state.get("backbone")
     if not isinstance(bb, Mapping) or not isinstance(bb.get("model"), str):
         raise DataError(

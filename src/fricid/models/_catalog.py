@@ -1,0 +1,59 @@
+"""The analytic and dynamic model registries and :func:`get_model` (re-exported by
+:mod:`fricid.models`), in a module of their own so that the stateful models (the hybrid's
+backbone) can look a family up without importing the package that registers them."""
+
+from __future__ import annotations
+
+from ..errors import ConfigError
+from ._analytic import CoulombViscous, LoadDependent, Stribeck, VelocityLoadTemperature
+from ._asymmetric import Asymmetric
+from ._base import FrictionModel
+from ._temperature import WithTemperature
+from .dahl import Dahl
+from .lugre import LuGre
+
+__all__ = ["DYNAMIC", "MODELS", "get_model"]
+
+
+#: The analytic models by registry name, in the order of the BAS-RBFNN paper's Table 1.
+MODELS: dict[str, type[FrictionModel]] = {
+    cls.name: cls for cls in (CoulombViscous, Stribeck, LoadDependent, VelocityLoadTemperature)
+}
+
+
+#: Dynamic models by registry name (their ``predict`` is the steady state; identified from
+#: trajectories by :mod:`fricid.identify.trajectory`); kept out of :data:`MODELS`, whose
+#: families are fitted to friction samples.
+DYNAMIC: dict[str, type[FrictionModel]] = {cls.name: cls for cls in (LuGre, Dahl)}
+
+
+def get_model(name: str | FrictionModel, asymmetric: bool = False) -> FrictionModel:
+    """The model called ``name`` (see :data:`MODELS`); ``name_asym`` or ``asymmetric=True``
+    gives its per-direction variant, ``name_temp`` its temperature-dependent viscous term
+    (:class:`WithTemperature`; ``name_temp_asym`` both, one activation temperature shared by
+    the directions). A model instance is passed through."""
+    if isinstance(name, FrictionModel):
+        model = name
+    else:
+        key = name.strip().lower()
+        if key.endswith("_asym"):
+            key, asymmetric = key[: -len("_asym")], True
+        if key in DYNAMIC and not asymmetric:
+            return DYNAMIC[key]()
+        temperature = key.endswith("_temp")
+        if temperature:
+            key = key[: -len("_temp")]
+        if key not in MODELS:
+            raise ConfigError(
+                f"unknown model '{name}'; choose one of: {', '.join(MODELS)} "
+                "(append _asym for separate parameters per direction, _temp for a "
+                "temperature-dependent viscous term, _temp_asym for both)"
+            )
+        model = MODELS[key]()
+        if temperature:
+            return WithTemperature(Asymmetric(model) if asymmetric else model)
+    if asymmetric and not model.is_asymmetric:
+        if isinstance(model, WithTemperature):
+            return WithTemperature(Asymmetric(model.inner))
+        model = Asymmetric(model)
+    return model
