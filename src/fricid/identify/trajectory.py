@@ -142,6 +142,7 @@ from ..metrics import fit_statistics, metrics
 from ..models import get_model, lugre
 from ..samples import RawLog
 from ._trajectory_data import DerivativeFilter, derivatives, dilate, uniform_series
+from ._trajectory_filtered import ParallelFilter, filtered_route
 from ._trajectory_routes import (
     JOINT_PARAMS,
     _refine_static,
@@ -152,10 +153,10 @@ from ._trajectory_routes import (
     _windows,
 )
 
-__all__ = ["ROUTES", "DerivativeFilter", "PassivityWarning", "fit_trajectory"]
+__all__ = ["ROUTES", "DerivativeFilter", "ParallelFilter", "PassivityWarning", "fit_trajectory"]
 
-#: Routes of :func:`fit_trajectory`.
-ROUTES = ("two_stage", "joint", "regression")
+#: Routes of :func:`fit_trajectory` (the first is LuGre's default).
+ROUTES = ("filtered", "two_stage", "joint", "regression")
 
 #: Static models a trajectory identifies by regression.
 STATIC_MODELS = ("stribeck", "coulomb_viscous")
@@ -230,9 +231,10 @@ def fit_trajectory(
     model: str = "lugre",
     method: str = "lm",
     *,
-    route: str = "two_stage",
+    route: str = "filtered",
     gravity: str = "fit",
     derivative: DerivativeFilter | None = None,
+    parallel: ParallelFilter | None = None,
     v_slide: float = 0.02,
     guard: float = 0.2,
     v_window: float | None = None,
@@ -253,12 +255,17 @@ def fit_trajectory(
     method : str
         Any fricid optimiser (:data:`fricid.optim.METHODS`), used by both routes.
     route : str
-        ``two_stage`` (default for LuGre), ``joint`` (then every parameter by simulation
-        error), ``regression`` (static models; the only route for them).
+        ``filtered`` (default for LuGre: every parameter at once by the parallel-filtered
+        equation error), ``two_stage``, ``joint`` (then every parameter by simulation
+        error), ``regression`` (static models; the only route for them). With ``static=``
+        the ``filtered`` route becomes ``two_stage``.
     gravity : str
         ``fit`` (p_x, p_y estimated) or ``none`` (a horizontal joint).
     derivative : DerivativeFilter, optional
-        The zero-phase derivative filter (default Savitzky-Golay, 21 ms, order 3).
+        The zero-phase derivative filter of the regression (default Savitzky-Golay, 21 ms,
+        order 3).
+    parallel : ParallelFilter, optional
+        The ``filtered`` route's low-pass on both sides (default Butterworth 20 Hz, order 4).
     v_slide : float
         Speed [rad/s] above which a sample counts as sliding for the regression.
     guard : float
@@ -274,7 +281,8 @@ def fit_trajectory(
     static : FittedModel, optional
         A ``stribeck`` fit from constant-velocity sweeps: the static part is taken from it.
     n_sub : int
-        Sub-steps per sample of the simulation route.
+        Sub-steps per sample of the simulation route and of the ``filtered`` route's bristle
+        state.
     cluster_time : float
         Block length [s] of the regression's cluster-robust covariance.
     seed, max_evals
@@ -304,6 +312,8 @@ def fit_trajectory(
         raise ConfigError(f"unknown route '{route}'; one of: {', '.join(ROUTES)}")
     if key != "lugre" and route != "regression":
         route = "regression"
+    if key == "lugre" and route == "filtered" and static is not None:
+        route = "two_stage"
     if key == "lugre" and route == "regression":
         raise ConfigError("LuGre's sigma_0 and sigma_1 need the simulation route (two_stage)")
     if gravity not in ("fit", "none"):
@@ -356,21 +366,44 @@ def fit_trajectory(
         if n in static_model.param_names
     }
     sim_info: dict[str, Any] = {}
-    if key == "lugre":
+    y, yhat = series.torque[mask], series.torque[mask] - r1
+    if key == "lugre" and not joint_vals["inertia"] > 0:
+        row = stage1.table().get("inertia", {})
+        raise DataError(
+            f"the trajectory does not determine the inertia (J = {joint_vals['inertia']:.3g} "
+            f"+/- {row.get('stderr', float('nan')):.2g} kg m^2): a single sine makes J qdd "
+            "and the gravity torque collinear; excite several frequencies (a multi-sine or a "
+            "chirp)",
+            file=log.source,
+        )
+    if key == "lugre" and route == "filtered":
+        parallel = parallel or ParallelFilter()
+        start = np.array([1e4, 1.0] + [static_tab[n]["value"] for n in lugre.PARAM_NAMES[2:]])
+        order = [stage1.names.index(n) for n in ("tau_v", "tau_c", "tau_s", "w_s", "delta")]
+        stage, y, r = filtered_route(
+            series,
+            start,
+            stage1.bounds[order],
+            gravity,
+            method,
+            seed,
+            max_evals,
+            cluster_time,
+            n_sub,
+            parallel,
+        )
+        yhat = y - r
+        stages["filtered"] = stage
+        results.append(stage.result)
+        final.update(stage.table())
+        bounds_out.update({n: list(b) for n, b in zip(stage.names, stage.bounds, strict=True)})
+        sim_info = {"parallel_filter": parallel.describe(rate), "n_sub": int(n_sub)}
+    elif key == "lugre":
         base = np.array(
             [1e4, 1.0]
             + [static_tab[n]["value"] for n in lugre.PARAM_NAMES[2:]]
             + [joint_vals["inertia"], joint_vals["p_x"], joint_vals["p_y"]]
         )
-        if not joint_vals["inertia"] > 0:
-            row = stage1.table().get("inertia", {})
-            raise DataError(
-                f"the trajectory does not determine the inertia (J = {joint_vals['inertia']:.3g} "
-                f"+/- {row.get('stderr', float('nan')):.2g} kg m^2): a single sine makes J qdd "
-                "and the gravity torque collinear; excite several frequencies (a multi-sine or a "
-                "chirp)",
-                file=log.source,
-            )
         w_s = static_tab["w_s"]["value"]
         v_win = v_window if v_window is not None else max(w_s, 2.0 * v_slide)
         w = _windows(
@@ -468,7 +501,6 @@ def fit_trajectory(
     se = np.array([final[n]["stderr"] for n in param_names])
     low = np.array([final[n]["ci95_low"] for n in param_names])
     high = np.array([final[n]["ci95_high"] for n in param_names])
-    y, yhat = series.torque[mask], series.torque[mask] - r1
     fitted = FittedModel(
         model=key,
         params=dict(zip(param_names, map(float, values), strict=True)),
@@ -477,7 +509,8 @@ def fit_trajectory(
         ci95={n: float((h - lo) / 2) for n, lo, h in zip(param_names, low, high, strict=True)},
         ci95_low=dict(zip(param_names, low, strict=True)),
         ci95_high=dict(zip(param_names, high, strict=True)),
-        ci_method="cluster-robust" + (", two-step" if key == "lugre" else ""),
+        ci_method="cluster-robust"
+        + (", two-step" if key == "lugre" and route != "filtered" else ""),
         metrics={
             **metrics(y, yhat),
             **{
@@ -517,13 +550,17 @@ def fit_trajectory(
     joint_tab = {
         n: row for n, row in (last_regression or [stage1])[-1].table().items() if n in JOINT_PARAMS
     }
+    if "filtered" in stages:
+        joint_tab = {n: r for n, r in stages["filtered"].table().items() if n in JOINT_PARAMS}
     if "simulation_joint" in stages:
         joint_tab.update(
             {n: r for n, r in stages["simulation_joint"].table().items() if n in JOINT_PARAMS}
         )
     info: dict[str, Any] = {
         "route": route,
-        "static_from": "sweeps" if static is not None else "regression",
+        "static_from": "sweeps"
+        if static is not None
+        else ("filtered" if route == "filtered" else "regression"),
         "derivative": derivative.describe(rate),
         "resampled": series.resampled,
         "sample_rate": rate,
