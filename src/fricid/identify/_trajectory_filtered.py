@@ -21,14 +21,16 @@ positions and velocities (``n_sub`` sub-steps per period; the mean velocity of a
 then exactly the position's increment over it, whatever the velocity sensor's noise), and the
 friction entering the equation is its exact mean over each period
 (:func:`fricid.models.lugre.mean_friction`). Both matter, measured on the virtual joint (20 s
-multi-sine, seed 11, noise-free, 1 kHz): with the velocity held at the period's mean
-(``n_sub = 1``) and the friction at the sample, sigma_0 came out 21 % low and sigma_1 70 %
-high; with the exact period mean but the velocity still held, 10 % low and 74 % low; with the
-Hermite interpolant and 4 sub-steps, sigma_0 +3 % and sigma_1 -19 %, the static part and J
-within 0.2 %. The remaining error is the velocity's shape inside the one period in which the
-joint breaks away at a reversal (the velocity jumps by about 0.1 rad/s within a millisecond):
-8 sub-steps left it as it was, and logging at 10 kHz removed it (sigma_0 -0.1 %, sigma_1
-+3 %). With the trajectory noise it is well inside the intervals (module notes of
+multi-sine, seed 11, noise-free, 1 kHz): a first version that held the velocity at the
+period's mean and took the friction at the sample gave sigma_0 21 % low and sigma_1 70 %
+high; the exact period mean with the velocity held (``n_sub=1``), sigma_0 -10 % and sigma_1
+-74 %; the Hermite interpolant with 4 sub-steps (the default), sigma_0 +3.5 % and sigma_1
+-20 %, the static part and J within 1.5 per mille. The error left is the velocity's shape
+inside the one period in which the joint breaks away at a reversal (the velocity jumps by
+about 0.1 rad/s within a millisecond), which no interpolant of the samples knows: 8
+sub-steps gave +4.5 % and -17 %, while the same experiment logged at 10 kHz put every
+parameter within 0.3 per mille (the method is consistent). Under the trajectory noise it is
+inside the intervals at the default 20 Hz cut-off, not at 40 or 60 Hz (module notes of
 :mod:`fricid.identify.trajectory`).
 
 J, p_x and p_y enter linearly: they are projected out of every candidate's residual (variable
