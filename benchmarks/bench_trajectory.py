@@ -53,7 +53,7 @@ w_s        3/5, 4.2 %                3/5, 19 %
 delta      3/5, 2.9 %                4/5, 13 %
 total      26/35                     24/32 closed
 overlap    23/25 static intervals    19/25
-slowest    2.54 s                    5.65 s
+slowest    2.54 s (1.25 s, 2nd run)  5.65 s
 =========  ========================  ========================
 
 Seeds 0-4 are unlucky for the filtered route: on seeds 10-59 it covered 336/350 (module

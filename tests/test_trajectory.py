@@ -344,6 +344,7 @@ def test_filtered_route_is_consistent_on_a_noise_free_log():
     info = fitted.provenance["trajectory"]
     assert info["route"] == "filtered" and set(info["routes"]) == {"regression", "filtered"}
     assert info["parallel_filter"]["cutoff"] == 20.0 and fitted.converged
+    assert info["parallel_filter"]["decimate"] == 10  # 1 kHz to 100 Hz: five times 20 Hz
     truth = TRUTH.params()
     for n in ("sigma_2", "tau_c", "tau_s", "w_s", "delta"):
         assert fitted.params[n] == pytest.approx(truth[n], rel=5e-3), n

@@ -89,7 +89,8 @@ class ParallelFilter:
         """The decimation factor at sample rate ``rate`` [Hz]."""
         if self.decimate is not None:
             return int(self.decimate)
-        return max(int(rate / (DECIMATED_RATE * self.cutoff)), 1)
+        # a rate read from time stamps is a hair off (999.9999... Hz): round before the floor
+        return max(int(np.floor(round(rate / (DECIMATED_RATE * self.cutoff), 6))), 1)
 
     def describe(self, rate: float) -> dict[str, Any]:
         """The settings, as recorded in provenance."""

@@ -63,13 +63,14 @@ Passivity ([BO00], :func:`fricid.models.lugre.passivity_margin`) is checked at t
 and at the corner of the 95 % intervals least favourable to it, reported in the provenance,
 and warned about (:class:`PassivityWarning`) when the estimate is not passive.
 
-What it recovers (``benchmarks/bench_trajectory.py``, its one run for the report: LuGre
+What it recovers (``benchmarks/bench_trajectory.py``, run for the report: LuGre
 truth, 60 s multi-sine at 1 kHz, trajectory noise, ``lm``, seeds 0-4; coverage by the closed
 95 % intervals; shared 2-core machine). ``filtered``: every interval closed (sigma_1 too, at
 the light damping ratio 0.05); covered sigma_0 4/5, sigma_1 5/5, sigma_2 4/5, tau_c 4/5,
 tau_s 3/5, w_s 3/5, delta 3/5 (26/35); seed 0 tau_s 0.793 [0.781, 0.805], w_s 0.103
 [0.099, 0.108], sigma_0 9.5e3 [8.5e3, 1.07e4], sigma_1 1.07 [0.72, 1.61]; static
-intervals overlapping the sweeps' 23/25; 1.7-2.5 s per identification. ``two_stage``, same
+intervals overlapping the sweeps' 23/25; 1.0-2.5 s per identification (two runs, before
+and after the decimation factor's rounding was fixed: the same table). ``two_stage``, same
 run conditions (``--route two_stage``): sigma_1 open on 3/5 seeds, covered 24/32 closed
 (tau_s 2/5), seed 0 tau_s 0.734 [0.674, 0.793], half-widths 3-9 times the filtered route's,
 overlap 19/25, 4.1-5.7 s. Seeds 0-4 are the unlucky ones: on seeds 10-59 (not the
@@ -539,7 +540,7 @@ def fit_trajectory(
         "route": route,
         "static_from": "sweeps"
         if static is not None
-        else ("filtered" if route == "filtered" else "regression"),
+        else ("the same joint estimate" if route == "filtered" else "regression"),
         "derivative": derivative.describe(rate),
         "resampled": series.resampled,
         "sample_rate": rate,
