@@ -123,6 +123,15 @@ def test_options_are_checked():
         fit_trajectory(log, "lugre", route="regression")
     with pytest.raises(ConfigError, match="derivative filter"):
         DerivativeFilter(method="spline")
+    from fricid.identify.trajectory import ParallelFilter
+
+    with pytest.raises(ConfigError, match="parallel filter"):
+        ParallelFilter(cutoff=0.0)
+    with pytest.raises(ConfigError, match="not below Nyquist"):
+        fit_trajectory(log, "lugre", parallel=ParallelFilter(cutoff=600.0))
+    short = tr.simulate_trajectory(tr.multisine(duration=0.6), TRUTH, JOINT)
+    with pytest.raises(DataError, match="too short for the parallel filter"):
+        fit_trajectory(short, "lugre")
 
 
 def write_joint_bag(path: Path, log) -> Path:

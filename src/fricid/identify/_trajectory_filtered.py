@@ -134,6 +134,7 @@ def filtered_route(
     cluster_time: float,
     n_sub: int,
     filt: ParallelFilter,
+    source: str | None = None,
 ) -> tuple[_Stage, np.ndarray, np.ndarray]:
     """Every LuGre parameter with J, p_x, p_y by the parallel-filtered equation error.
 
@@ -155,6 +156,8 @@ def filtered_route(
         Sub-steps per period of the bristle state.
     filt : ParallelFilter
         The low-pass on both sides.
+    source : str, optional
+        The log's file, named in errors.
 
     Returns
     -------
@@ -169,7 +172,9 @@ def filtered_route(
     dt, n = series.dt, series.time.size
     rate = 1.0 / dt
     if filt.cutoff >= 0.5 * rate:
-        raise ConfigError(f"parallel filter cut-off {filt.cutoff} Hz is not below Nyquist")
+        raise ConfigError(
+            f"parallel filter cut-off {filt.cutoff} Hz is not below Nyquist ({0.5 * rate:g} Hz)"
+        )
     sos = signal.butter(filt.order, filt.cutoff / (0.5 * rate), output="sos")
 
     def low(x):
@@ -178,7 +183,11 @@ def filtered_route(
     m = round(filt.trim * rate)
     keep = np.arange(max(m, 1), n - m, filt.factor(rate))
     if keep.size < 30:
-        raise DataError(f"the log ({n} samples) is too short for the parallel filter")
+        raise DataError(
+            f"the log ({n} samples, {n * dt:.3g} s) is too short for the parallel filter: it "
+            f"needs {2 * filt.trim:g} s trimmed and 30 decimated samples besides",
+            file=source,
+        )
     q = series.position
     q_mid = np.concatenate([q[:1], 0.5 * (q[1:] + q[:-1])])
     u = np.concatenate([series.torque[:1], series.torque[:-1]])  # held over period i

@@ -371,6 +371,7 @@ def fit_trajectory(
             cluster_time,
             n_sub,
             parallel,
+            log.source,
         )
         yhat = y - r
         stages["filtered"] = stage
