@@ -70,7 +70,7 @@ def test_static_model_from_a_trajectory_within_intervals():
     assert fitted.provenance["trajectory"]["derivative"]["method"] == "savgol"
 
 
-def test_lugre_from_a_trajectory_covers_the_truth_on_two_seeds(tmp_path):
+def test_lugre_two_stage_route_covers_the_truth_on_two_seeds(tmp_path):
     hits, opened = {}, []
     for seed in (0, 1):
         log = tr.simulate_trajectory(
@@ -78,7 +78,7 @@ def test_lugre_from_a_trajectory_covers_the_truth_on_two_seeds(tmp_path):
         )
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            fitted = fit_trajectory(log, "lugre", "lm", seed=seed)
+            fitted = fit_trajectory(log, "lugre", "lm", seed=seed, route="two_stage")
         for n, ok in covered(fitted, TRUTH.params()).items():
             if any(fitted.ci_open[n]):  # not determined: counted apart, never as a hit
                 opened.append((seed, n))
@@ -123,6 +123,15 @@ def test_options_are_checked():
         fit_trajectory(log, "lugre", route="regression")
     with pytest.raises(ConfigError, match="derivative filter"):
         DerivativeFilter(method="spline")
+    from fricid.identify.trajectory import ParallelFilter
+
+    with pytest.raises(ConfigError, match="parallel filter"):
+        ParallelFilter(cutoff=0.0)
+    with pytest.raises(ConfigError, match="not below Nyquist"):
+        fit_trajectory(log, "lugre", parallel=ParallelFilter(cutoff=600.0))
+    short = tr.simulate_trajectory(tr.multisine(duration=0.6), TRUTH, JOINT)
+    with pytest.raises(DataError, match="too short for the parallel filter"):
+        fit_trajectory(short, "lugre")
 
 
 def write_joint_bag(path: Path, log) -> Path:
@@ -192,7 +201,7 @@ def test_any_optimiser_and_static_part_from_sweeps():
         warnings.simplefilter("ignore")
         fitted = fit_trajectory(log, "lugre", "bas", max_evals=60, seed=1)
     assert fitted.method == "bas" and fitted.convergence is not None
-    assert fitted.provenance["trajectory"]["routes"]["simulation"]["nfev"] <= 60
+    assert fitted.provenance["trajectory"]["routes"]["filtered"]["nfev"] <= 60
     sweep = FittedModel(
         model="stribeck",
         params=dict(zip(Stribeck().param_names, STATIC, strict=True)),
@@ -311,3 +320,78 @@ def test_simulate_trajectory_refuses_an_unknown_experiment_and_writes_nothing(tm
     )
     assert res.exit_code == 2 and "--duration must be between 1 and 3600 s" in res.output
     assert not out.exists()
+
+
+def test_mean_friction_is_the_period_mean_of_a_fine_simulation():
+    from fricid.models import lugre
+
+    up, n, dt = 4, 401, 1e-3
+    v_sub = 0.2 * np.sin(np.arange((n - 1) * up + 1) * dt / up * 2 * np.pi * 1.3)
+    F = lugre.mean_friction(TRUTH.theta, v_sub, dt, up, 0.0)
+    fine = 256  # each sub-step cut again: the rectangle rule's error shrinks as 1/fine
+    _, Z = lugre.simulate(TRUTH.theta, np.repeat(v_sub[1:], fine), dt / up / fine, 0.0)
+    Z = np.concatenate([[0.0], Z])
+    per = up * fine
+    z_mean = Z[1:].reshape(n - 1, per).mean(axis=1)
+    v_mean = v_sub[1:].reshape(n - 1, up).mean(axis=1)
+    th = TRUTH.theta
+    ref = th[0] * z_mean + th[1] * np.diff(Z[::per]) / dt + th[2] * v_mean
+    np.testing.assert_allclose(F[1:], ref, atol=2e-4)
+    with pytest.raises(ConfigError, match="per period"):
+        lugre.mean_friction(TRUTH.theta, v_sub[:-1], dt, up)
+
+
+def test_filtered_route_is_consistent_on_a_noise_free_log():
+    """Every LuGre parameter with J, p_x, p_y at once by the parallel-filtered equation error:
+    noise-free, the static part and the joint within a few per mille, sigma_0 and sigma_1
+    within the error of the bristle drive between samples (module notes of
+    ``_trajectory_filtered``: sigma_0 +3 %, sigma_1 -20 % on 20 s)."""
+    log = tr.simulate_trajectory(
+        tr.multisine(duration=8.0, seed=21), TRUTH, JOINT, noise=tr.Noise.none()
+    )
+    fitted = fit_trajectory(log, "lugre")
+    info = fitted.provenance["trajectory"]
+    assert info["route"] == "filtered" and set(info["routes"]) == {"regression", "filtered"}
+    assert info["parallel_filter"]["cutoff"] == 20.0 and fitted.converged
+    assert info["parallel_filter"]["decimate"] == 10  # 1 kHz to 100 Hz: five times 20 Hz
+    truth = TRUTH.params()
+    for n in ("sigma_2", "tau_c", "tau_s", "w_s", "delta"):
+        assert fitted.params[n] == pytest.approx(truth[n], rel=5e-3), n
+    for n, v in (("inertia", 0.01), ("p_x", 0.3), ("p_y", 0.1)):
+        assert info["joint"][n]["value"] == pytest.approx(v, rel=5e-3), n
+    assert fitted.params["sigma_0"] == pytest.approx(1e4, rel=0.1)
+    assert fitted.params["sigma_1"] == pytest.approx(1.0, rel=0.35)
+    assert not any(any(o) for o in fitted.ci_open.values())
+
+
+def test_filtered_route_covers_the_truth_with_noise_and_the_cli_selects_routes(tmp_path):
+    log = tr.simulate_trajectory(tr.multisine(duration=15.0, seed=22), TRUTH, JOINT, seed=22)
+    fitted = fit_trajectory(log, "lugre")
+    hits = covered(fitted, TRUTH.params())
+    assert not any(any(o) for o in fitted.ci_open.values())
+    assert sum(hits.values()) >= 6, hits  # 7 intervals of 95 %: at most one miss
+    from fricid.io.tables import write_rawlog
+
+    path = write_rawlog(log, tmp_path / "traj.parquet")
+    for route in ("filtered", "two_stage"):
+        out = tmp_path / f"{route}.json"
+        result = CliRunner().invoke(
+            app,
+            [
+                "fit",
+                str(path),
+                "--trajectory",
+                "--model",
+                "lugre",
+                "--route",
+                route,
+                "--out",
+                str(out),
+            ],
+        )
+        assert result.exit_code == 0, result.output
+        info = json.loads(out.read_text())["provenance"]["trajectory"]
+        assert info["route"] == route
+    assert "parallel filter (both sides)" in result.output or route == "two_stage"
+    bad = CliRunner().invoke(app, ["fit", str(path), "--trajectory", "--route", "spline"])
+    assert bad.exit_code == 2 and "unknown route" in bad.output

@@ -152,6 +152,14 @@ def fit_command(
     log_format: Annotated[
         str, typer.Option("--format", help="--trajectory: the log's reader (fricid.io.READERS).")
     ] = "table",
+    route: Annotated[
+        str,
+        typer.Option(
+            "--route",
+            help="--trajectory, lugre: filtered (every parameter by the parallel-filtered "
+            "equation error), two_stage or joint (simulation error).",
+        ),
+    ] = "filtered",
     reader_option: Annotated[
         list[str] | None,
         typer.Option("--reader-option", help="--trajectory: a reader option KEY=VALUE."),
@@ -185,7 +193,7 @@ def fit_command(
             reader_options=parse_reader_options(reader_option),
             seed=seed,
             max_evals=max_evals,
-            route="two_stage",
+            route=route,
             gravity="fit",
             out=out,
         )

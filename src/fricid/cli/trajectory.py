@@ -46,6 +46,12 @@ def trajectory_text(fitted) -> str:
         f"    derivatives: {d.get('method')} of the {d.get('source')}, "
         + ", ".join(f"{k} {v}" for k, v in d.items() if k not in ("method", "source")),
     ]
+    pf = info.get("parallel_filter")
+    if pf:
+        lines.append(
+            f"    parallel filter (both sides): Butterworth {pf['cutoff']:g} Hz, order "
+            f"{pf['order']}, zero phase, decimated by {pf['decimate']}"
+        )
     for name, row in info.get("joint", {}).items():
         lines.append(
             f"    {name}: {row['value']:.6g} +/- {row['stderr']:.2g} "

@@ -8,112 +8,92 @@ with fricid's sign convention (:func:`fricid.sim.gravity_torque`; BAS-RBFNN pape
 (the issue writes ``+ p_x cos q - p_y sin q``: the same law with the gravity coefficients of
 opposite sign; fricid keeps the extractor's, so the two paths give comparable numbers).
 
-Derivatives by a zero-phase filter (:class:`DerivativeFilter`: Savitzky-Golay by default, or
-Butterworth with ``filtfilt``); its choice and settings go into the provenance.
+Derivatives for the regression by a zero-phase filter (:class:`DerivativeFilter`:
+Savitzky-Golay by default, or Butterworth with ``filtfilt``); the ``filtered`` route's own
+low-pass (:class:`ParallelFilter`); their settings go into the provenance.
 
-Two routes, compared in the result's provenance (``provenance["trajectory"]``):
+Routes, recorded in the result's provenance (``provenance["trajectory"]``):
 
+``filtered`` (parallel-filtered equation error; the default for LuGre)
+    All seven LuGre parameters with J, p_x, p_y at once, by the equation of motion on every
+    sample, both sides filtered by one zero-phase low-pass and decimated (Gautier 1997;
+    Gautier, Janot and Vandanjon 2013, IDIM-LS; Pham and Gautier 1991), the bristle state
+    driven by the measured motion: no simulation of the joint, no windows, no guards
+    (:mod:`._trajectory_filtered`, whose notes say how the bristle state is driven between
+    samples and what that leaves at 1 kHz).
 ``regression`` (inverse dynamics)
     ``u - f_static(qd; theta) = J qdd - p_x cos q + p_y sin q`` on the samples that slide
     (``|qd| >= v_slide``, grown by half the filter window): linear in ``J, p_x, p_y``, which
     are projected out of every candidate's residual (variable projection, Golub and Pereyra
     1973) so the optimiser searches the friction parameters only, then recovered by least
-    squares. Fast (one model evaluation per candidate, no simulation). It sees LuGre's
-    steady state only ([CW95]: at constant velocity LuGre is the static Stribeck law with
-    ``tau_v = sigma_2``), so it determines sigma_2 and the Stribeck parameters, not
-    sigma_0, sigma_1.
-``simulation`` (simulation error)
+    squares. It sees LuGre's steady state only ([CW95]: at constant velocity LuGre is the
+    static Stribeck law with ``tau_v = sigma_2``); the route of the static models, and the
+    start of the others.
+``simulation`` (simulation error; in ``two_stage`` and ``joint``)
     The joint is simulated under the measured torque (:func:`fricid.models.lugre.
     simulate_joint`, ``n_sub`` sub-steps per sample) over windows around every low-speed
-    stretch (``|qd| < v_window``: reversals, sticking, pre-sliding), each window starting
-    from the measured position and velocity and the bristle force balance, and cut into
-    segments of :data:`SEGMENT` seconds that restart from the measured motion while the
-    bristle state carries on from the simulation (multiple shooting; restarting z too from a
-    force balance with the filtered acceleration left a transient in every segment that,
-    on the virtual joint, hid sigma_1 entirely: 20 s multi-sine, noise-free, sigma_1 = 8
-    with the static part known came out 0.02 [0.001, 1000], and 7.88 [7.85, 7.91] with z
-    carried on; ``tests/test_trajectory.py``); the residuals are
-    the simulated minus the measured position and velocity, each channel scaled by its RMS at
-    the start. This is what determines sigma_0 and sigma_1: they act only near zero velocity.
+    stretch (``|qd| < v_window``), cut into segments of :data:`SEGMENT` seconds that restart
+    from the measured motion while the bristle state carries on (multiple shooting;
+    restarting z too from a force balance hid sigma_1 entirely:
+    ``tests/test_trajectory.py``); residuals the simulated minus the measured position and
+    velocity, each channel scaled by its RMS at the start.
 
-Which, and why. By default (``route="two_stage"``) the static part (sigma_2 and the Stribeck
-parameters, with J, p_x, p_y) comes from the regression, then sigma_0 and sigma_1 from the
-simulation error with the rest held: the classic order of LuGre identification ([CW95]
-section IV; Canudas de Wit and Lischinsky 1997; Altpeter 1999): the static map is well
-determined by sliding data and cheap to fit, while the simulation error is expensive and
-non-convex in all seven parameters at once. The uncertainty of the first stage is carried
-into the second by the two-step covariance of Murphy and Topel (1985): ``V2 + G V1 G^T``,
-``G = -(J2' J2)^-1 J2' J21``, with ``J21`` the sensitivity of the simulation residuals to the
-first stage's parameters. Refinement (:data:`REFINE` passes): the regression treats the
-friction at low sliding speeds as static, while LuGre's bristles lag there; once sigma_0
-and sigma_1 are known, the static part is identified again with LuGre's friction along the
-filtered motion (:func:`fricid.models.lugre.simulate`, the regression's samples; the
-uncertainty of sigma_0, sigma_1 carried in by Murphy-Topel), then sigma_0, sigma_1 again
-from there. Measured (20 s multi-sine, seed 0, noise-free, before segments carried z on):
-tau_s 0.774 [0.766, 0.782] -> 0.782 [0.759, 0.806] for 0.8, w_s 0.110 [0.107, 0.112] ->
-0.107 [0.101, 0.114] for 0.1: the bias shrinks and the intervals now cover. More passes
-moved no parameter beyond its third digit (the same run with sigma_1 = 8, 2 and 3 passes):
-a fixed point, so one pass is the default. It does not remove the whole bias (next
-paragraph). ``route="joint"`` then refines every parameter (and J, p_x, p_y) by the
-simulation error from the two-stage estimate (all jointly: the maximum-likelihood
-estimate when the noise is in the measured motion, at about five times the cost).
-``static=`` takes the static part from a fit to constant-velocity sweeps instead (a
-``stribeck`` :class:`~fricid.fitted.FittedModel`): only J, p_x, p_y are then regressed.
-Static models (``stribeck``, ``coulomb_viscous``) take the regression route alone.
+Which, and why. ``route="filtered"`` by default: it is the standard of robot identification
+(IDIM) and, measured below, it determines every parameter, with intervals three to nine
+times narrower than ``two_stage``, in half the time. ``two_stage`` (the static part from the
+regression, then sigma_0 and sigma_1 by simulation error, the classic order of LuGre
+identification: [CW95] section IV; Canudas de Wit and Lischinsky 1997; Altpeter 1999; the
+first stage's uncertainty carried by the two-step covariance of Murphy and Topel (1985), and
+:data:`REFINE` passes re-fitting the static part with LuGre's friction along the motion)
+treats the friction of the slowly sliding samples as static although LuGre's bristles lag
+there, and sees the Stribeck region only outside guards around the reversals; the filtered
+route uses every sample with LuGre's own friction. ``route="joint"`` refines everything by
+the simulation error from the two-stage estimate. ``static=`` (a ``stribeck`` fit from
+sweeps) takes the static part from the sweeps; it runs ``two_stage`` (only J, p_x, p_y are
+then regressed). Static models (``stribeck``, ``coulomb_viscous``) take the regression.
 
 Uncertainty: cluster-robust covariances (:func:`._trajectory_data.cluster_covariance`; blocks
-of ``cluster_time`` seconds for the regression, the windows for the simulation error), t
-quantiles with G - 1 degrees of freedom; sigma_0 and sigma_1 are searched and their
-intervals formed on a log scale (their intervals are asymmetric; the standard error shown is
-the delta method's). Every fricid optimiser works on both routes (the objective goes through
-:func:`fricid.optim.minimize`; least-squares methods get the residuals).
+of ``cluster_time`` seconds, or the simulation windows), t quantiles with G - 1 degrees of
+freedom; sigma_0 and sigma_1 are searched and their intervals formed on a log scale
+(asymmetric intervals; the standard error shown is the delta method's). Every fricid
+optimiser works on every route (through :func:`fricid.optim.minimize`; least-squares
+methods get the residuals).
 
 Passivity ([BO00], :func:`fricid.models.lugre.passivity_margin`) is checked at the estimate
 and at the corner of the 95 % intervals least favourable to it, reported in the provenance,
 and warned about (:class:`PassivityWarning`) when the estimate is not passive.
 
-What it does and does not recover (``benchmarks/bench_trajectory.py``: LuGre truth, 60 s
-multi-sine at 1 kHz, 5 seeds, ``lm``; coverage over the closed intervals, open ones counted
-apart as not determined): sigma_0 5/5 (seed 0: 1.09e4 [7.8e3, 1.5e4] for 1e4); sigma_2,
-tau_c, delta 4/5; w_s 3/5; tau_s 2/5; sigma_1 (damping ratio 0.05) not determined on 3/5
-seeds (interval open, [0.001, 1000]), covered on the other 2/2. With ``--sigma1 8`` (damping
-ratio 0.4, a truth that is not passive with this static part) sigma_1 is determined on 4/5
-seeds but biased low (seed 0: 7.09 [6.86, 7.33]; covered 0/4), sigma_0 2/5, tau_s 1/5,
-w_s 0/5. What is left: the Stribeck shape. The regression sees it only on the few samples
-that slide slowly outside the guards, so its intervals are wide, and the current noise
-(10 mA, 5 mN m) alone moved seed 0's tau_s from 0.784 to 0.733 (interval +/- 0.06);
-noise-free, a bias of
-about 2 % remains after the refinement (tau_s 0.784 [0.779, 0.789]); and errors in the static
-part carry into sigma_0 and sigma_1 (with the static part known exactly, noise-free: sigma_1
-7.88 for 8, 1.16 [1.03, 1.30] for 1). Freeing tau_s, w_s and delta in the simulation route
-as well determined them better on one seed but cost about four times as long (shared
-machine) and gave intervals too narrow to trust; it is not offered. ``route="joint"``
-(every parameter by simulation error; tried before segments carried z on) was slower still
-and not better on the seeds tried.
+What it recovers (``benchmarks/bench_trajectory.py``, run for the report: LuGre
+truth, 60 s multi-sine at 1 kHz, trajectory noise, ``lm``, seeds 0-4; coverage by the closed
+95 % intervals; shared 2-core machine). ``filtered``: every interval closed (sigma_1 too, at
+the light damping ratio 0.05); covered sigma_0 4/5, sigma_1 5/5, sigma_2 4/5, tau_c 4/5,
+tau_s 3/5, w_s 3/5, delta 3/5 (26/35); seed 0 tau_s 0.793 [0.781, 0.805], w_s 0.103
+[0.099, 0.108], sigma_0 9.5e3 [8.5e3, 1.07e4], sigma_1 1.07 [0.72, 1.61]; static
+intervals overlapping the sweeps' 23/25; 1.0-2.5 s per identification (two runs, before
+and after the decimation factor's rounding was fixed: the same table). ``two_stage``, same
+run conditions (``--route two_stage``): sigma_1 open on 3/5 seeds, covered 24/32 closed
+(tau_s 2/5), seed 0 tau_s 0.734 [0.674, 0.793], half-widths 3-9 times the filtered route's,
+overlap 19/25, 4.1-5.7 s. Seeds 0-4 are the unlucky ones: on seeds 10-59 (not the
+benchmark's, ``filtered``) 336/350 intervals covered (96 %; every parameter 47-50/50), the
+misses clustered on a few seeds where the Stribeck trio misses together (their estimates are
+correlated), as on seeds 0-4. The cut-off: 20 Hz; at 40 and 60 Hz (seeds 10-29) the intervals
+halved but sigma_0 was covered on 4/20 and 2/20 seeds: the bristle drive's error at 1 kHz
+(:mod:`._trajectory_filtered`: noise-free, 20 s, sigma_0 +3.5 %, sigma_1 -20 %, the static
+part and J within 1.5 per mille; at 10 kHz every parameter within 0.3 per mille) then exceeds
+the intervals. With ``--sigma1 8`` (damping ratio 0.4; seeds 10-19) 69/70 covered, sigma_1's
+half-width 1.7 %.
 
 A designed experiment for the Stribeck shape (:func:`fricid.sim.trajectory.slow_multisine`,
 ``bench_trajectory.py --experiment slow_multisine``: the same 60 s, its first half
-constant-speed plateaus at 0.03, 0.05, 0.1, 0.2, 0.3 rad/s both ways, the multi-sine faded
-in for the second) recovers the static part: tau_c 5/5, w_s 5/5, tau_s 4/5, delta 4/5
-(seed 0: tau_s 0.8002 [0.7991, 0.8014], w_s 0.1001 [0.0997, 0.1004]), every static interval
-overlapping the sweeps' on 3/5 seeds. But it costs the dynamics: sigma_2 is biased low
-(seed 0: 0.1986 [0.1978, 0.1995], 0/5) together with J high (0.01008 [0.01006, 0.0101]),
-and sigma_0 comes out about 3e4 (1/5 covered); on seed 0 sigma_1's interval collapsed to
-zero width ([0.9982, 0.9982]), which no one should trust. The bias is not from the plateaus
-entering the simulation route: keeping only the samples within 0.05-0.3 s of a reversal in
-its windows, or making the plateau reversals ten times faster, left sigma_0 at 2.4-3.2e4
-(seeds 11-12, not the benchmark's); a 30 s multi-sine alone gave sigma_0 8.9e3
-[6.1e3, 1.3e4] on seed 11. Noise-free (seed 11) the bias stays (sigma_2 0.1986
-[0.1983, 0.1988], J 0.010066, sigma_0 3.5e4), with ramps four times gentler or a fade four
-times longer too; with plateaus at 0.2 and 0.3 rad/s only, sigma_0 was covered again
-(1.24e4 [9.6e3, 1.6e4]) and sigma_2 too, but not the Stribeck shape. So it is the slow
-plateaus (below about 2 w_s) that pull sigma_0 up, and not through the static part: with
-the sweeps' stribeck fit as ``static=`` (seed 11, noisy) sigma_0 was still 3.44e4
-[3.37e4, 3.51e4] (the plain multi-sine: 1.007e4 [9.7e3, 1.05e4]), J 0.010073 (0.010047).
-Left to find: what in the simulation route's slow reversals (or the regressed J) pulls it;
-a candidate is LuGre's lag at low speed, whose friction deviation
-``-g g' qdd / (sigma_0 |qd|)`` acts like extra inertia where the Stribeck curve falls. The
-default stays the plain multi-sine until that is understood.
+constant-speed plateaus at 0.03-0.3 rad/s both ways, the multi-sine faded in for the
+second). With the filtered route (seeds 10-19) it pins the static part: tau_s, w_s, delta
+10/10 with half-widths 0.08 %, 0.23 %, 0.34 % (the multi-sine's: 1.5 %, 4 %, 3 %), sigma_2
+and tau_c 9/10; sigma_0 8/10 (within 2 %), but sigma_1 5/10 (8-15 % low, half-widths 7-10 %):
+the 1 kHz bristle drive's error, larger than those intervals. (With ``two_stage`` it biased
+sigma_0 to about 3e4 and sigma_2 low, for a reason the earlier record left open.) The
+default stays the plain multi-sine; the slow plateaus are the experiment for a precise static
+part, and logging faster (or a bristle drive that follows the break-away within a period) is
+what would make sigma_1 as precise.
 
 This module is longer than 500 lines because these notes carry the measured record of what
 a trajectory does and does not determine, which belongs beside the code that produces it.
@@ -142,6 +122,7 @@ from ..metrics import fit_statistics, metrics
 from ..models import get_model, lugre
 from ..samples import RawLog
 from ._trajectory_data import DerivativeFilter, derivatives, dilate, uniform_series
+from ._trajectory_filtered import ParallelFilter, filtered_route
 from ._trajectory_routes import (
     JOINT_PARAMS,
     _refine_static,
@@ -152,10 +133,10 @@ from ._trajectory_routes import (
     _windows,
 )
 
-__all__ = ["ROUTES", "DerivativeFilter", "PassivityWarning", "fit_trajectory"]
+__all__ = ["ROUTES", "DerivativeFilter", "ParallelFilter", "PassivityWarning", "fit_trajectory"]
 
-#: Routes of :func:`fit_trajectory`.
-ROUTES = ("two_stage", "joint", "regression")
+#: Routes of :func:`fit_trajectory` (the first is LuGre's default).
+ROUTES = ("filtered", "two_stage", "joint", "regression")
 
 #: Static models a trajectory identifies by regression.
 STATIC_MODELS = ("stribeck", "coulomb_viscous")
@@ -230,9 +211,10 @@ def fit_trajectory(
     model: str = "lugre",
     method: str = "lm",
     *,
-    route: str = "two_stage",
+    route: str = "filtered",
     gravity: str = "fit",
     derivative: DerivativeFilter | None = None,
+    parallel: ParallelFilter | None = None,
     v_slide: float = 0.02,
     guard: float = 0.2,
     v_window: float | None = None,
@@ -253,12 +235,17 @@ def fit_trajectory(
     method : str
         Any fricid optimiser (:data:`fricid.optim.METHODS`), used by both routes.
     route : str
-        ``two_stage`` (default for LuGre), ``joint`` (then every parameter by simulation
-        error), ``regression`` (static models; the only route for them).
+        ``filtered`` (default for LuGre: every parameter at once by the parallel-filtered
+        equation error), ``two_stage``, ``joint`` (then every parameter by simulation
+        error), ``regression`` (static models; the only route for them). With ``static=``
+        the ``filtered`` route becomes ``two_stage``.
     gravity : str
         ``fit`` (p_x, p_y estimated) or ``none`` (a horizontal joint).
     derivative : DerivativeFilter, optional
-        The zero-phase derivative filter (default Savitzky-Golay, 21 ms, order 3).
+        The zero-phase derivative filter of the regression (default Savitzky-Golay, 21 ms,
+        order 3).
+    parallel : ParallelFilter, optional
+        The ``filtered`` route's low-pass on both sides (default Butterworth 20 Hz, order 4).
     v_slide : float
         Speed [rad/s] above which a sample counts as sliding for the regression.
     guard : float
@@ -274,7 +261,8 @@ def fit_trajectory(
     static : FittedModel, optional
         A ``stribeck`` fit from constant-velocity sweeps: the static part is taken from it.
     n_sub : int
-        Sub-steps per sample of the simulation route.
+        Sub-steps per sample of the simulation route and of the ``filtered`` route's bristle
+        state.
     cluster_time : float
         Block length [s] of the regression's cluster-robust covariance.
     seed, max_evals
@@ -304,6 +292,8 @@ def fit_trajectory(
         raise ConfigError(f"unknown route '{route}'; one of: {', '.join(ROUTES)}")
     if key != "lugre" and route != "regression":
         route = "regression"
+    if key == "lugre" and route == "filtered" and static is not None:
+        route = "two_stage"
     if key == "lugre" and route == "regression":
         raise ConfigError("LuGre's sigma_0 and sigma_1 need the simulation route (two_stage)")
     if gravity not in ("fit", "none"):
@@ -356,21 +346,45 @@ def fit_trajectory(
         if n in static_model.param_names
     }
     sim_info: dict[str, Any] = {}
-    if key == "lugre":
+    y, yhat = series.torque[mask], series.torque[mask] - r1
+    if key == "lugre" and not joint_vals["inertia"] > 0:
+        row = stage1.table().get("inertia", {})
+        raise DataError(
+            f"the trajectory does not determine the inertia (J = {joint_vals['inertia']:.3g} "
+            f"+/- {row.get('stderr', float('nan')):.2g} kg m^2): a single sine makes J qdd "
+            "and the gravity torque collinear; excite several frequencies (a multi-sine or a "
+            "chirp)",
+            file=log.source,
+        )
+    if key == "lugre" and route == "filtered":
+        parallel = parallel or ParallelFilter()
+        start = np.array([1e4, 1.0] + [static_tab[n]["value"] for n in lugre.PARAM_NAMES[2:]])
+        order = [stage1.names.index(n) for n in ("tau_v", "tau_c", "tau_s", "w_s", "delta")]
+        stage, y, r = filtered_route(
+            series,
+            start,
+            stage1.bounds[order],
+            gravity,
+            method,
+            seed,
+            max_evals,
+            cluster_time,
+            n_sub,
+            parallel,
+            log.source,
+        )
+        yhat = y - r
+        stages["filtered"] = stage
+        results.append(stage.result)
+        final.update(stage.table())
+        bounds_out.update({n: list(b) for n, b in zip(stage.names, stage.bounds, strict=True)})
+        sim_info = {"parallel_filter": parallel.describe(rate), "n_sub": int(n_sub)}
+    elif key == "lugre":
         base = np.array(
             [1e4, 1.0]
             + [static_tab[n]["value"] for n in lugre.PARAM_NAMES[2:]]
             + [joint_vals["inertia"], joint_vals["p_x"], joint_vals["p_y"]]
         )
-        if not joint_vals["inertia"] > 0:
-            row = stage1.table().get("inertia", {})
-            raise DataError(
-                f"the trajectory does not determine the inertia (J = {joint_vals['inertia']:.3g} "
-                f"+/- {row.get('stderr', float('nan')):.2g} kg m^2): a single sine makes J qdd "
-                "and the gravity torque collinear; excite several frequencies (a multi-sine or a "
-                "chirp)",
-                file=log.source,
-            )
         w_s = static_tab["w_s"]["value"]
         v_win = v_window if v_window is not None else max(w_s, 2.0 * v_slide)
         w = _windows(
@@ -468,7 +482,6 @@ def fit_trajectory(
     se = np.array([final[n]["stderr"] for n in param_names])
     low = np.array([final[n]["ci95_low"] for n in param_names])
     high = np.array([final[n]["ci95_high"] for n in param_names])
-    y, yhat = series.torque[mask], series.torque[mask] - r1
     fitted = FittedModel(
         model=key,
         params=dict(zip(param_names, map(float, values), strict=True)),
@@ -477,7 +490,8 @@ def fit_trajectory(
         ci95={n: float((h - lo) / 2) for n, lo, h in zip(param_names, low, high, strict=True)},
         ci95_low=dict(zip(param_names, low, strict=True)),
         ci95_high=dict(zip(param_names, high, strict=True)),
-        ci_method="cluster-robust" + (", two-step" if key == "lugre" else ""),
+        ci_method="cluster-robust"
+        + (", two-step" if key == "lugre" and route != "filtered" else ""),
         metrics={
             **metrics(y, yhat),
             **{
@@ -517,13 +531,17 @@ def fit_trajectory(
     joint_tab = {
         n: row for n, row in (last_regression or [stage1])[-1].table().items() if n in JOINT_PARAMS
     }
+    if "filtered" in stages:
+        joint_tab = {n: r for n, r in stages["filtered"].table().items() if n in JOINT_PARAMS}
     if "simulation_joint" in stages:
         joint_tab.update(
             {n: r for n, r in stages["simulation_joint"].table().items() if n in JOINT_PARAMS}
         )
     info: dict[str, Any] = {
         "route": route,
-        "static_from": "sweeps" if static is not None else "regression",
+        "static_from": "sweeps"
+        if static is not None
+        else ("the same joint estimate" if route == "filtered" else "regression"),
         "derivative": derivative.describe(rate),
         "resampled": series.resampled,
         "sample_rate": rate,

@@ -10,7 +10,7 @@ import math
 
 from numba import njit
 
-__all__ = ["run"]
+__all__ = ["run", "run_mean"]
 
 
 @njit(cache=True)
@@ -37,6 +37,53 @@ def run(theta, v, dt, z0, F, Z):  # pragma: no cover - compiled
                 z = z + vi * dt[i]
             Z[j, i] = z
             F[j, i] = s0 * z + s1 * dz + s2 * vi
+    return 0
+
+
+@njit(cache=True)
+def run_mean(theta, v, h, up, z0, F):  # pragma: no cover - compiled
+    """Friction averaged over each sample period, for every row of ``theta``.
+
+    ``v`` holds ``up`` sub-step velocities per sample period (``(n - 1) up + 1`` entries, the
+    first the velocity before the first sample), each held over a sub-step of ``h`` seconds;
+    the bristle state follows the exact update of :func:`run`, and its mean over a sub-step
+    is exact too (``z_ss + (z0 - z_ss) (1 - exp(-a h)) / (a h)``). ``F[j, i]`` (``i >= 1``)
+    is the mean friction over the period ending at sample ``i``: ``sigma_0 mean(z) +
+    sigma_1 (z_i - z_{i-1}) / (up h) + sigma_2 mean(v)``; ``F[j, 0]`` the friction at the
+    first sample in the steady state of ``v[0]``.
+    """
+    k = theta.shape[0]
+    n = F.shape[1]
+    period = up * h
+    for j in range(k):
+        s0, s1, s2 = theta[j, 0], theta[j, 1], theta[j, 2]
+        tau_c, tau_s, w_s, delta = theta[j, 3], theta[j, 4], theta[j, 5], theta[j, 6]
+        ws = max(abs(w_s), 1e-12)
+        z = z0[j]
+        F[j, 0] = s0 * z + s2 * v[0]
+        for i in range(1, n):
+            z_start = z
+            acc_z = 0.0
+            acc_v = 0.0
+            for m in range(up):
+                vi = v[(i - 1) * up + 1 + m]
+                av = abs(vi)
+                if av > 0.0 and s0 > 0.0:
+                    g = max(tau_c + (tau_s - tau_c) * math.exp(-((av / ws) ** delta)), 1e-12)
+                    x = s0 * av / g * h
+                    z_ss = g / s0 if vi > 0.0 else -g / s0
+                    if x > 1e-9:
+                        e = math.exp(-x)
+                        acc_z += z_ss + (z - z_ss) * (1.0 - e) / x
+                    else:
+                        e = 1.0 - x
+                        acc_z += z + 0.5 * (vi - x / h * z) * h
+                    z = z_ss + (z - z_ss) * e
+                else:
+                    acc_z += z + 0.5 * vi * h
+                    z = z + vi * h
+                acc_v += vi
+            F[j, i] = s0 * acc_z / up + s1 * (z - z_start) / period + s2 * acc_v / up
     return 0
 
 

@@ -62,6 +62,7 @@ __all__ = [
     "PARAMETERS",
     "PARAM_NAMES",
     "LuGre",
+    "mean_friction",
     "passivity_margin",
     "simulate",
     "simulate_joint",
@@ -157,6 +158,50 @@ def simulate(theta, v, dt, z0=None) -> tuple[np.ndarray, np.ndarray]:
 
     run(batch, v, dt, z0, F, Z)
     return (F[0], Z[0]) if single else (F, Z)
+
+
+def mean_friction(theta, v_sub, dt: float, up: int, z0=None) -> np.ndarray:
+    """Friction averaged over each sample period, along a velocity given ``up`` times per period.
+
+    What an equation of motion integrated over a sample period needs (the mean torque of a
+    zero-order-hold drive balances the mean friction, not the friction at the sample): the
+    bristle state is updated exactly over each sub-step (module notes), and its mean over the
+    sub-step is exact too.
+
+    Parameters
+    ----------
+    theta : array_like
+        ``(7,)`` or ``(k, 7)`` in the order of :data:`PARAM_NAMES`.
+    v_sub : array_like
+        ``((n - 1) up + 1,)`` velocity [rad/s]: entry 0 at the first sample, then ``up``
+        sub-step velocities per period, each held over ``dt / up``.
+    dt : float
+        Sample period [s].
+    up : int
+        Sub-steps per period.
+    z0 : float or array_like, optional
+        Bristle state at the first sample, scalar or ``(k,)``; default 0.
+
+    Returns
+    -------
+    ndarray
+        ``(n,)`` or ``(k, n)``: entry ``i >= 1`` the mean friction [N m] over the period
+        ending at sample ``i``; entry 0 ``sigma_0 z0 + sigma_2 v_sub[0]``.
+    """
+    batch, single = _batch(theta)
+    v = np.ascontiguousarray(np.asarray(v_sub, dtype=float).ravel())
+    up = int(up)
+    if up < 1 or (v.size - 1) % up:
+        raise ConfigError(f"LuGre mean friction: {v.size} velocities are not 1 + {up} per period")
+    if not (np.isfinite(dt) and dt > 0):
+        raise ConfigError("LuGre mean friction: the sample period must be finite and > 0")
+    k = batch.shape[0]
+    z0 = np.ascontiguousarray(np.broadcast_to(np.asarray(0.0 if z0 is None else z0, float), (k,)))
+    F = np.empty((k, (v.size - 1) // up + 1))
+    from ._lugre_kernel import run_mean  # lazy: importing numba takes a while
+
+    run_mean(batch, v, float(dt) / up, up, z0, F)
+    return F[0] if single else F
 
 
 def simulate_joint(
