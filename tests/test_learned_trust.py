@@ -113,7 +113,9 @@ def test_learned_statistics_count_effective_dof(rbf, gp, samples):
 
 def test_learned_files_record_convergence_and_their_cv(rbf, gp, samples, tmp_path):
     assert rbf.converged and rbf.convergence["certified_by"] == "closed_form"
-    assert gp.converged is not None
+    assert gp.nfev > 0 and gp.convergence["nfev"] == gp.nfev
+    assert gp.converged == (gp.convergence["certified_by"] == "optimizer")
+
     v = rbf.validation
     assert v["source"] == CV_SOURCE and v["scheme"] == "kfold:5"
     state = rbf.state["n_centers_selection"]
@@ -126,6 +128,16 @@ def test_learned_files_record_convergence_and_their_cv(rbf, gp, samples, tmp_pat
     back = FittedModel.load(rbf.save(tmp_path / "rbf.json"))
     assert back.validation == json.loads(json.dumps(rbf.to_dict()))["validation"]
     assert back.statistics_note == rbf.statistics_note
+
+
+def test_gp_convergence_from_the_optimisers_status():
+    from fricid.identify._learned_trust import process_convergence
+
+    ok = {"starts": 3, "nfev": 40, "converged": True, "message": "CONVERGENCE"}
+    bad = {**ok, "converged": False, "message": "ABNORMAL_TERMINATION_IN_LNSRCH"}
+    assert process_convergence([ok], ["length scale near its bound"])["converged"]
+    block = process_convergence([ok, bad], [])
+    assert not block["converged"] and "ABNORMAL" in block["reason"] and block["nfev"] == 80
 
 
 def test_optimiser_trainer_out_of_budget_is_not_converged(samples):

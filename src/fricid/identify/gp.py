@@ -36,6 +36,7 @@ import warnings
 from typing import Any
 
 import numpy as np
+import scipy.optimize
 from scipy.linalg import cho_factor, cho_solve
 from sklearn.exceptions import ConvergenceWarning as SklearnConvergenceWarning
 from sklearn.gaussian_process import GaussianProcessRegressor
@@ -240,12 +241,24 @@ def _train_side(
     kernel = ConstantKernel(1.0, (1e-4, 1e4)) * RBF(np.ones(d), (1e-2, 1e3)) + WhiteKernel(
         1e-2, (1e-10, 10.0)
     )
+    runs: list[Any] = []
+
+    def lbfgs(obj_func, initial_theta, bounds):
+        """scikit-learn's own L-BFGS-B call (``optimizer="fmin_l_bfgs_b"``), its result kept:
+        the optimiser's status and evaluations go into the model file."""
+        res = scipy.optimize.minimize(
+            obj_func, initial_theta, method="L-BFGS-B", jac=True, bounds=bounds
+        )
+        runs.append(res)
+        return res.x, res.fun
+
     gpr = GaussianProcessRegressor(
-        kernel, alpha=1e-10, n_restarts_optimizer=n_restarts, random_state=seed
+        kernel, alpha=1e-10, optimizer=lbfgs, n_restarts_optimizer=n_restarts, random_state=seed
     )
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", SklearnConvergenceWarning)
         gpr.fit(Z[sub], t[sub])
+    best = min(runs, key=lambda r: float(r.fun))
     k = gpr.kernel_
     s2 = float(k.k1.k1.constant_value)
     lengths = np.atleast_1d(np.asarray(k.k1.k2.length_scale, dtype=float)) * np.ones(d)
@@ -281,6 +294,12 @@ def _train_side(
         "log_marginal_likelihood": float(gpr.log_marginal_likelihood_value_),
         "kernel": str(k),
         "edf": edf,
+        "optimizer": {
+            "starts": len(runs),
+            "nfev": int(sum(int(r.nfev) for r in runs)),
+            "converged": bool(best.success),
+            "message": str(best.message),
+        },
     }
     if dropped:
         state["dropped_inputs"] = dropped
@@ -367,18 +386,19 @@ def _fit(
     )
     scatter = measurement_scatter(samples)
     notes = sorted({n for s in sides for n in s.get("training_notes", [])})
+    runs = [s["optimizer"] for s in sides]
     return FittedModel(
         model="gp",
         params={},
         metrics=metrics(samples.y, y_hat, samples.direction, scatter.value),
         statistics=statistics,
         statistics_note=note,
-        convergence=process_convergence(notes),
+        convergence=process_convergence(runs, notes),
         loss={"scatter": scatter.to_dict()},
         method="sklearn-gpr",
         seed=seed,
-        nfev=0,
-        status=0,
+        nfev=sum(r["nfev"] for r in runs),
+        status=0 if all(r["converged"] for r in runs) else 1,
         message=f"trained in {time.perf_counter() - start:.3g} s",
         operating_range={
             name: [float(X[:, INPUTS.index(name)].min()), float(X[:, INPUTS.index(name)].max())]

@@ -40,6 +40,7 @@ from typing import Any
 import numpy as np
 
 from ..fitted import FittedModel
+from ..fitted._file import _convergence_line
 from ..metrics import NOISE_RATIO, verdict
 from ..samples import FrictionSamples
 from ._heldout import MIN_LEVELS, VALIDATE_WORK, own_cv
@@ -111,6 +112,8 @@ class Trust:
     what_to_do : str
         For a model whose error misses the scatter: what to do
         (:func:`fricid.report.advice.misfit_advice`); "" otherwise.
+    model : str
+        The model's registry name.
     """
 
     level: str
@@ -133,6 +136,7 @@ class Trust:
     rbf: bool = False
     cv: dict[str, Any] | None = None
     what_to_do: str = ""
+    model: str = ""
 
     def line(self) -> str:
         """``"Trust: with caveats, because ..."``, and for a model that misses the data what
@@ -290,10 +294,11 @@ def assess_trust(
         The samples it was identified on: their quality table, and the held-out validation
         when the file has none.
     run_validation : bool, default True
-        Run :func:`fricid.identify.validate` (``lovo``) when the file holds no validation, the
-        model is analytic and folds x samples x parameters is at most ``max_work``.
+        Run :func:`fricid.identify.validate` (``lovo``) when the file holds no validation, or
+        only a learned model's own cross-validation, and the problem is small enough (module
+        notes).
     max_work : int
-        The size limit of that validation (see :data:`VALIDATE_WORK`).
+        The size limit of an analytic model's validation (see :data:`VALIDATE_WORK`).
 
     Returns
     -------
@@ -305,10 +310,7 @@ def assess_trust(
     if conv is None:
         line = "not recorded in this model file"
     elif converged:
-        by = {"optimizer": "the optimiser's own test", "polish": "a local polish"}.get(
-            str(conv.get("certified_by")), "the fit"
-        )
-        line = f"converged (certified by {by})"
+        line = _convergence_line(conv)
     else:
         line = f"NOT converged: {conv.get('reason') or conv.get('message') or 'no reason given'}"
     rows, qsummary, qcaveat = _quality(samples)
@@ -325,6 +327,7 @@ def assess_trust(
         quality=rows,
         quality_summary=qsummary,
         rbf=fitted.kind == "rbf",
+        model=fitted.model,
     )
     mine = own_cv(fitted.validation)
     if (mine or trust.validation is None) and samples is not None and run_validation and converged:
@@ -414,6 +417,16 @@ def quality_frame(rows: list[dict[str, Any]]) -> Any:
     return pd.DataFrame(out)
 
 
+#: The identifiability line of a learned model.
+_LEARNED_IDENT = {
+    "rbf": "not applicable to the network's weights (not physical; see the bootstrap "
+    "intervals of its predictions)",
+    "hybrid": "the backbone's parameters are a starting shape, not identified values (the "
+    "residual network absorbs what they miss); see the bootstrap intervals of its predictions",
+    "gp": "not applicable to the process's hyperparameters (not physical; see its posterior band)",
+}
+
+
 def trust_text(trust: Trust) -> str:
     """The section's list: data quality, convergence, identifiability, held-out error,
     operating range (plain text with the report's small markup)."""
@@ -424,10 +437,7 @@ def trust_text(trust: Trust) -> str:
     lines.append(conv + ".")
     ident = []
     if trust.rbf:
-        ident.append(
-            "not applicable to the network's weights (not physical; see the "
-            "bootstrap intervals of its predictions)"
-        )
+        ident.append(_LEARNED_IDENT.get(trust.model, _LEARNED_IDENT["rbf"]))
     elif trust.converged is False:
         ident.append("not assessed: the fit did not converge")
     if trust.not_determined:
