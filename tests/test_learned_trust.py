@@ -221,3 +221,23 @@ def test_cli_fit_prints_the_learned_models_held_out_error(samples, tmp_path):
     assert res.exit_code == 0, res.output
     assert "(effective)" in res.stdout and "RMSE / scatter" in res.stdout
     assert "# convergence" in res.stdout
+
+
+def test_misfit_advice_reads_in_sample_interior_and_end_folds(rbf, samples):
+    from fricid.report.advice import misfit_advice
+
+    def folds(interior: float, ends: float) -> dict:
+        speeds = np.geomspace(0.01, 1.0, 6)
+        rows = [
+            {"fold": k, "speed": v, "n": 10, "rmse": ends if k in (0, 5) else interior}
+            for k, v in enumerate(speeds)
+        ]
+        return {"scheme": "lovo", "folds": rows}
+
+    # rbf follows the set-points (in-sample under the threshold)
+    gaps = misfit_advice(rbf, folds(10e-3, 10e-3), 1e-3, 3.0, samples)
+    assert "not the velocity levels held out (interior folds 10x)" in gaps
+    assert "up to 2.51x apart" in gaps and "--model auto --learned" in gaps
+    ends = misfit_advice(rbf, folds(1e-3, 50e-3), 1e-3, 3.0, samples)
+    assert "misses when the slowest or fastest level is held out" in ends
+    assert "between 0.01 and 1 rad/s held up" in ends
