@@ -26,7 +26,10 @@ where the samples have both, ``g(|v|, load, T)`` with ``F = sign(v) g``:
 
 The state holds the points, the weights and the matrix of the posterior variance, so the
 predictive standard deviation travels with the model file (``FittedModel.predict(X,
-return_std=True)``).
+return_std=True)``). The model file records the marginal-likelihood optimiser's own status
+and evaluations (``state["optimizer"]``, the ``convergence`` block) and the effective degrees
+of freedom, the trace of the posterior mean's smoother (``state["edf"]``; the fit statistics
+count them, :mod:`fricid.identify._learned_trust`).
 """
 
 from __future__ import annotations

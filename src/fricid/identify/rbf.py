@@ -33,6 +33,12 @@ one network per direction for samples of both directions, and one for a single d
 (``state["symmetry"]``, :mod:`fricid.models.rbf`). The estimator itself stays a plain
 regressor on the ``X`` it is given, so the paper's study (``v > 0`` data) is unchanged.
 
+The model file records what can be trusted (:func:`trust_records`,
+:mod:`fricid.identify._learned_trust`): convergence (``lsq`` exact in closed form; an optimiser
+trainer met its target or spent its budget), the effective degrees of freedom (the trace of
+the ridge hat matrix, ESL eq. 3.50) behind the fit statistics, and the structure search's
+cross-validation error as the ``validation``, labelled with what it tests.
+
 Reading of the paper (where it is unclear, DESIGN.md "Faithful and honest")
 --------------------------------------------------------------------------
 * **Target MSE.** The paper trains to "MSE 0.0001" (section 4.3) and reports mean absolute
