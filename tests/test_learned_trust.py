@@ -221,6 +221,15 @@ def test_cli_fit_prints_the_learned_models_held_out_error(samples, tmp_path):
     assert res.exit_code == 0, res.output
     assert "(effective)" in res.stdout and "RMSE / scatter" in res.stdout
     assert "# convergence" in res.stdout
+    res = CliRunner().invoke(
+        app, ["report", str(tmp_path / "gp.json"), str(csv), "--out", str(tmp_path / "r")]
+    )
+    assert res.exit_code == 0, res.output
+    line = next(x for x in res.stderr.splitlines() if x.startswith("Trust:"))
+    # before: "with caveats, because convergence is not recorded in this model file; no
+    # held-out validation (in-sample error only)"
+    assert "not recorded" not in line and "in-sample error only" not in line
+    assert "held-out error" in line or line.startswith("Trust: yes")
 
 
 def test_misfit_advice_reads_in_sample_interior_and_end_folds(rbf, samples):
