@@ -209,7 +209,10 @@ def test_identify_fit_rbf_equals_fit_rbf():
     assert c.status == 1 and "budget" in c.message and a.status is None
     # the samples hold both directions: one network per direction (issue 11, defect 1)
     assert c.state["symmetry"] == "per_direction"
-    assert c.statistics["ndata"] == 120 and c.statistics["nvarys"] == 2 * (6 * 3 + 6 + 6 + 1)
+    # searched centres: no effective degrees of freedom, so no nvarys, AIC or BIC (issue 15)
+    assert c.statistics["ndata"] == 120 and "nvarys" not in c.statistics
+    assert "effective degrees of freedom are undefined" in c.statistics_note
+    assert c.convergence["converged"] is False and "budget" in c.convergence["reason"]
 
 
 def test_identify_fit_rbf_rejects_named_parameter_arguments():

@@ -321,6 +321,8 @@ def goodness_text(fitted, samples=None) -> str:
             lines.append(f"    {v['failed']} of {len(v['folds'])} folds could not be fitted")
         if v.get("not_converged"):
             lines.append(f"    {v['not_converged']} fold fits did not converge")
+        if v.get("note"):
+            lines.append(f"    note: {v['note']}")
     sel = fitted.selection
     if sel:
         lines += ["[[Model selection]]", f"    chosen: {sel['reason']}"]

@@ -42,7 +42,9 @@ def report_command(
         typer.Option(
             "--validate/--no-validate",
             help="Run leave-one-velocity-out validation for the trust section when the model "
-            "file has none (analytic models, when it takes a few seconds at most).",
+            "file has none, or only a learned model's own random-fold cross-validation "
+            "(when the problem is small enough: a few seconds for analytic models, up to "
+            "about ten for learned ones, each fold retrained).",
         ),
     ] = True,
 ) -> None:

@@ -87,7 +87,12 @@ class FittedModel:
     init : starting value of each free parameter.
     statistics : fit statistics after lmfit: ``ndata``, ``nvarys``, ``nfree``, ``chisqr``
         (the SSE), ``redchi``, ``aic``, ``bic``, ``rsquared``
-        (:func:`fricid.metrics.fit_statistics`).
+        (:func:`fricid.metrics.fit_statistics`); for the learned models ``nvarys_effective``
+        and ``nfree_effective`` (the effective degrees of freedom, the trace of the hat
+        matrix) in place of ``nvarys`` and ``nfree``, or neither and no AIC, BIC or reduced
+        chi-square where they are undefined (:mod:`fricid.identify._learned_trust`).
+    statistics_note : how the statistics count the model's degrees of freedom, or why some
+        are not given ("" for an analytic fit: its free parameters).
     bounds : the search box of each free parameter.
     operating_range : min and max of velocity, load and temperature in the data.
     provenance : data source, sample count, fricid version, creation time.
@@ -128,6 +133,7 @@ class FittedModel:
     ci_method: str = ""
     uncertainty_note: dict[str, str] = field(default_factory=dict)
     convergence: dict[str, Any] | None = None
+    statistics_note: str = ""
 
     @property
     def converged(self) -> bool | None:
@@ -277,6 +283,10 @@ class FittedModel:
             lines.append(f"    # data points      = {int(n)}")
         if st.get("nvarys") is not None:
             lines.append(f"    # variables        = {int(st['nvarys'])}")
+        elif st.get("nvarys_effective") is not None:
+            lines.append(f"    # variables        = {st['nvarys_effective']:.4g} (effective)")
+        if self.statistics_note:
+            lines.append(f"    # statistics       = {self.statistics_note}")
         rows = (
             ("chi-square", st.get("chisqr", self.metrics.get("sse"))),
             ("reduced chi-square", st.get("redchi")),

@@ -61,14 +61,26 @@ def _num(value: Any) -> float:
     return float("nan") if value is None else float(value)
 
 
+#: What ``convergence["certified_by"]`` means, as the fit report and the report's trust
+#: section say it.
+CERTIFIED_BY = {
+    "optimizer": "optimiser's own test",
+    "polish": "local polish",
+    "closed_form": "exact by construction: least squares in closed form",
+    "target": "the trainer met its target training error",
+}
+
+
 def _convergence_line(conv: dict[str, Any]) -> str:
     """The fit report's convergence line, from the model file's convergence block."""
     ratio = _num(conv.get("polish_sse_ratio"))
     polish = f"local polish SSE ratio {ratio:.6g}" if np.isfinite(ratio) else "no polish"
     if conv.get("converged"):
-        by = {"optimizer": "optimiser's own test", "polish": "local polish"}.get(
-            str(conv.get("certified_by")), "recorded"
-        )
+        by = CERTIFIED_BY.get(str(conv.get("certified_by")), "recorded")
+        if conv.get("certified_by") in ("closed_form", "target"):
+            base = conv.get("backbone")
+            tail = f"; backbone {_convergence_line(base)}" if isinstance(base, dict) else ""
+            return f"converged ({by}{tail})"
         return f"converged (certified by the {by}; {polish})"
     return f"NOT CONVERGED ({polish}; {conv.get('nfev')} of {conv.get('max_evals')} evaluations)"
 

@@ -26,7 +26,10 @@ where the samples have both, ``g(|v|, load, T)`` with ``F = sign(v) g``:
 
 The state holds the points, the weights and the matrix of the posterior variance, so the
 predictive standard deviation travels with the model file (``FittedModel.predict(X,
-return_std=True)``).
+return_std=True)``). The model file records the marginal-likelihood optimiser's own status
+and evaluations (``state["optimizer"]``, the ``convergence`` block) and the effective degrees
+of freedom, the trace of the posterior mean's smoother (``state["edf"]``; the fit statistics
+count them, :mod:`fricid.identify._learned_trust`).
 """
 
 from __future__ import annotations
@@ -36,6 +39,7 @@ import warnings
 from typing import Any
 
 import numpy as np
+import scipy.optimize
 from scipy.linalg import cho_factor, cho_solve
 from sklearn.exceptions import ConvergenceWarning as SklearnConvergenceWarning
 from sklearn.gaussian_process import GaussianProcessRegressor
@@ -46,10 +50,12 @@ from .. import __version__
 from ..errors import ConfigError, DataError
 from ..fitted import FittedModel
 from ..io.atomic import created_timestamp
-from ..metrics import fit_statistics, metrics
+from ..metrics import metrics
 from ..models import INPUTS
 from ..models.gp import GP_KIND, predict_gp
 from ..samples import FrictionSamples, samples_hash
+from ._learned_trust import learned_statistics, process_convergence
+from ._scatter import measurement_scatter
 
 __all__ = ["DEFAULT_MAX_POINTS", "farthest_points", "fit_gp"]
 
@@ -164,6 +170,43 @@ def _posterior(
     return alpha, 0.5 * (B + B.T), gain, cov, dbeta
 
 
+def _smoother_trace(
+    P: np.ndarray,
+    Z: np.ndarray,
+    A: np.ndarray,
+    lengths: np.ndarray,
+    s2: float,
+    noise: float,
+    exact: bool,
+) -> float:
+    """The effective degrees of freedom of the posterior mean at the training points: the
+    trace of the linear map ``S`` from targets to fitted values, at these hyperparameters,
+    the mean's basis ``A (n, q)`` estimated with it (R&W section 2.6; ESL eq. 3.50 for its
+    ridge form).
+
+    With ``dbeta = C M^T t`` and ``alpha = W (t - A dbeta)`` (:func:`_posterior`) the fit at
+    the points is ``A dbeta + K_zp alpha``, so ``tr S = tr(C M^T A) + tr(W K_zp) -
+    tr(C M^T K_zp W A)``, formed from ``m x m`` and ``n x q`` products only.
+    """
+    m = len(P)
+    Kmm = _kernel_matrix(P, P, lengths, s2)
+    if exact:
+        factor = cho_factor(Kmm + (noise + 1e-10) * np.eye(m), lower=True)
+        M = cho_solve(factor, A)
+        w_kzp = cho_solve(factor, Kmm)
+        kzp_w_a = Kmm @ M
+    else:
+        Kmn = _kernel_matrix(P, Z, lengths, s2)
+        _, jitter = _cholesky(Kmm, s2)
+        S = noise * (Kmm + jitter * np.eye(m)) + Kmn @ Kmn.T
+        Sigma, _ = _cholesky(S, float(np.trace(S)) / m)
+        M = (A - Kmn.T @ cho_solve(Sigma, Kmn @ A)) / noise
+        w_kzp = cho_solve(Sigma, Kmn @ Kmn.T)
+        kzp_w_a = Kmn.T @ cho_solve(Sigma, Kmn @ A)
+    cov = np.linalg.inv(A.T @ M)
+    return float(np.trace(cov @ (M.T @ A)) + np.trace(w_kzp) - np.trace(cov @ (M.T @ kzp_w_a)))
+
+
 def _train_side(
     samples: FrictionSamples, names: list[str], max_points: int, n_restarts: int, seed: int
 ) -> dict[str, Any]:
@@ -201,12 +244,24 @@ def _train_side(
     kernel = ConstantKernel(1.0, (1e-4, 1e4)) * RBF(np.ones(d), (1e-2, 1e3)) + WhiteKernel(
         1e-2, (1e-10, 10.0)
     )
+    runs: list[Any] = []
+
+    def lbfgs(obj_func, initial_theta, bounds):
+        """scikit-learn's own L-BFGS-B call (``optimizer="fmin_l_bfgs_b"``), its result kept:
+        the optimiser's status and evaluations go into the model file."""
+        res = scipy.optimize.minimize(
+            obj_func, initial_theta, method="L-BFGS-B", jac=True, bounds=bounds
+        )
+        runs.append(res)
+        return res.x, res.fun
+
     gpr = GaussianProcessRegressor(
-        kernel, alpha=1e-10, n_restarts_optimizer=n_restarts, random_state=seed
+        kernel, alpha=1e-10, optimizer=lbfgs, n_restarts_optimizer=n_restarts, random_state=seed
     )
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", SklearnConvergenceWarning)
         gpr.fit(Z[sub], t[sub])
+    best = min(runs, key=lambda r: float(r.fun))
     k = gpr.kernel_
     s2 = float(k.k1.k1.constant_value)
     lengths = np.atleast_1d(np.asarray(k.k1.k2.length_scale, dtype=float)) * np.ones(d)
@@ -215,6 +270,7 @@ def _train_side(
     exact = len(sub) == n
     alpha, Bm, gain, cov, dbeta = _posterior(P, Z, t, A, lengths, s2, noise, exact)
     coef = coef + y_scale * dbeta
+    edf = _smoother_trace(P, Z, A, lengths, s2, noise, exact)
     inducing = (
         "all training points"
         if exact
@@ -240,6 +296,13 @@ def _train_side(
         "n_train": n,
         "log_marginal_likelihood": float(gpr.log_marginal_likelihood_value_),
         "kernel": str(k),
+        "edf": edf,
+        "optimizer": {
+            "starts": len(runs),
+            "nfev": int(sum(int(r.nfev) for r in runs)),
+            "converged": bool(best.success),
+            "message": str(best.message),
+        },
     }
     if dropped:
         state["dropped_inputs"] = dropped
@@ -314,19 +377,31 @@ def _fit(
     state = {"kind": GP_KIND, "symmetry": symmetry, **state}
     y_hat = predict_gp(state, samples.X)
     X = samples.X
-    n_hyper = sum(
-        len(s["length_scales"]) + len(s["mean_coef"]) + 2
-        for s in ([state["pos"], state["neg"]] if symmetry == "per_direction" else [state])
+    sides = [state["pos"], state["neg"]] if symmetry == "per_direction" else [state]
+    n_hyper = sum(len(s["length_scales"]) + 2 for s in sides)
+    statistics, note = learned_statistics(
+        samples.y,
+        y_hat,
+        sum(float(s["edf"]) for s in sides),
+        "trace of the posterior mean's smoother at the fitted hyperparameters, the mean's "
+        f"coefficients included (R&W section 2.6); the {n_hyper} kernel hyperparameters "
+        "fitted by marginal likelihood are not counted",
     )
+    scatter = measurement_scatter(samples)
+    notes = sorted({n for s in sides for n in s.get("training_notes", [])})
+    runs = [s["optimizer"] for s in sides]
     return FittedModel(
         model="gp",
         params={},
-        metrics=metrics(samples.y, y_hat),
-        statistics=fit_statistics(samples.y, y_hat, n_hyper),
+        metrics=metrics(samples.y, y_hat, samples.direction, scatter.value),
+        statistics=statistics,
+        statistics_note=note,
+        convergence=process_convergence(runs, notes),
+        loss={"scatter": scatter.to_dict()},
         method="sklearn-gpr",
         seed=seed,
-        nfev=0,
-        status=0,
+        nfev=sum(r["nfev"] for r in runs),
+        status=0 if all(r["converged"] for r in runs) else 1,
         message=f"trained in {time.perf_counter() - start:.3g} s",
         operating_range={
             name: [float(X[:, INPUTS.index(name)].min()), float(X[:, INPUTS.index(name)].max())]

@@ -38,7 +38,6 @@ import numpy as np
 
 from ..errors import ConfigError
 from ..fitted import FittedModel
-from ..metrics import fit_statistics, metrics
 from ..models import INPUTS, get_model
 from ..models.hybrid import STATE_KIND
 from ..models.rbf import STATE_VERSION
@@ -195,12 +194,13 @@ def fit_hybrid(
             }
         )
     y_hat = samples.friction - resid + res.predict(samples.X, warn=False)
-    n_numbers = int(res.statistics.get("nvarys", 0)) + len(base.params)
+    from ._learned_trust import hybrid_records
+
+    records = hybrid_records(samples, base, res, y_hat)
     return FittedModel(
         model="hybrid",
         params={},
-        metrics=metrics(samples.y, y_hat),
-        statistics=fit_statistics(samples.y, y_hat, n_numbers),
+        **records,
         method=f"{base.method} + {res.method}",
         seed=res.seed,
         nfev=int((base.nfev or 0) + (res.nfev or 0)),

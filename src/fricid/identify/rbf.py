@@ -33,6 +33,12 @@ one network per direction for samples of both directions, and one for a single d
 (``state["symmetry"]``, :mod:`fricid.models.rbf`). The estimator itself stays a plain
 regressor on the ``X`` it is given, so the paper's study (``v > 0`` data) is unchanged.
 
+The model file records what can be trusted (:func:`trust_records`,
+:mod:`fricid.identify._learned_trust`): convergence (``lsq`` exact in closed form; an optimiser
+trainer met its target or spent its budget), the effective degrees of freedom (the trace of
+the ridge hat matrix, ESL eq. 3.50) behind the fit statistics, and the structure search's
+cross-validation error as the ``validation``, labelled with what it tests.
+
 Reading of the paper (where it is unclear, DESIGN.md "Faithful and honest")
 --------------------------------------------------------------------------
 * **Target MSE.** The paper trains to "MSE 0.0001" (section 4.3) and reports mean absolute
@@ -84,7 +90,7 @@ from .. import __version__
 from ..errors import ConfigError
 from ..fitted import FittedModel
 from ..io.atomic import created_timestamp
-from ..metrics import fit_statistics, metrics
+from ..metrics import metrics
 from ..models import INPUTS
 from ..models.rbf import (
     STATE_KIND,
@@ -95,8 +101,17 @@ from ..models.rbf import (
     tail_terms,
 )
 from ..samples import FrictionSamples, samples_hash
+from ._learned_trust import (
+    cv_pieces,
+    cv_validation,
+    hat_trace,
+    learned_statistics,
+    network_convergence,
+    side_states,
+)
 from ._rbf_estimator import LSQ_IGNORES, TRAINERS, RBFNetRegressor
 from ._rbf_select import check_centres, choose_structure, drop_constant_inputs
+from ._scatter import measurement_scatter
 
 __all__ = [
     "LSQ_IGNORES",
@@ -106,6 +121,7 @@ __all__ = [
     "side_data",
     "symmetry_for",
     "to_fitted_model",
+    "trust_records",
 ]
 
 
@@ -140,8 +156,48 @@ def _state(est: RBFNetRegressor, inputs: Sequence[str]) -> dict[str, Any]:
 
 
 def _n_numbers(est: RBFNetRegressor) -> int:
-    """Fitted numbers of a network (centres, widths, weights, bias): its ``nvarys``."""
-    return int(est.centers_.size + est.widths_.size + est.weights_.size + bool(est.fit_bias))
+    """Fitted numbers of a network (centres, widths, weights, bias, linear tail)."""
+    return int(
+        est.centers_.size
+        + est.widths_.size
+        + est.weights_.size
+        + bool(est.fit_bias)
+        + est.linear_.size
+    )
+
+
+def trust_records(
+    ests: Sequence[RBFNetRegressor], state: dict[str, Any], samples: FrictionSamples
+) -> tuple[dict[str, Any], float | None, str, dict[str, Any] | None]:
+    """What a network's file records about its trust (:mod:`fricid.identify._learned_trust`):
+    the convergence block, the effective degrees of freedom (None where undefined) with how
+    they were counted, and the validation record of the structure search's cross-validation
+    (None when it did not validate the trained network: an optimiser trainer, or no CV)."""
+    sides = side_states(state)
+    edfs = [s.get("edf") for s in sides]
+    numbers = sum(_n_numbers(e) for e in ests)
+    if all(isinstance(e, int | float) for e in edfs):
+        edf: float | None = float(sum(edfs))
+        parts = ["the output layer"]
+        parts += ["the linear tail"] if ests[0].linear_tail else []
+        parts += ["the bias"] if ests[0].fit_bias or ests[0].linear_tail else []
+        how = (
+            f"trace of the ridge hat matrix (ESL eq. 3.50) of {', '.join(parts)}, for a "
+            f"network that stores {numbers} numbers"
+        )
+    else:
+        edf = None
+        how = (
+            f"the centres and widths of the network ({numbers} numbers) were searched with "
+            "the targets, so it is no linear smoother and its effective degrees of freedom "
+            "are undefined"
+            if str(ests[0].trainer).lower() != "lsq"
+            else "the effective degrees of freedom were not recorded"
+        )
+    pieces = cv_pieces(state)
+    lsq = str(ests[0].trainer).lower() == "lsq"
+    validation = cv_validation(samples, pieces) if pieces and lsq else None
+    return network_convergence(ests), edf, how, validation
 
 
 def symmetry_for(samples: FrictionSamples) -> str:
@@ -213,11 +269,18 @@ def _model(
         for side, e in zip(sides, ests, strict=True)
         if e.message_
     )
+    convergence, edf, how, validation = trust_records(ests, state, samples)
+    statistics, note = learned_statistics(samples.y, y_hat, edf, how)
+    scatter = measurement_scatter(samples)
     return FittedModel(
         model="rbf",
         params={},
-        metrics=metrics(samples.y, y_hat),
-        statistics=fit_statistics(samples.y, y_hat, sum(_n_numbers(e) for e in ests)),
+        metrics=metrics(samples.y, y_hat, samples.direction, scatter.value),
+        statistics=statistics,
+        statistics_note=note,
+        convergence=convergence,
+        validation=validation,
+        loss={"scatter": scatter.to_dict()},
         method=trainer if trainer == "lsq" else f"{trainer}/{est.encoding}",
         seed=int(rs) if isinstance(rs, Integral) else None,
         nfev=int(sum(e.n_evals_ for e in ests)),
@@ -324,11 +387,13 @@ def _train_side(
     if params.get("n_centers") is not None:
         check_centres(int(params["n_centers"]), len(t), where)
     chosen, note = choose_structure(X, t, params)
+    note["n_samples"] = len(t)
     params.update({k: v for k, v in chosen.items() if params.get(k) is None})
     notes["n_centers_selection"] = note
     if "prediction_interval" in note:
         notes["prediction_interval"] = note["prediction_interval"]
     est = RBFNetRegressor(**params).fit(X, t)
+    notes["edf"] = hat_trace(est, X)
     if est.linear_tail:  # the floor of the magnitude g (models.rbf notes)
         notes["magnitude_floor"] = 0.5 * max(float(np.min(est.predict(X))), 0.0)
     return est, {**_state(est, kept), **notes}

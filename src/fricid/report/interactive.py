@@ -196,9 +196,13 @@ def residual_figure(
                 "name": word,
                 "x": _list((np.abs(v) if both else v) * vf),
                 "y": _list(residual[sel] * rf),
-                "customdata": np.column_stack(
-                    [samples.load[sel], samples.temperature[sel]]
-                ).tolist(),
+                # a column not measured is NaN: null in the JSON, which allows no NaN
+                "customdata": [
+                    list(pair)
+                    for pair in zip(
+                        _list(samples.load[sel]), _list(samples.temperature[sel]), strict=True
+                    )
+                ],
                 "hovertemplate": "%{x:.4g}, %{y:.4g}<br>load %{customdata[0]:.3g} N m, "
                 "%{customdata[1]:.3g} °C<extra></extra>",
                 "marker": {"symbol": symbol, "color": COLORS[k % len(COLORS)], "size": 7},

@@ -168,10 +168,10 @@ def _strong_correlations(frame: pd.DataFrame, limit: float = 0.9) -> list[str]:
 
 
 def _model_description(fitted: FittedModel) -> str:
-    if fitted.model == "gp":
+    if fitted.model in ("gp", "hybrid"):
         from ..models import get_predictor
 
-        return get_predictor("gp").describe(fitted.state) + "."
+        return get_predictor(fitted.model).describe(fitted.state) + "."
     if fitted.kind == "rbf":
         return (
             "RBF neural network (BAS-RBFNN paper, eq. 14-15): Gaussian basis functions of "
@@ -203,8 +203,8 @@ def model_report(
         models, whose CIs come from the Jacobian at the optimum).
     seed : seed of the bootstrap.
     validate : run a leave-one-velocity-out validation for the trust section when the model
-        file has none, the model is analytic and it takes at most a few seconds
-        (:func:`fricid.report.trust.assess_trust`).
+        file has none (or only a learned model's own random-fold cross-validation) and the
+        problem is small enough (:func:`fricid.report.trust.assess_trust`).
 
     Returns
     -------

@@ -266,7 +266,10 @@ def rbf_parameter_items(
         note = (
             " The 90 % prediction interval (saved in the model file) covers a new averaged "
             "sample, noise included: conformal, from the cross-validation residuals of the "
-            "network's structure selection."
+            "network's structure selection. Those folds are random, so every velocity level "
+            "was in training: the coverage holds at the measured velocity levels, not "
+            "between or beyond them (there, see the leave-one-velocity-out error under "
+            "'Can I trust this?')."
         )
     hybrid = fitted.model == "hybrid"
     main: list = [

@@ -11,10 +11,15 @@ module reads them (and, where given, the samples) into one :class:`Trust`:
 - identifiability: parameters not determined (``uncertainty_note``, a NaN standard error) and
   intervals with an open side (``ci_open``); an open lower side at a bound of 0 means
   "consistent with zero" and is not a caveat;
-- held-out error against the measurement scatter: the file's ``validation``; else, for an
-  analytic model given its samples, :func:`fricid.identify.validate` with ``lovo`` when its
-  size (folds x samples x parameters) is at most :data:`VALIDATE_WORK` and the samples have at least
-  :data:`MIN_LEVELS` velocity levels; else the fit's in-sample
+- held-out error against the measurement scatter: the file's ``validation``; else (or when
+  it is a learned model's own random-fold cross-validation, which tests the measured
+  set-points only), given the samples, :func:`fricid.identify.validate` with ``lovo`` when
+  the samples have at least :data:`MIN_LEVELS` velocity levels and it is small enough
+  (:mod:`._heldout`: an analytic model's folds x samples x parameters at most
+  :data:`VALIDATE_WORK`; a learned model's folds x samples at most
+  :data:`fricid.identify._learned_trust.LEARNED_VALIDATE_WORK`, each fold retrained as
+  ``fit`` trains it), so analytic and learned verdicts rest on the same test; else the
+  learned model's own cross-validation, with the caveat, or the fit's in-sample
   ``rmse_over_scatter``, labelled as such;
 - the operating range, outside which predictions are extrapolated.
 
@@ -23,21 +28,23 @@ model misses the data by more than :data:`MISS_RATIO` times the scatter; ``"with
 when anything else above is short of clean (a parameter not determined or not bounded, an
 error between :data:`fricid.metrics.NOISE_RATIO` and :data:`MISS_RATIO` times the scatter,
 no held-out error or no scatter, convergence not recorded, set-points flagged for scatter or
-with outliers dropped); ``"yes"`` otherwise.
+with outliers dropped); ``"yes"`` otherwise. A model whose error misses the scatter gets
+what to do (:func:`fricid.report.advice.misfit_advice`).
 """
 
 from __future__ import annotations
 
-import warnings
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
-from ..errors import FricidError
 from ..fitted import FittedModel
+from ..fitted._file import _convergence_line
 from ..metrics import NOISE_RATIO, verdict
 from ..samples import FrictionSamples
+from ._heldout import MIN_LEVELS, VALIDATE_WORK, own_cv
+from ._heldout import run_validation as _run_validation
 
 __all__ = [
     "MIN_LEVELS",
@@ -53,15 +60,6 @@ __all__ = [
 #: A model whose (held-out) RMSE exceeds this multiple of the measurement scatter is not
 #: trusted: most of its error is the model's, not the noise's.
 MISS_RATIO = 3.0
-
-#: Largest leave-one-velocity-out validation the report runs itself, as folds x samples x
-#: parameters. A count, not a measured time, so the verdict does not depend on how busy the
-#: machine is (larger problems: ``fricid fit --validate lovo``).
-VALIDATE_WORK = 50_000
-
-#: The report runs its own leave-one-velocity-out validation only with at least this many
-#: velocity levels (with fewer, each held-out level is an extrapolation from a handful).
-MIN_LEVELS = 5
 
 _UNITS = {"velocity": "rad/s", "load": "N m", "temperature": "degC"}
 
@@ -106,7 +104,16 @@ class Trust:
     quality_summary : str
         One line on them.
     rbf : bool
-        The model is the RBF network (no physical parameters to identify).
+        The model is learned (the RBF network, the hybrid, the GP: no physical parameters
+        to identify).
+    cv : dict or None
+        A learned model's own cross-validation record when the verdict is on another
+        validation (shown beside it).
+    what_to_do : str
+        For a model whose error misses the scatter: what to do
+        (:func:`fricid.report.advice.misfit_advice`); "" otherwise.
+    model : str
+        The model's registry name.
     """
 
     level: str
@@ -127,10 +134,15 @@ class Trust:
     quality: list[dict[str, Any]] | None = None
     quality_summary: str = ""
     rbf: bool = False
+    cv: dict[str, Any] | None = None
+    what_to_do: str = ""
+    model: str = ""
 
     def line(self) -> str:
-        """``"Trust: with caveats, because ..."``."""
-        return f"Trust: {self.level}, because " + "; ".join(self.reasons) + "."
+        """``"Trust: with caveats, because ..."``, and for a model that misses the data what
+        to do (:func:`fricid.report.advice.misfit_advice`)."""
+        out = f"Trust: {self.level}, because " + "; ".join(self.reasons) + "."
+        return out + (f" What to do: {self.what_to_do}." if self.what_to_do else "")
 
 
 def not_determined(fitted: FittedModel) -> list[str]:
@@ -238,40 +250,6 @@ def _point_name(row: dict[str, Any]) -> str:
     return f"{row['label']} ({where})" if row.get("label") else where
 
 
-def _run_validation(
-    fitted: FittedModel, samples: FrictionSamples, max_work: int
-) -> tuple[dict[str, Any] | None, str]:
-    """Leave-one-velocity-out validation of ``fitted``'s model on ``samples`` when folds x
-    samples x parameters is at most ``max_work``."""
-    from ..identify.validate import level_labels, validate
-
-    if fitted.kind == "rbf":
-        return None, "not run for the RBF network (each fold retrains it); in-sample only"
-    folds = int(np.unique(level_labels(samples)).size)
-    if folds < MIN_LEVELS:
-        return None, (
-            f"not run here: {folds} velocity level(s), and holding one out of so few asks "
-            "the model to extrapolate; in-sample only"
-        )
-    work = folds * len(samples) * max(len(fitted.params) - len(fitted.fixed), 1)
-    if work > max_work:
-        return None, (
-            f"not run here ({folds} folds x {len(samples)} samples x parameters = {work:,}, "
-            f"over the report's {max_work:,}; use fricid fit --validate lovo); in-sample only"
-        )
-    fixed = {n: fitted.params[n] for n in fitted.fixed if n in fitted.params}
-    options: dict[str, Any] = {"intervals": "none"}
-    if isinstance(fitted.loss.get("loss"), str):
-        options["loss"] = fitted.loss["loss"]
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            val = validate(samples, fitted.model, "lovo", "lm", fixed=fixed, **options)
-    except FricidError as exc:
-        return None, f"could not be run here ({exc}); in-sample only"
-    return val.to_dict(), f"run by this report: lovo, {folds} folds, each fitted by lm"
-
-
 def _heldout(trust: Trust, fitted: FittedModel, samples: FrictionSamples | None) -> None:
     """The ratio to grade by: held out, else the file's in-sample ratio, else the in-sample
     ratio on ``samples`` (a network's file may not record its scatter)."""
@@ -316,10 +294,11 @@ def assess_trust(
         The samples it was identified on: their quality table, and the held-out validation
         when the file has none.
     run_validation : bool, default True
-        Run :func:`fricid.identify.validate` (``lovo``) when the file holds no validation, the
-        model is analytic and folds x samples x parameters is at most ``max_work``.
+        Run :func:`fricid.identify.validate` (``lovo``) when the file holds no validation, or
+        only a learned model's own cross-validation, and the problem is small enough (module
+        notes).
     max_work : int
-        The size limit of that validation (see :data:`VALIDATE_WORK`).
+        The size limit of an analytic model's validation (see :data:`VALIDATE_WORK`).
 
     Returns
     -------
@@ -331,10 +310,7 @@ def assess_trust(
     if conv is None:
         line = "not recorded in this model file"
     elif converged:
-        by = {"optimizer": "the optimiser's own test", "polish": "a local polish"}.get(
-            str(conv.get("certified_by")), "the fit"
-        )
-        line = f"converged (certified by {by})"
+        line = _convergence_line(conv)
     else:
         line = f"NOT converged: {conv.get('reason') or conv.get('message') or 'no reason given'}"
     rows, qsummary, qcaveat = _quality(samples)
@@ -351,13 +327,25 @@ def assess_trust(
         quality=rows,
         quality_summary=qsummary,
         rbf=fitted.kind == "rbf",
+        model=fitted.model,
     )
-    if trust.validation is None and samples is not None and run_validation and converged:
-        trust.validation, trust.validation_note = _run_validation(fitted, samples, max_work)
+    mine = own_cv(fitted.validation)
+    if (mine or trust.validation is None) and samples is not None and run_validation and converged:
+        val, trust.validation_note = _run_validation(fitted, samples, max_work)
+        trust.validation = val or trust.validation
     elif trust.validation is None:
         trust.validation_note = "no held-out validation in the file; in-sample only"
+    elif mine:
+        trust.validation_note = "leave-one-velocity-out not run here; the fit's own CV only"
+    if mine and trust.validation is not fitted.validation:
+        trust.cv = fitted.validation
     _heldout(trust, fitted, samples)
     _grade(trust, fitted, qcaveat)
+    if trust.converged is not False and trust.heldout_ratio > MISS_RATIO:
+        from .advice import misfit_advice
+
+        held = trust.validation if trust.heldout_source != "in-sample" else None
+        trust.what_to_do = misfit_advice(fitted, held, trust.scatter, MISS_RATIO, samples)
     return trust
 
 
@@ -385,6 +373,11 @@ def _grade(trust: Trust, fitted: FittedModel, quality_caveat: str) -> None:
         caveats.append("no measurement scatter to compare the error with")
     if np.isfinite(ratio) and kind == "in-sample" and not no:
         caveats.append("no held-out validation (in-sample error only)")
+    elif np.isfinite(ratio) and own_cv(trust.validation) and not no:
+        caveats.append(
+            "held out at the measured velocity levels only (the fit's own random-fold CV; "
+            "between and beyond them untested)"
+        )
     if quality_caveat:
         caveats.append(quality_caveat)
     if no:
@@ -424,6 +417,16 @@ def quality_frame(rows: list[dict[str, Any]]) -> Any:
     return pd.DataFrame(out)
 
 
+#: The identifiability line of a learned model.
+_LEARNED_IDENT = {
+    "rbf": "not applicable to the network's weights (not physical; see the bootstrap "
+    "intervals of its predictions)",
+    "hybrid": "the backbone's parameters are a starting shape, not identified values (the "
+    "residual network absorbs what they miss); see the bootstrap intervals of its predictions",
+    "gp": "not applicable to the process's hyperparameters (not physical; see its posterior band)",
+}
+
+
 def trust_text(trust: Trust) -> str:
     """The section's list: data quality, convergence, identifiability, held-out error,
     operating range (plain text with the report's small markup)."""
@@ -434,10 +437,7 @@ def trust_text(trust: Trust) -> str:
     lines.append(conv + ".")
     ident = []
     if trust.rbf:
-        ident.append(
-            "not applicable to the network's weights (not physical; see the "
-            "bootstrap intervals of its predictions)"
-        )
+        ident.append(_LEARNED_IDENT.get(trust.model, _LEARNED_IDENT["rbf"]))
     elif trust.converged is False:
         ident.append("not assessed: the fit did not converge")
     if trust.not_determined:
@@ -462,6 +462,14 @@ def trust_text(trust: Trust) -> str:
         held = "no measurement scatter to compare with"
     if trust.validation_note:
         held += f" ({trust.validation_note})"
+    cv = trust.cv or (trust.validation if own_cv(trust.validation) else None)
+    if cv and cv.get("rmse") is not None:
+        held += (
+            f"; the fit's own cross-validation ({cv.get('scheme')}): {cv['rmse']:.3g} N m, "
+            f"{cv.get('verdict', '')}: {cv.get('note', '')}"
+        )
+    if trust.what_to_do:
+        held += f". What to do: {trust.what_to_do}"
     lines.append(f"- **Error against scatter**: {held}.")
     lines.append(
         f"- **Operating range** (predictions outside it are extrapolated): "

@@ -1,0 +1,123 @@
+"""The held-out validation a report runs itself for its trust verdict (:mod:`.trust`):
+leave-one-velocity-out of an analytic model when folds x samples x parameters is at most
+:data:`VALIDATE_WORK`, of a learned model (``rbf`` and ``hybrid`` trained by least squares,
+``gp``; each fold retrained as ``fit`` trains it) when folds x samples is at most
+:data:`fricid.identify._learned_trust.LEARNED_VALIDATE_WORK`, with at least
+:data:`MIN_LEVELS` velocity levels either way.
+"""
+
+from __future__ import annotations
+
+import warnings
+from typing import Any
+
+import numpy as np
+
+from ..errors import FricidError
+from ..fitted import FittedModel
+from ..samples import FrictionSamples
+
+__all__ = ["MIN_LEVELS", "VALIDATE_WORK", "own_cv", "run_validation"]
+
+#: Largest leave-one-velocity-out validation the report runs itself, as folds x samples x
+#: parameters. A count, not a measured time, so the verdict does not depend on how busy the
+#: machine is (larger problems: ``fricid fit --validate lovo``).
+VALIDATE_WORK = 50_000
+
+#: The report runs its own leave-one-velocity-out validation only with at least this many
+#: velocity levels (with fewer, each held-out level is an extrapolation from a handful).
+MIN_LEVELS = 5
+
+
+def run_validation(
+    fitted: FittedModel, samples: FrictionSamples, max_work: int
+) -> tuple[dict[str, Any] | None, str]:
+    """Leave-one-velocity-out validation of ``fitted``'s model on ``samples`` when folds x
+    samples x parameters is at most ``max_work`` (a learned model: :func:`_run_learned`)."""
+    from ..identify.validate import level_labels
+
+    fallback = "in-sample only" if fitted.validation is None else "the fit's own CV only"
+    folds = int(np.unique(level_labels(samples)).size)
+    if folds < MIN_LEVELS:
+        return None, (
+            f"not run here: {folds} velocity level(s), and holding one out of so few asks "
+            f"the model to extrapolate; {fallback}"
+        )
+    if fitted.kind == "rbf":  # the learned models: each fold retrains, structure search too
+        return _run_learned(fitted, samples, folds, fallback)
+    work = folds * len(samples) * max(len(fitted.params) - len(fitted.fixed), 1)
+    if work > max_work:
+        return None, (
+            f"not run here ({folds} folds x {len(samples)} samples x parameters = {work:,}, "
+            f"over the report's {max_work:,}; use fricid fit --validate lovo); {fallback}"
+        )
+    fixed = {n: fitted.params[n] for n in fitted.fixed if n in fitted.params}
+    options: dict[str, Any] = {"intervals": "none"}
+    if isinstance(fitted.loss.get("loss"), str):
+        options["loss"] = fitted.loss["loss"]
+    return _lovo(
+        samples,
+        fitted.model,
+        "lm",
+        f"{folds} folds, each fitted by lm",
+        fallback,
+        fixed=fixed,
+        **options,
+    )
+
+
+def _lovo(
+    samples: FrictionSamples, model: str, method: str, how: str, fallback: str, **options: Any
+) -> tuple[dict[str, Any] | None, str]:
+    """:func:`fricid.identify.validate` with ``lovo``, its warnings silenced."""
+    from ..identify.validate import validate
+
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            val = validate(samples, model, "lovo", method, **options)
+    except FricidError as exc:
+        return None, f"could not be run here ({exc}); {fallback}"
+    return val.to_dict(), f"run by this report: lovo, {how}"
+
+
+def _run_learned(
+    fitted: FittedModel, samples: FrictionSamples, folds: int, fallback: str
+) -> tuple[dict[str, Any] | None, str]:
+    """Leave-one-velocity-out of a learned model (``rbf``, ``hybrid``: trained by least
+    squares; ``gp``), each fold retrained as ``fit`` trains it (the structure search, the
+    backbone's selection, the GP's hyperparameters), when folds x samples is at most
+    :data:`fricid.identify._learned_trust.LEARNED_VALIDATE_WORK`."""
+    from ..identify._learned_trust import LEARNED_VALIDATE_WORK
+
+    work = folds * len(samples)
+    trainer = str((fitted.state or {}).get("trainer") or "")
+    residual = (fitted.state or {}).get("residual") or {}
+    trainer = trainer or str(residual.get("trainer") or "")
+    if fitted.model != "gp" and trainer != "lsq":
+        return None, (
+            f"not run here for a network trained by '{trainer}' (each fold would rerun its "
+            f"optimiser; use fricid fit --validate lovo); {fallback}"
+        )
+    if work > LEARNED_VALIDATE_WORK:
+        return None, (
+            f"not run here ({folds} folds x {len(samples)} samples = {work:,}, over the "
+            f"report's {LEARNED_VALIDATE_WORK:,} for a learned model, each fold retrained; "
+            f"use fricid fit --validate lovo); {fallback}"
+        )
+    options: dict[str, Any] = {}
+    if fitted.model == "gp":
+        params = (fitted.provenance or {}).get("estimator_params") or {}
+        options["options"] = {k: params[k] for k in ("max_points", "n_restarts") if k in params}
+    seed = fitted.seed if fitted.seed is not None else 0
+    how = f"{folds} folds, each retrained as fit trains {fitted.model}"
+    method = "lm" if fitted.model == "gp" else "lsq"
+    return _lovo(samples, fitted.model, method, how, fallback, seed=seed, **options)
+
+
+def own_cv(validation: dict[str, Any] | None) -> bool:
+    """The validation is a learned model's record of its own structure search's CV (random
+    folds at the measured set-points, :mod:`fricid.identify._learned_trust`)."""
+    from ..identify._learned_trust import CV_SOURCE
+
+    return bool(validation) and validation.get("source") == CV_SOURCE

@@ -1,0 +1,115 @@
+"""What to do about a model whose held-out error misses the measurement scatter (the trust
+verdict's "no", :mod:`fricid.report.trust`): advice computed from the file and the validation,
+never a promise of what another model would achieve.
+
+Three readings, from the in-sample error against the scatter and, for leave-one-velocity-out,
+the interior folds (:func:`fricid.identify.validate.interior_rmse`):
+
+- the in-sample error alone misses (over :data:`~fricid.report.trust.MISS_RATIO` times the
+  scatter): the family cannot follow the data, and more data will not change that; a learned
+  model (the hybrid: an analytic backbone plus a learned residual) or the comparison of every
+  family by held-out error (``--model auto --learned``) is what to try;
+- the model follows the measured set-points but misses the interior held-out levels: between
+  the measured speeds its predictions are not backed by the data; measure more velocity levels
+  in the widest gaps, or compare the families by held-out error;
+- it follows the set-points and the interior levels, and misses only when the slowest or the
+  fastest level is held out: an extrapolation; its predictions inside the measured speeds
+  held up.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..fitted import FittedModel
+from ..samples import FrictionSamples
+
+__all__ = ["misfit_advice"]
+
+
+def _in_sample_ratio(fitted: FittedModel, samples: FrictionSamples | None, scatter: float):
+    ratio = fitted.metrics.get("rmse_over_scatter")
+    if ratio is not None:
+        return float(ratio)
+    if samples is None or not np.isfinite(scatter) or scatter <= 0:
+        return float("nan")
+    from ..metrics import rmse
+
+    return rmse(samples.y, fitted.predict(samples.X, warn=False)) / scatter
+
+
+def _name(samples: FrictionSamples | None) -> str:
+    source = getattr(samples, "source", None) if samples is not None else None
+    name = Path(str(source)).name if source else ""
+    safe = name and all(c.isalnum() or c in "._-" for c in name)
+    return name if safe else "SAMPLES"
+
+
+def misfit_advice(
+    fitted: FittedModel,
+    validation: dict[str, Any] | None,
+    scatter: float,
+    miss_ratio: float,
+    samples: FrictionSamples | None = None,
+) -> str:
+    """What to do about a model whose (held-out) error exceeds ``miss_ratio`` scatters.
+
+    Parameters
+    ----------
+    fitted : FittedModel
+    validation : dict or None
+        The validation the verdict is on (``Validation.to_dict()``), None for in-sample.
+    scatter : float
+        N m, the measurement scatter.
+    miss_ratio : float
+        The verdict's threshold (:data:`fricid.report.trust.MISS_RATIO`).
+    samples : FrictionSamples, optional
+        Their file name goes into the commands; without a recorded in-sample ratio, the
+        in-sample error is computed on them.
+
+    Returns
+    -------
+    str
+        One sentence (module notes), ``""`` when no reading applies.
+    """
+    from ..identify.validate import interior_rmse
+
+    name = _name(samples)
+    learned = fitted.kind == "rbf"
+    r_in = _in_sample_ratio(fitted, samples, scatter)
+    auto = f"compare every family by held-out error (fricid fit {name} --model auto --learned)"
+    if np.isfinite(r_in) and r_in > miss_ratio:
+        what = "this model" if learned else f"the {fitted.model} family"
+        return (
+            f"{what} cannot follow these data: its in-sample error alone is {r_in:.3g}x the "
+            "scatter, so more data will not help; fit a learned model (fricid fit "
+            f"{name} --model hybrid: an analytic backbone plus a learned residual), or {auto}"
+        )
+    folds = (validation or {}).get("folds") or []
+    if (validation or {}).get("scheme") != "lovo" or len(folds) < 3 or not np.isfinite(r_in):
+        return (
+            f"it follows the samples in-sample ({r_in:.3g}x the scatter) but not held out: too "
+            f"flexible for these data; {auto}"
+            if np.isfinite(r_in)
+            else ""
+        )
+    inner = interior_rmse(folds) / scatter
+    speeds = np.sort([float(f["speed"]) for f in folds if float(f["speed"]) > 0])
+    gap = float(np.max(speeds[1:] / speeds[:-1])) if speeds.size > 1 else float("nan")
+    if np.isfinite(inner) and inner <= miss_ratio:
+        return (
+            f"it follows the measured set-points (in-sample {r_in:.3g}x the scatter) and the "
+            f"interior held-out levels ({inner:.3g}x), and misses when the slowest or fastest "
+            f"level is held out: an extrapolation; its predictions between "
+            f"{speeds[0]:.3g} and {speeds[-1]:.3g} rad/s held up, beyond them measure first"
+        )
+    other = f"; or {auto}" if learned else ""
+    return (
+        f"it follows the measured set-points (in-sample {r_in:.3g}x the scatter) but not the "
+        f"velocity levels held out (interior folds {inner:.3g}x): between the {len(folds)} "
+        f"measured speeds, up to {gap:.3g}x apart, its predictions are not backed by the data; "
+        f"measure more velocity levels in the widest gaps{other}"
+    )
