@@ -226,13 +226,17 @@ class _CrossValidation:
         if self.linear:
             A = np.hstack([A, self.L[order]])
         oof = np.full((len(self.alphas), len(self.ts)), np.nan)
+        # the training folds' normal equations from the whole set's minus the held-out
+        # fold's (one Gram matrix of all samples, one of each fold: half the products of
+        # forming each training fold's), centred through the column sums when fitting a bias
+        S_all, s_all, r_all = A.T @ A, A.sum(axis=0), A.T @ self.ts
         for train, test in self.splits:
-            At, tt = A[train], self.ts[train]
-            mu = At.mean(axis=0) if self.fit_bias else np.zeros(A.shape[1])
-            tm = float(tt.mean()) if self.fit_bias else 0.0
-            Ac = At - mu
-            G = Ac.T @ Ac / len(train)
-            h = Ac.T @ (tt - tm) / len(train)
+            Ae, te, nt = A[test], self.ts[test], len(train)
+            s = s_all - Ae.sum(axis=0)
+            mu = s / nt if self.fit_bias else np.zeros(A.shape[1])
+            tm = float((self.ts.sum() - te.sum()) / nt) if self.fit_bias else 0.0
+            G = (S_all - Ae.T @ Ae - nt * np.outer(mu, mu)) / nt
+            h = (r_all - Ae.T @ te - nt * tm * mu) / nt
             for k, alpha in enumerate(self.alphas):
                 Gk = G.copy()
                 Gk[np.diag_indices_from(Gk)] += alpha
