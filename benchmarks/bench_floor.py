@@ -25,8 +25,8 @@ noise (1.0 = a model equal to the truth) and the training seconds, for
 * ``gp``: ``fit(samples, "gp")``, fricid's Gaussian process (inducing subset of 400 points
   above 400 samples);
 * ``sklearn GP``: scikit-learn's ``GaussianProcessRegressor`` with an ARD RBF kernel plus
-  white noise (as issue 15's table; first reporting seed only, as the training-time
-  reference);
+  white noise (as issue 15's table; its configuration and default optimiser unchanged),
+  timed on every reporting seed like the others;
 * ``MLP``: scikit-learn's ``MLPRegressor`` with two hidden layers of 64.
 
 Both scikit-learn models get the structure the fricid models get (the same for every model:
@@ -34,7 +34,9 @@ fair): standardised inputs ``asinh(|v| / v_min)``, the other measured inputs and
 (per-direction samples), target ``sign(v) F``, prediction ``sign(v) g``.
 
 Goals (issue 15): the default model <= 1.10 x noise on each kind; its training time <= 0.1 x
-the GP's (fricid's ``gp``) on the same data.
+the GP's on the same data, reported against both references: fricid's ``gp`` and issue 15's
+scikit-learn GP (the mean seconds over the same seeds, in the same run; every timed family is
+fitted once on a tuning draw first, so that no timing includes numba's compilation).
 
 Part 2: the paper-1 preset (``paper1``, full design, the oracle's Gaussian noise on the true
 friction, :func:`fricid.experiments.rbfnn_study.paper1_data`, seed 1001) against the true
@@ -184,8 +186,38 @@ DEFAULT = "hybrid"
 FAMILIES = ("best analytic", "rbf plain", "rbf", "hybrid", "gp", "sklearn GP", "MLP")
 
 
+def _warm_up() -> None:
+    """Fit every timed fricid family once on a tuning draw (seed 0) of each kind, untimed, so
+    that no timing below includes numba's compilation or first imports."""
+    for kind in KINDS:
+        d = draw(kind, 0)
+        for name in ("rbf", "hybrid", "gp"):
+            if name != "gp" or "gp" in STATEFUL or "gp" in MODELS:
+                fit(d.train, name, seed=0)
+
+
+#: The training-time references: fricid's ``gp`` and issue 15's scikit-learn GP.
+REFERENCES = ("gp", "sklearn GP")
+
+
+def _time_verdict(t_def: float, acc, ref: str) -> str:
+    vals = acc[ref]
+    if not vals:
+        return f"{ref}: not timed"
+    t_ref = float(np.mean([v[1] for v in vals]))
+    ratio = t_def / t_ref
+    return (
+        f"{ratio:.3f} x {ref}'s {t_ref:.3f} s "
+        f"({'meets' if ratio <= GOAL_TIME else 'MISSES'} <= {GOAL_TIME})"
+    )
+
+
 def part1(seeds, with_gp: bool) -> None:
-    print("Held-out RMSE / noise (mean over reporting seeds), training seconds in brackets\n")
+    _warm_up()
+    print(
+        "Held-out RMSE / noise (mean over reporting seeds), mean training seconds in brackets "
+        "(every seed timed, numba compiled beforehand)\n"
+    )
     head = f"{'family':<16}" + "".join(f"{k:>26}" for k in KINDS)
     print(head)
     rows: dict[str, list[str]] = {f: [] for f in FAMILIES}
@@ -193,7 +225,7 @@ def part1(seeds, with_gp: bool) -> None:
     for kind in KINDS:
         acc: dict[str, list[tuple[float, float]]] = {f: [] for f in FAMILIES}
         best_names = set()
-        for k, seed in enumerate(seeds):
+        for seed in seeds:
             d = draw(kind, seed)
             r, name, dt = _analytic(d)
             acc["best analytic"].append((r, dt))
@@ -205,7 +237,7 @@ def part1(seeds, with_gp: bool) -> None:
             acc["hybrid"].append(_fricid(d, "hybrid"))
             if "gp" in STATEFUL or "gp" in MODELS:
                 acc["gp"].append(_fricid(d, "gp"))
-            if with_gp and k == 0:
+            if with_gp:
                 acc["sklearn GP"].append(_sklearn(d, "gp"))
             acc["MLP"].append(_sklearn(d, "mlp"))
         for f in FAMILIES:
@@ -215,23 +247,16 @@ def part1(seeds, with_gp: bool) -> None:
             else:
                 r = np.mean([v[0] for v in vals])
                 t = np.mean([v[1] for v in vals])
-                cell = f"{r:.2f} [{t:.1f} s]"
+                cell = f"{r:.2f} [{t:.3f} s]"
                 if f == "best analytic":
-                    cell = f"{r:.2f} {'/'.join(sorted(best_names))[:11]} [{t:.1f}s]"
+                    cell = f"{r:.2f} {'/'.join(sorted(best_names))[:11]} [{t:.2f}s]"
             rows[f].append(cell)
         default = np.mean([v[0] for v in acc[DEFAULT]])
-        t_def = np.mean([v[1] for v in acc[DEFAULT]])
-        ref = acc["gp"] or acc["sklearn GP"]
-        t_gp = np.mean([v[1] for v in ref]) if ref else np.nan
+        t_def = float(np.mean([v[1] for v in acc[DEFAULT]]))
         verdict.append(
             f"{kind}: default ({DEFAULT}) {default:.2f} x noise "
             f"({'meets' if default <= GOAL_RATIO else 'MISSES'} <= {GOAL_RATIO}); training "
-            + (
-                f"{t_def / t_gp:.3f} x the GP's "
-                f"({'meets' if t_def <= GOAL_TIME * t_gp else 'MISSES'} <= {GOAL_TIME})"
-                if np.isfinite(t_gp)
-                else "(no GP timed)"
-            )
+            f"{t_def:.3f} s = " + "; ".join(_time_verdict(t_def, acc, ref) for ref in REFERENCES)
         )
     for f in FAMILIES:
         print(f"{f:<16}" + "".join(f"{c:>26}" for c in rows[f]))
@@ -257,7 +282,7 @@ def part2(seed: int) -> None:
         m, times[name] = _timed(lambda name=name: fit(samples, name, seed=0))
         err = np.abs(m.predict(unseen.X, warn=False) - unseen.friction) * 1e3
         label = name + (f" ({m.state['backbone']['model']})" if name == "hybrid" else "")
-        print(f"{label:<22}{err.mean():>8.2f}{err.max():>8.2f}{times[name]:>9.1f}")
+        print(f"{label:<22}{err.mean():>8.2f}{err.max():>8.2f}{times[name]:>9.3f}")
         if name == DEFAULT:
             mean_default = float(err.mean())
     ok = mean_default <= GOAL_UNSEEN * 1e3 * floor
@@ -265,7 +290,7 @@ def part2(seed: int) -> None:
     print(
         f"Goal: default ({DEFAULT}) mean {mean_default:.2f} mN m = "
         f"{mean_default / (1e3 * floor):.2f} x the noise ({'meets' if ok else 'MISSES'} <= "
-        f"{GOAL_UNSEEN}); training {ratio:.2f} x the gp's "
+        f"{GOAL_UNSEEN}); training {ratio:.3f} x the gp's "
         f"({'meets' if ratio <= GOAL_TIME else 'MISSES'} <= {GOAL_TIME}); paper's BAS-RBFNN "
         "1.2/6.3, issue 15's GP 0.53/1.18"
     )
