@@ -230,31 +230,60 @@ class _CrossValidation:
         # fold's (one Gram matrix of all samples, one of each fold: half the products of
         # forming each training fold's), centred through the column sums when fitting a bias
         S_all, s_all, r_all = A.T @ A, A.sum(axis=0), A.T @ self.ts
+        folds = []
         for train, test in self.splits:
             Ae, te, nt = A[test], self.ts[test], len(train)
-            s = s_all - Ae.sum(axis=0)
-            mu = s / nt if self.fit_bias else np.zeros(A.shape[1])
+            mu = (s_all - Ae.sum(axis=0)) / nt if self.fit_bias else np.zeros(A.shape[1])
             tm = float((self.ts.sum() - te.sum()) / nt) if self.fit_bias else 0.0
             G = (S_all - Ae.T @ Ae - nt * np.outer(mu, mu)) / nt
             h = (r_all - Ae.T @ te - nt * tm * mu) / nt
-            for k, alpha in enumerate(self.alphas):
-                Gk = G.copy()
-                Gk[np.diag_indices_from(Gk)] += alpha
-                try:
-                    w = scipy.linalg.cho_solve(
-                        scipy.linalg.cho_factor(Gk, check_finite=False, overwrite_a=True),
-                        h,
-                        check_finite=False,
-                    )
-                except (np.linalg.LinAlgError, scipy.linalg.LinAlgError):
-                    w = np.linalg.lstsq(G + alpha * np.eye(len(h)), h, rcond=None)[0]
-                oof[k, test] = (A[test] - mu) @ w + tm
+            folds.append((test, mu, tm, G, h))
+        W = self._solve_all([f[3] for f in folds], [f[4] for f in folds])
+        for (test, mu, tm, _, _), w in zip(folds, W, strict=True):
+            oof[:, test] = ((A[test] - mu) @ w.T + tm).T
         rmse = np.sqrt(np.mean((oof - self.ts) ** 2, axis=1)) * self.half
         rmse = np.where(np.isfinite(rmse), rmse, np.inf)
         k = int(np.argmin(rmse))
         out = (k, float(rmse[k]), (oof[k] - self.ts) * self.half)
         self._memo[key] = out
         return out
+
+    #: Up to this many output weights, :meth:`_solve_all` solves every fold and penalty in
+    #: one batched call (the per-call overhead dominates small systems); above, one Cholesky
+    #: solve each (a batched LU would cost twice the arithmetic).
+    BATCH_MAX = 128
+
+    def _solve_all(self, Gs: list[np.ndarray], hs: list[np.ndarray]) -> np.ndarray:
+        """Ridge solutions ``(G + alpha I) w = h`` for every fold (``Gs``, ``hs``) and penalty
+        of :attr:`alphas`: ``(folds, len(alphas), p)``. Cholesky where ``G + alpha I`` is
+        positive definite, else least squares (rounding can leave it indefinite)."""
+        G = np.asarray(Gs)
+        h = np.asarray(hs)
+        nf, p = h.shape
+        alphas = np.asarray(self.alphas, dtype=float)
+        if p <= self.BATCH_MAX:
+            GA = np.repeat(G[:, None], len(alphas), axis=1)
+            GA[..., np.arange(p), np.arange(p)] += alphas[None, :, None]
+            try:
+                np.linalg.cholesky(GA)  # positive definite, all of them (else per system)
+                hA = np.broadcast_to(h[:, None, :, None], (nf, len(alphas), p, 1))
+                return np.linalg.solve(GA, hA)[..., 0]
+            except np.linalg.LinAlgError:
+                pass
+        W = np.empty((nf, len(alphas), p))
+        for f in range(nf):
+            for k, alpha in enumerate(alphas):
+                Gk = G[f].copy()
+                Gk[np.diag_indices_from(Gk)] += alpha
+                try:
+                    W[f, k] = scipy.linalg.cho_solve(
+                        scipy.linalg.cho_factor(Gk, check_finite=False, overwrite_a=True),
+                        h[f],
+                        check_finite=False,
+                    )
+                except (np.linalg.LinAlgError, scipy.linalg.LinAlgError):
+                    W[f, k] = np.linalg.lstsq(G[f] + alpha * np.eye(p), h[f], rcond=None)[0]
+        return W
 
 
 def choose_structure(

