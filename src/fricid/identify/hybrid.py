@@ -198,7 +198,7 @@ def fit_backbone(
             best = (bic, (name, fixed, fitted), list(caught))
     if best is None:
         raise ConfigError("no analytic backbone could be fitted to these samples")
-    if isinstance(best[1], tuple):  # the lean winner: fitted in full, from its optimum
+    if lean and backbone is None:  # the lean winner: fitted in full, from its optimum
         name, fixed, params = best[1]
         free = {k: v for k, v in params.items() if k not in fixed}
         with warnings.catch_warnings(record=True) as caught:
@@ -212,7 +212,7 @@ def fit_backbone(
                 options={"n_starts": 1},
             )
         return fitted, table, list(caught)
-    return best[1], table, best[2]
+    return best[1][2], table, best[2]
 
 
 def fit_hybrid(
