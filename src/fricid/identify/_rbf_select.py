@@ -140,11 +140,9 @@ def structure_grid(n: int) -> list[int]:
 def _kmeans_centres(Z: np.ndarray, m: int, random_state: Any) -> np.ndarray:
     """The centres :class:`RBFNetRegressor` ``.fit`` places with ``random_state`` (the same
     draws in the same order, so the chosen candidate is the network fit trains)."""
-    from sklearn.cluster import KMeans
-    from sklearn.exceptions import ConvergenceWarning as SklearnConvergenceWarning
     from sklearn.utils import check_random_state
 
-    from ._rbf_estimator import _KMEANS_MIN, _KMEANS_PER_CENTRE
+    from ._rbf_estimator import _KMEANS_MIN, _KMEANS_PER_CENTRE, kmeans_centres
 
     rs = check_random_state(_seed(random_state))
     kmeans_seed = int(rs.randint(np.iinfo(np.int32).max))
@@ -152,9 +150,7 @@ def _kmeans_centres(Z: np.ndarray, m: int, random_state: Any) -> np.ndarray:
     n = Z.shape[0]
     n_kmeans = max(_KMEANS_MIN, _KMEANS_PER_CENTRE * m)
     Zk = Z if n <= n_kmeans else Z[rs.permutation(n)[:n_kmeans]]
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", SklearnConvergenceWarning)
-        return KMeans(n_clusters=m, n_init=1, random_state=kmeans_seed).fit(Zk).cluster_centers_
+    return kmeans_centres(Zk, m, kmeans_seed)
 
 
 def conformal_half_widths(residuals: np.ndarray, levels=INTERVAL_LEVELS) -> list[float]:
