@@ -49,3 +49,23 @@ def test_batched_ridge_solves_match_the_per_system_solves():
             assert np.linalg.norm(r_b) <= 1e-8 * np.linalg.norm(hs[f]) + np.linalg.norm(r_s)
     # well-conditioned penalty: the same weights
     np.testing.assert_allclose(batched[:, 2], single[:, 2], rtol=1e-8, atol=1e-10)
+
+
+@pytest.mark.parametrize(
+    ("n", "d", "m", "dup"), [(60, 1, 5, False), (300, 3, 40, True), (500, 2, 120, False)]
+)
+def test_kmeans_centres_are_scikit_learns_bit_for_bit(n, d, m, dup):
+    import warnings
+
+    from sklearn.cluster import KMeans
+
+    from fricid.identify._rbf_estimator import kmeans_centres
+
+    rng = np.random.default_rng(n)
+    Z = rng.normal(size=(n, d)) * rng.uniform(0.1, 10, size=d)
+    if dup:
+        Z = np.round(Z)  # duplicate points
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        expected = KMeans(n_clusters=m, n_init=1, random_state=12345).fit(Z).cluster_centers_
+    np.testing.assert_array_equal(kmeans_centres(Z, m, 12345), expected)
