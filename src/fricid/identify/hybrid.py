@@ -6,8 +6,12 @@ RBF network trained on what it leaves, ``fit(samples, "hybrid")``.
    when the temperature varies, the temperature variant of each one with a viscous term
    (:func:`backbone_candidates`: ``coulomb_viscous_temp``, ``stribeck_temp``, ``msk_temp``,
    their ``_asym``; the Arrhenius viscous term of :mod:`fricid.models._temperature`) is
-   fitted by :func:`fricid.identify.fit` (least squares); the one with the smallest BIC is
-   kept (``state["backbone_selection"]`` lists them). ``backbone=`` names one instead.
+   fitted by least squares on a lean path (one ``lm`` start warm-started from the nested
+   family, no intervals or diagnostics: :func:`_lean_fit`); the one with the smallest BIC is
+   kept (``state["backbone_selection"]`` lists them) and fitted by
+   :func:`fricid.identify.fit` from its optimum, its convergence certified (the lean path
+   picks the family the full multi-start fits pick: :func:`fit_backbone`). ``backbone=``
+   names one instead.
    The BIC, not the cross-validated error of backbone plus residual, chooses: the residual
    network absorbs what any backbone misses inside the data (on issue 15's held-out laws the
    hybrids' cross-validated errors differ by a few per cent), so only the backbone decides
