@@ -137,8 +137,31 @@ def _lean_fit(
 
 
 def _nested(name: str) -> str | None:
-    """The simpler family ``name`` extends (its warm start): ``msk_temp_asym`` -> ``msk_asym``."""
-    return name.replace("_temp", "", 1) if "_temp" in name else None
+    """The simpler family ``name`` extends (its warm start): ``msk_temp_asym`` -> ``msk_asym``
+    (the Arrhenius term added), ``msk_asym`` -> ``msk`` (one level per direction)."""
+    if "_temp" in name:
+        return name.replace("_temp", "", 1)
+    return name[: -len("_asym")] if name.endswith("_asym") else None
+
+
+def _warm_start(
+    name: str, fixed: dict[str, float], optima: dict[tuple[str, frozenset], dict[str, float]]
+) -> dict[str, float] | None:
+    """The nested family's optimum (:func:`_nested`, the same parameters fixed) as starting
+    values for ``name``: a per-direction family takes the symmetric one's values on both
+    sides (``tau_c`` -> ``tau_c_pos``, ``tau_c_neg``)."""
+    parent = _nested(name)
+    if parent is None:
+        return None
+    base = optima.get((parent, _fixed_key(fixed)))
+    if base is None or parent.endswith("_asym") or not name.endswith("_asym"):
+        return base
+    return {f"{k}_{side}": v for k, v in base.items() for side in ("pos", "neg")}
+
+
+def _fixed_key(fixed: dict[str, float]) -> frozenset:
+    """The fixed parameters' names without their direction (``delta_pos`` -> ``delta``)."""
+    return frozenset(k.removesuffix("_pos").removesuffix("_neg") for k in fixed)
 
 
 def fit_backbone(
@@ -177,17 +200,15 @@ def fit_backbone(
             )
     table: list[dict[str, Any]] = []
     best: tuple[float, Any, Any] | None = None
-    optima: dict[tuple[str, tuple[str, ...]], dict[str, float]] = {}
+    optima: dict[tuple[str, frozenset], dict[str, float]] = {}
     for name, fixed in names:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
             try:
                 if lean and backbone is None:
-                    key = tuple(sorted(fixed))
-                    parent = _nested(name)
-                    warm = optima.get((parent, key)) if parent else None
+                    warm = _warm_start(name, fixed, optima)
                     bic, rmse, fitted = _lean_fit(samples, name, fixed, warm)
-                    optima[(name, key)] = fitted
+                    optima[(name, _fixed_key(fixed))] = fitted
                 else:
                     fitted = _fit.fit(samples, name, fixed=fixed or None)
                     bic = float(fitted.statistics.get("bic", np.inf))
