@@ -70,8 +70,9 @@ def _kmeans_plusplus(Xc: np.ndarray, m: int, rs: np.random.RandomState) -> np.nd
     closest = sq_dist(Xc[[first]])
     pot = closest @ w
     for c in range(1, m):
-        cand = np.searchsorted(np.cumsum(w * closest), rs.uniform(size=trials) * pot)
-        np.clip(cand, None, closest.size - 1, out=cand)
+        # unit weights: w * closest is closest, and the clip an upper bound only
+        cand = np.searchsorted(np.cumsum(closest), rs.uniform(size=trials) * pot)
+        np.minimum(cand, closest.size - 1, out=cand)
         D = sq_dist(Xc[cand])
         np.minimum(closest, D, out=D)
         cand_pot = D @ w.reshape(-1, 1)
