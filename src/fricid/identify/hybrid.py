@@ -108,13 +108,19 @@ def _lean_fit(
     ------
     ConfigError
         The family cannot be fitted to these samples (too few of them, wrong directions).
+    DataError
+        The samples cannot determine its parameters
+        (:func:`~fricid.identify.checks.check_identifiable`, as :func:`fricid.identify.fit`).
     """
     from ..optim import minimize
+    from .checks import check_identifiable
     from .problem import IdentificationProblem
 
-    problem = IdentificationProblem(get_model(name), samples, fixed=fixed or None)
+    model = get_model(name)
+    problem = IdentificationProblem(model, samples, fixed=fixed or None)
     if problem.n_obs < problem.n_free:
         raise ConfigError(f"{problem.n_obs} samples cannot identify '{name}'")
+    check_identifiable(samples, model, fixed=problem.fixed)  # as fit: its errors and warnings
     start = problem.start()
     lo, hi = problem.bounds[:, 0], problem.bounds[:, 1]
     for j, p in enumerate(problem.free_names):
