@@ -45,8 +45,8 @@ friction in Fig. 10's unseen region (52-60 deg/s, positions -22 to -10 deg, 45-5
 training seconds of ``vlt``, ``rbf``, ``hybrid`` and ``gp``. Goal: the default's mean error <= 2
 x the averaged samples' noise (the RMS of :func:`fricid.sim.expected_noise_std`).
 
-What it showed (``python benchmarks/bench_floor.py``, 2026-11-22 22:24 UTC, the machine shared
-by three engineers and an integrator, load average 2-3 on 2 cores; 143 s; held-out RMSE /
+What it showed (``python benchmarks/bench_floor.py``, 2026-11-22 22:38 UTC, the machine shared
+by three engineers and an integrator, load average 1.3-2.8 on 2 cores; 110 s; held-out RMSE /
 noise, mean over seeds 1001-1003, mean training seconds over the same seeds in brackets):
 
 ==============  ===================  ====================  ================
@@ -54,12 +54,12 @@ family          grid (1848 points)   asym_arrhenius (150)  sigmoid (540)
 ==============  ===================  ====================  ================
 best analytic   10.52 (msk_temp)     0.98 (stribeck_temp_  0.99 (msk_asym)
                                      asym)
-rbf plain       135.96 [0.399 s]     9.37 [0.052 s]        11.29 [0.068 s]
-rbf             1.15 [0.683 s]       1.36 [0.065 s]        1.10 [0.110 s]
-hybrid          **1.08** [0.663 s]   **1.01** [0.097 s]    **0.99** [0.237 s]
-gp              1.24 [2.300 s]       1.13 [0.185 s]        0.99 [1.962 s]
-sklearn GP      1.43 [28.696 s]      1.12 [0.079 s]        1.16 [1.437 s]
-MLP             16.41 [0.119 s]      16.73 [0.026 s]       9.53 [0.066 s]
+rbf plain       135.96 [0.344 s]     9.37 [0.033 s]        11.29 [0.060 s]
+rbf             1.15 [0.613 s]       1.36 [0.054 s]        1.10 [0.077 s]
+hybrid          **1.08** [0.557 s]   **1.01** [0.080 s]    **0.99** [0.110 s]
+gp              1.24 [1.879 s]       1.13 [0.106 s]        0.99 [1.132 s]
+sklearn GP      1.43 [23.566 s]      1.12 [0.045 s]        1.16 [0.916 s]
+MLP             16.41 [0.074 s]      16.73 [0.017 s]       9.53 [0.035 s]
 ==============  ===================  ====================  ================
 
 The default learned model (``hybrid``: the backbone by BIC among the families and their
@@ -74,30 +74,34 @@ Training time, hybrid / GP (goal <= 0.1), same run:
 ==============  ============  ==============  ============  ==============
 reference       grid          asym_arrhenius  sigmoid       paper-1 (6615)
 ==============  ============  ==============  ============  ==============
-fricid ``gp``   0.288 MISSED  0.524 MISSED    0.121 MISSED  0.750 MISSED
-sklearn GP      0.023 met     1.230 MISSED    0.165 MISSED  (not run)
+fricid ``gp``   0.296 MISSED  0.762 MISSED    0.097 met     0.762 MISSED
+sklearn GP      0.024 met     1.795 MISSED    0.120 MISSED  (not run)
 ==============  ============  ==============  ============  ==============
 
-An earlier run of the same code but for two small exact speed-ups (22:16 UTC, 150 s) gave
-hybrid 0.725 / 0.118 / 0.136 s, gp 2.403 / 0.134 / 1.381 s, sklearn GP 33.6 / 0.054 / 1.022
-s: ratios 0.302 / 0.880 / 0.098 (met) against ``gp`` and 0.022 / 2.2 / 0.133 against
-scikit-learn's; on the sigmoid the goal is met or missed by the machine's load of the moment.
-Before this work (the table's previous edition, same machine): hybrid 2.8 / 1.6 / 1.0 s. The
-hybrid's seconds now go (sigmoid, wall-clock per phase): about 40 % to the backbone's lean
-least-squares fits (8 candidates, one ``lm`` start each, and the winner's certified fit), 55 %
-to the residual network's cross-validated structure (about 25 candidates per direction, 5
-folds: k-means placements, a third of the total, and ridge solves); on the grid over 80 % to
-the latter (400-centre candidates:
-Gram matrices and Cholesky factorisations of 400 x 400, six of them). Why the rest is missed:
+The sigmoid's ratios sit at the goal and move with the machine's load: a run 14 minutes
+earlier (22:24 UTC, load 2-3; the same code but for the lean path's identifiability check)
+gave hybrid 0.663 / 0.097 / 0.237 s, ratios 0.288 / 0.524 / 0.121 against ``gp`` and 0.023 /
+1.230 / 0.165 against scikit-learn's; one at 22:16 UTC (two small exact speed-ups fewer)
+0.302 / 0.880 / 0.098 and 0.022 / 2.2 / 0.133.
+
+Before this work (the table's previous edition, same machine, 3 seeds): hybrid 2.8 / 1.6 /
+1.0 s against ``gp`` 3.6 / 0.1 / 1.2 s. The hybrid's seconds now go (sigmoid, wall-clock per
+phase): about 40 % to the backbone's lean least-squares fits (8 candidates, one ``lm`` start
+each, and the winner's certified fit), 55 % to the residual network's cross-validated
+structure (about 25 candidates per direction, 5 folds: k-means placements, a third of the
+total, and ridge solves); on the grid over 80 % to the latter (400-centre candidates, six of
+them: Gram matrices and Cholesky factorisations of 400 x 400). Why the rest is missed:
 fricid's ``gp`` trains on an inducing subset of 400 points, so it is itself fast on the grid
-and the paper-1 preset; on 150 points both GPs take tens of milliseconds (a 150 x 150
-Cholesky per step), less than the fixed cost of a dozen backbone fits and fifty
+and the paper-1 preset; on 150 points both GPs take 45-110 ms (150 x 150 Cholesky
+factorisations), less than the fixed cost of a dozen backbone fits and fifty
 cross-validation candidates.
 
 Timings: the machine this was written on was shared (2 cores): read the seconds as ratios
-within one run. OpenBLAS is held to one thread (``OPENBLAS_NUM_THREADS=1``
-set before numpy loads, unless already set): on a loaded machine its threads made a 400 x 400
-Cholesky factorisation 300 times slower.
+within one run. OpenBLAS and OpenMP are held to one thread (``OPENBLAS_NUM_THREADS=1``,
+``OMP_NUM_THREADS=1`` set before numpy loads, unless already set): on a loaded machine
+OpenBLAS's threads made a 400 x 400 Cholesky factorisation 300 times slower, and OpenMP's
+made scikit-learn's k-means (the RBF networks' centres) 6 to 150 times slower (1848 points
+and 400 centres to 270 points and 5 centres, measured 2026-11-22).
 """
 
 from __future__ import annotations
