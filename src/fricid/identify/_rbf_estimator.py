@@ -47,6 +47,78 @@ _KMEANS_MIN = 2000
 _KMEANS_PER_CENTRE = 25
 
 
+def _kmeans_plusplus(Xc: np.ndarray, m: int, rs: np.random.RandomState) -> np.ndarray:
+    """Indices of scikit-learn's k-means++ seeds (Arthur and Vassilvitskii 2007, greedy with
+    ``2 + ln m`` local trials) on the centred data ``Xc``: drawn from ``rs`` as scikit-learn
+    draws them and computed by the same operations, so the seeds are the same bit for bit,
+    without its per-call input validation (which took most of the time of the small sets'
+    cross-validation)."""
+    n = Xc.shape[0]
+    xx = np.einsum("ij,ij->i", Xc, Xc)
+    w = np.ones(n)
+    trials = 2 + int(np.log(m))
+
+    def sq_dist(C: np.ndarray) -> np.ndarray:  # scikit-learn's _euclidean_distances, squared
+        D = -2 * (C @ Xc.T)
+        D += np.einsum("ij,ij->i", C, C)[:, None]
+        D += xx[None, :]
+        return np.maximum(D, 0, out=D)
+
+    first = int(rs.choice(n, p=w / w.sum()))
+    idx = np.full(m, -1, dtype=int)
+    idx[0] = first
+    closest = sq_dist(Xc[[first]])
+    pot = closest @ w
+    for c in range(1, m):
+        # unit weights: w * closest is closest, and the clip an upper bound only
+        cand = np.searchsorted(np.cumsum(closest), rs.uniform(size=trials) * pot)
+        np.minimum(cand, closest.size - 1, out=cand)
+        D = sq_dist(Xc[cand])
+        np.minimum(closest, D, out=D)
+        cand_pot = D @ w.reshape(-1, 1)
+        best = int(np.argmin(cand_pot))
+        pot, closest, idx[c] = cand_pot[best], D[best], cand[best]
+    return idx
+
+
+def kmeans_centres(Z: np.ndarray, m: int, seed: int) -> np.ndarray:
+    """The centres of ``KMeans(n_clusters=m, n_init=1, random_state=seed).fit(Z)``, the same
+    bit for bit: the data centred and the tolerance set as ``KMeans.fit`` does, its k-means++
+    seeds (:func:`_kmeans_plusplus`), then its own Lloyd iterations from them; scikit-learn's
+    ``KMeans`` itself when its private Lloyd routine is not there (another version) or ``m``
+    is not between 1 and the number of points (its error message).
+
+    Duplicate points can leave fewer distinct clusters than centres: scikit-learn's
+    convergence warning is silenced (the width floor and the ridge penalty cope, the user
+    learns of it through the fit's accuracy).
+    """
+    X = np.array(Z, dtype=float, order="C", copy=True)
+    try:
+        from sklearn.cluster._kmeans import _kmeans_single_lloyd, _tolerance
+        from sklearn.utils._openmp_helpers import _openmp_effective_n_threads
+    except ImportError:  # pragma: no cover - another scikit-learn
+        _kmeans_single_lloyd = None
+    if _kmeans_single_lloyd is None or not 1 <= m <= X.shape[0] or X.ndim != 2:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", SklearnConvergenceWarning)
+            return KMeans(n_clusters=m, n_init=1, random_state=seed).fit(X).cluster_centers_
+    tol = _tolerance(X, 1e-4)  # KMeans's default tol, on the data before centring
+    mean = X.mean(axis=0)
+    X -= mean
+    idx = _kmeans_plusplus(X, m, np.random.RandomState(seed))
+    _, _, centres, _ = _kmeans_single_lloyd(
+        X,
+        np.ones(X.shape[0]),
+        X[idx],
+        max_iter=300,
+        verbose=False,
+        tol=tol,
+        n_threads=_openmp_effective_n_threads(),
+    )
+    centres += mean
+    return centres
+
+
 class RBFNetRegressor(RegressorMixin, BaseEstimator):
     """Gaussian radial basis function network (BAS-RBFNN paper, eq. 14-15), scikit-learn style.
 
@@ -332,12 +404,7 @@ class RBFNetRegressor(RegressorMixin, BaseEstimator):
         n_kmeans = max(_KMEANS_MIN, _KMEANS_PER_CENTRE * m)
         Zk = Z if n <= n_kmeans else Z[rs.permutation(n)[:n_kmeans]]
 
-        with warnings.catch_warnings():
-            # duplicate points: fewer distinct clusters than centres; the width floor and
-            # the ridge penalty cope, the user learns of it through the fit's accuracy
-            warnings.simplefilter("ignore", SklearnConvergenceWarning)
-            km = KMeans(n_clusters=m, n_init=1, random_state=kmeans_seed)
-            C0 = km.fit(Zk).cluster_centers_
+        C0 = kmeans_centres(Zk, m, kmeans_seed)
         s0 = core.nn_widths(C0, float(self.width_factor), spread)
         L, lin_shift, lin_scale = (
             _linear_columns(X, tuple(self.linear_magnitude), int(self.tail_order))

@@ -140,11 +140,9 @@ def structure_grid(n: int) -> list[int]:
 def _kmeans_centres(Z: np.ndarray, m: int, random_state: Any) -> np.ndarray:
     """The centres :class:`RBFNetRegressor` ``.fit`` places with ``random_state`` (the same
     draws in the same order, so the chosen candidate is the network fit trains)."""
-    from sklearn.cluster import KMeans
-    from sklearn.exceptions import ConvergenceWarning as SklearnConvergenceWarning
     from sklearn.utils import check_random_state
 
-    from ._rbf_estimator import _KMEANS_MIN, _KMEANS_PER_CENTRE
+    from ._rbf_estimator import _KMEANS_MIN, _KMEANS_PER_CENTRE, kmeans_centres
 
     rs = check_random_state(_seed(random_state))
     kmeans_seed = int(rs.randint(np.iinfo(np.int32).max))
@@ -152,9 +150,7 @@ def _kmeans_centres(Z: np.ndarray, m: int, random_state: Any) -> np.ndarray:
     n = Z.shape[0]
     n_kmeans = max(_KMEANS_MIN, _KMEANS_PER_CENTRE * m)
     Zk = Z if n <= n_kmeans else Z[rs.permutation(n)[:n_kmeans]]
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", SklearnConvergenceWarning)
-        return KMeans(n_clusters=m, n_init=1, random_state=kmeans_seed).fit(Zk).cluster_centers_
+    return kmeans_centres(Zk, m, kmeans_seed)
 
 
 def conformal_half_widths(residuals: np.ndarray, levels=INTERVAL_LEVELS) -> list[float]:
@@ -226,31 +222,64 @@ class _CrossValidation:
         if self.linear:
             A = np.hstack([A, self.L[order]])
         oof = np.full((len(self.alphas), len(self.ts)), np.nan)
+        # the training folds' normal equations from the whole set's minus the held-out
+        # fold's (one Gram matrix of all samples, one of each fold: half the products of
+        # forming each training fold's), centred through the column sums when fitting a bias
+        S_all, s_all, r_all = A.T @ A, A.sum(axis=0), A.T @ self.ts
+        folds = []
         for train, test in self.splits:
-            At, tt = A[train], self.ts[train]
-            mu = At.mean(axis=0) if self.fit_bias else np.zeros(A.shape[1])
-            tm = float(tt.mean()) if self.fit_bias else 0.0
-            Ac = At - mu
-            G = Ac.T @ Ac / len(train)
-            h = Ac.T @ (tt - tm) / len(train)
-            for k, alpha in enumerate(self.alphas):
-                Gk = G.copy()
-                Gk[np.diag_indices_from(Gk)] += alpha
-                try:
-                    w = scipy.linalg.cho_solve(
-                        scipy.linalg.cho_factor(Gk, check_finite=False, overwrite_a=True),
-                        h,
-                        check_finite=False,
-                    )
-                except (np.linalg.LinAlgError, scipy.linalg.LinAlgError):
-                    w = np.linalg.lstsq(G + alpha * np.eye(len(h)), h, rcond=None)[0]
-                oof[k, test] = (A[test] - mu) @ w + tm
+            Ae, te, nt = A[test], self.ts[test], len(train)
+            mu = (s_all - Ae.sum(axis=0)) / nt if self.fit_bias else np.zeros(A.shape[1])
+            tm = float((self.ts.sum() - te.sum()) / nt) if self.fit_bias else 0.0
+            G = (S_all - Ae.T @ Ae - nt * np.outer(mu, mu)) / nt
+            h = (r_all - Ae.T @ te - nt * tm * mu) / nt
+            folds.append((test, mu, tm, G, h))
+        W = self._solve_all([f[3] for f in folds], [f[4] for f in folds])
+        for (test, mu, tm, _, _), w in zip(folds, W, strict=True):
+            oof[:, test] = ((A[test] - mu) @ w.T + tm).T
         rmse = np.sqrt(np.mean((oof - self.ts) ** 2, axis=1)) * self.half
         rmse = np.where(np.isfinite(rmse), rmse, np.inf)
         k = int(np.argmin(rmse))
         out = (k, float(rmse[k]), (oof[k] - self.ts) * self.half)
         self._memo[key] = out
         return out
+
+    #: Up to this many output weights, :meth:`_solve_all` solves every fold and penalty in
+    #: one batched call (the per-call overhead dominates small systems); above, one Cholesky
+    #: solve each (a batched LU would cost twice the arithmetic).
+    BATCH_MAX = 128
+
+    def _solve_all(self, Gs: list[np.ndarray], hs: list[np.ndarray]) -> np.ndarray:
+        """Ridge solutions ``(G + alpha I) w = h`` for every fold (``Gs``, ``hs``) and penalty
+        of :attr:`alphas`: ``(folds, len(alphas), p)``. Cholesky where ``G + alpha I`` is
+        positive definite, else least squares (rounding can leave it indefinite)."""
+        G = np.asarray(Gs)
+        h = np.asarray(hs)
+        nf, p = h.shape
+        alphas = np.asarray(self.alphas, dtype=float)
+        if p <= self.BATCH_MAX:
+            GA = np.repeat(G[:, None], len(alphas), axis=1)
+            GA[..., np.arange(p), np.arange(p)] += alphas[None, :, None]
+            try:
+                np.linalg.cholesky(GA)  # positive definite, all of them (else per system)
+                hA = np.broadcast_to(h[:, None, :, None], (nf, len(alphas), p, 1))
+                return np.linalg.solve(GA, hA)[..., 0]
+            except np.linalg.LinAlgError:
+                pass
+        W = np.empty((nf, len(alphas), p))
+        for f in range(nf):
+            for k, alpha in enumerate(alphas):
+                Gk = G[f].copy()
+                Gk[np.diag_indices_from(Gk)] += alpha
+                try:
+                    W[f, k] = scipy.linalg.cho_solve(
+                        scipy.linalg.cho_factor(Gk, check_finite=False, overwrite_a=True),
+                        h[f],
+                        check_finite=False,
+                    )
+                except (np.linalg.LinAlgError, scipy.linalg.LinAlgError):
+                    W[f, k] = np.linalg.lstsq(G[f] + alpha * np.eye(p), h[f], rcond=None)[0]
+        return W
 
 
 def choose_structure(
