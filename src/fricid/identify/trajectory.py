@@ -123,6 +123,7 @@ from ..models import get_model, lugre
 from ..samples import RawLog
 from ._trajectory_data import DerivativeFilter, derivatives, dilate, uniform_series
 from ._trajectory_filtered import ParallelFilter, filtered_route
+from ._trajectory_rate import rate_bias as _rate_bias
 from ._trajectory_routes import (
     JOINT_PARAMS,
     _refine_static,
@@ -133,7 +134,14 @@ from ._trajectory_routes import (
     _windows,
 )
 
-__all__ = ["ROUTES", "DerivativeFilter", "ParallelFilter", "PassivityWarning", "fit_trajectory"]
+__all__ = [
+    "ROUTES",
+    "DerivativeFilter",
+    "ParallelFilter",
+    "PassivityWarning",
+    "RateBiasWarning",
+    "fit_trajectory",
+]
 
 #: Routes of :func:`fit_trajectory` (the first is LuGre's default).
 ROUTES = ("filtered", "two_stage", "joint", "regression")
@@ -168,6 +176,35 @@ REFINE = 1
 
 class PassivityWarning(FricidWarning):
     """An identified dynamic friction model is not passive (it could create energy)."""
+
+
+class RateBiasWarning(FricidWarning):
+    """The log's rate biases sigma_0 or sigma_1 by a sizeable part of their intervals."""
+
+
+#: Rate-bias checks of the ``filtered`` route: ``warn`` estimates it and warns, ``off`` not.
+RATE_BIAS = ("warn", "off")
+
+#: Warn when the estimated rate bias exceeds this many standard errors (log10 scale).
+RATE_BIAS_WARN = 0.5
+
+
+def _warn_rate_bias(stage, rb: dict[str, Any]) -> None:
+    """One line when the rate bias of sigma_0 or sigma_1 is a sizeable part of its interval."""
+    parts = []
+    for i, n in enumerate(("sigma_0", "sigma_1")):
+        se_log = stage.stderr[i] / (stage.values[i] * np.log(10.0))
+        if abs(rb[n]["log10_bias"]) > RATE_BIAS_WARN * se_log:
+            parts.append(f"{n} {100 * rb[n]['relative']:+.2g} %")
+    if parts:
+        warnings.warn(
+            f"logging at {rb['log_rate']:.6g} Hz biases {', '.join(parts)}, as estimated by "
+            "simulation at the estimate (the break-away between samples; over half a "
+            "standard error; corrected values in the provenance): log at "
+            f"{10 * rb['log_rate']:.6g} Hz or faster to remove it",
+            RateBiasWarning,
+            stacklevel=3,
+        )
 
 
 def _passivity(names: list[str], values, low, high) -> dict[str, Any]:
@@ -223,6 +260,7 @@ def fit_trajectory(
     cluster_time: float = 0.5,
     seed: int = 0,
     max_evals: int | None = None,
+    rate_bias: str = "warn",
 ) -> FittedModel:
     """Identify a joint's friction, inertia and gravity from a trajectory (module notes).
 
@@ -267,6 +305,13 @@ def fit_trajectory(
         Block length [s] of the regression's cluster-robust covariance.
     seed, max_evals
         As for :func:`fricid.optim.minimize` (the budget is per stage).
+    rate_bias : {"warn", "off"}
+        ``warn`` (default): the ``filtered`` route's bias of sigma_0 and sigma_1 at the
+        log's rate is estimated by simulation at the estimate
+        (:func:`._trajectory_rate.rate_bias`, about the route's own time again), recorded
+        in ``provenance["trajectory"]["rate_bias"]`` with the corrected values (not
+        applied), and warned about (:class:`RateBiasWarning`) when it exceeds
+        :data:`RATE_BIAS_WARN` standard errors; ``off`` skips it.
 
     Returns
     -------
@@ -298,6 +343,8 @@ def fit_trajectory(
         raise ConfigError("LuGre's sigma_0 and sigma_1 need the simulation route (two_stage)")
     if gravity not in ("fit", "none"):
         raise ConfigError(f"gravity must be 'fit' or 'none', got '{gravity}'")
+    if rate_bias not in RATE_BIAS:
+        raise ConfigError(f"rate_bias must be 'warn' or 'off', got '{rate_bias}'")
     derivative = derivative or DerivativeFilter()
     t_start = time.perf_counter()
     series = uniform_series(log)
@@ -379,6 +426,12 @@ def fit_trajectory(
         final.update(stage.table())
         bounds_out.update({n: list(b) for n, b in zip(stage.names, stage.bounds, strict=True)})
         sim_info = {"parallel_filter": parallel.describe(rate), "n_sub": int(n_sub)}
+        if rate_bias == "warn":
+            rb = _rate_bias(
+                series, stage, stage1.bounds[order], gravity, method, seed, n_sub, parallel
+            )
+            sim_info["rate_bias"] = rb
+            _warn_rate_bias(stage, rb)
     elif key == "lugre":
         base = np.array(
             [1e4, 1.0]
