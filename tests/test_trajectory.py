@@ -401,6 +401,10 @@ def test_filtered_route_covers_the_truth_with_noise_and_the_cli_selects_routes(t
         assert result.exit_code == 0, result.output
         info = json.loads(out.read_text())["provenance"]["trajectory"]
         assert info["route"] == route
-    assert "parallel filter (both sides)" in result.output or route == "two_stage"
+        if route == "filtered":  # the report block and the rate bias's one-line warning
+            assert "parallel filter (both sides)" in result.output
+            assert "rate bias at 1000 Hz" in result.output and "rate_bias" in info
+            saved = json.loads(out.read_text())["provenance"]["warnings"]
+            assert any(w.startswith("RateBiasWarning: logging at 1000 Hz") for w in saved)
     bad = CliRunner().invoke(app, ["fit", str(path), "--trajectory", "--route", "spline"])
     assert bad.exit_code == 2 and "unknown route" in bad.output
