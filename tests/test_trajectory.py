@@ -408,3 +408,25 @@ def test_filtered_route_covers_the_truth_with_noise_and_the_cli_selects_routes(t
             assert any(w.startswith("RateBiasWarning: logging at 1000 Hz") for w in saved)
     bad = CliRunner().invoke(app, ["fit", str(path), "--trajectory", "--route", "spline"])
     assert bad.exit_code == 2 and "unknown route" in bad.output
+
+
+def test_rate_bias_says_why_it_was_not_estimated(monkeypatch):
+    """A simulation at the estimate that diverges leaves the reason, and no warning."""
+    log = tr.simulate_trajectory(tr.multisine(duration=3.0, seed=23), TRUTH, JOINT, seed=23)
+    from fricid.models import lugre
+
+    def diverged(*args, **kwargs):
+        n = np.asarray(args[5]).size
+        return {k: np.full(n, np.nan) for k in ("position", "velocity", "torque")}
+
+    monkeypatch.setattr(lugre, "simulate_joint", diverged)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RateBiasWarning)
+        fitted = fit_trajectory(log, "lugre")
+    rb = fitted.provenance["trajectory"]["rate_bias"]
+    assert rb["skipped"] == "the simulation at the estimate diverged" and "sigma_0" not in rb
+    from fricid.cli.trajectory import trajectory_text
+
+    assert "rate bias: not estimated (the simulation at the estimate diverged)" in (
+        trajectory_text(fitted)
+    )

@@ -64,7 +64,9 @@ def trajectory_text(fitted) -> str:
             f"converged {route.get('converged')}, residual RMS {rms}"
         )
     rb = info.get("rate_bias")
-    if rb:
+    if rb and "skipped" in rb:
+        lines.append(f"    rate bias: not estimated ({rb['skipped']})")
+    elif rb:
         lines.append(
             f"    rate bias at {rb['log_rate']:.6g} Hz (simulated at the estimate, "
             f"{rb['internal_rate']:.6g} Hz inside; not applied): "

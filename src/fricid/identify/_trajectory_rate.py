@@ -26,6 +26,7 @@ from typing import Any
 
 import numpy as np
 
+from ..errors import FricidError
 from ..models import lugre
 from ._trajectory_data import Series
 from ._trajectory_filtered import LOG_BOX, ParallelFilter, filtered_route
@@ -67,7 +68,8 @@ def rate_bias(
         ``sigma_0`` and ``sigma_1``: ``{"log10_bias", "relative", "corrected"}`` (the bias on
         the log10 scale, as a relative change ``10**b - 1``, and ``10**(2 log10 theta_hat -
         log10 theta*)``); ``internal_rate`` [Hz], ``log_rate`` [Hz], ``seconds`` of the
-        re-identification's route.
+        re-identification's route; or, instead of the estimates, ``skipped`` with the reason
+        (the simulation at the estimate diverged, or its identification failed).
     """
     theta = np.asarray(stage.values[:7], dtype=float)
     joint = [*stage.values[7:], 0.0, 0.0]
@@ -88,17 +90,19 @@ def rate_bias(
         gains=GAINS,
         n_sub=SUB_STEPS,
     )
+    out: dict[str, Any] = {"internal_rate": SUB_STEPS / dt, "log_rate": 1.0 / dt}
+    if not all(np.isfinite(sim[k]).all() for k in ("position", "velocity", "torque")):
+        return {**out, "skipped": "the simulation at the estimate diverged"}
     again = replace(
         series, position=sim["position"], velocity=sim["velocity"], torque=sim["torque"]
     )
-    redo, _, _ = filtered_route(
-        again, theta, static_bounds, gravity, method, seed, None, 0.5, n_sub, filt
-    )
-    out: dict[str, Any] = {
-        "internal_rate": SUB_STEPS / dt,
-        "log_rate": 1.0 / dt,
-        "seconds": redo.seconds,
-    }
+    try:
+        redo, _, _ = filtered_route(
+            again, theta, static_bounds, gravity, method, seed, None, 0.5, n_sub, filt
+        )
+    except FricidError as exc:
+        return {**out, "skipped": f"the re-identification failed: {exc}"}
+    out["seconds"] = redo.seconds
     for i, name in enumerate(LOG_BOX):
         b = float(np.log10(redo.values[i]) - np.log10(theta[i]))
         out[name] = {

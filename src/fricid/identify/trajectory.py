@@ -192,6 +192,8 @@ RATE_BIAS_WARN = 0.5
 def _warn_rate_bias(stage, rb: dict[str, Any]) -> None:
     """One line when the rate bias of sigma_0 or sigma_1 is a sizeable part of its interval."""
     parts = []
+    if "skipped" in rb:
+        return
     for i, n in enumerate(("sigma_0", "sigma_1")):
         se_log = stage.stderr[i] / (stage.values[i] * np.log(10.0))
         if abs(rb[n]["log10_bias"]) > RATE_BIAS_WARN * se_log:
