@@ -13,7 +13,7 @@ from typer.testing import CliRunner
 from fricid.cli import app
 from fricid.errors import ConfigError, DataError
 from fricid.fitted import FittedModel
-from fricid.identify.trajectory import DerivativeFilter, fit_trajectory
+from fricid.identify.trajectory import DerivativeFilter, RateBiasWarning, fit_trajectory
 from fricid.models import Stribeck
 from fricid.sim import Joint, ModelLaw
 from fricid.sim import trajectory as tr
@@ -121,6 +121,8 @@ def test_options_are_checked():
         fit_trajectory(log, "vlt")
     with pytest.raises(ConfigError, match="simulation route"):
         fit_trajectory(log, "lugre", route="regression")
+    with pytest.raises(ConfigError, match="rate_bias must be"):
+        fit_trajectory(log, "lugre", rate_bias="correct")
     with pytest.raises(ConfigError, match="derivative filter"):
         DerivativeFilter(method="spline")
     from fricid.identify.trajectory import ParallelFilter
@@ -345,11 +347,13 @@ def test_filtered_route_is_consistent_on_a_noise_free_log():
     """Every LuGre parameter with J, p_x, p_y at once by the parallel-filtered equation error:
     noise-free, the static part and the joint within a few per mille, sigma_0 and sigma_1
     within the error of the bristle drive between samples (module notes of
-    ``_trajectory_filtered``: sigma_0 +3 %, sigma_1 -20 % on 20 s)."""
+    ``_trajectory_filtered``: sigma_0 +3 %, sigma_1 -20 % on 20 s), a bias fricid estimates
+    by simulation at the estimate and warns about, its corrected values closer to the truth."""
     log = tr.simulate_trajectory(
         tr.multisine(duration=8.0, seed=21), TRUTH, JOINT, noise=tr.Noise.none()
     )
-    fitted = fit_trajectory(log, "lugre")
+    with pytest.warns(RateBiasWarning, match=r"logging at 1000 Hz biases sigma_0 \+.*10000 Hz"):
+        fitted = fit_trajectory(log, "lugre")
     info = fitted.provenance["trajectory"]
     assert info["route"] == "filtered" and set(info["routes"]) == {"regression", "filtered"}
     assert info["parallel_filter"]["cutoff"] == 20.0 and fitted.converged
@@ -362,6 +366,11 @@ def test_filtered_route_is_consistent_on_a_noise_free_log():
     assert fitted.params["sigma_0"] == pytest.approx(1e4, rel=0.1)
     assert fitted.params["sigma_1"] == pytest.approx(1.0, rel=0.35)
     assert not any(any(o) for o in fitted.ci_open.values())
+    rb = info["rate_bias"]
+    assert rb["internal_rate"] == pytest.approx(16000.0) and rb["log_rate"] == pytest.approx(1e3)
+    for n, v in (("sigma_0", 1e4), ("sigma_1", 1.0)):  # 8 s: +3.0 %, -17 % to +0.7 %, +2.7 %
+        assert abs(rb[n]["corrected"] / v - 1) < 0.3 * abs(fitted.params[n] / v - 1), n
+    assert "rate_bias" not in fit_trajectory(log, "lugre", rate_bias="off").provenance["trajectory"]
 
 
 def test_filtered_route_covers_the_truth_with_noise_and_the_cli_selects_routes(tmp_path):
@@ -392,6 +401,32 @@ def test_filtered_route_covers_the_truth_with_noise_and_the_cli_selects_routes(t
         assert result.exit_code == 0, result.output
         info = json.loads(out.read_text())["provenance"]["trajectory"]
         assert info["route"] == route
-    assert "parallel filter (both sides)" in result.output or route == "two_stage"
+        if route == "filtered":  # the report block and the rate bias's one-line warning
+            assert "parallel filter (both sides)" in result.output
+            assert "rate bias at 1000 Hz" in result.output and "rate_bias" in info
+            saved = json.loads(out.read_text())["provenance"]["warnings"]
+            assert any(w.startswith("RateBiasWarning: logging at 1000 Hz") for w in saved)
     bad = CliRunner().invoke(app, ["fit", str(path), "--trajectory", "--route", "spline"])
     assert bad.exit_code == 2 and "unknown route" in bad.output
+
+
+def test_rate_bias_says_why_it_was_not_estimated(monkeypatch):
+    """A simulation at the estimate that diverges leaves the reason, and no warning."""
+    log = tr.simulate_trajectory(tr.multisine(duration=3.0, seed=23), TRUTH, JOINT, seed=23)
+    from fricid.models import lugre
+
+    def diverged(*args, **kwargs):
+        n = np.asarray(args[5]).size
+        return {k: np.full(n, np.nan) for k in ("position", "velocity", "torque")}
+
+    monkeypatch.setattr(lugre, "simulate_joint", diverged)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RateBiasWarning)
+        fitted = fit_trajectory(log, "lugre")
+    rb = fitted.provenance["trajectory"]["rate_bias"]
+    assert rb["skipped"] == "the simulation at the estimate diverged" and "sigma_0" not in rb
+    from fricid.cli.trajectory import trajectory_text
+
+    assert "rate bias: not estimated (the simulation at the estimate diverged)" in (
+        trajectory_text(fitted)
+    )

@@ -63,6 +63,18 @@ def trajectory_text(fitted) -> str:
             f"    route {name}: {route.get('nfev')} evaluations, {route.get('seconds', 0):.2f} s, "
             f"converged {route.get('converged')}, residual RMS {rms}"
         )
+    rb = info.get("rate_bias")
+    if rb and "skipped" in rb:
+        lines.append(f"    rate bias: not estimated ({rb['skipped']})")
+    elif rb:
+        lines.append(
+            f"    rate bias at {rb['log_rate']:.6g} Hz (simulated at the estimate, "
+            f"{rb['internal_rate']:.6g} Hz inside; not applied): "
+            + ", ".join(
+                f"{n} {100 * rb[n]['relative']:+.2g} % (corrected {rb[n]['corrected']:.4g})"
+                for n in ("sigma_0", "sigma_1")
+            )
+        )
     p = info.get("passivity")
     if p:
         lines.append(
