@@ -241,3 +241,18 @@ def test_methods_lists_every_stateful_model():
     for name in STATEFUL:
         assert re.search(rf"^\s+{re.escape(name)}\s", res.stdout, re.M), name
     assert "rbf" in STATEFUL
+
+
+def test_warning_labels_split_the_class_name_into_words(capsys):
+    """The CLI's one-line warnings name their category in words (RateBiasWarning: 'rate bias')."""
+    from fricid.cli import _app
+    from fricid.errors import DataQualityWarning, FricidWarning
+    from fricid.identify.trajectory import RateBiasWarning
+
+    for category, label in (
+        (RateBiasWarning, "rate bias"),
+        (DataQualityWarning, "data quality"),
+        (FricidWarning, "warning"),
+    ):
+        _app._show_warning("text", category, "f.py", 1)
+        assert f"warning ({label}): text" in capsys.readouterr().err

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+import re
 import signal
 import sys
 import threading
@@ -243,8 +244,9 @@ def _show_warning(message, category, filename, lineno, file=None, line=None) -> 
     """``warnings.showwarning`` for the CLI: one line on stderr, no source line."""
     text = " ".join(str(message).split())
     if issubclass(category, FricidWarning):
-        label = category.__name__.removesuffix("Warning").lower() or "warning"
-        label = {"fricid": "warning", "dataquality": "data quality"}.get(label, label)
+        words = re.findall(r"[A-Z][a-z0-9]*", category.__name__.removesuffix("Warning"))
+        label = " ".join(words).lower()
+        label = "warning" if label in ("", "fricid") else label
         line_out = f"[bold yellow]warning ({label}):[/] {escape(text)}"
     else:
         line_out = f"[bold yellow]warning:[/] {escape(text)} ({category.__name__})"

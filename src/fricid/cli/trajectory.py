@@ -79,10 +79,15 @@ def trajectory_text(fitted) -> str:
     if p:
         lines.append(
             f"    passivity: {'passive' if p['passive'] else 'NOT passive'} (margin "
-            f"{p['margin']}; across the 95 % intervals: "
+            f"{_margin(p['margin'])}; across the 95 % intervals: "
             f"{'passive' if p['passive_across_ci95'] else 'not guaranteed'}); {p['condition']}"
         )
     return "\n".join(lines)
+
+
+def _margin(value) -> str:
+    """The passivity margin in sigma_1's unit, three significant digits."""
+    return "undefined" if value is None else f"{value:.3g} N m s/rad"
 
 
 def run_trajectory(
