@@ -44,6 +44,7 @@ import numpy as np
 
 from ..errors import ConfigError
 from ..fitted import FittedModel
+from ..metrics import fit_statistics
 from ..models import INPUTS, get_model
 from ..models.hybrid import STATE_KIND
 from ..models.rbf import STATE_VERSION
