@@ -26,7 +26,10 @@ RBF network trained on what it leaves, ``fit(samples, "hybrid")``.
 2. **Residual.** The RBF network (:func:`fricid.identify.rbf.fit_rbf`) is trained on
    ``F - F_backbone`` with its sign of motion, *without* bias or linear tail, so it vanishes
    far from its centres and the model returns to the backbone outside the data; its size,
-   widths and penalty are chosen by cross-validation, and its trainer is least squares
+   widths and penalty are chosen by cross-validation over random folds and folds of whole
+   interior speed levels (:mod:`fricid.identify._rbf_folds`: random folds alone chose
+   residuals that followed the demo's 6 measured speeds and swung between them), and its
+   trainer is least squares
    (``lsq``), BAS or GA as the BAS-RBFNN paper's (``method=``).
 
 The prediction intervals saved with the model are the residual network's conformal intervals

@@ -436,9 +436,10 @@ def fit_rbf(
         tail (``linear_tail=True``: far from the data the network returns to Coulomb plus
         viscous friction, linear in load and temperature), the asinh velocity warp at the
         smallest measured speed (``velocity_scale``), and the number of centres, width
-        factor, velocity stretch and ridge penalty not given (or None) chosen by 5-fold
-        cross-validation of the ``lsq`` trainer
-        (:func:`fricid.identify._rbf_select.choose_structure`; ``state["n_centers_selection"]``),
+        factor, velocity stretch and ridge penalty not given (or None) chosen by
+        cross-validation of the ``lsq`` trainer over random folds and folds of whole interior
+        speed levels (:mod:`fricid.identify._rbf_folds`,
+        :func:`fricid.identify._rbf_select.choose_structure`; ``state["n_centers_selection"]``),
         whose held-out residuals give conformal prediction intervals
         (``state["prediction_interval"]``). A given number of centres above half the samples
         warns (:class:`~fricid.errors.IdentifiabilityWarning`).
