@@ -117,11 +117,12 @@ def test_learned_files_record_convergence_and_their_cv(rbf, gp, samples, tmp_pat
     assert gp.converged == (gp.convergence["certified_by"] == "optimizer")
 
     v = rbf.validation
-    assert v["source"] == CV_SOURCE and v["scheme"] == "kfold:5"
+    # 8 speeds: the 4 interior levels held out whole (fricid.identify._rbf_folds)
+    assert v["source"] == CV_SOURCE and v["scheme"] == "levels:4"
     state = rbf.state["n_centers_selection"]
-    assert v["rmse"] == pytest.approx(state["cv_rmse_chosen"])
+    assert v["rmse"] == pytest.approx(state["cv_rmse_levels_chosen"])
     assert v["scatter"] == pytest.approx(1e-3) and v["ratio"] == pytest.approx(v["rmse"] / 1e-3)
-    assert "measured set-points only" in v["note"]
+    assert "between the measured speeds, not beyond them" in v["note"]
     from fricid.cli.fit import goodness_text
 
     assert "note: out-of-fold error of the settings" in goodness_text(rbf)
@@ -188,8 +189,8 @@ def test_report_verdict_of_a_learned_model_rests_on_lovo(gp, rbf, samples):
     assert trust.heldout_source == "lovo" and "each retrained" in trust.validation_note
     # not run: the verdict falls back to the file's CV, with its caveat
     quick = assess_trust(rbf, samples, run_validation=False)
-    assert quick.heldout_source == "kfold:5"
-    assert "held out at the measured velocity levels only" in quick.line()
+    assert quick.heldout_source == "levels:4"
+    assert "held out between the measured speeds only" in quick.line()
     assert "convergence is not recorded" not in quick.line()
 
 

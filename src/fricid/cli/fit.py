@@ -73,7 +73,8 @@ def fit_command(
         int | None,
         typer.Option(
             help="rbf, hybrid: number of Gaussian units (hidden layer); default chosen with "
-            "the widths and the ridge penalty by 5-fold cross-validation."
+            "the widths and the ridge penalty by cross-validation (random folds and whole "
+            "speed levels held out)."
         ),
     ] = None,
     inputs: Annotated[

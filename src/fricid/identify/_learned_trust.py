@@ -23,12 +23,14 @@ parameter count of :func:`fricid.metrics.fit_statistics`) do not apply as they a
   ESL eq. 7.29-7.30 with ``d`` the effective count); where it is undefined (an optimiser
   searched the centres and widths with the targets), no AIC, BIC or reduced chi-square is
   given, and ``statistics_note`` says which.
-- **Held-out error.** The ``lsq`` structure search's 5-fold cross-validation already has the
+- **Held-out error.** The ``lsq`` structure search's cross-validation already has the
   out-of-fold error of the chosen settings: :func:`cv_validation` records it in the
-  ``validation`` schema of :func:`fricid.identify.validate.validate`, scheme ``kfold:5``,
-  against the measurement scatter, with ``note`` saying what it tests: the folds are dealt at
-  random, so every velocity level stays in training and it tests prediction at the measured
-  set-points only; and the settings were chosen by it (optimistic). The report's verdict uses
+  ``validation`` schema of :func:`fricid.identify.validate.validate` against the measurement
+  scatter, with ``note`` saying what it tests. Its folds hold out whole interior speed levels
+  (scheme ``levels:K``, :func:`fricid.identify._rbf_folds.level_folds`), so it tests
+  prediction between the measured speeds, not beyond them; with too few levels they are
+  dealt at random (scheme ``kfold:K``), and it tests the measured set-points only. Either
+  way the settings were chosen by it (optimistic). The report's verdict uses
   leave-one-velocity-out instead, the analytic path's test, when it is affordable
   (:data:`LEARNED_VALIDATE_WORK`; :mod:`fricid.report.trust`).
 """
@@ -250,14 +252,16 @@ def cv_validation(samples: FrictionSamples, pieces: Sequence[tuple[float, int, i
     ----------
     samples : FrictionSamples
         The training samples (their measurement scatter is the yardstick).
-    pieces : sequence of (rmse, n, folds)
-        Per trained network: the chosen settings' out-of-fold RMSE [N m], its samples and
-        folds (two networks per direction are pooled by their sizes).
+    pieces : sequence of (rmse, n, folds, kind)
+        Per trained network (:func:`cv_pieces`): the chosen settings' out-of-fold RMSE [N m],
+        its held-out samples, folds and their kind (``"velocity_levels"`` or ``"random"``);
+        two networks per direction are pooled by their sizes.
 
     Returns
     -------
     dict
-        :meth:`fricid.identify.validate.Validation.to_dict`'s keys (``scheme`` ``kfold:K``,
+        :meth:`fricid.identify.validate.Validation.to_dict`'s keys (``scheme`` ``levels:K``
+        or ``kfold:K``,
         ``rmse``, ``scatter``, ``ratio``, ``verdict``, no ``folds``), with ``source``
         (:data:`CV_SOURCE`) and ``note`` (what it tests; module notes).
     """
@@ -266,12 +270,27 @@ def cv_validation(samples: FrictionSamples, pieces: Sequence[tuple[float, int, i
     err = float(np.sqrt(sum(p[0] ** 2 * p[1] for p in pieces) / n)) if n else float("nan")
     ratio = err / sc.value if np.isfinite(sc.value) and sc.value > 0 else float("nan")
     k = min(p[2] for p in pieces)
+    levels = all(p[3] == "velocity_levels" for p in pieces)
+    if levels:
+        tests = (
+            f"out-of-fold error of the settings the {k}-fold cross-validation chose (whole "
+            "interior speed levels held out, the slowest and fastest always in training: it "
+            "tests prediction between the measured speeds, not beyond them; and slightly "
+            "optimistic, being the best of the candidates)"
+        )
+    else:
+        tests = (
+            f"out-of-fold error of the settings the {k}-fold cross-validation chose (random "
+            "folds: every velocity level stays in training, so it tests prediction at the "
+            "measured set-points only, not between or beyond them; and slightly optimistic, "
+            "being the best of the candidates)"
+        )
 
     def finite(x: float) -> float | None:
         return float(x) if np.isfinite(x) else None
 
     return {
-        "scheme": f"kfold:{k}",
+        "scheme": f"{'levels' if levels else 'kfold'}:{k}",
         "rmse": finite(err),
         "scatter": finite(sc.value),
         "scatter_method": sc.method,
@@ -282,13 +301,8 @@ def cv_validation(samples: FrictionSamples, pieces: Sequence[tuple[float, int, i
         "not_converged": 0,
         "folds": [],
         "source": CV_SOURCE,
-        "note": (
-            f"out-of-fold error of the settings the {k}-fold cross-validation chose (random "
-            "folds: every velocity level stays in training, so it tests prediction at the "
-            "measured set-points only, not between or beyond them; and slightly optimistic, "
-            "being the best of the candidates). fricid report runs leave-one-velocity-out, "
-            "or fricid fit --validate lovo"
-        ),
+        "note": f"{tests}. fricid report runs leave-one-velocity-out, or fricid fit "
+        "--validate lovo",
     }
 
 
@@ -297,15 +311,24 @@ def side_states(state: dict[str, Any]) -> list[dict[str, Any]]:
     return [state["pos"], state["neg"]] if "pos" in state else [state]
 
 
-def cv_pieces(state: dict[str, Any]) -> list[tuple[float, int, int]]:
-    """Per network of ``state``: (out-of-fold RMSE [N m] of the chosen settings, samples,
-    folds) of its structure search; empty when any network has none."""
+def cv_pieces(state: dict[str, Any]) -> list[tuple[float, int, int, str]]:
+    """Per network of ``state``: (out-of-fold RMSE [N m] of the chosen settings, held-out
+    samples, folds, their kind) of its structure search, the level folds' where it had them
+    (the test between measured speeds), else the random folds'; empty when any network has
+    none. Files written before level folds have neither: random folds, every sample held out
+    once."""
     pieces = []
     for side in side_states(state):
         sel = side.get("n_centers_selection") or {}
         if sel.get("cv_rmse_chosen") is None or not sel.get("n_samples"):
             return []
-        pieces.append((float(sel["cv_rmse_chosen"]), int(sel["n_samples"]), int(sel["folds"])))
+        if sel.get("cv_rmse_levels_chosen") is not None:  # level folds: the between-speeds test
+            rmse, n = float(sel["cv_rmse_levels_chosen"]), int(sel["n_held"])
+            pieces.append((rmse, n, int(sel["level_folds"]), "velocity_levels"))
+        else:
+            pieces.append(
+                (float(sel["cv_rmse_chosen"]), int(sel["n_samples"]), int(sel["folds"]), "random")
+            )
     return pieces
 
 

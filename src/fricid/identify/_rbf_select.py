@@ -18,6 +18,7 @@ import scipy.linalg
 from ..errors import DataError, DataQualityWarning, IdentifiabilityWarning
 from ..models.rbf import tail_columns
 from ._rbf_estimator import LSQ_IGNORES, RBFNetRegressor
+from ._rbf_folds import FOLDS, LEVEL_GAP_ALLOWANCE, cv_folds
 
 __all__ = [
     "ALPHAS",
@@ -36,9 +37,6 @@ __all__ = [
 
 #: The largest number of centres :func:`choose_n_centers` tries.
 MAX_AUTO_CENTERS = 60
-
-#: Folds of the cross-validation behind :func:`choose_n_centers`.
-FOLDS = 5
 
 
 def centre_grid(n: int) -> list[int]:
@@ -169,12 +167,20 @@ def conformal_half_widths(residuals: np.ndarray, levels=INTERVAL_LEVELS) -> list
 
 class _CrossValidation:
     """k-fold held-out residuals of ``lsq`` networks sharing their hidden layers (see
-    :func:`choose_structure`); ``residuals(m, wf, stretch)`` -> (alpha index, rmse [N m],
-    residuals [N m]) of the best penalty, memoised."""
+    :func:`choose_structure`); ``residuals(m, wf, stretch)`` -> (alpha index, score [N m],
+    residuals [N m] of every fold set pooled, RMSE [N m] per fold set: random, then levels)
+    of the best penalty, memoised. The score is the random folds' RMSE, or
+    ``max(random, levels / LEVEL_GAP_ALLOWANCE)`` with level folds
+    (:mod:`fricid.identify._rbf_folds`)."""
 
-    def __init__(self, X: np.ndarray, t: np.ndarray, params: Mapping[str, Any], alphas) -> None:
-        from sklearn.model_selection import KFold
-
+    def __init__(
+        self,
+        X: np.ndarray,
+        t: np.ndarray,
+        params: Mapping[str, Any],
+        alphas,
+        speed_input: bool = True,
+    ) -> None:
         n, self.d = X.shape
         vscale = params.get("velocity_scale")
         Xw = X.copy()
@@ -196,18 +202,23 @@ class _CrossValidation:
         self.ts = (t - mid) / self.half
         self.seed = _seed(params.get("random_state"))
         self.alphas = alphas
-        self.folds = min(FOLDS, n // 2)
-        self.splits = (
-            list(KFold(self.folds, shuffle=True, random_state=self.seed).split(X))
-            if self.folds >= 2
-            else []
-        )
+        rnd, lvl, self.note = cv_folds(X[:, 0] if speed_input else None, n, self.seed)
+        self.splits = rnd
+        self.folds = len(rnd)
+        #: (splits, held-out mask) of the random folds, then of the level folds if any
+        self.sets = []
+        for splits in (rnd, lvl) if lvl else (rnd,):
+            held = np.zeros(n, dtype=bool)
+            for _, test in splits:
+                held[test] = True
+            self.sets.append((splits, held))
+        self.held = self.sets[-1][1]
         self._centres: dict[tuple[int, float], np.ndarray] = {}
         self._memo: dict[tuple, tuple[int, float, np.ndarray]] = {}
 
     def residuals(
         self, m: int, wf: float, stretch: float, order: int = 1
-    ) -> tuple[int, float, np.ndarray]:
+    ) -> tuple[int, float, np.ndarray, list[float]]:
         from ..models import _rbf_core as core
 
         key = (m, wf, stretch, order)
@@ -221,26 +232,31 @@ class _CrossValidation:
         A = core.design(Z, C, core.nn_widths(C, wf, float(np.sqrt(self.d))))
         if self.linear:
             A = np.hstack([A, self.L[order]])
-        oof = np.full((len(self.alphas), len(self.ts)), np.nan)
+        oof = np.full((len(self.sets), len(self.alphas), len(self.ts)), np.nan)
         # the training folds' normal equations from the whole set's minus the held-out
         # fold's (one Gram matrix of all samples, one of each fold: half the products of
         # forming each training fold's), centred through the column sums when fitting a bias
         S_all, s_all, r_all = A.T @ A, A.sum(axis=0), A.T @ self.ts
         folds = []
-        for train, test in self.splits:
-            Ae, te, nt = A[test], self.ts[test], len(train)
-            mu = (s_all - Ae.sum(axis=0)) / nt if self.fit_bias else np.zeros(A.shape[1])
-            tm = float((self.ts.sum() - te.sum()) / nt) if self.fit_bias else 0.0
-            G = (S_all - Ae.T @ Ae - nt * np.outer(mu, mu)) / nt
-            h = (r_all - Ae.T @ te - nt * tm * mu) / nt
-            folds.append((test, mu, tm, G, h))
-        W = self._solve_all([f[3] for f in folds], [f[4] for f in folds])
-        for (test, mu, tm, _, _), w in zip(folds, W, strict=True):
-            oof[:, test] = ((A[test] - mu) @ w.T + tm).T
-        rmse = np.sqrt(np.mean((oof - self.ts) ** 2, axis=1)) * self.half
+        for j, (splits, _) in enumerate(self.sets):
+            for train, test in splits:
+                Ae, te, nt = A[test], self.ts[test], len(train)
+                mu = (s_all - Ae.sum(axis=0)) / nt if self.fit_bias else np.zeros(A.shape[1])
+                tm = float((self.ts.sum() - te.sum()) / nt) if self.fit_bias else 0.0
+                G = (S_all - Ae.T @ Ae - nt * np.outer(mu, mu)) / nt
+                h = (r_all - Ae.T @ te - nt * tm * mu) / nt
+                folds.append((j, test, mu, tm, G, h))
+        W = self._solve_all([f[4] for f in folds], [f[5] for f in folds])
+        for (j, test, mu, tm, _, _), w in zip(folds, W, strict=True):
+            oof[j][:, test] = ((A[test] - mu) @ w.T + tm).T
+        # level folds hold out no end level
+        errs = [oof[j][:, held] - self.ts[held] for j, (_, held) in enumerate(self.sets)]
+        err = np.concatenate(errs, axis=1)
+        per = [np.sqrt(np.mean(e**2, axis=1)) * self.half for e in errs]
+        rmse = per[0] if len(per) == 1 else np.maximum(per[0], per[1] / LEVEL_GAP_ALLOWANCE)
         rmse = np.where(np.isfinite(rmse), rmse, np.inf)
         k = int(np.argmin(rmse))
-        out = (k, float(rmse[k]), (oof[k] - self.ts) * self.half)
+        out = (k, float(rmse[k]), err[k] * self.half, [float(p[k]) for p in per])
         self._memo[key] = out
         return out
 
@@ -283,11 +299,13 @@ class _CrossValidation:
 
 
 def choose_structure(
-    X: np.ndarray, t: np.ndarray, params: Mapping[str, Any]
+    X: np.ndarray, t: np.ndarray, params: Mapping[str, Any], speed_input: bool = True
 ) -> tuple[dict[str, Any], dict[str, Any]]:
     """Number of centres, width factor, velocity stretch and ridge penalty of the ``lsq``
-    network by k-fold cross-validation (issue 15, "defaults chosen by held-out error"), and
-    prediction intervals from the chosen candidate's held-out residuals.
+    network by cross-validation over random folds and folds of whole speed levels (issue 15,
+    "defaults chosen by the held-out error that matters": the score of
+    :mod:`fricid.identify._rbf_folds`; random folds only when there are too few levels),
+    and prediction intervals from the chosen candidate's held-out residuals.
 
     The search is coordinate-wise: the number of centres over :func:`structure_grid` (width
     factor 1.5, no stretch), then the width factor (:data:`WIDTH_FACTORS`), the velocity
@@ -309,6 +327,8 @@ def choose_structure(
     params : mapping
         :class:`RBFNetRegressor` parameters; those given (not None) among ``n_centers``,
         ``width_factor``, ``velocity_stretch``, ``alpha`` are held, the others chosen.
+    speed_input : bool
+        The first input is the speed ``|v|`` (its levels make the folds).
 
     Returns
     -------
@@ -316,10 +336,13 @@ def choose_structure(
         The chosen ``n_centers``, ``width_factor``, ``velocity_stretch``, ``alpha``.
     dict
         The note saved in the model file: ``grid`` (centres), ``width_factors``,
-        ``stretches``, ``alphas``, ``folds``, ``cv_rmse`` [N m] per number of centres (last
-        pass), ``chosen`` (centres), ``chosen_width_factor``, ``chosen_stretch``,
-        ``chosen_alpha``, ``cv_rmse_chosen`` and ``prediction_interval`` (levels, half-widths
-        [N m], method).
+        ``stretches``, ``alphas``, ``folds`` (random), ``cv_folds``, ``cv_levels``,
+        ``level_folds``, ``cv_note`` (:func:`~fricid.identify._rbf_folds.cv_folds`),
+        ``cv_rmse`` [N m] the score per number of centres (last pass), ``n_held`` (samples
+        the level folds hold out, else all), ``chosen`` (centres), ``chosen_width_factor``,
+        ``chosen_stretch``, ``chosen_alpha``, ``cv_rmse_chosen`` (random folds),
+        ``cv_rmse_levels_chosen`` and ``cv_score_chosen`` (with level folds) and
+        ``prediction_interval`` (levels, half-widths [N m], method).
     """
     n = X.shape[0]
 
@@ -332,13 +355,15 @@ def choose_structure(
     if params.get("velocity_scale") is not None or params.get("velocity_stretch") is not None:
         stretches = tuple(float(x) for x in held("velocity_stretch", STRETCHES))
     alphas = tuple(max(float(a), 1e-12) for a in held("alpha", ALPHAS))
-    cv = _CrossValidation(X, t, params, alphas)
+    cv = _CrossValidation(X, t, params, alphas, speed_input)
     note: dict[str, Any] = {
         "grid": grid,
         "width_factors": list(widths),
         "stretches": list(stretches),
         "alphas": list(alphas),
         "folds": cv.folds,
+        "n_held": int(cv.held.sum()),
+        **cv.note,
         "trainer": "lsq",
     }
     wf = 1.5 if 1.5 in widths else widths[0]
@@ -371,7 +396,14 @@ def choose_structure(
     (_, _, stretch, _), _ = best_of([(m, wf, x, order) for x in stretches])
     (_, _, _, order), _ = best_of([(m, wf, stretch, o) for o in orders])
     (m, _, _, _), per_m = best_of([(g, wf, stretch, order) for g in grid])
-    k, rmse, resid = cv.residuals(m, wf, stretch, order)
+    k, score, resid, per = cv.residuals(m, wf, stretch, order)
+    held = (
+        "random folds"
+        if len(per) == 1
+        else "random folds and folds of interior speed levels, pooled"
+    )
+    if len(per) == 2:
+        note.update(cv_rmse_levels_chosen=per[1], cv_score_chosen=score)
     note.update(
         cv_rmse=[r if np.isfinite(r) else None for r in per_m],
         chosen=m,
@@ -379,12 +411,12 @@ def choose_structure(
         chosen_stretch=stretch,
         chosen_alpha=alphas[k],
         chosen_tail_order=order,
-        cv_rmse_chosen=rmse,
+        cv_rmse_chosen=per[0],
         prediction_interval={
             "levels": list(INTERVAL_LEVELS),
             "half_width": conformal_half_widths(resid),
             "method": f"conformal: quantiles of the {cv.folds}-fold cross-validation "
-            "residuals of the chosen candidate (CV+, Barber et al. 2021)",
+            f"residuals of the chosen candidate (CV+, Barber et al. 2021; {held})",
         },
     )
     chosen = {

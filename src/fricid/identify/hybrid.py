@@ -19,14 +19,18 @@ RBF network trained on what it leaves, ``fit(samples, "hybrid")``.
    parameters extrapolates best (paper-1 preset, ``python benchmarks/bench_floor.py``,
    2026-11-22: unseen-region mean error 0.80 mN m with ``msk_temp``, the BIC's choice,
    against 3.90 with ``vlt``, the choice before the temperature variants joined). On issue
-   15's held-out laws the hybrid is fricid's learned model nearest the noise floor (same
-   run: 1.08 / 1.01 / 0.99 x noise on the grid, Arrhenius and sigmoid kinds; trained in
-   0.56 / 0.08 / 0.11 s, the machine shared, against fricid's ``gp`` 1.88 / 0.11 / 1.13 s
-   and scikit-learn's exact GP 23.6 / 0.05 / 0.92 s: the bench's run of 22:38 UTC).
+   15's held-out laws the hybrid is fricid's learned model nearest the noise floor (the
+   bench's run of 23:04 UTC: 1.18 / 1.01 / 0.99 x noise on the grid, Arrhenius and sigmoid
+   kinds, the grid's 1.18 above the 1.10 goal; trained in 1.00 / 0.08 / 0.13 s, the machine
+   shared, against fricid's ``gp`` 3.03 / 0.10 / 1.13 s and scikit-learn's exact GP 31.0 /
+   0.04 / 0.94 s).
 2. **Residual.** The RBF network (:func:`fricid.identify.rbf.fit_rbf`) is trained on
    ``F - F_backbone`` with its sign of motion, *without* bias or linear tail, so it vanishes
    far from its centres and the model returns to the backbone outside the data; its size,
-   widths and penalty are chosen by cross-validation, and its trainer is least squares
+   widths and penalty are chosen by cross-validation over random folds and folds of whole
+   interior speed levels (:mod:`fricid.identify._rbf_folds`: random folds alone chose
+   residuals that followed the demo's 6 measured speeds and swung between them), and its
+   trainer is least squares
    (``lsq``), BAS or GA as the BAS-RBFNN paper's (``method=``).
 
 The prediction intervals saved with the model are the residual network's conformal intervals

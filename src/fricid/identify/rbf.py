@@ -386,7 +386,7 @@ def _train_side(
         raise ConfigError("velocity_scale warps the first input, which must be 'velocity'")
     if params.get("n_centers") is not None:
         check_centres(int(params["n_centers"]), len(t), where)
-    chosen, note = choose_structure(X, t, params)
+    chosen, note = choose_structure(X, t, params, speed_input=kept[0] == "velocity")
     note["n_samples"] = len(t)
     params.update({k: v for k, v in chosen.items() if params.get(k) is None})
     notes["n_centers_selection"] = note
@@ -436,9 +436,10 @@ def fit_rbf(
         tail (``linear_tail=True``: far from the data the network returns to Coulomb plus
         viscous friction, linear in load and temperature), the asinh velocity warp at the
         smallest measured speed (``velocity_scale``), and the number of centres, width
-        factor, velocity stretch and ridge penalty not given (or None) chosen by 5-fold
-        cross-validation of the ``lsq`` trainer
-        (:func:`fricid.identify._rbf_select.choose_structure`; ``state["n_centers_selection"]``),
+        factor, velocity stretch and ridge penalty not given (or None) chosen by
+        cross-validation of the ``lsq`` trainer over random folds and folds of whole interior
+        speed levels (:mod:`fricid.identify._rbf_folds`,
+        :func:`fricid.identify._rbf_select.choose_structure`; ``state["n_centers_selection"]``),
         whose held-out residuals give conformal prediction intervals
         (``state["prediction_interval"]``). A given number of centres above half the samples
         warns (:class:`~fricid.errors.IdentifiabilityWarning`).

@@ -471,6 +471,11 @@ def _describe_net(st: Mapping[str, Any]) -> str:
         + (
             f"; {st['n_centers_selection'].get('chosen')} centres chosen by "
             f"{st['n_centers_selection'].get('folds')}-fold cross-validation"
+            + (
+                " and whole speed levels held out"
+                if st["n_centers_selection"].get("cv_folds") == "velocity_levels"
+                else ""
+            )
             if isinstance(st.get("n_centers_selection"), Mapping)
             else ""
         )

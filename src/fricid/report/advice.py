@@ -81,8 +81,14 @@ def misfit_advice(
     learned = fitted.kind == "rbf"
     r_in = _in_sample_ratio(fitted, samples, scatter)
     auto = f"compare every family by held-out error (fricid fit {name} --model auto --learned)"
+    if np.isfinite(r_in) and r_in > miss_ratio and learned:
+        return (
+            f"it does not follow the measured set-points either (in-sample {r_in:.3g}x the "
+            "scatter): the settings it chose trade them for smoothness between the measured "
+            f"speeds; measure more velocity levels in the widest gaps, or {auto}"
+        )
     if np.isfinite(r_in) and r_in > miss_ratio:
-        what = "this model" if learned else f"the {fitted.model} family"
+        what = f"the {fitted.model} family"
         return (
             f"{what} cannot follow these data: its in-sample error alone is {r_in:.3g}x the "
             "scatter, so more data will not help; fit a learned model (fricid fit "

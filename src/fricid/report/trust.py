@@ -374,8 +374,12 @@ def _grade(trust: Trust, fitted: FittedModel, quality_caveat: str) -> None:
     if np.isfinite(ratio) and kind == "in-sample" and not no:
         caveats.append("no held-out validation (in-sample error only)")
     elif np.isfinite(ratio) and own_cv(trust.validation) and not no:
+        levels = str(trust.validation.get("scheme", "")).startswith("levels")
         caveats.append(
-            "held out at the measured velocity levels only (the fit's own random-fold CV; "
+            "held out between the measured speeds only (the fit's own CV over whole speed "
+            "levels; beyond them untested)"
+            if levels
+            else "held out at the measured velocity levels only (the fit's own random-fold CV; "
             "between and beyond them untested)"
         )
     if quality_caveat:
