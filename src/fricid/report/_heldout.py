@@ -116,8 +116,9 @@ def _run_learned(
 
 
 def own_cv(validation: dict[str, Any] | None) -> bool:
-    """The validation is a learned model's record of its own structure search's CV (random
-    folds at the measured set-points, :mod:`fricid.identify._learned_trust`)."""
+    """The validation is a learned model's record of its own structure search's CV (folds of
+    whole interior speed levels, or random folds where there are too few levels; the record's
+    scheme says which: :mod:`fricid.identify._learned_trust`)."""
     from ..identify._learned_trust import CV_SOURCE
 
     return bool(validation) and validation.get("source") == CV_SOURCE
