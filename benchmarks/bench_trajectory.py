@@ -62,9 +62,9 @@ slowest    5.46 s (2.54 s without    5.65 s
            the rate bias)
 =========  ========================  ========================
 
-Seeds 0-4 are unlucky for the filtered route: on seeds 10-59 it covered 336/350 (module
-notes of :mod:`fricid.identify.trajectory`), on seeds 10-49 270/280 with the Monte-Carlo
-spread of the static part within 5 % of the reported standard errors
+Seeds 0-4 are unlucky for the filtered route: on seeds 10-59 it covered 336/350
+(``python benchmarks/calib_trajectory.py --first 10 --seeds 50``), on seeds 10-49 270/280
+with the Monte-Carlo spread of the static part within 5 % of the reported standard errors
 (``benchmarks/calib_trajectory.py``).
 """
 

@@ -89,7 +89,8 @@ without (earlier runs: the same table). ``two_stage``, same
 run conditions (``--route two_stage``): sigma_1 open on 3/5 seeds, covered 24/32 closed
 (tau_s 2/5), seed 0 tau_s 0.734 [0.674, 0.793], half-widths 3-9 times the filtered route's,
 overlap 19/25, 4.1-5.7 s. Seeds 0-4 are the unlucky ones: on seeds 10-59 (not the
-benchmark's, ``filtered``) 336/350 intervals covered (96 %; every parameter 47-50/50), the
+benchmark's, ``filtered``; ``python benchmarks/calib_trajectory.py --first 10 --seeds 50``)
+336/350 intervals covered (96 %; every parameter 47-50/50; p_x 45/50, p_y 46/50), the
 misses clustered on a few seeds where the Stribeck trio misses together (their estimates are
 correlated), as on seeds 0-4. The cut-off: 20 Hz; at 40 and 60 Hz (seeds 10-29) the intervals
 halved but sigma_0 was covered on 4/20 and 2/20 seeds: the bristle drive's error at 1 kHz
