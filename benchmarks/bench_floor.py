@@ -76,7 +76,14 @@ the ``msk_temp`` backbone, 1.55 x the averaged samples' noise of 0.51 mN m (goal
 ``vlt`` 8.50 / 12.70, ``gp`` 0.56 / 1.73, the BAS-RBFNN paper 1.2 / 6.3); ``rbf`` 4.86 /
 15.09 (2.28 / 4.60 with random folds only; why, not examined yet).
 
-Training time, hybrid / GP (goal <= 0.1), same run:
+Re-run after the ridge penalty's one-standard-error rule (random folds only,
+:func:`fricid.identify._rbf_folds.choose_penalty`), 2026-11-22 23:34 UTC, load average 2.1 on
+2 cores, 110 s: every error above and below the same to the printed digits (these fits all
+deal level folds, where the rule does not apply); training seconds hybrid 0.756 / 0.082 /
+0.127, ``gp`` 1.904 / 0.106 / 1.119 (grid / asym_arrhenius / sigmoid), paper-1 hybrid 1.668,
+``gp`` 1.830.
+
+Training time, hybrid / GP (goal <= 0.1), 23:04 run:
 
 ==============  ============  ==============  ============  ==============
 reference       grid          asym_arrhenius  sigmoid       paper-1 (6615)

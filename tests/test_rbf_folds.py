@@ -15,6 +15,7 @@ from fricid.identify._rbf_folds import (
     FOLDS,
     LEVEL_GAP_ALLOWANCE,
     MIN_LEVELS,
+    choose_penalty,
     cv_folds,
     speed_levels,
 )
@@ -120,3 +121,45 @@ def test_rbf_default_predicts_the_demos_interior_speed_levels():
         warnings.simplefilter("ignore")
         v = validate(samples, "rbf", "lovo", method="lsq", seed=0)
     assert interior_rmse(v.folds) / v.scatter.value < 20.0
+
+
+def test_penalty_is_the_largest_within_one_standard_error_of_the_best():
+    """The one-standard-error rule of :func:`choose_penalty`: a smaller penalty whose score
+    is better by less than its noise loses to the larger one; one better by far wins."""
+    rng = np.random.default_rng(0)
+    base = rng.normal(size=2000)
+    alphas = (1e-11, 1e-8, 1e-5)
+    near = np.stack([base, base * 1.005, base * 1.5])  # 1e-8 within 0.5 %, 1e-5 far off
+    k, score, per = choose_penalty([near], alphas)
+    assert int(np.argmin(score)) == 0 and k == 1
+    assert per[0][k] == pytest.approx(np.sqrt(np.mean((base * 1.005) ** 2)))
+    far = np.stack([base, base * 1.2, base * 1.5])  # 1e-11 better by 20 %: kept
+    assert choose_penalty([far], alphas)[0] == 0
+    # with level folds: the best score, max(random, levels / allowance), as before the rule
+    levels = np.stack([base * 4.0, base * 2.0, base * 2.02])
+    k, score, _ = choose_penalty([near, levels], alphas)
+    np.testing.assert_allclose(score, np.maximum(per[0], [2.0, 1.0, 1.01]), rtol=0.05)
+    assert k == int(np.argmin(score)) == 1
+    levels_close = np.stack([base * 1.6, base * 1.61, base * 3.0])
+    assert choose_penalty([near, levels_close], alphas)[0] == 0  # no rule on top of levels
+    # a penalty that failed (not finite) is never chosen
+    bad = np.stack([base * np.nan, base, base])
+    assert choose_penalty([bad], alphas)[0] == 2
+
+
+def test_hybrid_residual_without_level_folds_has_no_swing_at_the_fast_end(monkeypatch):
+    """Issue 15, the grid kind's tuning seed 7 with random folds only: the penalty 1e-11
+    (the best random-fold score by a hair) left the hybrid 3.4x the noise off the truth;
+    the one-standard-error rule takes 1e-8 and 1.09x."""
+    from fricid.identify import _rbf_folds
+    from fricid.sim.heldout_laws import draw
+
+    monkeypatch.setattr(_rbf_folds, "MIN_LEVELS", 10**9)
+    d = draw("grid", 7)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        m = fit(d.train, "hybrid", seed=0)
+    sel = m.state["residual"]["n_centers_selection"]
+    assert sel["cv_folds"] == "random" and sel["chosen_alpha"] > 1e-11
+    r = m.predict(d.test.X, warn=False) - d.test.y
+    assert np.sqrt(np.mean(r * r)) / d.noise < 1.3

@@ -18,7 +18,7 @@ import scipy.linalg
 from ..errors import DataError, DataQualityWarning, IdentifiabilityWarning
 from ..models.rbf import tail_columns
 from ._rbf_estimator import LSQ_IGNORES, RBFNetRegressor
-from ._rbf_folds import FOLDS, LEVEL_GAP_ALLOWANCE, cv_folds
+from ._rbf_folds import FOLDS, choose_penalty, cv_folds
 
 __all__ = [
     "ALPHAS",
@@ -170,7 +170,8 @@ class _CrossValidation:
     :func:`choose_structure`); ``residuals(m, wf, stretch)`` -> (alpha index, score [N m],
     residuals [N m] of every fold set pooled, RMSE [N m] per fold set: random, then levels)
     of the best penalty, memoised. The score is the random folds' RMSE, or
-    ``max(random, levels / LEVEL_GAP_ALLOWANCE)`` with level folds
+    ``max(random, levels / LEVEL_GAP_ALLOWANCE)`` with level folds; the penalty by
+    :func:`~fricid.identify._rbf_folds.choose_penalty`
     (:mod:`fricid.identify._rbf_folds`)."""
 
     def __init__(
@@ -252,10 +253,7 @@ class _CrossValidation:
         # level folds hold out no end level
         errs = [oof[j][:, held] - self.ts[held] for j, (_, held) in enumerate(self.sets)]
         err = np.concatenate(errs, axis=1)
-        per = [np.sqrt(np.mean(e**2, axis=1)) * self.half for e in errs]
-        rmse = per[0] if len(per) == 1 else np.maximum(per[0], per[1] / LEVEL_GAP_ALLOWANCE)
-        rmse = np.where(np.isfinite(rmse), rmse, np.inf)
-        k = int(np.argmin(rmse))
+        k, rmse, per = choose_penalty([e * self.half for e in errs], self.alphas)
         out = (k, float(rmse[k]), err[k] * self.half, [float(p[k]) for p in per])
         self._memo[key] = out
         return out
