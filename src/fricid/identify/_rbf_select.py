@@ -203,7 +203,9 @@ class _CrossValidation:
         self.ts = (t - mid) / self.half
         self.seed = _seed(params.get("random_state"))
         self.alphas = alphas
-        rnd, lvl, self.note = cv_folds(X[:, 0] if speed_input else None, n, self.seed)
+        speed = X[:, 0] if speed_input else None
+        levels = bool(params.get("level_folds", True))
+        rnd, lvl, self.note = cv_folds(speed, n, self.seed, levels=levels)
         self.splits = rnd
         self.folds = len(rnd)
         #: (splits, held-out mask) of the random folds, then of the level folds if any

@@ -19,32 +19,27 @@ RBF network trained on what it leaves, ``fit(samples, "hybrid")``.
    parameters extrapolates best (paper-1 preset, ``python benchmarks/bench_floor.py``,
    2026-11-22: unseen-region mean error 0.80 mN m with ``msk_temp``, the BIC's choice,
    against 3.90 with ``vlt``, the choice before the temperature variants joined). On issue
-   15's held-out laws the hybrid is fricid's learned model nearest the noise floor (the
-   bench's run of 23:04 UTC: 1.18 / 1.01 / 0.99 x noise on the grid, Arrhenius and sigmoid
-   kinds, the grid's 1.18 above the 1.10 goal; trained in 1.00 / 0.08 / 0.13 s, the machine
-   shared, against fricid's ``gp`` 3.03 / 0.10 / 1.13 s and scikit-learn's exact GP 31.0 /
-   0.04 / 0.94 s).
+   15's held-out laws the hybrid is fricid's learned model nearest the noise floor
+   (``python benchmarks/bench_floor.py``, 23:40 UTC, the machine shared: 1.08 / 1.01 / 0.99 x
+   noise on the grid, Arrhenius and sigmoid kinds; trained in 0.57 / 0.08 / 0.11 s against
+   fricid's ``gp`` 2.00 / 0.10 / 1.11 s and scikit-learn's exact GP 24.2 / 0.04 / 0.91 s).
 2. **Residual.** The RBF network (:func:`fricid.identify.rbf.fit_rbf`) is trained on
    ``F - F_backbone`` with its sign of motion, *without* bias or linear tail, so it vanishes
    far from its centres and the model returns to the backbone outside the data; its size,
-   widths and penalty are chosen by cross-validation over random folds and folds of whole
-   interior speed levels (:mod:`fricid.identify._rbf_folds`: random folds alone chose
-   residuals that followed the demo's 6 measured speeds and swung between them), and its
-   trainer is least squares
-   (``lsq``), BAS or GA as the BAS-RBFNN paper's (``method=``).
-   The grid kind's bad tails under random folds alone (tuning seeds 0-49: 6 seeds at
-   2.3-4.3x the noise) had one cause: the ridge penalty. Every seed took the same backbone
-   (``msk_temp``) and residual structure (214 centres, width factor 2.2); the 6 bad ones took
-   the penalty 1e-11 instead of 1e-8 at the same random-fold score, and their error sat
-   between the fastest measured speeds (6-12x the noise in the last gap, 27-45 deg/s, at
-   every load and temperature). With random folds only the penalty is now chosen by the
-   one-standard-error rule (:func:`fricid.identify._rbf_folds.choose_penalty`): grid hybrid
-   1.370 / 1.119 / 2.327 / 4.294 -> 1.110 / 1.106 / 1.152 / 1.172 (mean / median / p90 /
-   max). Where level folds are dealt (the grid's 12 speeds) the structure they choose costs
-   the grid's median +0.08 (1.196, tails gone either way) whatever their weight (``levels /
-   2, 3, 4``: median 1.19 each), while the demo's rbf needs them (leave-one-velocity-out
-   interior error 11x the scatter with them, 53x with random folds and the rule): the grid's
-   1.10 goal and the demo pull the fold design apart, which is left open.
+   widths and penalty are chosen by cross-validation over random folds, the penalty by the
+   one-standard-error rule (:func:`fricid.identify._rbf_folds.choose_penalty`), and its
+   trainer is least squares (``lsq``), BAS or GA as the BAS-RBFNN paper's (``method=``).
+   The grid kind's bad tails under random folds with the best-scoring penalty (tuning seeds
+   0-49: 6 seeds at 2.3-4.3x the noise) had one cause, the penalty: every seed took the same
+   backbone (``msk_temp``) and residual structure (214 centres, width factor 2.2); the 6 bad
+   ones took 1e-11 instead of 1e-8 at the same random-fold score, and their error sat between
+   the fastest measured speeds (6-12x the noise in the last gap, 27-45 deg/s). The rule takes
+   1e-8: 1.370 / 1.119 / 2.327 / 4.294 -> 1.110 / 1.106 / 1.152 / 1.172 (mean / median / p90 /
+   max; ``python benchmarks/bench_learned_tuning.py --random-folds-only``). Folds of whole
+   speed levels (the plain ``rbf``'s) were tried for the residual too and are not its default:
+   against the truth they did worse (:mod:`fricid.identify._rbf_folds` notes: grid 1.194 mean;
+   the demo's design, between the measured speeds, 5.35 against 4.25 mN m on seed 0); they
+   remain an option, ``network={"level_folds": True}``.
 
 The prediction intervals saved with the model are the residual network's conformal intervals
 (cross-validation residuals of the residual fit, the backbone held; they do not include the
@@ -311,7 +306,11 @@ def fit_hybrid(
     from dataclasses import replace
 
     res_samples = replace(samples, friction=resid)
-    res = fit_rbf(res_samples, names, **{**network, "linear_tail": False, "fit_bias": False})
+    res = fit_rbf(
+        res_samples,
+        names,
+        **{"level_folds": False, **network, "linear_tail": False, "fit_bias": False},
+    )
     residual = dict(res.state or {})
     used = set(names) | set(model.inputs)
     state: dict[str, Any] = {

@@ -386,7 +386,10 @@ def _train_side(
         raise ConfigError("velocity_scale warps the first input, which must be 'velocity'")
     if params.get("n_centers") is not None:
         check_centres(int(params["n_centers"]), len(t), where)
-    chosen, note = choose_structure(X, t, params, speed_input=kept[0] == "velocity")
+    level_folds = bool(params.pop("level_folds", True))
+    chosen, note = choose_structure(
+        X, t, {**params, "level_folds": level_folds}, speed_input=kept[0] == "velocity"
+    )
     note["n_samples"] = len(t)
     params.update({k: v for k, v in chosen.items() if params.get(k) is None})
     notes["n_centers_selection"] = note
