@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
+from _synthetic import averaged_samples
 from fricid.cli import app
 from fricid.fitted import FittedModel
 from fricid.identify import fit
@@ -28,15 +29,7 @@ def _samples(seed: int = 0, noise: float = 1e-3, reps: int = 3) -> FrictionSampl
     v = np.repeat(np.geomspace(0.01, 1.0, 8), 3 * reps)
     temp = np.tile(np.repeat([20.0, 30.0, 40.0], reps), 8)
     f = 0.1 + 0.05 * np.exp(-((v / 0.05) ** 2)) + 0.05 * v + 0.0005 * (temp - 30)
-    return FrictionSamples(
-        velocity=v,
-        load=None,
-        temperature=temp,
-        friction=f + noise * rng.normal(size=v.size),
-        std=np.full(v.size, noise * 10),
-        count=np.full(v.size, 100),
-        source="syn.csv",
-    )
+    return averaged_samples(v, temp, f, noise, rng)
 
 
 @pytest.fixture(scope="module")

@@ -8,6 +8,7 @@ import warnings
 import numpy as np
 import pytest
 
+from _synthetic import averaged_samples
 from fricid.identify import fit
 from fricid.identify._learned_trust import cv_pieces, cv_validation
 from fricid.identify._rbf_folds import (
@@ -36,15 +37,7 @@ def _samples(speeds=SPEEDS, seed: int = 0, noise: float = 1e-3) -> FrictionSampl
     v = v * np.tile([1, 1, 1, -1, -1, -1], len(speeds))
     temp = np.tile([20.0, 30.0, 40.0, 20.0, 30.0, 40.0], len(speeds))
     f = np.sign(v) * _law(np.abs(v), temp)
-    return FrictionSamples(
-        velocity=v,
-        load=None,
-        temperature=temp,
-        friction=f + noise * rng.normal(size=v.size),
-        std=np.full(v.size, noise * 10),
-        count=np.full(v.size, 100),
-        source="syn.csv",
-    )
+    return averaged_samples(v, temp, f, noise, rng)
 
 
 def test_speed_levels_group_speeds_that_scatter_about_a_set_point():

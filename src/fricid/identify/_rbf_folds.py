@@ -44,7 +44,7 @@ from typing import Any
 
 import numpy as np
 
-from ._scatter import LEVEL_RTOL
+from ._scatter import speed_levels
 
 __all__ = [
     "END_LEVELS",
@@ -76,18 +76,6 @@ LEVEL_GAP_ALLOWANCE = 2.0
 PENALTY_SE = 1.0
 
 Split = tuple[np.ndarray, np.ndarray]
-
-
-def speed_levels(speed: np.ndarray, rtol: float = LEVEL_RTOL) -> np.ndarray:
-    """Level index of each ``|speed|`` (0 the slowest): sorted speeds within ``rtol`` of each
-    other share one, as :func:`fricid.identify._scatter.level_labels` groups samples."""
-    s_abs = np.abs(np.asarray(speed, dtype=float))
-    order = np.argsort(s_abs, kind="stable")
-    s = s_abs[order]
-    new = np.r_[False, s[1:] > s[:-1] * (1.0 + rtol) + 1e-12]
-    labels = np.empty(s.size, dtype=int)
-    labels[order] = np.cumsum(new)
-    return labels
 
 
 def cv_folds(

@@ -39,6 +39,7 @@ __all__ = [
     "measurement_scatter",
     "sample_weights",
     "sem_autocorrelated",
+    "speed_levels",
 ]
 
 #: Relative gap between two velocity levels (as the extraction's set-point clustering).
@@ -96,11 +97,17 @@ def level_labels(samples: FrictionSamples, rtol: float = LEVEL_RTOL) -> np.ndarr
     numpy.ndarray of int (n,)
         Level index, 0 for the slowest; both directions of a speed share a level.
     """
-    speed = np.abs(samples.velocity)
-    order = np.argsort(speed, kind="stable")
-    s = speed[order]
+    return speed_levels(samples.velocity, rtol)
+
+
+def speed_levels(speed: np.ndarray, rtol: float = LEVEL_RTOL) -> np.ndarray:
+    """Level index of each ``|speed|`` (0 the slowest): sorted speeds within ``rtol`` of each
+    other share one (:func:`level_labels` on bare speeds)."""
+    s_abs = np.abs(np.asarray(speed, dtype=float))
+    order = np.argsort(s_abs, kind="stable")
+    s = s_abs[order]
     new = np.r_[False, s[1:] > s[:-1] * (1.0 + rtol) + 1e-12]
-    labels = np.empty(speed.size, dtype=int)
+    labels = np.empty(s.size, dtype=int)
     labels[order] = np.cumsum(new)
     return labels
 
