@@ -201,12 +201,12 @@ def compensate_command(
         warnings.simplefilter("always", FricidWarning)
         result = compensation_study(fitted, config, truth=plant, smoothing=Smoothing(smooth, zone))
     _relay(caught)
-    if not no_plot:
-        plot_path = plot or Path(f"{model.stem}.compensation.png")
-        plot_compensation(result, plot_path)
-        err_console.print(f"wrote {plot_path}")
-    if as_json:
-        console.print_json(json.dumps(result.to_dict()))
+    if _plot_or_json(
+        result,
+        plot_compensation,
+        None if no_plot else plot or Path(f"{model.stem}.compensation.png"),
+        as_json,
+    ):
         return
     cfg = result.config
     k_p, k_d = cfg.gains
@@ -240,6 +240,17 @@ def compensate_command(
     for note in result.notes:
         if not note.startswith("the reference goes outside"):  # warned on stderr above
             console.print(f"note: {note}", highlight=False)
+
+
+def _plot_or_json(result, plot_fn, plot_path: Path | None, as_json: bool) -> bool:
+    """Write the figure (unless ``plot_path`` is None) and, with ``as_json``, print the JSON
+    summary; True when the JSON was the whole output."""
+    if plot_path is not None:
+        plot_fn(result, plot_path)
+        err_console.print(f"wrote {plot_path}")
+    if as_json:
+        console.print_json(json.dumps(result.to_dict()))
+    return as_json
 
 
 def _relay(caught) -> None:
@@ -292,12 +303,12 @@ def _dynamic(fitted, config, plant, lugre, options, model, plot, no_plot, as_jso
             seed=0,
         )
     _relay(caught)
-    if not no_plot:
-        plot_path = plot or Path(f"{model.stem}.compensation.png")
-        plot_lugre_compensation(result, plot_path)
-        err_console.print(f"wrote {plot_path}")
-    if as_json:
-        console.print_json(json.dumps(result.to_dict()))
+    if _plot_or_json(
+        result,
+        plot_lugre_compensation,
+        None if no_plot else plot or Path(f"{model.stem}.compensation.png"),
+        as_json,
+    ):
         return
     cfg = result.config
     table = Table(

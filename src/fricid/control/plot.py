@@ -56,13 +56,7 @@ def plot_compensation(result: CompensationResult, path: str | os.PathLike[str]) 
         ls="--",
         label=f"feed-forward ({result.model})",
     )
-    ax_v.set_ylabel("velocity [rad/s]")
-    ax_e.set_ylabel("tracking error [mrad]")
-    ax_f.set_ylabel("torque [N m]")
-    ax_f.set_xlabel("time [s]")
-    for ax in (ax_v, ax_e, ax_f):
-        ax.grid(True, alpha=0.3)
-        ax.legend(loc="upper right", fontsize="small")
+    _label_axes(ax_v, ax_e, ax_f)
     kp, kd = result.config.gains
     title = f"Friction compensation: model '{result.model}', true friction '{result.truth}'"
     if np.isfinite(result.improvement):
@@ -109,13 +103,7 @@ def plot_lugre_compensation(
         if k:
             ax_f.plot(t, runs["friction"][k], color=c, lw=0.9, label=f"true friction, {name} run")
             ax_f.plot(t, runs["feedforward"][k], color=c, lw=1.0, ls="--", label=f"{name}")
-    ax_v.set_ylabel("velocity [rad/s]")
-    ax_e.set_ylabel("tracking error [mrad]")
-    ax_f.set_ylabel("torque [N m]")
-    ax_f.set_xlabel("time [s]")
-    for ax in (ax_v, ax_e, ax_f):
-        ax.grid(True, alpha=0.3)
-        ax.legend(loc="upper right", fontsize="small")
+    _label_axes(ax_v, ax_e, ax_f)
     kp, kd = result.config.gains
     fig.suptitle(
         f"LuGre friction compensation: true friction '{result.truth}', model "
@@ -126,3 +114,14 @@ def plot_lugre_compensation(
     with atomic_path(path) as tmp:
         fig.savefig(tmp, format="png", dpi=110)
     return path
+
+
+def _label_axes(ax_v, ax_e, ax_f) -> None:
+    """Units, grid and legend of the velocity, tracking-error and torque panels."""
+    ax_v.set_ylabel("velocity [rad/s]")
+    ax_e.set_ylabel("tracking error [mrad]")
+    ax_f.set_ylabel("torque [N m]")
+    ax_f.set_xlabel("time [s]")
+    for ax in (ax_v, ax_e, ax_f):
+        ax.grid(True, alpha=0.3)
+        ax.legend(loc="upper right", fontsize="small")

@@ -18,15 +18,14 @@ from typing import Any
 
 import numpy as np
 
-from .. import __version__
 from ..errors import ConfigError, ConvergenceWarning, IdentifiabilityWarning, IgnoredArgumentWarning
 from ..fitted import FittedModel
-from ..io.atomic import created_timestamp
 from ..metrics import fit_statistics, metrics
 from ..models import INPUTS, FrictionModel, get_model
 from ..optim import METHODS, OptimizeResult, minimize
-from ..samples import FrictionSamples, samples_hash
+from ..samples import FrictionSamples
 from ._convergence import certify
+from ._records import operating_range, provenance
 from ._scatter import measurement_scatter, sample_weights
 from .checks import check_identifiable
 from .problem import ROBUST_LOSSES, IdentificationProblem
@@ -34,17 +33,6 @@ from .uncertainty import INTERVALS, assess
 from .varpro import varpro
 
 __all__ = ["evaluate", "fit"]
-
-
-def _provenance(samples: FrictionSamples) -> dict[str, Any]:
-    return {
-        "source": samples.source,
-        "n_samples": len(samples),
-        "samples_sha256_16": samples_hash(samples),
-        "directions": list(samples.directions()),
-        "fricid_version": __version__,
-        "created": created_timestamp(),
-    }
 
 
 def fit(
@@ -272,12 +260,8 @@ def fit(
             n: [float(lo), float(hi)]
             for n, (lo, hi) in zip(free_names, problem.bounds, strict=True)
         },
-        operating_range={
-            name: [float(X[:, j].min()), float(X[:, j].max())]
-            for j, name in enumerate(INPUTS)
-            if name in samples.measured
-        },
-        provenance=_provenance(samples),
+        operating_range=operating_range(samples, X),
+        provenance=provenance(samples),
         status=int(result.status),
         message=str(result.message),
         init={} if start is None else dict(zip(free_names, map(float, start), strict=True)),

@@ -55,15 +55,14 @@ from sklearn.gaussian_process import GaussianProcessRegressor
 from sklearn.gaussian_process.kernels import RBF, ConstantKernel, WhiteKernel
 from threadpoolctl import threadpool_limits
 
-from .. import __version__
 from ..errors import ConfigError, DataError
 from ..fitted import FittedModel
-from ..io.atomic import created_timestamp
 from ..metrics import metrics
 from ..models import INPUTS
 from ..models.gp import GP_KIND, predict_gp
-from ..samples import FrictionSamples, samples_hash
+from ..samples import FrictionSamples
 from ._learned_trust import learned_statistics, process_convergence
+from ._records import operating_range, provenance
 from ._scatter import measurement_scatter
 
 __all__ = ["DEFAULT_MAX_POINTS", "farthest_points", "fit_gp"]
@@ -385,7 +384,6 @@ def _fit(
         state = _train_side(samples, *args, seed0)
     state = {"kind": GP_KIND, "symmetry": symmetry, **state}
     y_hat = predict_gp(state, samples.X)
-    X = samples.X
     sides = [state["pos"], state["neg"]] if symmetry == "per_direction" else [state]
     n_hyper = sum(len(s["length_scales"]) + 2 for s in sides)
     statistics, note = learned_statistics(
@@ -412,24 +410,15 @@ def _fit(
         nfev=sum(r["nfev"] for r in runs),
         status=0 if all(r["converged"] for r in runs) else 1,
         message=f"trained in {time.perf_counter() - start:.3g} s",
-        operating_range={
-            name: [float(X[:, INPUTS.index(name)].min()), float(X[:, INPUTS.index(name)].max())]
-            for name in INPUTS
-            if name in samples.measured
-        },
-        provenance={
-            "source": samples.source,
-            "n_samples": len(samples),
-            "samples_sha256_16": samples_hash(samples),
-            "directions": list(samples.directions()),
-            "fricid_version": __version__,
-            "created": created_timestamp(),
-            "estimator": "fricid.identify.gp.fit_gp",
-            "estimator_params": {
+        operating_range=operating_range(samples),
+        provenance=provenance(
+            samples,
+            estimator="fricid.identify.gp.fit_gp",
+            estimator_params={
                 "inputs": names,
                 "max_points": max_points,
                 "n_restarts": n_restarts,
             },
-        },
+        ),
         state=state,
     )

@@ -86,10 +86,8 @@ from typing import Any
 import numpy as np
 from sklearn.utils.validation import check_is_fitted
 
-from .. import __version__
 from ..errors import ConfigError
 from ..fitted import FittedModel
-from ..io.atomic import created_timestamp
 from ..metrics import metrics
 from ..models import INPUTS
 from ..models.rbf import (
@@ -100,7 +98,7 @@ from ..models.rbf import (
     predict_state,
     tail_terms,
 )
-from ..samples import FrictionSamples, samples_hash
+from ..samples import FrictionSamples
 from ._learned_trust import (
     cv_pieces,
     cv_validation,
@@ -111,6 +109,7 @@ from ._learned_trust import (
 )
 from ._rbf_estimator import LSQ_IGNORES, TRAINERS, RBFNetRegressor
 from ._rbf_select import check_centres, choose_structure, drop_constant_inputs
+from ._records import operating_range, provenance
 from ._scatter import measurement_scatter
 
 __all__ = [
@@ -287,25 +286,16 @@ def _model(
         status=status,
         message=message,
         history=_history(ests, n),
-        operating_range={
-            name: [float(X[:, INPUTS.index(name)].min()), float(X[:, INPUTS.index(name)].max())]
-            for name in INPUTS
-            if name in samples.measured
-        },
-        provenance={
-            "source": samples.source,
-            "n_samples": n,
-            "samples_sha256_16": samples_hash(samples),
-            "directions": list(samples.directions()),
-            "fricid_version": __version__,
-            "created": created_timestamp(),
-            "estimator": "fricid.identify.rbf.RBFNetRegressor",
-            "estimator_params": {
+        operating_range=operating_range(samples),
+        provenance=provenance(
+            samples,
+            estimator="fricid.identify.rbf.RBFNetRegressor",
+            estimator_params={
                 k: v
                 for k, v in est.get_params().items()
                 if k != "random_state" or isinstance(v, Integral | None)
             },
-        },
+        ),
         state=state,
     )
 

@@ -15,7 +15,9 @@ velocity ``sign(0) = 0``; exports offer a smoothed sign for controllers.
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
+from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -233,3 +235,43 @@ def parameter_batch(theta, names: tuple[str, ...], title: str) -> tuple[np.ndarr
             f"got an array of shape {theta.shape}"
         )
     return batch, single
+
+
+def simulation_inputs(
+    v, dt, state0, k: int, title: str
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The dynamic models' simulation inputs as C-contiguous arrays: velocities ``(n,)``,
+    sample periods broadcast to ``(n,)`` (finite and >= 0, else a ConfigError naming the model
+    ``title``) and the initial state broadcast to the ``k`` parameter rows (default 0)."""
+    v = np.ascontiguousarray(np.asarray(v, dtype=float).ravel())
+    dt = np.ascontiguousarray(np.broadcast_to(np.asarray(dt, dtype=float), (v.size,)))
+    if v.size and (not np.all(np.isfinite(dt)) or np.any(dt < 0)):
+        raise ConfigError(f"{title} simulation: sample periods must be finite and >= 0")
+    s0 = np.asarray(0.0 if state0 is None else state0, float)
+    return v, dt, np.ascontiguousarray(np.broadcast_to(s0, (k,)))
+
+
+def state_array(
+    state: Mapping[str, Any], key: str, shape: tuple[int | None, ...], title: str, where: str
+) -> np.ndarray:
+    """``state[key]`` of a stored-state model (``title``: "RBF model", "GP model") as a finite
+    float array of ``shape`` (None: any length); anything else is a DataError naming the
+    column ``where.key``."""
+    column = f"{where}.{key}"
+    if key not in state:
+        raise DataError(f"{title} state lacks '{key}'", column=column)
+    try:
+        arr = np.asarray(state[key], dtype=float)
+    except (TypeError, ValueError):
+        raise DataError(f"{title} state '{key}' is not numeric", column=column) from None
+    if arr.ndim != len(shape) or any(
+        want is not None and got != want for got, want in zip(arr.shape, shape, strict=True)
+    ):
+        raise DataError(
+            f"{title} state '{key}' has shape {arr.shape}, expected "
+            f"{tuple('*' if s is None else s for s in shape)}",
+            column=column,
+        )
+    if not np.isfinite(arr).all():
+        raise DataError(f"{title} state '{key}' has non-finite values", column=column)
+    return arr

@@ -48,8 +48,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import ConfigError
-from ._base import FrictionModel, Parameter, parameter_batch
+from ._base import FrictionModel, Parameter, parameter_batch, simulation_inputs
 
 __all__ = [
     "PARAMETERS",
@@ -120,12 +119,9 @@ def simulate(theta, v, dt, f0=None) -> tuple[np.ndarray, np.ndarray]:
         NaN rows for parameters outside the domain (sigma_0, tau_c or alpha not positive).
     """
     batch, single = _batch(theta)
-    v = np.ascontiguousarray(np.asarray(v, dtype=float).ravel())
-    n, k = v.size, batch.shape[0]
-    dt = np.ascontiguousarray(np.broadcast_to(np.asarray(dt, dtype=float), (n,)))
-    if n and (not np.all(np.isfinite(dt)) or np.any(dt < 0)):
-        raise ConfigError("Dahl simulation: sample periods must be finite and >= 0")
-    f0 = np.ascontiguousarray(np.broadcast_to(np.asarray(0.0 if f0 is None else f0, float), (k,)))
+    k = batch.shape[0]
+    v, dt, f0 = simulation_inputs(v, dt, f0, k, "Dahl")
+    n = v.size
     F = np.empty((k, n))
     S = np.empty((k, n))
     from ._dahl_kernel import run  # lazy: importing numba takes a while

@@ -65,7 +65,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from ..errors import DataError
-from ._base import INPUTS
+from ._base import INPUTS, state_array
 
 __all__ = ["GP", "GP_KIND", "GP_SYMMETRIES", "GaussianProcess", "gp_sides", "predict_gp"]
 
@@ -80,23 +80,7 @@ _CHUNK = 4096
 
 
 def _array(state: Mapping[str, Any], key: str, shape: tuple[int | None, ...], where: str):
-    if key not in state:
-        raise DataError(f"GP model state lacks '{key}'", column=f"{where}.{key}")
-    try:
-        arr = np.asarray(state[key], dtype=float)
-    except (TypeError, ValueError):
-        raise DataError(f"GP state '{key}' is not numeric", column=f"{where}.{key}") from None
-    if arr.ndim != len(shape) or any(
-        want is not None and got != want for got, want in zip(arr.shape, shape, strict=True)
-    ):
-        raise DataError(
-            f"GP state '{key}' has shape {arr.shape}, expected "
-            f"{tuple('*' if s is None else s for s in shape)}",
-            column=f"{where}.{key}",
-        )
-    if not np.isfinite(arr).all():
-        raise DataError(f"GP state '{key}' has non-finite values", column=f"{where}.{key}")
-    return arr
+    return state_array(state, key, shape, "GP model", where)
 
 
 def gp_sides(state: Mapping[str, Any] | None) -> dict[str, Mapping[str, Any]]:

@@ -56,7 +56,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import ConfigError
-from ._base import FrictionModel, Parameter, parameter_batch
+from ._base import FrictionModel, Parameter, parameter_batch, simulation_inputs
 
 __all__ = [
     "PARAMETERS",
@@ -146,12 +146,9 @@ def simulate(theta, v, dt, z0=None) -> tuple[np.ndarray, np.ndarray]:
         Friction [N m] and state [rad], ``(n,)`` or ``(k, n)`` like ``theta``.
     """
     batch, single = _batch(theta)
-    v = np.ascontiguousarray(np.asarray(v, dtype=float).ravel())
-    n, k = v.size, batch.shape[0]
-    dt = np.ascontiguousarray(np.broadcast_to(np.asarray(dt, dtype=float), (n,)))
-    if n and (not np.all(np.isfinite(dt)) or np.any(dt < 0)):
-        raise ConfigError("LuGre simulation: sample periods must be finite and >= 0")
-    z0 = np.ascontiguousarray(np.broadcast_to(np.asarray(0.0 if z0 is None else z0, float), (k,)))
+    k = batch.shape[0]
+    v, dt, z0 = simulation_inputs(v, dt, z0, k, "LuGre")
+    n = v.size
     F = np.empty((k, n))
     Z = np.empty((k, n))
     from ._lugre_kernel import run  # lazy: importing numba takes a while

@@ -65,7 +65,7 @@ import numpy as np
 
 from ..errors import ConfigError, DataError
 from . import _rbf_core as core
-from ._base import INPUTS
+from ._base import INPUTS, state_array
 
 __all__ = [
     "NETWORK",
@@ -226,23 +226,7 @@ def check_inputs(inputs: Sequence[str]) -> list[str]:
 
 
 def _state_array(state: Mapping[str, Any], key: str, shape: tuple[int | None, ...]) -> np.ndarray:
-    if key not in state:
-        raise DataError(f"RBF model state lacks '{key}'", column=f"state.{key}")
-    try:
-        arr = np.asarray(state[key], dtype=float)
-    except (TypeError, ValueError):
-        raise DataError(f"RBF model state '{key}' is not numeric", column=f"state.{key}") from None
-    if arr.ndim != len(shape) or any(
-        want is not None and got != want for got, want in zip(arr.shape, shape, strict=True)
-    ):
-        raise DataError(
-            f"RBF model state '{key}' has shape {arr.shape}, expected "
-            f"{tuple('*' if s is None else s for s in shape)}",
-            column=f"state.{key}",
-        )
-    if not np.isfinite(arr).all():
-        raise DataError(f"RBF model state '{key}' has non-finite values", column=f"state.{key}")
-    return arr
+    return state_array(state, key, shape, "RBF model", "state")
 
 
 def _network(

@@ -1,0 +1,37 @@
+"""What every identified model file records of its data: provenance and operating range."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from .. import __version__
+from ..io.atomic import created_timestamp
+from ..models import INPUTS
+from ..samples import FrictionSamples, samples_hash
+
+__all__ = ["operating_range", "provenance"]
+
+
+def provenance(samples: FrictionSamples, **extra: Any) -> dict[str, Any]:
+    """Source, size, hash, directions, version and time of ``samples`` (plus ``extra``)."""
+    return {
+        "source": samples.source,
+        "n_samples": len(samples),
+        "samples_sha256_16": samples_hash(samples),
+        "directions": list(samples.directions()),
+        "fricid_version": __version__,
+        "created": created_timestamp(),
+        **extra,
+    }
+
+
+def operating_range(samples: FrictionSamples, X: np.ndarray | None = None) -> dict[str, list]:
+    """Min and max of each measured input (columns of ``X``, default ``samples.X``)."""
+    X = samples.X if X is None else X
+    return {
+        name: [float(X[:, j].min()), float(X[:, j].max())]
+        for j, name in enumerate(INPUTS)
+        if name in samples.measured
+    }
