@@ -47,44 +47,51 @@ _KMEANS_MIN = 2000
 _KMEANS_PER_CENTRE = 25
 
 
-def _kmeans_plusplus(Xc: np.ndarray, m: int, rs: np.random.RandomState) -> np.ndarray:
+def _kmeans_plusplus(Xc: np.ndarray, m: int, seed: int) -> np.ndarray:
     """Indices of scikit-learn's k-means++ seeds (Arthur and Vassilvitskii 2007, greedy with
-    ``2 + ln m`` local trials) on the centred data ``Xc``: drawn from ``rs`` as scikit-learn
-    draws them and computed by the same operations, so the seeds are the same bit for bit,
-    without its per-call input validation (which took most of the time of the small sets'
+    ``2 + ln m`` local trials) on the centred data ``Xc`` from ``RandomState(seed)``, drawn as
+    scikit-learn draws them (the first seed by ``choice`` with equal weights, one uniform, then
+    each seed's trials: one stream, :func:`_uniforms`) and computed by its operations in one
+    compiled loop (:func:`fricid.identify._kmeans_kernel.plusplus`), without its per-call input
+    validation and per-centre numpy calls (which took most of the time of the small sets'
     cross-validation)."""
+    from ._kmeans_kernel import plusplus
+
     n = Xc.shape[0]
-    xx = np.einsum("ij,ij->i", Xc, Xc)
-    w = np.ones(n)
     trials = 2 + int(np.log(m))
+    u = _uniforms(seed, 1 + (m - 1) * trials)
+    cdf = np.cumsum(np.full(n, 1.0 / n))  # RandomState.choice(n, p=...)'s, as it forms it
+    cdf /= cdf[-1]
+    first = int(cdf.searchsorted(u[0], side="right"))
+    return plusplus(np.ascontiguousarray(Xc, dtype=float), first, u[1:].reshape(m - 1, trials))
 
-    def sq_dist(C: np.ndarray) -> np.ndarray:  # scikit-learn's _euclidean_distances, squared
-        D = -2 * (C @ Xc.T)
-        D += np.einsum("ij,ij->i", C, C)[:, None]
-        D += xx[None, :]
-        return np.maximum(D, 0, out=D)
 
-    first = int(rs.choice(n, p=w / w.sum()))
-    idx = np.full(m, -1, dtype=int)
-    idx[0] = first
-    closest = sq_dist(Xc[[first]])
-    pot = closest @ w
-    for c in range(1, m):
-        # unit weights: w * closest is closest, and the clip an upper bound only
-        cand = np.searchsorted(np.cumsum(closest), rs.uniform(size=trials) * pot)
-        np.minimum(cand, closest.size - 1, out=cand)
-        D = sq_dist(Xc[cand])
-        np.minimum(closest, D, out=D)
-        cand_pot = D @ w.reshape(-1, 1)
-        best = int(np.argmin(cand_pot))
-        pot, closest, idx[c] = cand_pot[best], D[best], cand[best]
-    return idx
+#: Uniform streams of :func:`_uniforms`, by seed (a few, the longest drawn so far).
+_STREAMS: dict[int, np.ndarray] = {}
+
+
+def _uniforms(seed: int, k: int) -> np.ndarray:
+    """The first ``k`` draws of ``RandomState(seed).random_sample()`` (what ``uniform`` and
+    ``choice`` consume), memoised per seed: the cross-validated structure search places
+    centres 20-40 times per network from the same seed, and each new ``RandomState`` costs
+    about 0.1 ms, more than the seeding of a small set."""
+    u = _STREAMS.get(seed)
+    if u is None or u.size < k:
+        if len(_STREAMS) >= 16:
+            _STREAMS.clear()
+        u = np.random.RandomState(seed).random_sample(max(k, 4096))
+        u.flags.writeable = False
+        _STREAMS[seed] = u
+    return u[:k]
 
 
 def kmeans_centres(Z: np.ndarray, m: int, seed: int) -> np.ndarray:
-    """The centres of ``KMeans(n_clusters=m, n_init=1, random_state=seed).fit(Z)``, the same
-    bit for bit: the data centred and the tolerance set as ``KMeans.fit`` does, its k-means++
-    seeds (:func:`_kmeans_plusplus`), then its own Lloyd iterations from them; scikit-learn's
+    """The centres of ``KMeans(n_clusters=m, n_init=1, random_state=seed).fit(Z)``: the data
+    centred and the tolerance set as ``KMeans.fit`` does, its k-means++ seeds from its random
+    stream (:func:`_kmeans_plusplus`, compiled: its sums round differently from scikit-learn's
+    BLAS calls, so where two candidate seeds tie within rounding it may take the other one, on
+    1 of 30 random problems without duplicate points, ``tests/test_hybrid_speed.py``), then
+    scikit-learn's own Lloyd iterations from them; scikit-learn's
     ``KMeans`` itself when its private Lloyd routine is not there (another version) or ``m``
     is not between 1 and the number of points (its error message).
 
@@ -105,7 +112,7 @@ def kmeans_centres(Z: np.ndarray, m: int, seed: int) -> np.ndarray:
     tol = _tolerance(X, 1e-4)  # KMeans's default tol, on the data before centring
     mean = X.mean(axis=0)
     X -= mean
-    idx = _kmeans_plusplus(X, m, np.random.RandomState(seed))
+    idx = _kmeans_plusplus(X, m, seed)
     _, _, centres, _ = _kmeans_single_lloyd(
         X,
         np.ones(X.shape[0]),

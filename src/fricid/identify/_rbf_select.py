@@ -7,6 +7,7 @@ Used by :func:`fricid.identify.rbf.fit_rbf`; the estimator itself
 
 from __future__ import annotations
 
+import functools
 import warnings
 from collections.abc import Mapping, Sequence
 from numbers import Integral
@@ -142,13 +143,23 @@ def _kmeans_centres(Z: np.ndarray, m: int, random_state: Any) -> np.ndarray:
 
     from ._rbf_estimator import _KMEANS_MIN, _KMEANS_PER_CENTRE, kmeans_centres
 
-    rs = check_random_state(_seed(random_state))
-    kmeans_seed = int(rs.randint(np.iinfo(np.int32).max))
-    rs.randint(np.iinfo(np.int32).max)  # the search seed, drawn second by fit
+    seed = _seed(random_state)
     n = Z.shape[0]
     n_kmeans = max(_KMEANS_MIN, _KMEANS_PER_CENTRE * m)
-    Zk = Z if n <= n_kmeans else Z[rs.permutation(n)[:n_kmeans]]
-    return kmeans_centres(Zk, m, kmeans_seed)
+    if n <= n_kmeans:  # no subset drawn: the first draw only, the same for every call
+        return kmeans_centres(Z, m, _first_seed(seed))
+    rs = check_random_state(seed)
+    kmeans_seed = int(rs.randint(np.iinfo(np.int32).max))
+    rs.randint(np.iinfo(np.int32).max)  # the search seed, drawn second by fit
+    return kmeans_centres(Z[rs.permutation(n)[:n_kmeans]], m, kmeans_seed)
+
+
+@functools.lru_cache(maxsize=64)
+def _first_seed(seed: int) -> int:
+    """The k-means seed :class:`RBFNetRegressor` ``.fit`` draws first from ``seed``
+    (memoised: the structure search asks for it 20-40 times per network, and each new
+    ``RandomState`` costs about 0.1 ms)."""
+    return int(np.random.RandomState(seed).randint(np.iinfo(np.int32).max))
 
 
 def conformal_half_widths(residuals: np.ndarray, levels=INTERVAL_LEVELS) -> list[float]:

@@ -20,9 +20,9 @@ RBF network trained on what it leaves, ``fit(samples, "hybrid")``.
    2026-11-22: unseen-region mean error 0.80 mN m with ``msk_temp``, the BIC's choice,
    against 3.90 with ``vlt``, the choice before the temperature variants joined). On issue
    15's held-out laws the hybrid is fricid's learned model nearest the noise floor
-   (``python benchmarks/bench_floor.py``, 23:40 UTC, the machine shared: 1.08 / 1.01 / 0.99 x
-   noise on the grid, Arrhenius and sigmoid kinds; trained in 0.57 / 0.08 / 0.11 s against
-   fricid's ``gp`` 2.00 / 0.10 / 1.11 s and scikit-learn's exact GP 24.2 / 0.04 / 0.91 s).
+   (``python benchmarks/bench_floor.py``, 2026-11-23 01:18 UTC: 1.08 / 1.01 / 0.99 x noise on
+   the grid, Arrhenius and sigmoid kinds; trained in 0.55 / 0.07 / 0.09 s against fricid's
+   ``gp`` 2.27 / 0.11 / 1.12 s and scikit-learn's exact GP 22.9 / 0.045 / 0.94 s).
 2. **Residual.** The RBF network (:func:`fricid.identify.rbf.fit_rbf`) is trained on
    ``F - F_backbone`` with its sign of motion, *without* bias or linear tail, so it vanishes
    far from its centres and the model returns to the backbone outside the data; its size,
