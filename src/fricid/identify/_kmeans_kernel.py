@@ -2,16 +2,20 @@
 
 A module of its own so that importing :mod:`fricid.identify.rbf` does not import numba, and so
 that the kernel is a module-level function numba can cache across processes. It runs the
-arithmetic of scikit-learn's ``_kmeans_plusplus`` (unit sample weights) in one compiled loop:
-scikit-learn's makes about ten numpy calls per centre, whose fixed cost was a third of the
-hybrid's centre placement on small sets (:func:`fricid.identify._rbf_estimator.kmeans_centres`,
-called 20-40 times per residual network by the cross-validated structure search).
+arithmetic of scikit-learn's ``_kmeans_plusplus`` (unit sample weights) in one compiled loop,
+where scikit-learn's makes about ten numpy calls per centre: a fixed cost that grows with the
+number of centres and is paid 20-40 times per residual network by the cross-validated structure
+search (:func:`fricid.identify._rbf_estimator.kmeans_centres`). With the memoised random
+streams the hybrid trained 13-15 % faster on issue 15's held-out laws (median times of the two
+implementations alternated in one process, a one-off script, 2026-11-23) and gives the same
+models on their tuning and reporting seeds (``benchmarks/bench_learned_tuning.py``,
+``benchmarks/bench_floor.py``).
 
-Lloyd's iterations stay scikit-learn's: a compiled copy of them, 2-60 times faster per call,
-resolved exact ties on lattice data (a design grid's points equidistant from two centres)
-otherwise than scikit-learn's BLAS rounding does, and over the tuning seeds 0-49 of issue 15's
-grid kind the networks were worse with it (hybrid 1.134 against 1.110 x the noise, rbf 1.245
-against 1.196; ``python benchmarks/bench_learned_tuning.py``, 2026-11-23).
+Lloyd's iterations stay scikit-learn's. A compiled copy of them (tried, not kept) resolved the
+exact ties of lattice data (a design grid's points equidistant from two centres) otherwise than
+scikit-learn's BLAS rounding does, and over the tuning seeds 0-49 of issue 15's grid kind the
+networks were worse with it (hybrid 1.134 against 1.110 x the noise, rbf 1.245 against 1.196;
+``python benchmarks/bench_learned_tuning.py`` with that copy, 2026-11-23).
 """
 
 from __future__ import annotations
