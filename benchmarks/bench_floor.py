@@ -95,19 +95,19 @@ fricid ``gp``   0.244 MISSED  0.641 MISSED    0.082 met     0.835 MISSED
 
 The sigmoid kind sits at the goal: the ``--full-gp`` run (seed 1001, one fit per timing, the
 machine shared) gave 0.106, and earlier runs (2026-11-22 22:16-23:40 UTC, before the compiled
-k-means++ seeding, other loads) 0.120-0.165 against scikit-learn's GP. Before
-the lean backbone path the hybrid took 2.8 / 1.6 / 1.0 s. The hybrid's seconds go (sigmoid,
-wall-clock per phase): about 45 % to the backbone's lean least-squares fits (8 candidates, one
-``lm`` start each, and the winner's certified fit), 50 % to the residual network's
-cross-validated structure (about 20 candidates per direction: k-means placements and ridge
-solves); on the grid over 80 % to the latter (400-centre candidates: Gram matrices and
+k-means++ seeding, other loads) 0.120-0.165 against scikit-learn's GP. Before the lean backbone
+path the hybrid took 2.8 / 1.6 / 1.0 s. The hybrid's seconds go (sigmoid, wall-clock per phase,
+a one-off timing of seed 1001): about 45 % to the backbone's lean least-squares fits (8
+candidates, one ``lm`` start each, and the winner's certified fit), 50 % to the residual
+network's cross-validated structure (about 20 candidates per direction: k-means placements and
+ridge solves); on the grid over 80 % to the latter (400-centre candidates: Gram matrices and
 Cholesky factorisations of 400 x 400). Why the 150-point kind is missed: there scikit-learn's
 exact GP trains in 45 ms (150 x 150 Cholesky factorisations), and the least a BIC-chosen
-backbone costs, one least-squares fit of the family the hybrid chose (``stribeck_temp_asym``,
-11 parameters, from its default start), took 8.7 ms, 0.19 x the GP's, before the eleven other
-candidates, the certified refit and the residual network (the bench prints this floor for
-every kind). fricid's ``gp`` trains on an inducing subset of 400 points, so it is itself fast
-on the grid and the paper-1 preset.
+backbone costs, one least-squares fit of the family the hybrid chose (``stribeck_temp_asym``, 11
+parameters, from its default start), took 8.7 ms, 0.19 x the GP's, before the eleven other
+candidates, the certified refit and the residual network (the bench prints this floor for every
+kind). fricid's ``gp`` trains on an inducing subset of 400 points, so it is itself fast on the
+grid and the paper-1 preset.
 
 Timings: the machine this was written on was shared (2 cores): read the seconds as ratios
 within one run. OpenBLAS and OpenMP are held to one thread (``OPENBLAS_NUM_THREADS=1``,
@@ -195,8 +195,9 @@ def _analytic(d):
 
 
 def _fricid(d, name, **kw):
+    """Held-out ratio, training seconds and the fitted model."""
     m, dt = _timed(lambda: fit(d.train, name, seed=0, **kw))
-    return _ratio(lambda X: m.predict(X, warn=False), d), dt
+    return _ratio(lambda X: m.predict(X, warn=False), d), dt, m
 
 
 def _sklearn_gp(k: int, optimizer="fmin_l_bfgs_b"):
@@ -237,13 +238,13 @@ def _sklearn(d, which: str):
     return _ratio(predict, d), dt
 
 
-def _one_backbone_fit(samples) -> float:
+def _one_backbone_fit(samples, m) -> float:
     """Seconds of the least a BIC-chosen backbone costs: one lean least-squares fit
-    (:func:`fricid.identify.hybrid._lean_fit`) of the family the hybrid chose, from its default
-    start, before any other candidate, the certified refit or the residual network."""
+    (:func:`fricid.identify.hybrid._lean_fit`) of the family the hybrid ``m`` chose on
+    ``samples``, from its default start, before any other candidate, the certified refit or
+    the residual network."""
     from fricid.identify.hybrid import _lean_fit
 
-    m = fit(samples, "hybrid", seed=0)
     name = m.state["backbone"]["model"]
     rows = [r for r in m.state["backbone_selection"] if r["model"] == name and r["bic"]]
     fixed = min(rows, key=lambda r: r["bic"])["fixed"]
@@ -328,7 +329,12 @@ def part1(seeds, with_gp: bool) -> None:
             f"({'meets' if default <= GOAL_RATIO else 'MISSES'} <= {GOAL_RATIO}); training "
             f"{t_def:.3f} s = " + "; ".join(_time_verdict(t_def, acc, ref) for ref in REFERENCES)
         )
-        t_one = np.mean([_one_backbone_fit(draw(kind, seed).train) for seed in seeds])
+        t_one = np.mean(
+            [
+                _one_backbone_fit(draw(kind, seed).train, v[2])
+                for seed, v in zip(seeds, acc[DEFAULT], strict=True)
+            ]
+        )
         verdict.append(
             f"  its chosen backbone's one least-squares fit alone: {t_one:.4f} s = "
             + "; ".join(_time_verdict(t_one, acc, ref) for ref in REFERENCES)
