@@ -12,11 +12,11 @@ in the grid's box, with their own noise), and print the mean over seeds of held-
 noise (1.0 = a model equal to the truth) and the training seconds, for
 
 * ``best analytic``: the best held-out ratio among the analytic families the hybrid's backbone
-  selection tries (:func:`fricid.identify.hybrid.backbone_candidates`: those
-  :func:`fricid.identify.select.candidates` lists the data support, and their ``*_temp``
+  selection tries (:func:`fricid.identify.learned.hybrid.backbone_candidates`: those
+  :func:`fricid.identify.static.select.candidates` lists the data support, and their ``*_temp``
   variants when the temperature varies): an oracle choice among them, flattering them;
-* ``rbf plain``: ``fit(samples, "rbf", network={"linear_tail": False, "velocity_scale":
-  None})``: no structure, the size, widths and penalty still cross-validated;
+* ``rbf plain``: ``fit(samples, "rbf", settings={"network": {"linear_tail": False, "velocity_scale":
+  None}})``: no structure, the size, widths and penalty still cross-validated;
 * ``rbf``: ``fit(samples, "rbf")``, ``fricid fit --model rbf``'s defaults: structured (linear
   tail, asinh velocity warp) with its structure chosen by cross-validation;
 * ``hybrid``: ``fit(samples, "hybrid")``, ``fricid fit --model hybrid``'s defaults: the
@@ -50,7 +50,7 @@ What it showed (``python benchmarks/bench_floor.py``, 2026-11-23 01:18 UTC, the 
 but for this run, 360 s; held-out RMSE / noise, mean over seeds 1001-1003, training seconds in
 brackets: the fastest of 3 fits, mean over the same seeds). The plain ``rbf`` scores its
 structure by random folds and folds of whole speed levels; the hybrid's residual by random
-folds with the ridge penalty's one-standard-error rule (:mod:`fricid.identify._rbf_folds`
+folds with the ridge penalty's one-standard-error rule (:mod:`fricid.identify.learned._rbf_folds`
 notes why each):
 
 ==============  ===================  ====================  ================
@@ -131,7 +131,7 @@ import warnings
 import numpy as np
 
 from fricid.identify import fit
-from fricid.identify.hybrid import backbone_candidates
+from fricid.identify.learned.hybrid import backbone_candidates
 from fricid.models import MODELS, STATEFUL
 from fricid.sim.heldout_laws import KINDS, REPORTING_SEEDS, draw
 
@@ -240,10 +240,10 @@ def _sklearn(d, which: str):
 
 def _one_backbone_fit(samples, m) -> float:
     """Seconds of the least a BIC-chosen backbone costs: one lean least-squares fit
-    (:func:`fricid.identify.hybrid._lean_fit`) of the family the hybrid ``m`` chose on
+    (:func:`fricid.identify.learned.hybrid._lean_fit`) of the family the hybrid ``m`` chose on
     ``samples``, from its default start, before any other candidate, the certified refit or
     the residual network."""
-    from fricid.identify.hybrid import _lean_fit
+    from fricid.identify.learned.hybrid import _lean_fit
 
     name = m.state["backbone"]["model"]
     rows = [r for r in m.state["backbone_selection"] if r["model"] == name and r["bic"]]
@@ -302,7 +302,9 @@ def part1(seeds, with_gp: bool) -> None:
             acc["best analytic"].append((r, dt))
             best_names.add(name)
             acc["rbf plain"].append(
-                _fricid(d, "rbf", network={"linear_tail": False, "velocity_scale": None})
+                _fricid(
+                    d, "rbf", settings={"network": {"linear_tail": False, "velocity_scale": None}}
+                )
             )
             acc["rbf"].append(_fricid(d, "rbf"))
             acc["hybrid"].append(_fricid(d, "hybrid"))

@@ -1,6 +1,6 @@
 """Held-out RMSE / noise of the learned defaults (``rbf``, ``hybrid``) on TUNING seeds of
 :mod:`fricid.sim.heldout_laws` (never the reporting seeds 1001-1003 of ``bench_floor.py``):
-what the structure search's folds (:mod:`fricid.identify._rbf_folds`) were chosen with.
+what the structure search's folds (:mod:`fricid.identify.learned._rbf_folds`) were chosen with.
 
 Usage: ``python benchmarks/bench_learned_tuning.py [--seeds 50] [--kinds grid,sigmoid]
 [--random-folds-only] [--fit-seed 0]`` (about 2 minutes for 50 seeds on 2 idle cores;
@@ -27,9 +27,10 @@ grid ``hybrid`` 1.234, ``rbf`` 1.196.
 
 The grid hybrid's tails under random folds were the ridge penalty (the 6 seeds above 2.2 took
 1e-11, the others 1e-8, all the same backbone and structure: notes of
-:mod:`fricid.identify.hybrid`). With random folds only (data with too few speed levels) the
+:mod:`fricid.identify.learned.hybrid`). With random folds only (data with too few speed levels) the
 penalty is now chosen by the one-standard-error rule
-(:func:`fricid.identify._rbf_folds.choose_penalty`); ``--random-folds-only``, 23:32-23:36 UTC,
+(:func:`fricid.identify.learned._rbf_folds.choose_penalty`); ``--random-folds-only``, 23:32-23:36
+UTC,
 same seeds, the machine shared (load 2-2.5 on 2 cores):
 
 ==============  ==================================  ==================================
@@ -50,13 +51,13 @@ from 1.26 to 1.40), and the level folds' weight does not move the grid's median 
 3``: hybrid median 1.187, ``/ 4``: 1.195, with the rule).
 
 After these runs the hybrid's residual was set to random folds with the rule
-(``level_folds=False`` in :func:`fricid.identify.hybrid.fit_hybrid`; checked against the
-truth on the demo's design too, :mod:`fricid.identify._rbf_folds` notes), the plain ``rbf``
+(``level_folds=False`` in :func:`fricid.identify.learned.hybrid.fit_hybrid`; checked against the
+truth on the demo's design too, :mod:`fricid.identify.learned._rbf_folds` notes), the plain ``rbf``
 keeping both fold kinds: the default run now deals the hybrid as in the second table's right
 column and the ``rbf`` as in the first's (the code paths of those runs; this script was not
 re-run as a whole after the change).
 
-Since the compiled k-means++ seeding (:mod:`fricid.identify._kmeans_kernel`, 2026-11-23: the
+Since the compiled k-means++ seeding (:mod:`fricid.identify.learned._kmeans_kernel`, 2026-11-23: the
 same draws, exact ties resolved by other rounding), the default run gives every ``hybrid`` row
 and the ``asym`` and ``sigmoid`` ``rbf`` rows to within 0.001 of the tables above, and grid
 ``rbf`` 1.225 / 1.212 / 1.285 / 1.345. That is no loss: the fits' seed 0, with which the

@@ -13,7 +13,7 @@ LuGreTruth`: sigma_0 1e4 N m/rad, sigma_1 1 N m s/rad, sigma_2 0.2 N m s/rad, ta
 tau_s 0.8 N m, w_s 0.1 rad/s, delta 1; J 0.01 kg m^2, p_x 0.3 N m, p_y 0.1 N m) tracks a
 multi-sine (0.2, 0.5, 1.1, 2.3 Hz, 0.3 rad, random phases from the seed) for ``--duration``
 seconds at 1 kHz, logged with :data:`fricid.sim.trajectory.TRAJECTORY_NOISE`, and
-:func:`fricid.identify.trajectory.fit_trajectory` identifies it (``--route``: ``filtered``,
+:func:`fricid.identify.dynamic.trajectory.fit_trajectory` identifies it (``--route``: ``filtered``,
 the default, every parameter at once by the parallel-filtered equation error; or
 ``two_stage``, ``joint``). The same
 joint's steady state (the static Stribeck law LuGre reduces to at constant velocity) is swept
@@ -24,7 +24,7 @@ sweeps extracted and fitted with ``stribeck`` by ``lm``.
 (the same duration: constant-speed plateaus at 0.03-0.3 rad/s both ways for the first half,
 the same multi-sine faded in for the second), a designed experiment for the Stribeck region;
 the default stays the plain multi-sine (the module notes of
-:mod:`fricid.identify.trajectory` say why).
+:mod:`fricid.identify.dynamic.trajectory` say why).
 
 Tables: (1) per parameter: truth, sweep estimate with its 95 % interval (seed 0),
 trajectory estimate with its interval (seed 0), and the coverage of the trajectory intervals
@@ -35,7 +35,7 @@ the relative half-width of each seed-0 interval is printed beside it;
 (2) per seed: identification time (the whole ``fit_trajectory`` call, numba
 compiled beforehand; with the filtered route it includes the rate-bias estimate), each route's
 time, the rate bias's time and its estimate of sigma_0's and sigma_1's relative bias at the
-log's rate (:mod:`fricid.identify._trajectory_rate`, not applied), and whether each static
+log's rate (:mod:`fricid.identify.dynamic._rate`, not applied), and whether each static
 parameter's trajectory and sweep intervals overlap. The machine may be shared: times are
 wall-clock on whatever cores were free.
 
@@ -80,7 +80,7 @@ import numpy as np
 
 from fricid.extract import extract
 from fricid.identify import fit
-from fricid.identify.trajectory import fit_trajectory
+from fricid.identify.dynamic.trajectory import fit_trajectory
 from fricid.models import Stribeck, lugre
 from fricid.sim import Joint, ModelLaw, preset, simulate
 from fricid.sim import trajectory as tr

@@ -4,7 +4,7 @@ Usage: ``python benchmarks/bench_validation.py [--real FOLDER] [--scheme lovo] [
 [--seeds 3]`` (about 2.5 minutes on 2 cores; ``--size quick`` about 45 s).
 
 For each data set, ``fit(samples, "auto")`` picks a model by held-out error
-(:mod:`fricid.identify.select`), and the first table prints: set, model, held-out RMSE (the
+(:mod:`fricid.identify.static.select`), and the first table prints: set, model, held-out RMSE (the
 scheme), the measurement scatter with how it was estimated, and their ratio with the verdict.
 Sets:
 
@@ -104,7 +104,7 @@ def selected(samples, scheme: str, scatter):
     t0 = time.perf_counter()
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        fitted = fit(samples, "auto", scheme=scheme, scatter=scatter)
+        fitted = fit(samples, "auto", settings={"scheme": scheme, "scatter": scatter})
     return fitted, time.perf_counter() - t0
 
 

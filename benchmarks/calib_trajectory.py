@@ -5,7 +5,7 @@ Usage: ``python benchmarks/calib_trajectory.py [--first 10] [--seeds 40] [--dura
 
 For each seed, the virtual joint with the default LuGre truth tracks the multi-sine of
 ``bench_trajectory.py`` (with the trajectory noise, or none) and
-:func:`fricid.identify.trajectory.fit_trajectory` identifies it (``lm``). Table 1, per
+:func:`fricid.identify.dynamic.trajectory.fit_trajectory` identifies it (``lm``). Table 1, per
 parameter (sigma_0 and sigma_1 on their log10 search scale): the Monte-Carlo standard
 deviation of the estimates over the mean reported standard error and the coverage of the
 95 % intervals (CR1, the route's), then the same with the cluster jackknife linearised at the
@@ -25,10 +25,10 @@ import warnings
 import numpy as np
 from scipy import stats
 
-import fricid.identify._trajectory_filtered as filtered
-from fricid.identify._trajectory_data import cluster_covariance
-from fricid.identify.trajectory import fit_trajectory
-from fricid.identify.uncertainty import covariance_svd
+import fricid.identify.dynamic._filtered as filtered
+from fricid.identify.dynamic._data import cluster_covariance
+from fricid.identify.dynamic.trajectory import fit_trajectory
+from fricid.identify.static.uncertainty import covariance_svd
 from fricid.models import lugre
 from fricid.sim import Joint
 from fricid.sim import trajectory as tr

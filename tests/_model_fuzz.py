@@ -33,7 +33,7 @@ from fricid.cli import app
 from fricid.errors import FricidError
 from fricid.fitted import FittedModel
 from fricid.identify import fit
-from fricid.identify.rbf import fit_rbf
+from fricid.identify.learned.rbf import fit_rbf
 from fricid.samples import FrictionSamples
 
 #: Model families fuzzed: analytic, per-direction (_asym) and the RBF network.

@@ -67,7 +67,7 @@ def _record_saved_models():
     import sys
 
     import fricid.identify
-    import fricid.identify.rbf
+    import fricid.identify.learned.rbf
     import fricid.samples
     import fricid.workflow
     from fricid.fitted import FittedModel

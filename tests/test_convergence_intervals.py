@@ -20,7 +20,7 @@ from fricid.errors import ConvergenceWarning, FricidWarning, IdentifiabilityWarn
 from fricid.extract import extract
 from fricid.fitted import FittedModel
 from fricid.identify import IdentificationProblem, fit
-from fricid.identify.profile import profile_intervals, profile_threshold
+from fricid.identify.static.profile import profile_intervals, profile_threshold
 from fricid.io import epos_steady_samples, write_samples
 from fricid.models import get_model
 from fricid.sim import preset, simulate

@@ -222,7 +222,7 @@ def build_workspace(ws: Path, leadscrew: Path) -> None:
 
     # a trajectory of any motion (LuGre truth) and its identified model, as simulate/fit write
     from fricid.cli.simulate import _trajectory_log
-    from fricid.identify.trajectory import fit_trajectory
+    from fricid.identify.dynamic.trajectory import fit_trajectory
 
     traj = _trajectory_log("multisine", 10.0, 0)
     write_rawlog(traj, ws / "traj.parquet")

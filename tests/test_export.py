@@ -222,7 +222,7 @@ def test_unrepresentable_c_exports_say_so_and_write_nothing(tmp_path):
 
 def rbf_fitted(inputs, velocity_scale=None, n_centers=15) -> FittedModel:
     """A small RBF network trained (least squares) on the paper1 law of the virtual joint."""
-    from fricid.identify.rbf import fit_rbf
+    from fricid.identify.learned.rbf import fit_rbf
     from fricid.samples import FrictionSamples
     from fricid.sim import LoadTemperatureLaw
 

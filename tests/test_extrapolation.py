@@ -22,7 +22,7 @@ from fricid.errors import (
 )
 from fricid.fitted import FittedModel
 from fricid.identify import fit
-from fricid.identify.rbf import fit_rbf
+from fricid.identify.learned.rbf import fit_rbf
 from fricid.samples import FrictionSamples
 
 runner = CliRunner()
@@ -222,7 +222,7 @@ def noisy(n=90, seed=0) -> FrictionSamples:
 
 
 def test_number_of_centres_chosen_by_held_out_error():
-    from fricid.identify._rbf_select import structure_grid
+    from fricid.identify.learned._rbf_select import structure_grid
 
     s = noisy()
     with pytest.warns(DataQualityWarning, match=r"temperature \(every sample at 25\)"):
@@ -253,7 +253,7 @@ def test_about_as_many_centres_as_samples_warns():
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DataQualityWarning)
         with pytest.warns(IdentifiabilityWarning, match="25 centres for 40 samples"):
-            fit(s, "rbf", seed=0, network={"n_centers": 25})
+            fit(s, "rbf", seed=0, settings={"network": {"n_centers": 25}})
         with warnings.catch_warnings():
             warnings.simplefilter("error", IdentifiabilityWarning)
-            fit(s, "rbf", seed=0, network={"n_centers": 10})
+            fit(s, "rbf", seed=0, settings={"network": {"n_centers": 10}})

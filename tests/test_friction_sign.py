@@ -102,7 +102,7 @@ def test_rbf_network_opposes_motion(joint, trainer, which, tmp_path):
         network["target_mse"] = None
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        fitted = fit(samples, "rbf", trainer, seed=0, max_evals=300, network=network)
+        fitted = fit(samples, "rbf", trainer, seed=0, max_evals=300, settings={"network": network})
     expected = "odd" if which == "combined" else "per_direction"
     assert fitted.state["symmetry"] == expected
     path = fitted.save(tmp_path / "rbf.json")
@@ -126,7 +126,7 @@ def test_rbf_network_opposes_motion(joint, trainer, which, tmp_path):
 def test_one_direction_network_warns_on_the_other_side(joint):
     _, by_direction, _ = joint
     pos = by_direction.subset(by_direction.direction == 1)
-    fitted = fit(pos, "rbf", seed=0, network={"n_centers": 6})
+    fitted = fit(pos, "rbf", seed=0, settings={"network": {"n_centers": 6}})
     assert fitted.state["symmetry"] == "pos"
     load, temp = float(pos.load.mean()), float(pos.temperature.mean())
     v = float(np.median(pos.velocity))
@@ -142,7 +142,7 @@ def test_legacy_combined_rbf_file_loads_odd_and_is_repaired(joint, tmp_path):
     """A file from before the symmetry was recorded (no state["symmetry"], trained on v > 0
     only) is read as odd; one of both directions stays signed (the network as trained)."""
     combined, _, _ = joint
-    fitted = fit(combined, "rbf", seed=0, network={"n_centers": 8})
+    fitted = fit(combined, "rbf", seed=0, settings={"network": {"n_centers": 8}})
     d = fitted.to_dict()
     del d["state"]["symmetry"]
     (tmp_path / "old.json").write_text(json.dumps(d))

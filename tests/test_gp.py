@@ -47,7 +47,7 @@ def gp_model() -> FittedModel:
 
 @pytest.fixture(scope="module")
 def small_gp() -> FittedModel:
-    return fit(samples_of(40, seed=5), "gp", options={"n_restarts": 0})
+    return fit(samples_of(40, seed=5), "gp", settings={"n_restarts": 0})
 
 
 def test_gp_is_registered_and_per_direction(gp_model):
@@ -86,7 +86,7 @@ def test_gp_band_widens_outside_the_data(gp_model):
 
 def test_gp_inducing_subset_uses_every_sample():
     samples = samples_of(300, seed=2)
-    fitted = fit(samples, "gp", options={"max_points": 60, "n_restarts": 1})
+    fitted = fit(samples, "gp", settings={"max_points": 60, "n_restarts": 1})
     side = fitted.state["pos"]
     assert len(side["points"]) == 60 and "DTC" in side["inducing"]
     assert side["n_train"] == int(np.sum(samples.velocity > 0))
@@ -104,7 +104,7 @@ def test_gp_combined_samples_are_odd():
     samples = FrictionSamples(
         velocity=X[:, 0], load=X[:, 1], temperature=X[:, 2], friction=y, direction=0
     )
-    fitted = fit(samples, "gp", options={"n_restarts": 0})
+    fitted = fit(samples, "gp", settings={"n_restarts": 0})
     assert fitted.state["symmetry"] == "odd"
     assert fitted.state["inputs"] == ["velocity", "load"]
     assert fitted.state["dropped_inputs"] == {"temperature": 30.0}
@@ -202,7 +202,7 @@ def test_a_damaged_gp_file_is_a_data_error(small_gp, tmp_path, key):
 def test_inducing_posterior_survives_a_numerically_singular_kernel_matrix():
     # close inducing points under long length scales: K_mm is singular to rounding, which made
     # the held-out grid law of issue 15 (1848 samples) fail with "not positive definite"
-    from fricid.identify.gp import _cholesky, _posterior
+    from fricid.identify.learned.gp import _cholesky, _posterior
 
     with pytest.raises(np.linalg.LinAlgError):
         np.linalg.cholesky(np.ones((3, 3)))

@@ -19,7 +19,7 @@ from fricid.cli import app
 from fricid.errors import ConfigError, DataError, IdentifiabilityWarning
 from fricid.fleet import read_manifest
 from fricid.identify import fit
-from fricid.identify.checks import check_identifiable
+from fricid.identify.static.checks import check_identifiable
 from fricid.io import (
     read_epos,
     read_rawlog,

@@ -7,8 +7,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from fricid.identify._rbf_select import _CrossValidation
-from fricid.identify.hybrid import fit_backbone
+from fricid.identify.learned._rbf_select import _CrossValidation
+from fricid.identify.learned.hybrid import fit_backbone
 from fricid.sim.heldout_laws import draw
 
 
@@ -69,7 +69,7 @@ def _inertia(Z, C):
 
 @pytest.mark.parametrize("lattice", [False, True])
 def test_kmeans_centres_are_scikit_learns(lattice):
-    """The compiled k-means (:mod:`fricid.identify._kmeans_kernel`) follows scikit-learn's
+    """The compiled k-means (:mod:`fricid.identify.learned._kmeans_kernel`) follows scikit-learn's
     recipe and random stream; its sums round differently from scikit-learn's BLAS calls, so
     where two candidates tie within rounding it may choose the other one. Without exact ties:
     scikit-learn's centres (to rounding) on nearly every problem, as good on the rest; on a
@@ -78,7 +78,7 @@ def test_kmeans_centres_are_scikit_learns(lattice):
 
     from sklearn.cluster import KMeans
 
-    from fricid.identify._rbf_estimator import kmeans_centres
+    from fricid.identify.learned._rbf_estimator import kmeans_centres
 
     equal, ratios, ours, theirs = 0, [], 0.0, 0.0
     for Z, m in _kmeans_problems(lattice):
@@ -101,7 +101,7 @@ def test_kmeans_centres_are_scikit_learns(lattice):
 def test_memoised_uniform_streams_are_randomstates_draws():
     """The k-means++ seeding's memoised streams are ``RandomState(seed)``'s draws, whatever
     length was asked for first."""
-    from fricid.identify._rbf_estimator import _uniforms
+    from fricid.identify.learned._rbf_estimator import _uniforms
 
     for seed in (0, 7, 2**31 - 2):
         short = _uniforms(seed, 10)

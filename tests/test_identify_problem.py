@@ -18,7 +18,7 @@ from fricid.errors import (
 )
 from fricid.fitted import FittedModel
 from fricid.identify import IdentificationProblem, fit
-from fricid.identify.uncertainty import covariance_svd, jacobian_uncertainty
+from fricid.identify.static.uncertainty import covariance_svd, jacobian_uncertainty
 from fricid.models import STATEFUL, get_model, get_predictor
 from fricid.models.rbf import NETWORK
 from fricid.samples import FrictionSamples
@@ -194,16 +194,25 @@ def test_old_model_files_without_the_new_fields_still_load(tmp_path):
 
 
 def test_identify_fit_rbf_equals_fit_rbf():
-    from fricid.identify.rbf import fit_rbf
+    from fricid.identify.learned.rbf import fit_rbf
 
     s = network_samples()
-    a = fit(s, "rbf", "lsq", seed=3, network={"n_centers": 10})
+    a = fit(s, "rbf", "lsq", seed=3, settings={"network": {"n_centers": 10}})
     b = fit_rbf(s, n_centers=10, trainer="lsq", random_state=3)
     assert a.model == b.model == "rbf" and a.method == b.method == "lsq"
     assert a.state == b.state
     np.testing.assert_array_equal(a.predict(s.X), b.predict(s.X))
-    assert fit(s, "rbf", seed=3, network={"n_centers": 10}).state == a.state  # "lm" means lsq
-    c = fit(s, "rbf", "bas", seed=3, max_evals=60, network={"n_centers": 6, "target_mse": None})
+    assert (
+        fit(s, "rbf", seed=3, settings={"network": {"n_centers": 10}}).state == a.state
+    )  # default: lsq
+    c = fit(
+        s,
+        "rbf",
+        "bas",
+        seed=3,
+        max_evals=60,
+        settings={"network": {"n_centers": 6, "target_mse": None}},
+    )
     d = fit_rbf(s, n_centers=6, trainer="bas", random_state=3, max_epochs=2, target_mse=None)
     assert c.method == "bas/hybrid" and c.state == d.state and c.nfev == d.nfev == 60
     assert c.status == 1 and "budget" in c.message and a.status is None
@@ -219,14 +228,16 @@ def test_identify_fit_rbf_rejects_named_parameter_arguments():
     s = network_samples(40)
     with pytest.raises(ConfigError, match="no named parameters: fixed"):
         fit(s, "rbf", fixed={"tau_c": 1.0})
-    with pytest.warns(IgnoredArgumentWarning, match="callback"):
-        fit(s, "rbf", network={"n_centers": 4}, callback=lambda r: None)
-    with pytest.warns(IgnoredArgumentWarning, match="apply to model 'rbf' only"):
-        fit(stribeck_samples(), "coulomb_viscous", network={"n_centers": 4})
+    with pytest.raises(ConfigError, match="does not take callback"):
+        fit(s, "rbf", settings={"network": {"n_centers": 4}}, callback=lambda r: None)
+    with pytest.raises(ConfigError, match="analytic identification takes no settings"):
+        fit(stribeck_samples(), "coulomb_viscous", settings={"network": {"n_centers": 4}})
+    with pytest.raises(ConfigError, match="trains with method lsq, bas, ga; got 'lm'"):
+        fit(s, "rbf", "lm")
 
 
 def test_lsq_trainer_warns_about_the_options_it_ignores():
-    from fricid.identify.rbf import RBFNetRegressor
+    from fricid.identify.learned.rbf import RBFNetRegressor
 
     s = network_samples(40)
     with pytest.warns(IgnoredArgumentWarning, match="ignores encoding, method_options") as rec:
@@ -240,7 +251,7 @@ def test_lsq_trainer_warns_about_the_options_it_ignores():
 
 def test_fitted_model_dispatches_prediction_through_the_model_registry(monkeypatch):
     s = network_samples(60)
-    rbf = fit(s, "rbf", network={"n_centers": 5})
+    rbf = fit(s, "rbf", settings={"network": {"n_centers": 5}})
     cv = fit(stribeck_samples(), "coulomb_viscous")
     assert get_predictor("rbf") is NETWORK and STATEFUL["rbf"] is NETWORK
     assert get_predictor("coulomb_viscous").stateful is False

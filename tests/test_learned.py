@@ -86,7 +86,9 @@ def test_default_rbf_is_structured_cross_validated_and_near_the_floor(asym):
         assert net["linear_terms"][:3] == ["velocity", "temperature", "velocity*temperature"]
         assert sel["chosen"] == len(net["centers"]) and sel["folds"] == 5
         assert {"chosen_width_factor", "chosen_stretch", "chosen_alpha"} <= set(sel)
-    plain = fit(asym.train, "rbf", network={"linear_tail": False, "velocity_scale": None})
+    plain = fit(
+        asym.train, "rbf", settings={"network": {"linear_tail": False, "velocity_scale": None}}
+    )
     assert "linear" not in plain.state["pos"]
     # structure pays: the default is near the noise floor, the plain network is not
     assert _ratio(m, asym) < 1.6 < _ratio(plain, asym)
@@ -94,7 +96,7 @@ def test_default_rbf_is_structured_cross_validated_and_near_the_floor(asym):
 
 def test_structured_network_extrapolates_in_speed_like_coulomb_viscous(sigmoid):
     m = fit(sigmoid.train, "rbf")
-    plain = fit(sigmoid.train, "rbf", network={"linear_tail": False})
+    plain = fit(sigmoid.train, "rbf", settings={"network": {"linear_tail": False}})
     law = heldout_law("sigmoid")
     vmax = np.abs(sigmoid.train.velocity).max()
     for f, rel in ((2.0, 0.15), (4.0, None)):
@@ -190,7 +192,7 @@ def test_hybrid_backbone_residual_file_report_and_physics_outside(asym, tmp_path
 
 
 def test_hybrid_backbones_include_the_temperature_variants(asym, sigmoid):
-    from fricid.identify.hybrid import backbone_candidates, fit_backbone
+    from fricid.identify.learned.hybrid import backbone_candidates, fit_backbone
 
     names = [name for name, _ in backbone_candidates(asym.train)]
     assert {"stribeck_temp_asym", "coulomb_viscous_temp_asym", "stribeck_temp"} <= set(names)
@@ -208,7 +210,7 @@ def test_hybrid_backbones_include_the_temperature_variants(asym, sigmoid):
 
 def test_hybrid_refuses_a_residual_with_a_tail(sigmoid):
     with pytest.raises(ConfigError, match="linear tail"):
-        fit(sigmoid.train, "hybrid", network={"linear_tail": True})
+        fit(sigmoid.train, "hybrid", settings={"network": {"linear_tail": True}})
 
 
 def test_hybrid_c_export_equals_python(asym, tmp_path):
@@ -230,14 +232,14 @@ def test_hybrid_c_export_equals_python(asym, tmp_path):
 
 
 def test_auto_with_learned_families_picks_one_when_clearly_better():
-    from fricid.identify.select import candidates
+    from fricid.identify.static.select import candidates
 
     d = draw("asym_arrhenius", 11)
     small = d.train.subset(np.isin(d.train.temperature, (15.0, 35.0, 55.0)))
     assert [c.model for c in candidates(small)][-1] == "vlt_asym"  # off by default
     learned = {c.model: c for c in candidates(small, learned=True)}
     assert {"rbf", "hybrid"} <= set(learned) and not learned["rbf"].note
-    m = fit(small, "auto", learned=True, scheme="kfold:3")
+    m = fit(small, "auto", settings={"learned": True, "scheme": "kfold:3"})
     rows = {r["model"]: r for r in m.selection["table"]}
     assert rows["rbf"]["heldout_rmse"] is not None
     # the asymmetric Arrhenius law is none of the analytic families: a learned one wins

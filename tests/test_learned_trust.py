@@ -15,8 +15,8 @@ from _synthetic import averaged_samples
 from fricid.cli import app
 from fricid.fitted import FittedModel
 from fricid.identify import fit
-from fricid.identify._learned_trust import CV_SOURCE, hat_trace, learned_statistics
-from fricid.identify.rbf import RBFNetRegressor
+from fricid.identify.learned._trust import CV_SOURCE, hat_trace, learned_statistics
+from fricid.identify.learned.rbf import RBFNetRegressor
 from fricid.io import write_samples
 from fricid.report.trust import assess_trust
 from fricid.samples import FrictionSamples
@@ -74,7 +74,7 @@ def test_hat_trace_is_the_trace_of_the_fitted_map(options):
 
 @pytest.mark.parametrize("exact", [True, False])
 def test_gp_smoother_trace_is_the_trace_of_the_posterior_mean_map(exact):
-    from fricid.identify import gp as G
+    from fricid.identify.learned import gp as G
 
     rng = np.random.default_rng(0)
     Z = rng.normal(size=(50, 2))
@@ -110,7 +110,7 @@ def test_learned_files_record_convergence_and_their_cv(rbf, gp, samples, tmp_pat
     assert gp.converged == (gp.convergence["certified_by"] == "optimizer")
 
     v = rbf.validation
-    # 8 speeds: the 4 interior levels held out whole (fricid.identify._rbf_folds)
+    # 8 speeds: the 4 interior levels held out whole (fricid.identify.learned._rbf_folds)
     assert v["source"] == CV_SOURCE and v["scheme"] == "levels:4"
     state = rbf.state["n_centers_selection"]
     assert v["rmse"] == pytest.approx(state["cv_rmse_levels_chosen"])
@@ -125,7 +125,7 @@ def test_learned_files_record_convergence_and_their_cv(rbf, gp, samples, tmp_pat
 
 
 def test_gp_convergence_from_the_optimisers_status():
-    from fricid.identify._learned_trust import process_convergence
+    from fricid.identify.learned._trust import process_convergence
 
     ok = {"starts": 3, "nfev": 40, "converged": True, "message": "CONVERGENCE"}
     bad = {**ok, "converged": False, "message": "ABNORMAL_TERMINATION_IN_LNSRCH"}
@@ -142,7 +142,7 @@ def test_optimiser_trainer_out_of_budget_is_not_converged(samples):
             "rbf",
             "bas",
             max_evals=30,
-            network={"n_centers": 6, "target_mse": 1e-12},
+            settings={"network": {"n_centers": 6, "target_mse": 1e-12}},
         )
     conv = fitted.convergence
     assert conv["converged"] is False and "budget" in conv["reason"]
@@ -154,7 +154,7 @@ def test_optimiser_trainer_out_of_budget_is_not_converged(samples):
 def test_hybrid_records_both_parts(samples):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        fitted = fit(samples, "hybrid", network={"backbone": "stribeck"})
+        fitted = fit(samples, "hybrid", settings={"backbone": "stribeck"})
     conv = fitted.convergence
     assert conv["converged"] and conv["backbone"]["converged"]
     assert "backbone" in fitted.report().split("# convergence")[1].splitlines()[0]

@@ -49,7 +49,7 @@ def test_models_that_need_an_input_not_measured_say_so(tmp_path):
     with pytest.raises(ConfigError, match=r"model 'msk' .* no load"):
         fit(samples, "msk")
     with pytest.raises(ConfigError, match=r"'rbf' .* no load"):
-        fit(samples, "rbf", seed=0, inputs=("velocity", "load"))
+        fit(samples, "rbf", seed=0, settings={"inputs": ("velocity", "load")})
     # issue 15: by default the network takes the measured inputs (it was an error)
     assert fit(samples, "rbf", seed=0).state["inputs"] == ["velocity"]
     fitted = fit(samples, "stribeck")

@@ -247,7 +247,7 @@ def test_warning_labels_split_the_class_name_into_words(capsys):
     """The CLI's one-line warnings name their category in words (RateBiasWarning: 'rate bias')."""
     from fricid.cli import _app
     from fricid.errors import DataQualityWarning, FricidWarning
-    from fricid.identify.trajectory import RateBiasWarning
+    from fricid.identify.dynamic.trajectory import RateBiasWarning
 
     for category, label in (
         (RateBiasWarning, "rate bias"),

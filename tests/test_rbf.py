@@ -14,7 +14,7 @@ from sklearn.utils.estimator_checks import parametrize_with_checks
 
 from fricid.errors import ConfigError, DataError
 from fricid.fitted import FittedModel
-from fricid.identify.rbf import RBFNetRegressor, fit_rbf, to_fitted_model
+from fricid.identify.learned.rbf import RBFNetRegressor, fit_rbf, to_fitted_model
 from fricid.models import _rbf_core as core
 from fricid.models.rbf import predict_state
 from fricid.samples import FrictionSamples

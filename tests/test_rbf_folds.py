@@ -1,5 +1,5 @@
 """Issue 15: the RBF structure search cross-validates over whole speed levels
-(:mod:`fricid.identify._rbf_folds`), and its record says which folds it used."""
+(:mod:`fricid.identify.learned._rbf_folds`), and its record says which folds it used."""
 
 from __future__ import annotations
 
@@ -10,8 +10,7 @@ import pytest
 
 from _synthetic import averaged_samples
 from fricid.identify import fit
-from fricid.identify._learned_trust import cv_pieces, cv_validation
-from fricid.identify._rbf_folds import (
+from fricid.identify.learned._rbf_folds import (
     END_LEVELS,
     FOLDS,
     LEVEL_GAP_ALLOWANCE,
@@ -20,7 +19,8 @@ from fricid.identify._rbf_folds import (
     cv_folds,
     speed_levels,
 )
-from fricid.identify._rbf_select import choose_structure
+from fricid.identify.learned._rbf_select import choose_structure
+from fricid.identify.learned._trust import cv_pieces, cv_validation
 from fricid.samples import FrictionSamples
 
 SPEEDS = np.geomspace(0.01, 1.0, 9)
@@ -144,7 +144,7 @@ def test_hybrid_residual_without_level_folds_has_no_swing_at_the_fast_end(monkey
     """Issue 15, the grid kind's tuning seed 7 with random folds only: the penalty 1e-11
     (the best random-fold score by a hair) left the hybrid 3.4x the noise off the truth;
     the one-standard-error rule takes 1e-8 and 1.09x."""
-    from fricid.identify import _rbf_folds
+    from fricid.identify.learned import _rbf_folds
     from fricid.sim.heldout_laws import draw
 
     monkeypatch.setattr(_rbf_folds, "MIN_LEVELS", 10**9)
@@ -182,7 +182,7 @@ def test_hybrid_residual_on_random_folds_is_closer_to_the_truth_between_speeds()
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         default = fit(samples, "hybrid", seed=0)
-        levels = fit(samples, "hybrid", seed=0, network={"level_folds": True})
+        levels = fit(samples, "hybrid", seed=0, settings={"network": {"level_folds": True}})
         vlt = fit(samples, "vlt", seed=0)
     assert default.state["residual"]["n_centers_selection"]["cv_folds"] == "random"
     assert levels.state["residual"]["n_centers_selection"]["cv_folds"] == "velocity_levels"

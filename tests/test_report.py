@@ -182,7 +182,7 @@ def test_render_escapes_and_rejects_bad_items():
 
 def test_report_for_the_rbf_network_with_bootstrap(paper1_samples, tmp_path):
     from fricid.fitted import FittedModel
-    from fricid.identify.rbf import fit_rbf
+    from fricid.identify.learned.rbf import fit_rbf
 
     fitted = fit_rbf(paper1_samples, n_centers=8, random_state=0)
     path = fitted.save(tmp_path / "rbf.json")

@@ -13,7 +13,7 @@ from typer.testing import CliRunner
 from fricid.cli import app
 from fricid.errors import ConfigError, DataError
 from fricid.fitted import FittedModel
-from fricid.identify.trajectory import DerivativeFilter, RateBiasWarning, fit_trajectory
+from fricid.identify.dynamic.trajectory import DerivativeFilter, RateBiasWarning, fit_trajectory
 from fricid.models import Stribeck
 from fricid.sim import Joint, ModelLaw
 from fricid.sim import trajectory as tr
@@ -125,7 +125,7 @@ def test_options_are_checked():
         fit_trajectory(log, "lugre", rate_bias="correct")
     with pytest.raises(ConfigError, match="derivative filter"):
         DerivativeFilter(method="spline")
-    from fricid.identify.trajectory import ParallelFilter
+    from fricid.identify.dynamic.trajectory import ParallelFilter
 
     with pytest.raises(ConfigError, match="parallel filter"):
         ParallelFilter(cutoff=0.0)
@@ -224,7 +224,7 @@ def test_any_optimiser_and_static_part_from_sweeps():
 
 
 def test_passivity_is_judged_at_the_estimate_and_the_worst_corner():
-    from fricid.identify.trajectory import _passivity
+    from fricid.identify.dynamic._outcome import passivity as _passivity
 
     names = list(TRUTH.params())
     values = TRUTH.theta

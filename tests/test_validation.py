@@ -20,7 +20,7 @@ from fricid.identify import (
     sample_weights,
     validate,
 )
-from fricid.identify.select import candidates
+from fricid.identify.static.select import candidates
 from fricid.identify.validate import asymmetry_note, fold_labels, parse_scheme
 from fricid.identify.validate import sem_autocorrelated as sem_ac
 from fricid.io import write_samples

@@ -25,7 +25,7 @@ from ._progress import QuietOption, fit_progress
 
 
 def _method_help() -> str:
-    from ..identify.varpro import SUMMARY
+    from ..identify.static.varpro import SUMMARY
     from ..optim import METHODS
 
     items = [f"{name}: {cls.summary}" for name, cls in METHODS.items()]
@@ -147,7 +147,7 @@ def fit_command(
         typer.Option(
             "--trajectory",
             help="SAMPLES is a raw log of any motion: identify lugre (or stribeck, "
-            "coulomb_viscous) with J and gravity from it (fricid.identify.trajectory).",
+            "coulomb_viscous) with J and gravity from it (fricid.identify.dynamic.trajectory).",
         ),
     ] = False,
     log_format: Annotated[
@@ -207,10 +207,12 @@ def fit_command(
     data = select_direction(read_samples(samples), direction)
     key = model.strip().lower()
     rbf = key in ("rbf", "hybrid")
-    options = {"loss": loss, "f_scale": f_scale, "weights": weights}
-    options.update(
-        _rbf_network(centers, inputs, backbone if key == "hybrid" else None) if rbf else {}
-    )
+    options: dict = {"loss": loss, "f_scale": f_scale, "weights": weights}
+    settings = _rbf_settings(centers, inputs, backbone if key == "hybrid" else None) if rbf else {}
+    if key == "auto":
+        settings.update({"scheme": validate} if validate else {})
+        settings.update({"learned": True} if learned else {})
+    trainer = _rbf_trainer(method) if rbf else (None if key == "gp" else method)
     fixed = parse_assignments(fix, "--fix")
     with (
         warnings.catch_warnings(record=True) as caught,
@@ -220,18 +222,18 @@ def fit_command(
         ),
     ):
         warnings.simplefilter("always")
-        options.update({"callback": callback} if callback is not None else {})
+        if callback is not None and key not in ("rbf", "hybrid", "gp"):
+            options["callback"] = callback
         fitted = fit(
             data,
             model,
-            _rbf_trainer(method) if rbf else method,
-            fixed=parse_assignments(fix, "--fix"),
+            trainer,
+            fixed=fixed,
             bounds=parse_ranges(bound, "--bound"),
             seed=seed,
             max_evals=max_evals,
+            settings=settings or None,
             **options,
-            **({"scheme": validate} if key == "auto" and validate else {}),
-            **({"learned": True} if key == "auto" and learned else {}),
         )
         if validate and key != "auto":
             track.stage(f"validating {fitted.model} ({validate})", restart=True)
@@ -240,11 +242,12 @@ def fit_command(
                 data,
                 fitted.model,
                 validate,
-                _rbf_trainer(method) if rbf else method,
+                trainer,
                 seed=seed,
-                fixed=parse_assignments(fix, "--fix"),
+                fixed=fixed,
                 bounds=parse_ranges(bound, "--bound"),
                 max_evals=max_evals,
+                settings=settings or None,
                 **options,
             ).to_dict()
     lines = [f"{w.category.__name__}: {w.message}" for w in caught]
@@ -335,8 +338,8 @@ def goodness_text(fitted, samples=None) -> str:
 
 
 def _rbf_trainer(method: str) -> str:
-    """The RBF network's trainer: lsq (k-means, widths, ridge weights; the default --method
-    lm means it), bas (BAS-RBFNN) or ga (GA-RBFNN)."""
+    """The RBF network's trainer: lsq (k-means, widths, ridge weights; what the command's
+    default --method lm selects for these models), bas (BAS-RBFNN) or ga (GA-RBFNN)."""
     from ..errors import ConfigError
 
     trainer = "lsq" if method == "lm" else method
@@ -347,13 +350,12 @@ def _rbf_trainer(method: str) -> str:
     return trainer
 
 
-def _rbf_network(centers: int | None, inputs: str | None, backbone: str | None = None) -> dict:
-    """``identify.fit``'s network arguments from --centers, --inputs and --backbone (the
-    velocity warp, the widths and the penalty are fit's structured defaults)."""
-    network: dict = {"n_centers": centers}
+def _rbf_settings(centers: int | None, inputs: str | None, backbone: str | None = None) -> dict:
+    """``identify.fit``'s settings from --centers, --inputs and --backbone (the velocity warp,
+    the widths and the penalty are fit's structured defaults)."""
+    out: dict = {"network": {"n_centers": centers}}
     if backbone:
-        network["backbone"] = backbone
-    out: dict = {"network": network}
+        out["backbone"] = backbone
     if inputs:
         out["inputs"] = [name.strip() for name in inputs.split(",") if name.strip()]
     return out
@@ -363,7 +365,7 @@ def _rbf_network(centers: int | None, inputs: str | None, backbone: str | None =
 def methods_command() -> None:
     """List the models (analytic, then those that predict from a stored state such as the RBF
     network) and the optimisers, with a line on each."""
-    from ..identify.varpro import SUMMARY
+    from ..identify.static.varpro import SUMMARY
     from ..models import MODELS, STATEFUL
     from ..optim import METHODS
 

@@ -3,7 +3,7 @@
 A hook in :mod:`fricid.cli.fit` delegates here. The log is opened by any reader that gives
 a time series (:func:`fricid.io.open_log`: ``table``, ``generic``, ``rosbag``, ``channels``,
 ``mat``, ``epos``; reader options as ``--reader-option KEY=VALUE``), its chunks joined, and
-identified by :func:`fricid.identify.trajectory.fit_trajectory`.
+identified by :func:`fricid.identify.dynamic.trajectory.fit_trajectory`.
 """
 
 from __future__ import annotations
@@ -104,7 +104,7 @@ def run_trajectory(
     out: Path | None,
 ) -> None:
     """Open, identify, save and print (the ``--trajectory`` branch of ``fricid fit``)."""
-    from ..identify.trajectory import fit_trajectory
+    from ..identify import fit
     from ..io import open_log
     from ..samples import RawLog
 
@@ -119,8 +119,13 @@ def run_trajectory(
     log = chunks[0] if len(chunks) == 1 else RawLog.concatenate(chunks)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        fitted = fit_trajectory(
-            log, model, method, route=route, gravity=gravity, seed=seed, max_evals=max_evals
+        fitted = fit(
+            log,
+            model,
+            method,
+            seed=seed,
+            max_evals=max_evals,
+            settings={"route": route, "gravity": gravity},
         )
     lines = [f"{w.category.__name__}: {w.message}" for w in caught]
     if lines:

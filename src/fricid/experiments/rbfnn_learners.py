@@ -2,7 +2,8 @@
 unfitted estimators by row label, and how each is fitted and described.
 
 RBFNN (``lsq``) and BAS-RBFNN ([B] section 3, hybrid encoding) are
-:class:`fricid.identify.rbf.RBFNetRegressor`; the velocity-load-temperature model ([B] eq. 4)
+:class:`fricid.identify.learned.rbf.RBFNetRegressor`; the velocity-load-temperature model ([B] eq.
+4)
 is fitted by :func:`fricid.identify.fit`; scikit-learn's MLP and a Gaussian process are the
 baselines the paper did not run.
 """
@@ -16,7 +17,7 @@ from typing import Any
 import numpy as np
 
 from ..identify import fit as identify_fit
-from ..identify.rbf import RBFNetRegressor
+from ..identify.learned.rbf import RBFNetRegressor
 from ..samples import FrictionSamples
 from .rbfnn_config import MLP_BASE, StudyConfig
 

@@ -72,7 +72,7 @@ class FittedModel:
         search bound (the data do not bound the parameter there).
     ci_method : ``"profile"``, ``"jacobian"`` or ``""`` (no intervals).
     uncertainty_note : why a parameter has no interval, or why a side is open.
-    convergence : the convergence block (``fricid.identify._convergence.certify``):
+    convergence : the convergence block (``fricid.identify.static.convergence.certify``):
         ``converged``, ``status``, ``message``, ``nfev``, ``max_evals``, ``polish_sse_ratio``,
         ``polish_nfev``, ``certified_by`` and, when not converged, ``reason`` and ``advice``;
         None when not recorded.
@@ -90,7 +90,7 @@ class FittedModel:
         (:func:`fricid.metrics.fit_statistics`); for the learned models ``nvarys_effective``
         and ``nfree_effective`` (the effective degrees of freedom, the trace of the hat
         matrix) in place of ``nvarys`` and ``nfree``, or neither and no AIC, BIC or reduced
-        chi-square where they are undefined (:mod:`fricid.identify._learned_trust`).
+        chi-square where they are undefined (:mod:`fricid.identify.learned._trust`).
     statistics_note : how the statistics count the model's degrees of freedom, or why some
         are not given ("" for an analytic fit: its free parameters).
     bounds : the search box of each free parameter.
@@ -103,7 +103,7 @@ class FittedModel:
     validation : held-out validation (:func:`fricid.identify.validate.validate`): scheme,
         held-out RMSE, scatter, ratio, verdict, folds; None when not validated.
     selection : ``fit(samples, "auto")``'s comparison of candidate models
-        (:mod:`fricid.identify.select`): the table, the choice and why; None otherwise.
+        (:mod:`fricid.identify.static.select`): the table, the choice and why; None otherwise.
     """
 
     model: str

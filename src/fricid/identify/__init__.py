@@ -1,44 +1,44 @@
-"""Identification: samples + model + optimiser -> :class:`~fricid.fitted.FittedModel`.
+"""Identification: samples or a trajectory log + model + method ->
+:class:`~fricid.fitted.FittedModel`.
 
-* :func:`fit`, :func:`evaluate` (:mod:`fricid.identify._fit`): least-squares identification of
-  any model, the RBF network included (``fit(samples, "rbf", method="bas")``);
-* :class:`IdentificationProblem` (:mod:`fricid.identify.problem`): model, data, loss, bounds
-  and fixed parameters, evaluated for a batch of candidates; the one place the objective is
-  written;
-* :func:`validate` (:mod:`fricid.identify.validate`): held-out RMSE (leave one velocity
-  level out, k-fold) beside the measurement scatter estimated from the data
-  (:func:`measurement_scatter`), with a verdict;
-* :func:`select` (:mod:`fricid.identify.select`): ``fit(samples, "auto")``, the candidate
-  families compared by held-out error;
-* :func:`jacobian_uncertainty` (:mod:`fricid.identify.uncertainty`): standard errors and
-  covariance by an SVD pseudo-inverse, as scipy's ``curve_fit``; what ``fit`` reports of
-  them (:func:`~fricid.identify.uncertainty.assess`: nothing for an unconverged fit or a
-  degenerate optimum);
-* :func:`profile_intervals` (:mod:`fricid.identify.profile`): profile-likelihood 95 %
-  intervals inside the search box;
-* :mod:`fricid.identify.rbf`: the RBF network's scikit-learn estimator and trainers
-  (imported on use: it needs scikit-learn); :mod:`fricid.identify.hybrid`: an analytic
-  backbone plus an RBF residual (``fit(samples, "hybrid")``).
+One public entry, :func:`fit` (:mod:`fricid.identify.dispatch`, an explicit table of the kinds
+of identification), over three rooms that share :class:`IdentificationProblem`
+(:mod:`fricid.identify.problem`, the one place the objective is written):
+
+* :mod:`fricid.identify.static`: analytic laws by least squares (BAS-RBFNN paper eq. 1-4,
+  RWSAVSBAS paper eq. 7 and 11), their uncertainty and profile intervals, variable
+  projection, and ``model="auto"`` (the family chosen by held-out error);
+* :mod:`fricid.identify.learned`: the RBF network (plain, BAS-RBFNN, GA-RBFNN), the hybrid and
+  the Gaussian process (imported on use: they need scikit-learn);
+* :mod:`fricid.identify.dynamic`: LuGre, Dahl and static laws with inertia and gravity from any
+  trajectory.
+
+What every room's result is judged by lives here too, computed once: :func:`validate`
+(held-out RMSE, leave one velocity level out or k-fold), :func:`measurement_scatter` and the
+trust verdict.
 """
 
 from __future__ import annotations
 
 from ..samples import samples_hash
-from ._fit import evaluate
 from ._scatter import Scatter, measurement_scatter, sample_weights
+from .dispatch import KINDS, fit, kind_of
 from .problem import IdentificationProblem
-from .profile import profile_intervals
-from .select import fit, select
-from .uncertainty import jacobian_uncertainty
+from .static.least_squares import evaluate
+from .static.profile import profile_intervals
+from .static.select import select
+from .static.uncertainty import jacobian_uncertainty
 from .validate import Validation, validate
 
 __all__ = [
+    "KINDS",
     "IdentificationProblem",
     "Scatter",
     "Validation",
     "evaluate",
     "fit",
     "jacobian_uncertainty",
+    "kind_of",
     "measurement_scatter",
     "profile_intervals",
     "sample_weights",

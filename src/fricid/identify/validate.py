@@ -34,7 +34,7 @@ import numpy as np
 from ..errors import ConfigError, ConvergenceWarning, FricidError
 from ..metrics import rmse, verdict
 from ..samples import FrictionSamples
-from ._learned import fit
+from ._named import fit_named as fit
 from ._scatter import (
     WEIGHTS,
     Scatter,
@@ -243,7 +243,7 @@ def validate(
     samples: FrictionSamples,
     model: str,
     scheme: str = "lovo",
-    method: str = "lm",
+    method: str | None = None,
     *,
     scatter: Scatter | None = None,
     seed: int | np.random.Generator | None = 0,
@@ -260,8 +260,9 @@ def validate(
         A model name, as :func:`fricid.identify.fit` takes it (not ``"auto"``).
     scheme : str, default "lovo"
         ``lovo``, ``kfold`` or ``kfold:K`` (module docstring).
-    method : str, default "lm"
-        The optimiser of each fold's fit.
+    method : str, optional
+        The optimiser of each fold's fit (default: the model's, as :func:`fricid.identify.fit`
+        chooses it).
     scatter : Scatter, optional
         Default: :func:`measurement_scatter` of ``samples``.
     seed : int or numpy.random.Generator, optional

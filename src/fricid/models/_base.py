@@ -92,7 +92,8 @@ class FrictionModel(ABC):
     #: Predicts from a parameter vector (False), not a stored state (the RBF network).
     stateful: bool = False
     #: The parameters the prediction is a linear combination of, for fixed values of the
-    #: others (variable projection, :mod:`fricid.identify.varpro`); ``()`` when none is declared.
+    #: others (variable projection, :mod:`fricid.identify.static.varpro`); ``()`` when none is
+    # declared.
     linear_params: tuple[str, ...] = ()
     #: The viscous coefficient ``c`` of a model of the form ``sign(v) G(|v|, load, T) + c v``
     #: (None when the model has no such term), which a temperature law may scale

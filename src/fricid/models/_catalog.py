@@ -22,7 +22,7 @@ MODELS: dict[str, type[FrictionModel]] = {
 
 
 #: Dynamic models by registry name (their ``predict`` is the steady state; identified from
-#: trajectories by :mod:`fricid.identify.trajectory`); kept out of :data:`MODELS`, whose
+#: trajectories by :mod:`fricid.identify.dynamic.trajectory`); kept out of :data:`MODELS`, whose
 #: families are fitted to friction samples.
 DYNAMIC: dict[str, type[FrictionModel]] = {cls.name: cls for cls in (LuGre, Dahl)}
 

@@ -2,7 +2,7 @@
 from a stored state (issue 15).
 
 Training (scikit-learn's ``GaussianProcessRegressor`` for the kernel's hyperparameters, the
-inducing-point subset) is :mod:`fricid.identify.gp`'s job; this module only evaluates what a
+inducing-point subset) is :mod:`fricid.identify.learned.gp`'s job; this module only evaluates what a
 model file holds, so that ``FittedModel.predict``, the C export and a loaded file agree.
 
 Structure that physics guarantees: friction opposes motion and is, per direction, a function

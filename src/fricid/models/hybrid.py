@@ -14,7 +14,7 @@ A state (``FittedModel.state`` of a model ``"hybrid"``) holds ``kind`` (``"hybri
 ``state_version`` (2), ``symmetry`` (the residual's), ``inputs`` (every input either part
 uses), ``backbone`` (``{"model": name, "params": {name: value}}``) and ``residual`` (an RBF
 state), plus training notes (``prediction_interval``, ``backbone_selection``) that prediction
-ignores. Identification: :mod:`fricid.identify.hybrid`.
+ignores. Identification: :mod:`fricid.identify.learned.hybrid`.
 """
 
 from __future__ import annotations

@@ -5,7 +5,8 @@ This is the models layer's part of the network (DESIGN.md, layer table): Gaussia
 (eq. 14) and a linear output (eq. 15) with an optional bias, on inputs standardised as the
 state records, and the checks that a stored state is well formed. Training the network (the
 ``lsq`` recipe, BAS-RBFNN and GA-RBFNN through :mod:`fricid.optim`) and the scikit-learn
-estimator live in the identification layer, :mod:`fricid.identify.rbf`; the numerical kernels
+estimator live in the identification layer, :mod:`fricid.identify.learned.rbf`; the numerical
+kernels
 (design matrices, least-squares output weights) in :mod:`fricid.models._rbf_core`.
 
 A state (``FittedModel.state`` of a model ``"rbf"``) holds ``kind`` (``"gaussian_rbf"``),
@@ -305,7 +306,7 @@ def tail_terms(inputs: Sequence[str], order: int = 1) -> list[str]:
     e.g. ``velocity*temperature`` (a viscous coefficient linear in load and temperature), and
     with ``order=2`` times each other one squared, ``velocity*temperature*temperature`` (a
     viscous coefficient quadratic in them: an Arrhenius-like coefficient to second order).
-    Cross-validation chooses the order (:mod:`fricid.identify._rbf_select`)."""
+    Cross-validation chooses the order (:mod:`fricid.identify.learned._rbf_select`)."""
     names = list(inputs)
     first, others = names[0], names[1:]
     out = names + [f"{first}*{o}" for o in others]
@@ -346,7 +347,7 @@ def predict_state(state: Mapping[str, Any] | None, X) -> np.ndarray:
     temperature [degC] (``FrictionSamples.X``); eq. 14-15, with the sign of motion as
     ``state["symmetry"]`` says (module notes).
 
-    ``state`` is ``FittedModel.state`` as ``fricid.identify.rbf.to_fitted_model`` writes it.
+    ``state`` is ``FittedModel.state`` as ``fricid.identify.learned.rbf.to_fitted_model`` writes it.
 
     Raises
     ------
@@ -377,7 +378,7 @@ def predict_state(state: Mapping[str, Any] | None, X) -> np.ndarray:
 def interval_half_width(state: Mapping[str, Any] | None, X, level: float = 0.9) -> np.ndarray:
     """Half-width [N m] of the prediction interval at ``level`` stored with a learned model
     (``state["prediction_interval"]`` of each network: conformal quantiles of its
-    cross-validation residuals, :func:`fricid.identify._rbf_select.conformal_half_widths`),
+    cross-validation residuals, :func:`fricid.identify.learned._rbf_select.conformal_half_widths`),
     at each row of ``X (n, 3)``: the ``pos`` network's for ``v > 0`` and the ``neg`` one's
     for ``v < 0`` of a per-direction state; a hybrid model's are its residual network's.
 

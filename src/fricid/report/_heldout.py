@@ -2,7 +2,7 @@
 leave-one-velocity-out of an analytic model when folds x samples x parameters is at most
 :data:`VALIDATE_WORK`, of a learned model (``rbf`` and ``hybrid`` trained by least squares,
 ``gp``; each fold retrained as ``fit`` trains it) when folds x samples is at most
-:data:`fricid.identify._learned_trust.LEARNED_VALIDATE_WORK`, with at least
+:data:`fricid.identify.learned._trust.LEARNED_VALIDATE_WORK`, with at least
 :data:`MIN_LEVELS` velocity levels either way.
 """
 
@@ -67,7 +67,12 @@ def run_validation(
 
 
 def _lovo(
-    samples: FrictionSamples, model: str, method: str, how: str, fallback: str, **options: Any
+    samples: FrictionSamples,
+    model: str,
+    method: str | None,
+    how: str,
+    fallback: str,
+    **options: Any,
 ) -> tuple[dict[str, Any] | None, str]:
     """:func:`fricid.identify.validate` with ``lovo``, its warnings silenced."""
     from ..identify.validate import validate
@@ -87,8 +92,8 @@ def _run_learned(
     """Leave-one-velocity-out of a learned model (``rbf``, ``hybrid``: trained by least
     squares; ``gp``), each fold retrained as ``fit`` trains it (the structure search, the
     backbone's selection, the GP's hyperparameters), when folds x samples is at most
-    :data:`fricid.identify._learned_trust.LEARNED_VALIDATE_WORK`."""
-    from ..identify._learned_trust import LEARNED_VALIDATE_WORK
+    :data:`fricid.identify.learned._trust.LEARNED_VALIDATE_WORK`."""
+    from ..identify.learned._trust import LEARNED_VALIDATE_WORK
 
     work = folds * len(samples)
     trainer = str((fitted.state or {}).get("trainer") or "")
@@ -108,17 +113,16 @@ def _run_learned(
     options: dict[str, Any] = {}
     if fitted.model == "gp":
         params = (fitted.provenance or {}).get("estimator_params") or {}
-        options["options"] = {k: params[k] for k in ("max_points", "n_restarts") if k in params}
+        options["settings"] = {k: params[k] for k in ("max_points", "n_restarts") if k in params}
     seed = fitted.seed if fitted.seed is not None else 0
     how = f"{folds} folds, each retrained as fit trains {fitted.model}"
-    method = "lm" if fitted.model == "gp" else "lsq"
-    return _lovo(samples, fitted.model, method, how, fallback, seed=seed, **options)
+    return _lovo(samples, fitted.model, None, how, fallback, seed=seed, **options)
 
 
 def own_cv(validation: dict[str, Any] | None) -> bool:
     """The validation is a learned model's record of its own structure search's CV (folds of
     whole interior speed levels, or random folds where there are too few levels; the record's
-    scheme says which: :mod:`fricid.identify._learned_trust`)."""
-    from ..identify._learned_trust import CV_SOURCE
+    scheme says which: :mod:`fricid.identify.learned._trust`)."""
+    from ..identify.learned._trust import CV_SOURCE
 
     return bool(validation) and validation.get("source") == CV_SOURCE

@@ -6,7 +6,7 @@ module reads them (and, where given, the samples) into one :class:`Trust`:
 - data quality per set-point: kept and dropped samples, and why, from the samples'
   ``meta["quality"]`` (:class:`fricid.extract.QualityTable`), or a note that it is not
   recorded;
-- convergence: the ``convergence`` block (:func:`fricid.identify._convergence.certify`), its
+- convergence: the ``convergence`` block (:func:`fricid.identify.static.convergence.certify`), its
   reason and advice when the fit did not converge;
 - identifiability: parameters not determined (``uncertainty_note``, a NaN standard error) and
   intervals with an open side (``ci_open``); an open lower side at a bound of 0 means
@@ -17,7 +17,7 @@ module reads them (and, where given, the samples) into one :class:`Trust`:
   the samples have at least :data:`MIN_LEVELS` velocity levels and it is small enough
   (:mod:`._heldout`: an analytic model's folds x samples x parameters at most
   :data:`VALIDATE_WORK`; a learned model's folds x samples at most
-  :data:`fricid.identify._learned_trust.LEARNED_VALIDATE_WORK`, each fold retrained as
+  :data:`fricid.identify.learned._trust.LEARNED_VALIDATE_WORK`, each fold retrained as
   ``fit`` trains it), so analytic and learned verdicts rest on the same test; else the
   learned model's own cross-validation, with the caveat, or the fit's in-sample
   ``rmse_over_scatter``, labelled as such;

@@ -33,7 +33,7 @@ from every fricid model family, so fits are tested under honest misspecification
     (-3..3 N m), 540 points; temperature not measured. Noise 1.5 mN m.
 
 Seeds: :data:`TUNING_SEEDS` (0-99) are the draws a developer may look at while choosing
-defaults (the cross-validation grids of :mod:`fricid.identify._rbf_select` were checked on
+defaults (the cross-validation grids of :mod:`fricid.identify.learned._rbf_select` were checked on
 seeds 0-2); :data:`REPORTING_SEEDS` (1001-1003) are the draws ``benchmarks/bench_floor.py``
 reports, never used to choose anything. The two sets are disjoint (:func:`draw` refuses
 neither; the separation is a convention the benchmark keeps).

@@ -220,7 +220,7 @@ def slow_multisine(
     samples; the plateaus give the steady state at those speeds for seconds at a time, as a
     sweep does (the paper's design, [BAS-RBFNN] section 4), while the multi-sine excites the
     dynamics (inertia, gravity, bristles). On the virtual joint it pins the static part
-    down but biases sigma_0 (the notes of :mod:`fricid.identify.trajectory`, measured by
+    down but biases sigma_0 (the notes of :mod:`fricid.identify.dynamic.trajectory`, measured by
     ``benchmarks/bench_trajectory.py --experiment slow_multisine``).
     """
     t = _time(duration, rate)

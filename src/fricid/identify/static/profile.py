@@ -32,7 +32,7 @@ import numpy as np
 from scipy import stats
 from scipy.optimize import least_squares
 
-from .problem import IdentificationProblem
+from ..problem import IdentificationProblem
 
 __all__ = ["GRID", "N_BISECT", "ProfileInterval", "profile_intervals", "profile_threshold"]
 

@@ -31,8 +31,8 @@ it is evaluated at a noisy estimate and grows as sigma_1's estimate falls (60 s,
 seed 13, -0.31 at an estimate 0.22 low; seed 15, -0.075 at one 0.055 high; a 15 s log,
 seed 22, put it at -74 %), an uncertainty the correction would have to carry and that is
 not estimated here. fricid therefore applies nothing: the bias and the corrected values go
-into the provenance, and :func:`fricid.identify.trajectory.fit_trajectory` warns
-(:class:`fricid.identify.trajectory.RateBiasWarning`) when the bias exceeds half a standard
+into the provenance, and :func:`fricid.identify.dynamic.trajectory.fit_trajectory` warns
+(:class:`fricid.identify.dynamic.trajectory.RateBiasWarning`) when the bias exceeds half a standard
 error, naming ten times the log's rate as the rate that removes it (10 kHz put every
 parameter within 0.3 per mille, :mod:`._trajectory_filtered`). It costs one simulation and
 one re-identification from the estimate: about the filtered route's own time again.
@@ -45,11 +45,11 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import FricidError
-from ..models import lugre
-from ._trajectory_data import Series
-from ._trajectory_filtered import LOG_BOX, ParallelFilter, filtered_route
-from ._trajectory_routes import _Stage
+from ...errors import FricidError
+from ...models import lugre
+from ._data import Series
+from ._filtered import LOG_BOX, ParallelFilter, filtered_route
+from ._routes import _Stage
 
 __all__ = ["GAINS", "SUB_STEPS", "rate_bias"]
 

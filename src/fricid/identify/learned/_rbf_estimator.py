@@ -1,6 +1,7 @@
 """The scikit-learn estimator of the RBF network, :class:`RBFNetRegressor` (BAS-RBFNN paper,
-eq. 14-21): the ``lsq`` recipe here, the optimiser trainers in :mod:`fricid.identify._rbf_search`.
-Public home and the reading of the paper: :mod:`fricid.identify.rbf`.
+eq. 14-21): the ``lsq`` recipe here, the optimiser trainers in
+:mod:`fricid.identify.learned._rbf_search`.
+Public home and the reading of the paper: :mod:`fricid.identify.learned.rbf`.
 """
 
 from __future__ import annotations
@@ -18,10 +19,10 @@ from sklearn.utils import check_random_state
 from sklearn.utils._param_validation import Interval, InvalidParameterError, StrOptions
 from sklearn.utils.validation import check_is_fitted, validate_data
 
-from ..errors import ConfigError, DataError, IgnoredArgumentWarning
-from ..models import _rbf_core as core
-from ..models.rbf import mse_z, predict_z, tail_columns
-from ..optim import METHODS
+from ...errors import ConfigError, DataError, IgnoredArgumentWarning
+from ...models import _rbf_core as core
+from ...models.rbf import mse_z, predict_z, tail_columns
+from ...optim import METHODS
 from ._rbf_search import search_network
 
 __all__ = ["LSQ_IGNORES", "TRAINERS", "RBFNetRegressor"]
@@ -52,7 +53,8 @@ def _kmeans_plusplus(Xc: np.ndarray, m: int, seed: int) -> np.ndarray:
     ``2 + ln m`` local trials) on the centred data ``Xc`` from ``RandomState(seed)``, drawn as
     scikit-learn draws them (the first seed by ``choice`` with equal weights, one uniform, then
     each seed's trials: one stream, :func:`_uniforms`) and computed by its operations in one
-    compiled loop (:func:`fricid.identify._kmeans_kernel.plusplus`), without its per-call input
+    compiled loop (:func:`fricid.identify.learned._kmeans_kernel.plusplus`), without its per-call
+    input
     validation and per-centre numpy calls (which took most of the time of the small sets'
     cross-validation)."""
     from ._kmeans_kernel import plusplus
@@ -189,12 +191,13 @@ class RBFNetRegressor(RegressorMixin, BaseEstimator):
         Gaussians fit it. None: plain standardisation, as the paper.
     target_mse : float or None, default 1e-4
         Stop an optimiser trainer once the training MSE of the target mapped onto [-1, 1]
-        reaches this value (the paper's 0.0001; see :mod:`fricid.identify.rbf`). None: use the whole
+        reaches this value (the paper's 0.0001; see :mod:`fricid.identify.learned.rbf`). None: use
+        the whole
         budget.
     max_epochs : int, default 500
         Budget of an optimiser trainer, in epochs.
     evals_per_epoch : int, default 30
-        Candidate evaluations per epoch (a GA generation; see :mod:`fricid.identify.rbf`).
+        Candidate evaluations per epoch (a GA generation; see :mod:`fricid.identify.learned.rbf`).
     method_options : dict or None, default None
         Options for the optimiser (``fricid.optim.minimize(..., options=...)``).
     random_state : int, RandomState instance or None, default None
@@ -244,7 +247,7 @@ class RBFNetRegressor(RegressorMixin, BaseEstimator):
 
     Examples
     --------
-    >>> from fricid.identify.rbf import RBFNetRegressor
+    >>> from fricid.identify.learned.rbf import RBFNetRegressor
     >>> net = RBFNetRegressor(n_centers=40, random_state=0)
     >>> net.fit(samples.X, samples.y).predict(samples.X)  # doctest: +SKIP
     >>> cross_val_score(RBFNetRegressor(), samples.X, samples.y, cv=5)  # doctest: +SKIP

@@ -1,8 +1,8 @@
 """Choices made before an RBF network is trained (issue 11, "Validation built in"): the number
 of centres by cross-validated error, and inputs that do not vary dropped with a note.
 
-Used by :func:`fricid.identify.rbf.fit_rbf`; the estimator itself
-(:class:`~fricid.identify.rbf.RBFNetRegressor`) stays a plain scikit-learn regressor.
+Used by :func:`fricid.identify.learned.rbf.fit_rbf`; the estimator itself
+(:class:`~fricid.identify.learned.rbf.RBFNetRegressor`) stays a plain scikit-learn regressor.
 """
 
 from __future__ import annotations
@@ -16,8 +16,8 @@ from typing import Any
 import numpy as np
 import scipy.linalg
 
-from ..errors import DataError, DataQualityWarning, IdentifiabilityWarning
-from ..models.rbf import tail_columns
+from ...errors import DataError, DataQualityWarning, IdentifiabilityWarning
+from ...models.rbf import tail_columns
 from ._rbf_estimator import LSQ_IGNORES, RBFNetRegressor
 from ._rbf_folds import FOLDS, choose_penalty, cv_folds
 
@@ -182,8 +182,8 @@ class _CrossValidation:
     residuals [N m] of every fold set pooled, RMSE [N m] per fold set: random, then levels)
     of the best penalty, memoised. The score is the random folds' RMSE, or
     ``max(random, levels / LEVEL_GAP_ALLOWANCE)`` with level folds; the penalty by
-    :func:`~fricid.identify._rbf_folds.choose_penalty`
-    (:mod:`fricid.identify._rbf_folds`)."""
+    :func:`~fricid.identify.learned._rbf_folds.choose_penalty`
+    (:mod:`fricid.identify.learned._rbf_folds`)."""
 
     def __init__(
         self,
@@ -233,7 +233,7 @@ class _CrossValidation:
     def residuals(
         self, m: int, wf: float, stretch: float, order: int = 1
     ) -> tuple[int, float, np.ndarray, list[float]]:
-        from ..models import _rbf_core as core
+        from ...models import _rbf_core as core
 
         key = (m, wf, stretch, order)
         if key in self._memo:
@@ -315,7 +315,7 @@ def choose_structure(
     """Number of centres, width factor, velocity stretch and ridge penalty of the ``lsq``
     network by cross-validation over random folds and folds of whole speed levels (issue 15,
     "defaults chosen by the held-out error that matters": the score of
-    :mod:`fricid.identify._rbf_folds`; random folds only when there are too few levels),
+    :mod:`fricid.identify.learned._rbf_folds`; random folds only when there are too few levels),
     and prediction intervals from the chosen candidate's held-out residuals.
 
     The search is coordinate-wise: the number of centres over :func:`structure_grid` (width
@@ -348,7 +348,7 @@ def choose_structure(
     dict
         The note saved in the model file: ``grid`` (centres), ``width_factors``,
         ``stretches``, ``alphas``, ``folds`` (random), ``cv_folds``, ``cv_levels``,
-        ``level_folds``, ``cv_note`` (:func:`~fricid.identify._rbf_folds.cv_folds`),
+        ``level_folds``, ``cv_note`` (:func:`~fricid.identify.learned._rbf_folds.cv_folds`),
         ``cv_rmse`` [N m] the score per number of centres (last pass), ``n_held`` (samples
         the level folds hold out, else all), ``chosen`` (centres), ``chosen_width_factor``,
         ``chosen_stretch``, ``chosen_alpha``, ``cv_rmse_chosen`` (random folds),

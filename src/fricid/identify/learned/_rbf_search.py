@@ -10,7 +10,7 @@ Two encodings of the search vector ``theta`` (one candidate network):
   its ridge least-squares solution on the training target (:class:`HybridNetwork`, a
   variable-projection model whose ``fused_mse`` is :class:`~fricid.models._rbf_core.RidgeScorer`).
 
-Used by :class:`fricid.identify.rbf.RBFNetRegressor`; see that module for the reading of the
+Used by :class:`fricid.identify.learned.rbf.RBFNetRegressor`; see that module for the reading of the
 paper (target MSE, epochs, encodings).
 """
 
@@ -23,11 +23,11 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import ConfigError
-from ..models import _rbf_core as core
-from ..models.rbf import mse_z
-from ..optim import METHODS, minimize
-from .problem import IdentificationProblem
+from ...errors import ConfigError
+from ...models import _rbf_core as core
+from ...models.rbf import mse_z
+from ...optim import METHODS, minimize
+from ..problem import IdentificationProblem
 
 __all__ = ["FullNetwork", "HybridNetwork", "method_options", "search_network"]
 
@@ -134,7 +134,8 @@ def _bounds(Z: np.ndarray, m: int, full: bool, w_max: float, fit_bias: bool) -> 
 def search_network(est: Any, method: str, Z: np.ndarray, t: np.ndarray, start: Network, seed: int):
     """Search the network's parameters with ``fricid.optim.minimize`` (eq. 18-21 for BAS).
 
-    ``est`` is the :class:`~fricid.identify.rbf.RBFNetRegressor` being fitted: its parameters
+    ``est`` is the :class:`~fricid.identify.learned.rbf.RBFNetRegressor` being fitted: its
+    parameters
     are read, and its training record (``mse_history_``, ``n_epochs_``, ``n_evals_``,
     ``epochs_to_target_``, ``initial_mse_``) written. Returns the best network on the scaled
     target, never worse than ``start`` when the search started from it.

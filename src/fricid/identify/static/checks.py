@@ -26,9 +26,9 @@ from collections.abc import Collection
 
 import numpy as np
 
-from ..errors import DataError, IdentifiabilityWarning
-from ..models import FrictionModel, get_model
-from ..samples import FrictionSamples
+from ...errors import DataError, IdentifiabilityWarning
+from ...models import FrictionModel, get_model
+from ...samples import FrictionSamples
 
 __all__ = ["LEVEL_RTOL", "check_identifiable"]
 

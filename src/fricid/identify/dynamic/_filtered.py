@@ -1,4 +1,5 @@
-"""The ``filtered`` route of :mod:`fricid.identify.trajectory`: every LuGre parameter with J,
+"""The ``filtered`` route of :mod:`fricid.identify.dynamic.trajectory`: every LuGre parameter with
+J,
 p_x, p_y at once, by the equation error on all samples, both sides low-pass filtered alike.
 
 The equation of motion integrated over one sample period (the drive holds the torque
@@ -31,7 +32,7 @@ about 0.1 rad/s within a millisecond), which no interpolant of the samples knows
 sub-steps gave +4.5 % and -17 %, while the same experiment logged at 10 kHz put every
 parameter within 0.3 per mille (the method is consistent). Under the trajectory noise it is
 inside the intervals at the default 20 Hz cut-off, not at 40 or 60 Hz (module notes of
-:mod:`fricid.identify.trajectory`).
+:mod:`fricid.identify.dynamic.trajectory`).
 
 J, p_x and p_y enter linearly: they are projected out of every candidate's residual (variable
 projection, Golub and Pereyra 1973) and recovered by least squares; the optimiser searches
@@ -49,11 +50,11 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import ConfigError, DataError
-from ..models import lugre
-from ._trajectory_data import Series, blocks, cluster_covariance
-from ._trajectory_routes import JOINT_PARAMS, _run, _Stage, _t975
-from .uncertainty import jacobian
+from ...errors import ConfigError, DataError
+from ...models import lugre
+from ..static.uncertainty import jacobian
+from ._data import Series, blocks, cluster_covariance
+from ._routes import JOINT_PARAMS, _run, _Stage, _t975
 
 __all__ = ["ParallelFilter", "filtered_route"]
 

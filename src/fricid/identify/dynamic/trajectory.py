@@ -125,30 +125,26 @@ J. Business & Economic Statistics 3(4), 1985.
 from __future__ import annotations
 
 import time
-import warnings
 from typing import Any
 
 import numpy as np
 
-from .. import __version__
-from ..errors import ConfigError, DataError, FricidWarning
-from ..fitted import FittedModel
-from ..io.atomic import created_timestamp
-from ..metrics import fit_statistics, metrics
-from ..models import get_model, lugre
-from ..samples import RawLog
-from ._trajectory_data import DerivativeFilter, derivatives, dilate, uniform_series
-from ._trajectory_filtered import ParallelFilter, filtered_route
-from ._trajectory_rate import rate_bias as _rate_bias
-from ._trajectory_routes import (
-    JOINT_PARAMS,
-    _refine_static,
-    _regression,
-    _sim_bounds,
-    _SimProblem,
-    _simulation,
-    _windows,
+from ...errors import ConfigError, DataError
+from ...fitted import FittedModel
+from ...models import get_model, lugre
+from ...samples import RawLog
+from ._data import DerivativeFilter, derivatives, dilate, uniform_series
+from ._filtered import ParallelFilter, filtered_route
+from ._outcome import (
+    RATE_BIAS,
+    PassivityWarning,
+    RateBiasWarning,
+    warn_rate_bias,
 )
+from ._rate import rate_bias as _rate_bias
+from ._result import build_result
+from ._routes import JOINT_PARAMS, _regression
+from ._simroute import simulation_route
 
 __all__ = [
     "ROUTES",
@@ -173,92 +169,6 @@ _STATIC_OF_LUGRE = {
     "tau_v": "sigma_2",
     "delta": "delta",
 }
-
-#: Seconds a simulation window opens before a low-speed stretch and closes after it.
-WINDOW_BEFORE = 0.02
-WINDOW_AFTER = 0.06
-
-#: Seconds of one simulated segment: each starts again from the measured motion (multiple
-#: shooting). Open-loop, a joint near break-away is so sensitive to the torque that a
-#: simulation over a whole window can stay stuck where the joint broke away (or the reverse)
-#: and never recover; the bristle dynamics play out within a few milliseconds, well inside a
-#: segment.
-SEGMENT = 0.025
-
-#: Passes of the refinement (static part with LuGre's friction along the motion, then
-#: sigma_0 and sigma_1 again) after the two-stage estimate; 0 for the plain two-stage route.
-REFINE = 1
-
-
-class PassivityWarning(FricidWarning):
-    """An identified dynamic friction model is not passive (it could create energy)."""
-
-
-class RateBiasWarning(FricidWarning):
-    """The log's rate biases sigma_0 or sigma_1 by a sizeable part of their intervals."""
-
-
-#: Rate-bias checks of the ``filtered`` route: ``warn`` estimates it and warns, ``off`` not.
-RATE_BIAS = ("warn", "off")
-
-#: Warn when the estimated rate bias exceeds this many standard errors (log10 scale).
-RATE_BIAS_WARN = 0.5
-
-
-def _warn_rate_bias(stage, rb: dict[str, Any]) -> None:
-    """One line when the rate bias of sigma_0 or sigma_1 is a sizeable part of its interval."""
-    parts = []
-    if "skipped" in rb:
-        return
-    for i, n in enumerate(("sigma_0", "sigma_1")):
-        se_log = stage.stderr[i] / (stage.values[i] * np.log(10.0))
-        if abs(rb[n]["log10_bias"]) > RATE_BIAS_WARN * se_log:
-            parts.append(f"{n} {100 * rb[n]['relative']:+.2g} %")
-    if parts:
-        warnings.warn(
-            f"logging at {rb['log_rate']:.6g} Hz biases {', '.join(parts)}, as estimated by "
-            "simulation at the estimate (the break-away between samples; over half a "
-            "standard error; corrected values in the provenance): log at "
-            f"{10 * rb['log_rate']:.6g} Hz or faster to remove it",
-            RateBiasWarning,
-            stacklevel=3,
-        )
-
-
-def _passivity(names: list[str], values, low, high) -> dict[str, Any]:
-    """[BO00] margin at the estimate and at the least favourable corner of the intervals."""
-    p = dict(zip(names, values, strict=True))
-    worst = dict(p)
-    lo, hi = dict(zip(names, low, strict=True)), dict(zip(names, high, strict=True))
-    for n, side in (("sigma_1", hi), ("sigma_2", lo), ("tau_c", lo), ("tau_s", hi)):
-        if np.isfinite(side[n]):
-            worst[n] = side[n]
-    at = float(lugre.passivity_margin(np.array([p[n] for n in lugre.PARAM_NAMES])))
-    corner = float(lugre.passivity_margin(np.array([worst[n] for n in lugre.PARAM_NAMES])))
-    return {
-        "condition": "sigma_1 <= 4 sigma_2 tau_c / (tau_s - tau_c) (Barabanov and Ortega 2000)",
-        "margin": at if np.isfinite(at) else None,
-        "passive": bool(at >= 0),
-        "margin_worst_in_ci95": corner if np.isfinite(corner) else None,
-        "passive_across_ci95": bool(corner >= 0),
-    }
-
-
-def _converged(results: list, method: str, max_evals) -> dict[str, Any]:
-    ok = all(bool(r.success) for r in results)
-    last = results[-1]
-    out = {
-        "converged": ok,
-        "status": int(last.status),
-        "message": str(last.message),
-        "nfev": int(sum(r.nfev for r in results)),
-        "max_evals": int(max_evals) if max_evals is not None else int(last.nfev),
-        "certified_by": "optimizer",
-    }
-    if not ok:
-        out["reason"] = "a stage of the trajectory identification stopped before converging"
-        out["advice"] = f"raise --max-evals, or use --method lm (ran '{method}')"
-    return out
 
 
 def fit_trajectory(
@@ -449,205 +359,56 @@ def fit_trajectory(
                 series, stage, stage1.bounds[order], gravity, method, seed, n_sub, parallel
             )
             sim_info["rate_bias"] = rb
-            _warn_rate_bias(stage, rb)
+            warn_rate_bias(stage, rb)
     elif key == "lugre":
-        base = np.array(
-            [1e4, 1.0]
-            + [static_tab[n]["value"] for n in lugre.PARAM_NAMES[2:]]
-            + [joint_vals["inertia"], joint_vals["p_x"], joint_vals["p_y"]]
-        )
-        w_s = static_tab["w_s"]["value"]
-        v_win = v_window if v_window is not None else max(w_s, 2.0 * v_slide)
-        w = _windows(
+        sim_info, static_tab = simulation_route(
             series,
             vf,
             acc,
-            v_win,
-            int(WINDOW_BEFORE * rate),
-            int(WINDOW_AFTER * rate),
-            max(int(SEGMENT * rate), 4),
-        )
-        problem = _SimProblem(w, base, ["sigma_0", "sigma_1"], n_sub)
-        held = [rename.get(n, n) for n in stage1.names] if static is None else list(stage1.names)
-        b2 = _sim_bounds(problem, stage1, rename)
-        problem.set_scale(problem.full(b2.mean(axis=1)))
-        stage2 = _simulation(
-            problem, b2, b2.mean(axis=1), method, seed, max_evals, first=(stage1, held)
-        )
-        results.append(stage2.result)
-        for k in range(REFINE if static is None else 0):
-            # the static part again with LuGre's friction along the motion, then sigma_0,
-            # sigma_1 again from there (module notes: "Refinement")
-            ref = _refine_static(
-                series,
-                vf,
-                acc,
-                mask,
-                stage2,
-                stage1,
-                gravity,
-                method,
-                seed,
-                max_evals,
-                cluster_n,
-            )
-            stages[f"refinement_{k + 1}"] = ref
-            results.append(ref.result)
-            static_tab = {rename.get(n, n): row for n, row in ref.table().items()}
-            final.update(static_tab)
-            joint_vals.update({n: static_tab[n]["value"] for n in JOINT_PARAMS if n in static_tab})
-            problem.base = np.array(
-                [*stage2.values]
-                + [static_tab[n]["value"] for n in lugre.PARAM_NAMES[2:]]
-                + [joint_vals["inertia"], joint_vals["p_x"], joint_vals["p_y"]]
-            )
-            held = [rename.get(n, n) for n in ref.names]
-            stage2 = _simulation(
-                problem,
-                b2,
-                problem.to_u(stage2.values),
-                method,
-                seed,
-                max_evals,
-                first=(ref, held),
-            )
-            results.append(stage2.result)
-        stages["simulation"] = stage2
-        for n, row in stage2.table().items():
-            final[n] = row
-        bounds_out.update({n: list(b) for n, b in zip(stage2.names, stage2.bounds, strict=True)})
-        if route == "joint":
-            base = problem.full(problem.to_u(stage2.values))[0]
-            names = list(lugre.PARAM_NAMES) + list(JOINT_PARAMS[: 1 if gravity == "none" else 3])
-            problem3 = _SimProblem(w, base, names, n_sub)
-            problem3.scale = problem.scale
-            tab = {**static_tab, **{n: {"value": v} for n, v in joint_vals.items()}}
-            b3 = []
-            for n in names:
-                if n in ("sigma_0", "sigma_1"):
-                    b3.append(b2[["sigma_0", "sigma_1"].index(n)])
-                elif n in bounds_out:
-                    b3.append(bounds_out[n])
-                else:
-                    b3.append(_sim_bounds(problem3, stage1, rename)[names.index(n)])
-            b3 = np.array(b3, dtype=float)
-            x3 = np.clip(
-                problem3.to_u(base[[problem3.all_names.index(n) for n in names]]),
-                b3[:, 0],
-                b3[:, 1],
-            )
-            stage3 = _simulation(problem3, b3, x3, method, seed, max_evals)
-            stages["simulation_joint"] = stage3
-            results.append(stage3.result)
-            del tab
-            for n, row in stage3.table().items():
-                final[n] = row
-        sim_info = {
-            "windows": w.count,
-            "window_samples": int(w.index.size),
-            "v_window": float(v_win),
-            "n_sub": int(n_sub),
-        }
-    param_names = list(lugre.PARAM_NAMES) if key == "lugre" else list(static_model.param_names)
-    values = np.array([final[n]["value"] for n in param_names])
-    se = np.array([final[n]["stderr"] for n in param_names])
-    low = np.array([final[n]["ci95_low"] for n in param_names])
-    high = np.array([final[n]["ci95_high"] for n in param_names])
-    fitted = FittedModel(
-        model=key,
-        params=dict(zip(param_names, map(float, values), strict=True)),
-        units=dict(get_model(key).units),
-        stderr=dict(zip(param_names, se, strict=True)),
-        ci95={n: float((h - lo) / 2) for n, lo, h in zip(param_names, low, high, strict=True)},
-        ci95_low=dict(zip(param_names, low, strict=True)),
-        ci95_high=dict(zip(param_names, high, strict=True)),
-        ci_method="cluster-robust"
-        + (", two-step" if key == "lugre" and route != "filtered" else ""),
-        metrics={
-            **metrics(y, yhat),
-            **{
-                f"sim_rmse_{k}": v
-                for k, v in stages.get("simulation", stage1).rms.items()
-                if k != "torque"
+            mask,
+            {
+                "stage1": stage1,
+                "static": static,
+                "rename": rename,
+                "static_tab": static_tab,
+                "joint_vals": joint_vals,
+                "stages": stages,
+                "results": results,
+                "final": final,
+                "bounds_out": bounds_out,
+                "method": method,
+                "seed": seed,
+                "max_evals": max_evals,
+                "n_sub": n_sub,
+                "gravity": gravity,
+                "route": route,
+                "v_slide": v_slide,
+                "v_window": v_window,
+                "cluster_n": cluster_n,
             },
+        )
+    return build_result(
+        key,
+        route,
+        log,
+        series,
+        vf,
+        y,
+        yhat,
+        n_joint=len(c),
+        stages=stages,
+        results=results,
+        final=final,
+        bounds_out=bounds_out,
+        options={
+            "method": method,
+            "seed": seed,
+            "max_evals": max_evals,
+            "static": static,
+            "derivative": derivative,
+            "v_slide": v_slide,
+            "gravity": gravity,
+            "t_start": t_start,
         },
-        statistics=fit_statistics(y, yhat, len(param_names) + len(c)),
-        method=method,
-        seed=seed,
-        nfev=int(sum(r.nfev for r in results)),
-        bounds={n: b for n, b in bounds_out.items() if n in param_names},
-        operating_range={
-            "velocity": [float(vf.min()), float(vf.max())],
-            "temperature": [float(series.temperature.min()), float(series.temperature.max())],
-        },
-        convergence=_converged(results, method, max_evals) if results else None,
-        status=int(results[-1].status) if results else None,
-        message=str(results[-1].message) if results else "",
+        sim_info=sim_info,
     )
-    fitted.at_bound = [
-        n
-        for n in param_names
-        if n in fitted.bounds
-        and (
-            np.isclose(final[n]["value"], fitted.bounds[n][0], rtol=1e-6, atol=0)
-            or np.isclose(final[n]["value"], fitted.bounds[n][1], rtol=1e-6, atol=0)
-        )
-    ]
-    fitted.ci_open = {
-        n: [bool(lo <= fitted.bounds[n][0]), bool(h >= fitted.bounds[n][1])]
-        for n, lo, h in zip(param_names, low, high, strict=True)
-        if n in fitted.bounds
-    }
-    last_regression = [st for name, st in stages.items() if name.startswith("refinement")]
-    joint_tab = {
-        n: row for n, row in (last_regression or [stage1])[-1].table().items() if n in JOINT_PARAMS
-    }
-    if "filtered" in stages:
-        joint_tab = {n: r for n, r in stages["filtered"].table().items() if n in JOINT_PARAMS}
-    if "simulation_joint" in stages:
-        joint_tab.update(
-            {n: r for n, r in stages["simulation_joint"].table().items() if n in JOINT_PARAMS}
-        )
-    info: dict[str, Any] = {
-        "route": route,
-        "static_from": "sweeps"
-        if static is not None
-        else ("the same joint estimate" if route == "filtered" else "regression"),
-        "derivative": derivative.describe(rate),
-        "resampled": series.resampled,
-        "sample_rate": rate,
-        "v_slide": v_slide,
-        "gravity": gravity,
-        "joint": joint_tab,
-        "routes": {
-            name: {
-                "parameters": st.table(),
-                "rms": st.rms,
-                "seconds": st.seconds,
-                "clusters": st.clusters,
-                "nfev": int(st.result.nfev) if st.result is not None else 0,
-                "converged": bool(st.result.success) if st.result is not None else None,
-            }
-            for name, st in stages.items()
-        },
-        "seconds": time.perf_counter() - t_start,
-        **sim_info,
-    }
-    if key == "lugre":
-        info["passivity"] = _passivity(param_names, values, low, high)
-        if not info["passivity"]["passive"]:
-            warnings.warn(
-                f"the identified LuGre model is not passive (margin "
-                f"{info['passivity']['margin']:.3g} N m s/rad): {info['passivity']['condition']}",
-                PassivityWarning,
-                stacklevel=2,
-            )
-    fitted.provenance = {
-        "source": log.source,
-        "n_samples": int(series.time.size),
-        "directions": [-1, 1],
-        "fricid_version": __version__,
-        "created": created_timestamp(),
-        "trajectory": info,
-    }
-    return fitted

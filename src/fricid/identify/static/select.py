@@ -22,25 +22,23 @@ The rules (issue 11, "Validation built in"):
   held-out RMSE is within :data:`PREFER_SIMPLER` (5 %) of the best, or within the noise
   (:data:`fricid.metrics.NOISE_RATIO` times the measurement scatter).
 
-:func:`fit` is :func:`fricid.identify._learned.fit` with ``model="auto"`` routed here (it is
-``fricid.identify.fit``).
+``fricid.identify.fit(samples, "auto")`` calls :func:`select`.
 """
 
 from __future__ import annotations
 
-import functools
 from typing import Any
 
 import numpy as np
 
-from ..errors import ConfigError
-from ..fitted import FittedModel
-from ..metrics import NOISE_RATIO
-from ..samples import FrictionSamples
-from . import _fit, _learned
-from ._candidates import FAMILIES, LEARNED, PREFER_SIMPLER, Candidate, candidates
-from ._scatter import Scatter, measurement_scatter
-from .validate import validate
+from ...errors import ConfigError
+from ...fitted import FittedModel
+from ...metrics import NOISE_RATIO
+from ...samples import FrictionSamples
+from .._named import fit_named
+from .._scatter import Scatter, measurement_scatter
+from ..validate import validate
+from .candidates import FAMILIES, LEARNED, PREFER_SIMPLER, Candidate, candidates
 
 __all__ = [
     "FAMILIES",
@@ -48,7 +46,6 @@ __all__ = [
     "PREFER_SIMPLER",
     "Candidate",
     "candidates",
-    "fit",
     "select",
 ]
 
@@ -117,7 +114,14 @@ def select(
             table.append({**row, "heldout_rmse": None, "ratio": None, "note": c.note})
             continue
         v = validate(
-            samples, c.model, scheme, method, scatter=sc, seed=seed, fixed=c.fixed, **fit_options
+            samples,
+            c.model,
+            scheme,
+            _method(c.model, method),
+            scatter=sc,
+            seed=seed,
+            fixed=c.fixed,
+            **_options(c.model, fit_options),
         )
         runs[c.label] = v
         ok = np.isfinite(v.rmse) and v.failed == 0
@@ -142,8 +146,13 @@ def select(
     chosen = min(ok, key=lambda r: (r["n_params"], "_asym" in r["model"]))
     reason = _reason(chosen, best, sc, scheme, noise)
     pick = found[chosen["model"]]
-    fitted = _learned.fit(
-        samples, pick.model, method, seed=seed, fixed=pick.fixed or None, **fit_options
+    fitted = fit_named(
+        samples,
+        pick.model,
+        _method(pick.model, method),
+        seed=seed,
+        fixed=pick.fixed or None,
+        **_options(pick.model, fit_options),
     )
     fitted.selection = {
         "scheme": scheme,
@@ -170,25 +179,13 @@ def _reason(
     return f"{head}, {why} ({best['model']}, {best['heldout_rmse']:.3g} N m), and simpler"
 
 
-@functools.wraps(_fit.fit)
-def fit(samples: FrictionSamples, model: Any, method: str = "lm", **kwargs: Any) -> FittedModel:
-    if isinstance(model, str) and model.strip().lower() == "auto":
-        opts = {k: v for k, v in kwargs.items() if k not in ("network", "inputs", "callback")}
-        if len(opts) != len(kwargs):
-            raise ConfigError(
-                "model 'auto' tries analytic families: no network, inputs or callback"
-            )
-        return select(samples, method, **opts)
-    return _learned.fit(samples, model, method, **kwargs)
+def _method(model: str, method: str) -> str | None:
+    """The analytic candidates' optimiser; a learned candidate trains with its own default."""
+    return None if model in LEARNED else method
 
 
-fit.__doc__ = (
-    (_fit.fit.__doc__ or "")
-    + """
-    Notes
-    -----
-    ``model="auto"`` selects among the analytic families by held-out error
-    (:func:`fricid.identify.select.select`; the comparison is saved as
-    ``FittedModel.selection``).
-    """
-)
+def _options(model: str, fit_options: dict[str, Any]) -> dict[str, Any]:
+    """What a candidate's fit takes: a learned one neither optimiser options nor intervals."""
+    if model not in LEARNED:
+        return fit_options
+    return {k: v for k, v in fit_options.items() if k not in ("options", "intervals", "f_scale")}

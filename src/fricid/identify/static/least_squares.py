@@ -3,11 +3,11 @@
 ``fit`` states the problem (:class:`~fricid.identify.problem.IdentificationProblem`: the sum of
 squared errors between the model and the measured friction, the RWSAVSBAS paper's objective,
 eq. 11 there), minimises it with any method of :mod:`fricid.optim`, certifies convergence by a
-short local polish (:mod:`fricid.identify._convergence`), then gives the parameters'
+short local polish (:mod:`fricid.identify.static.convergence`), then gives the parameters'
 uncertainty only where it means something: standard errors from the Jacobian and
-profile-likelihood intervals inside the search box (:mod:`fricid.identify.uncertainty`,
-:mod:`fricid.identify.profile`). The RBF network (``model="rbf"``) is trained by
-:func:`fricid.identify.rbf.fit_rbf`.
+profile-likelihood intervals inside the search box (:mod:`fricid.identify.static.uncertainty`,
+:mod:`fricid.identify.static.profile`). The RBF network (``model="rbf"``) is trained by
+:func:`fricid.identify.learned.rbf.fit_rbf`.
 """
 
 from __future__ import annotations
@@ -18,17 +18,22 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import ConfigError, ConvergenceWarning, IdentifiabilityWarning, IgnoredArgumentWarning
-from ..fitted import FittedModel
-from ..metrics import fit_statistics, metrics
-from ..models import INPUTS, FrictionModel, get_model
-from ..optim import METHODS, OptimizeResult, minimize
-from ..samples import FrictionSamples
-from ._convergence import certify
-from ._records import operating_range, provenance
-from ._scatter import measurement_scatter, sample_weights
+from ...errors import (
+    ConfigError,
+    ConvergenceWarning,
+    IdentifiabilityWarning,
+    IgnoredArgumentWarning,
+)
+from ...fitted import FittedModel
+from ...metrics import fit_statistics, metrics
+from ...models import INPUTS, FrictionModel, get_model
+from ...optim import METHODS, OptimizeResult, minimize
+from ...samples import FrictionSamples
+from .._records import operating_range, provenance
+from .._scatter import measurement_scatter, sample_weights
+from ..problem import ROBUST_LOSSES, IdentificationProblem
 from .checks import check_identifiable
-from .problem import ROBUST_LOSSES, IdentificationProblem
+from .convergence import certify
 from .uncertainty import INTERVALS, assess
 from .varpro import varpro
 
@@ -63,16 +68,17 @@ def fit(
     model : str or FrictionModel
         A model name (``fricid.models.MODELS``, ``*_asym`` for per-direction), an instance,
         ``*_temp`` / ``*_temp_asym`` with an Arrhenius viscous term, ``"rbf"`` for the RBF
-        network (:mod:`fricid.identify.rbf`), ``"hybrid"`` for an analytic backbone plus an RBF
-        residual (:mod:`fricid.identify.hybrid`; ``network`` may name its ``backbone``) or
-        ``"gp"`` for the Gaussian process (:mod:`fricid.identify.gp`; its options, e.g.
+        network (:mod:`fricid.identify.learned.rbf`), ``"hybrid"`` for an analytic backbone plus an
+        RBF
+        residual (:mod:`fricid.identify.learned.hybrid`; ``network`` may name its ``backbone``) or
+        ``"gp"`` for the Gaussian process (:mod:`fricid.identify.learned.gp`; its options, e.g.
         ``max_points``, through ``options``).
     method : str, default "lm"
         Any method of ``fricid.optim.METHODS`` (``"lm"``: the default least-squares method,
         scipy's bounded trust-region reflective solver, a Levenberg-Marquardt-type method, with
         multi-start; :mod:`fricid.optim._least_squares`), or ``"varpro"``: the exact
         least-squares optimum by variable projection for models that declare
-        ``linear_params`` (:mod:`fricid.identify.varpro`). For ``"rbf"``: ``"lsq"`` (k-means,
+        ``linear_params`` (:mod:`fricid.identify.static.varpro`). For ``"rbf"``: ``"lsq"`` (k-means,
         widths, ridge least squares) or an optimiser trainer (``"bas"`` for BAS-RBFNN,
         ``"ga"`` for GA-RBFNN, ...); the default ``"lm"`` means ``"lsq"`` there.
     fixed : mapping of str to float, optional
@@ -92,14 +98,15 @@ def fit(
     callback : callable, optional
         Passed to ``fricid.optim.minimize`` (analytic models only).
     network : mapping, optional
-        ``"rbf"`` only: parameters of :class:`~fricid.identify.rbf.RBFNetRegressor`
+        ``"rbf"`` only: parameters of :class:`~fricid.identify.learned.rbf.RBFNetRegressor`
         (``n_centers``, ``velocity_scale``, ``encoding``, ...).
     inputs : sequence of str, default ("velocity", "load", "temperature")
         ``"rbf"`` only: the network's input columns.
     intervals : {"auto", "profile", "jacobian", "none"}, default "auto"
         95 % intervals of the parameters: profile likelihood inside the search box
-        (:mod:`fricid.identify.profile`; ``"auto"`` uses it for at most
-        :data:`~fricid.identify.uncertainty.PROFILE_AUTO_MAX` free parameters), the Jacobian's
+        (:mod:`fricid.identify.static.profile`; ``"auto"`` uses it for at most
+        :data:`~fricid.identify.static.uncertainty.PROFILE_AUTO_MAX` free parameters), the
+        Jacobian's
         ``value +/- t se`` cut at the box, or none. A fit that did not converge, or whose
         optimum is degenerate (rank-deficient Jacobian), gets none whatever is asked.
     loss : {"l2", "soft_l1", "huber"}, default "l2"
@@ -117,7 +124,7 @@ def fit(
     FittedModel
         With ``status`` and ``message`` from the optimiser, the ``convergence`` block (the
         optimiser's status and a local polish's verdict,
-        :func:`~fricid.identify._convergence.certify`),
+        :func:`~fricid.identify.static.convergence.certify`),
         fit statistics, standard errors (SVD pseudo-inverse), 95 % intervals
         (``ci95_low``, ``ci95_high``, ``ci_open``, ``ci_method``), the reason where a parameter
         has none (``uncertainty_note``) and correlations.
@@ -136,7 +143,7 @@ def fit(
     IdentifiabilityWarning
         The data do not determine some parameter: too few velocity levels, no load or
         temperature variation for a model that uses them (checked before fitting,
-        :func:`~fricid.identify.checks.check_identifiable`); a rank-deficient Jacobian at the
+        :func:`~fricid.identify.static.checks.check_identifiable`); a rank-deficient Jacobian at the
         optimum (which combination is free); or an interval that reaches a bound of the
         search box other than 0 (which bound, and its strongest correlation).
     IgnoredArgumentWarning

@@ -16,7 +16,7 @@ data cannot see shows a singular value of that size rather than one below scipy'
 :func:`assess` is what ``fit`` reports (issue 11, defects 5 and 7): no interval at all for a
 fit that did not converge or for a degenerate optimum (a rank-deficient Jacobian: the
 linearised intervals there, such as ``Coulomb 2e-10 +- 210 N m``, mean nothing); otherwise
-profile-likelihood intervals inside the search box (:mod:`fricid.identify.profile`) for up
+profile-likelihood intervals inside the search box (:mod:`fricid.identify.static.profile`) for up
 to :data:`PROFILE_AUTO_MAX` free parameters (or when asked), else the Jacobian's Wald
 intervals cut at the box with the cut sides flagged; each side that reaches a bound other than
 zero is named in an :class:`~fricid.errors.IdentifiabilityWarning`, with the parameter's

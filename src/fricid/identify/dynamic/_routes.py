@@ -1,4 +1,4 @@
-"""The two routes of :mod:`fricid.identify.trajectory`: inverse-dynamics regression and
+"""The two routes of :mod:`fricid.identify.dynamic.trajectory`: inverse-dynamics regression and
 simulation error (see that module's notes), each returning a :class:`_Stage` (estimate,
 cluster-robust covariance, 95 % intervals, the optimiser's result, timing)."""
 
@@ -10,11 +10,11 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import ConfigError, DataError
-from ..models import lugre
-from ..optim import METHODS, minimize
-from ._trajectory_data import Series, blocks, cluster_covariance, low_speed_windows
-from .uncertainty import jacobian
+from ...errors import ConfigError, DataError
+from ...models import lugre
+from ...optim import METHODS, minimize
+from ..static.uncertainty import jacobian
+from ._data import Series, blocks, cluster_covariance, low_speed_windows
 
 __all__ = ["JOINT_PARAMS", "LSQ_STARTS"]
 

@@ -1,7 +1,8 @@
 """Identification of the hybrid model (issue 15): an analytic backbone identified first, then an
 RBF network trained on what it leaves, ``fit(samples, "hybrid")``.
 
-1. **Backbone.** Each analytic family the data support (:func:`fricid.identify.select.candidates`:
+1. **Backbone.** Each analytic family the data support
+(:func:`fricid.identify.static.select.candidates`:
    Stribeck, MSK, VLT, ..., their ``_asym`` variants for samples of both directions) and,
    when the temperature varies, the temperature variant of each one with a viscous term
    (:func:`backbone_candidates`: ``coulomb_viscous_temp``, ``stribeck_temp``, ``msk_temp``,
@@ -23,11 +24,11 @@ RBF network trained on what it leaves, ``fit(samples, "hybrid")``.
    (``python benchmarks/bench_floor.py``, 2026-11-23 01:18 UTC: 1.08 / 1.01 / 0.99 x noise on
    the grid, Arrhenius and sigmoid kinds; trained in 0.55 / 0.07 / 0.09 s against fricid's
    ``gp`` 2.27 / 0.11 / 1.12 s and scikit-learn's exact GP 22.9 / 0.045 / 0.94 s).
-2. **Residual.** The RBF network (:func:`fricid.identify.rbf.fit_rbf`) is trained on
+2. **Residual.** The RBF network (:func:`fricid.identify.learned.rbf.fit_rbf`) is trained on
    ``F - F_backbone`` with its sign of motion, *without* bias or linear tail, so it vanishes
    far from its centres and the model returns to the backbone outside the data; its size,
    widths and penalty are chosen by cross-validation over random folds, the penalty by the
-   one-standard-error rule (:func:`fricid.identify._rbf_folds.choose_penalty`), and its
+   one-standard-error rule (:func:`fricid.identify.learned._rbf_folds.choose_penalty`), and its
    trainer is least squares (``lsq``), BAS or GA as the BAS-RBFNN paper's (``method=``).
    The grid kind's bad tails under random folds with the best-scoring penalty (tuning seeds
    0-49: 6 seeds at 2.3-4.3x the noise) had one cause, the penalty: every seed took the same
@@ -37,7 +38,8 @@ RBF network trained on what it leaves, ``fit(samples, "hybrid")``.
    1e-8: 1.370 / 1.119 / 2.327 / 4.294 -> 1.110 / 1.106 / 1.152 / 1.172 (mean / median / p90 /
    max; ``python benchmarks/bench_learned_tuning.py --random-folds-only``). Folds of whole
    speed levels (the plain ``rbf``'s) were tried for the residual too and are not its default:
-   against the truth they did worse (:mod:`fricid.identify._rbf_folds` notes: grid 1.194 mean;
+   against the truth they did worse (:mod:`fricid.identify.learned._rbf_folds` notes: grid 1.194
+   mean;
    the demo's design, between the measured speeds, 5.35 against 4.25 mN m on seed 0); they
    remain an option, ``network={"level_folds": True}``.
 
@@ -54,13 +56,13 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import ConfigError
-from ..fitted import FittedModel
-from ..metrics import fit_statistics
-from ..models import INPUTS, get_model
-from ..models.hybrid import STATE_KIND
-from ..models.rbf import STATE_VERSION
-from ..samples import FrictionSamples
+from ...errors import ConfigError
+from ...fitted import FittedModel
+from ...metrics import fit_statistics
+from ...models import INPUTS, get_model
+from ...models.hybrid import STATE_KIND
+from ...models.rbf import STATE_VERSION
+from ...samples import FrictionSamples
 
 __all__ = ["TEMPERATURE_FAMILIES", "backbone_candidates", "fit_backbone", "fit_hybrid"]
 
@@ -74,11 +76,11 @@ TEMPERATURE_MIN_LEVELS = 3
 
 def backbone_candidates(samples: FrictionSamples) -> list[tuple[str, dict[str, float]]]:
     """The backbones :func:`fit_backbone` tries: ``(name, fixed)`` of every analytic
-    candidate the data support (:func:`fricid.identify.select.candidates`), each followed,
+    candidate the data support (:func:`fricid.identify.static.select.candidates`), each followed,
     when the samples have at least :data:`TEMPERATURE_MIN_LEVELS` distinct temperatures, by
     its temperature variant if its family is in :data:`TEMPERATURE_FAMILIES`
     (``stribeck_asym`` -> ``stribeck_temp_asym``, the same parameters fixed)."""
-    from ._candidates import LEARNED, candidates
+    from ..static.candidates import LEARNED, candidates
 
     temps = samples.temperature[np.isfinite(samples.temperature)]
     with_temp = np.unique(np.round(temps * 2.0)).size >= TEMPERATURE_MIN_LEVELS
@@ -124,11 +126,11 @@ def _lean_fit(
         The family cannot be fitted to these samples (too few of them, wrong directions).
     DataError
         The samples cannot determine its parameters
-        (:func:`~fricid.identify.checks.check_identifiable`, as :func:`fricid.identify.fit`).
+        (:func:`~fricid.identify.static.checks.check_identifiable`, as :func:`fricid.identify.fit`).
     """
-    from ..optim import minimize
-    from .checks import check_identifiable
-    from .problem import IdentificationProblem
+    from ...optim import minimize
+    from ..problem import IdentificationProblem
+    from ..static.checks import check_identifiable
 
     model = get_model(name)
     problem = IdentificationProblem(model, samples, fixed=fixed or None)
@@ -207,7 +209,7 @@ def fit_backbone(
     list
         The warnings of the chosen backbone's fit.
     """
-    from . import _fit
+    from ..static import least_squares as _fit
 
     if backbone is not None:
         names = [(str(backbone).strip().lower(), {})]
@@ -278,7 +280,7 @@ def fit_hybrid(
     backbone : str, optional
         The backbone's registry name (e.g. ``"stribeck_asym"``); default chosen by BIC.
     **network
-        :class:`~fricid.identify.rbf.RBFNetRegressor` parameters of the residual network
+        :class:`~fricid.identify.learned.rbf.RBFNetRegressor` parameters of the residual network
         (``trainer="bas"`` or ``"ga"`` for the paper's trainers); ``linear_tail`` and
         ``fit_bias`` are off (the residual returns to zero outside the data).
 
@@ -334,7 +336,7 @@ def fit_hybrid(
             }
         )
     y_hat = samples.friction - resid + res.predict(samples.X, warn=False)
-    from ._learned_trust import hybrid_records
+    from ._trust import hybrid_records
 
     records = hybrid_records(samples, base, res, y_hat)
     return FittedModel(
@@ -347,6 +349,6 @@ def fit_hybrid(
         status=res.status,
         message=res.message,
         operating_range=res.operating_range,
-        provenance={**res.provenance, "estimator": "fricid.identify.hybrid.fit_hybrid"},
+        provenance={**res.provenance, "estimator": "fricid.identify.learned.hybrid.fit_hybrid"},
         state=state,
     )

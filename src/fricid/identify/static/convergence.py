@@ -16,8 +16,8 @@ from typing import Any
 
 import numpy as np
 
-from ..optim import OptimizeResult, minimize
-from .problem import IdentificationProblem
+from ...optim import OptimizeResult, minimize
+from ..problem import IdentificationProblem
 
 __all__ = ["POLISH_EVALS_PER_PARAM", "POLISH_RTOL", "advice", "certify"]
 

@@ -1,4 +1,4 @@
-"""Helpers of :mod:`fricid.identify.trajectory`: a log on a uniform grid, zero-phase
+"""Helpers of :mod:`fricid.identify.dynamic.trajectory`: a log on a uniform grid, zero-phase
 derivatives, the low-speed windows of the simulation-error route, and cluster-robust
 covariances.
 
@@ -46,9 +46,9 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import ConfigError, DataError
-from ..samples import RawLog
-from .uncertainty import covariance_svd
+from ...errors import ConfigError, DataError
+from ...samples import RawLog
+from ..static.uncertainty import covariance_svd
 
 __all__ = [
     "FILTERS",

@@ -12,7 +12,7 @@ It is trained by one of
   method of :data:`fricid.optim.METHODS`: the network's parameters are searched by
   :func:`fricid.optim.minimize`, minimising the training mean squared error (eq. 16-17, an
   :class:`~fricid.identify.problem.IdentificationProblem` with loss ``mse``), until a target
-  MSE or the epoch budget (:mod:`fricid.identify._rbf_search`). Two encodings of the search
+  MSE or the epoch budget (:mod:`fricid.identify.learned._rbf_search`). Two encodings of the search
   vector:
 
   - ``"full"``: centres, widths *and* output weights (and bias) are all searched, as the
@@ -34,7 +34,7 @@ one network per direction for samples of both directions, and one for a single d
 regressor on the ``X`` it is given, so the paper's study (``v > 0`` data) is unchanged.
 
 The model file records what can be trusted (:func:`trust_records`,
-:mod:`fricid.identify._learned_trust`): convergence (``lsq`` exact in closed form; an optimiser
+:mod:`fricid.identify.learned._trust`): convergence (``lsq`` exact in closed form; an optimiser
 trainer met its target or spent its budget), the effective degrees of freedom (the trace of
 the ridge hat matrix, ESL eq. 3.50) behind the fit statistics, and the structure search's
 cross-validation error as the ``validation``, labelled with what it tests.
@@ -86,11 +86,11 @@ from typing import Any
 import numpy as np
 from sklearn.utils.validation import check_is_fitted
 
-from ..errors import ConfigError
-from ..fitted import FittedModel
-from ..metrics import metrics
-from ..models import INPUTS
-from ..models.rbf import (
+from ...errors import ConfigError
+from ...fitted import FittedModel
+from ...metrics import metrics
+from ...models import INPUTS
+from ...models.rbf import (
     STATE_KIND,
     STATE_VERSION,
     check_inputs,
@@ -98,8 +98,12 @@ from ..models.rbf import (
     predict_state,
     tail_terms,
 )
-from ..samples import FrictionSamples
-from ._learned_trust import (
+from ...samples import FrictionSamples
+from .._records import operating_range, provenance
+from .._scatter import measurement_scatter
+from ._rbf_estimator import LSQ_IGNORES, TRAINERS, RBFNetRegressor
+from ._rbf_select import check_centres, choose_structure, drop_constant_inputs
+from ._trust import (
     cv_pieces,
     cv_validation,
     hat_trace,
@@ -107,10 +111,6 @@ from ._learned_trust import (
     network_convergence,
     side_states,
 )
-from ._rbf_estimator import LSQ_IGNORES, TRAINERS, RBFNetRegressor
-from ._rbf_select import check_centres, choose_structure, drop_constant_inputs
-from ._records import operating_range, provenance
-from ._scatter import measurement_scatter
 
 __all__ = [
     "LSQ_IGNORES",
@@ -168,7 +168,7 @@ def _n_numbers(est: RBFNetRegressor) -> int:
 def trust_records(
     ests: Sequence[RBFNetRegressor], state: dict[str, Any], samples: FrictionSamples
 ) -> tuple[dict[str, Any], float | None, str, dict[str, Any] | None]:
-    """What a network's file records about its trust (:mod:`fricid.identify._learned_trust`):
+    """What a network's file records about its trust (:mod:`fricid.identify.learned._trust`):
     the convergence block, the effective degrees of freedom (None where undefined) with how
     they were counted, and the validation record of the structure search's cross-validation
     (None when it did not validate the trained network: an optimiser trainer, or no CV)."""
@@ -289,7 +289,7 @@ def _model(
         operating_range=operating_range(samples),
         provenance=provenance(
             samples,
-            estimator="fricid.identify.rbf.RBFNetRegressor",
+            estimator="fricid.identify.learned.rbf.RBFNetRegressor",
             estimator_params={
                 k: v
                 for k, v in est.get_params().items()
@@ -431,8 +431,9 @@ def fit_rbf(
         smallest measured speed (``velocity_scale``), and the number of centres, width
         factor, velocity stretch and ridge penalty not given (or None) chosen by
         cross-validation of the ``lsq`` trainer over random folds and folds of whole interior
-        speed levels (:mod:`fricid.identify._rbf_folds`,
-        :func:`fricid.identify._rbf_select.choose_structure`; ``state["n_centers_selection"]``),
+        speed levels (:mod:`fricid.identify.learned._rbf_folds`,
+        :func:`fricid.identify.learned._rbf_select.choose_structure`;
+        ``state["n_centers_selection"]``),
         whose held-out residuals give conformal prediction intervals
         (``state["prediction_interval"]``). A given number of centres above half the samples
         warns (:class:`~fricid.errors.IdentifiabilityWarning`).

@@ -25,7 +25,7 @@ where the samples have both, ``g(|v|, load, T)`` with ``F = sign(v) g``:
    DTC), so prediction is a kernel sum over at most ``max_points`` stored points.
 
 The hyperparameters are not chosen by the cross-validation over whole speed levels that the
-RBF networks' structure search uses (:mod:`fricid.identify._rbf_folds`): scoring them by
+RBF networks' structure search uses (:mod:`fricid.identify.learned._rbf_folds`): scoring them by
 held-out levels would refit the GP per fold for each of the optimiser's dozens of candidate
 hyperparameters, where the marginal likelihood needs one factorisation each. A report's
 leave-one-velocity-out (:mod:`fricid.report._heldout`) refits them in every fold: holding them
@@ -38,7 +38,7 @@ predictive standard deviation travels with the model file (``FittedModel.predict
 return_std=True)``). The model file records the marginal-likelihood optimiser's own status
 and evaluations (``state["optimizer"]``, the ``convergence`` block) and the effective degrees
 of freedom, the trace of the posterior mean's smoother (``state["edf"]``; the fit statistics
-count them, :mod:`fricid.identify._learned_trust`).
+count them, :mod:`fricid.identify.learned._trust`).
 """
 
 from __future__ import annotations
@@ -55,15 +55,15 @@ from sklearn.gaussian_process import GaussianProcessRegressor
 from sklearn.gaussian_process.kernels import RBF, ConstantKernel, WhiteKernel
 from threadpoolctl import threadpool_limits
 
-from ..errors import ConfigError, DataError
-from ..fitted import FittedModel
-from ..metrics import metrics
-from ..models import INPUTS
-from ..models.gp import GP_KIND, predict_gp
-from ..samples import FrictionSamples
-from ._learned_trust import learned_statistics, process_convergence
-from ._records import operating_range, provenance
-from ._scatter import measurement_scatter
+from ...errors import ConfigError, DataError
+from ...fitted import FittedModel
+from ...metrics import metrics
+from ...models import INPUTS
+from ...models.gp import GP_KIND, predict_gp
+from ...samples import FrictionSamples
+from .._records import operating_range, provenance
+from .._scatter import measurement_scatter
+from ._trust import learned_statistics, process_convergence
 
 __all__ = ["DEFAULT_MAX_POINTS", "farthest_points", "fit_gp"]
 
@@ -413,7 +413,7 @@ def _fit(
         operating_range=operating_range(samples),
         provenance=provenance(
             samples,
-            estimator="fricid.identify.gp.fit_gp",
+            estimator="fricid.identify.learned.gp.fit_gp",
             estimator_params={
                 "inputs": names,
                 "max_points": max_points,

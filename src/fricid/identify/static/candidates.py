@@ -1,6 +1,7 @@
 """The models ``"auto"`` may fit (:func:`candidates`), each with the reason the data cannot
-support it: the list :func:`fricid.identify.select.select` validates and the hybrid's backbone
-search (:mod:`fricid.identify.hybrid`) fits, in a module below both."""
+support it: the list :func:`fricid.identify.static.select.select` validates and the hybrid's
+backbone
+search (:mod:`fricid.identify.learned.hybrid`) fits, in a module below both."""
 
 from __future__ import annotations
 
@@ -8,9 +9,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..models import get_model
-from ..samples import FrictionSamples
-from ._scatter import level_labels
+from ...models import get_model
+from ...samples import FrictionSamples
+from .._scatter import level_labels
 
 __all__ = ["FAMILIES", "LEARNED", "PREFER_SIMPLER", "Candidate", "candidates"]
 

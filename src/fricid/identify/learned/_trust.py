@@ -2,7 +2,7 @@
 number of parameters behind its fit statistics, and the held-out error of its chosen settings.
 
 The learned families (``rbf``, ``hybrid``, ``gp``) are not least-squares fits of named
-parameters, so the analytic path's records (:func:`fricid.identify._convergence.certify`, the
+parameters, so the analytic path's records (:func:`fricid.identify.static.convergence.certify`, the
 parameter count of :func:`fricid.metrics.fit_statistics`) do not apply as they are:
 
 - **Convergence.** The ``lsq`` trainer solves the output layer by ridge least squares in
@@ -27,7 +27,7 @@ parameter count of :func:`fricid.metrics.fit_statistics`) do not apply as they a
   out-of-fold error of the chosen settings: :func:`cv_validation` records it in the
   ``validation`` schema of :func:`fricid.identify.validate.validate` against the measurement
   scatter, with ``note`` saying what it tests. Its folds hold out whole interior speed levels
-  (scheme ``levels:K``, :func:`fricid.identify._rbf_folds.level_folds`), so it tests
+  (scheme ``levels:K``, :func:`fricid.identify.learned._rbf_folds.level_folds`), so it tests
   prediction between the measured speeds, not beyond them; with too few levels they are
   dealt at random (scheme ``kfold:K``), and it tests the measured set-points only. Either
   way the settings were chosen by it (optimistic). The report's verdict uses
@@ -42,9 +42,9 @@ from typing import Any
 
 import numpy as np
 
-from ..metrics import fitness, verdict
-from ..samples import FrictionSamples
-from ._scatter import measurement_scatter
+from ...metrics import fitness, verdict
+from ...samples import FrictionSamples
+from .._scatter import measurement_scatter
 
 __all__ = [
     "CV_SOURCE",
@@ -90,7 +90,7 @@ def hat_trace(est: Any, X: np.ndarray) -> float | None:
         optimiser trainer (the centres and widths were searched with the targets, so the
         fit is not a linear smoother).
     """
-    from ..models import _rbf_core as core
+    from ...models import _rbf_core as core
     from ._rbf_estimator import _linear_columns
 
     if str(est.trainer).strip().lower() != "lsq":
@@ -342,8 +342,9 @@ def hybrid_records(
     samples : FrictionSamples
         The training samples.
     base, res : FittedModel
-        The backbone's fit (:func:`fricid.identify._fit.fit`) and the residual network's
-        (:func:`fricid.identify.rbf.fit_rbf`).
+        The backbone's fit (:func:`fricid.identify.static.least_squares.fit`) and the residual
+        network's
+        (:func:`fricid.identify.learned.rbf.fit_rbf`).
     y_hat : ndarray (n,)
         The hybrid's fitted friction.
 
@@ -357,7 +358,7 @@ def hybrid_records(
         are; the backbone's block under ``backbone``), ``validation`` (the residual
         network's cross-validation, the backbone held, :func:`cv_validation`) and ``loss``.
     """
-    from ..metrics import metrics
+    from ...metrics import metrics
 
     sc = measurement_scatter(samples)
     p = len(base.params) - len(base.fixed)

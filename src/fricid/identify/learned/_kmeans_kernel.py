@@ -1,11 +1,12 @@
 """The compiled greedy k-means++ seeding of the RBF network's centres (numba, cached on disk).
 
-A module of its own so that importing :mod:`fricid.identify.rbf` does not import numba, and so
+A module of its own so that importing :mod:`fricid.identify.learned.rbf` does not import numba, and
+so
 that the kernel is a module-level function numba can cache across processes. It runs the
 arithmetic of scikit-learn's ``_kmeans_plusplus`` (unit sample weights) in one compiled loop,
 where scikit-learn's makes about ten numpy calls per centre: a fixed cost that grows with the
 number of centres and is paid 20-40 times per residual network by the cross-validated structure
-search (:func:`fricid.identify._rbf_estimator.kmeans_centres`). With the memoised random
+search (:func:`fricid.identify.learned._rbf_estimator.kmeans_centres`). With the memoised random
 streams the hybrid trained 13-15 % faster on issue 15's held-out laws (median times of the two
 implementations alternated in one process, a one-off script, 2026-11-23) and gives the same
 models on their tuning and reporting seeds (``benchmarks/bench_learned_tuning.py``,

@@ -56,9 +56,9 @@ from typing import Any
 import numpy as np
 from scipy.optimize import least_squares, lsq_linear
 
-from ..errors import ConfigError
-from ..optim import OptimizeResult, minimize
-from .problem import IdentificationProblem
+from ...errors import ConfigError
+from ...optim import OptimizeResult, minimize
+from ..problem import IdentificationProblem
 
 __all__ = ["GRID_POINTS", "N_POLISH", "SUMMARY", "VARPRO_OPTIONS", "linear_split", "varpro"]
 

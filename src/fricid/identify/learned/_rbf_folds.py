@@ -18,7 +18,7 @@ gap the network must bridge, so the level folds' error overstates the error betw
 measured levels; and next to the ends (one end level left in training) it measures
 extrapolation more than interpolation: with one end level kept, the level folds alone chose
 settings that doubled the ``rbf``'s held-out error on the ``grid`` kind (tuning seeds 0-49).
-The structure search (:mod:`fricid.identify._rbf_select`) therefore scores a candidate by
+The structure search (:mod:`fricid.identify.learned._rbf_select`) therefore scores a candidate by
 ``max(random-fold RMSE, level-fold RMSE / LEVEL_GAP_ALLOWANCE)``: the measured levels must be
 followed, and the error across a doubled gap may be at most :data:`LEVEL_GAP_ALLOWANCE` times
 that. With fewer than :data:`MIN_LEVELS` levels (or no speed input) only the random folds
@@ -44,7 +44,7 @@ from typing import Any
 
 import numpy as np
 
-from ._scatter import speed_levels
+from .._scatter import speed_levels
 
 __all__ = [
     "END_LEVELS",
@@ -94,7 +94,7 @@ def cv_folds(
         Deals the random folds.
     levels : bool
         Deal level folds when there are enough levels (False: random folds only, the hybrid's
-        residual; :mod:`fricid.identify.hybrid` notes why).
+        residual; :mod:`fricid.identify.learned.hybrid` notes why).
 
     Returns
     -------

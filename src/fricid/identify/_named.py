@@ -1,0 +1,161 @@
+"""Fit one named model to samples: the analytic and learned kinds of :func:`fricid.identify.fit`.
+
+Below :mod:`fricid.identify.dispatch`, :mod:`fricid.identify.validate` and
+:mod:`fricid.identify.static.select`, which all refit named models (validation refits per fold,
+selection per candidate), so that none of them imports the public entry back.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from typing import Any
+
+import numpy as np
+
+from ..errors import ConfigError
+from ..fitted import FittedModel
+from ..models import STATEFUL, FrictionModel
+from ..optim import OptimizeResult
+from ..samples import FrictionSamples, RawLog
+
+__all__ = ["KINDS", "LEARNED", "SETTINGS", "fit_named", "kind_of"]
+
+#: The kinds of identification and what does each (module notes).
+KINDS: dict[str, str] = {
+    "analytic": "fricid.identify.static.least_squares.fit",
+    "learned": "fricid.identify.learned.train.fit_learned",
+    "dynamic": "fricid.identify.dynamic.trajectory.fit_trajectory",
+    "auto": "fricid.identify.static.select.select",
+}
+
+#: The ``settings`` each kind (or learned model) takes; anything else is a ConfigError.
+SETTINGS: dict[str, tuple[str, ...]] = {
+    "analytic": (),
+    "rbf": ("inputs", "network"),
+    "hybrid": ("inputs", "network", "backbone"),
+    "gp": ("inputs", "max_points", "n_restarts"),
+    "dynamic": (
+        "route",
+        "gravity",
+        "derivative",
+        "parallel",
+        "v_slide",
+        "guard",
+        "v_window",
+        "static",
+        "n_sub",
+        "cluster_time",
+        "rate_bias",
+    ),
+    "auto": ("scheme", "scatter", "learned"),
+}
+
+#: The learned models (stored state, no named parameters).
+LEARNED = ("rbf", "hybrid", "gp")
+
+
+def kind_of(data: FrictionSamples | RawLog, model: str | FrictionModel) -> str:
+    """The kind of identification for ``data`` and ``model`` (:data:`KINDS`)."""
+    if isinstance(data, RawLog):
+        return "dynamic"
+    if not isinstance(data, FrictionSamples):
+        raise ConfigError(
+            f"fit takes FrictionSamples or a RawLog (a trajectory); got {type(data).__name__}"
+        )
+    key = model.strip().lower() if isinstance(model, str) else None
+    if key == "auto":
+        return "auto"
+    if key in LEARNED or (key is not None and key in STATEFUL):
+        return "learned"
+    return "analytic"
+
+
+def _settings(kind: str, model: Any, settings: Mapping[str, Any] | None) -> dict[str, Any]:
+    """``settings`` checked against what ``kind`` (or the learned ``model``) takes."""
+    given = dict(settings or {})
+    key = model.strip().lower() if kind == "learned" and isinstance(model, str) else kind
+    allowed = SETTINGS.get(key, ())
+    unknown = sorted(set(given) - set(allowed))
+    if unknown:
+        what = f"model '{key}'" if kind == "learned" else f"{kind} identification"
+        takes = ", ".join(allowed) if allowed else "no settings"
+        raise ConfigError(f"{what} takes {takes}; not: {', '.join(unknown)}")
+    return given
+
+
+def fit_named(
+    samples: FrictionSamples,
+    model: str | FrictionModel,
+    method: str | None = None,
+    *,
+    fixed: Mapping[str, float] | None = None,
+    bounds: Mapping[str, tuple[float, float]] | None = None,
+    x0: Mapping[str, float] | None = None,
+    seed: int | np.random.Generator | None = 0,
+    max_evals: int | None = None,
+    options: Mapping[str, Any] | None = None,
+    callback: Callable[[OptimizeResult], Any] | None = None,
+    intervals: str = "auto",
+    loss: str = "l2",
+    f_scale: float | None = None,
+    weights: str | Any = "none",
+    settings: Mapping[str, Any] | None = None,
+) -> FittedModel:
+    """:func:`fricid.identify.fit` for an analytic or learned ``model`` (not ``"auto"``, not a
+    trajectory): the same arguments, the same meaning."""
+    kind = kind_of(samples, model)
+    if kind not in ("analytic", "learned"):
+        raise ConfigError(f"fit_named fits one named model to samples; got {kind} identification")
+    extra = _settings(kind, model, settings)
+    if kind == "learned":
+        from .learned.train import fit_learned
+
+        _refuse(kind, loss=str(loss).lower() not in ("l2", "sse"))
+        _refuse(kind, weights=not _no_weights(weights), f_scale=f_scale, callback=callback)
+        return fit_learned(
+            samples,
+            str(model).strip().lower(),
+            method,
+            seed=seed,
+            max_evals=max_evals,
+            options=options,
+            fixed=fixed,
+            bounds=bounds,
+            x0=x0,
+            **extra,
+        )
+    from .static.least_squares import fit as fit_analytic
+
+    return fit_analytic(
+        samples,
+        model,
+        method or "lm",
+        fixed=fixed,
+        bounds=bounds,
+        x0=x0,
+        seed=seed,
+        max_evals=max_evals,
+        options=dict(options) if options is not None else None,
+        callback=callback,
+        intervals=intervals,
+        loss=loss,
+        f_scale=f_scale,
+        weights=weights,
+    )
+
+
+def _refuse(kind: str, **given: Any) -> None:
+    """ConfigError naming the arguments given that ``kind`` does not take."""
+    named = [k for k, v in given.items() if v is not None and v is not False and v != {}]
+    if named:
+        raise ConfigError(f"{kind} identification does not take {', '.join(named)}")
+
+
+def _no_weights(weights: Any) -> bool:
+    return weights is None or (isinstance(weights, str) and weights.strip().lower() == "none")
+
+
+def _int_seed(seed: int | np.random.Generator | None) -> int:
+    if isinstance(seed, np.random.Generator):
+        return int(seed.integers(2**31))
+    return 0 if seed is None else int(seed)
