@@ -7,7 +7,7 @@ selection per candidate), so that none of them imports the public entry back.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
@@ -15,7 +15,6 @@ import numpy as np
 from ..errors import ConfigError
 from ..fitted import FittedModel
 from ..models import STATEFUL, FrictionModel
-from ..optim import OptimizeResult
 from ..samples import FrictionSamples, RawLog
 
 __all__ = ["KINDS", "LEARNED", "SETTINGS", "fit_named", "kind_of"]
@@ -88,59 +87,37 @@ def fit_named(
     model: str | FrictionModel,
     method: str | None = None,
     *,
-    fixed: Mapping[str, float] | None = None,
-    bounds: Mapping[str, tuple[float, float]] | None = None,
-    x0: Mapping[str, float] | None = None,
-    seed: int | np.random.Generator | None = 0,
-    max_evals: int | None = None,
-    options: Mapping[str, Any] | None = None,
-    callback: Callable[[OptimizeResult], Any] | None = None,
-    intervals: str = "auto",
-    loss: str = "l2",
-    f_scale: float | None = None,
-    weights: str | Any = "none",
     settings: Mapping[str, Any] | None = None,
+    **arguments: Any,
 ) -> FittedModel:
     """:func:`fricid.identify.fit` for an analytic or learned ``model`` (not ``"auto"``, not a
-    trajectory): the same arguments, the same meaning."""
+    trajectory): ``arguments`` are that function's keywords (``fixed``, ``bounds``, ``seed``,
+    ``loss``, ...), with the same meaning; an unknown one is a TypeError, as there."""
     kind = kind_of(samples, model)
     if kind not in ("analytic", "learned"):
         raise ConfigError(f"fit_named fits one named model to samples; got {kind} identification")
     extra = _settings(kind, model, settings)
-    if kind == "learned":
-        from .learned.train import fit_learned
+    if kind == "analytic":
+        from .static.least_squares import fit as fit_analytic
 
-        _refuse(kind, loss=str(loss).lower() not in ("l2", "sse"))
-        _refuse(kind, weights=not _no_weights(weights), f_scale=f_scale, callback=callback)
-        return fit_learned(
-            samples,
-            str(model).strip().lower(),
-            method,
-            seed=seed,
-            max_evals=max_evals,
-            options=options,
-            fixed=fixed,
-            bounds=bounds,
-            x0=x0,
-            **extra,
-        )
-    from .static.least_squares import fit as fit_analytic
+        if arguments.get("options") is not None:
+            arguments["options"] = dict(arguments["options"])
+        return fit_analytic(samples, model, method or "lm", **arguments)
+    from .learned.train import fit_learned
 
-    return fit_analytic(
+    shared = ("seed", "max_evals", "options", "fixed", "bounds", "x0")
+    unknown = set(arguments) - {*shared, "callback", "intervals", "loss", "f_scale", "weights"}
+    if unknown:
+        raise TypeError(f"fit() got unexpected keyword arguments: {', '.join(sorted(unknown))}")
+    loss, weights = arguments.get("loss", "l2"), arguments.get("weights", "none")
+    _refuse(kind, loss=str(loss).lower() not in ("l2", "sse"), weights=not _no_weights(weights))
+    _refuse(kind, f_scale=arguments.get("f_scale"), callback=arguments.get("callback"))
+    return fit_learned(
         samples,
-        model,
-        method or "lm",
-        fixed=fixed,
-        bounds=bounds,
-        x0=x0,
-        seed=seed,
-        max_evals=max_evals,
-        options=dict(options) if options is not None else None,
-        callback=callback,
-        intervals=intervals,
-        loss=loss,
-        f_scale=f_scale,
-        weights=weights,
+        str(model).strip().lower(),
+        method,
+        **{k: arguments[k] for k in shared if k in arguments},
+        **extra,
     )
 
 
