@@ -105,6 +105,10 @@ def test_record_is_recomputed_for_other_samples_options_or_model(fitted, leadscr
     assert not assess_trust(model, None, validate=False).reused
     again = assess_trust(broken, leadscrew, validate=False)
     assert not again.reused and again.to_dict() == record.to_dict()
+    # a record of the right key but of types the report cannot read is not used either
+    for bad in ({"reasons": "text"}, {"open_sides": ["a"]}, {"heldout_ratio": "1"}):
+        odd = replace(model, trust={**record.to_dict(), **bad})
+        assert not assess_trust(odd, leadscrew, validate=False).reused
     # other options: a record without lovo is not the one a default report shows
     assert assess_trust(model, leadscrew).heldout_source == RUN_HERE
 

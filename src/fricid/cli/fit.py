@@ -267,7 +267,8 @@ def trust_lines(trust) -> str:
 
     lines = ["[[Trust]]", f"    {trust.line()}"]
     if math.isfinite(trust.heldout_ratio):
-        scheme = f" ({trust.heldout_scheme})" if trust.held_out else ""
+        named = not trust.held_out or trust.heldout_scheme in trust.heldout_source
+        scheme = "" if named else f" ({trust.heldout_scheme})"
         lines.append(
             f"    error / scatter    = {trust.heldout_ratio:.3g}: {trust.verdict} "
             f"[{trust.heldout_source}{scheme}]"

@@ -45,8 +45,6 @@ warnings); anything else is computed again. A record that does not parse is igno
 
 from __future__ import annotations
 
-import hashlib
-import json
 from dataclasses import asdict, dataclass, field, fields
 from typing import Any
 
@@ -57,6 +55,7 @@ from ..fitted._file import _convergence_line
 from ..metrics import NOISE_RATIO, rmse, verdict
 from ..samples import FrictionSamples, samples_hash
 from ._diagnostics import DROPS, not_determined, open_sides, quality_rows, range_text
+from ._fingerprint import canonical, json_ready, model_hash, samples_detail_hash
 from ._heldout import LEARNED_VALIDATE_WORK, MIN_LEVELS, VALIDATE_WORK, own_cv, run_validation
 from ._scatter import measurement_scatter
 
@@ -206,7 +205,7 @@ class Trust:
         """JSON-ready (non-finite numbers as None), for the model file's ``trust``."""
         d = asdict(self)
         d.pop("reused")
-        return _json_ready(d)
+        return json_ready(d)
 
     @classmethod
     def from_dict(cls, d: dict[str, Any]) -> Trust:
@@ -220,27 +219,56 @@ class Trust:
         known = {f.name for f in fields(cls)} - {"reused"}
         kwargs = {k: v for k, v in dict(d).items() if k in known}
         for key in ("heldout_ratio", "heldout_rmse", "scatter"):
-            kwargs[key] = float("nan") if kwargs.get(key) is None else float(kwargs[key])
+            value = kwargs.get(key)
+            if value is not None and (
+                isinstance(value, bool) or not isinstance(value, int | float)
+            ):
+                raise TypeError(f"trust record: '{key}' is not a number")
+            kwargs[key] = float("nan") if value is None else float(value)
         out = cls(**kwargs)
-        if not isinstance(out.level, str) or not isinstance(out.reasons, list):
-            raise TypeError("a trust record needs a level and its reasons")
+        _check_types(out)
         return out
 
 
-def _json_ready(value: Any) -> Any:
-    if isinstance(value, dict):
-        return {str(k): _json_ready(v) for k, v in value.items()}
-    if isinstance(value, list | tuple):
-        return [_json_ready(v) for v in value]
-    if isinstance(value, np.ndarray):
-        return _json_ready(value.tolist())
-    if isinstance(value, bool | np.bool_):
-        return bool(value)
-    if isinstance(value, int | np.integer):
-        return int(value)
-    if isinstance(value, float | np.floating):
-        return float(value) if np.isfinite(value) else None
-    return value
+#: The type of each text, list and mapping field of a record read from a file: a record
+#: of other types is not used (the report would fail on it).
+_TEXT = (
+    "level",
+    "convergence",
+    "advice",
+    "heldout_source",
+    "heldout_scheme",
+    "verdict",
+    "validation_note",
+    "range",
+    "quality_summary",
+    "what_to_do",
+    "model",
+)
+
+
+def _check_types(record: Trust) -> None:
+    """TypeError unless every field of ``record`` has the type the report reads."""
+
+    def texts(value: Any) -> bool:
+        return isinstance(value, list) and all(isinstance(v, str) for v in value)
+
+    def rows(value: Any) -> bool:
+        return isinstance(value, list) and all(isinstance(v, dict) for v in value)
+
+    ok = [
+        record.level in ("yes", "with caveats", "no"),
+        all(isinstance(getattr(record, k), str) for k in _TEXT),
+        texts(record.reasons) and texts(record.not_determined),
+        isinstance(record.open_sides, dict) and texts(list(record.open_sides.values())),
+        record.converged is None or isinstance(record.converged, bool),
+        isinstance(record.learned, bool) and isinstance(record.options, dict),
+        record.quality is None or rows(record.quality),
+    ]
+    for part in (record.validation, record.cv):
+        ok.append(part is None or (isinstance(part, dict) and rows(part.get("folds") or [])))
+    if not all(ok):
+        raise TypeError("not a trust record of this fricid")
 
 
 # -- what a record was computed on -------------------------------------------------------
@@ -254,54 +282,6 @@ def trust_options(validate: bool = True, max_work: int = VALIDATE_WORK) -> dict[
         "learned_work": int(LEARNED_VALIDATE_WORK),
         "min_levels": int(MIN_LEVELS),
     }
-
-
-def _canonical(value: Any) -> Any:
-    """Numbers as floats (1 and 1.0 alike, as a JSON round trip leaves them), recursively."""
-    if isinstance(value, dict):
-        return {str(k): _canonical(v) for k, v in value.items()}
-    if isinstance(value, list | tuple):
-        return [_canonical(v) for v in value]
-    if isinstance(value, bool) or value is None or isinstance(value, str):
-        return value
-    if isinstance(value, int | float):
-        return float(value)
-    return value
-
-
-def _digest(doc: Any) -> str:
-    text = json.dumps(_canonical(doc), sort_keys=True, separators=(",", ":"))
-    return hashlib.sha256(text.encode("utf-8")).hexdigest()[:16]
-
-
-def model_hash(fitted: FittedModel) -> str:
-    """A hash of the model file without its ``trust`` and the provenance's time, version and
-    warnings (what may change after the record is computed without changing the model)."""
-    d = fitted.to_dict()
-    for key in ("trust", "fricid_version", "schema_version"):
-        d.pop(key, None)
-    d["provenance"] = {
-        k: v
-        for k, v in (d.get("provenance") or {}).items()
-        if k not in ("created", "fricid_version", "warnings")
-    }
-    return _digest(d)
-
-
-def samples_detail_hash(samples: FrictionSamples) -> str:
-    """A hash of what the scatter and the quality table read besides the values: count, std
-    and ``meta`` ``sem``, ``sem_method``, ``sem_caveat`` and ``quality``."""
-    meta = {k: samples.meta.get(k) for k in ("sem", "sem_method", "sem_caveat", "quality")}
-    doc = {"count": samples.count.tolist(), "std": samples.std.tolist(), "meta": meta}
-    return _digest(json.loads(json.dumps(doc, default=_default)))
-
-
-def _default(value: Any) -> Any:
-    if isinstance(value, np.ndarray):
-        return value.tolist()
-    if isinstance(value, np.generic):
-        return value.item()
-    return str(value)
 
 
 def _key(
@@ -324,7 +304,7 @@ def _stored(fitted: FittedModel, key: dict[str, Any]) -> Trust | None:
         stored = Trust.from_dict(fitted.trust)
     except (TypeError, ValueError, KeyError):
         return None
-    same = all(_canonical(getattr(stored, k)) == _canonical(v) for k, v in key.items())
+    same = all(canonical(getattr(stored, k)) == canonical(v) for k, v in key.items())
     if not same:
         return None
     stored.reused = True
