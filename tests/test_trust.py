@@ -221,3 +221,32 @@ def test_fit_without_validate_stores_the_lovo_the_report_would_run(leadscrew, tm
     line, _ = _report(model, samples, tmp_path / "r")
     assert line.startswith(f"Trust: {stored['trust']['level']}, because")
     assert pd.notna(stored["trust"]["heldout_ratio"])
+
+
+def test_run_joint_takes_fricid_fits_options_and_gives_the_same_model(leadscrew_dir, tmp_path):
+    """run_joint with --validate, --loss, --f-scale, --weights, --intervals: the model, its
+    validation and its trust record are fricid fit's, bit for bit."""
+    from fricid.workflow import run_joint
+
+    options = {"validate": "kfold:4", "loss": "soft_l1", "weights": "std", "intervals": "jacobian"}
+    run = run_joint(
+        leadscrew_dir,
+        reader="epos",
+        reader_options={"flip_sign": True},
+        models=("stribeck_asym",),
+        f_scale=5e-5,
+        **options,
+    )
+    joint = run.fits["stribeck_asym"]
+    assert joint.loss["loss"] == "soft_l1" and joint.loss["weights"] == "std"
+    assert joint.ci_method == "jacobian" and joint.validation["scheme"] == "kfold:4"
+    assert run.trust["stribeck_asym"].to_dict() == joint.trust
+    samples = write_samples(run.used["stribeck_asym"], tmp_path / "s.csv")
+    flags = [f"--{k}={v}" for k, v in options.items()]
+    model = tmp_path / "m.json"
+    args = ["fit", str(samples), "-m", "stribeck_asym", "--f-scale", "5e-5", *flags]
+    res = runner.invoke(app, [*args, "-o", str(model), "--quiet"])
+    assert res.exit_code == 0, res.output
+    by_hand = FittedModel.load(model)
+    assert by_hand.params == joint.params and by_hand.validation == joint.validation
+    assert by_hand.trust == joint.trust

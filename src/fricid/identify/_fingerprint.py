@@ -52,15 +52,16 @@ def _digest(doc: Any) -> str:
 
 
 def model_hash(fitted: FittedModel) -> str:
-    """A hash of the model file without its ``trust`` and the provenance's time, version and
-    warnings (what may change after the record is computed without changing the model)."""
+    """A hash of the model file without its ``trust`` and the provenance's source, time,
+    version and warnings (what may change after the record is computed, or between two
+    copies of the same samples, without changing the model)."""
     d = fitted.to_dict()
     for key in ("trust", "fricid_version", "schema_version"):
         d.pop(key, None)
     d["provenance"] = {
         k: v
         for k, v in (d.get("provenance") or {}).items()
-        if k not in ("created", "fricid_version", "warnings")
+        if k not in ("source", "created", "fricid_version", "warnings")
     }
     return _digest(d)
 

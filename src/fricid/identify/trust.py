@@ -39,8 +39,8 @@ fleet store it). :func:`assess_trust` returns it instead of computing again only
 computed by this record format (:data:`TRUST_VERSION`) on the same samples (their values,
 :func:`fricid.samples.samples_hash`, and what the scatter and the quality table read: count,
 std, ``meta`` sem and quality), with the same options (``validate``, the work limits), for
-the same model (every field of the file but ``trust`` and the provenance's time, version and
-warnings); anything else is computed again. A record that does not parse is ignored.
+the same model (every field of the file but ``trust`` and the provenance's source, time,
+version and warnings); anything else is computed again. A record that does not parse is ignored.
 """
 
 from __future__ import annotations
