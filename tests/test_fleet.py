@@ -319,11 +319,16 @@ def test_results_table_has_per_joint_verdict_columns(fleet):
     ok = table[table["status"] == "ok"]
     assert ok["converged"].all() and str(ok["converged"].dtype) == "boolean"
     assert (ok["n_not_determined"] == 0).all()
-    # no validation in the fleet: the fit's in-sample RMSE over the scatter, labelled so
-    assert (ok["heldout_source"] == "in-sample").all()
+    # no --validate in the manifest: the trust verdict ran lovo itself (11 levels, small),
+    # as fricid fit and fricid report do, and the model file carries that record
+    assert (ok["heldout_source"] == "lovo run here").all()
+    assert (ok["heldout_scheme"] == "lovo").all()
     for row in ok.itertuples():
         saved = json.loads((run.out / row.model_file).read_text())
-        assert row.heldout_ratio == pytest.approx(saved["metrics"]["rmse_over_scatter"])
+        assert saved["validation"] is None
+        assert row.heldout_ratio == pytest.approx(saved["trust"]["heldout_ratio"])
+        assert row.heldout_ratio == pytest.approx(saved["trust"]["validation"]["ratio"])
+        assert row.trust == saved["trust"]["level"]
         assert row.verdict.startswith(("within noise", "misses by"))
         assert row.trust in ("yes", "with caveats")
         lo, hi = saved["operating_range"]["velocity"]
@@ -336,12 +341,13 @@ def test_verdict_columns_of_an_unconverged_fit():
     from fricid.errors import ConvergenceWarning
     from fricid.fleet.job import verdict_columns
     from fricid.identify import fit
+    from fricid.identify.trust import assess_trust
     from fricid.sim import true_samples
 
     samples = true_samples(scenario())
     with pytest.warns(ConvergenceWarning):
         fitted = fit(samples, "stribeck", "bas", max_evals=100)
-    cols = verdict_columns(fitted, samples)
+    cols = verdict_columns(assess_trust(fitted, samples))
     assert cols["converged"] is False and cols["trust"] == "no"
     assert cols["extrapolation_free_range"].startswith("speed 0.01 to 2 rad/s")
 

@@ -15,12 +15,13 @@ module, rule), so the list says what is left to move.
 
 from __future__ import annotations
 
+import ast
 from collections import defaultdict
 from functools import cache
 
 import pytest
 
-from _source import ROOT, Import, Module, imports, modules, unit
+from _source import ROOT, Import, Module, imports, modules, tree, unit
 
 #: The table's rows, bottom of the stack (top of DESIGN.md's table) first.
 ROWS: tuple[tuple[str, ...], ...] = (
@@ -282,3 +283,83 @@ def test_no_import_cycle_between_modules():
 )
 def test_rules_read_as_design_md_says(name, other, ok):
     assert (other in allowed(name)) is ok
+
+
+#: The modules that compute validation, the measurement scatter and the trust verdict: the
+#: identification layer's (DESIGN.md: "validation, scatter and the trust verdict, computed
+#: here once"), which report/ renders and never runs.
+VALIDATION_MODULES = frozenset(
+    f"{ROOT}.identify.{name}"
+    for name in (
+        "validate",
+        "_scatter",
+        "_heldout",
+        "_advice",
+        "static.select",
+        "learned._trust",
+    )
+)
+
+#: Functions whose call computes a validation, a scatter or a verdict.
+VALIDATION_CALLS = frozenset(
+    {
+        "validate",
+        "measurement_scatter",
+        "assess_trust",
+        "run_validation",
+        "misfit_advice",
+        "interior_rmse",
+        "cv_validation",
+    }
+)
+
+
+def _called_names(module: Module) -> list[tuple[int, str]]:
+    """(line, name) of every call by a plain or attribute name in one module."""
+    found = []
+    for node in ast.walk(tree(module.path)):
+        if isinstance(node, ast.Call):
+            func = node.func
+            name = func.attr if isinstance(func, ast.Attribute) else getattr(func, "id", None)
+            if name:
+                found.append((node.lineno, name))
+    return found
+
+
+def report_modules() -> list[Module]:
+    return [
+        m for m in modules() if m.name == f"{ROOT}.report" or m.name.startswith(f"{ROOT}.report.")
+    ]
+
+
+def test_report_imports_no_validation():
+    """report/ renders the trust record (fricid.identify.trust) and never computes a
+    validation, a scatter or a verdict: it imports none of the modules that do, and calls
+    none of their functions."""
+    assert report_modules()
+    bad = [
+        describe(imp, m.rel)
+        for m in report_modules()
+        for imp in imports(m)
+        if imp.target in VALIDATION_MODULES
+    ]
+    bad += [
+        f"{m.rel}:{line}: calls {name}()"
+        for m in report_modules()
+        for line, name in _called_names(m)
+        if name in VALIDATION_CALLS
+    ]
+    assert not bad, "report/ computes validation:\n" + "\n".join(bad)
+
+
+def test_report_validation_check_finds_an_offender(tmp_path):
+    path = tmp_path / "bad.py"
+    path.write_text(
+        "from ..identify.validate import measurement_scatter\n"
+        "def f(s):\n"
+        "    return measurement_scatter(s)\n",
+        encoding="utf-8",
+    )
+    module = Module("fricid.report.bad", path, False)
+    assert [i.target for i in imports(module)] == ["fricid.identify.validate"]
+    assert (3, "measurement_scatter") in _called_names(module)

@@ -17,8 +17,8 @@ from fricid.fitted import FittedModel
 from fricid.identify import fit
 from fricid.identify.learned._trust import CV_SOURCE, hat_trace, learned_statistics
 from fricid.identify.learned.rbf import RBFNetRegressor
+from fricid.identify.trust import OWN_CV, RUN_HERE, assess_trust
 from fricid.io import write_samples
-from fricid.report.trust import assess_trust
 from fricid.samples import FrictionSamples
 
 
@@ -179,10 +179,11 @@ def test_old_learned_files_still_load(rbf, tmp_path):
 
 def test_report_verdict_of_a_learned_model_rests_on_lovo(gp, rbf, samples):
     trust = assess_trust(gp, samples)
-    assert trust.heldout_source == "lovo" and "each retrained" in trust.validation_note
+    assert (trust.heldout_source, trust.heldout_scheme) == (RUN_HERE, "lovo")
+    assert "each retrained" in trust.validation_note
     # not run: the verdict falls back to the file's CV, with its caveat
-    quick = assess_trust(rbf, samples, run_validation=False)
-    assert quick.heldout_source == "levels:4"
+    quick = assess_trust(rbf, samples, validate=False)
+    assert (quick.heldout_source, quick.heldout_scheme) == (OWN_CV, "levels:4")
     assert "held out between the measured speeds only" in quick.line()
     assert "convergence is not recorded" not in quick.line()
 
@@ -227,7 +228,7 @@ def test_cli_fit_prints_the_learned_models_held_out_error(samples, tmp_path):
 
 
 def test_misfit_advice_reads_in_sample_interior_and_end_folds(rbf, samples):
-    from fricid.report.advice import misfit_advice
+    from fricid.identify._advice import misfit_advice
 
     def folds(interior: float, ends: float) -> dict:
         speeds = np.geomspace(0.01, 1.0, 6)

@@ -113,3 +113,31 @@ def test_yaml_values_are_read_like_csv_cells(tmp_path):
     assert a.settings() == b.settings() and a.date == b.date == "2024-01-05"
     assert a.reader_options == {"flip_sign": True, "nominal_torque": pytest.approx(9.84e-3)}
     assert a.seed == 3 and isinstance(a.seed, int)
+
+
+def test_fit_options_of_fricid_fit_reach_run_joint(tmp_path):
+    """validate, loss, f_scale, weights and intervals: fricid fit's options, as columns."""
+    (tmp_path / "m.csv").write_text(
+        "robot,joint,log,validate,loss,f_scale [mN m],weights,intervals\n"
+        "r,j,x,KFOLD:4,soft_l1,0.5,std,jacobian\n"
+        "r,k,x,,,,,\n",
+        encoding="utf-8",
+    )
+    given, default = read_manifest(tmp_path / "m.csv").joints
+    kwargs = given.run_kwargs()
+    assert (kwargs["validate"], kwargs["loss"], kwargs["weights"]) == ("kfold:4", "soft_l1", "std")
+    assert kwargs["f_scale"] == pytest.approx(5e-4) and kwargs["intervals"] == "jacobian"
+    assert given.settings()["validate"] == "kfold:4"
+    want = {"validate": None, "loss": "l2", "f_scale": None, "weights": "none", "intervals": "auto"}
+    assert {k: default.run_kwargs()[k] for k in want} == want
+    for column, cell, words in (
+        ("validate", "lovo:3", "must be lovo, kfold or kfold:K"),
+        ("validate", "kfold:1", "must be lovo, kfold or kfold:K"),
+        ("loss", "cauchy", "must be one of: l2, soft_l1, huber"),
+        ("weights", "given", "must be one of: none, std"),
+        ("intervals", "bootstrap", "must be one of: auto, profile, jacobian, none"),
+    ):
+        (tmp_path / "bad.csv").write_text(f"robot,joint,log,{column}\nr,j,x,{cell}\n")
+        with pytest.raises(DataError, match=words) as info:
+            read_manifest(tmp_path / "bad.csv")
+        assert info.value.row == 2 and info.value.column == column

@@ -14,6 +14,7 @@ from fricid.cli import app
 from fricid.errors import ConfigError
 from fricid.extract import extract
 from fricid.identify import fit
+from fricid.identify.trust import assess_trust
 from fricid.io import epos_steady_samples, write_samples
 from fricid.report import Document, Figure, Table, model_report, write_document
 from fricid.report.render import render_html, render_markdown
@@ -69,7 +70,9 @@ def leadscrew(leadscrew_dir):
 @pytest.mark.parametrize("family", FAMILIES)
 def test_report_renders_for_each_family(family, paper1_samples, tmp_path):
     fitted = fit(paper1_samples, family, "lm", max_evals=3000)
-    doc = model_report(fitted, paper1_samples, velocity_unit="deg/s")
+    doc = model_report(
+        fitted, paper1_samples, trust=assess_trust(fitted, paper1_samples), velocity_unit="deg/s"
+    )
     out = tmp_path / "rep"
     path = write_document(doc, out)
     assert path == out / "report.html"
@@ -83,7 +86,9 @@ def test_report_renders_for_each_family(family, paper1_samples, tmp_path):
 
 def test_report_on_real_leadscrew_per_direction(leadscrew, tmp_path):
     fitted = fit(leadscrew, "stribeck_asym")
-    doc = model_report(fitted, leadscrew, velocity_unit="rpm")
+    doc = model_report(
+        fitted, leadscrew, trust=assess_trust(fitted, leadscrew), velocity_unit="rpm"
+    )
     write_document(doc, tmp_path / "rep")
     assert_report_folder(
         tmp_path / "rep",
@@ -187,7 +192,9 @@ def test_report_for_the_rbf_network_with_bootstrap(paper1_samples, tmp_path):
     fitted = fit_rbf(paper1_samples, n_centers=8, random_state=0)
     path = fitted.save(tmp_path / "rbf.json")
     fitted = FittedModel.load(path)
-    doc = model_report(fitted, paper1_samples, bootstrap=50)
+    doc = model_report(
+        fitted, paper1_samples, trust=assess_trust(fitted, paper1_samples), bootstrap=50
+    )
     write_document(doc, tmp_path / "rep")
     assert_report_folder(
         tmp_path / "rep",
@@ -211,24 +218,22 @@ def _trust_section(doc: Document):
 def test_report_validation_limit_is_a_size_not_a_time(leadscrew):
     """Whether the report runs lovo itself depends on the problem's size only, never on how
     busy the machine is (a measured time made the verdict flip under load)."""
-    from fricid.report.trust import assess_trust
-
     fitted = fit(leadscrew, "stribeck_asym")
     small = assess_trust(fitted, leadscrew, max_work=1)
     assert small.validation is None
-    assert "over the report's 1; use fricid fit --validate lovo" in small.validation_note
+    assert "over the limit of 1; use fricid fit --validate lovo" in small.validation_note
     assert assess_trust(fitted, leadscrew).validation is not None
 
 
 def test_trust_yes_for_a_converged_fit_within_noise(leadscrew, tmp_path):
     fitted = fit(leadscrew, "stribeck_asym")
     assert fitted.converged and fitted.validation is None
-    doc = model_report(fitted, leadscrew)
+    doc = model_report(fitted, leadscrew, trust=assess_trust(fitted, leadscrew))
     sec, line = _trust_section(doc)
     assert line.startswith("Trust: yes, because the fit converged")
     assert doc.meta["trust"] == line and next(iter(doc.meta)) == "trust"
-    # the report ran lovo itself, and says so; the quality table of the EPOS reader is shown
-    assert "held-out RMSE (lovo)" in sec.text and "run by this report" in sec.text
+    # the trust check ran lovo itself, and says so; the quality table of the EPOS reader is shown
+    assert "held-out RMSE (lovo run here)" in sec.text and "lovo run here: 16 folds" in sec.text
     assert "32 set-points" in sec.text
     names = {getattr(i, "name", None) for i in sec.items}
     assert {"quality", "heldout"} <= names
@@ -247,7 +252,7 @@ def test_trust_no_for_a_bas_fit_with_a_tiny_budget(leadscrew):
     with pytest.warns(ConvergenceWarning):
         fitted = fit(leadscrew, "stribeck", "bas", max_evals=200)
     assert fitted.converged is False
-    doc = model_report(fitted, leadscrew)
+    doc = model_report(fitted, leadscrew, trust=assess_trust(fitted, leadscrew))
     sec, line = _trust_section(doc)
     assert line.startswith("Trust: no, because the fit did NOT converge")
     assert "--method bas+lm" in line
@@ -259,7 +264,6 @@ def test_trust_no_for_a_bas_fit_with_a_tiny_budget(leadscrew):
 
 def test_trust_names_open_sides_and_undetermined_parameters():
     from fricid.fitted import FittedModel
-    from fricid.report.trust import assess_trust
 
     fitted = FittedModel(
         model="stribeck",
@@ -295,7 +299,7 @@ def test_report_of_a_per_direction_rbf_network(leadscrew, tmp_path):
     names = coefficient_names(fitted.state)
     assert A.shape == (len(leadscrew), len(names))
     assert any(n.startswith("pos ") for n in names) and any(n.startswith("neg ") for n in names)
-    doc = model_report(fitted, leadscrew, bootstrap=50)
+    doc = model_report(fitted, leadscrew, trust=assess_trust(fitted, leadscrew), bootstrap=50)
     write_document(doc, tmp_path / "rep")
     titles = [s.title for s in doc.sections]
     assert titles[0] == "Can I trust this?" and titles[1] == "Parameters"

@@ -21,6 +21,7 @@ import pytest
 
 from fricid.errors import FricidWarning
 from fricid.identify import fit
+from fricid.identify.trust import assess_trust
 from fricid.report import model_report, write_document
 from fricid.samples import FrictionSamples
 
@@ -71,7 +72,7 @@ def report(tmp_path_factory) -> Path:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", FricidWarning)
         fitted = fit(samples, "stribeck_asym", "varpro")
-        doc = model_report(fitted, samples, validate=False)
+        doc = model_report(fitted, samples, trust=assess_trust(fitted, samples, validate=False))
     return write_document(doc, tmp_path_factory.mktemp("browser") / "report")
 
 

@@ -12,6 +12,7 @@ import pytest
 
 from fricid.errors import FricidWarning
 from fricid.identify import fit
+from fricid.identify.trust import assess_trust
 from fricid.report import Document, Figure, model_report, render_html, render_markdown
 from fricid.report.interactive import stribeck_range
 from fricid.samples import FrictionSamples
@@ -32,7 +33,9 @@ def doc():
     )
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", FricidWarning)
-        return model_report(fit(samples, "stribeck_asym", "varpro"), samples, validate=False)
+        fitted = fit(samples, "stribeck_asym", "varpro")
+        trust = assess_trust(fitted, samples, validate=False)
+        return model_report(fitted, samples, trust=trust)
 
 
 def _specs(html: str) -> dict[str, dict]:

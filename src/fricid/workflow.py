@@ -9,8 +9,10 @@ fleet is identified exactly as it would be by hand (DESIGN.md, "The flow of data
 
 :func:`load_joint` reads a log with one of the readers of :mod:`fricid.io.registry`
 (:data:`~fricid.io.READERS`) and extracts its friction samples;
-:func:`select_samples` picks the rows a model is fitted to; :func:`run_joint` does both and
-fits every model, isolating a model whose fit fails from the others.
+:func:`select_samples` picks the rows a model is fitted to; :func:`fit_samples` fits one model
+as ``fricid fit`` does (the fit, its ``--validate`` validation, then the trust record of
+:func:`fricid.identify.trust.assess_trust`, stored in the model); :func:`run_joint` does all
+three and fits every model, isolating a model whose fit fails from the others.
 """
 
 from __future__ import annotations
@@ -20,7 +22,7 @@ import time
 from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -30,12 +32,16 @@ from .fitted import FittedModel
 from .io.registry import check_keys, check_reader, gives_samples, open_log
 from .samples import FrictionSamples, RawLog
 
+if TYPE_CHECKING:
+    from .identify.trust import Trust
+
 __all__ = [
     "DIRECTIONS",
     "EXTRACT_OPTIONS",
     "SAMPLE_SETS",
     "JointData",
     "JointRun",
+    "fit_samples",
     "load_joint",
     "run_joint",
     "select_direction",
@@ -108,7 +114,10 @@ class JointRun:
     extract_seconds : float
         Wall time of reading and extraction [s].
     fit_seconds : dict of str to float
-        Model name -> wall time of its fit [s].
+        Model name -> wall time of its fit (validation and trust included) [s].
+    trust : dict of str to Trust
+        Model name -> its trust record (:func:`fricid.identify.trust.assess_trust`, also in
+        the model's ``trust``).
     """
 
     data: JointData
@@ -117,6 +126,7 @@ class JointRun:
     used: dict[str, FrictionSamples] = field(default_factory=dict)
     extract_seconds: float = 0.0
     fit_seconds: dict[str, float] = field(default_factory=dict)
+    trust: dict[str, Trust] = field(default_factory=dict)
 
 
 def _design_hints(log: RawLog) -> dict[str, Any]:
@@ -266,6 +276,87 @@ def select_samples(
     return select_direction(chosen, direction)
 
 
+def fit_samples(
+    samples: FrictionSamples,
+    model: str,
+    method: str | None = "lm",
+    *,
+    fixed: Mapping[str, float] | None = None,
+    bounds: Mapping[str, tuple[float, float]] | None = None,
+    seed: int = 0,
+    max_evals: int | None = None,
+    validate: str | None = None,
+    loss: str = "l2",
+    f_scale: float | None = None,
+    weights: str = "none",
+    intervals: str = "auto",
+    settings: Mapping[str, Any] | None = None,
+    callback: Callable[[Any], Any] | None = None,
+    on_stage: Callable[[str], None] | None = None,
+) -> tuple[FittedModel, Trust]:
+    """Fit one model to samples as ``fricid fit`` does: fit, validate, assess trust.
+
+    Parameters
+    ----------
+    samples : FrictionSamples
+    model, method, fixed, bounds, seed, max_evals, loss, f_scale, weights, intervals, settings
+        Passed to :func:`fricid.identify.fit` (``model="auto"``: ``validate`` is its scheme).
+    validate : str, optional
+        Held-out validation of the fitted model (``"lovo"``, ``"kfold:K"``;
+        :func:`fricid.identify.validate`), each fold fitted with the same options; stored as
+        the model's ``validation``.
+    callback : callable, optional
+        The optimiser's callback (analytic fits; progress).
+    on_stage : callable, optional
+        Called with a label when the validation or the trust assessment starts (progress).
+
+    Returns
+    -------
+    FittedModel
+        With ``validation`` (when asked) and ``trust`` (the record's ``to_dict()``).
+    Trust
+        The record of :func:`fricid.identify.trust.assess_trust` (default options: a
+        leave-one-velocity-out run there when the fit brought no validation and the problem
+        is small enough).
+    """
+    from .identify import fit
+    from .identify import validate as validate_model
+    from .identify.trust import assess_trust
+
+    key = model.strip().lower()
+    extra = dict(settings or {})
+    if key == "auto" and validate:
+        extra["scheme"] = validate
+    options: dict[str, Any] = {"loss": loss, "f_scale": f_scale, "weights": weights}
+    common = dict(fixed=fixed, bounds=bounds, seed=seed, max_evals=max_evals, **options)
+    fitted = fit(
+        samples,
+        model,
+        method,
+        settings=extra or None,
+        intervals=intervals,
+        callback=callback,
+        **common,
+    )
+    if validate and key != "auto":
+        if on_stage is not None:
+            on_stage(f"validating {fitted.model} ({validate})")
+        fitted.validation = validate_model(
+            samples,
+            fitted.model,
+            validate,
+            method,
+            settings=settings or None,
+            intervals=intervals,
+            **common,
+        ).to_dict()
+    if on_stage is not None:
+        on_stage(f"assessing trust in {fitted.model}")
+    trust = assess_trust(fitted, samples)
+    fitted.trust = trust.to_dict()
+    return fitted, trust
+
+
 def run_joint(
     path: str | os.PathLike[str],
     *,
@@ -280,9 +371,14 @@ def run_joint(
     fixed: Mapping[str, float] | None = None,
     bounds: Mapping[str, tuple[float, float]] | None = None,
     max_evals: int | None = None,
+    validate: str | None = None,
+    loss: str = "l2",
+    f_scale: float | None = None,
+    weights: str = "none",
+    intervals: str = "auto",
     chunk_rows: int = 1_000_000,
 ) -> JointRun:
-    """Identify one joint: :func:`load_joint`, then :func:`fricid.identify.fit` per model.
+    """Identify one joint: :func:`load_joint`, then :func:`fit_samples` per model.
 
     Parameters
     ----------
@@ -298,19 +394,22 @@ def run_joint(
     fixed, bounds : Mapping, optional
         Parameters held fixed / search ranges (SI), applied to every model that has the
         parameter named.
+    validate, loss, f_scale, weights, intervals
+        As ``fricid fit`` takes them (``--validate``, ``--loss``, ``--f-scale``,
+        ``--weights``, ``--intervals``; :func:`fit_samples`), so a joint identified here and
+        by ``fricid fit`` gives the same model, held-out error and trust verdict.
 
     Returns
     -------
     JointRun
         A model whose fit fails (a :class:`~fricid.errors.FricidError`) is in ``errors``; the
-        other models are still fitted.
+        other models are still fitted, each with its trust record.
 
     Raises
     ------
     FricidError
         The log cannot be read or extracted (nothing can be fitted then).
     """
-    from .identify import fit
     from .models import get_model
 
     if not models:
@@ -339,14 +438,19 @@ def run_joint(
             own = set(model.param_names)
             used = select_samples(data, name, samples=samples, direction=direction)
             run.used[name] = used
-            run.fits[name] = fit(
+            run.fits[name], run.trust[name] = fit_samples(
                 used,
-                model,
+                name,
                 method,
                 fixed={k: v for k, v in (fixed or {}).items() if k in own},
                 bounds={k: v for k, v in (bounds or {}).items() if k in own},
                 seed=seed,
                 max_evals=max_evals,
+                validate=validate,
+                loss=loss,
+                f_scale=f_scale,
+                weights=weights,
+                intervals=intervals,
             )
         except FricidError as exc:
             run.errors[name] = exc

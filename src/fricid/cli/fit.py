@@ -135,6 +135,14 @@ def fit_command(
             ),
         ),
     ] = "none",
+    intervals: Annotated[
+        str,
+        typer.Option(
+            "--intervals",
+            help="95 % intervals of the parameters: auto (profile likelihood inside the search "
+            "box where it applies), profile, jacobian or none.",
+        ),
+    ] = "auto",
     out: Annotated[
         Path | None,
         out_option(
@@ -177,7 +185,10 @@ def fit_command(
     the friction's magnitude per direction (the R-squared above is the BAS-RBFNN paper's
     Table 1 fitness, of the signed friction, which flatters per-direction data); with
     --validate or --model auto, the held-out RMSE and a verdict; with auto, the candidates
-    compared. Warnings print as one line each on stderr and are saved in the model file
+    compared. Last, [[Trust]]: the trust verdict (fricid.identify.trust; held-out error from
+    --validate, else leave one velocity level out run there when small enough, else in-sample,
+    labelled), saved in the model file, where `fricid report` on the same samples reads it.
+    Warnings print as one line each on stderr and are saved in the model file
     (provenance "warnings"). Progress goes to stderr: a bar on a terminal, otherwise a line
     per tenth of the evaluation budget with the time left (population methods) or every few
     seconds; --quiet: none.
@@ -198,20 +209,16 @@ def fit_command(
             gravity="fit",
             out=out,
         )
-    from ..identify import fit
-    from ..identify import validate as validate_model
     from ..io import read_samples
-    from ..workflow import select_direction
+    from ..workflow import fit_samples, select_direction
 
     check_paths(inputs={"SAMPLES": samples}, out_files={"--out": out})
     data = select_direction(read_samples(samples), direction)
     key = model.strip().lower()
     rbf = key in ("rbf", "hybrid")
-    options: dict = {"loss": loss, "f_scale": f_scale, "weights": weights}
     settings = _rbf_settings(centers, inputs, backbone if key == "hybrid" else None) if rbf else {}
-    if key == "auto":
-        settings.update({"scheme": validate} if validate else {})
-        settings.update({"learned": True} if learned else {})
+    if key == "auto" and learned:
+        settings["learned"] = True
     trainer = _rbf_trainer(method) if rbf else (None if key == "gp" else method)
     fixed = parse_assignments(fix, "--fix")
     with (
@@ -222,9 +229,7 @@ def fit_command(
         ),
     ):
         warnings.simplefilter("always")
-        if callback is not None and key not in ("rbf", "hybrid", "gp"):
-            options["callback"] = callback
-        fitted = fit(
+        fitted, trust = fit_samples(
             data,
             model,
             trainer,
@@ -232,24 +237,15 @@ def fit_command(
             bounds=parse_ranges(bound, "--bound"),
             seed=seed,
             max_evals=max_evals,
+            validate=validate,
+            loss=loss,
+            f_scale=f_scale,
+            weights=weights,
+            intervals=intervals,
             settings=settings or None,
-            **options,
+            callback=callback if key not in ("rbf", "hybrid", "gp") else None,
+            on_stage=lambda label: track.stage(label, restart=True),
         )
-        if validate and key != "auto":
-            track.stage(f"validating {fitted.model} ({validate})", restart=True)
-            options.pop("callback", None)
-            fitted.validation = validate_model(
-                data,
-                fitted.model,
-                validate,
-                trainer,
-                seed=seed,
-                fixed=fixed,
-                bounds=parse_ranges(bound, "--bound"),
-                max_evals=max_evals,
-                settings=settings or None,
-                **options,
-            ).to_dict()
     lines = [f"{w.category.__name__}: {w.message}" for w in caught]
     if lines:
         fitted.provenance["warnings"] = lines
@@ -257,9 +253,29 @@ def fit_command(
     fitted.save(out)
     console.print(fitted.report(), markup=False, highlight=False, soft_wrap=True)
     console.print(goodness_text(fitted, data), markup=False, highlight=False, soft_wrap=True)
+    console.print(trust_lines(trust), markup=False, highlight=False, soft_wrap=True)
     for w in caught:  # shown as the CLI shows every warning (one line on stderr)
         warnings.showwarning(w.message, w.category, w.filename, w.lineno)
     err_console.print(f"wrote {escape(str(out))}")
+
+
+def trust_lines(trust) -> str:
+    """The ``[[Trust]]`` block of ``fricid fit``: the verdict line of the trust record stored
+    in the model file (:func:`fricid.identify.trust.assess_trust`), and where its error
+    ratio came from."""
+    import math
+
+    lines = ["[[Trust]]", f"    {trust.line()}"]
+    if math.isfinite(trust.heldout_ratio):
+        named = not trust.held_out or trust.heldout_scheme in trust.heldout_source
+        scheme = "" if named else f" ({trust.heldout_scheme})"
+        lines.append(
+            f"    error / scatter    = {trust.heldout_ratio:.3g}: {trust.verdict} "
+            f"[{trust.heldout_source}{scheme}]"
+        )
+    if trust.validation_note:
+        lines.append(f"    note: {trust.validation_note}")
+    return "\n".join(lines)
 
 
 def goodness_text(fitted, samples=None) -> str:

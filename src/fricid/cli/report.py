@@ -42,9 +42,11 @@ def report_command(
         typer.Option(
             "--validate/--no-validate",
             help="Run leave-one-velocity-out validation for the trust section when the model "
-            "file has none, or only a learned model's own random-fold cross-validation "
-            "(when the problem is small enough: a few seconds for analytic models, up to "
-            "about ten for learned ones, each fold retrained).",
+            "file has none, or only a learned model's own cross-validation (when the problem "
+            "is small enough: a few seconds for analytic models, up to about ten for learned "
+            "ones, each fold retrained). The trust record `fricid fit` stored in the model "
+            "file is read instead when it was computed on the same samples with the same "
+            "options (--validate, the default, as fit computes it).",
         ),
     ] = True,
 ) -> None:
@@ -54,11 +56,16 @@ def report_command(
     metrics, measured against predicted friction over velocity, residuals against each input
     and the optimiser's convergence. The verdict line is printed on stderr too.
 
+    The verdict is fricid.identify.trust's record: the one the model file carries (from
+    `fricid fit` or the fleet) when it was computed on the same samples with the same
+    options, else computed now; the report renders it and computes no verdict of its own.
+
     Outputs in the folder: report.html (self-contained), report.md, one CSV per table and one
     PNG per figure, written all or nothing.
     """
     from ..errors import ConfigError
     from ..fitted import FittedModel
+    from ..identify.trust import assess_trust
     from ..io import read_samples
     from ..report import model_report, write_document
     from ..units import UNITS
@@ -72,14 +79,15 @@ def report_command(
     data = read_samples(samples)
     out = out or Path(f"{model.stem}-report")
     with err_console.status("building the report", spinner="dots"):
+        trust = assess_trust(fitted, data, validate=validate)
         doc = model_report(
             fitted,
             data,
+            trust=trust,
             velocity_unit=velocity_unit,
             bootstrap=bootstrap,
             seed=seed,
             samples_label=samples.name,
-            validate=validate,
         )
         path = write_document(doc, out)
     console.print(str(path), highlight=False, soft_wrap=True)

@@ -104,6 +104,10 @@ class FittedModel:
         held-out RMSE, scatter, ratio, verdict, folds; None when not validated.
     selection : ``fit(samples, "auto")``'s comparison of candidate models
         (:mod:`fricid.identify.static.select`): the table, the choice and why; None otherwise.
+    trust : the trust verdict and where each of its numbers came from
+        (:class:`fricid.identify.trust.Trust`, ``to_dict()``), with what it was computed on
+        (samples and model hashes, options); None when not assessed. ``fricid fit`` and the
+        fleet store it; ``fricid report`` reuses it only for the same samples and options.
     """
 
     model: str
@@ -143,6 +147,7 @@ class FittedModel:
     loss: dict[str, Any] = field(default_factory=dict)
     validation: dict[str, Any] | None = None
     selection: dict[str, Any] | None = None
+    trust: dict[str, Any] | None = None
 
     # -- prediction ----------------------------------------------------------------------
     @property

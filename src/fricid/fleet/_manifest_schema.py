@@ -145,7 +145,7 @@ def _read_cell(fld: Field, raw: Any) -> Any:
         return raw.isoformat()[:10]
     if isinstance(raw, str):
         raw = raw.strip()
-        if fld.choices or fld.name in ("model", "method"):
+        if fld.choices or fld.name in ("model", "method", "validate"):
             raw = raw.lower()
     kind = fld.text
     if kind == "number" and not isinstance(raw, bool):

@@ -22,6 +22,7 @@ import numpy as np
 
 from ..errors import FricidError
 from ..fitted import FittedModel
+from ..identify.trust import Trust
 from ..samples import FrictionSamples
 from .hashing import input_hash
 from .manifest import JointSpec
@@ -112,13 +113,15 @@ def fit_row(
     fitted: FittedModel | None,
     used: FrictionSamples | None,
     error: str | None = None,
+    trust: Trust | None = None,
 ) -> dict[str, Any]:
     """One results-table row: a model's parameters, CIs, metrics and operating range.
 
     Parameters are ``param_<name>``, their standard errors ``stderr_<name>`` and the
     half-widths of their 95 % confidence intervals ``ci95_<name>`` (SI units, listed in
-    ``units``); the verdict columns of :func:`verdict_columns`; a failed fit has ``status``
-    ``"failed"`` and its ``error``.
+    ``units``); the verdict columns of :func:`verdict_columns` of ``trust`` (the fit's trust
+    record, default the one the model carries); a failed fit has ``status`` ``"failed"`` and
+    its ``error``.
     """
     row: dict[str, Any] = {
         "robot": spec.robot,
@@ -143,7 +146,10 @@ def fit_row(
         return row
     for key in ("fitness", "sse", "rmse", "rmspe", "mae", "max_abs_error"):
         row[key] = fitted.metrics.get(key)
-    row.update(verdict_columns(fitted, used))
+    if trust is None and fitted.trust is not None:
+        trust = Trust.from_dict(fitted.trust)
+    if trust is not None:
+        row.update(verdict_columns(trust))
     row["nfev"] = fitted.nfev
     row["at_bound"] = ";".join(fitted.at_bound) or None
     row["fixed"] = ";".join(fitted.fixed) or None
@@ -157,26 +163,25 @@ def fit_row(
     return row
 
 
-def verdict_columns(fitted: FittedModel, used: FrictionSamples | None) -> dict[str, Any]:
-    """The per-joint verdict columns of a fit (issue 11, "Where it shows").
-
-    From :func:`fricid.report.trust.assess_trust` of the model and the samples it was fitted
-    on (no validation is run here): ``trust`` (``yes``, ``with caveats``, ``no``),
-    ``converged`` (None when not recorded), ``heldout_ratio`` (held-out RMSE over the
-    measurement scatter from the model's validation, else the fit's in-sample
-    ``rmse_over_scatter``; ``heldout_source`` says which), ``verdict`` (within noise, or
-    misses by a factor), ``n_not_determined`` (free parameters the data do not determine)
-    and ``extrapolation_free_range`` (the operating range as text).
+def verdict_columns(trust: Trust) -> dict[str, Any]:
+    """The per-joint verdict columns of a fit (issue 11, "Where it shows"), read from its
+    trust record (:func:`fricid.identify.trust.assess_trust`, computed once by
+    :func:`fricid.workflow.fit_samples`, as ``fricid fit`` computes it; nothing is computed
+    here): ``trust`` (``yes``, ``with caveats``, ``no``), ``converged`` (None when not
+    recorded), ``heldout_ratio`` (RMSE over the measurement scatter), ``heldout_source``
+    (where it came from: ``lovo run here``, ``the fit's --validate``, ``the learned model's
+    own CV``, or ``in-sample only``) and ``heldout_scheme`` (``lovo``, ``kfold:K``, ...;
+    empty in-sample), ``verdict`` (within noise, or misses by a factor),
+    ``n_not_determined`` (free parameters the data do not determine) and
+    ``extrapolation_free_range`` (the operating range as text).
     """
-    from ..report.trust import assess_trust
-
-    trust = assess_trust(fitted, used, run_validation=False)
     ratio = trust.heldout_ratio
     return {
         "trust": trust.level,
         "converged": trust.converged,
         "heldout_ratio": float(ratio) if np.isfinite(ratio) else None,
         "heldout_source": trust.heldout_source or None,
+        "heldout_scheme": trust.heldout_scheme or None,
         "verdict": trust.verdict,
         "n_not_determined": len(trust.not_determined),
         "extrapolation_free_range": trust.range or None,
@@ -201,7 +206,14 @@ def _compute(spec: JointSpec, digest: str) -> JointOutcome:
     for name in spec.models:
         fitted = run.fits.get(name)
         err = run.errors.get(name)
-        row = fit_row(spec, name, fitted, run.used.get(name), None if err is None else str(err))
+        row = fit_row(
+            spec,
+            name,
+            fitted,
+            run.used.get(name),
+            None if err is None else str(err),
+            run.trust.get(name),
+        )
         row["time_extract_s"] = run.extract_seconds
         row["time_fit_s"] = run.fit_seconds.get(name)
         rows.append(row)

@@ -68,6 +68,9 @@ _DEFAULTS: dict[str, Any] = {
     "seed": 0,
     "direction": "all",
     "samples": "auto",
+    "loss": "l2",
+    "weights": "none",
+    "intervals": "auto",
 }
 
 
@@ -96,6 +99,8 @@ class JointSpec:
         Options of :func:`fricid.extract.extract` (SI units).
     models, method, seed, max_evals, samples, direction, fixed, bounds
         See :func:`fricid.workflow.run_joint`.
+    validate, loss, f_scale, weights, intervals
+        As ``fricid fit`` takes them (:func:`fricid.workflow.run_joint`; ``f_scale`` in N m).
     chunk_rows : int
         Rows read at a time (memory, not results).
     """
@@ -117,6 +122,11 @@ class JointSpec:
     direction: str = "all"
     fixed: dict[str, float] = field(default_factory=dict)
     bounds: dict[str, list[float]] = field(default_factory=dict)
+    validate: str | None = None
+    loss: str = "l2"
+    f_scale: float | None = None
+    weights: str = "none"
+    intervals: str = "auto"
     chunk_rows: int = 1_000_000
 
     @property
@@ -141,6 +151,11 @@ class JointSpec:
             "direction": self.direction,
             "fixed": self.fixed,
             "bounds": self.bounds,
+            "validate": self.validate,
+            "loss": self.loss,
+            "f_scale": self.f_scale,
+            "weights": self.weights,
+            "intervals": self.intervals,
         }
 
     def run_kwargs(self) -> dict[str, Any]:
@@ -157,6 +172,11 @@ class JointSpec:
             "direction": self.direction,
             "fixed": self.fixed,
             "bounds": {k: (v[0], v[1]) for k, v in self.bounds.items()},
+            "validate": self.validate,
+            "loss": self.loss,
+            "f_scale": self.f_scale,
+            "weights": self.weights,
+            "intervals": self.intervals,
             "chunk_rows": self.chunk_rows,
         }
 
@@ -225,6 +245,11 @@ def _spec(entry: Entry, file: Path) -> JointSpec:
         direction=got.get("direction", _DEFAULTS["direction"]),
         fixed=got.get("fix", {}),
         bounds=got.get("bound", {}),
+        validate=got.get("validate"),
+        loss=got.get("loss", _DEFAULTS["loss"]),
+        f_scale=got.get("f_scale"),
+        weights=got.get("weights", _DEFAULTS["weights"]),
+        intervals=got.get("intervals", _DEFAULTS["intervals"]),
         chunk_rows=got.get("chunk_rows", 1_000_000),
     )
 

@@ -10,8 +10,9 @@ Columns (SI units; each parameter's unit in ``units``):
   ``temperature_max`` [degC];
 - verdict (issue 11; :func:`fricid.fleet.job.verdict_columns`): ``trust`` (``yes``,
   ``with caveats``, ``no``), ``converged``, ``heldout_ratio`` (RMSE over the measurement
-  scatter, held out where the model was validated, else in-sample: ``heldout_source``),
-  ``verdict`` (within noise, or misses by a factor), ``n_not_determined``,
+  scatter), ``heldout_source`` (``lovo run here``, ``the fit's --validate``, ``the learned
+  model's own CV`` or ``in-sample only``), ``heldout_scheme``, ``verdict`` (within noise, or
+  misses by a factor), ``n_not_determined``,
   ``extrapolation_free_range`` (the operating range, as text);
 - fit: ``fitness`` (R^2), ``sse`` [N^2 m^2], ``rmse``, ``mae``, ``max_abs_error`` [N m],
   ``rmspe`` (a fraction: 0.021 is 2.1 %, as in the model file; commands and reports print
@@ -77,6 +78,7 @@ _STRINGS = (
     "fricid_version",
     "trust",
     "heldout_source",
+    "heldout_scheme",
     "verdict",
     "extrapolation_free_range",
 )
@@ -88,6 +90,7 @@ VERDICT_COLUMNS = (
     "converged",
     "heldout_ratio",
     "heldout_source",
+    "heldout_scheme",
     "verdict",
     "n_not_determined",
     "extrapolation_free_range",

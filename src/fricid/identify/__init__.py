@@ -15,7 +15,8 @@ of identification), over three rooms that share :class:`IdentificationProblem`
 
 What every room's result is judged by lives here too, computed once: :func:`validate`
 (held-out RMSE, leave one velocity level out or k-fold), :func:`measurement_scatter` and the
-trust verdict.
+trust verdict (:mod:`fricid.identify.trust`: :func:`assess_trust` returns one :class:`Trust`
+record, which ``fricid fit``, the fleet and ``fricid report`` read and never recompute).
 """
 
 from __future__ import annotations
@@ -28,13 +29,16 @@ from .static.least_squares import evaluate
 from .static.profile import profile_intervals
 from .static.select import select
 from .static.uncertainty import jacobian_uncertainty
+from .trust import Trust, assess_trust
 from .validate import Validation, validate
 
 __all__ = [
     "KINDS",
     "IdentificationProblem",
     "Scatter",
+    "Trust",
     "Validation",
+    "assess_trust",
     "evaluate",
     "fit",
     "jacobian_uncertainty",

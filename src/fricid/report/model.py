@@ -1,14 +1,15 @@
 """The report for one identified model on one data set (``fricid report MODEL.json SAMPLES``).
 
-Contents, in order: "Can I trust this?" first (:mod:`.trust`: a one-line verdict, data quality
-per set-point, convergence, identifiability, held-out error against the measurement scatter,
-operating range); the model and its parameters with their 95 % intervals ``[low, high]``
-(profile likelihood inside the search box where the model file has them, open sides marked;
-for the RBF network, predicted friction with bootstrap intervals over the operating range, its
-weights in an appendix); fit metrics on the identification data and on the given samples,
-measured against predicted friction over velocity (one curve per temperature and load band),
-residuals against each input, predicted against measured, and the optimiser's convergence
-history where there is one.
+Contents, in order: "Can I trust this?" first (:mod:`.trust` renders the record
+:func:`fricid.identify.trust.assess_trust` computed: a one-line verdict, data quality per
+set-point, convergence, identifiability, held-out error against the measurement scatter and
+where it came from, operating range); the model and its parameters with their 95 % intervals
+``[low, high]`` (profile likelihood inside the search box where the model file has them, open
+sides marked; for the RBF network, predicted friction with bootstrap intervals over the
+operating range, its weights in an appendix); fit metrics on the identification data and on the
+given samples, measured against predicted friction over velocity (one curve per temperature and
+load band), residuals against each input, predicted against measured, and the optimiser's
+convergence history where there is one.
 """
 
 from __future__ import annotations
@@ -20,10 +21,11 @@ import pandas as pd
 
 from ..fitted import FittedModel
 from ..identify import evaluate
+from ..identify.trust import Trust, not_determined
 from ..samples import FrictionSamples
 from . import interactive, plots
 from .document import Document, Figure, Note, Table
-from .trust import Trust, assess_trust, not_determined, quality_frame, trust_text
+from .trust import quality_frame, trust_text
 
 __all__ = ["METRIC_LABELS", "metrics_table", "model_report", "parameter_table"]
 
@@ -185,11 +187,11 @@ def model_report(
     fitted: FittedModel,
     samples: FrictionSamples,
     *,
+    trust: Trust,
     velocity_unit: str = "rad/s",
     samples_label: str | None = None,
     bootstrap: int = 200,
     seed: int = 0,
-    validate: bool = True,
 ) -> Document:
     """Build the report of ``fitted`` on ``samples``.
 
@@ -197,14 +199,13 @@ def model_report(
     ----------
     fitted : the identified model (``FittedModel.load`` of a JSON model file).
     samples : friction samples to compare against (usually the identification data).
+    trust : the trust record to show first (:func:`fricid.identify.trust.assess_trust` of
+        ``fitted`` and ``samples``; the report renders it and computes no verdict).
     velocity_unit : display unit of velocity in the figures (``rad/s``, ``deg/s``, ``rpm``).
     samples_label : name of the samples in tables (default: their source file name).
     bootstrap : resamples for the RBF network's prediction interval (ignored for analytic
         models, whose CIs come from the Jacobian at the optimum).
     seed : seed of the bootstrap.
-    validate : run a leave-one-velocity-out validation for the trust section when the model
-        file has none (or only a learned model's own random-fold cross-validation) and the
-        problem is small enough (:func:`fricid.report.trust.assess_trust`).
 
     Returns
     -------
@@ -233,8 +234,12 @@ def model_report(
         },
     )
 
-    trust = assess_trust(fitted, samples, run_validation=validate)
-    doc.meta = {"trust": trust.line(), **doc.meta}
+    record = (
+        "read from the model file (computed on these samples with these options)"
+        if trust.reused
+        else "computed for this report"
+    )
+    doc.meta = {"trust": trust.line(), "trust record": record, **doc.meta}
     _trust_section(doc, trust)
 
     appendix: list = []

@@ -30,9 +30,9 @@ parameter count of :func:`fricid.metrics.fit_statistics`) do not apply as they a
   (scheme ``levels:K``, :func:`fricid.identify.learned._rbf_folds.level_folds`), so it tests
   prediction between the measured speeds, not beyond them; with too few levels they are
   dealt at random (scheme ``kfold:K``), and it tests the measured set-points only. Either
-  way the settings were chosen by it (optimistic). The report's verdict uses
+  way the settings were chosen by it (optimistic). The trust verdict uses
   leave-one-velocity-out instead, the analytic path's test, when it is affordable
-  (:data:`LEARNED_VALIDATE_WORK`; :mod:`fricid.report.trust`).
+  (:data:`LEARNED_VALIDATE_WORK`; :mod:`fricid.identify.trust`).
 """
 
 from __future__ import annotations
@@ -60,10 +60,10 @@ __all__ = [
 ]
 
 #: ``validation["source"]`` of a learned model's record of its own structure search's
-#: cross-validation (a report runs leave-one-velocity-out in its place when it can).
+#: cross-validation (the trust verdict runs leave-one-velocity-out in its place when it can).
 CV_SOURCE = "structure_search"
 
-#: Largest leave-one-velocity-out validation of a learned model a report runs itself, as
+#: Largest leave-one-velocity-out validation of a learned model the trust verdict runs itself, as
 #: folds x samples: each fold retrains the model with its structure search (a count, not a
 #: measured time, so the verdict does not depend on how busy the machine is). The demo's
 #: samples (``fricid demo``), 6 x 330 = 1,980: ``validate(samples, m, "lovo")`` took 1.1 s
@@ -301,8 +301,8 @@ def cv_validation(samples: FrictionSamples, pieces: Sequence[tuple[float, int, i
         "not_converged": 0,
         "folds": [],
         "source": CV_SOURCE,
-        "note": f"{tests}. fricid report runs leave-one-velocity-out, or fricid fit "
-        "--validate lovo",
+        "note": f"{tests}. The trust verdict runs leave-one-velocity-out when it is quick, or "
+        "fricid fit --validate lovo",
     }
 
 

@@ -24,14 +24,14 @@ where the samples have both, ``g(|v|, load, T)`` with ``F = sign(v) g``:
    deterministic training conditional on that subset (Quinonero-Candela & Rasmussen 2005,
    DTC), so prediction is a kernel sum over at most ``max_points`` stored points.
 
-The hyperparameters are not chosen by the cross-validation over whole speed levels that the
-RBF networks' structure search uses (:mod:`fricid.identify.learned._rbf_folds`): scoring them by
+The hyperparameters are not chosen by the cross-validation over whole speed levels that the RBF
+networks' structure search uses (:mod:`fricid.identify.learned._rbf_folds`): scoring them by
 held-out levels would refit the GP per fold for each of the optimiser's dozens of candidate
-hyperparameters, where the marginal likelihood needs one factorisation each. A report's
-leave-one-velocity-out (:mod:`fricid.report._heldout`) refits them in every fold: holding them
-at the full fit's values would be cheaper (R&W section 5.4.2), but the held-out level's own
-targets would then have chosen the length scales that predict it, the optimism the level
-folds are there to remove.
+hyperparameters, where the marginal likelihood needs one factorisation each. The trust
+verdict's leave-one-velocity-out (:mod:`fricid.identify._heldout`) refits them in every fold:
+holding them at the full fit's values would be cheaper (R&W section 5.4.2), but the held-out
+level's own targets would then have chosen the length scales that predict it, the optimism the
+level folds are there to remove.
 
 The state holds the points, the weights and the matrix of the posterior variance, so the
 predictive standard deviation travels with the model file (``FittedModel.predict(X,

@@ -1,11 +1,11 @@
 """What to do about a model whose held-out error misses the measurement scatter (the trust
-verdict's "no", :mod:`fricid.report.trust`): advice computed from the file and the validation,
-never a promise of what another model would achieve.
+verdict's "no", :mod:`fricid.identify.trust`): advice computed from the file and the
+validation, never a promise of what another model would achieve.
 
 Three readings, from the in-sample error against the scatter and, for leave-one-velocity-out,
 the interior folds (:func:`fricid.identify.validate.interior_rmse`):
 
-- the in-sample error alone misses (over :data:`~fricid.report.trust.MISS_RATIO` times the
+- the in-sample error alone misses (over :data:`~fricid.identify.trust.MISS_RATIO` times the
   scatter): the family cannot follow the data, and more data will not change that; a learned
   model (the hybrid: an analytic backbone plus a learned residual) or the comparison of every
   family by held-out error (``--model auto --learned``) is what to try;
@@ -19,13 +19,14 @@ the interior folds (:func:`fricid.identify.validate.interior_rmse`):
 
 from __future__ import annotations
 
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from ..fitted import FittedModel
+from ..metrics import rmse
 from ..samples import FrictionSamples
+from .validate import interior_rmse
 
 __all__ = ["misfit_advice"]
 
@@ -36,16 +37,7 @@ def _in_sample_ratio(fitted: FittedModel, samples: FrictionSamples | None, scatt
         return float(ratio)
     if samples is None or not np.isfinite(scatter) or scatter <= 0:
         return float("nan")
-    from ..metrics import rmse
-
     return rmse(samples.y, fitted.predict(samples.X, warn=False)) / scatter
-
-
-def _name(samples: FrictionSamples | None) -> str:
-    source = getattr(samples, "source", None) if samples is not None else None
-    name = Path(str(source)).name if source else ""
-    safe = name and all(c.isalnum() or c in "._-" for c in name)
-    return name if safe else "SAMPLES"
 
 
 def misfit_advice(
@@ -65,19 +57,18 @@ def misfit_advice(
     scatter : float
         N m, the measurement scatter.
     miss_ratio : float
-        The verdict's threshold (:data:`fricid.report.trust.MISS_RATIO`).
+        The verdict's threshold (:data:`fricid.identify.trust.MISS_RATIO`).
     samples : FrictionSamples, optional
-        Their file name goes into the commands; without a recorded in-sample ratio, the
-        in-sample error is computed on them.
+        Without a recorded in-sample ratio, the in-sample error is computed on them. The
+        commands name them ``SAMPLES``, not by their file: the advice is part of the trust
+        record, which depends on the samples' content, not on where they were read from.
 
     Returns
     -------
     str
         One sentence (module notes), ``""`` when no reading applies.
     """
-    from ..identify.validate import interior_rmse
-
-    name = _name(samples)
+    name = "SAMPLES"
     learned = fitted.kind == "rbf"
     r_in = _in_sample_ratio(fitted, samples, scatter)
     auto = f"compare every family by held-out error (fricid fit {name} --model auto --learned)"

@@ -1,0 +1,127 @@
+"""What a model file and its samples say about trust before any validation: parameters the
+data do not determine or bound, the operating range, and the samples' quality table.
+
+Helpers of :mod:`fricid.identify.trust` (the verdict), kept apart so that the verdict's module
+stays readable; :func:`not_determined` is also the report's parameter table status.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from ..fitted import FittedModel
+from ..samples import FrictionSamples
+
+__all__ = ["DROPS", "not_determined", "open_sides", "quality_rows", "range_text"]
+
+_UNITS = {"velocity": "rad/s", "load": "N m", "temperature": "degC"}
+
+#: The quality table's drop counts and what each dropped.
+DROPS = {
+    "dropped_rest": "at rest",
+    "dropped_transient": "transient",
+    "dropped_outlier": "outliers",
+    "dropped_saturated": "saturated",
+}
+
+
+def not_determined(fitted: FittedModel) -> list[str]:
+    """Free parameters the data do not determine: their ``uncertainty_note`` says so ("not
+    determined", "not identified"), or, in a file without notes from a converged fit, their
+    standard error is missing."""
+    out = []
+    for name in fitted.params:
+        if name in fitted.fixed:
+            continue
+        note = fitted.uncertainty_note.get(name, "")
+        se = fitted.stderr.get(name)
+        missing = se is None or not np.isfinite(se)
+        if note.startswith(("not determined", "not identified")) or (
+            not note and missing and fitted.converged is not False and fitted.kind != "rbf"
+        ):
+            out.append(name)
+    return out
+
+
+def _zero_floor(fitted: FittedModel, name: str, sides: list[bool]) -> bool:
+    """Only the lower side is open, at a bound of 0: the parameter is consistent with 0."""
+    box = fitted.bounds.get(name) or [np.nan, np.nan]
+    return bool(sides[0] and not sides[1] and box[0] == 0)
+
+
+def open_sides(fitted: FittedModel, *, include_zero: bool = False) -> dict[str, str]:
+    """Free parameters whose 95 % interval reaches a bound of the search box, with the note
+    of the fit (or one made here); ``include_zero`` keeps those open only at a lower bound of
+    0 ("consistent with zero")."""
+    out = {}
+    for name, sides in (fitted.ci_open or {}).items():
+        if name in fitted.fixed or not any(sides):
+            continue
+        if _zero_floor(fitted, name, sides) and not include_zero:
+            continue
+        which = " and ".join(s for s, o in zip(("lower", "upper"), sides, strict=True) if o)
+        out[name] = fitted.uncertainty_note.get(name) or f"{which} side reaches the search bound"
+    return out
+
+
+def range_text(fitted: FittedModel) -> str:
+    """The extrapolation-free operating range: ``"velocity 0.0105 to 0.838 rad/s; ..."``.
+
+    Velocity of a model of combined samples (direction 0, odd in velocity) is given as speed
+    ``|v|`` for either direction; one identified on one direction names it. Inputs the model
+    does not use are left out; ``""`` when the file records no range.
+    """
+    used = set(fitted.inputs_used()) if fitted.operating_range else set()
+    dirs = sorted({int(d) for d in (fitted.provenance or {}).get("directions") or ()})
+    parts = []
+    for name in ("velocity", "load", "temperature"):
+        pair = fitted.operating_range.get(name)
+        if not pair or name not in used:
+            continue
+        lo, hi = float(pair[0]), float(pair[1])
+        unit = _UNITS[name]
+        if name == "velocity" and dirs == [0]:
+            parts.append(f"speed {lo:.4g} to {hi:.4g} {unit} (either direction)")
+        elif name == "velocity" and dirs in ([1], [-1]):
+            side = "positive" if dirs == [1] else "negative"
+            parts.append(f"velocity {lo:.4g} to {hi:.4g} {unit} ({side} direction only)")
+        elif lo == hi:
+            parts.append(f"{name} {lo:.4g} {unit} only")
+        else:
+            parts.append(f"{name} {lo:.4g} to {hi:.4g} {unit}")
+    return "; ".join(parts)
+
+
+def quality_rows(
+    samples: FrictionSamples | None,
+) -> tuple[list[dict[str, Any]] | None, str, str]:
+    """(rows, summary, caveat) of the samples' quality table (``meta["quality"]``,
+    :class:`fricid.extract.QualityTable`): rows None when not recorded."""
+    rows = None if samples is None else samples.meta.get("quality")
+    if not isinstance(rows, list) or not rows or not all(isinstance(r, dict) for r in rows):
+        return None, "not recorded with these samples (no meta quality table)", ""
+    points = [r for r in rows if r.get("kind", "setpoint") == "setpoint"]
+    total = {k: sum(int(r.get(k) or 0) for r in rows) for k in DROPS}
+    kept = sum(int(r.get("kept") or 0) for r in points)
+    flagged = [r for r in points if r.get("flagged")]
+    dropped = ", ".join(f"{v} {DROPS[k]}" for k, v in total.items() if v) or "none"
+    summary = f"{len(points)} set-points, {kept} samples averaged; dropped: {dropped}"
+    caveats = []
+    if flagged:
+        names = ", ".join(_point_name(r) for r in flagged[:4])
+        caveats.append(
+            f"{len(flagged)} set-point(s) with scatter far above their neighbours' ({names})"
+        )
+    if total["dropped_outlier"]:
+        caveats.append(f"{total['dropped_outlier']} outlier sample(s) dropped")
+    if flagged:
+        summary += f"; {len(flagged)} flagged for high scatter"
+    return rows, summary, "; ".join(caveats)
+
+
+def _point_name(row: dict[str, Any]) -> str:
+    v = row.get("velocity")
+    where = f"{v:.4g} rad/s" if isinstance(v, int | float) else "?"
+    return f"{row['label']} ({where})" if row.get("label") else where

@@ -1,0 +1,82 @@
+"""What a trust record was computed on (:mod:`fricid.identify.trust`, "Reuse"): hashes of the
+model file and of the samples that survive a JSON round trip, and the record made JSON-ready.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from typing import Any
+
+import numpy as np
+
+from ..fitted import FittedModel
+from ..samples import FrictionSamples
+
+__all__ = ["canonical", "json_ready", "model_hash", "samples_detail_hash"]
+
+
+def json_ready(value: Any) -> Any:
+    """``value`` with numpy values as Python ones and non-finite floats as None, recursively."""
+    if isinstance(value, dict):
+        return {str(k): json_ready(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [json_ready(v) for v in value]
+    if isinstance(value, np.ndarray):
+        return json_ready(value.tolist())
+    if isinstance(value, bool | np.bool_):
+        return bool(value)
+    if isinstance(value, int | np.integer):
+        return int(value)
+    if isinstance(value, float | np.floating):
+        return float(value) if np.isfinite(value) else None
+    return value
+
+
+def canonical(value: Any) -> Any:
+    """Numbers as floats (1 and 1.0 alike, as a JSON round trip leaves them), recursively."""
+    if isinstance(value, dict):
+        return {str(k): canonical(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [canonical(v) for v in value]
+    if isinstance(value, bool) or value is None or isinstance(value, str):
+        return value
+    if isinstance(value, int | float):
+        return float(value)
+    return value
+
+
+def _digest(doc: Any) -> str:
+    text = json.dumps(canonical(doc), sort_keys=True, separators=(",", ":"))
+    return hashlib.sha256(text.encode("utf-8")).hexdigest()[:16]
+
+
+def model_hash(fitted: FittedModel) -> str:
+    """A hash of the model file without its ``trust`` and the provenance's source, time,
+    version and warnings (what may change after the record is computed, or between two
+    copies of the same samples, without changing the model)."""
+    d = fitted.to_dict()
+    for key in ("trust", "fricid_version", "schema_version"):
+        d.pop(key, None)
+    d["provenance"] = {
+        k: v
+        for k, v in (d.get("provenance") or {}).items()
+        if k not in ("source", "created", "fricid_version", "warnings")
+    }
+    return _digest(d)
+
+
+def samples_detail_hash(samples: FrictionSamples) -> str:
+    """A hash of what the scatter and the quality table read besides the values: count, std
+    and ``meta`` ``sem``, ``sem_method``, ``sem_caveat`` and ``quality``."""
+    meta = {k: samples.meta.get(k) for k in ("sem", "sem_method", "sem_caveat", "quality")}
+    doc = {"count": samples.count.tolist(), "std": samples.std.tolist(), "meta": meta}
+    return _digest(json.loads(json.dumps(doc, default=_default)))
+
+
+def _default(value: Any) -> Any:
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, np.generic):
+        return value.item()
+    return str(value)

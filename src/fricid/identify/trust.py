@@ -1,0 +1,484 @@
+"""Can I trust this model? The one place the verdict is computed: :func:`assess_trust`.
+
+``fricid fit``, the fleet (through :func:`fricid.workflow.fit_samples`) and ``fricid report``
+all call :func:`assess_trust` and read the one record it returns, a :class:`Trust`; the report
+renders it and the fleet's verdict columns are its fields, so neither recomputes anything. It
+reads the model file (and, where given, the samples the model was identified on):
+
+- data quality per set-point: kept and dropped samples, and why, from the samples'
+  ``meta["quality"]`` (:class:`fricid.extract.QualityTable`), or a note that it is not
+  recorded;
+- convergence: the ``convergence`` block (:func:`fricid.identify.static.convergence.certify`),
+  its reason and advice when the fit did not converge;
+- identifiability: parameters not determined (``uncertainty_note``, a NaN standard error) and
+  intervals with an open side (``ci_open``); an open lower side at a bound of 0 means
+  "consistent with zero" and is not a caveat;
+- held-out error against the measurement scatter, from (``Trust.heldout_source``):
+  :data:`FROM_FIT` (the fit's own held-out validation: ``fricid fit --validate``, the
+  manifest's ``validate``, or ``--model auto``'s choice); else, given the samples,
+  :data:`RUN_HERE` (:func:`fricid.identify.validate` with ``lovo``, when the samples have at
+  least :data:`MIN_LEVELS` velocity levels and the problem is small enough:
+  :mod:`._heldout`, an analytic model's folds x samples x parameters at most
+  :data:`VALIDATE_WORK`, a learned model's folds x samples at most
+  :data:`LEARNED_VALIDATE_WORK`, each fold retrained as ``fit`` trains it); else
+  :data:`OWN_CV` (a learned model's own cross-validation, with its caveat); else
+  :data:`IN_SAMPLE` (the fit's ``rmse_over_scatter``): an in-sample number is never labelled
+  held out;
+- the operating range, outside which predictions are extrapolated.
+
+The level is ``"no"`` when the fit did not converge, no free parameter is determined, or the
+model misses the data by more than :data:`MISS_RATIO` times the scatter; ``"with caveats"``
+when anything else above is short of clean (a parameter not determined or not bounded, an
+error between :data:`fricid.metrics.NOISE_RATIO` and :data:`MISS_RATIO` times the scatter,
+no held-out error or no scatter, convergence not recorded, set-points flagged for scatter or
+with outliers dropped); ``"yes"`` otherwise. A model whose error misses the scatter gets
+what to do (:func:`._advice.misfit_advice`).
+
+Reuse. The model file may carry the record (``FittedModel.trust``; ``fricid fit`` and the
+fleet store it). :func:`assess_trust` returns it instead of computing again only when it was
+computed by this record format (:data:`TRUST_VERSION`) on the same samples (their values,
+:func:`fricid.samples.samples_hash`, and what the scatter and the quality table read: count,
+std, ``meta`` sem and quality), with the same options (``validate``, the work limits), for
+the same model (every field of the file but ``trust`` and the provenance's source, time,
+version and warnings); anything else is computed again. A record that does not parse is ignored.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, field, fields
+from typing import Any
+
+import numpy as np
+
+from ..fitted import FittedModel
+from ..fitted._file import _convergence_line
+from ..metrics import NOISE_RATIO, rmse, verdict
+from ..samples import FrictionSamples, samples_hash
+from ._diagnostics import DROPS, not_determined, open_sides, quality_rows, range_text
+from ._fingerprint import canonical, json_ready, model_hash, samples_detail_hash
+from ._heldout import LEARNED_VALIDATE_WORK, MIN_LEVELS, VALIDATE_WORK, own_cv, run_validation
+from ._scatter import measurement_scatter
+
+__all__ = [
+    "DROPS",
+    "FROM_FIT",
+    "HELD_OUT",
+    "IN_SAMPLE",
+    "LEARNED_VALIDATE_WORK",
+    "MIN_LEVELS",
+    "MISS_RATIO",
+    "OWN_CV",
+    "RUN_HERE",
+    "TRUST_VERSION",
+    "VALIDATE_WORK",
+    "Trust",
+    "assess_trust",
+    "not_determined",
+    "open_sides",
+    "own_cv",
+    "range_text",
+    "trust_options",
+]
+
+#: A model whose (held-out) RMSE exceeds this multiple of the measurement scatter is not
+#: trusted: most of its error is the model's, not the noise's.
+MISS_RATIO = 3.0
+
+#: Format of the record and of the rules behind it: a stored record of another is recomputed.
+TRUST_VERSION = 1
+
+#: ``Trust.heldout_source``: leave-one-velocity-out run by :func:`assess_trust`.
+RUN_HERE = "lovo run here"
+#: ... the fit's own held-out validation (``--validate``, the manifest's ``validate``, auto).
+FROM_FIT = "the fit's --validate"
+#: ... a learned model's own structure-search cross-validation.
+OWN_CV = "the learned model's own CV"
+#: ... no held-out error: the fit's in-sample RMSE over the scatter.
+IN_SAMPLE = "in-sample only"
+#: The sources whose ratio is a held-out one.
+HELD_OUT = (RUN_HERE, FROM_FIT, OWN_CV)
+
+
+@dataclass
+class Trust:
+    """Whether to trust a model, the diagnostics behind it, and where each number came from.
+
+    Attributes
+    ----------
+    level : str
+        ``"yes"``, ``"with caveats"`` or ``"no"``.
+    reasons : list of str
+        Why, most severe first.
+    converged : bool or None
+        None when the file does not record it.
+    convergence : str
+        One line: converged (and how it was certified), or NOT converged with the reason.
+    advice : str
+        What to do about a fit that did not converge ("" otherwise).
+    not_determined : list of str
+        Free parameters the data do not determine.
+    open_sides : dict of str to str
+        Free parameters whose 95 % interval reaches a bound of the search box, with the note.
+    heldout_ratio : float
+        RMSE over the measurement scatter: held out when ``heldout_source`` is one of
+        :data:`HELD_OUT`, else the fit's in-sample ratio (NaN when there is no scatter).
+    heldout_rmse, scatter : float
+        N m, the RMSE of that ratio and the scatter (NaN when unknown).
+    heldout_source : str
+        :data:`RUN_HERE`, :data:`FROM_FIT`, :data:`OWN_CV`, :data:`IN_SAMPLE`, or ``""``
+        (no ratio at all).
+    heldout_scheme : str
+        The held-out scheme (``"lovo"``, ``"kfold:5"``, ``"levels:4"``), ``""`` in-sample.
+    verdict : str
+        :func:`fricid.metrics.verdict` of the ratio.
+    validation : dict or None
+        The validation the ratio is on (``Validation.to_dict()``), None in-sample.
+    validation_note : str
+        How a validation was run here, or why none was.
+    range : str
+        The extrapolation-free operating range, as text.
+    quality : list of dict or None
+        The samples' ``meta["quality"]`` rows, None when not recorded.
+    quality_summary : str
+        One line on them.
+    learned : bool
+        The model is learned (the RBF network, the hybrid, the GP: no physical parameters
+        to identify).
+    cv : dict or None
+        A learned model's own cross-validation record when the verdict is on another
+        validation (shown beside it).
+    what_to_do : str
+        For a model whose error misses the scatter: what to do; "" otherwise.
+    model : str
+        The model's registry name.
+    samples_hash, samples_detail_hash, model_hash : str or None
+        What it was computed on (module notes, "Reuse"); None without samples.
+    options : dict
+        The options it was computed with (:func:`trust_options`).
+    version : int
+        :data:`TRUST_VERSION` of the record.
+    reused : bool
+        Read from the model file rather than computed now (not stored).
+    """
+
+    level: str
+    reasons: list[str]
+    converged: bool | None
+    convergence: str
+    advice: str = ""
+    not_determined: list[str] = field(default_factory=list)
+    open_sides: dict[str, str] = field(default_factory=dict)
+    heldout_ratio: float = float("nan")
+    heldout_rmse: float = float("nan")
+    scatter: float = float("nan")
+    heldout_source: str = ""
+    heldout_scheme: str = ""
+    verdict: str = ""
+    validation: dict[str, Any] | None = None
+    validation_note: str = ""
+    range: str = ""
+    quality: list[dict[str, Any]] | None = None
+    quality_summary: str = ""
+    learned: bool = False
+    cv: dict[str, Any] | None = None
+    what_to_do: str = ""
+    model: str = ""
+    samples_hash: str | None = None
+    samples_detail_hash: str | None = None
+    model_hash: str | None = None
+    options: dict[str, Any] = field(default_factory=dict)
+    version: int = TRUST_VERSION
+    reused: bool = field(default=False, compare=False)
+
+    @property
+    def held_out(self) -> bool:
+        """The ratio is a held-out one (:data:`HELD_OUT`)."""
+        return self.heldout_source in HELD_OUT
+
+    def line(self) -> str:
+        """``"Trust: with caveats, because ..."``, and for a model that misses the data what
+        to do."""
+        out = f"Trust: {self.level}, because " + "; ".join(self.reasons) + "."
+        return out + (f" What to do: {self.what_to_do}." if self.what_to_do else "")
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready (non-finite numbers as None), for the model file's ``trust``."""
+        d = asdict(self)
+        d.pop("reused")
+        return json_ready(d)
+
+    @classmethod
+    def from_dict(cls, d: dict[str, Any]) -> Trust:
+        """The record :meth:`to_dict` wrote (unknown keys ignored).
+
+        Raises
+        ------
+        TypeError, ValueError, KeyError
+            Not such a record.
+        """
+        known = {f.name for f in fields(cls)} - {"reused"}
+        kwargs = {k: v for k, v in dict(d).items() if k in known}
+        for key in ("heldout_ratio", "heldout_rmse", "scatter"):
+            value = kwargs.get(key)
+            if value is not None and (
+                isinstance(value, bool) or not isinstance(value, int | float)
+            ):
+                raise TypeError(f"trust record: '{key}' is not a number")
+            kwargs[key] = float("nan") if value is None else float(value)
+        out = cls(**kwargs)
+        _check_types(out)
+        return out
+
+
+#: The type of each text, list and mapping field of a record read from a file: a record
+#: of other types is not used (the report would fail on it).
+_TEXT = (
+    "level",
+    "convergence",
+    "advice",
+    "heldout_source",
+    "heldout_scheme",
+    "verdict",
+    "validation_note",
+    "range",
+    "quality_summary",
+    "what_to_do",
+    "model",
+)
+
+
+def _check_types(record: Trust) -> None:
+    """TypeError unless every field of ``record`` has the type the report reads."""
+
+    def texts(value: Any) -> bool:
+        return isinstance(value, list) and all(isinstance(v, str) for v in value)
+
+    def rows(value: Any) -> bool:
+        return isinstance(value, list) and all(isinstance(v, dict) for v in value)
+
+    ok = [
+        record.level in ("yes", "with caveats", "no"),
+        all(isinstance(getattr(record, k), str) for k in _TEXT),
+        texts(record.reasons) and texts(record.not_determined),
+        isinstance(record.open_sides, dict) and texts(list(record.open_sides.values())),
+        record.converged is None or isinstance(record.converged, bool),
+        isinstance(record.learned, bool) and isinstance(record.options, dict),
+        record.quality is None or rows(record.quality),
+    ]
+    for part in (record.validation, record.cv):
+        ok.append(part is None or (isinstance(part, dict) and rows(part.get("folds") or [])))
+    if not all(ok):
+        raise TypeError("not a trust record of this fricid")
+
+
+# -- what a record was computed on -------------------------------------------------------
+
+
+def trust_options(validate: bool = True, max_work: int = VALIDATE_WORK) -> dict[str, Any]:
+    """The options a record depends on: whether a validation may be run here and its limits."""
+    return {
+        "validate": bool(validate),
+        "max_work": int(max_work),
+        "learned_work": int(LEARNED_VALIDATE_WORK),
+        "min_levels": int(MIN_LEVELS),
+    }
+
+
+def _key(
+    fitted: FittedModel, samples: FrictionSamples | None, options: dict[str, Any]
+) -> dict[str, Any]:
+    return {
+        "samples_hash": None if samples is None else samples_hash(samples),
+        "samples_detail_hash": None if samples is None else samples_detail_hash(samples),
+        "model_hash": model_hash(fitted),
+        "options": options,
+        "version": TRUST_VERSION,
+    }
+
+
+def _stored(fitted: FittedModel, key: dict[str, Any]) -> Trust | None:
+    """The model file's record when it was computed on ``key`` (module notes), else None."""
+    if not isinstance(fitted.trust, dict):
+        return None
+    try:
+        stored = Trust.from_dict(fitted.trust)
+    except (TypeError, ValueError, KeyError):
+        return None
+    same = all(canonical(getattr(stored, k)) == canonical(v) for k, v in key.items())
+    if not same:
+        return None
+    stored.reused = True
+    return stored
+
+
+# -- the verdict --------------------------------------------------------------------------
+
+
+def assess_trust(
+    fitted: FittedModel,
+    samples: FrictionSamples | None = None,
+    *,
+    validate: bool = True,
+    max_work: int = VALIDATE_WORK,
+    reuse: bool = True,
+) -> Trust:
+    """Whether to trust ``fitted``, from its file and (optionally) its samples.
+
+    Parameters
+    ----------
+    fitted : FittedModel
+        The model.
+    samples : FrictionSamples, optional
+        The samples it was identified on: their quality table, and the held-out validation
+        when the fit has none.
+    validate : bool, default True
+        Run :func:`fricid.identify.validate` (``lovo``) when the fit holds no validation, or
+        only a learned model's own cross-validation, and the problem is small enough (module
+        notes).
+    max_work : int
+        The size limit of an analytic model's validation (:data:`VALIDATE_WORK`).
+    reuse : bool, default True
+        Return the record the model file carries when it was computed on the same samples,
+        options and model (module notes, "Reuse").
+
+    Returns
+    -------
+    Trust
+        The level and its reasons, each number with its source (module notes).
+    """
+    options = trust_options(validate, max_work)
+    key = _key(fitted, samples, options)
+    if reuse:
+        stored = _stored(fitted, key)
+        if stored is not None:
+            return stored
+    trust = _base(fitted, samples)
+    trust.samples_hash, trust.samples_detail_hash = key["samples_hash"], key["samples_detail_hash"]
+    trust.model_hash, trust.options = key["model_hash"], options
+    mine = own_cv(fitted.validation)
+    can_run = samples is not None and validate and trust.converged
+    if (mine or fitted.validation is None) and can_run:
+        val, trust.validation_note = run_validation(fitted, samples, max_work)
+        if val is not None:
+            trust.validation, trust.heldout_source = val, RUN_HERE
+    elif fitted.validation is None:
+        trust.validation_note = "no held-out validation in the file; in-sample only"
+    elif mine:
+        trust.validation_note = "leave-one-velocity-out not run here; the fit's own CV only"
+    if trust.validation is None and fitted.validation is not None:
+        trust.validation = fitted.validation
+        trust.heldout_source = OWN_CV if mine else FROM_FIT
+    if mine and trust.heldout_source == RUN_HERE:
+        trust.cv = fitted.validation
+    _ratio(trust, fitted, samples)
+    quality_caveat = _quality(trust, samples)
+    _grade(trust, fitted, quality_caveat)
+    if trust.converged is not False and trust.heldout_ratio > MISS_RATIO:
+        from ._advice import misfit_advice
+
+        held = trust.validation if trust.held_out else None
+        trust.what_to_do = misfit_advice(fitted, held, trust.scatter, MISS_RATIO, samples)
+    return trust
+
+
+def _base(fitted: FittedModel, samples: FrictionSamples | None) -> Trust:
+    """The record's file diagnostics: convergence, identifiability, range (module notes)."""
+    conv = fitted.convergence
+    converged = fitted.converged
+    if conv is None:
+        line = "not recorded in this model file"
+    elif converged:
+        line = _convergence_line(conv)
+    else:
+        line = f"NOT converged: {conv.get('reason') or conv.get('message') or 'no reason given'}"
+    return Trust(
+        level="yes",
+        reasons=[],
+        converged=converged,
+        convergence=line,
+        advice=str(conv.get("advice", "")) if conv is not None and not converged else "",
+        not_determined=not_determined(fitted),
+        open_sides=open_sides(fitted),
+        range=range_text(fitted),
+        learned=fitted.kind == "rbf",
+        model=fitted.model,
+    )
+
+
+def _quality(trust: Trust, samples: FrictionSamples | None) -> str:
+    """Set the quality rows and summary; return the caveat ("" for none)."""
+    trust.quality, trust.quality_summary, caveat = quality_rows(samples)
+    return caveat
+
+
+def _ratio(trust: Trust, fitted: FittedModel, samples: FrictionSamples | None) -> None:
+    """The ratio to grade by: held out (``trust.validation``), else the file's in-sample
+    ratio, else the in-sample ratio on ``samples`` (a network's file may not record its
+    scatter)."""
+    v = trust.validation
+    if v and v.get("ratio") is not None:
+        trust.heldout_ratio = float(v["ratio"])
+        trust.heldout_rmse = float(v["rmse"]) if v.get("rmse") is not None else np.nan
+        trust.scatter = float(v["scatter"]) if v.get("scatter") is not None else np.nan
+        trust.heldout_scheme = str(v.get("scheme", ""))
+    else:  # no held-out ratio (no validation, or one without a scatter): in-sample
+        trust.heldout_source = ""
+        if fitted.metrics.get("rmse_over_scatter") is not None:
+            trust.heldout_ratio = float(fitted.metrics["rmse_over_scatter"])
+            trust.heldout_rmse = float(fitted.metrics.get("rmse", np.nan))
+            trust.scatter = float(fitted.metrics.get("scatter", np.nan))
+            trust.heldout_source = IN_SAMPLE
+        elif samples is not None:
+            sc = measurement_scatter(samples)
+            if np.isfinite(sc.value) and sc.value > 0:
+                trust.heldout_rmse = rmse(samples.y, fitted.predict(samples.X, warn=False))
+                trust.scatter = sc.value
+                trust.heldout_ratio = trust.heldout_rmse / sc.value
+                trust.heldout_source = IN_SAMPLE
+    trust.verdict = verdict(trust.heldout_ratio)
+
+
+def _grade(trust: Trust, fitted: FittedModel, quality_caveat: str) -> None:
+    """Set ``trust.level`` and ``trust.reasons`` (module notes)."""
+    no, caveats = [], []
+    free = [n for n in fitted.params if n not in fitted.fixed]
+    if trust.converged is False:
+        no.append(f"the fit did NOT converge ({trust.advice or 'see the convergence block'})")
+    elif trust.converged is None:
+        caveats.append("convergence is not recorded in this model file")
+    if free and len(trust.not_determined) == len(free):
+        no.append("no parameter is determined by the data")
+    elif trust.not_determined:
+        caveats.append(f"not determined by the data: {', '.join(trust.not_determined)}")
+    if trust.open_sides:
+        caveats.append(f"not bounded by the data: {', '.join(trust.open_sides)}")
+    ratio = trust.heldout_ratio
+    kind = "held-out" if trust.held_out else "in-sample"
+    if np.isfinite(ratio) and ratio > MISS_RATIO:
+        no.append(f"the {kind} error {trust.verdict} the measurement scatter")
+    elif np.isfinite(ratio) and ratio > NOISE_RATIO:
+        caveats.append(f"the {kind} error {trust.verdict} the measurement scatter")
+    elif not np.isfinite(ratio):
+        caveats.append("no measurement scatter to compare the error with")
+    if np.isfinite(ratio) and not trust.held_out and not no:
+        caveats.append("no held-out validation (in-sample error only)")
+    elif np.isfinite(ratio) and trust.heldout_source == OWN_CV and not no:
+        levels = trust.heldout_scheme.startswith("levels")
+        caveats.append(
+            "held out between the measured speeds only (the fit's own CV over whole speed "
+            "levels; beyond them untested)"
+            if levels
+            else "held out at the measured velocity levels only (the fit's own random-fold CV; "
+            "between and beyond them untested)"
+        )
+    if quality_caveat:
+        caveats.append(quality_caveat)
+    if no:
+        trust.level, trust.reasons = "no", no + caveats
+        return
+    if caveats:
+        trust.level, trust.reasons = "with caveats", caveats
+        return
+    held = f"{kind} error is within noise ({ratio:.2f}x the scatter)"
+    det = "every parameter is determined" if free else "the network fits"
+    trust.level, trust.reasons = "yes", [f"the fit converged, {det} and the {held}"]

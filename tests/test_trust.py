@@ -1,0 +1,252 @@
+"""``fricid.identify.trust``: the one trust record, where each number came from, when a stored
+record is reused, and the same verdict from ``fricid fit``, the fleet and ``fricid report``."""
+
+from __future__ import annotations
+
+import json
+import re
+import warnings
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+from typer.testing import CliRunner
+
+from fricid.cli import app
+from fricid.cli.simulate import design_hints
+from fricid.fitted import FittedModel
+from fricid.identify import fit, trust
+from fricid.identify.trust import (
+    FROM_FIT,
+    IN_SAMPLE,
+    RUN_HERE,
+    Trust,
+    assess_trust,
+)
+from fricid.io import epos_steady_samples, write_rawlog, write_samples
+from fricid.sim import preset, simulate
+from fricid.workflow import fit_samples
+
+runner = CliRunner()
+
+
+@pytest.fixture(scope="module")
+def leadscrew(leadscrew_dir):
+    return epos_steady_samples(leadscrew_dir)
+
+
+@pytest.fixture(scope="module")
+def fitted(leadscrew):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return fit(leadscrew, "stribeck_asym")
+
+
+def _no_validation(monkeypatch):
+    """Make any validation run by the trust check fail the test."""
+
+    def boom(*args, **kwargs):
+        raise AssertionError("the stored trust record should have been reused")
+
+    monkeypatch.setattr(trust, "run_validation", boom)
+
+
+# -- the record and its sources ------------------------------------------------------------------
+
+
+def test_sources_say_where_the_ratio_came_from(fitted, leadscrew):
+    here = assess_trust(fitted, leadscrew)
+    assert (here.heldout_source, here.heldout_scheme, here.held_out) == (RUN_HERE, "lovo", True)
+    assert here.heldout_ratio == pytest.approx(here.validation["ratio"])
+    # no validation run: the in-sample ratio, never labelled held out
+    inside = assess_trust(fitted, leadscrew, validate=False)
+    assert (inside.heldout_source, inside.heldout_scheme, inside.held_out) == (IN_SAMPLE, "", False)
+    assert inside.heldout_ratio == pytest.approx(fitted.metrics["rmse_over_scatter"])
+    assert "no held-out validation (in-sample error only)" in inside.line()
+    # the fit's own validation is used as it is, and named so
+    validated, record = fit_samples(leadscrew, "stribeck_asym", validate="kfold:4")
+    assert (record.heldout_source, record.heldout_scheme) == (FROM_FIT, "kfold:4")
+    assert record.heldout_ratio == validated.validation["ratio"]
+    assert validated.trust == record.to_dict()
+
+
+def test_record_round_trips_and_is_reused_from_the_model_file(
+    fitted, leadscrew, tmp_path, monkeypatch
+):
+    record = assess_trust(fitted, leadscrew)
+    assert not record.reused
+    again = Trust.from_dict(json.loads(json.dumps(record.to_dict())))
+    assert again.to_dict() == record.to_dict()
+    model = replace(fitted, trust=record.to_dict())
+    model.provenance = {**model.provenance, "warnings": ["added after the record"]}
+    loaded = FittedModel.load(model.save(tmp_path / "m.json"))
+    _no_validation(monkeypatch)
+    reused = assess_trust(loaded, leadscrew)
+    assert reused.reused and reused.to_dict() == record.to_dict()
+
+
+def test_record_is_recomputed_for_other_samples_options_or_model(fitted, leadscrew):
+    record = assess_trust(fitted, leadscrew, validate=False)  # no lovo: quick to recompute
+    model = replace(fitted, trust=record.to_dict())
+    assert assess_trust(model, leadscrew, validate=False).reused
+    # other samples: one row fewer, or the same values with other standard errors
+    fewer = leadscrew.subset(np.arange(len(leadscrew)) > 0)
+    other_std = replace(leadscrew, std=leadscrew.std * 2.0)
+    # another model, another record format, a record that does not parse
+    edited = replace(model, params={**model.params, "tau_c_pos": model.params["tau_c_pos"] * 1.01})
+    old = replace(model, trust={**record.to_dict(), "version": 0})
+    broken = replace(model, trust={"level": 3})
+    for m, s in ((model, fewer), (model, other_std), (edited, leadscrew), (old, leadscrew)):
+        assert not assess_trust(m, s, validate=False).reused
+    assert not assess_trust(model, leadscrew, validate=False, reuse=False).reused
+    assert not assess_trust(model, leadscrew, validate=False, max_work=10).reused
+    assert not assess_trust(model, None, validate=False).reused
+    again = assess_trust(broken, leadscrew, validate=False)
+    assert not again.reused and again.to_dict() == record.to_dict()
+    # a record of the right key but of types the report cannot read is not used either
+    for bad in ({"reasons": "text"}, {"open_sides": ["a"]}, {"heldout_ratio": "1"}):
+        odd = replace(model, trust={**record.to_dict(), **bad})
+        assert not assess_trust(odd, leadscrew, validate=False).reused
+    # other options: a record without lovo is not the one a default report shows
+    assert assess_trust(model, leadscrew).heldout_source == RUN_HERE
+
+
+# -- the same verdict everywhere ------------------------------------------------------------------
+
+
+def _report(model: Path, samples: Path, out: Path) -> tuple[str, str]:
+    """``fricid report``: (the Trust line it prints, the report's Markdown)."""
+    res = runner.invoke(app, ["report", str(model), str(samples), "--out", str(out)])
+    assert res.exit_code == 0, res.output
+    line = next(x for x in res.stderr.splitlines() if x.startswith("Trust:"))
+    return line, (out / "report.md").read_text(encoding="utf-8")
+
+
+def _ratio(md: str) -> float:
+    """The error ratio of the report's trust section: its RMSE over its scatter (3 digits)."""
+    m = re.search(r"RMSE (?:\([^)]*\) )?([0-9.e+-]+) N m against a scatter of ([0-9.e+-]+) N m", md)
+    return float(m.group(1)) / float(m.group(2))
+
+
+def _level(line: str) -> str:
+    return re.match(r"Trust: (yes|with caveats|no), because", line).group(1)
+
+
+def _fresh(model: Path, samples: Path) -> Trust:
+    """The record `fricid report` computes when the model file carries none."""
+    from fricid.io import read_samples
+
+    fitted = FittedModel.load(model)
+    assert fitted.trust is not None
+    fitted.trust = None
+    return assess_trust(fitted, read_samples(samples))
+
+
+@pytest.mark.slow  # about 25 s: a fleet of two joints, two extractions, two reports
+def test_fleet_row_and_report_agree(tmp_path, leadscrew_dir):
+    """A fleet row and `fricid report` on the fleet's model file and the same samples give the
+    same held-out ratio and verdict: the paper-1 virtual joint's vlt (validated by the trust
+    check itself) and the EPOS lead screw's stribeck_asym (the manifest's validate)."""
+    from fricid.fleet import SerialExecutor, read_results, run_fleet
+
+    sc = preset("paper1", "reduced")
+    hints = design_hints(sc)
+    chunks = (replace(c, meta={**c.meta, "design": hints}) for c in simulate(sc, seed=3))
+    log = write_rawlog(chunks, tmp_path / "paper1.parquet")
+    (tmp_path / "m.yaml").write_text(
+        f"joints:\n  - robot: virtual\n    joint: j1\n    log: {log}\n    model: vlt\n"
+        f"  - robot: leadscrew\n    joint: axis\n    log: {leadscrew_dir}\n    reader: epos\n"
+        "    flip_sign: true\n    nominal_torque [mN m]: 9.84\n    model: stribeck_asym\n"
+        "    validate: lovo\n",
+        encoding="utf-8",
+    )
+    run = run_fleet(tmp_path / "m.yaml", tmp_path / "out", executor=SerialExecutor())
+    assert run.failed == 0
+    table = read_results(tmp_path / "out" / "results.csv").set_index("robot")
+    extract = {
+        "virtual": ["extract", str(log)],
+        "leadscrew": ["extract", str(leadscrew_dir), "--format", "epos", "--flip-sign"],
+    }
+    sources = {"virtual": RUN_HERE, "leadscrew": FROM_FIT}
+    for robot, args in extract.items():
+        row = table.loc[robot]
+        samples = tmp_path / f"{robot}.parquet"
+        assert runner.invoke(app, [*args, "-o", str(samples)]).exit_code == 0
+        model = tmp_path / "out" / row["model_file"]
+        line, md = _report(model, samples, tmp_path / f"{robot}-report")
+        assert row["heldout_source"] == sources[robot] and row["heldout_scheme"] == "lovo"
+        assert _level(line) == row["trust"]
+        assert row["verdict"] in md and "read from the model file" in md
+        assert _ratio(md) == pytest.approx(row["heldout_ratio"], rel=1e-2)
+        # computed afresh, as the report computes it without a stored record: the same
+        fresh = _fresh(model, samples)
+        assert fresh.line() == line and fresh.heldout_ratio == row["heldout_ratio"]
+    # the lovo-validated vlt misses by far more than its in-sample ratio said
+    vlt = table.loc["virtual"]
+    saved = json.loads((tmp_path / "out" / vlt["model_file"]).read_text())
+    assert vlt["trust"] == "no" and vlt["heldout_ratio"] > saved["metrics"]["rmse_over_scatter"]
+
+
+def test_fit_validate_lovo_and_report_agree(leadscrew, tmp_path):
+    """`fricid fit --validate lovo` prints the verdict it stores; `fricid report` on the same
+    samples reads the same record, and computing it again gives the same line."""
+    samples = write_samples(leadscrew, tmp_path / "s.csv")
+    model = tmp_path / "m.json"
+    res = runner.invoke(
+        app,
+        ["fit", str(samples), "-m", "stribeck_asym", "--validate", "lovo", "-o", str(model)],
+    )
+    assert res.exit_code == 0, res.output
+    block = res.stdout.split("[[Trust]]\n", 1)[1].splitlines()
+    fit_line = block[0].strip()
+    assert "[the fit's --validate (lovo)]" in block[1]
+    stored = json.loads(model.read_text())
+    assert stored["trust"]["heldout_source"] == FROM_FIT
+    assert stored["trust"]["heldout_ratio"] == stored["validation"]["ratio"]
+    line, md = _report(model, samples, tmp_path / "r")
+    assert line == fit_line and "read from the model file" in md
+    assert _ratio(md) == pytest.approx(stored["validation"]["ratio"], rel=1e-2)
+    assert _fresh(model, samples).line() == fit_line
+
+
+def test_fit_without_validate_stores_the_lovo_the_report_would_run(leadscrew, tmp_path):
+    samples = write_samples(leadscrew, tmp_path / "s.csv")
+    model = tmp_path / "m.json"
+    res = runner.invoke(app, ["fit", str(samples), "-m", "stribeck", "-o", str(model)])
+    assert res.exit_code == 0, res.output
+    stored = json.loads(model.read_text())
+    assert stored["validation"] is None and stored["trust"]["heldout_source"] == RUN_HERE
+    line, _ = _report(model, samples, tmp_path / "r")
+    assert line.startswith(f"Trust: {stored['trust']['level']}, because")
+    assert pd.notna(stored["trust"]["heldout_ratio"])
+
+
+def test_run_joint_takes_fricid_fits_options_and_gives_the_same_model(leadscrew_dir, tmp_path):
+    """run_joint with --validate, --loss, --f-scale, --weights, --intervals: the model, its
+    validation and its trust record are fricid fit's, bit for bit."""
+    from fricid.workflow import run_joint
+
+    options = {"validate": "kfold:4", "loss": "soft_l1", "weights": "std", "intervals": "jacobian"}
+    run = run_joint(
+        leadscrew_dir,
+        reader="epos",
+        reader_options={"flip_sign": True},
+        models=("stribeck_asym",),
+        f_scale=5e-5,
+        **options,
+    )
+    joint = run.fits["stribeck_asym"]
+    assert joint.loss["loss"] == "soft_l1" and joint.loss["weights"] == "std"
+    assert joint.ci_method == "jacobian" and joint.validation["scheme"] == "kfold:4"
+    assert run.trust["stribeck_asym"].to_dict() == joint.trust
+    samples = write_samples(run.used["stribeck_asym"], tmp_path / "s.csv")
+    flags = [f"--{k}={v}" for k, v in options.items()]
+    model = tmp_path / "m.json"
+    args = ["fit", str(samples), "-m", "stribeck_asym", "--f-scale", "5e-5", *flags]
+    res = runner.invoke(app, [*args, "-o", str(model), "--quiet"])
+    assert res.exit_code == 0, res.output
+    by_hand = FittedModel.load(model)
+    assert by_hand.params == joint.params and by_hand.validation == joint.validation
+    assert by_hand.trust == joint.trust
