@@ -150,8 +150,8 @@ def _interrupt_line(signum: int) -> tuple[int, str]:
 
 def _on_late_signal(signum: int, frame: FrameType | None) -> None:
     """SIGINT or SIGTERM after the command finished: say so in one line now, and end with
-    its status once the exit hooks have run (:func:`end_process`); raising
-    here would interrupt those hooks (pools shutting down, temporary files removed)."""
+    its status once the exit hooks have run (:func:`end_process`); raising here would
+    interrupt those hooks (pools shutting down, temporary files removed)."""
     _State.signal = _State.late = signum
     if not _State.reported:
         _State.reported = True
@@ -176,11 +176,12 @@ def end_process(status: int | None) -> None:
     one (they run in reverse order): pools are shut down, temporary files removed. If
     SIGINT or SIGTERM arrived after the command finished (:func:`_on_late_signal` said so
     in one line), the process ends with status 130 or 143. Otherwise it ends with the
-    command's status at once, without the interpreter's teardown (freeing modules, some
-    0.5 s): during that teardown Python runs no signal handler and puts the default action
-    back, so a Ctrl-C there would kill the process without a word. With an unknown status,
-    or where the command did not own the signals, the teardown runs as usual with both
-    signals ignored.
+    command's status at once, without the interpreter's teardown (freeing modules, a good
+    part of a second after a fleet run): during that teardown Python runs no signal handler
+    and puts the default action back, so a Ctrl-C there would kill the process without a
+    word. With an unknown status the teardown runs as usual, both signals ignored; where
+    the command did not own the signals (not in the main thread, or ignored from the
+    start), nothing changes.
     """
     ours = [s for s in (signal.SIGINT, signal.SIGTERM) if signal.getsignal(s) is _on_late_signal]
     for signum in ours:

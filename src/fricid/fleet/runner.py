@@ -209,7 +209,6 @@ def run_fleet(
             for j, result in runner.run(run_job, jobs):
                 p = pending[j]
                 outcome = _outcome(p.spec, result)
-                show_warnings(outcome)
                 if outcome.status == "unchanged" and p.reusable:
                     record = store.refresh(
                         p.spec,
@@ -232,6 +231,7 @@ def run_fleet(
                     computed += 1
                     status = "computed" if outcome.status == "ok" else "failed"
                 records[p.index] = record
+                show_warnings(outcome)  # the worker's, as this process's (after the record)
                 notify(JointEvent(p.spec, status, record))
             done = [r for r in records if r is not None]
             table = results_table(done)

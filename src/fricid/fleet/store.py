@@ -49,6 +49,7 @@ from ._fs import kind_of, model_parts, read_regular, record_parts, require_real
 from .hashing import RECORD_FORMAT
 from .job import JointOutcome, warning_lines
 from .manifest import JointSpec
+from .table import row_problem
 
 __all__ = ["FleetStore"]
 
@@ -66,8 +67,7 @@ MAX_RECORD_BYTES = 16 * 2**20
 #: A model name as the store puts it in a file name.
 _MODEL = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]*\Z")
 
-#: The values of a record, by key: what each must be (None allowed for every one but
-#: ``status``, ``date`` and the collections).
+#: The keys of a record whose values are text or None.
 _TEXT_KEYS = ("stage", "error", "traceback", "input_hash", "input_stat", "settings_hash", "log")
 
 
@@ -117,8 +117,6 @@ def _iso_date(value: Any) -> bool:
 
 def _record_problem(record: dict[str, Any], spec: JointSpec) -> str | None:
     """Why ``record`` (of fricid's format) cannot be the record of ``spec``, or None."""
-    from .table import row_problem
-
     if record.get("robot") != spec.robot or record.get("joint") != spec.joint:
         return "it is the record of another joint"
     if record.get("status") not in ("ok", "failed"):
