@@ -9,7 +9,10 @@ one line on stderr and exit status 130 for Ctrl-C (SIGINT), 143 for SIGTERM. SIG
 turned into :class:`Terminated`, a ``KeyboardInterrupt``, so every cleanup path an interrupt
 takes runs for it too (temporary files removed, worker pools torn down). An exception chained
 from an interrupt, or raised while one is being handled (numba's ``RuntimeError: no compiled
-object yet`` after Ctrl-C during compilation), counts as that interrupt.
+object yet`` after Ctrl-C during compilation), counts as that interrupt. An interrupt that
+arrives after the command has finished (while the process shuts down: its pools, threads and
+exit hooks) prints the same line and ends the process with the same status, once the exit
+hooks have run (:func:`end_process`).
 """
 
 from __future__ import annotations
@@ -115,6 +118,8 @@ class _State:
     depth = 0
     signal: int | None = None
     reported = False
+    #: A signal that arrived after the command had finished (:func:`_on_late_signal`).
+    late: int | None = None
     unraisable_hook: Any = sys.__unraisablehook__
     #: ``--quiet`` given to ``fricid`` itself: no progress display (:mod:`fricid.cli._progress`).
     quiet = False
@@ -137,6 +142,60 @@ def _on_signal(signum: int, frame: FrameType | None) -> None:
     raise KeyboardInterrupt
 
 
+def _interrupt_line(signum: int) -> tuple[int, str]:
+    if signum == signal.SIGTERM:
+        return EXIT_TERMINATED, f"terminated (SIGTERM); {_DEFAULT_DETAIL}"
+    return EXIT_INTERRUPTED, f"interrupted; {_DEFAULT_DETAIL}"
+
+
+def _on_late_signal(signum: int, frame: FrameType | None) -> None:
+    """SIGINT or SIGTERM after the command finished: say so in one line now, and end with
+    its status once the exit hooks have run (:func:`end_process`); raising here would
+    interrupt those hooks (pools shutting down, temporary files removed)."""
+    _State.signal = _State.late = signum
+    if not _State.reported:
+        _State.reported = True
+        with contextlib.suppress(Exception):
+            sys.stdout.flush()
+        with contextlib.suppress(Exception):
+            sys.stderr.write(_interrupt_line(signum)[1] + "\n")
+            sys.stderr.flush()
+
+
+def end_process(status: int | None) -> None:
+    """End the console script's process once its exit hooks have run.
+
+    Parameters
+    ----------
+    status : int or None
+        The command's exit status (None: unknown, an exception escaped).
+
+    Notes
+    -----
+    The console script registers this as its first exit hook, so it runs after every other
+    one (they run in reverse order): pools are shut down, temporary files removed. If
+    SIGINT or SIGTERM arrived after the command finished (:func:`_on_late_signal` said so
+    in one line), the process ends with status 130 or 143. Otherwise it ends with the
+    command's status at once, without the interpreter's teardown (freeing modules, a good
+    part of a second after a fleet run): during that teardown Python runs no signal handler
+    and puts the default action back, so a Ctrl-C there would kill the process without a
+    word. With an unknown status the teardown runs as usual, both signals ignored; where
+    the command did not own the signals (not in the main thread, or ignored from the
+    start), nothing changes.
+    """
+    ours = [s for s in (signal.SIGINT, signal.SIGTERM) if signal.getsignal(s) is _on_late_signal]
+    for signum in ours:
+        signal.signal(signum, signal.SIG_IGN)  # (runs a pending handler first)
+    if _State.late is not None:
+        status = _interrupt_line(_State.late)[0]
+    elif not ours or status is None:
+        return
+    for stream in (sys.stdout, sys.stderr):
+        with contextlib.suppress(Exception):
+            stream.flush()
+    os._exit(status)
+
+
 def _on_alarm(signum: int, frame: FrameType | None) -> None:
     """Raise again an interrupt that was swallowed (see :func:`_on_unraisable`)."""
     if _State.signal is not None:
@@ -156,36 +215,57 @@ def _on_unraisable(unraisable: Any) -> None:
 
 
 @contextlib.contextmanager
-def signal_handlers() -> Iterator[None]:
+def _signals_blocked() -> Iterator[None]:
+    """SIGINT and SIGTERM held back (delivered at the end) while handlers are changed."""
+    if not hasattr(signal, "pthread_sigmask"):  # pragma: no cover - not POSIX
+        yield
+        return
+    old = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT, signal.SIGTERM})
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, old)
+
+
+@contextlib.contextmanager
+def signal_handlers(*, until_exit: bool = False) -> Iterator[None]:
     """SIGINT and SIGTERM raise (``KeyboardInterrupt``, :class:`Terminated`) for the body.
 
     Only in the main thread (the only one that may set handlers), and not for a signal that
     is ignored (``nohup``, a background job): that stays ignored. The previous handlers are
-    restored after the body.
+    restored after the body; with ``until_exit`` (the console script, for the rest of the
+    process) a signal after the body is reported in one line instead
+    (:func:`end_process`). Signals are held back while the handlers change.
     """
     outer = _State.depth == 0
     if outer:
-        _State.signal, _State.reported = None, False
+        _State.signal, _State.reported, _State.late = None, False, None
     _State.depth += 1
     previous: dict[int, Any] = {}
+    main_thread = threading.current_thread() is threading.main_thread()
     try:
-        if threading.current_thread() is threading.main_thread():
-            for signum in (signal.SIGINT, signal.SIGTERM):
-                old = signal.getsignal(signum)
-                if old is not signal.SIG_IGN:
-                    previous[signum] = old
-                    signal.signal(signum, _on_signal)
-            if outer and previous:
-                previous[signal.SIGALRM] = signal.signal(signal.SIGALRM, _on_alarm)
-                _State.unraisable_hook, sys.unraisablehook = sys.unraisablehook, _on_unraisable
+        if main_thread:
+            with _signals_blocked():
+                for signum in (signal.SIGINT, signal.SIGTERM):
+                    old = signal.getsignal(signum)
+                    if old is not signal.SIG_IGN:
+                        previous[signum] = old
+                        signal.signal(signum, _on_signal)
+                if outer and previous:
+                    previous[signal.SIGALRM] = signal.signal(signal.SIGALRM, _on_alarm)
+                    _State.unraisable_hook = sys.unraisablehook
+                    sys.unraisablehook = _on_unraisable
         yield
     finally:
-        _State.depth -= 1
-        if signal.SIGALRM in previous:
-            signal.setitimer(signal.ITIMER_REAL, 0)
-            sys.unraisablehook = _State.unraisable_hook
-        for signum, old in previous.items():
-            signal.signal(signum, old if old is not None else signal.SIG_DFL)
+        with _signals_blocked() if main_thread else contextlib.nullcontext():
+            _State.depth -= 1
+            if signal.SIGALRM in previous:
+                signal.setitimer(signal.ITIMER_REAL, 0)
+                sys.unraisablehook = _State.unraisable_hook
+            for signum, old in previous.items():
+                if until_exit and outer and signum != signal.SIGALRM:
+                    old = _on_late_signal
+                signal.signal(signum, old if old is not None else signal.SIG_DFL)
 
 
 def _chain(exc: BaseException) -> Iterator[BaseException]:
@@ -289,29 +369,34 @@ def handle_errors(func: Callable[..., Any]) -> Callable[..., Any]:
     return wrapper
 
 
-def main(args: list[str] | None = None) -> None:
+def main(args: list[str] | None = None, *, until_exit: bool = False) -> None:
     """Run the ``fricid`` command line (the console script's entry, via :mod:`fricid.cli`).
 
     Everything runs under :func:`signal_handlers`, from importing the sub-commands to the
-    exit, so an interrupt that lands outside a command (while importing, or while the
-    arguments are parsed) also ends in one line and status 130 or 143.
+    exit, so an interrupt that lands outside a command (while importing, while the
+    arguments are parsed, or while the handlers are put back) also ends in one line and
+    status 130 or 143. ``until_exit``: the process ends with this call (the console script),
+    and a signal after the command is reported too (:func:`end_process`).
     """
-    with signal_handlers():
-        try:
-            from . import _commands  # noqa: F401  (registers the sub-commands)
+    try:
+        with signal_handlers(until_exit=until_exit):
+            try:
+                from . import _commands  # noqa: F401  (registers the sub-commands)
 
-            app(args=args)
-        except SystemExit as exc:
-            # typer turns a KeyboardInterrupt outside a command into a silent exit 130
-            if exc.code in (EXIT_INTERRUPTED, EXIT_TERMINATED) and _State.signal is not None:
-                code = EXIT_TERMINATED if _State.signal == signal.SIGTERM else EXIT_INTERRUPTED
-                _report_interrupt(*(interrupt_exit(exc) or (code, "interrupted")))
-            raise
-        except BaseException as exc:
-            stop = interrupt_exit(exc)
-            if stop is None:
+                app(args=args)
+            except SystemExit as exc:
+                # typer turns a KeyboardInterrupt outside a command into a silent exit 130
+                if exc.code in (EXIT_INTERRUPTED, EXIT_TERMINATED) and _State.signal is not None:
+                    code = EXIT_TERMINATED if _State.signal == signal.SIGTERM else EXIT_INTERRUPTED
+                    _report_interrupt(*(interrupt_exit(exc) or (code, "interrupted")))
                 raise
-            _report_interrupt(*stop)
+    except SystemExit:
+        raise
+    except BaseException as exc:  # an interrupt anywhere above, while it was reported too
+        stop = interrupt_exit(exc)
+        if stop is None:
+            raise
+        _report_interrupt(*stop)
 
 
 def _restore_source_date(previous: str | None) -> None:

@@ -22,6 +22,7 @@ import pandas as pd
 from ..errors import ConfigError
 from ..io import atomic_path, atomic_write
 from ..models import get_model
+from ._fs import require_real
 
 __all__ = ["Drift", "compare", "plot_drift", "write_drift"]
 
@@ -271,12 +272,13 @@ def plot_drift(drift: Drift, path: str | os.PathLike[str], *, top: int = 30) -> 
 
 
 def write_drift(drift: Drift, out: str | os.PathLike[str]) -> dict[str, Path]:
-    """Write ``drift_joints.csv``, ``drift_params.csv`` and ``drift.png`` into ``out``."""
+    """Write ``drift_joints.csv``, ``drift_params.csv`` and ``drift.png`` into ``out`` (each
+    refused if it is a symbolic link or not a regular file: :func:`._fs.require_real`)."""
     out = Path(out)
     paths = {
-        "joints": out / "drift_joints.csv",
-        "params": out / "drift_params.csv",
-        "plot": out / "drift.png",
+        "joints": require_real(out, ["drift_joints.csv"]),
+        "params": require_real(out, ["drift_params.csv"]),
+        "plot": require_real(out, ["drift.png"]),
     }
     for name in ("joints", "params"):
         with atomic_write(paths[name], "w") as fh:

@@ -9,12 +9,16 @@ the content unchanged returns at once.
 
 from __future__ import annotations
 
+import errno
 import hashlib
 import json
+import os
+import stat
 from pathlib import Path
 from typing import Any
 
 from .. import __version__
+from ._fs import kind_of
 
 __all__ = ["RECORD_FORMAT", "input_files", "input_hash", "input_stat", "settings_hash"]
 
@@ -24,19 +28,40 @@ RECORD_FORMAT = "fricid-fleet-record/1"
 _BLOCK = 1 << 20
 
 
+#: Readers that take a folder as a joint's log (an EPOS folder of recordings, a ROS 2 bag,
+#: a folder of per-channel files); the others read one file.
+FOLDER_READERS = ("epos", "rosbag", "channels")
+
+
+def _regular(path: Path) -> None:
+    """Refuse (``OSError``) a log file that is not a regular file: a FIFO would block the
+    worker that opens it, a device (``/dev/zero``) would be read without end."""
+    mode = os.stat(path).st_mode
+    if not stat.S_ISREG(mode):
+        raise OSError(errno.EINVAL, f"{kind_of(mode)}, not a regular file", str(path))
+
+
 def input_files(path: Path, reader: str, reader_options: dict[str, Any]) -> list[Path]:
     """The files a joint's log consists of: the file, an EPOS folder's recordings, or every
     file of another folder (a ROS 2 bag: its metadata and storage files).
 
-    Raises :class:`OSError` when the log is missing.
+    Raises :class:`OSError` when the log is missing, when it is a folder for a reader that
+    reads one file, or when it (or a file in its folder) is not a regular file: a FIFO, a
+    device or a socket, checked with ``os.stat`` before anything opens it.
     """
-    if reader == "epos" and path.is_dir():
-        pattern = str(reader_options.get("pattern", "*.csv"))
-        return sorted(p for p in path.glob(pattern) if p.is_file())
-    if path.is_dir():
-        return sorted(p for p in path.rglob("*") if p.is_file())
-    if not path.exists():
-        raise FileNotFoundError(2, "No such file or directory", str(path))
+    mode = os.stat(path).st_mode  # FileNotFoundError when missing
+    if stat.S_ISDIR(mode):
+        if reader not in FOLDER_READERS:
+            raise OSError(errno.EISDIR, f"a folder; reader '{reader}' reads a file", str(path))
+        if reader == "epos":
+            pattern = str(reader_options.get("pattern", "*.csv"))
+            found = [p for p in path.glob(pattern) if not p.is_dir()]
+        else:
+            found = [p for p in path.rglob("*") if not p.is_dir()]
+        for p in found:
+            _regular(p)
+        return sorted(found)
+    _regular(path)
     return [path]
 
 

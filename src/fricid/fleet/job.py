@@ -4,17 +4,21 @@
 :func:`run_job` never raises for a bad joint: an unreadable log, a failed extraction or a
 failed fit comes back as a :class:`JointOutcome` with the stage and the error (and, for an
 error that is not fricid's own, its traceback), so one joint cannot stop the fleet. The worker
-only computes; the driver writes every file.
+only computes; the driver writes every file. The warnings a joint raises travel with its
+outcome too (:func:`shown_warning`): the driver shows them as its own, one line each, and
+keeps them in the joint's record, instead of the worker printing them in Python's raw format.
 """
 
 from __future__ import annotations
 
+import importlib
 import os
 import resource
 import socket
 import sys
 import time
 import traceback
+import warnings
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -33,7 +37,9 @@ __all__ = [
     "failed_outcome",
     "fit_row",
     "run_job",
+    "show_warnings",
     "verdict_columns",
+    "warning_lines",
 ]
 
 
@@ -70,6 +76,8 @@ class JointOutcome:
     seconds : wall time of the whole job [s].
     worker : ``host:pid`` of the process that ran it.
     peak_rss_mb : that process's peak resident memory so far [MB].
+    warnings : the warnings the joint raised, as ``{"category": "module:Name", "message",
+        "filename", "lineno"}`` (see :func:`show_warnings`).
     """
 
     robot: str
@@ -84,6 +92,53 @@ class JointOutcome:
     seconds: float = 0.0
     worker: str = ""
     peak_rss_mb: float = 0.0
+    warnings: list[dict[str, Any]] = field(default_factory=list)
+
+
+def _warning_dict(w: warnings.WarningMessage) -> dict[str, Any]:
+    category = w.category
+    return {
+        "category": f"{category.__module__}:{category.__qualname__}",
+        "message": " ".join(str(w.message).split()),
+        "filename": str(w.filename),
+        "lineno": int(w.lineno or 0),
+    }
+
+
+def _category(path: str) -> type[Warning]:
+    """The warning class ``module:Name`` (a worker's warning), UserWarning if unknown."""
+    module_name, _, name = str(path).partition(":")
+    try:
+        found: Any = sys.modules.get(module_name) or importlib.import_module(module_name)
+        for part in name.split("."):
+            found = getattr(found, part)
+    except Exception:  # an unknown module or class: shown as a UserWarning
+        return UserWarning
+    return found if isinstance(found, type) and issubclass(found, Warning) else UserWarning
+
+
+def warning_lines(outcome: JointOutcome) -> list[str]:
+    """The warnings a joint raised, as text (``Category: message``), for its record."""
+    return [
+        f"{_category(w.get('category', '')).__name__}: {w.get('message', '')}"
+        for w in outcome.warnings
+    ]
+
+
+def show_warnings(outcome: JointOutcome) -> None:
+    """Raise again, in this process, the warnings a joint raised in its worker.
+
+    Each is raised with its category, its message prefixed by the joint (``robot/joint:
+    ...``) and the place the worker raised it, so the warning filters and display of this
+    process apply: the CLI shows each as one line, as its other warnings.
+    """
+    for w in outcome.warnings:
+        warnings.warn_explicit(
+            f"{outcome.robot}/{outcome.joint}: {w.get('message', '')}",
+            _category(w.get("category", "")),
+            str(w.get("filename", "")),
+            int(w.get("lineno", 0) or 0),
+        )
 
 
 def _peak_rss_mb() -> float:
@@ -237,16 +292,34 @@ def run_job(job: JointJob) -> JointOutcome:
 
     BLAS and OpenMP run single-threaded inside the job, so a joint's numbers do not depend on
     how many threads its process happened to have: results are bit-identical whichever
-    executor ran them.
+    executor ran them. The warnings the joint raises are caught and returned in the outcome
+    (:func:`show_warnings`).
     """
+    t0 = time.perf_counter()
+    with warnings.catch_warnings(record=True) as caught:
+        out = _run(job)
+    out.warnings = [_warning_dict(w) for w in caught]
+    out.seconds = time.perf_counter() - t0
+    out.worker = f"{socket.gethostname()}:{os.getpid()}"
+    out.peak_rss_mb = _peak_rss_mb()
+    return out
+
+
+def _read_error(spec: JointSpec, exc: OSError) -> str:
+    text = f"cannot read the log {spec.log}: {exc.strerror or exc}"
+    if exc.filename is not None and str(exc.filename) != str(spec.log):
+        text += f" ({exc.filename})"
+    return text
+
+
+def _run(job: JointJob) -> JointOutcome:
     from threadpoolctl import threadpool_limits
 
     spec = job.spec
-    t0 = time.perf_counter()
     try:
         digest = input_hash(spec.log, spec.reader, spec.reader_options)
     except OSError as exc:
-        out = failed_outcome(spec, "read", f"cannot read the log {spec.log}: {exc.strerror or exc}")
+        out = failed_outcome(spec, "read", _read_error(spec, exc))
     else:
         if job.expect_hash is not None and digest == job.expect_hash:
             out = JointOutcome(spec.robot, spec.joint, "unchanged", input_hash=digest)
@@ -264,7 +337,4 @@ def run_job(job: JointJob) -> JointOutcome:
                     traceback.format_exc(),
                     input_hash=digest,
                 )
-    out.seconds = time.perf_counter() - t0
-    out.worker = f"{socket.gethostname()}:{os.getpid()}"
-    out.peak_rss_mb = _peak_rss_mb()
     return out

@@ -38,8 +38,10 @@ How a manifest is read
 from __future__ import annotations
 
 import csv
+import errno
 import io
 import os
+import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -47,6 +49,7 @@ from typing import Any
 
 from ..errors import ConfigError, DataError
 from ..io.registry import READER_OPTIONS
+from ._fs import NAME_MAX, PATH_MAX, fs_limits, joint_names, read_regular
 from ._manifest_schema import (
     FIELDS,
     SCHEMA,
@@ -59,7 +62,31 @@ from ._manifest_schema import (
     validator,
 )
 
-__all__ = ["FIELDS", "SCHEMA", "Field", "JointSpec", "Manifest", "read_manifest"]
+__all__ = [
+    "FIELDS",
+    "MAX_MANIFEST_BYTES",
+    "SCHEMA",
+    "Field",
+    "JointSpec",
+    "Manifest",
+    "check_names",
+    "read_manifest",
+]
+
+#: The largest manifest read [bytes]: some 150 000 joints of CSV; larger is refused
+#: before it is read (split the fleet into several manifests).
+MAX_MANIFEST_BYTES = 16 * 2**20
+
+#: A YAML manifest's aliases may stand for at most this many values in all (and at most
+#: ten times the values written): a few hundred bytes of nested aliases ("billion laughs")
+#: would otherwise stand for billions.
+MAX_YAML_VALUES = 2_000_000
+#: How deep a YAML manifest may nest (a manifest needs 4 levels).
+MAX_YAML_DEPTH = 32
+
+#: A robot or joint name, whole (the schema's pattern, anchored at the very end: a
+#: JSON Schema ``$`` also matches before a final line break).
+_NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]*")
 
 _DEFAULTS: dict[str, Any] = {
     "reader": "table",
@@ -195,6 +222,82 @@ class Manifest:
         return iter(self.joints)
 
 
+# --------------------------------------------------------------------------- names
+
+
+def _short(text: str, n: int = 48) -> str:
+    """``text``, or its start and end when longer than ``n`` characters."""
+    return text if len(text) <= n else f"{text[: n - 20]}...{text[-16:]}"
+
+
+def check_names(
+    spec: JointSpec,
+    file: str | os.PathLike[str],
+    *,
+    out: str | os.PathLike[str] | None = None,
+    labels: Mapping[str, str] | None = None,
+) -> None:
+    """Refuse a joint whose names the file system cannot hold, before any work.
+
+    Every name the fleet derives from the joint's robot, joint and model names (its folders,
+    its record and model files, their temporary names, its partition of the results table;
+    :func:`fricid.fleet._fs.joint_names`) must fit in ``NAME_MAX`` bytes, and with ``out``
+    (the output folder) every path in ``PATH_MAX``: the limits of the file system holding
+    ``out`` (``os.pathconf``), else 255 and 4096. A robot or joint name must also match
+    the manifest's name pattern whole (letters, digits, ``.``, ``_``, ``-``).
+
+    Parameters
+    ----------
+    spec : JointSpec
+        The joint.
+    file : path-like
+        The manifest, for the message.
+    out : path-like, optional
+        The output folder; without it only names are checked (against 255 bytes).
+    labels : Mapping[str, str], optional
+        The columns' labels as the manifest writes them, for the message.
+
+    Raises
+    ------
+    DataError
+        Naming the manifest, the joint's row and the column.
+    """
+    labels = labels or {}
+    for column, value in (("robot", spec.robot), ("joint", spec.joint)):
+        if not _NAME.fullmatch(value):
+            raise DataError(
+                f"{_short(value)!r} is not a usable name: letters, digits, '.', '_' and '-' "
+                "only, starting with a letter or digit (it names files)",
+                file=file,
+                row=spec.row,
+                column=labels.get(column, column),
+            )
+    name_max, path_max = fs_limits(out) if out is not None else (NAME_MAX, PATH_MAX)
+    base = len(os.fsencode(os.path.abspath(out))) + 1 if out is not None else 0
+    for got in joint_names(spec.robot, spec.joint, spec.models):
+        value = spec.robot if got.column == "robot" else spec.joint
+        column = labels.get(got.column, got.column)
+        if got.name_bytes > name_max:
+            raise DataError(
+                f"'{_short(value)}' ({len(value)} characters) is too long: fricid names "
+                f"'{_short(got.name)}' after it, {got.name_bytes} bytes"
+                f"{' as the temporary file it writes first' if got.temporary else ''}, over "
+                f"the file system's limit of {name_max} bytes per name",
+                file=file,
+                row=spec.row,
+                column=column,
+            )
+        if out is not None and base + got.path_bytes >= path_max:
+            raise DataError(
+                f"'{_short(value)}' makes a path of {base + got.path_bytes} bytes under the "
+                f"output folder {out}, over the file system's limit of {path_max - 1}: use "
+                "a shorter output folder or shorter names",
+                file=file,
+                row=spec.row,
+                column=column,
+            )
+
+
 # --------------------------------------------------------------------------- reading
 
 
@@ -224,10 +327,17 @@ def _spec(entry: Entry, file: Path) -> JointSpec:
     if "joint" in READER_OPTIONS[reader] and "joint" not in reader_options:
         reader_options["joint"] = got["joint"]  # a bag's joint: the joint column by default
     log_text = got["log"]
+    if "\0" in log_text:
+        raise DataError(
+            "a path cannot hold a NUL character",
+            file=file,
+            row=entry.row,
+            column=entry.labels.get("log", "log"),
+        )
     log = Path(log_text).expanduser()
     if not log.is_absolute():
         log = file.parent / log
-    return JointSpec(
+    spec = JointSpec(
         robot=got["robot"],
         joint=got["joint"],
         log=Path(os.path.abspath(log)),
@@ -252,13 +362,25 @@ def _spec(entry: Entry, file: Path) -> JointSpec:
         intervals=got.get("intervals", _DEFAULTS["intervals"]),
         chunk_rows=got.get("chunk_rows", 1_000_000),
     )
+    check_names(spec, file, labels=entry.labels)
+    return spec
 
 
 def _read_text(path: Path) -> str:
+    """The manifest's text: a regular file of at most :data:`MAX_MANIFEST_BYTES`, UTF-8."""
     try:
-        raw = path.read_bytes()
+        raw = read_regular(path, MAX_MANIFEST_BYTES)
     except OSError as exc:
-        raise DataError(f"cannot read the manifest: {exc.strerror}", file=path) from None
+        if exc.errno == errno.EINVAL:  # a FIFO, a device, a folder: never read
+            why = f"it is {exc.strerror}, not a regular file"
+        elif exc.errno == errno.EFBIG:
+            why = (
+                f"it is larger than {MAX_MANIFEST_BYTES // 2**20} MiB; split the fleet into "
+                "several manifests"
+            )
+        else:
+            why = exc.strerror or str(exc)
+        raise DataError(f"cannot read the manifest: {why}", file=path) from None
     try:
         return raw.decode("utf-8-sig")
     except UnicodeDecodeError as exc:
@@ -301,11 +423,10 @@ def _csv_entries(path: Path, text: str) -> list[tuple[int, dict[str, Any]]]:
     return entries
 
 
-def _yaml_lines(text: str, key_path: list[Any]) -> list[int] | None:
+def _yaml_lines(node: Any, key_path: list[Any]) -> list[int] | None:
     """1-based lines of the items of the YAML sequence at ``key_path`` (None if unknown)."""
     import yaml
 
-    node = yaml.compose(text, Loader=yaml.SafeLoader)
     for key in key_path:
         if not isinstance(node, yaml.MappingNode):
             return None
@@ -316,6 +437,84 @@ def _yaml_lines(text: str, key_path: list[Any]) -> list[int] | None:
     if not isinstance(node, yaml.SequenceNode):
         return None
     return [item.start_mark.line + 1 for item in node.value]
+
+
+def _yaml_budget(root: Any, path: Path) -> None:
+    """Refuse a YAML document whose aliases stand for too many values, that refers to
+    itself, or that nests too deeply (:data:`MAX_YAML_VALUES`, :data:`MAX_YAML_DEPTH`).
+
+    Walks the composed nodes once each: an alias is the node it names, so the values a
+    node stands for are counted without expanding anything.
+    """
+    import yaml
+
+    values: dict[int, int] = {}  # node -> the values it stands for, expanded
+    depth: dict[int, int] = {}
+    on_path: set[int] = set()
+    stack: list[tuple[Any, bool]] = [(root, False)]
+    while stack:
+        node, done = stack.pop()
+        key = id(node)
+        children: list[Any] = []
+        if isinstance(node, yaml.SequenceNode):
+            children = list(node.value)
+        elif isinstance(node, yaml.MappingNode):
+            children = [n for pair in node.value for n in pair]
+        if done:
+            on_path.discard(key)
+            values[key] = 1 + sum(values[id(c)] for c in children)
+            depth[key] = 1 + max((depth[id(c)] for c in children), default=0)
+            if depth[key] > MAX_YAML_DEPTH:
+                line = node.start_mark.line + 1
+                raise DataError(
+                    f"not a manifest: nested more than {MAX_YAML_DEPTH} levels deep",
+                    file=path,
+                    row=line,
+                )
+            continue
+        if key in values:
+            continue
+        if key in on_path:
+            raise DataError(
+                "not a manifest: an alias refers to a value that contains it",
+                file=path,
+                row=node.start_mark.line + 1,
+            )
+        on_path.add(key)
+        stack.append((node, True))
+        stack.extend((c, False) for c in children if id(c) not in values)
+    total, written = values[id(root)], len(values)
+    if total > min(MAX_YAML_VALUES, max(10 * written, 10_000)):
+        raise DataError(
+            f"not a manifest: its aliases stand for {total} values ({written} written); "
+            "write the values out, or use fewer aliases",
+            file=path,
+        )
+
+
+def _yaml_load(path: Path, text: str) -> tuple[Any, Any]:
+    """The YAML document and its composed node, within :func:`_yaml_budget`."""
+    import yaml
+
+    loader_class = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
+    loader = loader_class(text)
+    try:
+        node = loader.get_single_node()
+        if node is None:
+            return None, None
+        _yaml_budget(node, path)
+        return loader.construct_document(node), node
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        row = None if mark is None else mark.line + 1
+        problem = " ".join(str(getattr(exc, "problem", None) or exc).split())  # one line
+        raise DataError(f"not valid YAML: {problem}", file=path, row=row) from None
+    except RecursionError:
+        raise DataError(
+            f"not a manifest: nested more than {MAX_YAML_DEPTH} levels deep", file=path
+        ) from None
+    finally:
+        loader.dispose()
 
 
 def _document_error(doc: Any, path: Path, lines: list[int | None]) -> DataError | None:
@@ -338,15 +537,7 @@ def _document_error(doc: Any, path: Path, lines: list[int | None]) -> DataError 
 
 
 def _yaml_entries(path: Path, text: str) -> tuple[dict[str, Any], list[tuple[int | None, Any]]]:
-    import yaml
-
-    try:
-        doc = yaml.safe_load(text)
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        row = None if mark is None else mark.line + 1
-        problem = " ".join(str(getattr(exc, "problem", None) or exc).split())  # one line
-        raise DataError(f"not valid YAML: {problem}", file=path, row=row) from None
+    doc, node = _yaml_load(path, text)
     where = ["joints"] if isinstance(doc, Mapping) else []
     if not isinstance(doc, Mapping):
         doc = {"joints": doc}
@@ -355,7 +546,7 @@ def _yaml_entries(path: Path, text: str) -> tuple[dict[str, Any], list[tuple[int
     joints = doc.get("joints")
     lines: list[int | None] = []
     if isinstance(joints, list):
-        lines = _yaml_lines(text, where) or [None] * len(joints)
+        lines = _yaml_lines(node, where) or [None] * len(joints)
     error = _document_error(doc, path, lines)
     if error is not None:
         raise error

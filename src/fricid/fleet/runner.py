@@ -25,8 +25,8 @@ import pandas as pd
 from ..errors import ConfigError
 from .executors import Executor, ProcessExecutor
 from .hashing import input_stat, settings_hash
-from .job import JointJob, JointOutcome, failed_outcome, run_job
-from .manifest import JointSpec, Manifest, read_manifest
+from .job import JointJob, JointOutcome, failed_outcome, run_job, show_warnings
+from .manifest import JointSpec, Manifest, check_names, read_manifest
 from .store import FleetStore
 from .table import results_table, write_results
 
@@ -170,6 +170,8 @@ def run_fleet(
         except ValueError:
             raise ConfigError(f"date must be YYYY-MM-DD, got '{date}'") from None
     run_date = date or _today()
+    for spec in manifest:  # before any work: names the file system cannot hold
+        check_names(spec, manifest.path, out=out)
     owned = executor is None
     runner: Any = ProcessExecutor() if executor is None else executor
     notify = progress or (lambda event: None)
@@ -177,6 +179,9 @@ def run_fleet(
     computed = skipped = 0
     try:
         with FleetStore(out) as store:
+            store.check_outputs()
+            for spec in manifest:  # before any work: nothing is written through a link
+                store.check(spec)
             pending: list[_Pending] = []
             for k, spec in enumerate(manifest):
                 settings = spec.settings()
@@ -191,7 +196,7 @@ def run_fleet(
                 )
                 if reusable and stat is not None and previous.get("input_stat") == stat:
                     records[k] = store.refresh(
-                        previous, date=spec.date or previous["date"], input_stat=stat
+                        spec, previous, date=spec.date or previous["date"], input_stat=stat
                     )
                     skipped += 1
                     notify(JointEvent(spec, "skipped", records[k]))
@@ -206,7 +211,10 @@ def run_fleet(
                 outcome = _outcome(p.spec, result)
                 if outcome.status == "unchanged" and p.reusable:
                     record = store.refresh(
-                        p.previous, date=p.spec.date or p.previous["date"], input_stat=p.stat
+                        p.spec,
+                        p.previous,
+                        date=p.spec.date or p.previous["date"],
+                        input_stat=p.stat,
                     )
                     skipped += 1
                     status = "skipped"
@@ -223,6 +231,7 @@ def run_fleet(
                     computed += 1
                     status = "computed" if outcome.status == "ok" else "failed"
                 records[p.index] = record
+                show_warnings(outcome)  # the worker's, as this process's (after the record)
                 notify(JointEvent(p.spec, status, record))
             done = [r for r in records if r is not None]
             table = results_table(done)

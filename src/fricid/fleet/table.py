@@ -31,10 +31,10 @@ written atomically too, so a reader never sees a half-written table.
 from __future__ import annotations
 
 import os
+import sys
 from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
-from urllib.parse import quote
 
 import pandas as pd
 import pyarrow as pa
@@ -43,6 +43,7 @@ import pyarrow.parquet as pq
 
 from ..errors import DataError
 from ..io.atomic import atomic_dir, atomic_path, atomic_write
+from ._fs import partition_dir, require_real
 
 __all__ = [
     "PARTITIONS",
@@ -50,6 +51,7 @@ __all__ = [
     "VERDICT_COLUMNS",
     "read_results",
     "results_table",
+    "row_problem",
     "write_results",
 ]
 
@@ -170,9 +172,37 @@ def results_table(records: Iterable[dict[str, Any]]) -> pa.Table:
     return pa.Table.from_pylist([{n: row.get(n) for n in names} for row in rows], schema=schema)
 
 
-def _partition_dir(value: Any) -> str:
-    """A hive partition folder's value, encoded as pyarrow's reader decodes it."""
-    return "__HIVE_DEFAULT_PARTITION__" if value is None else quote(str(value), safe="")
+#: The largest integer an int64 column holds, and the largest a float64 column holds.
+_INT64 = 2**63 - 1
+_FLOAT_MAX = int(sys.float_info.max)
+
+
+def _value_problem(name: str, value: Any) -> str | None:
+    kind = _type(name)
+    if value is None:
+        return None
+    if kind == pa.string():
+        ok = isinstance(value, str)
+    elif kind == pa.bool_():
+        ok = isinstance(value, bool)
+    elif kind == pa.int64():
+        ok = isinstance(value, int) and not isinstance(value, bool) and abs(value) <= _INT64
+    else:
+        ok = isinstance(value, int | float) and not isinstance(value, bool)
+        ok = ok and (not isinstance(value, int) or abs(value) <= _FLOAT_MAX)
+    return None if ok else f"its row's {name[:80]!r} is not a {kind}"
+
+
+def row_problem(row: dict[str, Any]) -> str | None:
+    """Why ``row`` (a record's row, as read from a file) cannot enter the results table
+    (:func:`results_table` gives every column one type), or None."""
+    for name, value in row.items():
+        if not isinstance(name, str):
+            return "its row has a column name that is not text"
+        why = _value_problem(name, value)
+        if why is not None:
+            return why
+    return None
 
 
 def _write_partitions(table: pa.Table, folder: Path) -> None:
@@ -186,7 +216,7 @@ def _write_partitions(table: pa.Table, folder: Path) -> None:
     for key in dict.fromkeys(keys):
         rows = data.filter(pa.array([k == key for k in keys]))
         where = folder.joinpath(
-            *(f"{p}={_partition_dir(v)}" for p, v in zip(PARTITIONS, key, strict=True))
+            *(f"{p}={partition_dir(v)}" for p, v in zip(PARTITIONS, key, strict=True))
         )
         with atomic_path(where / "part-0.parquet") as part:
             pq.write_table(rows, part)
@@ -194,13 +224,14 @@ def _write_partitions(table: pa.Table, folder: Path) -> None:
 
 def write_results(table: pa.Table, root: str | os.PathLike[str]) -> tuple[Path, Path]:
     """Write ``table`` as ``root/results/`` (Parquet, partitioned by robot and date) and
-    ``root/results.csv``. Returns both paths."""
+    ``root/results.csv``. Returns both paths. A symbolic link at either, or something of
+    another kind, is refused (:func:`._fs.require_real`)."""
     root = Path(root)
     root.mkdir(parents=True, exist_ok=True)
-    dataset = root / "results"
+    dataset = require_real(root, ["results"], folder=True)
+    csv_path = require_real(root, ["results.csv"])
     with atomic_dir(dataset) as tmp:
         _write_partitions(table, tmp)
-    csv_path = root / "results.csv"
     with atomic_write(csv_path, "w") as fh:
         table.to_pandas().to_csv(fh, index=False)
     return dataset, csv_path

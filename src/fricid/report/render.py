@@ -200,31 +200,106 @@ def render_html(doc: Document) -> str:
 
 
 # -- Markdown ---------------------------------------------------------------------------------
+#
+# Every text reaches the Markdown as it reaches the HTML: a table cell or a meta value as
+# plain text, a title, caption, note or section text as the tiny markup of the module
+# docstring (its `code` and **bold** kept, everything else literal). Plain text is escaped
+# so that no Markdown or HTML reader gives it a meaning: the characters HTML and Markdown
+# read (< > & ` * _ [ ] | \\ ! ~ #) get a backslash, a line cannot start a block (a list, a
+# heading, a quote, a code block), line breaks become spaces. A code span's fence is longer
+# than any run of backticks in it, and its text is never read as HTML by a Markdown reader.
+
+#: Characters escaped with a backslash wherever they are (CommonMark allows one before any
+#: ASCII punctuation): HTML (``<``, ``>``, ``&``), emphasis, code, links, tables, images,
+#: strike-through, headings. ``_`` is escaped only where it could open or close emphasis.
+_MD_ALWAYS = frozenset("\\`*[]<>&|!~#")
+#: What could open a block at the start of a line (a list, a quote, a setext underline, an
+#: ordered list's number): its punctuation gets a backslash there.
+_MD_BLOCK_START = re.compile(r"[-+=>:]|\d{1,9}[.)]")
 
 
-def _md_escape(text: str) -> str:
-    return text.replace("|", "\\|").replace("\n", " ")
+def _md_escape(text: str, *, line_start: bool = True) -> str:
+    """``text`` as literal Markdown on one line: nothing in it is markup or HTML.
+
+    With ``line_start`` it may begin a line, so a first character that would open a block
+    there (``-``, ``+``, ``=``, ``>``, ``:``, ``1.``) is escaped too.
+    """
+    text = re.sub(r"\s+", " ", str(text))  # line breaks (and U+2028, ...) to spaces
+    out = []
+    for i, ch in enumerate(text):
+        if ch in _MD_ALWAYS:
+            out.append("\\" + ch)
+        elif ch == "_":
+            before = text[i - 1] if i else " "
+            after = text[i + 1] if i + 1 < len(text) else " "
+            out.append("_" if before.isalnum() and after.isalnum() else "\\_")
+        else:
+            out.append(ch)
+    escaped = "".join(out)
+    start = _MD_BLOCK_START.match(escaped) if line_start else None
+    if start is None:
+        return escaped
+    at = start.end() - 1  # the punctuation: the sign, or the number's '.' or ')'
+    return escaped[:at] + "\\" + escaped[at:]
+
+
+def _md_cell(text: str) -> str:
+    """A table cell: literal (:func:`_md_escape`), inside its row (never a line's start)."""
+    return _md_escape(text, line_start=False)
+
+
+def _md_code(text: str) -> str:
+    """A Markdown code span of ``text`` (one line), fenced by more backticks than it holds."""
+    runs = [len(r) for r in re.findall(r"`+", text)]
+    fence = "`" * (max(runs, default=0) + 1)
+    pad = " " if text.startswith("`") or text.endswith("`") or not text.strip() else ""
+    return f"{fence}{pad}{text}{pad}{fence}"
+
+
+def _md_inline(text: str) -> str:
+    """One line of the tiny markup as Markdown: `code` and **bold** as the HTML renders
+    them (:func:`_inline_html`), every other character literal."""
+    parts: list[str] = []
+    for k, piece in enumerate(re.split(r"`([^`]+)`", " ".join(str(text).split()))):
+        if k % 2:
+            parts.append(_md_code(piece))
+            continue
+        for j, bit in enumerate(re.split(r"\*\*([^*]+)\*\*", piece)):
+            literal = _md_escape(bit, line_start=not parts)
+            parts.append(f"**{literal}**" if j % 2 else literal)
+    return "".join(parts)
+
+
+def _md_text(text: str) -> str:
+    """Paragraphs and ``- `` lists of the tiny markup (:func:`_blocks`) as Markdown."""
+    parts = []
+    for kind, lines in _blocks(text):
+        if kind == "ul":
+            parts.append("\n".join(f"- {_md_inline(i)}" for i in lines))
+        else:
+            parts.append(_md_inline(" ".join(lines)))
+    return "\n\n".join(parts)
 
 
 def _table_md(table: Table) -> str:
     header, rows = _cells(table)
     lines = [
-        f"### {table.title}",
+        f"### {_md_inline(table.title)}",
         "",
-        "| " + " | ".join(_md_escape(h) for h in header) + " |",
+        "| " + " | ".join(_md_cell(h) for h in header) + " |",
         "|" + "|".join(":---" if i == 0 else "---:" for i in range(len(header))) + "|",
     ]
-    lines += ["| " + " | ".join(_md_escape(c) for c in row) + " |" for row in rows]
+    lines += ["| " + " | ".join(_md_cell(c) for c in row) + " |" for row in rows]
     if table.caption:
-        lines += ["", table.caption.strip()]
+        lines += ["", _md_text(table.caption)]
     lines += ["", f"Data: [{table.name}.csv]({table.name}.csv)"]
     return "\n".join(lines)
 
 
 def _figure_md(fig: Figure) -> str:
-    lines = [f"### {fig.title}", "", f"![{fig.title}]({fig.name}.png)"]
+    lines = [f"### {_md_inline(fig.title)}", "", f"![{_md_cell(fig.title)}]({fig.name}.png)"]
     if fig.caption:
-        lines += ["", fig.caption.strip()]
+        lines += ["", _md_text(fig.caption)]
     return "\n".join(lines)
 
 
@@ -234,7 +309,7 @@ def _item_md(item) -> str:
     if isinstance(item, Figure):
         return _figure_md(item)
     if isinstance(item, Note):
-        text = item.text.strip()
+        text = _md_text(item.text)
         if item.kind == "warning":
             return "\n".join("> " + ln if ln else ">" for ln in text.splitlines())
         return text
@@ -242,19 +317,23 @@ def _item_md(item) -> str:
 
 
 def render_markdown(doc: Document) -> str:
-    """The document as Markdown; figures and CSVs are linked as files beside it."""
-    parts = [f"# {doc.title}"]
+    """The document as Markdown; figures and CSVs are linked as files beside it.
+
+    Every text is escaped as the HTML escapes it (:func:`_md_escape`): a string from a file
+    (a model's name, notes, provenance, a file name) is shown as it is, never read as
+    Markdown or HTML.
+    """
+    parts = [f"# {_md_inline(doc.title)}"]
     if doc.summary:
-        parts.append(doc.summary.strip())
+        parts.append(_md_text(doc.summary))
     if doc.meta:
         rows = [
-            f"| {_md_escape(str(k))} | {_md_escape(format_value(v, 6))} |"
-            for k, v in doc.meta.items()
+            f"| {_md_cell(str(k))} | {_md_cell(format_value(v, 6))} |" for k, v in doc.meta.items()
         ]
         parts.append("\n".join(["| | |", "|:---|:---|", *rows]))
     for sec in doc.sections:
-        parts.append(f"## {sec.title}")
+        parts.append(f"## {_md_inline(sec.title)}")
         if sec.text:
-            parts.append(sec.text.strip())
+            parts.append(_md_text(sec.text))
         parts.extend(_item_md(i) for i in sec.items)
-    return "\n\n".join(parts) + "\n"
+    return "\n\n".join(p for p in parts if p) + "\n"
