@@ -84,7 +84,7 @@ def _with_deadline(call, fifo: Path, seconds: float = 10.0) -> dict[str, object]
 def site(tmp_path):
     """A manifest of one joint whose log is missing (it fails at once), an output folder,
     and a user's files outside it."""
-    home = tmp_path / "home"
+    home = tmp_path / "userdir"
     home.mkdir()
     (home / "victim.txt").write_text(PRECIOUS)
     (home / "j1.json").write_text(PRECIOUS)
@@ -127,9 +127,9 @@ def _plant_record(out: Path, files, status: str = "failed", **extra) -> Path:
     "rel",
     [
         "ABS",  # the absolute path of the user's file
-        "../../../home/victim.txt",
-        "models/r1/../../../home/victim.txt",
-        "models/r1/j1.stribeck.json/../../../../home/victim.txt",
+        "../../../userdir/victim.txt",
+        "models/r1/../../../userdir/victim.txt",
+        "models/r1/j1.stribeck.json/../../../../userdir/victim.txt",
         "models/r2/j9.stribeck.json",  # another joint's model file, inside --out
         "models/r1/j1.vlt.json",  # the path of another model than the record says
     ],
@@ -179,7 +179,7 @@ def test_the_fleets_own_stale_model_file_is_still_removed(site):
     [
         {"model_files": ["/etc/passwd"]},
         {"model_files": {"stribeck": 5}},
-        {"robot": "../../home", "joint": "victim"},  # a record of another joint
+        {"robot": "../../userdir", "joint": "victim"},  # a record of another joint
         {"date": "../../" + "x" * 300},
         {"rows": [{"robot": "r1", "joint": "j1", "date": "2026-01-01", "n_samples": "lots"}]},
         {"rows": "not rows"},
@@ -207,7 +207,7 @@ def test_a_record_naming_another_joint_cannot_redirect_a_write(site):
         out,
         {},
         status="ok",
-        robot="../../home",
+        robot="../../userdir",
         settings_hash=settings_hash(spec.settings()),
         input_hash=input_hash(spec.log, spec.reader, spec.reader_options),
         input_stat="changed since",
@@ -225,13 +225,13 @@ def test_a_record_naming_another_joint_cannot_redirect_a_write(site):
 @pytest.mark.parametrize(
     ("link", "target"),
     [
-        ("records/r1", "home"),  # the record would land in the user's folder
-        ("records", "home"),
-        ("records/r1/j1.json", "home/j1.json"),
-        ("models/r1", "home"),
-        ("results.csv", "home/victim.txt"),
-        ("results", "home"),
-        (".lock", "home/victim.txt"),
+        ("records/r1", "userdir"),  # the record would land in the user's folder
+        ("records", "userdir"),
+        ("records/r1/j1.json", "userdir/j1.json"),
+        ("models/r1", "userdir"),
+        ("results.csv", "userdir/victim.txt"),
+        ("results", "userdir"),
+        (".lock", "userdir/victim.txt"),
     ],
 )
 def test_nothing_is_written_through_a_link_under_out(site, link, target):
