@@ -123,7 +123,7 @@ def test_the_virtual_joint_written_as_urdf(tmp_path):
         ("<model/>", "not <robot>"),
         (
             "<robot><link name='a'><inertial><mass value='heavy'/></inertial></link></robot>",
-            r"<link name='a'> <inertial><mass>: value='heavy' is not 1 numbers",
+            r"<link name='a'> <inertial><mass>: value='heavy' is not 1 plain decimal numbers",
         ),
         (
             "<robot><link name='a'/><joint name='j' type='revolute'><parent link='a'/>"
@@ -133,7 +133,7 @@ def test_the_virtual_joint_written_as_urdf(tmp_path):
         (
             "<robot><link name='a'/><link name='b'/><joint name='j' type='revolute'>"
             "<parent link='a'/><child link='b'/><origin xyz='0 0 nan'/></joint></robot>",
-            r"<joint name='j'> <origin>: xyz='0 0 nan' is not 3 finite numbers",
+            r"<joint name='j'> <origin>: xyz='0 0 nan' is not 3 plain decimal numbers",
         ),
         ("<robot><link name='a'/><link name='b'/></robot>", "one tree"),
     ],

@@ -8,6 +8,22 @@ joints' ``type``, ``<parent>``, ``<child>``, ``<origin xyz rpy>`` and ``<axis xy
 meshes, limits and inertia tensors are ignored. Bad input is one :class:`DataError` naming the
 file and the element.
 
+What is read is checked before it is used:
+
+- the file: a regular file (no device, FIFO or directory), read with a cap of
+  :data:`MAX_BYTES`; its encoding is taken from its byte-order mark or, without one, its XML
+  declaration (UTF-8, UTF-16, UTF-32, US-ASCII or ISO-8859-1; any other is refused), and the
+  DOCTYPE and entity refusal applies to the decoded text, so no encoding hides a declaration;
+- the numbers: every numeric attribute matches a plain decimal number (digits, an optional
+  point and exponent: no ``nan``, ``inf``, ``0x10``, ``0_1`` or non-ASCII digits) and lies in
+  a physical range: positions (origins, centres of mass) and axis components within
+  :data:`MAX_LENGTH` m, angles within :data:`MAX_ANGLE` rad, masses 0 or within
+  :data:`MASS_RANGE` kg (0 is a massless link, as a link without ``<inertial>`` is: URDF
+  writers put ``<mass value="0"/>`` on frames that carry no body), and a moving joint's axis
+  of norm at least :data:`MIN_AXIS_NORM` (then normalised);
+- the graph: every joint names defined links, its parent differs from its child, no link has
+  two parent joints, the joints form no cycle, and exactly one link (the root) has no parent.
+
 :func:`gravity_coefficients` gives eq. 7's ``p_x, p_y`` [N m] of a revolute (or continuous)
 joint from the masses and centres of mass of every link downstream of it, with the chain's
 other joints at given positions (default zero) and gravity ``-z`` in the root link's frame.
@@ -33,8 +49,11 @@ Conventions
 
 from __future__ import annotations
 
+import codecs
 import math
 import os
+import re
+import stat
 import xml.etree.ElementTree as ET
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -45,7 +64,11 @@ import numpy as np
 from ..errors import ConfigError, DataError
 
 __all__ = [
+    "MASS_RANGE",
+    "MAX_ANGLE",
     "MAX_BYTES",
+    "MAX_LENGTH",
+    "MIN_AXIS_NORM",
     "STANDARD_GRAVITY",
     "GravityLoad",
     "Robot",
@@ -59,6 +82,53 @@ MAX_BYTES = 8 * 1024 * 1024
 
 #: m/s^2, the gravity used unless another is given.
 STANDARD_GRAVITY = 9.80665
+
+#: Largest magnitude [m] of a position coordinate (origins, centres of mass) and of an axis
+#: component: a kilometre is beyond any robot.
+MAX_LENGTH = 1e3
+
+#: Largest magnitude [rad] of an ``rpy`` angle.
+MAX_ANGLE = 1e3
+
+#: The masses [kg] a link may have besides 0 (a massless link).
+MASS_RANGE = (1e-9, 1e6)
+
+#: Smallest norm of a moving joint's axis (the axis is normalised).
+MIN_AXIS_NORM = 1e-6
+
+#: A plain decimal number: ASCII digits, optional sign, point and exponent.
+_NUMBER = re.compile(r"[-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][-+]?[0-9]+)?")
+
+#: Byte-order marks and the encodings they announce (UTF-32 before UTF-16: a prefix).
+_BOMS = (
+    (codecs.BOM_UTF32_LE, "utf-32-le"),
+    (codecs.BOM_UTF32_BE, "utf-32-be"),
+    (codecs.BOM_UTF8, "utf-8"),
+    (codecs.BOM_UTF16_LE, "utf-16-le"),
+    (codecs.BOM_UTF16_BE, "utf-16-be"),
+)
+
+#: The first bytes of ``<?`` or ``<r`` without a byte-order mark (XML 1.0, appendix F).
+_SNIFF = (
+    (b"\x00\x00\x00<", "utf-32-be"),
+    (b"<\x00\x00\x00", "utf-32-le"),
+    (b"\x00<\x00", "utf-16-be"),
+    (b"<\x00", "utf-16-le"),
+)
+
+#: Declared encodings read (normalised names) and the codec of each.
+_DECLARED = {
+    "utf8": "utf-8",
+    "usascii": "ascii",
+    "ascii": "ascii",
+    "iso88591": "latin-1",
+    "latin1": "latin-1",
+    "utf16": "utf-16",
+    "utf32": "utf-32",
+}
+
+_DECLARATION = re.compile(r"\A\s*<\?xml\b[^>]*?\?>")
+_ENCODING = re.compile(r"""encoding\s*=\s*(?:"([^"]*)"|'([^']*)')""")
 
 _ROTATING = ("revolute", "continuous")
 _TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
@@ -110,9 +180,12 @@ class Robot:
         children: dict[str, list[str]] = {}
         for j in self.joints.values():
             children.setdefault(j.parent, []).append(j.child)
-        out, todo = [], [self.joints[joint].child]
+        out, todo, seen = [], [self.joints[joint].child], set()
         while todo:
             link = todo.pop()
+            if link in seen:  # a tree has none; read_urdf refuses cycles
+                continue
+            seen.add(link)
             out.append(link)
             todo.extend(children.get(link, ()))
         return out
@@ -188,7 +261,7 @@ def _about(axis: np.ndarray, angle: float) -> np.ndarray:
 
 
 class _Reader:
-    """Attribute parsing with errors naming the file and the element."""
+    """Attribute parsing with errors naming the file, the element and the attribute."""
 
     def __init__(self, source: str) -> None:
         self.source = source
@@ -196,15 +269,18 @@ class _Reader:
     def fail(self, where: str, what: str) -> DataError:
         return DataError(f"{where}: {what}", file=self.source)
 
-    def numbers(self, el, attr: str, where: str, count: int, default: str) -> np.ndarray:
+    def numbers(
+        self, el, attr: str, where: str, count: int, default: str, bound: float
+    ) -> np.ndarray:
+        """``count`` plain decimal numbers (module notes) of magnitude at most ``bound``."""
         text = el.get(attr, default) if el is not None else default
         parts = text.split()
-        try:
-            values = np.array([float(p) for p in parts], dtype=float)
-        except ValueError:
-            raise self.fail(where, f"{attr}='{text[:40]}' is not {count} numbers") from None
-        if values.size != count or not np.isfinite(values).all():
-            raise self.fail(where, f"{attr}='{text[:40]}' is not {count} finite numbers")
+        shown = f"{attr}='{text[:40]}'"
+        if len(parts) != count or not all(_NUMBER.fullmatch(p) for p in parts):
+            raise self.fail(where, f"{shown} is not {count} plain decimal numbers")
+        values = np.array([float(p) for p in parts], dtype=float)
+        if not np.isfinite(values).all() or (np.abs(values) > bound).any():
+            raise self.fail(where, f"{shown} has a magnitude over {bound:g}")
         return values
 
     def name(self, el, where: str) -> str:
@@ -222,13 +298,17 @@ class _Reader:
         mass_el = inertial.find("mass")
         if mass_el is None:
             raise self.fail(where, "<inertial> has no <mass>")
-        mass = float(self.numbers(mass_el, "value", f"{where} <inertial><mass>", 1, "")[0])
-        if mass < 0:
-            raise self.fail(f"{where} <inertial><mass>", f"value={mass!r} is negative")
+        at = f"{where} <inertial><mass>"
+        mass = float(self.numbers(mass_el, "value", at, 1, "", math.inf)[0])
+        low, high = MASS_RANGE
+        if mass != 0 and not low <= mass <= high:
+            raise self.fail(
+                at, f"value={mass!r} kg is not 0 (massless) nor within [{low:g}, {high:g}] kg"
+            )
         com = self.numbers(
-            inertial.find("origin"), "xyz", f"{where} <inertial><origin>", 3, "0 0 0"
+            inertial.find("origin"), "xyz", f"{where} <inertial><origin>", 3, "0 0 0", MAX_LENGTH
         )
-        return name, _Link(mass, com)
+        return name, _Link(abs(mass), com)
 
     def joint(self, el) -> _Joint:
         name = self.name(el, "a <joint>")
@@ -242,14 +322,127 @@ class _Reader:
             if end is None or not end.get("link"):
                 raise self.fail(where, f"has no <{tag} link='...'>")
             ends.append(end.get("link"))
+        if ends[0] == ends[1]:
+            raise self.fail(where, f"its parent and child are the same link '{ends[0][:60]}'")
         origin = el.find("origin")
-        xyz = self.numbers(origin, "xyz", f"{where} <origin>", 3, "0 0 0")
-        rpy = self.numbers(origin, "rpy", f"{where} <origin>", 3, "0 0 0")
-        axis = self.numbers(el.find("axis"), "xyz", f"{where} <axis>", 3, "1 0 0")
+        xyz = self.numbers(origin, "xyz", f"{where} <origin>", 3, "0 0 0", MAX_LENGTH)
+        rpy = self.numbers(origin, "rpy", f"{where} <origin>", 3, "0 0 0", MAX_ANGLE)
+        axis = self.numbers(el.find("axis"), "xyz", f"{where} <axis>", 3, "1 0 0", MAX_LENGTH)
         norm = float(np.linalg.norm(axis))
-        if kind in ("revolute", "continuous", "prismatic") and not norm > 0:
-            raise self.fail(f"{where} <axis>", "xyz is the zero vector")
+        if kind in ("revolute", "continuous", "prismatic") and not norm >= MIN_AXIS_NORM:
+            raise self.fail(f"{where} <axis>", f"xyz has norm {norm:.3g}, under {MIN_AXIS_NORM:g}")
         return _Joint(name, kind, ends[0], ends[1], xyz, _rpy(*rpy), axis / (norm or 1.0))
+
+
+def _read_bytes(path: Path) -> bytes:
+    """The file's bytes: a regular file only, at most :data:`MAX_BYTES`."""
+    src = str(path)
+    try:
+        # non-blocking: opening a FIFO must not wait for a writer before it is refused
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
+    except OSError as exc:
+        raise DataError(f"cannot read the URDF: {exc.strerror or exc}", file=src) from None
+    try:
+        if not stat.S_ISREG(os.fstat(fd).st_mode):
+            raise DataError("the URDF is not a regular file", file=src)
+        with os.fdopen(fd, "rb", closefd=False) as fh:
+            data = fh.read(MAX_BYTES + 1)
+    except OSError as exc:
+        raise DataError(f"cannot read the URDF: {exc.strerror or exc}", file=src) from None
+    finally:
+        os.close(fd)
+    if len(data) > MAX_BYTES:
+        raise DataError(f"the URDF is over the {MAX_BYTES} bytes read", file=src)
+    return data
+
+
+def _declared_encoding(text: str, src: str) -> str | None:
+    """The codec of the encoding the XML declaration at the start of ``text`` names (None
+    without one); an encoding not read is a DataError."""
+    declaration = _DECLARATION.match(text)
+    match = _ENCODING.search(declaration.group()) if declaration else None
+    if match is None:
+        return None
+    declared = (match.group(1) or match.group(2) or "").strip()
+    codec = _DECLARED.get(re.sub(r"[^a-z0-9]", "", declared.lower()))
+    if codec is None:
+        raise DataError(
+            f"the XML declaration names encoding '{declared[:40]}'; a URDF is read in UTF-8, "
+            "UTF-16, UTF-32, US-ASCII or ISO-8859-1 (save it as UTF-8)",
+            file=src,
+        )
+    return codec
+
+
+def _decode(data: bytes, src: str) -> str:
+    """The file's text: the encoding from the byte-order mark or the first bytes, and the
+    XML declaration (module notes); a declaration that contradicts them is refused."""
+    found = next(((bom, name) for bom, name in _BOMS if data.startswith(bom)), None)
+    if found is not None:
+        data, codec = data[len(found[0]) :], found[1]
+    else:
+        codec = next((name for head, name in _SNIFF if data.startswith(head)), None)
+    if codec is None:  # ASCII-compatible: the declaration decides, UTF-8 by default
+        codec = _declared_encoding(data[:512].decode("latin-1"), src) or "utf-8"
+        if codec.startswith(("utf-16", "utf-32")):
+            raise DataError(
+                f"the XML declaration names {codec.upper()}, which the bytes are not", file=src
+            )
+    try:
+        text = data.decode(codec)
+    except UnicodeDecodeError as exc:
+        raise DataError(f"not valid {codec.upper()} text (byte {exc.start})", file=src) from None
+    declared = _declared_encoding(text, src)
+    if declared is not None and not (codec.startswith(declared) or declared == codec):
+        raise DataError(
+            f"the XML declaration names {declared.upper()} but the file is {codec.upper()}",
+            file=src,
+        )
+    return text
+
+
+def _parse(path: Path) -> ET.Element:
+    """The root element of the file, decoded and checked (module notes)."""
+    src = str(path)
+    text = _decode(_read_bytes(path), src)
+    upper = text.upper()
+    if "<!DOCTYPE" in upper or "<!ENTITY" in upper:
+        raise DataError("a URDF with a DOCTYPE or entity declaration is refused", file=src)
+    # the text without its declaration, as UTF-8: the parser sees the encoding checked here
+    body = _DECLARATION.sub("", text, count=1)
+    try:
+        return ET.fromstring(body.encode("utf-8"))
+    except ET.ParseError as exc:
+        raise DataError(f"not XML: {exc}", file=src) from None
+
+
+def _check_graph(links: dict[str, _Link], joints: dict[str, _Joint], src: str) -> str:
+    """The root link of a tree; a cycle or anything but one root is a DataError."""
+    parent_of = {j.child: j for j in joints.values()}
+    done: set[str] = set()
+    for start in links:
+        path: list[str] = []
+        link = start
+        while link in parent_of and link not in done:
+            if link in path:
+                cycle = path[path.index(link) :]
+                names = " -> ".join(f"'{parent_of[name].name[:60]}'" for name in reversed(cycle))
+                raise DataError(
+                    f"<joint name='{parent_of[link].name[:60]}'>: the joints {names} form a "
+                    "cycle; a URDF must be a tree",
+                    file=src,
+                )
+            path.append(link)
+            link = parent_of[link].parent
+        done.update(path)
+    roots = [name for name in links if name not in parent_of]
+    if len(roots) != 1:
+        raise DataError(
+            f"the URDF must form one tree; links without a parent joint: "
+            f"{', '.join(r[:60] for r in roots[:5]) or 'none'}",
+            file=src,
+        )
+    return roots[0]
 
 
 def read_urdf(path: str | os.PathLike[str]) -> Robot:
@@ -267,26 +460,16 @@ def read_urdf(path: str | os.PathLike[str]) -> Robot:
     Raises
     ------
     DataError
-        One line naming the file (and the element): a file over :data:`MAX_BYTES`, not XML,
-        with a DOCTYPE or entity declaration, xacro macros, a root that is not ``<robot>``, a
-        bad number, a joint naming an unknown link, a link with two parents, or no single root.
+        One line naming the file (and the element and attribute): not a regular file, over
+        :data:`MAX_BYTES`, an encoding not read (module notes), not XML, with a DOCTYPE or
+        entity declaration, xacro macros, a root that is not ``<robot>``, a number that is not
+        a plain decimal or lies outside its physical range, a joint naming an unknown link or
+        the same link as parent and child, a link with two parents, a cycle of joints, or not
+        exactly one root.
     """
     path = Path(path)
     src = str(path)
-    try:
-        size = path.stat().st_size
-        if size > MAX_BYTES:
-            raise DataError(f"the URDF is {size} bytes, over the {MAX_BYTES} read", file=src)
-        data = path.read_bytes()
-    except OSError as exc:
-        raise DataError(f"cannot read the URDF: {exc.strerror or exc}", file=src) from None
-    head = data.upper()
-    if b"<!DOCTYPE" in head or b"<!ENTITY" in head:
-        raise DataError("a URDF with a DOCTYPE or entity declaration is refused", file=src)
-    try:
-        root = ET.fromstring(data)
-    except ET.ParseError as exc:
-        raise DataError(f"not XML: {exc}", file=src) from None
+    root = _parse(path)
     macro = next((el.tag for el in root.iter() if el.tag.startswith("{")), None)
     if macro is not None:  # xacro:macro, xacro:include ... (namespaced elements)
         raise DataError(
@@ -319,14 +502,7 @@ def read_urdf(path: str | os.PathLike[str]) -> Robot:
             )
         parent_of[j.child] = j.name
         joints[j.name] = j
-    roots = [name for name in links if name not in parent_of]
-    if len(roots) != 1:
-        raise DataError(
-            f"the URDF must form one tree; links without a parent joint: "
-            f"{', '.join(r[:60] for r in roots[:5]) or 'none (a cycle)'}",
-            file=src,
-        )
-    return Robot(root.get("name", ""), roots[0], links, joints, src)
+    return Robot(root.get("name", ""), _check_graph(links, joints, src), links, joints, src)
 
 
 def _link_frames(robot: Robot, q: Mapping[str, float]):
