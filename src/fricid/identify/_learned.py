@@ -95,6 +95,12 @@ def _fit_network(
             "model 'rbf' does not take a callback; ignored", IgnoredArgumentWarning, stacklevel=3
         )
     params = dict(network or {})
+    m = params.get("n_centers")
+    if m is not None and (isinstance(m, bool) or not isinstance(m, int | np.integer) or m < 1):
+        raise ConfigError(
+            f"the network's number of centres (--centers, n_centers) must be a whole number "
+            f">= 1; got {m!r}"
+        )
     key = str(method).strip().lower()
     params["trainer"] = "lsq" if key == "lm" else key
     if isinstance(seed, np.random.Generator):
