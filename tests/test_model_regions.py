@@ -175,9 +175,11 @@ def test_the_cli_refuses_a_bound_outside_the_region(tmp_path):
     from fricid.io import write_samples
 
     path = write_samples(_samples(), tmp_path / "s.csv")
-    args = ["fit", str(path), "--model", "stribeck", "--bound", "tau_v=-1:1", "--out", "m"]
+    out = tmp_path / "m.json"
+    args = ["fit", str(path), "--model", "stribeck", "--bound", "tau_v=-1:1", "--out", str(out)]
     res = CliRunner().invoke(app, args)
     assert res.exit_code == 2 and "tau_v >= 0" in res.output, res.output
+    assert not out.exists()
 
 
 def test_a_hybrid_backbone_outside_its_region():
