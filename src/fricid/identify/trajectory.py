@@ -136,7 +136,7 @@ from ..fitted import FittedModel
 from ..io.atomic import created_timestamp
 from ..metrics import fit_statistics, metrics
 from ..models import get_model, lugre
-from ..samples import RawLog
+from ..samples import RawLog, check_trajectory_log
 from ._trajectory_data import DerivativeFilter, derivatives, dilate, uniform_series
 from ._trajectory_filtered import ParallelFilter, filtered_route
 from ._trajectory_rate import rate_bias as _rate_bias
@@ -365,6 +365,7 @@ def fit_trajectory(
         raise ConfigError(f"rate_bias must be 'warn' or 'off', got '{rate_bias}'")
     derivative = derivative or DerivativeFilter()
     t_start = time.perf_counter()
+    check_trajectory_log(log)  # holes, grid size, stuck torque: before any allocation
     series = uniform_series(log)
     rate = 1.0 / series.dt
     vf, acc = derivatives(series, derivative)
