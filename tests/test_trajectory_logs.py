@@ -96,7 +96,7 @@ def test_the_current_stuck_at_10_A(clean, tmp_path):
     refused_by_fit(path, "column 'current'", "10 A in every row", "stuck")
 
 
-@pytest.mark.parametrize("share", [0.1, 0.5])
+@pytest.mark.parametrize("share", [0.025, 0.1, 0.5])
 def test_a_current_stuck_while_the_joint_moves(clean, tmp_path, share):
     n = len(clean)
     a, b = n // 4, n // 4 + int(share * n)
@@ -116,7 +116,8 @@ def test_a_stuck_torque_channel(clean):
 
 def test_what_real_logs_do_passes(clean):
     """Coarse quantisation (0.02 A steps), stamps jittered by 0.5 %, two samples dropped
-    (a step three times the median), and a current held while the joint rests."""
+    (a step three times the median), a current held while the joint rests, and one held for
+    40 rows (under ``STUCK_MIN_SAMPLES``) while it moves."""
     rng = np.random.default_rng(3)
     current = np.round(clean.current / 0.02) * 0.02
     t = clean.time + rng.uniform(-0.005, 0.005, len(clean)) * 1e-3
@@ -131,3 +132,7 @@ def test_what_real_logs_do_passes(clean):
     current = rest.current.copy()
     current[:500] = 0.3
     check_trajectory_log(dataclasses.replace(rest, current=current))
+    current = clean.current.copy()
+    current[1200:1240] = current[1200]
+    assert np.ptp(clean.velocity[1200:1240]) > 0.05 * np.ptp(clean.velocity)
+    check_trajectory_log(dataclasses.replace(clean, current=current))
