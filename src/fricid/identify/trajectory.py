@@ -375,6 +375,7 @@ def fit_trajectory(
         else int(rate / derivative.cutoff)
     )
     mask = ~dilate(np.abs(vf) < v_slide, half, max(half, round(guard * rate)))
+    mask[:half], mask[mask.size - half :] = False, False  # the filter's edges: extrapolated
     if mask.sum() < 50:
         raise DataError(
             f"only {int(mask.sum())} samples slide faster than {v_slide:g} rad/s: too few for "

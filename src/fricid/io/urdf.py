@@ -279,7 +279,9 @@ class _Reader:
         if len(parts) != count or not all(_NUMBER.fullmatch(p) for p in parts):
             raise self.fail(where, f"{shown} is not {count} plain decimal numbers")
         values = np.array([float(p) for p in parts], dtype=float)
-        if not np.isfinite(values).all() or (np.abs(values) > bound).any():
+        if not np.isfinite(values).all():
+            raise self.fail(where, f"{shown} overflows a double")
+        if (np.abs(values) > bound).any():
             raise self.fail(where, f"{shown} has a magnitude over {bound:g}")
         return values
 
