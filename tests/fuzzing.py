@@ -350,12 +350,15 @@ class _Count(logging.Handler):
         self.records.append(record)
 
 
-def classify(call: Callable[[], Any], path: Path) -> tuple[str, Any]:
+def classify(
+    call: Callable[[], Any], path: Path, check: Callable[[Any], None] = check_valid
+) -> tuple[str, Any]:
     """``("error", message)`` or ``("valid", result)``; anything else raises.
 
     Another exception propagates (a traceback); a RuntimeWarning, a multi-line message, a
-    message that does not name ``path``, more than two log warnings or an invalid result
-    raise :class:`WrongAnswer` or AssertionError.
+    message that does not name ``path``, more than two log warnings or a result that
+    ``check`` refuses (default :func:`check_valid`) raise :class:`WrongAnswer` or
+    AssertionError.
     """
     counter = _Count()
     logger = logging.getLogger("fricid")
@@ -373,7 +376,7 @@ def classify(call: Callable[[], Any], path: Path) -> tuple[str, Any]:
     finally:
         logger.removeHandler(counter)
     assert len(counter.records) <= 2, f"{len(counter.records)} log warnings for one file"
-    check_valid(result)
+    check(result)
     return "valid", result
 
 

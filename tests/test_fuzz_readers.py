@@ -20,6 +20,7 @@ from __future__ import annotations
 import json
 import shutil
 import tempfile
+import time
 from pathlib import Path
 
 import numpy as np
@@ -40,6 +41,7 @@ from fuzzing import (
     mutate,
     same_values,
 )
+from fuzzing_structures import run_trajectory, run_urdf
 
 # --------------------------------------------------------------------------- the tests
 
@@ -139,3 +141,35 @@ def test_parquet_metadata_regressions(tmp_path, doc, words):
     pq.write_table(table.replace_schema_metadata({b"fricid": json.dumps(doc).encode()}), path)
     outcome, message = classify(lambda: read_samples(path), path)
     assert outcome == "error" and words in message
+
+
+# --------------------------------------------------------------------------- structures
+
+#: Seconds any generated case may take (every case within 60 s; these are small). Peak
+#: memory is measured by ``benchmarks/fuzz_readers.py`` (tracing it here would make the
+#: cases several times slower).
+CASE_SECONDS = 20.0
+
+
+@settings(FUZZ, max_examples=60)
+@given(data=st.data())
+def test_generated_urdfs(workspace, data):
+    """Random trees with cycles, self-loops, second parents, missing links, hostile numbers
+    (1e308, 1e-320 kg, 0_1, NaN), DOCTYPEs and encodings (UTF-16, UTF-32, Latin-1): a clean
+    error for every defect, else eq. 7 as the structure gives it (``fuzzing_structures``)."""
+    workspace.n += 1
+    start = time.perf_counter()
+    run_urdf(workspace.folder, HypothesisChooser(data), workspace.n)
+    assert time.perf_counter() - start < CASE_SECONDS
+
+
+@settings(FUZZ, max_examples=10)
+@given(data=st.data())
+def test_damaged_trajectory_logs(workspace, data):
+    """The virtual joint's 2 s multi-sine with holes, moved or repeated stamps, lost rows and
+    stuck currents: a clean error for every defect, else an inertia and static friction
+    within a factor 1.5 of the truth."""
+    workspace.n += 1
+    start = time.perf_counter()
+    run_trajectory(workspace.folder, HypothesisChooser(data), workspace.n)
+    assert time.perf_counter() - start < CASE_SECONDS

@@ -25,7 +25,7 @@ from _source import ROOT, Import, Module, imports, modules, tree, unit
 
 #: The table's rows, bottom of the stack (top of DESIGN.md's table) first.
 ROWS: tuple[tuple[str, ...], ...] = (
-    ("units", "errors", "metrics"),
+    ("units", "errors", "metrics", "_jit"),
     ("samples",),
     ("io",),
     ("models",),
@@ -49,10 +49,11 @@ MAY_IMPORT: dict[str, tuple[tuple[str, ...], bool]] = {
     "units": (("errors",), False),
     "errors": ((), False),
     "metrics": ((), False),
+    "_jit": ((), False),  # numba's compilers with the cache fallback
     "samples": (("units", "errors"), False),
     "io": (("samples",), True),
-    "models": (("units", "errors"), False),
-    "optim": (("errors",), False),
+    "models": (("units", "errors", "_jit"), False),
+    "optim": (("errors", "_jit"), False),
     "extract": (("samples", "io", "units", "errors"), False),
     "sim": (("samples", "models"), False),
     "fitted": (("models", "samples", "metrics", "io"), False),

@@ -123,7 +123,7 @@ def test_the_virtual_joint_written_as_urdf(tmp_path):
         ("<model/>", "not <robot>"),
         (
             "<robot><link name='a'><inertial><mass value='heavy'/></inertial></link></robot>",
-            r"<link name='a'> <inertial><mass>: value='heavy' is not 1 numbers",
+            r"<link name='a'> <inertial><mass>: value='heavy' is not 1 plain decimal numbers",
         ),
         (
             "<robot><link name='a'/><joint name='j' type='revolute'><parent link='a'/>"
@@ -133,7 +133,7 @@ def test_the_virtual_joint_written_as_urdf(tmp_path):
         (
             "<robot><link name='a'/><link name='b'/><joint name='j' type='revolute'>"
             "<parent link='a'/><child link='b'/><origin xyz='0 0 nan'/></joint></robot>",
-            r"<joint name='j'> <origin>: xyz='0 0 nan' is not 3 finite numbers",
+            r"<joint name='j'> <origin>: xyz='0 0 nan' is not 3 plain decimal numbers",
         ),
         ("<robot><link name='a'/><link name='b'/></robot>", "one tree"),
     ],
@@ -154,9 +154,9 @@ def test_an_expanded_xacro_with_its_namespace_loads(tmp_path):
 
 
 def test_size_cap(tmp_path, monkeypatch):
-    import fricid.io.urdf as urdf
+    import fricid.io._urdf_text as urdf_text
 
-    monkeypatch.setattr(urdf, "MAX_BYTES", 100)
+    monkeypatch.setattr(urdf_text, "MAX_BYTES", 100)
     path = _write(tmp_path, "<robot>" + " " * 200 + "</robot>")
     with pytest.raises(DataError, match="over the 100"):
         read_urdf(path)

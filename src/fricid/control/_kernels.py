@@ -11,8 +11,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
+from .._jit import njit
 from ..models._lugre_kernel import run as lugre_run
 
 __all__ = ["drive_lugre", "lugre_plant_step", "track_lugre"]

@@ -26,7 +26,7 @@ from ..optim import JitObjective
 from ..samples import FrictionSamples
 
 try:  # the compiled twin of the objective (optional: the numpy path is always there)
-    from numba import njit
+    from .._jit import njit
 except ImportError:  # pragma: no cover - numba is a dependency
     njit = None
 

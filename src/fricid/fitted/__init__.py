@@ -11,7 +11,8 @@ A model file may come from a stranger, so loading is strict (issue 12): the file
 :func:`fricid.io._jsonfile.read_json` (at most 64 MiB, UTF-8, nesting at most 64 deep, no
 NaN, Infinity or overflowing numbers, no repeated keys), checked against the JSON Schema
 (finite numbers, bounded sizes, identifier names, the RBF network's typed arrays), and
-:meth:`FittedModel.from_dict` refuses ranges whose minimum exceeds their maximum and a model
+:meth:`FittedModel.from_dict` refuses parameters outside their family's valid region
+(``fricid.models.Parameter.region``), ranges whose minimum exceeds their maximum and a model
 that cannot be evaluated, or predicts a non-finite friction, on its operating range. Every
 failure is one :class:`~fricid.errors.DataError` line naming the file given.
 """
@@ -47,6 +48,19 @@ __all__ = ["MIN_CORREL", "RANGE_TOLERANCE", "SCHEMA_VERSION", "FittedModel", "Ra
 
 #: Correlations at or below this magnitude are left out of the fit report (lmfit's default).
 MIN_CORREL = 0.1
+
+
+def _check_region(model, theta, field_name: str, name: str, source: str | None) -> None:
+    """A :class:`DataError` naming the file and the first parameter of ``theta`` outside the
+    valid region its family declares (``fricid.models.Parameter.region``)."""
+    bad = model.region_violation(theta)
+    if bad is not None:
+        param, value = bad
+        raise DataError(
+            f"field '{field_name}/{param.name}': {value!r} lies outside model '{name}''s valid "
+            f"region ({param.rule}, the {param.description})",
+            file=source,
+        )
 
 
 @dataclass
@@ -381,9 +395,11 @@ class FittedModel:
         DataError
             The document is not a model file of a version this fricid reads, does not match
             the schema (``fricid/schemas/model.schema.json``: finite numbers of at most 1e300
-            in magnitude, bounded sizes), names an unknown model or parameters, has a range or
-            bound whose minimum exceeds its maximum, or gives a model that cannot be
-            evaluated, or predicts a non-finite friction, on its operating range.
+            in magnitude, bounded sizes), names an unknown model or parameters, has a parameter
+            outside its family's valid region (``fricid.models.Parameter.region``: ``w_s > 0``,
+            ``tau_c >= 0``, ...), has a range or bound whose minimum exceeds its maximum, or
+            gives a model that cannot be evaluated, or predicts a non-finite friction, on its
+            operating range.
 
         Notes
         -----
@@ -425,9 +441,10 @@ class FittedModel:
             out.state = {**out.state, "symmetry": legacy_symmetry(directions)}
         if not stateful:
             try:
-                out.theta()
+                theta = out.theta()
             except ConfigError as exc:  # unknown model, or parameter names that do not match
                 raise DataError(one_line(str(exc)), file=source) from None
+            _check_region(out.friction_model(), theta, "params", out.model, source)
         rows = out.correlation or []
         if any(len(row) != len(rows) for row in rows):
             raise DataError("field 'correlation': not a square matrix", file=source)

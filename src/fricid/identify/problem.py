@@ -90,6 +90,25 @@ class Predictor(Protocol):
     def predict(self, theta: Any, X: Any) -> np.ndarray: ...  # pragma: no cover
 
 
+def _check_regions(model: Any, base: np.ndarray, full: np.ndarray) -> None:
+    """A :class:`ConfigError` when a fixed value or a search bound lies outside the valid
+    region of its parameter (``fricid.models.Parameter.region``): the fit could return a
+    model that no model file may hold."""
+    if not hasattr(model, "region_violation"):
+        return
+    for vector, what in (
+        (base, "fixed at"),
+        (full[:, 0], "bounded below by"),
+        (full[:, 1], "bounded above by"),
+    ):
+        bad = model.region_violation(vector)
+        if bad is not None:
+            raise ConfigError(
+                f"parameter '{bad[0].name}' {what} {bad[1]!r}, outside its valid region "
+                f"({bad[0].rule}) of model '{model.name}'"
+            )
+
+
 class IdentificationProblem:
     """A model to identify from data, with its loss, bounds and fixed parameters.
 
@@ -237,6 +256,7 @@ class IdentificationProblem:
         for name, value in self.fixed.items():
             self.base[self.names.index(name)] = value
         self.bounds = full[self.free]
+        _check_regions(model, self.base, full)
 
     def _init_generic(self, bounds: Any) -> None:
         if bounds is None or isinstance(bounds, Mapping):

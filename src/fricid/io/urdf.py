@@ -8,6 +8,22 @@ joints' ``type``, ``<parent>``, ``<child>``, ``<origin xyz rpy>`` and ``<axis xy
 meshes, limits and inertia tensors are ignored. Bad input is one :class:`DataError` naming the
 file and the element.
 
+What is read is checked before it is used:
+
+- the file: a regular file (no device, FIFO or directory), read with a cap of
+  :data:`MAX_BYTES`; its encoding is taken from its byte-order mark or, without one, its XML
+  declaration (UTF-8, UTF-16, UTF-32, US-ASCII or ISO-8859-1; any other is refused), and the
+  DOCTYPE and entity refusal applies to the decoded text, so no encoding hides a declaration;
+- the numbers: every numeric attribute matches a plain decimal number (digits, an optional
+  point and exponent: no ``nan``, ``inf``, ``0x10``, ``0_1`` or non-ASCII digits) and lies in
+  a physical range: positions (origins, centres of mass) and axis components within
+  :data:`MAX_LENGTH` m, angles within :data:`MAX_ANGLE` rad, masses 0 or within
+  :data:`MASS_RANGE` kg (0 is a massless link, as a link without ``<inertial>`` is: URDF
+  writers put ``<mass value="0"/>`` on frames that carry no body), and a moving joint's axis
+  of norm at least :data:`MIN_AXIS_NORM` (then normalised);
+- the graph: every joint names defined links, its parent differs from its child, no link has
+  two parent joints, the joints form no cycle, and exactly one link (the root) has no parent.
+
 :func:`gravity_coefficients` gives eq. 7's ``p_x, p_y`` [N m] of a revolute (or continuous)
 joint from the masses and centres of mass of every link downstream of it, with the chain's
 other joints at given positions (default zero) and gravity ``-z`` in the root link's frame.
@@ -35,7 +51,7 @@ from __future__ import annotations
 
 import math
 import os
-import xml.etree.ElementTree as ET
+import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -43,9 +59,14 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ConfigError, DataError
+from ._urdf_text import MAX_BYTES, check_graph, parse_xml
 
 __all__ = [
+    "MASS_RANGE",
+    "MAX_ANGLE",
     "MAX_BYTES",
+    "MAX_LENGTH",
+    "MIN_AXIS_NORM",
     "STANDARD_GRAVITY",
     "GravityLoad",
     "Robot",
@@ -54,11 +75,24 @@ __all__ = [
     "urdf_gravity",
 ]
 
-#: Largest URDF read [bytes] (meshes live in separate files, so real URDFs are far smaller).
-MAX_BYTES = 8 * 1024 * 1024
-
 #: m/s^2, the gravity used unless another is given.
 STANDARD_GRAVITY = 9.80665
+
+#: Largest magnitude [m] of a position coordinate (origins, centres of mass) and of an axis
+#: component: a kilometre is beyond any robot.
+MAX_LENGTH = 1e3
+
+#: Largest magnitude [rad] of an ``rpy`` angle.
+MAX_ANGLE = 1e3
+
+#: The masses [kg] a link may have besides 0 (a massless link).
+MASS_RANGE = (1e-9, 1e6)
+
+#: Smallest norm of a moving joint's axis (the axis is normalised).
+MIN_AXIS_NORM = 1e-6
+
+#: A plain decimal number: ASCII digits, optional sign, point and exponent.
+_NUMBER = re.compile(r"[-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][-+]?[0-9]+)?")
 
 _ROTATING = ("revolute", "continuous")
 _TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
@@ -110,9 +144,12 @@ class Robot:
         children: dict[str, list[str]] = {}
         for j in self.joints.values():
             children.setdefault(j.parent, []).append(j.child)
-        out, todo = [], [self.joints[joint].child]
+        out, todo, seen = [], [self.joints[joint].child], set()
         while todo:
             link = todo.pop()
+            if link in seen:  # a tree has none; read_urdf refuses cycles
+                continue
+            seen.add(link)
             out.append(link)
             todo.extend(children.get(link, ()))
         return out
@@ -188,7 +225,7 @@ def _about(axis: np.ndarray, angle: float) -> np.ndarray:
 
 
 class _Reader:
-    """Attribute parsing with errors naming the file and the element."""
+    """Attribute parsing with errors naming the file, the element and the attribute."""
 
     def __init__(self, source: str) -> None:
         self.source = source
@@ -196,15 +233,20 @@ class _Reader:
     def fail(self, where: str, what: str) -> DataError:
         return DataError(f"{where}: {what}", file=self.source)
 
-    def numbers(self, el, attr: str, where: str, count: int, default: str) -> np.ndarray:
+    def numbers(
+        self, el, attr: str, where: str, count: int, default: str, bound: float
+    ) -> np.ndarray:
+        """``count`` plain decimal numbers (module notes) of magnitude at most ``bound``."""
         text = el.get(attr, default) if el is not None else default
         parts = text.split()
-        try:
-            values = np.array([float(p) for p in parts], dtype=float)
-        except ValueError:
-            raise self.fail(where, f"{attr}='{text[:40]}' is not {count} numbers") from None
-        if values.size != count or not np.isfinite(values).all():
-            raise self.fail(where, f"{attr}='{text[:40]}' is not {count} finite numbers")
+        shown = f"{attr}='{text[:40]}'"
+        if len(parts) != count or not all(_NUMBER.fullmatch(p) for p in parts):
+            raise self.fail(where, f"{shown} is not {count} plain decimal numbers")
+        values = np.array([float(p) for p in parts], dtype=float)
+        if not np.isfinite(values).all():
+            raise self.fail(where, f"{shown} overflows a double")
+        if (np.abs(values) > bound).any():
+            raise self.fail(where, f"{shown} has a magnitude over {bound:g}")
         return values
 
     def name(self, el, where: str) -> str:
@@ -222,13 +264,17 @@ class _Reader:
         mass_el = inertial.find("mass")
         if mass_el is None:
             raise self.fail(where, "<inertial> has no <mass>")
-        mass = float(self.numbers(mass_el, "value", f"{where} <inertial><mass>", 1, "")[0])
-        if mass < 0:
-            raise self.fail(f"{where} <inertial><mass>", f"value={mass!r} is negative")
+        at = f"{where} <inertial><mass>"
+        mass = float(self.numbers(mass_el, "value", at, 1, "", math.inf)[0])
+        low, high = MASS_RANGE
+        if mass != 0 and not low <= mass <= high:
+            raise self.fail(
+                at, f"value={mass!r} kg is not 0 (massless) nor within [{low:g}, {high:g}] kg"
+            )
         com = self.numbers(
-            inertial.find("origin"), "xyz", f"{where} <inertial><origin>", 3, "0 0 0"
+            inertial.find("origin"), "xyz", f"{where} <inertial><origin>", 3, "0 0 0", MAX_LENGTH
         )
-        return name, _Link(mass, com)
+        return name, _Link(abs(mass), com)
 
     def joint(self, el) -> _Joint:
         name = self.name(el, "a <joint>")
@@ -242,13 +288,15 @@ class _Reader:
             if end is None or not end.get("link"):
                 raise self.fail(where, f"has no <{tag} link='...'>")
             ends.append(end.get("link"))
+        if ends[0] == ends[1]:
+            raise self.fail(where, f"its parent and child are the same link '{ends[0][:60]}'")
         origin = el.find("origin")
-        xyz = self.numbers(origin, "xyz", f"{where} <origin>", 3, "0 0 0")
-        rpy = self.numbers(origin, "rpy", f"{where} <origin>", 3, "0 0 0")
-        axis = self.numbers(el.find("axis"), "xyz", f"{where} <axis>", 3, "1 0 0")
+        xyz = self.numbers(origin, "xyz", f"{where} <origin>", 3, "0 0 0", MAX_LENGTH)
+        rpy = self.numbers(origin, "rpy", f"{where} <origin>", 3, "0 0 0", MAX_ANGLE)
+        axis = self.numbers(el.find("axis"), "xyz", f"{where} <axis>", 3, "1 0 0", MAX_LENGTH)
         norm = float(np.linalg.norm(axis))
-        if kind in ("revolute", "continuous", "prismatic") and not norm > 0:
-            raise self.fail(f"{where} <axis>", "xyz is the zero vector")
+        if kind in ("revolute", "continuous", "prismatic") and not norm >= MIN_AXIS_NORM:
+            raise self.fail(f"{where} <axis>", f"xyz has norm {norm:.3g}, under {MIN_AXIS_NORM:g}")
         return _Joint(name, kind, ends[0], ends[1], xyz, _rpy(*rpy), axis / (norm or 1.0))
 
 
@@ -267,26 +315,16 @@ def read_urdf(path: str | os.PathLike[str]) -> Robot:
     Raises
     ------
     DataError
-        One line naming the file (and the element): a file over :data:`MAX_BYTES`, not XML,
-        with a DOCTYPE or entity declaration, xacro macros, a root that is not ``<robot>``, a
-        bad number, a joint naming an unknown link, a link with two parents, or no single root.
+        One line naming the file (and the element and attribute): not a regular file, over
+        :data:`MAX_BYTES`, an encoding not read (module notes), not XML, with a DOCTYPE or
+        entity declaration, xacro macros, a root that is not ``<robot>``, a number that is not
+        a plain decimal or lies outside its physical range, a joint naming an unknown link or
+        the same link as parent and child, a link with two parents, a cycle of joints, or not
+        exactly one root.
     """
     path = Path(path)
     src = str(path)
-    try:
-        size = path.stat().st_size
-        if size > MAX_BYTES:
-            raise DataError(f"the URDF is {size} bytes, over the {MAX_BYTES} read", file=src)
-        data = path.read_bytes()
-    except OSError as exc:
-        raise DataError(f"cannot read the URDF: {exc.strerror or exc}", file=src) from None
-    head = data.upper()
-    if b"<!DOCTYPE" in head or b"<!ENTITY" in head:
-        raise DataError("a URDF with a DOCTYPE or entity declaration is refused", file=src)
-    try:
-        root = ET.fromstring(data)
-    except ET.ParseError as exc:
-        raise DataError(f"not XML: {exc}", file=src) from None
+    root = parse_xml(path)
     macro = next((el.tag for el in root.iter() if el.tag.startswith("{")), None)
     if macro is not None:  # xacro:macro, xacro:include ... (namespaced elements)
         raise DataError(
@@ -319,14 +357,7 @@ def read_urdf(path: str | os.PathLike[str]) -> Robot:
             )
         parent_of[j.child] = j.name
         joints[j.name] = j
-    roots = [name for name in links if name not in parent_of]
-    if len(roots) != 1:
-        raise DataError(
-            f"the URDF must form one tree; links without a parent joint: "
-            f"{', '.join(r[:60] for r in roots[:5]) or 'none (a cycle)'}",
-            file=src,
-        )
-    return Robot(root.get("name", ""), roots[0], links, joints, src)
+    return Robot(root.get("name", ""), check_graph(links, joints, src), links, joints, src)
 
 
 def _link_frames(robot: Robot, q: Mapping[str, float]):

@@ -1,5 +1,10 @@
 """The analytic friction models of both papers.
 
+Each parameter declares, beside its search bounds, the region where the equation is physical
+(``Parameter.region``): friction levels and viscous coefficients ``>= 0``, Stribeck velocities
+and exponents ``> 0``, the temperature slopes of ``vlt`` any value. A model file outside it is
+refused at load (:mod:`fricid.fitted`), and a fit cannot be bounded or fixed outside it.
+
 References
 ----------
 [B] "An Optimized RBF Neural Network Based on Beetle Antennae Search Algorithm for Modeling
@@ -34,8 +39,10 @@ class CoulombViscous(FrictionModel):
     inputs = ("velocity",)
     viscous = "beta"
     parameters = (
-        Parameter("f_c", "N m", "torque", 0.5, 0.0, 2.0, "Coulomb friction"),
-        Parameter("beta", "N m s/rad", "viscous", 0.5, 0.0, 2.0, "viscous coefficient"),
+        Parameter("f_c", "N m", "torque", 0.5, 0.0, 2.0, "Coulomb friction", "nonnegative"),
+        Parameter(
+            "beta", "N m s/rad", "viscous", 0.5, 0.0, 2.0, "viscous coefficient", "nonnegative"
+        ),
     )
 
     def _predict(self, theta, X):
@@ -63,11 +70,17 @@ class Stribeck(FrictionModel):
     inputs = ("velocity",)
     viscous = "tau_v"
     parameters = (
-        Parameter("tau_c", "N m", "torque", 0.5, 0.0, 2.0, "Coulomb friction"),
-        Parameter("tau_s", "N m", "torque", 0.8, 0.0, 2.0, "static (break-away) friction"),
-        Parameter("w_s", "rad/s", "velocity", 0.1, 1e-4, 1.0, "Stribeck velocity"),
-        Parameter("tau_v", "N m s/rad", "viscous", 0.2, 0.0, 2.0, "viscous coefficient"),
-        Parameter("delta", "1", "one", 1.0, 0.2, 4.0, "Stribeck exponent (xi in eq. 2)"),
+        Parameter("tau_c", "N m", "torque", 0.5, 0.0, 2.0, "Coulomb friction", "nonnegative"),
+        Parameter(
+            "tau_s", "N m", "torque", 0.8, 0.0, 2.0, "static (break-away) friction", "nonnegative"
+        ),
+        Parameter("w_s", "rad/s", "velocity", 0.1, 1e-4, 1.0, "Stribeck velocity", "positive"),
+        Parameter(
+            "tau_v", "N m s/rad", "viscous", 0.2, 0.0, 2.0, "viscous coefficient", "nonnegative"
+        ),
+        Parameter(
+            "delta", "1", "one", 1.0, 0.2, 4.0, "Stribeck exponent (xi in eq. 2)", "positive"
+        ),
     )
 
     def _predict(self, theta, X):
@@ -91,13 +104,23 @@ class LoadDependent(FrictionModel):
     inputs = ("velocity", "load")
     viscous = "beta"
     parameters = (
-        Parameter("f_c", "N m", "torque", 0.4, 0.0, 2.0, "Coulomb friction at zero load"),
-        Parameter("f_s", "N m", "torque", 0.6, 0.0, 2.0, "static friction at zero load"),
-        Parameter("f_ck", "1", "load_coef", 0.1, 0.0, 2.0, "Coulomb increase per |load|"),
-        Parameter("f_sk", "1", "load_coef", 0.1, 0.0, 2.0, "static increase per |load|"),
-        Parameter("v_s", "rad/s", "velocity", 0.1, 1e-4, 1.0, "Stribeck velocity"),
-        Parameter("xi", "1", "one", 1.0, 0.2, 4.0, "Stribeck exponent"),
-        Parameter("beta", "N m s/rad", "viscous", 0.2, 0.0, 2.0, "viscous coefficient"),
+        Parameter(
+            "f_c", "N m", "torque", 0.4, 0.0, 2.0, "Coulomb friction at zero load", "nonnegative"
+        ),
+        Parameter(
+            "f_s", "N m", "torque", 0.6, 0.0, 2.0, "static friction at zero load", "nonnegative"
+        ),
+        Parameter(
+            "f_ck", "1", "load_coef", 0.1, 0.0, 2.0, "Coulomb increase per |load|", "nonnegative"
+        ),
+        Parameter(
+            "f_sk", "1", "load_coef", 0.1, 0.0, 2.0, "static increase per |load|", "nonnegative"
+        ),
+        Parameter("v_s", "rad/s", "velocity", 0.1, 1e-4, 1.0, "Stribeck velocity", "positive"),
+        Parameter("xi", "1", "one", 1.0, 0.2, 4.0, "Stribeck exponent", "positive"),
+        Parameter(
+            "beta", "N m s/rad", "viscous", 0.2, 0.0, 2.0, "viscous coefficient", "nonnegative"
+        ),
     )
 
     def _predict(self, theta, X):
@@ -128,14 +151,24 @@ class VelocityLoadTemperature(FrictionModel):
     equation = "BAS-RBFNN paper, eq. 4 (Table 2 parameters)"
     inputs = ("velocity", "load", "temperature")
     parameters = (
-        Parameter("f_c", "N m", "torque", 0.3, 0.0, 2.0, "Coulomb friction"),
-        Parameter("f_ctl", "1", "load_coef", 0.2, 0.0, 4.0, "Coulomb increase per |load|"),
-        Parameter("f_stl", "1", "load_coef", 0.2, 0.0, 4.0, "Stribeck increase per |load|"),
-        Parameter("f_v0", "N m", "torque", 0.5, 0.0, 10.0, "viscous level at 0 degC"),
-        Parameter("f_vT", "N m/degC", "temp_coef", 0.0, -4.0, 4.0, "viscous level per degC"),
-        Parameter("v_tl0", "rad/s", "velocity", 0.1, 1e-4, 1.0, "Stribeck velocity"),
-        Parameter("v_v0", "rad/s", "velocity", 1.0, 1e-3, 20.0, "viscous saturation velocity"),
-        Parameter("v_vT", "rad/s/degC", "velocity_temp", 0.0, -1.0, 10.0, "its change per degC"),
+        Parameter("f_c", "N m", "torque", 0.3, 0.0, 2.0, "Coulomb friction", "nonnegative"),
+        Parameter(
+            "f_ctl", "1", "load_coef", 0.2, 0.0, 4.0, "Coulomb increase per |load|", "nonnegative"
+        ),
+        Parameter(
+            "f_stl", "1", "load_coef", 0.2, 0.0, 4.0, "Stribeck increase per |load|", "nonnegative"
+        ),
+        Parameter(
+            "f_v0", "N m", "torque", 0.5, 0.0, 10.0, "viscous level at 0 degC", "nonnegative"
+        ),
+        Parameter("f_vT", "N m/degC", "temp_coef", 0.0, -4.0, 4.0, "viscous level per degC", "any"),
+        Parameter("v_tl0", "rad/s", "velocity", 0.1, 1e-4, 1.0, "Stribeck velocity", "positive"),
+        Parameter(
+            "v_v0", "rad/s", "velocity", 1.0, 1e-3, 20.0, "viscous saturation velocity", "positive"
+        ),
+        Parameter(
+            "v_vT", "rad/s/degC", "velocity_temp", 0.0, -1.0, 10.0, "its change per degC", "any"
+        ),
     )
 
     def _predict(self, theta, X):

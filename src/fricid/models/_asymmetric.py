@@ -37,6 +37,7 @@ class Asymmetric(FrictionModel):
                 p.lower,
                 p.upper,
                 f"{p.description} ({word} direction)",
+                p.region,
             )
             for suffix, word in (("_pos", "positive"), ("_neg", "negative"))
             for p in base.parameters

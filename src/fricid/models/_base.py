@@ -23,7 +23,15 @@ import numpy as np
 
 from ..errors import ConfigError, DataError
 
-__all__ = ["INPUTS", "KELVIN", "NOMINAL_ACTIVATION", "FrictionModel", "Parameter", "data_scales"]
+__all__ = [
+    "INPUTS",
+    "KELVIN",
+    "NOMINAL_ACTIVATION",
+    "REGIONS",
+    "FrictionModel",
+    "Parameter",
+    "data_scales",
+]
 
 #: Input columns of X, in order.
 INPUTS: tuple[str, ...] = ("velocity", "load", "temperature")
@@ -48,6 +56,9 @@ NOMINAL_ACTIVATION = 1.0 / (1.0 / 293.15 - 1.0 / 333.15)
 #: Degrees Celsius to kelvin.
 KELVIN = 273.15
 
+#: A parameter's valid region (``Parameter.region``) and the rule it states.
+REGIONS = {"any": "any real value", "nonnegative": ">= 0", "positive": "> 0"}
+
 
 @dataclass(frozen=True)
 class Parameter:
@@ -56,6 +67,12 @@ class Parameter:
     ``default``, ``lower`` and ``upper`` are multiples of the data scale named by ``kind``
     (:func:`data_scales`): a torque parameter bounded by ``[0, 2]`` may range up to twice the
     largest measured friction. So default bounds fit a 0.1 N m wrist and a 100 N m shoulder alike.
+
+    ``region`` is where the family's equation is physical whatever the data (:data:`REGIONS`):
+    ``"nonnegative"`` (a friction level, a viscous coefficient), ``"positive"`` (a Stribeck
+    velocity, an exponent, a stiffness) or ``"any"``. The search bounds lie inside it (checked
+    here, for any positive data scale); a model file whose parameter lies outside it is refused
+    at load (:meth:`FrictionModel.region_violation`).
     """
 
     name: str
@@ -65,6 +82,7 @@ class Parameter:
     lower: float
     upper: float
     description: str = ""
+    region: str = "any"
 
     def __post_init__(self) -> None:
         if self.kind not in SCALE_KINDS:
@@ -74,6 +92,27 @@ class Parameter:
                 f"parameter '{self.name}': default {self.default} outside bounds "
                 f"[{self.lower}, {self.upper}]"
             )
+        if self.region not in REGIONS:
+            raise ConfigError(f"parameter '{self.name}': unknown region '{self.region}'")
+        if not (self.admits(self.lower) and self.admits(self.upper)):
+            raise ConfigError(
+                f"parameter '{self.name}': bounds [{self.lower}, {self.upper}] leave its valid "
+                f"region {self.rule}"
+            )
+
+    def admits(self, value: float) -> bool:
+        """Whether ``value`` (not NaN; an infinite search bound counts) lies inside the
+        parameter's valid region."""
+        if np.isnan(value):
+            return False
+        if self.region == "positive":
+            return value > 0
+        return value >= 0 if self.region == "nonnegative" else True
+
+    @property
+    def rule(self) -> str:
+        """The valid region as a rule, e.g. ``"w_s > 0"``."""
+        return f"{self.name} {REGIONS[self.region]}"
 
 
 class FrictionModel(ABC):
@@ -142,6 +181,15 @@ class FrictionModel(ABC):
                 + (f"; unknown: {', '.join(extra)}" if extra else "")
             )
         return np.array([float(values[n]) for n in self.param_names])
+
+    def region_violation(self, theta) -> tuple[Parameter, float] | None:
+        """The first parameter of the vector ``theta`` ``(d,)`` outside its valid region
+        (``Parameter.region``) with its value, or None when every one lies inside."""
+        values = np.asarray(theta, dtype=float).ravel()
+        for p, value in zip(self.parameters, values, strict=True):
+            if not p.admits(float(value)):
+                return p, float(value)
+        return None
 
     def __repr__(self) -> str:
         return f"{type(self).__name__}({', '.join(self.param_names)})"

@@ -34,7 +34,7 @@ from ._base import KELVIN
 from ._temperature import T_REF
 
 try:
-    from numba import njit
+    from .._jit import njit
 
     HAVE_NUMBA = True
 except ImportError:  # pragma: no cover - numba is a dependency

@@ -62,10 +62,12 @@ __all__ = [
 
 #: Dahl's parameters, in the order of ``theta`` columns.
 PARAMETERS: tuple[Parameter, ...] = (
-    Parameter("sigma_0", "N m/rad", "one", 1e4, 1.0, 1e7, "rest stiffness"),
-    Parameter("tau_c", "N m", "torque", 0.5, 1e-6, 2.0, "Coulomb friction"),
-    Parameter("alpha", "1", "one", 1.0, 0.1, 4.0, "shape of the stress-strain curve"),
-    Parameter("sigma_2", "N m s/rad", "viscous", 0.2, 0.0, 2.0, "viscous coefficient"),
+    Parameter("sigma_0", "N m/rad", "one", 1e4, 1.0, 1e7, "rest stiffness", "positive"),
+    Parameter("tau_c", "N m", "torque", 0.5, 1e-6, 2.0, "Coulomb friction", "positive"),
+    Parameter("alpha", "1", "one", 1.0, 0.1, 4.0, "shape of the stress-strain curve", "positive"),
+    Parameter(
+        "sigma_2", "N m s/rad", "viscous", 0.2, 0.0, 2.0, "viscous coefficient", "nonnegative"
+    ),
 )
 PARAM_NAMES: tuple[str, ...] = tuple(p.name for p in PARAMETERS)
 

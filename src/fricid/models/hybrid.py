@@ -41,7 +41,7 @@ def backbone_of(state: Mapping[str, Any]):
     ------
     DataError
         A state without a well-formed ``backbone`` (an object naming a registered analytic
-        model and all of its parameters as numbers).
+        model and all of its parameters as numbers inside their valid regions).
     """
     bb = state.get("backbone")
     if not isinstance(bb, Mapping) or not isinstance(bb.get("model"), str):
@@ -60,6 +60,13 @@ def backbone_of(state: Mapping[str, Any]):
     if not np.isfinite(theta).all():
         raise DataError(
             "the hybrid model's backbone has non-finite parameters", column="state.backbone"
+        )
+    bad = model.region_violation(theta)
+    if bad is not None:
+        raise DataError(
+            f"the hybrid model's backbone parameter {bad[0].name} = {bad[1]!r} lies outside "
+            f"model '{model.name}''s valid region ({bad[0].rule})",
+            column=f"state.backbone.params.{bad[0].name}",
         )
     return model, theta
 

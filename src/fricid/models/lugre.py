@@ -75,13 +75,17 @@ __all__ = [
 #: the data scales of :func:`fricid.models.data_scales` except sigma_0 and sigma_1, whose
 #: defaults are absolute (typical of geared robot joints) and whose bounds a caller sets.
 PARAMETERS: tuple[Parameter, ...] = (
-    Parameter("sigma_0", "N m/rad", "one", 1e4, 1.0, 1e7, "bristle stiffness"),
-    Parameter("sigma_1", "N m s/rad", "one", 1.0, 0.0, 1e5, "bristle damping"),
-    Parameter("sigma_2", "N m s/rad", "viscous", 0.2, 0.0, 2.0, "viscous coefficient"),
-    Parameter("tau_c", "N m", "torque", 0.5, 0.0, 2.0, "Coulomb friction"),
-    Parameter("tau_s", "N m", "torque", 0.8, 0.0, 2.0, "static (break-away) friction"),
-    Parameter("w_s", "rad/s", "velocity", 0.1, 1e-4, 1.0, "Stribeck velocity"),
-    Parameter("delta", "1", "one", 1.0, 0.2, 4.0, "Stribeck exponent"),
+    Parameter("sigma_0", "N m/rad", "one", 1e4, 1.0, 1e7, "bristle stiffness", "positive"),
+    Parameter("sigma_1", "N m s/rad", "one", 1.0, 0.0, 1e5, "bristle damping", "nonnegative"),
+    Parameter(
+        "sigma_2", "N m s/rad", "viscous", 0.2, 0.0, 2.0, "viscous coefficient", "nonnegative"
+    ),
+    Parameter("tau_c", "N m", "torque", 0.5, 0.0, 2.0, "Coulomb friction", "nonnegative"),
+    Parameter(
+        "tau_s", "N m", "torque", 0.8, 0.0, 2.0, "static (break-away) friction", "nonnegative"
+    ),
+    Parameter("w_s", "rad/s", "velocity", 0.1, 1e-4, 1.0, "Stribeck velocity", "positive"),
+    Parameter("delta", "1", "one", 1.0, 0.2, 4.0, "Stribeck exponent", "positive"),
 )
 PARAM_NAMES: tuple[str, ...] = tuple(p.name for p in PARAMETERS)
 

@@ -20,7 +20,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import cfunc, njit, typeof, types
+from numba import typeof, types
+
+from .._jit import cfunc, njit
 
 __all__ = ["first_call", "function_of", "outer_iteration"]
 
@@ -41,10 +43,7 @@ def function_of(kernel, data: tuple):
             types.Array(types.float64, 2, "A"), types.Array(types.float64, 1, "A"), dtype
         )
         py_func = getattr(kernel, "py_func", kernel)
-        try:
-            _FUNCTIONS[key] = cfunc(sig, cache=True)(py_func)
-        except RuntimeError:  # pragma: no cover - no cache locator for this function
-            _FUNCTIONS[key] = cfunc(sig)(py_func)
+        _FUNCTIONS[key] = cfunc(sig, cache=True)(py_func)  # in memory where no cache dir
     return _FUNCTIONS[key]
 
 

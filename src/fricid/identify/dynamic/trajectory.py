@@ -132,7 +132,7 @@ import numpy as np
 from ...errors import ConfigError, DataError
 from ...fitted import FittedModel
 from ...models import get_model, lugre
-from ...samples import RawLog
+from ...samples import RawLog, check_trajectory_log
 from ._data import DerivativeFilter, derivatives, dilate, uniform_series
 from ._filtered import ParallelFilter, filtered_route
 from ._outcome import (
@@ -275,6 +275,7 @@ def fit_trajectory(
         raise ConfigError(f"rate_bias must be 'warn' or 'off', got '{rate_bias}'")
     derivative = derivative or DerivativeFilter()
     t_start = time.perf_counter()
+    check_trajectory_log(log)  # holes, grid size, stuck torque: before any allocation
     series = uniform_series(log)
     rate = 1.0 / series.dt
     vf, acc = derivatives(series, derivative)
@@ -284,6 +285,7 @@ def fit_trajectory(
         else int(rate / derivative.cutoff)
     )
     mask = ~dilate(np.abs(vf) < v_slide, half, max(half, round(guard * rate)))
+    mask[:half], mask[mask.size - half :] = False, False  # the filter's edges: extrapolated
     if mask.sum() < 50:
         raise DataError(
             f"only {int(mask.sum())} samples slide faster than {v_slide:g} rad/s: too few for "

@@ -22,7 +22,8 @@ networks were worse with it (hybrid 1.134 against 1.110 x the noise, rbf 1.245 a
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+
+from fricid._jit import njit  # absolute: the module may move within identify/
 
 __all__ = ["plusplus"]
 

@@ -84,6 +84,12 @@ def fit_learned(
     from .rbf import RBFNetRegressor, fit_rbf
 
     params = dict(network or {})
+    m = params.get("n_centers")
+    if m is not None and (isinstance(m, bool) or not isinstance(m, int | np.integer) or m < 1):
+        raise ConfigError(
+            f"the network's number of centres (--centers, n_centers) must be a whole number "
+            f">= 1; got {m!r}"
+        )
     params["trainer"] = trainer
     params["random_state"] = seed
     if options is not None:
