@@ -77,7 +77,10 @@ def _check_chunk(fh: BinaryIO, start: int, length: int) -> None:
     if uncompressed > MAX_CHUNK_BYTES or (compression == b"" and uncompressed != size):
         raise _Bad(f"implausible uncompressed chunk size {uncompressed}", start)
     if crc and compression in (b"", b"zstd", b"lz4"):
-        got = _chunk_crc(fh, size, compression.decode(), uncompressed, start)
+        try:
+            got = _chunk_crc(fh, size, compression.decode(), uncompressed, start)
+        except ImportError:  # no streaming decompressor here: the bag library checks the CRC
+            return
         if got != crc:
             raise _Bad(
                 f"chunk checksum mismatch (CRC-32 0x{got:08x}, recorded 0x{crc:08x}): its "
