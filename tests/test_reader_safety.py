@@ -371,6 +371,15 @@ def test_design_metadata_of_the_wrong_type_is_a_data_error(tmp_path):
             load_joint(bad, "table")
 
 
+@pytest.mark.parametrize("grid", ["-1e308:1e308:1", "0:1:1e-320", "0:1e300:1e-300"])
+def test_a_grid_of_infinitely_many_points_is_a_config_error(grid):
+    """Found by the fuzzer through a manifest's positions: an OverflowError before."""
+    from fricid.io.options import MAX_GRID, parse_grid
+
+    with pytest.raises(ConfigError, match=f"at most {MAX_GRID}"):
+        parse_grid(grid)
+
+
 # ------------------------------------------------------------------------------ no silent coercion
 
 
