@@ -3,10 +3,15 @@
 Each case damages an undamaged file of one reader with one to three mutations (truncation,
 byte flips, random bytes, binary junk, not-UTF-8, huge numbers, NaN/inf text, empty and
 header-only files, wrong field counts, trailing empty fields, BOM, CRLF, bad metadata,
-corrupt MCAP length fields) and classifies the outcome as the test suite does
-(``tests/fuzzing.py``): a clean error (a FricidError on one line naming the file), a valid
-result, a traceback (any other exception) or a wrong answer (a result that breaks the
-invariants, a RuntimeWarning, a multi-line message or one not naming the file). Two more
+corrupt MCAP length fields; for MATLAB files their header, tags, dimensions and classes
+word by word, decompression bombs, every MATLAB type in place of a variable and the HDF5
+constructs of v7.3 files; byte flips in Parquet and MCAP files with checksums) and
+classifies the outcome as the test suite does (``tests/fuzzing.py``): a clean error (a
+FricidError on one line naming the file), a valid result, a traceback (any other exception)
+or a wrong answer (a result that breaks the invariants, other values after damage to a file
+whose checksums cover it, a RuntimeWarning, a multi-line message or one not naming the
+file, a case over 2 GB of peak memory or 60 s). The ``channels`` row draws folders of
+per-channel files and patterns (:func:`fuzzing.channels_case`). Two more
 rows build their cases from a structure whose defects are known (``tests/fuzzing_structures.py``):
 ``urdf`` (random trees with cycles, self-loops, second parents, hostile numbers, DOCTYPEs and
 encodings; eq. 7 of a joint) and ``trajectory`` (the virtual joint's 2 s multi-sine with
@@ -40,12 +45,12 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 
-from fuzzing import READERS, RngChooser, Workspace
+from fuzzing import READERS, RngChooser, Workspace, channels_case
 from fuzzing_structures import measured, run_trajectory, run_urdf
 
 #: The rows built from a structure, beside the byte-damaged readers.
 STRUCTURES = {"urdf": run_urdf, "trajectory": run_trajectory}
-NAMES = [*READERS, *STRUCTURES]
+NAMES = [*READERS, "channels", *STRUCTURES]
 COUNTS = ("cases", "errors", "valid", "tracebacks", "wrong")
 
 
@@ -54,6 +59,9 @@ def _case(work: Workspace, name: str, rng: np.random.Generator) -> tuple[str, fl
     if name in STRUCTURES:
         work.n += 1
         call = partial(STRUCTURES[name], work.folder, RngChooser(rng), work.n)
+    elif name == "channels":
+        work.n += 1
+        call = partial(channels_case, work.folder / f"channels{work.n}", RngChooser(rng))
     else:
         call = partial(work.run, READERS[name], RngChooser(rng))
     (outcome, _what), seconds, peak = measured(call)

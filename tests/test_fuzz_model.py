@@ -159,7 +159,7 @@ def test_brackets_inside_strings_do_not_count_as_nesting(folder, valid):
 def test_the_size_cap(folder, valid, monkeypatch):
     assert _jsonfile.MAX_BYTES == 64 * 2**20
     monkeypatch.setattr(_jsonfile, "MAX_BYTES", 1000)
-    refused(valid["stribeck"], "larger than 0 MiB")
+    refused(valid["stribeck"], "larger than 1000 bytes")
     res = runner.invoke(app, ["predict", str(valid["stribeck"]), "--velocity", "1"])
     assert res.exit_code == 2 and "larger than" in res.output
 

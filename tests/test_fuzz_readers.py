@@ -12,7 +12,12 @@ Anything else (another exception, a RuntimeWarning, a multi-line message, a valu
 the invariants, a flood of log lines) fails. Mutations are drawn by hypothesis here, bounded
 so the module runs in well under a minute; ``benchmarks/fuzz_readers.py`` runs the same
 cases longer from a seed and prints the counts (cases, clean errors, valid results,
-tracebacks, wrong answers).
+tracebacks, wrong answers, peak memory, time).
+
+Issue 25 adds MATLAB v5 and v7.3 files (headers, dimensions, compressed elements and bombs,
+types), per-channel folders (file sets and patterns: every file a pattern matches read once)
+and byte flips in Parquet and MCAP files with checksums (an error, or the very values); every
+case within 2 GB of peak memory and 60 s.
 """
 
 from __future__ import annotations
@@ -37,6 +42,7 @@ from fuzzing import (
     HypothesisChooser,
     RngChooser,
     Workspace,
+    channels_case,
     classify,
     mutate,
     same_values,
@@ -70,7 +76,7 @@ def test_damaged_files_give_a_clean_error_or_a_valid_result(workspace, name, dat
 @pytest.mark.parametrize("name", list(READERS))
 def test_benign_changes_read_the_same_values(workspace, name):
     reader = READERS[name]
-    if reader.suffix in (".parquet", ".mcap"):
+    if reader.suffix in (".parquet", ".mcap", ".mat"):
         pytest.skip("binary format")
     data, expected = workspace.baseline(reader)
     for kinds in (["bom"], ["crlf"], ["bom", "crlf"]):
@@ -81,6 +87,15 @@ def test_benign_changes_read_the_same_values(workspace, name):
         path.write_bytes(damaged)
         outcome, result = classify(lambda p=path: reader.read(p), path)
         assert outcome == "valid" and same_values(result, expected), (kinds, result)
+
+
+@FUZZ
+@given(data=st.data())
+def test_per_channel_folders(workspace, data):
+    """Random file sets and patterns: a clean error, or runs that read every matched file
+    once (no run dropped, no file read as two channels)."""
+    workspace.n += 1
+    channels_case(workspace.folder / f"channels{workspace.n}", HypothesisChooser(data))
 
 
 json_values = st.recursive(

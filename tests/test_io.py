@@ -146,12 +146,14 @@ ROUND_TRIP = settings(
 @st.composite
 def samples_strategy(draw):
     n = draw(st.integers(1, 20))
+    velocity = np.asarray(draw(column("velocity", n)), dtype=float)
+    combined = np.array(draw(st.lists(st.booleans(), min_size=n, max_size=n)))
     return FrictionSamples(
-        velocity=draw(column("velocity", n)),
+        velocity=velocity,
         load=draw(column("load", n)),
         temperature=draw(column("temperature", n)),
         friction=draw(column("friction", n)),
-        direction=np.array(draw(st.lists(st.sampled_from([-1, 0, 1]), min_size=n, max_size=n))),
+        direction=np.where(combined, 0, np.sign(velocity)),  # 0, or the velocity's sign
         count=np.array(draw(st.lists(st.integers(1, 2**53), min_size=n, max_size=n))),
         std=draw(column("std", n)),
         source=draw(st.none() | texts),

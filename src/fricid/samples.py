@@ -20,6 +20,7 @@ import numpy as np
 from .errors import ConfigError, DataError
 
 __all__ = [
+    "DIRECTION_TOLERANCE",
     "LIMITS",
     "OPTIONAL_INPUTS",
     "RAWLOG_COLUMNS",
@@ -71,6 +72,11 @@ LIMITS: dict[str, tuple[float, float, str]] = {
     "std": (0.0, 1e9, "N m"),
     "torque_constant": (0.0, 1e6, "N m/A"),
 }
+
+
+#: Speed [rad/s] below which a velocity's sign is not taken to contradict a row's direction
+#: (a rounding residue, not a motion).
+DIRECTION_TOLERANCE = 1e-9
 
 
 def _check_range(name: str, arr: np.ndarray, source: str | None) -> None:
@@ -442,8 +448,9 @@ class FrictionSamples:
         Friction torque [N m].
     direction : array_like of {-1, 0, 1}, shape (n,), optional
         +1 or -1 for a sample measured in one direction of motion (velocity and friction
-        then carry that sign), 0 when both directions were combined by eq. 11 of the
-        BAS-RBFNN paper (velocity and friction are then the positive-direction values).
+        then carry that sign; a velocity of the other sign is refused), 0 when both
+        directions were combined by eq. 11 of the BAS-RBFNN paper (velocity and friction are
+        then the positive-direction values).
         Default: the sign of ``velocity``.
     count : array_like of int, shape (n,), optional
         The number of raw samples averaged into each row, >= 1 (default 1).
@@ -458,7 +465,9 @@ class FrictionSamples:
     ------
     DataError
         No rows, a column of the wrong shape or length, a non-finite value (in load or
-        temperature: some but not all), a direction other than -1, 0, +1, a count below 1
+        temperature: some but not all), a direction other than -1, 0, +1 or one that
+        contradicts its row's velocity (+1 with a velocity below -:data:`DIRECTION_TOLERANCE`,
+        or the reverse), a count below 1
         or a negative std (the row and column named).
 
     See Also
@@ -504,6 +513,17 @@ class FrictionSamples:
             row = int(bad[0])
             raise DataError(
                 f"direction must be -1, 0 or +1, got {direction[row]!r}",
+                file=src,
+                row=row,
+                column="direction",
+            )
+        against = np.flatnonzero(direction * velocity < -DIRECTION_TOLERANCE)
+        if against.size:
+            row = int(against[0])
+            raise DataError(
+                f"direction {int(direction[row]):+d} contradicts the velocity "
+                f"{float(velocity[row])!r} rad/s of the same row ({against.size} such rows): "
+                "a row measured in one direction has a velocity of that sign",
                 file=src,
                 row=row,
                 column="direction",

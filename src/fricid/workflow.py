@@ -27,7 +27,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from .errors import ConfigError, DataError, FricidError
-from .extract import ExtractionResult, extract
+from .extract import GRAVITY_MODES, ExtractionResult, extract
 from .fitted import FittedModel
 from .io.registry import check_keys, check_reader, gives_samples, open_log
 from .samples import FrictionSamples, RawLog
@@ -130,10 +130,45 @@ class JointRun:
 
 
 def _design_hints(log: RawLog) -> dict[str, Any]:
-    """The extraction hints ``fricid simulate`` records with a log (``meta["design"]``)."""
+    """The extraction hints ``fricid simulate`` records with a log (``meta["design"]``),
+    checked: they come from the file, so a bad one is a DataError naming the file and key."""
     meta = log.meta if isinstance(log.meta, Mapping) else {}
     hints = meta.get("design", {})
-    return dict(hints) if isinstance(hints, Mapping) else {}
+    if not isinstance(hints, Mapping):
+        return {}
+    hints = dict(hints)
+
+    def bad(key: str, what: str) -> DataError:
+        shown = repr(hints[key])
+        shown = shown if len(shown) <= 60 else shown[:57] + "..."
+        return DataError(
+            f"metadata 'design.{key}' must be {what}, got {shown}",
+            file=log.source,
+            column=f"meta.design.{key}",
+        )
+
+    if "positions_rad" in hints:
+        value = hints["positions_rad"]
+        if not isinstance(value, list) or not all(
+            isinstance(p, int | float) and not isinstance(p, bool) for p in value
+        ):
+            raise bad("positions_rad", "a list of numbers [rad]")
+        positions = np.asarray(value, dtype=float)
+        if positions.size == 0 or not np.isfinite(positions).all():
+            raise bad("positions_rad", "a non-empty list of finite angles [rad]")
+        if np.unique(positions).size != positions.size:
+            raise bad("positions_rad", "distinct angles [rad]")
+    halfwidth = hints.get("bin_halfwidth_rad")
+    if halfwidth is not None and not (
+        isinstance(halfwidth, int | float)
+        and not isinstance(halfwidth, bool)
+        and np.isfinite(halfwidth)
+        and halfwidth > 0
+    ):
+        raise bad("bin_halfwidth_rad", "a positive angle [rad]")
+    if "gravity" in hints and hints["gravity"] not in GRAVITY_MODES:
+        raise bad("gravity", f"one of {', '.join(GRAVITY_MODES)}")
+    return hints
 
 
 def _extract_stream(

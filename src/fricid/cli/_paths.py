@@ -1,7 +1,8 @@
 """Checks of the paths a command was given, before it reads or writes anything.
 
 Every command calls :func:`check_paths` once, first thing, with its input and output paths,
-so that a missing input, a folder where a file is meant (or the reverse) and an output that
+so that a missing input, a folder where a file is meant (or the reverse), an input that is
+neither a regular file nor a folder (a device, a FIFO) and an output that
 cannot be written are one line on stderr and exit status 2 (DESIGN.md, "Errors"), never a
 traceback, a usage screen or a partial output (a second output refused after the first was
 written). The commands leave ``exists=`` and ``dir_okay=`` out of their ``typer`` arguments:
@@ -13,7 +14,8 @@ from __future__ import annotations
 from collections.abc import Collection, Mapping
 from pathlib import Path
 
-from ..errors import ConfigError
+from ..errors import ConfigError, DataError
+from ..io._files import check_input
 
 __all__ = ["check_paths"]
 
@@ -26,6 +28,10 @@ def _input(name: str, path: Path, folders: bool) -> None:
         raise ConfigError(f"{name}: no such {what} '{path}'")
     if path.is_dir() and not folders:
         raise ConfigError(f"{name}: '{path}' is a folder; give a file")
+    try:  # a device (/dev/zero), a FIFO or a socket would never end or block the read
+        check_input(path, folder=None, what="input")
+    except DataError as exc:
+        raise ConfigError(f"{name}: {exc}") from None
 
 
 def _out_file(name: str, path: Path) -> None:

@@ -5,7 +5,11 @@ registry of readers and their options (:mod:`.registry`: :data:`READERS`,
 (:mod:`.options`); atomic writes (:mod:`.atomic`).
 
 Every reader converts to SI once, at the edge, and names the file, row and column of bad
-input (:class:`~fricid.errors.DataError`); every writer is atomic (DESIGN.md, "Files").
+input (:class:`~fricid.errors.DataError`); every writer is atomic (DESIGN.md, "Files"). An
+input that is not a regular file (a device such as ``/dev/zero``, a FIFO, a socket), or not a
+folder where one is expected, is refused before it is opened, and a file read whole is read
+with a byte cap (:mod:`._files`). What a file declares (array sizes, compressed sizes) is
+checked against a cap before anything is allocated; Parquet and MCAP checksums are verified.
 
 The readers and writers are imported on first use, so a module that needs only the registry,
 the option parsers or the atomic writer (the fleet manifest, a fleet worker) does not import

@@ -7,6 +7,7 @@ bag itself (unreadable, truncated, corrupt, a topic missing or of another type) 
 
 from __future__ import annotations
 
+import os
 import struct
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -16,6 +17,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import DataError
+from ._files import check_input
 from ._mcap import check_mcap
 
 __all__ = [
@@ -73,8 +75,13 @@ def open_bag(path: Path) -> Iterator[Any]:
     from rosbags.highlevel import AnyReader
     from rosbags.typesys import Stores, get_typestore
 
-    if not path.exists():
+    if not os.path.lexists(path):
         raise DataError("no such bag (a rosbag2 directory, .mcap, .db3 or .bag file)", file=path)
+    check_input(path, folder=None, what="bag (a rosbag2 folder, .mcap, .db3 or .bag file)")
+    if path.is_dir():
+        for part in sorted(path.iterdir()):
+            if part.suffix in (".mcap", ".db3", ".yaml"):
+                check_input(part, what="file of the bag")
     if path.is_dir() and not (path / "metadata.yaml").is_file():
         raise DataError(
             "a folder without metadata.yaml is not a rosbag2 bag (give the bag's folder, or its "
@@ -104,10 +111,41 @@ def unreadable(exc: BaseException) -> str:
     )
 
 
+#: The fields read from each message type (a bag's own definition may lack one).
+_FIELDS = {
+    JOINT_STATE: (
+        "header.stamp.sec",
+        "header.stamp.nanosec",
+        "name",
+        "position",
+        "velocity",
+        "effort",
+    ),
+    TEMPERATURE: ("header.stamp.sec", "header.stamp.nanosec", "temperature"),
+}
+
+
+def _check_fields(msg: Any, msgtype: str, index: int, path: Path) -> None:
+    """Refuse a message without a field fricid reads (a damaged or foreign definition)."""
+    for dotted in _FIELDS.get(msgtype, ()):
+        node = msg
+        for part in dotted.split("."):
+            if not hasattr(node, part):
+                raise DataError(
+                    f"message {index} ({msgtype}) has no field '{dotted}': the bag's definition "
+                    "of the message type is not the standard one (a damaged bag?)",
+                    file=path,
+                    row=index,
+                )
+            node = getattr(node, part)
+
+
 def messages(reader: Any, connections: list[Any], path: Path) -> Iterator[tuple[int, Any]]:
-    """``(receive time [ns], message)`` of ``connections``, corrupt data as DataError."""
+    """``(receive time [ns], message)`` of ``connections``, corrupt data as DataError (a
+    message without a field fricid reads included)."""
     errors = bag_errors()
     stream = reader.messages(connections=connections)
+    index = -1
     while True:
         try:
             item = next(stream, None)
@@ -117,6 +155,8 @@ def messages(reader: Any, connections: list[Any], path: Path) -> Iterator[tuple[
             msg = reader.deserialize(raw, connection.msgtype)
         except errors as exc:
             raise DataError(unreadable(exc), file=path) from None
+        index += 1
+        _check_fields(msg, connection.msgtype, index, path)
         yield stamp, msg
 
 

@@ -23,6 +23,7 @@ import pyarrow.csv as pacsv
 from ..errors import DataError
 from ..units import SI_UNITS
 from ._columns import split_label
+from ._files import check_input
 from ._meta import dumps_meta, encode_text
 from .atomic import atomic_write
 
@@ -102,17 +103,15 @@ def read_preamble(path: str | os.PathLike[str]) -> Preamble:
     Raises
     ------
     DataError
-        An empty file, no header line, or text that is not UTF-8 (the line named).
+        Not a regular file (a folder, a device, a FIFO), an empty file, no header line, or
+        text that is not UTF-8 (the line named).
     """
     path = Path(path)
     comments: dict[str, tuple[str | None, str]] = {}
     offset = 0
     line = 0
-    try:
-        fh = open(path, "rb")  # noqa: SIM115 - closed below
-    except IsADirectoryError:
-        raise DataError("is a folder, not a CSV file", file=path) from None
-    with fh:
+    check_input(path, what="CSV file")
+    with open(path, "rb") as fh:
         while True:
             raw = fh.readline()
             if not raw:

@@ -27,6 +27,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import DataError
+from ._files import read_capped
 
 __all__ = [
     "MAX_BYTES",
@@ -134,16 +135,11 @@ def read_json(path: str | PathLike[str], *, what: str = "JSON file") -> Any:
     Raises
     ------
     DataError
-        The file cannot be read, exceeds a limit, is not UTF-8 or not valid JSON, or holds a
+        The file cannot be read or is not a regular file (a folder, a device, a FIFO),
+        exceeds a limit, is not UTF-8 or not valid JSON, or holds a
         value that is not finite in double precision.
     """
-    try:
-        with open(path, "rb") as fh:
-            data = fh.read(MAX_BYTES + 1)
-    except OSError as exc:
-        raise DataError(f"cannot read the {what}: {exc.strerror or exc}", file=path) from None
-    if len(data) > MAX_BYTES:
-        raise DataError(f"the {what} is larger than {MAX_BYTES // 2**20} MiB", file=path)
+    data = read_capped(path, MAX_BYTES, what=what)
     if data.startswith(b"\xef\xbb\xbf"):
         data = data[3:]
     depth = _max_depth(data)

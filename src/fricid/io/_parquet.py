@@ -1,10 +1,21 @@
 """Parquet machinery shared by the readers and writers: schema metadata, column reads, batch
-streaming, streamed atomic writing."""
+streaming, streamed atomic writing, integrity.
+
+Integrity: fricid writes every page with its CRC-32 (Parquet's page checksums) and reads with
+their verification on, so a damaged page is an error, never other values. The footer has no
+checksum in Parquet, so fricid adds one record at the end of writing, under
+:data:`CHECK_KEY`: the row count, the CRC-32 of fricid's metadata document and the CRC-32 of
+each column's values (as float64, little-endian, in row order). A reader checks the record
+when it opens the file (a renamed or missing column, other metadata, another row count) and
+each column's values once read. A file without the record (written by another tool, or by an
+older fricid) is read as before, its page checksums verified where it has them.
+"""
 
 from __future__ import annotations
 
 import json
 import os
+import zlib
 from collections.abc import Iterable, Iterator, Mapping
 from pathlib import Path
 from typing import Any
@@ -16,10 +27,12 @@ import pyarrow.parquet as pq
 from ..errors import DataError
 from ..units import SI_UNITS
 from ._csv import one_line, rechunk
+from ._files import check_input
 from ._meta import dumps_meta
 from .atomic import atomic_path
 
 __all__ = [
+    "CHECK_KEY",
     "META_KEY",
     "ROW_GROUP_ROWS",
     "iter_columns",
@@ -32,6 +45,9 @@ __all__ = [
 
 #: Key of fricid's JSON document in the Parquet schema metadata.
 META_KEY = b"fricid"
+
+#: Key of fricid's integrity record in the Parquet footer's key-value metadata.
+CHECK_KEY = b"fricid-check"
 
 #: Largest Parquet row group written: bounds the memory a streaming reader needs per group
 #: (5 float64 columns x 256 Ki rows = 10 MB).
@@ -53,18 +69,101 @@ def open_parquet(path: str | os.PathLike[str]) -> pq.ParquetFile:
 
     Raises
     ------
-    FileNotFoundError
-        No such file.
     DataError
-        A damaged or truncated file.
+        No such file, not a regular file (a folder, a device, a FIFO), a damaged or
+        truncated file.
     """
+    check_input(path, what="Parquet file")
     try:
         # no pre-buffering: it reads ahead whole row groups, unbounded for iter_batches
-        return pq.ParquetFile(path, pre_buffer=False)
+        pf = pq.ParquetFile(path, pre_buffer=False, page_checksum_verification=True)
     except (pa.ArrowException, OSError, UnicodeError) as exc:
-        if isinstance(exc, FileNotFoundError):
-            raise
         raise DataError(f"not a readable Parquet file ({one_line(exc)})", file=path) from None
+    check_record(pf, path)
+    return pf
+
+
+def _damaged(what: str, path: str | os.PathLike[str]) -> DataError:
+    return DataError(f"damaged file: {what} (fricid's integrity record)", file=path)
+
+
+def check_record(pf: pq.ParquetFile, path: str | os.PathLike[str]) -> dict[str, int] | None:
+    """Check a file's footer against fricid's integrity record (:data:`CHECK_KEY`).
+
+    Parameters
+    ----------
+    pf : pyarrow.parquet.ParquetFile
+        The open file.
+    path : str or os.PathLike
+        Its path (for messages).
+
+    Returns
+    -------
+    dict of str to int or None
+        Column -> CRC-32 of its values, to check once they are read; None for a file
+        without the record (written by another tool or an older fricid).
+
+    Raises
+    ------
+    DataError
+        A record that is damaged or absent though fricid's metadata says it was written,
+        metadata or a row count that does not match it, a column of the record missing.
+    """
+    try:
+        raw = (pf.metadata.metadata or {}).get(CHECK_KEY)
+        doc = (pf.schema_arrow.metadata or {}).get(META_KEY)
+        names = pf.schema_arrow.names
+        rows = pf.metadata.num_rows
+    except (pa.ArrowException, OSError, UnicodeError) as exc:
+        raise DataError(f"not a readable Parquet file ({one_line(exc)})", file=path) from None
+    if raw is None:
+        try:
+            promised = json.loads(doc or b"{}").get("integrity") == CHECK_KEY.decode()
+        except (ValueError, AttributeError, RecursionError):
+            promised = False  # schema_meta names the bad document
+        if promised:
+            raise _damaged("the record is missing", path)
+        return None
+    try:
+        record = json.loads(raw)
+        crcs = record["crc32"]
+        ok = (
+            isinstance(record["rows"], int)
+            and isinstance(record["doc_crc32"], int)
+            and isinstance(crcs, dict)
+            and all(isinstance(v, int) for v in crcs.values())
+        )
+    except (ValueError, KeyError, TypeError, RecursionError):
+        ok = False
+    if not ok:
+        raise _damaged("the record is not readable", path)
+    if record["doc_crc32"] != zlib.crc32(doc or b""):
+        raise _damaged("the metadata does not match its checksum", path)
+    if record["rows"] != rows:
+        raise _damaged(f"{rows} rows, {record['rows']} written", path)
+    missing = [name for name in crcs if name not in names]
+    if missing:
+        raise _damaged(f"column '{missing[0]}' is missing", path)
+    return crcs
+
+
+def _crc(values: np.ndarray, start: int = 0) -> int:
+    """CRC-32 of float64 values, little-endian (continuing from ``start``)."""
+    return zlib.crc32(np.ascontiguousarray(values, dtype="<f8").tobytes(), start)
+
+
+def _check_values(
+    crcs: dict[str, int] | None, found: dict[str, int], path: str | os.PathLike[str]
+) -> None:
+    """Each column read against the CRC-32 written with it."""
+    for label, crc in found.items():
+        if crcs is not None and label in crcs and crcs[label] != crc:
+            raise DataError(
+                "damaged file: its values do not match the checksum written with them "
+                "(fricid's integrity record)",
+                file=path,
+                column=label,
+            )
 
 
 def schema_meta(pf: pq.ParquetFile, path: str | os.PathLike[str]) -> dict[str, Any]:
@@ -153,11 +252,14 @@ def read_columns(pf: pq.ParquetFile, labels: list[str], path: Path) -> dict[str,
         Unreadable data, a null, non-numeric or non-finite value (rows in messages are
         0-based records).
     """
+    crcs = check_record(pf, path)
     try:
         table = pf.read(columns=labels)
     except (pa.ArrowException, OSError, UnicodeError) as exc:
         raise DataError(f"cannot read Parquet data ({one_line(exc)})", file=path) from None
-    return _to_float(table, labels, path, 0)
+    columns = _to_float(table, labels, path, 0)
+    _check_values(crcs, {label: _crc(columns[label]) for label in labels}, path)
+    return columns
 
 
 def iter_columns(
@@ -186,8 +288,11 @@ def iter_columns(
     Raises
     ------
     DataError
-        As :func:`read_columns`.
+        As :func:`read_columns`; values that do not match fricid's integrity record after
+        the last chunk.
     """
+    crcs = check_record(pf, path)
+    found = dict.fromkeys(labels, 0)
     batches = pf.iter_batches(batch_size=min(chunk_rows, 1 << 20), columns=labels)
     stream = rechunk(batches, chunk_rows)
     start = 0
@@ -195,10 +300,13 @@ def iter_columns(
         try:
             table = next(stream)
         except StopIteration:
+            _check_values(crcs, found, path)
             return
         except (pa.ArrowException, OSError, UnicodeError) as exc:
             raise DataError(f"cannot read Parquet data ({one_line(exc)})", file=path) from None
-        yield start, _to_float(table, labels, path, start)
+        columns = _to_float(table, labels, path, start)
+        found = {label: _crc(columns[label], found[label]) for label in labels}
+        yield start, columns
         start += table.num_rows
 
 
@@ -233,7 +341,7 @@ def parquet_doc(
     bytes
         ASCII JSON, stored under :data:`META_KEY`.
     """
-    doc: dict[str, Any] = {"format": fmt, "units": dict(units)}
+    doc: dict[str, Any] = {"format": fmt, "units": dict(units), "integrity": CHECK_KEY.decode()}
     if torque_constant is not None:
         doc["units"]["torque_constant"] = SI_UNITS["torque_constant"]
         doc["torque_constant"] = float(torque_constant)
@@ -256,16 +364,27 @@ def write_parquet(path: Path, doc: bytes, tables: Iterable[pa.Table]) -> None:
         The metadata document (:func:`parquet_doc`).
     tables : iterable of pyarrow.Table
         The rows, in order, all with the same schema; streamed, in row groups of at most
-        :data:`ROW_GROUP_ROWS` rows.
+        :data:`ROW_GROUP_ROWS` rows. Pages are written with their checksums, and fricid's
+        integrity record (:data:`CHECK_KEY`) is added at the end.
     """
     with atomic_path(path) as tmp:
         writer = None
+        crcs: dict[str, int] = {}
+        rows = 0
         try:
             for table in tables:
                 if writer is None:
                     schema = table.schema.with_metadata({META_KEY: doc})
-                    writer = pq.ParquetWriter(tmp, schema)
+                    writer = pq.ParquetWriter(tmp, schema, write_page_checksum=True)
+                    crcs = dict.fromkeys(table.schema.names, 0)
                 writer.write_table(table, row_group_size=ROW_GROUP_ROWS)
+                for name in crcs:
+                    values = table.column(name).cast(pa.float64()).to_numpy(zero_copy_only=False)
+                    crcs[name] = _crc(values, crcs[name])
+                rows += table.num_rows
+            if writer is not None:
+                record = {"rows": rows, "doc_crc32": zlib.crc32(doc), "crc32": crcs}
+                writer.add_key_value_metadata({CHECK_KEY: json.dumps(record).encode("ascii")})
         finally:
             if writer is not None:
                 writer.close()

@@ -44,6 +44,7 @@ import pandas as pd
 from ..errors import ConfigError, DataError, DataQualityWarning
 from ..samples import RawLog
 from ..units import UNITS, to_si
+from ._files import check_input, read_capped
 from .generic import integrate_velocity
 
 __all__ = ["CHANNEL_QUANTITIES", "JOINS", "compile_pattern", "read_channels"]
@@ -114,7 +115,8 @@ def _sort_key(value: str) -> tuple[int, float, str]:
 
 def _read_two_columns(path: Path, quantity: str) -> tuple[np.ndarray, np.ndarray]:
     """``time value`` rows (blank, comma or semicolon separated; ``#`` lines skipped)."""
-    lines = path.read_text(encoding="utf-8", errors="replace").splitlines()
+    text = read_capped(path, what=f"{quantity} file").decode("utf-8", errors="replace")
+    lines = text.splitlines()
     body = pd.Series(lines, index=np.arange(1, len(lines) + 1), dtype=object).str.strip()
     body = body[(body != "") & ~body.str.startswith("#")]
     if body.empty:
@@ -199,18 +201,52 @@ def _runs(
                 f"{{{', '.join(sorted(f))}}}, not {{{', '.join(fields)}}}"
             )
     runs: dict[tuple[str, ...], dict[str, Path]] = {}
+    owner: dict[str, str] = {}  # file -> the quantity whose pattern matched it
     for q, (rx, _) in compiled.items():
-        found = 0
+        found: dict[tuple[str, ...], list[str]] = {}
         for rel in files:
             m = rx.fullmatch(rel)
             if m is None:
                 continue
-            found += 1
-            key = tuple(m.group(f) for f in fields)
-            runs.setdefault(key, {})[q] = folder / rel
+            if rel in owner:
+                raise ConfigError(
+                    f"{folder}: file '{rel}' matches both the {owner[rel]} pattern "
+                    f"'{patterns[owner[rel]]}' and the {q} pattern '{patterns[q]}'; each "
+                    "channel needs its own files"
+                )
+            owner[rel] = q
+            found.setdefault(tuple(m.group(f) for f in fields), []).append(rel)
         if not found:
             raise DataError(f"no file matches {q} pattern '{patterns[q]}'", file=folder)
+        for key, rels in found.items():
+            if len(rels) > 1:
+                raise ConfigError(_ambiguous(folder, q, patterns[q], fields, key, rels))
+            runs.setdefault(key, {})[q] = folder / rels[0]
     return runs, fields
+
+
+def _ambiguous(
+    folder: Path,
+    quantity: str,
+    pattern: str,
+    fields: tuple[str, ...],
+    key: tuple[str, ...],
+    rels: list[str],
+) -> str:
+    """The message for a pattern that matches several files of one run."""
+    shown = ", ".join(repr(r) for r in rels[:4]) + (
+        f" and {len(rels) - 4} more" if len(rels) > 4 else ""
+    )
+    run = (
+        "{" + ", ".join(f"{f}={v!r}" for f, v in zip(fields, key, strict=True)) + "}"
+        if fields
+        else "(the patterns have no {field})"
+    )
+    return (
+        f"{folder}: the {quantity} pattern '{pattern}' matches {len(rels)} files of one run "
+        f"{run}: {shown}; put a {{field}} where their names differ (e.g. {{run}} or "
+        "{speed}) so that each run is one set of files"
+    )
 
 
 def read_channels(
@@ -262,14 +298,15 @@ def read_channels(
     ------
     ConfigError
         An unknown quantity, join or unit, a missing unit, patterns naming different fields,
-        no velocity/position or torque/current channel, several joints without ``joint=``.
+        no velocity/position or torque/current channel, several joints without ``joint=``; a
+        pattern that matches several files of one run (no field tells them apart: the
+        pattern and a few files named), a file that matches the patterns of two channels.
     DataError
         No file for a pattern, a run missing a channel (naming the run), a bad cell (file,
         row, column), time not increasing, time stamps that differ with ``join="exact"``.
     """
     folder = Path(folder)
-    if not folder.is_dir():
-        raise DataError("not a folder (--format channels reads a folder of files)", file=folder)
+    check_input(folder, folder=True, what="folder of per-channel files (--format channels)")
     if not channels:
         raise ConfigError(
             "reading per-channel files needs a pattern per quantity (--channels "

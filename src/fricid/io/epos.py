@@ -42,6 +42,7 @@ from ..errors import ConfigError, DataError, DataQualityWarning
 from ..metrics import sem_autocorrelated
 from ..samples import FrictionSamples, RawLog
 from ..units import UNITS, to_si
+from ._files import check_input, read_capped
 from ._steady import (
     OUTLIER_SIGMAS,
     SCATTER_RATIO,
@@ -95,7 +96,7 @@ class _Recording:
 
 
 def _read_text(path: Path) -> list[str]:
-    raw = path.read_bytes()
+    raw = read_capped(path, what="EPOS recording")
     for encoding in ("utf-8-sig", "cp1252"):
         try:
             text = raw.decode(encoding)
@@ -461,8 +462,7 @@ def _read(
 
 def _files(folder: str | os.PathLike[str], pattern: str) -> list[Path]:
     folder = Path(folder)
-    if not folder.is_dir():
-        raise DataError("not a folder", file=folder)
+    check_input(folder, folder=True, what="folder of EPOS recordings")
     files = sorted(p for p in folder.glob(pattern) if p.is_file())
     if not files:
         raise DataError(f"no files matching '{pattern}'", file=folder)

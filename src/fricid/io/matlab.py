@@ -17,7 +17,10 @@ variable needs a unit (DESIGN.md, "Units"): MATLAB files do not carry one.
 from __future__ import annotations
 
 import os
-from collections.abc import Mapping
+import warnings
+import zlib
+from collections.abc import Collection, Mapping
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -26,9 +29,19 @@ import numpy as np
 from ..errors import ConfigError, DataError
 from ..samples import FrictionSamples, RawLog
 from ..units import UNITS, to_si
+from ._files import check_input
+from ._mat73 import h5_child, h5_kind, h5_values
+from ._matv5 import V5Bad, check_v5
 from .generic import integrate_velocity
 
-__all__ = ["LOG_VARIABLES", "SAMPLE_VARIABLES", "mat_variables", "read_mat"]
+__all__ = [
+    "LOG_VARIABLES",
+    "MAX_BYTES",
+    "NUMERIC_CLASSES",
+    "SAMPLE_VARIABLES",
+    "mat_variables",
+    "read_mat",
+]
 
 #: Quantities of a log read from a ``.mat`` file (time, velocity and torque or current needed).
 LOG_VARIABLES: tuple[str, ...] = (
@@ -46,25 +59,126 @@ SAMPLE_VARIABLES: tuple[str, ...] = ("velocity", "friction", "load", "temperatur
 _QUANTITY = {"friction": "torque", "load": "torque"}  # unit kind of a samples quantity
 
 
-def _load(path: Path) -> Any:
-    """The file's variables: a dict (v5) or an open ``h5py.File`` (v7.3)."""
-    import h5py
-    import scipy.io
+#: The largest array read from a MATLAB file, and the most data a file may hold once
+#: inflated [bytes]: what a file declares is checked against it before anything is read.
+MAX_BYTES = 2 * 2**30
 
-    if not path.is_file():
-        raise DataError("no such file", file=path)
-    if h5py.is_hdf5(path):
-        return h5py.File(path, "r")
+#: MATLAB classes read as numbers (converted to float64).
+NUMERIC_CLASSES = frozenset(
+    ("double", "single", "int8", "uint8", "int16", "uint16", "int32", "uint32", "int64", "uint64")
+)
+
+#: What to do with an array of a class that is not numbers, by the start of its class name.
+_ADVICE = (
+    ("logical", "is logical (true/false), not numbers; store the {q} values as double"),
+    (
+        "complex",
+        "is complex; store the {q} values as real doubles (fricid drops no imaginary "
+        "part silently)",
+    ),
+    ("sparse", "is a sparse matrix; store the {q} values as a full double array (full(x))"),
+    ("char", "is text (char), not numbers; store the {q} values as double"),
+    ("cell", "is a cell array; store the {q} values as one double array (cell2mat(x))"),
+    ("struct", "is an array of structs; store the {q} values as one double array"),
+)
+
+#: Most names listed by :func:`mat_variables`, and the deepest struct nesting walked.
+_MAX_LISTED, _MAX_DEPTH = 100_000, 32
+
+
+def _one_line(exc: BaseException) -> str:
+    return " ".join(str(exc).split())[:300] or type(exc).__name__
+
+
+@dataclass
+class _Root:
+    """An open MATLAB file: its variables (a dict, or an ``h5py.File`` for v7.3) and, for a
+    v5 file, each array's class as its structure declares it (``a.b`` -> ``"logical"``)."""
+
+    node: Any
+    kinds: dict[str, str]
+
+    def close(self) -> None:
+        if hasattr(self.node, "close"):
+            self.node.close()
+
+
+def _load(path: Path, wanted: Collection[str] | None = None) -> _Root:
+    """Open a MATLAB file, its structure checked (:data:`MAX_BYTES`); ``wanted``: the
+    top-level variables to read from a v5 file (default all), each one there."""
+    import h5py
+
+    size = check_input(path, what="MATLAB file").st_size
     try:
-        return scipy.io.loadmat(path, simplify_cells=True)
-    except (ValueError, TypeError, OSError, NotImplementedError) as exc:
-        raise DataError(f"not a readable MATLAB file: {exc}", file=path) from None
+        hdf5 = h5py.is_hdf5(path)
+    except (OSError, ValueError, RuntimeError) as exc:
+        raise DataError(f"cannot read the MATLAB file: {_one_line(exc)}", file=path) from None
+    if hdf5:
+        try:
+            return _Root(h5py.File(path, "r"), {})
+        except (OSError, ValueError, RuntimeError, KeyError, TypeError) as exc:
+            raise DataError(
+                f"not a readable MATLAB v7.3 (HDF5) file: {_one_line(exc)}", file=path
+            ) from None
+    try:
+        with open(path, "rb") as fh:
+            names, kinds = check_v5(fh, size, MAX_BYTES)
+    except V5Bad as bad:
+        raise DataError(str(bad), file=path, column=bad.where) from None
+    if wanted is not None:
+        for name in wanted:
+            if name not in names:
+                raise DataError(
+                    f"no variable '{name}': the file has "
+                    + (", ".join(repr(n) for n in sorted(names)) or "no variables"),
+                    file=path,
+                    column=name,
+                )
+    return _Root(_loadmat(path, None if wanted is None else sorted(set(wanted))), kinds)
+
+
+def _loadmat(path: Path, names: list[str] | None) -> dict[str, Any]:
+    """scipy's reading of a checked v5 file; its warnings and errors as one DataError."""
+    import scipy.io
+    from scipy.io.matlab import MatReadError
+
+    errors = (
+        ValueError,
+        TypeError,
+        OSError,
+        NotImplementedError,
+        MatReadError,
+        zlib.error,
+        KeyError,
+        IndexError,
+        EOFError,
+        OverflowError,
+        UnicodeError,
+        AttributeError,
+        RecursionError,
+        Warning,  # a duplicate name, an unreadable variable: scipy warns and goes on
+    )
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            return scipy.io.loadmat(path, simplify_cells=True, variable_names=names)
+    except errors as exc:
+        raise DataError(f"not a readable MATLAB file: {_one_line(exc)}", file=path) from None
 
 
 def _names(node: Any) -> list[str]:
     if isinstance(node, Mapping) or hasattr(node, "keys"):
-        return sorted(k for k in node if not str(k).startswith("__") and k != "#refs#")
+        try:
+            keys = list(node.keys())
+        except (OSError, KeyError, RuntimeError, ValueError):
+            return []
+        return sorted(str(k) for k in keys if not str(k).startswith(("__", "#")))
     return []
+
+
+def _child(node: Any, part: str, name: str, path: Path) -> Any:
+    """``node[part]``, a v7.3 link to another file or to nothing refused."""
+    return h5_child(node, part, name, path) if hasattr(node, "id") else node[part]
 
 
 def mat_variables(path: str | os.PathLike[str]) -> list[str]:
@@ -79,29 +193,69 @@ def mat_variables(path: str | os.PathLike[str]) -> list[str]:
     -------
     list of str
         Sorted names, for messages and discovery.
+
+    Raises
+    ------
+    DataError
+        Not a readable MATLAB file, or one that declares more than :data:`MAX_BYTES`.
     """
-    root = _load(Path(path))
+    path = Path(path)
+    root = _load(path)
     try:
         out: list[str] = []
 
-        def walk(node: Any, prefix: str) -> None:
+        def walk(node: Any, prefix: str, depth: int) -> None:
+            if depth > _MAX_DEPTH:
+                raise DataError(f"structs nested more than {_MAX_DEPTH} deep", file=path)
             for name in _names(node):
-                child = node[name]
-                if _names(child):
-                    walk(child, f"{prefix}{name}.")
+                if len(out) >= _MAX_LISTED:
+                    raise DataError(f"more than {_MAX_LISTED} variables", file=path)
+                try:
+                    child = _child(node, name, prefix + name, path)
+                except DataError:
+                    out.append(prefix + name)
+                    continue
+                if _names(child) and _kind_of(child, prefix + name, root) == "struct":
+                    walk(child, f"{prefix}{name}.", depth + 1)
                 else:
                     out.append(prefix + name)
 
-        walk(root, "")
+        walk(root.node, "", 0)
         return out
     finally:
-        if hasattr(root, "close"):
-            root.close()
+        root.close()
 
 
-def _variable(root: Any, name: str, path: Path, joint: str | None) -> np.ndarray:
+def _kind_of(node: Any, name: str, root: _Root) -> str:
+    """The MATLAB class of a variable: ``struct``, ``double``, ``logical``, ``cell``..."""
+    if hasattr(node, "id"):  # an HDF5 (v7.3) group or dataset
+        return h5_kind(node)
+    kind = root.kinds.get(name)
+    if kind is not None:
+        return kind
+    return "struct" if isinstance(node, Mapping) else "double"
+
+
+def _refuse(kind: str, name: str, quantity: str, path: Path) -> DataError:
+    """The error for a variable of a class that is not numbers, saying what to store."""
+    for start, advice in _ADVICE:
+        if kind.startswith(start):
+            return DataError(
+                f"variable '{name}' ({quantity}) {advice.format(q=quantity)}",
+                file=path,
+                column=name,
+            )
+    return DataError(
+        f"variable '{name}' ({quantity}) is a MATLAB {kind}, not a numeric array; store the "
+        f"{quantity} values as double",
+        file=path,
+        column=name,
+    )
+
+
+def _variable(root: _Root, name: str, path: Path, joint: str | None, quantity: str) -> np.ndarray:
     """One variable (``a.b`` for a struct field) as a float vector, the joint's column."""
-    node = root
+    node = root.node
     seen = ""
     for part in name.strip().split("."):
         if part not in _names(node):
@@ -112,21 +266,26 @@ def _variable(root: Any, name: str, path: Path, joint: str | None) -> np.ndarray
                 file=path,
                 column=name,
             )
-        node = node[part]
         seen = f"{seen}.{part}" if seen else part
-    if _names(node):
+        node = _child(node, part, seen, path)
+    kind = _kind_of(node, name.strip(), root)
+    if kind == "struct" and _names(node):
         raise DataError(
             f"'{name}' is a struct (fields {', '.join(_names(node))}), not an array",
             file=path,
             column=name,
         )
-    try:
-        if hasattr(node, "id"):  # an HDF5 (v7.3) dataset, stored transposed (column-major)
-            arr = np.asarray(node[()], dtype=float).T
-        else:
-            arr = np.asarray(node, dtype=float)
-    except (TypeError, ValueError):
-        raise DataError(f"'{name}' is not numeric", file=path, column=name) from None
+    if kind not in NUMERIC_CLASSES:
+        raise _refuse(kind, name, quantity, path)
+    if hasattr(node, "id"):  # an HDF5 (v7.3) dataset
+        arr = h5_values(node, name, path, MAX_BYTES)
+    else:
+        arr = np.asarray(node) if not isinstance(node, list) else np.asarray(node, dtype=object)
+        if arr.dtype.kind not in "iuf":
+            raise _refuse(
+                "struct" if arr.dtype.kind == "O" else f"{arr.dtype}", name, quantity, path
+            )
+        arr = arr.astype(float)
     if arr.ndim == 2 and 1 in arr.shape:
         arr = arr.reshape(-1)
     if arr.ndim == 2:
@@ -210,7 +369,10 @@ def read_mat(
         An unknown quantity or unit, a missing unit, a required quantity missing, a variable
         with several joint columns and no ``joint``.
     DataError
-        Not a MATLAB file, a variable missing (listing what is there), not numeric, of the
+        Not a MATLAB file (or not a regular file), a damaged one, one that declares more
+        than :data:`MAX_BYTES` (an array, or its data once inflated), a link to another file;
+        a variable missing (listing what is there), not numbers (logical, complex, sparse,
+        text, a cell or struct array, an object: saying what to store instead), of the
         wrong shape, of another length than the others, with a non-finite value or (a table)
         a zero velocity; file, row and variable named.
     """
@@ -243,17 +405,17 @@ def read_mat(
             "friction=NAME:UNIT for a table of means"
         )
     unit_of = {q: _unit(q, units) for q in variables}
-    root = _load(path)
+    wanted = {name.strip().split(".")[0] for spec in variables.values() for name in spec.split(",")}
+    root = _load(path, wanted)
     try:
         si = {}
         for q, spec in variables.items():
-            parts = [_variable(root, name, path, joint) for name in spec.split(",")]
+            parts = [_variable(root, name, path, joint, q) for name in spec.split(",")]
             si[q] = np.asarray(
                 to_si(np.concatenate(parts), unit_of[q], _QUANTITY.get(q, q)), dtype=float
             )
     finally:
-        if hasattr(root, "close"):
-            root.close()
+        root.close()
     first = next(iter(variables))
     for q, values in si.items():
         if len(values) != len(si[first]):

@@ -205,9 +205,10 @@ def parse_grid(value: Any) -> list[float]:
             raise ConfigError(message) from None
         if not (step > 0 and stop >= start):
             raise ConfigError(f"START:STOP:STEP needs step > 0 and stop >= start, got '{value}'")
-        count = math.floor((stop - start) / step + 1e-9) + 1
-        if count > MAX_GRID:
-            raise ConfigError(f"'{value}' gives {count:.3g} points; at most {MAX_GRID}")
+        span = (stop - start) / step  # infinite for -1e308:1e308:1 or a step of 1e-320
+        if not math.isfinite(span) or span + 1 > MAX_GRID:
+            raise ConfigError(f"'{value}' gives {span + 1:.3g} points; at most {MAX_GRID}")
+        count = math.floor(span + 1e-9) + 1
         return [start + step * i for i in range(count)]
     points = [parse_number(v) for v in split_list(value, spaces=True)]
     if not points:
