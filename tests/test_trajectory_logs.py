@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
-import fricid.samples as samples_module
+import fricid.samples._trajectory_log as samples_module
 from fricid.cli import app
 from fricid.errors import DataError
 from fricid.identify.dynamic.trajectory import fit_trajectory
