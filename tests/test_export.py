@@ -2,32 +2,16 @@
 
 from __future__ import annotations
 
-import shutil
 import subprocess
-from pathlib import Path
 
 import numpy as np
 import pytest
 
+from _c_harness import compile_and_run, compile_c, needs_cc
 from fricid.errors import ConfigError
 from fricid.export import ExportError, Smoothing, c_code, export_c, smooth_predict
 from fricid.fitted import FittedModel
 from fricid.models import MODELS, get_model
-
-CC = shutil.which("cc") or shutil.which("gcc")
-needs_cc = pytest.mark.skipif(
-    CC is None, reason="no C compiler (cc or gcc) on PATH: optional, not a Python dependency"
-)
-CFLAGS = [
-    "-std=c99",
-    "-O2",
-    "-Wall",
-    "-Wextra",
-    "-Wpedantic",
-    "-Werror",
-    "-Wshadow",
-    "-Wconversion",
-]
 
 #: Parameters of each family, per direction (the negative side differs on purpose).
 PARAMS = {
@@ -85,41 +69,6 @@ def points(n: int = 3000, seed: int = 0) -> np.ndarray:
     v = speed * rng.choice([-1.0, 1.0], n)
     v[:8] = [0.0, -0.0, 0.01, -0.01, 0.02, -0.02, 1e-300, -1e-300]
     return np.column_stack([v, rng.uniform(-0.5, 0.5, n), rng.uniform(0.0, 50.0, n)])
-
-
-HARNESS = r"""
-#include <stdio.h>
-#include "fricid_friction.h"
-int main(void)
-{
-    double v, l, t;
-    while (scanf("%lf %lf %lf", &v, &l, &t) == 3)
-        printf("%.17g\n", fricid_friction(v, l, t));
-    return 0;
-}
-"""
-
-
-def compile_and_run(directory: Path, X: np.ndarray) -> np.ndarray:
-    (directory / "main.c").write_text(HARNESS)
-    exe = directory / "friction"
-    subprocess.run(
-        [
-            CC,
-            *CFLAGS,
-            "-o",
-            str(exe),
-            str(directory / "main.c"),
-            str(directory / "fricid_friction.c"),
-            "-lm",
-        ],
-        check=True,
-        capture_output=True,
-        text=True,
-    )
-    text = "\n".join(" ".join(repr(float(x)) for x in row) for row in X)
-    res = subprocess.run([str(exe)], input=text, check=True, capture_output=True, text=True)
-    return np.array([float(line) for line in res.stdout.split()])
 
 
 def relative_error(c: np.ndarray, py: np.ndarray, scale: np.ndarray | None = None) -> float:
@@ -295,21 +244,7 @@ def test_prefix_lets_two_joints_link_together(tmp_path):
         'int main(void) { printf("%.17g %.17g\\n", elbow_friction(0.5, 0.0, 25.0), '
         "wrist_friction(-0.5, 0.2, 30.0)); return 0; }\n"
     )
-    exe = tmp_path / "two"
-    subprocess.run(
-        [
-            CC,
-            *CFLAGS,
-            "-o",
-            str(exe),
-            str(tmp_path / "main.c"),
-            str(tmp_path / "elbow_friction.c"),
-            str(tmp_path / "wrist_friction.c"),
-            "-lm",
-        ],
-        check=True,
-        capture_output=True,
-    )
+    exe = compile_c(tmp_path, ["main.c", "elbow_friction.c", "wrist_friction.c"], "two")
     got = [
         float(x)
         for x in subprocess.run(

@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import hashlib
 import json
-import shutil
 import string
 import subprocess
 import urllib.parse
@@ -26,6 +25,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from typer.testing import CliRunner
 
+from _c_harness import CC, compile_and_run, compile_c, needs_cc
 from fricid.cli import app
 from fricid.errors import DataError
 from fricid.export import (
@@ -45,10 +45,6 @@ from fricid.fitted import FittedModel
 from fricid.models.smoothing import smooth_predict
 
 runner = CliRunner()
-
-CC = shutil.which("gcc") or shutil.which("cc")
-needs_cc = pytest.mark.skipif(CC is None, reason="no C compiler (gcc or cc) on PATH")
-CFLAGS = ["-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic"]
 
 #: The exploit of issue 12: closes the comment and redefines `return`.
 EXPLOIT = "lm */\n#define return return 1000.0 +\n/*"
@@ -291,37 +287,6 @@ def test_yaml_node_and_joint_names_with_yaml_meaning_round_trip():
 
 # -- C: compiled, run against Python, and equal to the template ------------------------------
 
-HARNESS = r"""
-#include <stdio.h>
-#include "fricid_friction.h"
-int main(void)
-{
-    double v, l, t;
-    while (scanf("%lf %lf %lf", &v, &l, &t) == 3)
-        printf("%.17g\n", fricid_friction(v, l, t));
-    return 0;
-}
-"""
-
-
-C_FILES = ("main.c", "fricid_friction.c")
-
-
-def compile_and_run(directory: Path, X: np.ndarray) -> np.ndarray:
-    (directory / "main.c").write_text(HARNESS)
-    exe = directory / "friction"
-    res = subprocess.run(
-        [CC, *CFLAGS, "-o", str(exe), *(str(directory / f) for f in C_FILES), "-lm"],
-        capture_output=True,
-        text=True,
-    )
-    assert res.returncode == 0, res.stderr
-    text = "\n".join(" ".join(repr(float(x)) for x in row) for row in X)
-    run = subprocess.run(
-        [str(exe)], input=text, check=True, capture_output=True, text=True, cwd=directory
-    )
-    return np.array([float(line) for line in run.stdout.split()])
-
 
 def check_c(directory: Path, fitted: FittedModel, smoothing=None, clamp=False) -> None:
     v = np.array([-10.0, -1.0, -0.05, -0.001, 0.0, 0.001, 0.05, 1.0, 10.0])
@@ -398,7 +363,7 @@ def test_hostile_file_names_through_the_cli(tmp_path, name):
             assert list(yaml.safe_load(res.stdout)) == ["friction_compensation"]
         else:
             parse_xml(res.stdout)
-    if CC is not None:
+    if CC is not None:  # the C export too, where a compiler is
         res = runner.invoke(app, ["export", str(path), "--to", "c", "--out", str(tmp_path / "c")])
         assert res.exit_code == 0, res.output
         check_c(tmp_path / "c", stribeck())
@@ -417,11 +382,7 @@ def test_numbers_read_back_bit_for_bit_in_c(tmp_path_factory, values):
         '    for (i = 0; i < sizeof x / sizeof x[0]; ++i)\n        printf("%a\\n", x[i]);\n'
         "    return 0;\n}\n"
     )
-    exe = directory / "n"
-    res = subprocess.run(
-        [CC, *CFLAGS, "-o", str(exe), str(directory / "n.c")], capture_output=True, text=True
-    )
-    assert res.returncode == 0, res.stderr
+    exe = compile_c(directory, ["n.c"], "n")
     out = subprocess.run([str(exe)], capture_output=True, text=True, check=True).stdout.split()
     assert [float.fromhex(h) for h in out] == values
     assert [np.signbit(float.fromhex(h)) for h in out] == [np.signbit(x) for x in values]

@@ -8,6 +8,7 @@ import json
 import numpy as np
 import pytest
 
+from _c_harness import compile_and_run, needs_cc
 from fricid.errors import ConfigError, DataError
 from fricid.export.c import export_c
 from fricid.fitted import FittedModel
@@ -15,7 +16,7 @@ from fricid.identify import fit
 from fricid.models import STATEFUL, get_predictor
 from fricid.models.smoothing import smooth_predict
 from fricid.samples import FrictionSamples
-from test_export import SMOOTHINGS, compile_and_run, needs_cc, points, relative_error
+from test_export import SMOOTHINGS, points, relative_error
 
 SIGMA = 0.01
 
