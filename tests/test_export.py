@@ -11,7 +11,7 @@ import pytest
 
 from fricid.errors import ConfigError
 from fricid.export import ExportError, Smoothing, c_code, export_c, smooth_predict
-from fricid.fitted import FittedModel
+from fricid.fitted import FittedModel, OptimizerRecord
 from fricid.models import MODELS, get_model
 
 CC = shutil.which("cc") or shutil.which("gcc")
@@ -74,7 +74,9 @@ def make_fitted(family: str, asym: bool) -> FittedModel:
         name = f"{family}_asym"
     else:
         params, name = dict(pos), family
-    return FittedModel(model=name, params=params, operating_range=RANGE, method="test", seed=0)
+    return FittedModel.from_values(
+        name, params, operating_range=RANGE, optimizer=OptimizerRecord(method="test", seed=0)
+    )
 
 
 def points(n: int = 3000, seed: int = 0) -> np.ndarray:
@@ -277,7 +279,7 @@ def sum_scale(fitted: FittedModel, X: np.ndarray) -> np.ndarray:
 
 
 def test_rbf_tanh_is_refused(tmp_path):
-    rbf = FittedModel(model="rbf", params={}, state={"centers": [[0.0]]})
+    rbf = FittedModel(model="rbf", state={"centers": [[0.0]]})
     with pytest.raises(ExportError, match="stored on signed velocity and has no sign term"):
         export_c(rbf, tmp_path, Smoothing("tanh", 0.01))
     assert not any(tmp_path.iterdir())
