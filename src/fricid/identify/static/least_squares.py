@@ -123,12 +123,13 @@ def fit(
     Returns
     -------
     FittedModel
-        With ``status`` and ``message`` from the optimiser, the ``convergence`` block (the
-        optimiser's status and a local polish's verdict,
-        :func:`~fricid.identify.static.convergence.certify`),
-        fit statistics, standard errors (SVD pseudo-inverse), 95 % intervals
-        (``ci95_low``, ``ci95_high``, ``ci_open``, ``ci_method``), the reason where a parameter
-        has none (``uncertainty_note``) and correlations.
+        With the optimiser's record (``optimizer``: method, seed, status, message,
+        evaluations, budget, history), the ``convergence`` verdict (a local polish's,
+        :func:`~fricid.identify.static.convergence.certify`), fit statistics, one record per
+        parameter (:class:`~fricid.fitted.Parameter`: start, search bounds, standard error
+        from the SVD pseudo-inverse, the 95 % interval and its open ends (``ci_method`` says
+        how it was found), the note saying why a parameter has none, the flags) and
+        correlations.
 
     Raises
     ------
