@@ -87,7 +87,7 @@ def rwsavsbas_table(samples: FrictionSamples, problem: IdentificationProblem) ->
     t = time.perf_counter()
     slow = fit(samples, "stribeck", "rwsavsbas", options={"jit": False}, **kw)
     t_slow = time.perf_counter() - t
-    n = fast.nfev
+    n = fast.optimizer.nfev
     lo, hi = problem.bounds[:, 0], problem.bounds[:, 1]
     X = lo + np.random.default_rng(0).random((n, problem.n_free)) * (hi - lo)
     chunks = np.array_split(X, max(1, n // 100_000))
@@ -183,8 +183,8 @@ def lm_table(
         t = time.perf_counter()
         f = fit(smp, "stribeck", fixed={"delta": 1.0}, intervals="none")
         print(
-            f"whole fit() with lm on {label}: {time.perf_counter() - t:.3f} s, {f.nfev} "
-            f"evaluations ({f.message[:60]})"
+            f"whole fit() with lm on {label}: {time.perf_counter() - t:.3f} s, "
+            f"{f.optimizer.nfev} evaluations ({f.optimizer.message[:60]})"
         )
 
 

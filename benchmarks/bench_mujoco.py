@@ -73,8 +73,8 @@ LUGRE = dict(sigma_0=1e3, sigma_1=0.5, sigma_2=0.1, tau_c=0.3, tau_s=0.5, w_s=0.
 
 
 def lugre_fit(**changes) -> FittedModel:
-    return FittedModel(
-        model="lugre", params={**LUGRE, **changes}, operating_range={"velocity": [-2.0, 2.0]}
+    return FittedModel.from_values(
+        "lugre", {**LUGRE, **changes}, operating_range={"velocity": [-2.0, 2.0]}
     )
 
 
@@ -84,11 +84,11 @@ def theta_of(params: dict) -> np.ndarray:
 
 def truths() -> list[tuple[str, float, dict, list[tuple[str, str, dict | None]]]]:
     """(name, torque amplitude, truth for ``drive``, [(row, fragment, joint overrides)])."""
-    cv = FittedModel(
-        model="coulomb_viscous", params={"f_c": 0.3, "beta": 0.1}, operating_range=STATIC_RANGE
+    cv = FittedModel.from_values(
+        "coulomb_viscous", {"f_c": 0.3, "beta": 0.1}, operating_range=STATIC_RANGE
     )
     st_params = {"tau_c": 0.3, "tau_s": 0.5, "w_s": 0.05, "tau_v": 0.1, "delta": 2.0}
-    st = FittedModel(model="stribeck", params=st_params, operating_range=STATIC_RANGE)
+    st = FittedModel.from_values("stribeck", st_params, operating_range=STATIC_RANGE)
     bound = 4 * 0.1 * 0.3 / (0.5 - 0.3)  # sigma_1 at the passivity bound
     stiff = lugre_fit(sigma_0=1e4, sigma_1=bound)
     out = []

@@ -29,8 +29,8 @@ the default stays the plain multi-sine (the module notes of
 Tables: (1) per parameter: truth, sweep estimate with its 95 % interval (seed 0),
 trajectory estimate with its interval (seed 0), and the coverage of the trajectory intervals
 over the seeds, counted over the closed intervals only: an interval that reaches a bound of
-the search box (``FittedModel.ci_open``) says the experiment does not determine the
-parameter, and is counted apart as "not determined", never as a hit;
+the search box (the parameter record's ``low_open`` or ``high_open``) says the experiment does
+not determine the parameter, and is counted apart as "not determined", never as a hit;
 the relative half-width of each seed-0 interval is printed beside it;
 (2) per seed: identification time (the whole ``fit_trajectory`` call, numba
 compiled beforehand; with the filtered route it includes the rate-bias estimate), each route's
@@ -149,14 +149,15 @@ def main() -> None:
         seconds = time.perf_counter() - t0
         s = sweeps(seed, truth_model)
         for n, v in truth.items():
-            if any(f.ci_open.get(n, (False, False))):
+            p = f.parameters[n]
+            if p.low_open or p.high_open:
                 undetermined[n] += 1
             else:
-                cover[n] += int(f.ci95_low[n] <= v <= f.ci95_high[n])
+                cover[n] += int(p.ci95[0] <= v <= p.ci95[1])
         overlap = {
             STATIC_NAMES[n]: bool(
-                max(f.ci95_low[STATIC_NAMES[n]], s.ci95_low[n])
-                <= min(f.ci95_high[STATIC_NAMES[n]], s.ci95_high[n])
+                max(f.parameters[STATIC_NAMES[n]].ci95[0], s.parameters[n].ci95[0])
+                <= min(f.parameters[STATIC_NAMES[n]].ci95[1], s.parameters[n].ci95[1])
             )
             for n in STATIC_NAMES
         }
@@ -179,16 +180,16 @@ def main() -> None:
     for n, v in truth.items():
         if n in inverse:
             k = inverse[n]
-            sw = f"{sweep0.params[k]:.4g} [{sweep0.ci95_low[k]:.4g}, {sweep0.ci95_high[k]:.4g}]"
+            q = sweep0.parameters[k]
+            sw = f"{q.value:.4g} [{q.ci95[0]:.4g}, {q.ci95[1]:.4g}]"
         else:
             sw = "- (no effect at constant speed)"
-        width = (traj0.ci95_high[n] - traj0.ci95_low[n]) / 2 / abs(traj0.params[n])
-        tj = (
-            f"{traj0.params[n]:.4g} [{traj0.ci95_low[n]:.4g}, {traj0.ci95_high[n]:.4g}] "
-            f"{100 * width:.2g} %"
-        )
-        if any(traj0.ci_open.get(n, (False, False))):
-            tj = f"not determined [{traj0.ci95_low[n]:.4g}, {traj0.ci95_high[n]:.4g}] open"
+        p = traj0.parameters[n]
+        low, high = p.ci95
+        width = (high - low) / 2 / abs(p.value)
+        tj = f"{p.value:.4g} [{low:.4g}, {high:.4g}] {100 * width:.2g} %"
+        if p.low_open or p.high_open:
+            tj = f"not determined [{low:.4g}, {high:.4g}] open"
         closed = args.seeds - undetermined[n]
         print(
             f"{n:<9} {v:>9.4g}  {sw:<32} {tj:<44} {cover[n]}/{closed}; "

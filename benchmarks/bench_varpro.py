@@ -90,7 +90,7 @@ def run(samples, model, method, kw) -> tuple[float, float, int]:
         warnings.simplefilter("ignore", FricidWarning)
         t = time.perf_counter()
         f = fit(samples, model, method, intervals="none", **kw)
-        return time.perf_counter() - t, float(f.metrics["sse"]), int(f.nfev)
+        return time.perf_counter() - t, float(f.metrics["sse"]), int(f.optimizer.nfev)
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -1,10 +1,11 @@
 """Fuzz model files longer than the test suite does, and print the counts (issue 12, defect 4).
 
 The mutations and the classification are those of ``tests/test_fuzz_model.py``
-(``tests/_model_fuzz.py``): valid model files of every family (analytic, ``_asym``, ``rbf``)
-are damaged (byte flips, truncation, inserted bytes, non-UTF-8, random JSON values, NaN,
-Infinity and 1e400, deleted and added keys, deep nesting, huge arrays, values of another
-field) and loaded through the API; every ``--cli-every``-th case also goes through ``fricid
+(``tests/_model_fuzz.py``): valid model files of every family (analytic, ``_asym``, ``rbf``,
+and files of schema version 1 an earlier fricid wrote, read through the upgrade) are damaged
+(byte flips, truncation, inserted bytes, non-UTF-8, random JSON values, NaN, Infinity and
+1e400, deleted and added keys, deep nesting, huge arrays, values of another field) and loaded
+through the API; every ``--cli-every``-th case also goes through ``fricid
 predict`` or ``fricid export`` (C, URDF, MJCF, YAML). Each outcome is a clean error (one line
 naming the file), a valid result (finite friction on the model's operating range), a
 traceback or a wrong answer; the last two are listed with the case's seed so that

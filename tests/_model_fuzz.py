@@ -36,8 +36,15 @@ from fricid.identify import fit
 from fricid.identify.learned.rbf import fit_rbf
 from fricid.samples import FrictionSamples
 
-#: Model families fuzzed: analytic, per-direction (_asym) and the RBF network.
-FAMILIES = ("coulomb_viscous", "stribeck", "vlt", "stribeck_asym", "msk_asym", "rbf")
+#: Model files of schema version 1, written by an earlier fricid (their reading upgrades them).
+V1_FILES = Path(__file__).parent / "data" / "model_files_v1"
+
+#: Families of schema version 1 fuzzed: ``<model>_v1`` is ``V1_FILES / "<model>.json"``.
+V1_FAMILIES = ("stribeck_v1", "hybrid_v1", "lugre_v1")
+
+#: Model families fuzzed: analytic, per-direction (_asym), the RBF network, and files of
+#: schema version 1.
+FAMILIES = ("coulomb_viscous", "stribeck", "vlt", "stribeck_asym", "msk_asym", "rbf", *V1_FAMILIES)
 
 #: Byte-level and JSON-level mutations.
 KINDS = (
@@ -96,7 +103,22 @@ TEXTS = (
     "gaussian_rbf",
 )
 
-KEYS = ("model", "params", "state", "tau_c", "velocity", "centers", "widths", "x", "", "\ud800")
+KEYS = (
+    "model",
+    "parameters",
+    "value",
+    "bounds",
+    "optimizer",
+    "params",
+    "state",
+    "tau_c",
+    "velocity",
+    "centers",
+    "widths",
+    "x",
+    "",
+    "\ud800",
+)
 
 
 def samples() -> FrictionSamples:
@@ -109,22 +131,38 @@ def samples() -> FrictionSamples:
     return FrictionSamples(velocity=v, load=load, temperature=temp, friction=f, source="fuzz")
 
 
+def v1_file(family: str) -> Path:
+    """The schema-version-1 file of a family of :data:`V1_FAMILIES`."""
+    return V1_FILES / f"{family.removesuffix('_v1')}.json"
+
+
 def valid_models() -> dict[str, FittedModel]:
-    """One fitted model of every family in :data:`FAMILIES`."""
+    """One model of every family in :data:`FAMILIES` (fitted, or read from version 1)."""
     s = samples()
+    fitted = [name for name in FAMILIES if name != "rbf" and name not in V1_FAMILIES]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         # a short budget: the files need the fields of a fit, not its best optimum
-        out = {name: fit(s, name, max_evals=1500) for name in FAMILIES if name != "rbf"}
+        out = {name: fit(s, name, max_evals=1500) for name in fitted}
         # one network (the forward direction: symmetry "pos"), so that the state's arrays
         # sit at its top level where the tests damage them; per-direction states hold two
         out["rbf"] = fit_rbf(s.subset(s.direction == 1), n_centers=8, trainer="lsq", random_state=0)
+    out.update({name: FittedModel.load(v1_file(name)) for name in V1_FAMILIES})
     return out
 
 
 def write_valid(folder: Path) -> dict[str, Path]:
-    """The model files of :func:`valid_models` in ``folder``, by family."""
-    return {name: m.save(folder / f"{name}.json") for name, m in valid_models().items()}
+    """The model files of :func:`valid_models` in ``folder``, by family (the version-1 files
+    copied as they are)."""
+    out = {}
+    for name, m in valid_models().items():
+        path = folder / f"{name}.json"
+        if name in V1_FAMILIES:
+            path.write_bytes(v1_file(name).read_bytes())
+        else:
+            m.save(path)
+        out[name] = path
+    return out
 
 
 # -- mutations -----------------------------------------------------------------------------

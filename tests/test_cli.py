@@ -47,7 +47,8 @@ def test_fit_and_evaluate(demo_dir, tmp_path):
     )
     assert res.exit_code == 0, res.output
     assert "tau_c" in res.output and "95 % CI" in res.output
-    assert json.loads(out.read_text())["params"]["delta"] == 1.0
+    delta = json.loads(out.read_text())["parameters"]["delta"]
+    assert delta["value"] == 1.0 and delta["fixed"] is True
     res = run("evaluate", out, demo_dir / "samples.csv", "--json")
     assert res.exit_code == 0, res.output
     assert 0.0 < json.loads(res.stdout)["fitness"] <= 1.0

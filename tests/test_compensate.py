@@ -29,9 +29,9 @@ FAST = {"frequency": 0.5, "periods": 1.0, "amplitude": 0.2, "dt": 2e-4}
 
 
 def cv(f_c: float = 0.1, beta: float = 0.05) -> FittedModel:
-    return FittedModel(
-        model="coulomb_viscous",
-        params={"f_c": f_c, "beta": beta},
+    return FittedModel.from_values(
+        "coulomb_viscous",
+        {"f_c": f_c, "beta": beta},
         operating_range={"velocity": [0.01, 1.0], "load": [0, 0], "temperature": [25, 25]},
     )
 
@@ -45,9 +45,9 @@ def preset_truth(name: str) -> Truth:
 def paper2() -> FittedModel:
     names = ("tau_c", "tau_s", "w_s", "tau_v", "delta")
     theta = preset("paper2", "quick").joint.law.theta
-    return FittedModel(
-        model="stribeck",
-        params=dict(zip(names, map(float, theta), strict=True)),
+    return FittedModel.from_values(
+        "stribeck",
+        dict(zip(names, map(float, theta), strict=True)),
         operating_range={"velocity": [0.005, 4.0], "load": [0, 0], "temperature": [25, 25]},
     )
 
@@ -235,9 +235,9 @@ LUGRE = (1e3, 0.5, 0.1, 0.3, 0.5, 0.05, 2.0)
 def stribeck_of_lugre() -> FittedModel:
     """The static part of LUGRE, as a sweep identification would give it."""
     s2, tau_c, tau_s, w_s, delta = LUGRE[2:]
-    return FittedModel(
-        model="stribeck",
-        params={"tau_c": tau_c, "tau_s": tau_s, "w_s": w_s, "tau_v": s2, "delta": delta},
+    return FittedModel.from_values(
+        "stribeck",
+        {"tau_c": tau_c, "tau_s": tau_s, "w_s": w_s, "tau_v": s2, "delta": delta},
         operating_range={"velocity": [0.01, 2.0], "load": [0, 0], "temperature": [25, 25]},
     )
 
@@ -281,7 +281,7 @@ def test_lugre_parameters_and_truth_checks():
     with pytest.raises(ConfigError, match="SIGMA_0,SIGMA_1"):
         lugre_parameters(stribeck_of_lugre())
     with pytest.raises(ConfigError, match="Stribeck curve"):
-        lugre_parameters(FittedModel(model="msk", params={}))
+        lugre_parameters(FittedModel(model="msk"))
     with pytest.raises(ConfigError):
         LuGreTruth((1e3, 0.5, 0.1, 0.0, 0.5, 0.05, 2.0))  # tau_c = 0
     with pytest.raises(ConfigError, match="crossing window"):

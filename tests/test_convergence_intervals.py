@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import json
 import warnings
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -30,6 +31,9 @@ PAPER2_TRUTH = {"tau_c": 0.084, "tau_s": 0.641, "w_s": 0.066, "tau_v": 0.0026}
 
 #: A single start "reaches the optimum" when its SSE is within this factor of the best SSE.
 AT_OPTIMUM = 1.001
+
+#: Model files written by fricid's schema version 1 (tests/data/model_files_v1/README.md).
+V1_FILES = Path(__file__).parent / "data" / "model_files_v1"
 
 
 def _samples(name: str, size: str, seed: int = 0):
@@ -115,7 +119,8 @@ def test_lm_reaches_the_optimum_from_starts_all_over_the_box(
         one = quiet_fit(samples, model, "lm", x0=x0, options={"n_starts": 1}, max_evals=5000)
         single[name] = one.metrics["sse"] / best
         if single[name] > AT_OPTIMUM:
-            assert one.nfev >= 50 or single[name] < 1.5, (name, one.nfev, single[name])
+            nfev = one.optimizer.nfev
+            assert nfev >= 50 or single[name] < 1.5, (name, nfev, single[name])
             multi[name] = quiet_fit(samples, model, "lm", x0=x0).metrics["sse"] / best
     assert single["middle"] <= AT_OPTIMUM, single
     ok = np.mean([r <= AT_OPTIMUM for r in single.values()])
@@ -131,7 +136,7 @@ def test_lm_is_the_bounded_trust_region_and_minpack_still_stalls(paper2):
     best = optimum(paper2, "stribeck")
     old = quiet_fit(paper2, "stribeck", "lm_minpack", x0=x0, options={"n_starts": 1})
     new = quiet_fit(paper2, "stribeck", "lm", x0=x0, options={"n_starts": 1})
-    assert old.metrics["sse"] > 100 * best and old.nfev < 50
+    assert old.metrics["sse"] > 100 * best and old.optimizer.nfev < 50
     assert new.metrics["sse"] <= AT_OPTIMUM * best
 
 
@@ -145,17 +150,17 @@ def test_bas_far_from_the_optimum_warns_and_gives_no_interval(paper2, tmp_path):
         f = fit(paper2, "stribeck", "bas")
     conv = f.convergence
     assert conv["converged"] is False and f.converged is False
-    assert conv["polish_sse_ratio"] < 0.01 and conv["nfev"] == f.nfev == 3001
-    assert conv["max_evals"] == 3001 and "advice" in conv and "reason" in conv
-    for name in f.stderr:
-        assert np.isnan(f.stderr[name]) and np.isnan(f.ci95[name])
-        assert np.isnan(f.ci95_low[name]) and np.isnan(f.ci95_high[name])
-        assert "did not converge" in f.uncertainty_note[name]
+    assert conv["polish_sse_ratio"] < 0.01 and f.optimizer.nfev == 3001
+    assert f.optimizer.max_evals == 3001 and "advice" in conv and "reason" in conv
+    assert not {"status", "message", "nfev", "max_evals"} & set(conv)  # stored once
+    for p in f.parameters.values():
+        assert np.isnan(p.stderr) and np.isnan(p.ci95_halfwidth) and not p.has_interval
+        assert "did not converge" in p.note and not p.not_determined
     text = f.report()
     assert text.startswith("NOT CONVERGED:") and "95 % CI" not in text
     g = FittedModel.load(f.save(tmp_path / "bas.json"))  # validated against the schema
     assert g.convergence["converged"] is False and g.report() == text
-    assert np.isnan(g.ci95_low["tau_c"])
+    assert np.isnan(g.parameters["tau_c"].ci95[0])
 
 
 def test_converged_fit_is_certified_and_keeps_its_intervals(paper2):
@@ -165,14 +170,14 @@ def test_converged_fit_is_certified_and_keeps_its_intervals(paper2):
     assert f.converged and f.convergence["certified_by"] == "optimizer"
     assert f.convergence["polish_sse_ratio"] == pytest.approx(1.0, abs=1e-6)
     assert "converged (certified" in f.report()
-    assert all(np.isfinite(f.ci95_low[n]) for n in f.stderr)
+    assert all(p.has_interval for p in f.parameters.values())
 
 
 def test_budget_spent_before_the_optimum_is_not_converged(paper2):
     with pytest.warns(ConvergenceWarning, match="raise --max-evals"):
         f = fit(paper2, "stribeck", "lm", max_evals=40)
-    assert not f.converged and f.convergence["status"] == 1
-    assert f.convergence["max_evals"] == 40 and np.isnan(f.stderr["tau_c"])
+    assert not f.converged and f.optimizer.status == 1
+    assert f.optimizer.max_evals == 40 and np.isnan(f.parameters["tau_c"].stderr)
 
 
 def test_vlt_from_the_upper_corner_converges_within_the_default_budget(paper1):
@@ -182,14 +187,14 @@ def test_vlt_from_the_upper_corner_converges_within_the_default_budget(paper1):
     with warnings.catch_warnings():
         warnings.simplefilter("error", ConvergenceWarning)
         f = fit(paper1, "vlt", "lm", x0=dict(zip(m.param_names, hi, strict=True)))
-    assert f.converged and f.nfev < 20_000
+    assert f.converged and f.optimizer.nfev < 20_000
     assert f.metrics["sse"] <= AT_OPTIMUM * optimum(paper1, "vlt")
 
 
 def test_leadscrew_stribeck_asym_converges_and_says_so(leadscrew):
     """defect_5.py case C: the old lm spent its budget and recorded nothing."""
     f = quiet_fit(leadscrew, "stribeck_asym", "lm")
-    assert f.converged and f.status == 0 and f.nfev < 20_000
+    assert f.converged and f.optimizer.status == 0 and f.optimizer.nfev < 20_000
 
 
 def test_cli_fit_bas_says_not_converged(paper2, tmp_path):
@@ -204,17 +209,19 @@ def test_cli_fit_bas_says_not_converged(paper2, tmp_path):
     assert "NOT CONVERGED" in res.output and "95 % CI" not in res.output
     saved = json.loads((tmp_path / "m.json").read_text())
     assert saved["convergence"]["converged"] is False
-    assert saved["ci95_low"]["tau_c"] is None
+    assert saved["parameters"]["tau_c"]["ci95"] == [None, None]
 
 
 # -- defect 7: intervals that can be true ---------------------------------------------------------
 
 
 def _inside_box(f: FittedModel) -> None:
-    for name, (lo, hi) in f.bounds.items():
-        low, high = f.ci95_low[name], f.ci95_high[name]
+    for name, p in f.parameters.items():
+        if p.bounds is None:
+            continue
+        (lo, hi), (low, high) = p.bounds, p.ci95
         if np.isfinite(low):
-            assert lo <= low <= f.params[name] <= high <= hi, (name, low, high, lo, hi)
+            assert lo <= low <= p.value <= high <= hi, (name, low, high, lo, hi)
 
 
 def test_leadscrew_symmetric_stribeck_names_what_the_data_cannot_identify(leadscrew):
@@ -225,8 +232,9 @@ def test_leadscrew_symmetric_stribeck_names_what_the_data_cannot_identify(leadsc
     assert f.ci_method == "profile"
     _inside_box(f)
     for name in ("w_s", "delta"):
-        assert f.ci_open[name] == [True, True]
-        assert "not identified" in f.uncertainty_note[name]
+        p = f.parameters[name]
+        assert p.low_open and p.high_open and p.not_determined
+        assert "not identified" in p.note
     assert "correlated with" in str(rec[0].message)
     # the Jacobian's intervals, asked for, are cut at the box and flagged there
     with warnings.catch_warnings():
@@ -234,7 +242,7 @@ def test_leadscrew_symmetric_stribeck_names_what_the_data_cannot_identify(leadsc
         g = fit(leadscrew, "stribeck", "lm", intervals="jacobian")
     assert g.ci_method == "jacobian"
     _inside_box(g)
-    assert g.ci_open["w_s"] == [True, True]
+    assert g.parameters["w_s"].low_open and g.parameters["w_s"].high_open
 
 
 def test_leadscrew_per_direction_profile_finds_the_open_side(leadscrew):
@@ -243,13 +251,14 @@ def test_leadscrew_per_direction_profile_finds_the_open_side(leadscrew):
     with pytest.warns(IdentifiabilityWarning, match=r"do not bound w_s_pos \(reaches the bound"):
         f = fit(leadscrew, "stribeck_asym", "lm", intervals="profile")
     _inside_box(f)
-    assert f.ci_open["w_s_pos"] == [False, True]
-    assert f.ci95_high["w_s_pos"] == pytest.approx(f.bounds["w_s_pos"][1])
+    pos = f.parameters["w_s_pos"]
+    assert not pos.low_open and pos.high_open
+    assert pos.ci95[1] == pytest.approx(pos.bounds[1])
     for name in ("tau_c_neg", "tau_s_neg", "w_s_neg", "delta_neg"):
-        assert f.ci_open[name] == [False, False], name
+        assert not f.parameters[name].low_open and not f.parameters[name].high_open, name
     # the profile interval is asymmetric where the model is nonlinear in the parameter
-    v = f.params["w_s_neg"]
-    assert f.ci95_high["w_s_neg"] - v > 1.3 * (v - f.ci95_low["w_s_neg"])
+    neg = f.parameters["w_s_neg"]
+    assert neg.ci95[1] - neg.value > 1.3 * (neg.value - neg.ci95[0])
     assert "reaches the bound w_s_pos <= 20.84 rad/s" in f.report()
 
 
@@ -268,8 +277,8 @@ def test_degenerate_optimum_gets_no_interval(paper2):
     assert f.metrics["sse"] > 100 * optimum(paper2, "stribeck")
     msgs = " ".join(str(w.message) for w in rec)
     assert "w_s has no effect" in msgs and "delta has no effect" in msgs
-    assert all(np.isnan(f.ci95_low[n]) and np.isnan(f.stderr[n]) for n in f.stderr)
-    assert all("degenerate" in n or "not determined" in n for n in f.uncertainty_note.values())
+    assert all(np.isnan(p.ci95[0]) and np.isnan(p.stderr) for p in f.parameters.values())
+    assert all("degenerate" in p.note or "not determined" in p.note for p in f.parameters.values())
     assert "+/-" not in f.report() and "95 % CI" not in f.report()
 
 
@@ -300,21 +309,23 @@ def test_profile_intervals_cover_the_truth_on_the_virtual_joint():
         samples = _samples("paper2", "reduced", seed)
         f = quiet_fit(samples, "stribeck", "lm", fixed={"delta": 1.0}, seed=seed)
         assert f.converged and f.ci_method == "profile"
-        covered += sum(f.ci95_low[k] <= v <= f.ci95_high[k] for k, v in PAPER2_TRUTH.items())
+        ends = {k: f.parameters[k].ci95 for k in PAPER2_TRUTH}
+        covered += sum(ends[k][0] <= v <= ends[k][1] for k, v in PAPER2_TRUTH.items())
     assert covered >= 70, covered
 
 
-def test_a_file_without_the_new_fields_loads_and_reports_as_before(paper2, tmp_path):
-    """Old model files (no convergence block, no interval ends) still load and print their
-    half-width intervals."""
-    f = quiet_fit(paper2, "stribeck", "lm", fixed={"delta": 1.0})
-    d = f.to_dict()
+def test_a_file_without_the_new_fields_loads_and_reports_as_before(tmp_path):
+    """Old model files (schema version 1 without a convergence block or interval ends) still
+    load and print their half-width intervals."""
+    d = json.loads((V1_FILES / "stribeck.json").read_text())
     for key in ("convergence", "ci95_low", "ci95_high", "ci_open", "ci_method", "uncertainty_note"):
         d.pop(key)
     path = tmp_path / "old.json"
     path.write_text(json.dumps(d))
     g = FittedModel.load(path)
-    assert g.convergence is None and g.converged is None and g.ci95_low == {}
+    assert g.convergence is None and g.converged is None
+    assert not any(p.has_interval for p in g.parameters.values())
     text = g.report()
     assert "NOT CONVERGED" not in text and "# convergence" not in text
-    assert f"95 % CI +/- {g.ci95['tau_c']:.3g}" in text
+    assert f"95 % CI +/- {d['ci95']['tau_c']:.3g}" in text
+    assert g.parameters["tau_c"].ci95_halfwidth == d["ci95"]["tau_c"]

@@ -10,7 +10,7 @@ import pytest
 from _c_harness import compile_and_run, compile_c, needs_cc
 from fricid.errors import ConfigError
 from fricid.export import ExportError, Smoothing, c_code, export_c, smooth_predict
-from fricid.fitted import FittedModel
+from fricid.fitted import FittedModel, OptimizerRecord
 from fricid.models import MODELS, get_model
 
 #: Parameters of each family, per direction (the negative side differs on purpose).
@@ -58,7 +58,9 @@ def make_fitted(family: str, asym: bool) -> FittedModel:
         name = f"{family}_asym"
     else:
         params, name = dict(pos), family
-    return FittedModel(model=name, params=params, operating_range=RANGE, method="test", seed=0)
+    return FittedModel.from_values(
+        name, params, operating_range=RANGE, optimizer=OptimizerRecord(method="test", seed=0)
+    )
 
 
 def points(n: int = 3000, seed: int = 0) -> np.ndarray:
@@ -226,7 +228,7 @@ def sum_scale(fitted: FittedModel, X: np.ndarray) -> np.ndarray:
 
 
 def test_rbf_tanh_is_refused(tmp_path):
-    rbf = FittedModel(model="rbf", params={}, state={"centers": [[0.0]]})
+    rbf = FittedModel(model="rbf", state={"centers": [[0.0]]})
     with pytest.raises(ExportError, match="stored on signed velocity and has no sign term"):
         export_c(rbf, tmp_path, Smoothing("tanh", 0.01))
     assert not any(tmp_path.iterdir())

@@ -16,6 +16,7 @@ import string
 import subprocess
 import urllib.parse
 import xml.etree.ElementTree as ET
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -41,7 +42,7 @@ from fricid.export import (
 )
 from fricid.export._common import PLAIN_LIMIT, fmt_float, plain
 from fricid.export.clamp import clamp_inputs
-from fricid.fitted import FittedModel
+from fricid.fitted import FittedModel, OptimizerRecord
 from fricid.models.smoothing import smooth_predict
 
 runner = CliRunner()
@@ -115,15 +116,14 @@ METHOD, DATA, FILE = "METHODXQ", "DATAXQ", "FILEXQ"
 
 
 def stribeck(method: str = "lm", data: str = "bench", **kw) -> FittedModel:
-    return FittedModel(
-        model="stribeck",
-        params=dict(PAPER2),
+    return FittedModel.from_values(
+        "stribeck",
+        dict(PAPER2),
         operating_range=RANGE,
-        method=method,
-        seed=0,
         provenance={"source": data, "n_samples": 40},
         metrics={"fitness": 0.99, "rmse": 0.01},
         **kw,
+        optimizer=OptimizerRecord(method=method, seed=0),
     )
 
 
@@ -393,7 +393,7 @@ def test_hostile_rbf_model_compiles_and_matches_python(tmp_path):
     from test_export import rbf_fitted
 
     fitted = rbf_fitted(("velocity", "load"), 0.02)
-    fitted.method = EXPLOIT
+    fitted.optimizer = replace(fitted.optimizer, method=EXPLOIT)
     fitted.provenance = {"source": CONSTRUCTOR}
     fitted = FittedModel.load(fitted.save(tmp_path / "rbf--->.json"))
     res = runner.invoke(
@@ -422,7 +422,7 @@ def test_prefix_is_a_strict_identifier(tmp_path, prefix):
 )
 def test_non_finite_parameters_are_refused_by_name(tmp_path, field, value):
     fitted = stribeck()
-    fitted.params[field] = value
+    fitted.parameters[field] = replace(fitted.parameters[field], value=value)
     with pytest.raises(DataError, match=field):
         export_c(fitted, tmp_path / "c")
     assert not (tmp_path / "c").exists()
@@ -438,7 +438,9 @@ def test_non_finite_operating_range_is_refused(tmp_path):
 def test_non_finite_model_in_a_file_gives_one_line_and_no_file(tmp_path):
     d = stribeck().to_dict()
     path = tmp_path / "m.json"
-    path.write_text(json.dumps(d).replace('"tau_s": 0.641', '"tau_s": 1e400'))
+    text = json.dumps(d).replace('"tau_s": {"value": 0.641', '"tau_s": {"value": 1e400')
+    assert "1e400" in text
+    path.write_text(text)
     out = tmp_path / "c"
     res = runner.invoke(app, ["export", str(path), "--to", "c", "--out", str(out)])
     assert res.exit_code == 2, res.output
@@ -463,9 +465,9 @@ def test_c_header_states_the_operating_range_in_numbers():
 
 
 def test_clamp_limits_per_input():
-    fitted = FittedModel(
-        model="vlt_asym",
-        params={
+    fitted = FittedModel.from_values(
+        "vlt_asym",
+        {
             **{f"{k}_pos": v for k, v in VLT.items()},
             **{f"{k}_neg": v for k, v in VLT.items()},
         },
@@ -498,9 +500,9 @@ def test_clamped_c_matches_python(tmp_path, smoothing):
     for k, fitted in enumerate(
         [
             stribeck(),
-            FittedModel(
-                model="vlt",
-                params=dict(VLT),
+            FittedModel.from_values(
+                "vlt",
+                dict(VLT),
                 operating_range={
                     "velocity": [-1.0, 2.0],
                     "load": [-0.5, 0.5],

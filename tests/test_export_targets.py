@@ -23,7 +23,7 @@ from fricid.export import (
     ros2_yaml_text,
     urdf_text,
 )
-from fricid.fitted import SCHEMA_VERSION, FittedModel
+from fricid.fitted import SCHEMA_VERSION, FittedModel, OptimizerRecord
 
 runner = CliRunner()
 
@@ -37,16 +37,19 @@ PAPER2 = {"tau_c": 0.084, "tau_s": 0.641, "w_s": 0.066, "tau_v": 0.0026, "delta"
 
 
 def cv_asym() -> FittedModel:
-    return FittedModel(
-        model="coulomb_viscous_asym",
-        params={"f_c_pos": 0.3, "beta_pos": 0.1, "f_c_neg": 0.2, "beta_neg": 0.15},
+    return FittedModel.from_values(
+        "coulomb_viscous_asym",
+        {"f_c_pos": 0.3, "beta_pos": 0.1, "f_c_neg": 0.2, "beta_neg": 0.15},
         operating_range={"velocity": [-2.0, 2.0], "load": [0, 0], "temperature": [25, 25]},
     )
 
 
 def stribeck() -> FittedModel:
-    return FittedModel(
-        model="stribeck", params=dict(PAPER2), operating_range=RANGE, method="lm", seed=0
+    return FittedModel.from_values(
+        "stribeck",
+        dict(PAPER2),
+        operating_range=RANGE,
+        optimizer=OptimizerRecord(method="lm", seed=0),
     )
 
 
@@ -59,9 +62,7 @@ def model_file(tmp_path):
 
 
 def test_projection_of_coulomb_viscous_is_exact():
-    f = FittedModel(
-        model="coulomb_viscous", params={"f_c": 0.3, "beta": 0.1}, operating_range=RANGE
-    )
+    f = FittedModel.from_values("coulomb_viscous", {"f_c": 0.3, "beta": 0.1}, operating_range=RANGE)
     p = project(f)
     assert p.coulomb["both"] == pytest.approx(0.3, rel=1e-9)
     assert p.viscous["both"] == pytest.approx(0.1, rel=1e-9)
@@ -95,9 +96,9 @@ def test_projection_is_least_squares_over_the_grid():
 
 
 def test_load_and_temperature_dependence_reported_lost():
-    f = FittedModel(
-        model="msk",
-        params={
+    f = FittedModel.from_values(
+        "msk",
+        {
             "f_c": 0.04,
             "f_s": 0.12,
             "f_ck": 0.6,
@@ -114,7 +115,7 @@ def test_load_and_temperature_dependence_reported_lost():
 
 
 def test_missing_operating_range_is_explained():
-    f = FittedModel(model="coulomb_viscous", params={"f_c": 0.3, "beta": 0.1})
+    f = FittedModel.from_values("coulomb_viscous", {"f_c": 0.3, "beta": 0.1})
     with pytest.raises(ExportError, match="no operating range for velocity"):
         project(f)
     assert project(f, velocity_range=(0.1, 1), load_range=0, temperature_range=25).rms_error < 1e-9
@@ -269,9 +270,9 @@ def test_predict_refuses_mixed_units_and_missing_inputs(tmp_path, model_file):
     res = run("predict", model_file, "--input", csv, "--velocity-unit", "rad/s")
     assert res.exit_code == 2
     assert "mixed units" in res.output
-    vlt = FittedModel(
-        model="vlt",
-        params={
+    vlt = FittedModel.from_values(
+        "vlt",
+        {
             "f_c": 0.05,
             "f_ctl": 0.6,
             "f_stl": 0.3,

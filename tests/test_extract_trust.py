@@ -255,7 +255,8 @@ def test_combined_faults_fit_recovers_the_truth_as_well_as_clean():
     for name, value in truth.items():
         for label in fits:
             f = fits[label]
-            assert abs(f.params[name] - value) < 3 * f.stderr[name] + 1e-6, (label, name)
+            se = f.parameters[name].stderr
+            assert abs(f.params[name] - value) < 3 * se + 1e-6, (label, name)
     rmse = {k: f.metrics["rmse"] for k, f in fits.items()}
     assert rmse["faulty"] < 1.5 * rmse["clean"], rmse
 

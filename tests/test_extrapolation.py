@@ -47,11 +47,8 @@ def vlt(directions=(0,), velocity=None) -> FittedModel:
         "v_vT": 0.008,
     }
     rng = dict(RANGE, velocity=velocity or RANGE["velocity"])
-    return FittedModel(
-        model="vlt",
-        params=params,
-        operating_range=rng,
-        provenance={"directions": list(directions)},
+    return FittedModel.from_values(
+        "vlt", params, operating_range=rng, provenance={"directions": list(directions)}
     )
 
 
@@ -106,12 +103,12 @@ def test_range_check_kinds():
         out.message
     )
     # inputs the model does not use are not checked; nor inputs without a range
-    cv = FittedModel(
-        model="coulomb_viscous", params={"f_c": 0.1, "beta": 0.05}, operating_range=RANGE
+    cv = FittedModel.from_values(
+        "coulomb_viscous", {"f_c": 0.1, "beta": 0.05}, operating_range=RANGE
     )
     assert cv.range_check(np.array([[0.1, 9.0, 900.0]])) == []
     assert (
-        FittedModel(model="coulomb_viscous", params={"f_c": 0.1, "beta": 0.05}).range_check(
+        FittedModel.from_values("coulomb_viscous", {"f_c": 0.1, "beta": 0.05}).range_check(
             np.array([[100.0, 0.0, 25.0]])
         )
         == []
@@ -154,9 +151,9 @@ def zero_truth() -> Truth:
 def test_compensate_never_claims_an_improvement_it_did_not_measure():
     """Feed-forward of friction the plant does not have makes tracking worse: the result says
     so, warns, and the verdict is not "smaller"."""
-    m = FittedModel(
-        model="coulomb_viscous",
-        params={"f_c": 0.3, "beta": 0.05},
+    m = FittedModel.from_values(
+        "coulomb_viscous",
+        {"f_c": 0.3, "beta": 0.05},
         operating_range={"velocity": [0.01, 1.0], "load": [0, 0], "temperature": [25, 25]},
     )
     cfg = TrackingConfig(frequency=0.5, periods=1.0, amplitude=0.2, dt=2e-4)
@@ -174,9 +171,9 @@ def test_compensate_never_claims_an_improvement_it_did_not_measure():
 def test_cli_compensate_says_worse_on_stderr_and_titles_the_plot_so(tmp_path, monkeypatch):
     import fricid.control.plot as plot
 
-    m = FittedModel(
-        model="coulomb_viscous",
-        params={"f_c": 3.0, "beta": 0.5},  # ten times the paper1 joint's friction
+    m = FittedModel.from_values(
+        "coulomb_viscous",
+        {"f_c": 3.0, "beta": 0.5},  # ten times the paper1 joint's friction
         operating_range={"velocity": [0.0174, 0.524], "load": [0, 0], "temperature": [25, 25]},
         provenance={"directions": [0]},
     )

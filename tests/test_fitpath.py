@@ -238,11 +238,11 @@ def test_fit_judges_the_first_lm_start_against_the_measurement_scatter():
     known = FrictionSamples(
         velocity=v, load=0.0, temperature=25.0, friction=y, std=np.full(n, 0.01), count=100
     )
-    assert "not doubtful" in fit(known, "stribeck", **kw).message
+    assert "not doubtful" in fit(known, "stribeck", **kw).optimizer.message
     # a scatter far below the residual (the model cannot fit): restart
     tiny = FrictionSamples(
         velocity=v, load=0.0, temperature=25.0, friction=y, std=np.full(n, 1e-7), count=100
     )
-    assert "restart_above" in fit(tiny, "stribeck", **kw).message
+    assert "restart_above" in fit(tiny, "stribeck", **kw).optimizer.message
     bare = FrictionSamples(velocity=v, load=0.0, temperature=25.0, friction=y)
-    assert "8 start(s)" in fit(bare, "stribeck", **kw).message
+    assert "8 start(s)" in fit(bare, "stribeck", **kw).optimizer.message

@@ -213,7 +213,7 @@ def test_fleet_joint_equals_single_joint_commands(fleet, tmp_path):
     assert res.exit_code == 0, res.output
     by_hand = FittedModel.load(model)
     in_fleet = FittedModel.load(run.out / "models" / "r1" / "j3.stribeck.json")
-    assert in_fleet.params == by_hand.params and in_fleet.ci95 == by_hand.ci95
+    assert in_fleet.to_dict()["parameters"] == by_hand.to_dict()["parameters"]
     assert in_fleet.metrics == by_hand.metrics
     direct = run_joint(log, models=("stribeck",), fixed={"delta": 1.0}, seed=3)
     assert direct.fits["stribeck"].params == by_hand.params
@@ -296,7 +296,7 @@ def test_outputs_and_failure_isolation(fleet):
     assert missing["stage"] == "read" and "No such file" in missing["error"]
     for row in ok.itertuples():
         saved = json.loads((run.out / row.model_file).read_text())
-        assert saved["params"]["tau_c"] == row.param_tau_c
+        assert saved["parameters"]["tau_c"]["value"] == row.param_tau_c
         assert row.ci95_tau_c > 0 and len(row.input_hash) == 64
     parts = sorted(p.relative_to(run.results).as_posix() for p in run.results.rglob("*.parquet"))
     assert parts[0] == "robot=r0/date=2026-03-01/part-0.parquet" and len(parts) == 3

@@ -174,7 +174,9 @@ def test_every_model_file_the_suite_wrote_opposes_motion():
         checked += 1
         n = wrong_signs(fitted, samples)
         if n:
-            wrong.append(f"{fitted.model} ({fitted.method}, {samples.source}): {n} grid points")
+            wrong.append(
+                f"{fitted.model} ({fitted.optimizer.method}, {samples.source}): {n} grid points"
+            )
     assert checked > 0
     assert not wrong, wrong
 

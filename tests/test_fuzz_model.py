@@ -1,7 +1,8 @@
 """Model files from strangers (issue 12, defect 4): loading is strict, and every outcome of a
 hostile file is a clean error or a model that predicts finite friction on its range.
 
-Valid files of every family (analytic, ``_asym``, ``rbf``) are mutated (byte flips,
+Valid files of every family (analytic, ``_asym``, ``rbf``, and files of schema version 1 that
+an earlier fricid wrote) are mutated (byte flips,
 truncation, inserted bytes, non-UTF-8, random JSON values in any field, NaN/Infinity/1e400
 numbers, deleted and added keys, deep nesting, huge arrays, values of another field) and
 loaded through the API and, for a sample, through ``fricid predict`` and ``fricid export``;
@@ -90,16 +91,23 @@ def test_valid_files_of_every_family_load_and_predict_as_written(valid):
         loaded = FittedModel.load(path)
         X = mf.grid(loaded)
         assert np.allclose(loaded.predict(X), models[family].predict(X), rtol=1e-12, atol=0)
-        assert mf.classify(path) == ("valid", family)
+        assert mf.classify(path) == ("valid", family.removesuffix("_v1"))
 
 
 def test_a_file_without_the_newer_fields_still_loads(folder, valid):
     for family in ("stribeck_asym", "rbf"):
         d = doc(valid, family)
-        for key in ("statistics", "status", "message", "init", "operating_range", "history"):
+        for key in ("statistics", "operating_range", "optimizer"):
             d.pop(key, None)
+        for record in d["parameters"].values():
+            for key in ("init", "ci95", "low_open", "high_open", "note", "not_determined"):
+                record.pop(key)
         d["provenance"] = {"source": "an old file", "created": "2025-01-01T00:00:00+00:00"}
         assert FittedModel.load(write(folder, f"old_{family}.json", d)).model == family
+    d = doc(valid, "stribeck_v1")  # version 1 without its newer fields
+    for key in ("statistics", "status", "message", "init", "operating_range", "history"):
+        d.pop(key, None)
+    assert FittedModel.load(write(folder, "old_stribeck_v1.json", d)).model == "stribeck"
 
 
 # -- the issue's cases: one line naming the file, through the API -----------------------
@@ -108,21 +116,26 @@ def test_a_file_without_the_newer_fields_still_loads(folder, valid):
 @pytest.mark.parametrize(
     ("text", "words"),
     [
-        ("NaN", ["params/tau_s", "NaN is not a finite number"]),
-        ("Infinity", ["params/tau_s", "Infinity"]),
-        ("-Infinity", ["params/tau_s", "-Infinity"]),
-        ("1e400", ["params/tau_s", "1e400 exceeds 1e+300"]),
-        ("-2e300", ["params/tau_s", "1e+300"]),
-        ("1" + "0" * 400, ["params/tau_s", "exceeds"]),
-        ("9" * 5000, ["params/tau_s", "exceeds"]),
-        ('"0.6"', ["params/tau_s", "schema"]),
-        ("true", ["params/tau_s", "schema"]),
+        ("NaN", ["parameters/tau_s/value", "NaN is not a finite number"]),
+        ("Infinity", ["parameters/tau_s/value", "Infinity"]),
+        ("-Infinity", ["parameters/tau_s/value", "-Infinity"]),
+        ("1e400", ["parameters/tau_s/value", "1e400 exceeds 1e+300"]),
+        ("-2e300", ["parameters/tau_s/value", "1e+300"]),
+        ("1" + "0" * 400, ["parameters/tau_s/value", "exceeds"]),
+        ("9" * 5000, ["parameters/tau_s/value", "exceeds"]),
+        ('"0.6"', ["parameters/tau_s/value", "schema (version 2)"]),
+        ("true", ["parameters/tau_s/value", "schema"]),
     ],
 )
 def test_numbers_that_are_not_finite_are_refused_by_field(folder, valid, text, words):
     d = doc(valid)
-    d["params"]["tau_s"] = mf.Raw(text)
+    d["parameters"]["tau_s"]["value"] = mf.Raw(text)
     refused(write(folder, "number.json", d), *words)
+    # the same in a file of version 1, named by its own field
+    d = doc(valid, "stribeck_v1")
+    d["params"]["tau_s"] = mf.Raw(text)
+    old = {"parameters/tau_s/value": "params/tau_s", "schema (version 2)": "schema (version 1)"}
+    refused(write(folder, "number_v1.json", d), *[old.get(w, w) for w in words])
 
 
 @pytest.mark.parametrize(
@@ -151,9 +164,9 @@ def test_a_folder_or_a_missing_file_is_refused(folder):
 
 def test_brackets_inside_strings_do_not_count_as_nesting(folder, valid):
     d = doc(valid)
-    d["method"] = "[" * 500
+    d["optimizer"]["method"] = "[" * 500
     d["provenance"]["note"] = '{"' * 300 + "\\" * 7
-    assert FittedModel.load(write(folder, "brackets.json", d)).method == "[" * 500
+    assert FittedModel.load(write(folder, "brackets.json", d)).optimizer.method == "[" * 500
 
 
 def test_the_size_cap(folder, valid, monkeypatch):
@@ -168,23 +181,33 @@ def test_the_size_cap(folder, valid, monkeypatch):
     ("edit", "words"),
     [
         (lambda d: d["provenance"].update(x=[0] * (_jsonfile.MAX_ITEMS + 1)), ["provenance/x"]),
-        (lambda d: d.update(history=[[1, 1, 1]]), ["history/0"]),
+        (lambda d: d["optimizer"].update(history=[[1, 1, 1]]), ["optimizer/history/0"]),
         (lambda d: d["provenance"].update(x={f"k{i}": 0 for i in range(10_001)}), ["10000"]),
-        (lambda d: d.update(method="x" * 100_001), ["method", "longer than 1000 characters"]),
+        (
+            lambda d: d["optimizer"].update(method="x" * 100_001),
+            ["optimizer/method", "longer than 1000 characters"],
+        ),
         (lambda d: d["provenance"].update(source="\ud800"), ["provenance/source", "surrogate"]),
-        (lambda d: d["params"].update({"a\nb": 1.0}), ["params", "does not match"]),
+        (lambda d: d["parameters"].update({"a\nb": {"value": 1.0}}), ["parameters", "not match"]),
         (lambda d: d.update(model="stribeck\n#define"), ["field 'model'"]),
         (lambda d: d.update(model="nonesuch"), ["unknown model 'nonesuch'"]),
-        (lambda d: d["params"].pop("w_s"), ["missing: w_s"]),
+        (lambda d: d["parameters"].pop("w_s"), ["missing: w_s"]),
+        (lambda d: d["parameters"]["w_s"].pop("value"), ["parameters/w_s", "'value'"]),
         (lambda d: d["operating_range"].update(velocity=[2.0, -2.0]), ["minimum 2.0 exceeds"]),
-        (lambda d: d["bounds"].update(tau_c=[1.0, 0.0]), ["bounds/tau_c"]),
+        (
+            lambda d: d["parameters"]["tau_c"].update(bounds=[1.0, 0.0]),
+            ["parameters/tau_c/bounds", "minimum 1.0 exceeds"],
+        ),
+        (lambda d: d["parameters"]["tau_c"].update(ci95=[0.1]), ["parameters/tau_c/ci95"]),
+        (lambda d: d["parameters"]["tau_c"].update(low_open=1), ["parameters/tau_c/low_open"]),
         (lambda d: d["operating_range"].update(temperature=[-300.0, 25.0]), ["temperature"]),
-        (lambda d: d["stderr"].update(tau_c=-1.0), ["stderr/tau_c"]),
+        (lambda d: d["parameters"]["tau_c"].update(stderr=-1.0), ["parameters/tau_c/stderr"]),
         (lambda d: d.update(correlation=[[1.0, 0.5], [0.5]]), ["correlation"]),
         (lambda d: d.update(correlation=[[1.0, 2.0], [2.0, 1.0]]), ["correlation/0/1"]),
-        (lambda d: d.update(seed=-1), ["seed"]),
+        (lambda d: d["optimizer"].update(seed=-1), ["optimizer/seed"]),
+        (lambda d: d["optimizer"].update(nfev=None), ["optimizer/nfev"]),
         (lambda d: d["metrics"].update(n=1.5), ["metrics/n"]),
-        (lambda d: d.update(history=[[1.0], [2.0, 3.0]]), ["history/0"]),
+        (lambda d: d["optimizer"].update(history=[[1.0], [2.0, 3.0]]), ["optimizer/history/0"]),
     ],
 )
 def test_absurd_sizes_names_and_values_are_refused(folder, valid, edit, words):
@@ -217,22 +240,24 @@ def test_rbf_networks_with_inconsistent_arrays_are_refused(folder, valid, edit, 
 
 def test_a_model_that_overflows_on_its_range_is_refused(folder, valid):
     d = doc(valid)
-    d["params"]["tau_v"] = 1e300
+    d["parameters"]["tau_v"]["value"] = 1e300
     d["operating_range"]["velocity"] = [-1e300, 1e300]
     refused(write(folder, "overflow.json", d), "non-finite friction", "velocity -1e+300")
     d = doc(valid, "vlt")  # vlt's viscous level times (1 - exp(...)): inf * 0 at v = 0
-    d["params"].update(f_v0=1e300, f_vT=1e300)
+    d["parameters"]["f_v0"]["value"] = d["parameters"]["f_vT"]["value"] = 1e300
     d["operating_range"].update(velocity=[-1.0, 1.0], temperature=[25.0, 1e300])
     refused(write(folder, "overflow_vlt.json", d), "non-finite friction")
 
 
 def test_from_dict_checks_python_values_as_strictly(valid):
     d = doc(valid)
-    d["params"]["tau_s"] = math.nan
-    with pytest.raises(DataError, match=r"^given\.json: field 'params/tau_s'.*not finite"):
+    d["parameters"]["tau_s"]["value"] = math.nan
+    with pytest.raises(
+        DataError, match=r"^given\.json: field 'parameters/tau_s/value'.*not finite"
+    ):
         FittedModel.from_dict(d, source="given.json")
-    d["params"]["tau_s"] = 1e301
-    with pytest.raises(DataError, match="params/tau_s"):
+    d["parameters"]["tau_s"]["value"] = 1e301
+    with pytest.raises(DataError, match="parameters/tau_s/value"):
         FittedModel.from_dict(d, source="given.json")
 
 
@@ -273,7 +298,7 @@ def test_every_command_that_loads_a_model_exits_2_with_one_line(
 ):
     if isinstance(content, str):
         d = doc(valid)
-        d["params"]["tau_c"] = mf.Raw(content)
+        d["parameters"]["tau_c"]["value"] = mf.Raw(content)
         content = mf.dumps(d)
     path = write(folder, f"{command}_{name}", content)
     out = folder / f"out_{command}_{name}"
@@ -326,7 +351,7 @@ def _subschemas(node, path=()):
             if key in ("properties", "$defs"):
                 for name, sub in value.items():
                     yield from _subschemas(sub, (*path, key, name))
-            elif key in ("items", "additionalProperties", "propertyNames", "then", "if"):
+            elif key in ("items", "additionalProperties", "propertyNames", "then", "else", "if"):
                 yield from _subschemas(value, (*path, key))
             elif key in ("allOf", "oneOf", "anyOf"):
                 for i, sub in enumerate(value):

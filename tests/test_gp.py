@@ -11,7 +11,7 @@ import pytest
 from _c_harness import compile_and_run, needs_cc
 from fricid.errors import ConfigError, DataError
 from fricid.export.c import export_c
-from fricid.fitted import FittedModel
+from fricid.fitted import FittedModel, OptimizerRecord
 from fricid.identify import fit
 from fricid.models import STATEFUL, get_predictor
 from fricid.models.smoothing import smooth_predict
@@ -138,11 +138,10 @@ def test_gp_model_file_round_trip(gp_model, tmp_path):
 
 
 def test_return_std_needs_a_posterior():
-    fitted = FittedModel(
-        model="stribeck",
-        params=dict.fromkeys(("tau_c", "tau_s"), 0.1) | {"w_s": 0.1, "tau_v": 0.1, "delta": 1.0},
-        method="test",
-        seed=0,
+    fitted = FittedModel.from_values(
+        "stribeck",
+        dict.fromkeys(("tau_c", "tau_s"), 0.1) | {"w_s": 0.1, "tau_v": 0.1, "delta": 1.0},
+        optimizer=OptimizerRecord(method="test", seed=0),
     )
     with pytest.raises(ConfigError, match="standard deviation"):
         fitted.predict(np.zeros((1, 3)), return_std=True)

@@ -29,7 +29,7 @@ def test_noiseless_stribeck_recovered_exactly():
     for name, value in TRUTH.items():
         assert f.params[name] == pytest.approx(value, rel=1e-6), name
     assert f.metrics["sse"] < 1e-20
-    assert f.fixed == ["delta"]
+    assert f.fixed == ("delta",) and f.parameters["delta"].fixed
 
 
 @pytest.mark.parametrize("method", ["lm", "trf"])
@@ -40,7 +40,7 @@ def test_noisy_stribeck_within_standard_errors(method):
     for seed in range(5):
         f = fit(stribeck_samples(0.003, seed), "stribeck", method, fixed={"delta": 1.0})
         for name in ("tau_c", "tau_s", "w_s", "tau_v"):
-            z = (f.params[name] - TRUTH[name]) / f.stderr[name]
+            z = (f.params[name] - TRUTH[name]) / f.parameters[name].stderr
             errors.append(z)
             assert abs(z) < 4.0, (seed, name, z)
     # the z-scores behave like standard normals: their RMS is near 1

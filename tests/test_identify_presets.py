@@ -32,8 +32,9 @@ def test_paper2_stribeck_recovered_within_standard_errors(seed):
     samples = extracted("paper2", "full", seed).samples
     f = fit(samples, "stribeck", "lm", fixed={"delta": 1.0}, seed=seed)
     for name, truth in PAPER2_TRUTH.items():
-        z = (f.params[name] - truth) / f.stderr[name]
-        assert abs(z) < 3.0, (name, f.params[name], truth, f.stderr[name])
+        se = f.parameters[name].stderr
+        z = (f.params[name] - truth) / se
+        assert abs(z) < 3.0, (name, f.params[name], truth, se)
     # the optimal SSE is the paper's fitness order of magnitude (Table 1: 1.3e-4)
     assert 3e-5 < f.metrics["sse"] < 4e-4
 
@@ -67,5 +68,5 @@ def test_leadscrew_stribeck_per_direction_is_plausible(leadscrew_dir):
         assert 0.2 < p["w_s"] < 21.0, p  # rad/s: 2 to 200 rpm
     # the drive is asymmetric: the two sides differ by more than their uncertainty
     d = f.params["tau_s_pos"] - f.params["tau_s_neg"]
-    se = np.hypot(f.stderr["tau_s_pos"], f.stderr["tau_s_neg"])
+    se = np.hypot(f.parameters["tau_s_pos"].stderr, f.parameters["tau_s_neg"].stderr)
     assert abs(d) > 2 * se

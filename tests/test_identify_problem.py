@@ -131,7 +131,7 @@ def test_unidentifiable_parameter_has_no_stderr_and_warns():
 
 def test_fit_report_prints_what_the_file_stores(tmp_path):
     f = fit(stribeck_samples(), "stribeck", fixed={"delta": 1.0})
-    assert f.status == 0 and f.message.startswith("converged")
+    assert f.optimizer.status == 0 and f.optimizer.message.startswith("converged")
     st = f.statistics
     assert st["ndata"] == 40 and st["nvarys"] == 4 and st["nfree"] == 36
     assert st["chisqr"] == pytest.approx(f.metrics["sse"])
@@ -139,9 +139,11 @@ def test_fit_report_prints_what_the_file_stores(tmp_path):
     assert st["aic"] == pytest.approx(40 * np.log(st["chisqr"] / 40) + 8)
     assert st["bic"] == pytest.approx(40 * np.log(st["chisqr"] / 40) + np.log(40) * 4)
     assert st["rsquared"] == pytest.approx(f.metrics["fitness"])
-    assert set(f.init) == {"tau_c", "tau_s", "w_s", "tau_v"}
+    starts = {n: p.init for n, p in f.parameters.items() if p.init is not None}
+    assert set(starts) == {"tau_c", "tau_s", "w_s", "tau_v"}
     g = FittedModel.load(f.save(tmp_path / "m.json"))
-    assert g.statistics == pytest.approx(f.statistics) and g.init == f.init
+    assert g.statistics == pytest.approx(f.statistics)
+    assert {n: p.init for n, p in g.parameters.items() if p.init is not None} == starts
     text = g.report()
     assert text == f.report()
     for field in (
@@ -173,20 +175,26 @@ def test_fit_report_flags_boundary_and_initial_value():
     with pytest.warns(ConvergenceWarning):
         f = fit(s, "stribeck", "lm", fixed={"delta": 1.0}, bounds={"w_s": (0.1, 0.2)}, max_evals=1)
     text = f.report()
-    assert "[at initial value]" in text and f.status == 1
+    assert "[at initial value]" in text and f.optimizer.status == 1
+    assert any(p.at_initial_value for p in f.parameters.values())
     f = fit(s, "stribeck", fixed={"delta": 1.0}, bounds={"w_s": (0.1, 0.2)})
-    assert "w_s" in f.at_bound and "[at boundary]" in f.report()
+    assert f.parameters["w_s"].at_bound and f.at_bound == ("w_s",)
+    assert "[at boundary]" in f.report()
 
 
 def test_old_model_files_without_the_new_fields_still_load(tmp_path):
     f = fit(stribeck_samples(), "stribeck", fixed={"delta": 1.0})
     d = f.to_dict()
-    for key in ("status", "message", "init", "statistics"):
-        d.pop(key)
+    for key in ("status", "message"):
+        d["optimizer"].pop(key)
+    for record in d["parameters"].values():
+        record.pop("init")
+    d.pop("statistics")
     path = tmp_path / "old.json"
     path.write_text(json.dumps(d))
     g = FittedModel.load(path)
-    assert g.status is None and g.statistics == {}
+    assert g.optimizer.status is None and g.statistics == {}
+    assert all(p.init is None for p in g.parameters.values())
     assert "chi-square" in g.report() and "R-squared" in g.report()
 
 
@@ -199,7 +207,7 @@ def test_identify_fit_rbf_equals_fit_rbf():
     s = network_samples()
     a = fit(s, "rbf", "lsq", seed=3, settings={"network": {"n_centers": 10}})
     b = fit_rbf(s, n_centers=10, trainer="lsq", random_state=3)
-    assert a.model == b.model == "rbf" and a.method == b.method == "lsq"
+    assert a.model == b.model == "rbf" and a.optimizer.method == b.optimizer.method == "lsq"
     assert a.state == b.state
     np.testing.assert_array_equal(a.predict(s.X), b.predict(s.X))
     assert (
@@ -214,8 +222,9 @@ def test_identify_fit_rbf_equals_fit_rbf():
         settings={"network": {"n_centers": 6, "target_mse": None}},
     )
     d = fit_rbf(s, n_centers=6, trainer="bas", random_state=3, max_epochs=2, target_mse=None)
-    assert c.method == "bas/hybrid" and c.state == d.state and c.nfev == d.nfev == 60
-    assert c.status == 1 and "budget" in c.message and a.status is None
+    assert c.optimizer.method == "bas/hybrid" and c.state == d.state
+    assert c.optimizer.nfev == d.optimizer.nfev == 60 and a.optimizer.status is None
+    assert c.optimizer.status == 1 and "budget" in c.optimizer.message
     # the samples hold both directions: one network per direction (issue 11, defect 1)
     assert c.state["symmetry"] == "per_direction"
     # searched centres: no effective degrees of freedom, so no nvarys, AIC or BIC (issue 15)

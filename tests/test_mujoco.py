@@ -37,8 +37,8 @@ LUGRE = dict(sigma_0=1e3, sigma_1=0.5, sigma_2=0.1, tau_c=0.3, tau_s=0.5, w_s=0.
 
 
 def lugre_model(**changes) -> FittedModel:
-    return FittedModel(
-        model="lugre", params={**LUGRE, **changes}, operating_range={"velocity": [-2.0, 2.0]}
+    return FittedModel.from_values(
+        "lugre", {**LUGRE, **changes}, operating_range={"velocity": [-2.0, 2.0]}
     )
 
 
@@ -57,8 +57,8 @@ def rms(a: np.ndarray, b: np.ndarray) -> float:
 def test_cli_export_runs_in_mujoco_and_tracks_the_karnopp_joint(tmp_path, mujoco):
     """Coulomb-viscous truth, exported exactly: MuJoCo's trajectory follows the Python joint's;
     frictionloss is a soft constraint, and a stiffer solreffriction follows it closer."""
-    cv = FittedModel(
-        model="coulomb_viscous", params={"f_c": 0.3, "beta": 0.1}, operating_range=RANGE
+    cv = FittedModel.from_values(
+        "coulomb_viscous", {"f_c": 0.3, "beta": 0.1}, operating_range=RANGE
     )
     cv.save(tmp_path / "cv.json")
     out = tmp_path / "cv.mjcf"
@@ -167,4 +167,4 @@ def test_lugre_export_refuses_bad_names_and_values():
     with pytest.raises(ExportError, match="finite"):
         mjcf_text(lugre_model(sigma_0=float("nan")))
     with pytest.raises(ExportError, match="needs the parameters"):
-        mjcf_text(FittedModel(model="lugre", params={"sigma_0": 1.0}))
+        mjcf_text(FittedModel.from_values("lugre", {"sigma_0": 1.0}))

@@ -396,9 +396,10 @@ def test_fitted_model_round_trip(tmp_path, inputs):
         random_state=3,
     )
     assert fitted.model == "rbf" and fitted.kind == "rbf" and fitted.params == {}
-    assert fitted.method == "bas/hybrid" and fitted.seed == 3 and fitted.nfev == 90
+    opt = fitted.optimizer
+    assert opt.method == "bas/hybrid" and opt.seed == 3 and opt.nfev == 90
     assert fitted.metrics["n"] == 150 and fitted.metrics["fitness"] > 0.9
-    assert fitted.provenance["n_samples"] == 150 and len(fitted.history) == 3
+    assert fitted.provenance["n_samples"] == 150 and len(opt.history) == 3
     assert fitted.state["inputs"] == list(inputs)
     path = fitted.save(tmp_path / "rbf.json")
     d = json.loads(path.read_text())

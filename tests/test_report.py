@@ -263,18 +263,32 @@ def test_trust_no_for_a_bas_fit_with_a_tiny_budget(leadscrew):
 
 
 def test_trust_names_open_sides_and_undetermined_parameters():
-    from fricid.fitted import FittedModel
+    from fricid.fitted import FittedModel, Parameter
 
+    nan = float("nan")
+    records = [
+        Parameter("tau_c", 1.0, stderr=0.01),
+        Parameter("tau_s", 1.5, stderr=0.01),
+        Parameter(
+            "w_s",
+            0.1,
+            stderr=nan,
+            note="not determined: w_s and delta trade off",
+            not_determined=True,
+        ),
+        Parameter("tau_v", 0.2, stderr=0.01, bounds=(0.0, 5.0), low_open=True),
+        Parameter(
+            "delta",
+            2.0,
+            stderr=0.3,
+            bounds=(0.5, 10.0),
+            high_open=True,
+            note="reaches the bound delta <= 10",
+        ),
+    ]
     fitted = FittedModel(
         model="stribeck",
-        params={"tau_c": 1.0, "tau_s": 1.5, "w_s": 0.1, "tau_v": 0.2, "delta": 2.0},
-        stderr={"tau_c": 0.01, "tau_s": 0.01, "w_s": float("nan"), "tau_v": 0.01, "delta": 0.3},
-        bounds={"tau_v": [0.0, 5.0], "delta": [0.5, 10.0]},
-        ci_open={"tau_v": [True, False], "delta": [False, True]},
-        uncertainty_note={
-            "w_s": "not determined: w_s and delta trade off",
-            "delta": "reaches the bound delta <= 10",
-        },
+        parameters={p.name: p for p in records},
         convergence={"converged": True, "certified_by": "optimizer"},
         metrics={"rmse": 0.02, "scatter": 0.01, "rmse_over_scatter": 2.0},
         operating_range={"velocity": [0.1, 2.0]},

@@ -37,21 +37,24 @@ def test_written_files_match_the_schema(tmp_path, fitted):
     path = fitted.save(tmp_path / "m.json")
     d = json.loads(path.read_text())
     validate_model_dict(d)  # no error
-    assert d["schema_version"] == SCHEMA_VERSION
-    assert d["units"]["beta_pos"] == "N m s/rad"
+    assert d["schema_version"] == SCHEMA_VERSION == 2
+    assert d["parameters"]["beta_pos"]["unit"] == "N m s/rad"
     assert {"source", "fricid_version", "created"} <= d["provenance"].keys()
-    assert d["method"] == "lm" and d["seed"] == 0
+    assert d["optimizer"]["method"] == "lm" and d["optimizer"]["seed"] == 0
     assert FittedModel.load(path).params == fitted.params
 
 
 @pytest.mark.parametrize(
     ("edit", "field"),
     [
-        (lambda d: d["params"].update(f_c_pos="0.1"), "params/f_c_pos"),
+        (
+            lambda d: d["parameters"]["f_c_pos"].update(value="0.1"),
+            "parameters/f_c_pos/value",
+        ),
         (lambda d: d.update(model=""), "model"),
-        (lambda d: d.update(fixed="f_c"), "fixed"),
+        (lambda d: d["parameters"]["f_c_pos"].update(fixed="f_c"), "parameters/f_c_pos/fixed"),
         (lambda d: d["operating_range"].update(velocity=[0.1]), "operating_range/velocity"),
-        (lambda d: d.update(seed=1.5), "seed"),
+        (lambda d: d["optimizer"].update(seed=1.5), "optimizer/seed"),
         (lambda d: d.update(model="rbf", state=None), "state"),
         (lambda d: d["provenance"].update(directions=[2]), "provenance/directions/0"),
     ],
@@ -69,17 +72,17 @@ def test_bad_field_is_named(tmp_path, fitted, edit, field):
 
 def test_missing_required_field(tmp_path, fitted):
     d = fitted.to_dict()
-    del d["params"]
+    del d["parameters"]
     path = tmp_path / "noparams.json"
     path.write_text(json.dumps(d))
-    with pytest.raises(DataError, match="'params' is a required property"):
+    with pytest.raises(DataError, match="'parameters' is a required property"):
         FittedModel.load(path)
 
 
 def test_newer_schema_version_asks_for_an_upgrade(tmp_path, fitted):
     d = fitted.to_dict()
     d["schema_version"] = SCHEMA_VERSION + 1
-    d["params"] = "a format we do not know"  # a newer file may change anything
+    d["parameters"] = "a format we do not know"  # a newer file may change anything
     path = tmp_path / "new.json"
     path.write_text(json.dumps(d))
     with pytest.raises(DataError, match=r"newer than this fricid .* upgrade fricid"):

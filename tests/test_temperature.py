@@ -11,7 +11,7 @@ import pytest
 from _c_harness import compile_and_run, needs_cc
 from fricid.errors import ConfigError, IdentifiabilityWarning
 from fricid.export.c import export_c
-from fricid.fitted import FittedModel
+from fricid.fitted import FittedModel, OptimizerRecord
 from fricid.identify import evaluate, fit
 from fricid.models import MODELS, WithTemperature, get_model
 from fricid.models._temperature import T_REF, arrhenius_factor
@@ -79,9 +79,10 @@ def test_fit_recovers_a_known_temperature_law():
         warnings.simplefilter("error", IdentifiabilityWarning)
         fitted = fit(samples, "stribeck_temp_asym")
     # within 4 standard errors of the truth
-    assert abs(fitted.params["e_t"] - TRUE["e_t"]) < 4 * fitted.stderr["e_t"]
+    assert abs(fitted.params["e_t"] - TRUE["e_t"]) < 4 * fitted.parameters["e_t"].stderr
     for name in ("tau_v_pos", "tau_v_neg", "tau_c_pos", "tau_c_neg"):
-        assert abs(fitted.params[name] - TRUE[name]) < 4 * fitted.stderr[name], name
+        se = fitted.parameters[name].stderr
+        assert abs(fitted.params[name] - TRUE[name]) < 4 * se, name
     # held-out temperatures: RMSE against the noisy data near the noise, against the truth
     # well below it
     assert evaluate(fitted, held_out)["rmse"] < 1.2 * SIGMA
@@ -116,12 +117,11 @@ def test_c_export_matches_python(tmp_path, name):
     theta = model.defaults()
     theta[-1] = 2800.0
     theta[: len(theta) // 2] *= 1.3  # the two directions differ
-    fitted = FittedModel(
-        model=name,
-        params=dict(zip(model.param_names, map(float, theta), strict=True)),
+    fitted = FittedModel.from_values(
+        name,
+        dict(zip(model.param_names, map(float, theta), strict=True)),
         operating_range={"velocity": [-5.0, 5.0], "load": [-0.5, 0.5], "temperature": [0, 50]},
-        method="test",
-        seed=0,
+        optimizer=OptimizerRecord(method="test", seed=0),
     )
     X = points()
     for k, smoothing in enumerate(SMOOTHINGS):

@@ -12,7 +12,7 @@ from typer.testing import CliRunner
 
 from fricid.cli import app
 from fricid.errors import ConfigError, DataError
-from fricid.fitted import FittedModel
+from fricid.fitted import FittedModel, Parameter
 from fricid.identify.dynamic.trajectory import DerivativeFilter, RateBiasWarning, fit_trajectory
 from fricid.models import Stribeck
 from fricid.sim import Joint, ModelLaw
@@ -23,8 +23,21 @@ STATIC = np.array([0.5, 0.8, 0.1, 0.2, 1.0])  # stribeck: tau_c, tau_s, w_s, tau
 TRUTH = tr.LuGreTruth()
 
 
+def sweep_of(values: np.ndarray, stderr: float, half: float) -> FittedModel:
+    """A Stribeck fit from sweeps: ``values`` with standard error ``stderr`` and the 95 %
+    interval ``value +/- half``."""
+    return FittedModel(
+        model="stribeck",
+        parameters={
+            n: Parameter(n, float(v), stderr=stderr, ci95=(float(v) - half, float(v) + half))
+            for n, v in zip(Stribeck().param_names, values, strict=True)
+        },
+    )
+
+
 def covered(fitted, truth: dict[str, float]) -> dict[str, bool]:
-    return {n: bool(fitted.ci95_low[n] <= v <= fitted.ci95_high[n]) for n, v in truth.items()}
+    ends = {n: fitted.parameters[n].ci95 for n in truth}
+    return {n: bool(ends[n][0] <= v <= ends[n][1]) for n, v in truth.items()}
 
 
 @pytest.mark.parametrize("kind", tr.KINDS)
@@ -80,7 +93,8 @@ def test_lugre_two_stage_route_covers_the_truth_on_two_seeds(tmp_path):
             warnings.simplefilter("ignore")
             fitted = fit_trajectory(log, "lugre", "lm", seed=seed, route="two_stage")
         for n, ok in covered(fitted, TRUTH.params()).items():
-            if any(fitted.ci_open[n]):  # not determined: counted apart, never as a hit
+            p = fitted.parameters[n]
+            if p.low_open or p.high_open:  # not determined: counted apart, never as a hit
                 opened.append((seed, n))
             else:
                 hits[(seed, n)] = ok
@@ -202,20 +216,14 @@ def test_any_optimiser_and_static_part_from_sweeps():
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         fitted = fit_trajectory(log, "lugre", "bas", max_evals=60, seed=1)
-    assert fitted.method == "bas" and fitted.convergence is not None
+    assert fitted.optimizer.method == "bas" and fitted.convergence is not None
     assert fitted.provenance["trajectory"]["routes"]["filtered"]["nfev"] <= 60
-    sweep = FittedModel(
-        model="stribeck",
-        params=dict(zip(Stribeck().param_names, STATIC, strict=True)),
-        stderr=dict.fromkeys(Stribeck().param_names, 0.001),
-        ci95_low=dict(zip(Stribeck().param_names, STATIC - 0.002, strict=True)),
-        ci95_high=dict(zip(Stribeck().param_names, STATIC + 0.002, strict=True)),
-    )
+    sweep = sweep_of(STATIC, stderr=0.001, half=0.002)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         two = fit_trajectory(log, "lugre", static=sweep)
     assert two.provenance["trajectory"]["static_from"] == "sweeps"
-    assert two.params["tau_s"] == 0.8 and two.ci95_low["tau_s"] == pytest.approx(0.798)
+    assert two.params["tau_s"] == 0.8 and two.parameters["tau_s"].ci95[0] == pytest.approx(0.798)
     assert set(two.provenance["trajectory"]["routes"]["regression"]["parameters"]) == {
         "inertia",
         "p_x",
@@ -277,18 +285,12 @@ def test_bristle_damping_determined_when_the_static_part_is_known():
         JOINT,
         noise=tr.Noise.none(),
     )
-    names = Stribeck().param_names
-    sweep = FittedModel(
-        model="stribeck",
-        params=dict(zip(names, STATIC, strict=True)),
-        stderr=dict.fromkeys(names, 1e-6),
-        ci95_low=dict(zip(names, STATIC, strict=True)),
-        ci95_high=dict(zip(names, STATIC, strict=True)),
-    )
+    sweep = sweep_of(STATIC, stderr=1e-6, half=0.0)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         fitted = fit_trajectory(log, "lugre", static=sweep)
-    assert not any(fitted.ci_open["sigma_1"])
+    assert not fitted.parameters["sigma_1"].low_open
+    assert not fitted.parameters["sigma_1"].high_open
     assert fitted.params["sigma_1"] == pytest.approx(8.0, rel=0.05)
     assert fitted.params["sigma_0"] == pytest.approx(1e4, rel=0.1)
 
@@ -365,7 +367,7 @@ def test_filtered_route_is_consistent_on_a_noise_free_log():
         assert info["joint"][n]["value"] == pytest.approx(v, rel=5e-3), n
     assert fitted.params["sigma_0"] == pytest.approx(1e4, rel=0.1)
     assert fitted.params["sigma_1"] == pytest.approx(1.0, rel=0.35)
-    assert not any(any(o) for o in fitted.ci_open.values())
+    assert not any(p.low_open or p.high_open for p in fitted.parameters.values())
     rb = info["rate_bias"]
     assert rb["internal_rate"] == pytest.approx(16000.0) and rb["log_rate"] == pytest.approx(1e3)
     for n, v in (("sigma_0", 1e4), ("sigma_1", 1.0)):  # 8 s: +3.0 %, -17 % to +0.7 %, +2.7 %
@@ -377,7 +379,7 @@ def test_filtered_route_covers_the_truth_with_noise_and_the_cli_selects_routes(t
     log = tr.simulate_trajectory(tr.multisine(duration=15.0, seed=22), TRUTH, JOINT, seed=22)
     fitted = fit_trajectory(log, "lugre")
     hits = covered(fitted, TRUTH.params())
-    assert not any(any(o) for o in fitted.ci_open.values())
+    assert not any(p.low_open or p.high_open for p in fitted.parameters.values())
     assert sum(hits.values()) >= 6, hits  # 7 intervals of 95 %: at most one miss
     from fricid.io.tables import write_rawlog
 

@@ -104,9 +104,9 @@ def test_varpro_reaches_the_study_optimum_from_any_start(study):
     samples, kw, optimum = study
     for x0 in starts(samples, "stribeck", kw):
         f = quiet(samples, "stribeck", "varpro", x0=x0, intervals="none", **kw)
-        assert f.converged and f.method == "varpro"
+        assert f.converged and f.optimizer.method == "varpro"
         assert f.metrics["sse"] <= optimum * (1 + EXACT), (x0, f.metrics["sse"], optimum)
-        assert f.init == {}  # no start: the search covers the box
+        assert all(p.init is None for p in f.parameters.values())  # the search covers the box
     with pytest.warns(IgnoredArgumentWarning, match="x0 is not used"):
         fit(samples, "stribeck", "varpro", x0={"w_s": 0.5}, intervals="none", **kw)
 
@@ -171,7 +171,7 @@ def test_robust_loss_is_a_polished_local_fit_and_says_so():
     kw = {"loss": "soft_l1", "f_scale": 0.002 * np.abs(samples.y).max(), "intervals": "none"}
     f = quiet(samples, "stribeck", "varpro", **kw)
     g = quiet(samples, "stribeck", "lm", **kw)
-    assert f.converged and "robust loss" in f.message
+    assert f.converged and "robust loss" in f.optimizer.message
     assert f.statistics["chisqr"] == pytest.approx(g.statistics["chisqr"], rel=1e-3)
 
 
@@ -180,9 +180,9 @@ def test_result_has_intervals_like_lm(study):
     f = quiet(samples, "stribeck", "varpro", **kw)
     g = quiet(samples, "stribeck", "lm", **kw)
     assert f.ci_method == g.ci_method and f.convergence["certified_by"] == "optimizer"
-    for n in f.stderr:
-        assert f.ci95_low[n] == pytest.approx(g.ci95_low[n], rel=1e-3, abs=1e-9)
-        assert f.ci95_high[n] == pytest.approx(g.ci95_high[n], rel=1e-3, abs=1e-9)
+    for n in f.free:
+        ends = f.parameters[n].ci95
+        assert ends == pytest.approx(g.parameters[n].ci95, rel=1e-3, abs=1e-9)
 
 
 class _NoLinear(FrictionModel):

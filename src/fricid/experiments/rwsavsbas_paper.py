@@ -25,7 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..fitted import FittedModel
+from ..fitted import FittedModel, OptimizerRecord, Parameter
 from ..identify import jacobian_uncertainty
 from ..io import epos_steady_samples
 from ..metrics import metrics
@@ -280,15 +280,16 @@ def _fitted_from(theta: np.ndarray, samples: FrictionSamples, method: str) -> Fi
     se, _ = jacobian_uncertainty(problem.residuals, theta, len(y))
     t95 = float(stats.t.ppf(0.975, max(len(y) - len(theta), 1)))
     params = {**dict(zip(PARAMS, map(float, theta), strict=True)), **FIXED}
+    records = {
+        n: Parameter(n, v, unit=model.units.get(n, ""), fixed=n in FIXED) for n, v in params.items()
+    }
+    for n, v in zip(PARAMS, map(float, se), strict=True):
+        records[n] = replace(records[n], stderr=v, ci95_halfwidth=v * t95)
     return FittedModel(
         model="stribeck",
-        params=params,
-        units=model.units,
-        fixed=["delta"],
-        stderr=dict(zip(PARAMS, map(float, se), strict=True)),
-        ci95={n: float(v) * t95 for n, v in zip(PARAMS, se, strict=True)},
+        parameters=records,
         metrics=metrics(y, model.predict(model.param_vector(params), X)),
-        method=method,
+        optimizer=OptimizerRecord(method=method),
     )
 
 

@@ -75,8 +75,8 @@ def hybrid_parts(
     state = dict(fitted.state or {})
     model, theta = backbone_of(state)  # DataError if malformed
     params = dict(zip(model.param_names, (float(x) for x in theta), strict=True))
-    backbone = FittedModel(model=model.name, params=params)
-    residual = FittedModel(model="rbf", params={}, state=dict(state["residual"]))
+    backbone = FittedModel.from_values(model.name, params)
+    residual = FittedModel(model="rbf", state=dict(state["residual"]))
     plain = Smoothing()
     b_consts, b_funcs = analytic_parts(backbone, plain)
     r_consts, r_funcs = rbf_parts(residual, plain)

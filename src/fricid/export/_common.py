@@ -218,13 +218,13 @@ def summary_lines(
             + (f", from {plain(source)}" if source else "")
         )
     prov = fitted.provenance if isinstance(fitted.provenance, dict) else {}
-    seed = fitted.seed
+    seed, method = fitted.optimizer.seed, fitted.optimizer.method
     seed_text = str(seed) if isinstance(seed, int) and not isinstance(seed, bool) else "none"
     n = prov.get("n_samples")
     count = f", {n} samples" if isinstance(n, int) and not isinstance(n, bool) and n >= 0 else ""
     data = prov.get("source")
     lines.append(
-        f"identified by {plain(fitted.method) if fitted.method else 'an unrecorded method'} "
+        f"identified by {plain(method) if method else 'an unrecorded method'} "
         f"(seed {seed_text}) from {plain(data) if data else 'unrecorded data'}{count}"
     )
     metrics = fitted.metrics if isinstance(fitted.metrics, dict) else {}

@@ -1,8 +1,12 @@
 """``FittedModel``: an identified friction model with its metrics, uncertainty and provenance.
 
 It is what ``identify.fit`` returns and what the JSON model file holds; reports, exports and
-``fricid predict`` start from it. The JSON is plain (numbers, strings, lists), versioned by
-``schema_version``, with SI units recorded per parameter. Prediction is dispatched by model
+``fricid predict`` start from it. Each parameter is one record (:class:`Parameter`, after
+lmfit's: value, unit, fixed, start, bounds, standard error, 95 % interval and its open ends,
+flags), and how the optimum was found is one record too (:class:`OptimizerRecord`). The JSON
+is plain (numbers, strings, lists), versioned by ``schema_version`` (files of version 1, with
+the parameters spread over one object per field, are read through
+:func:`fricid.fitted._migrate.upgrade`), SI units throughout. Prediction is dispatched by model
 (:func:`fricid.models.get_predictor`): analytic models take the parameter vector, the RBF
 network its stored ``state``. :meth:`FittedModel.report` prints a fit report after lmfit's
 ``fit_report`` from what the file stores.
@@ -21,9 +25,11 @@ from __future__ import annotations
 
 import json
 import warnings
-from dataclasses import asdict, dataclass, field
+from collections.abc import Mapping
+from dataclasses import dataclass, field, fields
 from os import PathLike
 from pathlib import Path
+from types import MappingProxyType
 from typing import Any
 
 import numpy as np
@@ -34,20 +40,21 @@ from ..io._jsonfile import check_document, one_line, read_json
 from ..models import INPUTS, get_model, get_predictor
 from ..models._range import RANGE_TOLERANCE, RangeViolation, range_violations
 from ..models.rbf import legacy_symmetry
-from ._file import (
-    SCHEMA_VERSION,
-    _clean,
-    _convergence_line,
-    _downsample,
-    _num,
-    _probe_inputs,
-    _validate_schema,
-)
+from ._file import SCHEMA_VERSION, _clean, _downsample, _num, _probe_inputs, _validate_schema
+from ._migrate import upgrade
+from ._parameter import OptimizerRecord, Parameter, is_not_determined, parameters_from_values
+from ._report import MIN_CORREL, fit_report
 
-__all__ = ["MIN_CORREL", "RANGE_TOLERANCE", "SCHEMA_VERSION", "FittedModel", "RangeViolation"]
-
-#: Correlations at or below this magnitude are left out of the fit report (lmfit's default).
-MIN_CORREL = 0.1
+__all__ = [
+    "MIN_CORREL",
+    "RANGE_TOLERANCE",
+    "SCHEMA_VERSION",
+    "FittedModel",
+    "OptimizerRecord",
+    "Parameter",
+    "RangeViolation",
+    "is_not_determined",
+]
 
 
 def _check_region(model, theta, field_name: str, name: str, source: str | None) -> None:
@@ -70,35 +77,28 @@ class FittedModel:
     Attributes
     ----------
     model : registry name of the model (``fricid.models.MODELS``, ``*_asym``, or ``"rbf"``).
-    params : every parameter's value, fixed ones included (SI units, see ``units``).
-    units : unit of each parameter.
-    fixed : names of the parameters held fixed during the fit.
-    stderr : standard error of each free parameter from the Jacobian at the optimum
-        (``cov = s^2 (J^T J)^+``, an SVD pseudo-inverse as scipy's ``curve_fit``,
-        ``s^2 = SSE / (n - p)``); NaN where not determined, and for every parameter of a fit
-        that did not converge or whose optimum is degenerate (``uncertainty_note`` says why).
-    ci95 : half-width of the linearised 95 % interval ``t(0.975, n - p) * stderr`` (NaN where
-        ``stderr`` is); the interval to use is ``ci95_low`` .. ``ci95_high``.
-    ci95_low, ci95_high : ends of the 95 % interval, inside the search box (profile
-        likelihood, or the linearised interval cut at the box: ``ci_method``); NaN where there
-        is none. Empty in files written before they were.
-    ci_open : per free parameter, ``[lower, upper]``: that side of the interval reaches the
-        search bound (the data do not bound the parameter there).
-    ci_method : ``"profile"``, ``"jacobian"`` or ``""`` (no intervals).
-    uncertainty_note : why a parameter has no interval, or why a side is open.
-    convergence : the convergence block (``fricid.identify.static.convergence.certify``):
-        ``converged``, ``status``, ``message``, ``nfev``, ``max_evals``, ``polish_sse_ratio``,
-        ``polish_nfev``, ``certified_by`` and, when not converged, ``reason`` and ``advice``;
-        None when not recorded.
-    at_bound : free parameters that ended on a bound of the search box (their
-        uncertainty is not meaningful).
-    correlation : correlation matrix of the free parameters (list of lists), or None.
+    parameters : one :class:`Parameter` per parameter, fixed ones included, in the model's
+        order (empty for the learned models): value, unit, fixed, start, search bounds,
+        standard error, 95 % interval with its open ends, the note saying why there is no
+        interval, and the flags at bound, not determined, at initial value. The standard
+        error comes from the Jacobian at the optimum (``cov = s^2 (J^T J)^+``, an SVD
+        pseudo-inverse as scipy's ``curve_fit``, ``s^2 = SSE / (n - p)``); NaN where not
+        determined, and for every parameter of a fit that did not converge or whose optimum
+        is degenerate (the note says why). The interval's ends lie inside the search box
+        (profile likelihood, or the linearised interval ``t(0.975, n - p) * stderr`` cut at
+        the box: ``ci_method``). ``params``, ``units``, ``fixed``, ``free`` and ``at_bound``
+        are read-only views of these records.
+    ci_method : ``"profile"``, ``"jacobian"``, ``"cluster-robust"`` (trajectories) or ``""``
+        (no intervals).
+    correlation : correlation matrix of the free parameters (list of lists, rows in the order
+        of ``free``), or None.
+    optimizer : the optimiser's record (:class:`OptimizerRecord`): method, seed, status and
+        message (why it stopped: ``fricid.optim.OptimizeResult.status``), evaluations, budget
+        and the history of (evaluations, best SSE) pairs.
+    convergence : the verdict on convergence (``fricid.identify.static.convergence.certify``):
+        ``converged``, ``polish_sse_ratio``, ``polish_nfev``, ``certified_by`` and, when not
+        converged, ``reason`` and ``advice``; None when not recorded.
     metrics : fit metrics on the identification data (``fricid.metrics.metrics``).
-    method, seed, nfev : how it was found; ``history`` is (nfev, best SSE) pairs.
-    status, message : why the optimiser stopped (``fricid.optim.OptimizeResult.status``: 0
-        converged, 1 budget spent, 2 stopped by the callback, 4 iteration limit); None and ""
-        when not recorded (files from before they were).
-    init : starting value of each free parameter.
     statistics : fit statistics after lmfit: ``ndata``, ``nvarys``, ``nfree``, ``chisqr``
         (the SSE), ``redchi``, ``aic``, ``bic``, ``rsquared``
         (:func:`fricid.metrics.fit_statistics`); for the learned models ``nvarys_effective``
@@ -107,7 +107,6 @@ class FittedModel:
         chi-square where they are undefined (:mod:`fricid.identify.learned._trust`).
     statistics_note : how the statistics count the model's degrees of freedom, or why some
         are not given ("" for an analytic fit: its free parameters).
-    bounds : the search box of each free parameter.
     operating_range : min and max of velocity, load and temperature in the data.
     provenance : data source, sample count, fricid version, creation time.
     state : model-specific arrays for non-analytic models (the RBF network).
@@ -125,43 +124,61 @@ class FittedModel:
     """
 
     model: str
-    params: dict[str, float]
-    units: dict[str, str] = field(default_factory=dict)
-    fixed: list[str] = field(default_factory=list)
-    stderr: dict[str, float] = field(default_factory=dict)
-    ci95: dict[str, float] = field(default_factory=dict)
-    at_bound: list[str] = field(default_factory=list)
+    parameters: dict[str, Parameter] = field(default_factory=dict)
+    ci_method: str = ""
     correlation: list[list[float]] | None = None
+    optimizer: OptimizerRecord = field(default_factory=OptimizerRecord)
+    convergence: dict[str, Any] | None = None
     metrics: dict[str, float] = field(default_factory=dict)
-    method: str = ""
-    seed: int | None = None
-    nfev: int = 0
-    history: list[list[float]] | None = None
-    bounds: dict[str, list[float]] = field(default_factory=dict)
+    statistics: dict[str, float] = field(default_factory=dict)
+    statistics_note: str = ""
     operating_range: dict[str, list[float]] = field(default_factory=dict)
     provenance: dict[str, Any] = field(default_factory=dict)
     state: dict[str, Any] | None = None
-    status: int | None = None
-    message: str = ""
-    init: dict[str, float] = field(default_factory=dict)
-    statistics: dict[str, float] = field(default_factory=dict)
-    ci95_low: dict[str, float] = field(default_factory=dict)
-    ci95_high: dict[str, float] = field(default_factory=dict)
-    ci_open: dict[str, list[bool]] = field(default_factory=dict)
-    ci_method: str = ""
-    uncertainty_note: dict[str, str] = field(default_factory=dict)
-    convergence: dict[str, Any] | None = None
-    statistics_note: str = ""
+    loss: dict[str, Any] = field(default_factory=dict)
+    validation: dict[str, Any] | None = None
+    selection: dict[str, Any] | None = None
+    trust: dict[str, Any] | None = None
+
+    @classmethod
+    def from_values(
+        cls, model: str, values: Mapping[str, float], units: Mapping[str, str] | None = None, **kw
+    ) -> FittedModel:
+        """A model known by its parameters' values alone (a hand-made model, a backbone);
+        ``kw`` are the other fields."""
+        return cls(model=model, parameters=parameters_from_values(values, units), **kw)
+
+    # -- views of the parameter records ----------------------------------------------------
+    @property
+    def params(self) -> Mapping[str, float]:
+        """Every parameter's value by name, fixed ones included (read-only; lmfit's
+        ``valuesdict``)."""
+        return MappingProxyType({n: p.value for n, p in self.parameters.items()})
+
+    @property
+    def units(self) -> Mapping[str, str]:
+        """Every parameter's unit by name (read-only)."""
+        return MappingProxyType({n: p.unit for n, p in self.parameters.items()})
+
+    @property
+    def fixed(self) -> tuple[str, ...]:
+        """The parameters held fixed, in the model's order."""
+        return tuple(n for n, p in self.parameters.items() if p.fixed)
+
+    @property
+    def free(self) -> tuple[str, ...]:
+        """The parameters the fit varied, in the model's order (the correlation's rows)."""
+        return tuple(n for n, p in self.parameters.items() if not p.fixed)
+
+    @property
+    def at_bound(self) -> tuple[str, ...]:
+        """The free parameters that ended on a bound of the search box."""
+        return tuple(n for n, p in self.parameters.items() if p.at_bound)
 
     @property
     def converged(self) -> bool | None:
         """Whether the fit converged (the ``convergence`` block; None when not recorded)."""
         return None if self.convergence is None else bool(self.convergence.get("converged"))
-
-    loss: dict[str, Any] = field(default_factory=dict)
-    validation: dict[str, Any] | None = None
-    selection: dict[str, Any] | None = None
-    trust: dict[str, Any] | None = None
 
     # -- prediction ----------------------------------------------------------------------
     @property
@@ -282,101 +299,16 @@ class FittedModel:
             network; ``[[Correlations]]`` above ``min_correl``, largest first. Files from
             before the intervals were stored print ``95 % CI +/- half-width`` as they did.
         """
-        lines = []
-        conv = self.convergence
-        if conv is not None and not conv.get("converged"):
-            lines.append(
-                f"NOT CONVERGED: {conv.get('reason', conv.get('message', ''))}; "
-                f"{conv.get('advice', '')}. No confidence intervals."
-            )
-        lines += ["[[Model]]", f"    {self.model}", "[[Fit Statistics]]"]
-        lines.append(f"    # fitting method   = {self.method} (seed {self.seed})")
-        lines.append(f"    # function evals   = {self.nfev}")
-        if self.status is not None:
-            lines.append(f"    # status           = {self.status}: {self.message}")
-        if conv is not None:
-            lines.append(f"    # convergence      = {_convergence_line(conv)}")
-        st = self.statistics
-        n = st.get("ndata", self.metrics.get("n"))
-        if n is not None:
-            lines.append(f"    # data points      = {int(n)}")
-        if st.get("nvarys") is not None:
-            lines.append(f"    # variables        = {int(st['nvarys'])}")
-        elif st.get("nvarys_effective") is not None:
-            lines.append(f"    # variables        = {st['nvarys_effective']:.4g} (effective)")
-        if self.statistics_note:
-            lines.append(f"    # statistics       = {self.statistics_note}")
-        rows = (
-            ("chi-square", st.get("chisqr", self.metrics.get("sse"))),
-            ("reduced chi-square", st.get("redchi")),
-            ("Akaike info crit", st.get("aic")),
-            ("Bayesian info crit", st.get("bic")),
-            ("R-squared", st.get("rsquared", self.metrics.get("fitness"))),
-        )
-        lines += [f"    {k:<18} = {_num(v):.8g}" for k, v in rows if v is not None]
-        model = get_predictor(self.model)
-        if model.stateful:
-            lines += ["[[Network]]", f"    {model.describe(self.state)}"]
-            return "\n".join(lines)
-        lines.append("[[Variables]]")
-        width = max((len(name) for name in self.params), default=0) + 1
-        for name, value in self.params.items():
-            lines.append(f"    {name + ':':<{width}} {value: .8g} {self.units.get(name, '')}")
-            lines[-1] = lines[-1].rstrip() + self._variable_note(name, value)
-        lines += self._correlation_lines(min_correl)
-        return "\n".join(lines)
-
-    def _variable_note(self, name: str, value: float) -> str:
-        if name in self.fixed:
-            return " (fixed)"
-        se = _num(self.stderr.get(name))
-        note = ""
-        if np.isfinite(se):
-            rel = f" ({abs(se / value):.2%})" if value != 0 else ""
-            note += f" +/- {se:.3g}{rel}"
-            low, high = _num(self.ci95_low.get(name)), _num(self.ci95_high.get(name))
-            if np.isfinite(low) and np.isfinite(high):
-                note += f" (95 % CI [{low:.4g}, {high:.4g}], {self.ci_method or 'jacobian'})"
-            elif np.isfinite(_num(self.ci95.get(name))):
-                note += f" (95 % CI +/- {_num(self.ci95.get(name)):.3g})"
-        if name in self.init:
-            note += f" (init = {self.init[name]:.8g})"
-        why = self.uncertainty_note.get(name, "")
-        flags = []
-        if name in self.at_bound:
-            flags.append("at boundary")
-        if name in self.init and value == self.init[name]:
-            flags.append("at initial value")
-        if not np.isfinite(se) and (not why or why.startswith("not determined")):
-            flags.append("not determined")
-        if why:
-            flags.append(why.removeprefix("not determined: "))
-        return note + "".join(f" [{f}]" for f in flags)
-
-    def _correlation_lines(self, min_correl: float) -> list[str]:
-        """``C(a, b) = r`` for the pairs above ``min_correl``, largest magnitude first."""
-        if not self.correlation:
-            return []
-        names = list(self.stderr)
-        corr = np.asarray(self.correlation, dtype=float)
-        if corr.shape != (len(names), len(names)):
-            return []
-        pairs = [
-            (float(corr[i, j]), names[i], names[j])
-            for i in range(len(names))
-            for j in range(i + 1, len(names))
-            if np.isfinite(corr[i, j]) and abs(corr[i, j]) > min_correl
-        ]
-        if not pairs:
-            return []
-        pairs.sort(key=lambda p: -abs(p[0]))
-        head = f"[[Correlations]] (unreported correlations are <= {min_correl:.3f})"
-        return [head] + [f"    C({a}, {b}) = {r:+.4f}" for r, a, b in pairs]
+        return fit_report(self, min_correl)
 
     # -- JSON ----------------------------------------------------------------------------
     def to_dict(self) -> dict[str, Any]:
-        d = asdict(self)
-        d["history"] = _downsample(np.asarray(self.history) if self.history else None)
+        """The model file's JSON document (schema version :data:`SCHEMA_VERSION`)."""
+        d: dict[str, Any] = {f.name: getattr(self, f.name) for f in fields(self)}
+        d["parameters"] = {n: p.to_dict() for n, p in self.parameters.items()}
+        d["optimizer"] = self.optimizer.to_dict()
+        history = self.optimizer.history
+        d["optimizer"]["history"] = _downsample(np.asarray(history) if history else None)
         return _clean({"schema_version": SCHEMA_VERSION, "fricid_version": __version__, **d})
 
     @classmethod
@@ -403,6 +335,10 @@ class FittedModel:
 
         Notes
         -----
+        A file of schema version 1 (one object per field of the parameters, the optimiser's
+        record in two places) is read through :func:`fricid.fitted._migrate.upgrade` and
+        saves in the current layout.
+
         An RBF network from before ``state["symmetry"]`` was recorded is read with
         :func:`fricid.models.rbf.legacy_symmetry`: trained on combined samples (provenance
         directions ``[0]``, so on ``v > 0`` only) it is read as odd, ``F = sign(v) g(|v|)``,
@@ -422,14 +358,21 @@ class FittedModel:
                 file=source,
             )
         _validate_schema(d, source)
-        known = set(cls.__dataclass_fields__)
-        kwargs = {k: v for k, v in d.items() if k in known}
-        if "model" not in kwargs or "params" not in kwargs:
-            raise DataError("model file lacks 'model' or 'params'", file=source)
-        for key in ("params", "stderr", "ci95", "ci95_low", "ci95_high", "init", "statistics"):
-            if key in kwargs:
-                kwargs[key] = {k: _num(v) for k, v in kwargs[key].items()}
-        out = cls(**kwargs)
+        if version < SCHEMA_VERSION:
+            d = upgrade(d, source)
+        plain = {f.name for f in fields(cls)} - {"parameters", "optimizer"}
+        kwargs = {k: d[k] for k in plain if k in d}
+        if "statistics" in kwargs:
+            kwargs["statistics"] = {k: _num(v) for k, v in kwargs["statistics"].items()}
+        conv = kwargs.get("convergence")
+        converged = None if not isinstance(conv, dict) else bool(conv.get("converged"))
+        out = cls(
+            parameters={
+                n: Parameter.from_dict(n, r, converged) for n, r in d["parameters"].items()
+            },
+            optimizer=OptimizerRecord.from_dict(d.get("optimizer")),
+            **kwargs,
+        )
         try:
             stateful = get_predictor(out.model).stateful
         except ConfigError as exc:
@@ -448,13 +391,14 @@ class FittedModel:
         rows = out.correlation or []
         if any(len(row) != len(rows) for row in rows):
             raise DataError("field 'correlation': not a square matrix", file=source)
-        for key in ("operating_range", "bounds"):
-            for name, (low, high) in getattr(out, key).items():
-                if low > high:
-                    raise DataError(
-                        f"field '{key}/{name}': the minimum {low!r} exceeds the maximum {high!r}",
-                        file=source,
-                    )
+        spans = [(f"operating_range/{n}", pair) for n, pair in out.operating_range.items()]
+        spans += [(f"parameters/{n}/bounds", p.bounds) for n, p in out.parameters.items()]
+        for where, pair in spans:
+            if pair is not None and pair[0] > pair[1]:
+                raise DataError(
+                    f"field '{where}': the minimum {pair[0]!r} exceeds the maximum {pair[1]!r}",
+                    file=source,
+                )
         out._check_predictions(source)
         return out
 

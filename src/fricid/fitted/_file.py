@@ -19,8 +19,8 @@ from ..errors import DataError
 from ..io._jsonfile import one_line
 from ..models import INPUTS
 
-#: Version of the JSON model file this fricid writes and reads.
-SCHEMA_VERSION = 1
+#: Version of the JSON model file this fricid writes (it reads this one and version 1).
+SCHEMA_VERSION = 2
 
 #: Velocities probed where a model file records no velocity range [rad/s].
 _PROBE_VELOCITY = (-1.0, -0.01, 0.0, 0.01, 1.0)
@@ -71,8 +71,11 @@ CERTIFIED_BY = {
 }
 
 
-def _convergence_line(conv: dict[str, Any]) -> str:
-    """The fit report's convergence line, from the model file's convergence block."""
+def _convergence_line(
+    conv: dict[str, Any], nfev: int | None = None, max_evals: int | None = None
+) -> str:
+    """The fit report's convergence line, from the model file's convergence block and, for a
+    fit that did not converge, the optimiser's evaluations and budget."""
     ratio = _num(conv.get("polish_sse_ratio"))
     polish = f"local polish SSE ratio {ratio:.6g}" if np.isfinite(ratio) else "no polish"
     if conv.get("converged"):
@@ -82,7 +85,7 @@ def _convergence_line(conv: dict[str, Any]) -> str:
             tail = f"; backbone {_convergence_line(base)}" if isinstance(base, dict) else ""
             return f"converged ({by}{tail})"
         return f"converged (certified by the {by}; {polish})"
-    return f"NOT CONVERGED ({polish}; {conv.get('nfev')} of {conv.get('max_evals')} evaluations)"
+    return f"NOT CONVERGED ({polish}; {nfev} of {max_evals} evaluations)"
 
 
 @lru_cache(maxsize=1)
@@ -105,7 +108,8 @@ _LIMITS = {
 
 
 def _validate_schema(d: dict[str, Any], source: str | None) -> None:
-    """Raise a :class:`DataError` naming the file and the first failing field."""
+    """Raise a :class:`DataError` naming the file and the first failing field (the schema
+    describes every version this fricid reads; the message names the document's)."""
     from jsonschema.exceptions import best_match
 
     # the first errors suffice to name one; a hostile file may have millions
@@ -117,8 +121,11 @@ def _validate_schema(d: dict[str, Any], source: str | None) -> None:
     if not message:
         message = one_line(error.message)
         message = message if len(message) <= 200 else message[:197] + "..."
+    version = d.get("schema_version")
+    version = version if isinstance(version, int) and 0 < version <= SCHEMA_VERSION else None
     raise DataError(
-        f"field '{where}' does not match the model file schema (version {SCHEMA_VERSION}): "
+        f"field '{where}' does not match the model file schema (version "
+        f"{version or SCHEMA_VERSION}): "
         f"{message}",
         file=source,
     )

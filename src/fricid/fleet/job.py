@@ -205,16 +205,14 @@ def fit_row(
         trust = Trust.from_dict(fitted.trust)
     if trust is not None:
         row.update(verdict_columns(trust))
-    row["nfev"] = fitted.nfev
+    row["nfev"] = fitted.optimizer.nfev
     row["at_bound"] = ";".join(fitted.at_bound) or None
     row["fixed"] = ";".join(fitted.fixed) or None
     row["units"] = ";".join(f"{k}={u}" for k, u in fitted.units.items())
-    for name, value in fitted.params.items():
-        row[f"param_{name}"] = value
-    for name in fitted.params:
-        row[f"stderr_{name}"] = fitted.stderr.get(name)
-    for name in fitted.params:
-        row[f"ci95_{name}"] = fitted.ci95.get(name)
+    records = fitted.parameters.values()
+    row.update({f"param_{p.name}": p.value for p in records})
+    row.update({f"stderr_{p.name}": None if p.fixed else p.stderr for p in records})
+    row.update({f"ci95_{p.name}": None if p.fixed else p.ci95_halfwidth for p in records})
     return row
 
 

@@ -9,9 +9,7 @@ from __future__ import annotations
 
 from typing import Any
 
-import numpy as np
-
-from ..fitted import FittedModel
+from ..fitted import FittedModel, Parameter
 from ..samples import FrictionSamples
 
 __all__ = ["DROPS", "not_determined", "open_sides", "quality_rows", "range_text"]
@@ -28,27 +26,17 @@ DROPS = {
 
 
 def not_determined(fitted: FittedModel) -> list[str]:
-    """Free parameters the data do not determine: their ``uncertainty_note`` says so ("not
-    determined", "not identified"), or, in a file without notes from a converged fit, their
-    standard error is missing."""
-    out = []
-    for name in fitted.params:
-        if name in fitted.fixed:
-            continue
-        note = fitted.uncertainty_note.get(name, "")
-        se = fitted.stderr.get(name)
-        missing = se is None or not np.isfinite(se)
-        if note.startswith(("not determined", "not identified")) or (
-            not note and missing and fitted.converged is not False and fitted.kind != "rbf"
-        ):
-            out.append(name)
-    return out
+    """Free parameters the data do not determine (their record's flag: the note says so, "not
+    determined", "not identified", or, from a converged fit without notes, the standard error
+    is missing)."""
+    if fitted.kind == "rbf":
+        return []
+    return [n for n, p in fitted.parameters.items() if p.not_determined and not p.fixed]
 
 
-def _zero_floor(fitted: FittedModel, name: str, sides: list[bool]) -> bool:
+def _zero_floor(p: Parameter) -> bool:
     """Only the lower side is open, at a bound of 0: the parameter is consistent with 0."""
-    box = fitted.bounds.get(name) or [np.nan, np.nan]
-    return bool(sides[0] and not sides[1] and box[0] == 0)
+    return bool(p.low_open and not p.high_open and p.bounds is not None and p.bounds[0] == 0)
 
 
 def open_sides(fitted: FittedModel, *, include_zero: bool = False) -> dict[str, str]:
@@ -56,13 +44,14 @@ def open_sides(fitted: FittedModel, *, include_zero: bool = False) -> dict[str, 
     of the fit (or one made here); ``include_zero`` keeps those open only at a lower bound of
     0 ("consistent with zero")."""
     out = {}
-    for name, sides in (fitted.ci_open or {}).items():
-        if name in fitted.fixed or not any(sides):
+    for name, p in fitted.parameters.items():
+        sides = (p.low_open, p.high_open)
+        if p.fixed or not any(sides):
             continue
-        if _zero_floor(fitted, name, sides) and not include_zero:
+        if _zero_floor(p) and not include_zero:
             continue
         which = " and ".join(s for s, o in zip(("lower", "upper"), sides, strict=True) if o)
-        out[name] = fitted.uncertainty_note.get(name) or f"{which} side reaches the search bound"
+        out[name] = p.note or f"{which} side reaches the search bound"
     return out
 
 

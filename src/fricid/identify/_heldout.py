@@ -55,13 +55,13 @@ def run_validation(
         )
     if fitted.kind == "rbf":  # the learned models: each fold retrains, structure search too
         return _run_learned(fitted, samples, folds, fallback)
-    work = folds * len(samples) * max(len(fitted.params) - len(fitted.fixed), 1)
+    work = folds * len(samples) * max(len(fitted.free), 1)
     if work > max_work:
         return None, (
             f"not run here ({folds} folds x {len(samples)} samples x parameters = {work:,}, "
             f"over the limit of {max_work:,}; use fricid fit --validate lovo); {fallback}"
         )
-    fixed = {n: fitted.params[n] for n in fitted.fixed if n in fitted.params}
+    fixed = {n: fitted.params[n] for n in fitted.fixed}
     options: dict[str, Any] = {"intervals": "none"}
     if isinstance(fitted.loss.get("loss"), str):
         options["loss"] = fitted.loss["loss"]
@@ -122,7 +122,7 @@ def _run_learned(
     if fitted.model == "gp":
         params = (fitted.provenance or {}).get("estimator_params") or {}
         options["settings"] = {k: params[k] for k in ("max_points", "n_restarts") if k in params}
-    seed = fitted.seed if fitted.seed is not None else 0
+    seed = fitted.optimizer.seed if fitted.optimizer.seed is not None else 0
     how = f"{folds} folds, each retrained as fit trains {fitted.model}"
     return _lovo(samples, fitted.model, None, how, fallback, seed=seed, **options)
 

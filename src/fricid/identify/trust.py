@@ -10,8 +10,9 @@ reads the model file (and, where given, the samples the model was identified on)
   recorded;
 - convergence: the ``convergence`` block (:func:`fricid.identify.static.convergence.certify`),
   its reason and advice when the fit did not converge;
-- identifiability: parameters not determined (``uncertainty_note``, a NaN standard error) and
-  intervals with an open side (``ci_open``); an open lower side at a bound of 0 means
+- identifiability: parameters not determined (each parameter record's flag: its note, or a
+  NaN standard error) and intervals with an open end (the records' ``low_open``,
+  ``high_open``); an open lower end at a bound of 0 means
   "consistent with zero" and is not a caveat;
 - held-out error against the measurement scatter, from (``Trust.heldout_source``):
   :data:`FROM_FIT` (the fit's own held-out validation: ``fricid fit --validate``, the
@@ -441,7 +442,7 @@ def _ratio(trust: Trust, fitted: FittedModel, samples: FrictionSamples | None) -
 def _grade(trust: Trust, fitted: FittedModel, quality_caveat: str) -> None:
     """Set ``trust.level`` and ``trust.reasons`` (module notes)."""
     no, caveats = [], []
-    free = [n for n in fitted.params if n not in fitted.fixed]
+    free = fitted.free
     if trust.converged is False:
         no.append(f"the fit did NOT converge ({trust.advice or 'see the convergence block'})")
     elif trust.converged is None:

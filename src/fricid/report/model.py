@@ -19,7 +19,7 @@ import logging
 import numpy as np
 import pandas as pd
 
-from ..fitted import FittedModel
+from ..fitted import FittedModel, Parameter
 from ..identify import evaluate
 from ..identify.trust import Trust, not_determined
 from ..samples import FrictionSamples
@@ -47,24 +47,18 @@ def _metric_value(key: str, value: float) -> float:
     return 100.0 * value if key == "rmspe" else value
 
 
-def _interval(fitted: FittedModel, name: str, value: float) -> tuple[float, float, str, str]:
+def _interval(fitted: FittedModel, p: Parameter) -> tuple[float, float, str, str]:
     """(low, high, text, method) of a free parameter's 95 % interval; NaNs and "" for none."""
-    low = _num(fitted.ci95_low.get(name))
-    high = _num(fitted.ci95_high.get(name))
+    low, high = p.ci95
     method = fitted.ci_method or "jacobian"
-    if not (np.isfinite(low) and np.isfinite(high)):
-        half = _num(fitted.ci95.get(name))
+    if not p.has_interval:
+        half = p.ci95_halfwidth
         if not np.isfinite(half) or fitted.converged is False:
             return np.nan, np.nan, "", ""
-        low, high, method = value - half, value + half, "jacobian (value ± half-width)"
-    sides = fitted.ci_open.get(name) or [False, False]
-    lo_t = f"{low:.4g}" + (" (open)" if sides[0] else "")
-    hi_t = f"{high:.4g}" + (" (open)" if sides[1] else "")
+        low, high, method = p.value - half, p.value + half, "jacobian (value ± half-width)"
+    lo_t = f"{low:.4g}" + (" (open)" if p.low_open else "")
+    hi_t = f"{high:.4g}" + (" (open)" if p.high_open else "")
     return low, high, f"[{lo_t}, {hi_t}]", method
-
-
-def _num(value) -> float:
-    return float("nan") if value is None else float(value)
 
 
 def parameter_table(fitted: FittedModel) -> pd.DataFrame:
@@ -74,19 +68,18 @@ def parameter_table(fitted: FittedModel) -> pd.DataFrame:
     not bounded by the data, free)."""
     rows = []
     undetermined = set(not_determined(fitted))
-    for name, value in fitted.params.items():
-        note = fitted.uncertainty_note.get(name, "")
-        if name in fitted.fixed:
+    for name, p in fitted.parameters.items():
+        if p.fixed:
             low, high, text, method, status = np.nan, np.nan, "", "", "fixed"
         else:
-            low, high, text, method = _interval(fitted, name, value)
+            low, high, text, method = _interval(fitted, p)
             if name in undetermined:
-                status = note or "not determined (Jacobian rank-deficient)"
+                status = p.note or "not determined (Jacobian rank-deficient)"
             elif fitted.converged is False:
                 status = "no interval: the fit did not converge"
-            elif note:
-                status = note
-            elif name in fitted.at_bound:
+            elif p.note:
+                status = p.note
+            elif p.at_bound:
                 status = "at a bound of the search box"
             elif not text:
                 status = "no interval"
@@ -95,8 +88,8 @@ def parameter_table(fitted: FittedModel) -> pd.DataFrame:
         rows.append(
             {
                 "parameter": name,
-                "value": value,
-                "unit": fitted.units.get(name, ""),
+                "value": p.value,
+                "unit": p.unit,
                 "95% interval": text or "–",
                 "95% CI low": low,
                 "95% CI high": high,
@@ -151,7 +144,7 @@ def _range_note(fitted: FittedModel, samples: FrictionSamples) -> Note | None:
 def _correlation_frame(fitted: FittedModel) -> pd.DataFrame | None:
     if not fitted.correlation:
         return None
-    free = [n for n in fitted.params if n not in fitted.fixed]
+    free = list(fitted.free)
     corr = np.asarray(fitted.correlation, dtype=float)
     if corr.shape != (len(free), len(free)):
         return None
@@ -214,6 +207,7 @@ def model_report(
     label = samples_label or (
         str(samples.source).rsplit("/", 1)[-1] if samples.source else "these samples"
     )
+    opt = fitted.optimizer
     predicted = fitted.predict(samples.X)
     residual = samples.friction - predicted
     on_samples = evaluate(fitted, samples)
@@ -222,8 +216,8 @@ def model_report(
         summary=_model_description(fitted),
         meta={
             "model": fitted.model,
-            "identified by": f"{fitted.method} (seed {fitted.seed}, {fitted.nfev} evaluations)"
-            if fitted.method
+            "identified by": f"{opt.method} (seed {opt.seed}, {opt.nfev} evaluations)"
+            if opt.method
             else "–",
             "identification data": fitted.provenance.get("source") or "–",
             "samples in this report": f"{label} ({len(samples)} rows, directions "
@@ -392,7 +386,7 @@ def model_report(
         for item in appendix:
             sec.add(item)
 
-    history = np.asarray(fitted.history, dtype=float) if fitted.history else None
+    history = np.asarray(opt.history, dtype=float) if opt.history else None
     if history is not None and history.ndim == 2 and len(history) > 1:
         sec = doc.section("Convergence")
         sec.add(
@@ -400,8 +394,8 @@ def model_report(
                 "convergence",
                 "Optimiser convergence",
                 plots.convergence(
-                    {fitted.method or "optimiser": history},
-                    title=f"{fitted.method}: best SSE against evaluations",
+                    {opt.method or "optimiser": history},
+                    title=f"{opt.method}: best SSE against evaluations",
                 ),
                 caption="Best sum of squared errors found so far against the number of "
                 "model evaluations (the RWSAVSBAS paper's fitness, eq. 11).",

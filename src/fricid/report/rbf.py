@@ -194,8 +194,7 @@ def _residual_view(
     model, theta = backbone_of(fitted.state or {})
     view = FittedModel(
         model="rbf",
-        params={},
-        method=fitted.method,
+        optimizer=fitted.optimizer,
         operating_range=fitted.operating_range,
         provenance=fitted.provenance,
         state=dict((fitted.state or {})["residual"]),
@@ -206,7 +205,10 @@ def _residual_view(
 
 def _facts(fitted: FittedModel) -> pd.DataFrame:
     state = fitted.state or {}
-    rows: dict[str, Any] = {"symmetry": state.get("symmetry") or "signed", "trainer": fitted.method}
+    rows: dict[str, Any] = {
+        "symmetry": state.get("symmetry") or "signed",
+        "trainer": fitted.optimizer.method,
+    }
     if fitted.model == "hybrid":
         bb = state.get("backbone") or {}
         rows["analytic backbone"] = f"{bb.get('model')}: " + ", ".join(

@@ -11,7 +11,7 @@ from typing import Any
 import numpy as np
 
 from ... import __version__
-from ...fitted import FittedModel
+from ...fitted import FittedModel, OptimizerRecord, Parameter, is_not_determined
 from ...io.atomic import created_timestamp
 from ...metrics import fit_statistics, metrics
 from ...models import get_model, lugre
@@ -50,19 +50,29 @@ def build_result(
     stage1 = stages["regression"]
     param_names = list(lugre.PARAM_NAMES) if key == "lugre" else list(get_model(key).param_names)
     values = np.array([final[n]["value"] for n in param_names])
-    se = np.array([final[n]["stderr"] for n in param_names])
     low = np.array([final[n]["ci95_low"] for n in param_names])
     high = np.array([final[n]["ci95_high"] for n in param_names])
+    convergence = converged(results, method) if results else None
     fitted = FittedModel(
         model=key,
-        params=dict(zip(param_names, map(float, values), strict=True)),
-        units=dict(get_model(key).units),
-        stderr=dict(zip(param_names, se, strict=True)),
-        ci95={n: float((h - lo) / 2) for n, lo, h in zip(param_names, low, high, strict=True)},
-        ci95_low=dict(zip(param_names, low, strict=True)),
-        ci95_high=dict(zip(param_names, high, strict=True)),
+        parameters=_records(
+            param_names,
+            final,
+            get_model(key).units,
+            bounds_out,
+            None if convergence is None else convergence["converged"],
+        ),
         ci_method="cluster-robust"
         + (", two-step" if key == "lugre" and route != "filtered" else ""),
+        optimizer=OptimizerRecord(
+            method=method,
+            seed=seed,
+            status=int(results[-1].status) if results else None,
+            message=str(results[-1].message) if results else "",
+            nfev=int(sum(r.nfev for r in results)),
+            max_evals=_budget(results, max_evals),
+        ),
+        convergence=convergence,
         metrics={
             **metrics(y, yhat),
             **{
@@ -72,32 +82,11 @@ def build_result(
             },
         },
         statistics=fit_statistics(y, yhat, len(param_names) + n_joint),
-        method=method,
-        seed=seed,
-        nfev=int(sum(r.nfev for r in results)),
-        bounds={n: b for n, b in bounds_out.items() if n in param_names},
         operating_range={
             "velocity": [float(vf.min()), float(vf.max())],
             "temperature": [float(series.temperature.min()), float(series.temperature.max())],
         },
-        convergence=converged(results, method, max_evals) if results else None,
-        status=int(results[-1].status) if results else None,
-        message=str(results[-1].message) if results else "",
     )
-    fitted.at_bound = [
-        n
-        for n in param_names
-        if n in fitted.bounds
-        and (
-            np.isclose(final[n]["value"], fitted.bounds[n][0], rtol=1e-6, atol=0)
-            or np.isclose(final[n]["value"], fitted.bounds[n][1], rtol=1e-6, atol=0)
-        )
-    ]
-    fitted.ci_open = {
-        n: [bool(lo <= fitted.bounds[n][0]), bool(h >= fitted.bounds[n][1])]
-        for n, lo, h in zip(param_names, low, high, strict=True)
-        if n in fitted.bounds
-    }
     last_regression = [st for name, st in stages.items() if name.startswith("refinement")]
     joint_tab = {
         n: row for n, row in (last_regression or [stage1])[-1].table().items() if n in JOINT_PARAMS
@@ -151,3 +140,46 @@ def build_result(
         "trajectory": info,
     }
     return fitted
+
+
+def _budget(results: list, max_evals: int | None) -> int | None:
+    """The evaluation budget: ``max_evals``, else the last stage's evaluations (None with no
+    optimiser stage)."""
+    if not results:
+        return None
+    return int(max_evals) if max_evals is not None else int(results[-1].nfev)
+
+
+def _records(
+    names: list[str],
+    final: dict[str, dict[str, float]],
+    units: dict[str, str],
+    bounds: dict[str, list[float]],
+    converged: bool | None,
+) -> dict[str, Parameter]:
+    """One :class:`~fricid.fitted.Parameter` per name of the final table: value, standard
+    error, the cluster-robust 95 % interval (its ends open where they reach the search box),
+    and at a bound where the value is within ``1e-6`` relative of one."""
+    out = {}
+    for n in names:
+        row, box = final[n], bounds.get(n)
+        value, se = float(row["value"]), float(row["stderr"])
+        low, high = float(row["ci95_low"]), float(row["ci95_high"])
+        out[n] = Parameter(
+            n,
+            value,
+            unit=units.get(n, ""),
+            bounds=None if box is None else (float(box[0]), float(box[1])),
+            stderr=se,
+            ci95=(low, high),
+            ci95_halfwidth=(high - low) / 2,
+            low_open=box is not None and bool(low <= box[0]),
+            high_open=box is not None and bool(high >= box[1]),
+            at_bound=box is not None
+            and bool(
+                np.isclose(value, box[0], rtol=1e-6, atol=0)
+                or np.isclose(value, box[1], rtol=1e-6, atol=0)
+            ),
+            not_determined=is_not_determined("", se, converged),
+        )
+    return out

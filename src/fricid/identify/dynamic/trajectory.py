@@ -310,11 +310,12 @@ def fit_trajectory(
     static_tab = {rename.get(n, n): v for n, v in stage1.table().items()}
     if static is not None:
         for n in static_model.param_names:
+            p = static.parameters[n]
             static_tab[rename.get(n, n)] = {
-                "value": static.params[n],
-                "stderr": static.stderr.get(n, float("nan")),
-                "ci95_low": static.ci95_low.get(n, float("nan")),
-                "ci95_high": static.ci95_high.get(n, float("nan")),
+                "value": p.value,
+                "stderr": p.stderr,
+                "ci95_low": p.ci95[0],
+                "ci95_high": p.ci95[1],
             }
     final = dict(static_tab)
     bounds_out = {

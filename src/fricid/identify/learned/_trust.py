@@ -54,6 +54,7 @@ __all__ = [
     "hat_trace",
     "hybrid_records",
     "learned_statistics",
+    "network_budget",
     "network_convergence",
     "process_convergence",
     "side_states",
@@ -155,6 +156,14 @@ def learned_statistics(
     return out, f"effective degrees of freedom {edf:.4g}: {how}"
 
 
+def network_budget(ests: Sequence[Any]) -> int:
+    """The evaluation budget of trained networks: their epochs times evaluations per epoch,
+    0 for the closed-form ``lsq`` trainer (no budget applies)."""
+    if str(ests[0].trainer).strip().lower() == "lsq":
+        return 0
+    return int(sum(int(e.max_epochs) * int(e.evals_per_epoch) for e in ests))
+
+
 def network_convergence(ests: Sequence[Any]) -> dict[str, Any]:
     """The convergence block of trained networks (one, or one per direction).
 
@@ -163,34 +172,19 @@ def network_convergence(ests: Sequence[Any]) -> dict[str, Any]:
     reason (budget spent at which MSE) and advice.
     """
     trainer = str(ests[0].trainer).strip().lower()
-    nfev = int(sum(int(e.n_evals_) for e in ests))
-    budget = int(sum(int(e.max_epochs) * int(e.evals_per_epoch) for e in ests))
-    block: dict[str, Any] = {
-        "converged": True,
-        "status": 0,
-        "message": "",
-        "nfev": nfev,
-        "max_evals": budget if trainer != "lsq" else 0,
-        "polish_sse_ratio": None,
-        "polish_nfev": 0,
-    }
+    block: dict[str, Any] = {"converged": True, "polish_sse_ratio": None, "polish_nfev": 0}
     if trainer == "lsq":
-        block.update(
-            certified_by="closed_form",
-            message="output layer by ridge least squares, solved exactly (closed form)",
-        )
+        block.update(certified_by="closed_form")
         return block
     missed = [e for e in ests if e.epochs_to_target_ is None]
     if not missed:
-        block.update(certified_by="target", message="target training MSE met")
+        block.update(certified_by="target")
         return block
     e = missed[0]
     target = "no target MSE set" if e.target_mse is None else f"target {e.target_mse:g}"
     block.update(
         converged=False,
-        status=1,
         certified_by="",
-        message=f"budget of {int(e.max_epochs)} epochs spent",
         reason=(
             f"trainer '{trainer}' spent its budget of {int(e.max_epochs)} epochs at training "
             f"MSE {float(e.train_mse_):.3g} (target-scaled), {target} not met"
@@ -223,10 +217,6 @@ def process_convergence(runs: Sequence[dict[str, Any]], notes: Sequence[str]) ->
     failed = [r for r in runs if not r.get("converged")]
     block: dict[str, Any] = {
         "converged": not failed,
-        "status": 0 if not failed else 1,
-        "message": "; ".join(sorted({str(r.get("message", "")) for r in runs})),
-        "nfev": int(sum(int(r.get("nfev", 0)) for r in runs)),
-        "max_evals": 0,
         "polish_sse_ratio": None,
         "polish_nfev": 0,
         "certified_by": "optimizer" if not failed else "",
@@ -361,7 +351,7 @@ def hybrid_records(
     from ...metrics import metrics
 
     sc = measurement_scatter(samples)
-    p = len(base.params) - len(base.fixed)
+    p = len(base.free)
     edf_res = (res.statistics or {}).get("nvarys_effective")
     if edf_res is not None:
         edf: float | None = p + float(edf_res)
@@ -376,9 +366,6 @@ def hybrid_records(
     rconv = dict(res.convergence or {})
     conv = {**rconv, "backbone": bconv}
     conv["converged"] = bool(bconv.get("converged")) and bool(rconv.get("converged"))
-    conv["message"] = (
-        f"backbone {base.model}: {bconv.get('message', '')}; residual: {rconv.get('message', '')}"
-    )
     if not bconv.get("converged"):
         conv.update(
             certified_by="",

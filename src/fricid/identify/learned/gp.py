@@ -56,7 +56,7 @@ from sklearn.gaussian_process.kernels import RBF, ConstantKernel, WhiteKernel
 from threadpoolctl import threadpool_limits
 
 from ...errors import ConfigError, DataError
-from ...fitted import FittedModel
+from ...fitted import FittedModel, OptimizerRecord
 from ...metrics import metrics
 from ...models import INPUTS
 from ...models.gp import GP_KIND, predict_gp
@@ -399,17 +399,19 @@ def _fit(
     runs = [s["optimizer"] for s in sides]
     return FittedModel(
         model="gp",
-        params={},
         metrics=metrics(samples.y, y_hat, samples.direction, scatter.value),
         statistics=statistics,
         statistics_note=note,
         convergence=process_convergence(runs, notes),
         loss={"scatter": scatter.to_dict()},
-        method="sklearn-gpr",
-        seed=seed,
-        nfev=sum(r["nfev"] for r in runs),
-        status=0 if all(r["converged"] for r in runs) else 1,
-        message=f"trained in {time.perf_counter() - start:.3g} s",
+        optimizer=OptimizerRecord(
+            method="sklearn-gpr",
+            seed=seed,
+            status=0 if all(r["converged"] for r in runs) else 1,
+            message=f"trained in {time.perf_counter() - start:.3g} s",
+            nfev=sum(r["nfev"] for r in runs),
+            max_evals=0,
+        ),
         operating_range=operating_range(samples),
         provenance=provenance(
             samples,

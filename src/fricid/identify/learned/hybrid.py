@@ -57,7 +57,7 @@ from typing import Any
 import numpy as np
 
 from ...errors import ConfigError
-from ...fitted import FittedModel
+from ...fitted import FittedModel, OptimizerRecord
 from ...metrics import fit_statistics
 from ...models import INPUTS, get_model
 from ...models.hybrid import STATE_KIND
@@ -339,15 +339,20 @@ def fit_hybrid(
     from ._trust import hybrid_records
 
     records = hybrid_records(samples, base, res, y_hat)
+    bopt, ropt = base.optimizer, res.optimizer
     return FittedModel(
         model="hybrid",
-        params={},
         **records,
-        method=f"{base.method} + {res.method}",
-        seed=res.seed,
-        nfev=int((base.nfev or 0) + (res.nfev or 0)),
-        status=res.status,
-        message=res.message,
+        optimizer=OptimizerRecord(
+            method=f"{bopt.method} + {ropt.method}",
+            seed=ropt.seed,
+            status=ropt.status,
+            message=ropt.message,
+            nfev=int((bopt.nfev or 0) + (ropt.nfev or 0)),
+            max_evals=None
+            if bopt.max_evals is None or ropt.max_evals is None
+            else bopt.max_evals + ropt.max_evals,
+        ),
         operating_range=res.operating_range,
         provenance={**res.provenance, "estimator": "fricid.identify.learned.hybrid.fit_hybrid"},
         state=state,

@@ -87,7 +87,7 @@ import numpy as np
 from sklearn.utils.validation import check_is_fitted
 
 from ...errors import ConfigError
-from ...fitted import FittedModel
+from ...fitted import FittedModel, OptimizerRecord
 from ...metrics import metrics
 from ...models import INPUTS
 from ...models.rbf import (
@@ -108,6 +108,7 @@ from ._trust import (
     cv_validation,
     hat_trace,
     learned_statistics,
+    network_budget,
     network_convergence,
     side_states,
 )
@@ -273,19 +274,21 @@ def _model(
     scatter = measurement_scatter(samples)
     return FittedModel(
         model="rbf",
-        params={},
         metrics=metrics(samples.y, y_hat, samples.direction, scatter.value),
         statistics=statistics,
         statistics_note=note,
         convergence=convergence,
         validation=validation,
         loss={"scatter": scatter.to_dict()},
-        method=trainer if trainer == "lsq" else f"{trainer}/{est.encoding}",
-        seed=int(rs) if isinstance(rs, Integral) else None,
-        nfev=int(sum(e.n_evals_ for e in ests)),
-        status=status,
-        message=message,
-        history=_history(ests, n),
+        optimizer=OptimizerRecord(
+            method=trainer if trainer == "lsq" else f"{trainer}/{est.encoding}",
+            seed=int(rs) if isinstance(rs, Integral) else None,
+            status=status,
+            message=message,
+            nfev=int(sum(e.n_evals_ for e in ests)),
+            max_evals=network_budget(ests),
+            history=_history(ests, n),
+        ),
         operating_range=operating_range(samples),
         provenance=provenance(
             samples,

@@ -54,20 +54,16 @@ def certify(problem: IdentificationProblem, result: OptimizeResult) -> dict[str,
     Returns
     -------
     dict
-        ``converged`` (bool), ``status`` and ``message`` (the optimiser's), ``nfev``,
-        ``max_evals`` (the budget), ``polish_sse_ratio`` (polished SSE / fit SSE; 1 when the
-        polish found nothing lower), ``polish_nfev``, ``certified_by`` (``"optimizer"``: its
-        own test and the polish agree; ``"polish"``: the optimiser stopped otherwise, the polish
-        finds nothing lower; ``""`` when not converged) and, when not converged, ``reason`` and
-        ``advice``.
+        The verdict: ``converged`` (bool), ``polish_sse_ratio`` (polished SSE / fit SSE; 1
+        when the polish found nothing lower), ``polish_nfev``, ``certified_by``
+        (``"optimizer"``: its own test and the polish agree; ``"polish"``: the optimiser
+        stopped otherwise, the polish finds nothing lower; ``""`` when not converged) and,
+        when not converged, ``reason`` and ``advice``. The optimiser's own status, message,
+        evaluations and budget are the model's optimiser record, not repeated here.
     """
     sse = float(result.fun)
     block: dict[str, Any] = {
         "converged": False,
-        "status": int(result.status),
-        "message": str(result.message),
-        "nfev": int(result.nfev),
-        "max_evals": int(result.get("max_evals", result.nfev)),
         "polish_sse_ratio": float("nan"),
         "polish_nfev": 0,
         "certified_by": "",
@@ -96,8 +92,9 @@ def certify(problem: IdentificationProblem, result: OptimizeResult) -> dict[str,
         block["certified_by"] = "optimizer" if result.success else "polish"
         return block
     method = str(result.method)
+    max_evals = int(result.get("max_evals", result.nfev))
     block["reason"] = (
-        f"method '{method}' ended after {result.nfev} of {block['max_evals']} evaluations "
+        f"method '{method}' ended after {result.nfev} of {max_evals} evaluations "
         f"(status {int(result.status)}: {result.message}) at SSE {sse:.4g}, but a local "
         f"least-squares polish from there reaches {best:.4g} ({sse / best:.3g}x lower)"
     )

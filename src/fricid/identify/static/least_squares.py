@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import warnings
 from collections.abc import Callable, Mapping, Sequence
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -24,7 +25,7 @@ from ...errors import (
     IdentifiabilityWarning,
     IgnoredArgumentWarning,
 )
-from ...fitted import FittedModel
+from ...fitted import FittedModel, OptimizerRecord, Parameter, is_not_determined
 from ...metrics import fit_statistics, metrics
 from ...models import INPUTS, FrictionModel, get_model
 from ...optim import METHODS, OptimizeResult, minimize
@@ -34,7 +35,7 @@ from .._scatter import measurement_scatter, sample_weights
 from ..problem import ROBUST_LOSSES, IdentificationProblem
 from .checks import check_identifiable
 from .convergence import certify
-from .uncertainty import INTERVALS, assess
+from .uncertainty import INTERVALS, Uncertainty, assess
 from .varpro import varpro
 
 __all__ = ["evaluate", "fit"]
@@ -122,12 +123,13 @@ def fit(
     Returns
     -------
     FittedModel
-        With ``status`` and ``message`` from the optimiser, the ``convergence`` block (the
-        optimiser's status and a local polish's verdict,
-        :func:`~fricid.identify.static.convergence.certify`),
-        fit statistics, standard errors (SVD pseudo-inverse), 95 % intervals
-        (``ci95_low``, ``ci95_high``, ``ci_open``, ``ci_method``), the reason where a parameter
-        has none (``uncertainty_note``) and correlations.
+        With the optimiser's record (``optimizer``: method, seed, status, message,
+        evaluations, budget, history), the ``convergence`` verdict (a local polish's,
+        :func:`~fricid.identify.static.convergence.certify`), fit statistics, one record per
+        parameter (:class:`~fricid.fitted.Parameter`: start, search bounds, standard error
+        from the SVD pseudo-inverse, the 95 % interval and its open ends (``ci_method`` says
+        how it was found), the note saying why a parameter has none, the flags) and
+        correlations.
 
     Raises
     ------
@@ -210,7 +212,6 @@ def fit(
             stacklevel=2,
         )
     theta = problem.expand(result.x)[0]
-    names, free_names = problem.names, problem.free_names
     unc = assess(
         problem,
         result.x,
@@ -239,39 +240,27 @@ def fit(
         with np.errstate(invalid="ignore", divide="ignore"):
             corr = (cov / np.outer(d, d)).tolist()
 
-    def per_free(values) -> dict[str, float]:
-        return {n: float(v) for n, v in zip(free_names, values, strict=True)}
-
     y_hat = model.predict(theta, X)
     return FittedModel(
         model=model.name,
-        params={n: float(v) for n, v in zip(names, theta, strict=True)},
-        units=model.units,
-        fixed=sorted(problem.fixed),
-        stderr=per_free(unc.stderr),
-        ci95=per_free(unc.ci95),
-        ci95_low=per_free(unc.low),
-        ci95_high=per_free(unc.high),
-        ci_open={n: [bool(a), bool(b)] for n, (a, b) in zip(free_names, unc.open, strict=True)},
+        parameters=_records(
+            problem, theta, unc, start, problem.at_bound(result.x), convergence["converged"]
+        ),
         ci_method=unc.method,
-        uncertainty_note=dict(unc.notes),
-        convergence=convergence,
-        at_bound=problem.at_bound(result.x),
         correlation=corr,
+        optimizer=OptimizerRecord(
+            method=result.method,
+            seed=result.seed,
+            status=int(result.status),
+            message=str(result.message),
+            nfev=int(result.nfev),
+            max_evals=int(result.get("max_evals", result.nfev)),
+            history=np.asarray(result.history).tolist(),
+        ),
+        convergence=convergence,
         metrics=metrics(y, y_hat, samples.direction, scatter.value),
-        method=result.method,
-        seed=result.seed,
-        nfev=int(result.nfev),
-        history=np.asarray(result.history).tolist(),
-        bounds={
-            n: [float(lo), float(hi)]
-            for n, (lo, hi) in zip(free_names, problem.bounds, strict=True)
-        },
         operating_range=operating_range(samples, X),
         provenance=provenance(samples),
-        status=int(result.status),
-        message=str(result.message),
-        init={} if start is None else dict(zip(free_names, map(float, start), strict=True)),
         statistics=fit_statistics(y, y_hat, problem.n_free, w),
         loss={
             "loss": "l2" if problem.loss == "sse" else problem.loss,
@@ -280,6 +269,39 @@ def fit(
             "scatter": scatter.to_dict(),
         },
     )
+
+
+def _records(
+    problem: IdentificationProblem,
+    theta: np.ndarray,
+    unc: Uncertainty,
+    start: np.ndarray | None,
+    at_bound: Sequence[str],
+    converged: bool,
+) -> dict[str, Parameter]:
+    """One :class:`~fricid.fitted.Parameter` per parameter of ``problem`` at ``theta``: the
+    free ones with their start, search bounds, standard error, interval (``unc``) and flags."""
+    units = problem.model.units
+    out = {
+        n: Parameter(n, float(v), unit=units.get(n, ""), fixed=n in problem.fixed)
+        for n, v in zip(problem.names, theta, strict=True)
+    }
+    for j, n in enumerate(problem.free_names):
+        note = unc.notes.get(n, "")
+        out[n] = replace(
+            out[n],
+            init=None if start is None else float(start[j]),
+            bounds=(float(problem.bounds[j, 0]), float(problem.bounds[j, 1])),
+            stderr=float(unc.stderr[j]),
+            ci95=(float(unc.low[j]), float(unc.high[j])),
+            ci95_halfwidth=float(unc.ci95[j]),
+            low_open=bool(unc.open[j, 0]),
+            high_open=bool(unc.open[j, 1]),
+            note=note,
+            at_bound=n in at_bound,
+            not_determined=is_not_determined(note, float(unc.stderr[j]), converged),
+        )
+    return out
 
 
 #: ``lm`` restarts (multi-start) when its first start's RMS residual exceeds this many times

@@ -255,7 +255,7 @@ def _table2(fitted: FittedModel) -> list:
     for name, (value, symbol) in PAPER["table2"].items():
         k = _PAPER_UNITS[name]
         ours = fitted.params[name]
-        ci = fitted.ci95.get(name, np.nan)
+        ci = fitted.parameters[name].ci95_halfwidth
         rows.append(
             {
                 "parameter": symbol,

@@ -290,8 +290,8 @@ def _table2(
         if truth is not None:
             row["virtual joint (true)"] = truth[name]
         row[f"ours: {best_label}"] = best.params[name]
-        row["ours: 95% CI ±"] = best.ci95.get(name, np.nan)
-        row[f"{reference.method} (reference)"] = reference.params[name]
+        row["ours: 95% CI ±"] = best.parameters[name].ci95_halfwidth
+        row[f"{reference.optimizer.method} (reference)"] = reference.params[name]
         rows.append(row)
     last = {"parameter": "SSE [N² m²]"}
     if paper_numbers:
@@ -302,7 +302,7 @@ def _table2(
         {
             f"ours: {best_label}": best.metrics["sse"],
             "ours: 95% CI ±": np.nan,
-            f"{reference.method} (reference)": reference.metrics["sse"],
+            f"{reference.optimizer.method} (reference)": reference.metrics["sse"],
         }
     )
     rows.append(last)

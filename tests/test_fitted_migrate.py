@@ -1,0 +1,194 @@
+"""Model files of schema version 1 (``fricid.fitted._migrate``): files an earlier fricid wrote
+load, predict the same numbers bit for bit, print the same fit report, exports, parameter
+table, fleet row and trust lists as that fricid did (``tests/data/model_files_v1``), and save
+again in the current layout."""
+
+from __future__ import annotations
+
+import json
+import math
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from fricid.errors import DataError
+from fricid.export import (
+    c_code,
+    file_sha256,
+    mjcf_text,
+    ros2_yaml_text,
+    urdf_text,
+    validate_model_dict,
+)
+from fricid.fitted import SCHEMA_VERSION, FittedModel
+from fricid.fleet.job import fit_row
+from fricid.fleet.manifest import JointSpec
+from fricid.report.model import parameter_table
+from fricid.report.trust import not_determined, open_sides
+
+V1_FILES = Path(__file__).parent / "data" / "model_files_v1"
+EXPECTED = json.loads((V1_FILES / "expected.json").read_text())
+FAMILIES = sorted(EXPECTED)
+
+#: Fields of version 1 that version 2 holds in ``parameters`` and ``optimizer``.
+V1_ONLY = {"params", "units", "fixed", "stderr", "ci95", "at_bound", "method", "seed", "nfev"}
+V1_ONLY |= {"history", "bounds", "status", "message", "init", "ci95_low", "ci95_high"}
+V1_ONLY |= {"ci_open", "uncertainty_note"}
+
+
+def v1_doc(family: str) -> dict:
+    return json.loads((V1_FILES / f"{family}.json").read_text())
+
+
+def load(family: str) -> FittedModel:
+    return FittedModel.load(V1_FILES / f"{family}.json")
+
+
+def quiet(call, *args, **kw):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return call(*args, **kw)
+
+
+def exports(fitted: FittedModel, path: Path) -> dict[str, str]:
+    """What fricid exports for the model of ``path``, as ``make_v1.py.txt`` recorded it."""
+    sha, out = file_sha256(path), {}
+    for target, build in (("urdf", urdf_text), ("mjcf", mjcf_text), ("yaml", ros2_yaml_text)):
+        out[target] = quiet(build, fitted, source=path.name, sha256=sha)
+    try:
+        code = quiet(c_code, fitted, source=path.name, sha256=sha)
+        out["c"] = code.header + "\n//--\n" + code.source
+    except Exception as exc:  # the recorded text of a model the C export refuses
+        out["c"] = f"error: {type(exc).__name__}: {exc}"
+    return out
+
+
+def same(a, b) -> bool:
+    both_nan = isinstance(a, float) and isinstance(b, float) and math.isnan(a) and math.isnan(b)
+    return both_nan or a == b
+
+
+@pytest.mark.parametrize("family", FAMILIES)
+def test_version_1_files_predict_and_print_as_before(family):
+    expected, path = EXPECTED[family], V1_FILES / f"{family}.json"
+    fitted = load(family)
+    y = quiet(fitted.predict, np.array(expected["X"]))
+    assert np.array_equal(y, np.array(expected["y"]))  # bit for bit
+    assert fitted.report() == expected["report"]
+    assert exports(fitted, path) == expected["exports"]
+    table = parameter_table(fitted).to_csv(index=False) if fitted.parameters else ""
+    assert table == expected["parameter_table"]
+    spec = JointSpec(robot="r", joint="j", log=Path("/nonexistent/log.csv"), log_text="log.csv")
+    row = quiet(fit_row, spec, family, fitted, None)
+    assert row.keys() == expected["fleet_row"].keys()
+    assert all(same(row[k], v) for k, v in expected["fleet_row"].items()), family
+    assert not_determined(fitted) == expected["not_determined"]
+    assert open_sides(fitted, include_zero=True) == expected["open_sides"]
+
+
+@pytest.mark.parametrize("family", FAMILIES)
+def test_version_1_files_save_in_the_current_layout(family, tmp_path):
+    fitted = load(family)
+    d = fitted.to_dict()
+    assert d["schema_version"] == SCHEMA_VERSION == 2
+    assert not V1_ONLY & set(d) and {"parameters", "optimizer"} <= set(d)
+    assert not {"status", "message", "nfev", "max_evals"} & set(d["convergence"] or {})
+    validate_model_dict(d)
+    again = FittedModel.load(fitted.save(tmp_path / "again.json"))
+    X = np.array(EXPECTED[family]["X"])
+    assert np.array_equal(quiet(again.predict, X), quiet(fitted.predict, X))
+    assert again.report() == fitted.report() and again.to_dict() == d
+
+
+def test_the_records_hold_what_the_ten_fields_held():
+    d, fitted = v1_doc("stribeck"), load("stribeck")
+    assert list(fitted.parameters) == list(d["params"])
+    for name, p in fitted.parameters.items():
+        assert p.value == d["params"][name] and p.unit == d["units"][name]
+        assert p.fixed == (name in d["fixed"]) and p.at_bound == (name in d["at_bound"])
+        if p.fixed:
+            assert p.init is None and p.bounds is None and math.isnan(p.stderr)
+            continue
+        assert p.init == d["init"][name] and list(p.bounds) == d["bounds"][name]
+        assert p.stderr == d["stderr"][name] and p.ci95_halfwidth == d["ci95"][name]
+        assert p.ci95 == (d["ci95_low"][name], d["ci95_high"][name])
+        assert [p.low_open, p.high_open] == d["ci_open"][name]
+        assert p.note == d["uncertainty_note"][name]
+    assert fitted.fixed == ("delta",) and fitted.at_bound == ("w_s",)
+    assert [n for n, p in fitted.parameters.items() if p.not_determined] == ["tau_s", "w_s"]
+    opt = fitted.optimizer
+    assert (opt.method, opt.seed, opt.status, opt.message) == (
+        d["method"],
+        d["seed"],
+        d["status"],
+        d["message"],
+    )
+    assert opt.nfev == d["nfev"] and opt.max_evals == d["convergence"]["max_evals"]
+    assert opt.history == d["history"]
+    assert fitted.convergence == {
+        k: v
+        for k, v in d["convergence"].items()
+        if k not in ("status", "message", "nfev", "max_evals")
+    }
+
+
+def test_a_correlation_in_another_order_is_reordered_to_the_free_parameters(tmp_path):
+    d = v1_doc("stribeck")
+    names = list(d["stderr"])
+    order = [2, 0, 3, 1]  # stderr (the rows' order in version 1) written in another order
+    d["stderr"] = {names[i]: d["stderr"][names[i]] for i in order}
+    d["correlation"] = [[d["correlation"][i][j] for j in order] for i in order]
+    path = tmp_path / "reordered.json"
+    path.write_text(json.dumps(d))
+    assert FittedModel.load(path).correlation == load("stribeck").correlation
+    assert FittedModel.load(path).report() == EXPECTED["stribeck"]["report"]
+
+
+def test_an_unconverged_block_without_a_reason_keeps_its_message():
+    d = v1_doc("stribeck_bas")
+    del d["convergence"]["reason"]
+    fitted = FittedModel.from_dict(d, source="old.json")
+    assert fitted.convergence["reason"] == d["convergence"]["message"]
+    assert fitted.report().startswith(f"NOT CONVERGED: {d['convergence']['message']}; ")
+
+
+def test_errors_in_a_version_1_file_name_its_own_fields():
+    d = v1_doc("stribeck")
+    d["bounds"]["tau_c"] = [1.0, 0.0]
+    with pytest.raises(DataError, match=r"^old\.json: field 'bounds/tau_c': the minimum 1\.0"):
+        FittedModel.from_dict(d, source="old.json")
+    d = v1_doc("stribeck")
+    d["stderr"]["tau_c"] = -1.0
+    with pytest.raises(DataError, match=r"field 'stderr/tau_c' .* schema \(version 1\)"):
+        FittedModel.from_dict(d, source="old.json")
+    d = v1_doc("stribeck")
+    del d["params"]
+    with pytest.raises(DataError, match="'params' is a required property"):
+        FittedModel.from_dict(d, source="old.json")
+    d = v1_doc("stribeck")
+    d["params"].pop("w_s")
+    with pytest.raises(DataError, match="missing: w_s"):
+        FittedModel.from_dict(d, source="old.json")
+
+
+def test_the_upgrade_leaves_the_document_as_it_was():
+    d = v1_doc("lugre")
+    before = json.dumps(d, sort_keys=True)
+    FittedModel.from_dict(d, source="old.json")
+    assert json.dumps(d, sort_keys=True) == before
+
+
+def test_an_unconverged_fit_does_not_call_its_parameters_not_determined():
+    """A fit that did not converge has no standard errors at all, which says nothing about
+    what the data determine: no "not determined" flag (version 1 files without notes printed
+    one; the NOT CONVERGED line says why there are no intervals)."""
+    d = v1_doc("stribeck_bas")
+    del d["uncertainty_note"]
+    fitted = FittedModel.from_dict(d, source="old.json")
+    text = fitted.report()
+    assert text.startswith("NOT CONVERGED: ") and "[not determined]" not in text
+    assert not_determined(fitted) == [] and not any(
+        p.not_determined for p in fitted.parameters.values()
+    )
