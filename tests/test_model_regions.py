@@ -14,7 +14,7 @@ from typer.testing import CliRunner
 
 from fricid.cli import app
 from fricid.errors import ConfigError, DataError
-from fricid.fitted import FittedModel
+from fricid.fitted import FittedModel, OptimizerRecord
 from fricid.identify import fit
 from fricid.models import Parameter, get_model
 from fricid.models.hybrid import backbone_of
@@ -41,7 +41,9 @@ def model_file(tmp_path, family: str, **change: float):
     model = get_model(family)
     params = dict(zip(model.param_names, model.defaults().tolist(), strict=True))
     params.update(change)
-    fitted = FittedModel(model=family, params=params, operating_range=RANGE, method="test")
+    fitted = FittedModel.from_values(
+        family, params, operating_range=RANGE, optimizer=OptimizerRecord(method="test")
+    )
     path = tmp_path / f"{family}.json"
     path.write_text(json.dumps(fitted.to_dict()))
     return path
@@ -99,7 +101,7 @@ def test_a_parameter_outside_its_region_is_refused_at_load(tmp_path, family, nam
         FittedModel.load(path)
     message = str(info.value)
     assert message.startswith(str(path)) and "\n" not in message
-    assert f"field 'params/{name}'" in message and "valid region" in message
+    assert f"field 'parameters/{name}/value'" in message and "valid region" in message
 
 
 @pytest.mark.parametrize(

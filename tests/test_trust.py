@@ -95,7 +95,11 @@ def test_record_is_recomputed_for_other_samples_options_or_model(fitted, leadscr
     fewer = leadscrew.subset(np.arange(len(leadscrew)) > 0)
     other_std = replace(leadscrew, std=leadscrew.std * 2.0)
     # another model, another record format, a record that does not parse
-    edited = replace(model, params={**model.params, "tau_c_pos": model.params["tau_c_pos"] * 1.01})
+    tau_c = model.parameters["tau_c_pos"]
+    edited = replace(
+        model,
+        parameters={**model.parameters, "tau_c_pos": replace(tau_c, value=tau_c.value * 1.01)},
+    )
     old = replace(model, trust={**record.to_dict(), "version": 0})
     broken = replace(model, trust={"level": 3})
     for m, s in ((model, fewer), (model, other_std), (edited, leadscrew), (old, leadscrew)):

@@ -64,7 +64,7 @@ def _check_region(model, theta, field_name: str, name: str, source: str | None) 
     if bad is not None:
         param, value = bad
         raise DataError(
-            f"field '{field_name}/{param.name}': {value!r} lies outside model '{name}''s valid "
+            f"field '{field_name}/{param.name}/value': {value!r} lies outside model '{name}''s valid "
             f"region ({param.rule}, the {param.description})",
             file=source,
         )
@@ -387,7 +387,7 @@ class FittedModel:
                 theta = out.theta()
             except ConfigError as exc:  # unknown model, or parameter names that do not match
                 raise DataError(one_line(str(exc)), file=source) from None
-            _check_region(out.friction_model(), theta, "params", out.model, source)
+            _check_region(out.friction_model(), theta, "parameters", out.model, source)
         rows = out.correlation or []
         if any(len(row) != len(rows) for row in rows):
             raise DataError("field 'correlation': not a square matrix", file=source)
