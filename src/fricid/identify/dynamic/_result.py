@@ -1,5 +1,11 @@
 """The result of a trajectory identification as a model file: parameters with their
 intervals, the stages' records, the joint's inertia and gravity, and what was checked.
+
+Intervals are given only for a fit whose every stage is certified converged
+(:func:`._outcome.converged`), as for an analytic fit
+(:func:`fricid.identify.static.uncertainty.assess`): otherwise the standard errors and 95 %
+intervals are withheld (NaN, and the reason in ``uncertainty_note``), in the parameters, the
+joint's table and every route's, and a :class:`~fricid.errors.ConvergenceWarning` says why.
 """
 
 from __future__ import annotations
@@ -11,6 +17,7 @@ from typing import Any
 import numpy as np
 
 from ... import __version__
+from ...errors import ConvergenceWarning
 from ...fitted import FittedModel
 from ...io.atomic import created_timestamp
 from ...metrics import fit_statistics, metrics
@@ -21,6 +28,21 @@ from ._outcome import PassivityWarning, converged, passivity
 from ._routes import JOINT_PARAMS
 
 __all__ = ["build_result"]
+
+#: The note of a parameter whose interval is withheld (as an analytic fit's).
+NO_INTERVAL = "no interval: the fit did not converge (see the convergence block)"
+
+#: The entries of a parameter's table that an unconverged fit does not give.
+_INTERVAL_KEYS = ("stderr", "ci95_low", "ci95_high")
+
+
+def _withheld(table: dict[str, dict[str, float]]) -> dict[str, dict[str, float]]:
+    """A parameter table without its standard errors and intervals (NaN)."""
+    nan = float("nan")
+    return {
+        n: {k: (nan if k in _INTERVAL_KEYS else v) for k, v in row.items()}
+        for n, row in table.items()
+    }
 
 
 def build_result(
@@ -34,16 +56,28 @@ def build_result(
     *,
     n_joint: int,
     stages: dict[str, Any],
-    results: list,
+    fits: list,
     final: dict[str, dict[str, float]],
     bounds_out: dict[str, list[float]],
     options: dict[str, Any],
     sim_info: dict[str, Any],
 ) -> FittedModel:
     """The :class:`~fricid.fitted.FittedModel` of a trajectory identification: the final
-    parameter table, the stages' convergence, the joint's J and gravity, LuGre's passivity
-    and the provenance (``provenance["trajectory"]``)."""
+    parameter table, the stages' convergence (``fits``: each search, named, in order), the
+    joint's J and gravity, LuGre's passivity and the provenance
+    (``provenance["trajectory"]``); no intervals unless converged (module notes)."""
     method, seed, max_evals = options["method"], options["seed"], options["max_evals"]
+    rename = options.get("rename", {})
+    convergence = converged(fits, method, max_evals, rename) if fits else None
+    ok = convergence is None or convergence["converged"]
+    if not ok:
+        warnings.warn(
+            f"identifying '{key}' from the trajectory did not converge: "
+            f"{convergence['reason']}; {convergence['advice']}; its intervals are withheld",
+            ConvergenceWarning,
+            stacklevel=3,
+        )
+        final = _withheld(final)
     static, derivative = options["static"], options["derivative"]
     v_slide, gravity, t_start = options["v_slide"], options["gravity"], options["t_start"]
     rate = 1.0 / series.dt
@@ -61,8 +95,11 @@ def build_result(
         ci95={n: float((h - lo) / 2) for n, lo, h in zip(param_names, low, high, strict=True)},
         ci95_low=dict(zip(param_names, low, strict=True)),
         ci95_high=dict(zip(param_names, high, strict=True)),
-        ci_method="cluster-robust"
-        + (", two-step" if key == "lugre" and route != "filtered" else ""),
+        ci_method=(
+            "cluster-robust" + (", two-step" if key == "lugre" and route != "filtered" else "")
+        )
+        if ok
+        else "",
         metrics={
             **metrics(y, yhat),
             **{
@@ -74,15 +111,16 @@ def build_result(
         statistics=fit_statistics(y, yhat, len(param_names) + n_joint),
         method=method,
         seed=seed,
-        nfev=int(sum(r.nfev for r in results)),
+        nfev=int(sum(st.result.nfev for _, st in fits)),
         bounds={n: b for n, b in bounds_out.items() if n in param_names},
         operating_range={
             "velocity": [float(vf.min()), float(vf.max())],
             "temperature": [float(series.temperature.min()), float(series.temperature.max())],
         },
-        convergence=converged(results, method, max_evals) if results else None,
-        status=int(results[-1].status) if results else None,
-        message=str(results[-1].message) if results else "",
+        convergence=convergence,
+        status=int(fits[-1][1].result.status) if fits else None,
+        message=str(fits[-1][1].result.message) if fits else "",
+        uncertainty_note={} if ok else dict.fromkeys(param_names, NO_INTERVAL),
     )
     fitted.at_bound = [
         n
@@ -96,7 +134,7 @@ def build_result(
     fitted.ci_open = {
         n: [bool(lo <= fitted.bounds[n][0]), bool(h >= fitted.bounds[n][1])]
         for n, lo, h in zip(param_names, low, high, strict=True)
-        if n in fitted.bounds
+        if n in fitted.bounds and ok
     }
     last_regression = [st for name, st in stages.items() if name.startswith("refinement")]
     joint_tab = {
@@ -108,6 +146,8 @@ def build_result(
         joint_tab.update(
             {n: r for n, r in stages["simulation_joint"].table().items() if n in JOINT_PARAMS}
         )
+    if not ok:
+        joint_tab = _withheld(joint_tab)
     info: dict[str, Any] = {
         "route": route,
         "static_from": "sweeps"
@@ -121,7 +161,7 @@ def build_result(
         "joint": joint_tab,
         "routes": {
             name: {
-                "parameters": st.table(),
+                "parameters": st.table() if ok else _withheld(st.table()),
                 "rms": st.rms,
                 "seconds": st.seconds,
                 "clusters": st.clusters,
