@@ -81,7 +81,8 @@ import warnings
 
 import numpy as np
 
-from fricid.identify import _rbf_folds, fit
+from fricid.identify import fit
+from fricid.identify.learned import _rbf_folds
 from fricid.sim.heldout_laws import KINDS, TUNING_SEEDS, draw
 
 
