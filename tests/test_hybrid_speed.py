@@ -110,3 +110,21 @@ def test_memoised_uniform_streams_are_randomstates_draws():
         np.testing.assert_array_equal(long, expected)
         np.testing.assert_array_equal(short, expected[:10])
         assert not long.flags.writeable
+
+
+def test_lloyd_runs_through_public_kmeans_and_draws_nothing_from_its_random_state():
+    """Lloyd's iterations are scikit-learn's public ``KMeans`` started from the compiled
+    k-means++ seeds: the same centres as ``KMeans(init=seeds, n_init=1)`` with its own checks,
+    and the one random state every call hands it is never drawn from."""
+    from sklearn.cluster import KMeans
+
+    from fricid.identify.learned import _rbf_estimator as est
+
+    before = est._LLOYD_RANDOM_STATE.get_state()
+    for Z, m in list(_kmeans_problems(False))[:6]:
+        seeds = Z[est._kmeans_plusplus(Z - Z.mean(axis=0), m, 5)]
+        expected = KMeans(m, init=seeds, n_init=1, random_state=5).fit(Z).cluster_centers_
+        np.testing.assert_array_equal(est.kmeans_centres(Z, m, 5), expected)
+    after = est._LLOYD_RANDOM_STATE.get_state()
+    assert after[0] == before[0] and np.array_equal(after[1], before[1])
+    assert after[2:] == before[2:]

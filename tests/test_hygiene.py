@@ -247,3 +247,67 @@ def test_no_absolute_machine_paths(path):
         if any(needle in line for needle in needles)
     ]
     assert not bad, "\n".join(bad)
+
+
+# ------------------------------------------------------------------ public scikit-learn API only
+
+
+def private_sklearn_imports(source: str) -> list[str]:
+    """The private scikit-learn modules or names a source imports: an ``import`` or
+    ``from ... import`` (at any depth: in functions, ``try`` blocks) or an
+    ``importlib.import_module`` / ``__import__`` call with a constant name, any of whose parts
+    after ``sklearn`` begins with ``_`` (dunders such as ``__version__`` excepted)."""
+
+    def private(dotted: str) -> bool:
+        head, *rest = dotted.split(".")
+        return head == "sklearn" and any(
+            p.startswith("_") and not (p.startswith("__") and p.endswith("__")) for p in rest
+        )
+
+    found = []
+    for node in ast.walk(ast.parse(source)):
+        names: list[str] = []
+        if isinstance(node, ast.Import):
+            names = [alias.name for alias in node.names]
+        elif isinstance(node, ast.ImportFrom) and not node.level and node.module:
+            names = [f"{node.module}.{alias.name}" for alias in node.names]
+        elif isinstance(node, ast.Call) and node.args:
+            func = node.func
+            called = func.attr if isinstance(func, ast.Attribute) else getattr(func, "id", "")
+            arg = node.args[0]
+            if called in ("import_module", "__import__") and isinstance(arg, ast.Constant):
+                names = [str(arg.value)]
+        found += [f"line {node.lineno}: {n}" for n in names if private(n)]
+    return found
+
+
+def test_the_private_sklearn_import_check_finds_each_form():
+    source = (
+        "from sklearn.utils._param_validation import Interval\n"
+        "def f():\n"
+        "    from sklearn.cluster._kmeans import _kmeans_single_lloyd\n"
+        "    from sklearn.utils import _openmp_helpers\n"
+        "    import sklearn._config\n"
+        "    importlib.import_module('sklearn.cluster._kmeans')\n"
+        "from sklearn.cluster import KMeans\n"
+        "from sklearn import __version__\n"
+        "import sklearn.utils.validation\n"
+    )
+    assert [f.split(": ")[1] for f in private_sklearn_imports(source)] == [
+        "sklearn.utils._param_validation.Interval",
+        "sklearn.cluster._kmeans._kmeans_single_lloyd",
+        "sklearn.utils._openmp_helpers",
+        "sklearn._config",
+        "sklearn.cluster._kmeans",
+    ]
+
+
+def test_src_uses_public_sklearn_api_only():
+    """fricid allows a range of scikit-learn releases (pyproject.toml); a private module can
+    change or vanish in any of them, so ``src/`` imports none."""
+    bad = [
+        f"{m.rel}: {hit}"
+        for m in modules()
+        for hit in private_sklearn_imports(m.path.read_text(encoding="utf-8"))
+    ]
+    assert not bad, "\n".join(bad)

@@ -85,6 +85,32 @@ def test_problem_generic_model_needs_array_bounds_and_refuses_bad_input():
         IdentificationProblem(get_model("stribeck"), stribeck_samples(), fixed={"xi": 1})
 
 
+def test_residual_problem_follows_the_problem_protocol_and_is_certified_alike():
+    """Any batch residual function makes a problem of the protocol that
+    ``IdentificationProblem`` follows; certification treats the two alike."""
+    from fricid.identify.problem import Problem, ResidualProblem
+    from fricid.identify.static.convergence import certify
+    from fricid.optim import minimize
+
+    s = stribeck_samples(0.003)
+    p = IdentificationProblem(get_model("stribeck"), s, fixed={"delta": 1.0})
+    q = ResidualProblem(p.residuals, p.bounds, p.free_names, p.y)
+    assert isinstance(p, Problem) and isinstance(q, Problem)
+    assert not isinstance(object(), Problem)
+    assert (q.n_obs, q.n_free, q.free_names) == (p.n_obs, p.n_free, p.free_names)
+    T = p.bounds[:, 0] + np.random.default_rng(1).random((7, 4)) * np.ptp(p.bounds, axis=1)
+    np.testing.assert_array_equal(q.evaluate(T), p.evaluate(T))
+    np.testing.assert_array_equal(q.expand(T), T)
+    for method, evals in (("lm", None), ("bas", 200)):
+        res = minimize(
+            None, p.bounds, method, seed=0, max_evals=evals, residuals=p.residuals, x0=p.start()
+        )
+        a, b = certify(p, res), certify(q, res)
+        assert a == b and a["converged"] is (method == "lm")
+    with pytest.raises(ConfigError, match="one row per name"):
+        ResidualProblem(p.residuals, p.bounds[:2], p.free_names, p.y)
+
+
 # -- covariance by SVD -------------------------------------------------------------------------
 
 

@@ -60,6 +60,7 @@ SMALL = {
     "rwsavsbas": ({"n_outer": 3, "n_inner": 20}, None),
     "ga": ({}, 300),
     "bas+lm": ({"global_evals": 150, "global_options": {"n_iter": 40}}, 400),
+    "lbfgsb": ({}, 300),
     "lm": ({"n_starts": 3}, 300),
     "trf": ({"n_starts": 3}, 300),
     "lm_minpack": ({"n_starts": 3}, 300),
@@ -147,6 +148,7 @@ CONVERGENCE = {
     "rwsavsbas": (RWS_SHORT, None, 1e-6, 1e-6),
     "ga": ({}, 4000, 1e-3, 5e-3),
     "bas+lm": ({}, 3000, 1e-20, 1e-20),
+    "lbfgsb": ({}, 2000, 1e-12, 1e-8),
     "lm": ({}, 2000, 1e-20, 1e-20),
     "trf": ({}, 2000, 1e-20, 1e-20),
     "de": ({}, 4000, 1e-8, 1e-12),
@@ -403,6 +405,19 @@ def test_bas_without_position_evaluates_only_the_antennae():
 
 
 # -- status, success and the two entry points ---------------------------------------------------
+
+
+def test_default_method_is_cheap_and_local() -> None:
+    """Without a method, ``minimize`` runs a cheap bounded local method, as scipy's does:
+    ``lbfgsb`` from a scalar objective, ``lm`` given residuals; the global methods are one
+    argument away."""
+    r = minimize(sphere, B4)
+    assert r.method == "lbfgsb" and r.success and r.fun < 1e-10 and r.nfev < 100
+    r = minimize(None, B4, residuals=sphere_res)
+    assert r.method == "lm" and r.success and r.fun < 1e-20 and r.nfev < 100
+    assert [x.method for x in minimize_runs(sphere, B4, runs=2)] == ["lbfgsb"] * 2
+    r = minimize(sphere, B4, "rwsavsbas", seed=0, options={"n_outer": 2, "n_inner": 5})
+    assert r.method == "rwsavsbas" and r.nfev == 33  # 1 + 2 outer x (1 + 5 inner x 3)
 
 
 def test_minimize_returns_one_result_and_has_no_runs_argument() -> None:

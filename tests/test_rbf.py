@@ -359,6 +359,44 @@ def test_bad_inputs_give_clear_errors():
         RBFNetRegressor(5, trainer="bas", method_options={"speed": 1}).fit(X, y)
 
 
+@pytest.mark.parametrize(
+    ("name", "bad", "accepts"),
+    [
+        ("n_centers", 0, r"an int in the range \[1, inf\)"),
+        ("n_centers", 2.5, "an int"),
+        ("n_centers", True, "an int"),
+        ("trainer", 3, "an instance of 'str'"),
+        ("encoding", "weights", r"a str among \{'full', 'hybrid'\}"),
+        ("init", "zeros", r"a str among \{'kmeans', 'random'\}"),
+        ("width_factor", 0.0, r"a float in the range \(0, inf\)"),
+        ("alpha", float("nan"), r"a float in the range \[0, inf\)"),
+        ("fit_bias", "yes", "an instance of 'bool'"),
+        ("linear_tail", 1, "an instance of 'bool'"),
+        ("linear_magnitude", 3, "an array-like"),
+        ("tail_order", 3, r"an int in the range \[1, 2\]"),
+        ("velocity_stretch", -1.0, "a float"),
+        ("velocity_scale", 0.0, r"a float in the range \(0, inf\) or None"),
+        ("target_mse", float("inf"), "or None"),
+        ("max_epochs", 0, "an int"),
+        ("evals_per_epoch", 1.5, "an int"),
+        ("method_options", "fast", "a dict or None"),
+        ("random_state", -1, "a numpy RandomState or None"),
+    ],
+)
+def test_each_parameter_is_checked_at_fit_in_scikit_learns_words(name, bad, accepts):
+    """Parameters are checked by fricid's own code (scikit-learn's is private), in its
+    wording, when ``fit`` runs; ``__init__`` stores them as given."""
+    X = np.random.default_rng(3).uniform(size=(20, 2))
+    net = RBFNetRegressor(**{"n_centers": 5, name: bad})
+    assert net.get_params()[name] is bad
+    with pytest.raises(ConfigError, match=rf"^The '{name}' parameter of RBFNetRegressor must be "):
+        net.fit(X, X.sum(axis=1))
+    with pytest.raises(ConfigError, match=accepts + r".*\. Got .* instead\.$"):
+        net.fit(X, X.sum(axis=1))
+    ok = {"n_centers": np.int64(5), "alpha": 0, "random_state": np.random.RandomState(0)}
+    RBFNetRegressor(**ok, fit_bias=np.bool_(True), linear_magnitude=[1]).fit(X, X.sum(axis=1))
+
+
 def test_zero_variance_named_by_feature_name():
     import pandas as pd
 

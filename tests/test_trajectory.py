@@ -11,7 +11,7 @@ import pytest
 from typer.testing import CliRunner
 
 from fricid.cli import app
-from fricid.errors import ConfigError, DataError
+from fricid.errors import ConfigError, ConvergenceWarning, DataError
 from fricid.fitted import FittedModel, Parameter
 from fricid.identify.dynamic.trajectory import DerivativeFilter, RateBiasWarning, fit_trajectory
 from fricid.models import Stribeck
@@ -83,7 +83,19 @@ def test_static_model_from_a_trajectory_within_intervals():
     assert fitted.provenance["trajectory"]["derivative"]["method"] == "savgol"
 
 
-def test_lugre_two_stage_route_covers_the_truth_on_two_seeds(tmp_path):
+def test_lugre_two_stage_route_covers_the_truth_on_two_seeds(tmp_path, monkeypatch):
+    from fricid.identify.dynamic import _result
+    from fricid.identify.dynamic._routes import _SimProblem
+    from fricid.identify.problem import Problem
+
+    searched = []  # every stage's search is a problem of the protocol, certified alike
+
+    def spy(fits, *args):
+        searched.extend(stage.problem for _, stage in fits)
+        return converged(fits, *args)
+
+    converged = _result.converged
+    monkeypatch.setattr(_result, "converged", spy)
     hits, opened = {}, []
     for seed in (0, 1):
         log = tr.simulate_trajectory(
@@ -101,6 +113,8 @@ def test_lugre_two_stage_route_covers_the_truth_on_two_seeds(tmp_path):
         info = fitted.provenance["trajectory"]
         assert set(info["routes"]) == {"regression", "refinement_1", "simulation"}
         assert info["passivity"]["condition"].startswith("sigma_1 <=")
+    assert len(searched) == 8 and all(isinstance(p, Problem) for p in searched)
+    assert sum(isinstance(p, _SimProblem) for p in searched) == 4
     # only sigma_1 (damping ratio 0.05) may be left undetermined by 10 s of multi-sine
     assert {n for _, n in opened} <= {"sigma_1"}, opened
     # up to 14 intervals of 95 %: at most 2 misses is the honest floor (binomial, p 0.97)
@@ -114,6 +128,67 @@ def test_lugre_two_stage_route_covers_the_truth_on_two_seeds(tmp_path):
         * np.exp(-((0.5 / fitted.params["w_s"]) ** fitted.params["delta"]))
         + fitted.params["sigma_2"] * 0.5
     )
+
+
+def test_unconverged_trajectory_fit_withholds_its_intervals(tmp_path):
+    """A trajectory identification's convergence is certified as an analytic fit's (a local
+    least-squares polish of the problem each reported stage minimised), not taken from the
+    optimiser's flag: a search cut short withholds every standard error and interval (the
+    parameters', the joint's, the routes') and says why; a converged one keeps them."""
+    from fricid.cli.trajectory import trajectory_text
+
+    law = ModelLaw(Stribeck(), STATIC)
+    log = tr.simulate_trajectory(tr.multisine(duration=4.0, seed=3), law, JOINT, seed=3)
+    with pytest.warns(ConvergenceWarning, match="did not converge.*intervals are withheld"):
+        cut = fit_trajectory(log, "stribeck", "bas", max_evals=40)
+    conv = cut.convergence
+    assert not conv["converged"] and conv["reason"].startswith("stage 'regression': method 'bas'")
+    assert conv["polish_sse_ratio"] < 0.5 and conv["stages"][0]["stage"] == "regression"
+    records = cut.parameters.values()
+    assert all(np.isnan(p.stderr) and np.isnan(p.ci95[0]) for p in records)
+    assert all(p.note and not (p.low_open or p.high_open) for p in records)
+    info = cut.provenance["trajectory"]
+    for row in [*info["joint"].values(), *info["routes"]["regression"]["parameters"].values()]:
+        assert np.isnan(row["stderr"]) and np.isnan(row["ci95_high"]) and np.isfinite(row["value"])
+    assert cut.report().startswith("NOT CONVERGED: stage 'regression'")
+    saved = FittedModel.load(cut.save(tmp_path / "cut.json"))
+    assert "inertia: 0.0" in trajectory_text(saved)
+    assert "(no interval: the fit did not converge)" in trajectory_text(saved)
+
+    good = fit_trajectory(log, "stribeck", "lm")
+    conv = good.convergence
+    assert conv["converged"] and conv["certified_by"] == "optimizer"
+    assert conv["polish_sse_ratio"] == pytest.approx(1.0, abs=1e-6) and conv["polish_nfev"] > 0
+    assert all(np.isfinite(p.stderr) for p in good.parameters.values())
+    assert "+/- " in trajectory_text(good)
+
+
+def test_only_the_reported_stages_decide_a_trajectory_fits_convergence():
+    """A search that only started a later search of all its parameters (the regression before
+    the filtered route, the simulation before a refinement, every stage before ``joint``'s) is
+    recorded, not polished; the stages whose estimates are reported decide."""
+    from types import SimpleNamespace
+
+    from fricid.identify.dynamic._outcome import _deciding
+    from fricid.identify.dynamic.trajectory import _STATIC_OF_LUGRE
+    from fricid.models import lugre
+
+    regression = SimpleNamespace(names=[*Stribeck().param_names, "inertia", "p_x", "p_y"])
+    simulation = SimpleNamespace(names=["sigma_0", "sigma_1"])
+    every = SimpleNamespace(names=[*lugre.PARAM_NAMES, "inertia", "p_x", "p_y"])
+    two_stage = [
+        ("regression", regression),
+        ("simulation", simulation),
+        ("refinement_1", regression),
+        ("simulation after refinement_1", simulation),
+    ]
+    assert _deciding(two_stage, _STATIC_OF_LUGRE) == [False, False, True, True]
+    joint = [*two_stage, ("simulation_joint", every)]
+    assert _deciding(joint, _STATIC_OF_LUGRE) == [False] * 4 + [True]
+    filtered = [("regression", regression), ("filtered", every)]
+    assert _deciding(filtered, _STATIC_OF_LUGRE) == [False, True]
+    assert _deciding(filtered, {}) == [True, True]  # without the renaming tau_v is not covered
+    assert _deciding([("regression", regression)], {}) == [True]
 
 
 def test_single_sine_cannot_separate_inertia_from_gravity():
@@ -359,6 +434,9 @@ def test_filtered_route_is_consistent_on_a_noise_free_log():
     info = fitted.provenance["trajectory"]
     assert info["route"] == "filtered" and set(info["routes"]) == {"regression", "filtered"}
     assert info["parallel_filter"]["cutoff"] == 20.0 and fitted.converged
+    stages = fitted.convergence["stages"]  # the regression only started the filtered route
+    assert [b["stage"] for b in stages] == ["regression", "filtered"]
+    assert stages[0]["superseded"] and stages[1]["certified_by"] == "optimizer"
     assert info["parallel_filter"]["decimate"] == 10  # 1 kHz to 100 Hz: five times 20 Hz
     truth = TRUTH.params()
     for n in ("sigma_2", "tau_c", "tau_s", "w_s", "delta"):

@@ -210,3 +210,26 @@ def test_cli_lists_and_fits_with_varpro(tmp_path):
     res = runner.invoke(app, ["fit", str(path), "--method", "varpro", "--out", str(out)])
     assert res.exit_code == 0, res.output
     assert out.exists() and "varpro" in res.output
+
+
+def test_projected_problem_follows_the_problem_protocol(study):
+    """varpro's inner problem (the nonlinear parameters, the linear ones solved) is a problem
+    of the protocol: its loss at varpro's nu is the full problem's at varpro's result, and
+    certification applies to it as to any fit."""
+    from fricid.identify.problem import IdentificationProblem, Problem
+    from fricid.identify.static.convergence import certify
+    from fricid.identify.static.varpro import _blocks, _Projection, linear_split, varpro
+
+    samples, kw, f_opt = study
+    problem = IdentificationProblem(get_model("stribeck"), samples, **kw)
+    lin, nl = linear_split(problem)
+    proj = _Projection(problem, _blocks(problem, lin, nl)[0], problem.start())
+    assert isinstance(proj, Problem)
+    assert proj.free_names == ["w_s"] and proj.n_free == 1 and proj.n_obs == samples.y.size
+    res = varpro(problem)
+    nu = res.x[nl][None]
+    assert proj.evaluate(nu)[0] == pytest.approx(res.fun, rel=1e-12)
+    np.testing.assert_allclose(proj.expand(nu)[0], res.x, rtol=1e-12, atol=1e-15)
+    inner = {**res, "x": res.x[nl], "fun": float(proj.evaluate(nu)[0])}
+    assert certify(proj, type(res)(inner))["converged"]
+    assert res.fun <= f_opt * (1 + EXACT)

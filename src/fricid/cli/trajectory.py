@@ -9,6 +9,7 @@ identified by :func:`fricid.identify.dynamic.trajectory.fit_trajectory`.
 from __future__ import annotations
 
 import json
+import math
 import warnings
 from pathlib import Path
 
@@ -52,11 +53,10 @@ def trajectory_text(fitted) -> str:
             f"    parallel filter (both sides): Butterworth {pf['cutoff']:g} Hz, order "
             f"{pf['order']}, zero phase, decimated by {pf['decimate']}"
         )
+    conv = fitted.convergence or {}
+    why = "the fit did not converge" if conv and not conv.get("converged") else "not determined"
     for name, row in info.get("joint", {}).items():
-        lines.append(
-            f"    {name}: {row['value']:.6g} +/- {row['stderr']:.2g} "
-            f"(95 % CI [{row['ci95_low']:.5g}, {row['ci95_high']:.5g}])"
-        )
+        lines.append(f"    {name}: {row['value']:.6g} {_interval(row, why)}")
     for name, route in info.get("routes", {}).items():
         rms = ", ".join(f"{k} {v:.3g}" for k, v in route.get("rms", {}).items())
         lines.append(
@@ -83,6 +83,15 @@ def trajectory_text(fitted) -> str:
             f"{'passive' if p['passive_across_ci95'] else 'not guaranteed'}); {p['condition']}"
         )
     return "\n".join(lines)
+
+
+def _interval(row: dict, why: str) -> str:
+    """``+/- se (95 % CI [low, high])``, or ``why`` there is none (the model file stores
+    null)."""
+    se, low, high = (row.get(k) for k in ("stderr", "ci95_low", "ci95_high"))
+    if any(v is None or not math.isfinite(v) for v in (se, low, high)):
+        return f"(no interval: {why})"
+    return f"+/- {se:.2g} (95 % CI [{low:.5g}, {high:.5g}])"
 
 
 def _margin(value) -> str:

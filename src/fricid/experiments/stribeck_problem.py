@@ -3,9 +3,10 @@
 [R] B. Kou et al., "A New Parameter Identification Method for Industrial Robots with
 Friction", Machines 10(5) 349, 2022: the Stribeck model (eq. 7, delta = 1) fitted to 17
 friction samples by minimising the SSE (eq. 11). :func:`paper2_samples` simulates them on the
-``paper2`` preset, :class:`StribeckProblem` holds the objective (:func:`sse_objective` builds
-the callable the optimisers get, with its compiled twin) and :func:`global_optimum` finds the
-exact optimum by variable projection.
+``paper2`` preset, :class:`StribeckProblem` holds the objective (an
+:class:`~fricid.identify.problem.IdentificationProblem`; :func:`sse_objective` hands the
+optimisers its callable, with the compiled twin every analytic fit uses) and
+:func:`global_optimum` finds the exact optimum by variable projection.
 
 The search box (:data:`BOUNDS`) is ours ([R] does not give one): tau_c and tau_s in
 [0, 2] N m, w_s in [0.001, 1] rad/s, tau_v in [0, 0.1] N m s/rad. The beetle methods step in
@@ -24,11 +25,6 @@ from ..identify.problem import IdentificationProblem
 from ..models import Stribeck
 from ..optim import JitObjective
 from ..samples import FrictionSamples
-
-try:  # the compiled twin of the objective (optional: the numpy path is always there)
-    from .._jit import njit
-except ImportError:  # pragma: no cover - numba is a dependency
-    njit = None
 
 __all__ = [
     "BOUNDS",
@@ -59,27 +55,6 @@ def paper2_samples(seed: int = 0, size: str = "full") -> tuple[np.ndarray, np.nd
     result = extract(simulate(preset("paper2", size), seed=seed), gravity="none")
     s = result.samples
     return np.asarray(s.X[:, 0], dtype=float), np.asarray(s.y, dtype=float)
-
-
-if njit is not None:
-
-    @njit(cache=True)
-    def _sse_kernel(X, out, data):  # pragma: no cover - compiled
-        """SSE of the Stribeck model (delta = 1) for each row (tau_c, tau_s, w_s, tau_v)."""
-        v, y = data
-        for k in range(X.shape[0]):
-            tc, ts, ws, tv = X[k, 0], X[k, 1], X[k, 2], X[k, 3]
-            ws = max(abs(ws), 1e-12)
-            s = 0.0
-            for i in range(v.shape[0]):
-                a = abs(v[i])
-                sg = 0.0 if v[i] == 0.0 else (1.0 if v[i] > 0.0 else -1.0)
-                r = sg * (tc + (ts - tc) * np.exp(-a / ws)) + tv * v[i] - y[i]
-                s += r * r
-            out[k] = s
-
-else:  # pragma: no cover
-    _sse_kernel = None
 
 
 @dataclass
@@ -178,10 +153,12 @@ def sse_objective(problem: StribeckProblem, *, jit: bool = True):
     problem : StribeckProblem
         The data and box.
     jit : bool
-        With numba available, a :class:`~fricid.optim.JitObjective` whose every call runs the
-        compiled kernel (so every method evaluates candidates with the same compiled code;
-        RWSAVSBAS can also run its whole inner loop compiled on the same kernel); otherwise,
-        or with ``jit=False``, the batched numpy :meth:`StribeckProblem.sse`.
+        With numba available, the :class:`~fricid.optim.JitObjective` of the problem's
+        :meth:`~fricid.identify.problem.IdentificationProblem.objective`: every call runs the
+        compiled loss kernel of fricid's analytic models
+        (:func:`fricid.models._kernels.loss_kernel`), so every method evaluates candidates
+        with the same compiled code, and RWSAVSBAS can also run its whole inner loop compiled
+        on it; otherwise, or with ``jit=False``, the batched numpy :meth:`StribeckProblem.sse`.
 
     Returns
     -------
@@ -190,18 +167,12 @@ def sse_objective(problem: StribeckProblem, *, jit: bool = True):
 
     Notes
     -----
-    The one place the study builds its objective: the numpy path is the
-    :class:`~fricid.identify.problem.IdentificationProblem`'s; the compiled kernel computes
-    the same SSE (a test checks they agree).
+    The study writes no objective of its own: both paths are the
+    :class:`~fricid.identify.problem.IdentificationProblem`'s (the compiled kernel computes
+    the numpy path's SSE; a test holds them together).
     """
-    if jit and _sse_kernel is not None:
-        data = (problem.velocity, problem.friction)
-
-        def compiled(X: np.ndarray) -> np.ndarray:
-            X = np.ascontiguousarray(np.atleast_2d(X), dtype=float)
-            out = np.empty(X.shape[0])
-            _sse_kernel(X, out, data)
-            return out
-
-        return JitObjective(compiled, _sse_kernel, data)
+    if jit:
+        fun = problem.identification.objective()
+        if isinstance(fun, JitObjective):
+            return fun
     return problem.sse

@@ -16,7 +16,8 @@ figure and files are :mod:`fricid.report.studies.stribeck`'s (``fricid bench str
 box, exact optimum) is :mod:`.stribeck_problem`, the rows (methods, budgets) :mod:`.stribeck_specs`.
 
 Fairness. Every timed method evaluates candidates with the same objective code, the compiled
-numba kernel of :func:`.stribeck_problem.sse_objective` (numpy only without numba): every
+numba kernel of fricid's analytic fits, :func:`fricid.models._kernels.loss_kernel`, through
+:func:`.stribeck_problem.sse_objective` (numpy only without numba): every
 method here takes batches (or single points, which the kernel serves as batches of one), so
 the kernel is the objective all of them can take, and the fastest; timing some on numpy and
 one on the kernel measured the objective, not the algorithm. RWSAVSBAS's table row runs its
@@ -38,7 +39,7 @@ import numpy as np
 import pandas as pd
 
 from ..errors import ConfigError
-from ..optim import OptimizeResult, minimize, minimize_runs
+from ..optim import JitObjective, OptimizeResult, minimize, minimize_runs
 from .paper_numbers import RWSAVSBAS as PAPER_NUMBERS
 from .stribeck_problem import (
     BOUNDS,
@@ -229,14 +230,15 @@ def _run(
     theta_opt, f_opt = global_optimum(problem)
     fast = sse_objective(problem, jit=True)
     plain = sse_objective(problem, jit=False)
-    objective_code = "compiled kernel" if fast is not plain else "numpy"
+    compiled = isinstance(fast, JitObjective)
+    objective_code = "compiled kernel" if compiled else "numpy"
     bounds = problem.bounds
     results: dict[str, list[OptimizeResult]] = {}
     rows = []
     perf: dict[str, float] = {}
 
     # compile the kernel and RWSAVSBAS's compiled loop once, outside every timing
-    if fast is not plain:
+    if compiled:
         say("compiling the objective kernel and RWSAVSBAS's loop (numba)")
         t = time.perf_counter()
         fast(bounds[:, 0][None])
@@ -313,14 +315,14 @@ def _run(
             f"({rep + 1}/{repeats})"
         )
         times["batch_numpy"].append(_time_batches(plain, X, n_batches))
-        if fast is not plain:
+        if compiled:
             kernel_call(X[:10])
             times["batch_kernel"].append(_time_batches(kernel_call, X, n_batches))
             t = time.perf_counter()
             minimize_runs(fast, bounds, "rwsavsbas", seed=seed, runs=runs, options=rws_opts)
             times["rws_jit"].append(time.perf_counter() - t)
     perf["batch_numpy_seconds"] = min(times["batch_numpy"])
-    if fast is not plain:
+    if compiled:
         perf["rws_jit_seconds"] = min(times["rws_jit"])
         perf["ratio_loop_vs_jit"] = perf["rws_loop_seconds"] / perf["rws_jit_seconds"]
         perf["batch_kernel_seconds"] = min(times["batch_kernel"])
@@ -399,7 +401,7 @@ def _run(
         "data_seed": data_seed,
         "bounds": {n: tuple(map(float, b)) for n, b in zip(FREE, bounds, strict=True)},
         "success_rtol": SUCCESS_RTOL,
-        "jit": fast is not plain,
+        "jit": compiled,
     }
     return StudyResult(table, readings, hybrid, convergence, perf, optimum, claims, config, results)
 

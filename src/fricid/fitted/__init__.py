@@ -64,8 +64,8 @@ def _check_region(model, theta, field_name: str, name: str, source: str | None) 
     if bad is not None:
         param, value = bad
         raise DataError(
-            f"field '{field_name}/{param.name}/value': {value!r} lies outside model '{name}''s valid "
-            f"region ({param.rule}, the {param.description})",
+            f"field '{field_name}/{param.name}/value': {value!r} lies outside model "
+            f"'{name}''s valid region ({param.rule}, the {param.description})",
             file=source,
         )
 

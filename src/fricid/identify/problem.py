@@ -5,8 +5,16 @@ A problem knows the model, the data and the objective; it knows nothing of the o
 evaluates a whole batch of candidate parameter vectors ``T (k, p)`` at once (DESIGN.md,
 "Vectorised"): :meth:`IdentificationProblem.residuals` gives ``(k, n)`` weighted residuals and
 :meth:`IdentificationProblem.evaluate` the loss ``(k,)``, the one place where fricid's
-identification objective is written (``identify.fit``, the RBF trainer and, next, the studies
+identification objective is written (``identify.fit``, the RBF trainer and the papers' studies
 all use it).
+
+:class:`Problem` is the protocol every fit's problem follows, whatever the room: names, the
+search box, residuals and loss of a batch, sizes. :class:`IdentificationProblem` is one;
+:class:`ResidualProblem` makes one of any batch residual function (the trajectory routes'
+projected equation error, the variable projection's inner problem), so that convergence
+certification (:func:`fricid.identify.static.convergence.certify`) and the Jacobian's
+uncertainty (:func:`fricid.identify.static.uncertainty.jacobian`) apply to every fit the
+same way.
 
 Robust losses (``soft_l1``, ``huber``) for logs with spikes are written as a least-squares
 problem on transformed residuals, ``r' = sign(r) c sqrt(rho((r / c)^2))``, so that
@@ -23,8 +31,17 @@ import numpy as np
 
 from ..errors import ConfigError
 from ..samples import FrictionSamples
+from ._protocol import Problem, ResidualProblem
 
-__all__ = ["LOSSES", "ROBUST_LOSSES", "IdentificationProblem", "Predictor", "robust_residuals"]
+__all__ = [
+    "LOSSES",
+    "ROBUST_LOSSES",
+    "IdentificationProblem",
+    "Predictor",
+    "Problem",
+    "ResidualProblem",
+    "robust_residuals",
+]
 
 #: The losses: ``sse``, the sum of (weighted) squared errors (the RWSAVSBAS paper's fitness,
 #: eq. 11 there), also called ``l2``; ``mse``, that sum over the number of samples (the

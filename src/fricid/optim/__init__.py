@@ -7,8 +7,11 @@ Methods (``METHODS[name].summary`` has the one-line description):
 
 * beetle antennae search family: ``bas``, ``vsbas``, ``ibas``, ``rwsavsbas``;
 * ``ga``, a real-coded genetic algorithm;
-* baselines: ``lm`` (the default least-squares method: scipy's bounded trust-region
-  reflective solver with a batched Jacobian), ``trf`` (the same with scipy's own Jacobian),
+* local: ``lbfgsb`` (scipy's bounded quasi-Newton L-BFGS-B with a batched finite-difference
+  gradient: the default of :func:`minimize` without residuals), ``lm`` (the default
+  least-squares method, and of :func:`minimize` given residuals: scipy's bounded trust-region
+  reflective solver with a batched Jacobian);
+* baselines: ``trf`` (``lm`` with scipy's own Jacobian),
   ``lm_minpack`` (MINPACK in sin coordinates, legacy), ``de``, ``dual_annealing`` (scipy),
   ``cmaes`` (the ``cma`` package);
 * ``bas+lm``: a beetle global phase polished by ``lm``.
@@ -31,6 +34,7 @@ from . import (  # noqa: F401  (each registers its methods)
     _hybrid,
     _ibas,
     _least_squares,
+    _local,
     _rwsavsbas,
     _scipy_global,
     _vsbas,
@@ -56,6 +60,7 @@ _ORDER = (
     "rwsavsbas",
     "ga",
     "bas+lm",
+    "lbfgsb",
     "lm",
     "trf",
     "lm_minpack",

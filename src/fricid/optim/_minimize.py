@@ -26,7 +26,15 @@ from ._api import (
     check_bounds,
 )
 
-__all__ = ["minimize", "minimize_runs"]
+__all__ = ["DEFAULT_LSQ_METHOD", "DEFAULT_METHOD", "minimize", "minimize_runs"]
+
+#: The method of :func:`minimize` when none is named and no residuals are given: a cheap
+#: bounded local method (as scipy's ``minimize`` defaults to a local quasi-Newton one); the
+#: global methods (the beetle family, ``ga``, ``de``, ...) are one argument away.
+DEFAULT_METHOD = "lbfgsb"
+
+#: The method when none is named and ``residuals`` are given: bounded least squares.
+DEFAULT_LSQ_METHOD = "lm"
 
 
 def _check_seed_int(seed) -> int:
@@ -101,7 +109,7 @@ def _solve(solver: Solver, objective: Objective) -> tuple[int, int, str]:
 def minimize(
     fun: Callable[[np.ndarray], np.ndarray] | None,
     bounds,
-    method: str = "rwsavsbas",
+    method: str | None = None,
     *,
     seed: int | np.random.Generator | None = None,
     max_evals: int | None = None,
@@ -119,8 +127,12 @@ def minimize(
         is the sum of squared residuals).
     bounds : sequence of (float, float)
         ``(lower, upper)``, one pair per parameter.
-    method : str
-        A key of :data:`METHODS` (case-insensitive).
+    method : str, optional
+        A key of :data:`METHODS` (case-insensitive). Default: :data:`DEFAULT_LSQ_METHOD`
+        (``lm``, bounded least squares) when ``residuals`` are given, else
+        :data:`DEFAULT_METHOD` (``lbfgsb``, bounded quasi-Newton): cheap and local, from
+        ``x0`` or the box centre. Name a global method (``rwsavsbas``, ``bas``, ``ga``,
+        ``de``, ...) to search the whole box.
     seed : int or numpy.random.Generator, optional
         The same seed gives the same result bit for bit; None draws one (recorded in the
         result).
@@ -163,7 +175,7 @@ def minimize(
 def minimize_runs(
     fun: Callable[[np.ndarray], np.ndarray] | None,
     bounds,
-    method: str = "rwsavsbas",
+    method: str | None = None,
     *,
     runs: int,
     seed: int | np.random.Generator | None = None,
@@ -178,7 +190,9 @@ def minimize_runs(
     Parameters
     ----------
     fun, bounds, method, max_evals, options, x0, residuals
-        As for :func:`minimize` (``max_evals`` is the budget of each run).
+        As for :func:`minimize` (``max_evals`` is the budget of each run; the default
+        methods are local and deterministic, so their runs from one start agree: name a
+        global method for independent runs).
     runs : int
         Number of runs, at least 1.
     seed : int or numpy.random.Generator, optional
@@ -210,6 +224,8 @@ def _minimize(
 ) -> list[OptimizeResult]:
     """The one implementation behind :func:`minimize` (``runs`` None) and
     :func:`minimize_runs`; ``stacklevel`` points warnings at their caller."""
+    if method is None:
+        method = DEFAULT_LSQ_METHOD if residuals is not None else DEFAULT_METHOD
     key = str(method).strip().lower()
     if key not in METHODS:
         raise ConfigError(

@@ -52,6 +52,7 @@ import numpy as np
 
 from ...errors import ConfigError, DataError
 from ...models import lugre
+from ..problem import ResidualProblem
 from ..static.uncertainty import jacobian
 from ._data import Series, blocks, cluster_covariance
 from ._routes import JOINT_PARAMS, _run, _Stage, _t975
@@ -222,7 +223,8 @@ def filtered_route(
     box = np.array([LOG_BOX["sigma_0"], LOG_BOX["sigma_1"], *static_bounds], dtype=float)
     x0 = np.where(is_log, np.log10(np.maximum(start, 1e-300)), start)
     x0 = np.clip(x0, box[:, 0], box[:, 1])
-    result = _run(projected, box, method, x0, seed, max_evals, 1)
+    search = ResidualProblem(projected, box, lugre.PARAM_NAMES, y)
+    result = _run(search, method, x0, seed, max_evals, 1)
     u_hat = np.asarray(result.x, dtype=float)
     c = np.linalg.lstsq(Phi, y - friction(u_hat)[0], rcond=None)[0]
 
@@ -261,5 +263,6 @@ def filtered_route(
         g,
         rms,
         bounds,
+        search,
     )
     return stage, y, r0

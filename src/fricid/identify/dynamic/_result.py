@@ -1,5 +1,12 @@
 """The result of a trajectory identification as a model file: parameters with their
 intervals, the stages' records, the joint's inertia and gravity, and what was checked.
+
+Intervals are given only for a fit whose every stage is certified converged
+(:func:`._outcome.converged`), as for an analytic fit
+(:func:`fricid.identify.static.uncertainty.assess`): otherwise the standard errors and 95 %
+intervals are withheld (NaN, and the reason in each parameter record's ``note``), in the
+parameters, the
+joint's table and every route's, and a :class:`~fricid.errors.ConvergenceWarning` says why.
 """
 
 from __future__ import annotations
@@ -11,6 +18,7 @@ from typing import Any
 import numpy as np
 
 from ... import __version__
+from ...errors import ConvergenceWarning
 from ...fitted import FittedModel, OptimizerRecord, Parameter, is_not_determined
 from ...io.atomic import created_timestamp
 from ...metrics import fit_statistics, metrics
@@ -21,6 +29,21 @@ from ._outcome import PassivityWarning, converged, passivity
 from ._routes import JOINT_PARAMS
 
 __all__ = ["build_result"]
+
+#: The note of a parameter whose interval is withheld (as an analytic fit's).
+NO_INTERVAL = "no interval: the fit did not converge (see the convergence block)"
+
+#: The entries of a parameter's table that an unconverged fit does not give.
+_INTERVAL_KEYS = ("stderr", "ci95_low", "ci95_high")
+
+
+def _withheld(table: dict[str, dict[str, float]]) -> dict[str, dict[str, float]]:
+    """A parameter table without its standard errors and intervals (NaN)."""
+    nan = float("nan")
+    return {
+        n: {k: (nan if k in _INTERVAL_KEYS else v) for k, v in row.items()}
+        for n, row in table.items()
+    }
 
 
 def build_result(
@@ -34,16 +57,28 @@ def build_result(
     *,
     n_joint: int,
     stages: dict[str, Any],
-    results: list,
+    fits: list,
     final: dict[str, dict[str, float]],
     bounds_out: dict[str, list[float]],
     options: dict[str, Any],
     sim_info: dict[str, Any],
 ) -> FittedModel:
     """The :class:`~fricid.fitted.FittedModel` of a trajectory identification: the final
-    parameter table, the stages' convergence, the joint's J and gravity, LuGre's passivity
-    and the provenance (``provenance["trajectory"]``)."""
+    parameter table, the stages' convergence (``fits``: each search, named, in order), the
+    joint's J and gravity, LuGre's passivity and the provenance
+    (``provenance["trajectory"]``); no intervals unless converged (module notes)."""
     method, seed, max_evals = options["method"], options["seed"], options["max_evals"]
+    rename = options.get("rename", {})
+    convergence = converged(fits, method, max_evals, rename) if fits else None
+    ok = convergence is None or convergence["converged"]
+    if not ok:
+        warnings.warn(
+            f"identifying '{key}' from the trajectory did not converge: "
+            f"{convergence['reason']}; {convergence['advice']}; its intervals are withheld",
+            ConvergenceWarning,
+            stacklevel=3,
+        )
+        final = _withheld(final)
     static, derivative = options["static"], options["derivative"]
     v_slide, gravity, t_start = options["v_slide"], options["gravity"], options["t_start"]
     rate = 1.0 / series.dt
@@ -52,7 +87,6 @@ def build_result(
     values = np.array([final[n]["value"] for n in param_names])
     low = np.array([final[n]["ci95_low"] for n in param_names])
     high = np.array([final[n]["ci95_high"] for n in param_names])
-    convergence = converged(results, method) if results else None
     fitted = FittedModel(
         model=key,
         parameters=_records(
@@ -61,16 +95,20 @@ def build_result(
             get_model(key).units,
             bounds_out,
             None if convergence is None else convergence["converged"],
+            note="" if ok else NO_INTERVAL,
         ),
-        ci_method="cluster-robust"
-        + (", two-step" if key == "lugre" and route != "filtered" else ""),
+        ci_method=(
+            "cluster-robust" + (", two-step" if key == "lugre" and route != "filtered" else "")
+        )
+        if ok
+        else "",
         optimizer=OptimizerRecord(
             method=method,
             seed=seed,
-            status=int(results[-1].status) if results else None,
-            message=str(results[-1].message) if results else "",
-            nfev=int(sum(r.nfev for r in results)),
-            max_evals=_budget(results, max_evals),
+            status=int(fits[-1][1].result.status) if fits else None,
+            message=str(fits[-1][1].result.message) if fits else "",
+            nfev=int(sum(st.result.nfev for _, st in fits)),
+            max_evals=_budget(fits, max_evals),
         ),
         convergence=convergence,
         metrics={
@@ -97,6 +135,8 @@ def build_result(
         joint_tab.update(
             {n: r for n, r in stages["simulation_joint"].table().items() if n in JOINT_PARAMS}
         )
+    if not ok:
+        joint_tab = _withheld(joint_tab)
     info: dict[str, Any] = {
         "route": route,
         "static_from": "sweeps"
@@ -110,7 +150,7 @@ def build_result(
         "joint": joint_tab,
         "routes": {
             name: {
-                "parameters": st.table(),
+                "parameters": st.table() if ok else _withheld(st.table()),
                 "rms": st.rms,
                 "seconds": st.seconds,
                 "clusters": st.clusters,
@@ -142,12 +182,12 @@ def build_result(
     return fitted
 
 
-def _budget(results: list, max_evals: int | None) -> int | None:
-    """The evaluation budget: ``max_evals``, else the last stage's evaluations (None with no
-    optimiser stage)."""
-    if not results:
+def _budget(fits: list, max_evals: int | None) -> int | None:
+    """The evaluation budget: ``max_evals``, else the last search's evaluations (None with no
+    search)."""
+    if not fits:
         return None
-    return int(max_evals) if max_evals is not None else int(results[-1].nfev)
+    return int(max_evals) if max_evals is not None else int(fits[-1][1].result.nfev)
 
 
 def _records(
@@ -156,10 +196,12 @@ def _records(
     units: dict[str, str],
     bounds: dict[str, list[float]],
     converged: bool | None,
+    note: str = "",
 ) -> dict[str, Parameter]:
     """One :class:`~fricid.fitted.Parameter` per name of the final table: value, standard
     error, the cluster-robust 95 % interval (its ends open where they reach the search box),
-    and at a bound where the value is within ``1e-6`` relative of one."""
+    and at a bound where the value is within ``1e-6`` relative of one; ``note`` says why an
+    interval is missing (an unconverged fit's: no end is then open)."""
     out = {}
     for n in names:
         row, box = final[n], bounds.get(n)
@@ -173,13 +215,14 @@ def _records(
             stderr=se,
             ci95=(low, high),
             ci95_halfwidth=(high - low) / 2,
-            low_open=box is not None and bool(low <= box[0]),
-            high_open=box is not None and bool(high >= box[1]),
+            low_open=box is not None and not note and bool(low <= box[0]),
+            high_open=box is not None and not note and bool(high >= box[1]),
             at_bound=box is not None
             and bool(
                 np.isclose(value, box[0], rtol=1e-6, atol=0)
                 or np.isclose(value, box[1], rtol=1e-6, atol=0)
             ),
-            not_determined=is_not_determined("", se, converged),
+            note=note,
+            not_determined=is_not_determined(note, se, converged),
         )
     return out

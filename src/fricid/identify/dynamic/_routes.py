@@ -1,6 +1,13 @@
 """The two routes of :mod:`fricid.identify.dynamic.trajectory`: inverse-dynamics regression and
 simulation error (see that module's notes), each returning a :class:`_Stage` (estimate,
-cluster-robust covariance, 95 % intervals, the optimiser's result, timing)."""
+cluster-robust covariance, 95 % intervals, the optimiser's result, the problem it minimised,
+timing).
+
+Every stage's search is a problem of the problem protocol
+(:class:`fricid.identify.problem.Problem`): a :class:`~fricid.identify.problem.ResidualProblem`
+of the projected equation error, or :class:`_SimProblem` of the simulation error, so that its
+convergence is certified as an analytic fit's is (:func:`._outcome.converged`).
+"""
 
 from __future__ import annotations
 
@@ -13,6 +20,7 @@ import numpy as np
 from ...errors import ConfigError, DataError
 from ...models import lugre
 from ...optim import METHODS, minimize
+from ..problem import Problem, ResidualProblem
 from ..static.uncertainty import jacobian
 from ._data import Series, blocks, cluster_covariance, low_speed_windows
 
@@ -36,7 +44,8 @@ _JOINT_UNITS = {"inertia": "kg m^2", "p_x": "N m", "p_y": "N m"}
 
 @dataclass
 class _Stage:
-    """One route's estimate: names, values, standard errors, 95 % intervals, bookkeeping."""
+    """One route's estimate: names, values, standard errors, 95 % intervals, bookkeeping;
+    ``problem`` is what the optimiser minimised (None when nothing was searched)."""
 
     names: list[str]
     values: np.ndarray
@@ -49,6 +58,7 @@ class _Stage:
     clusters: int
     rms: dict[str, float]
     bounds: np.ndarray
+    problem: Problem | None = None
 
     def table(self) -> dict[str, dict[str, float]]:
         return {
@@ -70,17 +80,13 @@ def _t975(dof: int) -> float:
     return float(t.ppf(0.975, max(dof, 1)))
 
 
-def _run(fun_res, bounds, method, x0, seed, max_evals, starts=None):
-    """``minimize`` with residuals for the least-squares methods (``starts`` of them, default
-    :data:`LSQ_STARTS`), their SSE for the others."""
+def _run(problem: Problem, method, x0, seed, max_evals, starts=None):
+    """``minimize`` of ``problem`` over its box: with its residuals for the least-squares
+    methods (``starts`` of them, default :data:`LSQ_STARTS`), its loss for the others."""
     key = method.strip().lower()
     if key not in METHODS:
         raise ConfigError(f"unknown method '{method}'; choose one of: {', '.join(METHODS)}")
-
-    def sse(U):
-        r = fun_res(U)
-        return np.einsum("ij,ij->i", r, r)
-
+    bounds = problem.bounds
     if METHODS[key].uses_residuals:
         n = LSQ_STARTS if starts is None else starts
         options = {"n_starts": n} if "n_starts" in METHODS[key].options else None
@@ -91,10 +97,10 @@ def _run(fun_res, bounds, method, x0, seed, max_evals, starts=None):
             seed=seed,
             max_evals=max_evals,
             x0=x0,
-            residuals=fun_res,
+            residuals=problem.residuals,
             options=options,
         )
-    return minimize(sse, bounds, key, seed=seed, max_evals=max_evals, x0=x0)
+    return minimize(problem.objective(), bounds, key, seed=seed, max_evals=max_evals, x0=x0)
 
 
 def _regression(series, vf, acc, mask, model, gravity, method, seed, max_evals, cluster_n, fixed):
@@ -116,9 +122,10 @@ def _regression(series, vf, acc, mask, model, gravity, method, seed, max_evals, 
         R = y[None, :] - model.predict(np.atleast_2d(P), X)
         return R - (R @ Qphi) @ Qphi.T
 
-    result = None
+    result, search = None, None
     if fixed is None:
-        result = _run(projected, bounds, method, x0, seed, max_evals)
+        search = ResidualProblem(projected, bounds, model.param_names, y)
+        result = _run(search, method, x0, seed, max_evals)
         theta = np.asarray(result.x, dtype=float)
     else:
         theta = np.asarray(fixed, dtype=float)
@@ -148,7 +155,8 @@ def _regression(series, vf, acc, mask, model, gravity, method, seed, max_evals, 
     low = np.maximum(p_hat - tq * se, box[:, 0])
     high = np.minimum(p_hat + tq * se, box[:, 1])
     rms = {"torque": float(np.sqrt(np.mean(r0**2)))}
-    stage = _Stage(names, p_hat, se, low, high, cov, result, time.perf_counter() - t0, g, rms, box)
+    seconds = time.perf_counter() - t0
+    stage = _Stage(names, p_hat, se, low, high, cov, result, seconds, g, rms, box, search)
     return stage, theta, c, r0
 
 
@@ -206,19 +214,39 @@ _LOG = ("sigma_0", "sigma_1")
 
 
 class _SimProblem:
-    """Simulation-error residuals over the windows, for a chosen set of free parameters.
+    """Simulation-error residuals over the windows, for a chosen set of free parameters: a
+    problem of the problem protocol (:class:`fricid.identify.problem.Problem`).
 
-    The full vector is LuGre's seven parameters then J, p_x, p_y; the optimiser moves
-    ``free`` of them (sigma_0, sigma_1 as log10).
+    The full vector (``names``) is LuGre's seven parameters then J, p_x, p_y; the optimiser
+    moves ``free_names`` of them (at positions ``free``; sigma_0, sigma_1 as log10) inside
+    ``bounds`` (in those coordinates, :func:`_sim_bounds`).
     """
 
-    def __init__(self, w: _Windows, base: np.ndarray, free: list[str], n_sub: int) -> None:
-        self.w, self.base, self.free, self.n_sub = w, base, free, n_sub
-        self.all_names = list(lugre.PARAM_NAMES) + list(JOINT_PARAMS)
-        self.pos = [self.all_names.index(n) for n in free]
-        self.log = np.array([n in _LOG for n in free])
+    def __init__(
+        self, w: _Windows, base: np.ndarray, free_names: list[str], n_sub: int, bounds
+    ) -> None:
+        self.w, self.base, self.n_sub = w, base, n_sub
+        self.names = (*lugre.PARAM_NAMES, *JOINT_PARAMS)
+        self.free_names = list(free_names)
+        self.free = [self.names.index(n) for n in free_names]
+        self.bounds = np.asarray(bounds, dtype=float)
+        self.log = np.array([n in _LOG for n in free_names])
         self.keep = ~w.reset
         self.scale = np.ones(2)
+
+    @property
+    def n_free(self) -> int:
+        return len(self.free)
+
+    @property
+    def n_obs(self) -> int:
+        return 2 * int(self.keep.sum())
+
+    @property
+    def y(self) -> np.ndarray:
+        """The measured positions and velocities, scaled as the residuals are."""
+        k = self.keep
+        return np.concatenate([self.w.q[k] / self.scale[0], self.w.v[k] / self.scale[1]])
 
     def to_u(self, values: np.ndarray) -> np.ndarray:
         return np.where(self.log, np.log10(np.maximum(values, 1e-300)), values)
@@ -229,8 +257,12 @@ class _SimProblem:
     def full(self, U, at=None) -> np.ndarray:
         U = np.atleast_2d(U)
         P = np.tile(self.base if at is None else at, (len(U), 1))
-        P[:, self.pos] = self.to_values(U)
+        P[:, self.free] = self.to_values(U)
         return P
+
+    def expand(self, U) -> np.ndarray:
+        """Every parameter ``(k, 10)``, natural units, of candidates ``U (k, p)``."""
+        return self.full(U)
 
     def simulate(self, P: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         w = self.w
@@ -261,6 +293,14 @@ class _SimProblem:
     def residuals(self, U) -> np.ndarray:
         return self.residuals_full(self.full(U))
 
+    def evaluate(self, U) -> np.ndarray:
+        """The sum of squared (scaled) residuals of each candidate."""
+        r = self.residuals(U)
+        return np.einsum("ij,ij->i", r, r)
+
+    def objective(self):
+        return self.evaluate
+
     def set_scale(self, P: np.ndarray) -> None:
         Q, V = self.simulate(np.atleast_2d(P))
         k = self.keep
@@ -273,20 +313,22 @@ class _SimProblem:
         return np.concatenate([lab, lab])
 
 
-def _simulation(problem: _SimProblem, bounds_u, x0_u, method, seed, max_evals, first=None):
-    """The simulation-error route over ``problem.free``; ``first`` = (stage, names in the
-    full vector) carries the first stage's covariance into this one (Murphy-Topel)."""
+def _simulation(problem: _SimProblem, x0_u, method, seed, max_evals, first=None):
+    """The simulation-error route over ``problem.free_names`` in ``problem.bounds``; ``first``
+    = (stage, names in the full vector) carries the first stage's covariance into this one
+    (Murphy-Topel)."""
     t0 = time.perf_counter()
-    result = _run(problem.residuals, bounds_u, method, x0_u, seed, max_evals, SIM_STARTS)
+    bounds_u = problem.bounds
+    result = _run(problem, method, x0_u, seed, max_evals, SIM_STARTS)
     u_hat = np.asarray(result.x, dtype=float)
     Jm, r0 = jacobian(problem.residuals, u_hat)
     cov, se, g = cluster_covariance(Jm, r0, problem.labels())
     if first is not None:
         stage, held = first
         P_hat = problem.full(u_hat)[0]
-        sel = [i for i, n in enumerate(held) if n is not None and n not in problem.free]
+        sel = [i for i, n in enumerate(held) if n is not None and n not in problem.free_names]
         if sel:
-            cols = [problem.all_names.index(held[i]) for i in sel]
+            cols = [problem.names.index(held[i]) for i in sel]
 
             def shifted(S):
                 S = np.atleast_2d(S)
@@ -310,7 +352,7 @@ def _simulation(problem: _SimProblem, bounds_u, x0_u, method, seed, max_evals, f
         )
     )
     return _Stage(
-        list(problem.free),
+        list(problem.free_names),
         values,
         stderr,
         problem.to_values(lo_u),
@@ -321,6 +363,7 @@ def _simulation(problem: _SimProblem, bounds_u, x0_u, method, seed, max_evals, f
         g,
         {k: float(v) for k, v in rms.items()},
         np.column_stack([problem.to_values(bounds_u[:, 0]), problem.to_values(bounds_u[:, 1])]),
+        problem,
     )
 
 
@@ -377,7 +420,8 @@ def _refine_static(
 
     bounds = stage1.bounds[:d]
     x0 = np.clip(stage1.values[:d], bounds[:, 0], bounds[:, 1])
-    result = _run(projected, bounds, method, x0, seed, max_evals, 1)
+    search = ResidualProblem(projected, bounds, stage1.names[:d], y)
+    result = _run(search, method, x0, seed, max_evals, 1)
     theta = np.asarray(result.x, dtype=float)
     c = np.linalg.lstsq(Phi, y - friction(theta)[0], rcond=None)[0]
 
@@ -402,17 +446,21 @@ def _refine_static(
     high = np.minimum(p_hat + tq * se, box[:, 1])
     names = list(stage1.names[:d]) + list(JOINT_PARAMS[:nd])
     rms = {"torque": float(np.sqrt(np.mean(r0**2)))}
-    return _Stage(names, p_hat, se, low, high, cov, result, time.perf_counter() - t0, g, rms, box)
+    seconds = time.perf_counter() - t0
+    return _Stage(names, p_hat, se, low, high, cov, result, seconds, g, rms, box, search)
 
 
-def _sim_bounds(problem: _SimProblem, stage1: _Stage, names_full: dict[str, str]) -> np.ndarray:
-    """Search box of the simulation route, in its coordinates (log10 for sigma_0, sigma_1)."""
+def _sim_bounds(
+    free_names: list[str], w: _Windows, stage1: _Stage, names_full: dict[str, str]
+) -> np.ndarray:
+    """Search box of the simulation route over ``free_names`` on the windows ``w``, in its
+    coordinates (log10 for sigma_0, sigma_1)."""
     out = []
     by_name = {
         names_full.get(n, n): (v, b)
         for n, v, b in zip(stage1.names, stage1.values, stage1.bounds, strict=True)
     }
-    for n in problem.free:
+    for n in free_names:
         if n == "sigma_0":
             out.append((2.0, 7.0))
         elif n == "sigma_1":
@@ -422,7 +470,7 @@ def _sim_bounds(problem: _SimProblem, stage1: _Stage, names_full: dict[str, str]
             out.append((0.2 * v, 5.0 * v))
         elif n in ("p_x", "p_y"):
             v = by_name[n][0]
-            half = max(0.5 * abs(v), 0.05 * float(np.max(np.abs(problem.w.tau))))
+            half = max(0.5 * abs(v), 0.05 * float(np.max(np.abs(w.tau))))
             out.append((v - half, v + half))
         else:
             out.append(tuple(by_name[n][1]))

@@ -42,15 +42,16 @@ def simulation_route(
     :mod:`.trajectory`), refined :data:`REFINE` times; ``joint`` then every parameter at once.
 
     ``fit`` holds the state of :func:`.trajectory.fit_trajectory` (the regression's stage,
-    its tables, the options); its ``stages``, ``results``, ``final`` and ``bounds_out`` are
-    updated in place. Returns the provenance's simulation record and the static table.
+    its tables, the options); its ``stages``, ``fits`` (each search, named, in order),
+    ``final`` and ``bounds_out`` are updated in place. Returns the provenance's simulation
+    record and the static table.
     """
     rate = 1.0 / series.dt
     stage1, static, rename = fit["stage1"], fit["static"], fit["rename"]
     static_tab, joint_vals = fit["static_tab"], fit["joint_vals"]
-    stages, results, final, bounds_out = (
+    stages, fits, final, bounds_out = (
         fit["stages"],
-        fit["results"],
+        fit["fits"],
         fit["final"],
         fit["bounds_out"],
     )
@@ -78,14 +79,13 @@ def simulation_route(
         int(WINDOW_AFTER * rate),
         max(int(SEGMENT * rate), 4),
     )
-    problem = _SimProblem(w, base, ["sigma_0", "sigma_1"], n_sub)
+    dynamic = ["sigma_0", "sigma_1"]
+    b2 = _sim_bounds(dynamic, w, stage1, rename)
+    problem = _SimProblem(w, base, dynamic, n_sub, b2)
     held = [rename.get(n, n) for n in stage1.names] if static is None else list(stage1.names)
-    b2 = _sim_bounds(problem, stage1, rename)
     problem.set_scale(problem.full(b2.mean(axis=1)))
-    stage2 = _simulation(
-        problem, b2, b2.mean(axis=1), method, seed, max_evals, first=(stage1, held)
-    )
-    results.append(stage2.result)
+    stage2 = _simulation(problem, b2.mean(axis=1), method, seed, max_evals, first=(stage1, held))
+    fits.append(("simulation", stage2))
     for k in range(REFINE if static is None else 0):
         # the static part again with LuGre's friction along the motion, then sigma_0,
         # sigma_1 again from there (module notes: "Refinement")
@@ -103,7 +103,7 @@ def simulation_route(
             cluster_n,
         )
         stages[f"refinement_{k + 1}"] = ref
-        results.append(ref.result)
+        fits.append((f"refinement_{k + 1}", ref))
         static_tab = {rename.get(n, n): row for n, row in ref.table().items()}
         final.update(static_tab)
         joint_vals.update({n: static_tab[n]["value"] for n in JOINT_PARAMS if n in static_tab})
@@ -115,14 +115,13 @@ def simulation_route(
         held = [rename.get(n, n) for n in ref.names]
         stage2 = _simulation(
             problem,
-            b2,
             problem.to_u(stage2.values),
             method,
             seed,
             max_evals,
             first=(ref, held),
         )
-        results.append(stage2.result)
+        fits.append((f"simulation after refinement_{k + 1}", stage2))
     stages["simulation"] = stage2
     for n, row in stage2.table().items():
         final[n] = row
@@ -130,26 +129,26 @@ def simulation_route(
     if route == "joint":
         base = problem.full(problem.to_u(stage2.values))[0]
         names = list(lugre.PARAM_NAMES) + list(JOINT_PARAMS[: 1 if gravity == "none" else 3])
-        problem3 = _SimProblem(w, base, names, n_sub)
-        problem3.scale = problem.scale
         tab = {**static_tab, **{n: {"value": v} for n, v in joint_vals.items()}}
         b3 = []
         for n in names:
-            if n in ("sigma_0", "sigma_1"):
-                b3.append(b2[["sigma_0", "sigma_1"].index(n)])
+            if n in dynamic:
+                b3.append(b2[dynamic.index(n)])
             elif n in bounds_out:
                 b3.append(bounds_out[n])
             else:
-                b3.append(_sim_bounds(problem3, stage1, rename)[names.index(n)])
+                b3.append(_sim_bounds(names, w, stage1, rename)[names.index(n)])
         b3 = np.array(b3, dtype=float)
+        problem3 = _SimProblem(w, base, names, n_sub, b3)
+        problem3.scale = problem.scale
         x3 = np.clip(
-            problem3.to_u(base[[problem3.all_names.index(n) for n in names]]),
+            problem3.to_u(base[[problem3.names.index(n) for n in names]]),
             b3[:, 0],
             b3[:, 1],
         )
-        stage3 = _simulation(problem3, b3, x3, method, seed, max_evals)
+        stage3 = _simulation(problem3, x3, method, seed, max_evals)
         stages["simulation_joint"] = stage3
-        results.append(stage3.result)
+        fits.append(("simulation_joint", stage3))
         del tab
         for n, row in stage3.table().items():
             final[n] = row

@@ -12,7 +12,8 @@ implementations alternated in one process, a one-off script, 2026-11-23) and giv
 models on their tuning and reporting seeds (``benchmarks/bench_learned_tuning.py``,
 ``benchmarks/bench_floor.py``).
 
-Lloyd's iterations stay scikit-learn's. A compiled copy of them (tried, not kept) resolved the
+Lloyd's iterations stay scikit-learn's (its public ``KMeans`` started from these seeds). A
+compiled copy of them (tried, not kept) resolved the
 exact ties of lattice data (a design grid's points equidistant from two centres) otherwise than
 scikit-learn's BLAS rounding does, and over the tuning seeds 0-49 of issue 15's grid kind the
 networks were worse with it (hybrid 1.134 against 1.110 x the noise, rbf 1.245 against 1.196;

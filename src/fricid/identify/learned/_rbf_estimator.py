@@ -8,21 +8,21 @@ from __future__ import annotations
 
 import math
 import warnings
-from numbers import Integral, Real
-from typing import Any, ClassVar
+from typing import Any
 
 import numpy as np
+from sklearn import config_context
 from sklearn.base import BaseEstimator, RegressorMixin
 from sklearn.cluster import KMeans
 from sklearn.exceptions import ConvergenceWarning as SklearnConvergenceWarning
 from sklearn.utils import check_random_state
-from sklearn.utils._param_validation import Interval, InvalidParameterError, StrOptions
 from sklearn.utils.validation import check_is_fitted, validate_data
 
 from ...errors import ConfigError, DataError, IgnoredArgumentWarning
 from ...models import _rbf_core as core
 from ...models.rbf import mse_z, predict_z, tail_columns
 from ...optim import METHODS
+from ._rbf_params import check_params
 from ._rbf_search import search_network
 
 __all__ = ["LSQ_IGNORES", "TRAINERS", "RBFNetRegressor"]
@@ -87,45 +87,39 @@ def _uniforms(seed: int, k: int) -> np.ndarray:
     return u[:k]
 
 
+#: The random state handed to ``KMeans`` started from given seeds: its ``fit`` makes a
+#: ``RandomState`` of whatever it is given (0.4 ms from an int), and Lloyd's iterations from
+#: given seeds draw nothing from it, so one instance serves every call (a test checks that it
+#: is never drawn from).
+_LLOYD_RANDOM_STATE = np.random.RandomState(0)
+
+
 def kmeans_centres(Z: np.ndarray, m: int, seed: int) -> np.ndarray:
-    """The centres of ``KMeans(n_clusters=m, n_init=1, random_state=seed).fit(Z)``: the data
-    centred and the tolerance set as ``KMeans.fit`` does, its k-means++ seeds from its random
-    stream (:func:`_kmeans_plusplus`, compiled: its sums round differently from scikit-learn's
-    BLAS calls, so where two candidate seeds tie within rounding it may take the other one, on
-    1 of 30 random problems without duplicate points, ``tests/test_hybrid_speed.py``), then
-    scikit-learn's own Lloyd iterations from them; scikit-learn's
-    ``KMeans`` itself when its private Lloyd routine is not there (another version) or ``m``
-    is not between 1 and the number of points (its error message).
+    """The centres of ``KMeans(n_clusters=m, n_init=1, random_state=seed).fit(Z)``: its
+    k-means++ seeds drawn from its random stream and computed on the data centred as
+    ``KMeans.fit`` centres it (:func:`_kmeans_plusplus`, compiled: its sums round differently
+    from scikit-learn's BLAS calls, so where two candidate seeds tie within rounding it may
+    take the other one, on 1 of 30 random problems without duplicate points,
+    ``tests/test_hybrid_speed.py``), then scikit-learn's own Lloyd iterations from them,
+    through its public API (``KMeans(init=seeds, n_init=1, algorithm="lloyd")``, which
+    centres, sets the tolerance and iterates as the default fit does; its input and parameter
+    checks skipped by scikit-learn's public ``config_context``: the network's ``fit`` has
+    checked the data); ``KMeans`` itself when ``m`` is not between 1 and the number of points
+    (its error message).
 
     Duplicate points can leave fewer distinct clusters than centres: scikit-learn's
     convergence warning is silenced (the width floor and the ridge penalty cope, the user
     learns of it through the fit's accuracy).
     """
     X = np.array(Z, dtype=float, order="C", copy=True)
-    try:
-        from sklearn.cluster._kmeans import _kmeans_single_lloyd, _tolerance
-        from sklearn.utils._openmp_helpers import _openmp_effective_n_threads
-    except ImportError:  # pragma: no cover - another scikit-learn
-        _kmeans_single_lloyd = None
-    if _kmeans_single_lloyd is None or not 1 <= m <= X.shape[0] or X.ndim != 2:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", SklearnConvergenceWarning)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", SklearnConvergenceWarning)
+        if X.ndim != 2 or not 1 <= m <= X.shape[0]:
             return KMeans(n_clusters=m, n_init=1, random_state=seed).fit(X).cluster_centers_
-    tol = _tolerance(X, 1e-4)  # KMeans's default tol, on the data before centring
-    mean = X.mean(axis=0)
-    X -= mean
-    idx = _kmeans_plusplus(X, m, seed)
-    _, _, centres, _ = _kmeans_single_lloyd(
-        X,
-        np.ones(X.shape[0]),
-        X[idx],
-        max_iter=300,
-        verbose=False,
-        tol=tol,
-        n_threads=_openmp_effective_n_threads(),
-    )
-    centres += mean
-    return centres
+        seeds = X[_kmeans_plusplus(X - X.mean(axis=0), m, seed)]
+        lloyd = KMeans(m, init=seeds, n_init=1, algorithm="lloyd", random_state=_LLOYD_RANDOM_STATE)
+        with config_context(assume_finite=True, skip_parameter_validation=True):
+            return lloyd.fit(X).cluster_centers_
 
 
 class RBFNetRegressor(RegressorMixin, BaseEstimator):
@@ -253,26 +247,6 @@ class RBFNetRegressor(RegressorMixin, BaseEstimator):
     >>> cross_val_score(RBFNetRegressor(), samples.X, samples.y, cv=5)  # doctest: +SKIP
     """
 
-    _parameter_constraints: ClassVar[dict[str, list[Any]]] = {
-        "n_centers": [Interval(Integral, 1, None, closed="left")],
-        "trainer": [str],
-        "encoding": [StrOptions({"hybrid", "full"})],
-        "init": [StrOptions({"kmeans", "random"})],
-        "width_factor": [Interval(Real, 0, None, closed="neither")],
-        "alpha": [Interval(Real, 0, None, closed="left")],
-        "fit_bias": ["boolean"],
-        "linear_tail": ["boolean"],
-        "velocity_stretch": [Interval(Real, 0, None, closed="neither")],
-        "linear_magnitude": ["array-like"],
-        "tail_order": [Interval(Integral, 1, 2, closed="both")],
-        "velocity_scale": [Interval(Real, 0, None, closed="neither"), None],
-        "target_mse": [Interval(Real, 0, None, closed="neither"), None],
-        "max_epochs": [Interval(Integral, 1, None, closed="left")],
-        "evals_per_epoch": [Interval(Integral, 1, None, closed="left")],
-        "method_options": [dict, None],
-        "random_state": ["random_state"],
-    }
-
     def __init__(
         self,
         n_centers: int = 20,
@@ -314,12 +288,9 @@ class RBFNetRegressor(RegressorMixin, BaseEstimator):
 
     # -- validation ----------------------------------------------------------------------
     def _check_params(self) -> str:
-        """Validate the parameters (sklearn's constraints, raised as :class:`ConfigError`);
-        return the trainer's name, lower-cased."""
-        try:
-            self._validate_params()
-        except InvalidParameterError as exc:
-            raise ConfigError(str(exc)) from None
+        """Validate the parameters (:func:`._rbf_params.check_params`, scikit-learn's wording,
+        raised as :class:`ConfigError`); return the trainer's name, lower-cased."""
+        check_params(self)
         trainer = self.trainer.strip().lower()
         if trainer == "lsq":
             ignored = [

@@ -7,7 +7,9 @@ trust region, one start at the result) with :data:`POLISH_EVALS_PER_PARAM` ``* (
 evaluations. If that lowers the SSE by more than :data:`POLISH_RTOL` relative, the fit had not
 converged, and the ratio says by how much; otherwise the result is a local optimum, whatever
 the optimiser's status (certified). The fit keeps the optimiser's own point either way (a
-paper's BAS run stays a BAS run); the polish only measures.
+paper's BAS run stays a BAS run); the polish only measures. Any problem of the problem
+protocol (:class:`fricid.identify.problem.Problem`) is certified alike: the analytic fits'
+and each stage of a trajectory identification.
 """
 
 from __future__ import annotations
@@ -17,7 +19,7 @@ from typing import Any
 import numpy as np
 
 from ...optim import OptimizeResult, minimize
-from ..problem import IdentificationProblem
+from ..problem import Problem
 
 __all__ = ["POLISH_EVALS_PER_PARAM", "POLISH_RTOL", "advice", "certify"]
 
@@ -41,13 +43,15 @@ def advice(method: str) -> str:
     return "raise --max-evals, or start elsewhere (--seed, x0)"
 
 
-def certify(problem: IdentificationProblem, result: OptimizeResult) -> dict[str, Any]:
+def certify(problem: Problem, result: OptimizeResult) -> dict[str, Any]:
     """The convergence block of a fit (stored in ``FittedModel.convergence``).
 
     Parameters
     ----------
-    problem : IdentificationProblem
-        The problem that was minimised (loss ``sse``).
+    problem : Problem
+        The problem that was minimised (loss ``sse``): an
+        :class:`~fricid.identify.problem.IdentificationProblem`, or any other of the problem
+        protocol (:class:`~fricid.identify.problem.Problem`: a trajectory route's stage).
     result : OptimizeResult
         The optimiser's result.
 

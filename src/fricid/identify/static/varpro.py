@@ -147,7 +147,13 @@ def _axes(bounds: np.ndarray, points: int) -> list[np.ndarray]:
 
 
 class _Projection:
-    """The projected least-squares problem of one block: basis, bounded linear solves."""
+    """The projected least-squares problem of one block: basis, bounded linear solves.
+
+    A problem of the problem protocol (:class:`fricid.identify.problem.Problem`) over the
+    block's nonlinear parameters ``nu`` (``free_names``, in ``bounds``): :meth:`residuals` are
+    the weighted residuals with the linear parameters solved for each candidate, and
+    :meth:`expand` gives the whole free vector of ``problem`` (``names``) with them.
+    """
 
     def __init__(self, problem: IdentificationProblem, block: _Block, start: np.ndarray):
         self.problem, self.block, self.start = problem, block, start
@@ -157,8 +163,44 @@ class _Projection:
         self.y = problem.y[rows]
         lo_hi = problem.bounds[block.lin]
         self.lo, self.hi = lo_hi[:, 0], lo_hi[:, 1]
+        self.names = tuple(problem.free_names)
+        self.bounds = problem.bounds[block.nl]
         self.nfev = 0
         self._active: tuple[np.ndarray, np.ndarray] | None = None
+
+    # -- the problem protocol ------------------------------------------------------------
+    @property
+    def free_names(self) -> list[str]:
+        return [self.names[i] for i in self.block.nl]
+
+    @property
+    def n_obs(self) -> int:
+        return int(self.y.size)
+
+    @property
+    def n_free(self) -> int:
+        return len(self.block.nl)
+
+    def residuals(self, NU: np.ndarray) -> np.ndarray:
+        """Weighted residuals ``(G, n)`` at nonlinear values ``NU (G, q)``, the linear
+        parameters solved within their bounds for each."""
+        A, b = self.basis(NU)
+        return self.solve_ab(A, b, NU.shape[0])[2]
+
+    def evaluate(self, NU: np.ndarray) -> np.ndarray:
+        """The projected SSE ``(G,)``: the problem's least SSE at each ``nu``."""
+        R = self.residuals(np.atleast_2d(NU))
+        return np.einsum("gn,gn->g", R, R)
+
+    def objective(self):
+        return self.evaluate
+
+    def expand(self, NU: np.ndarray) -> np.ndarray:
+        """Free vectors ``(G, p)`` of ``problem``: ``NU`` with the linear parameters solved."""
+        NU = np.atleast_2d(np.asarray(NU, dtype=float))
+        A, b = self.basis(NU)
+        C = self.solve_ab(A, b, NU.shape[0])[0]
+        return self.candidates(NU, C)
 
     def candidates(self, NU: np.ndarray, C: np.ndarray | None = None) -> np.ndarray:
         """Free vectors ``(G, p)`` with the block's nonlinear values ``NU`` (and linear ``C``)."""
@@ -261,8 +303,7 @@ class _Projection:
         lo, width = bounds[:, 0], bounds[:, 1] - bounds[:, 0]
 
         def residuals(U: np.ndarray) -> np.ndarray:
-            A, b = self.basis(lo + np.clip(U, 0.0, 1.0) * width)
-            return self.solve_ab(A, b, U.shape[0])[2]
+            return self.residuals(lo + np.clip(U, 0.0, 1.0) * width)
 
         def jacobian(u: np.ndarray) -> np.ndarray:
             """Forward differences, every column in one batched call (inward at the upper
