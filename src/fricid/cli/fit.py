@@ -174,7 +174,14 @@ def fit_command(
         typer.Option("--reader-option", help="--trajectory: a reader option KEY=VALUE."),
     ] = None,
 ) -> None:
-    """Identify a friction model from samples and write it as a JSON model file.
+    """Identify a friction model from samples (or, with --trajectory, a log) and write it as a
+    JSON model file.
+
+    One identification for every kind (fricid.identify.fit): analytic laws by least squares
+    (--model stribeck, vlt, ...: fricid.identify.static), learned models (--model rbf, hybrid,
+    gp: fricid.identify.learned), the family chosen by held-out error (--model auto), and
+    friction with inertia and gravity from any trajectory (--trajectory:
+    fricid.identify.dynamic).
 
     Prints the fit report (after lmfit's): method, evaluations and convergence status; data
     points, variables, chi-square (SSE [N^2 m^2]), reduced chi-square, AIC, BIC, R^2; each
