@@ -408,7 +408,7 @@ def check_trajectory(defects: list[str], result: Any) -> None:
     a defect that must be refused."""
     if defects:
         raise WrongAnswer(f"a log with {defects} was fitted")
-    if not isinstance(getattr(result, "params", None), dict):
+    if not isinstance(getattr(result, "parameters", None), dict):
         raise WrongAnswer(f"unexpected result {type(result).__name__}")
     for name, truth in TRUTH.items():
         value = trajectory_value(result, name)

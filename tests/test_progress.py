@@ -106,7 +106,10 @@ def test_fit_population_method_counts_evaluations(no_grace, tmp_path, samples_cs
     counts = [ln for ln in lines if "/3,000 evaluations" in ln]
     assert counts and "fitting stribeck (vsbas)" in counts[0], lines
     assert any("budget spent; certifying convergence" in ln for ln in lines), lines
-    assert lines[-1].endswith("done (3,000/3,000 evaluations)"), lines
+    assert any("3,000/3,000 evaluations (100 %)" in ln for ln in lines), lines
+    # then the trust verdict's own step (its leave-one-velocity-out), and the end
+    assert any("assessing trust in stribeck" in ln for ln in lines), lines
+    assert lines[-1].endswith("done"), lines
 
 
 def test_fit_without_callback_still_says_it_runs(no_grace, tmp_path, samples_csv):

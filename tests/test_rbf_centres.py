@@ -36,4 +36,4 @@ def test_cli_centers_below_one(tmp_path, model, centers):
 @pytest.mark.parametrize("centers", [0, -1, 2.5, True, "4"])
 def test_api_centers_not_a_count(centers):
     with pytest.raises(ConfigError, match="whole number >= 1"):
-        fit(samples(), "rbf", network={"n_centers": centers})
+        fit(samples(), "rbf", settings={"network": {"n_centers": centers}})

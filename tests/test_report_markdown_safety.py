@@ -155,8 +155,8 @@ def _hostile_model(tmp_path: Path) -> Path:
         kept.append(path)
     for path in kept:
         _set(doc, path, HOSTILE)
-    for name in doc["params"]:
-        doc.setdefault("uncertainty_note", {})[name] = HOSTILE
+    for record in doc["parameters"].values():
+        record["note"] = HOSTILE
     assert len(kept) >= 5, kept
     model = tmp_path / "m.json"
     model.write_text(json.dumps(doc))
