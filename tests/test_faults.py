@@ -357,6 +357,7 @@ def test_fleet_sigkill_takes_the_workers_along(busy_fleet):
     assert _alive(alive) == [], [p.cmdline() for p in _alive(alive)]
 
 
+@pytest.mark.slow  # 4 s measured under load (default run kept short)
 def test_fleet_interrupt_says_what_was_kept(data, tmp_path):
     """Ctrl-C after two joints: their records stay, and the line says so and how to resume."""
     manifest = tmp_path / "fleet.csv"
@@ -383,6 +384,7 @@ def test_fleet_interrupt_says_what_was_kept(data, tmp_path):
 # --------------------------------------------------------------------------- Ctrl-C
 
 
+@pytest.mark.slow  # 21 s measured under load; the interrupt's landing depends on load
 @pytest.mark.parametrize(
     ("args", "library", "delay"),
     [
@@ -458,6 +460,7 @@ def test_errors_chained_from_an_interrupt_are_the_interrupt(capsys):
 # --------------------------------------------------------------------------- reproducible
 
 
+@pytest.mark.slow  # 3 s measured under load (default run kept short)
 def test_identical_runs_give_identical_model_files(data, tmp_path, monkeypatch):
     def fit(name: str, *options: str) -> bytes:
         path = tmp_path / name
