@@ -1,11 +1,13 @@
 # fricid: two commands on a fresh machine, `make demo` and `make test`.
+# `make test` leaves out the tests marked slow (a few minutes on two cores); `make test-all`
+# runs the whole suite, as CI (.ci/run) does.
 PYTHON ?= python3
 VENV   ?= .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 DEVSTAMP := $(VENV)/.installed-dev
 
-.PHONY: demo test lint bench clean
+.PHONY: demo test test-all lint bench clean
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -24,6 +26,9 @@ demo: $(STAMP)
 
 test: $(DEVSTAMP)
 	$(BIN)/python -m pytest
+
+test-all: $(DEVSTAMP)
+	$(BIN)/python -m pytest -m ""
 
 lint: $(DEVSTAMP)
 	$(BIN)/ruff check src tests benchmarks

@@ -25,6 +25,7 @@ def demo_dir(tmp_path_factory):
     return out
 
 
+@pytest.mark.slow  # 6 s measured under load (default run kept short)
 def test_demo_writes_everything_and_prints_table1(demo_dir):
     for name in (
         "samples.csv",
@@ -212,6 +213,7 @@ def test_extract_generic_table_with_units(tmp_path):
     assert res.exit_code == 2 and "furlong/s" in res.output
 
 
+@pytest.mark.slow  # 6 s measured under load (default run kept short)
 def test_fit_rbf_network_and_predict(demo_dir, tmp_path):
     out = tmp_path / "rbf.json"
     res = run("fit", demo_dir / "samples.csv", "--model", "rbf", "--centers", "12", "--out", out)
@@ -224,6 +226,7 @@ def test_fit_rbf_network_and_predict(demo_dir, tmp_path):
     assert res.exit_code == 2 and "lsq, bas or ga" in res.output
 
 
+@pytest.mark.slow  # 3 s measured under load (default run kept short)
 def test_a_warning_is_one_line_on_stderr(demo_dir, tmp_path):
     """DESIGN.md, "Errors": a caveat on an answer that stands is one line on stderr."""
     out = tmp_path / "bas.json"

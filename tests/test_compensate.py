@@ -160,6 +160,7 @@ def test_default_config_stays_in_the_operating_range():
     assert peak == pytest.approx(2.0)  # half of the 4 rad/s identified
 
 
+@pytest.mark.slow  # 2 s measured under load (default run kept short)
 def test_compensate_command(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     model = cv().save(tmp_path / "cv.json")
@@ -242,6 +243,7 @@ def stribeck_of_lugre() -> FittedModel:
     )
 
 
+@pytest.mark.slow  # 2 s measured under load (default run kept short)
 def test_lugre_observer_beats_static_feedforward_at_crossings():
     theta = lugre_parameters(stribeck_of_lugre(), 1e3, 0.5)
     np.testing.assert_array_equal(theta, LUGRE)

@@ -90,6 +90,7 @@ def box_starts(samples, model: str, n_corners: int, n_random: int, seed: int = 1
 # -- defect 6: lm from anywhere in the box -------------------------------------------------------
 
 
+@pytest.mark.slow  # 22 s measured under load (default run kept short)
 @pytest.mark.parametrize(
     ("data", "model", "n_corners", "n_random", "single_ok"),
     [
@@ -180,6 +181,7 @@ def test_budget_spent_before_the_optimum_is_not_converged(paper2):
     assert f.optimizer.max_evals == 40 and np.isnan(f.parameters["tau_c"].stderr)
 
 
+@pytest.mark.slow  # 4 s measured under load (default run kept short)
 def test_vlt_from_the_upper_corner_converges_within_the_default_budget(paper1):
     """defect_5.py case B: the old lm spent its whole 20 000 and stopped at 2.37x."""
     m = get_model("vlt")

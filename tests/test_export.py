@@ -97,6 +97,7 @@ def zone_scale(fitted: FittedModel, X: np.ndarray, smoothing: Smoothing) -> np.n
 SMOOTHINGS = [Smoothing(), Smoothing("tanh", 0.01), Smoothing("linear", 0.02)]
 
 
+@pytest.mark.slow  # 6 s measured under load (default run kept short)
 @needs_cc
 @pytest.mark.parametrize("asym", [False, True], ids=["sym", "asym"])
 @pytest.mark.parametrize("family", sorted(PARAMS))

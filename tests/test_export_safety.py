@@ -152,6 +152,7 @@ def test_blanks_at_the_ends_survive_the_export(name):
     assert c_text(stribeck(), source=name, sha256=SHA) == expected(c_text, "lm", "bench", name)
 
 
+@pytest.mark.slow  # 3 s measured under load (default run kept short)
 @settings(max_examples=300, deadline=None)
 @given(hostile)
 def test_escaper_is_inert_and_reversible(text):
@@ -350,6 +351,7 @@ def test_xml_and_yaml_exploits_through_the_cli(tmp_path):
     assert res.exit_code == 2 and "ROS 2 node name" in res.output
 
 
+@pytest.mark.slow  # 2 s measured under load (default run kept short)
 @pytest.mark.parametrize(
     "name", ["m--->.json", "m *\n#define return return 1000.0 +\n.json", "a\u2028b: 1 #.json"]
 )

@@ -194,6 +194,7 @@ def test_cli_compensate_says_worse_on_stderr_and_titles_the_plot_so(tmp_path, mo
     assert titles and "made tracking worse" in titles[0] and (tmp_path / "c.png").exists()
 
 
+@pytest.mark.slow  # 3 s measured under load (default run kept short)
 def test_compensate_warns_when_the_reference_leaves_the_range(tmp_path):
     path = vlt().save(tmp_path / "vlt.json")
     res = run("compensate", path, "--truth", "paper1", "--no-plot", "--peak-velocity", "5")

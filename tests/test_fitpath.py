@@ -41,6 +41,7 @@ def _child() -> dict:
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
+@pytest.mark.slow  # 6 s measured under load (default run kept short)
 def test_a_second_process_loads_the_compiled_path_from_the_cache():
     """The first process may compile (cold cache); the second must only load: numba typed
     the kernel argument by its memory address before, so every process recompiled."""

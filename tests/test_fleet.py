@@ -188,6 +188,7 @@ def test_cli_bad_manifest_is_one_line_exit_2(tmp_path):
 # --------------------------------------------------------------------------- one joint
 
 
+@pytest.mark.slow  # 4 s measured under load (default run kept short)
 def test_fleet_joint_equals_single_joint_commands(fleet, tmp_path):
     """The fleet's model file holds exactly what `fricid extract` + `fricid fit` give."""
     manifest, run = fleet
@@ -260,6 +261,7 @@ def test_generic_reader_with_column_mapping_and_units(fleet, tmp_path):
     assert got["param_tau_c"] == pytest.approx(want["param_tau_c"], rel=1e-6)
 
 
+@pytest.mark.slow  # 3 s measured under load (default run kept short)
 def test_epos_folder_as_in_the_single_joint_commands(tmp_path, leadscrew_dir):
     (tmp_path / "m.yaml").write_text(
         f"joints:\n  - robot: leadscrew\n    joint: axis\n    log: {leadscrew_dir}\n"
@@ -398,6 +400,7 @@ def test_rerun_skips_unchanged_and_redoes_what_changed(fleet, tmp_path):
     )
 
 
+@pytest.mark.slow  # 5 s measured under load (default run kept short)
 def test_killed_run_leaves_no_partial_output_and_resumes(fleet, tmp_path):
     """SIGKILL the driver after two joints; the next run keeps them and finishes the rest."""
     manifest, reference = fleet
@@ -438,6 +441,7 @@ def test_killed_run_leaves_no_partial_output_and_resumes(fleet, tmp_path):
 # --------------------------------------------------------------------------- drift
 
 
+@pytest.mark.slow  # 5 s measured under load (default run kept short)
 def test_drift_flags_exactly_the_changed_joints(fleet, tmp_path):
     _manifest, baseline = fleet
     later = make_fleet(tmp_path / "later", seed0=100, changed={1: 1.6, 4: 0.6})
@@ -457,6 +461,7 @@ def test_drift_flags_exactly_the_changed_joints(fleet, tmp_path):
     assert not strict.joints["drifted"].any()
 
 
+@pytest.mark.slow  # 5 s measured under load (default run kept short)
 def test_cli_fleet_with_baseline(fleet, tmp_path):
     manifest, baseline = fleet
     out = tmp_path / "cli"
@@ -497,6 +502,7 @@ def _die_once(item):
     return marker.name
 
 
+@pytest.mark.slow  # 7 s measured under load (default run kept short)
 def test_process_pool_identical_to_serial(fleet, tmp_path):
     manifest, serial = fleet
     run = run_fleet(manifest, tmp_path / "pool", executor=ProcessExecutor(2), date="2026-03-01")
@@ -509,6 +515,7 @@ def test_process_pool_identical_to_serial(fleet, tmp_path):
     )
 
 
+@pytest.mark.slow  # 3 s measured under load (default run kept short)
 def test_process_pool_resubmits_after_a_worker_dies(tmp_path):
     for i in range(1, 3):
         (tmp_path / f"m{i}").write_text("alive")
@@ -546,6 +553,7 @@ def test_dask_listens_on_loopback_only(dask_local):
     assert dask_local.client.scheduler.address.startswith("tcp://127.0.0.1:")
 
 
+@pytest.mark.slow  # 6 s measured under load (default run kept short)
 def test_dask_local_cluster_identical_to_serial(fleet, dask_local, tmp_path):
     manifest, serial = fleet
     run = run_fleet(manifest, tmp_path / "dask", executor=dask_local, date="2026-03-01")
@@ -557,6 +565,7 @@ def test_dask_local_cluster_identical_to_serial(fleet, dask_local, tmp_path):
     )
 
 
+@pytest.mark.slow  # 2 s measured under load (default run kept short)
 def test_dask_tcp_scheduler_address(fleet, dask_local, tmp_path):
     from fricid.fleet import make_executor
 
@@ -571,6 +580,7 @@ def test_dask_tcp_scheduler_address(fleet, dask_local, tmp_path):
     )
 
 
+@pytest.mark.slow  # 6 s measured under load (default run kept short)
 def test_dask_worker_killed_mid_run_loses_nothing(fleet, dask_local, tmp_path):
     """SIGKILL a worker that is running a joint; Dask reruns its tasks; every joint is there."""
     manifest, serial = fleet

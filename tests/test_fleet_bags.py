@@ -83,6 +83,7 @@ def test_manifest_rows_carry_the_bag_options(bag_fleet):
     )
 
 
+@pytest.mark.slow  # 2 s measured under load (default run kept short)
 def test_fleet_runs_a_bag_folder_and_an_mcap_file(bag_fleet, tmp_path):
     run = run_fleet(bag_fleet, tmp_path / "out", executor=SerialExecutor(), date="2026-03-01")
     assert run.failed == 0, run.failures

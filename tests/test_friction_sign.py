@@ -78,6 +78,7 @@ ANALYTIC = [(name, "combined") for name in MODELS] + [
 ]
 
 
+@pytest.mark.slow  # 13 s measured under load (default run kept short)
 @pytest.mark.parametrize(("model", "which"), ANALYTIC)
 def test_every_analytic_family_opposes_motion(joint, model, which, tmp_path):
     combined, by_direction, _ = joint
@@ -213,6 +214,7 @@ def cli_files(tmp_path_factory):
     return d
 
 
+@pytest.mark.slow  # 2 s measured under load (default run kept short)
 @pytest.mark.parametrize("name", ["rbf.json", "rbf_dir.json"])
 def test_cli_predict_negative_velocity_is_negative(cli_files, name):
     from fricid.sim import preset
@@ -259,6 +261,7 @@ def test_c_export_of_the_network_equals_python(cli_files, tmp_path, name, smooth
     assert np.all(np.sign(got[X[:, 0] != 0]) == np.sign(X[X[:, 0] != 0, 0]))
 
 
+@pytest.mark.slow  # 5 s measured under load (default run kept short)
 def test_cli_compensate_with_the_network_helps(cli_files):
     res = run("compensate", cli_files / "rbf.json", "--truth", "paper1", "--no-plot", "--json")
     assert res.exit_code == 0, res.output

@@ -47,6 +47,7 @@ def _run(folder: Path, ch: RngChooser, n: list[int]) -> str:
     return outcome
 
 
+@pytest.mark.slow  # 2 s measured under load (default run kept short)
 @FUZZ
 @given(data=st.data())
 def test_a_hostile_fleet_ends_cleanly_and_touches_nothing_outside_out(folder, data):

@@ -85,6 +85,7 @@ def refused(path: Path, *words: str) -> str:
 # -- valid files, old and new -----------------------------------------------------------
 
 
+@pytest.mark.slow  # 5 s measured under load (default run kept short)
 def test_valid_files_of_every_family_load_and_predict_as_written(valid):
     models = mf.valid_models()
     for family, path in valid.items():
@@ -313,6 +314,7 @@ def test_every_command_that_loads_a_model_exits_2_with_one_line(
 # -- fuzzing ----------------------------------------------------------------------------
 
 
+@pytest.mark.slow  # 26 s measured under load (default run kept short)
 @settings(max_examples=200, **FUZZ)
 @given(
     family=st.sampled_from(mf.FAMILIES),
@@ -328,6 +330,7 @@ def test_fuzzed_model_files_load_cleanly_or_predict_finite_friction(
     assert outcome in ("error", "valid"), f"{family}/{kind}: {outcome}: {detail}"
 
 
+@pytest.mark.slow  # 6 s measured under load (default run kept short)
 @settings(max_examples=40, **FUZZ)
 @given(
     family=st.sampled_from(mf.FAMILIES),

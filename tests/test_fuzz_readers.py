@@ -178,6 +178,7 @@ def test_generated_urdfs(workspace, data):
     assert time.perf_counter() - start < CASE_SECONDS
 
 
+@pytest.mark.slow  # 2 s measured under load (default run kept short)
 @settings(FUZZ, max_examples=10)
 @given(data=st.data())
 def test_damaged_trajectory_logs(workspace, data):

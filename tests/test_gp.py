@@ -114,6 +114,7 @@ def test_gp_combined_samples_are_odd():
     np.testing.assert_allclose(fitted.predict(Xm, warn=False), -fitted.predict(X, warn=False))
 
 
+@pytest.mark.slow  # 2 s measured under load (default run kept short)
 def test_gp_model_file_round_trip(gp_model, tmp_path):
     path = gp_model.save(tmp_path / "gp.json")
     back = FittedModel.load(path)
@@ -147,6 +148,7 @@ def test_return_std_needs_a_posterior():
         fitted.predict(np.zeros((1, 3)), return_std=True)
 
 
+@pytest.mark.slow  # 2 s measured under load (default run kept short)
 @needs_cc
 def test_gp_c_export_matches_python(gp_model, tmp_path):
     X = points()

@@ -12,6 +12,7 @@ from fricid.identify.learned.hybrid import fit_backbone
 from fricid.sim.heldout_laws import draw
 
 
+@pytest.mark.slow  # 7 s measured under load (default run kept short)
 @pytest.mark.parametrize(("kind", "seed"), [("asym_arrhenius", 7), ("sigmoid", 3)])
 def test_lean_backbone_selection_picks_the_full_fits_family(kind, seed):
     samples = draw(kind, seed).train  # tuning seeds
@@ -67,6 +68,7 @@ def _inertia(Z, C):
     return float(((Z[:, None, :] - C[None]) ** 2).sum(-1).min(axis=1).sum())
 
 
+@pytest.mark.slow  # 10 s measured under load (default run kept short)
 @pytest.mark.parametrize("lattice", [False, True])
 def test_kmeans_centres_are_scikit_learns(lattice):
     """The compiled k-means (:mod:`fricid.identify.learned._kmeans_kernel`) follows scikit-learn's

@@ -121,6 +121,7 @@ def test_import_alone_reports_the_error(tmp_path, monkeypatch, fork):
     assert "ImportError: boom" in failures["fricid_bad_probe"]
 
 
+@pytest.mark.slow  # 37 s measured under load (default run kept short)
 def test_every_module_imports_in_isolation():
     """``python -c "import fricid.x.y"`` for every module: no module relies on another having
     been imported first (cycles, registration order, missing imports)."""
@@ -223,6 +224,7 @@ def test_copied_blocks_are_found_across_and_within_files(tmp_path):
     ]  # c.py shares only 10 lines: allowed
 
 
+@pytest.mark.slow  # 3 s measured under load (default run kept short)
 def test_no_copied_block_over_10_lines():
     """No run of more than 10 significant lines (ignoring blank lines, comments, imports and
     docstrings) stands twice in ``src/``: such code is shared, not copied."""

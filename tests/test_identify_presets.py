@@ -25,6 +25,7 @@ def extracted(name: str, size: str, seed: int):
     return extract(simulate(scenario, seed=seed), **scenario.extract_options())
 
 
+@pytest.mark.slow  # 18 s measured under load (default run kept short)
 @pytest.mark.parametrize("seed", [0, 1, 2])
 def test_paper2_stribeck_recovered_within_standard_errors(seed):
     """Tolerance: 3 standard errors (Jacobian at the optimum) per parameter; a fit that is
@@ -39,6 +40,7 @@ def test_paper2_stribeck_recovered_within_standard_errors(seed):
     assert 3e-5 < f.metrics["sse"] < 4e-4
 
 
+@pytest.mark.slow  # 2 s measured under load (default run kept short)
 def test_paper1_models_order_as_table1():
     samples = extracted("paper1", "reduced", 0).samples
     fitness = {

@@ -188,6 +188,7 @@ def _with_recorded(data, path) -> dict:
     return {**data.meta, "recorded_source": data.source}
 
 
+@pytest.mark.slow  # 2 s measured under load (default run kept short)
 @pytest.mark.parametrize("suffix", [".csv", ".parquet"])
 @ROUND_TRIP
 @given(samples=samples_strategy())

@@ -94,6 +94,7 @@ def test_default_rbf_is_structured_cross_validated_and_near_the_floor(asym):
     assert _ratio(m, asym) < 1.6 < _ratio(plain, asym)
 
 
+@pytest.mark.slow  # 2 s measured under load (default run kept short)
 def test_structured_network_extrapolates_in_speed_like_coulomb_viscous(sigmoid):
     m = fit(sigmoid.train, "rbf")
     plain = fit(sigmoid.train, "rbf", settings={"network": {"linear_tail": False}})
@@ -109,6 +110,7 @@ def test_structured_network_extrapolates_in_speed_like_coulomb_viscous(sigmoid):
             assert np.all(err < rel * np.abs(want))
 
 
+@pytest.mark.slow  # 3 s measured under load (default run kept short)
 def test_prediction_intervals_saved_cover_new_samples(sigmoid, tmp_path):
     m = fit(sigmoid.train, "rbf")
     path = m.save(tmp_path / "m.json")
@@ -123,6 +125,7 @@ def test_prediction_intervals_saved_cover_new_samples(sigmoid, tmp_path):
     assert np.isnan(interval_half_width(loaded.state, sigmoid.test.X, 0.5)).all()
 
 
+@pytest.mark.slow  # 3 s measured under load (default run kept short)
 def test_floor_keeps_friction_opposing_motion_far_outside():
     d = draw("grid", 2)
     sub = d.train.subset(d.train.load > 0.2)  # a narrow load range
@@ -136,6 +139,7 @@ def test_floor_keeps_friction_opposing_motion_far_outside():
         predict_state(bad, X)
 
 
+@pytest.mark.slow  # 6 s measured under load (default run kept short)
 def test_old_state_without_tail_still_predicts():
     d = draw("sigmoid", 2)
     m = fit(d.train, "rbf")
@@ -232,6 +236,7 @@ def test_hybrid_c_export_equals_python(asym, tmp_path):
         assert np.max(np.abs(got - want)) <= 1e-12 * np.max(np.abs(want))
 
 
+@pytest.mark.slow  # 9 s measured under load (default run kept short)
 def test_auto_with_learned_families_picks_one_when_clearly_better():
     from fricid.identify.static.select import candidates
 

@@ -54,6 +54,7 @@ def gp(samples):
 # -- effective degrees of freedom (finding c) ---------------------------------------------------
 
 
+@pytest.mark.slow  # 2 s measured under load (default run kept short)
 @pytest.mark.parametrize(
     "options",
     [{"alpha": 1e-5}, {"alpha": 1e-5, "linear_tail": True}, {"alpha": 1e-3, "fit_bias": False}],
@@ -191,6 +192,7 @@ def test_report_verdict_of_a_learned_model_rests_on_lovo(gp, rbf, samples):
 # -- what to do (finding a) ---------------------------------------------------------------------
 
 
+@pytest.mark.slow  # 3 s measured under load (default run kept short)
 def test_cli_report_says_what_to_do_about_a_family_that_cannot_follow(samples, tmp_path):
     csv = write_samples(samples, tmp_path / "syn.csv")
     runner = CliRunner()
@@ -208,6 +210,7 @@ def test_cli_report_says_what_to_do_about_a_family_that_cannot_follow(samples, t
     assert "--model hybrid" in line and "--model auto --learned" in line
 
 
+@pytest.mark.slow  # 8 s measured under load (default run kept short)
 def test_cli_fit_prints_the_learned_models_held_out_error(samples, tmp_path):
     csv = write_samples(samples, tmp_path / "syn.csv")
     res = CliRunner().invoke(

@@ -60,6 +60,7 @@ def test_wrong_shapes_and_periods_are_refused():
         lugre.simulate(THETA, [0.1, 0.2], [1e-3, -1.0])
 
 
+@pytest.mark.slow  # 3 s measured under load (default run kept short)
 def test_joint_under_torque_slides_at_the_steady_state_or_sticks():
     # above break-away the joint settles where steady friction balances the torque
     r = lugre.simulate_joint(THETA, 0.01, 0.0, 0.0, 1e-3, np.full(4000, 0.9))

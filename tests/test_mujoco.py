@@ -54,6 +54,7 @@ def rms(a: np.ndarray, b: np.ndarray) -> float:
     return float(np.sqrt(np.mean((a - b) ** 2)))
 
 
+@pytest.mark.slow  # 3 s measured under load (default run kept short)
 def test_cli_export_runs_in_mujoco_and_tracks_the_karnopp_joint(tmp_path, mujoco):
     """Coulomb-viscous truth, exported exactly: MuJoCo's trajectory follows the Python joint's;
     frictionloss is a soft constraint, and a stiffer solreffriction follows it closer."""

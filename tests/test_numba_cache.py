@@ -72,6 +72,7 @@ def _unwritable_env(tmp_path: Path) -> dict[str, str]:
     return env
 
 
+@pytest.mark.slow  # 5 s measured under load (default run kept short)
 def test_kernels_compile_in_memory_without_a_cache_directory(tmp_path):
     res = subprocess.run(
         [sys.executable, "-c", CHILD, *KERNEL_MODULES],

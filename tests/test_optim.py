@@ -157,6 +157,7 @@ CONVERGENCE = {
 }
 
 
+@pytest.mark.slow  # 5 s measured under load (default run kept short)
 @pytest.mark.parametrize("method", list(CONVERGENCE))
 def test_reaches_known_optimum(method: str) -> None:
     opts, budget, tol_sphere, tol_rosen = CONVERGENCE[method]
@@ -254,6 +255,7 @@ def _sphere_kernel(X, out, data):  # pragma: no cover - compiled
         out[k] = s
 
 
+@pytest.mark.slow  # 6 s measured under load (default run kept short)
 @pytest.mark.parametrize("budget", [None, 1000, 1001, 1003])
 def test_compiled_rwsavsbas_matches_the_numpy_path(budget) -> None:
     """Same algorithm, same random numbers: on the sphere (no transcendental functions) the

@@ -16,6 +16,7 @@ def problem() -> study.StribeckProblem:
     return study.StribeckProblem(v, y)
 
 
+@pytest.mark.slow  # 6 s measured under load (default run kept short)
 def test_paper2_samples_and_global_optimum(problem) -> None:
     assert problem.velocity.shape == problem.friction.shape == (17,)
     theta, f_opt = study.global_optimum(problem)

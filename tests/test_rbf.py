@@ -184,6 +184,7 @@ def reduced():
     return samples, truth.y, float(np.sqrt(np.mean(expected_noise_std(scenario) ** 2)))
 
 
+@pytest.mark.slow  # 2 s measured under load (default run kept short)
 def test_held_out_error_bounded_on_reduced_paper1(reduced):
     """Out-of-fold (3-fold) RMSE against the true friction: a few noise floors (the reduced
     design has only 6 velocities, so interpolating the Stribeck dip between them dominates)."""

@@ -97,6 +97,7 @@ def test_structure_search_and_its_validation_record_name_the_folds():
     assert cv_validation(s, cv_pieces(old))["scheme"] == "kfold:5"
 
 
+@pytest.mark.slow  # 10 s measured under load (default run kept short)
 def test_rbf_default_predicts_the_demos_interior_speed_levels():
     """The demo's samples (paper-1 preset, reduced design: 6 speeds up to 3x apart): random
     folds alone chose a network that followed the measured levels and swung between them,
@@ -140,6 +141,7 @@ def test_penalty_is_the_largest_within_one_standard_error_of_the_best():
     assert choose_penalty([bad], alphas)[0] == 2
 
 
+@pytest.mark.slow  # 5 s measured under load (default run kept short)
 def test_hybrid_residual_without_level_folds_has_no_swing_at_the_fast_end(monkeypatch):
     """Issue 15, the grid kind's tuning seed 7 with random folds only: the penalty 1e-11
     (the best random-fold score by a hair) left the hybrid 3.4x the noise off the truth;
@@ -158,6 +160,7 @@ def test_hybrid_residual_without_level_folds_has_no_swing_at_the_fast_end(monkey
     assert np.sqrt(np.mean(r * r)) / d.noise < 1.3
 
 
+@pytest.mark.slow  # 7 s measured under load (default run kept short)
 def test_hybrid_residual_on_random_folds_is_closer_to_the_truth_between_speeds():
     """Issue 15, the demo's design (paper-1 preset, reduced: 6 speeds up to 3x apart), against
     the virtual joint's true friction at the geometric middles between the measured speeds:

@@ -61,6 +61,7 @@ def test_paper1_oracle_data():
         paper1_data("reduced", data="csv")
 
 
+@pytest.mark.slow  # 27 s measured under load (default run kept short)
 def test_tables_have_every_row_and_the_papers_numbers(result):
     t = result.tables
     assert set(t) >= {
@@ -217,6 +218,7 @@ def test_given_data_is_used_and_checked():
         run_study(tiny(), data=(data[0], data[1][:-1], data[2]))
 
 
+@pytest.mark.slow  # 29 s measured under load (default run kept short)
 def test_cli_bench_rbfnn(tmp_path):
     from fricid.cli import app
 

@@ -528,6 +528,7 @@ def _flips(data: bytes, step: int) -> list[bytes]:
     return out
 
 
+@pytest.mark.slow  # 2 s measured under load (default run kept short)
 @pytest.mark.parametrize("kind", ["samples", "rawlog"])
 def test_parquet_byte_flips_give_an_error_or_the_very_values(tmp_path, kind):
     """Every 7th byte flipped in turn (the old files changed values silently for 5 % of

@@ -67,6 +67,7 @@ def leadscrew(leadscrew_dir):
     return epos_steady_samples(leadscrew_dir)
 
 
+@pytest.mark.slow  # 5 s measured under load (default run kept short)
 @pytest.mark.parametrize("family", FAMILIES)
 def test_report_renders_for_each_family(family, paper1_samples, tmp_path):
     fitted = fit(paper1_samples, family, "lm", max_evals=3000)
@@ -84,6 +85,7 @@ def test_report_renders_for_each_family(family, paper1_samples, tmp_path):
     assert "95% CI low" in params
 
 
+@pytest.mark.slow  # 2 s measured under load (default run kept short)
 def test_report_on_real_leadscrew_per_direction(leadscrew, tmp_path):
     fitted = fit(leadscrew, "stribeck_asym")
     doc = model_report(
@@ -302,6 +304,7 @@ def test_trust_names_open_sides_and_undetermined_parameters():
     assert trust.range == "speed 0.1 to 2 rad/s (either direction)"
 
 
+@pytest.mark.slow  # 2 s measured under load (default run kept short)
 def test_report_of_a_per_direction_rbf_network(leadscrew, tmp_path):
     from fricid.fitted import FittedModel
     from fricid.report.rbf import coefficient_names, hidden_layer

@@ -1,7 +1,7 @@
 """Issue 17: the HTML report checked in a real headless browser.
 
 Selenium (the ``dev`` extra) drives Debian's ``chromium`` with ``chromium-driver`` (``.ci/run``
-installs both before ``make test``): the page loads without console errors, every figure is
+installs both before ``make test-all``): the page loads without console errors, every figure is
 visible (each interactive Plotly figure drawn, each PNG decoded), the table of contents
 links reach their sections, and a screenshot is saved as a test artefact: ``report.png``
 in the test's tmp folder and, when ``FRICID_ARTIFACTS`` is set, copied into that folder as

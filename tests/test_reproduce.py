@@ -58,6 +58,7 @@ def rwsavsbas(tmp_path_factory):
     return out, res
 
 
+@pytest.mark.slow  # 25 s measured under load (default run kept short)
 def test_bas_rbfnn_quick_has_every_item(bas_rbfnn):
     out, res = bas_rbfnn
     html, files = check_folder(out)
@@ -157,6 +158,7 @@ def test_bas_rbfnn_table4_fig9_fig10_paper_beside_ours(bas_rbfnn):
     assert "baseline" in md and "tuned" in md and "extrapolat" in md
 
 
+@pytest.mark.slow  # 21 s measured under load (default run kept short)
 def test_rwsavsbas_quick_has_every_item(rwsavsbas):
     out, res = rwsavsbas
     html, files = check_folder(out)

@@ -25,6 +25,7 @@ STUDIES = (
 )
 
 
+@pytest.mark.slow  # 10 s measured under load (default run kept short)
 @pytest.mark.parametrize("module", STUDIES)
 def test_a_study_imports_neither_report_nor_matplotlib(module):
     code = (

@@ -286,6 +286,7 @@ def test_cli_refuses_a_log_without_motion(tmp_path):
     assert result.exit_code == 2
 
 
+@pytest.mark.slow  # 3 s measured under load (default run kept short)
 def test_any_optimiser_and_static_part_from_sweeps():
     log = tr.simulate_trajectory(tr.multisine(duration=6.0, seed=5), TRUTH, JOINT, seed=5)
     with warnings.catch_warnings():
@@ -453,6 +454,7 @@ def test_filtered_route_is_consistent_on_a_noise_free_log():
     assert "rate_bias" not in fit_trajectory(log, "lugre", rate_bias="off").provenance["trajectory"]
 
 
+@pytest.mark.slow  # 3 s measured under load (default run kept short)
 def test_filtered_route_covers_the_truth_with_noise_and_the_cli_selects_routes(tmp_path):
     log = tr.simulate_trajectory(tr.multisine(duration=15.0, seed=22), TRUTH, JOINT, seed=22)
     fitted = fit_trajectory(log, "lugre")

@@ -193,6 +193,7 @@ def test_fleet_row_and_report_agree(tmp_path, leadscrew_dir):
     assert vlt["trust"] == "no" and vlt["heldout_ratio"] > saved["metrics"]["rmse_over_scatter"]
 
 
+@pytest.mark.slow  # 2 s measured under load (default run kept short)
 def test_fit_validate_lovo_and_report_agree(leadscrew, tmp_path):
     """`fricid fit --validate lovo` prints the verdict it stores; `fricid report` on the same
     samples reads the same record, and computing it again gives the same line."""
@@ -215,6 +216,7 @@ def test_fit_validate_lovo_and_report_agree(leadscrew, tmp_path):
     assert _fresh(model, samples).line() == fit_line
 
 
+@pytest.mark.slow  # 2 s measured under load (default run kept short)
 def test_fit_without_validate_stores_the_lovo_the_report_would_run(leadscrew, tmp_path):
     samples = write_samples(leadscrew, tmp_path / "s.csv")
     model = tmp_path / "m.json"

@@ -210,6 +210,7 @@ def test_candidates_follow_the_data():
     assert "both directions" in {c.label: c.note for c in candidates(comb)}["stribeck_asym"]
 
 
+@pytest.mark.slow  # 4 s measured under load (default run kept short)
 def test_auto_picks_stribeck_asym_on_an_asymmetric_stribeck_truth(tmp_path):
     s = directional("stribeck_asym", asym_truth())
     with warnings.catch_warnings():
@@ -224,6 +225,7 @@ def test_auto_picks_stribeck_asym_on_an_asymmetric_stribeck_truth(tmp_path):
     assert back.selection == f.selection and back.validation["verdict"]
 
 
+@pytest.mark.slow  # 4 s measured under load (default run kept short)
 def test_auto_picks_coulomb_viscous_on_a_linear_truth():
     s = directional("coulomb_viscous", [0.1, 0.05], levels=8)
     with warnings.catch_warnings():
@@ -312,6 +314,7 @@ def test_metrics_keep_the_paper_fitness():
 # -- the command line -----------------------------------------------------------------------
 
 
+@pytest.mark.slow  # 6 s measured under load (default run kept short)
 def test_cli_fit_validate_auto_robust(tmp_path):
     s = directional("stribeck_asym", asym_truth(), levels=8)
     path = tmp_path / "s.csv"

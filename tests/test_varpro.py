@@ -100,6 +100,7 @@ def test_declared_linear_parameters_enter_linearly(name):
     np.testing.assert_allclose(m.predict(zero, X), 0.0, atol=1e-14)
 
 
+@pytest.mark.slow  # 5 s measured under load (default run kept short)
 def test_varpro_reaches_the_study_optimum_from_any_start(study):
     samples, kw, optimum = study
     for x0 in starts(samples, "stribeck", kw):

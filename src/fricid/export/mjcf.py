@@ -38,7 +38,6 @@ import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import minimize_scalar
 
 from ..errors import ConfigError
 from ..fitted import FittedModel
@@ -172,6 +171,8 @@ def lugre_mapping(fitted: FittedModel, velocity_range=None) -> LuGreMapping:
 
     w_s = float(theta[5])
     if theta[6] != MUJOCO_STRIBECK_EXPONENT:
+        from scipy.optimize import minimize_scalar  # here: `fricid --help` starts without it
+
         res = minimize_scalar(
             lambda lw: float(np.mean((mapped(math.exp(lw)) - F) ** 2)),
             bounds=(math.log(w_s) - 6.0, math.log(w_s) + 6.0),

@@ -24,7 +24,6 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from scipy.optimize import nnls
 
 from ..errors import DataError
 from ..fitted import FittedModel
@@ -146,6 +145,8 @@ def operating_grid(
 
 
 def _nnls(A: np.ndarray, y: np.ndarray) -> np.ndarray:
+    from scipy.optimize import nnls  # here: `fricid --help` starts without it
+
     scale = np.maximum(np.abs(A).max(axis=0), 1e-300)
     x, _ = nnls(A / scale, y)
     return x / scale

@@ -24,13 +24,14 @@ import numpy as np
 
 from ..fitted import FittedModel
 from ..models import FrictionModel
-from ..optim import OptimizeResult
+from ..optim import OptimizeResult, single_blas_thread
 from ..samples import FrictionSamples, RawLog
 from ._named import KINDS, SETTINGS, _int_seed, _no_weights, _refuse, _settings, fit_named, kind_of
 
 __all__ = ["KINDS", "SETTINGS", "fit", "kind_of"]
 
 
+@single_blas_thread
 def fit(
     data: FrictionSamples | RawLog,
     model: str | FrictionModel,

@@ -33,6 +33,7 @@ import numpy as np
 
 from ..errors import ConfigError, ConvergenceWarning, FricidError
 from ..metrics import rmse, verdict
+from ..optim import single_blas_thread
 from ..samples import FrictionSamples
 from ._named import fit_named as fit
 from ._scatter import (
@@ -239,6 +240,7 @@ def interior_rmse(folds: Sequence[Mapping[str, Any]]) -> float:
     return float(np.sqrt(np.sum(n * mse) / n.sum()))
 
 
+@single_blas_thread
 def validate(
     samples: FrictionSamples,
     model: str,

@@ -12,7 +12,6 @@ chunks of candidates (never a loop over samples) so that memory stays near
 from __future__ import annotations
 
 import numpy as np
-import scipy.linalg
 
 __all__ = [
     "CHUNK_ELEMENTS",
@@ -99,6 +98,8 @@ def lstsq_weights(
     (the normal equations would square its condition number), cutting singular values below
     machine precision.
     """
+    import scipy.linalg  # here, not at import: the command line starts without it
+
     n, m = Phi.shape
     if fit_bias:
         mu = Phi.mean(axis=0)

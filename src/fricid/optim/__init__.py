@@ -21,6 +21,8 @@ Methods (``METHODS[name].summary`` has the one-line description):
 ``minimize_runs(..., runs=N)`` makes N independent runs (seeds ``seed .. seed + N - 1``),
 batched into one objective call per iteration for bas, vsbas, ibas, rwsavsbas and ga (with
 option ``dedupe=False``; by default GA skips its clones, each run counting its own).
+:func:`one_blas_thread` (a context) and :func:`single_blas_thread` (a decorator) keep BLAS to
+one thread on the least-squares paths (:mod:`fricid.optim._threads`).
 :class:`JitObjective` pairs an objective with a numba kernel for RWSAVSBAS's compiled path.
 Conventions (unit box, clipping, NaN, history, budgets): :mod:`fricid.optim._api`.
 """
@@ -41,15 +43,19 @@ from . import (  # noqa: F401  (each registers its methods)
 )
 from ._api import METHODS, STATUS_MESSAGES, JitObjective, OptimizeResult, check_bounds
 from ._minimize import minimize, minimize_runs
+from ._threads import blas_threads, one_blas_thread, single_blas_thread
 
 __all__ = [
     "METHODS",
     "STATUS_MESSAGES",
     "JitObjective",
     "OptimizeResult",
+    "blas_threads",
     "check_bounds",
     "minimize",
     "minimize_runs",
+    "one_blas_thread",
+    "single_blas_thread",
 ]
 
 #: The order methods are listed in (errors, ``--help``): the beetle family first.

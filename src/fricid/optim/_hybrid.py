@@ -16,6 +16,7 @@ import numpy as np
 from ..errors import ConfigError
 from ._api import METHODS, Budget, Solver, positive_option, register
 from ._least_squares import LeastSquaresLM
+from ._threads import single_blas_thread
 
 __all__ = ["BeetleLM"]
 
@@ -75,6 +76,7 @@ class BeetleLM(Solver):
             {"n_starts": int(o["n_polish"])}, dim=self.dim, x0=None, residuals=self.residuals
         )
 
+    @single_blas_thread
     def run(self) -> tuple[int, str]:
         obj = self.objective
         total = obj.max_evals

@@ -57,6 +57,7 @@ from scipy.optimize import least_squares
 
 from ..errors import ConfigError
 from ._api import Budget, Solver, choice_option, positive_option, register
+from ._threads import single_blas_thread
 
 __all__ = ["FD_STEP", "INSIDE", "LeastSquaresLM", "LeastSquaresMINPACK", "LeastSquaresTRF"]
 
@@ -178,6 +179,7 @@ class _LeastSquares(Solver):
 
         return jac
 
+    @single_blas_thread
     def run(self) -> tuple[int, str]:
         obj = self.objective
         starts = self._starts()

@@ -32,6 +32,7 @@ import numpy as np
 from scipy import stats
 from scipy.optimize import least_squares
 
+from ...optim import single_blas_thread
 from ..problem import IdentificationProblem
 
 __all__ = ["GRID", "N_BISECT", "ProfileInterval", "profile_intervals", "profile_threshold"]
@@ -171,6 +172,7 @@ def _side(refit: _Refit, x_hat: np.ndarray, bound: float, thr: float, best: list
     return inside_v + float(np.clip(t, 0.0, 1.0)) * (out_v - inside_v), False
 
 
+@single_blas_thread
 def profile_intervals(
     problem: IdentificationProblem,
     x_hat: np.ndarray,

@@ -34,6 +34,7 @@ import numpy as np
 from ...errors import ConfigError
 from ...fitted import FittedModel
 from ...metrics import NOISE_RATIO
+from ...optim import single_blas_thread
 from ...samples import FrictionSamples
 from .._named import fit_named
 from .._scatter import Scatter, measurement_scatter
@@ -50,6 +51,7 @@ __all__ = [
 ]
 
 
+@single_blas_thread
 def select(
     samples: FrictionSamples,
     method: str = "lm",

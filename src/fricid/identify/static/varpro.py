@@ -57,7 +57,7 @@ import numpy as np
 from scipy.optimize import least_squares, lsq_linear
 
 from ...errors import ConfigError
-from ...optim import OptimizeResult, minimize
+from ...optim import OptimizeResult, minimize, single_blas_thread
 from ..problem import IdentificationProblem
 
 __all__ = ["GRID_POINTS", "N_POLISH", "SUMMARY", "VARPRO_OPTIONS", "linear_split", "varpro"]
@@ -368,6 +368,7 @@ def _option(options: dict[str, Any], name: str, default: int) -> int:
     return int(value)
 
 
+@single_blas_thread
 def varpro(
     problem: IdentificationProblem,
     *,
