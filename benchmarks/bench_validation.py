@@ -30,7 +30,7 @@ gives each fold's held-out RMSE over the oracle noise.
 
 What it showed (issue 11's clean virtual joint at 1.24x): the scatter is not biased low (over
 30 seeds of the ``quick`` design it pools to 1.02x the oracle's noise and 0.99x the realised
-one; ``tests/test_scatter_oracle.py``), and ``auto`` picks the true family (Stribeck,
+one; ``tests/identify/test_scatter_oracle.py``), and ``auto`` picks the true family (Stribeck,
 delta = 1) on every seed shown (on the ``quick`` design's seed 4 the free-shape Stribeck,
 which contains it). The ``quick`` design (6 levels 0.01-2 rad/s, 3 passes) cannot
 test a 4-parameter law by leave-one-level-out: holding out 0.01 or 2 rad/s is an extrapolation

@@ -1,6 +1,6 @@
 """Fuzz model files longer than the test suite does, and print the counts (issue 12, defect 4).
 
-The mutations and the classification are those of ``tests/test_fuzz_model.py``
+The mutations and the classification are those of ``tests/fitted/test_fuzz_model.py``
 (``tests/_model_fuzz.py``): valid model files of every family (analytic, ``_asym``, ``rbf``,
 and files of schema version 1 an earlier fricid wrote, read through the upgrade) are damaged
 (byte flips, truncation, inserted bytes, non-UTF-8, random JSON values, NaN, Infinity and

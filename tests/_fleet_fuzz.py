@@ -1,6 +1,6 @@
 """Hostile fleet manifests and output folders, and the oracle that judges a fleet run.
 
-Shared by ``tests/test_fuzz_fleet.py`` (hypothesis draws the choices) and
+Shared by ``tests/fleet/test_fuzz_fleet.py`` (hypothesis draws the choices) and
 ``benchmarks/fuzz_fleet.py`` (a seeded generator draws them, longer, and counts outcomes).
 Each case is a fresh folder: a manifest (CSV or YAML) of one to three joints with drawn
 names (short, at and beyond the file system's limits, unicode, ``..``, separators, NUL,

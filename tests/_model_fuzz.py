@@ -1,6 +1,6 @@
 """Hostile variants of valid model files, and what loading one may end in (issue 12, defect 4).
 
-Shared by ``tests/test_fuzz_model.py`` (hypothesis draws the mutations) and
+Shared by ``tests/fitted/test_fuzz_model.py`` (hypothesis draws the mutations) and
 ``benchmarks/fuzz_model.py`` (a seeded ``random.Random`` draws them, for longer runs). Every
 mutation is drawn from a :class:`random.Random`, so both drive the same code.
 

@@ -40,7 +40,7 @@ def leadscrew_dir(real_data: Path) -> Path:
     return _folder_or_skip(real_data / "epos-leadscrew")
 
 
-# -- every model the suite fits and saves, for tests/test_friction_sign.py ---------------------
+# -- every model the suite fits and saves, for tests/models/test_friction_sign.py -----------
 
 #: ``(model dict, samples or None)`` of every model file a test wrote through
 #: ``FittedModel.save``; the samples are those the model was fitted on, found by the content

@@ -1,6 +1,6 @@
 """Damaged input files for every reader and the oracle that judges a reader's outcome.
 
-Shared by ``tests/test_fuzz_readers.py`` (hypothesis draws the damage) and
+Shared by ``tests/io/test_fuzz_readers.py`` (hypothesis draws the damage) and
 ``benchmarks/fuzz_readers.py`` (a seeded generator draws it, longer, and counts outcomes).
 A reader given a damaged file must end in a :class:`~fricid.errors.FricidError` on one line
 naming the file, or a valid result (finite SI values within :data:`fricid.samples.LIMITS`,

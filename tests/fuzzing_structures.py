@@ -1,7 +1,7 @@
 """Generated URDFs and damaged trajectory logs, with an oracle that knows their defects.
 
 Shared, like ``fuzzing.py`` (whose choosers and :func:`~fuzzing.classify` it uses), by
-``tests/test_fuzz_readers.py`` (hypothesis draws the cases) and ``benchmarks/fuzz_readers.py``
+``tests/io/test_fuzz_readers.py`` (hypothesis draws the cases) and ``benchmarks/fuzz_readers.py``
 (a seeded generator draws them, longer, and counts outcomes). The cases are built from a
 structure, not by flipping bytes, so the oracle knows which must fail:
 

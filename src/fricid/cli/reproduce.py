@@ -24,7 +24,8 @@ def reproduce_command(
         quick_option(
             "Reduced designs and budgets (RWSAVSBAS: its schedule compressed ten-fold; "
             "BAS-RBFNN: the 330-sample design, smaller networks). Measured as the setup of "
-            "tests/test_reproduce.py (pytest --durations) on 2 cores shared with other jobs, "
+            "tests/experiments/test_reproduce.py (pytest --durations) on 2 cores shared with "
+            "other jobs, "
             "load average about 14: rwsavsbas 221 s, bas-rbfnn 175 s."
         ),
     ] = False,

@@ -7,7 +7,8 @@ than ``max_loss`` (RMS error relative to the RMS friction, default 50 %), the ex
 refused with an :class:`ExportError` that says what would be lost; pass a larger
 ``max_loss`` (``--max-loss``) to write it anyway, or export to C for the full model.
 
-MJCF is checked in MuJoCo itself (:mod:`fricid.export.mujoco_check`, ``tests/test_mujoco.py``),
+MJCF is checked in MuJoCo itself (:mod:`fricid.export.mujoco_check`,
+``tests/export/test_mujoco.py``),
 and a LuGre model goes to MuJoCo 4's ``dcmotor`` LuGre friction (:mod:`fricid.export.mjcf`).
 """
 

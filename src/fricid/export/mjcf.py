@@ -22,7 +22,8 @@ LuGre (dynamic) models
     sigma_1 [N m s/rad], tau_c [N m], tau_s [N m], w_s [rad/s], with sigma_2 in the standard
     ``damping`` attribute; ``input="none"`` makes it a passive device, and ``motorconst="0 0"``
     disables its electrical branch (``resistance`` must still be positive). Its Stribeck curve
-    has no exponent: fricid's check (``tests/test_mujoco.py``, mujoco 4.0.0) finds the bristle
+    has no exponent: fricid's check (``tests/export/test_mujoco.py``, mujoco 4.0.0) finds the
+    bristle
     state at constant velocity settling to ``g(v) / sigma_0`` with
     ``g(v) = tau_c + (tau_s - tau_c) exp(-(v / w_s)^2)``, the exponent delta = 2
     (:data:`MUJOCO_STRIBECK_EXPONENT`). A model with another delta gets the ``w_s`` whose

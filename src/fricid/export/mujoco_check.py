@@ -5,7 +5,7 @@ The check of :func:`fricid.export.mjcf_text` in a real simulator (issue 16): the
 with a ``dcmotor``) is built into a model of one hinge joint with inertia ``J`` about its
 axis, no gravity, and a ``motor`` actuator (gear 1) that applies the torque; it is then
 stepped under a torque signal, one sample per step. Compare the trajectory with a Python
-joint under the true friction (:func:`fricid.control.plant.drive`): ``tests/test_mujoco.py``
+joint under the true friction (:func:`fricid.control.plant.drive`): ``tests/export/test_mujoco.py``
 and ``benchmarks/bench_mujoco.py`` do.
 
 Needs the optional ``mujoco`` package (``pip install fricid[mujoco]``), imported only when a

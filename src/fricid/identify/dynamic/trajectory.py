@@ -35,7 +35,8 @@ Routes, recorded in the result's provenance (``provenance["trajectory"]``):
     stretch (``|qd| < v_window``), cut into segments of :data:`SEGMENT` seconds that restart
     from the measured motion while the bristle state carries on (multiple shooting;
     restarting z too from a force balance hid sigma_1 entirely:
-    ``tests/test_trajectory.py``); residuals the simulated minus the measured position and
+    ``tests/identify/dynamic/test_trajectory.py``); residuals the simulated minus the measured
+    position and
     velocity, each channel scaled by its RMS at the start.
 
 Which, and why. ``route="filtered"`` by default: it is the standard of robot identification

@@ -100,7 +100,8 @@ def kmeans_centres(Z: np.ndarray, m: int, seed: int) -> np.ndarray:
     ``KMeans.fit`` centres it (:func:`_kmeans_plusplus`, compiled: its sums round differently
     from scikit-learn's BLAS calls, so where two candidate seeds tie within rounding it may
     take the other one, on 1 of 30 random problems without duplicate points,
-    ``tests/test_hybrid_speed.py``), then scikit-learn's own Lloyd iterations from them,
+    ``tests/identify/learned/test_hybrid_speed.py``), then scikit-learn's own Lloyd iterations from
+    them,
     through its public API (``KMeans(init=seeds, n_init=1, algorithm="lloyd")``, which
     centres, sets the tolerance and iterates as the default fit does; its input and parameter
     checks skipped by scikit-learn's public ``config_context``: the network's ``fit`` has

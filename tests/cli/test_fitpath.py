@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-SRC = Path(__file__).resolve().parents[1] / "src"
+from _paths import SRC
 
 #: A second process running RWSAVSBAS's compiled path: prints the cache statistics of the
 #: compiled outer iteration and of the kernel's function pointer.

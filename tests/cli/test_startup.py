@@ -18,11 +18,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from _paths import SRC
 from fricid.errors import FricidWarning
 from fricid.identify import fit
 from fricid.samples import FrictionSamples
-
-SRC = Path(__file__).resolve().parents[1] / "src"
 
 #: Modules that the start of the command line must not load.
 HEAVY = (

@@ -7,7 +7,16 @@ import subprocess
 import numpy as np
 import pytest
 
-from _c_harness import compile_and_run, compile_c, needs_cc
+from _c_harness import (
+    SMOOTHINGS,
+    compile_and_run,
+    compile_c,
+    needs_cc,
+    points,
+    relative_error,
+    sum_scale,
+    zone_scale,
+)
 from fricid.errors import ConfigError
 from fricid.export import ExportError, Smoothing, c_code, export_c, smooth_predict
 from fricid.fitted import FittedModel, OptimizerRecord
@@ -61,40 +70,6 @@ def make_fitted(family: str, asym: bool) -> FittedModel:
     return FittedModel.from_values(
         name, params, operating_range=RANGE, optimizer=OptimizerRecord(method="test", seed=0)
     )
-
-
-def points(n: int = 3000, seed: int = 0) -> np.ndarray:
-    """Velocities over six decades and both signs (zero and the smoothing zone edges
-    included), loads of both signs, temperatures 0-50 degC."""
-    rng = np.random.default_rng(seed)
-    speed = 10.0 ** rng.uniform(-5, 0.7, n)
-    v = speed * rng.choice([-1.0, 1.0], n)
-    v[:8] = [0.0, -0.0, 0.01, -0.01, 0.02, -0.02, 1e-300, -1e-300]
-    return np.column_stack([v, rng.uniform(-0.5, 0.5, n), rng.uniform(0.0, 50.0, n)])
-
-
-def relative_error(c: np.ndarray, py: np.ndarray, scale: np.ndarray | None = None) -> float:
-    """max |c - py| / max(|py|, scale) over points where that is > 1e-12 N m; the others
-    must agree to 1e-18 N m."""
-    ref = np.abs(py) if scale is None else np.maximum(np.abs(py), scale)
-    big = ref > 1e-12
-    assert np.all(np.abs(c[~big] - py[~big]) <= 1e-18)
-    return float(np.max(np.abs(c[big] - py[big]) / ref[big]))
-
-
-def zone_scale(fitted: FittedModel, X: np.ndarray, smoothing: Smoothing) -> np.ndarray | None:
-    """Inside a linear zone the result is a difference of the model's values at the zone
-    edges, which cancel near the crossing of a per-direction model: the error there is
-    relative to those values (the conditioning of the formula), elsewhere to the result."""
-    if smoothing.kind != "linear":
-        return None
-    edges = [X.copy(), X.copy()]
-    edges[0][:, 0], edges[1][:, 0] = smoothing.zone, -smoothing.zone
-    level = np.maximum(*(np.abs(fitted.predict(e)) for e in edges))
-    return np.where(np.abs(X[:, 0]) < smoothing.zone, level, 0.0)
-
-
-SMOOTHINGS = [Smoothing(), Smoothing("tanh", 0.01), Smoothing("linear", 0.02)]
 
 
 @pytest.mark.slow  # 6 s measured under load (default run kept short)
@@ -210,22 +185,6 @@ def test_rbf_c_matches_python(tmp_path, inputs, velocity_scale):
         scale = zone_scale(fitted, X, smoothing)
         scale = np.maximum(0.0 if scale is None else scale, sum_scale(fitted, X))
         assert relative_error(got, want, scale) <= 1e-12, (inputs, smoothing)
-
-
-def sum_scale(fitted: FittedModel, X: np.ndarray) -> np.ndarray:
-    """sum_j |w_j phi_j(x)| + |b|: the output is a sum of these terms, which cancel where the
-    network crosses zero, so this is the scale of its rounding error (the sum's condition)."""
-    from fricid.models.rbf import predict_state
-
-    def absolute(net: dict) -> dict:
-        return {**net, "weights": np.abs(net["weights"]).tolist(), "bias": abs(net["bias"])}
-
-    state = dict(fitted.state)
-    if state.get("symmetry") == "per_direction":
-        state.update(pos=absolute(state["pos"]), neg=absolute(state["neg"]))
-    else:
-        state = absolute(state)
-    return np.abs(predict_state(state, X))  # sign(v) g(|v|): the scale is that of g
 
 
 def test_rbf_tanh_is_refused(tmp_path):

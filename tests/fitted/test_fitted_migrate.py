@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from _paths import TEST_DATA
 from fricid.errors import DataError
 from fricid.export import (
     c_code,
@@ -40,7 +41,7 @@ VERDICT_COLUMNS = (
     "extrapolation_free_range",
 )
 
-V1_FILES = Path(__file__).parent / "data" / "model_files_v1"
+V1_FILES = TEST_DATA / "model_files_v1"
 EXPECTED = json.loads((V1_FILES / "expected.json").read_text())
 FAMILIES = sorted(EXPECTED)
 

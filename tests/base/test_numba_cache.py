@@ -18,9 +18,8 @@ from pathlib import Path
 import numba
 import pytest
 
+from _paths import SRC
 from fricid import _jit
-
-SRC = Path(__file__).resolve().parents[1] / "src"
 
 #: Every module that compiles a kernel (imported, and one kernel of each family called).
 KERNEL_MODULES = (

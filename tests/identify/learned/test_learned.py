@@ -218,9 +218,8 @@ def test_hybrid_refuses_a_residual_with_a_tail(sigmoid):
 
 
 def test_hybrid_c_export_equals_python(asym, tmp_path):
-    from _c_harness import compile_and_run, needs_cc
+    from _c_harness import compile_and_run, needs_cc, points
     from fricid.export import Smoothing, export_c, smooth_predict
-    from test_export import points
 
     if needs_cc.args[0]:
         pytest.skip("no C compiler")

@@ -8,7 +8,7 @@ import warnings
 import numpy as np
 import pytest
 
-from _c_harness import compile_and_run, needs_cc
+from _c_harness import SMOOTHINGS, compile_and_run, needs_cc, points, relative_error, zone_scale
 from fricid.errors import ConfigError, IdentifiabilityWarning
 from fricid.export.c import export_c
 from fricid.fitted import FittedModel, OptimizerRecord
@@ -17,7 +17,6 @@ from fricid.models import MODELS, WithTemperature, get_model
 from fricid.models._temperature import T_REF, arrhenius_factor
 from fricid.models.smoothing import smooth_predict
 from fricid.samples import FrictionSamples
-from test_export import SMOOTHINGS, points, relative_error, zone_scale
 
 #: A law written for this test: per-direction Stribeck levels, Arrhenius viscous term (e_t
 #: 3000 K: the viscous coefficient falls by about 2.3x from 20 to 65 degC).

@@ -8,7 +8,7 @@ import json
 import numpy as np
 import pytest
 
-from _c_harness import compile_and_run, needs_cc
+from _c_harness import SMOOTHINGS, compile_and_run, needs_cc, points, relative_error
 from fricid.errors import ConfigError, DataError
 from fricid.export.c import export_c
 from fricid.fitted import FittedModel, OptimizerRecord
@@ -16,7 +16,6 @@ from fricid.identify import fit
 from fricid.models import STATEFUL, get_predictor
 from fricid.models.smoothing import smooth_predict
 from fricid.samples import FrictionSamples
-from test_export import SMOOTHINGS, points, relative_error
 
 SIGMA = 0.01
 

@@ -10,12 +10,12 @@ from __future__ import annotations
 
 import json
 import warnings
-from pathlib import Path
 
 import numpy as np
 import pytest
 from typer.testing import CliRunner
 
+from _paths import TEST_DATA
 from fricid.cli import app
 from fricid.errors import ConvergenceWarning, FricidWarning, IdentifiabilityWarning
 from fricid.extract import extract
@@ -33,7 +33,7 @@ PAPER2_TRUTH = {"tau_c": 0.084, "tau_s": 0.641, "w_s": 0.066, "tau_v": 0.0026}
 AT_OPTIMUM = 1.001
 
 #: Model files written by fricid's schema version 1 (tests/data/model_files_v1/README.md).
-V1_FILES = Path(__file__).parent / "data" / "model_files_v1"
+V1_FILES = TEST_DATA / "model_files_v1"
 
 
 def _samples(name: str, size: str, seed: int = 0):

@@ -21,9 +21,10 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
+from _paths import REPO
 from fricid.cli import app
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = REPO
 README = ROOT / "README.md"
 MANIFEST_DOC = ROOT / "docs" / "manifest.md"
 
@@ -72,22 +73,25 @@ SMALLER: dict[str, tuple[list[str], str]] = {
     ),
     "fricid fleet manifest.csv --out results/ --cluster local:2": (
         ["--cluster", "", "--workers", "1"],
-        "a Dask cluster takes seconds to start (tests/test_fleet.py runs one)",
+        "a Dask cluster takes seconds to start (tests/fleet/test_fleet.py runs one)",
     ),
 }
 
 #: Commands only parsed here (``--help`` appended: every option named must exist), because
 #: they run for minutes even at their smallest, and the test that runs them instead.
 PARSE_ONLY: dict[str, str] = {
-    "fricid demo": "tests/test_cli.py runs it (--size quick) and checks its outputs",
+    "fricid demo": "tests/cli/test_cli.py runs it (--size quick) and checks its outputs",
     "fricid fit leadscrew.csv --model auto --validate lovo": (
-        "tests/test_validation.py runs `fricid fit --model auto` (lovo, its default); on the "
+        "tests/identify/test_validation.py runs `fricid fit --model auto` (lovo, its default); "
+        "on the "
         "lead screw it refits every family per held-out level: about 40 s on 2 shared cores"
     ),
-    "fricid reproduce rwsavsbas --quick": "tests/test_reproduce.py runs it (--quick)",
-    "fricid reproduce bas-rbfnn --quick": "tests/test_reproduce.py runs it (--quick)",
-    "fricid bench stribeck": "tests/test_optim_study.py runs the study (runs=1, quick)",
-    "fricid bench rbfnn --quick": "tests/test_rbfnn_study.py runs it (--quick, fewer seeds)",
+    "fricid reproduce rwsavsbas --quick": "tests/experiments/test_reproduce.py runs it (--quick)",
+    "fricid reproduce bas-rbfnn --quick": "tests/experiments/test_reproduce.py runs it (--quick)",
+    "fricid bench stribeck": "tests/experiments/test_optim_study.py runs the study (runs=1, quick)",
+    "fricid bench rbfnn --quick": (
+        "tests/experiments/test_rbfnn_study.py runs it (--quick, fewer seeds)"
+    ),
 }
 
 

@@ -242,9 +242,8 @@ def test_cli_predict_negative_velocity_is_negative(cli_files, name):
 @pytest.mark.parametrize("name", ["rbf.json", "rbf_dir.json"])
 @pytest.mark.parametrize("smooth", ["none", "tanh"])
 def test_c_export_of_the_network_equals_python(cli_files, tmp_path, name, smooth):
-    from _c_harness import compile_and_run, needs_cc
+    from _c_harness import compile_and_run, needs_cc, points, relative_error, sum_scale
     from fricid.export import Smoothing, export_c, smooth_predict
-    from test_export import points, relative_error, sum_scale
 
     if needs_cc.args[0]:
         pytest.skip("no C compiler")

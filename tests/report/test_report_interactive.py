@@ -1,5 +1,5 @@
 """Issue 17: interactive friction figures in the HTML report (Plotly, inlined, offline), the
-static PNGs kept for the Markdown. The browser check is tests/test_report_browser.py."""
+static PNGs kept for the Markdown. The browser check is tests/report/test_report_browser.py."""
 
 from __future__ import annotations
 
