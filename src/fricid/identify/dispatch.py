@@ -24,14 +24,13 @@ import numpy as np
 
 from ..fitted import FittedModel
 from ..models import FrictionModel
-from ..optim import OptimizeResult, single_blas_thread
+from ..optim import OptimizeResult, one_blas_thread
 from ..samples import FrictionSamples, RawLog
 from ._named import KINDS, SETTINGS, _int_seed, _no_weights, _refuse, _settings, fit_named, kind_of
 
 __all__ = ["KINDS", "SETTINGS", "fit", "kind_of"]
 
 
-@single_blas_thread
 def fit(
     data: FrictionSamples | RawLog,
     model: str | FrictionModel,
@@ -109,47 +108,48 @@ def fit(
     DataError
         Data that cannot identify the model.
     """
-    kind = kind_of(data, model)
-    extra = _settings(kind, model, settings)
-    if kind == "dynamic":
-        from .dynamic.trajectory import fit_trajectory
+    with one_blas_thread():  # every least-squares path on one BLAS thread
+        kind = kind_of(data, model)
+        extra = _settings(kind, model, settings)
+        if kind == "dynamic":
+            from .dynamic.trajectory import fit_trajectory
 
-        _refuse(kind, loss=loss != "l2", weights=not _no_weights(weights), f_scale=f_scale)
-        _refuse(kind, fixed=fixed, bounds=bounds, x0=x0, options=options, callback=callback)
-        name = model if isinstance(model, str) else model.name
-        return fit_trajectory(
-            data, name, method or "lm", seed=_int_seed(seed), max_evals=max_evals, **extra
-        )
-    if kind == "auto":
-        from .static.select import select
+            _refuse(kind, loss=loss != "l2", weights=not _no_weights(weights), f_scale=f_scale)
+            _refuse(kind, fixed=fixed, bounds=bounds, x0=x0, options=options, callback=callback)
+            name = model if isinstance(model, str) else model.name
+            return fit_trajectory(
+                data, name, method or "lm", seed=_int_seed(seed), max_evals=max_evals, **extra
+            )
+        if kind == "auto":
+            from .static.select import select
 
-        _refuse(kind, fixed=fixed, bounds=bounds, x0=x0, callback=callback)
-        return select(
+            _refuse(kind, fixed=fixed, bounds=bounds, x0=x0, callback=callback)
+            return select(
+                data,
+                method or "lm",
+                seed=seed,
+                max_evals=max_evals,
+                options=options,
+                intervals=intervals,
+                loss=loss,
+                f_scale=f_scale,
+                weights=weights,
+                **extra,
+            )
+        return fit_named(
             data,
-            method or "lm",
+            model,
+            method,
+            fixed=fixed,
+            bounds=bounds,
+            x0=x0,
             seed=seed,
             max_evals=max_evals,
             options=options,
+            callback=callback,
             intervals=intervals,
             loss=loss,
             f_scale=f_scale,
             weights=weights,
-            **extra,
+            settings=settings,
         )
-    return fit_named(
-        data,
-        model,
-        method,
-        fixed=fixed,
-        bounds=bounds,
-        x0=x0,
-        seed=seed,
-        max_evals=max_evals,
-        options=options,
-        callback=callback,
-        intervals=intervals,
-        loss=loss,
-        f_scale=f_scale,
-        weights=weights,
-        settings=settings,
-    )
