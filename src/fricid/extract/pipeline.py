@@ -22,7 +22,7 @@ import numpy as np
 
 from ..errors import ConfigError, DataError
 from ..samples import FrictionSamples, RawLog
-from .accumulate import SPIKE_SIGMAS, Accumulator, default_workers
+from .accumulate import SPIKE_SIGMAS, Accumulator
 from .bins import PositionBins, pool_cells
 from .gravity import GravityFit
 from .joint_gravity import JointGravityFit, fit_gravity_joint
@@ -225,7 +225,6 @@ def extract(
     temperature_atol: float = 1.0,
     outlier_sigmas: float | None = OUTLIER_SIGMAS,
     settle_sigmas: float | None = SETTLE_SIGMAS,
-    workers: int | None = None,
 ) -> ExtractionResult:
     """Friction samples from raw constant-velocity sweeps (BAS-RBFNN paper, eq. 7-13).
 
@@ -269,10 +268,6 @@ def extract(
     settle_sigmas : float or None
         Robust standard deviations of the settling test on velocity and torque
         (:func:`fricid.extract.steady.settled`, default 5); None keeps the whole steady part.
-    workers : int, optional
-        Threads checking segments while the log is read (default one per core, at most 4,
-        :func:`~fricid.extract.accumulate.default_workers`);
-        the result does not depend on it.
 
     Returns
     -------
@@ -331,7 +326,8 @@ def extract(
         min_samples=int(min_samples),
         moments=gravity != "none",
     )
-    acc.add_all(segments, default_workers() if workers is None else int(workers))
+    for seg in segments:
+        acc.add(seg)
     source = stream.name
     kinds = acc.classify()
     keep = kinds == "setpoint"

@@ -37,11 +37,6 @@ META_KEY = b"fricid"
 #: (5 float64 columns x 256 Ki rows = 10 MB).
 ROW_GROUP_ROWS = 1 << 18
 
-#: Rows of the record batches pyarrow decodes when streaming (2 MB for 5 float64 columns):
-#: small enough that its buffers are recycled in cache, where batches of a million rows cost
-#: twice the CPU (fresh pages faulted in for every batch); chunks are assembled from them.
-READ_BATCH_ROWS = 1 << 16
-
 
 def open_parquet(path: str | os.PathLike[str]) -> pq.ParquetFile:
     """Open a Parquet file.
@@ -193,7 +188,7 @@ def iter_columns(
     DataError
         As :func:`read_columns`.
     """
-    batches = pf.iter_batches(batch_size=min(chunk_rows, READ_BATCH_ROWS), columns=labels)
+    batches = pf.iter_batches(batch_size=min(chunk_rows, 1 << 20), columns=labels)
     stream = rechunk(batches, chunk_rows)
     start = 0
     while True:
