@@ -10,10 +10,14 @@ and rail checks, binning, the eq. 7 gravity fit.
 The sizes are the BAS-RBFNN paper's full campaign on the virtual joint (``fricid simulate
 --preset paper1 --size full``, 79 million rows, 16x) and its first quarter and sixteenth (4x,
 1x; the rows of the first temperatures, cut mid-run). Each measurement runs in a fresh
-subprocess, which reports the wall time and CPU time (user + system) of the work alone (after
-its imports) and its peak resident memory (``ru_maxrss``, imports included). Repeats are
-interleaved (floor, extraction, floor, ...) and the minimum of each is shown, so a machine
-busy with other work penalises both alike; the load average is printed before and after.
+subprocess, which first does the same work on the quick campaign (imports and first calls
+outside the timing), then reports the wall time and CPU time (user + system) of the work alone
+and its peak resident memory (``ru_maxrss``, imports included). The logs are written by
+another subprocess, so the parent stays small (Linux counts the parent's resident size at the
+fork in a child's ``ru_maxrss``). Repeats are interleaved (floor, extraction, floor, ...) and
+the minimum of each is shown, so a machine busy with other work penalises both alike; the load
+average is printed before and after. The floor reads without pyarrow's pre-buffering, as
+fricid does (pre-buffering reads whole row groups ahead: more memory, no faster).
 
     python benchmarks/bench_extract.py                      # simulates the campaign (~1 min)
     python benchmarks/bench_extract.py --log full.parquet   # an existing full campaign
@@ -74,14 +78,11 @@ def extraction(path: str) -> int:
     return data.extraction.diagnostics.rows
 
 
-def child(kind: str, path: str) -> None:
-    """Run one measurement in this (fresh) process and print it as JSON."""
-    if kind == "extract":
-        import fricid.workflow  # noqa: F401  (imports outside the timing)
-    else:
-        import numpy  # noqa: F401
-        import pyarrow.parquet  # noqa: F401
+def child(kind: str, path: str, warm: str) -> None:
+    """Run one measurement in this (fresh) process and print it as JSON; the imports and
+    first calls are made on the small log ``warm`` first, outside the timing."""
     work = extraction if kind == "extract" else floor
+    work(warm)
     before = resource.getrusage(resource.RUSAGE_SELF)
     t0 = time.perf_counter()
     rows = work(path)
@@ -101,36 +102,29 @@ def child(kind: str, path: str) -> None:
     )
 
 
-def measure(kind: str, path: Path) -> dict:
+def _run(*args: str) -> str:
+    """This script in a fresh process (``src`` first on the path); its standard output."""
     env = dict(os.environ)
     src = str(Path(__file__).resolve().parents[1] / "src")
     env["PYTHONPATH"] = src + os.pathsep + env.get("PYTHONPATH", "")
     out = subprocess.run(
-        [sys.executable, __file__, "--child", kind, str(path)],
-        capture_output=True,
-        text=True,
-        env=env,
-        check=True,
+        [sys.executable, __file__, *args], capture_output=True, text=True, env=env, check=True
     )
-    return json.loads(out.stdout.strip().splitlines()[-1])
+    return out.stdout
+
+
+def measure(kind: str, path: Path, warm: Path) -> dict:
+    return json.loads(_run("--child", kind, str(path), str(warm)).strip().splitlines()[-1])
 
 
 # --------------------------------------------------------------------------- the logs
 
 
-def simulate_full(path: Path) -> None:
-    env = dict(os.environ)
-    env["PYTHONPATH"] = str(Path(__file__).resolve().parents[1] / "src")
+def simulate(size: str, path: Path) -> None:
+    """``fricid simulate --preset paper1 --size SIZE`` (seed 0), in a fresh process."""
     code = "from fricid.cli import main; main()"
-    cmd = [sys.executable, "-c", code, "simulate", "--preset", "paper1", "--size", "full"]
-    subprocess.run([*cmd, "-q", "--out", str(path)], env=env, check=True)
-
-
-def simulate_reduced(path: Path) -> None:
-    from fricid.io import write_rawlog
-    from fricid.sim import preset, simulate_log
-
-    write_rawlog(simulate_log(preset("paper1", "reduced"), seed=0), path)
+    cmd = [sys.executable, "-c", code, "simulate", "--preset", "paper1", "--size", size]
+    subprocess.run([*cmd, "-q", "--out", str(path)], check=True)
 
 
 def prefix(src: Path, dst: Path, rows: int) -> None:
@@ -164,28 +158,31 @@ def repeat(src: Path, dst: Path, times: int) -> None:
             writer.write_table(shifted, row_group_size=1 << 18)
 
 
-def logs(args, workdir: Path) -> list[tuple[int, Path]]:
-    """The three logs, smallest first: (scale, path)."""
+def make(size: str, log: str | None, workdir: Path) -> None:
+    """Write the quick campaign (the warm-up log) and the three logs to ``workdir``; print
+    them as JSON, smallest first: [[scale, path], ...]."""
     import pyarrow.parquet as pq
 
-    if args.size == "reduced":
+    simulate("quick", workdir / "quick.parquet")
+    if size == "reduced":
         base = workdir / "reduced.parquet"
-        simulate_reduced(base)
+        simulate("reduced", base)
         out = [(1, base)]
         for k in SCALES[1:]:
             repeat(base, workdir / f"reduced_x{k}.parquet", k)
             out.append((k, workdir / f"reduced_x{k}.parquet"))
-        return out
-    full = Path(args.log) if args.log else workdir / "full.parquet"
-    if not args.log:
-        simulate_full(full)
-    n = pq.ParquetFile(full).metadata.num_rows
-    out = []
-    for k in SCALES[:-1]:
-        part = workdir / f"full_{k}of{SCALES[-1]}.parquet"
-        prefix(full, part, n * k // SCALES[-1])
-        out.append((k, part))
-    return [*out, (SCALES[-1], full)]
+    else:
+        full = Path(log) if log else workdir / "full.parquet"
+        if not log:
+            simulate("full", full)
+        n = pq.ParquetFile(full).metadata.num_rows
+        out = []
+        for k in SCALES[:-1]:
+            part = workdir / f"full_{k}of{SCALES[-1]}.parquet"
+            prefix(full, part, n * k // SCALES[-1])
+            out.append((k, part))
+        out.append((SCALES[-1], full))
+    print(json.dumps([[k, str(p)] for k, p in out]))
 
 
 # --------------------------------------------------------------------------- the table
@@ -220,21 +217,27 @@ def main() -> None:
     parser.add_argument("--log", help="an existing full paper-1 campaign (Parquet)")
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--workdir", help="keep the logs here (default: a temporary folder)")
-    parser.add_argument("--child", nargs=2, metavar=("KIND", "PATH"), help=argparse.SUPPRESS)
+    parser.add_argument("--child", nargs=3, help=argparse.SUPPRESS)
+    parser.add_argument("--make", nargs=3, help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.child:
         child(*args.child)
         return
+    if args.make:
+        make(args.make[0], args.make[1] or None, Path(args.make[2]))
+        return
     workdir = Path(args.workdir or tempfile.mkdtemp(prefix="fricid-bench-extract-"))
     workdir.mkdir(parents=True, exist_ok=True)
     try:
-        sizes = logs(args, workdir)
+        made = _run("--make", args.size, args.log or "", str(workdir))
+        sizes = [(k, Path(p)) for k, p in json.loads(made.strip().splitlines()[-1])]
+        warm = workdir / "quick.parquet"
         print(f"load average before: {' '.join(f'{x:.2f}' for x in os.getloadavg())}")
         results = {k: {"floor": [], "extract": []} for k, _ in sizes}
         for _ in range(args.repeats):
             for k, path in sizes:
                 for kind in ("floor", "extract"):
-                    results[k][kind].append(measure(kind, path))
+                    results[k][kind].append(measure(kind, path, warm))
         print(f"load average after:  {' '.join(f'{x:.2f}' for x in os.getloadavg())}")
         print(
             f"min of {args.repeats} interleaved runs, each in a fresh process; cores: "

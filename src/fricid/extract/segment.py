@@ -264,13 +264,12 @@ def _sign(velocity: np.ndarray) -> np.ndarray:
 
 
 def _join(carry: RawLog | None, chunk: RawLog, stop: int) -> RawLog:
-    """Rows ``[0, stop)`` of ``carry`` followed by ``chunk``."""
-    lc = 0 if carry is None else len(carry)
-    if stop <= lc:
-        return carry.slice(0, stop)
-    if carry is None or lc == 0:
+    """Rows ``[0, stop)`` of ``carry`` followed by ``chunk`` (a copy only where they meet)."""
+    if carry is None or len(carry) == 0:
         return chunk.slice(0, stop)
-    return RawLog.concatenate([carry, chunk.slice(0, stop - lc)])
+    if stop <= len(carry):
+        return carry.slice(0, stop)
+    return RawLog.concatenate([carry, chunk.slice(0, stop - len(carry))])
 
 
 def _segment(
