@@ -13,8 +13,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.ndimage import median_filter
 
+from ._stats import median, median_filter
 from .bins import Cells, CellTable, PositionBins
 from .joint_gravity import moments
 from .quality import QUALITY_COLUMNS, QualityTable
@@ -36,12 +36,12 @@ def count_spikes(raw: np.ndarray, filtered: np.ndarray) -> int:
     """Samples the filter moved by more than SPIKE_SIGMAS robust sigmas (1.4826 MAD of the
     changes; for quantised or noiseless data with MAD 0, the median nonzero change)."""
     r = np.abs(raw - filtered)
-    scale = 1.4826 * float(np.median(r))
+    scale = 1.4826 * median(r)
     if scale == 0.0:
         nonzero = r[r > 0]
         if nonzero.size == 0:
             return 0
-        scale = float(np.median(nonzero))
+        scale = median(nonzero)
     return int(np.count_nonzero(r > SPIKE_SIGMAS * scale))
 
 
@@ -107,7 +107,7 @@ class Accumulator:
         log = seg.log
         raw = log.motor_torque  # eq. 13
         if self.window > 1:
-            tau = median_filter(raw, size=self.window, mode="nearest")
+            tau = median_filter(raw, self.window)
             spikes = count_spikes(raw, tau)
         else:
             tau, spikes = raw, 0

@@ -27,6 +27,7 @@ import numpy as np
 
 from ..errors import ConfigError
 from ..samples import RawLog
+from ._stats import median, percentile
 
 __all__ = [
     "GAP_FACTOR",
@@ -133,11 +134,11 @@ def _steady(
     # the median of the faster half: a rest (or slow drift) at either end of the run, with the
     # sign of the move, must not pull the plateau towards zero
     speed = np.abs(v)
-    plateau = float(np.median(v[speed >= 0.5 * np.percentile(speed, 99)]))
+    plateau = median(v[speed >= 0.5 * percentile(speed, 99)])
     inside = np.flatnonzero(np.abs(v - plateau) <= velocity_tolerance * abs(plateau))
     if inside.size:
         # refine: the run's median is pulled towards the ramps; the band's median is not
-        plateau = float(np.median(v[inside]))
+        plateau = median(v[inside])
         inside = np.flatnonzero(np.abs(v - plateau) <= velocity_tolerance * abs(plateau))
     if plateau == 0.0 or inside.size == 0:
         counts.dropped_no_plateau += 1
@@ -198,6 +199,7 @@ def iter_segments(
     options = (velocity_tolerance, settle_time, int(min_samples), counts)
 
     carry: RawLog | None = None  # the open run, carried into the next chunk
+    carry_sign = 0.0  # its velocity's sign (one run: one sign)
     carry_row = 0
     for chunk in as_log_stream(logs):
         counts.chunks += 1
@@ -211,29 +213,39 @@ def iter_segments(
                 yield _segment(carry, carry_row, *found)
             carry_row += len(carry)
             carry = None
-        if carry is None:
-            buf, buf_row = chunk, carry_row
-        else:
-            buf, buf_row = RawLog.concatenate([carry, chunk]), carry_row
-        sign = np.sign(buf.velocity)
-        sign[np.abs(buf.velocity) <= REST_RESIDUE] = 0.0  # float residue: not moving
-        edges = np.flatnonzero(sign[1:] != sign[:-1]) + 1
-        if len(buf) > 2:  # a gap in the recording ends a run too
-            dt = np.diff(buf.time)
-            gaps = np.flatnonzero(dt > GAP_FACTOR * float(np.median(dt))) + 1
+        # the runs of carry + chunk, found without joining the two: only the runs that start in
+        # the carry are cut from a joined copy
+        lc = 0 if carry is None else len(carry)
+        n = lc + len(chunk)
+        sign = _sign(chunk.velocity)
+        edges = np.flatnonzero(sign[1:] != sign[:-1]) + (1 + lc)
+        if lc and sign[0] != carry_sign:
+            edges = np.concatenate(([lc], edges))
+        if n > 2:  # a gap in the recording ends a run too
+            dt = np.diff(chunk.time)
+            if lc:
+                dt = np.concatenate((np.diff(carry.time), chunk.time[:1] - carry.time[-1], dt))
+            gaps = np.flatnonzero(dt > GAP_FACTOR * median(dt)) + 1
             edges = np.union1d(edges, gaps)
         starts = np.concatenate(([0], edges))
-        stops = np.concatenate((edges, [len(buf)]))
-        for start, stop in zip(starts[:-1], stops[:-1], strict=True):
-            if sign[start] == 0:
+        stops = np.concatenate((edges, [n]))
+        in_carry = int(np.searchsorted(starts, lc))  # runs starting in the carry
+        head = _join(carry, chunk, int(stops[in_carry - 1])) if in_carry else None
+        for i, (start, stop) in enumerate(zip(starts[:-1], stops[:-1], strict=True)):
+            log, offset = (head, 0) if i < in_carry else (chunk, lc)
+            if (carry_sign if i < in_carry else sign[start - lc]) == 0:
                 counts.dropped_samples += int(stop - start)
                 continue
-            found = _steady(buf, int(start), int(stop), *options)
+            found = _steady(log, int(start) - offset, int(stop) - offset, *options)
             if found is not None:
-                yield _segment(buf, buf_row, *found)
+                yield _segment(log, carry_row + offset, *found)
         last = int(starts[-1])
-        carry = buf.slice(last, len(buf))
-        carry_row = buf_row + last
+        if last < lc:  # the open run goes on through the whole chunk (``head`` holds it)
+            carry = head.slice(last, n)
+        else:
+            carry = chunk.slice(last - lc, len(chunk))
+            carry_sign = float(sign[last - lc])
+        carry_row += last
     if carry is not None and len(carry) and abs(carry.velocity[0]) > REST_RESIDUE:
         found = _steady(carry, 0, len(carry), *options)
         if found is not None:
@@ -241,6 +253,23 @@ def iter_segments(
     elif carry is not None:
         counts.dropped_samples += len(carry)
     logger.debug("segmentation: %s", counts)
+
+
+def _sign(velocity: np.ndarray) -> np.ndarray:
+    """The sign of each velocity; 0 within :data:`REST_RESIDUE` of zero (float residue: not
+    moving)."""
+    sign = np.sign(velocity)
+    sign[np.abs(velocity) <= REST_RESIDUE] = 0.0
+    return sign
+
+
+def _join(carry: RawLog | None, chunk: RawLog, stop: int) -> RawLog:
+    """Rows ``[0, stop)`` of ``carry`` followed by ``chunk`` (a copy only where they meet)."""
+    if carry is None or len(carry) == 0:
+        return chunk.slice(0, stop)
+    if stop <= len(carry):
+        return carry.slice(0, stop)
+    return RawLog.concatenate([carry, chunk.slice(0, stop - len(carry))])
 
 
 def _segment(

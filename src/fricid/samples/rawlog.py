@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import copy
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from typing import Any
@@ -12,6 +13,9 @@ from ..errors import DataError
 from ._columns import LIMITS, _as_column
 
 __all__ = ["RawLog"]
+
+#: The array columns of a :class:`RawLog`.
+_COLUMNS = ("time", "position", "velocity", "temperature", "torque", "current")
 
 
 @dataclass(frozen=True, eq=False)
@@ -145,18 +149,15 @@ class RawLog:
         Returns
         -------
         RawLog
-            The rows, as views of this log's columns (no copy).
+            The rows, as views of this log's columns (no copy; not checked again: the rows
+            of a valid log are a valid log).
         """
         s = np.s_[start:stop]
-        return replace(
-            self,
-            time=self.time[s],
-            position=self.position[s],
-            velocity=self.velocity[s],
-            temperature=self.temperature[s],
-            torque=None if self.torque is None else self.torque[s],
-            current=None if self.current is None else self.current[s],
-        )
+        out = copy.copy(self)
+        for name in _COLUMNS:
+            column = getattr(self, name)
+            object.__setattr__(out, name, None if column is None else column[s])
+        return out
 
     @staticmethod
     def concatenate(logs: list[RawLog]) -> RawLog:
@@ -188,12 +189,26 @@ class RawLog:
                 return None
             return np.concatenate(parts)
 
-        return replace(
-            first,
-            time=cat("time"),
-            position=cat("position"),
-            velocity=cat("velocity"),
-            temperature=cat("temperature"),
-            torque=cat("torque"),
-            current=cat("current"),
-        )
+        columns = {name: cat(name) for name in _COLUMNS}
+        if columns["torque"] is None and (
+            columns["current"] is None or first.torque_constant is None
+        ):
+            return replace(first, **columns)  # no usable effort: the full check says why
+        # each log is valid, so only the junctions need checking
+        row = 0
+        last = None
+        for log in logs:
+            if len(log) and last is not None and not log.time[0] > last:
+                raise DataError(
+                    f"time is not strictly increasing ({last!r} then {log.time[0]!r})",
+                    file=first.source,
+                    row=row,
+                    column="time",
+                )
+            if len(log):
+                last = log.time[-1]
+            row += len(log)
+        out = copy.copy(first)
+        for name, column in columns.items():
+            object.__setattr__(out, name, column)
+        return out
