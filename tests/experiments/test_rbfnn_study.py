@@ -117,6 +117,7 @@ def test_tables_have_every_row_and_the_papers_numbers(result):
     assert PAPER["target_mse"] == 1e-4
 
 
+@pytest.mark.slow  # shares the study's module fixture (tens of seconds)
 def test_tuning_is_apart_from_reporting(result):
     from fricid.experiments.rbfnn_config import BAS_GRID, GA_GRID, MLP_GRID
     from fricid.experiments.rbfnn_study import TUNING_SEED_OFFSET
@@ -141,6 +142,7 @@ def test_tuning_is_apart_from_reporting(result):
     assert max(reported) < cfg.seed + TUNING_SEED_OFFSET
 
 
+@pytest.mark.slow  # shares the study's module fixture (tens of seconds)
 def test_the_search_reports_what_it_achieved(result):
     s = result.tables["search"]
     assert list(s["fit"]) == ["fold 1", "fold 2", "all data"]
@@ -157,6 +159,7 @@ def test_the_search_reports_what_it_achieved(result):
     assert "improved the training MSE in" in search_note(result)
 
 
+@pytest.mark.slow  # shares the study's module fixture (tens of seconds)
 def test_warnings_are_counted_not_silenced(result):
     t3 = result.tables["table3"]
     assert t3["warnings"].dtype.kind == "i" and (t3["warnings"] >= 0).all()
@@ -184,6 +187,7 @@ def test_ga_population_starts_around_x0():
     assert np.max(np.abs(seen[0].reshape(-1, 3) - x0)) > 0.5  # uniform in the box
 
 
+@pytest.mark.slow  # shares the study's module fixture (tens of seconds)
 def test_curves_and_predictions(result):
     for label in ("GA-RBFNN", "BAS-RBFNN"):
         curves = result.curves[label]
@@ -194,6 +198,7 @@ def test_curves_and_predictions(result):
     assert result.predictions["RBFNN"].shape == result.predictions["measured"].shape
 
 
+@pytest.mark.slow  # shares the study's module fixture (tens of seconds)
 def test_outputs_written(result, tmp_path):
     paths = write_outputs(result, tmp_path / "out")
     names = {p.name for p in paths}

@@ -81,6 +81,7 @@ def test_bas_rbfnn_quick_has_every_item(bas_rbfnn):
     assert "simulating" in res.output  # progress was shown
 
 
+@pytest.mark.slow  # shares the study's module fixture (tens of seconds)
 def test_bas_rbfnn_every_table_and_figure_of_the_paper(bas_rbfnn):
     out, res = bas_rbfnn
     html, files = check_folder(out)
@@ -114,6 +115,7 @@ def test_bas_rbfnn_every_table_and_figure_of_the_paper(bas_rbfnn):
     assert f"[{n}/{n}]" in res.output  # every progress step was shown
 
 
+@pytest.mark.slow  # shares the study's module fixture (tens of seconds)
 def test_bas_rbfnn_table3_paper_beside_ours_all_data_and_held_out(bas_rbfnn):
     out, _ = bas_rbfnn
     t3 = pd.read_csv(out / "table3_prediction_errors.csv").set_index("model")
@@ -134,6 +136,7 @@ def test_bas_rbfnn_table3_paper_beside_ours_all_data_and_held_out(bas_rbfnn):
     assert "GP" in t3.index and t3.loc["GP", "paper: mean [mN m]"] != t3.loc["GP", ours[0]]
 
 
+@pytest.mark.slow  # shares the study's module fixture (tens of seconds)
 def test_bas_rbfnn_table4_fig9_fig10_paper_beside_ours(bas_rbfnn):
     out, _ = bas_rbfnn
     t4 = pd.read_csv(out / "table4_ga_vs_bas.csv").set_index("model")
@@ -184,6 +187,7 @@ def test_rwsavsbas_quick_has_every_item(rwsavsbas):
     assert "a calibration, not a reproduction" in md
 
 
+@pytest.mark.slow  # shares the study's module fixture (tens of seconds)
 def test_rwsavsbas_runs_on_the_leadscrew_per_direction(rwsavsbas, leadscrew_dir):
     out, _ = rwsavsbas
     _, files = check_folder(out)
