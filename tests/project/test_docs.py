@@ -241,7 +241,7 @@ def build_workspace(ws: Path, leadscrew: Path) -> None:
 
 #: The real lead-screw recordings (tests/conftest.py's ``leadscrew_dir``), which the commands
 #: naming one of :data:`NEEDS_REAL` read; they are skipped, with the reason, where absent.
-LEADSCREW = Path(__file__).resolve().parents[2] / "shared" / "data" / "real" / "epos-leadscrew"
+LEADSCREW = REPO.parent / "shared" / "data" / "real" / "epos-leadscrew"
 NEEDS_REAL = ("epos-leadscrew", "leadscrew.csv", "recordings/", "resaved/")
 
 
