@@ -512,3 +512,25 @@ def test_rate_bias_says_why_it_was_not_estimated(monkeypatch):
     assert "rate bias: not estimated (the simulation at the estimate diverged)" in (
         trajectory_text(fitted)
     )
+
+
+def test_an_interval_that_spans_the_box_is_not_identified(tmp_path):
+    """The README's 10 s multi-sine does not inform sigma_1: its interval spans the whole
+    search box, and the parameter record says so (not determined, with the reason), as an
+    analytic fit's does; the parameters the log informs keep closed intervals."""
+    runner = CliRunner()
+    log = tmp_path / "traj.parquet"
+    res = runner.invoke(app, ["simulate", "--trajectory", "multisine", "--duration", "10",
+                              "--out", str(log)])  # fmt: skip
+    assert res.exit_code == 0, res.output
+    res = runner.invoke(app, ["fit", str(log), "--trajectory", "--model", "lugre",
+                              "--out", str(tmp_path / "l.json")])  # fmt: skip
+    assert res.exit_code == 0, res.output
+    fitted = FittedModel.load(tmp_path / "l.json")
+    spans = [n for n, p in fitted.parameters.items() if p.low_open and p.high_open]
+    assert "sigma_1" in spans
+    for name in spans:
+        record = fitted.parameters[name]
+        assert record.not_determined and record.note.startswith("not identified")
+    assert fitted.parameters["sigma_2"].not_determined is False
+    assert "[not identified: the 95 % interval spans" in res.stdout

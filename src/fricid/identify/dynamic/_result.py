@@ -201,12 +201,21 @@ def _records(
     """One :class:`~fricid.fitted.Parameter` per name of the final table: value, standard
     error, the cluster-robust 95 % interval (its ends open where they reach the search box),
     and at a bound where the value is within ``1e-6`` relative of one; ``note`` says why an
-    interval is missing (an unconverged fit's: no end is then open)."""
+    interval is missing (an unconverged fit's: no end is then open). A parameter whose
+    interval spans the whole search box is not identified, as an analytic fit says it."""
     out = {}
     for n in names:
         row, box = final[n], bounds.get(n)
         value, se = float(row["value"]), float(row["stderr"])
         low, high = float(row["ci95_low"]), float(row["ci95_high"])
+        low_open = box is not None and not note and bool(low <= box[0])
+        high_open = box is not None and not note and bool(high >= box[1])
+        why = note
+        if low_open and high_open:  # as an analytic fit says it (static.uncertainty)
+            why = (
+                "not identified: the 95 % interval spans the whole search range "
+                f"[{box[0]:.4g}, {box[1]:.4g}]"
+            )
         out[n] = Parameter(
             n,
             value,
@@ -215,14 +224,14 @@ def _records(
             stderr=se,
             ci95=(low, high),
             ci95_halfwidth=(high - low) / 2,
-            low_open=box is not None and not note and bool(low <= box[0]),
-            high_open=box is not None and not note and bool(high >= box[1]),
+            low_open=low_open,
+            high_open=high_open,
             at_bound=box is not None
             and bool(
                 np.isclose(value, box[0], rtol=1e-6, atol=0)
                 or np.isclose(value, box[1], rtol=1e-6, atol=0)
             ),
-            note=note,
-            not_determined=is_not_determined(note, se, converged),
+            note=why,
+            not_determined=is_not_determined(why, se, converged),
         )
     return out
