@@ -26,20 +26,9 @@ from fricid.export import (
 from fricid.fitted import SCHEMA_VERSION, FittedModel
 from fricid.fleet.job import fit_row
 from fricid.fleet.manifest import JointSpec
+from fricid.fleet.table import VERDICT_COLUMNS
 from fricid.identify._diagnostics import not_determined, open_sides
 from fricid.report.model import parameter_table
-
-#: The fleet row's verdict columns: read from the trust record (none in these checks).
-VERDICT_COLUMNS = (
-    "trust",
-    "converged",
-    "heldout_ratio",
-    "heldout_source",
-    "heldout_scheme",
-    "verdict",
-    "n_not_determined",
-    "extrapolation_free_range",
-)
 
 V1_FILES = TEST_DATA / "model_files_v1"
 EXPECTED = json.loads((V1_FILES / "expected.json").read_text())
