@@ -107,15 +107,17 @@ def _check_stuck_effort(log: RawLog) -> None:
     span = float(np.ptp(log.velocity))
     change = np.flatnonzero(steps > 0) + 1
     starts, stops = np.r_[0, change], np.r_[change, n]
-    for k in np.flatnonzero(stops - starts >= STUCK_MIN_SAMPLES):
-        a, b = int(starts[k]), int(stops[k])
-        sweep = float(np.ptp(log.velocity[a:b]))
-        if span > 0 and sweep >= STUCK_SWEEP * span:
-            raise DataError(
-                f"the {name} holds {float(x[a]):.6g} {unit} for rows {a} to {b - 1} "
-                f"({float(log.time[b - 1] - log.time[a]):.3g} s) while the velocity changes by "
-                f"{sweep:.3g} rad/s: a stuck sensor or a saturated drive; cut that stretch out",
-                file=log.source,
-                row=a,
-                column=name,
-            )
+    v = log.velocity
+    sweeps = np.maximum.reduceat(v, starts) - np.minimum.reduceat(v, starts)  # per held run
+    stuck = (stops - starts >= STUCK_MIN_SAMPLES) & (sweeps >= STUCK_SWEEP * span)
+    if span > 0 and stuck.any():
+        k = int(np.argmax(stuck))
+        a, b, sweep = int(starts[k]), int(stops[k]), float(sweeps[k])
+        raise DataError(
+            f"the {name} holds {float(x[a]):.6g} {unit} for rows {a} to {b - 1} "
+            f"({float(log.time[b - 1] - log.time[a]):.3g} s) while the velocity changes by "
+            f"{sweep:.3g} rad/s: a stuck sensor or a saturated drive; cut that stretch out",
+            file=log.source,
+            row=a,
+            column=name,
+        )
