@@ -1,13 +1,14 @@
 # fricid: two commands on a fresh machine, `make demo` and `make test`.
 # `make test` leaves out the tests marked slow (a few minutes on two cores); `make test-all`
-# runs the whole suite, as CI (.ci/run) does.
+# runs the whole suite, as CI (.ci/run) does; `make docs` builds the documentation site.
 PYTHON ?= python3
 VENV   ?= .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 DEVSTAMP := $(VENV)/.installed-dev
+DOCSTAMP := $(VENV)/.installed-docs
 
-.PHONY: demo test test-all lint bench clean
+.PHONY: demo test test-all lint docs bench clean
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -21,6 +22,10 @@ $(DEVSTAMP): pyproject.toml | $(BIN)/python
 	$(BIN)/python -m pip install --quiet -e ".[dev]"
 	touch $(STAMP) $@
 
+$(DOCSTAMP): pyproject.toml | $(BIN)/python
+	$(BIN)/python -m pip install --quiet -e ".[docs]"
+	touch $(STAMP) $@
+
 demo: $(STAMP)
 	$(BIN)/fricid demo
 
@@ -31,11 +36,15 @@ test-all: $(DEVSTAMP)
 	$(BIN)/python -m pytest -m ""
 
 lint: $(DEVSTAMP)
-	$(BIN)/ruff check src tests benchmarks
-	$(BIN)/ruff format --check src tests benchmarks
+	$(BIN)/ruff check src tests benchmarks docs
+	$(BIN)/ruff format --check src tests benchmarks docs
+
+# The documentation site (mkdocs.yml) into site/, offline; any warning fails the build.
+docs: $(DOCSTAMP)
+	NO_MKDOCS_2_WARNING=1 $(BIN)/mkdocs build --strict --quiet
 
 bench: $(STAMP)
 	@for b in benchmarks/bench_*.py; do echo "== $$b"; $(BIN)/python $$b || exit 1; done
 
 clean:
-	rm -rf $(VENV) build dist src/*.egg-info .pytest_cache fricid-demo
+	rm -rf $(VENV) build dist site src/*.egg-info .pytest_cache fricid-demo

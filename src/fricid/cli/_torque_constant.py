@@ -1,5 +1,6 @@
-"""``fricid extract``'s torque-constant flags: K of eq. 13 (``tau = K I``) from a torque sensor
-(``--identify-torque-constant``) or from the gravity load a URDF gives (``--urdf``)."""
+"""``fricid extract``'s torque-constant flags: K of the BAS-RBFNN paper's eq. 13
+(``tau = K I``) from a torque sensor (``--identify-torque-constant``) or from the gravity load
+a URDF gives (``--urdf``)."""
 
 from __future__ import annotations
 

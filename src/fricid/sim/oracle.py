@@ -1,4 +1,5 @@
-"""The test oracle: what an extraction of a simulated campaign should find.
+"""The test oracle: what an extraction of a simulated campaign should find (the equations cited
+are the BAS-RBFNN paper's).
 
 Rows follow the extractor's order: temperature, then velocity set-point, then position bin
 (ascending), then, per direction, -1 before +1. Truth is taken at the nominal operating point
