@@ -98,7 +98,7 @@ def exported(pkg: griffe.Module, name: str) -> list[str]:
             runtime = importlib.import_module(f"fricid.{name}")
         finally:
             sys.path.remove(str(SRC))
-        names = list(runtime.__all__)
+        names = list(getattr(runtime, "__all__", []))
         where = getattr(runtime, "_WHERE", {})
         return [
             _target(pkg[f"{name}.{where[n]}.{n}"]) if n in where else _target(module[n])
@@ -118,9 +118,8 @@ def reference_page(pkg: griffe.Module, name: str) -> str:
         "      show_root_heading: false",
         "",
     ]
-    if pkg[name].is_package or pkg[name].exports:
-        for path in exported(pkg, name):
-            lines += [f"::: {path}", ""]
+    for path in exported(pkg, name):
+        lines += [f"::: {path}", ""]
     return "\n".join(lines)
 
 
@@ -138,9 +137,8 @@ def rendered_paths(pkg: griffe.Module) -> set[str]:
 
     for name in PACKAGES:
         out.add(f"fricid.{name}")
-        if pkg[name].is_package or pkg[name].exports:
-            for path in exported(pkg, name):
-                walk(pkg[path.removeprefix("fricid.")])
+        for path in exported(pkg, name):
+            walk(pkg[path.removeprefix("fricid.")])
     return out
 
 

@@ -35,13 +35,15 @@ async def _quiet_shutdown() -> None:
 class DaskExecutor:
     """Runs the items as Dask tasks on ``client``'s cluster.
 
-    Parameters
-    ----------
-    client : a connected ``distributed.Client``.
-    cluster : a cluster this executor started and closes with itself, if any.
-
     Use :meth:`local` or :meth:`from_spec` to make one; use it as a context manager (or call
     :meth:`close`) to release the client and a cluster it started.
+
+    Parameters
+    ----------
+    client : distributed.Client
+        A connected client.
+    cluster : distributed.SpecCluster or None
+        A cluster this executor started and closes with itself, if any.
     """
 
     name = "dask"
