@@ -48,7 +48,7 @@ def test_paper1_full_is_the_papers_design():
     np.testing.assert_allclose(np.degrees(d.velocities[[0, 4, -1]]), [0.1, 2, 50])
     np.testing.assert_allclose(d.temperatures[[0, -1]], [5, 45])
     assert d.repetitions == 10 and d.sample_rate == 250
-    assert 60e6 < d.n_samples() < 90e6  # "about 70 million raw samples"
+    assert 60e6 < d.n_samples() < 90e6  # tens of millions of raw samples
     assert true_gravity(preset("paper1")) == (0.2011, 0.06175)
 
 

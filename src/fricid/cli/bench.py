@@ -54,9 +54,7 @@ def stribeck_command(
 
     Budgets rather than times: 8 runs per method; RWSAVSBAS 1000 x 100 iterations (301,001
     evaluations per run) and every equal-budget row as many; dual annealing and CMA-ES
-    10,000 (--quick: 30,101 and 3,000). Measured with benchmarks/bench_stribeck.py on 2
-    cores shared with other jobs: --quick 24 s and 235 s in two runs half an hour apart as the
-    load grew; the full settings 579 s (load average about 14; dual annealing 3 % of it).
+    10,000 (--quick: 30,101 and 3,000); benchmarks/bench_stribeck.py times it.
     """
     from ..experiments.stribeck_study import run_study
     from ..report.studies.stribeck import report_text, write_outputs

@@ -60,9 +60,7 @@ def rbfnn_command(
     setting, --quick 20 epochs), and the search's own gain over its start is reported.
 
     Budgets rather than times: Table 4 runs 5 seeds x 300 epochs x 30 evaluations per method
-    (7 methods with the variants), on 6615 samples. Measured with
-    benchmarks/bench_rbfnn.py --quick on 2 cores shared with other jobs (load average above
-    10): 273 s; the full settings were not timed on that machine.
+    (7 methods with the variants), on 6615 samples; benchmarks/bench_rbfnn.py times it.
     """
     from ..experiments.rbfnn_study import run_study, study_config
     from ..report.studies.rbfnn import summary_markdown, write_outputs

@@ -23,10 +23,7 @@ def reproduce_command(
         bool,
         quick_option(
             "Reduced designs and budgets (RWSAVSBAS: its schedule compressed ten-fold; "
-            "BAS-RBFNN: the 330-sample design, smaller networks). Measured as the setup of "
-            "tests/experiments/test_reproduce.py (pytest --durations) on 2 cores shared with "
-            "other jobs, "
-            "load average about 14: rwsavsbas 221 s, bas-rbfnn 175 s."
+            "BAS-RBFNN: the 330-sample design, smaller networks)."
         ),
     ] = False,
     seed: Annotated[int, seed_option("Random seed (same seed, same report).")] = 0,

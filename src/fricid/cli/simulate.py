@@ -12,6 +12,11 @@ from rich.markup import escape
 from ._app import app, err_console, handle_errors
 from ._progress import QuietOption, progress_bar
 
+#: Raw samples of the full ``paper1`` campaign, in millions, for ``--help`` (importing the
+#: simulator to count them would slow every command's start; tests/cli checks the count
+#: against ``preset("paper1", "full").design.n_samples()``).
+PAPER1_FULL_MILLIONS = 79
+
 
 def design_hints(scenario) -> dict:
     """What a later ``fricid extract`` needs to know about a simulated design (kept in the
@@ -66,7 +71,7 @@ def simulate_command(
     size: Annotated[
         str,
         typer.Option(
-            help="full (the paper's design; paper1 is ~70 million "
+            help=f"full (the paper's design; paper1 is about {PAPER1_FULL_MILLIONS} million "
             "samples), reduced (seconds), quick (tests)."
         ),
     ] = "reduced",

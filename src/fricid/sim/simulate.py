@@ -212,7 +212,7 @@ def simulate(
 
 def simulate_log(scenario: Scenario, *, seed: SeedLike = None) -> RawLog:
     """The whole campaign as one :class:`RawLog` (for the ``reduced`` and ``quick`` sizes; the
-    full ``paper1`` campaign is about 70 million samples: stream :func:`simulate` instead)."""
+    full ``paper1`` campaign is tens of millions of samples: stream :func:`simulate` instead)."""
     entropy = root_entropy(seed)
     log = RawLog.concatenate(list(simulate(scenario, seed=entropy, chunk="experiment")))
     meta = {"scenario": scenario.name, "size": scenario.size, "seed_entropy": entropy}
