@@ -5,7 +5,7 @@ checks the README against those files (``benchmarks/readme_numbers.py`` renders 
 
 - ``quickstart``: the README's Quick start on the real lead-screw recordings
   (``../shared/data/real/epos-leadscrew``): ``fricid extract`` then ``fricid fit``, each
-  command's stdout (``--quiet``: no progress lines) and wall time, into
+  command's stdout and stderr (``--quiet``: no progress lines) and wall time, into
   ``benchmarks/results/quickstart.json``; then ``fricid report`` on that model, and a
   screenshot of its ``report.html`` (title, summary, first figure) in headless Chromium
   (Selenium; Debian's ``chromium`` and ``chromium-driver``), scaled down, into
@@ -48,8 +48,9 @@ QUICKSTART = (
 PICTURE_WIDTH = 720
 
 
-def _fricid(args: list[str], cwd: Path) -> tuple[str, float, float]:
-    """Run ``fricid ARGS`` in ``cwd`` with this checkout's sources: (stdout, wall [s], CPU [s])."""
+def _fricid(args: list[str], cwd: Path) -> tuple[str, str, float, float]:
+    """Run ``fricid ARGS`` in ``cwd`` with this checkout's sources: stdout, stderr, wall and
+    CPU time [s] of the process."""
     env = {**os.environ, "PYTHONPATH": str(ROOT / "src"), "COLUMNS": "100"}
     code = "import sys; from fricid.cli import main; sys.argv[0] = 'fricid'; main()"
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
@@ -62,7 +63,7 @@ def _fricid(args: list[str], cwd: Path) -> tuple[str, float, float]:
     if res.returncode != 0:
         raise SystemExit(f"fricid {' '.join(args)}: exit {res.returncode}\n{res.stderr}")
     cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
-    return res.stdout, wall, cpu
+    return res.stdout, res.stderr, wall, cpu
 
 
 def _machine() -> dict:
@@ -137,8 +138,10 @@ def quickstart() -> None:
         (shared / "epos-leadscrew").symlink_to(LEADSCREW, target_is_directory=True)
         runs = []
         for command in QUICKSTART:
-            out, wall, cpu = _fricid(["--quiet", *command.split()[1:]], work)
-            runs.append({"command": command, "stdout": out, "wall_s": wall, "cpu_s": cpu})
+            out, err, wall, cpu = _fricid(["--quiet", *command.split()[1:]], work)
+            runs.append(
+                {"command": command, "stdout": out, "stderr": err, "wall_s": wall, "cpu_s": cpu}
+            )
             print(f"{command}: {wall:.1f} s")
         _write("quickstart.json", {"commands": runs, "machine": _machine()})
         _fricid(["--quiet", "report", "leadscrew.json", "leadscrew.csv", "--out", "rep"], work)
@@ -147,7 +150,7 @@ def quickstart() -> None:
 
 def demo() -> None:
     with tempfile.TemporaryDirectory() as tmp:
-        _, wall, cpu = _fricid(["--quiet", "demo"], Path(tmp))
+        _, _, wall, cpu = _fricid(["--quiet", "demo"], Path(tmp))
     print(f"fricid demo: {wall:.1f} s wall, {cpu:.1f} s CPU")
     previous = RESULTS / "demo.json"
     fresh = None
@@ -163,8 +166,10 @@ def demo() -> None:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("parts", nargs="*", choices=["quickstart", "demo"], default=[])
+    ap.add_argument("parts", nargs="*", help="quickstart, demo (default: both)")
     parts = ap.parse_args().parts or ["quickstart", "demo"]
+    if set(parts) - {"quickstart", "demo"}:
+        ap.error(f"unknown part(s): {sorted(set(parts) - {'quickstart', 'demo'})}")
     if "quickstart" in parts:
         quickstart()
     if "demo" in parts:
