@@ -55,14 +55,20 @@ PAPERS = {
     "CW95": (r"Canudas de Wit|\[CW95\]", "Canudas de Wit et al. 1995 (the LuGre model)"),
     "D76": (r"\[D76\]|Dahl \(?1976", "Dahl 1976 (the Dahl model)"),
     "GZ": (r"\[GZ\]|Gaz et al", "Gaz et al. 2019 (the Franka Emika Panda's friction)"),
+    "RW06": (
+        r"R&W|Rasmussen (?:&|and) (?:C\. K\. I\. )?Williams",
+        "Rasmussen and Williams 2006 (Gaussian Processes for Machine Learning)",
+    ),
+    "QR05": (
+        r"Quinonero-Candela",
+        "Quinonero-Candela and Rasmussen 2005 (sparse Gaussian processes)",
+    ),
     "ESL": (
         r"\bESL\b",
         "ESL (Hastie, Tibshirani and Friedman, The Elements of Statistical Learning)",
     ),
 }
 UNNAMED = "paper not named in the docstring"
-#: A paper named this close before an equation reference (in characters) is its paper.
-NEAR = 40
 _PAPER = re.compile("|".join(f"(?P<{k.replace('-', '_')}>{rx})" for k, (rx, _) in PAPERS.items()))
 #: ``eq. 7``, ``Eq. 7``, ``eqs. 14-15``, ``eq. (3)``, ``equation 13``, ``eq. 3.50``.
 _EQ = re.compile(
@@ -173,10 +179,21 @@ def _first_paper(obj: griffe.Object) -> str | None:
     return None
 
 
-def _paper_of(text: str, start: int, obj: griffe.Object) -> str:
-    """The paper of the equation reference at ``text[start:]``: one named just before it
-    (within :data:`NEAR` characters), else the first the docstring names, else its module's."""
-    before = list(_PAPER.finditer(text, max(0, start - NEAR), start))
+#: A paper named right after the reference: ``eq. 18 of [B]``, ``eq. 7 in the RWSAVSBAS paper``.
+_AFTER = re.compile(r"\s*(?:of|in|from)\s+(?:the\s+)?")
+
+
+def _paper_of(text: str, start: int, obj: griffe.Object, end: int | None = None) -> str:
+    """The paper of the equation reference ``text[start:end]``: one named right after it
+    (``eq. 18 of [B]``), else the one named last before it in its paragraph, else the first
+    its docstring names, else its module's."""
+    if end is not None:
+        after = _AFTER.match(text, end)
+        named = after and _PAPER.match(text, after.end())
+        if named:
+            return _paper_key(named)
+    paragraph_start = text.rfind("\n\n", 0, start) + 1
+    before = list(_PAPER.finditer(text, paragraph_start, start))
     if before:
         return _paper_key(before[-1])
     return _first_paper(obj) or UNNAMED
@@ -195,7 +212,7 @@ def citations(pkg: griffe.Module) -> list[Citation]:
     for obj in _objects(pkg):
         text = obj.docstring.value if obj.docstring else ""
         for m in _EQ.finditer(text):
-            paper = _paper_of(text, m.start(), obj)
+            paper = _paper_of(text, m.start(), obj, m.end())
             out += [Citation(paper, eq, obj.path) for eq in _labels(m.group(1), m.group(2))]
     return out
 
@@ -218,8 +235,10 @@ def equation_index(pkg: griffe.Module | None = None) -> str:
         "Where each equation of the papers fricid implements is cited in its docstrings, "
         "generated from the sources by `docs/hooks.py` at every build "
         f"({len(cites)} citations in {len({c.path for c in cites})} docstrings). "
-        "An equation is attributed to the paper its docstring names before it, else to the "
-        "paper its module's docstring names. Objects of the API reference are links; the "
+        "An equation is attributed to the paper named right after it (eq. 18 of [B]), else "
+        "to the one its docstring names last before it in the same paragraph, else to the "
+        "first paper the docstring names, else to its module's. "
+        "Objects of the API reference are links; the "
         "others are private helpers, named by their path.",
         "",
     ]
@@ -243,7 +262,7 @@ def equation_index(pkg: griffe.Module | None = None) -> str:
 
 # ---------------------------------------------------------------------------- MkDocs hooks
 
-_ROLE = re.compile(r":(?:py:)?(?:func|class|meth|attr|data|mod|obj|exc|const):(<code>)")
+_ROLE = re.compile(r":(?:py:)?(?:func|class|meth|attr|data|mod|obj|exc|const):(<code>)~?")
 
 
 def on_config(config, **kwargs):

@@ -142,8 +142,12 @@ def test_equation_index_is_generated_from_the_docstrings(hooks, pkg):
     # eq. 13 (tau = K I) of the BAS-RBFNN paper is cited by the extraction's docstring
     row = next(line for line in index.split("## ")[1].splitlines() if line.startswith("| eq. 13 |"))
     assert "[`extract.pipeline.extract`][fricid.extract.pipeline.extract]" in row
-    # a paper named right before the reference wins over the docstring's first paper
-    assert hooks._paper_of("BAS-RBFNN eq. 2, RWSAVSBAS paper eq. 7", 29, pkg) == "RWSAVSBAS"
+    # a paper named after the reference ("eq. 18 of [B]"), else the last one named before it
+    # in its paragraph, wins over the docstring's first paper
+    text = "BAS-RBFNN eq. 2, RWSAVSBAS paper eq. 7; b from eq. 18 of [B]\n\nthe eq. 11"
+    refs = list(hooks._EQ.finditer(text))
+    papers = [hooks._paper_of(text, m.start(), pkg["sim"], m.end()) for m in refs]
+    assert papers == ["BAS-RBFNN", "RWSAVSBAS", "BAS-RBFNN", hooks.UNNAMED]  # sim names none
     assert hooks._labels("14", "15") == ["14", "15"] and hooks._labels("3.50", None) == ["3.50"]
 
 

@@ -2,14 +2,14 @@
 
 One kernel, :func:`loss_kernel`, evaluates the identification loss of a batch of candidates
 ``X (k, d)`` (the free parameters) on the samples in one compiled loop, for coulomb_viscous
-(BAS-RBFNN paper eq. 1), stribeck (eq. 2 there; RWSAVSBAS paper eq. 7), msk (eq. 3) and vlt
-(eq. 4, as read in :class:`~fricid.models.VelocityLoadTemperature`), their per-direction
-``_asym`` variants, and the ``_temp`` / ``_temp_asym`` variants of the first three (the viscous
-coefficient scaled by :func:`~fricid.models._temperature.arrhenius_factor`). It computes
-exactly what :meth:`fricid.identify.problem.IdentificationProblem.evaluate` computes with
-numpy (the same formulas, weights, robust losses and ``mse`` divisor), up to rounding (the
-tests hold the two to 1e-12 relative); it is written once for all models and branches on a
-model code, so numba compiles (and caches) one function for every model.
+(BAS-RBFNN paper eq. 1), stribeck (eq. 2 there; RWSAVSBAS paper eq. 7), msk (BAS-RBFNN eq. 3)
+and vlt (BAS-RBFNN eq. 4, as read in :class:`~fricid.models.VelocityLoadTemperature`), their
+per-direction ``_asym`` variants, and the ``_temp`` / ``_temp_asym`` variants of the first three
+(the viscous coefficient scaled by :func:`~fricid.models._temperature.arrhenius_factor`). It
+computes exactly what :meth:`fricid.identify.problem.IdentificationProblem.evaluate` computes
+with numpy (the same formulas, weights, robust losses and ``mse`` divisor), up to rounding (the
+tests hold the two to 1e-12 relative); it is written once for all models and branches on a model
+code, so numba compiles (and caches) one function for every model.
 
 ``data`` (:func:`kernel_data`) is a tuple of fixed types: inputs ``(n, 3)``, friction ``(n,)``,
 square roots of the weights ``(n,)`` (ones when unweighted), the full parameter vector with the

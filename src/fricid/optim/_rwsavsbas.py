@@ -39,9 +39,10 @@ class RWSAVSBAS(Solver):
       1. ``b`` from eq. 18 of [B]; antennae ``x_r = x + (step / c) b``, ``x_l = x - (step / c) b``
          (eq. 19; [R] 4.1: ratio of step to antenna distance ``c = 3``);
       2. the wandering antenna ``x_w = G + sin(2 pi P / h_inner) step w`` ([R] 3.1.1);
-      3. the BAS solution ``x_B = x - step b sign(f(x_r) - f(x_l))`` (eq. 20 for minimisation),
-         credited with the value of the better antenna, ``f_B = min(f(x_r), f(x_l))`` (it is not
-         evaluated: three evaluations per inner iteration);
+      3. the BAS solution ``x_B = x - step b sign(f(x_r) - f(x_l))`` (eq. 20 of [B], for
+         minimisation), credited with the value of the better antenna,
+         ``f_B = min(f(x_r), f(x_l))`` (it is not evaluated: three evaluations per inner
+         iteration);
       4. Metropolis ([R] 3.1.2): the beetle continues from the wandering point if
          ``f(x_w) <= f_B`` or, when worse, with probability ``exp(-(f(x_w) - f_B) / T)``
          (tested as ``f(x_w) - f_B < -T log U``); otherwise from ``x_B``;
