@@ -44,8 +44,9 @@ QUICKSTART = (
     "--out leadscrew.csv",
     "fricid fit leadscrew.csv --model stribeck_asym --out leadscrew.json",
 )
-#: Width of the README's picture [px].
+#: Width of the README's picture [px], and its palette's size.
 PICTURE_WIDTH = 720
+PICTURE_COLOURS = 96
 
 
 def _fricid(args: list[str], cwd: Path) -> tuple[str, str, float, float]:
@@ -122,7 +123,8 @@ def screenshot(html: Path, png: Path, width: int = PICTURE_WIDTH) -> None:
     sheet.paste(fig, ((top.width - fig.width) // 2, top.height))
     small = sheet.resize((width, round(sheet.height * width / sheet.width)), Image.LANCZOS)
     png.parent.mkdir(parents=True, exist_ok=True)
-    small.save(png, optimize=True)
+    small = small.quantize(colors=PICTURE_COLOURS, method=Image.Quantize.FASTOCTREE)
+    small.save(png, optimize=True)  # a small file in the repository
     print(f"wrote {png} ({png.stat().st_size // 1024} KiB)")
 
 
