@@ -183,3 +183,39 @@ def test_site_page_examples_run(page, docs_workspace, tmp_path, monkeypatch):
     if any(name in text for name in NEEDS_REAL) and not LEADSCREW.is_dir():
         pytest.skip(f"real recordings not found at {LEADSCREW} (the page reads them)")
     _run_page(page, docs_workspace, tmp_path, monkeypatch)
+
+
+# ------------------------------------------------------------ the API reference's examples
+
+
+def _modules_with_examples() -> list[str]:
+    """The modules whose docstrings hold ``>>>`` examples (the API reference shows them)."""
+    out = []
+    for path in sorted((SRC / "fricid").rglob("*.py")):
+        if ">>>" in path.read_text(encoding="utf-8"):
+            parts = path.relative_to(SRC).with_suffix("").parts
+            out.append(".".join(parts[:-1] if parts[-1] == "__init__" else parts))
+    return out
+
+
+@pytest.mark.slow  # the modules' imports and a compensation run: seconds
+def test_docstring_examples_run(tmp_path, monkeypatch):
+    """Every ``>>>`` example in fricid's docstrings runs as a doctest (the ones marked
+    ``+SKIP`` need files a reader has: a bag, a samples file) and prints what it shows."""
+    import doctest
+    import importlib
+
+    monkeypatch.chdir(tmp_path)  # examples that write files write here
+    flags = doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE
+    attempted, failures = 0, []
+    for name in _modules_with_examples():
+        module = importlib.import_module(name)
+        runner = doctest.DocTestRunner(optionflags=flags)
+        for test in doctest.DocTestFinder().find(module, name):
+            out = io.StringIO()
+            result = runner.run(test, out=out.write)
+            if result.failed:
+                failures.append(out.getvalue())
+        attempted += runner.summarize(verbose=False).attempted
+    assert not failures, "\n".join(failures)
+    assert attempted >= 50, attempted

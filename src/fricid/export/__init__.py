@@ -1,9 +1,17 @@
 """Models out: C99 code, URDF / MJCF snippets, ros2_control-style YAML, the model file schema.
 
->>> from fricid.export import export_c, urdf_text, Smoothing      # doctest: +SKIP
->>> export_c(fitted, "out/", Smoothing("tanh", 0.01))              # out/fricid_friction.[ch]
->>> export_c(fitted, "out/", clamp=True)                           # inputs held in range
->>> print(urdf_text(fitted, joint="elbow"))                        # <dynamics .../> + comment
+>>> from fricid.export import Smoothing, export_c, urdf_text
+>>> from fricid.fitted import FittedModel
+>>> fitted = FittedModel.from_values(
+...     "stribeck",
+...     {"tau_c": 0.2, "tau_s": 0.3, "w_s": 0.1, "tau_v": 0.05, "delta": 1.0},
+...     operating_range={"velocity": [-1.0, 1.0]},
+... )
+>>> [p.name for p in export_c(fitted, "out/", Smoothing("tanh", 0.01))]
+['fricid_friction.h', 'fricid_friction.c']
+>>> paths = export_c(fitted, "out/", clamp=True)  # inputs held in the operating range
+>>> "<dynamics" in urdf_text(fitted, joint="elbow")  # <dynamics .../> and a comment
+True
 
 Targets that hold less than the model (URDF, MJCF and YAML hold Coulomb plus viscous
 friction) get the least-squares projection over the model's operating range, with its error
