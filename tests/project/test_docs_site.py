@@ -219,3 +219,20 @@ def test_docstring_examples_run(tmp_path, monkeypatch):
         attempted += runner.summarize(verbose=False).attempted
     assert not failures, "\n".join(failures)
     assert attempted >= 50, attempted
+
+
+def test_ci_builds_the_site_offline_with_warnings_as_errors():
+    """CI (.ci/run) builds the site by `make docs`, which runs mkdocs with --strict, from the
+    project's own docs extra; the theme fetches no web font and no plugin needs the network."""
+    ci = (REPO / ".ci" / "run").read_text(encoding="utf-8")
+    steps = re.findall(r"^make ([\w-]+)$", ci, re.M)
+    assert steps == ["lint", "docs", "test-all"], steps
+    makefile = (REPO / "Makefile").read_text(encoding="utf-8")
+    recipe = re.search(r"^docs: (.*)\n((?:\t.*\n)+)", makefile, re.M)
+    assert recipe and "mkdocs build --strict" in recipe.group(2)
+    assert '".[docs]"' in makefile and "docs" in PYPROJECT["project"]["optional-dependencies"]
+    config = (REPO / "mkdocs.yml").read_text(encoding="utf-8")
+    assert re.search(r"^  font: false$", config, re.M)
+    plugins = re.search(r"^plugins:\n((?:  .*\n)+)", config, re.M).group(1)
+    named = set(re.findall(r"^  - ([\w-]+)", plugins, re.M))
+    assert named == {"search", "autorefs", "mkdocstrings"}, named  # none fetches anything
