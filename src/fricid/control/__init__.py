@@ -20,8 +20,8 @@ zero-velocity crossings (:mod:`fricid.control.dynamic`).
 >>> from fricid.control import LuGreTruth, lugre_compensation_study, lugre_parameters
 >>> theta = lugre_parameters(fitted, sigma_0=1e3, sigma_1=0.2)
 >>> result = lugre_compensation_study(theta, truth=LuGreTruth(theta, inertia=0.01))
->>> sorted(result.rms_crossing)  # rad, per run
-['LuGre observer', 'PD only', 'static feed-forward']
+>>> ", ".join(sorted(result.rms_crossing))  # RMS error [rad] at the crossings, per run
+'LuGre observer, PD only, static feed-forward'
 """
 
 from __future__ import annotations

@@ -7,8 +7,8 @@
 ...     {"tau_c": 0.2, "tau_s": 0.3, "w_s": 0.1, "tau_v": 0.05, "delta": 1.0},
 ...     operating_range={"velocity": [-1.0, 1.0]},
 ... )
->>> [p.name for p in export_c(fitted, "out/", Smoothing("tanh", 0.01))]
-['fricid_friction.h', 'fricid_friction.c']
+>>> ", ".join(p.name for p in export_c(fitted, "out/", Smoothing("tanh", 0.01)))
+'fricid_friction.h, fricid_friction.c'
 >>> paths = export_c(fitted, "out/", clamp=True)  # inputs held in the operating range
 >>> "<dynamics" in urdf_text(fitted, joint="elbow")  # <dynamics .../> and a comment
 True
