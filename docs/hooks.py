@@ -260,6 +260,42 @@ def equation_index(pkg: griffe.Module | None = None) -> str:
     return "\n".join(lines)
 
 
+# ------------------------------------------------------------------- docstring examples
+
+_SECTION = re.compile(r"^\s*[A-Z][A-Za-z ]+\n\s*-{3,}\s*$", re.M)
+_FLAG = re.compile(r"\s*#\s*doctest:.*$")
+
+
+def fence_doctests(text: str) -> str:
+    """``text`` with each run of ``>>>`` example lines (before its first numpydoc section,
+    whose Examples the parser reads itself) in a ``pycon`` code fence, doctest flags left
+    out: Markdown would read ``>>>`` as nested quotes."""
+    section = _SECTION.search(text)
+    head, tail = (text[: section.start()], text[section.start() :]) if section else (text, "")
+    out: list[str] = []
+    block: list[str] = []
+    for line in [*head.split("\n"), None]:
+        if block and (line is None or not line.strip()):
+            indent = block[0][: len(block[0]) - len(block[0].lstrip())]
+            out += [f"{indent}```pycon", *block, f"{indent}```"]
+            block = []
+        if line is None:
+            break
+        if block or line.lstrip().startswith(">>>"):
+            block.append(_FLAG.sub("", line))
+        else:
+            out.append(line)
+    return "\n".join(out) + tail
+
+
+class DoctestFences(griffe.Extension):
+    """A griffe extension (mkdocs.yml) applying :func:`fence_doctests` to every docstring."""
+
+    def on_instance(self, *, obj, **kwargs) -> None:
+        if obj.docstring and ">>>" in obj.docstring.value:
+            obj.docstring.value = fence_doctests(obj.docstring.value)
+
+
 # ---------------------------------------------------------------------------- MkDocs hooks
 
 _ROLE = re.compile(r":(?:py:)?(?:func|class|meth|attr|data|mod|obj|exc|const):(<code>)~?")

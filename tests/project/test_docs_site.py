@@ -236,3 +236,15 @@ def test_ci_builds_the_site_offline_with_warnings_as_errors():
     plugins = re.search(r"^plugins:\n((?:  .*\n)+)", config, re.M).group(1)
     named = set(re.findall(r"^  - ([\w-]+)", plugins, re.M))
     assert named == {"search", "autorefs", "mkdocstrings"}, named  # none fetches anything
+
+
+def test_doctest_examples_are_fenced_as_code_on_the_site(hooks):
+    text = (
+        "Intro.\n\n>>> a = 1  # doctest: +SKIP\n>>> a\n1\n\nMore.\n\n"
+        "Examples\n--------\n>>> b = 2\n"
+    )
+    assert hooks.fence_doctests(text) == (
+        "Intro.\n\n```pycon\n>>> a = 1\n>>> a\n1\n```\n\nMore.\n\n"
+        "Examples\n--------\n>>> b = 2\n"  # the numpydoc section: the parser's own
+    )
+    assert "docs/hooks.py:DoctestFences" in (REPO / "mkdocs.yml").read_text(encoding="utf-8")
