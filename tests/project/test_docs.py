@@ -66,7 +66,7 @@ def test_every_readme_command_is_run_or_parsed():
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("command", readme_commands() + help_examples())
+@pytest.mark.parametrize("command", list(dict.fromkeys(readme_commands() + help_examples())))
 def test_documented_command_runs(command, docs_workspace, monkeypatch, tmp_path):
     if any(name in command for name in NEEDS_REAL) and not LEADSCREW.is_dir():
         pytest.skip(f"real recordings not found at {LEADSCREW} (the command reads them)")
