@@ -15,13 +15,14 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Iterable, Iterator
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
 
 from ..errors import ConfigError, DataError
 from ..samples import FrictionSamples, RawLog
+from ._gravity_mode import AUTO, explicit_none_note, no_fit_note, residual_check, resolve
 from .accumulate import SPIKE_SIGMAS, Accumulator
 from .bins import PositionBins, pool_cells
 from .gravity import GravityFit
@@ -185,16 +186,21 @@ class ExtractionResult:
 
 
 class _Source:
-    """Passes a log stream through, remembering the first log's source name."""
+    """Passes a log stream through, remembering the first log's source name and where its
+    position came from (``meta["position_source"]``; a reader that integrates the velocity
+    says so there, a position channel is assumed otherwise)."""
 
     def __init__(self, logs: RawLog | Iterable[RawLog]) -> None:
         self.logs = logs
         self.name: str | None = None
+        self.position_source: str | None = None
 
     def __iter__(self) -> Iterator[RawLog]:
         for log in as_log_stream(self.logs):
             if self.name is None:
                 self.name = log.source
+                meta = log.meta if isinstance(log.meta, dict) else {}
+                self.position_source = str(meta.get("position_source", "channel"))
             yield log
 
 
@@ -203,8 +209,10 @@ def _check_options(median_window, gravity, velocity_rtol, temperature_atol) -> N
         raise ConfigError(
             f"median_window must be an odd positive integer (1: no filter), got {median_window!r}"
         )
-    if gravity not in GRAVITY_MODES:
-        raise ConfigError(f"gravity must be one of {', '.join(GRAVITY_MODES)}; got {gravity!r}")
+    if gravity not in (*GRAVITY_MODES, AUTO):
+        raise ConfigError(
+            f"gravity must be one of {', '.join((*GRAVITY_MODES, AUTO))}; got {gravity!r}"
+        )
     if not (velocity_rtol > 0):
         raise ConfigError(f"velocity_rtol must be > 0, got {velocity_rtol!r}")
     if not (temperature_atol > 0):
@@ -242,7 +250,10 @@ def extract(
         Samples of the running median applied to the torque within each segment (odd; 1
         disables it). It removes current spikes (section 2.2: "further filtered by median
         filtering").
-    gravity : {"fit", "joint", "none"}
+    gravity : {"fit", "joint", "none", "auto"}
+        "auto": remove gravity whenever the log can tell it: "fit" with position bins, else
+        "joint" when the log has a position channel (falling back to "none" with a note when
+        eq. 7 is not determined), else "none" with a note saying gravity was not removed.
         "fit": a joint with gravity, the paper's method; eq. 11 pairs both directions at every
         operating point, eq. 7 is fitted and gives the loads (eq. 12). Where a set-point lacks
         one direction in some bin, pairing is impossible and "joint" is used instead (with a
@@ -251,7 +262,8 @@ def extract(
         (:func:`~.joint_gravity.fit_gravity_joint`); needs no pairing, nor position bins; a
         row with one direction is that direction's friction with gravity removed. "none": a
         horizontal joint; the torque is the friction, load 0; eq. 11 combines the directions
-        where both exist, a single direction is used as measured.
+        where both exist, a single direction is used as measured; on a log with a position
+        channel a note says that gravity was not removed.
     velocity_tolerance : float
         Relative band around a run's plateau velocity that counts as steady.
     settle_time : float
@@ -259,9 +271,10 @@ def extract(
     min_samples : int
         Shortest steady part kept (also after the checks below).
     velocity_rtol : float
-        Relative gap separating two velocity set-points.
+        Relative gap separating two velocity set-points, and the largest span of one relative
+        to its centre (:func:`~.segment.cluster`: set-points cannot chain).
     temperature_atol : float
-        degC gap separating two temperature set-points.
+        degC gap separating two temperature set-points, and the largest span of one.
     outlier_sigmas : float or None
         Robust standard deviations beyond which a torque sample is an outlier and dropped
         (:func:`fricid.extract.steady.outliers`, default 8); None disables the screen.
@@ -303,6 +316,7 @@ def extract(
     """
     _check_options(median_window, gravity, velocity_rtol, temperature_atol)
     bins = PositionBins(positions, bin_halfwidth)
+    requested = gravity
     if gravity == "fit" and bins.auto:
         raise ConfigError(
             "gravity='fit' needs position bins (positions=..., eq. 7 is fitted across them); "
@@ -342,6 +356,13 @@ def extract(
             file=source,
         )
     kept = [r for r, k in zip(acc.records, keep, strict=True) if k]
+    notes: list[str] = []
+    if gravity == AUTO:
+        gravity, note = resolve(not bins.auto, stream.position_source)
+    else:
+        note = explicit_none_note(stream.position_source) if gravity == "none" else ""
+    if note:
+        notes.append(note)
 
     # set-points: velocity by relative gaps, temperature by absolute gaps
     v_label, v_set = cluster(np.array([r.speed for r in kept]), velocity_rtol, relative=True)
@@ -382,22 +403,49 @@ def extract(
         )
     )
     meta = {"extract": options, "quality": quality.rows()}
+    forward = np.array([r.direction > 0 for r in kept], dtype=np.intp)
+    group = (t_label * v_set.size + v_label) * 2 + forward
 
     def joint_fit() -> JointGravityFit:
-        forward = np.array([r.direction > 0 for r in kept], dtype=np.intp)
-        group = (t_label * v_set.size + v_label) * 2 + forward
         stats = np.array([r.moments for r in kept])
         return fit_gravity_joint(stats, group, 2 * forward - 1, source=source)
 
-    notes: list[str] = []
-    samples, by_direction, fit, sem, direction_sem, position = assemble(
-        pooled, shape, t_set, v_set, gravity, source, meta, joint_fit, notes
+    try:
+        samples, by_direction, fit, sem, direction_sem, position = assemble(
+            pooled, shape, t_set, v_set, gravity, source, meta, joint_fit, notes
+        )
+    except DataError as exc:
+        if requested != AUTO or gravity != "joint":
+            raise
+        notes.append(no_fit_note(exc.message))
+        samples, by_direction, fit, sem, direction_sem, position = assemble(
+            pooled, shape, t_set, v_set, "none", source, meta, joint_fit, notes
+        )
+    used = "none" if fit is None else ("joint" if isinstance(fit, JointGravityFit) else "fit")
+    if used != requested:
+        options["gravity_requested"] = requested
+    options["gravity"] = used
+    residual = residual_check(fit, kept, group, pooled, shape)
+    if residual is not None:
+        per = [residual.per_group.get(int(g), np.nan) for g in np.unique(group)]
+        quality = quality.with_gravity_residual(per)
+        if residual.message():
+            notes.append(residual.message())
+    samples, by_direction = (
+        replace(
+            x,
+            meta={
+                **x.meta,
+                "quality": quality.rows(),
+                "extract": options,
+                **({"notes": list(notes)} if notes else {}),
+                **({} if residual is None else {"gravity_residual": residual.as_meta()}),
+            },
+        )
+        for x in (samples, by_direction)
     )
-    if notes:
-        options["gravity_requested"] = gravity
-        options["gravity"] = "joint"
-        for note in notes:
-            logger.info("%s", note)
+    for note in notes:
+        logger.info("%s", note)
     passes = pooled.passes[pooled.count > 0]
     binned = int(sum(r.cells.count.sum() for r in kept))
     diagnostics = Diagnostics(
@@ -421,7 +469,7 @@ def extract(
         passes_max=int(passes.max()),
         samples=quality.totals(),
     )
-    warn_quality(quality, source, stacklevel=2)
+    warn_quality(quality, source, stacklevel=2, gravity=residual)
     logger.info("extracted %d samples from %d segments", len(samples), len(kept))
     return ExtractionResult(
         samples,

@@ -449,6 +449,7 @@ def read_mat(
     if "temperature" not in si and temperature is None:
         raise ConfigError("give the temperature as --var temperature=NAME:UNIT or --temperature")
     position = si.get("position")
+    meta = {**meta, "position_source": "integrated velocity" if position is None else "channel"}
     if position is None:
         position = integrate_velocity(time, velocity)
     return RawLog(

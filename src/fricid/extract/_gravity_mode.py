@@ -1,0 +1,89 @@
+"""Which gravity mode an extraction uses, why, and what its fit left behind.
+
+Gravity is never left in silently: with a position channel it is removed by default (eq. 7
+of the BAS-RBFNN paper, by eq. 11 pairing with position bins, else by the joint fit of
+:mod:`.joint_gravity`); where it is not removed, one note says so and why. After the fit,
+:mod:`.gravity_check` looks for a pattern along the position that eq. 7 does not explain.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .gravity import GravityFit
+from .gravity_check import GravityResidual, check_joint, check_paired
+from .joint_gravity import JointGravityFit
+
+__all__ = ["AUTO", "explicit_none_note", "no_fit_note", "resolve", "residual_check"]
+
+#: ``extract(..., gravity=AUTO)``: remove gravity whenever the log can tell it.
+AUTO = "auto"
+
+#: ``RawLog.meta["position_source"]`` of a log whose position was integrated from velocity.
+INTEGRATED = "integrated velocity"
+
+
+def resolve(binned: bool, position_source: str | None) -> tuple[str, str]:
+    """The mode ``auto`` stands for, and the note when gravity is not removed ("" when it is):
+    ``fit`` with position bins, ``joint`` with a position channel, else ``none``."""
+    if binned:
+        return "fit", ""
+    if position_source == INTEGRATED:
+        return "none", (
+            "gravity not removed: the log has no position channel (position integrated from "
+            "velocity), so eq. 7 cannot be fitted; the friction includes any gravity torque "
+            "(a horizontal joint has none)"
+        )
+    return "joint", ""
+
+
+def explicit_none_note(position_source: str | None) -> str:
+    """The note for ``gravity="none"`` asked for on a log with a position channel."""
+    if position_source == INTEGRATED:
+        return ""
+    return (
+        "gravity not removed (gravity='none' was asked for): the log has a position channel, "
+        "but the friction written includes any gravity torque; omit --gravity to remove it"
+    )
+
+
+def no_fit_note(reason: str) -> str:
+    """The note when ``auto`` tried the joint fit and eq. 7 was not determined."""
+    first = reason.split(";")[0].rstrip(".")
+    return (
+        f"gravity not removed: {first}; the friction includes any gravity torque (give "
+        "position bins with --positions, or --gravity none to accept this)"
+    )
+
+
+def residual_check(fit, kept, group, pooled, shape) -> GravityResidual | None:
+    """Check ``fit``'s residuals along the position (:mod:`.gravity_check`).
+
+    ``kept`` are the set-point records (with ``blocks``), ``group`` their set-point labels
+    ``(t * nv + v) * 2 + forward``; ``pooled`` and ``shape`` (temperature, velocity, bin) are
+    the pooled cells, for an eq. 11 fit. ``per_group`` is keyed by the same labels.
+    """
+    if isinstance(fit, JointGravityFit):
+        blocks = np.array([r.blocks for r in kept])
+        direction = np.array([r.direction for r in kept])
+        return check_joint(blocks, group, direction, (fit.p_x, fit.p_y), fit.load_friction)
+    if not isinstance(fit, GravityFit):
+        return None
+    nt, nv, nb = shape
+
+    def grid(x: np.ndarray) -> np.ndarray:
+        return x.reshape(nt * nv, 2, nb).transpose(0, 2, 1)  # (set-point, bin, direction)
+
+    count, tau, sem, cos, sin, std = (
+        grid(getattr(pooled, k)) for k in ("count", "torque", "sem", "cos", "sin", "std")
+    )
+    both = (count > 0).all(axis=-1)
+    tau_g = -0.5 * (tau[..., 1] + tau[..., 0])[both]
+    se = 0.5 * np.sqrt(sem[..., 0] ** 2 + sem[..., 1] ** 2)[both]
+    fitted = fit.p_x * cos[both].mean(axis=-1) - fit.p_y * sin[both].mean(axis=-1)
+    c = count[both]
+    noise = float(np.sqrt(np.sum((c - 1).clip(min=0) * std[both] ** 2) / max(c.sum() - 1, 1)))
+    label = np.nonzero(both)[0]
+    res = check_paired(tau_g, se, fitted, noise, group=label)
+    per = {2 * k + fwd: v for k, v in res.per_group.items() for fwd in (0, 1)}
+    return GravityResidual(res.pattern_rms, res.expected, res.noise, res.structured, per)
