@@ -14,7 +14,7 @@ from .gravity import GravityFit
 from .gravity_check import GravityResidual, check_joint, check_paired
 from .joint_gravity import JointGravityFit
 
-__all__ = ["AUTO", "explicit_none_note", "no_fit_note", "resolve", "residual_check"]
+__all__ = ["AUTO", "explicit_none_note", "no_fit_note", "residual_check", "resolve"]
 
 #: ``extract(..., gravity=AUTO)``: remove gravity whenever the log can tell it.
 AUTO = "auto"

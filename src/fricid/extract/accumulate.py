@@ -307,9 +307,7 @@ class Accumulator:
                 f"{len(chosen) - flat} with fewer than min_samples={self.min_samples} samples "
                 "left after trimming ramps, settling, outliers and rail samples"
             )
-        return f"dropped as transient: {len(chosen)} run(s) at {speeds} rad/s: " + ", ".join(
-            parts
-        )
+        return f"dropped as transient: {len(chosen)} run(s) at {speeds} rad/s: " + ", ".join(parts)
 
 
 _NO_PLATEAU = "dropped as transient: runs without a velocity plateau (found at segmentation)"

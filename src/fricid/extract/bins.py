@@ -3,8 +3,9 @@
 Each segment (one pass at one velocity) contributes one *cell* per position bin: sample count,
 mean and sum of squared deviations (M2) of the torque, and means of position, velocity,
 temperature and of ``cos`` and ``sin`` of the position (the gravity torque of eq. 7 is linear in
-those two, so its mean over a cell's samples is exact however wide the cell). Cells are then pooled over repetitions into set-point groups with Chan's parallel
-formulas, which are exact and independent of the order or chunking of the data.
+those two, so its mean over a cell's samples is exact however wide the cell). Cells are then
+pooled over repetitions into set-point groups with Chan's parallel formulas, which are exact
+and independent of the order or chunking of the data.
 """
 
 from __future__ import annotations

@@ -54,9 +54,7 @@ class GravityFit:
         return self.p_x * np.cos(theta) - self.p_y * np.sin(theta)
 
 
-def fit_gravity(
-    theta, tau_g, *, source: str | None = None, cos=None, sin=None
-) -> GravityFit:
+def fit_gravity(theta, tau_g, *, source: str | None = None, cos=None, sin=None) -> GravityFit:
     """Fit eq. 7 to gravity torques ``tau_g`` [N m] at positions ``theta`` [rad].
 
     ``cos`` and ``sin``, when given, are the means of ``cos`` and ``sin`` of the positions

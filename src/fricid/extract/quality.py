@@ -203,6 +203,27 @@ class QualityTable:
             lines.append(",".join(cells))
         return "\n".join(lines) + "\n"
 
+    def accounting(self, limit: int = 12) -> list[str]:
+        """Every set-point accounted for, one line each: the set-points kept and how many merge
+        several runs, then each flagged set-point and each dropped group with its reason (at
+        most ``limit`` lines of those)."""
+        sp = self.setpoints
+        merged = sp & (self.runs > 1)
+        head = f"set-points: {int(sp.sum())} kept"
+        if merged.any():
+            lo, hi = int(self.runs[merged].min()), int(self.runs[merged].max())
+            runs = f"{lo}" if lo == hi else f"{lo}-{hi}"
+            head += f", {int(merged.sum())} of them merge {runs} runs each"
+        lines = [head]
+        for i in np.flatnonzero((sp & self.flagged) | ~sp):
+            dropped = int(self.dropped_rest[i] + self.dropped_transient[i])
+            what = f"flagged {self.label[i]}" if sp[i] else f"{self.kind[i]} ({self.label[i]})"
+            count = f" [{dropped} samples]" if not sp[i] else ""
+            lines.append(f"  {what}: {self.note[i]}{count}")
+        if len(lines) > limit + 1:
+            lines = [*lines[: limit + 1], f"  ... {len(lines) - limit - 1} more (quality table)"]
+        return lines
+
     def describe(self, limit: int = 40) -> str:
         """A fixed-width text table (at most ``limit`` rows; flagged rows first)."""
         head = (

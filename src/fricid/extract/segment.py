@@ -19,6 +19,7 @@ file) closes the open run.
 
 from __future__ import annotations
 
+import itertools
 import logging
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
@@ -317,7 +318,7 @@ def cluster(
     limit = tolerance * np.abs(s[:-1]) if relative else tolerance
     cuts = list(np.flatnonzero(gap > limit) + 1)
     bounds = [0, *cuts, s.size]
-    pending = list(zip(bounds[:-1], bounds[1:], strict=True))
+    pending = list(itertools.pairwise(bounds))
     starts = []
     while pending:
         a, b = pending.pop()
