@@ -12,8 +12,10 @@ What is compared (reading chosen: not in the paper):
 - joint fit (:mod:`.joint_gravity`): each pass's kept samples are cut into :data:`BLOCKS`
   consecutive blocks (:func:`block_stats`); a block's residual is its mean torque minus
   eq. 7's (and the load-dependent friction's) share, minus its pass's mean residual (the
-  friction level). Without a pattern those residuals are the noise of a block mean,
-  ``sigma / sqrt(n)``; with one they follow the position.
+  friction level). Binned by position, the part both directions share is kept (what is odd
+  in the direction is friction, as in eq. 11). Without a pattern it is the noise of block
+  means, ``sigma / sqrt(n)``, with ``sigma`` the samples' scatter about eq. 7 within the
+  blocks (from their co-moments); with one it follows the position.
 - eq. 11 pairing (:mod:`.gravity`): the residual of eq. 7 at each paired bin against the
   bins' standard errors.
 
@@ -28,6 +30,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .joint_gravity import MOMENT_SIZE, moments
+
 __all__ = [
     "BLOCKS",
     "BLOCK_SIZE",
@@ -40,16 +44,16 @@ __all__ = [
 ]
 
 #: Consecutive blocks a pass's kept samples are cut into for :func:`check_joint`.
-BLOCKS = 8
+BLOCKS = 16
 
-#: Columns of a :func:`block_stats` row: count, mean position, mean cos, mean sin, mean
-#: torque, sum of squared deviations of the torque.
-BLOCK_SIZE = 6
+#: Columns of a :func:`block_stats` row: mean position, then the block's
+#: :func:`~.joint_gravity.moments` (count, means of ``(-cos, sin, tau)``, their co-moments).
+BLOCK_SIZE = 1 + MOMENT_SIZE
 
 #: The residual pattern must exceed this many times its expected noise...
 STRUCTURE_SIGMAS = 4.0
 
-#: ... and this share of the samples' scatter (so it is larger than the noise).
+#: ... and this share of the samples' scatter about eq. 7 (so it is larger than the noise).
 STRUCTURE_FRACTION = 1.0
 
 
@@ -63,21 +67,11 @@ def block_stats(theta, tau, blocks: int = BLOCKS) -> np.ndarray:
     tau = np.asarray(tau, dtype=float)
     out = np.zeros((blocks, BLOCK_SIZE))
     n = theta.size
-    if n == 0:
-        return out
-    label = np.minimum((np.arange(n) * blocks) // n, blocks - 1)
-    count = np.bincount(label, minlength=blocks).astype(float)
-    safe = np.maximum(count, 1.0)
-
-    def mean(x: np.ndarray) -> np.ndarray:
-        return np.bincount(label, weights=x, minlength=blocks) / safe
-
-    out[:, 0] = count
-    out[:, 1] = mean(theta)
-    out[:, 2] = mean(np.cos(theta))
-    out[:, 3] = mean(np.sin(theta))
-    out[:, 4] = mean(tau)
-    out[:, 5] = np.bincount(label, weights=(tau - out[label, 4]) ** 2, minlength=blocks)
+    for k in range(min(blocks, n)):  # a loop over the few blocks, not over samples
+        a, b = (k * n) // blocks, ((k + 1) * n) // blocks
+        if b > a:
+            out[k, 0] = theta[a:b].mean()
+            out[k, 1:] = moments(theta[a:b], tau[a:b])
     return out
 
 
@@ -113,8 +107,9 @@ class GravityResidual:
             f"the gravity fit (eq. 7, one link) leaves a residual pattern along the position of "
             f"{self.pattern_rms:.3g} N m RMS, against {self.expected:.2g} N m from noise (sample "
             f"scatter {self.noise:.2g} N m): something else depends on the position (gravity "
-            "of other joints, e.g. sin(q1 + q2), cogging, a cable); the frictions average it "
-            "over the positions each set-point covered"
+            "of other joints, e.g. sin(q1 + q2), cogging, a cable, friction not linear in the "
+            "load); fricid does not model it, and each friction averages it over the positions "
+            "its set-point covered"
         )
 
     def as_meta(self) -> dict:
@@ -162,8 +157,8 @@ def check_joint(blocks, group, direction, p, q=None) -> GravityResidual:
     coef = np.asarray(p, dtype=float)[None, :] + (
         0.0 if q is None else s[:, None] * np.asarray(q, dtype=float)[None, :]
     )
-    n = b[..., 0]
-    z = np.stack([-b[..., 2], b[..., 3]], axis=-1)  # (pass, block, 2)
+    n = b[..., 1]
+    z = b[..., 2:4]  # (pass, block, 2): means of (-cos, sin)
     r = b[..., 4] - np.einsum("pbk,pk->pb", z, coef)
     has = n > 0
     w = np.where(has, n, 0.0)
@@ -172,19 +167,48 @@ def check_joint(blocks, group, direction, p, q=None) -> GravityResidual:
     resid = np.where(use, r - pass_mean[:, None], 0.0)
     if not use.any():
         return _decide(np.nan, np.nan, np.nan, {})
-    m2, dof = b[..., 5][use].sum(), (n[use] - 1.0).clip(min=0).sum()
-    noise = float(np.sqrt(m2 / dof)) if dof > 0 else np.nan
-    blocks_used = use.sum()
-    pattern = float(np.sqrt((resid[use] ** 2).sum() / blocks_used))
-    # the pass mean takes one block's worth of freedom from each pass
-    passes = use.any(axis=1).sum()
-    inflate = np.sqrt(max(blocks_used - passes, 1) / blocks_used)
-    expected = float(noise / np.sqrt(np.median(n[use])) * inflate)
+    # within each block, the samples' scatter about eq. 7: var(tau - z . c) from co-moments
+    c = b[..., 5:]  # z1z1, z1z2, z2z2, z1tau, z2tau, tautau
+    c1, c2 = coef[:, None, 0], coef[:, None, 1]
+    m2 = c[..., 5] - 2 * (c1 * c[..., 3] + c2 * c[..., 4])
+    m2 = m2 + c1 * c1 * c[..., 0] + 2 * c1 * c2 * c[..., 1] + c2 * c2 * c[..., 2]
+    dof = (n[use] - 1.0).clip(min=0).sum()
+    noise = float(np.sqrt(m2[use].clip(min=0).sum() / dof)) if dof > 0 else np.nan
+    block_noise = noise / np.sqrt(np.median(n[use]))
+    pattern, expected = _even_pattern(b[..., 0][use], resid[use], (s[:, None] * use)[use])
+    expected *= block_noise
     per_group = {}
     for g in np.unique(group[use.any(axis=1)]):
         sel = use & (group == g)[:, None]
         per_group[int(g)] = float(np.sqrt((resid[sel] ** 2).mean()))
     return _decide(pattern, expected, noise, per_group)
+
+
+def _even_pattern(theta, resid, sign) -> tuple[float, float]:
+    """RMS over position bins of the residuals' part common to both directions (about its
+    mean), and its expected value per unit block noise. Load-dependent friction is odd in the
+    direction and cancels here, as it does in eq. 11; gravity (any joint's), cogging and
+    cables are even and stay. Bins: :data:`BLOCKS` of equal width over the blocks' positions;
+    only bins both directions visited count."""
+    lo, hi = float(theta.min()), float(theta.max())
+    if not hi > lo:
+        return np.nan, np.nan
+    edge = np.minimum(((theta - lo) / (hi - lo) * BLOCKS).astype(np.intp), BLOCKS - 1)
+    fwd = (sign > 0).astype(np.intp)
+    cell = edge * 2 + fwd
+    count = np.bincount(cell, minlength=2 * BLOCKS).reshape(BLOCKS, 2)
+    total = np.bincount(cell, weights=resid, minlength=2 * BLOCKS).reshape(BLOCKS, 2)
+    both = (count > 0).all(axis=1)
+    if both.sum() < 3:
+        return np.nan, np.nan
+    mean = total[both] / count[both]
+    even = 0.5 * mean.sum(axis=1)
+    even -= even.mean()
+    # per unit block noise: var(even_j) = (1/n0 + 1/n1) / 4, less the mean removed
+    var = 0.25 * (1.0 / count[both]).sum(axis=1)
+    k = both.sum()
+    expected = float(np.sqrt(var.mean() * (k - 1) / k))
+    return float(np.sqrt(np.mean(even**2))), expected
 
 
 def check_paired(tau_g, se, fitted, noise: float, group=None) -> GravityResidual:
