@@ -56,7 +56,7 @@ def sweep_log(
         add(np.arange(m) / rate, np.full(m, q), np.zeros(m))
 
     for v, bias in zip(speeds, offsets, strict=True):
-        n = int(round((span[1] - span[0]) / v * rate))
+        n = round((span[1] - span[0]) / v * rate)
         t = np.arange(n) / rate
         add(t, span[0] + v * t, np.full(n, v), bias)
         dwell(span[1])
