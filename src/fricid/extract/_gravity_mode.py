@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from .gravity import GravityFit
-from .gravity_check import GravityResidual, check_joint, check_paired
+from .gravity_check import GravityResidual, block_noise, check_joint, check_paired
 from .joint_gravity import JointGravityFit
 
 __all__ = ["AUTO", "explicit_none_note", "no_fit_note", "residual_check", "resolve"]
@@ -74,15 +74,14 @@ def residual_check(fit, kept, group, pooled, shape) -> GravityResidual | None:
     def grid(x: np.ndarray) -> np.ndarray:
         return x.reshape(nt * nv, 2, nb).transpose(0, 2, 1)  # (set-point, bin, direction)
 
-    count, tau, sem, cos, sin, std = (
-        grid(getattr(pooled, k)) for k in ("count", "torque", "sem", "cos", "sin", "std")
+    count, tau, sem, cos, sin = (
+        grid(getattr(pooled, k)) for k in ("count", "torque", "sem", "cos", "sin")
     )
     both = (count > 0).all(axis=-1)
     tau_g = -0.5 * (tau[..., 1] + tau[..., 0])[both]
     se = 0.5 * np.sqrt(sem[..., 0] ** 2 + sem[..., 1] ** 2)[both]
     fitted = fit.p_x * cos[both].mean(axis=-1) - fit.p_y * sin[both].mean(axis=-1)
-    c = count[both]
-    noise = float(np.sqrt(np.sum((c - 1).clip(min=0) * std[both] ** 2) / max(c.sum() - 1, 1)))
+    noise = block_noise(np.array([r.blocks for r in kept]), (fit.p_x, fit.p_y))
     label = np.nonzero(both)[0]
     res = check_paired(tau_g, se, fitted, noise, group=label)
     per = {2 * k + fwd: v for k, v in res.per_group.items() for fwd in (0, 1)}

@@ -38,6 +38,7 @@ __all__ = [
     "STRUCTURE_FRACTION",
     "STRUCTURE_SIGMAS",
     "GravityResidual",
+    "block_noise",
     "block_stats",
     "check_joint",
     "check_paired",
@@ -167,13 +168,7 @@ def check_joint(blocks, group, direction, p, q=None) -> GravityResidual:
     resid = np.where(use, r - pass_mean[:, None], 0.0)
     if not use.any():
         return _decide(np.nan, np.nan, np.nan, {})
-    # within each block, the samples' scatter about eq. 7: var(tau - z . c) from co-moments
-    c = b[..., 5:]  # z1z1, z1z2, z2z2, z1tau, z2tau, tautau
-    c1, c2 = coef[:, None, 0], coef[:, None, 1]
-    m2 = c[..., 5] - 2 * (c1 * c[..., 3] + c2 * c[..., 4])
-    m2 = m2 + c1 * c1 * c[..., 0] + 2 * c1 * c2 * c[..., 1] + c2 * c2 * c[..., 2]
-    dof = (n[use] - 1.0).clip(min=0).sum()
-    noise = float(np.sqrt(m2[use].clip(min=0).sum() / dof)) if dof > 0 else np.nan
+    noise = _within_noise(b, coef, use)
     block_noise = noise / np.sqrt(np.median(n[use]))
     pattern, expected = _even_pattern(b[..., 0][use], resid[use], (s[:, None] * use)[use])
     expected *= block_noise
@@ -182,6 +177,28 @@ def check_joint(blocks, group, direction, p, q=None) -> GravityResidual:
         sel = use & (group == g)[:, None]
         per_group[int(g)] = float(np.sqrt((resid[sel] ** 2).mean()))
     return _decide(pattern, expected, noise, per_group)
+
+
+def _within_noise(b: np.ndarray, coef: np.ndarray, use: np.ndarray) -> float:
+    """N m, the samples' scatter about eq. 7 within the blocks ``use``: ``var(tau - z . c)``
+    from each block's co-moments, pooled (``coef`` per pass, ``(n_passes, 2)``)."""
+    c = b[..., 5:]  # z1z1, z1z2, z2z2, z1tau, z2tau, tautau
+    c1, c2 = coef[:, None, 0], coef[:, None, 1]
+    m2 = c[..., 5] - 2 * (c1 * c[..., 3] + c2 * c[..., 4])
+    m2 = m2 + c1 * c1 * c[..., 0] + 2 * c1 * c2 * c[..., 1] + c2 * c2 * c[..., 2]
+    dof = (b[..., 1][use] - 1.0).clip(min=0).sum()
+    return float(np.sqrt(m2[use].clip(min=0).sum() / dof)) if dof > 0 else np.nan
+
+
+def block_noise(blocks, p) -> float:
+    """N m, the samples' scatter about eq. 7 (coefficients ``p``) within the blocks of every
+    pass (``(n_passes, BLOCKS, BLOCK_SIZE)``, :func:`block_stats`): the noise an eq. 11 fit's
+    residuals are compared with (a position bin's own scatter holds gravity's slope)."""
+    b = np.asarray(blocks, dtype=float)
+    if b.ndim != 3 or b.shape[0] == 0:
+        return np.nan
+    coef = np.broadcast_to(np.asarray(p, dtype=float), (b.shape[0], 2))
+    return _within_noise(b, coef, b[..., 1] > 1)
 
 
 def _even_pattern(theta, resid, sign) -> tuple[float, float]:
