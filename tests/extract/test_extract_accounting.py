@@ -14,7 +14,7 @@ from fricid.cli import app
 from fricid.errors import DataQualityWarning
 from fricid.extract import cluster, extract
 from fricid.io import read_samples, write_rawlog, write_samples
-from fricid.samples import FrictionSamples, standstill_rows
+from fricid.samples import FrictionSamples
 
 
 def _quiet(fn, *args, **kwargs):
@@ -95,6 +95,8 @@ def test_standstill_rows_of_a_samples_file_are_dropped(tmp_path):
     """A per-direction mean at 6.7e-6 rad/s (the slowest real speed 0.02) is not a +1
     set-point: dropped on reading, with a warning naming the row; a logarithmic sweep down to
     1e-4 of the fastest speed keeps every row."""
+    from fricid.samples import standstill_rows
+
     v = np.r_[6.7e-6, np.linspace(0.02, 1.0, 10)]
     v = np.r_[v, -v[1:]]
     f = np.sign(v) * (1 + 2 * np.abs(v))
