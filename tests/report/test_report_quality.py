@@ -5,7 +5,6 @@ from __future__ import annotations
 import warnings
 
 from _sweeps import sweep_log
-
 from fricid.errors import DataQualityWarning
 from fricid.extract import extract
 from fricid.report.trust import quality_frame
