@@ -255,15 +255,17 @@ def flag_scatter(table: QualityTable, ratio: float = SCATTER_RATIO) -> QualityTa
     below :data:`SCATTER_FLOOR`, is never flagged).
 
     Merged runs are also flagged when the scatter *between* them (``run_scatter``, the spread
-    of the runs' means) exceeds ``ratio`` times the neighbours' typical spread, the larger of
-    their sample scatter and their own ``run_scatter`` (a mean scatters less than the samples
-    it averages, so runs of one condition stay below it; a ``run_scatter`` from two or three
-    runs is too rough to be compared alone). Each flag's reason is appended to ``note``."""
+    of the runs' means) exceeds ``ratio`` times the typical spread, the larger of their
+    sample scatter and their own ``run_scatter``, both of the neighbours and of all the log's
+    set-points (the median): a ``run_scatter`` from two or three runs is rough (the virtual
+    joint's per-run offsets give 0.002-0.03 N m between neighbours), the log's median is not.
+    Each flag's reason is appended to ``note``."""
     flagged = np.zeros(len(table), dtype=bool)
     note = table.note.copy()
     sp = np.flatnonzero(table.setpoints & np.isfinite(table.scatter))
     temps = np.round(table.temperature[sp], 6)
     spread = np.fmax(table.scatter, table.run_scatter)
+    typical = float(np.median(spread[sp])) if sp.size else np.nan
     for key in set(zip(temps.tolist(), table.direction[sp].tolist(), strict=True)):
         group = sp[(temps == key[0]) & (table.direction[sp] == key[1])]
         group = group[np.argsort(np.abs(table.velocity[group]))]
@@ -276,7 +278,7 @@ def flag_scatter(table: QualityTable, ratio: float = SCATTER_RATIO) -> QualityTa
             if s[j] > max(limit, SCATTER_FLOOR):
                 flagged[row] = True
                 note[row] = _append(note[row], f"scatter {s[j]:.3g} N m, >{ratio:g}x neighbours'")
-            limit = ratio * float(np.median(ref[near]))
+            limit = ratio * max(float(np.median(ref[near])), typical)
             if np.isfinite(between[j]) and between[j] > max(limit, SCATTER_FLOOR):
                 flagged[row] = True
                 note[row] = _append(
