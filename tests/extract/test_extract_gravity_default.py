@@ -118,3 +118,16 @@ def test_structured_gravity_residual_is_reported(mode):
     assert not any("residual pattern" in str(w.message) for w in caught)
     assert not clean.samples.meta["gravity_residual"]["structured"]
     assert not any("residual pattern" in n for n in clean.notes)
+
+
+def test_scatter_of_a_whole_traverse_is_about_eq7_not_gravity_range():
+    """One bin per traverse: the written std, standard error and the quality table's scatter
+    measure the noise about eq. 7 (0.05 N m raw, less after the median filter), not gravity's
+    range along 2.4 rad (about 0.8 N m standard deviation)."""
+    r = extract(sweep_log(SPEEDS, seed=1), gravity="joint")
+    for s in (r.by_direction, r.samples):
+        assert s.std.max() < 0.05
+        sem = np.array(s.meta["sem"], dtype=float)
+        np.testing.assert_allclose(sem, r.direction_sem if s is r.by_direction else r.sem)
+        assert sem.max() < 0.003
+    assert r.quality.scatter[r.quality.setpoints].max() < 0.05

@@ -86,3 +86,41 @@ def residual_check(fit, kept, group, pooled, shape) -> GravityResidual | None:
     res = check_paired(tau_g, se, fitted, noise, group=label)
     per = {2 * k + fwd: v for k, v in res.per_group.items() for fwd in (0, 1)}
     return GravityResidual(res.pattern_rms, res.expected, res.noise, res.structured, per)
+
+
+def std_about_gravity(fit, kept, group) -> dict[int, tuple[float, float]]:
+    """N m, each set-point's sample scatter about eq. 7 (and the load-dependent friction of a
+    joint fit) instead of about its mean torque, and the standard error of its friction, by
+    set-point label: ``(std, sem)``; ``sem`` as :func:`~.bins.pool_cells` defines it (the
+    scatter of the passes' mean residuals, or ``std / sqrt(n)`` for one pass).
+
+    With one position bin per traverse the torque of a pass sweeps the whole gravity curve;
+    its standard deviation about the mean is gravity's range, not noise. The residual
+    ``e = tau - z . c`` (``z = (-cos, sin)``, ``c = p`` or ``p + s q``) of each pass is pooled
+    from the pass's :func:`~.joint_gravity.moments` (Chan's formulas): its within-pass
+    co-moments give ``sum (e - ebar)^2`` exactly.
+    """
+    stats = np.array([r.moments for r in kept])
+    sign = np.where(np.array([r.direction for r in kept]) < 0, -1.0, 1.0)
+    p = np.array([fit.p_x, fit.p_y])
+    q = getattr(fit, "load_friction", None)
+    coef = p[None, :] + (0.0 if q is None else sign[:, None] * np.asarray(q)[None, :])
+    n = stats[:, 0]
+    mean = stats[:, 3] - np.einsum("pk,pk->p", stats[:, 1:3], coef)
+    c = stats[:, 4:]  # z1z1, z1z2, z2z2, z1tau, z2tau, tautau
+    c1, c2 = coef[:, 0], coef[:, 1]
+    m2 = c[:, 5] - 2 * (c1 * c[:, 3] + c2 * c[:, 4])
+    m2 = (m2 + c1 * c1 * c[:, 0] + 2 * c1 * c2 * c[:, 1] + c2 * c2 * c[:, 2]).clip(min=0)
+    out = {}
+    for g in np.unique(group):
+        sel = (group == g) & (n > 0)
+        total = n[sel].sum()
+        if total < 2:
+            continue
+        grand = (n[sel] * mean[sel]).sum() / total
+        between = (n[sel] * (mean[sel] - grand) ** 2).sum()
+        std = float(np.sqrt((m2[sel].sum() + between) / (total - 1)))
+        passes = int(sel.sum())
+        sem = np.sqrt(between / total / (passes - 1)) if passes > 1 else std / np.sqrt(total)
+        out[int(g)] = (std, float(sem))
+    return out

@@ -21,14 +21,21 @@ import numpy as np
 
 from ..errors import ConfigError, DataError
 from ..samples import RawLog
-from ._gravity_mode import AUTO, explicit_none_note, no_fit_note, residual_check, resolve
+from ._gravity_mode import (
+    AUTO,
+    explicit_none_note,
+    no_fit_note,
+    residual_check,
+    resolve,
+    std_about_gravity,
+)
 from .accumulate import SPIKE_SIGMAS, Accumulator
 from .bins import PositionBins, pool_cells
 from .joint_gravity import JointGravityFit, fit_gravity_joint
 from .quality import flag_scatter, warn_quality
 from .result import Diagnostics, ExtractionResult
 from .segment import SegmentCounts, as_log_stream, cluster, iter_segments
-from .separation import assemble
+from .separation import assemble, sem_meta
 from .steady import OUTLIER_SIGMAS, SETTLE_SIGMAS
 
 __all__ = ["GRAVITY_MODES", "SPIKE_SIGMAS", "Diagnostics", "ExtractionResult", "extract"]
@@ -252,18 +259,16 @@ def extract(
         "outlier_sigmas": outlier_sigmas,
         "settle_sigmas": settle_sigmas,
     }
-    quality = flag_scatter(
-        acc.quality(
-            kinds,
-            t_label,
-            v_label,
-            t_set,
-            v_set,
-            cells,
-            (counts.dropped_samples, counts.unsteady_samples),
-        )
+    unflagged = acc.quality(
+        kinds,
+        t_label,
+        v_label,
+        t_set,
+        v_set,
+        cells,
+        (counts.dropped_samples, counts.unsteady_samples),
     )
-    meta = {"extract": options, "quality": quality.rows()}
+    meta = {"extract": options, "quality": unflagged.rows()}
     forward = np.array([r.direction > 0 for r in kept], dtype=np.intp)
     group = (t_label * v_set.size + v_label) * 2 + forward
 
@@ -289,9 +294,18 @@ def extract(
     residual = residual_check(fit, kept, group, pooled, shape)
     if residual is not None:
         per = [residual.per_group.get(int(g), np.nan) for g in np.unique(group)]
-        quality = quality.with_gravity_residual(per)
+        unflagged = unflagged.with_gravity_residual(per)
         if residual.message():
             notes.append(residual.message())
+    if fit is not None and bins.auto:
+        samples, by_direction, unflagged = _scatter_about_gravity(
+            std_about_gravity(fit, kept, group), group, samples, by_direction, unflagged
+        )
+        sem, direction_sem = (
+            np.array([np.nan if e is None else e for e in x.meta["sem"]], dtype=float)
+            for x in (samples, by_direction)
+        )
+    quality = flag_scatter(unflagged)
     samples, by_direction = (
         replace(
             x,
@@ -344,3 +358,32 @@ def extract(
         quality,
         tuple(notes),
     )
+
+
+def _scatter_about_gravity(stats, group, samples, by_direction, quality):
+    """With one bin per traverse, the rows' ``std`` and standard errors and the set-points'
+    ``scatter`` about eq. 7 (``stats``: label -> (std, sem) [N m],
+    :func:`._gravity_mode.std_about_gravity`), not about the mean torque, which holds
+    gravity's range along the traverse. By-direction rows and set-point rows are in label
+    order; a combined row pools its two directions (eq. 11 halves the standard error)."""
+    labels = np.unique(group)
+    new = np.array([stats.get(int(g), (np.nan, np.nan)) for g in labels])
+    keep = np.isfinite(new[:, 0])
+    d_std = np.where(keep, new[:, 0], by_direction.std)
+    d_sem = np.where(keep, new[:, 1], np.asarray(by_direction.meta["sem"], dtype=float))
+    by_direction = replace(by_direction, std=d_std, meta={**by_direction.meta, **sem_meta(d_sem)})
+    column = quality.scatter.copy()
+    rows = np.flatnonzero(quality.setpoints)
+    column[rows] = np.where(keep, new[:, 0], column[rows])
+    quality = replace(quality, scatter=column)
+    pair = labels // 2
+    n = by_direction.count
+    m2 = np.bincount(pair, weights=d_std**2 * np.maximum(n - 1, 0))
+    total = np.bincount(pair, weights=n)
+    k = np.bincount(pair)
+    first = np.unique(pair)
+    combined = np.sqrt(m2 / np.maximum(total - k, 1))[first]
+    sem2 = np.bincount(pair, weights=d_sem**2)[first]
+    sem = np.where(k[first] == 2, 0.5 * np.sqrt(sem2), np.sqrt(sem2))
+    samples = replace(samples, std=combined, meta={**samples.meta, **sem_meta(sem)})
+    return samples, by_direction, quality
