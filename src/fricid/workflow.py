@@ -181,7 +181,8 @@ def _extract_stream(
 
     Unset ``positions``, ``bin_halfwidth`` and ``gravity`` come from the design recorded with
     the log (as ``fricid extract`` does); ``gravity`` then defaults to ``"fit"`` with position
-    bins and ``"none"`` without.
+    bins and ``"auto"`` without (gravity removed by the joint fit when the log has a position
+    channel; otherwise, or when eq. 7 is not determined, not removed, with a note saying so).
     """
     opts = dict(options)
     hints = _design_hints(first)
@@ -191,7 +192,7 @@ def _extract_stream(
             opts["bin_halfwidth"] = hints.get("bin_halfwidth_rad")
     if opts.get("gravity") is None:
         with_bins = opts.get("positions") is not None
-        opts["gravity"] = hints.get("gravity", "fit" if with_bins else "none")
+        opts["gravity"] = hints.get("gravity", "fit" if with_bins else "auto")
     if opts.get("positions") is not None:
         opts["positions"] = np.asarray(opts["positions"], dtype=float)
 

@@ -182,7 +182,7 @@ def test_extraction_summary_counts_read_right():
     assert "per direction)" not in first
     reps = sc.design.repetitions
     assert f", {reps} passes per sample" in second and "-" not in second.split("),")[-1]
-    from fricid.extract.pipeline import _count, _passes
+    from fricid.extract.result import _count, _passes
 
     assert _count(1, "temperature") == "1 temperature" and _count(2, "temperature") == (
         "2 temperatures"

@@ -280,7 +280,7 @@ def test_bad_options(quick1_log):
     with pytest.raises(ConfigError, match="median_window"):
         extract(quick1_log, median_window=4, gravity="none")
     with pytest.raises(ConfigError, match="gravity"):
-        extract(quick1_log, gravity="auto")
+        extract(quick1_log, gravity="upward")
     with pytest.raises(ConfigError, match="overlap"):
         extract(quick1_log, positions=[0.0, 0.1], bin_halfwidth=0.06)
     with pytest.raises(ConfigError, match="single position"):

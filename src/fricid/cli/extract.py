@@ -303,7 +303,8 @@ def extract_command(
             "cover the same positions it falls back to joint, with a note), joint (eq. 7 and "
             "one friction per set-point and direction by least squares over all steady "
             "samples, no pairing: e.g. --gravity joint) or none (horizontal joint: torque is "
-            "friction). Default: from the log's design, else fit with positions, none without."
+            "friction). Default: from the log's design, else fit with positions, joint with a "
+            "position channel (none, with a note, when eq. 7 is not determined), none without."
         ),
     ] = None,
     flip_sign: Annotated[
@@ -462,6 +463,9 @@ def extract_command(
         write_samples(data.by_direction, by_direction)
     if data.extraction is not None:
         console.print(data.extraction.summary(), markup=False, highlight=False)
+        if data.extraction.quality is not None:
+            for line in data.extraction.quality.accounting():
+                err_console.print(line, markup=False, highlight=False)
         if pos is None and data.extraction.options.get("positions") is not None:
             err_console.print("used the position bins recorded with the log")
     else:

@@ -10,8 +10,10 @@ Modules: :mod:`.segment` (constant-velocity segments, set-point clustering), :mo
 :mod:`.joint_gravity` (eq. 7 with per-set-point friction, no pairing), :mod:`.separation`
 (step 4: friction, gravity and the sample tables), :mod:`.torque_constant` (K of eq. 13 from
 current and a torque sensor, or from a gravity load known from a URDF),
-:mod:`.quality` (the per-set-point quality table and its warnings), :mod:`.pipeline`
-(:func:`extract`).
+:mod:`.quality` (the per-set-point quality table and its warnings), :mod:`.gravity_check`
+(does eq. 7 explain the position dependence?), :mod:`._gravity_mode` (which gravity mode, and
+the note when gravity is not removed), :mod:`.pipeline` (:func:`extract`), :mod:`.result`
+(what it returns).
 """
 
 from __future__ import annotations

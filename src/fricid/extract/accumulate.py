@@ -16,6 +16,7 @@ import numpy as np
 
 from ._stats import median, median_filter
 from .bins import Cells, CellTable, PositionBins
+from .gravity_check import block_stats
 from .joint_gravity import moments
 from .quality import QUALITY_COLUMNS, QualityTable
 from .segment import Segment
@@ -62,6 +63,8 @@ class Record:
     cells: Cells
     spikes: int
     moments: np.ndarray | None = None  # :func:`.joint_gravity.moments` of the kept samples
+    blocks: np.ndarray | None = None  # :func:`.gravity_check.block_stats` of the kept samples
+    source: str | None = None  # the file the segment was read from
 
 
 class Accumulator:
@@ -148,6 +151,8 @@ class Accumulator:
                 cells=cells,
                 spikes=spikes,
                 moments=moments(log.position[keep], tau[keep]) if self.moments else None,
+                blocks=block_stats(log.position[keep], tau[keep]) if self.moments else None,
+                source=log.source,
             )
         )
 
@@ -163,10 +168,12 @@ class Accumulator:
         speed = np.array([r.speed for r in self.records])
         duration = np.array([r.duration for r in self.records])
         quantum = max(self.quantum if np.isfinite(self.quantum) else 0.0, 1e-12)
-        rest = speed < rest_threshold(speed.max(), quantum=quantum, duration=duration)
+        self.rest_limit = rest_threshold(speed.max(), quantum=quantum, duration=duration)
+        rest = speed < self.rest_limit
         band = np.array([r.band_fraction for r in self.records])
         kept = np.array([r.kept for r in self.records])
-        kinds[(band < MIN_BAND_FRACTION) | (kept < self.min_samples)] = "unsteady"
+        self.no_plateau = band < MIN_BAND_FRACTION
+        kinds[self.no_plateau | (kept < self.min_samples)] = "unsteady"
         kinds[rest] = "rest"
         return kinds
 
@@ -181,7 +188,16 @@ class Accumulator:
             group=(first[:, None] + np.arange(nb)[None, :]).ravel(),
             **{
                 name: np.concatenate([getattr(r.cells, name) for r in chosen])
-                for name in ("count", "torque", "m2", "position", "velocity", "temperature")
+                for name in (
+                    "count",
+                    "torque",
+                    "m2",
+                    "position",
+                    "velocity",
+                    "temperature",
+                    "cos",
+                    "sin",
+                )
             },
         )
 
@@ -199,33 +215,29 @@ class Accumulator:
         the kept records, in the samples' order, then one per direction of rest and unsteady
         records, then the samples ``between`` = (at rest between runs, in runs dropped at
         segmentation for want of a plateau), as an ``unsteady`` and a ``between`` row of
-        direction 0."""
+        direction 0. Every row has a label (the files of its runs when they came from several
+        files, else its set-point) and a note saying what was merged or why it was dropped."""
         nb = self.bins.n_bins
         nv = v_set.size
         keep = kinds == "setpoint"
         kept = [r for r, k in zip(self.records, keep, strict=True) if k]
+        files = {r.source for r in self.records} - {None}
         forward = np.array([r.direction > 0 for r in kept], dtype=np.intp)
         group = (t_label * nv + v_label) * 2 + forward
-        # scatter about the cell means, pooled over each set-point's cells
-        cell_group = cells.group // nb
-        size = int(np.prod((t_set.size, nv, 2)))
-        has = cells.count > 0
-        m2 = np.bincount(cell_group, weights=cells.m2, minlength=size)
-        n = np.bincount(cell_group, weights=cells.count, minlength=size)
-        k = np.bincount(cell_group[has], minlength=size)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            scatter = np.where(n - k > 0, np.sqrt(m2 / np.maximum(n - k, 1)), np.nan)
+        scatter, run_scatter = _scatters(cells, nb, int(np.prod((t_set.size, nv, 2))))
         rows = []
         for g in np.unique(group):
             members = [r for r, gi in zip(kept, group, strict=True) if gi == g]
             it, rem = divmod(int(g), 2 * nv)
             iv, fwd = divmod(rem, 2)
             binned = int(sum(r.cells.count.sum() for r in members))
+            velocity = float(v_set[iv]) * (1 if fwd else -1)
             rows.append(
                 {
                     "kind": "setpoint",
+                    "label": _label(members, files, velocity, float(t_set[it])),
                     "temperature": float(t_set[it]),
-                    "velocity": float(v_set[iv]) * (1 if fwd else -1),
+                    "velocity": velocity,
                     "direction": 1 if fwd else -1,
                     "runs": len(members),
                     "kept": binned,
@@ -235,38 +247,114 @@ class Accumulator:
                     "dropped_outlier": sum(r.outlier for r in members),
                     "dropped_saturated": sum(r.saturated for r in members),
                     "scatter": float(scatter[g]),
+                    "run_scatter": float(run_scatter[g]),
+                    "note": _merged(members),
                 }
             )
         for kind, column in (("rest", "dropped_rest"), ("unsteady", "dropped_transient")):
             for direction in (-1, 1):
-                members = [
-                    r
-                    for r, kd in zip(self.records, kinds, strict=True)
-                    if kd == kind and r.direction == direction
-                ]
-                if not members:
+                chosen = np.flatnonzero(
+                    (kinds == kind) & np.array([r.direction == direction for r in self.records])
+                )
+                if not chosen.size:
                     continue
+                members = [self.records[i] for i in chosen]
                 row = dict.fromkeys(QUALITY_COLUMNS, 0)
                 row.update(
                     kind=kind,
-                    label="",
+                    label=_label(members, files, None, None),
                     temperature=float(np.mean([r.temperature for r in members])),
                     velocity=direction * float(np.median([r.speed for r in members])),
                     direction=direction,
                     runs=len(members),
                     scatter=np.nan,
+                    run_scatter=np.nan,
+                    gravity_residual=np.nan,
                     flagged=False,
+                    note=self._dropped_note(kind, chosen),
                 )
                 row[column] = sum(r.samples for r in members)
                 rows.append(row)
-        for kind, column, n in (
-            ("unsteady", "dropped_transient", between[1]),
-            ("between", "dropped_rest", between[0]),
+        for kind, column, n, why in (
+            ("unsteady", "dropped_transient", between[1], _NO_PLATEAU),
+            ("between", "dropped_rest", between[0], _BETWEEN),
         ):
             if n:
                 row = dict.fromkeys(QUALITY_COLUMNS, 0)
-                row.update(kind=kind, label="", temperature=np.nan, velocity=0.0)
-                row.update(scatter=np.nan, flagged=False)
+                row.update(kind=kind, label="between runs", temperature=np.nan, velocity=0.0)
+                row.update(scatter=np.nan, run_scatter=np.nan, gravity_residual=np.nan)
+                row.update(flagged=False, note=why)
                 row[column] = int(n)
                 rows.append(row)
         return QualityTable.from_rows(rows)
+
+    def _dropped_note(self, kind: str, chosen: np.ndarray) -> str:
+        """Why the records ``chosen`` (all rest, or all unsteady) were dropped, with speeds."""
+        speeds = _speeds([self.records[i].speed for i in chosen])
+        if kind == "rest":
+            limit = float(np.max(self.rest_limit[chosen]))
+            return (
+                f"dropped as standstill: {len(chosen)} run(s) at {speeds} rad/s, below the rest "
+                f"threshold {limit:.2g} rad/s (1e-3 of the fastest run, or under one encoder "
+                "step over the run)"
+            )
+        flat = int(self.no_plateau[chosen].sum())
+        parts = []
+        if flat:
+            parts.append(f"{flat} without a steady plateau (return or aborted moves)")
+        if len(chosen) - flat:
+            parts.append(
+                f"{len(chosen) - flat} with fewer than min_samples={self.min_samples} samples "
+                "left after trimming ramps, settling, outliers and rail samples"
+            )
+        return f"dropped as transient: {len(chosen)} run(s) at {speeds} rad/s: " + ", ".join(parts)
+
+
+_NO_PLATEAU = "dropped as transient: runs without a velocity plateau (found at segmentation)"
+_BETWEEN = "samples between runs: zero velocity, or runs shorter than min_samples"
+
+
+def _scatters(cells: CellTable, nb: int, size: int) -> tuple[np.ndarray, np.ndarray]:
+    """Per set-point: the samples' scatter about their cell means, and the scatter of the
+    runs' (passes') means about their cell means (NaN for a single run), pooled over cells."""
+    cell_group = cells.group // nb
+    has = cells.count > 0
+    m2 = np.bincount(cell_group, weights=cells.m2, minlength=size)
+    n = np.bincount(cell_group, weights=cells.count, minlength=size)
+    k = np.bincount(cell_group[has], minlength=size)
+    g, cg, c, t = cells.group[has], cell_group[has], cells.count[has], cells.torque[has]
+    cell_n = np.bincount(g, weights=c, minlength=g.max(initial=0) + 1)
+    cell_mean = np.bincount(g, weights=c * t, minlength=cell_n.size) / np.maximum(cell_n, 1)
+    cell_k = np.bincount(g, minlength=cell_n.size)
+    dev2 = np.bincount(cg, weights=(t - cell_mean[g]) ** 2, minlength=size)
+    dof = np.bincount(cg, weights=(cell_k[g] - 1.0) / np.maximum(cell_k[g], 1), minlength=size)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        scatter = np.where(n - k > 0, np.sqrt(m2 / np.maximum(n - k, 1)), np.nan)
+        runs = np.where(dof > 0.5, np.sqrt(dev2 / np.maximum(dof, 1e-300)), np.nan)
+    return scatter, runs
+
+
+def _speeds(speeds: list[float], limit: int = 6) -> str:
+    """``0.1, 0.2, 0.4`` (sorted, at most ``limit``, then how many more)."""
+    s = sorted(speeds)
+    text = ", ".join(f"{v:.3g}" for v in s[:limit])
+    return text + (f" and {len(s) - limit} more" if len(s) > limit else "")
+
+
+def _label(members: list[Record], files: set, velocity: float | None, temperature) -> str:
+    """A row's label: the files of its runs when the log came from several files, else its
+    set-point (``+0.2 rad/s, 25 degC``) or, for dropped runs, their speeds."""
+    if len(files) > 1:
+        names = sorted({str(r.source).replace("\\", "/").rsplit("/", 1)[-1] for r in members})
+        return ", ".join(names[:3]) + (f" and {len(names) - 3} more" if len(names) > 3 else "")
+    if velocity is None:
+        return f"runs at {_speeds([r.speed for r in members], 3)} rad/s"
+    return f"{velocity:+.4g} rad/s, {temperature:.4g} degC"
+
+
+def _merged(members: list[Record]) -> str:
+    """What a set-point row averaged: one run, or runs merged and their speed range."""
+    if len(members) == 1:
+        return "1 run"
+    speeds = [r.speed for r in members]
+    return f"{len(members)} runs merged ({min(speeds):.4g}-{max(speeds):.4g} rad/s)"

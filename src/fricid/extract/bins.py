@@ -1,9 +1,11 @@
 """Position bins and the statistics accumulated in them (vectorised, no loop over samples).
 
 Each segment (one pass at one velocity) contributes one *cell* per position bin: sample count,
-mean and sum of squared deviations (M2) of the torque, and means of position, velocity and
-temperature. Cells are then pooled over repetitions into set-point groups with Chan's parallel
-formulas, which are exact and independent of the order or chunking of the data.
+mean and sum of squared deviations (M2) of the torque, and means of position, velocity,
+temperature and of ``cos`` and ``sin`` of the position (the gravity torque of eq. 7 is linear in
+those two, so its mean over a cell's samples is exact however wide the cell). Cells are then
+pooled over repetitions into set-point groups with Chan's parallel formulas, which are exact
+and independent of the order or chunking of the data.
 """
 
 from __future__ import annotations
@@ -86,6 +88,8 @@ class Cells:
     position: np.ndarray
     velocity: np.ndarray
     temperature: np.ndarray
+    cos: np.ndarray | None = None  # mean cos(position)
+    sin: np.ndarray | None = None  # mean sin(position)
 
     @classmethod
     def of(cls, idx, torque, position, velocity, temperature, n_bins: int) -> Cells:
@@ -101,7 +105,16 @@ class Cells:
         tau = torque[keep]
         m = np.bincount(idx, weights=tau, minlength=n_bins) / safe
         m2 = np.bincount(idx, weights=(tau - m[idx]) ** 2, minlength=n_bins)
-        return cls(count, m, m2, mean(position), mean(velocity), mean(temperature))
+        return cls(
+            count,
+            m,
+            m2,
+            mean(position),
+            mean(velocity),
+            mean(temperature),
+            mean(np.cos(position)),
+            mean(np.sin(position)),
+        )
 
 
 @dataclass(frozen=True, eq=False)
@@ -115,6 +128,8 @@ class CellTable:
     position: np.ndarray
     velocity: np.ndarray
     temperature: np.ndarray
+    cos: np.ndarray | None = None  # mean cos(position); None: cos of the mean position
+    sin: np.ndarray | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -129,6 +144,8 @@ class Pooled:
     position: np.ndarray
     velocity: np.ndarray
     temperature: np.ndarray
+    cos: np.ndarray  # mean cos(position) of the samples
+    sin: np.ndarray  # mean sin(position) of the samples
 
 
 def pool_cells(cells: CellTable, n_groups: int) -> Pooled:
@@ -147,6 +164,8 @@ def pool_cells(cells: CellTable, n_groups: int) -> Pooled:
     def total(x: np.ndarray) -> np.ndarray:
         return np.bincount(g, weights=x, minlength=n_groups)
 
+    cos = np.cos(cells.position) if cells.cos is None else cells.cos
+    sin = np.sin(cells.position) if cells.sin is None else cells.sin
     count = total(n)
     passes = np.bincount(g, minlength=n_groups).astype(float)
     with np.errstate(invalid="ignore", divide="ignore"):
@@ -169,5 +188,7 @@ def pool_cells(cells: CellTable, n_groups: int) -> Pooled:
             position=total(n * cells.position[has]) / count,
             velocity=total(n * cells.velocity[has]) / count,
             temperature=total(n * cells.temperature[has]) / count,
+            cos=total(n * cos[has]) / count,
+            sin=total(n * sin[has]) / count,
         )
     return pooled

@@ -54,15 +54,22 @@ class GravityFit:
         return self.p_x * np.cos(theta) - self.p_y * np.sin(theta)
 
 
-def fit_gravity(theta, tau_g, *, source: str | None = None) -> GravityFit:
+def fit_gravity(theta, tau_g, *, source: str | None = None, cos=None, sin=None) -> GravityFit:
     """Fit eq. 7 to gravity torques ``tau_g`` [N m] at positions ``theta`` [rad].
+
+    ``cos`` and ``sin``, when given, are the means of ``cos`` and ``sin`` of the positions
+    each torque was averaged over (a position bin's samples): eq. 7 is linear in them, so the
+    fit is then exact however wide the bins, where ``cos(mean theta)`` is off by about
+    ``h^2 / 6`` relative for a bin of half-width ``h``.
 
     Needs at least two distinct positions (not half a turn apart, and spread over more than
     about 0.1 deg so the two coefficients are separable); raises :class:`DataError` otherwise.
     """
     theta = np.asarray(theta, dtype=float).ravel()
     y = np.asarray(tau_g, dtype=float).ravel()
-    A = np.column_stack([np.cos(theta), -np.sin(theta)])
+    c = np.cos(theta) if cos is None else np.asarray(cos, dtype=float).ravel()
+    s = np.sin(theta) if sin is None else np.asarray(sin, dtype=float).ravel()
+    A = np.column_stack([c, -s])
     coef, _, rank, sv = np.linalg.lstsq(A, y, rcond=None)
     if rank < 2 or sv[-1] < 1e-3 * sv[0]:
         raise DataError(

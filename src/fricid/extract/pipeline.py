@@ -15,186 +15,59 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Iterable, Iterator
-from dataclasses import dataclass, field
-from typing import Any
+from dataclasses import replace
 
 import numpy as np
 
 from ..errors import ConfigError, DataError
-from ..samples import FrictionSamples, RawLog
+from ..samples import RawLog
+from ._gravity_mode import (
+    AUTO,
+    explicit_none_note,
+    no_fit_note,
+    residual_check,
+    resolve,
+    std_about_gravity,
+)
 from .accumulate import SPIKE_SIGMAS, Accumulator
 from .bins import PositionBins, pool_cells
-from .gravity import GravityFit
 from .joint_gravity import JointGravityFit, fit_gravity_joint
-from .quality import QualityTable, flag_scatter, warn_quality
+from .quality import flag_scatter, warn_quality
+from .result import Diagnostics, ExtractionResult
 from .segment import SegmentCounts, as_log_stream, cluster, iter_segments
-from .separation import assemble
+from .separation import assemble, sem_meta
 from .steady import OUTLIER_SIGMAS, SETTLE_SIGMAS
 
 __all__ = ["GRAVITY_MODES", "SPIKE_SIGMAS", "Diagnostics", "ExtractionResult", "extract"]
 
 logger = logging.getLogger(__name__)
 
+#: Default ``velocity_rtol``: runs whose plateaus lie within 1 % of a set-point's centre are
+#: repeats of it. Repeats of one commanded speed agree far closer (the virtual joint's within
+#: 0.06 %; a drive tracks its command), while designs with closely spaced speeds (3 % apart, or
+#: 0.1 deg/s steps up to 5 deg/s: 2 %) must stay apart.
+VELOCITY_RTOL = 0.01
+
 #: Values of ``extract(..., gravity=...)``.
 GRAVITY_MODES = ("fit", "joint", "none")
 
 
-@dataclass(frozen=True, eq=False)
-class Diagnostics:
-    """What extraction found and discarded.
-
-    Attributes
-    ----------
-    rows, chunks : int
-        Raw samples and log chunks read.
-    runs : int
-        Runs of one velocity sign examined (including the flicker of a noisy velocity at rest).
-    segments : int
-        Constant-velocity segments kept as set-point passes.
-    dropped : dict of str to int
-        Runs dropped, by reason: ``short_run`` (fewer than ``min_samples``), ``no_plateau`` (no
-        sample near the plateau), ``short_steady`` (too short after removing ramps and settle
-        margins), ``rest`` (standstill), ``unsteady`` (no steady plateau: return moves).
-    spikes : int
-        Samples the median filter changed by more than ``SPIKE_SIGMAS`` robust sigmas.
-    binned, outside_bins : int
-        Kept samples inside / outside every position bin.
-    velocity_setpoints : numpy.ndarray
-        rad/s, the speeds found (cluster medians).
-    temperature_setpoints : numpy.ndarray
-        degC, the temperatures found.
-    passes_min, passes_max : int
-        Fewest and most passes averaged into one sample.
-    samples : dict of str to int
-        Samples kept and dropped over the whole log, by reason (``kept``, ``dropped_rest``,
-        ``dropped_transient``, ``dropped_outlier``, ``dropped_saturated``).
-    """
-
-    rows: int
-    chunks: int
-    runs: int
-    segments: int
-    dropped: dict[str, int]
-    spikes: int
-    binned: int
-    outside_bins: int
-    velocity_setpoints: np.ndarray
-    temperature_setpoints: np.ndarray
-    passes_min: int
-    passes_max: int
-    samples: dict[str, int] = field(default_factory=dict)
-
-
-@dataclass(frozen=True, eq=False)
-class ExtractionResult:
-    """The friction samples of a log and how they were obtained.
-
-    Attributes
-    ----------
-    samples : FrictionSamples
-        Combined samples, direction 0 (eq. 11): one row per (temperature, velocity, position
-        bin), sorted in that order; velocity and friction of the positive direction.
-    by_direction : FrictionSamples
-        The same operating points per direction (+1/-1, velocity and friction signed; rows
-        ordered as ``samples`` with -1 before +1): ``tau_f+- = tau+- + tau_g`` with the fitted
-        gravity, which keeps a drive's asymmetry.
-    gravity : GravityFit, JointGravityFit or None
-        The eq. 7 fit (eq. 11 pairing, or the joint fit with its per-set-point frictions), or
-        None with ``gravity="none"``.
-    diagnostics : Diagnostics
-        What was read, kept and dropped.
-    sem, direction_sem : numpy.ndarray
-        N m, standard error of each row's friction from the scatter of the repetitions (the
-        noise floor; use it for weighting or tolerances); also in ``samples.meta["sem"]`` and
-        ``by_direction.meta["sem"]``, so it is written with the samples.
-    position : numpy.ndarray
-        rad, mean position of each combined row's samples.
-    options : dict
-        The extraction options used (also in ``samples.meta["extract"]``).
-    quality : QualityTable or None
-        Per set-point and direction, samples kept and dropped (rest, transient, outlier,
-        saturated) and their scatter (also in ``samples.meta["quality"]``, so it is written
-        with the samples).
-    notes : tuple of str
-        What the user should know about how the result was obtained (e.g. eq. 11 pairing
-        impossible, gravity identified jointly instead).
-    """
-
-    samples: FrictionSamples
-    by_direction: FrictionSamples
-    gravity: GravityFit | JointGravityFit | None
-    diagnostics: Diagnostics
-    sem: np.ndarray
-    direction_sem: np.ndarray
-    position: np.ndarray
-    options: dict[str, Any] = field(default_factory=dict)
-    quality: QualityTable | None = None
-    notes: tuple[str, ...] = ()
-
-    def summary(self) -> str:
-        """A few lines describing the result (for a report or the CLI)."""
-        d = self.diagnostics
-        lines = [
-            f"{_count(len(self.samples), 'sample')} (both directions combined; "
-            f"{_per_direction(self.by_direction)}) from {_count(d.segments, 'segment')} of "
-            f"{_count(d.rows, 'row')}; {_count(d.spikes, 'spike')} filtered",
-            f"{_count(d.velocity_setpoints.size, 'velocity set-point')} "
-            f"({d.velocity_setpoints.min():.4g}-{d.velocity_setpoints.max():.4g} rad/s), "
-            f"{_count(d.temperature_setpoints.size, 'temperature')}, "
-            f"{_passes(d.passes_min, d.passes_max)} per sample",
-        ]
-        if d.samples:
-            n = d.samples
-            rest = d.dropped.get("rest", 0) + d.dropped.get("short_run", 0)
-            unsteady = sum(d.dropped.get(k, 0) for k in ("unsteady", "no_plateau", "short_steady"))
-            lines.append(
-                f"samples kept {n['kept']}, dropped: rest {n['dropped_rest']}, transient "
-                f"{n['dropped_transient']}, outlier {n['dropped_outlier']}, saturated "
-                f"{n['dropped_saturated']}; runs rejected: {rest} at rest or too short, "
-                f"{unsteady} without a steady plateau (return moves, aborted moves)"
-            )
-        if self.gravity is not None:
-            g = self.gravity
-            how = ""
-            if isinstance(g, JointGravityFit):
-                how = f", joint fit with {g.friction.size} set-point frictions, no pairing"
-            lines.append(
-                f"gravity (eq. 7{how}): p_x = {g.p_x:.5g} +- {g.p_x_se:.2g}, "
-                f"p_y = {g.p_y:.5g} +- {g.p_y_se:.2g} N m, residual {g.residual_rms:.2g} N m"
-            )
-        if isinstance(self.gravity, JointGravityFit):
-            lines.append(self._joint_frictions())
-        lines.extend(f"note: {n}" for n in self.notes)
-        if self.quality is not None and self.quality.flagged.any():
-            lines.append("set-points flagged (scatter far above their neighbours):")
-            lines.append(self.quality.subset(self.quality.flagged).describe())
-        return "\n".join(lines)
-
-    def _joint_frictions(self) -> str:
-        """The joint fit's friction per set-point and direction, with standard errors."""
-        g, d = self.gravity, self.diagnostics
-        nv = d.velocity_setpoints.size
-        parts = []
-        for label, f, se in zip(g.group, g.friction, g.friction_se, strict=True):
-            it, rem = divmod(int(label), 2 * nv)
-            iv, fwd = divmod(rem, 2)
-            v = d.velocity_setpoints[iv] * (1 if fwd else -1)
-            temperature = d.temperature_setpoints[it]
-            parts.append(f"{temperature:.4g} degC {v:+.4g} rad/s {f:+.4g}+-{se:.2g}")
-        return "set-point friction [N m] (joint fit): " + "; ".join(parts)
-
-
 class _Source:
-    """Passes a log stream through, remembering the first log's source name."""
+    """Passes a log stream through, remembering the first log's source name and where its
+    position came from (``meta["position_source"]``; a reader that integrates the velocity
+    says so there, a position channel is assumed otherwise)."""
 
     def __init__(self, logs: RawLog | Iterable[RawLog]) -> None:
         self.logs = logs
         self.name: str | None = None
+        self.position_source: str | None = None
 
     def __iter__(self) -> Iterator[RawLog]:
         for log in as_log_stream(self.logs):
             if self.name is None:
                 self.name = log.source
+                meta = log.meta if isinstance(log.meta, dict) else {}
+                self.position_source = str(meta.get("position_source", "channel"))
             yield log
 
 
@@ -203,8 +76,10 @@ def _check_options(median_window, gravity, velocity_rtol, temperature_atol) -> N
         raise ConfigError(
             f"median_window must be an odd positive integer (1: no filter), got {median_window!r}"
         )
-    if gravity not in GRAVITY_MODES:
-        raise ConfigError(f"gravity must be one of {', '.join(GRAVITY_MODES)}; got {gravity!r}")
+    if gravity not in (*GRAVITY_MODES, AUTO):
+        raise ConfigError(
+            f"gravity must be one of {', '.join((*GRAVITY_MODES, AUTO))}; got {gravity!r}"
+        )
     if not (velocity_rtol > 0):
         raise ConfigError(f"velocity_rtol must be > 0, got {velocity_rtol!r}")
     if not (temperature_atol > 0):
@@ -221,7 +96,7 @@ def extract(
     velocity_tolerance: float = 0.05,
     settle_time: float = 0.1,
     min_samples: int = 20,
-    velocity_rtol: float = 0.05,
+    velocity_rtol: float = VELOCITY_RTOL,
     temperature_atol: float = 1.0,
     outlier_sigmas: float | None = OUTLIER_SIGMAS,
     settle_sigmas: float | None = SETTLE_SIGMAS,
@@ -242,7 +117,10 @@ def extract(
         Samples of the running median applied to the torque within each segment (odd; 1
         disables it). It removes current spikes (section 2.2: "further filtered by median
         filtering").
-    gravity : {"fit", "joint", "none"}
+    gravity : {"fit", "joint", "none", "auto"}
+        "auto": remove gravity whenever the log can tell it: "fit" with position bins, else
+        "joint" when the log has a position channel (falling back to "none" with a note when
+        eq. 7 is not determined), else "none" with a note saying gravity was not removed.
         "fit": a joint with gravity, the paper's method; eq. 11 pairs both directions at every
         operating point, eq. 7 is fitted and gives the loads (eq. 12). Where a set-point lacks
         one direction in some bin, pairing is impossible and "joint" is used instead (with a
@@ -251,7 +129,8 @@ def extract(
         (:func:`~.joint_gravity.fit_gravity_joint`); needs no pairing, nor position bins; a
         row with one direction is that direction's friction with gravity removed. "none": a
         horizontal joint; the torque is the friction, load 0; eq. 11 combines the directions
-        where both exist, a single direction is used as measured.
+        where both exist, a single direction is used as measured; on a log with a position
+        channel a note says that gravity was not removed.
     velocity_tolerance : float
         Relative band around a run's plateau velocity that counts as steady.
     settle_time : float
@@ -259,9 +138,11 @@ def extract(
     min_samples : int
         Shortest steady part kept (also after the checks below).
     velocity_rtol : float
-        Relative gap separating two velocity set-points.
+        Relative gap separating two velocity set-points, and the largest span of one relative
+        to its centre (:func:`~.segment.cluster`: set-points cannot chain); default
+        :data:`VELOCITY_RTOL`.
     temperature_atol : float
-        degC gap separating two temperature set-points.
+        degC gap separating two temperature set-points, and the largest span of one.
     outlier_sigmas : float or None
         Robust standard deviations beyond which a torque sample is an outlier and dropped
         (:func:`fricid.extract.steady.outliers`, default 8); None disables the screen.
@@ -303,6 +184,7 @@ def extract(
     """
     _check_options(median_window, gravity, velocity_rtol, temperature_atol)
     bins = PositionBins(positions, bin_halfwidth)
+    requested = gravity
     if gravity == "fit" and bins.auto:
         raise ConfigError(
             "gravity='fit' needs position bins (positions=..., eq. 7 is fitted across them); "
@@ -342,6 +224,13 @@ def extract(
             file=source,
         )
     kept = [r for r, k in zip(acc.records, keep, strict=True) if k]
+    notes: list[str] = []
+    if gravity == AUTO:
+        gravity, note = resolve(not bins.auto, stream.position_source)
+    else:
+        note = explicit_none_note(stream.position_source) if gravity == "none" else ""
+    if note:
+        notes.append(note)
 
     # set-points: velocity by relative gaps, temperature by absolute gaps
     v_label, v_set = cluster(np.array([r.speed for r in kept]), velocity_rtol, relative=True)
@@ -370,34 +259,68 @@ def extract(
         "outlier_sigmas": outlier_sigmas,
         "settle_sigmas": settle_sigmas,
     }
-    quality = flag_scatter(
-        acc.quality(
-            kinds,
-            t_label,
-            v_label,
-            t_set,
-            v_set,
-            cells,
-            (counts.dropped_samples, counts.unsteady_samples),
-        )
+    unflagged = acc.quality(
+        kinds,
+        t_label,
+        v_label,
+        t_set,
+        v_set,
+        cells,
+        (counts.dropped_samples, counts.unsteady_samples),
     )
-    meta = {"extract": options, "quality": quality.rows()}
+    meta = {"extract": options, "quality": unflagged.rows()}
+    forward = np.array([r.direction > 0 for r in kept], dtype=np.intp)
+    group = (t_label * v_set.size + v_label) * 2 + forward
 
     def joint_fit() -> JointGravityFit:
-        forward = np.array([r.direction > 0 for r in kept], dtype=np.intp)
-        group = (t_label * v_set.size + v_label) * 2 + forward
         stats = np.array([r.moments for r in kept])
         return fit_gravity_joint(stats, group, 2 * forward - 1, source=source)
 
-    notes: list[str] = []
-    samples, by_direction, fit, sem, direction_sem, position = assemble(
-        pooled, shape, t_set, v_set, gravity, source, meta, joint_fit, notes
+    try:
+        samples, by_direction, fit, sem, direction_sem, position = assemble(
+            pooled, shape, t_set, v_set, gravity, source, meta, joint_fit, notes
+        )
+    except DataError as exc:
+        if requested != AUTO or gravity != "joint":
+            raise
+        notes.append(no_fit_note(exc.message))
+        samples, by_direction, fit, sem, direction_sem, position = assemble(
+            pooled, shape, t_set, v_set, "none", source, meta, joint_fit, notes
+        )
+    used = "none" if fit is None else ("joint" if isinstance(fit, JointGravityFit) else "fit")
+    if used != requested:
+        options["gravity_requested"] = requested
+    options["gravity"] = used
+    residual = residual_check(fit, kept, group, pooled, shape)
+    if residual is not None:
+        per = [residual.per_group.get(int(g), np.nan) for g in np.unique(group)]
+        unflagged = unflagged.with_gravity_residual(per)
+        if residual.message():
+            notes.append(residual.message())
+    if fit is not None and bins.auto:
+        samples, by_direction, unflagged = _scatter_about_gravity(
+            std_about_gravity(fit, kept, group), group, samples, by_direction, unflagged
+        )
+        sem, direction_sem = (
+            np.array([np.nan if e is None else e for e in x.meta["sem"]], dtype=float)
+            for x in (samples, by_direction)
+        )
+    quality = flag_scatter(unflagged)
+    samples, by_direction = (
+        replace(
+            x,
+            meta={
+                **x.meta,
+                "quality": quality.rows(),
+                "extract": options,
+                **({"notes": list(notes)} if notes else {}),
+                **({} if residual is None else {"gravity_residual": residual.as_meta()}),
+            },
+        )
+        for x in (samples, by_direction)
     )
-    if notes:
-        options["gravity_requested"] = gravity
-        options["gravity"] = "joint"
-        for note in notes:
-            logger.info("%s", note)
+    for note in notes:
+        logger.info("%s", note)
     passes = pooled.passes[pooled.count > 0]
     binned = int(sum(r.cells.count.sum() for r in kept))
     diagnostics = Diagnostics(
@@ -421,7 +344,7 @@ def extract(
         passes_max=int(passes.max()),
         samples=quality.totals(),
     )
-    warn_quality(quality, source, stacklevel=2)
+    warn_quality(quality, source, stacklevel=2, gravity=residual)
     logger.info("extracted %d samples from %d segments", len(samples), len(kept))
     return ExtractionResult(
         samples,
@@ -437,24 +360,30 @@ def extract(
     )
 
 
-def _count(n: int, noun: str, plural: str | None = None) -> str:
-    """``1 temperature``, ``5 temperatures``, ``1,211,640 rows`` (the summary's counts)."""
-    n = int(n)
-    return f"{n:,} " + (noun if n == 1 else plural or f"{noun}s")
-
-
-def _per_direction(by_direction: FrictionSamples) -> str:
-    """``330 + 330 per-direction samples`` (positive + negative), or the total when one-sided."""
-    d = np.asarray(by_direction.direction)
-    pos, neg = int((d > 0).sum()), int((d < 0).sum())
-    if pos and neg and pos + neg == len(d):
-        return f"{pos:,} + {neg:,} per-direction samples"
-    return f"{_count(len(d), 'per-direction sample')}"
-
-
-def _passes(lo: int, hi: int) -> str:
-    """``3 passes``, ``1 pass``, ``2-4 passes`` (repetitions averaged into each sample)."""
-    lo, hi = int(lo), int(hi)
-    if lo == hi:
-        return _count(lo, "pass", "passes")
-    return f"{lo}-{hi} passes"
+def _scatter_about_gravity(stats, group, samples, by_direction, quality):
+    """With one bin per traverse, the rows' ``std`` and standard errors and the set-points'
+    ``scatter`` about eq. 7 (``stats``: label -> (std, sem) [N m],
+    :func:`._gravity_mode.std_about_gravity`), not about the mean torque, which holds
+    gravity's range along the traverse. By-direction rows and set-point rows are in label
+    order; a combined row pools its two directions (eq. 11 halves the standard error)."""
+    labels = np.unique(group)
+    new = np.array([stats.get(int(g), (np.nan, np.nan)) for g in labels])
+    keep = np.isfinite(new[:, 0])
+    d_std = np.where(keep, new[:, 0], by_direction.std)
+    d_sem = np.where(keep, new[:, 1], np.asarray(by_direction.meta["sem"], dtype=float))
+    by_direction = replace(by_direction, std=d_std, meta={**by_direction.meta, **sem_meta(d_sem)})
+    column = quality.scatter.copy()
+    rows = np.flatnonzero(quality.setpoints)
+    column[rows] = np.where(keep, new[:, 0], column[rows])
+    quality = replace(quality, scatter=column)
+    pair = labels // 2
+    n = by_direction.count
+    m2 = np.bincount(pair, weights=d_std**2 * np.maximum(n - 1, 0))
+    total = np.bincount(pair, weights=n)
+    k = np.bincount(pair)
+    first = np.unique(pair)
+    combined = np.sqrt(m2 / np.maximum(total - k, 1))[first]
+    sem2 = np.bincount(pair, weights=d_sem**2)[first]
+    sem = np.where(k[first] == 2, 0.5 * np.sqrt(sem2), np.sqrt(sem2))
+    samples = replace(samples, std=combined, meta={**samples.meta, **sem_meta(sem)})
+    return samples, by_direction, quality

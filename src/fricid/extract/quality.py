@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import warnings
 from collections.abc import Sequence
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field, fields, replace
 from typing import Any
 
 import numpy as np
@@ -45,8 +45,14 @@ QUALITY_COLUMNS: dict[str, str] = {
     "dropped_outlier": "",
     "dropped_saturated": "",
     "scatter": "N m",
+    "run_scatter": "N m",
+    "gravity_residual": "N m",
     "flagged": "",
+    "note": "",
 }
+
+_TEXT = ("kind", "label", "note")
+_FLOATS = ("temperature", "velocity", "scatter", "run_scatter", "gravity_residual")
 
 #: Kinds of rows: a set-point whose samples were averaged, standstill rejected as rest,
 #: runs without a steady plateau (return moves, aborted moves), and samples between runs.
@@ -87,8 +93,19 @@ class QualityTable:
     scatter : numpy.ndarray
         N m, standard deviation of the kept samples' torque about their cell means (NaN
         without kept samples).
+    run_scatter : numpy.ndarray
+        N m, standard deviation of the merged runs' means about their cell means (NaN for a
+        single run): what merging runs into one set-point averaged away.
+    gravity_residual : numpy.ndarray
+        N m, RMS of what the gravity fit (eq. 7) left along the position in this set-point's
+        samples (:mod:`fricid.extract.gravity_check`; NaN without a gravity fit).
     flagged : numpy.ndarray
-        bool, scatter above :data:`SCATTER_RATIO` times the neighbours'.
+        bool, scatter (or, for merged runs, the scatter between them) above
+        :data:`SCATTER_RATIO` times the neighbours'.
+    note : numpy.ndarray
+        str, why the row is what it is: the runs merged (and their speeds), the reason runs
+        were dropped (standstill below the rest threshold, no steady plateau, too short after
+        trimming), and why it is flagged.
     """
 
     kind: np.ndarray
@@ -104,16 +121,21 @@ class QualityTable:
     dropped_outlier: np.ndarray
     dropped_saturated: np.ndarray
     scatter: np.ndarray
+    run_scatter: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    gravity_residual: np.ndarray = field(default_factory=lambda: np.zeros(0))
     flagged: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=bool))
+    note: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=object))
 
     @classmethod
     def from_rows(cls, rows: Sequence[dict[str, Any]]) -> QualityTable:
-        """Build from dicts keyed by :data:`QUALITY_COLUMNS` (``label``, ``flagged`` optional)."""
+        """Build from dicts keyed by :data:`QUALITY_COLUMNS` (``label``, ``flagged``, ``note``,
+        ``run_scatter`` and ``gravity_residual`` optional)."""
         cols: dict[str, Any] = {}
         for f in fields(cls):
-            default = {"label": "", "flagged": False}.get(f.name)
+            default = {"label": "", "flagged": False, "note": ""}.get(f.name, np.nan)
             values = [r.get(f.name, default) for r in rows]
-            if f.name in ("kind", "label"):
+            values = [np.nan if v is None and f.name not in _TEXT else v for v in values]
+            if f.name in _TEXT:
                 cols[f.name] = np.array(values, dtype=object)
             elif f.name == "flagged":
                 cols[f.name] = np.array(values, dtype=bool)
@@ -133,6 +155,12 @@ class QualityTable:
         """The rows where ``mask`` is true."""
         return QualityTable(**{f.name: getattr(self, f.name)[mask] for f in fields(self)})
 
+    def with_gravity_residual(self, values) -> QualityTable:
+        """The table with ``gravity_residual`` [N m] set on the set-point rows, in order."""
+        column = np.full(len(self), np.nan)
+        column[np.flatnonzero(self.setpoints)] = np.asarray(values, dtype=float)
+        return replace(self, gravity_residual=column)
+
     def totals(self) -> dict[str, int]:
         """Samples kept and dropped (by reason) over the whole table."""
         names = ("kept", "dropped_rest", "dropped_transient", "dropped_outlier")
@@ -145,11 +173,11 @@ class QualityTable:
             row: dict[str, Any] = {}
             for name in QUALITY_COLUMNS:
                 value = getattr(self, name)[i]
-                if name in ("kind", "label"):
+                if name in _TEXT:
                     row[name] = str(value)
                 elif name == "flagged":
                     row[name] = bool(value)
-                elif name == "scatter" or name in ("temperature", "velocity"):
+                elif name in _FLOATS:
                     row[name] = None if not np.isfinite(value) else float(value)
                 else:
                     row[name] = int(value)
@@ -175,6 +203,27 @@ class QualityTable:
             lines.append(",".join(cells))
         return "\n".join(lines) + "\n"
 
+    def accounting(self, limit: int = 12) -> list[str]:
+        """Every set-point accounted for, one line each: the set-points kept and how many merge
+        several runs, then each flagged set-point and each dropped group with its reason (at
+        most ``limit`` lines of those)."""
+        sp = self.setpoints
+        merged = sp & (self.runs > 1)
+        head = f"set-points: {int(sp.sum())} kept"
+        if merged.any():
+            lo, hi = int(self.runs[merged].min()), int(self.runs[merged].max())
+            runs = f"{lo}" if lo == hi else f"{lo}-{hi}"
+            head += f", {int(merged.sum())} of them merge {runs} runs each"
+        lines = [head]
+        for i in np.flatnonzero((sp & self.flagged) | ~sp):
+            dropped = int(self.dropped_rest[i] + self.dropped_transient[i])
+            what = f"flagged {self.label[i]}" if sp[i] else f"{self.kind[i]} ({self.label[i]})"
+            count = f" [{dropped} samples]" if not sp[i] else ""
+            lines.append(f"  {what}: {self.note[i]}{count}")
+        if len(lines) > limit + 1:
+            lines = [*lines[: limit + 1], f"  ... {len(lines) - limit - 1} more (quality table)"]
+        return lines
+
     def describe(self, limit: int = 40) -> str:
         """A fixed-width text table (at most ``limit`` rows; flagged rows first)."""
         head = (
@@ -192,6 +241,7 @@ class QualityTable:
                 f"{int(self.dropped_outlier[i]):>6}{int(self.dropped_saturated[i]):>6}"
                 f"{scatter:>11}  {'HIGH' if self.flagged[i] else ''}"
                 + (f" {self.label[i]}" if self.label[i] else "")
+                + (f": {self.note[i]}" if self.note[i] else "")
             )
         if len(self) > limit:
             lines.append(f"... {len(self) - limit} more rows")
@@ -202,20 +252,46 @@ def flag_scatter(table: QualityTable, ratio: float = SCATTER_RATIO) -> QualityTa
     """The table with ``flagged`` set where a set-point's scatter exceeds ``ratio`` times the
     median scatter of its neighbours: the set-points of the same temperature and direction,
     ordered by speed, up to two on each side (a set-point without neighbours, or with a scatter
-    below :data:`SCATTER_FLOOR`, is never flagged)."""
+    below :data:`SCATTER_FLOOR`, is never flagged).
+
+    Merged runs are also flagged when the scatter *between* them (``run_scatter``, the spread
+    of the runs' means) exceeds ``ratio`` times the typical spread, the larger of their
+    sample scatter and their own ``run_scatter``, both of the neighbours and of all the log's
+    set-points (the median): a ``run_scatter`` from two or three runs is rough (the virtual
+    joint's per-run offsets give 0.002-0.03 N m between neighbours), the log's median is not.
+    Each flag's reason is appended to ``note``."""
     flagged = np.zeros(len(table), dtype=bool)
+    note = table.note.copy()
     sp = np.flatnonzero(table.setpoints & np.isfinite(table.scatter))
     temps = np.round(table.temperature[sp], 6)
+    spread = np.fmax(table.scatter, table.run_scatter)
+    typical = float(np.median(spread[sp])) if sp.size else np.nan
     for key in set(zip(temps.tolist(), table.direction[sp].tolist(), strict=True)):
         group = sp[(temps == key[0]) & (table.direction[sp] == key[1])]
         group = group[np.argsort(np.abs(table.velocity[group]))]
-        s = table.scatter[group]
+        s, between, ref = table.scatter[group], table.run_scatter[group], spread[group]
         for j, row in enumerate(group):
-            others = np.concatenate([s[max(j - 2, 0) : j], s[j + 1 : j + 3]])
-            if others.size and s[j] > max(ratio * float(np.median(others)), SCATTER_FLOOR):
+            near = np.r_[max(j - 2, 0) : j, j + 1 : min(j + 3, group.size)]
+            if not near.size:
+                continue
+            limit = ratio * float(np.median(s[near]))
+            if s[j] > max(limit, SCATTER_FLOOR):
                 flagged[row] = True
+                note[row] = _append(note[row], f"scatter {s[j]:.3g} N m, >{ratio:g}x neighbours'")
+            limit = ratio * max(float(np.median(ref[near])), typical)
+            if np.isfinite(between[j]) and between[j] > max(limit, SCATTER_FLOOR):
+                flagged[row] = True
+                note[row] = _append(
+                    note[row],
+                    f"the merged runs' means scatter {between[j]:.3g} N m, "
+                    f">{ratio:g}x neighbours' (runs at different conditions merged?)",
+                )
     columns = {f.name: getattr(table, f.name) for f in fields(table)}
-    return QualityTable(**{**columns, "flagged": flagged})
+    return QualityTable(**{**columns, "flagged": flagged, "note": note})
+
+
+def _append(text: str, more: str) -> str:
+    return f"{text}; {more}" if text else more
 
 
 def _name(table: QualityTable, i: int) -> str:
@@ -224,18 +300,25 @@ def _name(table: QualityTable, i: int) -> str:
     return f"{table.label[i]} ({where})" if table.label[i] else where
 
 
-def warn_quality(table: QualityTable, source: str | None, *, stacklevel: int = 2) -> None:
+def warn_quality(
+    table: QualityTable, source: str | None, *, stacklevel: int = 2, gravity=None
+) -> None:
     """Warn once (:class:`~fricid.errors.DataQualityWarning`) when a set-point's scatter is far
-    above its neighbours', or samples were dropped as outliers or saturated; the message names
-    the file and the set-points (at most five) and says what to do."""
+    above its neighbours', samples were dropped as outliers or saturated, or the gravity fit
+    left a pattern along the position (``gravity``, a
+    :class:`~fricid.extract.gravity_check.GravityResidual`); the message names the file and
+    the set-points (at most five) and says what to do."""
     parts = []
+    if gravity is not None and gravity.message():
+        parts.append(gravity.message())
     where = f"{source}: " if source else ""
     high = np.flatnonzero(table.flagged)
     if high.size:
         names = "; ".join(_name(table, i) for i in high[:5])
         more = f" and {high.size - 5} more" if high.size > 5 else ""
         parts.append(
-            f"{high.size} set-point(s) scatter more than {SCATTER_RATIO:g}x their neighbours: "
+            f"{high.size} set-point(s) (or the runs merged into them) scatter more than "
+            f"{SCATTER_RATIO:g}x their neighbours: "
             f"{names}{more} (check those runs for disturbances before trusting their friction)"
         )
     for column, what in (

@@ -19,6 +19,7 @@ file) closes the open run.
 
 from __future__ import annotations
 
+import itertools
 import logging
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
@@ -296,8 +297,14 @@ def _segment(
 def cluster(
     values: np.ndarray, tolerance: float, *, relative: bool
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Group 1-D values into set-points: sorted, a new group starts where the gap to the
-    previous value exceeds ``tolerance`` (relative to that value when ``relative``).
+    """Group 1-D values into set-points whose span is bounded, so groups cannot chain.
+
+    Sorted, a new group starts where the gap to the previous value exceeds ``tolerance``
+    (relative to that value when ``relative``); then every group whose span (largest minus
+    smallest value) exceeds ``tolerance`` (times the magnitude of its median when
+    ``relative``) is split at its widest gap, recursively. Closely spaced values (speeds 3 %
+    apart over a decade) thus form groups no wider than the tolerance around their centre,
+    instead of one chain whose neighbours are each within the tolerance.
 
     Returns (labels (n,), centres (k,)): labels number the groups in ascending order and each
     centre is its group's median.
@@ -309,7 +316,21 @@ def cluster(
     s = values[order]
     gap = np.diff(s)
     limit = tolerance * np.abs(s[:-1]) if relative else tolerance
-    new = np.concatenate(([0], (gap > limit).astype(np.intp)))
+    cuts = list(np.flatnonzero(gap > limit) + 1)
+    bounds = [0, *cuts, s.size]
+    pending = list(itertools.pairwise(bounds))
+    starts = []
+    while pending:
+        a, b = pending.pop()
+        span = s[b - 1] - s[a]
+        allowed = tolerance * abs(float(np.median(s[a:b]))) if relative else tolerance
+        if b - a < 2 or span <= allowed:
+            starts.append(a)
+            continue
+        cut = a + 1 + int(np.argmax(np.diff(s[a:b])))
+        pending += [(a, cut), (cut, b)]
+    new = np.zeros(s.size, dtype=np.intp)
+    new[sorted(starts)[1:]] = 1
     sorted_labels = np.cumsum(new)
     labels = np.empty_like(sorted_labels)
     labels[order] = sorted_labels

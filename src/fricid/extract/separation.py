@@ -66,7 +66,9 @@ def assemble(pooled, shape, t_set, v_set, gravity, source, meta, joint_fit, note
         return x.reshape(nt, nv, 2, nb).transpose(0, 1, 3, 2)  # (t, v, bin, direction)
 
     count, tau, std, sem = (grid(getattr(pooled, k)) for k in ("count", "torque", "std", "sem"))
-    pos, vel, temp = (grid(getattr(pooled, k)) for k in ("position", "velocity", "temperature"))
+    pos, vel, temp, cos, sin = (
+        grid(getattr(pooled, k)) for k in ("position", "velocity", "temperature", "cos", "sin")
+    )
     has = count > 0
     both = has[..., 0] & has[..., 1]
     any_ = has[..., 0] | has[..., 1]
@@ -86,14 +88,18 @@ def assemble(pooled, shape, t_set, v_set, gravity, source, meta, joint_fit, note
     elif gravity == "fit":
         _, tau_g = separate(tau[both][:, 1], tau[both][:, 0])
         theta = 0.5 * (pos[both][:, 0] + pos[both][:, 1])
-        fit = fit_gravity(theta, tau_g, source=source)
+        mean_cos = 0.5 * (cos[both][:, 0] + cos[both][:, 1])
+        mean_sin = 0.5 * (sin[both][:, 0] + sin[both][:, 1])
+        fit = fit_gravity(theta, tau_g, source=source, cos=mean_cos, sin=mean_sin)
     elif gravity == "joint":
         fit = joint_fit()
 
     rows = np.argwhere(any_)  # (t, v, bin), C order = sorted
     sel = tuple(rows.T)
     # per row, columns (backward, forward): count, torque, std, sem, position, velocity, temp
-    c_, t_, s_, e_, p_, v_, T_ = (a[sel] for a in (count, tau, std, sem, pos, vel, temp))
+    c_, t_, s_, e_, p_, v_, T_, cos_, sin_ = (
+        a[sel] for a in (count, tau, std, sem, pos, vel, temp, cos, sin)
+    )
     h = has[sel]
     b2 = h[:, 0] & h[:, 1]
     n_tot = c_.sum(axis=1)
@@ -111,9 +117,13 @@ def assemble(pooled, shape, t_set, v_set, gravity, source, meta, joint_fit, note
             np.nanmax(np.where(h, e_, np.nan), axis=1),
         )
     if fit is not None:
-        load = fit.torque(position)
-        friction_dir = t_ + fit.torque(p_)
-        load_dir = fit.torque(p_)
+        # the gravity torque averaged over each cell's samples (eq. 7 is linear in cos and sin),
+        # not taken at the cell's mean position: a wide cell (a whole traverse) would keep
+        # gravity's curvature in the friction
+        load_dir = fit.p_x * cos_ - fit.p_y * sin_
+        with np.errstate(invalid="ignore"):
+            load = np.nansum(np.where(h, load_dir * c_, 0.0), axis=1) / n_tot
+        friction_dir = t_ + load_dir
         # a row measured in one direction: its friction with the fitted gravity removed
         friction = np.where(
             b2, friction, np.where(h[:, 1], friction_dir[:, 1], -friction_dir[:, 0])

@@ -100,7 +100,10 @@ def quality_rows(names, velocity, keep, std, flagged, temperature: float) -> lis
             "dropped_outlier": int((~k).sum()),
             "dropped_saturated": 0,
             "scatter": float(sd),
+            "run_scatter": None,
+            "gravity_residual": None,
             "flagged": bool(f),
+            "note": "1 file" + (f"; scatter >{SCATTER_RATIO:g}x neighbours'" if f else ""),
         }
         for name, v, k, sd, f in zip(names, velocity, keep, std, flagged, strict=True)
     ]

@@ -211,7 +211,11 @@ def read_table_log(
             torque_constant=torque_constant,
             joint=joint,
             source=str(path),
-            meta={"columns": columns, "units": unit_of},
+            meta={
+                "columns": columns,
+                "units": unit_of,
+                "position_source": "channel" if "position" in si else "integrated velocity",
+            },
         )
     except DataError as err:
         row = err.row

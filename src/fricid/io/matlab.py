@@ -27,7 +27,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import ConfigError, DataError
-from ..samples import FrictionSamples, RawLog
+from ..samples import FrictionSamples, RawLog, drop_standstill
 from ..units import UNITS, to_si
 from ._files import check_input
 from ._mat73 import h5_child, h5_kind, h5_values
@@ -436,7 +436,7 @@ def read_mat(
                 row=int(zero[0]),
                 column=variables["velocity"],
             )
-        return FrictionSamples(
+        means = FrictionSamples(
             velocity=velocity,
             load=si.get("load"),
             temperature=si.get("temperature", temperature),
@@ -445,10 +445,12 @@ def read_mat(
             source=str(path),
             meta={**meta, "method": "means as published (one row per velocity and direction)"},
         )
+        return drop_standstill(means, stacklevel=3)
     time, velocity = si["time"], si["velocity"]
     if "temperature" not in si and temperature is None:
         raise ConfigError("give the temperature as --var temperature=NAME:UNIT or --temperature")
     position = si.get("position")
+    meta = {**meta, "position_source": "integrated velocity" if position is None else "channel"}
     if position is None:
         position = integrate_velocity(time, velocity)
     return RawLog(

@@ -26,7 +26,14 @@ import numpy as np
 import pyarrow as pa
 
 from ..errors import ConfigError, DataError
-from ..samples import OPTIONAL_INPUTS, RAWLOG_COLUMNS, SAMPLE_COLUMNS, FrictionSamples, RawLog
+from ..samples import (
+    OPTIONAL_INPUTS,
+    RAWLOG_COLUMNS,
+    SAMPLE_COLUMNS,
+    FrictionSamples,
+    RawLog,
+    drop_standstill,
+)
 from ._csv import csv_preamble, preamble_fields, write_csv
 from ._parquet import parquet_doc, write_parquet
 from ._tablefile import Opened, meta_of, open_table, relocate, table_format
@@ -73,7 +80,9 @@ def read_samples(path: PathLike) -> FrictionSamples:
     -------
     FrictionSamples
         In SI units. ``source`` is ``path``; a different source recorded in the file is
-        kept as ``meta["recorded_source"]``.
+        kept as ``meta["recorded_source"]``. Standstill rows (a per-direction mean at a speed
+        far below every other, :func:`fricid.samples.drop_standstill`) are dropped with a
+        :class:`~fricid.errors.DataQualityWarning` naming them (``meta["dropped_standstill"]``).
 
     Raises
     ------
@@ -107,9 +116,10 @@ def read_samples(path: PathLike) -> FrictionSamples:
     for name in OPTIONAL_INPUTS:
         cols.setdefault(name, None)
     try:
-        return FrictionSamples(**cols, source=str(opened.path), meta=meta_of(info, opened.path))
+        samples = FrictionSamples(**cols, source=str(opened.path), meta=meta_of(info, opened.path))
     except DataError as err:
         raise relocate(err, opened, 0) from None
+    return drop_standstill(samples, stacklevel=2)
 
 
 def _open_rawlog(path: PathLike) -> Opened:

@@ -20,7 +20,9 @@ __all__ = ["quality_frame", "trust_text"]
 
 
 def quality_frame(rows: list[dict[str, Any]]) -> Any:
-    """The quality rows as a table: set-point, kept, dropped by reason, scatter, flag."""
+    """The quality rows as a table: set-point, kept, dropped by reason, scatter (of the
+    samples, and of the merged runs' means), what eq. 7 left along the position, flag, and
+    what the row merged or why it was dropped."""
     import pandas as pd
 
     out = []
@@ -36,7 +38,10 @@ def quality_frame(rows: list[dict[str, Any]]) -> Any:
                 "kept": r.get("kept"),
                 **{f"dropped: {why}": r.get(k) for k, why in DROPS.items()},
                 "scatter [N m]": r.get("scatter"),
+                "between runs [N m]": r.get("run_scatter"),
+                "gravity residual [N m]": r.get("gravity_residual"),
                 "high scatter": "HIGH" if r.get("flagged") else "",
+                "what and why": r.get("note") or "",
             }
         )
     return pd.DataFrame(out)

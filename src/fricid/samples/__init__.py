@@ -28,6 +28,7 @@ from ._columns import (
     _check_range,
     _optional_column,
 )
+from ._standstill import drop_standstill, standstill_rows
 from ._trajectory_log import check_trajectory_log
 from .rawlog import RawLog
 
@@ -40,6 +41,8 @@ __all__ = [
     "FrictionSamples",
     "RawLog",
     "check_trajectory_log",
+    "drop_standstill",
+    "standstill_rows",
 ]
 
 
