@@ -73,6 +73,7 @@ def parse() -> argparse.Namespace:
     ap.add_argument("--no-foreign", action="store_true")
     ap.add_argument("--foreign-only", action="store_true")
     ap.add_argument("--json", type=Path, default=None)
+    ap.add_argument("--from-json", type=Path, nargs="+", default=None, help="print saved runs")
     a = ap.parse_args()
     a.seeds = a.seeds or (1 if a.quick else 10)
     a.duration = a.duration or (10.0 if a.quick else 60.0)
@@ -235,7 +236,7 @@ def _fmt_err(x: float, absolute: bool) -> str:
         return "nan"
     if absolute:
         return f"{x:+.2g}a"
-    return f"{100 * x:+.2g}%" if abs(x) < 10 else f"x{x + 1:.2g}"
+    return f"{100 * x:+.3g}%" if abs(x) < 10 else f"x{x + 1:.2g}"
 
 
 def summary(rows: list[dict], key) -> list[str]:
@@ -244,7 +245,7 @@ def summary(rows: list[dict], key) -> list[str]:
     groups: dict = {}
     for r in rows:
         groups.setdefault(key(r), []).append(r)
-    head = f"{'setting':38s} {'fits':>5s} " + " ".join(f"{s:>7s}" for s in SHORT)
+    head = f"{'setting':42s} {'fits':>5s} " + " ".join(f"{s:>7s}" for s in SHORT)
     lines = [head + "  cover  sim-held  eqn-held (truth)  s@60s/1kHz"]
     for g, rs in groups.items():
         ok = [r for r in rs if "estimates" in r]
@@ -263,7 +264,7 @@ def summary(rows: list[dict], key) -> list[str]:
         qc = [x["position_counts"] for x in sims if "position_counts" in x]
         sim = f"{np.median(tq):.3g}" if tq else (f"{np.median(qc):.3g}cnt" if qc else "-")
         lines.append(
-            f"{g:38s} {len(ok):2d}/{len(rs):<2d} "
+            f"{g:42s} {len(ok):2d}/{len(rs):<2d} "
             + " ".join(f"{e:>7s}" for e in errs)
             + f"  {cov:3d}/{len(rs) * len(PARAMS):<3d} {sim:>8s} {hl:>17s}   "
             + f"{np.median(secs):6.1f} (max {max(secs):.1f})"
@@ -302,6 +303,9 @@ def main() -> None:
     ]
     t0 = time.perf_counter()
     rows = []
+    if a.from_json:
+        rows = [r for path in a.from_json for r in json.loads(path.read_text())]
+        settings = []
     if a.jobs > 1:
         with multiprocessing.get_context("spawn").Pool(a.jobs) as pool:
             for row in pool.imap_unordered(task, settings):
@@ -311,7 +315,7 @@ def main() -> None:
         for i, s in enumerate(settings):
             rows.append(task(s))
             _progress(rows[-1], i + 1, len(settings))
-    if not a.no_foreign and FOREIGN.is_dir():
+    if not (a.no_foreign or a.from_json) and FOREIGN.is_dir():
         rows += foreign_tasks(a.max_evals)
     print(f"# bench_lugre: {len(rows)} identifications, {time.perf_counter() - t0:.0f} s wall")
     print(f"# seeds {a.seeds}, {a.duration:g} s logs, max_evals {a.max_evals}, jobs {a.jobs}")
