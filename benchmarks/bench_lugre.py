@@ -318,7 +318,8 @@ def main() -> None:
     if not (a.no_foreign or a.from_json) and FOREIGN.is_dir():
         rows += foreign_tasks(a.max_evals)
     print(f"# bench_lugre: {len(rows)} identifications, {time.perf_counter() - t0:.0f} s wall")
-    print(f"# seeds {a.seeds}, {a.duration:g} s logs, max_evals {a.max_evals}, jobs {a.jobs}")
+    if settings:
+        print(f"# seeds {a.seeds}, {a.duration:g} s logs, max_evals {a.max_evals}, jobs {a.jobs}")
     print("\n## per setting (median relative error; a = absolute N m, truth 0)")
     print(
         "\n".join(summary(rows, lambda r: f"{r['truth']} {r['kind']} {r['rate']:g}Hz {r['cpr']}"))
