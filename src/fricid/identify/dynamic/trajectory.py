@@ -369,10 +369,7 @@ def fit_trajectory(
             log.source,
         )
         yhat = y - r
-        stages["filtered"] = stage
-        fits.append(("filtered", stage))
-        final.update(stage.table())
-        bounds_out.update({n: list(b) for n, b in zip(stage.names, stage.bounds, strict=True)})
+        _take_filtered(stage, stages, fits, final, bounds_out)
         sim_info = {"parallel_filter": parallel.describe(rate), "n_sub": int(n_sub)}
     elif key == "lugre" and route == "filtered":
         parallel = parallel or ParallelFilter()
@@ -392,10 +389,7 @@ def fit_trajectory(
             log.source,
         )
         yhat = y - r
-        stages["filtered"] = stage
-        fits.append(("filtered", stage))
-        final.update(stage.table())
-        bounds_out.update({n: list(b) for n, b in zip(stage.names, stage.bounds, strict=True)})
+        _take_filtered(stage, stages, fits, final, bounds_out)
         sim_info = {"parallel_filter": parallel.describe(rate), "n_sub": int(n_sub)}
         if rate_bias == "warn":
             rb = _rate_bias(
@@ -456,6 +450,14 @@ def fit_trajectory(
         },
         sim_info=sim_info,
     )
+
+
+def _take_filtered(stage, stages: dict, fits: list, final: dict, bounds_out: dict) -> None:
+    """Record the filtered route's stage: its search, its parameter table and its box."""
+    stages["filtered"] = stage
+    fits.append(("filtered", stage))
+    final.update(stage.table())
+    bounds_out.update({n: list(b) for n, b in zip(stage.names, stage.bounds, strict=True)})
 
 
 def _dahl_filtered(series, stage1, static_tab, run, n_sub, parallel, source):
