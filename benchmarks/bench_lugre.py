@@ -304,7 +304,11 @@ def main() -> None:
     t0 = time.perf_counter()
     rows = []
     if a.from_json:
-        rows = [r for path in a.from_json for r in json.loads(path.read_text())]
+        seen = {}  # one row per setting and seed (the same run saved twice counts once)
+        for path in a.from_json:
+            for r in json.loads(path.read_text()):
+                seen[(r["truth"], r["kind"], r["rate"], r["cpr"], r["seed"], r.get("file"))] = r
+        rows = list(seen.values())
         settings = []
     if a.jobs > 1:
         with multiprocessing.get_context("spawn").Pool(a.jobs) as pool:
