@@ -41,7 +41,8 @@ pessimistic and vary: one fit took 216 s once and 69 s again). Coverage of the c
 intervals, all ten parameters: chirp 89/170, trapezoid 70/170, torque steps 68/180, creep
 0/30 (every creep log refused: "only 0 samples slide"); tau_s, w_s, delta 0-3 of 17-18 per
 kind; sigma_0 2-6/17, sigma_1 1-8/18. Held-out torque under the drive (PD kinds) 2.9-3.0x
-the noise at the median (1.1-1.8x with 2^20 counts/rev, 1.2-11x with 2^17). Seconds scaled
+the noise at the median (per setting 1.1-3.0x with 2^20 counts/rev; 1.2-42x with 2^17, 42x
+on cdw95's chirp, whose torque spans 60 N m). Seconds scaled
 to 60 s at 1 kHz: median 36-85 per kind, worst 2089 (the foreign 2^17 trapezoid, 696 s for
 its 20 s).
 """
