@@ -75,6 +75,17 @@ def export_command(
             )
         ),
     ] = 0.5,
+    allow_undetermined: Annotated[
+        bool,
+        typer.Option(
+            "--allow-undetermined",
+            help=(
+                "Export a model identified from a trajectory even though its records say the "
+                "data do not determine some parameters (refused otherwise); the file's comment "
+                "names them."
+            ),
+        ),
+    ] = False,
 ) -> None:
     """Export a model for a controller or a simulator.
 
@@ -90,7 +101,15 @@ def export_command(
     from rich.markup import escape
 
     from ..errors import ConfigError, DataError
-    from ..export import TARGETS, Smoothing, description_text, export_c, file_sha256, write_text
+    from ..export import (
+        TARGETS,
+        Smoothing,
+        description_text,
+        export_c,
+        file_sha256,
+        refuse_undetermined,
+        write_text,
+    )
     from ..export.mjcf import is_lugre, lugre_mapping
     from ..fitted import FittedModel
 
@@ -101,6 +120,7 @@ def export_command(
     if target not in TARGETS:
         raise ConfigError(f"unknown export target '{to}'; choose one of: {', '.join(TARGETS)}")
     fitted = FittedModel.load(model)
+    refuse_undetermined(fitted, allow_undetermined)
     sha256 = file_sha256(model)
     try:
         if target == "c":

@@ -154,7 +154,7 @@ def fit_command(
         bool,
         typer.Option(
             "--trajectory",
-            help="SAMPLES is a raw log of any motion: identify lugre (or stribeck, "
+            help="SAMPLES is a raw log of any motion: identify lugre (or dahl, stribeck, "
             "coulomb_viscous) with J and gravity from it (fricid.identify.dynamic.trajectory).",
         ),
     ] = False,

@@ -30,7 +30,14 @@ names the model by its SHA-256. Smoothing near zero velocity is a model concern 
 from __future__ import annotations
 
 from ..models.smoothing import SMOOTHINGS, Smoothing, smooth_predict
-from ._common import ExportError, file_sha256, model_sha256, plain
+from ._common import (
+    ExportError,
+    file_sha256,
+    model_sha256,
+    plain,
+    refuse_undetermined,
+    undetermined_parameters,
+)
 from .c import CCode, c_code, export_c
 from .clamp import clamp_inputs, clamp_limits
 from .descriptions import (
@@ -66,9 +73,11 @@ __all__ = [
     "operating_grid",
     "plain",
     "project",
+    "refuse_undetermined",
     "ros2_yaml_text",
     "schema_path",
     "smooth_predict",
+    "undetermined_parameters",
     "urdf_text",
     "validate_model_dict",
     "write_text",

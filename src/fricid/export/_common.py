@@ -235,7 +235,43 @@ def summary_lines(
             parts.append(f"{key} {shown}")
     if parts:
         lines.append("fit on its data: " + ", ".join(parts) + " (rmse, max error in N m)")
+    undetermined = undetermined_parameters(fitted)
+    if undetermined:
+        lines.append(
+            "NOT DETERMINED by the trajectory, exported as identified: "
+            + ", ".join(plain(n) for n in undetermined)
+        )
     return lines
+
+
+def undetermined_parameters(fitted: FittedModel) -> list[str]:
+    """The parameters of a model identified from a trajectory (``provenance["trajectory"]``)
+    that its record says the data do not determine (:attr:`fricid.fitted.Parameter.
+    not_determined`: an interval open at both ends of the search box, or withheld)."""
+    prov = fitted.provenance if isinstance(fitted.provenance, dict) else {}
+    if "trajectory" not in prov:
+        return []
+    return [n for n, p in fitted.parameters.items() if p.not_determined]
+
+
+def refuse_undetermined(fitted: FittedModel, allow: bool) -> None:
+    """Refuse to export a trajectory model with an undetermined parameter unless ``allow``
+    (then :func:`summary_lines` names them in the file's comment).
+
+    Raises
+    ------
+    ExportError
+        Such a parameter, not allowed.
+    """
+    undetermined = undetermined_parameters(fitted)
+    if undetermined and not allow:
+        raise ExportError(
+            "the trajectory does not determine "
+            + ", ".join(plain(n) for n in undetermined)
+            + f" of the '{model_name(fitted)}' model (see its parameter records); a controller "
+            "or simulator would run on an arbitrary value: record a richer trajectory, or "
+            "export anyway with --allow-undetermined (the file's comment then names them)"
+        )
 
 
 def range_lines(fitted: FittedModel) -> list[str]:

@@ -61,8 +61,7 @@ def fit(
         exponent of the RWSAVSBAS paper's eq. 7; ``*_asym`` per direction, ``*_temp`` with an
         Arrhenius viscous term), an instance, a learned model (``"rbf"``, ``"hybrid"``,
         ``"gp"``), ``"auto"`` (the family chosen by held-out error), or for a trajectory
-        ``"lugre"``, ``"stribeck"`` or ``"coulomb_viscous"`` (``"dahl"`` is not identified from
-        trajectories yet).
+        ``"lugre"``, ``"dahl"``, ``"stribeck"`` or ``"coulomb_viscous"``.
     method : str, optional
         The optimiser. Analytic and dynamic: any of :data:`fricid.optim.METHODS` or
         ``"varpro"`` (analytic only); default ``"lm"``. ``rbf`` and ``hybrid``: ``"lsq"``

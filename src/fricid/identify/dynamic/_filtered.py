@@ -1,6 +1,6 @@
-"""The ``filtered`` route of :mod:`fricid.identify.dynamic.trajectory`: every LuGre parameter with
-J,
-p_x, p_y at once, by the equation error on all samples, both sides low-pass filtered alike.
+"""The ``filtered`` route of :mod:`fricid.identify.dynamic.trajectory`: every parameter of a
+dynamic friction law (LuGre, Dahl: :class:`Law`) with J, p_x, p_y at once, by the equation error
+on all samples, both sides low-pass filtered alike.
 
 The equation of motion integrated over one sample period (the drive holds the torque
 ``u_{i-1}`` over the period ending at sample ``i``)::
@@ -36,7 +36,8 @@ inside the intervals at the default 20 Hz cut-off, not at 40 or 60 Hz (module no
 
 J, p_x and p_y enter linearly: they are projected out of every candidate's residual (variable
 projection, Golub and Pereyra 1973) and recovered by least squares; the optimiser searches
-the seven LuGre parameters, sigma_0 and sigma_1 as log10. Intervals: the cluster-robust
+the law's parameters (LuGre's seven, sigma_0 and sigma_1 as log10; Dahl's four,
+sigma_0 as log10). Intervals: the cluster-robust
 covariance of all ten parameters (:func:`._trajectory_data.cluster_covariance`, blocks of
 ``cluster_time`` seconds), t quantiles with G - 1 degrees of freedom, on the log scale for
 sigma_0 and sigma_1.
@@ -45,25 +46,67 @@ sigma_0 and sigma_1.
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from ...errors import ConfigError, DataError
-from ...models import lugre
+from ...models import dahl, lugre
 from ..problem import ResidualProblem
 from ..static.uncertainty import jacobian
 from ._data import Series, blocks, cluster_covariance
 from ._routes import JOINT_PARAMS, _run, _Stage, _t975
 
-__all__ = ["ParallelFilter", "filtered_route"]
+__all__ = ["DAHL", "LUGRE", "Law", "ParallelFilter", "filtered_route"]
 
 #: Output rate of the decimation, in multiples of the cut-off.
 DECIMATED_RATE = 5.0
 
 #: Search box of sigma_0 and sigma_1, as log10 (as the simulation route's).
 LOG_BOX = {"sigma_0": (2.0, 7.0), "sigma_1": (-3.0, 3.0)}
+
+
+@dataclass(frozen=True)
+class Law:
+    """A dynamic friction law as the filtered route needs it.
+
+    ``names``: its parameters in ``theta`` order; those in :data:`LOG_BOX` are searched as
+    log10 in that box, the others in the box the caller gives. ``mean_friction(theta, v_sub,
+    dt, up)``: the friction averaged over each sample period, ``(k, n)``, along ``up``
+    sub-step velocities per period (entry 0 at the first sample), from the steady state at
+    the first sample.
+    """
+
+    name: str
+    names: tuple[str, ...]
+    mean_friction: Callable[[np.ndarray, np.ndarray, float, int], np.ndarray]
+
+    @property
+    def is_log(self) -> np.ndarray:
+        return np.array([n in LOG_BOX for n in self.names])
+
+
+def _lugre_mean(th: np.ndarray, v_sub: np.ndarray, dt: float, up: int) -> np.ndarray:
+    """LuGre's exact period means (:func:`fricid.models.lugre.mean_friction`)."""
+    z0 = np.sign(v_sub[0]) * lugre.stribeck_curve(th, v_sub[:1])[:, 0] / th[:, 0]
+    return np.atleast_2d(lugre.mean_friction(th, v_sub, dt, up, z0))
+
+
+def _dahl_mean(th: np.ndarray, v_sub: np.ndarray, dt: float, up: int) -> np.ndarray:
+    """Dahl's friction (:func:`fricid.models.dahl.simulate`, exact over each sub-step) at the
+    end of every sub-step, averaged over the ``up`` sub-steps of each period."""
+    f0 = np.sign(v_sub[0]) * th[:, 1]
+    F, _ = dahl.simulate(th, v_sub, dt / up, f0)
+    F = np.atleast_2d(F)
+    per = F[:, 1:].reshape(F.shape[0], -1, up).mean(axis=2)
+    return np.hstack([F[:, :1], per])
+
+
+#: The laws of the filtered route.
+LUGRE = Law("lugre", lugre.PARAM_NAMES, _lugre_mean)
+DAHL = Law("dahl", dahl.PARAM_NAMES, _dahl_mean)
 
 
 @dataclass(frozen=True)
@@ -137,17 +180,19 @@ def filtered_route(
     n_sub: int,
     filt: ParallelFilter,
     source: str | None = None,
+    law: Law = LUGRE,
 ) -> tuple[_Stage, np.ndarray, np.ndarray]:
-    """Every LuGre parameter with J, p_x, p_y by the parallel-filtered equation error.
+    """Every parameter of ``law`` with J, p_x, p_y by the parallel-filtered equation error.
 
     Parameters
     ----------
     series : Series
         The log on a uniform grid.
-    start : ndarray (7,)
-        Start of the search, LuGre's parameters (:data:`fricid.models.lugre.PARAM_NAMES`).
-    static_bounds : ndarray (5, 2)
-        Search box of sigma_2, tau_c, tau_s, w_s, delta.
+    start : ndarray (d,)
+        Start of the search, the law's parameters in ``law.names`` order.
+    static_bounds : ndarray (d - l, 2)
+        Search box of the law's parameters not searched on a log scale, in order (LuGre:
+        sigma_2, tau_c, tau_s, w_s, delta; Dahl: tau_c, alpha, sigma_2).
     gravity : str
         ``fit`` or ``none``.
     method, seed, max_evals
@@ -160,11 +205,13 @@ def filtered_route(
         The low-pass on both sides.
     source : str, optional
         The log's file, named in errors.
+    law : Law
+        The friction law (default LuGre).
 
     Returns
     -------
     stage : _Stage
-        LuGre's seven parameters then J (p_x, p_y); the stage's ``bounds`` in natural units.
+        The law's parameters then J (p_x, p_y); the stage's ``bounds`` in natural units.
     y, residual : ndarray
         The filtered torque and the residual at the estimate (decimated samples).
     """
@@ -204,33 +251,31 @@ def filtered_route(
     y = low(u)[keep]
     up = max(int(n_sub), 1)
     v_sub = _sub_velocity(series, up)
-    is_log = np.array([n in LOG_BOX for n in lugre.PARAM_NAMES])
+    is_log, d = law.is_log, len(law.names)
 
     def theta(U):
         U = np.atleast_2d(U)
         return np.where(is_log, 10.0 ** np.where(is_log, U, 0.0), U)
 
     def friction(U):
-        th = theta(U)
-        z0 = np.sign(v_sub[0]) * lugre.stribeck_curve(th, v_sub[:1])[:, 0] / th[:, 0]
-        F = lugre.mean_friction(th, v_sub, dt, up, z0)
-        return low(np.atleast_2d(F))[:, keep]
+        return low(law.mean_friction(theta(U), v_sub, dt, up))[:, keep]
 
     def projected(U):
         R = y[None, :] - friction(U)
         return R - (R @ Qphi) @ Qphi.T
 
-    box = np.array([LOG_BOX["sigma_0"], LOG_BOX["sigma_1"], *static_bounds], dtype=float)
+    rows = iter(np.asarray(static_bounds, dtype=float))
+    box = np.array([LOG_BOX[n] if n in LOG_BOX else next(rows) for n in law.names], float)
     x0 = np.where(is_log, np.log10(np.maximum(start, 1e-300)), start)
     x0 = np.clip(x0, box[:, 0], box[:, 1])
-    search = ResidualProblem(projected, box, lugre.PARAM_NAMES, y)
+    search = ResidualProblem(projected, box, law.names, y)
     result = _run(search, method, x0, seed, max_evals, 1)
     u_hat = np.asarray(result.x, dtype=float)
     c = np.linalg.lstsq(Phi, y - friction(u_hat)[0], rcond=None)[0]
 
     def full(P):
         P = np.atleast_2d(P)
-        return y[None, :] - friction(P[:, :7]) - P[:, 7:] @ Phi.T
+        return y[None, :] - friction(P[:, :d]) - P[:, d:] @ Phi.T
 
     p_hat = np.concatenate([u_hat, c])
     Jm, r0 = jacobian(full, p_hat)
@@ -248,7 +293,7 @@ def filtered_route(
 
     values = natural(p_hat)
     stderr = np.where(logs, values * np.log(10.0) * se, se)
-    names = list(lugre.PARAM_NAMES) + list(JOINT_PARAMS[:nd])
+    names = list(law.names) + list(JOINT_PARAMS[:nd])
     rms = {"torque_filtered": float(np.sqrt(np.mean(r0**2)))}
     bounds = np.column_stack([natural(box_all[:, 0]), natural(box_all[:, 1])])
     stage = _Stage(

@@ -14,11 +14,12 @@ low-pass (:class:`ParallelFilter`); their settings go into the provenance.
 
 Routes, recorded in the result's provenance (``provenance["trajectory"]``):
 
-``filtered`` (parallel-filtered equation error; the default for LuGre)
-    All seven LuGre parameters with J, p_x, p_y at once, by the equation of motion on every
-    sample, both sides filtered by one zero-phase low-pass and decimated (Gautier 1997;
-    Gautier, Janot and Vandanjon 2013, IDIM-LS; Pham and Gautier 1991), the bristle state
-    driven by the measured motion: no simulation of the joint, no windows, no guards
+``filtered`` (parallel-filtered equation error; the default for LuGre, the route of Dahl)
+    All seven LuGre parameters (or Dahl's four) with J, p_x, p_y at once, by the equation
+    of motion on every sample, both sides filtered by one zero-phase low-pass and decimated
+    (Gautier 1997; Gautier, Janot and Vandanjon 2013, IDIM-LS; Pham and Gautier 1991), the
+    bristle state driven by the measured motion: no simulation of the joint, no windows, no
+    guards
     (:mod:`._trajectory_filtered`, whose notes say how the bristle state is driven between
     samples and what that leaves at 1 kHz).
 ``regression`` (inverse dynamics)
@@ -52,6 +53,9 @@ route uses every sample with LuGre's own friction. ``route="joint"`` refines eve
 the simulation error from the two-stage estimate. ``static=`` (a ``stribeck`` fit from
 sweeps) takes the static part from the sweeps; it runs ``two_stage`` (only J, p_x, p_y are
 then regressed). Static models (``stribeck``, ``coulomb_viscous``) take the regression.
+Dahl (:mod:`fricid.models.dahl`) takes the filtered route only, started from a
+``coulomb_viscous`` regression (its steady state: tau_c, sigma_2 = the viscous coefficient),
+sigma_0 searched as log10 as LuGre's; no rate-bias estimate (that simulation is LuGre's).
 
 Uncertainty: cluster-robust covariances (:func:`._trajectory_data.cluster_covariance`; blocks
 of ``cluster_time`` seconds, or the simulation windows), t quantiles with G - 1 degrees of
@@ -142,10 +146,10 @@ import numpy as np
 
 from ...errors import ConfigError, DataError
 from ...fitted import FittedModel
-from ...models import get_model, lugre
+from ...models import dahl, get_model, lugre
 from ...samples import RawLog, check_trajectory_log
 from ._data import DerivativeFilter, derivatives, dilate, uniform_series
-from ._filtered import ParallelFilter, filtered_route
+from ._filtered import DAHL, ParallelFilter, filtered_route
 from ._outcome import (
     RATE_BIAS,
     PassivityWarning,
@@ -171,6 +175,12 @@ ROUTES = ("filtered", "two_stage", "joint", "regression")
 
 #: Static models a trajectory identifies by regression.
 STATIC_MODELS = ("stribeck", "coulomb_viscous")
+
+#: Dynamic models a trajectory identifies.
+DYNAMIC_MODELS = ("lugre", "dahl")
+
+#: The Dahl static part, as named in the ``coulomb_viscous`` model.
+_STATIC_OF_DAHL = {"f_c": "tau_c", "beta": "sigma_2"}
 
 #: The LuGre static part, as named in the ``stribeck`` model.
 _STATIC_OF_LUGRE = {
@@ -208,14 +218,14 @@ def fit_trajectory(
     log : RawLog
         Time, position, velocity, torque (or current with K), temperature; any reader's.
     model : str
-        ``lugre`` (dynamic), or a static model: ``stribeck``, ``coulomb_viscous``.
+        ``lugre`` or ``dahl`` (dynamic), or a static model: ``stribeck``, ``coulomb_viscous``.
     method : str
         Any fricid optimiser (:data:`fricid.optim.METHODS`), used by both routes.
     route : str
         ``filtered`` (default for LuGre: every parameter at once by the parallel-filtered
         equation error), ``two_stage``, ``joint`` (then every parameter by simulation
         error), ``regression`` (static models; the only route for them). With ``static=``
-        the ``filtered`` route becomes ``two_stage``.
+        the ``filtered`` route becomes ``two_stage``. Dahl: ``filtered`` only.
     gravity : str
         ``fit`` (p_x, p_y estimated) or ``none`` (a horizontal joint).
     derivative : DerivativeFilter, optional
@@ -267,14 +277,16 @@ def fit_trajectory(
         Too short a log, too few sliding samples, or (LuGre) no low-speed stretch.
     """
     key = str(model).strip().lower()
-    if key not in ("lugre", *STATIC_MODELS):
+    if key not in (*DYNAMIC_MODELS, *STATIC_MODELS):
         raise ConfigError(
-            f"a trajectory identifies lugre or a static model ({', '.join(STATIC_MODELS)}); "
-            f"got '{model}'"
+            f"a trajectory identifies lugre, dahl or a static model "
+            f"({', '.join(STATIC_MODELS)}); got '{model}'"
         )
     if route not in ROUTES:
         raise ConfigError(f"unknown route '{route}'; one of: {', '.join(ROUTES)}")
-    if key != "lugre" and route != "regression":
+    if key == "dahl" and (route != "filtered" or static is not None):
+        raise ConfigError("dahl is identified by the filtered route only (no static= either)")
+    if key in STATIC_MODELS and route != "regression":
         route = "regression"
     if key == "lugre" and route == "filtered" and static is not None:
         route = "two_stage"
@@ -303,7 +315,7 @@ def fit_trajectory(
             "the static friction",
             file=log.source,
         )
-    static_model = get_model("stribeck" if key == "lugre" else key)
+    static_model = get_model({"lugre": "stribeck", "dahl": "coulomb_viscous"}.get(key, key))
     fixed = None
     if static is not None:
         if static.model != "stribeck":
@@ -314,7 +326,7 @@ def fit_trajectory(
         series, vf, acc, mask, static_model, gravity, method, seed, max_evals, cluster_n, fixed
     )
     stages = {"regression": stage1}
-    rename = _STATIC_OF_LUGRE if key == "lugre" else {}
+    rename = {"lugre": _STATIC_OF_LUGRE, "dahl": _STATIC_OF_DAHL}.get(key, {})
     joint_vals = dict(zip(JOINT_PARAMS, [*list(c), 0.0, 0.0], strict=False))
     fits = [("regression", stage1)] if stage1.result is not None else []
     # the static part as the result states it: from the regression or the sweeps
@@ -336,7 +348,7 @@ def fit_trajectory(
     }
     sim_info: dict[str, Any] = {}
     y, yhat = series.torque[mask], series.torque[mask] - r1
-    if key == "lugre" and not joint_vals["inertia"] > 0:
+    if key in DYNAMIC_MODELS and not joint_vals["inertia"] > 0:
         row = stage1.table().get("inertia", {})
         raise DataError(
             f"the trajectory does not determine the inertia (J = {joint_vals['inertia']:.3g} "
@@ -345,7 +357,21 @@ def fit_trajectory(
             "chirp)",
             file=log.source,
         )
-    if key == "lugre" and route == "filtered":
+    if key == "dahl":
+        parallel = parallel or ParallelFilter()
+        stage, y, r = _dahl_filtered(
+            series,
+            stage1,
+            static_tab,
+            (gravity, method, seed, max_evals, cluster_time),
+            n_sub,
+            parallel,
+            log.source,
+        )
+        yhat = y - r
+        _take_filtered(stage, stages, fits, final, bounds_out)
+        sim_info = {"parallel_filter": parallel.describe(rate), "n_sub": int(n_sub)}
+    elif key == "lugre" and route == "filtered":
         parallel = parallel or ParallelFilter()
         start = np.array([1e4, 1.0] + [static_tab[n]["value"] for n in lugre.PARAM_NAMES[2:]])
         order = [stage1.names.index(n) for n in ("tau_v", "tau_c", "tau_s", "w_s", "delta")]
@@ -363,10 +389,7 @@ def fit_trajectory(
             log.source,
         )
         yhat = y - r
-        stages["filtered"] = stage
-        fits.append(("filtered", stage))
-        final.update(stage.table())
-        bounds_out.update({n: list(b) for n, b in zip(stage.names, stage.bounds, strict=True)})
+        _take_filtered(stage, stages, fits, final, bounds_out)
         sim_info = {"parallel_filter": parallel.describe(rate), "n_sub": int(n_sub)}
         if rate_bias == "warn":
             rb = _rate_bias(
@@ -426,4 +449,39 @@ def fit_trajectory(
             "rename": rename,
         },
         sim_info=sim_info,
+    )
+
+
+def _take_filtered(stage, stages: dict, fits: list, final: dict, bounds_out: dict) -> None:
+    """Record the filtered route's stage: its search, its parameter table and its box."""
+    stages["filtered"] = stage
+    fits.append(("filtered", stage))
+    final.update(stage.table())
+    bounds_out.update({n: list(b) for n, b in zip(stage.names, stage.bounds, strict=True)})
+
+
+def _dahl_filtered(series, stage1, static_tab, run, n_sub, parallel, source):
+    """Dahl's four parameters with J, p_x, p_y by the filtered route, started from the
+    ``coulomb_viscous`` regression (``run``: gravity, method, seed, max_evals, cluster_time)."""
+    gravity, method, seed, max_evals, cluster_time = run
+    order = [stage1.names.index(n) for n in ("f_c", "beta")]
+    (c_lo, c_hi), (v_lo, v_hi) = stage1.bounds[order]
+    alpha = next(p for p in dahl.PARAMETERS if p.name == "alpha")
+    bounds = np.array([(max(c_lo, 1e-3 * c_hi), c_hi), (alpha.lower, alpha.upper), (v_lo, v_hi)])
+    tau_c = float(np.clip(static_tab["tau_c"]["value"], *bounds[0]))
+    sigma_2 = float(np.clip(static_tab["sigma_2"]["value"], *bounds[2]))
+    start = np.array([1e4, tau_c, alpha.default, sigma_2])
+    return filtered_route(
+        series,
+        start,
+        bounds,
+        gravity,
+        method,
+        seed,
+        max_evals,
+        cluster_time,
+        n_sub,
+        parallel,
+        source,
+        law=DAHL,
     )

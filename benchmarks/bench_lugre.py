@@ -1,0 +1,368 @@
+"""LuGre from logs of an independent simulator, as real drives log them.
+
+Usage: ``python benchmarks/bench_lugre.py [--quick] [--jobs 1] [--seeds 10] [--duration 60]
+[--truths geared,cdw95,slow_stribeck] [--kinds chirp_pd,...] [--rates 1000,200]
+[--cprs 131072,1048576] [--max-evals N] [--no-foreign] [--json PATH]``.
+
+The logs come from :mod:`_lugre_truth` (its own RK4 joint, parameterisation and drive; none
+of fricid's simulation code): PD-tracked chirp, PD-tracked trapezoid with dwells and
+reversals, open-loop torque steps, creep below break-away; at 1 kHz and 200 Hz; encoders of
+2^17 and 2^20 counts/rev (velocity and acceleration by backward differences of the quantised
+position); white torque noise; three truth sets (``geared``, ``cdw95``: Canudas de Wit et al.
+1995's numbers, ``slow_stribeck``: vs = 5 mrad/s). Each log is written as the CSV fricid
+reads, read by :func:`fricid.io.read_rawlog` and identified through the public
+:func:`fricid.identify.fit` with model ``lugre`` (default route and method); a second log of
+the same truth, kind and settings (another seed) is held out.
+
+Per setting and per kind it prints: the median relative error of each parameter (the seven
+LuGre ones, J, p_x, p_y; absolute [N m] where the truth is 0, marked ``a``); the coverage of
+the 95 % intervals, an interval open at a search bound, withheld (unconverged fit) or of a
+parameter recorded as not determined counting as a miss, and a refused log (``DataError``)
+as misses of every parameter; the held-out torque error over the noise (RMS of ``u - J a - F
++ gravity`` with the fitted model on the held-out log, q, v, a by a 21 ms Savitzky-Golay of
+the quantised position, F by :func:`fricid.models.lugre.simulate` along v) beside the same
+number with the truth's parameters (the floor set by the derivatives: ``eqn-held``); the
+fitted joint driven by the held-out log's own drive plan in the independent simulator
+(``sim-held``: PD-tracked kinds, the RMS of its applied torque minus the logged torque over
+the noise, 1 for the truth; open-loop kinds, the RMS position error in encoder counts,
+``cnt``; ``-`` when the fitted joint is too stiff to simulate there); and the seconds per
+identification scaled to 60 s at 1 kHz (linearly in the samples). The foreign logs in the
+shared data folder (``data/foreign/lugre`` beside the repository, with their
+``truth.json``) are identified as extra rows, the other kind of the same encoder held out.
+
+``--quick``: seeds 1, 10 s logs, 1 kHz and 2^17 counts/rev only. The full run is the
+done-when table: 10 seeds, 60 s, every setting (48 settings, 480 identifications).
+``--from-json A.json B.json`` prints the tables of saved runs together.
+
+Baseline (fricid as it was when this benchmark was written; 10 s logs, seeds 0-2 at 1 kHz
+and 2^17 counts/rev, seed 0 elsewhere, the four foreign 20 s logs; 55 identifications,
+``--jobs 1`` on 2 cores shared with other jobs at load average 10-12, so the seconds are
+pessimistic and vary: one fit took 216 s once and 69 s again). Coverage of the closed 95 %
+intervals, all ten parameters: chirp 89/170, trapezoid 70/170, torque steps 68/180, creep
+0/30 (every creep log refused: "only 0 samples slide"); tau_s, w_s, delta 0-3 of 17-18 per
+kind; sigma_0 2-6/17, sigma_1 1-8/18. Held-out torque under the drive (PD kinds) 2.9-3.0x
+the noise at the median (per setting 1.1-3.0x with 2^20 counts/rev; 1.2-42x with 2^17, 42x
+on cdw95's chirp, whose torque spans 60 N m). Seconds scaled
+to 60 s at 1 kHz: median 36-85 per kind, worst 2089 (the foreign 2^17 trapezoid, 696 s for
+its 20 s).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import multiprocessing
+import sys
+import tempfile
+import time
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import _lugre_truth as lt
+
+#: Parameters reported, in fricid's names.
+PARAMS = ("sigma_0", "sigma_1", "sigma_2", "tau_c", "tau_s", "w_s", "delta", "inertia")
+PARAMS = (*PARAMS, "p_x", "p_y")
+SHORT = ("s0", "s1", "s2", "Fc", "Fs", "vs", "dl", "J", "px", "py")
+FOREIGN = Path(__file__).resolve().parents[2] / "shared" / "data" / "foreign" / "lugre"
+
+
+def parse() -> argparse.Namespace:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--quick", action="store_true")
+    ap.add_argument("--jobs", type=int, default=1)
+    ap.add_argument("--seeds", type=int, default=None)
+    ap.add_argument("--first-seed", type=int, default=0)
+    ap.add_argument("--duration", type=float, default=None)
+    ap.add_argument("--truths", default=",".join(lt.TRUTHS))
+    ap.add_argument("--kinds", default=",".join(lt.KINDS))
+    ap.add_argument("--rates", default=None)
+    ap.add_argument("--cprs", default=None)
+    ap.add_argument("--max-evals", type=int, default=None)
+    ap.add_argument("--no-foreign", action="store_true")
+    ap.add_argument("--foreign-only", action="store_true")
+    ap.add_argument("--json", type=Path, default=None)
+    ap.add_argument("--from-json", type=Path, nargs="+", default=None, help="print saved runs")
+    a = ap.parse_args()
+    a.seeds = a.seeds or (1 if a.quick else 10)
+    a.duration = a.duration or (10.0 if a.quick else 60.0)
+    a.rates = [float(r) for r in (a.rates or ("1000" if a.quick else "1000,200")).split(",")]
+    a.cprs = [int(c) for c in (a.cprs or ("131072" if a.quick else "131072,1048576")).split(",")]
+    return a
+
+
+def _read(path: Path):
+    from fricid.io import read_rawlog
+
+    return read_rawlog(path)
+
+
+def _identify(log, seed: int, max_evals: int | None) -> dict:
+    """fricid's LuGre fit of ``log``: estimates, intervals, flags, seconds (or the refusal)."""
+    from fricid.errors import FricidError
+    from fricid.identify import fit
+
+    t0 = time.perf_counter()
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            fitted = fit(log, "lugre", seed=seed, max_evals=max_evals)
+        except FricidError as err:
+            why = getattr(err, "message", str(err)).splitlines()[0]
+            return {"refused": why, "seconds": time.perf_counter() - t0}
+    seconds = time.perf_counter() - t0
+    est = {}
+    for n, p in fitted.parameters.items():
+        closed = not (p.low_open or p.high_open or p.not_determined)
+        est[n] = {"value": p.value, "ci95": list(p.ci95), "closed": bool(closed)}
+    for n, row in fitted.provenance["trajectory"]["joint"].items():
+        est[n] = {"value": row["value"], "ci95": [row["ci95_low"], row["ci95_high"]]}
+        est[n]["closed"] = True
+    return {
+        "estimates": est,
+        "converged": bool(fitted.converged),
+        "seconds": seconds,
+        "warnings": sorted({w.category.__name__ for w in caught}),
+    }
+
+
+def predicted_torque(values: dict, log) -> np.ndarray:
+    """``J a + F_LuGre(v) - (p_x cos q - p_y sin q)`` along the log's quantised position,
+    smoothed and differentiated by a 21 ms (at least 7 samples) Savitzky-Golay of order 3."""
+    from scipy.signal import savgol_filter
+
+    from fricid.models import lugre
+
+    dt = float(np.median(np.diff(log.time)))
+    w = max(round(0.021 / dt), 7) | 1
+    q = savgol_filter(log.position, w, 3)
+    v = savgol_filter(log.position, w, 3, deriv=1, delta=dt)
+    a = savgol_filter(log.position, w, 3, deriv=2, delta=dt)
+    th = np.array([values[n] for n in lugre.PARAM_NAMES])
+    z0 = np.sign(v[0]) * lugre.stribeck_curve(th, v[:1])[0] / th[0]
+    F, _ = lugre.simulate(th, v, dt, z0)
+    return values["inertia"] * a + F - (values["p_x"] * np.cos(q) - values["p_y"] * np.sin(q))
+
+
+def heldout(result: dict, truth: dict, log, noise: float) -> dict:
+    """Held-out torque RMS error over the noise, with the fit's values and with the truth's."""
+    edge = max(round(0.05 / float(np.median(np.diff(log.time)))), 1)
+    u = log.torque[edge:-edge]
+
+    def ratio(values):
+        e = u - predicted_torque(values, log)[edge:-edge]
+        return float(np.sqrt(np.mean(e**2)) / noise)
+
+    fit_values = {n: r["value"] for n, r in result["estimates"].items()}
+    return {"fit": ratio(fit_values), "truth": ratio(truth)}
+
+
+def simulated_heldout(result: dict, truth: lt.Truth, held: dict, setting: tuple) -> dict:
+    """The fitted joint under the held-out log's drive plan (the independent simulator):
+    closed loop, the RMS of the applied torque minus the logged torque over the noise (the
+    truth gives 1); open loop, the RMS position error in encoder counts."""
+    kind, duration, rate, cpr, seed = setting
+    values = {n: r["value"] for n, r in result["estimates"].items()}
+    try:
+        plant = lt.from_fricid(values)
+        sim = lt.simulate(truth, kind, duration, rate, cpr, seed, plant=plant, max_steps=4000)
+    except (ValueError, ZeroDivisionError) as err:
+        return {"skipped": str(err)}
+    if kind.endswith("_pd"):
+        e = sim["applied"] - held["torque"]
+        return {"torque_over_noise": float(np.sqrt(np.mean(e**2)) / truth.noise)}
+    e = (sim["true_position"] - held["true_position"]) / (2 * math.pi / cpr)
+    return {"position_counts": float(np.sqrt(np.mean(e**2)))}
+
+
+def task(args: tuple) -> dict:
+    """One identification: simulate, write, read, fit, hold out."""
+    truth_name, kind, rate, cpr, seed, duration, max_evals = args
+    truth = lt.TRUTHS[truth_name]
+    with tempfile.TemporaryDirectory() as tmp:
+        paths = []
+        for s in (seed, seed + 1000):
+            log = lt.simulate(truth, kind, duration, rate, cpr, s)
+            meta = {"kind": kind, "rate_hz": rate, "counts_per_rev": cpr, "seed": s}
+            paths.append(lt.write_log(log, Path(tmp) / f"{kind}_{s}.csv", truth, meta))
+        held_sim = log
+        fit_log, held = _read(paths[0]), _read(paths[1])
+    out = {"truth": truth_name, "kind": kind, "rate": rate, "cpr": cpr, "seed": seed}
+    out["n"] = int(fit_log.time.size)
+    out.update(_identify(fit_log, seed, max_evals))
+    if "estimates" in out:
+        out["heldout"] = heldout(out, truth.fricid_names(), held, truth.noise)
+        out["heldout"]["simulated"] = simulated_heldout(
+            out, truth, held_sim, (kind, duration, rate, cpr, seed + 1000)
+        )
+    return out
+
+
+def foreign_tasks(max_evals: int | None) -> list[dict]:
+    """The shared foreign logs against their truth.json, the other kind held out."""
+    info = json.loads((FOREIGN / "truth.json").read_text())
+    truth = {n: info[n] for n in ("sigma_0", "sigma_1", "sigma_2", "tau_c", "tau_s", "w_s")}
+    truth.update(delta=info["delta"], inertia=info["inertia"], p_x=0.0, p_y=info["mgl"])
+    rows = []
+    for name, meta in info["files"].items():
+        other = next(
+            f
+            for f, m in info["files"].items()
+            if f != name and m["encoder_counts_per_rev"] == meta["encoder_counts_per_rev"]
+        )
+        log, held = _read(FOREIGN / name), _read(FOREIGN / other)
+        row = {"truth": "foreign", "kind": meta["trajectory"], "rate": meta["rate_hz"]}
+        row.update(cpr=meta["encoder_counts_per_rev"], seed=0, n=int(log.time.size), file=name)
+        row.update(_identify(log, 0, max_evals))
+        if "estimates" in row:
+            row["heldout"] = heldout(row, truth, held, meta["torque_noise_std"])
+        row["truth_values"] = truth
+        rows.append(row)
+        print(f"done foreign {name}: {row['seconds']:.1f} s", file=sys.stderr, flush=True)
+    return rows
+
+
+def _truth_of(row: dict) -> dict:
+    return row.get("truth_values") or lt.TRUTHS[row["truth"]].fricid_names()
+
+
+def _error(row: dict, n: str) -> float:
+    t, v = _truth_of(row)[n], row["estimates"][n]["value"]
+    return v - t if t == 0 else (v - t) / abs(t)
+
+
+def _covered(row: dict, n: str) -> bool:
+    if "estimates" not in row:
+        return False
+    r, t = row["estimates"][n], _truth_of(row)[n]
+    lo, hi = r["ci95"]
+    ok = r["closed"] and all(x is not None and math.isfinite(x) for x in (lo, hi))
+    return bool(ok and lo <= t <= hi)
+
+
+def _fmt_err(x: float, absolute: bool) -> str:
+    if not math.isfinite(x):
+        return "nan"
+    if absolute:
+        return f"{x:+.2g}a"
+    return f"{100 * x:+.3g}%" if abs(x) < 10 else f"x{x + 1:.2g}"
+
+
+def summary(rows: list[dict], key) -> list[str]:
+    """One line per group of ``rows`` (``key(row)``): fits, median errors, coverage, held-out,
+    seconds."""
+    groups: dict = {}
+    for r in rows:
+        groups.setdefault(key(r), []).append(r)
+    head = f"{'setting':42s} {'fits':>5s} " + " ".join(f"{s:>7s}" for s in SHORT)
+    lines = [head + "  cover  sim-held  eqn-held (truth)  s@60s/1kHz"]
+    for g, rs in groups.items():
+        ok = [r for r in rs if "estimates" in r]
+        errs = []
+        for n in PARAMS:
+            vals = [_error(r, n) for r in ok]
+            zero = bool(ok) and _truth_of(ok[0])[n] == 0
+            errs.append(_fmt_err(float(np.median(vals)), zero) if vals else "-")
+        cov = sum(_covered(r, n) for r in rs for n in PARAMS)
+        held = [r["heldout"]["fit"] for r in ok]
+        floor = [r["heldout"]["truth"] for r in ok]
+        secs = [r["seconds"] * 60000.0 / r["n"] for r in rs]
+        hl = f"{np.median(held):6.3g} ({np.median(floor):.3g})" if held else "   -"
+        sims = [r["heldout"].get("simulated", {}) for r in ok]
+        tq = [x["torque_over_noise"] for x in sims if "torque_over_noise" in x]
+        qc = [x["position_counts"] for x in sims if "position_counts" in x]
+        sim = f"{np.median(tq):.3g}" if tq else (f"{np.median(qc):.3g}cnt" if qc else "-")
+        lines.append(
+            f"{g:42s} {len(ok):2d}/{len(rs):<2d} "
+            + " ".join(f"{e:>7s}" for e in errs)
+            + f"  {cov:3d}/{len(rs) * len(PARAMS):<3d} {sim:>8s} {hl:>17s}   "
+            + f"{np.median(secs):6.1f} (max {max(secs):.1f})"
+        )
+    return lines
+
+
+def coverage_lines(rows: list[dict], key) -> list[str]:
+    """Coverage per parameter, per group."""
+    groups: dict = {}
+    for r in rows:
+        groups.setdefault(key(r), []).append(r)
+    lines = [f"{'group':24s} " + " ".join(f"{s:>6s}" for s in SHORT) + "  refused unconverged"]
+    for g, rs in groups.items():
+        cells = [f"{sum(_covered(r, n) for r in rs)}/{len(rs)}" for n in PARAMS]
+        refused = sum("refused" in r for r in rs)
+        unconv = sum(("estimates" in r) and not r["converged"] for r in rs)
+        lines.append(
+            f"{g:24s} " + " ".join(f"{c:>6s}" for c in cells) + f"  {refused:7d} {unconv:11d}"
+        )
+    return lines
+
+
+def main() -> None:
+    a = parse()
+    from fricid import _jit  # noqa: F401  (numba imported once in the parent)
+
+    settings = [
+        (t, k, r, c, a.first_seed + s, a.duration, a.max_evals)
+        for t in a.truths.split(",")
+        for k in a.kinds.split(",")
+        for r in a.rates
+        for c in a.cprs
+        for s in range(a.seeds)
+        if not a.foreign_only
+    ]
+    t0 = time.perf_counter()
+    rows = []
+    if a.from_json:
+        seen = {}  # one row per setting and seed (the same run saved twice counts once)
+        for path in a.from_json:
+            for r in json.loads(path.read_text()):
+                seen[(r["truth"], r["kind"], r["rate"], r["cpr"], r["seed"], r.get("file"))] = r
+        rows = list(seen.values())
+        settings = []
+    if a.jobs > 1:
+        with multiprocessing.get_context("spawn").Pool(a.jobs) as pool:
+            for row in pool.imap_unordered(task, settings):
+                rows.append(row)
+                _progress(row, len(rows), len(settings))
+    else:
+        for i, s in enumerate(settings):
+            rows.append(task(s))
+            _progress(rows[-1], i + 1, len(settings))
+    if not (a.no_foreign or a.from_json) and FOREIGN.is_dir():
+        rows += foreign_tasks(a.max_evals)
+    print(f"# bench_lugre: {len(rows)} identifications, {time.perf_counter() - t0:.0f} s wall")
+    if settings:
+        print(f"# seeds {a.seeds}, {a.duration:g} s logs, max_evals {a.max_evals}, jobs {a.jobs}")
+    print("\n## per setting (median relative error; a = absolute N m, truth 0)")
+    print(
+        "\n".join(summary(rows, lambda r: f"{r['truth']} {r['kind']} {r['rate']:g}Hz {r['cpr']}"))
+    )
+    print("\n## per kind")
+    print("\n".join(summary(rows, lambda r: r["kind"])))
+    print("\n## coverage of the 95 % intervals per parameter, per kind")
+    print("\n".join(coverage_lines(rows, lambda r: r["kind"])))
+    print("\n## coverage per truth")
+    print("\n".join(coverage_lines(rows, lambda r: r["truth"])))
+    refusals = sorted({f"{r['kind']}: {r['refused']}" for r in rows if "refused" in r})
+    if refusals:
+        print("\n## refusals\n" + "\n".join(refusals))
+    if a.json:
+        a.json.write_text(json.dumps(rows, indent=1, default=float))
+
+
+def _progress(row: dict, i: int, n: int) -> None:
+    what = row.get("refused", "refused") if "refused" in row else f"{row['seconds']:.1f} s"
+    print(
+        f"[{i}/{n}] {row['truth']} {row['kind']} {row['rate']:g} Hz {row['cpr']} seed "
+        f"{row['seed']}: {what}",
+        file=sys.stderr,
+        flush=True,
+    )
+
+
+if __name__ == "__main__":
+    main()
