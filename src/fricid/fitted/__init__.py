@@ -41,6 +41,7 @@ from ..models import INPUTS, get_model, get_predictor
 from ..models._range import RANGE_TOLERANCE, RangeViolation, range_violations
 from ..models.rbf import legacy_symmetry
 from ._file import SCHEMA_VERSION, _clean, _downsample, _num, _probe_inputs, _validate_schema
+from ._interval import PredictionInterval, prediction_interval
 from ._migrate import upgrade
 from ._parameter import OptimizerRecord, Parameter, is_not_determined, parameters_from_values
 from ._report import MIN_CORREL, fit_report
@@ -52,6 +53,7 @@ __all__ = [
     "FittedModel",
     "OptimizerRecord",
     "Parameter",
+    "PredictionInterval",
     "RangeViolation",
     "is_not_determined",
 ]
@@ -117,6 +119,10 @@ class FittedModel:
         held-out RMSE, scatter, ratio, verdict, folds; None when not validated.
     selection : ``fit(samples, "auto")``'s comparison of candidate models
         (:mod:`fricid.identify.static.select`): the table, the choice and why; None otherwise.
+    prediction_interval : what an analytic model's prediction intervals need (the delta
+        method: ``free``, their ``covariance``, ``noise_std`` [N m], ``dof``;
+        :mod:`fricid.fitted._interval`); None for the learned models (their intervals are in
+        ``state``) and files from before it was stored.
     trust : the trust verdict and where each of its numbers came from
         (:class:`fricid.identify.trust.Trust`, ``to_dict()``), with what it was computed on
         (samples and model hashes, options); None when not assessed. ``fricid fit`` and the
@@ -139,6 +145,7 @@ class FittedModel:
     validation: dict[str, Any] | None = None
     selection: dict[str, Any] | None = None
     trust: dict[str, Any] | None = None
+    prediction_interval: dict[str, Any] | None = None
 
     @classmethod
     def from_values(
@@ -220,6 +227,26 @@ class FittedModel:
             raise ConfigError(f"model '{self.model}' has no predictive standard deviation")
         arg = self.state if model.stateful else self.theta()
         out = model.predict(arg, X, return_std=True) if return_std else model.predict(arg, X)
+        if warn:
+            self._warn_range(X)
+        return out
+
+    def predict_interval(self, X, level: float = 0.95, *, warn: bool = True) -> PredictionInterval:
+        """Friction [N m] at ``X`` (n, 3) with its prediction interval at ``level``: where a
+        new measured sample falls with probability ``level``, measurement noise included.
+
+        Analytic models: the delta method from the parameters' covariance and the residual
+        variance stored at the fit; ``gp``: its posterior with the fitted noise; ``rbf`` and
+        ``hybrid``: the conformal half-widths stored with the network (levels 0.9 and 0.95).
+        See :mod:`fricid.fitted._interval`. Warns as :meth:`predict` does; outside the
+        operating range the interval is not backed by data.
+
+        Raises
+        ------
+        ConfigError
+            A level outside (0, 1), or a model file that stores no interval (at that level).
+        """
+        out = prediction_interval(self, X, level)
         if warn:
             self._warn_range(X)
         return out

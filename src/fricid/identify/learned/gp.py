@@ -10,13 +10,18 @@ where the samples have both, ``g(|v|, load, T)`` with ``F = sign(v) g``:
    ``state["dropped_inputs"]``); all standardised (mean 0, standard deviation 1);
 2. the prior mean: ``c_0 + c_v |v| + c_l |load| + c_T T + c_vT |v| T`` by least squares
    (Coulomb-viscous with linear load and temperature terms, what the model returns to far
-   from the data);
+   from the data), |load| and T held to their measured range (``mean_bounds``), so that the
+   mean stays bounded outside it (:mod:`fricid.models.gp`);
 3. the kernel: scikit-learn's ``ConstantKernel * RBF(length_scale per input) + WhiteKernel``
    (ARD squared exponential plus white noise), its hyperparameters by maximum marginal
    likelihood (``GaussianProcessRegressor``, L-BFGS-B with ``n_restarts`` random restarts
    seeded by ``seed``) on the residuals of the mean, scaled to unit standard deviation;
 4. the posterior, with the mean's coefficients estimated with it (R&W section 2.7: their
-   uncertainty widens the band where the model extrapolates): exact (R&W eq. 2.25-2.26) on all
+   uncertainty widens the band where the model extrapolates; the correction to the
+   least-squares coefficients has the prior N(0, I) on the standardised basis, eq. 2.42 with
+   ``b = 0``, ``B = I``: a regularised mean, so that inputs that hardly vary, such as a
+   temperature drifting by a few tenths of a degree, neither make ``H K^-1 H^T`` singular
+   nor give coefficients of thousands that cancel inside the data): exact (R&W eq. 2.25-2.26) on all
    samples up to ``max_points``; above that, the hyperparameters are fitted on an inducing subset
    of ``max_points`` samples chosen by farthest-point sampling in the standardised input space
    (deterministic, starting from the sample farthest from the mean: it covers the measured
@@ -144,8 +149,9 @@ def _posterior(
     exact: bool,
 ) -> tuple[np.ndarray, ...]:
     """The posterior on stored points ``P`` of targets ``t`` at ``Z`` with the mean's basis
-    ``A (n, q)`` estimated with it (R&W section 2.7, eq. 2.41-2.42, vague prior on the
-    coefficients): ``(alpha, B, G, C, dbeta)``.
+    ``A (n, q)`` estimated with it (R&W section 2.7, eq. 2.41-2.42, with the prior ``b = 0``,
+    ``B = I`` on the correction ``dbeta``, ``A`` standardised by the caller): ``(alpha, B, G,
+    C, dbeta)``.
 
     ``dbeta`` corrects the least-squares mean, ``alpha`` weighs the points, and the variance
     is ``s2 - k^T B k + (h - G k)^T C (h - G k)`` for a kernel vector ``k`` and basis ``h``.
@@ -171,7 +177,7 @@ def _posterior(
         gain = cho_solve(Sigma, Kmn @ A).T  # H K_nm (noise K_mm + K_mn K_nm)^-1
         B = cho_solve(Kj_factor, np.eye(m)) - noise * cho_solve(Sigma, np.eye(m))
         weights = lambda r: cho_solve(Sigma, Kmn @ r)  # noqa: E731
-    cov = np.linalg.inv(A.T @ M)
+    cov = np.linalg.inv(A.T @ M + np.eye(A.shape[1]))  # the prior B = I (module notes)
     cov = 0.5 * (cov + cov.T)
     dbeta = cov @ (M.T @ t)
     alpha = weights(t - A @ dbeta)
@@ -211,7 +217,7 @@ def _smoother_trace(
         M = (A - Kmn.T @ cho_solve(Sigma, Kmn @ A)) / noise
         w_kzp = cho_solve(Sigma, Kmn @ Kmn.T)
         kzp_w_a = Kmn.T @ cho_solve(Sigma, Kmn @ A)
-    cov = np.linalg.inv(A.T @ M)
+    cov = np.linalg.inv(A.T @ M + np.eye(A.shape[1]))
     return float(np.trace(cov @ (M.T @ A)) + np.trace(w_kzp) - np.trace(cov @ (M.T @ kzp_w_a)))
 
 
@@ -276,9 +282,17 @@ def _train_side(
     noise = float(k.k2.noise_level)
     P = Z[sub]
     exact = len(sub) == n
-    alpha, Bm, gain, cov, dbeta = _posterior(P, Z, t, A, lengths, s2, noise, exact)
-    coef = coef + y_scale * dbeta
-    edf = _smoother_trace(P, Z, A, lengths, s2, noise, exact)
+    # the mean's correction on the standardised basis h_s = T h (prior N(0, I) there)
+    mu = np.r_[0.0, A[:, 1:].mean(axis=0)]
+    sd = np.r_[1.0, A[:, 1:].std(axis=0)]
+    sd[sd <= 0] = 1.0
+    Tm = np.diag(1.0 / sd)
+    Tm[1:, 0] = -mu[1:] / sd[1:]
+    As = A @ Tm.T
+    alpha, Bm, gain, cov, dbeta = _posterior(P, Z, t, As, lengths, s2, noise, exact)
+    coef = coef + y_scale * (Tm.T @ dbeta)
+    gain, cov = np.linalg.solve(Tm, gain), Tm.T @ cov @ Tm  # on the raw basis h
+    edf = _smoother_trace(P, Z, As, lengths, s2, noise, exact)
     inducing = (
         "all training points"
         if exact
@@ -300,6 +314,7 @@ def _train_side(
         "var_matrix": Bm.tolist(),
         "mean_gain": gain.tolist(),
         "mean_cov": cov.tolist(),
+        "mean_bounds": np.column_stack([R.min(axis=0), R.max(axis=0)]).tolist(),
         "inducing": inducing,
         "n_train": n,
         "log_marginal_likelihood": float(gpr.log_marginal_likelihood_value_),

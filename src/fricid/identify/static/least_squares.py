@@ -30,6 +30,7 @@ from ...metrics import fit_statistics, metrics
 from ...models import INPUTS, FrictionModel, get_model
 from ...optim import METHODS, OptimizeResult, minimize
 from ...samples import FrictionSamples
+from .._intervals import delta_record
 from .._records import operating_range, provenance
 from .._scatter import measurement_scatter, sample_weights
 from ..problem import ROBUST_LOSSES, IdentificationProblem
@@ -262,6 +263,7 @@ def fit(
         operating_range=operating_range(samples, X),
         provenance=provenance(samples),
         statistics=fit_statistics(y, y_hat, problem.n_free, w),
+        prediction_interval=delta_record(model.name, theta, problem.free_names, X, y),
         loss={
             "loss": "l2" if problem.loss == "sse" else problem.loss,
             "f_scale": problem.f_scale,

@@ -1,0 +1,135 @@
+"""Prediction intervals of a fitted model: where a new measured sample at ``x`` falls, with
+probability ``level``, measurement noise included
+(:meth:`fricid.fitted.FittedModel.predict_interval`).
+
+One rule per kind of model, each from what the model file stores:
+
+- **analytic** (``prediction_interval`` of the file, method ``"delta"``): the delta method,
+  ``F(x) -+ t(dof) sqrt(g^T C g + s^2)``, ``g`` the gradient of ``F(x)`` in the free
+  parameters (central differences, one batch call), ``C`` their covariance
+  ``s^2 (J^T J)^+`` at the optimum and ``s^2`` the residual variance ``SSE / (n - p)``
+  (Seber & Wild, *Nonlinear Regression*, 1989, section 5.1, eq. 5.7);
+- **gp**: the posterior standard deviation of the latent friction with the fitted white noise
+  added, ``F(x) -+ z sqrt(std^2 + noise_std^2)`` (Rasmussen & Williams 2006, eq. 2.24 with
+  the noise of the observation);
+- **rbf**, **hybrid**: the conformal half-widths stored with each network
+  (``state["prediction_interval"]``, :func:`fricid.models.rbf.interval_half_width`), at the
+  levels stored (0.9, 0.95).
+
+Outside the operating range none of these says anything a measurement backs.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from scipy import stats
+
+from ..errors import ConfigError
+from ..models import get_model, get_predictor
+from ..models.gp import gp_sides
+from ..models.rbf import interval_half_width
+
+__all__ = ["PredictionInterval", "analytic_half_width", "gradient", "prediction_interval"]
+
+
+@dataclass(frozen=True)
+class PredictionInterval:
+    """Friction and its prediction interval at each input row.
+
+    Attributes
+    ----------
+    friction, low, high : ndarray (n,)
+        The prediction [N m] and the interval's ends [N m].
+    level : float
+        The nominal coverage (0.95: 95 % of new samples inside).
+    method : str
+        How the interval was made (``"delta"``, ``"gp"``, ``"conformal"``).
+    """
+
+    friction: np.ndarray
+    low: np.ndarray
+    high: np.ndarray
+    level: float
+    method: str
+
+    @property
+    def half_width(self) -> np.ndarray:
+        """Half the interval's width [N m]."""
+        return 0.5 * (self.high - self.low)
+
+
+def gradient(model_name: str, theta: np.ndarray, free, X: np.ndarray) -> np.ndarray:
+    """``dF(x)/dtheta_j`` ``(p, n)`` of an analytic model at ``theta`` for the parameters
+    named in ``free``, by central differences in one batch call."""
+    model = get_model(model_name)
+    idx = np.array([model.param_names.index(n) for n in free], dtype=int)
+    p = idx.size
+    if not p:
+        return np.zeros((0, len(X)))
+    h = 1e-6 * np.maximum(np.abs(theta[idx]), 1e-3)
+    steps = np.repeat(np.asarray(theta, dtype=float)[None, :], 2 * p, axis=0)
+    steps[np.arange(p), idx] += h
+    steps[p + np.arange(p), idx] -= h
+    F = np.atleast_2d(model.predict(steps, X))
+    return (F[:p] - F[p:]) / (2 * h[:, None])
+
+
+def analytic_half_width(
+    model_name: str, theta: np.ndarray, record: Mapping[str, Any], X: np.ndarray, level: float
+) -> np.ndarray:
+    """Half-width of the delta-method interval of an analytic model (module notes) at ``X``.
+
+    ``record`` is the model file's ``prediction_interval``: ``free`` (the names of the free
+    parameters), ``covariance`` of those, ``noise_std`` and ``dof``.
+    """
+    G = gradient(model_name, theta, record["free"], X)
+    C = np.asarray(record["covariance"], dtype=float)
+    var = np.einsum("pn,pq,qn->n", G, C, G) + float(record["noise_std"]) ** 2
+    q = stats.t.ppf(0.5 + level / 2, max(int(record["dof"]), 1))
+    return q * np.sqrt(np.maximum(var, 0.0))
+
+
+def _gp_half_width(state: Mapping[str, Any], std: np.ndarray, X: np.ndarray, level: float):
+    sides = gp_sides(state)
+    v = X[:, 0]
+    noise = np.zeros(len(X))
+    for side, st in sides.items():
+        mask = {"all": v != 0, "pos": v > 0, "neg": v < 0}[side]
+        noise[mask] = float(st.get("noise_std", 0.0))
+    return stats.norm.ppf(0.5 + level / 2) * np.sqrt(std**2 + noise**2)
+
+
+def prediction_interval(fitted, X, level: float = 0.95) -> PredictionInterval:
+    """The interval of ``fitted`` (a :class:`~fricid.fitted.FittedModel`) at ``X (n, 3)``;
+    see :meth:`fricid.fitted.FittedModel.predict_interval`."""
+    level = float(level)
+    if not 0.0 < level < 1.0:
+        raise ConfigError(f"the interval's level must lie in (0, 1); got {level!r}")
+    X = np.asarray(X, dtype=float)
+    if fitted.model == "gp":
+        F, std = fitted.predict(X, warn=False, return_std=True)
+        half, method = _gp_half_width(fitted.state, std, X, level), "gp"
+    elif get_predictor(fitted.model).stateful:
+        F = fitted.predict(X, warn=False)
+        half, method = interval_half_width(fitted.state, X, level), "conformal"
+        if np.isnan(half[X[:, 0] != 0]).any():
+            raise ConfigError(
+                f"model '{fitted.model}' stores no prediction interval at level {level:g} "
+                "(the levels stored are 0.9 and 0.95; files before they were stored have none)"
+            )
+        half = np.nan_to_num(half)
+    else:
+        record = fitted.prediction_interval
+        if not isinstance(record, Mapping) or record.get("method") != "delta":
+            raise ConfigError(
+                f"model '{fitted.model}' stores no prediction interval (fit it again with "
+                "this fricid to get one)"
+            )
+        F = fitted.predict(X, warn=False)
+        half, method = analytic_half_width(fitted.model, fitted.theta(), record, X, level), "delta"
+    half = np.where(X[:, 0] == 0, 0.0, half)  # sign(0) = 0: no friction predicted at rest
+    return PredictionInterval(F, F - half, F + half, level, method)
