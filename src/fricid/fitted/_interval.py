@@ -10,11 +10,14 @@ One rule per kind of model, each from what the model file stores:
   ``s^2 (J^T J)^+`` at the optimum and ``s^2`` the residual variance ``SSE / (n - p)``
   (Seber & Wild, *Nonlinear Regression*, 1989, section 5.1, eq. 5.7);
 - **gp**: the posterior standard deviation of the latent friction with the fitted white noise
-  added, ``F(x) -+ z sqrt(std^2 + noise_std^2)`` (Rasmussen & Williams 2006, eq. 2.24 with
-  the noise of the observation);
+  added, ``F(x) -+ k sqrt(std^2 + noise_std^2)`` (Rasmussen & Williams 2006, eq. 2.24 with
+  the noise of the observation), ``k`` the held-out multiplier stored with each process
+  (``interval_scale``, :func:`fricid.identify.learned._gp_posterior.heldout_scale`) or, for
+  processes without one (inducing points, older files), the normal quantile;
 - **rbf**, **hybrid**: the conformal half-widths stored with each network
   (``state["prediction_interval"]``, :func:`fricid.models.rbf.interval_half_width`), at the
-  levels stored (0.9, 0.95).
+  levels stored (0.9, 0.95); a hybrid's with its backbone's ``g^T C g`` added in
+  quadrature (the residual's cross-validation holds the backbone).
 
 Outside the operating range none of these says anything a measurement backs.
 """
@@ -93,14 +96,41 @@ def analytic_half_width(
     return q * np.sqrt(np.maximum(var, 0.0))
 
 
+def _gp_scale(st: Mapping[str, Any], level: float) -> float:
+    """The multiplier of a process's predictive standard deviation at ``level``: its
+    held-out calibration (``interval_scale``) where stored at that level, else the normal
+    quantile."""
+    cal = st.get("interval_scale")
+    if isinstance(cal, Mapping):
+        for lv, k in zip(cal.get("levels") or (), cal.get("scale") or (), strict=False):
+            if abs(float(lv) - level) < 1e-9:
+                return max(float(k), 0.0)
+    return float(stats.norm.ppf(0.5 + level / 2))
+
+
 def _gp_half_width(state: Mapping[str, Any], std: np.ndarray, X: np.ndarray, level: float):
-    sides = gp_sides(state)
     v = X[:, 0]
-    noise = np.zeros(len(X))
-    for side, st in sides.items():
+    half = np.zeros(len(X))
+    for side, st in gp_sides(state).items():
         mask = {"all": v != 0, "pos": v > 0, "neg": v < 0}[side]
-        noise[mask] = float(st.get("noise_std", 0.0))
-    return stats.norm.ppf(0.5 + level / 2) * np.sqrt(std**2 + noise**2)
+        noise = float(st.get("noise_std", 0.0))
+        half[mask] = _gp_scale(st, level) * np.sqrt(std[mask] ** 2 + noise**2)
+    return half
+
+
+def _with_backbone(state: Mapping[str, Any], X: np.ndarray, half: np.ndarray, level: float):
+    """A hybrid's conformal half-width with its backbone's parameter uncertainty added in
+    quadrature (:mod:`fricid.identify.learned.hybrid` notes); as it is without a record."""
+    bb = state.get("backbone") if isinstance(state, Mapping) else None
+    record = bb.get("prediction_interval") if isinstance(bb, Mapping) else None
+    if not isinstance(record, Mapping) or record.get("method") != "delta":
+        return half
+    model = get_model(str(bb["model"]))
+    theta = model.param_vector(dict(bb["params"]))
+    G = gradient(model.name, theta, record["free"], X)
+    var = np.einsum("pn,pq,qn->n", G, np.asarray(record["covariance"], dtype=float), G)
+    q = stats.t.ppf(0.5 + level / 2, max(int(record["dof"]), 1))
+    return np.sqrt(half**2 + q**2 * np.maximum(var, 0.0))
 
 
 def prediction_interval(fitted, X, level: float = 0.95) -> PredictionInterval:
@@ -122,6 +152,8 @@ def prediction_interval(fitted, X, level: float = 0.95) -> PredictionInterval:
                 "(the levels stored are 0.9 and 0.95; files before they were stored have none)"
             )
         half = np.nan_to_num(half)
+        if fitted.model == "hybrid":
+            half = _with_backbone(fitted.state, X, half, level)
     else:
         record = fitted.prediction_interval
         if not isinstance(record, Mapping) or record.get("method") != "delta":

@@ -203,7 +203,7 @@ def test_a_damaged_gp_file_is_a_data_error(small_gp, tmp_path, key):
 def test_inducing_posterior_survives_a_numerically_singular_kernel_matrix():
     # close inducing points under long length scales: K_mm is singular to rounding, which made
     # the held-out grid law of issue 15 (1848 samples) fail with "not positive definite"
-    from fricid.identify.learned.gp import _cholesky, _posterior
+    from fricid.identify.learned._gp_posterior import _cholesky, _posterior
 
     with pytest.raises(np.linalg.LinAlgError):
         np.linalg.cholesky(np.ones((3, 3)))

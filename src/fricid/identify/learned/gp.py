@@ -54,7 +54,6 @@ from typing import Any
 
 import numpy as np
 import scipy.optimize
-from scipy.linalg import cho_factor, cho_solve
 from sklearn.exceptions import ConvergenceWarning as SklearnConvergenceWarning
 from sklearn.gaussian_process import GaussianProcessRegressor
 from sklearn.gaussian_process.kernels import RBF, ConstantKernel, WhiteKernel
@@ -68,35 +67,13 @@ from ...models.gp import GP_KIND, predict_gp
 from ...samples import FrictionSamples
 from .._records import operating_range, provenance
 from .._scatter import measurement_scatter
+from ._gp_posterior import _posterior, _smoother_trace, heldout_scale
 from ._trust import learned_statistics, process_convergence
 
 __all__ = ["DEFAULT_MAX_POINTS", "farthest_points", "fit_gp"]
 
 #: Stored points above which the inducing subset is used (module notes, step 4).
 DEFAULT_MAX_POINTS = 400
-
-#: Relative jitter on the diagonal of the inducing points' kernel matrix.
-_JITTER = 1e-8
-
-#: Most tenfold increases of the jitter :func:`_cholesky` tries.
-_JITTER_STEPS = 6
-
-
-def _cholesky(M: np.ndarray, scale: float) -> tuple[tuple[np.ndarray, bool], float]:
-    """``cho_factor`` of the symmetric ``M`` with ``jitter * I`` added, and that jitter:
-    ``_JITTER * scale``, raised tenfold (up to :data:`_JITTER_STEPS` times) while the
-    factorisation fails. Long length scales make the kernel matrix of close inducing points
-    numerically singular (its smallest eigenvalues fall below rounding); the jitter restores
-    it, as the nugget of R&W section 3.4.3 does."""
-    eye = np.eye(len(M))
-    for k in range(_JITTER_STEPS + 1):
-        jitter = _JITTER * scale * 10.0**k
-        try:
-            return cho_factor(M + jitter * eye, lower=True), jitter
-        except np.linalg.LinAlgError:
-            if k == _JITTER_STEPS:
-                raise
-    raise AssertionError("unreachable")  # pragma: no cover
 
 
 def farthest_points(Z: np.ndarray, m: int) -> np.ndarray:
@@ -128,97 +105,9 @@ def _symmetry(samples: FrictionSamples) -> str:
     return "per_direction" if dirs == {-1, 1} else ("pos" if dirs == {1} else "neg")
 
 
-def _kernel_matrix(A: np.ndarray, B: np.ndarray, lengths: np.ndarray, s2: float) -> np.ndarray:
-    d2 = np.sum(((A[:, None, :] - B[None, :, :]) / lengths) ** 2, axis=2)
-    return s2 * np.exp(-0.5 * d2)
-
-
 def _interaction(A: np.ndarray, used: list[str]) -> list[np.ndarray]:
     """``|v| T`` when both are used: the viscous coefficient linear in temperature."""
     return [A[:, 0] * A[:, used.index("temperature")]] if "temperature" in used else []
-
-
-def _posterior(
-    P: np.ndarray,
-    Z: np.ndarray,
-    t: np.ndarray,
-    A: np.ndarray,
-    lengths: np.ndarray,
-    s2: float,
-    noise: float,
-    exact: bool,
-) -> tuple[np.ndarray, ...]:
-    """The posterior on stored points ``P`` of targets ``t`` at ``Z`` with the mean's basis
-    ``A (n, q)`` estimated with it (R&W section 2.7, eq. 2.41-2.42, with the prior ``b = 0``,
-    ``B = I`` on the correction ``dbeta``, ``A`` standardised by the caller): ``(alpha, B, G,
-    C, dbeta)``.
-
-    ``dbeta`` corrects the least-squares mean, ``alpha`` weighs the points, and the variance
-    is ``s2 - k^T B k + (h - G k)^T C (h - G k)`` for a kernel vector ``k`` and basis ``h``.
-    Exact: ``K = K_nn + noise I`` (R&W eq. 2.25-2.26); else DTC on the points, with
-    ``K~^-1 = (Q_nn + noise I)^-1`` by the Woodbury identity (Quinonero-Candela & Rasmussen
-    2005, eq. 20-21).
-    """
-    m = len(P)
-    Kmm = _kernel_matrix(P, P, lengths, s2)
-    if exact:
-        factor = cho_factor(Kmm + (noise + 1e-10) * np.eye(m), lower=True)
-        M = cho_solve(factor, A)  # K^-1 H^T
-        gain = M.T  # H K^-1
-        B = cho_solve(factor, np.eye(m))
-        weights = lambda r: cho_solve(factor, r)  # noqa: E731
-    else:
-        Kmn = _kernel_matrix(P, Z, lengths, s2)
-        Kj_factor, jitter = _cholesky(Kmm, s2)
-        Kj = Kmm + jitter * np.eye(m)
-        S = noise * Kj + Kmn @ Kmn.T
-        Sigma, _ = _cholesky(S, float(np.trace(S)) / m)
-        M = (A - Kmn.T @ cho_solve(Sigma, Kmn @ A)) / noise
-        gain = cho_solve(Sigma, Kmn @ A).T  # H K_nm (noise K_mm + K_mn K_nm)^-1
-        B = cho_solve(Kj_factor, np.eye(m)) - noise * cho_solve(Sigma, np.eye(m))
-        weights = lambda r: cho_solve(Sigma, Kmn @ r)  # noqa: E731
-    cov = np.linalg.inv(A.T @ M + np.eye(A.shape[1]))  # the prior B = I (module notes)
-    cov = 0.5 * (cov + cov.T)
-    dbeta = cov @ (M.T @ t)
-    alpha = weights(t - A @ dbeta)
-    return alpha, 0.5 * (B + B.T), gain, cov, dbeta
-
-
-def _smoother_trace(
-    P: np.ndarray,
-    Z: np.ndarray,
-    A: np.ndarray,
-    lengths: np.ndarray,
-    s2: float,
-    noise: float,
-    exact: bool,
-) -> float:
-    """The effective degrees of freedom of the posterior mean at the training points: the
-    trace of the linear map ``S`` from targets to fitted values, at these hyperparameters,
-    the mean's basis ``A (n, q)`` estimated with it (R&W section 2.6; ESL eq. 3.50 for its
-    ridge form).
-
-    With ``dbeta = C M^T t`` and ``alpha = W (t - A dbeta)`` (:func:`_posterior`) the fit at
-    the points is ``A dbeta + K_zp alpha``, so ``tr S = tr(C M^T A) + tr(W K_zp) -
-    tr(C M^T K_zp W A)``, formed from ``m x m`` and ``n x q`` products only.
-    """
-    m = len(P)
-    Kmm = _kernel_matrix(P, P, lengths, s2)
-    if exact:
-        factor = cho_factor(Kmm + (noise + 1e-10) * np.eye(m), lower=True)
-        M = cho_solve(factor, A)
-        w_kzp = cho_solve(factor, Kmm)
-        kzp_w_a = Kmm @ M
-    else:
-        Kmn = _kernel_matrix(P, Z, lengths, s2)
-        _, jitter = _cholesky(Kmm, s2)
-        S = noise * (Kmm + jitter * np.eye(m)) + Kmn @ Kmn.T
-        Sigma, _ = _cholesky(S, float(np.trace(S)) / m)
-        M = (A - Kmn.T @ cho_solve(Sigma, Kmn @ A)) / noise
-        w_kzp = cho_solve(Sigma, Kmn @ Kmn.T)
-        kzp_w_a = Kmn.T @ cho_solve(Sigma, Kmn @ A)
-    cov = np.linalg.inv(A.T @ M + np.eye(A.shape[1]))
-    return float(np.trace(cov @ (M.T @ A)) + np.trace(w_kzp) - np.trace(cov @ (M.T @ kzp_w_a)))
 
 
 def _train_side(
@@ -293,6 +182,7 @@ def _train_side(
     coef = coef + y_scale * (Tm.T @ dbeta)
     gain, cov = np.linalg.solve(Tm, gain), Tm.T @ cov @ Tm  # on the raw basis h
     edf = _smoother_trace(P, Z, As, lengths, s2, noise, exact)
+    calibration = heldout_scale(Z, A, As, g, (lengths, s2, noise), y_scale) if exact else None
     inducing = (
         "all training points"
         if exact
@@ -327,6 +217,8 @@ def _train_side(
             "message": str(best.message),
         },
     }
+    if calibration is not None:
+        state["interval_scale"] = calibration
     if dropped:
         state["dropped_inputs"] = dropped
     notes = sorted({str(w.message).split(". ")[0] for w in caught})
