@@ -12,8 +12,9 @@ One rule per kind of model, each from what the model file stores:
 - **gp**: the posterior standard deviation of the latent friction with the fitted white noise
   added, ``F(x) -+ k sqrt(std^2 + noise_std^2)`` (Rasmussen & Williams 2006, eq. 2.24 with
   the noise of the observation), ``k`` the held-out multiplier stored with each process
-  (``interval_scale``, :func:`fricid.identify.learned._gp_posterior.heldout_scale`) or, for
-  processes without one (inducing points, older files), the normal quantile;
+  (``interval_scale``, :func:`fricid.identify.learned._gp_posterior.heldout_scale`), the
+  half-width not below the held-out residuals' conformal one stored with it; for processes
+  without one (inducing points, older files), ``k`` the normal quantile;
 - **rbf**, **hybrid**: the conformal half-widths stored with each network
   (``state["prediction_interval"]``, :func:`fricid.models.rbf.interval_half_width`), at the
   levels stored (0.9, 0.95); a hybrid's with its backbone's ``g^T C g`` added in
@@ -96,16 +97,18 @@ def analytic_half_width(
     return q * np.sqrt(np.maximum(var, 0.0))
 
 
-def _gp_scale(st: Mapping[str, Any], level: float) -> float:
-    """The multiplier of a process's predictive standard deviation at ``level``: its
-    held-out calibration (``interval_scale``) where stored at that level, else the normal
-    quantile."""
+def _gp_scale(st: Mapping[str, Any], level: float) -> tuple[float, float]:
+    """The multiplier of a process's predictive standard deviation at ``level`` and the
+    least half-width [N m]: its held-out calibration (``interval_scale``) where stored at
+    that level, else the normal quantile and 0."""
     cal = st.get("interval_scale")
     if isinstance(cal, Mapping):
-        for lv, k in zip(cal.get("levels") or (), cal.get("scale") or (), strict=False):
-            if abs(float(lv) - level) < 1e-9:
-                return max(float(k), 0.0)
-    return float(stats.norm.ppf(0.5 + level / 2))
+        levels = [float(x) for x in cal.get("levels") or ()]
+        hits = [j for j, lv in enumerate(levels) if abs(lv - level) < 1e-9]
+        scale, least = list(cal.get("scale") or ()), list(cal.get("half_width") or ())
+        if hits and hits[0] < min(len(scale), len(least)):
+            return max(float(scale[hits[0]]), 0.0), max(float(least[hits[0]]), 0.0)
+    return float(stats.norm.ppf(0.5 + level / 2)), 0.0
 
 
 def _gp_half_width(state: Mapping[str, Any], std: np.ndarray, X: np.ndarray, level: float):
@@ -114,7 +117,8 @@ def _gp_half_width(state: Mapping[str, Any], std: np.ndarray, X: np.ndarray, lev
     for side, st in gp_sides(state).items():
         mask = {"all": v != 0, "pos": v > 0, "neg": v < 0}[side]
         noise = float(st.get("noise_std", 0.0))
-        half[mask] = _gp_scale(st, level) * np.sqrt(std[mask] ** 2 + noise**2)
+        k, least = _gp_scale(st, level)
+        half[mask] = np.maximum(k * np.sqrt(std[mask] ** 2 + noise**2), least)
     return half
 
 
