@@ -215,9 +215,9 @@ class FittedModel:
             Warn (:class:`~fricid.errors.ExtrapolationWarning`, one per quantity) when inputs
             lie outside the operating range (:meth:`range_check`): above the identified
             speeds, on a side a one-direction model was not identified on, or outside the
-            load or temperature range. Speeds below the smallest identified one are
-            reported by :meth:`range_check` but not warned about here (every reversal passes
-            through them).
+            load or temperature range. Speeds below the smallest identified one, and in a
+            gap between measured speeds, are reported by :meth:`range_check` but not warned
+            about here (every reversal passes through them).
         return_std : bool, default False
             Also return the predictive standard deviation [N m] of the friction (models with
             a posterior: ``"gp"``); a ``ConfigError`` for the others.
@@ -253,7 +253,7 @@ class FittedModel:
 
     def _warn_range(self, X, stacklevel: int = 3) -> None:
         for bad in self.range_check(X):
-            if bad.kind != "below":
+            if bad.kind not in ("below", "gap"):
                 warnings.warn(bad.message, ExtrapolationWarning, stacklevel=stacklevel)
 
     def predict_point(self, velocity, load=0.0, temperature=25.0) -> np.ndarray:
@@ -289,7 +289,10 @@ class FittedModel:
         edges. Velocity: a model of combined samples (direction 0, odd in velocity) is
         compared by speed ``|v|`` (``"above"``, ``"below"``); a one-direction model by speed
         and side (``"side"``); a range spanning both directions by value (``"outside"``).
-        ``v = 0`` is never out of range (``sign(0) = 0``).
+        Where the file records the measured speeds per direction (``provenance["speeds"]``,
+        :func:`fricid.models._range.speed_coverage`), speeds below the slowest measured one
+        of their direction are ``"below"`` for every model, and speeds in a gap between
+        measured speeds are ``"gap"``. ``v = 0`` is never out of range (``sign(0) = 0``).
 
         Parameters
         ----------
@@ -301,8 +304,10 @@ class FittedModel:
         list of RangeViolation
             One per quantity and kind found, empty when every input is inside.
         """
-        dirs = (self.provenance or {}).get("directions") if self.provenance else None
-        return range_violations(X, self.operating_range, self.inputs_used(), dirs)
+        prov = self.provenance or {}
+        return range_violations(
+            X, self.operating_range, self.inputs_used(), prov.get("directions"), prov.get("speeds")
+        )
 
     # -- text ----------------------------------------------------------------------------
     def report(self, min_correl: float = MIN_CORREL) -> str:

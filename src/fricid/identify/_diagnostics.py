@@ -10,6 +10,7 @@ from __future__ import annotations
 from typing import Any
 
 from ..fitted import FittedModel, Parameter
+from ..models._range import coverage_text
 from ..samples import FrictionSamples
 
 __all__ = ["DROPS", "not_determined", "open_sides", "quality_rows", "range_text"]
@@ -58,9 +59,13 @@ def open_sides(fitted: FittedModel, *, include_zero: bool = False) -> dict[str, 
 def range_text(fitted: FittedModel) -> str:
     """The extrapolation-free operating range: ``"velocity 0.0105 to 0.838 rad/s; ..."``.
 
-    Velocity of a model of combined samples (direction 0, odd in velocity) is given as speed
-    ``|v|`` for either direction; one identified on one direction names it. Inputs the model
-    does not use are left out; ``""`` when the file records no range.
+    Velocity: where the file records the measured speeds per direction
+    (``provenance["speeds"]``), each direction's range and the gaps inside it
+    (:func:`fricid.models._range.coverage_text`: ``"velocity v > 0: measured 0.217 to 20.84
+    rad/s (nothing between 2 and 5), v < 0: ..."``); else, of a model of combined samples
+    (direction 0, odd in velocity), the speed ``|v|`` for either direction, and one
+    identified on one direction names it. Inputs the model does not use are left out; ``""``
+    when the file records no range.
     """
     used = set(fitted.inputs_used()) if fitted.operating_range else set()
     dirs = sorted({int(d) for d in (fitted.provenance or {}).get("directions") or ()})
@@ -71,7 +76,10 @@ def range_text(fitted: FittedModel) -> str:
             continue
         lo, hi = float(pair[0]), float(pair[1])
         unit = _UNITS[name]
-        if name == "velocity" and dirs == [0]:
+        speeds = coverage_text((fitted.provenance or {}).get("speeds"))
+        if name == "velocity" and speeds:
+            parts.append("velocity " + ", ".join(speeds))
+        elif name == "velocity" and dirs == [0]:
             parts.append(f"speed {lo:.4g} to {hi:.4g} {unit} (either direction)")
         elif name == "velocity" and dirs in ([1], [-1]):
             side = "positive" if dirs == [1] else "negative"
