@@ -36,6 +36,7 @@ from .._scatter import measurement_scatter, sample_weights
 from ..problem import ROBUST_LOSSES, IdentificationProblem
 from .checks import check_identifiable
 from .convergence import certify
+from .informed import uninformed
 from .uncertainty import INTERVALS, Uncertainty, assess
 from .varpro import varpro
 
@@ -245,7 +246,13 @@ def fit(
     return FittedModel(
         model=model.name,
         parameters=_records(
-            problem, theta, unc, start, problem.at_bound(result.x), convergence["converged"]
+            problem,
+            theta,
+            unc,
+            start,
+            problem.at_bound(result.x),
+            convergence["converged"],
+            uninformed(model.name, theta, samples),
         ),
         ci_method=unc.method,
         correlation=corr,
@@ -280,9 +287,12 @@ def _records(
     start: np.ndarray | None,
     at_bound: Sequence[str],
     converged: bool,
+    outside: Mapping[str, str] | None = None,
 ) -> dict[str, Parameter]:
     """One :class:`~fricid.fitted.Parameter` per parameter of ``problem`` at ``theta``: the
-    free ones with their start, search bounds, standard error, interval (``unc``) and flags."""
+    free ones with their start, search bounds, standard error, interval (``unc``) and flags;
+    ``outside`` names those outside the range the data can inform, with why
+    (:func:`~fricid.identify.static.informed.uninformed`: not determined)."""
     units = problem.model.units
     out = {
         n: Parameter(n, float(v), unit=units.get(n, ""), fixed=n in problem.fixed)
@@ -290,6 +300,8 @@ def _records(
     }
     for j, n in enumerate(problem.free_names):
         note = unc.notes.get(n, "")
+        if outside and n in outside and not note.startswith(("not determined", "not identified")):
+            note = outside[n] + (f"; {note}" if note else "")
         out[n] = replace(
             out[n],
             init=None if start is None else float(start[j]),
