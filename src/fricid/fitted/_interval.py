@@ -30,7 +30,6 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from scipy import stats
 
 from ..errors import ConfigError
 from ..models import get_model, get_predictor
@@ -38,6 +37,18 @@ from ..models.gp import gp_sides
 from ..models.rbf import interval_half_width
 
 __all__ = ["PredictionInterval", "analytic_half_width", "gradient", "prediction_interval"]
+
+
+def _t_ppf(q: float, dof: int) -> float:
+    from scipy import stats  # on first use: `fricid predict` starts without scipy.stats
+
+    return float(stats.t.ppf(q, dof))
+
+
+def _norm_ppf(q: float) -> float:
+    from scipy import stats
+
+    return float(stats.norm.ppf(q))
 
 
 @dataclass(frozen=True)
@@ -93,7 +104,7 @@ def analytic_half_width(
     G = gradient(model_name, theta, record["free"], X)
     C = np.asarray(record["covariance"], dtype=float)
     var = np.einsum("pn,pq,qn->n", G, C, G) + float(record["noise_std"]) ** 2
-    q = stats.t.ppf(0.5 + level / 2, max(int(record["dof"]), 1))
+    q = _t_ppf(0.5 + level / 2, max(int(record["dof"]), 1))
     return q * np.sqrt(np.maximum(var, 0.0))
 
 
@@ -108,7 +119,7 @@ def _gp_scale(st: Mapping[str, Any], level: float) -> tuple[float, float]:
         scale, least = list(cal.get("scale") or ()), list(cal.get("half_width") or ())
         if hits and hits[0] < min(len(scale), len(least)):
             return max(float(scale[hits[0]]), 0.0), max(float(least[hits[0]]), 0.0)
-    return float(stats.norm.ppf(0.5 + level / 2)), 0.0
+    return float(_norm_ppf(0.5 + level / 2)), 0.0
 
 
 def _gp_half_width(state: Mapping[str, Any], std: np.ndarray, X: np.ndarray, level: float):
@@ -133,7 +144,7 @@ def _with_backbone(state: Mapping[str, Any], X: np.ndarray, half: np.ndarray, le
     theta = model.param_vector(dict(bb["params"]))
     G = gradient(model.name, theta, record["free"], X)
     var = np.einsum("pn,pq,qn->n", G, np.asarray(record["covariance"], dtype=float), G)
-    q = stats.t.ppf(0.5 + level / 2, max(int(record["dof"]), 1))
+    q = _t_ppf(0.5 + level / 2, max(int(record["dof"]), 1))
     return np.sqrt(half**2 + q**2 * np.maximum(var, 0.0))
 
 
