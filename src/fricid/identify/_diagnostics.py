@@ -10,7 +10,7 @@ from __future__ import annotations
 from typing import Any
 
 from ..fitted import FittedModel, Parameter
-from ..models._range import coverage_text
+from ..models._range import coverage_text, gaps_note
 from ..samples import FrictionSamples
 
 __all__ = ["DROPS", "not_determined", "open_sides", "quality_rows", "range_text"]
@@ -59,16 +59,17 @@ def open_sides(fitted: FittedModel, *, include_zero: bool = False) -> dict[str, 
 def range_text(fitted: FittedModel) -> str:
     """The extrapolation-free operating range: ``"velocity 0.0105 to 0.838 rad/s; ..."``.
 
-    Velocity: where the file records the measured speeds per direction
-    (``provenance["speeds"]``), each direction's range and the gaps inside it
-    (:func:`fricid.models._range.coverage_text`: ``"velocity v > 0: measured 0.217 to 20.84
-    rad/s (nothing between 2 and 5), v < 0: ..."``); else, of a model of combined samples
-    (direction 0, odd in velocity), the speed ``|v|`` for either direction, and one
-    identified on one direction names it. Inputs the model does not use are left out; ``""``
-    when the file records no range.
+    Velocity of a model of combined samples (direction 0, odd in velocity) is given as speed
+    ``|v|`` for either direction; one identified on one direction names it; one identified on
+    both, where the file records the measured speeds per direction (``provenance["speeds"]``),
+    gives each direction's range (:func:`fricid.models._range.coverage_text`: ``"velocity
+    v > 0: measured 0.217 to 20.84 rad/s (nothing between 2 and 5), v < 0: ..."``). The gaps
+    between measured speeds are named in each case. Inputs the model does not use are left
+    out; ``""`` when the file records no range.
     """
     used = set(fitted.inputs_used()) if fitted.operating_range else set()
     dirs = sorted({int(d) for d in (fitted.provenance or {}).get("directions") or ()})
+    coverage = (fitted.provenance or {}).get("speeds")
     parts = []
     for name in ("velocity", "load", "temperature"):
         pair = fitted.operating_range.get(name)
@@ -76,14 +77,15 @@ def range_text(fitted: FittedModel) -> str:
             continue
         lo, hi = float(pair[0]), float(pair[1])
         unit = _UNITS[name]
-        speeds = coverage_text((fitted.provenance or {}).get("speeds"))
-        if name == "velocity" and speeds:
-            parts.append("velocity " + ", ".join(speeds))
-        elif name == "velocity" and dirs == [0]:
-            parts.append(f"speed {lo:.4g} to {hi:.4g} {unit} (either direction)")
+        if name == "velocity" and dirs == [0]:
+            gaps = gaps_note(coverage, "both")
+            parts.append(f"speed {lo:.4g} to {hi:.4g} {unit} (either direction{gaps})")
         elif name == "velocity" and dirs in ([1], [-1]):
             side = "positive" if dirs == [1] else "negative"
-            parts.append(f"velocity {lo:.4g} to {hi:.4g} {unit} ({side} direction only)")
+            gaps = gaps_note(coverage, side[:3])
+            parts.append(f"velocity {lo:.4g} to {hi:.4g} {unit} ({side} direction only{gaps})")
+        elif name == "velocity" and len(coverage_text(coverage)) == 2:  # per direction
+            parts.append("velocity " + ", ".join(coverage_text(coverage)))
         elif lo == hi:
             parts.append(f"{name} {lo:.4g} {unit} only")
         else:

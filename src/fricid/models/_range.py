@@ -21,6 +21,7 @@ __all__ = [
     "RANGE_TOLERANCE",
     "RangeViolation",
     "coverage_text",
+    "gaps_note",
     "range_violations",
     "speed_coverage",
 ]
@@ -77,6 +78,17 @@ def speed_coverage(velocity, directions: Sequence[int] = ()) -> dict[str, dict[s
         gaps = [[float(s[i]), float(s[i + 1])] for i in np.flatnonzero(steps > limit)]
         out[side] = {"range": [float(s[0]), float(s[-1])], "gaps": gaps}
     return out
+
+
+def gaps_note(coverage: Any, side: str) -> str:
+    """``"; nothing measured between a and b rad/s"`` for each gap of one side of a
+    :func:`speed_coverage` record; "" when it has none (or no such side)."""
+    rec = coverage.get(side) if isinstance(coverage, dict) else None
+    gaps = rec.get("gaps") if isinstance(rec, dict) else None
+    pairs = [_pair({"g": g}, "g") for g in gaps or []]
+    return "".join(
+        f"; nothing measured between {p[0]:.4g} and {p[1]:.4g} rad/s" for p in pairs if p
+    )
 
 
 def coverage_text(coverage: Any) -> list[str]:
