@@ -124,3 +124,14 @@ def test_from_values_makes_a_model_of_values_alone():
     assert m.params == {"f_c": 0.1, "beta": 0.05} and m.units == {"f_c": "N m", "beta": ""}
     assert m.optimizer == OptimizerRecord() and m.fixed == () and m.at_bound == ()
     assert m.predict_point(1.0) == pytest.approx(0.15)
+
+
+def test_near_zero_value_prints_its_absolute_error_only():
+    p = Parameter("tau_v", 4.3e-24, unit="N m s/rad", stderr=3.6e-3, bounds=(0.0, 1.0))
+    m = FittedModel(model="coulomb_viscous", parameters={"f_c": Parameter("f_c", 0.4), "beta": p})
+    line = next(ln for ln in m.report().splitlines() if ln.strip().startswith("beta"))
+    assert "+/- 0.0036" in line and "%" not in line, line
+    q = replace(p, value=0.5)
+    m = FittedModel(model="coulomb_viscous", parameters={"f_c": Parameter("f_c", 0.4), "beta": q})
+    line = next(ln for ln in m.report().splitlines() if ln.strip().startswith("beta"))
+    assert "+/- 0.0036 (0.72%)" in line, line

@@ -133,6 +133,13 @@ def export_command(
                 sha256=sha256,
                 clamp=clamp,
             )
+            from ..export.clamp import unclamped_speeds
+
+            unheld = unclamped_speeds(fitted) if clamp else ""
+            if unheld:
+                err_console.print(
+                    f"warning: {unheld}", markup=False, highlight=False, soft_wrap=True
+                )
             for path in paths:
                 err_console.print(f"wrote {escape(str(path))}", highlight=False)
             return

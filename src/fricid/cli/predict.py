@@ -78,14 +78,24 @@ def predict_command(
             "--out", "-o", help=("CSV file to write (atomically). Default: CSV on stdout.")
         ),
     ] = None,
+    interval: Annotated[
+        float | None,
+        typer.Option(
+            help="Also write the prediction interval at this level (e.g. 0.95): columns "
+            "'low' and 'high', where a new measured sample falls with that probability "
+            "(delta method for analytic models, the GP's posterior, conformal for rbf and "
+            "hybrid: levels 0.9 and 0.95)."
+        ),
+    ] = None,
 ) -> None:
     """Friction of a model at operating points: CSV with velocity, load, temperature and
     friction columns, each labelled with its unit.
 
     Points outside the operating range the model was identified on (above the identified
-    speeds, below the smallest one, on a side a one-direction model was not identified on,
-    outside the load or temperature range) are still predicted, with one warning line per
-    quantity on stderr.
+    speeds, below the smallest one of their direction, in a gap between measured speeds, on a
+    side a one-direction model was not identified on, outside the load or temperature range)
+    are still predicted, with one warning line each on stderr naming the measured range.
+    With --interval LEVEL, the prediction interval's ends are written too.
 
     Examples: `fricid predict m.json --velocity 0.1 --velocity 0.5 --load 0.2 --temperature 30`;
     `fricid predict m.json --input points.csv --velocity-unit deg/s --out friction.csv`.
@@ -135,8 +145,12 @@ def predict_command(
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", ExtrapolationWarning)  # said above, once per quantity
         friction = smooth_predict(fitted, X, Smoothing(smooth, zone_si))
+        extra = None
+        if interval is not None:  # its half-width around the friction written
+            half = fitted.predict_interval(X, interval, warn=False).half_width
+            extra = {"low": friction - half, "high": friction + half}
     units["friction"] = friction_unit
-    text = points_table(X, friction, units)
+    text = points_table(X, friction, units, extra)
     if out is None:
         sys.stdout.write(text)
         sys.stdout.flush()

@@ -319,23 +319,32 @@ class CompensationResult:
         }
 
 
-def _extrapolation_notes(fitted: FittedModel, v_r: np.ndarray, ff: np.ndarray, smoothing) -> list:
+def _extrapolation_notes(fitted: FittedModel, X: np.ndarray, ff: np.ndarray, smoothing) -> list:
     """A note when the reference runs below the identified speeds, where the feed-forward is
-    extrapolated (a fitted Stribeck peak can grow far beyond the data there)."""
-    pair = (fitted.operating_range or {}).get("velocity")
-    if not pair or (pair[0] < 0 < pair[1]):
-        return []
-    v_min = min(abs(float(pair[0])), abs(float(pair[1])))
+    extrapolated (a fitted Stribeck peak can grow far beyond the data there), and one per
+    gap between measured speeds it crosses; both from
+    :meth:`~fricid.fitted.FittedModel.range_check` (per direction where the file records
+    the measured speeds)."""
+    found = fitted.range_check(X)
+    notes = [
+        f"the reference crosses a gap of the measured speeds: {b.message}"
+        for b in found
+        if b.kind == "gap"
+    ]
+    lows = [b.low for b in found if b.kind == "below"]
+    v_min = max(lows, default=0.0)
     zone = 0.0 if smoothing is None else smoothing.zone
+    v_r = X[:, 0]
     below = np.abs(v_r) < v_min
     if v_min <= 0 or zone >= v_min or not below.any():
-        return []
+        return notes
     edge = np.abs(ff[~below]).max() if (~below).any() else 0.0
     return [
         f"the reference is below the identified speeds (|v| < {v_min:.4g} rad/s) "
         f"{100 * below.mean():.2g} % of the time, where the feed-forward is extrapolated "
         f"(up to {np.abs(ff[below]).max():.4g} N m, against at most {edge:.4g} N m elsewhere); "
-        f"--smooth linear --zone {v_min:.4g} holds it to the line between the identified edges"
+        f"--smooth linear --zone {v_min:.4g} holds it to the line between the identified edges",
+        *notes,
     ]
 
 
@@ -394,9 +403,9 @@ def compensation_study(
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", ExtrapolationWarning)  # checked once below
         ff = smooth_predict(fitted, X, smoothing)
-    notes += _extrapolation_notes(fitted, v_r, ff, smoothing)
+    notes += _extrapolation_notes(fitted, X, ff, smoothing)
     for bad in fitted.range_check(X):
-        if bad.kind == "below":  # reversals always pass through; noted above
+        if bad.kind in ("below", "gap"):  # reversals always pass through; noted above
             continue
         note = f"the reference goes outside the identified operating range: {bad.message}"
         notes.append(note)

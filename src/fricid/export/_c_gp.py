@@ -1,9 +1,10 @@
 """The Gaussian-process model in C: its posterior mean as a kernel sum over the stored points.
 
 Mirrors :mod:`fricid.models.gp` step by step: the prior mean (linear in |v|, |load|, T and
-|v| T), the inputs (|v|, |load|, T) warped (``asinh(|v| / velocity_scale)``), standardised
-and divided by the length scales, squared distances as ``max(||z||^2 + ||p||^2 - 2 z.p, 0)``, and
-``mean + y_scale * sum_j s2 exp(-0.5 d2_j) alpha_j``. The points divided by the length scales
+|v| T, |load| and T held to their measured range), the inputs (|v|, |load|, T) warped
+(``asinh(|v| / velocity_scale)``), standardised and divided by the length scales, squared
+distances as ``max(||z||^2 + ||p||^2 - 2 z.p, 0)``, and ``mean + y_scale * sum_j s2
+exp(-0.5 d2_j) alpha_j``. The points divided by the length scales
 and their squared norms are computed here once, in Python, with the operations the Python
 model uses, and written as constants. The standard deviation is not exported (a controller
 needs the friction); every number goes through :func:`fricid.export._common.fmt_float`, and
@@ -67,9 +68,15 @@ def _side(st: Mapping[str, Any], side: str) -> tuple[list[str], str]:
         )
     raw = ["fabs(load)" if name == "load" else _ARGS[name] for name in inputs]
     warped = [f"asinh(av / {pre}vscale)", *raw[1:]]
-    mean = " + ".join(f"{a} * {pre}mean[{i + 1}]" for i, a in enumerate(raw))
+    held = list(raw)  # the mean's basis: |load| and T held to their measured range
+    if "mean_bounds" in st:
+        pairs = [[fmt_float(float(x), "mean_bounds") for x in p] for p in st["mean_bounds"]]
+        held[1:] = [
+            f"fmin(fmax({a}, {lo}), {hi})" for a, (lo, hi) in zip(raw[1:], pairs[1:], strict=True)
+        ]
+    mean = " + ".join(f"{a} * {pre}mean[{i + 1}]" for i, a in enumerate(held))
     if len(coef) == d + 2:
-        mean += f") + {pre}mean[{d + 1}] * (av * temperature"
+        mean += f") + {pre}mean[{d + 1}] * (av * {held[inputs.index('temperature')]}"
     unused = [x for name, x in _ARGS.items() if name not in inputs]
     dot = " + ".join(f"z[{i}] * {pre}points[j][{i}]" for i in range(d))
     body = (

@@ -22,7 +22,7 @@ import numpy as np
 from ..fitted import FittedModel
 from ._common import ExportError, fmt_float, operating_pair
 
-__all__ = ["clamp_code", "clamp_inputs", "clamp_limits"]
+__all__ = ["clamp_code", "clamp_inputs", "clamp_limits", "unclamped_speeds"]
 
 
 def clamp_limits(fitted: FittedModel) -> dict[str, tuple[str, float, float]]:
@@ -76,6 +76,27 @@ def clamp_inputs(fitted: FittedModel, X) -> np.ndarray:
     return X
 
 
+def unclamped_speeds(fitted: FittedModel) -> str:
+    """One line on the speeds clamping cannot hold, from the measured speeds per direction
+    the model file records (``provenance["speeds"]``,
+    :func:`fricid.models._range.speed_coverage`): below the slowest measured speed (every
+    reversal passes through it) and inside gaps between measured speeds; "" when there are
+    none or the file records no speeds."""
+    from ..models._range import coverage_text
+
+    coverage = (fitted.provenance or {}).get("speeds")
+    if not isinstance(coverage, dict) or "velocity" not in clamp_limits(fitted):
+        return ""
+    lines = coverage_text(coverage)
+    if not lines:
+        return ""
+    return (
+        "--clamp holds the speed to the measured maximum but cannot hold speeds below the "
+        "slowest measured one or inside gaps, where the model is extrapolated or interpolated: "
+        + "; ".join(lines)
+    )
+
+
 def clamp_code(fitted: FittedModel) -> tuple[list[str], str]:
     """(header comment lines, C statements) of the input clamping, for :mod:`fricid.export.c`."""
     units = {"velocity": "rad/s", "load": "N m", "temperature": "degC"}
@@ -89,4 +110,7 @@ def clamp_code(fitted: FittedModel) -> tuple[list[str], str]:
             lo_text = fmt_float(lo, f"operating_range.{name}")
             notes.append(f"  {name} held in {lo_text} to {h} {units[name]}")
             code += f"    {name} = fmin(fmax({name}, {lo_text}), {h});\n"
+    unheld = unclamped_speeds(fitted)
+    if unheld:
+        notes.append(f"  not held: {unheld.split(': ', 1)[1]}")
     return ["Inputs are clamped to the operating range before evaluation:", *notes], code

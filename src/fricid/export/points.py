@@ -175,9 +175,15 @@ def points_matrix(
     return X
 
 
-def points_table(X: np.ndarray, friction: np.ndarray, units: Mapping[str, str]) -> str:
+def points_table(
+    X: np.ndarray,
+    friction: np.ndarray,
+    units: Mapping[str, str],
+    extra: Mapping[str, np.ndarray] | None = None,
+) -> str:
     """CSV text of points and friction, each column in ``units`` (SI where not given) and
-    labelled with it; 17 significant digits."""
+    labelled with it; 17 significant digits. ``extra`` columns (e.g. a prediction interval's
+    ends) are torques [N m], written after the friction in its unit."""
     out_units = {
         "velocity": units.get("velocity") or SI_UNITS["velocity"],
         "load": units.get("load") or SI_UNITS["torque"],
@@ -186,6 +192,10 @@ def points_table(X: np.ndarray, friction: np.ndarray, units: Mapping[str, str]) 
     }
     quantity = {**INPUT_QUANTITY, "friction": "torque"}
     data = {"velocity": X[:, 0], "load": X[:, 1], "temperature": X[:, 2], "friction": friction}
+    for name, col in (extra or {}).items():
+        data[name] = col
+        out_units[name] = out_units["friction"]
+        quantity[name] = "torque"
     cols = [np.asarray(from_si(data[k], out_units[k], quantity[k]), dtype=float) for k in data]
     buf = io.StringIO()
     buf.write(",".join(f"{k} [{out_units[k]}]" for k in data) + "\n")

@@ -41,6 +41,7 @@ from ..models import INPUTS, get_model, get_predictor
 from ..models._range import RANGE_TOLERANCE, RangeViolation, range_violations
 from ..models.rbf import legacy_symmetry
 from ._file import SCHEMA_VERSION, _clean, _downsample, _num, _probe_inputs, _validate_schema
+from ._interval import PredictionInterval, prediction_interval
 from ._migrate import upgrade
 from ._parameter import OptimizerRecord, Parameter, is_not_determined, parameters_from_values
 from ._report import MIN_CORREL, fit_report
@@ -52,6 +53,7 @@ __all__ = [
     "FittedModel",
     "OptimizerRecord",
     "Parameter",
+    "PredictionInterval",
     "RangeViolation",
     "is_not_determined",
 ]
@@ -117,6 +119,10 @@ class FittedModel:
         held-out RMSE, scatter, ratio, verdict, folds; None when not validated.
     selection : ``fit(samples, "auto")``'s comparison of candidate models
         (:mod:`fricid.identify.static.select`): the table, the choice and why; None otherwise.
+    prediction_interval : what an analytic model's prediction intervals need (the delta
+        method: ``free``, their ``covariance``, ``noise_std`` [N m], ``dof``;
+        :mod:`fricid.fitted._interval`); None for the learned models (their intervals are in
+        ``state``) and files from before it was stored.
     trust : the trust verdict and where each of its numbers came from
         (:class:`fricid.identify.trust.Trust`, ``to_dict()``), with what it was computed on
         (samples and model hashes, options); None when not assessed. ``fricid fit`` and the
@@ -139,6 +145,7 @@ class FittedModel:
     validation: dict[str, Any] | None = None
     selection: dict[str, Any] | None = None
     trust: dict[str, Any] | None = None
+    prediction_interval: dict[str, Any] | None = None
 
     @classmethod
     def from_values(
@@ -208,9 +215,9 @@ class FittedModel:
             Warn (:class:`~fricid.errors.ExtrapolationWarning`, one per quantity) when inputs
             lie outside the operating range (:meth:`range_check`): above the identified
             speeds, on a side a one-direction model was not identified on, or outside the
-            load or temperature range. Speeds below the smallest identified one are
-            reported by :meth:`range_check` but not warned about here (every reversal passes
-            through them).
+            load or temperature range. Speeds below the smallest identified one, and in a
+            gap between measured speeds, are reported by :meth:`range_check` but not warned
+            about here (every reversal passes through them).
         return_std : bool, default False
             Also return the predictive standard deviation [N m] of the friction (models with
             a posterior: ``"gp"``); a ``ConfigError`` for the others.
@@ -224,9 +231,29 @@ class FittedModel:
             self._warn_range(X)
         return out
 
+    def predict_interval(self, X, level: float = 0.95, *, warn: bool = True) -> PredictionInterval:
+        """Friction [N m] at ``X`` (n, 3) with its prediction interval at ``level``: where a
+        new measured sample falls with probability ``level``, measurement noise included.
+
+        Analytic models: the delta method from the parameters' covariance and the residual
+        variance stored at the fit; ``gp``: its posterior with the fitted noise; ``rbf`` and
+        ``hybrid``: the conformal half-widths stored with the network (levels 0.9 and 0.95).
+        See :mod:`fricid.fitted._interval`. Warns as :meth:`predict` does; outside the
+        operating range the interval is not backed by data.
+
+        Raises
+        ------
+        ConfigError
+            A level outside (0, 1), or a model file that stores no interval (at that level).
+        """
+        out = prediction_interval(self, X, level)
+        if warn:
+            self._warn_range(X)
+        return out
+
     def _warn_range(self, X, stacklevel: int = 3) -> None:
         for bad in self.range_check(X):
-            if bad.kind != "below":
+            if bad.kind not in ("below", "gap"):
                 warnings.warn(bad.message, ExtrapolationWarning, stacklevel=stacklevel)
 
     def predict_point(self, velocity, load=0.0, temperature=25.0) -> np.ndarray:
@@ -262,7 +289,10 @@ class FittedModel:
         edges. Velocity: a model of combined samples (direction 0, odd in velocity) is
         compared by speed ``|v|`` (``"above"``, ``"below"``); a one-direction model by speed
         and side (``"side"``); a range spanning both directions by value (``"outside"``).
-        ``v = 0`` is never out of range (``sign(0) = 0``).
+        Where the file records the measured speeds per direction (``provenance["speeds"]``,
+        :func:`fricid.models._range.speed_coverage`), speeds below the slowest measured one
+        of their direction are ``"below"`` for every model, and speeds in a gap between
+        measured speeds are ``"gap"``. ``v = 0`` is never out of range (``sign(0) = 0``).
 
         Parameters
         ----------
@@ -274,8 +304,10 @@ class FittedModel:
         list of RangeViolation
             One per quantity and kind found, empty when every input is inside.
         """
-        dirs = (self.provenance or {}).get("directions") if self.provenance else None
-        return range_violations(X, self.operating_range, self.inputs_used(), dirs)
+        prov = self.provenance or {}
+        return range_violations(
+            X, self.operating_range, self.inputs_used(), prov.get("directions"), prov.get("speeds")
+        )
 
     # -- text ----------------------------------------------------------------------------
     def report(self, min_correl: float = MIN_CORREL) -> str:

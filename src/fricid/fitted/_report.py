@@ -77,7 +77,9 @@ def _variable_note(p: Parameter, ci_method: str) -> str:
         return " (fixed)"
     note = ""
     if np.isfinite(p.stderr):
-        rel = f" ({abs(p.stderr / p.value):.2%})" if p.value != 0 else ""
+        # relative only where it means something: a value near zero (its error as large as
+        # itself) prints its absolute error alone, not "4.3e-24 +/- 8.4e25 %"
+        rel = f" ({abs(p.stderr / p.value):.2%})" if abs(p.stderr) < abs(p.value) else ""
         note += f" +/- {p.stderr:.3g}{rel}"
         if p.has_interval:
             low, high = p.ci95

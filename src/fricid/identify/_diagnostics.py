@@ -10,6 +10,7 @@ from __future__ import annotations
 from typing import Any
 
 from ..fitted import FittedModel, Parameter
+from ..models._range import coverage_text, gaps_note
 from ..samples import FrictionSamples
 
 __all__ = ["DROPS", "not_determined", "open_sides", "quality_rows", "range_text"]
@@ -59,11 +60,16 @@ def range_text(fitted: FittedModel) -> str:
     """The extrapolation-free operating range: ``"velocity 0.0105 to 0.838 rad/s; ..."``.
 
     Velocity of a model of combined samples (direction 0, odd in velocity) is given as speed
-    ``|v|`` for either direction; one identified on one direction names it. Inputs the model
-    does not use are left out; ``""`` when the file records no range.
+    ``|v|`` for either direction; one identified on one direction names it; one identified on
+    both, where the file records the measured speeds per direction (``provenance["speeds"]``),
+    gives each direction's range (:func:`fricid.models._range.coverage_text`: ``"velocity
+    v > 0: measured 0.217 to 20.84 rad/s (nothing between 2 and 5), v < 0: ..."``). The gaps
+    between measured speeds are named in each case. Inputs the model does not use are left
+    out; ``""`` when the file records no range.
     """
     used = set(fitted.inputs_used()) if fitted.operating_range else set()
     dirs = sorted({int(d) for d in (fitted.provenance or {}).get("directions") or ()})
+    coverage = (fitted.provenance or {}).get("speeds")
     parts = []
     for name in ("velocity", "load", "temperature"):
         pair = fitted.operating_range.get(name)
@@ -72,10 +78,14 @@ def range_text(fitted: FittedModel) -> str:
         lo, hi = float(pair[0]), float(pair[1])
         unit = _UNITS[name]
         if name == "velocity" and dirs == [0]:
-            parts.append(f"speed {lo:.4g} to {hi:.4g} {unit} (either direction)")
+            gaps = gaps_note(coverage, "both")
+            parts.append(f"speed {lo:.4g} to {hi:.4g} {unit} (either direction{gaps})")
         elif name == "velocity" and dirs in ([1], [-1]):
             side = "positive" if dirs == [1] else "negative"
-            parts.append(f"velocity {lo:.4g} to {hi:.4g} {unit} ({side} direction only)")
+            gaps = gaps_note(coverage, side[:3])
+            parts.append(f"velocity {lo:.4g} to {hi:.4g} {unit} ({side} direction only{gaps})")
+        elif name == "velocity" and len(coverage_text(coverage)) == 2:  # per direction
+            parts.append("velocity " + ", ".join(coverage_text(coverage)))
         elif lo == hi:
             parts.append(f"{name} {lo:.4g} {unit} only")
         else:

@@ -9,18 +9,22 @@ import numpy as np
 from .. import __version__
 from ..io.atomic import created_timestamp
 from ..models import INPUTS
+from ..models._range import speed_coverage
 from ..samples import FrictionSamples, samples_hash
 
 __all__ = ["operating_range", "provenance"]
 
 
 def provenance(samples: FrictionSamples, **extra: Any) -> dict[str, Any]:
-    """Source, size, hash, directions, version and time of ``samples`` (plus ``extra``)."""
+    """Source, size, hash, directions, the measured speeds per direction with the gaps
+    between them (``speeds``: :func:`fricid.models._range.speed_coverage`), version and time
+    of ``samples`` (plus ``extra``)."""
     return {
         "source": samples.source,
         "n_samples": len(samples),
         "samples_sha256_16": samples_hash(samples),
         "directions": list(samples.directions()),
+        "speeds": speed_coverage(samples.velocity, samples.directions()),
         "fricid_version": __version__,
         "created": created_timestamp(),
         **extra,

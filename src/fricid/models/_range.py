@@ -15,13 +15,151 @@ import numpy as np
 
 from ._base import INPUTS
 
-__all__ = ["RANGE_TOLERANCE", "RangeViolation", "range_violations"]
+__all__ = [
+    "GAP_FACTOR",
+    "GAP_MIN_RATIO",
+    "RANGE_TOLERANCE",
+    "RangeViolation",
+    "coverage_text",
+    "gaps_note",
+    "range_violations",
+    "speed_coverage",
+]
 
 #: Relative tolerance of :meth:`FittedModel.range_check`: inputs within this fraction of the
 #: identified span (or of the value, for a single value) beyond an edge are inside.
 RANGE_TOLERANCE = 0.01
 
 _UNITS = {"velocity": "rad/s", "load": "N m", "temperature": "degC"}
+
+#: A gap in the measured speeds: consecutive measured speeds more than this ratio apart ...
+GAP_MIN_RATIO = 2.0
+#: ... and more than this many times the design's median step (on log speed) apart.
+GAP_FACTOR = 1.5
+
+_SIDES = {"pos": "v > 0", "neg": "v < 0", "both": "|v|"}
+
+
+def speed_coverage(velocity, directions: Sequence[int] = ()) -> dict[str, dict[str, list]]:
+    """The measured speeds of each direction: their range and the gaps inside it.
+
+    Parameters
+    ----------
+    velocity : array_like
+        The samples' velocities [rad/s] (zero ignored).
+    directions : sequence of int
+        The samples' directions; ``[0]`` (combined samples, an odd model) gives one entry
+        ``"both"`` on ``|v|``, anything else ``"pos"`` and ``"neg"`` by the sign of ``v``.
+
+    Returns
+    -------
+    dict
+        Side -> ``{"range": [low, high], "gaps": [[a, b], ...]}`` [rad/s]; a gap is a pair
+        of consecutive measured speeds more than :data:`GAP_MIN_RATIO` apart and more than
+        :data:`GAP_FACTOR` times the design's median step on log speed (a geometric sweep of
+        ratio 1.4 has gaps where two speeds are over 2x apart, one of ratio 1.67 over 2.16x,
+        so that 2 to 5 rad/s in it is a gap; a linear sweep of 0.5 rad/s steps has none).
+    """
+    v = np.asarray(velocity, dtype=float).ravel()
+    v = v[np.isfinite(v) & (v != 0)]
+    if sorted(set(int(d) for d in directions)) == [0]:
+        groups = {"both": np.abs(v)}
+    else:
+        groups = {"pos": v[v > 0], "neg": -v[v < 0]}
+    out = {}
+    for side, speeds in groups.items():
+        if not speeds.size:
+            continue
+        s = np.unique(speeds)
+        steps = np.diff(np.log(s))
+        limit = (
+            max(np.log(GAP_MIN_RATIO), GAP_FACTOR * float(np.median(steps))) if steps.size else 0
+        )
+        gaps = [[float(s[i]), float(s[i + 1])] for i in np.flatnonzero(steps > limit)]
+        out[side] = {"range": [float(s[0]), float(s[-1])], "gaps": gaps}
+    return out
+
+
+def gaps_note(coverage: Any, side: str) -> str:
+    """``"; nothing measured between a and b rad/s"`` for each gap of one side of a
+    :func:`speed_coverage` record; "" when it has none (or no such side)."""
+    rec = coverage.get(side) if isinstance(coverage, dict) else None
+    gaps = rec.get("gaps") if isinstance(rec, dict) else None
+    pairs = [_pair({"g": g}, "g") for g in gaps or []]
+    return "".join(
+        f"; nothing measured between {p[0]:.4g} and {p[1]:.4g} rad/s" for p in pairs if p
+    )
+
+
+def coverage_text(coverage: Any) -> list[str]:
+    """One line per side of a :func:`speed_coverage` record: its range and gaps."""
+    if not isinstance(coverage, dict):
+        return []
+    lines = []
+    for side, label in _SIDES.items():
+        rec = coverage.get(side)
+        pair = _pair(rec, "range") if isinstance(rec, dict) else None
+        if pair is None:
+            continue
+        gaps = [g for g in (rec.get("gaps") or []) if _pair({"g": g}, "g") is not None]
+        tail = "; ".join(f"nothing between {a:.4g} and {b:.4g}" for a, b in gaps)
+        lines.append(
+            f"{label}: measured {pair[0]:.4g} to {pair[1]:.4g} rad/s"
+            + (f" ({tail})" if tail else " (no gaps)")
+        )
+    return lines
+
+
+def _coverage_violations(v: np.ndarray, coverage: dict) -> list[RangeViolation]:
+    """Speeds below the slowest measured one of their direction, or in a gap between
+    measured speeds (:func:`speed_coverage`)."""
+    out = []
+    for side, rec in coverage.items():
+        pair = _pair(rec, "range") if isinstance(rec, dict) else None
+        if side not in _SIDES or pair is None:
+            continue
+        mask = {"pos": v > 0, "neg": v < 0, "both": v != 0}[side]
+        speed = np.abs(v)
+        lo, hi = pair
+        where = f"measured {lo:.4g} to {hi:.4g} rad/s for {_SIDES[side]}"
+        below = mask & (speed < lo * (1 - RANGE_TOLERANCE))
+        if below.any():
+            w = float(v[below][np.argmin(speed[below])])
+            out.append(
+                RangeViolation(
+                    "velocity",
+                    "below",
+                    int(below.sum()),
+                    w,
+                    lo,
+                    hi,
+                    f"velocity {w:.4g} rad/s is below the smallest identified speed {lo:.4g} "
+                    f"rad/s ({where}): the low-speed (Stribeck) region is extrapolated",
+                )
+            )
+        for gap in rec.get("gaps") or []:
+            gp = _pair({"g": gap}, "g")
+            if gp is None:
+                continue
+            a, b = gp
+            inside = (
+                mask & (speed > a * (1 + RANGE_TOLERANCE)) & (speed < b * (1 - RANGE_TOLERANCE))
+            )
+            if inside.any():
+                w = float(v[inside][0])
+                out.append(
+                    RangeViolation(
+                        "velocity",
+                        "gap",
+                        int(inside.sum()),
+                        w,
+                        a,
+                        b,
+                        f"velocity {w:.4g} rad/s lies in a gap of the measured speeds (nothing "
+                        f"between {a:.4g} and {b:.4g} rad/s; {where}): interpolated",
+                    )
+                )
+    return out
 
 
 @dataclass(frozen=True)
@@ -36,6 +174,7 @@ class RangeViolation:
     kind : str
         ``"above"`` (a speed above the largest identified one), ``"below"`` (a speed between
         zero and the smallest identified one: the low-speed, Stribeck region extrapolated),
+        ``"gap"`` (a speed between two measured ones far apart: :func:`speed_coverage`),
         ``"side"`` (a velocity on the side a one-direction model was not identified on) or
         ``"outside"`` (below or above the range of load, temperature, or of a velocity range
         spanning both directions).
@@ -44,7 +183,8 @@ class RangeViolation:
     worst : float
         The input furthest out [SI unit].
     low, high : float
-        The identified range [SI unit] (speeds for ``above``/``below``).
+        The identified range [SI unit] (speeds for ``above``/``below``; the gap's ends for
+        ``gap``).
     message : str
         One line naming the input and how far out it is.
     """
@@ -154,7 +294,11 @@ def _velocity_violations(
 
 
 def range_violations(
-    X, ranges: Any, used: Sequence[str] = INPUTS, directions: Sequence[int] | None = None
+    X,
+    ranges: Any,
+    used: Sequence[str] = INPUTS,
+    directions: Sequence[int] | None = None,
+    coverage: Any = None,
 ) -> list[RangeViolation]:
     """The inputs of ``X`` outside ``ranges``; see :meth:`fricid.fitted.FittedModel.range_check`.
 
@@ -170,6 +314,11 @@ def range_violations(
     directions : sequence of int, optional
         ``provenance["directions"]`` of the model: ``[0]`` (or unknown) with a velocity range
         above zero compares speeds, ``[1]`` or ``[-1]`` the side too.
+    coverage : dict, optional
+        The measured speeds per direction (:func:`speed_coverage`, ``provenance["speeds"]``
+        of a model file): speeds below the slowest measured one of their direction
+        (``"below"``, also for a range spanning both directions) and speeds in a gap between
+        measured speeds (``"gap"``) are reported from it.
 
     Returns
     -------
@@ -186,7 +335,12 @@ def range_violations(
             dirs = sorted({int(d) for d in directions or ()})
         except (TypeError, ValueError):
             dirs = []
-        out += _velocity_violations(X[:, 0], *pair, dirs)
+        found = _velocity_violations(X[:, 0], *pair, dirs)
+        if isinstance(coverage, dict) and coverage:
+            found = [b for b in found if b.kind != "below"] + _coverage_violations(
+                X[:, 0], coverage
+            )
+        out += found
     for j, name in ((1, "load"), (2, "temperature")):
         pair = _pair(ranges, name) if name in used else None
         if pair is None:

@@ -18,6 +18,11 @@ constant far from the data):
 
 ``m(x) = c_0 + c_v |v| + c_l |load| + c_T T + c_vT |v| T`` (the inputs the state names; the
 last term, a viscous coefficient linear in temperature as in [B] eq. 4, when both are used),
+with |load| and T held to the range they were measured over (``mean_bounds``, optional in a
+state): a basis bounded in the inputs friction does not grow linearly with, so that
+coefficients that cancel over a narrow temperature range (a drift of a few tenths of a degree
+gives ``c_0`` and ``c_T`` of thousands) cannot run away outside it; |v| is left free, so the
+mean extrapolates as viscous friction does,
 
 ``k(z, p) = s2 * exp(-0.5 * sum_i ((z_i - p_i) / l_i)^2)`` (an anisotropic, ARD, squared
 exponential kernel; Rasmussen & Williams 2006, eq. 5.1),
@@ -44,7 +49,8 @@ A state (``FittedModel.state`` of a model ``"gp"``) holds ``kind`` (``"gaussian_
 ``state["neg"]``: ``inputs`` (velocity first), ``velocity_scale``, ``input_shift``,
 ``input_scale``, ``mean_coef`` (``c_0``, one per input, then ``c_vT``), ``length_scales``,
 ``signal_var`` (``s2``), ``noise_var``, ``y_scale``, ``points (m, d)``, ``alpha (m,)``,
-``var_matrix (m, m)`` and, optionally, ``mean_gain (q, m)`` and ``mean_cov (q, q)``, plus training
+``var_matrix (m, m)`` and, optionally, ``mean_gain (q, m)``, ``mean_cov (q, q)`` and
+``mean_bounds (d, 2)`` (each input's measured [low, high], |load| for the load), plus training
 notes that prediction ignores.
 
 References
@@ -155,6 +161,10 @@ class _Side:
         has_gain = "mean_gain" in st or "mean_cov" in st
         self.gain = _array(st, "mean_gain", (q, m), where) if has_gain else None
         self.cov = _array(st, "mean_cov", (q, q), where) if has_gain else None
+        has_bounds = "mean_bounds" in st  # optional: files before it extrapolate the mean
+        self.bounds = _array(st, "mean_bounds", (d, 2), where) if has_bounds else None
+        if self.bounds is not None and np.any(self.bounds[:, 0] > self.bounds[:, 1]):
+            raise DataError("GP state 'mean_bounds' needs low <= high", column=where)
         positive = (self.vscale, self.s2, self.y_scale, *self.scale, *self.lengths)
         if m == 0 or min(positive) <= 0 or self.noise < 0:
             raise DataError(
@@ -164,9 +174,22 @@ class _Side:
             )
 
     def raw(self, Xa: np.ndarray) -> np.ndarray:
-        """The inputs the process uses, |v| first and |load|, from ``Xa (n, 3)`` with |v| in
-        column 0."""
-        return np.abs(Xa[:, self.columns]) if 1 in self.columns else Xa[:, self.columns]
+        """The inputs the process uses, |v| first, |load| and the temperature as given, from
+        ``Xa (n, 3)`` with |v| in column 0."""
+        R = Xa[:, self.columns].copy()
+        if 1 in self.columns:
+            j = self.columns.index(1)
+            R[:, j] = np.abs(R[:, j])
+        return R
+
+    def bounded(self, R: np.ndarray) -> np.ndarray:
+        """``R`` with |load| and temperature held to the training range (``mean_bounds``),
+        as the mean's basis sees them; |v| as it is."""
+        if self.bounds is None:
+            return R
+        out = R.copy()
+        out[:, 1:] = np.clip(R[:, 1:], self.bounds[1:, 0], self.bounds[1:, 1])
+        return out
 
     def kernel(self, R: np.ndarray) -> np.ndarray:
         """``k(z(x), p_j)`` ``(n, m)`` at raw inputs ``R``; ``||a - b||^2`` computed as
@@ -181,14 +204,18 @@ class _Side:
         return self.s2 * np.exp(-0.5 * d2)
 
     def mean(self, R: np.ndarray) -> np.ndarray:
-        """The prior mean ``m(x)``: linear in |v|, |load| and T (module notes)."""
+        """The prior mean ``m(x)``: linear in |v|, |load| and T, the last two held to their
+        training range (module notes)."""
+        R = self.bounded(R)
         out = self.mean_coef[0] + R @ self.mean_coef[1 : len(self.columns) + 1]
         if self.vt:
             out = out + self.mean_coef[-1] * (R[:, 0] * R[:, self.columns.index(2)])
         return out
 
     def basis(self, R: np.ndarray) -> np.ndarray:
-        """The mean's basis ``h(x)`` ``(n, q)``: 1, the inputs, and |v| T when used."""
+        """The mean's basis ``h(x)`` ``(n, q)``: 1, the inputs (|load| and T held to their
+        training range), and |v| T when used."""
+        R = self.bounded(R)
         extra = [R[:, 0] * R[:, self.columns.index(2)]] if self.vt else []
         return np.column_stack([np.ones(len(R)), R, *extra])
 

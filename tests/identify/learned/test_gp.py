@@ -203,7 +203,7 @@ def test_a_damaged_gp_file_is_a_data_error(small_gp, tmp_path, key):
 def test_inducing_posterior_survives_a_numerically_singular_kernel_matrix():
     # close inducing points under long length scales: K_mm is singular to rounding, which made
     # the held-out grid law of issue 15 (1848 samples) fail with "not positive definite"
-    from fricid.identify.learned.gp import _cholesky, _posterior
+    from fricid.identify.learned._gp_posterior import _cholesky, _posterior
 
     with pytest.raises(np.linalg.LinAlgError):
         np.linalg.cholesky(np.ones((3, 3)))
@@ -216,3 +216,34 @@ def test_inducing_posterior_survives_a_numerically_singular_kernel_matrix():
     A = np.column_stack([np.ones(80), Z[:, 0]])
     alpha, B, gain, cov, dbeta = _posterior(P, Z, t, A, np.array([1e3, 1e3]), 1.0, 1e-6, False)
     assert all(np.all(np.isfinite(x)) for x in (alpha, B, gain, cov, dbeta))
+
+
+def _cold_samples(seed: int, temperature: np.ndarray | None = None) -> FrictionSamples:
+    """Speeds 0.2-6 rad/s both ways, a load of 0.5-0.7 N m, and ``temperature``."""
+    rng = np.random.default_rng(seed)
+    v = np.repeat(np.geomspace(0.2, 6.0, 12), 2) * np.tile([1.0, -1.0], 12)
+    load = rng.uniform(0.5, 0.7, v.size)
+    T = rng.uniform(-20.0, -5.0, v.size) if temperature is None else temperature
+    y = np.sign(v) * (1.0 + 0.1 * load + 0.3 * np.exp(-((np.abs(v) / 0.3) ** 2)) + 0.1 * np.abs(v))
+    y = y - 0.01 * np.sign(v) * T + 0.02 * rng.standard_normal(v.size)
+    return FrictionSamples(velocity=v, load=load, temperature=T, friction=y)
+
+
+def test_gp_below_zero_degrees_uses_the_temperature_as_measured():
+    # training takes |load| only; prediction took |T| as well when load was an input
+    s = _cold_samples(3)
+    m = fit(s, "gp", settings={"n_restarts": 0})
+    err = m.predict(s.X, warn=False) - s.friction
+    assert np.sqrt(np.mean(err**2)) < 0.05, err  # in-sample: about the noise (0.02)
+
+
+def test_gp_mean_stays_bounded_outside_a_narrow_temperature_range():
+    # a drift of +-0.3 degC around 30.9: the mean's temperature coefficients run to the
+    # thousands and cancel inside the data; outside it the bounded basis holds them
+    worst = 0.0
+    for seed in range(3):
+        s = _cold_samples(seed, 30.9 + np.random.default_rng(seed).uniform(-0.3, 0.3, 24))
+        m = fit(s, "gp", settings={"n_restarts": 0})
+        X = np.array([[1.0, 0.6, 33.0], [1.0, 0.6, 28.0], [-1.0, 0.6, -5.0], [8.0, 0.6, 31.0]])
+        worst = max(worst, float(np.max(np.abs(m.predict(X, warn=False)))))
+    assert worst < 1.5 * np.max(np.abs(s.friction)), worst

@@ -75,7 +75,7 @@ def test_hat_trace_is_the_trace_of_the_fitted_map(options):
 
 @pytest.mark.parametrize("exact", [True, False])
 def test_gp_smoother_trace_is_the_trace_of_the_posterior_mean_map(exact):
-    from fricid.identify.learned import gp as G
+    from fricid.identify.learned import _gp_posterior as G
 
     rng = np.random.default_rng(0)
     Z = rng.normal(size=(50, 2))

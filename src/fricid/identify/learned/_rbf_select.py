@@ -18,6 +18,7 @@ import scipy.linalg
 
 from ...errors import DataError, DataQualityWarning, IdentifiabilityWarning
 from ...models.rbf import tail_columns
+from ._conformal import INTERVAL_LEVELS, conformal_half_widths
 from ._rbf_estimator import LSQ_IGNORES, RBFNetRegressor
 from ._rbf_folds import FOLDS, choose_penalty, cv_folds
 
@@ -117,9 +118,6 @@ WIDTH_FACTORS = (1.0, 1.5, 2.2, 3.2)
 #: Ridge penalties (``alpha``, on the target scaled to [-1, 1]) it tries when none is given.
 ALPHAS = (1e-11, 1e-8, 1e-5)
 
-#: Levels of the prediction intervals saved with a network.
-INTERVAL_LEVELS = (0.9, 0.95)
-
 
 #: Fewest distinct levels of the first input (the speed) for the quadratic tail.
 QUADRATIC_MIN_LEVELS = 6
@@ -160,20 +158,6 @@ def _first_seed(seed: int) -> int:
     (memoised: the structure search asks for it 20-40 times per network, and each new
     ``RandomState`` costs about 0.1 ms)."""
     return int(np.random.RandomState(seed).randint(np.iinfo(np.int32).max))
-
-
-def conformal_half_widths(residuals: np.ndarray, levels=INTERVAL_LEVELS) -> list[float]:
-    """Half-widths of split-conformal prediction intervals from held-out residuals: the
-    ``ceil((n + 1) level)``-th smallest ``|r|`` (Vovk et al. 2005; with cross-validation
-    residuals, the CV+ reading of Barber et al. 2021, whose coverage is at least
-    ``2 level - 1``); the largest ``|r|`` when ``n`` is too small for the level."""
-    r = np.sort(np.abs(np.asarray(residuals, dtype=float)))
-    n = r.size
-    out = []
-    for level in levels:
-        k = int(np.ceil((n + 1) * float(level)))
-        out.append(float(r[min(k, n) - 1]))
-    return out
 
 
 class _CrossValidation:

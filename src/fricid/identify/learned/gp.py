@@ -10,13 +10,18 @@ where the samples have both, ``g(|v|, load, T)`` with ``F = sign(v) g``:
    ``state["dropped_inputs"]``); all standardised (mean 0, standard deviation 1);
 2. the prior mean: ``c_0 + c_v |v| + c_l |load| + c_T T + c_vT |v| T`` by least squares
    (Coulomb-viscous with linear load and temperature terms, what the model returns to far
-   from the data);
+   from the data), |load| and T held to their measured range (``mean_bounds``), so that the
+   mean stays bounded outside it (:mod:`fricid.models.gp`);
 3. the kernel: scikit-learn's ``ConstantKernel * RBF(length_scale per input) + WhiteKernel``
    (ARD squared exponential plus white noise), its hyperparameters by maximum marginal
    likelihood (``GaussianProcessRegressor``, L-BFGS-B with ``n_restarts`` random restarts
    seeded by ``seed``) on the residuals of the mean, scaled to unit standard deviation;
 4. the posterior, with the mean's coefficients estimated with it (R&W section 2.7: their
-   uncertainty widens the band where the model extrapolates): exact (R&W eq. 2.25-2.26) on all
+   uncertainty widens the band where the model extrapolates; the correction to the
+   least-squares coefficients has the prior N(0, I) on the standardised basis, eq. 2.42 with
+   ``b = 0``, ``B = I``: a regularised mean, so that inputs that hardly vary, such as a
+   temperature drifting by a few tenths of a degree, neither make ``H K^-1 H^T`` singular
+   nor give coefficients of thousands that cancel inside the data): exact (R&W eq. 2.25-2.26) on all
    samples up to ``max_points``; above that, the hyperparameters are fitted on an inducing subset
    of ``max_points`` samples chosen by farthest-point sampling in the standardised input space
    (deterministic, starting from the sample farthest from the mean: it covers the measured
@@ -49,7 +54,6 @@ from typing import Any
 
 import numpy as np
 import scipy.optimize
-from scipy.linalg import cho_factor, cho_solve
 from sklearn.exceptions import ConvergenceWarning as SklearnConvergenceWarning
 from sklearn.gaussian_process import GaussianProcessRegressor
 from sklearn.gaussian_process.kernels import RBF, ConstantKernel, WhiteKernel
@@ -63,35 +67,13 @@ from ...models.gp import GP_KIND, predict_gp
 from ...samples import FrictionSamples
 from .._records import operating_range, provenance
 from .._scatter import measurement_scatter
+from ._gp_posterior import _posterior, _smoother_trace, heldout_scale
 from ._trust import learned_statistics, process_convergence
 
 __all__ = ["DEFAULT_MAX_POINTS", "farthest_points", "fit_gp"]
 
 #: Stored points above which the inducing subset is used (module notes, step 4).
 DEFAULT_MAX_POINTS = 400
-
-#: Relative jitter on the diagonal of the inducing points' kernel matrix.
-_JITTER = 1e-8
-
-#: Most tenfold increases of the jitter :func:`_cholesky` tries.
-_JITTER_STEPS = 6
-
-
-def _cholesky(M: np.ndarray, scale: float) -> tuple[tuple[np.ndarray, bool], float]:
-    """``cho_factor`` of the symmetric ``M`` with ``jitter * I`` added, and that jitter:
-    ``_JITTER * scale``, raised tenfold (up to :data:`_JITTER_STEPS` times) while the
-    factorisation fails. Long length scales make the kernel matrix of close inducing points
-    numerically singular (its smallest eigenvalues fall below rounding); the jitter restores
-    it, as the nugget of R&W section 3.4.3 does."""
-    eye = np.eye(len(M))
-    for k in range(_JITTER_STEPS + 1):
-        jitter = _JITTER * scale * 10.0**k
-        try:
-            return cho_factor(M + jitter * eye, lower=True), jitter
-        except np.linalg.LinAlgError:
-            if k == _JITTER_STEPS:
-                raise
-    raise AssertionError("unreachable")  # pragma: no cover
 
 
 def farthest_points(Z: np.ndarray, m: int) -> np.ndarray:
@@ -123,96 +105,9 @@ def _symmetry(samples: FrictionSamples) -> str:
     return "per_direction" if dirs == {-1, 1} else ("pos" if dirs == {1} else "neg")
 
 
-def _kernel_matrix(A: np.ndarray, B: np.ndarray, lengths: np.ndarray, s2: float) -> np.ndarray:
-    d2 = np.sum(((A[:, None, :] - B[None, :, :]) / lengths) ** 2, axis=2)
-    return s2 * np.exp(-0.5 * d2)
-
-
 def _interaction(A: np.ndarray, used: list[str]) -> list[np.ndarray]:
     """``|v| T`` when both are used: the viscous coefficient linear in temperature."""
     return [A[:, 0] * A[:, used.index("temperature")]] if "temperature" in used else []
-
-
-def _posterior(
-    P: np.ndarray,
-    Z: np.ndarray,
-    t: np.ndarray,
-    A: np.ndarray,
-    lengths: np.ndarray,
-    s2: float,
-    noise: float,
-    exact: bool,
-) -> tuple[np.ndarray, ...]:
-    """The posterior on stored points ``P`` of targets ``t`` at ``Z`` with the mean's basis
-    ``A (n, q)`` estimated with it (R&W section 2.7, eq. 2.41-2.42, vague prior on the
-    coefficients): ``(alpha, B, G, C, dbeta)``.
-
-    ``dbeta`` corrects the least-squares mean, ``alpha`` weighs the points, and the variance
-    is ``s2 - k^T B k + (h - G k)^T C (h - G k)`` for a kernel vector ``k`` and basis ``h``.
-    Exact: ``K = K_nn + noise I`` (R&W eq. 2.25-2.26); else DTC on the points, with
-    ``K~^-1 = (Q_nn + noise I)^-1`` by the Woodbury identity (Quinonero-Candela & Rasmussen
-    2005, eq. 20-21).
-    """
-    m = len(P)
-    Kmm = _kernel_matrix(P, P, lengths, s2)
-    if exact:
-        factor = cho_factor(Kmm + (noise + 1e-10) * np.eye(m), lower=True)
-        M = cho_solve(factor, A)  # K^-1 H^T
-        gain = M.T  # H K^-1
-        B = cho_solve(factor, np.eye(m))
-        weights = lambda r: cho_solve(factor, r)  # noqa: E731
-    else:
-        Kmn = _kernel_matrix(P, Z, lengths, s2)
-        Kj_factor, jitter = _cholesky(Kmm, s2)
-        Kj = Kmm + jitter * np.eye(m)
-        S = noise * Kj + Kmn @ Kmn.T
-        Sigma, _ = _cholesky(S, float(np.trace(S)) / m)
-        M = (A - Kmn.T @ cho_solve(Sigma, Kmn @ A)) / noise
-        gain = cho_solve(Sigma, Kmn @ A).T  # H K_nm (noise K_mm + K_mn K_nm)^-1
-        B = cho_solve(Kj_factor, np.eye(m)) - noise * cho_solve(Sigma, np.eye(m))
-        weights = lambda r: cho_solve(Sigma, Kmn @ r)  # noqa: E731
-    cov = np.linalg.inv(A.T @ M)
-    cov = 0.5 * (cov + cov.T)
-    dbeta = cov @ (M.T @ t)
-    alpha = weights(t - A @ dbeta)
-    return alpha, 0.5 * (B + B.T), gain, cov, dbeta
-
-
-def _smoother_trace(
-    P: np.ndarray,
-    Z: np.ndarray,
-    A: np.ndarray,
-    lengths: np.ndarray,
-    s2: float,
-    noise: float,
-    exact: bool,
-) -> float:
-    """The effective degrees of freedom of the posterior mean at the training points: the
-    trace of the linear map ``S`` from targets to fitted values, at these hyperparameters,
-    the mean's basis ``A (n, q)`` estimated with it (R&W section 2.6; ESL eq. 3.50 for its
-    ridge form).
-
-    With ``dbeta = C M^T t`` and ``alpha = W (t - A dbeta)`` (:func:`_posterior`) the fit at
-    the points is ``A dbeta + K_zp alpha``, so ``tr S = tr(C M^T A) + tr(W K_zp) -
-    tr(C M^T K_zp W A)``, formed from ``m x m`` and ``n x q`` products only.
-    """
-    m = len(P)
-    Kmm = _kernel_matrix(P, P, lengths, s2)
-    if exact:
-        factor = cho_factor(Kmm + (noise + 1e-10) * np.eye(m), lower=True)
-        M = cho_solve(factor, A)
-        w_kzp = cho_solve(factor, Kmm)
-        kzp_w_a = Kmm @ M
-    else:
-        Kmn = _kernel_matrix(P, Z, lengths, s2)
-        _, jitter = _cholesky(Kmm, s2)
-        S = noise * (Kmm + jitter * np.eye(m)) + Kmn @ Kmn.T
-        Sigma, _ = _cholesky(S, float(np.trace(S)) / m)
-        M = (A - Kmn.T @ cho_solve(Sigma, Kmn @ A)) / noise
-        w_kzp = cho_solve(Sigma, Kmn @ Kmn.T)
-        kzp_w_a = Kmn.T @ cho_solve(Sigma, Kmn @ A)
-    cov = np.linalg.inv(A.T @ M)
-    return float(np.trace(cov @ (M.T @ A)) + np.trace(w_kzp) - np.trace(cov @ (M.T @ kzp_w_a)))
 
 
 def _train_side(
@@ -276,9 +171,18 @@ def _train_side(
     noise = float(k.k2.noise_level)
     P = Z[sub]
     exact = len(sub) == n
-    alpha, Bm, gain, cov, dbeta = _posterior(P, Z, t, A, lengths, s2, noise, exact)
-    coef = coef + y_scale * dbeta
-    edf = _smoother_trace(P, Z, A, lengths, s2, noise, exact)
+    # the mean's correction on the standardised basis h_s = T h (prior N(0, I) there)
+    mu = np.r_[0.0, A[:, 1:].mean(axis=0)]
+    sd = np.r_[1.0, A[:, 1:].std(axis=0)]
+    sd[sd <= 0] = 1.0
+    Tm = np.diag(1.0 / sd)
+    Tm[1:, 0] = -mu[1:] / sd[1:]
+    As = A @ Tm.T
+    alpha, Bm, gain, cov, dbeta = _posterior(P, Z, t, As, lengths, s2, noise, exact)
+    coef = coef + y_scale * (Tm.T @ dbeta)
+    gain, cov = np.linalg.solve(Tm, gain), Tm.T @ cov @ Tm  # on the raw basis h
+    edf = _smoother_trace(P, Z, As, lengths, s2, noise, exact)
+    calibration = heldout_scale(Z, A, As, g, (lengths, s2, noise), y_scale) if exact else None
     inducing = (
         "all training points"
         if exact
@@ -300,6 +204,7 @@ def _train_side(
         "var_matrix": Bm.tolist(),
         "mean_gain": gain.tolist(),
         "mean_cov": cov.tolist(),
+        "mean_bounds": np.column_stack([R.min(axis=0), R.max(axis=0)]).tolist(),
         "inducing": inducing,
         "n_train": n,
         "log_marginal_likelihood": float(gpr.log_marginal_likelihood_value_),
@@ -312,6 +217,8 @@ def _train_side(
             "message": str(best.message),
         },
     }
+    if calibration is not None:
+        state["interval_scale"] = calibration
     if dropped:
         state["dropped_inputs"] = dropped
     notes = sorted({str(w.message).split(". ")[0] for w in caught})

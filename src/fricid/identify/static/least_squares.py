@@ -30,11 +30,13 @@ from ...metrics import fit_statistics, metrics
 from ...models import INPUTS, FrictionModel, get_model
 from ...optim import METHODS, OptimizeResult, minimize
 from ...samples import FrictionSamples
+from .._intervals import delta_record
 from .._records import operating_range, provenance
 from .._scatter import measurement_scatter, sample_weights
 from ..problem import ROBUST_LOSSES, IdentificationProblem
 from .checks import check_identifiable
 from .convergence import certify
+from .informed import uninformed
 from .uncertainty import INTERVALS, Uncertainty, assess
 from .varpro import varpro
 
@@ -244,7 +246,13 @@ def fit(
     return FittedModel(
         model=model.name,
         parameters=_records(
-            problem, theta, unc, start, problem.at_bound(result.x), convergence["converged"]
+            problem,
+            theta,
+            unc,
+            start,
+            problem.at_bound(result.x),
+            convergence["converged"],
+            uninformed(model.name, theta, samples),
         ),
         ci_method=unc.method,
         correlation=corr,
@@ -262,6 +270,7 @@ def fit(
         operating_range=operating_range(samples, X),
         provenance=provenance(samples),
         statistics=fit_statistics(y, y_hat, problem.n_free, w),
+        prediction_interval=delta_record(model.name, theta, problem.free_names, X, y),
         loss={
             "loss": "l2" if problem.loss == "sse" else problem.loss,
             "f_scale": problem.f_scale,
@@ -278,9 +287,12 @@ def _records(
     start: np.ndarray | None,
     at_bound: Sequence[str],
     converged: bool,
+    outside: Mapping[str, str] | None = None,
 ) -> dict[str, Parameter]:
     """One :class:`~fricid.fitted.Parameter` per parameter of ``problem`` at ``theta``: the
-    free ones with their start, search bounds, standard error, interval (``unc``) and flags."""
+    free ones with their start, search bounds, standard error, interval (``unc``) and flags;
+    ``outside`` names those outside the range the data can inform, with why
+    (:func:`~fricid.identify.static.informed.uninformed`: not determined)."""
     units = problem.model.units
     out = {
         n: Parameter(n, float(v), unit=units.get(n, ""), fixed=n in problem.fixed)
@@ -288,6 +300,8 @@ def _records(
     }
     for j, n in enumerate(problem.free_names):
         note = unc.notes.get(n, "")
+        if outside and n in outside and not note.startswith(("not determined", "not identified")):
+            note = outside[n] + (f"; {note}" if note else "")
         out[n] = replace(
             out[n],
             init=None if start is None else float(start[j]),

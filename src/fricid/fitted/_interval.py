@@ -1,0 +1,182 @@
+"""Prediction intervals of a fitted model: where a new measured sample at ``x`` falls, with
+probability ``level``, measurement noise included
+(:meth:`fricid.fitted.FittedModel.predict_interval`).
+
+One rule per kind of model, each from what the model file stores:
+
+- **analytic** (``prediction_interval`` of the file, method ``"delta"``): the delta method,
+  ``F(x) -+ t(dof) sqrt(g^T C g + s^2)``, ``g`` the gradient of ``F(x)`` in the free
+  parameters (central differences, one batch call), ``C`` their covariance
+  ``s^2 (J^T J)^+`` at the optimum and ``s^2`` the residual variance ``SSE / (n - p)``
+  (Seber & Wild, *Nonlinear Regression*, 1989, section 5.1, eq. 5.7);
+- **gp**: the posterior standard deviation of the latent friction with the fitted white noise
+  added, ``F(x) -+ k sqrt(std^2 + noise_std^2)`` (Rasmussen & Williams 2006, eq. 2.24 with
+  the noise of the observation), ``k`` the held-out multiplier stored with each process
+  (``interval_scale``, :func:`fricid.identify.learned._gp_posterior.heldout_scale`), the
+  half-width not below the held-out residuals' conformal one stored with it; for processes
+  without one (inducing points, older files), ``k`` the normal quantile;
+- **rbf**, **hybrid**: the conformal half-widths stored with each network
+  (``state["prediction_interval"]``, :func:`fricid.models.rbf.interval_half_width`), at the
+  levels stored (0.9, 0.95); a hybrid's with its backbone's ``g^T C g`` added in
+  quadrature (the residual's cross-validation holds the backbone).
+
+Outside the operating range none of these says anything a measurement backs.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ..errors import ConfigError
+from ..models import get_model, get_predictor
+from ..models.gp import gp_sides
+from ..models.rbf import interval_half_width
+
+__all__ = ["PredictionInterval", "analytic_half_width", "gradient", "prediction_interval"]
+
+
+def _t_ppf(q: float, dof: int) -> float:
+    from scipy import stats  # on first use: `fricid predict` starts without scipy.stats
+
+    return float(stats.t.ppf(q, dof))
+
+
+def _norm_ppf(q: float) -> float:
+    from scipy import stats
+
+    return float(stats.norm.ppf(q))
+
+
+@dataclass(frozen=True)
+class PredictionInterval:
+    """Friction and its prediction interval at each input row.
+
+    Attributes
+    ----------
+    friction, low, high : ndarray (n,)
+        The prediction [N m] and the interval's ends [N m].
+    level : float
+        The nominal coverage (0.95: 95 % of new samples inside).
+    method : str
+        How the interval was made (``"delta"``, ``"gp"``, ``"conformal"``).
+    """
+
+    friction: np.ndarray
+    low: np.ndarray
+    high: np.ndarray
+    level: float
+    method: str
+
+    @property
+    def half_width(self) -> np.ndarray:
+        """Half the interval's width [N m]."""
+        return 0.5 * (self.high - self.low)
+
+
+def gradient(model_name: str, theta: np.ndarray, free, X: np.ndarray) -> np.ndarray:
+    """``dF(x)/dtheta_j`` ``(p, n)`` of an analytic model at ``theta`` for the parameters
+    named in ``free``, by central differences in one batch call."""
+    model = get_model(model_name)
+    idx = np.array([model.param_names.index(n) for n in free], dtype=int)
+    p = idx.size
+    if not p:
+        return np.zeros((0, len(X)))
+    h = 1e-6 * np.maximum(np.abs(theta[idx]), 1e-3)
+    steps = np.repeat(np.asarray(theta, dtype=float)[None, :], 2 * p, axis=0)
+    steps[np.arange(p), idx] += h
+    steps[p + np.arange(p), idx] -= h
+    F = np.atleast_2d(model.predict(steps, X))
+    return (F[:p] - F[p:]) / (2 * h[:, None])
+
+
+def analytic_half_width(
+    model_name: str, theta: np.ndarray, record: Mapping[str, Any], X: np.ndarray, level: float
+) -> np.ndarray:
+    """Half-width of the delta-method interval of an analytic model (module notes) at ``X``.
+
+    ``record`` is the model file's ``prediction_interval``: ``free`` (the names of the free
+    parameters), ``covariance`` of those, ``noise_std`` and ``dof``.
+    """
+    G = gradient(model_name, theta, record["free"], X)
+    C = np.asarray(record["covariance"], dtype=float)
+    var = np.einsum("pn,pq,qn->n", G, C, G) + float(record["noise_std"]) ** 2
+    q = _t_ppf(0.5 + level / 2, max(int(record["dof"]), 1))
+    return q * np.sqrt(np.maximum(var, 0.0))
+
+
+def _gp_scale(st: Mapping[str, Any], level: float) -> tuple[float, float]:
+    """The multiplier of a process's predictive standard deviation at ``level`` and the
+    least half-width [N m]: its held-out calibration (``interval_scale``) where stored at
+    that level, else the normal quantile and 0."""
+    cal = st.get("interval_scale")
+    if isinstance(cal, Mapping):
+        levels = [float(x) for x in cal.get("levels") or ()]
+        hits = [j for j, lv in enumerate(levels) if abs(lv - level) < 1e-9]
+        scale, least = list(cal.get("scale") or ()), list(cal.get("half_width") or ())
+        if hits and hits[0] < min(len(scale), len(least)):
+            return max(float(scale[hits[0]]), 0.0), max(float(least[hits[0]]), 0.0)
+    return float(_norm_ppf(0.5 + level / 2)), 0.0
+
+
+def _gp_half_width(state: Mapping[str, Any], std: np.ndarray, X: np.ndarray, level: float):
+    v = X[:, 0]
+    half = np.zeros(len(X))
+    for side, st in gp_sides(state).items():
+        mask = {"all": v != 0, "pos": v > 0, "neg": v < 0}[side]
+        noise = float(st.get("noise_std", 0.0))
+        k, least = _gp_scale(st, level)
+        half[mask] = np.maximum(k * np.sqrt(std[mask] ** 2 + noise**2), least)
+    return half
+
+
+def _with_backbone(state: Mapping[str, Any], X: np.ndarray, half: np.ndarray, level: float):
+    """A hybrid's conformal half-width with its backbone's parameter uncertainty added in
+    quadrature (:mod:`fricid.identify.learned.hybrid` notes); as it is without a record."""
+    bb = state.get("backbone") if isinstance(state, Mapping) else None
+    record = bb.get("prediction_interval") if isinstance(bb, Mapping) else None
+    if not isinstance(record, Mapping) or record.get("method") != "delta":
+        return half
+    model = get_model(str(bb["model"]))
+    theta = model.param_vector(dict(bb["params"]))
+    G = gradient(model.name, theta, record["free"], X)
+    var = np.einsum("pn,pq,qn->n", G, np.asarray(record["covariance"], dtype=float), G)
+    q = _t_ppf(0.5 + level / 2, max(int(record["dof"]), 1))
+    return np.sqrt(half**2 + q**2 * np.maximum(var, 0.0))
+
+
+def prediction_interval(fitted, X, level: float = 0.95) -> PredictionInterval:
+    """The interval of ``fitted`` (a :class:`~fricid.fitted.FittedModel`) at ``X (n, 3)``;
+    see :meth:`fricid.fitted.FittedModel.predict_interval`."""
+    level = float(level)
+    if not 0.0 < level < 1.0:
+        raise ConfigError(f"the interval's level must lie in (0, 1); got {level!r}")
+    X = np.asarray(X, dtype=float)
+    if fitted.model == "gp":
+        F, std = fitted.predict(X, warn=False, return_std=True)
+        half, method = _gp_half_width(fitted.state, std, X, level), "gp"
+    elif get_predictor(fitted.model).stateful:
+        F = fitted.predict(X, warn=False)
+        half, method = interval_half_width(fitted.state, X, level), "conformal"
+        if np.isnan(half[X[:, 0] != 0]).any():
+            raise ConfigError(
+                f"model '{fitted.model}' stores no prediction interval at level {level:g} "
+                "(the levels stored are 0.9 and 0.95; files before they were stored have none)"
+            )
+        half = np.nan_to_num(half)
+        if fitted.model == "hybrid":
+            half = _with_backbone(fitted.state, X, half, level)
+    else:
+        record = fitted.prediction_interval
+        if not isinstance(record, Mapping) or record.get("method") != "delta":
+            raise ConfigError(
+                f"model '{fitted.model}' stores no prediction interval (fit it again with "
+                "this fricid to get one)"
+            )
+        F = fitted.predict(X, warn=False)
+        half, method = analytic_half_width(fitted.model, fitted.theta(), record, X, level), "delta"
+    half = np.where(X[:, 0] == 0, 0.0, half)  # sign(0) = 0: no friction predicted at rest
+    return PredictionInterval(F, F - half, F + half, level, method)
