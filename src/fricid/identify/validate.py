@@ -273,7 +273,8 @@ def validate(
         As :func:`fricid.identify.fit` takes them.
     **fit_options
         Passed to :func:`fricid.identify.fit` (``max_evals``, ``loss``, ``weights``, ...).
-        Weights given as ``"std"`` are computed per training fold.
+        Weights given as ``"std"`` are computed per training fold. The folds' fits compute
+        no intervals (``intervals`` is ignored): only their predictions are used.
 
     Returns
     -------
@@ -312,7 +313,7 @@ def validate(
                     seed=seed,
                     fixed=fixed,
                     bounds=bounds,
-                    **fit_options,
+                    **{**fit_options, "intervals": "none"},  # only its predictions are used
                 )
             except FricidError as exc:
                 row["note"] = f"not fitted: {exc}"
