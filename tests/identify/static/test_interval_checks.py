@@ -115,24 +115,23 @@ def test_validation_folds_compute_no_intervals(paper2, monkeypatch):
     assert asked == ["none"] * 3 and np.isfinite(v.rmse)
 
 
-def test_auto_screens_folds_from_the_full_optimum_with_the_same_heldout_error(paper2, monkeypatch):
-    """``auto``'s folds start from each candidate's optimum on all samples with one start,
-    and the held-out errors are those of the folds fitted from the default start."""
-    starts = []
+def test_auto_refits_the_folds_together_with_the_same_heldout_error(paper2, monkeypatch):
+    """``auto``'s folds start from each candidate's optimum on all samples and are refitted
+    together (no fit per fold), and the held-out errors are those of a fit per fold from the
+    default start."""
+    per_fold = []
     real = validate_module.fit
     monkeypatch.setattr(
-        validate_module,
-        "fit",
-        lambda *a, **k: starts.append((k.get("x0"), k.get("options"))) or real(*a, **k),
+        validate_module, "fit", lambda *a, **k: per_fold.append(a[1]) or real(*a, **k)
     )
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", FricidWarning)
         chosen = fit(paper2, "auto", settings={"scheme": "kfold:4"})
-    assert starts and all(x0 and opts == {"n_starts": 1} for x0, opts in starts)
+    assert per_fold == []
     monkeypatch.setattr(validate_module, "fit", real)
-    for row in chosen.selection["table"]:
-        if row["heldout_rmse"] is None:
-            continue
+    scored = [r for r in chosen.selection["table"] if r["heldout_rmse"] is not None]
+    assert len(scored) == 3
+    for row in scored:
         model, _, fixed = row["model"].partition(" (delta=")
         plain = validate_module.validate(
             paper2, model, "kfold:4", fixed={"delta": 1.0} if fixed else None

@@ -173,11 +173,11 @@ def _screening(
     seed: int | np.random.Generator | None,
     options: dict[str, Any],
 ) -> dict[str, Any]:
-    """The folds' fit options of an analytic candidate fitted by the default ``lm`` without
-    optimiser options: each fold starts from the candidate's optimum on all the samples (one
-    fit without intervals), one start (``n_starts=1``), as a fold leaves out a little of the
-    data; a family that misses the data no longer restarts eight times per fold. Otherwise
-    (a learned family, another method, options given) ``options`` as they are."""
+    """The validation options of an analytic candidate fitted by the default ``lm`` without
+    optimiser options: every fold starts from the candidate's optimum on all the samples (one
+    fit without intervals), as a fold leaves out a little of the data, and the folds are
+    refitted together (:func:`fricid.identify.validate.validate`'s ``start``). Otherwise (a
+    learned family, another method, options given) ``options`` as they are."""
     if c.model in LEARNED or str(method).strip().lower() != "lm" or options.get("options"):
         return options
     full = fit_named(
@@ -188,8 +188,7 @@ def _screening(
         fixed=c.fixed or None,
         **{**options, "intervals": "none"},
     )
-    x0 = {n: p.value for n, p in full.parameters.items() if not p.fixed}
-    return {**options, "x0": x0, "options": {"n_starts": 1}}
+    return {**options, "start": {n: p.value for n, p in full.parameters.items() if not p.fixed}}
 
 
 def _reason(
