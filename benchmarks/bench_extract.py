@@ -128,34 +128,42 @@ def simulate(size: str, path: Path) -> None:
 
 
 def prefix(src: Path, dst: Path, rows: int) -> None:
-    """The first ``rows`` rows of a Parquet log, its metadata kept."""
+    """The first ``rows`` rows of a Parquet log, its metadata kept (fricid's writer: the
+    integrity record the reader checks)."""
+    import pyarrow as pa
     import pyarrow.parquet as pq
 
+    from fricid.io._parquet import META_KEY, write_parquet
+
     pf = pq.ParquetFile(src)
-    left = rows
-    with pq.ParquetWriter(dst, pf.schema_arrow) as writer:
+
+    def tables():
+        left = rows
         for batch in pf.iter_batches(batch_size=1 << 18):
             if left <= 0:
                 break
             batch = batch.slice(0, left)
-            writer.write_batch(batch, row_group_size=1 << 18)
             left -= batch.num_rows
+            yield pa.Table.from_batches([batch])
+
+    write_parquet(dst, pf.schema_arrow.metadata[META_KEY], tables())
 
 
 def repeat(src: Path, dst: Path, times: int) -> None:
-    """A Parquet log repeated end to end, each copy shifted to continue in time."""
+    """A Parquet log repeated end to end, each copy shifted to continue in time (fricid's
+    writer: the integrity record the reader checks)."""
     import pyarrow as pa
     import pyarrow.compute as pc
     import pyarrow.parquet as pq
+
+    from fricid.io._parquet import META_KEY, write_parquet
 
     pf = pq.ParquetFile(src)
     table = pf.read()
     t = table.column("time")
     span = pc.max(t).as_py() - pc.min(t).as_py() + 1.0
-    with pq.ParquetWriter(dst, pf.schema_arrow) as writer:
-        for k in range(times):
-            shifted = table.set_column(0, "time", pc.add(t, pa.scalar(k * span)))
-            writer.write_table(shifted, row_group_size=1 << 18)
+    shifted = (table.set_column(0, "time", pc.add(t, pa.scalar(k * span))) for k in range(times))
+    write_parquet(dst, pf.schema_arrow.metadata[META_KEY], shifted)
 
 
 def make(size: str, log: str | None, workdir: Path) -> None:
