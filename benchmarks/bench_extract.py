@@ -128,34 +128,42 @@ def simulate(size: str, path: Path) -> None:
 
 
 def prefix(src: Path, dst: Path, rows: int) -> None:
-    """The first ``rows`` rows of a Parquet log, its metadata kept."""
+    """The first ``rows`` rows of a Parquet log, its metadata kept (fricid's writer: the
+    integrity record the reader checks)."""
+    import pyarrow as pa
     import pyarrow.parquet as pq
 
+    from fricid.io._parquet import META_KEY, write_parquet
+
     pf = pq.ParquetFile(src)
-    left = rows
-    with pq.ParquetWriter(dst, pf.schema_arrow) as writer:
+
+    def tables():
+        left = rows
         for batch in pf.iter_batches(batch_size=1 << 18):
             if left <= 0:
                 break
             batch = batch.slice(0, left)
-            writer.write_batch(batch, row_group_size=1 << 18)
             left -= batch.num_rows
+            yield pa.Table.from_batches([batch])
+
+    write_parquet(dst, pf.schema_arrow.metadata[META_KEY], tables())
 
 
 def repeat(src: Path, dst: Path, times: int) -> None:
-    """A Parquet log repeated end to end, each copy shifted to continue in time."""
+    """A Parquet log repeated end to end, each copy shifted to continue in time (fricid's
+    writer: the integrity record the reader checks)."""
     import pyarrow as pa
     import pyarrow.compute as pc
     import pyarrow.parquet as pq
+
+    from fricid.io._parquet import META_KEY, write_parquet
 
     pf = pq.ParquetFile(src)
     table = pf.read()
     t = table.column("time")
     span = pc.max(t).as_py() - pc.min(t).as_py() + 1.0
-    with pq.ParquetWriter(dst, pf.schema_arrow) as writer:
-        for k in range(times):
-            shifted = table.set_column(0, "time", pc.add(t, pa.scalar(k * span)))
-            writer.write_table(shifted, row_group_size=1 << 18)
+    shifted = (table.set_column(0, "time", pc.add(t, pa.scalar(k * span))) for k in range(times))
+    write_parquet(dst, pf.schema_arrow.metadata[META_KEY], shifted)
 
 
 def make(size: str, log: str | None, workdir: Path) -> None:
@@ -226,34 +234,49 @@ def main() -> None:
     if args.make:
         make(args.make[0], args.make[1] or None, Path(args.make[2]))
         return
-    workdir = Path(args.workdir or tempfile.mkdtemp(prefix="fricid-bench-extract-"))
-    workdir.mkdir(parents=True, exist_ok=True)
+    results, sizes = run(args.size, args.log, args.repeats, args.workdir)
+    print(
+        f"min of {args.repeats} interleaved runs, each in a fresh process; cores: {os.cpu_count()}"
+    )
+    print(table(results, sizes))
+    print(
+        "time per row, relative to the smallest log: "
+        + ", ".join(f"{p:.2f}" for p in per_row(results, sizes))
+    )
+
+
+def run(
+    size: str, log: str | None, repeats: int, workdir: str | None = None
+) -> tuple[dict[int, dict[str, list[dict]]], list[tuple[int, Path]]]:
+    """Write the logs and measure floor and extraction on each, ``repeats`` interleaved runs
+    (the load average printed before and after); the logs are removed unless ``workdir``."""
+    folder = Path(workdir or tempfile.mkdtemp(prefix="fricid-bench-extract-"))
+    folder.mkdir(parents=True, exist_ok=True)
     try:
-        made = _run("--make", args.size, args.log or "", str(workdir))
+        made = _run("--make", size, log or "", str(folder))
         sizes = [(k, Path(p)) for k, p in json.loads(made.strip().splitlines()[-1])]
-        warm = workdir / "quick.parquet"
+        warm = folder / "quick.parquet"
         print(f"load average before: {' '.join(f'{x:.2f}' for x in os.getloadavg())}")
-        results = {k: {"floor": [], "extract": []} for k, _ in sizes}
-        for _ in range(args.repeats):
+        results: dict[int, dict[str, list[dict]]] = {
+            k: {"floor": [], "extract": []} for k, _ in sizes
+        }
+        for _ in range(repeats):
             for k, path in sizes:
                 for kind in ("floor", "extract"):
                     results[k][kind].append(measure(kind, path, warm))
         print(f"load average after:  {' '.join(f'{x:.2f}' for x in os.getloadavg())}")
-        print(
-            f"min of {args.repeats} interleaved runs, each in a fresh process; cores: "
-            f"{os.cpu_count()}"
-        )
-        print(table(results, sizes))
-        e = [min(r["wall"] for r in results[k]["extract"]) for k, _ in sizes]
-        n = [results[k]["extract"][0]["rows"] for k, _ in sizes]
-        per_row = [w / r for w, r in zip(e, n, strict=True)]
-        print(
-            "time per row, relative to the smallest log: "
-            + ", ".join(f"{p / per_row[0]:.2f}" for p in per_row)
-        )
+        return results, sizes
     finally:
-        if not args.workdir:
-            shutil.rmtree(workdir, ignore_errors=True)
+        if not workdir:
+            shutil.rmtree(folder, ignore_errors=True)
+
+
+def per_row(results: dict[int, dict[str, list[dict]]], sizes: list[tuple[int, Path]]) -> list:
+    """Extraction's time per row at each size, relative to the smallest log."""
+    e = [min(r["wall"] for r in results[k]["extract"]) for k, _ in sizes]
+    n = [results[k]["extract"][0]["rows"] for k, _ in sizes]
+    rate = [w / r for w, r in zip(e, n, strict=True)]
+    return [x / rate[0] for x in rate]
 
 
 if __name__ == "__main__":

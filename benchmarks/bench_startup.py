@@ -59,6 +59,21 @@ def model_file(folder: Path) -> Path:
 
 
 def startup(repeats: int) -> None:
+    got = measure(repeats)
+    times, floor = got["cpu"], got["cpu"]["import numpy, pandas"]
+    print(f"start-up CPU (user + system), min of {repeats} interleaved runs")
+    print(
+        f"  load average: {got['load_before']:.2f} before, {got['load_after']:.2f} after "
+        f"(1 min); cores: {os.cpu_count()}"
+    )
+    for name, t in times.items():
+        print(f"  {name:<22} {t:6.3f} s   {t / floor:5.2f}x the floor")
+
+
+def measure(repeats: int) -> dict:
+    """The minimum CPU seconds of each command over ``repeats`` interleaved runs (``cpu``,
+    by name; the floor is ``"import numpy, pandas"``) and the 1-minute load average before
+    and after."""
     load = os.getloadavg()[0]
     env = {**os.environ, "PYTHONPATH": str(ROOT / "src")}
     with tempfile.TemporaryDirectory() as tmp:
@@ -74,14 +89,11 @@ def startup(repeats: int) -> None:
         for _ in range(repeats):
             for name, argv in cases.items():
                 times[name].append(child_cpu(argv, env))
-    floor = min(times["import numpy, pandas"])
-    print(f"start-up CPU (user + system), min of {repeats} interleaved runs")
-    print(
-        f"  load average: {load:.2f} before, {os.getloadavg()[0]:.2f} after (1 min); cores: "
-        f"{os.cpu_count()}"
-    )
-    for name, t in times.items():
-        print(f"  {name:<22} {min(t):6.3f} s   {min(t) / floor:5.2f}x the floor")
+    return {
+        "cpu": {name: min(t) for name, t in times.items()},
+        "load_before": load,
+        "load_after": os.getloadavg()[0],
+    }
 
 
 def suites() -> None:

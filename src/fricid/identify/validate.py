@@ -251,6 +251,7 @@ def validate(
     seed: int | np.random.Generator | None = 0,
     fixed: Mapping[str, float] | None = None,
     bounds: Mapping[str, tuple[float, float]] | None = None,
+    start: Mapping[str, float] | None = None,
     **fit_options: Any,
 ) -> Validation:
     """Held-out RMSE of ``model`` on ``samples`` beside the measurement scatter.
@@ -271,9 +272,16 @@ def validate(
         The folds of ``kfold`` and each fold's fit.
     fixed, bounds : mapping, optional
         As :func:`fricid.identify.fit` takes them.
+    start : mapping of str to float, optional
+        The model's optimum on all the samples (free parameters): every fold starts there.
+        An analytic model fitted by least squares (``lm``, no weights, no optimiser options)
+        then refits all its folds together
+        (:func:`fricid.identify.static.folds.refit_folds`); a fold that does not converge
+        there, and any other model, gets its own fit from ``start`` with one start.
     **fit_options
         Passed to :func:`fricid.identify.fit` (``max_evals``, ``loss``, ``weights``, ...).
-        Weights given as ``"std"`` are computed per training fold.
+        Weights given as ``"std"`` are computed per training fold. The folds' fits compute
+        no intervals (``intervals`` is ignored): only their predictions are used.
 
     Returns
     -------
@@ -293,6 +301,9 @@ def validate(
     pred = np.full(len(samples), np.nan)
     folds: list[dict[str, Any]] = []
     not_converged = 0
+    together = _refit_together(samples, model, labels, method, fixed, bounds, start, fit_options)
+    if start is not None:
+        fit_options = {**fit_options, "x0": dict(start), "options": {"n_starts": 1}}
     for fold in np.unique(labels):
         held = labels == fold
         row: dict[str, Any] = {
@@ -302,6 +313,11 @@ def validate(
             "rmse": None,
             "note": "",
         }
+        if fold in together:
+            pred[held] = together[fold][held]
+            row["rmse"] = rmse(samples.y[held], pred[held])
+            folds.append(row)
+            continue
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
             try:
@@ -312,7 +328,7 @@ def validate(
                     seed=seed,
                     fixed=fixed,
                     bounds=bounds,
-                    **fit_options,
+                    **{**fit_options, "intervals": "none"},  # only its predictions are used
                 )
             except FricidError as exc:
                 row["note"] = f"not fitted: {exc}"
@@ -338,6 +354,48 @@ def validate(
         predictions=pred,
         not_converged=not_converged,
     )
+
+
+def _refit_together(
+    samples: FrictionSamples,
+    model: str,
+    labels: np.ndarray,
+    method: str | None,
+    fixed: Mapping[str, float] | None,
+    bounds: Mapping[str, tuple[float, float]] | None,
+    start: Mapping[str, float] | None,
+    fit_options: dict[str, Any],
+) -> dict[int, np.ndarray]:
+    """Predictions (every sample) of the folds refitted together from ``start`` (see
+    :func:`validate`), by fold label; the folds it cannot take are left out."""
+    from ..models import get_model
+    from ._named import kind_of
+    from .problem import IdentificationProblem
+    from .static.folds import refit_folds
+
+    loss = str(fit_options.get("loss", "l2")).strip().lower()
+    weights = fit_options.get("weights", "none")
+    plain = loss in ("l2", "sse") and isinstance(weights, str) and weights.lower() == "none"
+    plain &= not fit_options.get("options") and fit_options.get("max_evals") is None
+    if start is None or not plain or (method or "lm") != "lm":
+        return {}
+    if kind_of(samples, model) != "analytic":
+        return {}
+    problem = IdentificationProblem(get_model(model), samples, fixed=fixed, bounds=bounds)
+    x0 = np.clip(
+        [float(start[n]) for n in problem.free_names], problem.bounds[:, 0], problem.bounds[:, 1]
+    )
+    ids = np.unique(labels)
+    train = labels[None, :] != ids[:, None]
+    dirs = [d for d in (-1, 1) if d in set(samples.directions())]
+    enough = train.sum(axis=1) > problem.n_free
+    if str(model).strip().lower().endswith("_asym"):  # both directions in every fold
+        enough &= np.all([(train & (samples.direction == d)).any(axis=1) for d in dirs], axis=0)
+    if not enough.any():
+        return {}
+    X, ok = refit_folds(problem, train[enough], x0)
+    pred = problem.predict(X)
+    return {int(f): pred[i] for i, f in enumerate(ids[enough]) if ok[i]}
 
 
 #: Per-direction magnitudes further apart than this many scatters call for an ``_asym`` model.

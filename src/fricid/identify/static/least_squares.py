@@ -108,7 +108,9 @@ def fit(
     intervals : {"auto", "profile", "jacobian", "none"}, default "auto"
         95 % intervals of the parameters: profile likelihood inside the search box
         (:mod:`fricid.identify.static.profile`; ``"auto"`` uses it for at most
-        :data:`~fricid.identify.static.uncertainty.PROFILE_AUTO_MAX` free parameters), the
+        :data:`~fricid.identify.static.uncertainty.PROFILE_AUTO_MAX` free parameters and
+        re-fits only the sides where the quadratic approximation fails,
+        :mod:`fricid.identify.static.curvature`; ``"profile"`` re-fits every side), the
         Jacobian's
         ``value +/- t se`` cut at the box, or none. A fit that did not converge, or whose
         optimum is degenerate (rank-deficient Jacobian), gets none whatever is asked.

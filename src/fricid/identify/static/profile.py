@@ -179,6 +179,7 @@ def profile_intervals(
     *,
     level: float = 0.95,
     which: list[int] | None = None,
+    sides: np.ndarray | None = None,
 ) -> dict[str, ProfileInterval]:
     """Profile-likelihood intervals of the free parameters of a least-squares fit.
 
@@ -192,26 +193,35 @@ def profile_intervals(
         Confidence level.
     which : list of int, optional
         Indices of the free parameters to profile (default: all).
+    sides : ndarray of bool (p, 2), optional
+        The lower and upper sides to profile (default: both sides of ``which``); a side left
+        out has a NaN end, not open.
 
     Returns
     -------
     dict of str to ProfileInterval
-        Keyed by free-parameter name; every end lies inside the search box.
+        Keyed by free-parameter name (the parameters with a side profiled); every end lies
+        inside the search box.
     """
     x_hat = np.asarray(x_hat, dtype=float)
     r0 = problem.residuals(x_hat[None, :])[0]
     sse = float(r0 @ r0)
     thr = profile_threshold(sse, problem.n_obs, problem.n_free, level)
     out = {}
+    todo = np.ones((problem.n_free, 2), dtype=bool) if sides is None else np.asarray(sides)
     for j in range(problem.n_free) if which is None else which:
+        if not todo[j].any():
+            continue
         refit = _Refit(problem, j)
         best = [sse, sse]
         lo, hi = problem.bounds[j]
-        low, low_open = _side(refit, x_hat, float(lo), thr, best)
-        high, high_open = _side(refit, x_hat, float(hi), thr, best)
+        low, low_open = _side(refit, x_hat, float(lo), thr, best) if todo[j, 0] else (np.nan, False)
+        high, high_open = (
+            _side(refit, x_hat, float(hi), thr, best) if todo[j, 1] else (np.nan, False)
+        )
         out[problem.free_names[j]] = ProfileInterval(
-            low=float(min(low, x_hat[j])),
-            high=float(max(high, x_hat[j])),
+            low=float(min(low, x_hat[j])) if todo[j, 0] else np.nan,
+            high=float(max(high, x_hat[j])) if todo[j, 1] else np.nan,
             low_open=low_open,
             high_open=high_open,
             lower_sse=float(best[0]),

@@ -123,7 +123,7 @@ def select(
             scatter=sc,
             seed=seed,
             fixed=c.fixed,
-            **_options(c.model, fit_options),
+            **_screening(samples, c, method, seed, _options(c.model, fit_options)),
         )
         runs[c.label] = v
         ok = np.isfinite(v.rmse) and v.failed == 0
@@ -164,6 +164,31 @@ def select(
     }
     fitted.validation = runs[chosen["model"]].to_dict()
     return fitted
+
+
+def _screening(
+    samples: FrictionSamples,
+    c: Candidate,
+    method: str,
+    seed: int | np.random.Generator | None,
+    options: dict[str, Any],
+) -> dict[str, Any]:
+    """The validation options of an analytic candidate fitted by the default ``lm`` without
+    optimiser options: every fold starts from the candidate's optimum on all the samples (one
+    fit without intervals), as a fold leaves out a little of the data, and the folds are
+    refitted together (:func:`fricid.identify.validate.validate`'s ``start``). Otherwise (a
+    learned family, another method, options given) ``options`` as they are."""
+    if c.model in LEARNED or str(method).strip().lower() != "lm" or options.get("options"):
+        return options
+    full = fit_named(
+        samples,
+        c.model,
+        "lm",
+        seed=seed,
+        fixed=c.fixed or None,
+        **{**options, "intervals": "none"},
+    )
+    return {**options, "start": {n: p.value for n, p in full.parameters.items() if not p.fixed}}
 
 
 def _reason(

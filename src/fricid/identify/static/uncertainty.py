@@ -17,10 +17,13 @@ data cannot see shows a singular value of that size rather than one below scipy'
 fit that did not converge or for a degenerate optimum (a rank-deficient Jacobian: the
 linearised intervals there, such as ``Coulomb 2e-10 +- 210 N m``, mean nothing); otherwise
 profile-likelihood intervals inside the search box (:mod:`fricid.identify.static.profile`) for up
-to :data:`PROFILE_AUTO_MAX` free parameters (or when asked), else the Jacobian's Wald
-intervals cut at the box with the cut sides flagged; each side that reaches a bound other than
-zero is named in an :class:`~fricid.errors.IdentifiabilityWarning`, with the parameter's
-strongest correlation.
+to :data:`PROFILE_AUTO_MAX` free parameters (or when asked: then every side is profiled by
+re-fits; by default only the sides where the quadratic approximation fails at the Jacobian
+interval's ends, near a bound or for a poorly determined parameter,
+:mod:`fricid.identify.static.curvature`, the others taking its checked ends), else the
+Jacobian's Wald intervals cut at the box with the cut sides flagged; each side that reaches a
+bound other than zero is named in an :class:`~fricid.errors.IdentifiabilityWarning`, with the
+parameter's strongest correlation.
 """
 
 from __future__ import annotations
@@ -43,11 +46,14 @@ __all__ = [
 ]
 
 #: The interval methods of :func:`assess`: ``auto`` (profile for at most
-#: :data:`PROFILE_AUTO_MAX` free parameters, else Jacobian), ``profile``, ``jacobian``, ``none``.
+#: :data:`PROFILE_AUTO_MAX` free parameters, re-fitted only on the sides the quadratic
+#: approximation misses, else Jacobian), ``profile`` (every side re-fitted), ``jacobian``,
+#: ``none``.
 INTERVALS = ("auto", "profile", "jacobian", "none")
 
-#: ``intervals="auto"`` profiles fits with at most this many free parameters (about 0.2 s for
-#: the Stribeck model's five on 30 samples; eight parameters of ``vlt`` take seconds).
+#: ``intervals="auto"`` profiles fits with at most this many free parameters (re-fitting
+#: every side took about 0.2 s for the Stribeck model's five on 30 samples, eight parameters of
+#: ``vlt`` seconds; the sides the quadratic approximation passes cost no re-fit).
 PROFILE_AUTO_MAX = 5
 
 #: A correlation at least this strong is named as the reason a parameter is not bounded.
@@ -244,8 +250,6 @@ def assess(
     -------
     Uncertainty
     """
-    from .profile import profile_intervals
-
     names = problem.free_names
     p = len(names)
     nan = np.full(p, np.nan)
@@ -282,19 +286,44 @@ def assess(
     if key == "none":
         return out
     if key == "profile" or (key == "auto" and p <= PROFILE_AUTO_MAX):
-        prof = profile_intervals(problem, x)
-        for j, n in enumerate(names):
-            iv = prof[n]
-            out.low[j], out.high[j] = iv.low, iv.high
-            out.open[j] = iv.low_open, iv.high_open
-        out.method = "profile"
-        out.lower_sse = min(iv.lower_sse for iv in prof.values())
+        _profile(out, problem, x, float(r0 @ r0), checked=key == "auto")
     else:
         out.low, out.high = np.maximum(x - half, lo_b), np.minimum(x + half, hi_b)
         out.open = np.column_stack([x - half <= lo_b, x + half >= hi_b])
         out.method = "jacobian"
     _name_open_sides(out, problem, x, names, units or {})
     return out
+
+
+def _profile(out: Uncertainty, problem, x: np.ndarray, sse: float, checked: bool) -> None:
+    """``out``'s interval ends by the profile likelihood: with ``checked``, the sides where
+    the quadratic approximation holds at the Wald ends take its ends
+    (:func:`~fricid.identify.static.curvature.checked_ends`) and only the others are profiled
+    by re-fits; else every side is."""
+    from .curvature import checked_ends
+    from .profile import profile_intervals
+
+    p = x.size
+    ends, done, lowest = (
+        checked_ends(problem, x, out.cov, sse)
+        if checked and out.cov is not None
+        else (np.full((p, 2), np.nan), np.zeros((p, 2), bool), sse)
+    )
+    out.low, out.high = ends[:, 0].copy(), ends[:, 1].copy()
+    out.method = "profile"
+    out.lower_sse = lowest
+    if done.all():
+        return
+    prof = profile_intervals(problem, x, sides=~done)
+    for j, n in enumerate(problem.free_names):
+        iv = prof.get(n)
+        if iv is None:
+            continue
+        if not done[j, 0]:
+            out.low[j], out.open[j, 0] = iv.low, iv.low_open
+        if not done[j, 1]:
+            out.high[j], out.open[j, 1] = iv.high, iv.high_open
+        out.lower_sse = min(out.lower_sse, iv.lower_sse)
 
 
 def _name_open_sides(out: Uncertainty, problem, x, names: list[str], units) -> None:
