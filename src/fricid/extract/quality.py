@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import DataQualityWarning
+from ..errors import DataQualityWarning, user_stacklevel
 
 __all__ = ["QUALITY_COLUMNS", "SCATTER_RATIO", "QualityTable", "flag_scatter", "warn_quality"]
 
@@ -250,4 +250,4 @@ def warn_quality(table: QualityTable, source: str | None, *, stacklevel: int = 2
             parts.append(f"dropped {int(counts.sum())} {what}: {names}{more}")
     if parts:
         message = where + ". ".join(parts) + " (see the quality table)"
-        warnings.warn(message, DataQualityWarning, stacklevel=stacklevel + 1)
+        warnings.warn(message, DataQualityWarning, stacklevel=user_stacklevel())

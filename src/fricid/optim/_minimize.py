@@ -10,7 +10,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import ConfigError, IgnoredArgumentWarning
+from ..errors import ConfigError, IgnoredArgumentWarning, user_stacklevel
 from ._api import (
     BUDGET,
     CALLBACK,
@@ -243,7 +243,7 @@ def _minimize(
             f"method '{key}' does not use `residuals`; it minimises `fun` (least-squares "
             "methods: " + ", ".join(k for k, c in METHODS.items() if c.uses_residuals) + ")",
             IgnoredArgumentWarning,
-            stacklevel=stacklevel,
+            stacklevel=user_stacklevel(),
         )
     if fun is None:
         res_fun = residuals

@@ -26,7 +26,7 @@ from collections.abc import Collection
 
 import numpy as np
 
-from ...errors import DataError, IdentifiabilityWarning
+from ...errors import DataError, IdentifiabilityWarning, user_stacklevel
 from ...models import FrictionModel, get_model
 from ...samples import FrictionSamples
 
@@ -86,7 +86,7 @@ def _direction_sets(
 
 
 def _warn(message: str, stacklevel: int) -> None:
-    warnings.warn(message, IdentifiabilityWarning, stacklevel=stacklevel + 1)
+    warnings.warn(message, IdentifiabilityWarning, stacklevel=user_stacklevel())
 
 
 def check_identifiable(
