@@ -239,6 +239,8 @@ def fit_command(
         ),
     ):
         warnings.simplefilter("always")
+        if key == "auto":
+            settings["progress"] = _auto_progress(track)
         fitted, trust = fit_samples(
             data,
             model,
@@ -267,6 +269,20 @@ def fit_command(
     for w in caught:  # shown as the CLI shows every warning (one line on stderr)
         warnings.showwarning(w.message, w.category, w.filename, w.lineno)
     err_console.print(f"wrote {escape(str(out))}")
+
+
+def _auto_progress(track):
+    """``--model auto``'s progress: the candidate under way and its place in the list
+    (``auto: 3/9 stribeck_temp``), the count of candidates validated, and the time left once
+    the rate of the validated ones is known."""
+
+    def progress(i: int, n: int, label: str) -> None:
+        track.update(i, total=n)
+        head = f"auto: {i + 1}/{n} {label}" if i < n else f"auto: {label}"
+        track.stage(head, force=track.mode == "plain" and i == 0)
+
+    track.unit = "validated"
+    return progress
 
 
 def trust_lines(trust) -> str:
@@ -360,6 +376,8 @@ def goodness_text(fitted, samples=None) -> str:
             err = r.get("heldout_rmse")
             cell = f"{err:.4g} N m" if err is not None else "-"
             lines.append(f"    {r['model']:<22} {r['n_params']:>3} par  {cell:>14}  {r['note']}")
+        if sel.get("advice"):
+            lines.append(f"    advice: {sel['advice']}")
     return "\n".join(lines)
 
 

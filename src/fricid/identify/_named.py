@@ -46,7 +46,7 @@ SETTINGS: dict[str, tuple[str, ...]] = {
         "cluster_time",
         "rate_bias",
     ),
-    "auto": ("scheme", "scatter", "learned"),
+    "auto": ("scheme", "scatter", "learned", "progress"),
 }
 
 #: The learned models (stored state, no named parameters).
