@@ -259,3 +259,28 @@ def test_warning_labels_split_the_class_name_into_words(capsys):
     ):
         _app._show_warning("text", category, "f.py", 1)
         assert f"warning ({label}): text" in capsys.readouterr().err
+
+
+@pytest.mark.slow  # 4 s measured under load (two trajectory fits)
+def test_fit_trajectory_names_each_stage_and_its_place(no_grace, tmp_path):
+    """``fit --trajectory``: one line per stage with its place, no time left (stages of
+    unequal cost); nothing with --quiet."""
+    from fricid.io import write_rawlog
+    from fricid.models import Stribeck
+    from fricid.sim import Joint, ModelLaw
+    from fricid.sim import trajectory as tr
+
+    joint = Joint(law=lambda v, load, temp: np.zeros_like(v), p_x=0.3, p_y=0.1, inertia=0.01)
+    law = ModelLaw(Stribeck(), np.array([0.5, 0.8, 0.1, 0.2, 1.0]))
+    log = tr.simulate_trajectory(tr.multisine(duration=4.0, seed=2), law, joint, seed=2)
+    path = write_rawlog(log, tmp_path / "traj.parquet")
+    args = ("fit", path, "--trajectory", "--model", "stribeck", "--out", tmp_path / "m.json")
+    res = run(*args)
+    assert res.exit_code == 0, res.output
+    lines = progress_lines(res.stderr)
+    assert any("[1/3] checking the log" in ln for ln in lines), lines
+    assert any("[2/3] regression: static friction, inertia, gravity" in ln for ln in lines)
+    assert any("[3/3] intervals, passivity" in ln for ln in lines), lines
+    assert not any(" left" in ln for ln in lines), lines
+    res = run(*args[:-2], "-q", "--out", tmp_path / "q.json")
+    assert res.exit_code == 0 and not progress_lines(res.stderr)

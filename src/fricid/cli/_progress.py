@@ -107,6 +107,7 @@ class Tracker:
         bar: Any = None,
         unit: str = "",
         clock: Callable[[], float] = time.perf_counter,
+        timed: bool = True,
     ) -> None:
         self.label = self.title = label
         self.unit = unit
@@ -114,6 +115,9 @@ class Tracker:
         self.done = 0.0
         self.mode = mode
         self._clock = clock
+        #: Whether the count can time what is left: False for steps of unequal cost (a
+        #: paper's tables and figures, a trajectory's routes), whose rate is never known.
+        self.timed = timed
         self._est = Estimator(total, clock)
         self._bar = bar
         self._task = bar.add_task(escape(label), total=total, left="") if bar is not None else None
@@ -130,8 +134,8 @@ class Tracker:
 
     def estimate(self) -> float | None:
         """Seconds left, from the rate of the completed work (:class:`Estimator`); None until
-        that rate is known, and when the total is unknown."""
-        return self._est.remaining()
+        that rate is known, when the total is unknown, and for steps of unequal cost."""
+        return self._est.remaining() if self.timed else None
 
     def _left(self) -> str:
         left = self.estimate()
@@ -236,7 +240,12 @@ class Tracker:
 
 @contextmanager
 def tracker(
-    label: str, total: float | None = None, *, unit: str = "", quiet: bool = False
+    label: str,
+    total: float | None = None,
+    *,
+    unit: str = "",
+    quiet: bool = False,
+    timed: bool = True,
 ) -> Iterator[Tracker]:
     """Progress of one step on stderr; yields a :class:`Tracker`.
 
@@ -250,12 +259,15 @@ def tracker(
         What is counted ("chunks", "evaluations"), for the plain lines.
     quiet : bool, default False
         No output (also when ``--quiet`` was given to ``fricid`` itself).
+    timed : bool, default True
+        False: a count of steps of unequal cost, shown without a time left (their rate
+        says nothing of the time the rest takes).
     """
     if quiet or is_quiet():
-        yield Tracker(label, total, "quiet", unit=unit)
+        yield Tracker(label, total, "quiet", unit=unit, timed=timed)
         return
     if not err_console.is_terminal:
-        t = Tracker(label, total, "plain", unit=unit)
+        t = Tracker(label, total, "plain", unit=unit, timed=timed)
         stop = threading.Event()
 
         def beat() -> None:
@@ -280,7 +292,7 @@ def tracker(
         console=err_console,
         transient=True,
     ) as bar:
-        yield Tracker(label, total, "terminal", bar, unit=unit)
+        yield Tracker(label, total, "terminal", bar, unit=unit, timed=timed)
 
 
 @contextmanager

@@ -220,6 +220,7 @@ def fit_command(
             route=route,
             gravity="fit",
             out=out,
+            quiet=quiet,
         )
     from ..io import read_samples
     from ..workflow import fit_samples, select_direction
@@ -277,9 +278,9 @@ def _auto_progress(track):
     the rate of the validated ones is known."""
 
     def progress(i: int, n: int, label: str) -> None:
-        track.update(i, total=n)
+        track.total = float(n)
         head = f"auto: {i + 1}/{n} {label}" if i < n else f"auto: {label}"
-        track.stage(head, force=track.mode == "plain" and i == 0)
+        track.stage(head, done=i)
 
     track.unit = "validated"
     return progress

@@ -45,6 +45,7 @@ SETTINGS: dict[str, tuple[str, ...]] = {
         "n_sub",
         "cluster_time",
         "rate_bias",
+        "progress",
     ),
     "auto": ("scheme", "scatter", "learned", "progress"),
 }
