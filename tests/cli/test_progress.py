@@ -284,3 +284,17 @@ def test_fit_trajectory_names_each_stage_and_its_place(no_grace, tmp_path):
     assert not any(" left" in ln for ln in lines), lines
     res = run(*args[:-2], "-q", "--out", tmp_path / "q.json")
     assert res.exit_code == 0 and not progress_lines(res.stderr)
+
+
+@pytest.mark.slow  # 3 s measured under load (a fit and a report with its figures)
+def test_report_names_each_part_and_takes_quiet(no_grace, tmp_path, samples_csv):
+    model = tmp_path / "m.json"
+    assert run("fit", samples_csv, "--out", model, "-q").exit_code == 0
+    res = run("report", model, samples_csv, "--out", tmp_path / "rep", "--no-validate")
+    assert res.exit_code == 0, res.output
+    lines = progress_lines(res.stderr)
+    for part in ("the trust record", "figures: friction against velocity", "writing"):
+        assert any(f"report: {part}" in ln for ln in lines), (part, lines)
+    assert not any(" left" in ln for ln in lines), lines  # parts of unequal cost: not timed
+    res = run("report", model, samples_csv, "--out", tmp_path / "rep2", "-q")
+    assert res.exit_code == 0 and not progress_lines(res.stderr), res.stderr

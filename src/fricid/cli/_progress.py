@@ -219,7 +219,8 @@ class Tracker:
         if self.mode == "plain" and (force or self.elapsed >= GRACE_S):
             with self._lock:
                 self._last_tenth = int(10 * self.done / self.total) if self.total else -1
-                self._emit(self.line())
+                # a new stage names itself; "still running" is for the heartbeat lines
+                self._emit(self.line() if self.total or self.done else label)
 
     def heartbeat(self) -> None:
         """Called every second by the plain mode's timer: a line when one is due."""
