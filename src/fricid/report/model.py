@@ -472,7 +472,11 @@ def _curves_caption(samples: FrictionSamples) -> str:
         "band's median load and temperature."
     ]
     if np.ptp(samples.temperature) > 0 or np.ptp(samples.load) > 0:
-        parts.append("Colours are temperature bands, panels load bands.")
+        parts.append(
+            "The interactive chart has one panel per load and temperature band (named above "
+            "it; the axes shared, so panels compare at a glance) and a colour per direction; "
+            "in the PNG the panels are load bands and the colours temperature bands."
+        )
     if set(samples.directions()) == {-1, 1}:
         parts.append("Both directions of motion are shown; friction is signed like velocity.")
     return " ".join(parts)
