@@ -70,12 +70,26 @@ def test_detection_prefers_the_split_the_data_line_agrees_with():
     assert detect_dialect("a\tb", "1.5\t2").decimal == "."
 
 
+@pytest.mark.slow  # 6 s measured under load (a fit, the command line)
 def test_cli_reads_a_semicolon_file_and_takes_delimiter(tmp_path):
     from typer.testing import CliRunner
 
     from fricid.cli import app
+    from fricid.identify import fit
 
-    path = tmp_path / "semi.csv"
-    path.write_text("velocity [rad/s];friction [N m]\n0,5;0,25\n", encoding="utf-8")
-    res = CliRunner().invoke(app, ["--delimiter", "|", "fit", str(path)])
+    v = np.geomspace(0.05, 1.0, 6)
+    samples = tmp_path / "s.csv"
+    rows = "".join(f"{a!r};{0.1 + 0.02 * a!r}\n".replace(".", ",") for a in v.tolist())
+    samples.write_text("velocity [rad/s];friction [N m]\n" + rows, encoding="utf-8")
+    model = fit(read_samples(samples), "coulomb_viscous").save(tmp_path / "m.json")
+    assert model.exists()
+    points = tmp_path / "points.csv"
+    points.write_text("velocity [rad/s]\n0,5\n", encoding="utf-8")  # one column: a comma
+    runner = CliRunner()
+    res = runner.invoke(
+        app, ["--decimal", ",", "--delimiter", ";", "predict", str(model), "-i", str(points)]
+    )
+    assert res.exit_code == 0, res.output
+    assert res.stdout.splitlines()[1].startswith("0.5,")
+    res = runner.invoke(app, ["--delimiter", "|", "predict", str(model), "-i", str(points)])
     assert res.exit_code == 2 and "--delimiter must be one of" in res.output
