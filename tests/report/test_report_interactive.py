@@ -122,3 +122,16 @@ def test_small_multiples_per_band_and_residuals_against_every_input():
     assert res["layout"]["xaxis"]["type"] == "log"
     assert res["layout"]["yaxis2"]["matches"] == "y"
     assert len(res["layout"]["shapes"]) == 6  # ±2 RMSE in each panel
+
+
+def test_samples_without_load_or_temperature_are_drawn():
+    """Load and temperature not measured (NaN): one panel, with the samples and the model
+    (a band of NaN used to select nothing, leaving the chart empty)."""
+    from fricid.report.interactive import friction_figure
+
+    v = np.geomspace(0.01, 1.0, 8)
+    v = np.concatenate([v, -v])
+    samples = FrictionSamples(v, None, None, np.sign(v) * (0.1 + 0.02 * np.abs(v)))
+    spec = json.loads(friction_figure(samples, lambda X: np.sign(X[:, 0]) * 0.1))
+    assert [len(t["x"]) for t in spec["data"] if t["mode"] == "markers"] == [8, 8]
+    assert "xaxis" in spec["layout"] and "xaxis2" not in spec["layout"]

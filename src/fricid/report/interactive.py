@@ -23,7 +23,7 @@ import numpy as np
 
 from ..samples import FrictionSamples
 from .plots import velocity_grid
-from .style import COLORS, band_edges, torque_scale, velocity_scale
+from .style import COLORS, band_edges, in_band, torque_scale, velocity_scale
 
 __all__ = [
     "STRIBECK_VELOCITIES",
@@ -168,8 +168,7 @@ def _band_cells(samples: FrictionSamples, max_bands: int) -> tuple[list[tuple], 
     cells = []
     for i, tb in enumerate(t_bands):
         for j, lb in enumerate(l_bands):
-            sel = (samples.load >= lb[0]) & (samples.load <= lb[1])
-            sel &= (samples.temperature >= tb[0]) & (samples.temperature <= tb[1])
+            sel = in_band(samples.load, lb) & in_band(samples.temperature, tb)
             if not sel.any():
                 continue
             parts = []
@@ -219,10 +218,9 @@ def friction_figure(
     data: list[dict] = []
     shown: set[str] = set()
     for panel, (_, lb, tb, _label) in zip(panels, cells, strict=True):
-        in_band = (samples.load >= lb[0]) & (samples.load <= lb[1])
-        in_band &= (samples.temperature >= tb[0]) & (samples.temperature <= tb[1])
+        band = in_band(samples.load, lb) & in_band(samples.temperature, tb)
         for g, (d, mask) in enumerate(groups):
-            sel = mask & in_band
+            sel = mask & band
             if not sel.any():
                 continue
             color = COLORS[g % len(COLORS)]
