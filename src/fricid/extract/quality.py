@@ -227,7 +227,9 @@ def _name(table: QualityTable, i: int) -> str:
 def warn_quality(table: QualityTable, source: str | None, *, stacklevel: int = 2) -> None:
     """Warn once (:class:`~fricid.errors.DataQualityWarning`) when a set-point's scatter is far
     above its neighbours', or samples were dropped as outliers or saturated; the message names
-    the file and the set-points (at most five) and says what to do."""
+    the file and the set-points (at most five) and says what to do. It points at the first
+    caller outside fricid (:func:`fricid.errors.user_stacklevel`; ``stacklevel`` is kept for
+    callers that pass it)."""
     parts = []
     where = f"{source}: " if source else ""
     high = np.flatnonzero(table.flagged)

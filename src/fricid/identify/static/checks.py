@@ -108,8 +108,8 @@ def check_identifiable(
         Names of the parameters held fixed (a ``fixed=`` mapping of :func:`fricid.identify.fit`
         works): they need no data.
     stacklevel : int
-        Passed to :func:`warnings.warn`, counted from the caller of this function (2: its
-        caller's caller).
+        Kept for callers that pass it; the warning points at the first caller outside
+        fricid whatever the depth (:func:`fricid.errors.user_stacklevel`).
 
     Returns
     -------
