@@ -68,6 +68,9 @@ def test_detection_prefers_the_split_the_data_line_agrees_with():
         detect_dialect("a;b", "1,5;2,5").decimal,
     ) == (";", ",")
     assert detect_dialect("a\tb", "1.5\t2").decimal == "."
+    one = detect_dialect("velocity [rad/s]", "0,5")  # one column, a decimal comma
+    assert (one.delimiter, one.decimal) == (";", ",")
+    assert detect_dialect("velocity [rad/s]", "0.5") == detect_dialect("a", None)
 
 
 @pytest.mark.slow  # 6 s measured under load (a fit, the command line)
@@ -84,12 +87,11 @@ def test_cli_reads_a_semicolon_file_and_takes_delimiter(tmp_path):
     model = fit(read_samples(samples), "coulomb_viscous").save(tmp_path / "m.json")
     assert model.exists()
     points = tmp_path / "points.csv"
-    points.write_text("velocity [rad/s]\n0,5\n", encoding="utf-8")  # one column: a comma
+    points.write_text("velocity [rad/s]\n0,5\n", encoding="utf-8")  # one column, detected
     runner = CliRunner()
-    res = runner.invoke(
-        app, ["--decimal", ",", "--delimiter", ";", "predict", str(model), "-i", str(points)]
-    )
-    assert res.exit_code == 0, res.output
-    assert res.stdout.splitlines()[1].startswith("0.5,")
+    for told in ([], ["--decimal", ",", "--delimiter", ";"]):  # detected, or told
+        res = runner.invoke(app, [*told, "predict", str(model), "-i", str(points)])
+        assert res.exit_code == 0, res.output
+        assert res.stdout.splitlines()[1].startswith("0.5,")
     res = runner.invoke(app, ["--delimiter", "|", "predict", str(model), "-i", str(points)])
     assert res.exit_code == 2 and "--delimiter must be one of" in res.output

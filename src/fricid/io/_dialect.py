@@ -124,8 +124,8 @@ def detect_dialect(header: str, data: str | None) -> Dialect:
 
     What :func:`csv_dialect` gave is used as given; the rest is detected: the delimiter of
     :data:`DELIMITERS` that splits the header into the most fields, with the first data line
-    split into as many (a decimal comma splits it into more with ``,``); then the decimal mark
-    (:func:`_decimal`).
+    split into as many (a decimal comma splits it into more with ``,``), and ``;`` for a single
+    column written with a decimal comma; then the decimal mark (:func:`_decimal`).
     """
     delim, decimal = _GIVEN.get()
     if delim is None:
@@ -135,6 +135,8 @@ def detect_dialect(header: str, data: str | None) -> Dialect:
             fits = data is None or len(_fields(data, cand)) == n
             if n > width and fits:
                 best, width = cand, n
+        if width == 1 and data is not None and _COMMA_NUMBER.match(data) and decimal != ".":
+            best = ";"  # one column of decimal-comma numbers: no field is split at a comma
         delim = best
     if decimal is None:
         decimal = "." if delim == "," or data is None else _decimal(_fields(data, delim))
