@@ -6,7 +6,9 @@ one into a single line on stderr and exit status 2 (DESIGN.md, "Errors").
 
 from __future__ import annotations
 
+import sys
 from os import PathLike
+from pathlib import Path
 
 __all__ = [
     "ConfigError",
@@ -18,7 +20,32 @@ __all__ = [
     "FricidWarning",
     "IdentifiabilityWarning",
     "IgnoredArgumentWarning",
+    "user_stacklevel",
 ]
+
+#: The package's folder: frames of files under it are fricid's own.
+_PACKAGE = str(Path(__file__).resolve().parent)
+
+
+def user_stacklevel() -> int:
+    """The ``stacklevel`` that makes a warning point at the user's call.
+
+    Called as ``warnings.warn(message, category, stacklevel=user_stacklevel())``: counts the
+    frames from the function that warns up to the first one outside the fricid package (the
+    user's script, a notebook cell, a test), however deep inside fricid the warning arose, so
+    Python's ``file:line: Category: message`` names the user's line.
+
+    Returns
+    -------
+    int
+        1 when the whole stack is fricid's (the command line), the warning's own line.
+    """
+    frame = sys._getframe(1)
+    level = 1
+    while frame is not None and frame.f_code.co_filename.startswith(_PACKAGE):
+        frame = frame.f_back
+        level += 1
+    return level if frame is not None else 1
 
 
 class FricidError(Exception):

@@ -67,6 +67,17 @@ def exports(fitted: FittedModel, path: Path) -> dict[str, str]:
     return out
 
 
+def as_before(fitted) -> str:
+    """The fit report without the line added since the files were written (the RMSE, from
+    the file's own metrics, checked here), to compare with what that fricid printed."""
+    lines = fitted.report().splitlines()
+    added = [ln for ln in lines if ln.startswith("    RMSE [N m]         = ")]
+    assert len(added) == (fitted.metrics.get("rmse") is not None)
+    for ln in added:
+        assert float(ln.split("=")[1]) == pytest.approx(fitted.metrics["rmse"], rel=1e-7)
+    return "\n".join(ln for ln in lines if ln not in added)
+
+
 def same(a, b) -> bool:
     both_nan = isinstance(a, float) and isinstance(b, float) and math.isnan(a) and math.isnan(b)
     return both_nan or a == b
@@ -78,7 +89,7 @@ def test_version_1_files_predict_and_print_as_before(family):
     fitted = load(family)
     y = quiet(fitted.predict, np.array(expected["X"]))
     assert np.array_equal(y, np.array(expected["y"]))  # bit for bit
-    assert fitted.report() == expected["report"]
+    assert as_before(fitted) == expected["report"]
     assert exports(fitted, path) == expected["exports"]
     table = parameter_table(fitted).to_csv(index=False) if fitted.parameters else ""
     assert table == expected["parameter_table"]
@@ -148,7 +159,7 @@ def test_a_correlation_in_another_order_is_reordered_to_the_free_parameters(tmp_
     path = tmp_path / "reordered.json"
     path.write_text(json.dumps(d))
     assert FittedModel.load(path).correlation == load("stribeck").correlation
-    assert FittedModel.load(path).report() == EXPECTED["stribeck"]["report"]
+    assert as_before(FittedModel.load(path)) == EXPECTED["stribeck"]["report"]
 
 
 def test_an_unconverged_block_without_a_reason_keeps_its_message():

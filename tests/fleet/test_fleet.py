@@ -166,6 +166,39 @@ def test_manifest_errors_name_file_row_and_column(tmp_path, text, row, column, w
     assert words in str(err) and str(path) in str(err)
 
 
+def test_manifest_problems_in_several_rows_are_told_at_once(tmp_path):
+    path = tmp_path / "m.csv"
+    path.write_text(
+        "robot,joint,log,model,seed\nr,j,x.csv,msx,0\nr,k,x.csv,stribeck,-1\n"
+        "r,l,x.csv,stribeck,0\nr,l,y.csv,stribeck,0\n",
+        encoding="utf-8",
+    )
+    with pytest.raises(DataError) as info:
+        read_manifest(path)
+    err = info.value
+    assert [(p.row, p.column) for p in err.problems] == [(2, "model"), (3, "seed"), (5, "joint")]
+    text = str(err)
+    assert text.startswith(f"{path}: 3 problems: row 2, column 'model': unknown model")
+    assert "row 3, column 'seed'" in text and "row 5, column 'joint'" in text
+    res = runner.invoke(app, ["fleet", str(path), "--out", str(tmp_path / "o")])
+    assert res.exit_code == 2 and "3 problems" in res.output and "Traceback" not in res.output
+
+
+def test_results_csv_headers_carry_units_and_old_headers_still_read(fleet, tmp_path):
+    _manifest, run = fleet
+    header = run.results_csv.read_text(encoding="utf-8").splitlines()[0].split(",")
+    for label in ("rmse [N m]", "speed_min [rad/s]", "load_max [N m]", "sse [N^2 m^2]"):
+        assert label in header, label
+    assert "param_tau_c [N m]" in header and "time_fit_s [s]" in header
+    assert "rmse" not in header and "robot" in header and "fitness" in header
+    old = tmp_path / "results.csv"  # as written before the headers carried units
+    lines = run.results_csv.read_text(encoding="utf-8").splitlines(keepends=True)
+    bare = ",".join(label.partition(" [")[0] for label in header) + "\n"
+    old.write_text(bare + "".join(lines[1:]), encoding="utf-8")
+    pd.testing.assert_frame_equal(read_results(old), read_results(run.results_csv))
+    assert "rmse" in read_results(run.results_csv).columns
+
+
 def test_yaml_manifest_error_names_the_line(tmp_path):
     path = tmp_path / "m.yaml"
     path.write_text(

@@ -248,6 +248,36 @@ def test_trust_yes_for_a_converged_fit_within_noise(leadscrew, tmp_path):
     assert (params["value"] <= params["95% CI high"]).all()
 
 
+def test_verdict_and_figures_come_first_and_long_tables_are_folded(leadscrew, tmp_path):
+    """The verdict, then the figures; the 32-row data-quality table folded, the scatter it
+    shows named apart from the verdict's and explained."""
+    from fricid.report.render import render_html
+    from fricid.report.trust import READINGS_STD
+
+    fitted = fit(leadscrew, "stribeck_asym")
+    trust = assess_trust(fitted, leadscrew)
+    seen = []
+    doc = model_report(fitted, leadscrew, trust=trust, progress=seen.append)
+    assert seen[0] == "predictions, metrics" and "figures: residuals against each input" in seen
+    titles = [s.title for s in doc.sections]
+    assert titles[:3] == ["Can I trust this?", "Friction against velocity", "Residuals"]
+    assert titles.index("Parameters") > titles.index("Residuals")
+    quality = next(t for t in doc.tables() if t.name == "quality")
+    assert len(quality.frame) > 12 and quality.is_folded
+    assert READINGS_STD in quality.frame.columns and "scatter [N m]" not in quality.frame
+    assert f"{trust.scatter:.3g} N m" in quality.caption and "square root" in quality.caption
+    sec, _ = _trust_section(doc)
+    assert "**Measurement scatter** (the one number every comparison here uses): " in sec.text
+    html = render_html(doc)
+    folded = html.split('<details class="folded">')
+    assert (
+        len(folded) >= 2 and 'id="data-quality-per-set-point"' in folded[1].split("</details>")[0]
+    )
+    params = next(t for t in doc.tables() if t.name == "parameters")
+    assert not params.is_folded  # short tables stay open
+    assert html.index('id="plotly-friction_vs_velocity"') < html.index('id="parameters"')
+
+
 def test_trust_no_for_a_bas_fit_with_a_tiny_budget(leadscrew):
     from fricid.errors import ConvergenceWarning
 
@@ -259,7 +289,8 @@ def test_trust_no_for_a_bas_fit_with_a_tiny_budget(leadscrew):
     assert line.startswith("Trust: no, because the fit did NOT converge")
     assert "--method bas+lm" in line
     assert "NOT converged: method 'bas' ended after 200 of 200 evaluations" in sec.text
-    table = next(i for i in doc.sections[1].items if getattr(i, "name", "") == "parameters")
+    params = next(s for s in doc.sections if s.title == "Parameters")
+    table = next(i for i in params.items if getattr(i, "name", "") == "parameters")
     assert (table.frame["95% interval"] == "–").all()
     assert table.frame["status"].str.contains("did not converge").all()
 
@@ -319,8 +350,8 @@ def test_report_of_a_per_direction_rbf_network(leadscrew, tmp_path):
     doc = model_report(fitted, leadscrew, trust=assess_trust(fitted, leadscrew), bootstrap=50)
     write_document(doc, tmp_path / "rep")
     titles = [s.title for s in doc.sections]
-    assert titles[0] == "Can I trust this?" and titles[1] == "Parameters"
-    main = {getattr(i, "name", None) for i in doc.sections[1].items}
+    assert titles[:3] == ["Can I trust this?", "Friction against velocity", "Residuals"]
+    main = {getattr(i, "name", None) for i in doc.sections[titles.index("Parameters")].items}
     assert "prediction_ci" in main and "parameters" not in main  # the weights: an appendix
     assert any(t.startswith("Appendix") for t in titles)
     ci = __import__("pandas").read_csv(tmp_path / "rep" / "prediction_ci.csv")

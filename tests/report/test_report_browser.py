@@ -5,13 +5,17 @@ installs both before ``make test-all``): the page loads without console errors, 
 visible (each interactive Plotly figure drawn, each PNG decoded), the table of contents
 links reach their sections, and a screenshot is saved as a test artefact: ``report.png``
 in the test's tmp folder and, when ``FRICID_ARTIFACTS`` is set, copied into that folder as
-``report-browser.png``. Without selenium, a browser or its driver the test is skipped and
-says which is missing.
+``report-browser.png``. What a person sees is checked on the drawn page: no legend overlaps
+an axis title or a plotting area (bounding boxes), every axis is titled with its unit, the
+friction chart has one panel per load and temperature band (shared axes, a colour per
+direction, not per band) and the residuals one per input, the speed on a log axis. Without
+selenium, a browser or its driver the test is skipped and says which is missing.
 """
 
 from __future__ import annotations
 
 import os
+import re
 import shutil
 import warnings
 from pathlib import Path
@@ -74,6 +78,120 @@ def report(tmp_path_factory) -> Path:
         fitted = fit(samples, "stribeck_asym", "varpro")
         doc = model_report(fitted, samples, trust=assess_trust(fitted, samples, validate=False))
     return write_document(doc, tmp_path_factory.mktemp("browser") / "report")
+
+
+@pytest.fixture(scope="module")
+def banded_report(tmp_path_factory) -> Path:
+    """A report of samples at 3 loads and 3 temperatures (9 bands), both directions."""
+    rng = np.random.default_rng(1)
+    v0 = np.geomspace(0.005, 2.0, 8)
+    v, load, temp = (
+        a.ravel() for a in np.meshgrid(np.concatenate([v0, -v0]), [0.0, 0.5, 1.0], [20, 35, 50])
+    )
+    mag = 0.1 + 0.05 * load + 0.15 * np.exp(-np.abs(v) / 0.05) + 0.02 * np.abs(v)
+    mag *= 1.0 - 0.004 * (temp - 20)
+    f = np.sign(v) * mag + 0.002 * rng.standard_normal(v.size)
+    samples = FrictionSamples(
+        velocity=v, load=load, temperature=temp, friction=f, direction=np.sign(v).astype(int)
+    )
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", FricidWarning)
+        fitted = fit(samples, "stribeck", "varpro")
+        doc = model_report(fitted, samples, trust=assess_trust(fitted, samples, validate=False))
+    return write_document(doc, tmp_path_factory.mktemp("banded") / "report")
+
+
+#: What the page shows of every Plotly figure: its axes' titles (layout and drawn boxes), the
+#: legend's box, the plotting areas, the panel titles and the colours of the traces.
+_LAYOUT_JS = """
+var out = {};
+document.querySelectorAll('.plotly-figure').forEach(function (gd) {
+  var L = gd._fullLayout, box = function (e) {
+    var r = e.getBoundingClientRect();
+    return [r.left, r.top, r.right, r.bottom];
+  };
+  var axes = Object.keys(L).filter(function (k) { return /^[xy]axis[0-9]*$/.test(k); });
+  var texts = Array.from(gd.querySelectorAll('.infolayer text')).filter(function (t) {
+    return /^[xy][0-9]*title$/.test(t.getAttribute('class'));
+  });
+  var legend = gd.querySelector('g.legend');
+  out[gd.id] = {
+    axes: axes.map(function (k) {
+      return [k, L[k].title.text || '', L[k].type, L[k].matches || null];
+    }),
+    titles: texts.map(function (t) { return [t.getAttribute('class'), t.textContent, box(t)]; }),
+    legend: legend ? box(legend.querySelector('.bg') || legend) : null,
+    plots: Array.from(gd.querySelectorAll('.nsewdrag')).map(box),
+    panels: L._subplots.cartesian.length,
+    annotations: (L.annotations || []).map(function (a) { return a.text; }),
+    colors: Array.from(new Set(gd.data.map(function (t) {
+      return (t.marker && t.marker.color) || (t.line && t.line.color);
+    })))
+  };
+});
+return out;
+"""
+
+
+def _overlap(a, b) -> bool:
+    return a[0] < b[2] and b[0] < a[2] and a[1] < b[3] and b[1] < a[3]
+
+
+def _draw(browser, report) -> dict:
+    browser.get(report.as_uri())
+    browser.set_script_timeout(30)
+    drawn = browser.execute_async_script(
+        "var done = arguments[0], t0 = Date.now();"
+        "(function poll(){ var d = document.querySelectorAll('.plotly-figure');"
+        " var ok = Array.from(d).every(e => e.querySelector('svg.main-svg'));"
+        " if (ok || Date.now() - t0 > 20000) done(ok); else setTimeout(poll, 100);"
+        "})();"
+    )
+    assert drawn
+    return browser.execute_script(_LAYOUT_JS)
+
+
+@pytest.mark.slow  # 19-25 s each measured under load (the page holds plotly.js, 4 MB)
+@pytest.mark.parametrize("which", ["report", "banded_report"])
+def test_what_a_person_sees_legends_units_and_panels(browser, which, request, tmp_path):
+    figures = _draw(browser, request.getfixturevalue(which))
+    if which == "banded_report":  # the small multiples, as a CI artefact to look at
+        browser.execute_script(
+            "document.getElementById('plotly-friction_vs_velocity').scrollIntoView()"
+        )
+        shot = tmp_path / "report-banded.png"
+        assert browser.save_screenshot(str(shot))
+        artefacts = os.environ.get("FRICID_ARTIFACTS")
+        if artefacts:
+            Path(artefacts).mkdir(parents=True, exist_ok=True)
+            shutil.copy(shot, Path(artefacts) / "report-banded.png")
+    assert {"plotly-friction_vs_velocity", "plotly-residuals"} <= set(figures)
+    for name, fig in figures.items():
+        for key, title, _type, _matches in fig["axes"]:  # every axis titled, with its unit
+            assert re.search(r"\[[^\]]+\]", title), (name, key, title)
+        assert len(fig["titles"]) == len(fig["axes"]), (name, fig["titles"])
+        for cls, text, rect in fig["titles"]:  # drawn, and clear of the legend
+            assert text and rect[2] > rect[0] and rect[3] > rect[1], (name, cls)
+            assert fig["legend"] is None or not _overlap(fig["legend"], rect), (name, text)
+        for rect in fig["plots"]:  # the legend covers no data either
+            assert fig["legend"] is None or not _overlap(fig["legend"], rect), name
+    friction = figures["plotly-friction_vs_velocity"]
+    residuals = figures["plotly-residuals"]
+    assert len(friction["colors"]) == 2  # a colour per direction, whatever the bands
+    if which == "banded_report":  # 3 loads x 3 temperatures: one panel each, shared axes
+        assert friction["panels"] == 9 and len(friction["plots"]) == 9
+        assert len(set(friction["annotations"])) == 9
+        assert all("load" in a and "°C" in a for a in friction["annotations"])
+        shared = [m for _k, _t, _ty, m in friction["axes"]]
+        assert shared.count(None) == 2 and set(shared) == {None, "x", "y"}
+        titles = [t for _k, t, _ty, _m in residuals["axes"] if _k.startswith("x")]
+        assert residuals["panels"] == 3 and len(titles) == 3
+        assert titles[0].startswith("speed |velocity| [rad/s], log scale")
+        assert titles[1:] == ["load [N m]", "temperature [°C]"]
+    else:  # one band: one panel
+        assert friction["panels"] == 1 and residuals["panels"] == 1
+    speed = next(a for a in residuals["axes"] if a[0] == "xaxis")
+    assert speed[2] == "log"  # the speeds span three decades: the PNG's log axis
 
 
 def test_report_in_a_real_browser(browser, report, tmp_path):

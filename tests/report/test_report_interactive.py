@@ -86,3 +86,52 @@ def test_stribeck_range():
     assert stribeck_range(v, {"w_s": 0.02}) == pytest.approx((0.008, 0.4))
     assert stribeck_range(v, {"w_s": 0.5}) is None  # 20 w_s beyond the data: all of it
     assert stribeck_range(v, {}) is None
+
+
+def test_small_multiples_per_band_and_residuals_against_every_input():
+    """One panel per load and temperature band with shared axes and a colour per direction
+    (not one colour per band, which repeated past the palette); the residuals against every
+    input that varies, the speed on the log axis the PNG uses."""
+    from fricid.report.interactive import friction_figure, residual_figure
+
+    v0 = np.geomspace(0.005, 2.0, 6)
+    v, load, temp = (
+        a.ravel() for a in np.meshgrid(np.concatenate([v0, -v0]), [0.0, 0.5, 1.0], [20, 35, 50])
+    )
+    f = np.sign(v) * (0.1 + 0.05 * load + 0.02 * np.abs(v)) * (1 - 0.004 * (temp - 20))
+    samples = FrictionSamples(
+        velocity=v, load=load, temperature=temp, friction=f, direction=np.sign(v).astype(int)
+    )
+    spec = json.loads(friction_figure(samples, lambda X: np.sign(X[:, 0]) * 0.1))
+    layout = spec["layout"]
+    xaxes = sorted(k for k in layout if re.fullmatch(r"xaxis\d*", k))
+    yaxes = sorted(k for k in layout if re.fullmatch(r"yaxis\d*", k))
+    assert len(xaxes) == len(yaxes) == 9
+    assert [layout[k].get("matches") for k in xaxes].count("x") == 8  # shared
+    assert [layout[k].get("matches") for k in yaxes].count("y") == 8
+    assert all(layout[k]["title"]["text"].endswith("[rad/s], log scale") for k in xaxes)
+    labels = [a["text"] for a in layout["annotations"]]
+    assert "load 0.5 N m, 35 °C" in labels and len(set(labels)) == 9
+    colors = {t.get("marker", t.get("line", {})).get("color") for t in spec["data"]}
+    assert len(colors) == 2
+    assert sum(t["showlegend"] for t in spec["data"]) == 4  # each entry once
+    assert layout["legend"]["x"] > 1  # beside the panels, clear of the axis titles
+    res = json.loads(residual_figure(samples, f - np.sign(v) * 0.1))
+    titles = [res["layout"][k]["title"]["text"] for k in ("xaxis", "xaxis2", "xaxis3")]
+    assert titles == ["speed |velocity| [rad/s], log scale", "load [N m]", "temperature [°C]"]
+    assert res["layout"]["xaxis"]["type"] == "log"
+    assert res["layout"]["yaxis2"]["matches"] == "y"
+    assert len(res["layout"]["shapes"]) == 6  # ±2 RMSE in each panel
+
+
+def test_samples_without_load_or_temperature_are_drawn():
+    """Load and temperature not measured (NaN): one panel, with the samples and the model
+    (a band of NaN used to select nothing, leaving the chart empty)."""
+    from fricid.report.interactive import friction_figure
+
+    v = np.geomspace(0.01, 1.0, 8)
+    v = np.concatenate([v, -v])
+    samples = FrictionSamples(v, None, None, np.sign(v) * (0.1 + 0.02 * np.abs(v)))
+    spec = json.loads(friction_figure(samples, lambda X: np.sign(X[:, 0]) * 0.1))
+    assert [len(t["x"]) for t in spec["data"] if t["mode"] == "markers"] == [8, 8]
+    assert "xaxis" in spec["layout"] and "xaxis2" not in spec["layout"]

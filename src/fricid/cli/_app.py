@@ -428,9 +428,29 @@ def _root(
             "--quiet); results, warnings and errors still print."
         ),
     ),
+    delimiter: str | None = typer.Option(
+        None,
+        "--delimiter",
+        help="Field delimiter of every CSV file read: ',', ';' or tab (also: comma, "
+        "semicolon, tab). Default: detected from each file's header and first data line.",
+    ),
+    decimal: str | None = typer.Option(
+        None,
+        "--decimal",
+        help="Decimal mark of every CSV file read: '.' or ',' (with --delimiter ';' or tab). "
+        "Default: detected (a decimal comma when the data are written 0,25 and never 0.25).",
+    ),
 ) -> None:
     """Identify the friction of robot joints."""
     set_quiet(quiet)
+    if delimiter is not None or decimal is not None:
+        from ..io import csv_dialect
+
+        try:
+            ctx.with_resource(csv_dialect(delimiter, decimal))
+        except FricidError as exc:
+            err_console.print(f"[bold red]error:[/] {escape(str(exc))}", highlight=False)
+            raise typer.Exit(code=2) from None
     if reproducible and not os.environ.get("SOURCE_DATE_EPOCH", "").strip():
         previous = os.environ.get("SOURCE_DATE_EPOCH")
         os.environ["SOURCE_DATE_EPOCH"] = "0"  # read by fricid.io.atomic.created_timestamp

@@ -8,9 +8,10 @@ One display, three modes, chosen per run:
   :data:`GRACE_S` seconds, then one each time another tenth of the work is done (at most every
   :data:`MIN_GAP_S` seconds) and at least every three :data:`HEARTBEAT_S` (every
   :data:`HEARTBEAT_S` seconds when the total is unknown), each with the elapsed time and, when
-  the total is known, an estimate of the time left; a line when a new stage starts; and a
-  last ``done`` line. Steps that finish within :data:`GRACE_S` print nothing, so quick commands
-  stay quiet in scripts::
+  the total is known and the rate of the completed work is (:mod:`fricid.cli._estimate`), an
+  estimate of the time left, "about", corrected at every line; a line when a new stage
+  starts; and a last ``done`` line. Steps that finish within :data:`GRACE_S` print nothing,
+  so quick commands stay quiet in scripts::
 
       [   2.0 s] simulating: 4/35 (11 %), about 15 s left
       [  17.4 s] simulating: done (35/35)
@@ -38,10 +39,10 @@ from rich.progress import (
     Progress,
     TextColumn,
     TimeElapsedColumn,
-    TimeRemainingColumn,
 )
 
 from ._app import err_console, is_quiet, set_quiet
+from ._estimate import Estimator
 
 __all__ = [
     "GRACE_S",
@@ -99,16 +100,28 @@ class Tracker:
     """
 
     def __init__(
-        self, label: str, total: float | None, mode: str, bar: Any = None, unit: str = ""
+        self,
+        label: str,
+        total: float | None,
+        mode: str,
+        bar: Any = None,
+        unit: str = "",
+        clock: Callable[[], float] = time.perf_counter,
+        timed: bool = True,
     ) -> None:
         self.label = self.title = label
         self.unit = unit
         self.total = total
         self.done = 0.0
         self.mode = mode
+        self._clock = clock
+        #: Whether the count can time what is left: False for steps of unequal cost (a
+        #: paper's tables and figures, a trajectory's routes), whose rate is never known.
+        self.timed = timed
+        self._est = Estimator(total, clock)
         self._bar = bar
-        self._task = bar.add_task(escape(label), total=total) if bar is not None else None
-        self._start = time.perf_counter()
+        self._task = bar.add_task(escape(label), total=total, left="") if bar is not None else None
+        self._start = clock()
         self._last_line = -float("inf")
         self._last_tenth = -1
         self._printed = False
@@ -117,13 +130,16 @@ class Tracker:
     @property
     def elapsed(self) -> float:
         """Seconds since the step started."""
-        return time.perf_counter() - self._start
+        return self._clock() - self._start
 
     def estimate(self) -> float | None:
-        """Seconds left, from the rate so far; None when the total is unknown or nothing done."""
-        if not self.total or self.done <= 0:
-            return None
-        return self.elapsed * max(self.total - self.done, 0.0) / self.done
+        """Seconds left, from the rate of the completed work (:class:`Estimator`); None until
+        that rate is known, when the total is unknown, and for steps of unequal cost."""
+        return self._est.remaining() if self.timed else None
+
+    def _left(self) -> str:
+        left = self.estimate()
+        return f"about {_seconds(left)} left" if left else ""
 
     def line(self) -> str:
         """The plain line for the state now (without the time stamp)."""
@@ -132,9 +148,8 @@ class Tracker:
             count = (
                 f"{self.done:,.0f}/{self.total:,.0f}{unit} ({100 * self.done / self.total:.0f} %)"
             )
-            left = self.estimate()
-            tail = f", about {_seconds(left)} left" if left and self.done < self.total else ""
-            return f"{self.label}: {count}{tail}"
+            left = self._left() if self.done < self.total else ""
+            return f"{self.label}: {count}" + (f", {left}" if left else "")
         if self.done:
             return f"{self.label}: {self.done:,.0f}{unit} so far"
         return f"{self.label}: still running" if self._printed else self.label
@@ -171,8 +186,9 @@ class Tracker:
         if total is not None:
             self.total = total
         self.done = float(min(done, self.total) if self.total else done)
+        self._est.observe(self.done, self.total)
         if self._bar is not None:
-            self._bar.update(self._task, completed=self.done, total=self.total)
+            self._bar.update(self._task, completed=self.done, total=self.total, left=self._left())
         self._maybe_print()
 
     def advance(self, n: float = 1) -> None:
@@ -188,16 +204,23 @@ class Tracker:
         self.label = label
         if restart:
             self.total, self.done, self.unit = None, 0.0, ""
+            self._est = Estimator(None, self._clock)
         if done is not None:
             self.done = float(done)
+            self._est.observe(self.done, self.total)
         if self._bar is not None:
             self._bar.update(
-                self._task, description=escape(label), completed=self.done, total=self.total
+                self._task,
+                description=escape(label),
+                completed=self.done,
+                total=self.total,
+                left=self._left(),
             )
         if self.mode == "plain" and (force or self.elapsed >= GRACE_S):
             with self._lock:
                 self._last_tenth = int(10 * self.done / self.total) if self.total else -1
-                self._emit(self.line())
+                # a new stage names itself; "still running" is for the heartbeat lines
+                self._emit(self.line() if self.total or self.done else label)
 
     def heartbeat(self) -> None:
         """Called every second by the plain mode's timer: a line when one is due."""
@@ -218,7 +241,12 @@ class Tracker:
 
 @contextmanager
 def tracker(
-    label: str, total: float | None = None, *, unit: str = "", quiet: bool = False
+    label: str,
+    total: float | None = None,
+    *,
+    unit: str = "",
+    quiet: bool = False,
+    timed: bool = True,
 ) -> Iterator[Tracker]:
     """Progress of one step on stderr; yields a :class:`Tracker`.
 
@@ -232,12 +260,15 @@ def tracker(
         What is counted ("chunks", "evaluations"), for the plain lines.
     quiet : bool, default False
         No output (also when ``--quiet`` was given to ``fricid`` itself).
+    timed : bool, default True
+        False: a count of steps of unequal cost, shown without a time left (their rate
+        says nothing of the time the rest takes).
     """
     if quiet or is_quiet():
-        yield Tracker(label, total, "quiet", unit=unit)
+        yield Tracker(label, total, "quiet", unit=unit, timed=timed)
         return
     if not err_console.is_terminal:
-        t = Tracker(label, total, "plain", unit=unit)
+        t = Tracker(label, total, "plain", unit=unit, timed=timed)
         stop = threading.Event()
 
         def beat() -> None:
@@ -258,12 +289,11 @@ def tracker(
         BarColumn(),
         MofNCompleteColumn(),
         TimeElapsedColumn(),
-        TextColumn("left"),
-        TimeRemainingColumn(),
+        TextColumn("{task.fields[left]}"),
         console=err_console,
         transient=True,
     ) as bar:
-        yield Tracker(label, total, "terminal", bar, unit=unit)
+        yield Tracker(label, total, "terminal", bar, unit=unit, timed=timed)
 
 
 @contextmanager

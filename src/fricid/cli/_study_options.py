@@ -47,18 +47,21 @@ def seed_option(help: str, *, non_negative: bool = False) -> Any:
 
 
 @contextlib.contextmanager
-def study_progress(t0: float | None = None) -> Iterator[tuple[Callable[[str], None], Any]]:
+def study_progress(
+    t0: float | None = None, *, quiet: bool = False
+) -> Iterator[tuple[Callable[[str], None], Any]]:
     """A progress display on stderr for a long study (:func:`fricid.cli._progress.tracker`).
 
     Yields ``(progress, status)``: ``progress(message)`` names the stage under way (on a
     terminal, the bar's label; otherwise a line with the seconds since the start, and a line at
     least every 10 s while a stage runs); ``status.update(message)`` does the same for a last
-    message such as "writing ...". Nothing with ``fricid --quiet``. ``t0`` is accepted for the
-    callers' own total time (:func:`print_written`).
+    message such as "writing ...". Nothing with ``quiet`` (the command's ``--quiet``) or
+    ``fricid --quiet``. ``t0`` is accepted for the callers' own total time
+    (:func:`print_written`).
     """
     from ._progress import tracker
 
-    with tracker("study", None) as t:
+    with tracker("study", None, quiet=quiet) as t:
 
         def progress(msg: str) -> None:
             t.stage(msg, force=True)

@@ -10,6 +10,7 @@ import typer
 from rich.markup import escape
 
 from ._app import bench_app, console, handle_errors
+from ._progress import QuietOption
 from ._study_options import out_option, print_written, quick_option, seed_option, study_progress
 
 
@@ -38,6 +39,7 @@ def stribeck_command(
     seed: Annotated[
         int, seed_option("Base seed of the runs (run r uses seed + r).", non_negative=True)
     ] = 0,
+    quiet: QuietOption = False,
 ) -> None:
     """Compare the optimisers of the RWSAVSBAS paper's Table 1 and Fig. 6 on the simulated
     paper2 preset, at equal budgets first.
@@ -50,7 +52,7 @@ def stribeck_command(
     the exact global optimum (variable projection), evaluations and wall time. Then the
     readings of RWSAVSBAS the paper leaves open, bas+lm against lm from the same random
     starts, and RWSAVSBAS's compiled loop against evaluating as many candidates in batches.
-    Progress goes to stderr.
+    Progress goes to stderr (--quiet: none).
 
     Budgets rather than times: 8 runs per method; RWSAVSBAS 1000 x 100 iterations (301,001
     evaluations per run) and every equal-budget row as many; dual annealing and CMA-ES
@@ -61,7 +63,7 @@ def stribeck_command(
 
     t0 = time.perf_counter()
     written = None
-    with study_progress(t0) as (progress, status):
+    with study_progress(t0, quiet=quiet) as (progress, status):
         result = run_study(seed=seed, runs=runs, quick=quick, progress=progress)
         if out is not None:
             status.update(f"writing {escape(str(out))}")

@@ -10,6 +10,7 @@ import typer
 from rich.markup import escape
 
 from ._app import bench_app, console, handle_errors
+from ._progress import QuietOption
 from ._study_options import out_option, print_written, quick_option, seed_option, study_progress
 
 
@@ -46,6 +47,7 @@ def rbfnn_command(
         int | None,
         typer.Option(min=1, help="Epoch budget of BAS and GA (default 300; --quick 60)."),
     ] = None,
+    quiet: QuietOption = False,
 ) -> None:
     """Reproduce the BAS-RBFNN paper's network study on the simulated paper1 preset.
 
@@ -54,10 +56,11 @@ def rbfnn_command(
     paper, and out of fold; with scikit-learn's MLP and Gaussian process beside them),
     Table 4 (GA-RBFNN against BAS-RBFNN: epochs to the target MSE over several seeds),
     Fig. 10's errors in the unseen region, training times, and the performance targets,
-    each with the paper's number beside ours. Errors are in mN m. Progress goes to stderr.
-    BAS's, GA's and the MLP's settings are first tuned on another noise draw and other seeds
-    than those reported (3 settings each; BAS and GA 2 seeds x 60 epochs x 30 evaluations per
-    setting, --quick 20 epochs), and the search's own gain over its start is reported.
+    each with the paper's number beside ours. Errors are in mN m. Progress goes to stderr
+    (--quiet: none). BAS's, GA's and the MLP's settings are first tuned on another noise
+    draw and other seeds than those reported (3 settings each; BAS and GA 2 seeds x 60
+    epochs x 30 evaluations per setting, --quick 20 epochs), and the search's own gain over
+    its start is reported.
 
     Budgets rather than times: Table 4 runs 5 seeds x 300 epochs x 30 evaluations per method
     (7 methods with the variants), on 6615 samples; benchmarks/bench_rbfnn.py times it.
@@ -75,7 +78,7 @@ def rbfnn_command(
     cfg = study_config(quick, seed=seed, **changes)
     t0 = time.perf_counter()
     written = None
-    with study_progress(t0) as (progress, status):
+    with study_progress(t0, quiet=quiet) as (progress, status):
         result = run_study(cfg, progress=progress)
         if out is not None:
             status.update(f"writing {escape(str(out))}")

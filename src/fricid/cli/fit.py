@@ -59,12 +59,14 @@ def fit_command(
         ),
     ] = "stribeck",
     method: Annotated[
-        str,
+        str | None,
         typer.Option(
             help="Optimiser (see `fricid methods`): lm, varpro (exact optimum by variable "
-            "projection), trf, bas, vsbas, ibas, rwsavsbas, ga, de, cmaes, bas+lm, ..."
+            "projection), trf, bas, vsbas, ibas, rwsavsbas, ga, de, cmaes, bas+lm, ... "
+            "Default: lm for the analytic models (and --trajectory), lsq for rbf and hybrid "
+            "(their trainers: lsq, bas or ga)."
         ),
-    ] = "lm",
+    ] = None,
     fix: FixOption = None,
     bound: BoundOption = None,
     seed: SeedOption = 0,
@@ -200,6 +202,9 @@ def fit_command(
     per tenth of the evaluation budget with the time left (population methods) or every few
     seconds; --quiet: none.
     """
+    key = model.strip().lower()
+    rbf = key in ("rbf", "hybrid")
+    method = method or ("lsq" if rbf else "lm")
     if trajectory:  # delegated (cli/trajectory.py)
         from .trajectory import parse_reader_options, run_trajectory
 
@@ -215,14 +220,13 @@ def fit_command(
             route=route,
             gravity="fit",
             out=out,
+            quiet=quiet,
         )
     from ..io import read_samples
     from ..workflow import fit_samples, select_direction
 
     check_paths(inputs={"SAMPLES": samples}, out_files={"--out": out})
     data = select_direction(read_samples(samples), direction)
-    key = model.strip().lower()
-    rbf = key in ("rbf", "hybrid")
     settings = _rbf_settings(centers, inputs, backbone if key == "hybrid" else None) if rbf else {}
     if key == "auto" and learned:
         settings["learned"] = True
@@ -236,6 +240,8 @@ def fit_command(
         ),
     ):
         warnings.simplefilter("always")
+        if key == "auto":
+            settings["progress"] = _auto_progress(track)
         fitted, trust = fit_samples(
             data,
             model,
@@ -264,6 +270,20 @@ def fit_command(
     for w in caught:  # shown as the CLI shows every warning (one line on stderr)
         warnings.showwarning(w.message, w.category, w.filename, w.lineno)
     err_console.print(f"wrote {escape(str(out))}")
+
+
+def _auto_progress(track):
+    """``--model auto``'s progress: the candidate under way and its place in the list
+    (``auto: 3/9 stribeck_temp``), the count of candidates validated, and the time left once
+    the rate of the validated ones is known."""
+
+    def progress(i: int, n: int, label: str) -> None:
+        track.total = float(n)
+        head = f"auto: {i + 1}/{n} {label}" if i < n else f"auto: {label}"
+        track.stage(head, done=i)
+
+    track.unit = "validated"
+    return progress
 
 
 def trust_lines(trust) -> str:
@@ -357,12 +377,15 @@ def goodness_text(fitted, samples=None) -> str:
             err = r.get("heldout_rmse")
             cell = f"{err:.4g} N m" if err is not None else "-"
             lines.append(f"    {r['model']:<22} {r['n_params']:>3} par  {cell:>14}  {r['note']}")
+        if sel.get("advice"):
+            lines.append(f"    advice: {sel['advice']}")
     return "\n".join(lines)
 
 
 def _rbf_trainer(method: str) -> str:
-    """The RBF network's trainer: lsq (k-means, widths, ridge weights; what the command's
-    default --method lm selects for these models), bas (BAS-RBFNN) or ga (GA-RBFNN)."""
+    """The RBF network's trainer: lsq (k-means, widths, ridge weights; the default for these
+    models; ``lm``, the analytic models' default, is read as lsq), bas (BAS-RBFNN) or ga
+    (GA-RBFNN)."""
     from ..errors import ConfigError
 
     trainer = "lsq" if method == "lm" else method
@@ -386,44 +409,60 @@ def _rbf_settings(centers: int | None, inputs: str | None, backbone: str | None 
 
 @app.command("methods")
 def methods_command() -> None:
-    """List the models (analytic, then those that predict from a stored state such as the RBF
-    network) and the optimisers, with a line on each."""
+    """List every model (analytic with its _temp variants, dynamic, learned) and every
+    optimiser, one line each, from the registries (fricid.models, fricid.optim)."""
+    from rich.markup import escape as esc
+
+    for line in methods_lines():
+        bold = not line.startswith(" ")
+        console.print(f"[bold]{esc(line)}[/]" if bold else esc(line), highlight=False)
+
+
+def methods_lines() -> list[str]:
+    """The lines of ``fricid methods``: a heading, then one line per model or optimiser,
+    every name taken from the registries (:data:`fricid.models.MODELS`, ``DYNAMIC``,
+    ``STATEFUL``; :data:`fricid.optim.METHODS`) so that a family registered there is listed."""
+    from ..errors import ConfigError
     from ..identify.static.varpro import SUMMARY
-    from ..models import MODELS, STATEFUL
+    from ..models import DYNAMIC, MODELS, STATEFUL, get_model
     from ..optim import METHODS
 
-    console.print("[bold]Models[/] (append _asym for per-direction parameters):")
+    lines = ["Analytic models (append _asym for parameters per direction):"]
     for name, cls in MODELS.items():
         m = cls()
-        console.print(
-            f"  {name:<16} {m.title}; {m.equation}; parameters {', '.join(m.param_names)}",
-            highlight=False,
-        )
-    for line in stateful_model_lines(STATEFUL):
-        console.print(line, highlight=False, markup=False)
-    console.print(
-        f"  {'auto':<16} the analytic family chosen by held-out error (--validate)",
-        highlight=False,
-    )
-    console.print("[bold]Methods[/]:")
-    for name, cls in METHODS.items():
-        console.print(f"  {name:<16} {cls.summary}", highlight=False)
-    console.print(f"  {'varpro':<16} {SUMMARY}", highlight=False)
+        lines.append(f"  {name:<22} {m.title}; {m.equation}; parameters {', '.join(m.param_names)}")
+    for name in MODELS:
+        try:
+            m = get_model(f"{name}_temp")
+        except ConfigError:  # a family with no viscous term (vlt has its own temperature terms)
+            continue
+        extra = [p for p in m.param_names if p not in get_model(name).param_names]
+        lines.append(f"  {m.name:<22} {m.title}; extra parameter {', '.join(extra)}")
+    lines.append("Dynamic models (fit --trajectory: identified from a log of any motion):")
+    for name, cls in DYNAMIC.items():
+        m = cls()
+        lines.append(f"  {name:<22} {m.title}; {m.equation}; parameters {', '.join(m.param_names)}")
+    lines.append("Learned models (a stored state, no named parameters):")
+    lines += stateful_model_lines(STATEFUL)
+    lines.append(f"  {'auto':<22} the family chosen by held-out error (--learned: rbf, hybrid too)")
+    lines.append("Optimisers (--method):")
+    lines += [f"  {name:<22} {cls.summary}" for name, cls in METHODS.items()]
+    lines.append(f"  {'varpro':<22} {SUMMARY}")
+    return lines
 
 
 def stateful_model_lines(stateful: dict) -> list[str]:
-    """One line per model of ``fricid.models.STATEFUL`` (the RBF network, and any model a
-    later registration adds), for ``fricid methods``: name, title, equation, inputs."""
+    """One line per model of ``fricid.models.STATEFUL`` (the RBF network, the hybrid, the
+    Gaussian process, and any model a later registration adds): name, title, inputs."""
     lines = []
     for name, m in stateful.items():
         title = getattr(m, "title", "") or type(m).__name__
         equation = getattr(m, "equation", "")
         inputs = getattr(m, "inputs", None)
         bits = [title] + ([equation] if equation else [])
-        bits.append("stored state, no named parameters")
         if inputs:
             bits.append("inputs " + ", ".join(inputs))
-        if name == "rbf":
-            bits.append("trained with --method lsq, bas (BAS-RBFNN) or ga (GA-RBFNN)")
-        lines.append(f"  {name:<16} " + "; ".join(bits))
+        if name in ("rbf", "hybrid"):
+            bits.append("trained with --method lsq (default), bas (BAS-RBFNN) or ga (GA-RBFNN)")
+        lines.append(f"  {name:<22} " + "; ".join(bits))
     return lines

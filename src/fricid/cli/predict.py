@@ -12,6 +12,9 @@ import typer
 from ._app import app, err_console, handle_errors
 from ._paths import check_paths
 
+#: Significant digits of ``predict``'s numbers on a terminal (read by eye).
+DISPLAY_DIGITS = 6
+
 
 def _unit_help(quantity: str) -> str:
     from ..units import SI_UNITS, UNITS
@@ -87,6 +90,16 @@ def predict_command(
             "hybrid: levels 0.9 and 0.95)."
         ),
     ] = None,
+    digits: Annotated[
+        int | None,
+        typer.Option(
+            min=1,
+            max=17,
+            help="Significant digits of the numbers written. Default: on a terminal 6; into a "
+            "file or a pipe every number exact, in the fewest digits that read back to the "
+            "same value (0.2, not 0.20000000000000001).",
+        ),
+    ] = None,
 ) -> None:
     """Friction of a model at operating points: CSV with velocity, load, temperature and
     friction columns, each labelled with its unit.
@@ -150,7 +163,9 @@ def predict_command(
             half = fitted.predict_interval(X, interval, warn=False).half_width
             extra = {"low": friction - half, "high": friction + half}
     units["friction"] = friction_unit
-    text = points_table(X, friction, units, extra)
+    if digits is None and out is None and sys.stdout.isatty():
+        digits = DISPLAY_DIGITS
+    text = points_table(X, friction, units, extra, digits)
     if out is None:
         sys.stdout.write(text)
         sys.stdout.flush()

@@ -9,6 +9,7 @@ import typer
 
 from ._app import app, console, err_console, handle_errors
 from ._paths import check_paths
+from ._progress import QuietOption, tracker
 from ._study_options import out_option, seed_option
 
 
@@ -49,6 +50,7 @@ def report_command(
             "options (--validate, the default, as fit computes it).",
         ),
     ] = True,
+    quiet: QuietOption = False,
 ) -> None:
     """Write a report of MODEL on SAMPLES: first "Can I trust this?" (a one-line verdict, data
     quality per set-point, convergence, identifiability, held-out error against the
@@ -61,7 +63,9 @@ def report_command(
     options, else computed now; the report renders it and computes no verdict of its own.
 
     Outputs in the folder: report.html (self-contained), report.md, one CSV per table and one
-    PNG per figure, written all or nothing.
+    PNG per figure, written all or nothing. Progress goes to stderr (the part being built:
+    the trust record and its validation, each figure, the parameters, writing; no time left,
+    the parts differ too much in cost to time one by another); --quiet: none.
     """
     from ..errors import ConfigError
     from ..fitted import FittedModel
@@ -78,7 +82,12 @@ def report_command(
     fitted = FittedModel.load(model)
     data = read_samples(samples)
     out = out or Path(f"{model.stem}-report")
-    with err_console.status("building the report", spinner="dots"):
+    with tracker("report", None, quiet=quiet, timed=False) as track:
+
+        def progress(part: str) -> None:
+            track.stage(f"report: {part}")
+
+        progress("the trust record (held-out validation when the model file has none)")
         trust = assess_trust(fitted, data, validate=validate)
         doc = model_report(
             fitted,
@@ -88,7 +97,9 @@ def report_command(
             bootstrap=bootstrap,
             seed=seed,
             samples_label=samples.name,
+            progress=progress,
         )
+        progress(f"writing {out}/")
         path = write_document(doc, out)
     console.print(str(path), highlight=False, soft_wrap=True)
     err_console.print(str(doc.meta["trust"]), markup=False, highlight=False, soft_wrap=True)

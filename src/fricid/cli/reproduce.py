@@ -34,12 +34,15 @@ def reproduce_command(
 
     Writes report.html (self-contained), report.md, one CSV per table and one PNG per figure
     into the folder, all or nothing. Progress is shown on stderr (a bar on a terminal,
-    otherwise a line per step and at least every 30 s, with the time left; --quiet: none).
+    otherwise a line per step and at least every 30 s; no time left: the steps differ too
+    much in cost for one to time another; --quiet: none).
     """
     from ..report.reproduce import paper_steps, reproduce
 
     steps = paper_steps(paper)
-    with tracker(paper, total=len(steps), unit="steps done", quiet=quiet) as bar:
+    # steps of very unequal cost (a study, then its tables): counted, never timed one by
+    # another (a time left from them was off by minutes)
+    with tracker(paper, total=len(steps), unit="steps done", quiet=quiet, timed=False) as bar:
         seen: list[str] = []
 
         def progress(label: str) -> None:

@@ -17,6 +17,7 @@ from rich.markup import escape
 
 from ..errors import ConfigError, DataError
 from ._app import console, err_console
+from ._progress import tracker
 
 __all__ = ["parse_reader_options", "run_trajectory", "trajectory_text"]
 
@@ -111,8 +112,10 @@ def run_trajectory(
     route: str,
     gravity: str,
     out: Path | None,
+    quiet: bool = False,
 ) -> None:
-    """Open, identify, save and print (the ``--trajectory`` branch of ``fricid fit``)."""
+    """Open, identify, save and print (the ``--trajectory`` branch of ``fricid fit``), with
+    the stage under way on stderr (:func:`fricid.cli._progress.tracker`; ``quiet``: none)."""
     from ..identify import fit
     from ..io import open_log
     from ..samples import RawLog
@@ -126,15 +129,27 @@ def run_trajectory(
         )
     chunks = list(opened)
     log = chunks[0] if len(chunks) == 1 else RawLog.concatenate(chunks)
-    with warnings.catch_warnings(record=True) as caught:
+    label = f"identifying {model} from the trajectory"
+    with (
+        warnings.catch_warnings(record=True) as caught,
+        tracker(label, None, unit="stages", quiet=quiet, timed=False) as track,
+    ):
         warnings.simplefilter("always")
+
+        def progress(i: int, n: int, stage: str) -> None:
+            track.total = float(n)
+            if i < n:  # a line once past the grace (quick fits stay quiet)
+                track.stage(f"{label} [{i + 1}/{n}] {stage}", done=i)
+            else:
+                track.update(n)
+
         fitted = fit(
             log,
             model,
             method,
             seed=seed,
             max_evals=max_evals,
-            settings={"route": route, "gravity": gravity},
+            settings={"route": route, "gravity": gravity, "progress": progress},
         )
     lines = [f"{w.category.__name__}: {w.message}" for w in caught]
     if lines:

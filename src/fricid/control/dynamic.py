@@ -42,7 +42,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import ConfigError, FricidWarning
+from ..errors import ConfigError, FricidWarning, user_stacklevel
 from ..fitted import FittedModel
 from ..models import lugre
 from .tracking import TrackingConfig
@@ -298,7 +298,7 @@ def lugre_compensation_study(
                 f"{what} is not passive (sigma_1 above 4 sigma_2 tau_c / (tau_s - tau_c), "
                 "Barabanov and Ortega 2000): it can feed energy into the joint"
             )
-            warnings.warn(notes[-1], FricidWarning, stacklevel=2)
+            warnings.warn(notes[-1], FricidWarning, stacklevel=user_stacklevel())
     mask = crossing_mask(config, crossing_window)
     if not (math.isfinite(velocity_noise) and velocity_noise >= 0):
         raise ConfigError(f"velocity_noise must be >= 0 rad/s, got {velocity_noise!r}")
@@ -332,6 +332,6 @@ def lugre_compensation_study(
                 f"{name} made tracking worse than PD only: RMS error "
                 f"{1e3 * result.rms[name]:.4g} against {1e3 * result.rms[RUNS[0]]:.4g} mrad",
                 FricidWarning,
-                stacklevel=2,
+                stacklevel=user_stacklevel(),
             )
     return result

@@ -44,7 +44,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import ConfigError, ExtrapolationWarning, FricidWarning
+from ..errors import ConfigError, ExtrapolationWarning, FricidWarning, user_stacklevel
 from ..fitted import FittedModel
 from .plant import static_step
 
@@ -409,7 +409,7 @@ def compensation_study(
             continue
         note = f"the reference goes outside the identified operating range: {bad.message}"
         notes.append(note)
-        warnings.warn(note, ExtrapolationWarning, stacklevel=2)
+        warnings.warn(note, ExtrapolationWarning, stacklevel=user_stacklevel())
     runs = simulate_tracking(truth.law, np.vstack([np.zeros_like(ff), ff]), config)
     err = np.abs(runs["error"])
     result = CompensationResult(
@@ -426,5 +426,5 @@ def compensation_study(
         notes=notes,
     )
     if result.rms["with"] > result.rms["without"]:
-        warnings.warn(result.verdict(), FricidWarning, stacklevel=2)
+        warnings.warn(result.verdict(), FricidWarning, stacklevel=user_stacklevel())
     return result

@@ -180,10 +180,15 @@ def points_table(
     friction: np.ndarray,
     units: Mapping[str, str],
     extra: Mapping[str, np.ndarray] | None = None,
+    digits: int | None = None,
 ) -> str:
     """CSV text of points and friction, each column in ``units`` (SI where not given) and
-    labelled with it; 17 significant digits. ``extra`` columns (e.g. a prediction interval's
-    ends) are torques [N m], written after the friction in its unit."""
+    labelled with it. ``extra`` columns (e.g. a prediction interval's ends) are torques [N m],
+    written after the friction in its unit.
+
+    ``digits`` None writes every number exactly in the fewest digits that read back to the
+    same float (``0.2``, not ``0.20000000000000001``); an int rounds to that many significant
+    digits (``%.{digits}g``), for reading by eye."""
     out_units = {
         "velocity": units.get("velocity") or SI_UNITS["velocity"],
         "load": units.get("load") or SI_UNITS["torque"],
@@ -199,5 +204,15 @@ def points_table(
     cols = [np.asarray(from_si(data[k], out_units[k], quantity[k]), dtype=float) for k in data]
     buf = io.StringIO()
     buf.write(",".join(f"{k} [{out_units[k]}]" for k in data) + "\n")
-    np.savetxt(buf, np.column_stack(cols), delimiter=",", fmt="%.17g")
+    if digits is not None:
+        np.savetxt(buf, np.column_stack(cols), delimiter=",", fmt=f"%.{int(digits)}g")
+        return buf.getvalue()
+    text = [[_shortest(x) for x in col.tolist()] for col in cols]  # Python's round-trip repr
+    buf.writelines(",".join(row) + "\n" for row in zip(*text, strict=True))
     return buf.getvalue()
+
+
+def _shortest(x: float) -> str:
+    """``x`` in the fewest digits that read back to the same float; whole numbers without
+    ``.0`` (``25``, as ``%g`` writes them)."""
+    return str(int(x)) if x.is_integer() and abs(x) < 1e16 else repr(x)

@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import DataQualityWarning
+from ..errors import DataQualityWarning, user_stacklevel
 
 __all__ = ["QUALITY_COLUMNS", "SCATTER_RATIO", "QualityTable", "flag_scatter", "warn_quality"]
 
@@ -307,7 +307,9 @@ def warn_quality(
     above its neighbours', samples were dropped as outliers or saturated, or the gravity fit
     left a pattern along the position (``gravity``, a
     :class:`~fricid.extract.gravity_check.GravityResidual`); the message names the file and
-    the set-points (at most five) and says what to do."""
+    the set-points (at most five) and says what to do. It points at the first caller outside
+    fricid (:func:`fricid.errors.user_stacklevel`; ``stacklevel`` is kept for callers that
+    pass it)."""
     parts = []
     if gravity is not None and gravity.message():
         parts.append(gravity.message())
@@ -333,4 +335,4 @@ def warn_quality(
             parts.append(f"dropped {int(counts.sum())} {what}: {names}{more}")
     if parts:
         message = where + ". ".join(parts) + " (see the quality table)"
-        warnings.warn(message, DataQualityWarning, stacklevel=stacklevel + 1)
+        warnings.warn(message, DataQualityWarning, stacklevel=user_stacklevel())

@@ -35,7 +35,7 @@ from typing import Any
 import numpy as np
 
 from .. import __version__
-from ..errors import ConfigError, DataError, ExtrapolationWarning, FricidError
+from ..errors import ConfigError, DataError, ExtrapolationWarning, FricidError, user_stacklevel
 from ..io._jsonfile import check_document, one_line, read_json
 from ..models import INPUTS, get_model, get_predictor
 from ..models._range import RANGE_TOLERANCE, RangeViolation, range_violations
@@ -254,7 +254,7 @@ class FittedModel:
     def _warn_range(self, X, stacklevel: int = 3) -> None:
         for bad in self.range_check(X):
             if bad.kind not in ("below", "gap"):
-                warnings.warn(bad.message, ExtrapolationWarning, stacklevel=stacklevel)
+                warnings.warn(bad.message, ExtrapolationWarning, stacklevel=user_stacklevel())
 
     def predict_point(self, velocity, load=0.0, temperature=25.0) -> np.ndarray:
         """Friction [N m] at broadcastable velocity [rad/s], load [N m], temperature [degC];
@@ -324,7 +324,8 @@ class FittedModel:
             First, for a fit that did not converge, a line ``NOT CONVERGED: <reason>; <what
             to do>``. ``[[Model]]``; ``[[Fit Statistics]]`` (method, evaluations, status,
             convergence as certified, data points, variables, chi-square, reduced chi-square,
-            AIC, BIC, R-squared); ``[[Variables]]`` (value +/- standard error (relative), the
+            AIC, BIC, R-squared, RMSE [N m]); ``[[Variables]]`` (value +/- standard error
+            (relative), the
             95 % interval ``[low, high]`` and how it was found, start, and the flags "fixed",
             "at boundary", "at initial value", "not determined", and the reason a parameter
             has no interval or a side reaches a bound), or ``[[Network]]`` for the RBF

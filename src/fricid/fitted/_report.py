@@ -55,6 +55,7 @@ def fit_report(fitted: Any, min_correl: float = MIN_CORREL) -> str:
         ("Akaike info crit", st.get("aic")),
         ("Bayesian info crit", st.get("bic")),
         ("R-squared", st.get("rsquared", fitted.metrics.get("fitness"))),
+        ("RMSE [N m]", fitted.metrics.get("rmse")),
     )
     lines += [f"    {k:<18} = {_num(v):.8g}" for k, v in rows if v is not None]
     model = get_predictor(fitted.model)

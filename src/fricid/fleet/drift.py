@@ -28,6 +28,13 @@ __all__ = ["Drift", "compare", "plot_drift", "write_drift"]
 
 _KEY = ["robot", "joint", "model"]
 
+#: The unit of each drift column that has one, as written in the CSV headers (the parameter
+#: rows' values are in each row's ``unit``; ratios are dimensionless: no unit).
+DRIFT_UNITS = {
+    "friction_change_max": "N m",
+    "friction_change_rms": "N m",
+}
+
 
 @dataclass(frozen=True, eq=False)
 class Drift:
@@ -281,7 +288,9 @@ def write_drift(drift: Drift, out: str | os.PathLike[str]) -> dict[str, Path]:
         "plot": require_real(out, ["drift.png"]),
     }
     for name in ("joints", "params"):
+        frame = getattr(drift, name)
+        labels = {c: f"{c} [{u}]" for c, u in DRIFT_UNITS.items() if c in frame}
         with atomic_write(paths[name], "w") as fh:
-            getattr(drift, name).to_csv(fh, index=False)
+            frame.rename(columns=labels).to_csv(fh, index=False)
     plot_drift(drift, paths["plot"])
     return paths

@@ -406,7 +406,9 @@ def read_manifest(path: str | os.PathLike[str]) -> Manifest:
     DataError
         Naming the manifest, the row (line) and the column: an unknown column, a missing unit,
         a bad value (unknown model, method or reader, a non-number, ...), a missing required
-        value (robot, joint, log), an option of another reader, a joint listed twice.
+        value (robot, joint, log), an option of another reader, a joint listed twice. Every
+        row is checked: problems in several rows are told at once, in one error listing
+        each (its ``problems`` attribute holds them).
     ConfigError
         A file whose suffix is not ``.csv``, ``.yaml`` or ``.yml``.
     """
@@ -428,17 +430,43 @@ def read_manifest(path: str | os.PathLike[str]) -> Manifest:
         raise DataError("the manifest lists no joints", file=path)
     joints: list[JointSpec] = []
     first_row: dict[str, int | None] = {}
+    problems: list[DataError] = []
     for row, mapping in entries:
         entry = Entry(row, dict(defaults.values), dict(defaults.raw), dict(defaults.labels))
         entry.units = dict(defaults.units)
-        spec = _spec(read_entry(mapping, path, row, entry), path)
+        try:
+            spec = _spec(read_entry(mapping, path, row, entry), path)
+        except DataError as exc:  # every row is checked: all problems are told at once
+            problems.append(exc)
+            continue
         if spec.key in first_row:
-            raise DataError(
-                f"joint {spec.key} is listed twice (also at row {first_row[spec.key]})",
-                file=path,
-                row=row,
-                column="joint",
+            problems.append(
+                DataError(
+                    f"joint {spec.key} is listed twice (also at row {first_row[spec.key]})",
+                    file=path,
+                    row=row,
+                    column="joint",
+                )
             )
+            continue
         first_row[spec.key] = row
         joints.append(spec)
+    if problems:
+        raise _all_problems(problems, path)
     return Manifest(path, tuple(joints))
+
+
+def _all_problems(problems: list[DataError], path: Path) -> DataError:
+    """One error for the rows' problems: the problem itself when there is one, else one
+    naming the manifest and listing each (row, column, what), in file order, in its
+    ``problems`` attribute too."""
+    if len(problems) == 1:
+        return problems[0]
+    parts = []
+    for p in problems:
+        where = [f"row {p.row}"] if p.row is not None else []
+        where += [f"column '{p.column}'"] if p.column is not None else []
+        parts.append(f"{', '.join(where)}: {p.message}" if where else p.message)
+    error = DataError(f"{len(problems)} problems: " + "; ".join(parts), file=path)
+    error.problems = list(problems)
+    return error

@@ -42,7 +42,7 @@ from pathlib import Path
 from typing import Any
 
 from .. import __version__
-from ..errors import ConfigError, DataQualityWarning
+from ..errors import ConfigError, DataQualityWarning, user_stacklevel
 from ..io import atomic_write
 from ..io.atomic import pid_alive, remove_stale
 from ._fs import kind_of, model_parts, read_regular, record_parts, require_real
@@ -233,7 +233,7 @@ class FleetStore:
         warnings.warn(
             f"ignoring the record {path}: {why}; the joint runs again",
             DataQualityWarning,
-            stacklevel=3,
+            stacklevel=user_stacklevel(),
         )
 
     def load(self, spec: JointSpec) -> dict[str, Any] | None:
@@ -302,7 +302,7 @@ class FleetStore:
             f"not deleting the model file {str(rel)[:200]!r} (model {str(model)[:80]!r}) "
             f"that the record {record} names: {why}",
             DataQualityWarning,
-            stacklevel=3,
+            stacklevel=user_stacklevel(),
         )
 
     def save(

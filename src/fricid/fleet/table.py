@@ -21,6 +21,12 @@ Columns (SI units; each parameter's unit in ``units``):
 - run: ``time_extract_s``, ``time_fit_s``, ``time_total_s`` [s], ``worker``,
   ``peak_rss_mb`` [MB], ``fricid_version``.
 
+In ``results.csv`` every column with a unit says it in its header, as every fricid table
+does (``rmse [N m]``, ``speed_min [rad/s]``, ``time_fit_s [s]``; a parameter's column when
+every row gives it the same unit, ``param_tau_c [N m]``): :data:`CSV_UNITS`. The Parquet
+dataset keeps the bare names (its schema is the type) and :func:`read_results` reads both,
+and CSV files written before the units were added.
+
 Every column but the run columns (:data:`RUN_COLUMNS`) is the same, bit for bit, whichever
 executor computed the rows. The Parquet dataset (``results/``) is partitioned by robot and
 date (hive style, ``robot=<r>/date=<d>/part-0.parquet``): each file is written atomically
@@ -46,6 +52,7 @@ from ..io.atomic import atomic_dir, atomic_path, atomic_write
 from ._fs import partition_dir, require_real
 
 __all__ = [
+    "CSV_UNITS",
     "PARTITIONS",
     "RUN_COLUMNS",
     "VERDICT_COLUMNS",
@@ -138,6 +145,24 @@ _ORDER = (
     "model_file",
 )
 _PREFIXES = ("param_", "stderr_", "ci95_")
+
+#: The unit of each results column that has one, as written in ``results.csv``'s header.
+CSV_UNITS = {
+    "speed_min": "rad/s",
+    "speed_max": "rad/s",
+    "load_min": "N m",
+    "load_max": "N m",
+    "temperature_min": "degC",
+    "temperature_max": "degC",
+    "sse": "N^2 m^2",
+    "rmse": "N m",
+    "mae": "N m",
+    "max_abs_error": "N m",
+    "time_extract_s": "s",
+    "time_fit_s": "s",
+    "time_total_s": "s",
+    "peak_rss_mb": "MB",
+}
 
 
 def _type(name: str) -> pa.DataType:
@@ -232,14 +257,47 @@ def write_results(table: pa.Table, root: str | os.PathLike[str]) -> tuple[Path, 
     csv_path = require_real(root, ["results.csv"])
     with atomic_dir(dataset) as tmp:
         _write_partitions(table, tmp)
+    frame = table.to_pandas()
     with atomic_write(csv_path, "w") as fh:
-        table.to_pandas().to_csv(fh, index=False)
+        frame.rename(columns=csv_labels(frame)).to_csv(fh, index=False)
     return dataset, csv_path
+
+
+def _param_units(frame: pd.DataFrame) -> dict[str, str]:
+    """Parameter name -> its unit, for the parameters every row that has one agrees on (the
+    rows' ``units`` column, ``name=unit;...``)."""
+    seen: dict[str, set[str]] = {}
+    for text in frame.get("units", pd.Series(dtype=object)).dropna():
+        for item in str(text).split(";"):
+            name, sep, unit = item.partition("=")
+            if sep:
+                seen.setdefault(name, set()).add(unit)
+    return {name: units.pop() for name, units in seen.items() if len(units) == 1}
+
+
+def csv_labels(frame: pd.DataFrame) -> dict[str, str]:
+    """Column -> its header in ``results.csv``: ``name [unit]`` where it has a unit
+    (:data:`CSV_UNITS`; ``param_``, ``stderr_``, ``ci95_`` columns in their parameter's
+    unit), the bare name where it has none or is dimensionless text."""
+    units = dict(CSV_UNITS)
+    per_param = _param_units(frame)
+    for column in frame.columns:
+        for prefix in _PREFIXES:
+            if column.startswith(prefix) and column[len(prefix) :] in per_param:
+                units[column] = per_param[column[len(prefix) :]]
+    return {c: f"{c} [{units[c]}]" for c in frame.columns if c in units}
+
+
+def _bare(label: str) -> str:
+    """``rmse [N m]`` -> ``rmse`` (a header from before the units is left as it is)."""
+    name, bracket, _ = label.partition(" [")
+    return name if bracket and label.endswith("]") else label
 
 
 def _read_csv(path: Path) -> pd.DataFrame:
     dtypes = {name: "string" for name in _STRINGS}
     frame = pd.read_csv(path, dtype=dtypes)
+    frame = frame.rename(columns=_bare)
     for name in _INTS:
         if name in frame:
             frame[name] = frame[name].astype("Int64")

@@ -45,8 +45,9 @@ SETTINGS: dict[str, tuple[str, ...]] = {
         "n_sub",
         "cluster_time",
         "rate_bias",
+        "progress",
     ),
-    "auto": ("scheme", "scatter", "learned"),
+    "auto": ("scheme", "scatter", "learned", "progress"),
 }
 
 #: The learned models (stored state, no named parameters).

@@ -93,7 +93,8 @@ def fit(
         ``network`` (``RBFNetRegressor`` parameters), ``backbone`` (hybrid); ``gp``:
         ``inputs``, ``max_points``, ``n_restarts``; dynamic: ``route``, ``gravity``, ...
         (:func:`fricid.identify.dynamic.trajectory.fit_trajectory`); ``auto``: ``scheme``
-        (validation), ``scatter``, ``learned`` (try the learned families too).
+        (validation), ``scatter``, ``learned`` (try the learned families too), ``progress``
+        (``progress(i, n, candidate)``, :func:`.static.select.select`).
 
     Returns
     -------

@@ -21,6 +21,7 @@ from __future__ import annotations
 import importlib
 from typing import Any
 
+from ._dialect import csv_dialect as csv_dialect
 from .atomic import atomic_path as atomic_path
 from .atomic import atomic_write as atomic_write
 from .registry import EPOS_FOLDER_ONLY as EPOS_FOLDER_ONLY
@@ -61,6 +62,7 @@ __all__ = sorted(
         "atomic_path",
         "atomic_write",
         "check_reader",
+        "csv_dialect",
         "open_log",
     ]
 )

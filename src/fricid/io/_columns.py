@@ -188,8 +188,17 @@ def resolve_columns(
             want = key if quantity is None else f"{key} [{SI_UNITS[quantity]}]"
             raise DataError(
                 f"missing required column '{key}' (e.g. '{want}'); columns found: "
-                + (", ".join(repr(label) for label in labels) or "none"),
+                + (", ".join(repr(label) for label in labels) or "none")
+                + _delimiter_hint(labels),
                 file=file,
                 column=key,
             )
     return found
+
+
+def _delimiter_hint(labels: list[str]) -> str:
+    """A hint when one column label holds several (a header split at the wrong delimiter)."""
+    for mark, name in ((";", "';'"), ("\t", "tab"), (",", "','")):
+        if any(mark in label for label in labels):
+            return f"; the header looks delimited by {name}: give fricid --delimiter {name}"
+    return ""

@@ -23,6 +23,7 @@ import pyarrow.csv as pacsv
 from ..errors import DataError
 from ..units import SI_UNITS
 from ._columns import split_label
+from ._dialect import Dialect, detect_dialect
 from ._files import check_input
 from ._meta import dumps_meta, encode_text
 from .atomic import atomic_write
@@ -63,6 +64,8 @@ class Preamble:
     comments : dict of str to tuple of (str or None, str)
         ``{name: (unit or None, value text)}`` from leading ``# name [unit]: value`` lines,
         names lower-cased.
+    dialect : Dialect
+        The delimiter and decimal mark (:mod:`fricid.io._dialect`: detected or given).
     """
 
     path: Path
@@ -70,6 +73,7 @@ class Preamble:
     header_line: int
     header_offset: int
     comments: dict[str, tuple[str | None, str]] = field(default_factory=dict)
+    dialect: Dialect = field(default_factory=Dialect)
 
 
 def one_line(exc: BaseException) -> str:
@@ -88,7 +92,9 @@ def _decode(raw: bytes, path: Path, line: int) -> str:
 def read_preamble(path: str | os.PathLike[str]) -> Preamble:
     """Read the leading ``#`` comment lines and the header line of a CSV file.
 
-    Blank lines before the header are skipped; a UTF-8 byte-order mark is ignored.
+    Blank lines before the header are skipped; a UTF-8 byte-order mark is ignored. The
+    delimiter (``,``, ``;`` or a tab) and the decimal mark are detected from the header and
+    the first data line unless given (:func:`fricid.io.csv_dialect`, ``fricid --delimiter``).
 
     Parameters
     ----------
@@ -128,15 +134,30 @@ def read_preamble(path: str | os.PathLike[str]) -> Preamble:
                     name, unit = split_label(key)
                     comments[name.lower()] = (unit, value.strip())
             elif stripped:
+                header = text.rstrip("\r\n")
+                dialect = detect_dialect(header, _first_data_line(fh))
                 try:
-                    labels = next(csv.reader([text.rstrip("\r\n")]))
+                    labels = next(csv.reader([header], delimiter=dialect.delimiter))
                 except csv.Error as exc:
                     raise DataError(f"malformed header line: {exc}", file=path, row=line) from None
-                return Preamble(path, labels, line, offset, comments)
+                return Preamble(path, labels, line, offset, comments, dialect)
             offset += len(raw)
 
 
-def _convert_options(labels: list[str]) -> pacsv.ConvertOptions:
+def _first_data_line(fh: Any) -> str | None:
+    """The first non-blank line after the header (the file's position is left there), or
+    None; as text, invalid UTF-8 replaced (the read itself names such a line)."""
+    for _ in range(1000):
+        raw = fh.readline()
+        if not raw:
+            return None
+        text = raw.decode("utf-8", errors="replace").rstrip("\r\n")
+        if text.strip():
+            return text
+    return None
+
+
+def _convert_options(labels: list[str], dialect: Dialect) -> pacsv.ConvertOptions:
     """pyarrow's options to read ``labels`` as float64 with no null values."""
     return pacsv.ConvertOptions(
         column_types={label: pa.float64() for label in labels},
@@ -144,14 +165,24 @@ def _convert_options(labels: list[str]) -> pacsv.ConvertOptions:
         null_values=[],
         strings_can_be_null=False,
         quoted_strings_can_be_null=False,
+        decimal_point=dialect.decimal,
     )
 
 
-def _parse_float(text: str) -> float | None:
+def _parse_options(dialect: Dialect) -> pacsv.ParseOptions:
+    """pyarrow's options to split fields at the file's delimiter."""
+    return pacsv.ParseOptions(delimiter=dialect.delimiter)
+
+
+def _parse_float(text: str, decimal: str = ".") -> float | None:
     """``float(text)`` as pyarrow reads it (no digit separators), or None."""
     text = text.strip()
     if "_" in text:
         return None
+    if decimal == ",":
+        if "." in text:
+            return None
+        text = text.replace(",", ".")
     try:
         return float(text)
     except ValueError:
@@ -182,7 +213,7 @@ def locate_bad_value(pre: Preamble, labels: list[str], start: int = 0) -> DataEr
     with open(pre.path, encoding="utf-8", errors="replace", newline="") as fh:
         for _ in range(pre.header_line):
             fh.readline()
-        reader = csv.reader(fh)
+        reader = csv.reader(fh, delimiter=pre.dialect.delimiter)
         record = -1
         for fields in reader:
             if not fields:
@@ -199,7 +230,7 @@ def locate_bad_value(pre: Preamble, labels: list[str], start: int = 0) -> DataEr
                     row=line,
                 )
             for label, i in wanted:
-                value = _parse_float(fields[i])
+                value = _parse_float(fields[i], pre.dialect.decimal)
                 if value is None:
                     what = "empty value" if not fields[i].strip() else "not a number"
                     return DataError(
@@ -233,7 +264,7 @@ def record_line(pre: Preamble, record: int) -> int | None:
     with open(pre.path, encoding="utf-8", errors="replace", newline="") as fh:
         for _ in range(pre.header_line):
             fh.readline()
-        reader = csv.reader(fh)
+        reader = csv.reader(fh, delimiter=pre.dialect.delimiter)
         n = -1
         for fields in reader:
             if fields:
@@ -283,7 +314,11 @@ def read_numeric(pre: Preamble, labels: list[str]) -> dict[str, np.ndarray]:
     try:
         with pa.OSFile(str(pre.path)) as fh:
             fh.seek(pre.header_offset)
-            table = pacsv.read_csv(fh, convert_options=_convert_options(labels))
+            table = pacsv.read_csv(
+                fh,
+                parse_options=_parse_options(pre.dialect),
+                convert_options=_convert_options(labels, pre.dialect),
+            )
     except pa.ArrowInvalid as exc:
         raise _fail(pre, labels, exc) from None
     columns = {label: table.column(label).to_numpy() for label in labels}
@@ -357,7 +392,8 @@ def iter_numeric(
             reader = pacsv.open_csv(
                 fh,
                 read_options=pacsv.ReadOptions(block_size=STREAM_BLOCK_BYTES),
-                convert_options=_convert_options(labels),
+                parse_options=_parse_options(pre.dialect),
+                convert_options=_convert_options(labels, pre.dialect),
             )
             yield from reader
 

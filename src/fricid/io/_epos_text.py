@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from ..errors import DataError, DataQualityWarning
+from ..errors import DataError, DataQualityWarning, user_stacklevel
 from ._files import read_capped
 
 logger = logging.getLogger("fricid.io.epos")
@@ -191,7 +191,7 @@ def _warn_bad_rows(path: Path, skipped: list[dict[str, Any]]) -> None:
         f"{path}: skipped {len(skipped)} bad row{'s' if len(skipped) > 1 else ''} "
         f"(--skip-bad-rows): {listed}",
         DataQualityWarning,
-        stacklevel=4,
+        stacklevel=user_stacklevel(),
     )
 
 

@@ -11,7 +11,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import DataQualityWarning
+from ..errors import DataQualityWarning, user_stacklevel
 
 __all__ = [
     "OUTLIER_SIGMAS",
@@ -79,7 +79,9 @@ def warn_steady(folder: str, quality: list[dict[str, Any]], lines: dict[str, lis
                 f"{SCATTER_RATIO:g}x its neighbours'; check that recording"
             )
     if parts:
-        warnings.warn(f"{folder}: " + "; ".join(parts), DataQualityWarning, stacklevel=3)
+        warnings.warn(
+            f"{folder}: " + "; ".join(parts), DataQualityWarning, stacklevel=user_stacklevel()
+        )
 
 
 def quality_rows(names, velocity, keep, std, flagged, temperature: float) -> list[dict[str, Any]]:

@@ -41,7 +41,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ..errors import ConfigError, DataError, DataQualityWarning
+from ..errors import ConfigError, DataError, DataQualityWarning, user_stacklevel
 from ..samples import RawLog
 from ..units import UNITS, to_si
 from ._files import check_input, read_capped
@@ -423,7 +423,7 @@ def _read_run(
             f"stamps have no sample of every channel (join='{join}', tolerance {tol:g} s); "
             "those rows are dropped",
             DataQualityWarning,
-            stacklevel=3,
+            stacklevel=user_stacklevel(),
         )
     t_ref = t_ref[keep]
     values = {q: v[keep] for q, v in values.items()}

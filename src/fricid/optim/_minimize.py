@@ -10,7 +10,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import ConfigError, IgnoredArgumentWarning
+from ..errors import ConfigError, IgnoredArgumentWarning, user_stacklevel
 from ._api import (
     BUDGET,
     CALLBACK,
@@ -223,7 +223,8 @@ def _minimize(
     fun, bounds, method, seed, max_evals, options, callback, x0, residuals, runs, stacklevel
 ) -> list[OptimizeResult]:
     """The one implementation behind :func:`minimize` (``runs`` None) and
-    :func:`minimize_runs`; ``stacklevel`` points warnings at their caller."""
+    :func:`minimize_runs`; warnings point at the first caller outside fricid
+    (:func:`fricid.errors.user_stacklevel`; ``stacklevel`` is kept for the callers)."""
     if method is None:
         method = DEFAULT_LSQ_METHOD if residuals is not None else DEFAULT_METHOD
     key = str(method).strip().lower()
@@ -243,7 +244,7 @@ def _minimize(
             f"method '{key}' does not use `residuals`; it minimises `fun` (least-squares "
             "methods: " + ", ".join(k for k, c in METHODS.items() if c.uses_residuals) + ")",
             IgnoredArgumentWarning,
-            stacklevel=stacklevel,
+            stacklevel=user_stacklevel(),
         )
     if fun is None:
         res_fun = residuals

@@ -30,6 +30,11 @@ def _check_name(name: str) -> str:
     return name
 
 
+#: Tables longer than this many rows are folded in the HTML (the verdict and the figures stay
+#: in view; a click opens the table).
+FOLD_ROWS = 12
+
+
 @dataclass
 class Table:
     """A table: written as an HTML table, a Markdown pipe table and ``<name>.csv``.
@@ -43,6 +48,8 @@ class Table:
         and why ours differ.
     index : write the frame's index.
     digits : significant digits of floats in HTML and Markdown (CSV keeps full precision).
+    folded : shown folded in the HTML (a ``<details>`` element: the title and the number of
+        rows, opened on a click); None (the default): when longer than :data:`FOLD_ROWS`.
     """
 
     name: str
@@ -51,9 +58,15 @@ class Table:
     caption: str = ""
     index: bool = False
     digits: int = 4
+    folded: bool | None = None
 
     def __post_init__(self) -> None:
         _check_name(self.name)
+
+    @property
+    def is_folded(self) -> bool:
+        """Whether the HTML shows the table folded (``folded``, else its length)."""
+        return len(self.frame) > FOLD_ROWS if self.folded is None else bool(self.folded)
 
 
 @dataclass

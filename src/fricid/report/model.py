@@ -15,6 +15,8 @@ convergence history where there is one.
 from __future__ import annotations
 
 import logging
+from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -25,7 +27,7 @@ from ..identify.trust import Trust, not_determined
 from ..samples import FrictionSamples
 from . import interactive, plots
 from .document import Document, Figure, Note, Table
-from .trust import quality_frame, trust_text
+from .trust import quality_frame, scatter_explanation, trust_text
 
 __all__ = ["METRIC_LABELS", "metrics_table", "model_report", "parameter_table"]
 
@@ -185,8 +187,14 @@ def model_report(
     samples_label: str | None = None,
     bootstrap: int = 200,
     seed: int = 0,
+    progress: Callable[[str], Any] | None = None,
 ) -> Document:
     """Build the report of ``fitted`` on ``samples``.
+
+    The order is what a reader wants first: the trust verdict, the figures (friction
+    against velocity, residuals), then the parameters and the metrics; tables longer than
+    :data:`fricid.report.document.FOLD_ROWS` rows (the data quality per set-point, the
+    held-out folds) are folded in the HTML.
 
     Parameters
     ----------
@@ -199,11 +207,15 @@ def model_report(
     bootstrap : resamples for the RBF network's prediction interval (ignored for analytic
         models, whose CIs come from the Jacobian at the optimum).
     seed : seed of the bootstrap.
+    progress : called with the part being built (``"figures: friction against velocity"``,
+        ...), for a command's progress display.
 
     Returns
     -------
     Document, to be written with :func:`fricid.report.write_document`.
     """
+    say = progress or (lambda _label: None)
+    say("predictions, metrics")
     label = samples_label or (
         str(samples.source).rsplit("/", 1)[-1] if samples.source else "these samples"
     )
@@ -237,6 +249,81 @@ def model_report(
     _trust_section(doc, trust)
 
     appendix: list = []
+    say("figures: friction against velocity")
+    sec = doc.section("Friction against velocity")
+    sec.add(
+        Figure(
+            "friction_vs_velocity",
+            "Measured and predicted friction against velocity",
+            plots.friction_curves(
+                samples,
+                fitted.predict,
+                velocity_unit=velocity_unit,
+                title=f"{fitted.model}: friction against velocity",
+            ),
+            caption=_curves_caption(samples),
+            plotly=interactive.friction_figure(
+                samples,
+                fitted.predict,
+                velocity_unit=velocity_unit,
+                title=f"{fitted.model}: friction against velocity",
+            ),
+        )
+    )
+    if (samples.velocity != 0).any():
+        marks = interactive.stribeck_velocities(fitted.params)
+        moving = samples.subset(samples.velocity != 0)
+        sec.add(
+            Figure(
+                "stribeck_region",
+                "The Stribeck region: friction magnitude against speed, log axis",
+                plots.stribeck_region(
+                    moving,
+                    fitted.predict,
+                    marks,
+                    velocity_unit=velocity_unit,
+                    xlim=interactive.stribeck_range(moving.velocity, marks),
+                ),
+                caption="The low-speed end, where friction falls from its static level to the "
+                "Coulomb level, on a log speed axis, per direction (up to 20 times the "
+                "Stribeck velocity where that is inside the data; the interactive figure "
+                "zooms out on a double click)"
+                + (
+                    "; dotted lines mark the model's Stribeck velocities ("
+                    + ", ".join(marks)
+                    + ")."
+                    if marks
+                    else "."
+                ),
+                plotly=interactive.stribeck_figure(
+                    moving, fitted.predict, fitted.params, velocity_unit=velocity_unit
+                ),
+            )
+        )
+    sec.add(
+        Figure(
+            "parity",
+            "Predicted against measured friction",
+            plots.parity(samples.friction, predicted, title=f"{fitted.model}"),
+            caption="Points on the grey identity line are predicted exactly.",
+        )
+    )
+
+    say("figures: residuals against each input")
+    sec = doc.section("Residuals")
+    sec.add(
+        Figure(
+            "residuals",
+            "Residuals against each input",
+            plots.residual_panels(samples, residual, velocity_unit=velocity_unit),
+            caption="Measured minus predicted friction against each input that varies "
+            "in the data; structure (a trend, a curve) means the model misses an "
+            "effect, scatter within the dashed ±2 RMSE lines is noise.",
+            plotly=interactive.residual_figure(samples, residual, velocity_unit=velocity_unit),
+        )
+    )
+
+    say("parameters" + (", bootstrap intervals" if fitted.kind == "rbf" else ""))
     sec = doc.section("Parameters", _param_text(fitted))
     if fitted.model == "gp":  # the Gaussian process: its posterior band at the samples
         mean, std = fitted.predict(samples.X, warn=False, return_std=True)
@@ -309,78 +396,6 @@ def model_report(
     if note is not None:
         sec.add(note)
 
-    sec = doc.section("Friction against velocity")
-    sec.add(
-        Figure(
-            "friction_vs_velocity",
-            "Measured and predicted friction against velocity",
-            plots.friction_curves(
-                samples,
-                fitted.predict,
-                velocity_unit=velocity_unit,
-                title=f"{fitted.model}: friction against velocity",
-            ),
-            caption=_curves_caption(samples),
-            plotly=interactive.friction_figure(
-                samples,
-                fitted.predict,
-                velocity_unit=velocity_unit,
-                title=f"{fitted.model}: friction against velocity",
-            ),
-        )
-    )
-    if (samples.velocity != 0).any():
-        marks = interactive.stribeck_velocities(fitted.params)
-        moving = samples.subset(samples.velocity != 0)
-        sec.add(
-            Figure(
-                "stribeck_region",
-                "The Stribeck region: friction magnitude against speed, log axis",
-                plots.stribeck_region(
-                    moving,
-                    fitted.predict,
-                    marks,
-                    velocity_unit=velocity_unit,
-                    xlim=interactive.stribeck_range(moving.velocity, marks),
-                ),
-                caption="The low-speed end, where friction falls from its static level to the "
-                "Coulomb level, on a log speed axis, per direction (up to 20 times the "
-                "Stribeck velocity where that is inside the data; the interactive figure "
-                "zooms out on a double click)"
-                + (
-                    "; dotted lines mark the model's Stribeck velocities ("
-                    + ", ".join(marks)
-                    + ")."
-                    if marks
-                    else "."
-                ),
-                plotly=interactive.stribeck_figure(
-                    moving, fitted.predict, fitted.params, velocity_unit=velocity_unit
-                ),
-            )
-        )
-    sec.add(
-        Figure(
-            "parity",
-            "Predicted against measured friction",
-            plots.parity(samples.friction, predicted, title=f"{fitted.model}"),
-            caption="Points on the grey identity line are predicted exactly.",
-        )
-    )
-
-    sec = doc.section("Residuals")
-    sec.add(
-        Figure(
-            "residuals",
-            "Residuals against each input",
-            plots.residual_panels(samples, residual, velocity_unit=velocity_unit),
-            caption="Measured minus predicted friction against each input that varies "
-            "in the data; structure (a trend, a curve) means the model misses an "
-            "effect, scatter within the dashed ±2 RMSE lines is noise.",
-            plotly=interactive.residual_figure(samples, residual, velocity_unit=velocity_unit),
-        )
-    )
-
     if appendix:
         sec = doc.section("Appendix: the network's output weights")
         for item in appendix:
@@ -415,7 +430,8 @@ def _trust_section(doc: Document, trust: Trust) -> None:
                 "Data quality per set-point",
                 quality_frame(trust.quality),
                 caption="Samples averaged into each set-point's friction and those dropped, "
-                "by reason; HIGH marks a scatter far above the neighbouring set-points'.",
+                "by reason. " + scatter_explanation(trust) + " HIGH marks a set-point whose "
+                "readings scatter far more than its neighbours'.",
             )
         )
     v = trust.validation
@@ -456,7 +472,11 @@ def _curves_caption(samples: FrictionSamples) -> str:
         "band's median load and temperature."
     ]
     if np.ptp(samples.temperature) > 0 or np.ptp(samples.load) > 0:
-        parts.append("Colours are temperature bands, panels load bands.")
+        parts.append(
+            "The interactive chart has one panel per load and temperature band (named above "
+            "it; the axes shared, so panels compare at a glance) and a colour per direction; "
+            "in the PNG the panels are load bands and the colours temperature bands."
+        )
     if set(samples.directions()) == {-1, 1}:
         parts.append("Both directions of motion are shown; friction is signed like velocity.")
     return " ".join(parts)

@@ -18,7 +18,16 @@ import numpy as np
 from matplotlib.axes import Axes
 
 from ..samples import FrictionSamples
-from .style import COLORS, band_edges, new_figure, png, styled, torque_scale, velocity_scale
+from .style import (
+    COLORS,
+    band_edges,
+    in_band,
+    new_figure,
+    png,
+    styled,
+    torque_scale,
+    velocity_scale,
+)
 
 __all__ = [
     "convergence",
@@ -41,7 +50,7 @@ def _fmt(lo: float, hi: float, unit: str, digits: int = 3) -> str:
 
 
 def _mask(values: np.ndarray, band: tuple[float, float]) -> np.ndarray:
-    return (values >= band[0]) & (values <= band[1])
+    return in_band(values, band)
 
 
 def velocity_grid(velocity: np.ndarray, n: int = 200, *, log: bool) -> np.ndarray:

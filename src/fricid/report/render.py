@@ -38,6 +38,8 @@ figcaption,.caption{color:#444;font-size:.92em;margin-top:.3em}
 code{background:#f1f4f9;padding:0 .25em;border-radius:3px}
 nav ul{columns:2;font-size:.92em}.files{color:#666;font-size:.85em}
 .plotly-figure{width:100%;min-height:480px;border:1px solid #e3e7ee}
+details.folded summary{cursor:pointer}details.folded summary h3{display:inline;margin-right:.6em}
+details.folded .rows{color:#666;font-size:.9em}
 """
 
 
@@ -109,11 +111,18 @@ def _table_html(table: Table) -> str:
         "<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in row) + "</tr>" for row in rows
     )
     caption = _text_html(table.caption, "caption") if table.caption else ""
-    return (
-        f'<h3 id="{slug(table.title)}">{_inline_html(table.title)}</h3>\n'
+    heading = f'<h3 id="{slug(table.title)}">{_inline_html(table.title)}</h3>'
+    content = (
         f"<table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>\n{caption}\n"
         f'<div class="files">{table.name}.csv</div>'
     )
+    if table.is_folded:  # long: one line until opened, the verdict and figures stay in view
+        rows = len(table.frame)
+        return (
+            f'<details class="folded"><summary>{heading}'
+            f'<span class="rows">{rows} rows: click to show</span></summary>\n{content}</details>'
+        )
+    return f"{heading}\n{content}"
 
 
 def plotly_js() -> str | None:

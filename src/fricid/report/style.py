@@ -22,6 +22,7 @@ __all__ = [
     "COLORS",
     "RC",
     "band_edges",
+    "in_band",
     "new_figure",
     "png",
     "styled",
@@ -110,6 +111,15 @@ def velocity_scale(unit: str = "rad/s") -> tuple[float, str]:
     """Factor from rad/s to ``unit`` (``rad/s``, ``deg/s``, ``rpm``, ``rev/s``) and its label."""
     scale, _ = UNITS["velocity"][unit]
     return 1.0 / scale, unit
+
+
+def in_band(values: np.ndarray, band: tuple[float, float]) -> np.ndarray:
+    """Which ``values`` lie in the inclusive ``band``; a band of NaN (a quantity not
+    measured, :func:`band_edges` of NaN) holds the NaN values."""
+    values = np.asarray(values, dtype=float)
+    if np.isnan(band[0]):
+        return np.isnan(values)
+    return (values >= band[0]) & (values <= band[1])
 
 
 def band_edges(values, max_bands: int) -> list[tuple[float, float]]:

@@ -16,13 +16,18 @@ import numpy as np
 
 from ..identify.trust import DROPS, OWN_CV, RUN_HERE, Trust
 
-__all__ = ["quality_frame", "trust_text"]
+__all__ = ["READINGS_STD", "quality_frame", "scatter_explanation", "trust_text"]
+
+#: The quality table's column of the readings' scatter at a set-point: not the scatter the
+#: verdict compares the error with (:func:`scatter_explanation`).
+READINGS_STD = "readings std [N m]"
 
 
 def quality_frame(rows: list[dict[str, Any]]) -> Any:
-    """The quality rows as a table: set-point, kept, dropped by reason, scatter (of the
-    samples, and of the merged runs' means), what eq. 7 left along the position, flag, and
-    what the row merged or why it was dropped."""
+    """The quality rows as a table: set-point, kept, dropped by reason, the standard
+    deviation of the readings kept (:data:`READINGS_STD`), the scatter between the merged
+    runs' means, what eq. 7 left along the position, flag, and what the row merged or why it
+    was dropped."""
     import pandas as pd
 
     out = []
@@ -37,7 +42,7 @@ def quality_frame(rows: list[dict[str, Any]]) -> Any:
                 "runs": r.get("runs"),
                 "kept": r.get("kept"),
                 **{f"dropped: {why}": r.get(k) for k, why in DROPS.items()},
-                "scatter [N m]": r.get("scatter"),
+                READINGS_STD: r.get("scatter"),
                 "between runs [N m]": r.get("run_scatter"),
                 "gravity residual [N m]": r.get("gravity_residual"),
                 "high scatter": "HIGH" if r.get("flagged") else "",
@@ -85,6 +90,25 @@ def _error_line(trust: Trust) -> str:
     return held
 
 
+def scatter_explanation(trust: Trust) -> str:
+    """Why the quality table's readings std differs from the scatter of the verdict: one is
+    the spread of single readings at a set-point, the other the scatter of the samples the
+    model is fitted to (each a mean of many readings), which is what an error is compared
+    with."""
+    sc = (
+        f"the measurement scatter of the samples, {trust.scatter:.3g} N m"
+        if np.isfinite(trust.scatter)
+        else "the measurement scatter of the samples"
+    )
+    return (
+        f"The '{READINGS_STD}' column is the spread of the single readings kept at a "
+        f"set-point. The verdict compares the model's error with {sc}: each sample is the "
+        "mean of many readings, so its scatter is smaller, by about the square root of the "
+        "readings averaged (or measured between repeated passes). The verdict's number is "
+        "the one to compare the RMSE with."
+    )
+
+
 def trust_text(trust: Trust) -> str:
     """The section's list: data quality, convergence, identifiability, held-out error,
     operating range (plain text with the report's small markup)."""
@@ -107,6 +131,13 @@ def trust_text(trust: Trust) -> str:
         + "."
     )
     lines.append(f"- **Error against scatter**: {_error_line(trust)}.")
+    if np.isfinite(trust.scatter):
+        lines.append(
+            f"- **Measurement scatter** (the one number every comparison here uses): "
+            f"{trust.scatter:.3g} N m, the scatter of the samples the model was fitted to; "
+            "the readings' spread per set-point in the data-quality table is larger (each "
+            "sample averages many readings)."
+        )
     lines.append(
         f"- **Operating range** (predictions outside it are extrapolated): "
         f"{trust.range or 'not recorded'}."

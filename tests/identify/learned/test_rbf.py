@@ -348,7 +348,10 @@ def test_bad_inputs_give_clear_errors():
     flat[:, 2] = 25.0
     with pytest.raises(DataError, match="column '2': the input has zero variance"):
         RBFNetRegressor(5).fit(flat, y)
-    with pytest.raises(ConfigError, match="n_centers=31 exceeds the number of training samples"):
+    with pytest.raises(
+        ConfigError,
+        match=r"31 centres \(n_centers; --centers on the command line\) exceed the number",
+    ):
         RBFNetRegressor(31).fit(X, y)
     with pytest.raises(ConfigError, match="'n_centers' parameter of RBFNetRegressor"):
         RBFNetRegressor(0).fit(X, y)

@@ -10,7 +10,7 @@ from typing import Any
 
 import numpy as np
 
-from ...errors import FricidWarning
+from ...errors import FricidWarning, user_stacklevel
 from ...models import lugre
 
 __all__ = [
@@ -55,7 +55,7 @@ def warn_rate_bias(stage, rb: dict[str, Any]) -> None:
             "standard error; corrected values in the provenance): log at "
             f"{10 * rb['log_rate']:.6g} Hz or faster to remove it",
             RateBiasWarning,
-            stacklevel=3,
+            stacklevel=user_stacklevel(),
         )
 
 

@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 
 from ... import __version__
-from ...errors import ConvergenceWarning
+from ...errors import ConvergenceWarning, user_stacklevel
 from ...fitted import FittedModel, OptimizerRecord, Parameter, is_not_determined
 from ...io.atomic import created_timestamp
 from ...metrics import fit_statistics, metrics
@@ -76,7 +76,7 @@ def build_result(
             f"identifying '{key}' from the trajectory did not converge: "
             f"{convergence['reason']}; {convergence['advice']}; its intervals are withheld",
             ConvergenceWarning,
-            stacklevel=3,
+            stacklevel=user_stacklevel(),
         )
         final = _withheld(final)
     static, derivative = options["static"], options["derivative"]
@@ -169,7 +169,7 @@ def build_result(
                 f"the identified LuGre model is not passive (margin "
                 f"{info['passivity']['margin']:.3g} N m s/rad): {info['passivity']['condition']}",
                 PassivityWarning,
-                stacklevel=2,
+                stacklevel=user_stacklevel(),
             )
     fitted.provenance = {
         "source": log.source,

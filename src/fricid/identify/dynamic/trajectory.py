@@ -140,6 +140,7 @@ J. Business & Economic Statistics 3(4), 1985.
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -210,6 +211,7 @@ def fit_trajectory(
     seed: int = 0,
     max_evals: int | None = None,
     rate_bias: str = "warn",
+    progress: Callable[[int, int, str], Any] | None = None,
 ) -> FittedModel:
     """Identify a joint's friction, inertia and gravity from a trajectory (module notes).
 
@@ -261,6 +263,10 @@ def fit_trajectory(
         in ``provenance["trajectory"]["rate_bias"]`` with the corrected values (not
         applied), and warned about (:class:`RateBiasWarning`) when it exceeds
         :data:`RATE_BIAS_WARN` standard errors; ``off`` skips it.
+    progress : callable, optional
+        ``progress(i, n, label)`` as the ``i``-th (0-based) of the route's ``n`` stages
+        starts (the log's derivatives, the regression, the filtered or simulation route,
+        the rate bias, the intervals); ``progress(n, n, "done")`` at the end.
 
     Returns
     -------
@@ -298,6 +304,8 @@ def fit_trajectory(
         raise ConfigError(f"rate_bias must be 'warn' or 'off', got '{rate_bias}'")
     derivative = derivative or DerivativeFilter()
     t_start = time.perf_counter()
+    say = _stages(key, route, rate_bias, progress)
+    say("checking the log, derivatives")
     check_trajectory_log(log)  # holes, grid size, stuck torque: before any allocation
     series = uniform_series(log)
     rate = 1.0 / series.dt
@@ -322,6 +330,7 @@ def fit_trajectory(
             raise ConfigError(f"static= must be a stribeck fit, got '{static.model}'")
         fixed = static.theta()
     cluster_n = max(round(cluster_time * rate), 1)
+    say("regression: static friction, inertia, gravity")
     stage1, _theta_s, c, r1 = _regression(
         series, vf, acc, mask, static_model, gravity, method, seed, max_evals, cluster_n, fixed
     )
@@ -359,6 +368,7 @@ def fit_trajectory(
         )
     if key == "dahl":
         parallel = parallel or ParallelFilter()
+        say("filtered route: every Dahl parameter")
         stage, y, r = _dahl_filtered(
             series,
             stage1,
@@ -373,6 +383,7 @@ def fit_trajectory(
         sim_info = {"parallel_filter": parallel.describe(rate), "n_sub": int(n_sub)}
     elif key == "lugre" and route == "filtered":
         parallel = parallel or ParallelFilter()
+        say("filtered route: every LuGre parameter")
         start = np.array([1e4, 1.0] + [static_tab[n]["value"] for n in lugre.PARAM_NAMES[2:]])
         order = [stage1.names.index(n) for n in ("tau_v", "tau_c", "tau_s", "w_s", "delta")]
         stage, y, r = filtered_route(
@@ -392,12 +403,14 @@ def fit_trajectory(
         _take_filtered(stage, stages, fits, final, bounds_out)
         sim_info = {"parallel_filter": parallel.describe(rate), "n_sub": int(n_sub)}
         if rate_bias == "warn":
+            say("rate bias, by simulation at the estimate")
             rb = _rate_bias(
                 series, stage, stage1.bounds[order], gravity, method, seed, n_sub, parallel
             )
             sim_info["rate_bias"] = rb
             warn_rate_bias(stage, rb)
     elif key == "lugre":
+        say(f"{route} route: sigma_0, sigma_1 by simulation error")
         sim_info, static_tab = simulation_route(
             series,
             vf,
@@ -424,7 +437,8 @@ def fit_trajectory(
                 "cluster_n": cluster_n,
             },
         )
-    return build_result(
+    say("intervals, passivity")
+    result = build_result(
         key,
         route,
         log,
@@ -450,6 +464,28 @@ def fit_trajectory(
         },
         sim_info=sim_info,
     )
+    say("done")
+    return result
+
+
+def _stages(
+    key: str, route: str, rate_bias: str, progress: Callable[[int, int, str], Any] | None
+) -> Callable[[str], None]:
+    """``say(label)``: the next stage of the route, told to ``progress`` with its place
+    (``i`` of ``n``: the log, the regression, the route's own stages, the intervals)."""
+    n = 3
+    if key == "lugre":
+        n += 1 + (route == "filtered" and rate_bias == "warn")
+    elif key == "dahl":
+        n += 1
+    count = [0]
+
+    def say(label: str) -> None:
+        if progress is not None:
+            progress(min(count[0], n), n, label)
+        count[0] += 1
+
+    return say
 
 
 def _take_filtered(stage, stages: dict, fits: list, final: dict, bounds_out: dict) -> None:

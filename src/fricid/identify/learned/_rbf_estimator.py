@@ -18,7 +18,7 @@ from sklearn.exceptions import ConvergenceWarning as SklearnConvergenceWarning
 from sklearn.utils import check_random_state
 from sklearn.utils.validation import check_is_fitted, validate_data
 
-from ...errors import ConfigError, DataError, IgnoredArgumentWarning
+from ...errors import ConfigError, DataError, IgnoredArgumentWarning, user_stacklevel
 from ...models import _rbf_core as core
 from ...models.rbf import mse_z, predict_z, tail_columns
 from ...optim import METHODS
@@ -302,7 +302,7 @@ class RBFNetRegressor(RegressorMixin, BaseEstimator):
                     f"RBFNetRegressor(trainer='lsq') ignores {', '.join(ignored)}: they set up "
                     "an optimiser trainer (bas, ga, ...)",
                     IgnoredArgumentWarning,
-                    stacklevel=3,
+                    stacklevel=user_stacklevel(),
                 )
         else:
             if trainer not in METHODS:
@@ -342,8 +342,9 @@ class RBFNetRegressor(RegressorMixin, BaseEstimator):
         m = int(self.n_centers)
         if m > n:
             raise ConfigError(
-                f"n_centers={m} exceeds the number of training samples ({n}); an RBF network "
-                "needs at most one centre per sample"
+                f"{m} centres (n_centers; --centers on the command line) exceed the "
+                f"number of training samples ({n}); an RBF network needs at most one centre "
+                "per sample"
             )
         Xw = self._warp(X)
         shift = Xw.mean(axis=0)

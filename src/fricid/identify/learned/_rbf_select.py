@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 import scipy.linalg
 
-from ...errors import DataError, DataQualityWarning, IdentifiabilityWarning
+from ...errors import DataError, DataQualityWarning, IdentifiabilityWarning, user_stacklevel
 from ...models.rbf import tail_columns
 from ._conformal import INTERVAL_LEVELS, conformal_half_widths
 from ._rbf_estimator import LSQ_IGNORES, RBFNetRegressor
@@ -435,7 +435,7 @@ def check_centres(m: int, n: int, where: str = "") -> None:
             "is far above the in-sample error); use fewer centres, or leave the number unset "
             "(fricid chooses it by cross-validation)",
             IdentifiabilityWarning,
-            stacklevel=4,
+            stacklevel=user_stacklevel(),
         )
 
 
@@ -479,6 +479,6 @@ def drop_constant_inputs(
             f"the RBF network{where} drops the input(s) that do not vary: {what}; the model "
             f"uses {', '.join(kept)} only (noted in the model file)",
             DataQualityWarning,
-            stacklevel=4,
+            stacklevel=user_stacklevel(),
         )
     return kept, dropped

@@ -60,7 +60,7 @@ from typing import Any
 
 import numpy as np
 
-from ...errors import ConfigError
+from ...errors import ConfigError, user_stacklevel
 from ...fitted import FittedModel, OptimizerRecord
 from ...metrics import fit_statistics
 from ...models import INPUTS, get_model
@@ -305,7 +305,9 @@ def fit_hybrid(
     names = list(inputs) if inputs is not None else list(samples.measured)
     base, table, caught = fit_backbone(samples, backbone)
     for w in caught:
-        warnings.warn(f"hybrid backbone {base.model}: {w.message}", w.category, stacklevel=3)
+        warnings.warn(
+            f"hybrid backbone {base.model}: {w.message}", w.category, stacklevel=user_stacklevel()
+        )
     model = get_model(base.model)
     theta = base.theta()
     resid = samples.friction - model.predict(theta, samples.X)

@@ -26,7 +26,7 @@ from collections.abc import Collection
 
 import numpy as np
 
-from ...errors import DataError, IdentifiabilityWarning
+from ...errors import DataError, IdentifiabilityWarning, user_stacklevel
 from ...models import FrictionModel, get_model
 from ...samples import FrictionSamples
 
@@ -86,7 +86,7 @@ def _direction_sets(
 
 
 def _warn(message: str, stacklevel: int) -> None:
-    warnings.warn(message, IdentifiabilityWarning, stacklevel=stacklevel + 1)
+    warnings.warn(message, IdentifiabilityWarning, stacklevel=user_stacklevel())
 
 
 def check_identifiable(
@@ -108,8 +108,8 @@ def check_identifiable(
         Names of the parameters held fixed (a ``fixed=`` mapping of :func:`fricid.identify.fit`
         works): they need no data.
     stacklevel : int
-        Passed to :func:`warnings.warn`, counted from the caller of this function (2: its
-        caller's caller).
+        Kept for callers that pass it; the warning points at the first caller outside
+        fricid whatever the depth (:func:`fricid.errors.user_stacklevel`).
 
     Returns
     -------

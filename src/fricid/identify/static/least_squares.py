@@ -24,6 +24,7 @@ from ...errors import (
     ConvergenceWarning,
     IdentifiabilityWarning,
     IgnoredArgumentWarning,
+    user_stacklevel,
 )
 from ...fitted import FittedModel, OptimizerRecord, Parameter, is_not_determined
 from ...metrics import fit_statistics, metrics
@@ -160,7 +161,7 @@ def fit(
         warnings.warn(
             "`network` and `inputs` apply to model 'rbf' only; ignored",
             IgnoredArgumentWarning,
-            stacklevel=2,
+            stacklevel=user_stacklevel(),
         )
     model = get_model(model)
     samples.require(model.inputs, f"model '{model.name}'")
@@ -189,7 +190,7 @@ def fit(
             warnings.warn(
                 "method 'varpro' searches the whole search box; x0 is not used",
                 IgnoredArgumentWarning,
-                stacklevel=2,
+                stacklevel=user_stacklevel(),
             )
         result = varpro(problem, seed=seed, max_evals=max_evals, options=options, callback=callback)
     else:
@@ -213,7 +214,7 @@ def fit(
             f"fitting '{model.name}' did not converge: {convergence['reason']}; "
             f"{convergence['advice']}",
             ConvergenceWarning,
-            stacklevel=2,
+            stacklevel=user_stacklevel(),
         )
     theta = problem.expand(result.x)[0]
     unc = assess(
@@ -228,14 +229,14 @@ def fit(
         warnings.warn(
             f"fitting '{model.name}': the data " + "; the data ".join(unc.identifiability),
             IdentifiabilityWarning,
-            stacklevel=2,
+            stacklevel=user_stacklevel(),
         )
     if unc.lower_sse < float(result.fun) * (1 - 1e-6):
         warnings.warn(
             f"fitting '{model.name}': a profile re-fit found SSE {unc.lower_sse:.6g} below the "
             f"fit's {float(result.fun):.6g}; the fit is a local optimum (use more starts)",
             ConvergenceWarning,
-            stacklevel=2,
+            stacklevel=user_stacklevel(),
         )
     cov = unc.cov
     corr = None

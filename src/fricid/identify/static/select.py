@@ -27,6 +27,7 @@ The rules (issue 11, "Validation built in"):
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -60,6 +61,7 @@ def select(
     scatter: Scatter | None = None,
     seed: int | np.random.Generator | None = 0,
     learned: bool = False,
+    progress: Callable[[int, int, str], Any] | None = None,
     **fit_options: Any,
 ) -> FittedModel:
     """Fit the candidates, pick by held-out error, refit the choice on all the samples.
@@ -78,6 +80,10 @@ def select(
         Try the learned families too (``rbf``, ``hybrid``; :func:`candidates`). Off by
         default: validating one retrains it, its structure search included, for every fold
         (about 20 times an analytic family's time).
+    progress : callable, optional
+        ``progress(i, n, label)`` before the ``i``-th (0-based) of the ``n`` candidates that
+        are validated (``label`` its name), and ``progress(n, n, label)`` before the chosen
+        family is refitted on all the samples.
     **fit_options
         Passed to every fit (``max_evals``, ``loss``, ``weights``, ...).
 
@@ -85,7 +91,9 @@ def select(
     -------
     FittedModel
         The chosen model fitted on all the samples, with ``selection`` (scheme, chosen,
-        reason, table) and ``validation`` (the chosen model's).
+        reason, table, and ``advice`` when every analytic family misses the data by more
+        than :data:`fricid.identify.trust.MISS_RATIO` scatters and the learned families were
+        not tried: run again with ``learned=True``) and ``validation`` (the chosen model's).
 
     Raises
     ------
@@ -108,7 +116,10 @@ def select(
     robust = str(fit_options.get("loss", "l2")).lower() not in ("l2", "sse") or (
         fit_options.get("weights") not in (None, "none", "")
     )
+    todo = [c.label for c in found.values() if not c.note]
     for c in found.values():
+        if progress is not None and not c.note:
+            progress(todo.index(c.label), len(todo), c.label)
         row: dict[str, Any] = {"model": c.label, "n_params": c.n_params}
         if c.model in LEARNED and robust and not c.note:
             c = Candidate(c.label, c.model, c.fixed, c.n_params, "trains by least squares only")
@@ -148,6 +159,8 @@ def select(
     chosen = min(ok, key=lambda r: (r["n_params"], "_asym" in r["model"]))
     reason = _reason(chosen, best, sc, scheme, noise)
     pick = found[chosen["model"]]
+    if progress is not None:
+        progress(len(todo), len(todo), f"refitting {chosen['model']} on every sample")
     fitted = fit_named(
         samples,
         pick.model,
@@ -162,6 +175,9 @@ def select(
         "reason": reason,
         "table": table,
     }
+    advice = _learned_advice(best, table, learned)
+    if advice:
+        fitted.selection["advice"] = advice
     fitted.validation = runs[chosen["model"]].to_dict()
     return fitted
 
@@ -204,6 +220,24 @@ def _reason(
     else:
         why = f"within the noise ({NOISE_RATIO:g}x the scatter {sc.value:.3g} N m)"
     return f"{head}, {why} ({best['model']}, {best['heldout_rmse']:.3g} N m), and simpler"
+
+
+def _learned_advice(best: dict[str, Any], table: list[dict[str, Any]], learned: bool) -> str:
+    """What to try when no analytic family follows the data: the learned families, when
+    the best held-out error misses by more than the trust verdict's threshold and they were
+    not among the candidates; ``""`` otherwise."""
+    from ..trust import MISS_RATIO
+
+    ratio = best.get("ratio")
+    if learned or ratio is None or not ratio > MISS_RATIO:
+        return ""
+    if any(r["model"] in LEARNED for r in table):
+        return ""
+    return (
+        f"no analytic family follows these data (the best, {best['model']}, misses by "
+        f"{ratio:.3g}x the scatter held out): try the learned families too "
+        "(fricid fit SAMPLES --model auto --learned, or --model hybrid)"
+    )
 
 
 def _method(model: str, method: str) -> str | None:

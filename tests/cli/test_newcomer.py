@@ -1,0 +1,104 @@
+"""What a new user meets first: ``fricid methods``, the options' help and errors, the fit
+report, the numbers ``predict`` prints."""
+
+from __future__ import annotations
+
+import contextlib
+import re
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from fricid.cli import app
+
+runner = CliRunner()
+
+
+def run(*args):
+    return runner.invoke(app, [str(a) for a in args])
+
+
+@pytest.fixture(scope="module")
+def samples_csv(tmp_path_factory):
+    v = np.geomspace(0.01, 1.0, 8)
+    v = np.concatenate([v, -v])
+    f = np.sign(v) * (0.1 + 0.05 * np.exp(-((v / 0.05) ** 2))) + 0.02 * v
+    f = f + 1e-4 * np.random.default_rng(0).standard_normal(v.size)
+    path = tmp_path_factory.mktemp("newcomer") / "s.csv"
+    rows = "".join(f"{float(a)!r},{float(b)!r}\n" for a, b in zip(v, f, strict=True))
+    path.write_text("velocity [rad/s],friction [N m]\n" + rows)
+    return path
+
+
+def test_methods_lists_every_model_and_optimiser_from_the_registries():
+    from fricid.errors import ConfigError
+    from fricid.models import DYNAMIC, MODELS, STATEFUL, get_model
+    from fricid.optim import METHODS
+
+    res = run("methods")
+    assert res.exit_code == 0, res.output
+    listed = set(re.findall(r"^  (\S+)\s", res.stdout, re.M))
+    temp = set()
+    for name in MODELS:
+        with contextlib.suppress(ConfigError):
+            temp.add(get_model(f"{name}_temp").name)
+    assert {"stribeck_temp", "msk_temp", "coulomb_viscous_temp"} <= temp
+    want = {*MODELS, *temp, *DYNAMIC, *STATEFUL, "auto", *METHODS, "varpro"}
+    assert {"lugre", "dahl"} <= want
+    assert want == listed, (want - listed, listed - want)
+    for line in res.stdout.splitlines():  # one line each, with a description
+        if line.startswith("  "):
+            assert len(line.split(None, 1)) == 2, line
+
+
+def test_method_help_names_each_model_s_default():
+    res = run("fit", "--help")
+    assert res.exit_code == 0
+    text = " ".join(res.stdout.split())
+    assert "lsq for rbf and hybrid" in text
+    assert "[default: lm]" not in text
+
+
+@pytest.mark.slow  # 11 s measured under load (the network's structure search, the trust check)
+def test_rbf_trains_with_lsq_without_method(samples_csv, tmp_path):
+    out = tmp_path / "r.json"
+    res = run("fit", samples_csv, "--model", "rbf", "--centers", "4", "-q", "--out", out)
+    assert res.exit_code == 0, res.output
+    import json
+
+    assert json.loads(out.read_text())["state"]["trainer"] == "lsq"
+
+
+def test_too_many_centres_names_the_command_line_option(samples_csv, tmp_path):
+    res = run("fit", samples_csv, "--model", "rbf", "--centers", "1000", "--out", tmp_path / "x")
+    assert res.exit_code == 2
+    assert "--centers" in res.output and "Traceback" not in res.output
+
+
+def test_the_fit_report_states_the_rmse(samples_csv):
+    from fricid.identify import fit
+    from fricid.io import read_samples
+
+    fitted = fit(read_samples(samples_csv), "coulomb_viscous")
+    line = next(ln for ln in fitted.report().splitlines() if "RMSE" in ln)
+    assert line.split("=")[0].strip() == "RMSE [N m]"
+    assert float(line.split("=")[1]) == pytest.approx(fitted.metrics["rmse"], rel=1e-7)
+
+
+def test_predict_prints_numbers_with_the_digits_they_deserve(samples_csv, tmp_path):
+    from fricid.identify import fit
+    from fricid.io import read_samples
+
+    model = fit(read_samples(samples_csv), "coulomb_viscous").save(tmp_path / "m.json")
+    res = run("predict", model, "-v", "0.2", "-v", "0.1", "--load", "0.3", "--temperature", "25")
+    assert res.exit_code == 0, res.output
+    rows = res.stdout.splitlines()
+    assert rows[1].startswith("0.2,0.3,25,") and "0.20000000000000001" not in res.stdout
+    from fricid.fitted import FittedModel
+
+    fitted = FittedModel.load(model)
+    exact = fitted.predict(np.array([[0.2, 0.3, 25.0]]))[0]
+    assert float(rows[1].split(",")[3]) == exact  # exact: reads back to the same float
+    res = run("predict", model, "-v", "0.2", "--digits", "3")
+    assert res.stdout.splitlines()[1].split(",")[3] == f"{exact:.3g}"
