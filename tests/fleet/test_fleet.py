@@ -36,6 +36,7 @@ from fricid.fleet import (
     run_fleet,
     write_drift,
 )
+from fricid.identify.validate import interior_rmse
 from fricid.io import write_rawlog
 from fricid.io.atomic import HOST_TAG
 from fricid.models import Stribeck
@@ -324,12 +325,13 @@ def test_results_table_has_per_joint_verdict_columns(fleet):
     # no --validate in the manifest: the trust verdict ran lovo itself (11 levels, small),
     # as fricid fit and fricid report do, and the model file carries that record
     assert (ok["heldout_source"] == "lovo run here").all()
-    assert (ok["heldout_scheme"] == "lovo").all()
+    assert (ok["heldout_scheme"] == "lovo, interior levels").all()
     for row in ok.itertuples():
         saved = json.loads((run.out / row.model_file).read_text())
         assert saved["validation"] is None
         assert row.heldout_ratio == pytest.approx(saved["trust"]["heldout_ratio"])
-        assert row.heldout_ratio == pytest.approx(saved["trust"]["validation"]["ratio"])
+        val = saved["trust"]["validation"]  # graded on the interior folds of lovo
+        assert row.heldout_ratio == pytest.approx(interior_rmse(val["folds"]) / val["scatter"])
         assert row.trust == saved["trust"]["level"]
         assert row.verdict.startswith(("within noise", "misses by"))
         assert row.trust in ("yes", "with caveats")

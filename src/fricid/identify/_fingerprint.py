@@ -1,5 +1,6 @@
 """What a trust record was computed on (:mod:`fricid.identify.trust`, "Reuse"): hashes of the
-model file and of the samples that survive a JSON round trip, and the record made JSON-ready.
+model file and of the samples that survive a JSON round trip, the record made JSON-ready, and
+the check of the types of a record read back.
 """
 
 from __future__ import annotations
@@ -13,7 +14,13 @@ import numpy as np
 from ..fitted import FittedModel
 from ..samples import FrictionSamples
 
-__all__ = ["canonical", "json_ready", "model_hash", "samples_detail_hash"]
+__all__ = [
+    "canonical",
+    "check_record_types",
+    "json_ready",
+    "model_hash",
+    "samples_detail_hash",
+]
 
 
 def json_ready(value: Any) -> Any:
@@ -82,3 +89,46 @@ def _default(value: Any) -> Any:
     if isinstance(value, np.generic):
         return value.item()
     return str(value)
+
+
+#: The type of each text, list and mapping field of a record read from a file: a record
+#: of other types is not used (the report would fail on it).
+_TEXT = (
+    "level",
+    "convergence",
+    "advice",
+    "heldout_source",
+    "heldout_scheme",
+    "verdict",
+    "scatter_method",
+    "validation_note",
+    "range",
+    "quality_summary",
+    "what_to_do",
+    "model",
+)
+
+
+def check_record_types(record: Any) -> None:
+    """TypeError unless every field of ``record`` (a :class:`fricid.identify.trust.Trust`
+    read from a file) has the type the report reads."""
+
+    def texts(value: Any) -> bool:
+        return isinstance(value, list) and all(isinstance(v, str) for v in value)
+
+    def rows(value: Any) -> bool:
+        return isinstance(value, list) and all(isinstance(v, dict) for v in value)
+
+    ok = [
+        record.level in ("yes", "with caveats", "no"),
+        all(isinstance(getattr(record, k), str) for k in _TEXT),
+        texts(record.reasons) and texts(record.not_determined),
+        isinstance(record.open_sides, dict) and texts(list(record.open_sides.values())),
+        record.converged is None or isinstance(record.converged, bool),
+        isinstance(record.learned, bool) and isinstance(record.options, dict),
+        record.quality is None or rows(record.quality),
+    ]
+    for part in (record.validation, record.cv):
+        ok.append(part is None or (isinstance(part, dict) and rows(part.get("folds") or [])))
+    if not all(ok):
+        raise TypeError("not a trust record of this fricid")
