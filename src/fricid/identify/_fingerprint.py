@@ -12,14 +12,17 @@ from typing import Any
 import numpy as np
 
 from ..fitted import FittedModel
-from ..samples import FrictionSamples
+from ..samples import FrictionSamples, samples_hash
+from ._heldout import LEARNED_VALIDATE_WORK, MIN_LEVELS, TINY_SAMPLES, VALIDATE_WORK
 
 __all__ = [
     "canonical",
     "check_record_types",
     "json_ready",
     "model_hash",
+    "record_key",
     "samples_detail_hash",
+    "trust_options",
 ]
 
 
@@ -123,6 +126,7 @@ def check_record_types(record: Any) -> None:
         record.level in ("yes", "with caveats", "no"),
         all(isinstance(getattr(record, k), str) for k in _TEXT),
         texts(record.reasons) and texts(record.not_determined),
+        texts(record.downweighted),
         isinstance(record.open_sides, dict) and texts(list(record.open_sides.values())),
         record.converged is None or isinstance(record.converged, bool),
         isinstance(record.learned, bool) and isinstance(record.options, dict),
@@ -132,3 +136,27 @@ def check_record_types(record: Any) -> None:
         ok.append(part is None or (isinstance(part, dict) and rows(part.get("folds") or [])))
     if not all(ok):
         raise TypeError("not a trust record of this fricid")
+
+
+def trust_options(validate: bool = True, max_work: int = VALIDATE_WORK) -> dict[str, Any]:
+    """The options a record depends on: whether a validation may be run here and its limits."""
+    return {
+        "validate": bool(validate),
+        "max_work": int(max_work),
+        "learned_work": int(LEARNED_VALIDATE_WORK),
+        "min_levels": int(MIN_LEVELS),
+        "tiny_samples": int(TINY_SAMPLES),
+    }
+
+
+def record_key(
+    fitted: FittedModel, samples: FrictionSamples | None, options: dict[str, Any], version: int
+) -> dict[str, Any]:
+    """What a record of format ``version`` computed with ``options`` was computed on."""
+    return {
+        "samples_hash": None if samples is None else samples_hash(samples),
+        "samples_detail_hash": None if samples is None else samples_detail_hash(samples),
+        "model_hash": model_hash(fitted),
+        "options": options,
+        "version": version,
+    }

@@ -123,6 +123,8 @@ def _run(
     options: dict[str, Any] = {"intervals": "none"}
     if isinstance(fitted.loss.get("loss"), str):
         options["loss"] = fitted.loss["loss"]
+    if fitted.loss.get("weights") == "std":  # each training fold weighted as the fit was
+        options["weights"] = "std"
     return _validate(
         samples,
         fitted.model,

@@ -59,15 +59,16 @@ import numpy as np
 from ..fitted import FittedModel
 from ..fitted._file import _convergence_line
 from ..metrics import NOISE_RATIO, rmse, verdict
-from ..samples import FrictionSamples, samples_hash
-from ._diagnostics import DROPS, not_determined, open_sides, quality_rows, range_text
-from ._fingerprint import (
-    canonical,
-    check_record_types,
-    json_ready,
-    model_hash,
-    samples_detail_hash,
+from ..samples import FrictionSamples
+from ._diagnostics import (
+    DROPS,
+    downweighted,
+    not_determined,
+    open_sides,
+    quality_rows,
+    range_text,
 )
+from ._fingerprint import canonical, check_record_types, json_ready, record_key, trust_options
 from ._heldout import (
     LEARNED_VALIDATE_WORK,
     LOVO_INTERIOR,
@@ -182,6 +183,9 @@ class Trust:
         validation (shown beside it).
     what_to_do : str
         For a model whose error misses the scatter: what to do; "" otherwise.
+    downweighted : list of str
+        The samples a robust fit down-weighted (:func:`._diagnostics.downweighted`), left out
+        of the error graded (the fit is judged on the inliers).
     model : str
         The model's registry name.
     samples_hash, samples_detail_hash, model_hash : str or None
@@ -216,6 +220,7 @@ class Trust:
     learned: bool = False
     cv: dict[str, Any] | None = None
     what_to_do: str = ""
+    downweighted: list[str] = field(default_factory=list)
     model: str = ""
     samples_hash: str | None = None
     samples_detail_hash: str | None = None
@@ -265,28 +270,6 @@ class Trust:
 
 
 # -- what a record was computed on -------------------------------------------------------
-
-
-def trust_options(validate: bool = True, max_work: int = VALIDATE_WORK) -> dict[str, Any]:
-    """The options a record depends on: whether a validation may be run here and its limits."""
-    return {
-        "validate": bool(validate),
-        "max_work": int(max_work),
-        "learned_work": int(LEARNED_VALIDATE_WORK),
-        "min_levels": int(MIN_LEVELS),
-    }
-
-
-def _key(
-    fitted: FittedModel, samples: FrictionSamples | None, options: dict[str, Any]
-) -> dict[str, Any]:
-    return {
-        "samples_hash": None if samples is None else samples_hash(samples),
-        "samples_detail_hash": None if samples is None else samples_detail_hash(samples),
-        "model_hash": model_hash(fitted),
-        "options": options,
-        "version": TRUST_VERSION,
-    }
 
 
 def _stored(fitted: FittedModel, key: dict[str, Any]) -> Trust | None:
@@ -340,7 +323,7 @@ def assess_trust(
         The level and its reasons, each number with its source (module notes).
     """
     options = trust_options(validate, max_work)
-    key = _key(fitted, samples, options)
+    key = record_key(fitted, samples, options, TRUST_VERSION)
     if reuse:
         stored = _stored(fitted, key)
         if stored is not None:
@@ -350,35 +333,42 @@ def assess_trust(
     trust.model_hash, trust.options = key["model_hash"], options
     mine = own_cv(fitted.validation)
     can_run = samples is not None and validate and trust.converged
-    if (mine or fitted.validation is None) and can_run:
-        val, trust.validation_note = run_validation(fitted, samples, max_work)
+    low, trust.downweighted = downweighted(fitted, samples)
+    judged = samples if low is None else samples.subset(~low)  # a robust fit: its inliers
+    if (mine or fitted.validation is None or low is not None) and can_run:
+        val, trust.validation_note = run_validation(fitted, judged, max_work)
         if val is not None:
             trust.validation, trust.heldout_source = val, RUN_HERE
     elif fitted.validation is None:
         trust.validation_note = "no held-out validation in the file; in-sample only"
     elif mine:
         trust.validation_note = "leave-one-velocity-out not run here; the fit's own CV only"
-    if trust.validation is None and fitted.validation is not None:
+    if trust.validation is None and fitted.validation is not None and low is None:
         trust.validation = fitted.validation
         trust.heldout_source = OWN_CV if mine else FROM_FIT
     if mine and trust.heldout_source == RUN_HERE:
         trust.cv = fitted.validation
-    _ratio(trust, fitted, samples)
+    _ratio(trust, fitted, judged, inliers=low is not None)
     random = trust.heldout_scheme.startswith("kfold")
-    if can_run and len(samples) <= TINY_SAMPLES and not random:  # the worse of the two
+    if can_run and len(judged) <= TINY_SAMPLES and not random:  # the worse of the two
         before = trust.heldout_ratio if trust.held_out else np.nan
-        val, note = worse_kfold(fitted, samples, max_work, before, trust.heldout_scheme)
+        val, note = worse_kfold(fitted, judged, max_work, before, trust.heldout_scheme)
         trust.validation_note = "; ".join(x for x in (trust.validation_note, note) if x)
         if val is not None:
             trust.validation, trust.heldout_source = val, KFOLD_HERE
-            _ratio(trust, fitted, samples)
-    quality_caveat = _quality(trust, samples)
+            _ratio(trust, fitted, judged, inliers=low is not None)
+    if low is not None:
+        trust.validation_note = (
+            f"judged on the {len(judged)} inliers, the {int(low.sum())} sample(s) the "
+            f"{fitted.loss['loss']} loss down-weighted left out; " + trust.validation_note
+        )
+    trust.quality, trust.quality_summary, quality_caveat = quality_rows(samples)
     _grade(trust, fitted, quality_caveat)
     if trust.converged is not False and trust.heldout_ratio > MISS_RATIO:
         from ._advice import misfit_advice
 
         held = trust.validation if trust.held_out else None
-        trust.what_to_do = misfit_advice(fitted, held, trust.scatter, MISS_RATIO, samples)
+        trust.what_to_do = misfit_advice(fitted, held, trust.scatter, MISS_RATIO, judged)
     return trust
 
 
@@ -406,16 +396,13 @@ def _base(fitted: FittedModel, samples: FrictionSamples | None) -> Trust:
     )
 
 
-def _quality(trust: Trust, samples: FrictionSamples | None) -> str:
-    """Set the quality rows and summary; return the caveat ("" for none)."""
-    trust.quality, trust.quality_summary, caveat = quality_rows(samples)
-    return caveat
-
-
-def _ratio(trust: Trust, fitted: FittedModel, samples: FrictionSamples | None) -> None:
+def _ratio(
+    trust: Trust, fitted: FittedModel, samples: FrictionSamples | None, inliers: bool = False
+) -> None:
     """The ratio to grade by: held out (``trust.validation``; leave-one-velocity-out on its
     interior folds, :func:`._heldout.graded_rmse`), else the file's in-sample ratio, else the
-    in-sample ratio on ``samples`` (a network's file may not record its scatter)."""
+    in-sample ratio on ``samples`` (a network's file may not record its scatter, and the
+    file's ratio holds a robust fit's outliers: ``inliers``, ``samples`` are its inliers)."""
     v = trust.validation
     if v and v.get("ratio") is not None:
         trust.heldout_rmse, trust.heldout_scheme = graded_rmse(v)
@@ -424,7 +411,7 @@ def _ratio(trust: Trust, fitted: FittedModel, samples: FrictionSamples | None) -
         trust.scatter_method = str(v.get("scatter_method") or "")
     else:  # no held-out ratio (no validation, or one without a scatter): in-sample
         trust.heldout_source = ""
-        if fitted.metrics.get("rmse_over_scatter") is not None:
+        if fitted.metrics.get("rmse_over_scatter") is not None and not inliers:
             trust.heldout_ratio = float(fitted.metrics["rmse_over_scatter"])
             trust.heldout_rmse = float(fitted.metrics.get("rmse", np.nan))
             trust.scatter = float(fitted.metrics.get("scatter", np.nan))
@@ -477,6 +464,12 @@ def _grade(trust: Trust, fitted: FittedModel, quality_caveat: str) -> None:
         )
     if quality_caveat:
         caveats.append(quality_caveat)
+    if trust.downweighted:
+        loss = (fitted.loss or {}).get("loss")
+        caveats.append(
+            f"the {loss} loss down-weighted {len(trust.downweighted)} sample(s) as outliers "
+            f"({'; '.join(trust.downweighted)}), left out of the error graded"
+        )
     estimated = trust.scatter_method == SECOND_DIFFERENCES and np.isfinite(ratio)
     said = [ESTIMATED] if estimated else []
     if no:
