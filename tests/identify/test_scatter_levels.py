@@ -9,6 +9,7 @@ import pytest
 from fricid.errors import ConfigError
 from fricid.identify._scatter import (
     SECOND_DIFFERENCES,
+    level_labels,
     measurement_scatter,
     sample_weights,
     speed_levels,
@@ -89,3 +90,17 @@ def test_weights_std_refuse_an_estimated_scatter():
     s = _linear_law(0.1 * 1.03 ** np.arange(38))
     with pytest.raises(ConfigError, match="second differences"):
         sample_weights(s, "std")
+
+
+def test_the_two_directions_of_one_set_point_pair_once():
+    s = FrictionSamples(  # the EPOS lead screw's slowest set-point: 3 % apart by direction
+        velocity=[-0.2172, 0.2241, -1.0472, 1.048],
+        load=0.0,
+        temperature=25.0,
+        friction=[-1.0, 1.0, -1.5, 1.5],
+    )
+    assert level_labels(s).tolist() == [0, 0, 1, 1]
+    speed = 0.1 * 1.03 ** np.arange(12)  # one direction per speed, alternating
+    v = np.where(np.arange(12) % 2, speed, -speed)
+    one_each = FrictionSamples(velocity=v, load=0.0, temperature=25.0, friction=np.sign(v))
+    assert np.bincount(level_labels(one_each)).tolist() == [2] * 6  # pairs, never chains
