@@ -104,3 +104,14 @@ def test_the_two_directions_of_one_set_point_pair_once():
     v = np.where(np.arange(12) % 2, speed, -speed)
     one_each = FrictionSamples(velocity=v, load=0.0, temperature=25.0, friction=np.sign(v))
     assert np.bincount(level_labels(one_each)).tolist() == [2] * 6  # pairs, never chains
+
+
+def test_the_verdict_says_the_scatter_is_estimated():
+    from fricid.identify import fit
+    from fricid.identify.trust import ESTIMATED, assess_trust
+
+    s = _linear_law(0.1 * 1.03 ** np.arange(38))
+    trust = assess_trust(fit(s, "coulomb_viscous"), s)
+    assert trust.scatter_method == SECOND_DIFFERENCES
+    assert ESTIMATED in trust.line() and trust.level != "no"
+    assert 0.7 < trust.heldout_ratio < 1.4  # the true model against the noise, not the rise

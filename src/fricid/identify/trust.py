@@ -471,7 +471,7 @@ def _grade(trust: Trust, fitted: FittedModel, quality_caveat: str) -> None:
             f"({'; '.join(trust.downweighted)}), left out of the error graded"
         )
     estimated = trust.scatter_method == SECOND_DIFFERENCES and np.isfinite(ratio)
-    said = [ESTIMATED] if estimated else []
+    said = [f"the scatter is {ESTIMATED}"] if estimated else []
     if no:
         trust.level, trust.reasons = "no", no + caveats + said
         return

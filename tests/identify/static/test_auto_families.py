@@ -53,3 +53,13 @@ def test_auto_picks_the_temperature_family_of_an_arrhenius_law():
     x = np.column_stack([v, np.zeros_like(v), t])
     err = np.sqrt(np.mean((fitted.predict(x, warn=False) - _law(v, t)) ** 2) + NOISE**2)
     assert err / NOISE < 1.3  # measured 1.09 (15.5 when the temperature variants were left out)
+
+
+def test_on_tiny_data_only_a_significant_gain_beats_the_simpler_family():
+    from fricid.identify.static.select import _better
+
+    rng = np.random.default_rng(0)
+    y = rng.normal(0.0, 1.0, 12)
+    best = y + rng.normal(0.0, 0.05, 12)
+    assert not _better(best, y + rng.normal(0.0, 0.06, 12), y)  # noise apart
+    assert _better(best, y + 0.5, y)  # every sample worse by far
