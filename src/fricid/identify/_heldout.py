@@ -55,7 +55,7 @@ MIN_LEVELS = 5
 
 #: Samples up to which the verdict also runs random folds (:func:`run_kfold`) and takes the
 #: worse ratio.
-TINY_SAMPLES = 24
+TINY_SAMPLES = 20
 
 
 def run_validation(

@@ -58,7 +58,7 @@ __all__ = [
 
 
 #: Samples up to which a simpler candidate is kept unless the best is significantly better.
-TINY_SAMPLES = 24
+TINY_SAMPLES = 20
 
 #: ... significantly: by more than this many standard errors of the mean paired difference.
 TINY_SIGMAS = 2.0
