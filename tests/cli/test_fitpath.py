@@ -230,6 +230,7 @@ def test_lm_starts_once_unless_the_fit_is_doubtful():
 def test_fit_judges_the_first_lm_start_against_the_measurement_scatter():
     """fit sets restart_above at 3x the scatter's SSE; without a scatter every start runs."""
     from fricid.identify import fit
+    from fricid.identify._scatter import SECOND_DIFFERENCES
     from fricid.samples import FrictionSamples
 
     problem = _lm_problem()
@@ -245,5 +246,12 @@ def test_fit_judges_the_first_lm_start_against_the_measurement_scatter():
         velocity=v, load=0.0, temperature=25.0, friction=y, std=np.full(n, 1e-7), count=100
     )
     assert "restart_above" in fit(tiny, "stribeck", **kw).optimizer.message
+    # nothing repeats: the first start is judged against the scatter estimated from the
+    # second differences along the speed axis
     bare = FrictionSamples(velocity=v, load=0.0, temperature=25.0, friction=y)
-    assert "8 start(s)" in fit(bare, "stribeck", **kw).optimizer.message
+    assert fit(bare, "stribeck", **kw).loss["scatter"]["method"] == SECOND_DIFFERENCES
+    assert "not doubtful" in fit(bare, "stribeck", **kw).optimizer.message
+    # no scatter at all (too few speeds to estimate one): every start runs
+    few = bare.subset(np.arange(n) % 3 == 0)
+    assert np.isnan(fit(few, "stribeck", **kw).loss["scatter"]["value"] or np.nan)
+    assert "8 start(s)" in fit(few, "stribeck", **kw).optimizer.message

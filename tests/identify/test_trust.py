@@ -21,10 +21,12 @@ from fricid.identify import fit, trust
 from fricid.identify.trust import (
     FROM_FIT,
     IN_SAMPLE,
+    LOVO_INTERIOR,
     RUN_HERE,
     Trust,
     assess_trust,
 )
+from fricid.identify.validate import interior_rmse
 from fricid.io import epos_steady_samples, write_rawlog, write_samples
 from fricid.sim import preset, simulate
 from fricid.workflow import fit_samples
@@ -58,8 +60,14 @@ def _no_validation(monkeypatch):
 
 def test_sources_say_where_the_ratio_came_from(fitted, leadscrew):
     here = assess_trust(fitted, leadscrew)
-    assert (here.heldout_source, here.heldout_scheme, here.held_out) == (RUN_HERE, "lovo", True)
-    assert here.heldout_ratio == pytest.approx(here.validation["ratio"])
+    assert (here.heldout_source, here.heldout_scheme, here.held_out) == (
+        RUN_HERE,
+        LOVO_INTERIOR,
+        True,
+    )
+    assert here.validation["scheme"] == "lovo"  # every fold kept; graded on the interior ones
+    inner = interior_rmse(here.validation["folds"])
+    assert here.heldout_ratio == pytest.approx(inner / here.validation["scatter"])
     # no validation run: the in-sample ratio, never labelled held out
     inside = assess_trust(fitted, leadscrew, validate=False)
     assert (inside.heldout_source, inside.heldout_scheme, inside.held_out) == (IN_SAMPLE, "", False)
@@ -180,7 +188,7 @@ def test_fleet_row_and_report_agree(tmp_path, leadscrew_dir):
         assert runner.invoke(app, [*args, "-o", str(samples)]).exit_code == 0
         model = tmp_path / "out" / row["model_file"]
         line, md = _report(model, samples, tmp_path / f"{robot}-report")
-        assert row["heldout_source"] == sources[robot] and row["heldout_scheme"] == "lovo"
+        assert row["heldout_source"] == sources[robot] and row["heldout_scheme"] == LOVO_INTERIOR
         assert _level(line) == row["trust"]
         assert row["verdict"] in md and "read from the model file" in md
         assert _ratio(md) == pytest.approx(row["heldout_ratio"], rel=1e-2)
@@ -206,13 +214,14 @@ def test_fit_validate_lovo_and_report_agree(leadscrew, tmp_path):
     assert res.exit_code == 0, res.output
     block = res.stdout.split("[[Trust]]\n", 1)[1].splitlines()
     fit_line = block[0].strip()
-    assert "[the fit's --validate (lovo)]" in block[1]
+    assert f"[the fit's --validate ({LOVO_INTERIOR})]" in block[1]
     stored = json.loads(model.read_text())
     assert stored["trust"]["heldout_source"] == FROM_FIT
-    assert stored["trust"]["heldout_ratio"] == stored["validation"]["ratio"]
+    inner = interior_rmse(stored["validation"]["folds"]) / stored["validation"]["scatter"]
+    assert stored["trust"]["heldout_ratio"] == pytest.approx(inner)
     line, md = _report(model, samples, tmp_path / "r")
     assert line == fit_line and "read from the model file" in md
-    assert _ratio(md) == pytest.approx(stored["validation"]["ratio"], rel=1e-2)
+    assert _ratio(md) == pytest.approx(inner, rel=1e-2)
     assert _fresh(model, samples).line() == fit_line
 
 

@@ -235,7 +235,8 @@ def test_trust_yes_for_a_converged_fit_within_noise(leadscrew, tmp_path):
     assert line.startswith("Trust: yes, because the fit converged")
     assert doc.meta["trust"] == line and next(iter(doc.meta)) == "trust"
     # the trust check ran lovo itself, and says so; the quality table of the EPOS reader is shown
-    assert "held-out RMSE (lovo run here)" in sec.text and "lovo run here: 16 folds" in sec.text
+    assert "held-out RMSE (lovo, interior levels, lovo run here)" in sec.text, sec.text
+    assert "lovo run here: 16 folds" in sec.text
     assert "32 set-points" in sec.text
     names = {getattr(i, "name", None) for i in sec.items}
     assert {"quality", "heldout"} <= names

@@ -32,8 +32,11 @@ __all__ = ["misfit_advice"]
 
 
 def _in_sample_ratio(fitted: FittedModel, samples: FrictionSamples | None, scatter: float):
+    """The in-sample error over the scatter: the file's, or on ``samples`` when the file has
+    none or the fit was robust (the file's holds the outliers; ``samples`` are the inliers)."""
     ratio = fitted.metrics.get("rmse_over_scatter")
-    if ratio is not None:
+    robust = (fitted.loss or {}).get("loss") in ("soft_l1", "huber") and samples is not None
+    if ratio is not None and not robust:
         return float(ratio)
     if samples is None or not np.isfinite(scatter) or scatter <= 0:
         return float("nan")
@@ -59,7 +62,9 @@ def misfit_advice(
     miss_ratio : float
         The verdict's threshold (:data:`fricid.identify.trust.MISS_RATIO`).
     samples : FrictionSamples, optional
-        Without a recorded in-sample ratio, the in-sample error is computed on them. The
+        Without a recorded in-sample ratio, or for a robust fit (``--loss soft_l1``,
+        ``huber``: the samples given are its inliers), the in-sample error is computed on
+        them. The
         commands name them ``SAMPLES``, not by their file: the advice is part of the trust
         record, which depends on the samples' content, not on where they were read from.
 

@@ -7,13 +7,35 @@ stays readable; :func:`not_determined` is also the report's parameter table stat
 
 from __future__ import annotations
 
+import contextlib
 from typing import Any
 
+import numpy as np
+
+from ..errors import ConfigError
 from ..fitted import FittedModel, Parameter
 from ..models._range import coverage_text, gaps_note
 from ..samples import FrictionSamples
+from ._scatter import sample_weights
 
-__all__ = ["DROPS", "not_determined", "open_sides", "quality_rows", "range_text"]
+__all__ = [
+    "DOWN_WEIGHT",
+    "DROPS",
+    "downweighted",
+    "not_determined",
+    "open_sides",
+    "quality_rows",
+    "range_text",
+]
+
+#: A sample whose weight under a robust loss is below this is reported as down-weighted and
+#: left out of the error the verdict grades: soft_l1 ``1 / sqrt(1 + z^2)`` below it beyond
+#: ``|z| = 2.83`` scales, huber ``min(1, 1 / |z|)`` beyond 3 (``z`` the residual over the
+#: loss's scale, weighted as the fit weighs it), about 0.5 % of Gaussian noise either way.
+DOWN_WEIGHT = 1.0 / 3.0
+
+#: Down-weighted samples listed by name (the rest counted).
+_LISTED = 5
 
 _UNITS = {"velocity": "rad/s", "load": "N m", "temperature": "degC"}
 
@@ -124,3 +146,54 @@ def _point_name(row: dict[str, Any]) -> str:
     v = row.get("velocity")
     where = f"{v:.4g} rad/s" if isinstance(v, int | float) else "?"
     return f"{row['label']} ({where})" if row.get("label") else where
+
+
+def downweighted(
+    fitted: FittedModel, samples: FrictionSamples | None
+) -> tuple[np.ndarray | None, list[str]]:
+    """The samples a robust fit (``--loss soft_l1`` or ``huber``) down-weighted.
+
+    Parameters
+    ----------
+    fitted : FittedModel
+    samples : FrictionSamples, optional
+        The samples it was fitted to.
+
+    Returns
+    -------
+    numpy.ndarray of bool (n,) or None
+        True where the sample's robust weight is below :data:`DOWN_WEIGHT`; None for a fit by
+        least squares, without samples, or when none (or half or more) is down-weighted.
+    list of str
+        The down-weighted samples by velocity, load and temperature with their residual in
+        scales (the first few; then how many more).
+    """
+    loss = (fitted.loss or {}).get("loss")
+    scale = (fitted.loss or {}).get("f_scale")
+    if samples is None or loss not in ("soft_l1", "huber") or not scale or scale <= 0:
+        return None, []
+    r = samples.y - fitted.predict(samples.X, warn=False)
+    if (fitted.loss or {}).get("weights") == "std":
+        with contextlib.suppress(ConfigError):  # else the fit could not have weighed them
+            r = r * np.sqrt(sample_weights(samples, "std"))
+    z = np.abs(r) / float(scale)
+    huber = np.minimum(1.0, 1.0 / np.maximum(z, 1e-300))
+    weight = 1.0 / np.sqrt(1.0 + z**2) if loss == "soft_l1" else huber
+    low = weight < DOWN_WEIGHT
+    if not low.any() or 2 * low.sum() >= low.size:
+        return None, []
+    rows = np.flatnonzero(low)[np.argsort(-z[low])]
+    names = [_sample_name(samples, int(i), float(z[i])) for i in rows[:_LISTED]]
+    if rows.size > _LISTED:
+        names.append(f"and {rows.size - _LISTED} more")
+    return low, names
+
+
+def _sample_name(samples: FrictionSamples, i: int, z: float) -> str:
+    """``"row 3: v = -0.0979 rad/s, load 0 N m, 25 degC (residual 12x the loss's scale)"``."""
+    parts = [f"v = {samples.velocity[i]:+.4g} rad/s"]
+    if np.isfinite(samples.load[i]):
+        parts.append(f"load {samples.load[i]:.4g} N m")
+    if np.isfinite(samples.temperature[i]):
+        parts.append(f"{samples.temperature[i]:.4g} degC")
+    return f"row {i}: {', '.join(parts)} (residual {z:.3g}x the loss's scale)"

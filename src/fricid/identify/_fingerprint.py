@@ -1,5 +1,6 @@
 """What a trust record was computed on (:mod:`fricid.identify.trust`, "Reuse"): hashes of the
-model file and of the samples that survive a JSON round trip, and the record made JSON-ready.
+model file and of the samples that survive a JSON round trip, the record made JSON-ready, and
+the check of the types of a record read back.
 """
 
 from __future__ import annotations
@@ -11,9 +12,18 @@ from typing import Any
 import numpy as np
 
 from ..fitted import FittedModel
-from ..samples import FrictionSamples
+from ..samples import FrictionSamples, samples_hash
+from ._heldout import LEARNED_VALIDATE_WORK, MIN_LEVELS, TINY_SAMPLES, VALIDATE_WORK
 
-__all__ = ["canonical", "json_ready", "model_hash", "samples_detail_hash"]
+__all__ = [
+    "canonical",
+    "check_record_types",
+    "json_ready",
+    "model_hash",
+    "record_key",
+    "samples_detail_hash",
+    "trust_options",
+]
 
 
 def json_ready(value: Any) -> Any:
@@ -68,8 +78,10 @@ def model_hash(fitted: FittedModel) -> str:
 
 def samples_detail_hash(samples: FrictionSamples) -> str:
     """A hash of what the scatter and the quality table read besides the values: count, std
-    and ``meta`` ``sem``, ``sem_method``, ``sem_caveat`` and ``quality``."""
+    and ``meta`` ``sem``, ``sem_method``, ``sem_caveat``, ``setpoint`` and ``quality``."""
     meta = {k: samples.meta.get(k) for k in ("sem", "sem_method", "sem_caveat", "quality")}
+    if "setpoint" in samples.meta:
+        meta["setpoint"] = samples.meta["setpoint"]
     doc = {"count": samples.count.tolist(), "std": samples.std.tolist(), "meta": meta}
     return _digest(json.loads(json.dumps(doc, default=_default)))
 
@@ -80,3 +92,71 @@ def _default(value: Any) -> Any:
     if isinstance(value, np.generic):
         return value.item()
     return str(value)
+
+
+#: The type of each text, list and mapping field of a record read from a file: a record
+#: of other types is not used (the report would fail on it).
+_TEXT = (
+    "level",
+    "convergence",
+    "advice",
+    "heldout_source",
+    "heldout_scheme",
+    "verdict",
+    "scatter_method",
+    "validation_note",
+    "range",
+    "quality_summary",
+    "what_to_do",
+    "model",
+)
+
+
+def check_record_types(record: Any) -> None:
+    """TypeError unless every field of ``record`` (a :class:`fricid.identify.trust.Trust`
+    read from a file) has the type the report reads."""
+
+    def texts(value: Any) -> bool:
+        return isinstance(value, list) and all(isinstance(v, str) for v in value)
+
+    def rows(value: Any) -> bool:
+        return isinstance(value, list) and all(isinstance(v, dict) for v in value)
+
+    ok = [
+        record.level in ("yes", "with caveats", "no"),
+        all(isinstance(getattr(record, k), str) for k in _TEXT),
+        texts(record.reasons) and texts(record.not_determined),
+        texts(record.downweighted),
+        isinstance(record.open_sides, dict) and texts(list(record.open_sides.values())),
+        record.converged is None or isinstance(record.converged, bool),
+        isinstance(record.learned, bool) and isinstance(record.options, dict),
+        record.quality is None or rows(record.quality),
+    ]
+    for part in (record.validation, record.cv):
+        ok.append(part is None or (isinstance(part, dict) and rows(part.get("folds") or [])))
+    if not all(ok):
+        raise TypeError("not a trust record of this fricid")
+
+
+def trust_options(validate: bool = True, max_work: int = VALIDATE_WORK) -> dict[str, Any]:
+    """The options a record depends on: whether a validation may be run here and its limits."""
+    return {
+        "validate": bool(validate),
+        "max_work": int(max_work),
+        "learned_work": int(LEARNED_VALIDATE_WORK),
+        "min_levels": int(MIN_LEVELS),
+        "tiny_samples": int(TINY_SAMPLES),
+    }
+
+
+def record_key(
+    fitted: FittedModel, samples: FrictionSamples | None, options: dict[str, Any], version: int
+) -> dict[str, Any]:
+    """What a record of format ``version`` computed with ``options`` was computed on."""
+    return {
+        "samples_hash": None if samples is None else samples_hash(samples),
+        "samples_detail_hash": None if samples is None else samples_detail_hash(samples),
+        "model_hash": model_hash(fitted),
+        "options": options,
+        "version": version,
+    }

@@ -3,7 +3,13 @@ the fit brought none: leave-one-velocity-out of an analytic model when folds x s
 parameters is at most :data:`VALIDATE_WORK`, of a learned model (``rbf`` and ``hybrid`` trained
 by least squares, ``gp``; each fold retrained as ``fit`` trains it) when folds x samples is at
 most :data:`fricid.identify.learned._trust.LEARNED_VALIDATE_WORK`, with at least
-:data:`MIN_LEVELS` velocity levels either way.
+:data:`MIN_LEVELS` velocity levels either way (levels that cannot chain:
+:func:`fricid.identify._scatter.speed_levels`).
+
+On tiny data (at most :data:`TINY_SAMPLES` samples) :func:`run_kfold` adds random folds
+(``kfold:K``, ``K = min(5, n // 2)``): there, a handful of velocity levels each hold out only
+the speed a flexible model interpolates well, and random folds hold out single samples it has
+bent to fit; the verdict takes the worse of the two.
 
 The limits are counts, not measured times, so the verdict does not depend on how busy the
 machine is; a larger problem is validated by ``fricid fit --validate lovo``.
@@ -21,8 +27,23 @@ from ..fitted import FittedModel
 from ..samples import FrictionSamples
 from ._scatter import level_labels
 from .learned._trust import CV_SOURCE, LEARNED_VALIDATE_WORK
+from .validate import interior_rmse
 
-__all__ = ["LEARNED_VALIDATE_WORK", "MIN_LEVELS", "VALIDATE_WORK", "own_cv", "run_validation"]
+__all__ = [
+    "LEARNED_VALIDATE_WORK",
+    "LOVO_INTERIOR",
+    "MIN_LEVELS",
+    "TINY_SAMPLES",
+    "VALIDATE_WORK",
+    "graded_rmse",
+    "own_cv",
+    "run_kfold",
+    "run_validation",
+    "worse_kfold",
+]
+
+#: The scheme the verdict names for leave-one-velocity-out graded on its interior folds.
+LOVO_INTERIOR = "lovo, interior levels"
 
 #: Largest leave-one-velocity-out validation of an analytic model the verdict runs itself, as
 #: folds x samples x parameters (larger problems: ``fricid fit --validate lovo``).
@@ -31,6 +52,10 @@ VALIDATE_WORK = 50_000
 #: The verdict runs its own leave-one-velocity-out validation only with at least this many
 #: velocity levels (with fewer, each held-out level is an extrapolation from a handful).
 MIN_LEVELS = 5
+
+#: Samples up to which the verdict also runs random folds (:func:`run_kfold`) and takes the
+#: worse ratio.
+TINY_SAMPLES = 20
 
 
 def run_validation(
@@ -53,8 +78,41 @@ def run_validation(
             f"not run here: {folds} velocity level(s), and holding one out of so few asks "
             f"the model to extrapolate; {fallback}"
         )
+    return _run(fitted, samples, "lovo", folds, max_work, fallback)
+
+
+def run_kfold(
+    fitted: FittedModel, samples: FrictionSamples, max_work: int
+) -> tuple[dict[str, Any] | None, str]:
+    """Random-fold validation (``kfold:K``, ``K = min(5, n // 2)``) of ``fitted``'s model on
+    tiny ``samples`` (module notes), as :func:`run_validation` runs leave-one-velocity-out.
+
+    Returns
+    -------
+    dict or None
+        ``Validation.to_dict()``, None when not run (more than :data:`TINY_SAMPLES` samples,
+        fewer than four, or a model the verdict does not retrain).
+    str
+        How it was run, or why not.
+    """
+    n = len(samples)
+    k = min(5, n // 2)
+    if n > TINY_SAMPLES or k < 2:
+        return None, ""
+    return _run(fitted, samples, f"kfold:{k}", k, max_work, "leave-one-velocity-out only")
+
+
+def _run(
+    fitted: FittedModel,
+    samples: FrictionSamples,
+    scheme: str,
+    folds: int,
+    max_work: int,
+    fallback: str,
+) -> tuple[dict[str, Any] | None, str]:
+    """``scheme``'s validation of ``fitted``'s model, each fold fitted as ``fit`` fits it."""
     if fitted.kind == "rbf":  # the learned models: each fold retrains, structure search too
-        return _run_learned(fitted, samples, folds, fallback)
+        return _run_learned(fitted, samples, folds, fallback, scheme)
     work = folds * len(samples) * max(len(fitted.free), 1)
     if work > max_work:
         return None, (
@@ -65,9 +123,12 @@ def run_validation(
     options: dict[str, Any] = {"intervals": "none"}
     if isinstance(fitted.loss.get("loss"), str):
         options["loss"] = fitted.loss["loss"]
-    return _lovo(
+    if fitted.loss.get("weights") == "std":  # each training fold weighted as the fit was
+        options["weights"] = "std"
+    return _validate(
         samples,
         fitted.model,
+        scheme,
         "lm",
         f"{folds} folds, each fitted by lm",
         fallback,
@@ -76,28 +137,29 @@ def run_validation(
     )
 
 
-def _lovo(
+def _validate(
     samples: FrictionSamples,
     model: str,
+    scheme: str,
     method: str | None,
     how: str,
     fallback: str,
     **options: Any,
 ) -> tuple[dict[str, Any] | None, str]:
-    """:func:`fricid.identify.validate.validate` with ``lovo``, its warnings silenced."""
+    """:func:`fricid.identify.validate.validate` with ``scheme``, its warnings silenced."""
     from .validate import validate
 
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            val = validate(samples, model, "lovo", method, **options)
+            val = validate(samples, model, scheme, method, **options)
     except FricidError as exc:
         return None, f"could not be run here ({exc}); {fallback}"
-    return val.to_dict(), f"lovo run here: {how}"
+    return val.to_dict(), f"{scheme} run here: {how}"
 
 
 def _run_learned(
-    fitted: FittedModel, samples: FrictionSamples, folds: int, fallback: str
+    fitted: FittedModel, samples: FrictionSamples, folds: int, fallback: str, scheme: str
 ) -> tuple[dict[str, Any] | None, str]:
     """Leave-one-velocity-out of a learned model (``rbf``, ``hybrid``: trained by least
     squares; ``gp``), each fold retrained as ``fit`` trains it (the structure search, the
@@ -124,7 +186,7 @@ def _run_learned(
         options["settings"] = {k: params[k] for k in ("max_points", "n_restarts") if k in params}
     seed = fitted.optimizer.seed if fitted.optimizer.seed is not None else 0
     how = f"{folds} folds, each retrained as fit trains {fitted.model}"
-    return _lovo(samples, fitted.model, None, how, fallback, seed=seed, **options)
+    return _validate(samples, fitted.model, scheme, None, how, fallback, seed=seed, **options)
 
 
 def own_cv(validation: dict[str, Any] | None) -> bool:
@@ -132,3 +194,53 @@ def own_cv(validation: dict[str, Any] | None) -> bool:
     whole interior speed levels, or random folds where there are too few levels; the record's
     scheme says which: :mod:`fricid.identify.learned._trust`)."""
     return bool(validation) and validation.get("source") == CV_SOURCE
+
+
+def graded_rmse(validation: dict[str, Any]) -> tuple[float, str]:
+    """(RMSE, scheme) the verdict grades a validation record by.
+
+    Leave-one-velocity-out over its interior folds (:data:`LOVO_INTERIOR`;
+    :func:`fricid.identify.validate.interior_rmse`): holding out the slowest or the fastest
+    level asks for an extrapolation that a correct model fails too when the levels are few
+    (2x and 4.5x the noise on 6 levels: :mod:`fricid.identify.validate`), so the verdict,
+    which is about the measured range, leaves them out; the end folds stay in the record (the
+    advice reads them). With fewer than three folds, and for any other scheme, the pooled RMSE.
+    """
+    scheme = str(validation.get("scheme", ""))
+    err = float(validation["rmse"]) if validation.get("rmse") is not None else np.nan
+    if scheme == "lovo":
+        inner = interior_rmse(validation.get("folds") or [])
+        if np.isfinite(inner):
+            return inner, LOVO_INTERIOR
+    return err, scheme
+
+
+def worse_kfold(
+    fitted: FittedModel,
+    samples: FrictionSamples,
+    max_work: int,
+    ratio: float,
+    scheme: str,
+) -> tuple[dict[str, Any] | None, str]:
+    """On tiny data, random folds (:func:`run_kfold`) beside the held-out ``ratio`` already
+    found (``scheme``; NaN when none): a flexible model can pass the level folds of a handful
+    of speeds and still miss single held-out samples by far.
+
+    Returns
+    -------
+    dict or None
+        The random folds' ``Validation.to_dict()`` when their ratio is the worse (or the only)
+        one, else None.
+    str
+        What they found ("" when not run).
+    """
+    val, how = run_kfold(fitted, samples, max_work)
+    if val is None or val.get("ratio") is None:
+        return None, how
+    k_ratio = float(val["ratio"])
+    note = f"{len(samples)} samples, so random folds too: {how} ({k_ratio:.3g}x"
+    if np.isfinite(ratio) and k_ratio <= ratio:
+        return None, f"{note}; {scheme}'s {ratio:.3g}x is the worse and graded)"
+    if np.isfinite(ratio):
+        return val, f"{note}, worse than {scheme}'s {ratio:.3g}x: graded)"
+    return val, f"{note})"

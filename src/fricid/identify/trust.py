@@ -24,7 +24,12 @@ reads the model file (and, where given, the samples the model was identified on)
   :data:`LEARNED_VALIDATE_WORK`, each fold retrained as ``fit`` trains it); else
   :data:`OWN_CV` (a learned model's own cross-validation, with its caveat); else
   :data:`IN_SAMPLE` (the fit's ``rmse_over_scatter``): an in-sample number is never labelled
-  held out;
+  held out. Leave-one-velocity-out is graded on its interior folds (:data:`LOVO_INTERIOR`,
+  :func:`._heldout.graded_rmse`: the slowest and fastest held-out levels are extrapolations).
+  On tiny data (at most :data:`TINY_SAMPLES` samples) random folds are run too
+  (:func:`._heldout.worse_kfold`) and the worse ratio graded (:data:`KFOLD_HERE` when theirs);
+- the scatter: one estimated from second differences because nothing repeats is said so in
+  the reasons (:data:`ESTIMATED`), whatever the level;
 - the operating range, outside which predictions are extrapolated.
 
 The level is ``"no"`` when the fit did not converge, no free parameter is determined, or the
@@ -54,22 +59,43 @@ import numpy as np
 from ..fitted import FittedModel
 from ..fitted._file import _convergence_line
 from ..metrics import NOISE_RATIO, rmse, verdict
-from ..samples import FrictionSamples, samples_hash
-from ._diagnostics import DROPS, not_determined, open_sides, quality_rows, range_text
-from ._fingerprint import canonical, json_ready, model_hash, samples_detail_hash
-from ._heldout import LEARNED_VALIDATE_WORK, MIN_LEVELS, VALIDATE_WORK, own_cv, run_validation
-from ._scatter import measurement_scatter
+from ..samples import FrictionSamples
+from ._diagnostics import (
+    DROPS,
+    downweighted,
+    not_determined,
+    open_sides,
+    quality_rows,
+    range_text,
+)
+from ._fingerprint import canonical, check_record_types, json_ready, record_key, trust_options
+from ._heldout import (
+    LEARNED_VALIDATE_WORK,
+    LOVO_INTERIOR,
+    MIN_LEVELS,
+    TINY_SAMPLES,
+    VALIDATE_WORK,
+    graded_rmse,
+    own_cv,
+    run_validation,
+    worse_kfold,
+)
+from ._scatter import SECOND_DIFFERENCES, measurement_scatter
 
 __all__ = [
     "DROPS",
+    "ESTIMATED",
     "FROM_FIT",
     "HELD_OUT",
     "IN_SAMPLE",
+    "KFOLD_HERE",
     "LEARNED_VALIDATE_WORK",
+    "LOVO_INTERIOR",
     "MIN_LEVELS",
     "MISS_RATIO",
     "OWN_CV",
     "RUN_HERE",
+    "TINY_SAMPLES",
     "TRUST_VERSION",
     "VALIDATE_WORK",
     "Trust",
@@ -86,18 +112,22 @@ __all__ = [
 MISS_RATIO = 3.0
 
 #: Format of the record and of the rules behind it: a stored record of another is recomputed.
-TRUST_VERSION = 1
+TRUST_VERSION = 2
 
 #: ``Trust.heldout_source``: leave-one-velocity-out run by :func:`assess_trust`.
 RUN_HERE = "lovo run here"
+#: ... random folds run by :func:`assess_trust` on tiny data, the worse of them and lovo.
+KFOLD_HERE = "random folds run here"
 #: ... the fit's own held-out validation (``--validate``, the manifest's ``validate``, auto).
 FROM_FIT = "the fit's --validate"
 #: ... a learned model's own structure-search cross-validation.
 OWN_CV = "the learned model's own CV"
 #: ... no held-out error: the fit's in-sample RMSE over the scatter.
 IN_SAMPLE = "in-sample only"
+#: Said in the reasons when the scatter is estimated (:func:`._scatter.second_difference_scatter`).
+ESTIMATED = "estimated from second differences: no repeated runs, so not measured"
 #: The sources whose ratio is a held-out one.
-HELD_OUT = (RUN_HERE, FROM_FIT, OWN_CV)
+HELD_OUT = (RUN_HERE, FROM_FIT, OWN_CV, KFOLD_HERE)
 
 
 @dataclass
@@ -125,6 +155,9 @@ class Trust:
         :data:`HELD_OUT`, else the fit's in-sample ratio (NaN when there is no scatter).
     heldout_rmse, scatter : float
         N m, the RMSE of that ratio and the scatter (NaN when unknown).
+    scatter_method : str
+        How the scatter was estimated (``Scatter.method``; ``""`` when not recorded): one
+        estimated from second differences (no repeats) is said so in the reasons.
     heldout_source : str
         :data:`RUN_HERE`, :data:`FROM_FIT`, :data:`OWN_CV`, :data:`IN_SAMPLE`, or ``""``
         (no ratio at all).
@@ -150,6 +183,9 @@ class Trust:
         validation (shown beside it).
     what_to_do : str
         For a model whose error misses the scatter: what to do; "" otherwise.
+    downweighted : list of str
+        The samples a robust fit down-weighted (:func:`._diagnostics.downweighted`), left out
+        of the error graded (the fit is judged on the inliers).
     model : str
         The model's registry name.
     samples_hash, samples_detail_hash, model_hash : str or None
@@ -172,6 +208,7 @@ class Trust:
     heldout_ratio: float = float("nan")
     heldout_rmse: float = float("nan")
     scatter: float = float("nan")
+    scatter_method: str = ""
     heldout_source: str = ""
     heldout_scheme: str = ""
     verdict: str = ""
@@ -183,6 +220,7 @@ class Trust:
     learned: bool = False
     cv: dict[str, Any] | None = None
     what_to_do: str = ""
+    downweighted: list[str] = field(default_factory=list)
     model: str = ""
     samples_hash: str | None = None
     samples_detail_hash: str | None = None
@@ -227,74 +265,11 @@ class Trust:
                 raise TypeError(f"trust record: '{key}' is not a number")
             kwargs[key] = float("nan") if value is None else float(value)
         out = cls(**kwargs)
-        _check_types(out)
+        check_record_types(out)
         return out
 
 
-#: The type of each text, list and mapping field of a record read from a file: a record
-#: of other types is not used (the report would fail on it).
-_TEXT = (
-    "level",
-    "convergence",
-    "advice",
-    "heldout_source",
-    "heldout_scheme",
-    "verdict",
-    "validation_note",
-    "range",
-    "quality_summary",
-    "what_to_do",
-    "model",
-)
-
-
-def _check_types(record: Trust) -> None:
-    """TypeError unless every field of ``record`` has the type the report reads."""
-
-    def texts(value: Any) -> bool:
-        return isinstance(value, list) and all(isinstance(v, str) for v in value)
-
-    def rows(value: Any) -> bool:
-        return isinstance(value, list) and all(isinstance(v, dict) for v in value)
-
-    ok = [
-        record.level in ("yes", "with caveats", "no"),
-        all(isinstance(getattr(record, k), str) for k in _TEXT),
-        texts(record.reasons) and texts(record.not_determined),
-        isinstance(record.open_sides, dict) and texts(list(record.open_sides.values())),
-        record.converged is None or isinstance(record.converged, bool),
-        isinstance(record.learned, bool) and isinstance(record.options, dict),
-        record.quality is None or rows(record.quality),
-    ]
-    for part in (record.validation, record.cv):
-        ok.append(part is None or (isinstance(part, dict) and rows(part.get("folds") or [])))
-    if not all(ok):
-        raise TypeError("not a trust record of this fricid")
-
-
 # -- what a record was computed on -------------------------------------------------------
-
-
-def trust_options(validate: bool = True, max_work: int = VALIDATE_WORK) -> dict[str, Any]:
-    """The options a record depends on: whether a validation may be run here and its limits."""
-    return {
-        "validate": bool(validate),
-        "max_work": int(max_work),
-        "learned_work": int(LEARNED_VALIDATE_WORK),
-        "min_levels": int(MIN_LEVELS),
-    }
-
-
-def _key(
-    fitted: FittedModel, samples: FrictionSamples | None, options: dict[str, Any]
-) -> dict[str, Any]:
-    return {
-        "samples_hash": None if samples is None else samples_hash(samples),
-        "samples_detail_hash": None if samples is None else samples_detail_hash(samples),
-        "model_hash": model_hash(fitted),
-        "options": options,
-        "version": TRUST_VERSION,
-    }
 
 
 def _stored(fitted: FittedModel, key: dict[str, Any]) -> Trust | None:
@@ -348,7 +323,7 @@ def assess_trust(
         The level and its reasons, each number with its source (module notes).
     """
     options = trust_options(validate, max_work)
-    key = _key(fitted, samples, options)
+    key = record_key(fitted, samples, options, TRUST_VERSION)
     if reuse:
         stored = _stored(fitted, key)
         if stored is not None:
@@ -358,27 +333,42 @@ def assess_trust(
     trust.model_hash, trust.options = key["model_hash"], options
     mine = own_cv(fitted.validation)
     can_run = samples is not None and validate and trust.converged
-    if (mine or fitted.validation is None) and can_run:
-        val, trust.validation_note = run_validation(fitted, samples, max_work)
+    low, trust.downweighted = downweighted(fitted, samples)
+    judged = samples if low is None else samples.subset(~low)  # a robust fit: its inliers
+    if (mine or fitted.validation is None or low is not None) and can_run:
+        val, trust.validation_note = run_validation(fitted, judged, max_work)
         if val is not None:
             trust.validation, trust.heldout_source = val, RUN_HERE
     elif fitted.validation is None:
         trust.validation_note = "no held-out validation in the file; in-sample only"
     elif mine:
         trust.validation_note = "leave-one-velocity-out not run here; the fit's own CV only"
-    if trust.validation is None and fitted.validation is not None:
+    if trust.validation is None and fitted.validation is not None and low is None:
         trust.validation = fitted.validation
         trust.heldout_source = OWN_CV if mine else FROM_FIT
     if mine and trust.heldout_source == RUN_HERE:
         trust.cv = fitted.validation
-    _ratio(trust, fitted, samples)
-    quality_caveat = _quality(trust, samples)
+    _ratio(trust, fitted, judged, inliers=low is not None)
+    random = trust.heldout_scheme.startswith("kfold")
+    if can_run and len(judged) <= TINY_SAMPLES and not random:  # the worse of the two
+        before = trust.heldout_ratio if trust.held_out else np.nan
+        val, note = worse_kfold(fitted, judged, max_work, before, trust.heldout_scheme)
+        trust.validation_note = "; ".join(x for x in (trust.validation_note, note) if x)
+        if val is not None:
+            trust.validation, trust.heldout_source = val, KFOLD_HERE
+            _ratio(trust, fitted, judged, inliers=low is not None)
+    if low is not None:
+        trust.validation_note = (
+            f"judged on the {len(judged)} inliers, the {int(low.sum())} sample(s) the "
+            f"{fitted.loss['loss']} loss down-weighted left out; " + trust.validation_note
+        )
+    trust.quality, trust.quality_summary, quality_caveat = quality_rows(samples)
     _grade(trust, fitted, quality_caveat)
     if trust.converged is not False and trust.heldout_ratio > MISS_RATIO:
         from ._advice import misfit_advice
 
         held = trust.validation if trust.held_out else None
-        trust.what_to_do = misfit_advice(fitted, held, trust.scatter, MISS_RATIO, samples)
+        trust.what_to_do = misfit_advice(fitted, held, trust.scatter, MISS_RATIO, judged)
     return trust
 
 
@@ -406,31 +396,31 @@ def _base(fitted: FittedModel, samples: FrictionSamples | None) -> Trust:
     )
 
 
-def _quality(trust: Trust, samples: FrictionSamples | None) -> str:
-    """Set the quality rows and summary; return the caveat ("" for none)."""
-    trust.quality, trust.quality_summary, caveat = quality_rows(samples)
-    return caveat
-
-
-def _ratio(trust: Trust, fitted: FittedModel, samples: FrictionSamples | None) -> None:
-    """The ratio to grade by: held out (``trust.validation``), else the file's in-sample
-    ratio, else the in-sample ratio on ``samples`` (a network's file may not record its
-    scatter)."""
+def _ratio(
+    trust: Trust, fitted: FittedModel, samples: FrictionSamples | None, inliers: bool = False
+) -> None:
+    """The ratio to grade by: held out (``trust.validation``; leave-one-velocity-out on its
+    interior folds, :func:`._heldout.graded_rmse`), else the file's in-sample ratio, else the
+    in-sample ratio on ``samples`` (a network's file may not record its scatter, and the
+    file's ratio holds a robust fit's outliers: ``inliers``, ``samples`` are its inliers)."""
     v = trust.validation
     if v and v.get("ratio") is not None:
-        trust.heldout_ratio = float(v["ratio"])
-        trust.heldout_rmse = float(v["rmse"]) if v.get("rmse") is not None else np.nan
+        trust.heldout_rmse, trust.heldout_scheme = graded_rmse(v)
         trust.scatter = float(v["scatter"]) if v.get("scatter") is not None else np.nan
-        trust.heldout_scheme = str(v.get("scheme", ""))
+        trust.heldout_ratio = trust.heldout_rmse / trust.scatter
+        trust.scatter_method = str(v.get("scatter_method") or "")
     else:  # no held-out ratio (no validation, or one without a scatter): in-sample
         trust.heldout_source = ""
-        if fitted.metrics.get("rmse_over_scatter") is not None:
+        if fitted.metrics.get("rmse_over_scatter") is not None and not inliers:
             trust.heldout_ratio = float(fitted.metrics["rmse_over_scatter"])
             trust.heldout_rmse = float(fitted.metrics.get("rmse", np.nan))
             trust.scatter = float(fitted.metrics.get("scatter", np.nan))
             trust.heldout_source = IN_SAMPLE
+            recorded = (fitted.loss or {}).get("scatter") or {}
+            trust.scatter_method = str(recorded.get("method") or "")
         elif samples is not None:
             sc = measurement_scatter(samples)
+            trust.scatter_method = sc.method
             if np.isfinite(sc.value) and sc.value > 0:
                 trust.heldout_rmse = rmse(samples.y, fitted.predict(samples.X, warn=False))
                 trust.scatter = sc.value
@@ -474,12 +464,21 @@ def _grade(trust: Trust, fitted: FittedModel, quality_caveat: str) -> None:
         )
     if quality_caveat:
         caveats.append(quality_caveat)
+    if trust.downweighted:
+        loss = (fitted.loss or {}).get("loss")
+        caveats.append(
+            f"the {loss} loss down-weighted {len(trust.downweighted)} sample(s) as outliers "
+            f"({'; '.join(trust.downweighted)}), left out of the error graded"
+        )
+    estimated = trust.scatter_method == SECOND_DIFFERENCES and np.isfinite(ratio)
+    said = [f"the scatter is {ESTIMATED}"] if estimated else []
     if no:
-        trust.level, trust.reasons = "no", no + caveats
+        trust.level, trust.reasons = "no", no + caveats + said
         return
     if caveats:
-        trust.level, trust.reasons = "with caveats", caveats
+        trust.level, trust.reasons = "with caveats", caveats + said
         return
-    held = f"{kind} error is within noise ({ratio:.2f}x the scatter)"
+    which = f"the scatter {ESTIMATED}" if estimated else "the scatter"
+    held = f"{kind} error is within noise ({ratio:.2f}x {which})"
     det = "every parameter is determined" if free else "the network fits"
     trust.level, trust.reasons = "yes", [f"the fit converged, {det} and the {held}"]

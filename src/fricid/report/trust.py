@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from ..identify.trust import DROPS, OWN_CV, RUN_HERE, Trust
+from ..identify.trust import DROPS, OWN_CV, Trust
 
 __all__ = ["READINGS_STD", "quality_frame", "scatter_explanation", "trust_text"]
 
@@ -67,7 +67,7 @@ def _error_line(trust: Trust) -> str:
     if np.isfinite(trust.heldout_ratio):
         if not trust.held_out:
             label = "in-sample RMSE"
-        elif trust.heldout_source == RUN_HERE:  # the source names the scheme
+        elif trust.heldout_scheme in trust.heldout_source:  # the source names the scheme
             label = f"held-out RMSE ({trust.heldout_source})"
         else:
             label = f"held-out RMSE ({trust.heldout_scheme}, {trust.heldout_source})"

@@ -37,6 +37,7 @@ __all__ = [
     "LIMITS",
     "OPTIONAL_INPUTS",
     "RAWLOG_COLUMNS",
+    "ROW_META",
     "SAMPLE_COLUMNS",
     "FrictionSamples",
     "RawLog",
@@ -44,6 +45,13 @@ __all__ = [
     "drop_standstill",
     "standstill_rows",
 ]
+
+
+#: ``meta`` entries with one value per row, selected with the rows by
+#: :meth:`FrictionSamples.subset`: ``sem`` (each row's standard error) and ``setpoint`` (a
+#: label per row; rows sharing one are repeated runs of one operating point, e.g. one file,
+#: run or segment each at one commanded speed).
+ROW_META = ("sem", "setpoint")
 
 
 @dataclass(frozen=True, eq=False)
@@ -228,8 +236,8 @@ class FrictionSamples:
         Returns
         -------
         FrictionSamples
-            The selected rows; ``source`` and ``meta`` kept (the per-row standard errors
-            ``meta["sem"]`` selected with the rows).
+            The selected rows; ``source`` and ``meta`` kept (the per-row entries of
+            :data:`ROW_META` selected with the rows).
 
         Raises
         ------
@@ -237,10 +245,12 @@ class FrictionSamples:
             The selection is empty.
         """
         idx = np.asarray(mask)
-        meta = self.meta
-        sem = meta.get("sem")
-        if isinstance(sem, list | tuple) and len(sem) == len(self):
-            meta = {**meta, "sem": [sem[i] for i in np.arange(len(self))[idx]]}
+        meta = dict(self.meta)
+        rows = np.arange(len(self))[idx]
+        for key in ROW_META:
+            per_row = meta.get(key)
+            if isinstance(per_row, list | tuple) and len(per_row) == len(self):
+                meta[key] = [per_row[i] for i in rows]
         return replace(
             self,
             meta=meta,

@@ -17,7 +17,7 @@ from fricid.fitted import FittedModel
 from fricid.identify import fit
 from fricid.identify.learned._trust import CV_SOURCE, hat_trace, learned_statistics
 from fricid.identify.learned.rbf import RBFNetRegressor
-from fricid.identify.trust import OWN_CV, RUN_HERE, assess_trust
+from fricid.identify.trust import LOVO_INTERIOR, OWN_CV, RUN_HERE, assess_trust
 from fricid.io import write_samples
 from fricid.samples import FrictionSamples
 
@@ -180,7 +180,7 @@ def test_old_learned_files_still_load(rbf, tmp_path):
 
 def test_report_verdict_of_a_learned_model_rests_on_lovo(gp, rbf, samples):
     trust = assess_trust(gp, samples)
-    assert (trust.heldout_source, trust.heldout_scheme) == (RUN_HERE, "lovo")
+    assert (trust.heldout_source, trust.heldout_scheme) == (RUN_HERE, LOVO_INTERIOR)
     assert "each retrained" in trust.validation_note
     # not run: the verdict falls back to the file's CV, with its caveat
     quick = assess_trust(rbf, samples, validate=False)

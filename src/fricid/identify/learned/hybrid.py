@@ -67,37 +67,23 @@ from ...models import INPUTS, get_model
 from ...models.hybrid import STATE_KIND
 from ...models.rbf import STATE_VERSION
 from ...samples import FrictionSamples
+from ..static.candidates import TEMPERATURE_FAMILIES
 
 __all__ = ["TEMPERATURE_FAMILIES", "backbone_candidates", "fit_backbone", "fit_hybrid"]
-
-#: Families whose temperature variant (``<name>_temp``, :mod:`fricid.models._temperature`)
-#: the backbone selection tries: those with a viscous term.
-TEMPERATURE_FAMILIES: tuple[str, ...] = ("coulomb_viscous", "stribeck", "msk")
-
-#: Fewest distinct temperatures (to 0.5 degC) for the temperature variants.
-TEMPERATURE_MIN_LEVELS = 3
 
 
 def backbone_candidates(samples: FrictionSamples) -> list[tuple[str, dict[str, float]]]:
     """The backbones :func:`fit_backbone` tries: ``(name, fixed)`` of every analytic
-    candidate the data support (:func:`fricid.identify.static.select.candidates`), each followed,
-    when the samples have at least :data:`TEMPERATURE_MIN_LEVELS` distinct temperatures, by
-    its temperature variant if its family is in :data:`TEMPERATURE_FAMILIES`
-    (``stribeck_asym`` -> ``stribeck_temp_asym``, the same parameters fixed)."""
+    candidate the data support (:func:`fricid.identify.static.candidates.candidates`: the
+    families, their ``_asym`` variants and, with at least
+    :data:`~fricid.identify.static.candidates.TEMPERATURE_MIN_LEVELS` distinct temperatures,
+    their temperature variants, each after the family it extends: ``stribeck_asym`` ->
+    ``stribeck_temp_asym``, the same parameters fixed)."""
     from ..static.candidates import LEARNED, candidates
 
-    temps = samples.temperature[np.isfinite(samples.temperature)]
-    with_temp = np.unique(np.round(temps * 2.0)).size >= TEMPERATURE_MIN_LEVELS
-    out: list[tuple[str, dict[str, float]]] = []
-    for c in candidates(samples):
-        if c.note or c.model in LEARNED:
-            continue
-        out.append((c.model, dict(c.fixed)))
-        asym = c.model.endswith("_asym")
-        family = c.model[: -len("_asym")] if asym else c.model
-        if with_temp and family in TEMPERATURE_FAMILIES:
-            out.append((f"{family}_temp" + ("_asym" if asym else ""), dict(c.fixed)))
-    return out
+    return [
+        (c.model, dict(c.fixed)) for c in candidates(samples) if not (c.note or c.model in LEARNED)
+    ]
 
 
 #: ``lm`` options of the lean path (:func:`_lean_fit`): one start; tolerances 1e-8 instead of

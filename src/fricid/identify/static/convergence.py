@@ -4,9 +4,21 @@ An optimiser's own status says why it stopped (``fricid.optim.OptimizeResult.sta
 whether it stopped at the optimum: the beetle family stops after its schedule, any method when
 its budget is spent. :func:`certify` runs the default least-squares method (``lm``: bounded
 trust region, one start at the result) with :data:`POLISH_EVALS_PER_PARAM` ``* (p + 1)``
-evaluations. If that lowers the SSE by more than :data:`POLISH_RTOL` relative, the fit had not
-converged, and the ratio says by how much; otherwise the result is a local optimum, whatever
-the optimiser's status (certified). The fit keeps the optimiser's own point either way (a
+evaluations. The fit had converged when what the polish gained is below what the scatter of
+the data can resolve:
+
+``SSE_fit - SSE_polished <= max(POLISH_RTOL SSE_fit, RESOLVE_SE^2 s^2)``, with
+``s^2 = SSE_polished / (n - p)`` the residual variance.
+
+Near the optimum ``SSE(theta) - SSE_min = (theta - theta*)^T J^T J (theta - theta*)`` and the
+parameters' covariance is ``s^2 (J^T J)^-1``, so ``(SSE_fit - SSE_min) / s^2`` is the squared
+distance of the fit's parameters from the optimum in standard errors, along the worst
+direction: a gain below ``RESOLVE_SE^2 s^2`` (:data:`RESOLVE_SE` = 0.1 standard errors) moves
+no parameter, nor any combination of them, by more than a tenth of its standard error, far
+below what the data resolve. (An SSE gain of 0.011 % on 60 samples is 0.007 ``s^2``:
+converged.) Otherwise the fit had not converged, and the block says by how much (relative
+SSE gain and standard errors); either way the result is a local optimum whatever the
+optimiser's status (certified) or it is not. The fit keeps the optimiser's own point either way (a
 paper's BAS run stays a BAS run); the polish only measures. Any problem of the problem
 protocol (:class:`fricid.identify.problem.Problem`) is certified alike: the analytic fits'
 and each stage of a trajectory identification.
@@ -21,10 +33,15 @@ import numpy as np
 from ...optim import OptimizeResult, minimize
 from ..problem import Problem
 
-__all__ = ["POLISH_EVALS_PER_PARAM", "POLISH_RTOL", "advice", "certify"]
+__all__ = ["POLISH_EVALS_PER_PARAM", "POLISH_RTOL", "RESOLVE_SE", "advice", "certify"]
 
-#: Relative SSE decrease by the polish above which the fit counts as not converged.
+#: Relative SSE decrease by the polish at or below which the fit counts as converged (exact
+#: data, where the residual variance is 0).
 POLISH_RTOL = 1e-6
+
+#: A polish that moves the parameters by less than this many standard errors (along the worst
+#: direction: module notes) leaves the fit converged.
+RESOLVE_SE = 0.1
 
 #: The polish's budget is this many evaluations per free parameter, plus one set.
 POLISH_EVALS_PER_PARAM = 50
@@ -61,9 +78,10 @@ def certify(problem: Problem, result: OptimizeResult) -> dict[str, Any]:
         The verdict: ``converged`` (bool), ``polish_sse_ratio`` (polished SSE / fit SSE; 1
         when the polish found nothing lower), ``polish_nfev``, ``certified_by``
         (``"optimizer"``: its own test and the polish agree; ``"polish"``: the optimiser
-        stopped otherwise, the polish finds nothing lower; ``""`` when not converged) and,
-        when not converged, ``reason`` and ``advice``. The optimiser's own status, message,
-        evaluations and budget are the model's optimiser record, not repeated here.
+        stopped otherwise, the polish finds nothing the data can resolve lower; ``""`` when
+        not converged) and, when not converged, ``reason`` and ``advice``. The optimiser's own
+        status, message, evaluations and budget are the model's optimiser record, not repeated
+        here.
     """
     sse = float(result.fun)
     block: dict[str, Any] = {
@@ -91,16 +109,33 @@ def certify(problem: Problem, result: OptimizeResult) -> dict[str, Any]:
     floor = 1e-24 * max(float(problem.y @ problem.y), 1e-300)  # exact data: SSE ~ rounding
     block["polish_sse_ratio"] = best / sse if sse > floor else 1.0
     block["polish_nfev"] = int(polish.nfev)
-    if sse - best <= POLISH_RTOL * sse + floor:
+    dof = max(_n_obs(problem) - p, 1)
+    variance = best / dof  # the residual variance, in the objective's units per sample
+    moved = float(np.sqrt(max(sse - best, 0.0) / variance)) if variance > 0 else float("inf")
+    if sse - best <= max(POLISH_RTOL * sse, RESOLVE_SE**2 * variance) + floor:
         block["converged"] = True
         block["certified_by"] = "optimizer" if result.success else "polish"
         return block
     method = str(result.method)
     max_evals = int(result.get("max_evals", result.nfev))
+    gain = 100.0 * (sse - best) / sse
     block["reason"] = (
         f"method '{method}' ended after {result.nfev} of {max_evals} evaluations "
-        f"(status {int(result.status)}: {result.message}) at SSE {sse:.4g}, but a local "
-        f"least-squares polish from there reaches {best:.4g} ({sse / best:.3g}x lower)"
+        f"(status {int(result.status)}: {result.message}) at SSE {sse:.6g}, but a local "
+        f"least-squares polish from there reaches {best:.6g} ({gain:.3g} % lower: the "
+        f"parameters move by {_se_text(moved)}, more than the {RESOLVE_SE:g} below which the data "
+        "cannot tell the difference)"
     )
     block["advice"] = advice(method)
     return block
+
+
+def _n_obs(problem: Problem) -> int:
+    """The number of residuals of ``problem``."""
+    n = getattr(problem, "n_obs", None)
+    return int(n) if n is not None else int(np.size(problem.y))
+
+
+def _se_text(moved: float) -> str:
+    """``"3.2 standard errors"``; the residual variance 0: ``"any amount (exact data)"``."""
+    return f"{moved:.3g} standard errors" if np.isfinite(moved) else "any amount (exact data)"

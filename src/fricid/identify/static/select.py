@@ -20,7 +20,11 @@ The rules (issue 11, "Validation built in"):
   samples, so one is chosen only when clearly better than every analytic family;
 * the choice is the simplest candidate (fewest parameters, symmetric before ``_asym``) whose
   held-out RMSE is within :data:`PREFER_SIMPLER` (5 %) of the best, or within the noise
-  (:data:`fricid.metrics.NOISE_RATIO` times the measurement scatter).
+  (:data:`fricid.metrics.NOISE_RATIO` times the measurement scatter);
+* on tiny data (at most :data:`TINY_SAMPLES` samples) the held-out RMSE of each candidate is
+  itself noisy, so a simpler candidate is also kept when the best one's advantage is not
+  significant: the mean over the samples of the paired difference of squared held-out errors
+  (simpler minus best) is at most :data:`TINY_SIGMAS` standard errors of that mean.
 
 ``fricid.identify.fit(samples, "auto")`` calls :func:`select`.
 """
@@ -46,10 +50,19 @@ __all__ = [
     "FAMILIES",
     "LEARNED",
     "PREFER_SIMPLER",
+    "TINY_SAMPLES",
+    "TINY_SIGMAS",
     "Candidate",
     "candidates",
     "select",
 ]
+
+
+#: Samples up to which a simpler candidate is kept unless the best is significantly better.
+TINY_SAMPLES = 20
+
+#: ... significantly: by more than this many standard errors of the mean paired difference.
+TINY_SIGMAS = 2.0
 
 
 @single_blas_thread
@@ -156,8 +169,15 @@ def select(
     limit = best["heldout_rmse"] * (1.0 + PREFER_SIMPLER)
     noise = NOISE_RATIO * sc.value if np.isfinite(sc.value) else 0.0
     ok = [r for r in scored if r["heldout_rmse"] <= max(limit, noise)]
+    if len(samples) <= TINY_SAMPLES:
+        best_pred = runs[best["model"]].predictions
+        ok += [
+            r
+            for r in scored
+            if r not in ok and not _better(best_pred, runs[r["model"]].predictions, samples.y)
+        ]
     chosen = min(ok, key=lambda r: (r["n_params"], "_asym" in r["model"]))
-    reason = _reason(chosen, best, sc, scheme, noise)
+    reason = _reason(chosen, best, sc, scheme, noise, len(samples))
     pick = found[chosen["model"]]
     if progress is not None:
         progress(len(todo), len(todo), f"refitting {chosen['model']} on every sample")
@@ -207,8 +227,23 @@ def _screening(
     return {**options, "start": {n: p.value for n, p in full.parameters.items() if not p.fixed}}
 
 
+def _better(best: np.ndarray, other: np.ndarray, y: np.ndarray) -> bool:
+    """The held-out predictions ``best`` beat ``other`` significantly (module notes): the mean
+    paired difference of squared errors exceeds :data:`TINY_SIGMAS` standard errors."""
+    d = (other - y) ** 2 - (best - y) ** 2
+    d = d[np.isfinite(d)]
+    if d.size < 2:
+        return True
+    return bool(d.mean() > TINY_SIGMAS * d.std(ddof=1) / np.sqrt(d.size))
+
+
 def _reason(
-    chosen: dict[str, Any], best: dict[str, Any], sc: Scatter, scheme: str, noise: float
+    chosen: dict[str, Any],
+    best: dict[str, Any],
+    sc: Scatter,
+    scheme: str,
+    noise: float,
+    n_samples: int,
 ) -> str:
     """Why ``chosen`` won, in one sentence."""
     name, err = chosen["model"], chosen["heldout_rmse"]
@@ -217,8 +252,13 @@ def _reason(
         return f"{head}, the lowest of the candidates"
     if err <= best["heldout_rmse"] * (1.0 + PREFER_SIMPLER):
         why = f"within {PREFER_SIMPLER:.0%} of the best"
-    else:
+    elif err <= noise:
         why = f"within the noise ({NOISE_RATIO:g}x the scatter {sc.value:.3g} N m)"
+    else:
+        why = (
+            f"on {n_samples} samples not significantly worse (by {TINY_SIGMAS:g} standard "
+            "errors of the paired squared held-out errors) than the best"
+        )
     return f"{head}, {why} ({best['model']}, {best['heldout_rmse']:.3g} N m), and simpler"
 
 
