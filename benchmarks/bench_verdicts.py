@@ -94,6 +94,8 @@ def _tasks(args) -> list[tuple[int, str, int, tuple[str, ...]]]:
     models = tuple(args.models.split(","))
     out = []
     for cid, klass, seed in case_plan(args.cases):
+        if args.report_only and is_tuning(seed, args.seed_split):
+            continue
         extra = LEARNED if args.learned_every and cid % args.learned_every == 0 else ()
         out.append((cid, klass, seed, models + tuple(m for m in extra if m not in models)))
     return out
@@ -103,6 +105,7 @@ def run_all(args) -> tuple[list[dict[str, Any]], float]:
     """Every task, on ``args.jobs`` processes, with progress on stderr."""
     tasks = _tasks(args)
     rows: list[dict[str, Any]] = []
+    sink = None if args.rows is None else args.rows.open("a", encoding="utf-8")
     t0 = time.perf_counter()
     os.environ.setdefault("OMP_NUM_THREADS", "1")
     os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
@@ -111,16 +114,21 @@ def run_all(args) -> tuple[list[dict[str, Any]], float]:
             results = pool.map(run_case, tasks, chunksize=1)
             for k, got in enumerate(results, 1):
                 rows.extend(got)
-                _progress(k, len(tasks), got, t0)
+                _progress(k, len(tasks), got, t0, sink)
     else:
         for k, task in enumerate(tasks, 1):
             got = run_case(task)
             rows.extend(got)
-            _progress(k, len(tasks), got, t0)
+            _progress(k, len(tasks), got, t0, sink)
+    if sink is not None:
+        sink.close()
     return rows, time.perf_counter() - t0
 
 
-def _progress(k: int, n: int, got: list[dict[str, Any]], t0: float) -> None:
+def _progress(k: int, n: int, got: list[dict[str, Any]], t0: float, sink=None) -> None:
+    if sink is not None:  # one JSON line per fit, as it finishes (--rows)
+        sink.writelines(json.dumps(r, default=str) + "\n" for r in got)
+        sink.flush()
     bits = [
         f"{r['model']}={r['level']}"
         + (
@@ -308,6 +316,15 @@ def print_cli(rows: list[dict[str, Any]]) -> None:
     print(f"agreement: {sum(r['agree'] for r in rows)}/{len(rows)}")
 
 
+def read_rows(path: Path) -> list[dict[str, Any]]:
+    """The rows of a ``--json`` file or a ``--rows`` file (one JSON object per line)."""
+    text = path.read_text(encoding="utf-8")
+    try:
+        return list(json.loads(text)["rows"])
+    except (json.JSONDecodeError, KeyError, TypeError):
+        return [json.loads(line) for line in text.splitlines() if line.strip()]
+
+
 def parse(argv: list[str] | None = None) -> argparse.Namespace:
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     p.add_argument("--cases", type=int, default=325, help="number of cases (default 325)")
@@ -318,6 +335,15 @@ def parse(argv: list[str] | None = None) -> argparse.Namespace:
     p.add_argument("--learned-every", type=int, default=10, help="hybrid, gp every K-th case")
     p.add_argument("--cli-check", type=int, default=0, metavar="K")
     p.add_argument("--json", type=Path, default=None, metavar="PATH")
+    p.add_argument("--rows", type=Path, default=None, metavar="PATH", help="JSON lines as fits end")
+    p.add_argument("--report-only", action="store_true", help="skip the tuning cases")
+    p.add_argument(
+        "--tables-from",
+        type=Path,
+        default=None,
+        metavar="PATH",
+        help="print the tables of a --rows file or --json file instead of running",
+    )
     args = p.parse_args(argv)
     if args.quick:
         args.cases, args.models, args.learned_every = 26, "auto,coulomb_viscous", 0
@@ -338,8 +364,12 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
         + (f" ({tuning[0]}..{tuning[-1]})" if tuning else ""),
         flush=True,
     )
-    rows, seconds = run_all(args)
-    print(f"ran in {seconds:.0f} s on {args.jobs} process(es)")
+    if args.tables_from is not None:
+        rows, seconds = read_rows(args.tables_from), float("nan")
+        print(f"{len(rows)} fits read from {args.tables_from.name}")
+    else:
+        rows, seconds = run_all(args)
+        print(f"ran in {seconds:.0f} s on {args.jobs} process(es)")
     report(rows, args.seed_split)
     cli_rows: list[dict[str, Any]] = []
     if args.cli_check:

@@ -124,7 +124,7 @@ def test_prediction_interval_is_picked_up_generically():
     assert ve.prediction_interval(Bare(), X) is None
 
 
-def test_one_tiny_case_scores_and_tabulates():
+def test_one_tiny_case_scores_and_tabulates(tmp_path, capsys):
     rows = bv.run_case((6, "tiny", 1006, ("coulomb_viscous",)))
     (row,) = rows
     assert row["level"] in ("yes", "with caveats", "no")
@@ -132,6 +132,11 @@ def test_one_tiny_case_scores_and_tabulates():
     summ = bv.summary(rows)
     assert sum(summ["confusion"][row["level"]].values()) == 1
     assert summ["rates"]["n"] == 1
+    lines = tmp_path / "rows.jsonl"  # --rows output, re-tabulated by --tables-from
+    lines.write_text(json.dumps(rows[0]) + "\n" + json.dumps({**rows[0], "case": 19}) + "\n")
+    again = bv.main(["--tables-from", str(lines), "--seed-split", "0"])
+    assert again["report"]["rates"]["n"] == 2
+    assert "2 fits read from rows.jsonl" in capsys.readouterr().out
 
 
 @pytest.mark.slow
