@@ -3,8 +3,8 @@
 Usage::
 
     python benchmarks/bench_verdicts.py [--cases 325] [--quick] [--jobs 2] [--seed-split 4]
-        [--models auto,stribeck,coulomb_viscous] [--learned-every 10] [--cli-check K]
-        [--json PATH]
+        [--models stribeck,coulomb_viscous] [--auto-every 3] [--learned-every 10]
+        [--cli-check K] [--json PATH] [--rows PATH] [--report-only] [--tables-from PATH]
 
 Cases (:mod:`_verdict_cases`, generators written for this benchmark, not ``fricid.sim``):
 friction laws outside fricid's families, regular, closely spaced (3-5 %), irregular,
@@ -13,7 +13,8 @@ proportional to the friction, gross outliers, unknown noise (no std or count), g
 in, and a law with load and temperature. Case ``i`` is of class ``CLASSES[i % 13]`` and is
 drawn from seed ``1000 + i``.
 
-Each model (``--models``; ``--learned-every K`` adds ``hybrid`` and ``gp`` on every K-th case)
+Each model (``--models`` on every case; ``--auto-every K`` adds ``auto`` and
+``--learned-every K`` adds ``hybrid`` and ``gp`` on every K-th case)
 is fitted with ``fricid.identify.fit`` and judged by ``fricid.identify.trust.assess_trust``,
 as ``fricid fit`` and the fleet do; its verdict is compared with the TRUE held-out ratio
 (:mod:`_verdict_eval`): ``sqrt(mean (F_hat - F)^2 + mean sigma^2) / sqrt(mean sigma^2)`` on
@@ -30,11 +31,20 @@ on the grid, in every class ("n/a" for a model that exposes no interval).
 Seed split: a case whose seed is a multiple of ``--seed-split`` is a tuning case (to tune
 thresholds on); the tables are printed on the others, the report cases (``--seed-split 0``:
 all cases). Both sets go to ``--json``. ``--cli-check K``: K report cases through the API,
-``fricid fit`` + ``fricid report`` and the fleet (:mod:`_verdict_cli`), agreement printed.
+``fricid fit`` + ``fricid report`` and the fleet (:mod:`_verdict_cli`; ``auto`` and the
+first of ``--models``), agreement printed. ``--rows PATH`` appends one JSON line per fit as
+it ends, so an interrupted run keeps what it did; ``--tables-from PATH`` prints the tables
+of such a file (or of a ``--json`` file) without running; ``--report-only`` skips the
+tuning cases.
 
-Runtime: ``--quick`` (26 cases, ``auto`` and ``coulomb_viscous``) about a minute on an idle
-core; the full run is bounded by ``auto``'s cost per case (module ``bench_verdicts`` prints
-the seconds per model).
+Runtime is ``auto``'s: CPU seconds per fit and trust assessment (the last table prints
+them; measured on a shared machine): ``auto`` about 10 (up to 25 on load and temperature),
+``stribeck`` about 1-3, ``coulomb_viscous`` 0.4, ``hybrid`` 2-3, ``gp`` under 1. So the
+default full run (325 cases, ``auto`` on 109 of them, the learned models on 33) is some
+2,000 CPU seconds, over 15 minutes on 2 idle cores (``--auto-every 5``: about 12);
+``--quick`` is 13 cases, one per class, ``auto`` on 2 (cases 0 and 7), about 75 CPU seconds:
+under a minute with ``--jobs 2``. ``--auto-every`` and ``--seed-split`` should not share a
+factor, or ``auto`` runs on tuning cases only.
 """
 
 from __future__ import annotations
@@ -57,7 +67,7 @@ from _verdict_eval import run_model
 LEVELS = ("yes", "with caveats", "no", "error")
 TRUTH = ("<1.2", "1.2-1.5", ">1.5")
 BASE_SEED = 1000
-DEFAULT_MODELS = ("auto", "stribeck", "coulomb_viscous")
+DEFAULT_MODELS = ("stribeck", "coulomb_viscous")
 LEARNED = ("hybrid", "gp")
 
 
@@ -94,9 +104,15 @@ def _tasks(args) -> list[tuple[int, str, int, tuple[str, ...]]]:
     models = tuple(args.models.split(","))
     out = []
     for cid, klass, seed in case_plan(args.cases):
+        if cid < args.first:
+            continue
         if args.report_only and is_tuning(seed, args.seed_split):
             continue
-        extra = LEARNED if args.learned_every and cid % args.learned_every == 0 else ()
+        extra: tuple[str, ...] = ()
+        if args.auto_every and cid % args.auto_every == 0:
+            extra += ("auto",)
+        if args.learned_every and cid % args.learned_every == 0:
+            extra += LEARNED
         out.append((cid, klass, seed, models + tuple(m for m in extra if m not in models)))
     return out
 
@@ -328,15 +344,17 @@ def read_rows(path: Path) -> list[dict[str, Any]]:
 def parse(argv: list[str] | None = None) -> argparse.Namespace:
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     p.add_argument("--cases", type=int, default=325, help="number of cases (default 325)")
-    p.add_argument("--quick", action="store_true", help="26 cases, auto and coulomb_viscous")
+    p.add_argument("--quick", action="store_true", help="13 cases, one per class; auto on 2")
     p.add_argument("--jobs", type=int, default=1, help="worker processes (default 1)")
     p.add_argument("--seed-split", type=int, default=4, help="tuning: seed %% K == 0 (0: none)")
     p.add_argument("--models", default=",".join(DEFAULT_MODELS))
+    p.add_argument("--auto-every", type=int, default=3, help="auto every K-th case (1: all)")
     p.add_argument("--learned-every", type=int, default=10, help="hybrid, gp every K-th case")
     p.add_argument("--cli-check", type=int, default=0, metavar="K")
     p.add_argument("--json", type=Path, default=None, metavar="PATH")
     p.add_argument("--rows", type=Path, default=None, metavar="PATH", help="JSON lines as fits end")
     p.add_argument("--report-only", action="store_true", help="skip the tuning cases")
+    p.add_argument("--first", type=int, default=0, help="start at this case (resume a run)")
     p.add_argument(
         "--tables-from",
         type=Path,
@@ -346,7 +364,7 @@ def parse(argv: list[str] | None = None) -> argparse.Namespace:
     )
     args = p.parse_args(argv)
     if args.quick:
-        args.cases, args.models, args.learned_every = 26, "auto,coulomb_viscous", 0
+        args.cases, args.auto_every, args.learned_every = 13, 7, 0
     return args
 
 
@@ -355,6 +373,7 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
     tuning = [s for _, _, s in case_plan(args.cases) if is_tuning(s, args.seed_split)]
     print(
         f"{args.cases} cases, models {args.models}"
+        + (f" (+ auto every {args.auto_every}th case)" if args.auto_every else "")
         + (
             f" (+ {', '.join(LEARNED)} every {args.learned_every}th case)"
             if args.learned_every
@@ -377,7 +396,7 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
 
         plan = [c for c in case_plan(args.cases) if not is_tuning(c[2], args.seed_split)]
         cases = [make_case(*c) for c in plan[: args.cli_check]]
-        cli_rows = cli_check(cases, tuple(args.models.split(","))[:2])
+        cli_rows = cli_check(cases, ("auto", args.models.split(",")[0]))
         print_cli(cli_rows)
     result = {
         "cases": args.cases,

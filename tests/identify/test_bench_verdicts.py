@@ -143,6 +143,7 @@ def test_one_tiny_case_scores_and_tabulates(tmp_path, capsys):
 def test_bench_runs_end_to_end_with_json(tmp_path, capsys):
     out = tmp_path / "v.json"
     argv = ["--cases", "3", "--models", "coulomb_viscous", "--learned-every", "0"]
+    argv += ["--auto-every", "0"]
     result = bv.main([*argv, "--seed-split", "3", "--json", str(out)])
     text = capsys.readouterr().out
     assert "Verdict against the true held-out ratio" in text and "Coverage" in text
