@@ -47,6 +47,12 @@ def _level(text: str) -> str | None:
     return found[-1] if found else None
 
 
+def _outcome(level: str | None) -> str:
+    """A verdict, or ``failed`` for an error, a non-zero exit or a failed fleet row."""
+    known = ("yes", "with caveats", "no")
+    return level if level in known else "failed"
+
+
 def _cli(app, args: list[str]) -> tuple[int, str]:
     from typer.testing import CliRunner
 
@@ -104,7 +110,7 @@ def _one(case, model: str, folder: Path) -> dict[str, Any]:
             row["fleet_ratio"] = float(ratio) if ratio is not None else float("nan")
         except Exception as err:
             row["fleet"], row["fleet_ratio"] = f"error: {type(err).__name__}", float("nan")
-    levels = {row["api"], row["cli_fit"], row["cli_report"], row["fleet"]}
+    levels = {_outcome(row[k]) for k in ("api", "cli_fit", "cli_report", "fleet")}
     same_ratio = np.isclose(row["api_ratio"], row["fleet_ratio"], rtol=1e-6, equal_nan=True)
     row["agree"] = len(levels) == 1 and bool(same_ratio)
     return row
