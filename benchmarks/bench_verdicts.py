@@ -32,10 +32,10 @@ Seed split: a case whose seed is a multiple of ``--seed-split`` is a tuning case
 thresholds on); the tables are printed on the others, the report cases (``--seed-split 0``:
 all cases). Both sets go to ``--json``. ``--cli-check K``: K report cases through the API,
 ``fricid fit`` + ``fricid report`` and the fleet (:mod:`_verdict_cli`; ``auto`` and the
-first of ``--models``), agreement printed. ``--rows PATH`` appends one JSON line per fit as
-it ends, so an interrupted run keeps what it did; ``--tables-from PATH`` prints the tables
-of such a file (or of a ``--json`` file) without running; ``--report-only`` skips the
-tuning cases.
+first of ``--models``; cases with repeated runs first), agreement printed. ``--rows PATH``
+appends one JSON line per fit as it ends, so an interrupted run keeps what it did;
+``--tables-from PATH`` prints the tables of such a file (or of a ``--json`` file) without
+running; ``--report-only`` skips the tuning cases.
 
 Runtime is ``auto``'s: CPU seconds per fit and trust assessment (the last table prints
 them; measured on a shared machine): ``auto`` about 10 (up to 25 on load and temperature),
@@ -395,6 +395,8 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
         from _verdict_cli import cli_check
 
         plan = [c for c in case_plan(args.cases) if not is_tuning(c[2], args.seed_split)]
+        # repeated runs first: a table of means carries no std, so only repeats give a scatter
+        plan.sort(key=lambda c: c[1] not in ("repeats", "gravity"))
         cases = [make_case(*c) for c in plan[: args.cli_check]]
         cli_rows = cli_check(cases, ("auto", args.models.split(",")[0]))
         print_cli(cli_rows)
