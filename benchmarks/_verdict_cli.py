@@ -7,6 +7,8 @@ The samples of a case are written as a table of means, the form both the CLI (a 
 the case measures neither, since a table of means of the fleet always has the columns it is
 given), no std or count (a table of means carries none). The API, the CLI and the fleet are
 then run on exactly these samples, so their verdicts and ratios must agree to the digit.
+A failed fit is one outcome, however it shows (the API raises, the CLI exits 2, the fleet's
+row fails); a manifest that does not take the model (the fleet has no ``auto``) shows so.
 """
 
 from __future__ import annotations
