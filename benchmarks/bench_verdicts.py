@@ -38,13 +38,13 @@ appends one JSON line per fit as it ends, so an interrupted run keeps what it di
 running; ``--report-only`` skips the tuning cases.
 
 Runtime is ``auto``'s: CPU seconds per fit and trust assessment (the last table prints
-them; measured on a shared machine): ``auto`` about 10 (up to 25 on load and temperature),
-``stribeck`` about 1-3, ``coulomb_viscous`` 0.4, ``hybrid`` 2-3, ``gp`` under 1. So the
-default full run (325 cases, ``auto`` on 109 of them, the learned models on 33) is some
-2,000 CPU seconds, over 15 minutes on 2 idle cores (``--auto-every 5``: about 12);
-``--quick`` is 13 cases, one per class, ``auto`` on 2 (cases 0 and 7), about 75 CPU seconds:
-under a minute with ``--jobs 2``. ``--auto-every`` and ``--seed-split`` should not share a
-factor, or ``auto`` runs on tuning cases only.
+them), measured over 60 cases on a shared machine: ``auto`` 18 (its own leave-one-level-out
+over every candidate family), ``stribeck`` 2.4, ``coulomb_viscous`` 0.4, ``hybrid`` 1.3,
+``gp`` 1.1. So the default full run (325 cases, ``auto`` on 109 of them, the learned models on
+33) is some 3,000 CPU seconds, about 25 minutes on 2 idle cores (``--auto-every 9``: about
+14); ``--quick`` is 13 cases, one per class, ``auto`` on 2 (cases 0 and 7), about 75 CPU
+seconds: under a minute with ``--jobs 2``. ``--auto-every`` and ``--seed-split`` should not
+share a factor, or ``auto`` runs on tuning cases only.
 """
 
 from __future__ import annotations
