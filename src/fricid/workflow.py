@@ -182,7 +182,8 @@ def _extract_stream(
     Unset ``positions``, ``bin_halfwidth`` and ``gravity`` come from the design recorded with
     the log (as ``fricid extract`` does); ``gravity`` then defaults to ``"fit"`` with position
     bins and ``"auto"`` without (gravity removed by the joint fit when the log has a position
-    channel; otherwise, or when eq. 7 is not determined, not removed, with a note saying so).
+    channel; otherwise, or when eq. 7 of the BAS-RBFNN paper is not determined, not removed,
+    with a note saying so).
     """
     opts = dict(options)
     hints = _design_hints(first)

@@ -115,3 +115,15 @@ def test_the_verdict_says_the_scatter_is_estimated():
     assert trust.scatter_method == SECOND_DIFFERENCES
     assert ESTIMATED in trust.line() and trust.level != "no"
     assert 0.7 < trust.heldout_ratio < 1.4  # the true model against the noise, not the rise
+
+
+def test_repeats_are_found_when_load_and_temperature_were_not_measured():
+    speed = np.repeat([0.2, 0.5, 1.0, 2.0, 4.0], 3)  # three runs at each speed
+    rng = np.random.default_rng(3)
+    v = np.r_[-speed, speed]
+    y = np.sign(v) * (1.0 + 2.0 * np.abs(v)) + rng.normal(0.0, NOISE, v.size)
+    for load, temperature in ((None, None), (0.0, 25.0)):
+        samples = FrictionSamples(velocity=v, load=load, temperature=temperature, friction=y)
+        sc = measurement_scatter(samples)
+        assert sc.method == "between repeated runs"
+        assert 0.5 * NOISE < sc.value < 2.0 * NOISE

@@ -4,12 +4,13 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
 from fricid.errors import ConfigError, DataError
 from fricid.io import csv_dialect, read_samples
 from fricid.io._dialect import detect_dialect
+from fricid.samples import standstill_rows
 
 finite = st.floats(min_value=-1e6, max_value=1e6, allow_nan=False, allow_subnormal=False)
 positive = st.floats(min_value=1e-4, max_value=1e3, allow_nan=False)
@@ -33,10 +34,11 @@ def _write(path, rows, delimiter, decimal):
     dialect=st.sampled_from([(";", ","), ("\t", ","), (";", "."), ("\t", "."), (",", ".")]),
 )
 def test_delimiter_and_decimal_comma_are_detected(tmp_path, rows, dialect):
+    want = np.array(rows, dtype=float)
+    assume(not standstill_rows(want[:, 0], np.sign(want[:, 0])).any())  # dropped on read
     path = tmp_path / "table.csv"
     _write(path, rows, *dialect)
     s = read_samples(path)
-    want = np.array(rows, dtype=float)
     np.testing.assert_array_equal(s.velocity, want[:, 0])
     np.testing.assert_array_equal(s.load, want[:, 1])
     np.testing.assert_array_equal(s.friction, want[:, 2])

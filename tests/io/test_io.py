@@ -11,7 +11,7 @@ import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
 from fricid.errors import ConfigError, DataError
@@ -25,7 +25,7 @@ from fricid.io import (
     write_rawlog,
     write_samples,
 )
-from fricid.samples import LIMITS, SAMPLE_COLUMNS, FrictionSamples, RawLog
+from fricid.samples import LIMITS, SAMPLE_COLUMNS, FrictionSamples, RawLog, standstill_rows
 
 SAMPLES_HEADER = (
     "velocity [rad/s],load [N m],temperature [degC],friction [N m],direction,count,std [N m]"
@@ -193,6 +193,7 @@ def _with_recorded(data, path) -> dict:
 @ROUND_TRIP
 @given(samples=samples_strategy())
 def test_samples_round_trip(tmp_path, suffix, samples):
+    assume(not standstill_rows(samples.velocity, samples.direction).any())  # dropped on read
     path = tmp_path / f"s{suffix}"
     write_samples(samples, path)
     back = read_samples(path)

@@ -209,6 +209,18 @@ def speed_levels(speed: np.ndarray, rtol: float = LEVEL_RTOL) -> np.ndarray:
     return labels
 
 
+def input_keys(samples: FrictionSamples) -> tuple[np.ndarray, np.ndarray]:
+    """Load [N m] and temperature [degC] rounded for grouping (6 and 1 decimals); a column
+    not measured (NaN) becomes one key (``inf``), as ``np.unique(..., axis=0)`` never finds
+    two NaN rows equal."""
+
+    def key(x: np.ndarray, decimals: int) -> np.ndarray:
+        x = np.asarray(x, dtype=float)
+        return np.where(np.isnan(x), np.inf, np.round(x, decimals))
+
+    return key(samples.load, 6), key(samples.temperature, 1)
+
+
 def _repeat_groups(samples: FrictionSamples, rtol: float) -> np.ndarray:
     """Group index of each sample's operating point: the samples' own set-point labels
     (``meta["setpoint"]``, one per row: rows of one label are repeated runs of one
@@ -224,8 +236,7 @@ def _repeat_groups(samples: FrictionSamples, rtol: float) -> np.ndarray:
         [
             level_labels(samples, rtol),
             samples.direction,
-            np.round(samples.load, 6),
-            np.round(samples.temperature, 1),
+            *input_keys(samples),
         ]
     )
     _, group = np.unique(keys, axis=0, return_inverse=True)
@@ -304,9 +315,7 @@ def measurement_scatter(
 def _lines(samples: FrictionSamples) -> list[np.ndarray]:
     """Row indices of each line along the speed axis (one direction, load and temperature),
     sorted by speed."""
-    keys = np.column_stack(
-        [samples.direction, np.round(samples.load, 6), np.round(samples.temperature, 1)]
-    )
+    keys = np.column_stack([samples.direction, *input_keys(samples)])
     _, line = np.unique(keys, axis=0, return_inverse=True)
     line = line.ravel()
     speed = np.abs(samples.velocity)

@@ -26,8 +26,8 @@ READINGS_STD = "readings std [N m]"
 def quality_frame(rows: list[dict[str, Any]]) -> Any:
     """The quality rows as a table: set-point, kept, dropped by reason, the standard
     deviation of the readings kept (:data:`READINGS_STD`), the scatter between the merged
-    runs' means, what eq. 7 left along the position, flag, and what the row merged or why it
-    was dropped."""
+    runs' means, what eq. 7 of the BAS-RBFNN paper left along the position, flag, and what
+    the row merged or why it was dropped."""
     import pandas as pd
 
     out = []

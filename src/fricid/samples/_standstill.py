@@ -8,7 +8,9 @@ whatever held the joint. Extraction from a raw log drops such runs as rest
 here, by the same relative rule and a gap: a row is standstill when its speed is below
 :data:`STANDSTILL_RTOL` times the fastest speed of its direction *and* below
 :data:`STANDSTILL_GAP` times the slowest speed of that direction that is not (far below every
-other speed, so a logarithmic sweep down to 1e-4 of the fastest keeps its slow decades).
+other speed, so a logarithmic sweep down to 1e-4 of the fastest keeps its slow decades),
+and below :data:`STANDSTILL_MAX` [rad/s] (a speed a joint at rest cannot show as noise is a
+set-point, however far below the others).
 """
 
 from __future__ import annotations
@@ -20,7 +22,13 @@ import numpy as np
 
 from ..errors import DataQualityWarning
 
-__all__ = ["STANDSTILL_GAP", "STANDSTILL_RTOL", "drop_standstill", "standstill_rows"]
+__all__ = [
+    "STANDSTILL_GAP",
+    "STANDSTILL_MAX",
+    "STANDSTILL_RTOL",
+    "drop_standstill",
+    "standstill_rows",
+]
 
 #: A standstill row is slower than this share of its direction's fastest speed ...
 STANDSTILL_RTOL = 1e-3
@@ -28,11 +36,15 @@ STANDSTILL_RTOL = 1e-3
 #: ... and slower than this share of the slowest other speed of its direction.
 STANDSTILL_GAP = 0.05
 
+#: ... and slower than this [rad/s]: far above the velocity noise of a held joint (1e-5).
+STANDSTILL_MAX = 1e-2
+
 
 def standstill_rows(velocity, direction) -> np.ndarray:
     """Boolean mask of the standstill rows (module docstring): slower than
     :data:`STANDSTILL_RTOL` of the fastest speed of their direction and than
-    :data:`STANDSTILL_GAP` of the slowest speed there that is not; each direction (+1, -1, 0)
+    :data:`STANDSTILL_GAP` of the slowest speed there that is not, and than
+    :data:`STANDSTILL_MAX`; each direction (+1, -1, 0)
     is judged on its own, and one whose rows would all go is left alone."""
     speed = np.abs(np.asarray(velocity, dtype=float))
     direction = np.asarray(direction, dtype=float)
@@ -40,7 +52,7 @@ def standstill_rows(velocity, direction) -> np.ndarray:
     for d in np.unique(direction):
         idx = np.flatnonzero(direction == d)
         s = speed[idx]
-        candidate = s < STANDSTILL_RTOL * s.max()
+        candidate = (s < STANDSTILL_RTOL * s.max()) & (s < STANDSTILL_MAX)
         if candidate.all() or not candidate.any():
             continue
         mask[idx] = candidate & (s < STANDSTILL_GAP * s[~candidate].min())

@@ -16,7 +16,7 @@ import numpy as np
 
 from ...models import get_model
 from ...samples import FrictionSamples
-from .._scatter import level_labels
+from .._scatter import input_keys, level_labels
 
 __all__ = [
     "FAMILIES",
@@ -119,7 +119,7 @@ def candidates(samples: FrictionSamples, learned: bool = False) -> list[Candidat
     temp_varies = _varies(samples.temperature, 0.5)
     temps = temperature_levels(samples)
     points = np.unique(
-        np.column_stack([levels, np.round(samples.load, 6), np.round(samples.temperature, 1)]),
+        np.column_stack([levels, *input_keys(samples)]),
         axis=0,
     ).shape[0]
     out: list[Candidate] = []

@@ -122,7 +122,8 @@ def checked_ends(
     rise = profile_threshold(sse, problem.n_obs, p, level) - sse
     var = np.diag(cov)
     half = np.sqrt(rise * var / (sse / (problem.n_obs - p))) if sse > 0 else np.zeros(p)
-    trace = cov / var[None, :]  # column j: the trace's direction per unit of theta_j
+    with np.errstate(invalid="ignore", divide="ignore"):  # var 0: a fit without noise
+        trace = cov / var[None, :]  # column j: the trace's direction per unit of theta_j
     sign = np.array([-1.0, 1.0])
     T = x_hat[None, None, :] + sign[None, :, None] * (half[:, None] * trace.T)[:, None, :]
     T = T.reshape(2 * p, p)  # rows: (j, low), (j, high)
