@@ -13,9 +13,12 @@ checks the README against those files (``benchmarks/readme_numbers.py`` renders 
 - ``demo``: ``fricid demo`` (the default, reduced size) in a fresh folder, wall and CPU time of
   the process, into ``benchmarks/results/demo.json``. A fresh clone's ``make demo`` creates
   ``.venv`` and installs the dependencies first; that time is the ``fresh_make_demo`` entry,
-  left ``null`` here (the number to plug in: ``wall_s`` of ``fresh_make_demo``).
+  kept from the last ``fresh`` run.
+- ``fresh``: ``make demo`` in a fresh clone of the repository (``bench_speed.demo``: wall, CPU
+  and peak memory from ``/usr/bin/time -v``, the load average before and after), into the
+  ``fresh_make_demo`` entry of ``benchmarks/results/demo.json``; minutes, so not by default.
 
-Run from the repository root: ``python benchmarks/bench_readme.py [quickstart] [demo]``
+Run from the repository root: ``python benchmarks/bench_readme.py [quickstart] [demo] [fresh]``
 (both by default), then ``python benchmarks/readme_numbers.py --write`` to update the README.
 """
 
@@ -166,16 +169,40 @@ def demo() -> None:
     _write("demo.json", record)
 
 
+def fresh() -> None:
+    sys.path.insert(0, str(ROOT / "benchmarks"))
+    from bench_speed import demo as make_demo_in_a_clone
+
+    out = make_demo_in_a_clone()
+    if out["fresh"]["exit_status"] != 0:
+        raise SystemExit("make demo failed in the fresh clone: nothing written")
+    path = RESULTS / "demo.json"
+    record = json.loads(path.read_text(encoding="utf-8")) if path.is_file() else {}
+    r = out["fresh"]
+    record["fresh_make_demo"] = {
+        "command": "make demo (fresh clone: venv, install, demo)",
+        "wall_s": r["wall_s"],
+        "cpu_s": r["user_s"] + r["system_s"],
+        "peak_mb": r["peak_mb"],
+        "load_before": [float(x) for x in out["load_before"].split()],
+        "load_after": [float(x) for x in out["load_after"].split()],
+        "machine": _machine(),
+    }
+    _write("demo.json", record)
+
+
+PARTS = {"quickstart": quickstart, "demo": demo, "fresh": fresh}
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("parts", nargs="*", help="quickstart, demo (default: both)")
+    ap.add_argument("parts", nargs="*", help="quickstart, demo, fresh (default: the first two)")
     parts = ap.parse_args().parts or ["quickstart", "demo"]
-    if set(parts) - {"quickstart", "demo"}:
-        ap.error(f"unknown part(s): {sorted(set(parts) - {'quickstart', 'demo'})}")
-    if "quickstart" in parts:
-        quickstart()
-    if "demo" in parts:
-        demo()
+    if set(parts) - set(PARTS):
+        ap.error(f"unknown part(s): {sorted(set(parts) - set(PARTS))}")
+    for name, part in PARTS.items():
+        if name in parts:
+            part()
 
 
 if __name__ == "__main__":

@@ -9,7 +9,7 @@ from what this renders, or holds a number outside the marks.
 To plug in a number another benchmark measures (for instance a fresh clone's ``make demo``):
 write it into a JSON file of ``benchmarks/results/`` and point the :data:`NUMBERS` entry at
 it (file, key path, format); a ``null`` or missing value renders as :data:`NOT_MEASURED`.
-Placeholder now: ``make_demo_fresh`` (``demo.json``, ``fresh_make_demo.wall_s``).
+``make_demo_fresh*`` come from ``python benchmarks/bench_readme.py fresh``.
 
 Run from the repository root: ``python benchmarks/readme_numbers.py --write`` updates the
 README in place; ``--check`` exits 1 when it is stale.
@@ -36,9 +36,10 @@ NUMBERS: dict[str, tuple[str, str, str]] = {
     "demo_cpu": ("demo.json", "fricid_demo.cpu_s", "{:.0f} s"),
     "demo_load": ("demo.json", "machine.load_average.0", "{:.1f}"),
     "demo_cpus": ("demo.json", "machine.cpus", "{:d}"),
-    # PLACEHOLDER: a fresh clone's `make demo` (venv, install, demo), measured elsewhere; null
-    # until then.
+    # a fresh clone's `make demo` (venv, install, demo): `bench_readme.py fresh`
     "make_demo_fresh": ("demo.json", "fresh_make_demo.wall_s", "{:.0f} s"),
+    "make_demo_fresh_cpu": ("demo.json", "fresh_make_demo.cpu_s", "{:.0f} s"),
+    "make_demo_fresh_load": ("demo.json", "fresh_make_demo.load_before.0", "{:.1f}"),
     "quickstart_extract_wall": ("quickstart.json", "commands.0.wall_s", "{:.0f} s"),
     "quickstart_fit_wall": ("quickstart.json", "commands.1.wall_s", "{:.0f} s"),
     "quickstart_load": ("quickstart.json", "machine.load_average.0", "{:.1f}"),

@@ -299,6 +299,11 @@ def select_direction(samples: FrictionSamples, direction: str = "all") -> Fricti
     return samples.subset(mask)
 
 
+def _is_auto(model: str) -> bool:
+    """``model`` asks for the selection (:func:`fricid.identify.fit`'s ``"auto"``)."""
+    return model.strip().lower() == "auto"
+
+
 def select_samples(
     data: JointData, model: str, *, samples: str = "auto", direction: str = "all"
 ) -> FrictionSamples:
@@ -307,8 +312,9 @@ def select_samples(
 
     if samples not in SAMPLE_SETS:
         raise ConfigError(f"samples must be one of: {', '.join(SAMPLE_SETS)}; got '{samples}'")
-    if samples == "auto":
-        samples = "by_direction" if get_model(model).is_asymmetric else "combined"
+    if samples == "auto":  # the selection tries the per-direction families too
+        by_direction = _is_auto(model) or get_model(model).is_asymmetric
+        samples = "by_direction" if by_direction else "combined"
     chosen = data.by_direction if samples == "by_direction" else data.samples
     return select_direction(chosen, direction)
 
@@ -451,7 +457,7 @@ def run_joint(
 
     if not models:
         raise ConfigError("run_joint needs at least one model")
-    names = {n for m in models for n in get_model(m).param_names}
+    names = {n for m in models if not _is_auto(m) for n in get_model(m).param_names}
     for what, given in (("fixed", fixed), ("bounds", bounds)):
         unknown = sorted(set(given or {}) - names)
         if unknown:
@@ -471,8 +477,11 @@ def run_joint(
     for name in models:
         t1 = time.perf_counter()
         try:
-            model = get_model(name)
-            own = set(model.param_names)
+            own = (
+                {*(fixed or {}), *(bounds or {})}
+                if _is_auto(name)
+                else set(get_model(name).param_names)
+            )
             used = select_samples(data, name, samples=samples, direction=direction)
             run.used[name] = used
             run.fits[name], run.trust[name] = fit_samples(

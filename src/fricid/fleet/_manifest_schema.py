@@ -296,7 +296,8 @@ def to_values(entry: Entry, file: Path) -> dict[str, Any]:
         if "model" in got:
             column = "model"
             for name in got["model"]:
-                get_model(name)  # ConfigError lists the models
+                if name.strip().lower() != "auto":  # auto: the selection, as fricid fit does
+                    get_model(name)  # ConfigError lists the models
             got["model"] = tuple(dict.fromkeys(got["model"]))
         if "method" in got and got["method"] not in METHODS:
             column = "method"

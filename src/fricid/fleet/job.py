@@ -176,7 +176,8 @@ def fit_row(
     half-widths of their 95 % confidence intervals ``ci95_<name>`` (SI units, listed in
     ``units``); the verdict columns of :func:`verdict_columns` of ``trust`` (the fit's trust
     record, default the one the model carries); a failed fit has ``status`` ``"failed"`` and
-    its ``error``.
+    its ``error``. ``chosen`` is the model fitted: the family selected where ``model`` is
+    ``"auto"``.
     """
     row: dict[str, Any] = {
         "robot": spec.robot,
@@ -199,6 +200,7 @@ def fit_row(
         row["directions"] = ";".join(str(d) for d in used.directions())
     if fitted is None:
         return row
+    row["chosen"] = fitted.model  # the family "auto" selected; else the model itself
     for key in ("fitness", "sse", "rmse", "rmspe", "mae", "max_abs_error"):
         row[key] = fitted.metrics.get(key)
     if trust is None and fitted.trust is not None:
