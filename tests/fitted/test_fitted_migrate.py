@@ -95,9 +95,11 @@ def test_version_1_files_predict_and_print_as_before(family):
     assert table == expected["parameter_table"]
     spec = JointSpec(robot="r", joint="j", log=Path("/nonexistent/log.csv"), log_text="log.csv")
     row = quiet(fit_row, spec, family, fitted, None)
-    # the verdict columns come from the trust record alone now (none given here): the rest
-    # of the row is the old row
+    # the verdict columns come from the trust record alone now (none given here), and the
+    # row names the model fitted ("chosen": the family where "auto" was asked): the rest of
+    # the row is the old row
     want = {k: v for k, v in expected["fleet_row"].items() if k not in VERDICT_COLUMNS}
+    assert row.pop("chosen") == fitted.model
     assert row.keys() == want.keys()
     assert all(same(row[k], v) for k, v in want.items()), family
     assert not_determined(fitted) == expected["not_determined"]
