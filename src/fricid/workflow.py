@@ -299,11 +299,6 @@ def select_direction(samples: FrictionSamples, direction: str = "all") -> Fricti
     return samples.subset(mask)
 
 
-def _is_auto(model: str) -> bool:
-    """``model`` asks for the selection (:func:`fricid.identify.fit`'s ``"auto"``)."""
-    return model.strip().lower() == "auto"
-
-
 def select_samples(
     data: JointData, model: str, *, samples: str = "auto", direction: str = "all"
 ) -> FrictionSamples:
@@ -313,7 +308,7 @@ def select_samples(
     if samples not in SAMPLE_SETS:
         raise ConfigError(f"samples must be one of: {', '.join(SAMPLE_SETS)}; got '{samples}'")
     if samples == "auto":  # the selection tries the per-direction families too
-        by_direction = _is_auto(model) or get_model(model).is_asymmetric
+        by_direction = model.strip().lower() == "auto" or get_model(model).is_asymmetric
         samples = "by_direction" if by_direction else "combined"
     chosen = data.by_direction if samples == "by_direction" else data.samples
     return select_direction(chosen, direction)
@@ -457,7 +452,8 @@ def run_joint(
 
     if not models:
         raise ConfigError("run_joint needs at least one model")
-    names = {n for m in models if not _is_auto(m) for n in get_model(m).param_names}
+    fixed_models = [m for m in models if m.strip().lower() != "auto"]
+    names = {n for m in fixed_models for n in get_model(m).param_names}
     for what, given in (("fixed", fixed), ("bounds", bounds)):
         unknown = sorted(set(given or {}) - names)
         if unknown:
@@ -479,7 +475,7 @@ def run_joint(
         try:
             own = (
                 {*(fixed or {}), *(bounds or {})}
-                if _is_auto(name)
+                if name.strip().lower() == "auto"
                 else set(get_model(name).param_names)
             )
             used = select_samples(data, name, samples=samples, direction=direction)
