@@ -42,6 +42,10 @@ def test_speed_coverage_finds_the_gap_and_not_a_linear_step():
     assert cov["neg"]["range"] == [0.217, 13.0]
     linear = speed_coverage(np.arange(0.5, 20.01, 0.5), [0])
     assert linear == {"both": {"range": [0.5, 20.0], "gaps": []}}
+    from_slow = speed_coverage(np.r_[0.2172, 1.047 * np.arange(1, 8)], [1])  # EPOS-like
+    assert from_slow["pos"]["gaps"] == []
+    hole = speed_coverage(np.r_[np.linspace(0.1, 1.0, 8), np.linspace(4.0, 6.0, 5)], [1])
+    assert hole["pos"]["gaps"] == [[1.0, 4.0]]
     geometric = speed_coverage(np.geomspace(0.1, 10, 15), [1])
     assert geometric["pos"]["gaps"] == []
 

@@ -28,6 +28,7 @@ from fricid.identify.trust import (
 )
 from fricid.identify.validate import interior_rmse
 from fricid.io import epos_steady_samples, write_rawlog, write_samples
+from fricid.samples import FrictionSamples
 from fricid.sim import preset, simulate
 from fricid.workflow import fit_samples
 
@@ -265,3 +266,20 @@ def test_run_joint_takes_fricid_fits_options_and_gives_the_same_model(leadscrew_
     by_hand = FittedModel.load(model)
     assert by_hand.params == joint.params and by_hand.validation == joint.validation
     assert by_hand.trust == joint.trust
+
+
+def _linear_joint(speed: np.ndarray, seed: int) -> FrictionSamples:
+    rng = np.random.default_rng(seed)
+    v = np.r_[-speed, speed]
+    y = np.sign(v) * (0.3 + 0.1 * np.abs(v)) + rng.normal(0.0, 0.01, v.size)
+    return FrictionSamples(velocity=v, load=None, temperature=None, friction=y)
+
+
+def test_a_gap_between_measured_speeds_is_a_caveat():
+    holed = _linear_joint(np.r_[np.linspace(0.1, 1.0, 8), np.linspace(4.0, 6.0, 5)], 5)
+    trust = assess_trust(fit(holed, "coulomb_viscous"), holed)
+    assert trust.level != "yes"
+    assert any("no speed measured between 1 and 4 rad/s (v > 0)" in r for r in trust.reasons)
+    even = _linear_joint(np.linspace(0.1, 6.0, 13), 5)
+    reasons = assess_trust(fit(even, "coulomb_viscous"), even).reasons
+    assert not any("no speed measured" in r for r in reasons)

@@ -78,6 +78,25 @@ def open_sides(fitted: FittedModel, *, include_zero: bool = False) -> dict[str, 
     return out
 
 
+def gap_caveat(fitted: FittedModel) -> str:
+    """``"no speed measured between 1 and 4 rad/s (v > 0): the model is untested there"``
+    for each gap between measured speeds that the file records (``provenance["speeds"]``,
+    :func:`fricid.models._range.speed_coverage`): held-out validation leaves out measured
+    levels, so it says nothing of a gap; "" when there is none."""
+    coverage = (fitted.provenance or {}).get("speeds")
+    if not isinstance(coverage, dict):
+        return ""
+    parts = []
+    for side, label in (("pos", "v > 0"), ("neg", "v < 0"), ("both", "|v|")):
+        rec = coverage.get(side)
+        for gap in rec.get("gaps") or [] if isinstance(rec, dict) else []:
+            with contextlib.suppress(TypeError, ValueError):
+                parts.append(f"between {float(gap[0]):.4g} and {float(gap[1]):.4g} rad/s ({label})")
+    if not parts:
+        return ""
+    return f"no speed measured {', '.join(parts)}: the model is untested there"
+
+
 def range_text(fitted: FittedModel) -> str:
     """The extrapolation-free operating range: ``"velocity 0.0105 to 0.838 rad/s; ..."``.
 

@@ -37,8 +37,9 @@ model misses the data by more than :data:`MISS_RATIO` times the scatter; ``"with
 when anything else above is short of clean (a parameter not determined or not bounded, an
 error between :data:`fricid.metrics.NOISE_RATIO` and :data:`MISS_RATIO` times the scatter,
 no held-out error or no scatter, convergence not recorded, set-points flagged for scatter or
-with outliers dropped); ``"yes"`` otherwise. A model whose error misses the scatter gets
-what to do (:func:`._advice.misfit_advice`).
+with outliers dropped, a gap between the measured speeds (held-out validation leaves out
+measured levels and so says nothing of a gap)); ``"yes"`` otherwise. A model whose error
+misses the scatter gets what to do (:func:`._advice.misfit_advice`).
 
 Reuse. The model file may carry the record (``FittedModel.trust``; ``fricid fit`` and the
 fleet store it). :func:`assess_trust` returns it instead of computing again only when it was
@@ -63,6 +64,7 @@ from ..samples import FrictionSamples
 from ._diagnostics import (
     DROPS,
     downweighted,
+    gap_caveat,
     not_determined,
     open_sides,
     quality_rows,
@@ -112,7 +114,7 @@ __all__ = [
 MISS_RATIO = 3.0
 
 #: Format of the record and of the rules behind it: a stored record of another is recomputed.
-TRUST_VERSION = 2
+TRUST_VERSION = 3
 
 #: ``Trust.heldout_source``: leave-one-velocity-out run by :func:`assess_trust`.
 RUN_HERE = "lovo run here"
@@ -464,6 +466,9 @@ def _grade(trust: Trust, fitted: FittedModel, quality_caveat: str) -> None:
         )
     if quality_caveat:
         caveats.append(quality_caveat)
+    gaps = gap_caveat(fitted)
+    if gaps:
+        caveats.append(gaps)
     if trust.downweighted:
         loss = (fitted.loss or {}).get("loss")
         caveats.append(

@@ -56,9 +56,10 @@ def speed_coverage(velocity, directions: Sequence[int] = ()) -> dict[str, dict[s
     dict
         Side -> ``{"range": [low, high], "gaps": [[a, b], ...]}`` [rad/s]; a gap is a pair
         of consecutive measured speeds more than :data:`GAP_MIN_RATIO` apart and more than
-        :data:`GAP_FACTOR` times the design's median step on log speed (a geometric sweep of
-        ratio 1.4 has gaps where two speeds are over 2x apart, one of ratio 1.67 over 2.16x,
-        so that 2 to 5 rad/s in it is a gap; a linear sweep of 0.5 rad/s steps has none).
+        :data:`GAP_FACTOR` times the design's median step both on log speed and on speed (a
+        geometric sweep of ratio 1.4 has gaps where two speeds are over 2x apart, one of ratio
+        1.67 over 2.16x, so that 2 to 5 rad/s in it is a gap; a linear sweep has none, not
+        even its first step from a slow speed, 0.2 to 1.05 rad/s in steps of 1.05).
     """
     v = np.asarray(velocity, dtype=float).ravel()
     v = v[np.isfinite(v) & (v != 0)]
@@ -75,7 +76,8 @@ def speed_coverage(velocity, directions: Sequence[int] = ()) -> dict[str, dict[s
         limit = (
             max(np.log(GAP_MIN_RATIO), GAP_FACTOR * float(np.median(steps))) if steps.size else 0
         )
-        gaps = [[float(s[i]), float(s[i + 1])] for i in np.flatnonzero(steps > limit)]
+        wide = np.diff(s) > GAP_FACTOR * float(np.median(np.diff(s))) if steps.size else steps
+        gaps = [[float(s[i]), float(s[i + 1])] for i in np.flatnonzero((steps > limit) & wide)]
         out[side] = {"range": [float(s[0]), float(s[-1])], "gaps": gaps}
     return out
 
