@@ -14,7 +14,7 @@ import numpy as np
 
 from ..errors import ConfigError
 from ..fitted import FittedModel, Parameter
-from ..models._range import coverage_text, gaps_note
+from ..models._range import SIDES, coverage_text, gap_pairs, gaps_note
 from ..samples import FrictionSamples
 from ._scatter import sample_weights
 
@@ -84,14 +84,11 @@ def gap_caveat(fitted: FittedModel) -> str:
     :func:`fricid.models._range.speed_coverage`): held-out validation leaves out measured
     levels, so it says nothing of a gap; "" when there is none."""
     coverage = (fitted.provenance or {}).get("speeds")
-    if not isinstance(coverage, dict):
-        return ""
-    parts = []
-    for side, label in (("pos", "v > 0"), ("neg", "v < 0"), ("both", "|v|")):
-        rec = coverage.get(side)
-        for gap in rec.get("gaps") or [] if isinstance(rec, dict) else []:
-            with contextlib.suppress(TypeError, ValueError):
-                parts.append(f"between {float(gap[0]):.4g} and {float(gap[1]):.4g} rad/s ({label})")
+    parts = [
+        f"between {a:.4g} and {b:.4g} rad/s ({label})"
+        for side, label in SIDES.items()
+        for a, b in gap_pairs(coverage, side)
+    ]
     if not parts:
         return ""
     return f"no speed measured {', '.join(parts)}: the model is untested there"

@@ -19,8 +19,10 @@ __all__ = [
     "GAP_FACTOR",
     "GAP_MIN_RATIO",
     "RANGE_TOLERANCE",
+    "SIDES",
     "RangeViolation",
     "coverage_text",
+    "gap_pairs",
     "gaps_note",
     "range_violations",
     "speed_coverage",
@@ -37,7 +39,8 @@ GAP_MIN_RATIO = 2.0
 #: ... and more than this many times the design's median step (on log speed) apart.
 GAP_FACTOR = 1.5
 
-_SIDES = {"pos": "v > 0", "neg": "v < 0", "both": "|v|"}
+#: The sides of a :func:`speed_coverage` record and how messages name them.
+SIDES = {"pos": "v > 0", "neg": "v < 0", "both": "|v|"}
 
 
 def speed_coverage(velocity, directions: Sequence[int] = ()) -> dict[str, dict[str, list]]:
@@ -82,14 +85,21 @@ def speed_coverage(velocity, directions: Sequence[int] = ()) -> dict[str, dict[s
     return out
 
 
-def gaps_note(coverage: Any, side: str) -> str:
-    """``"; nothing measured between a and b rad/s"`` for each gap of one side of a
-    :func:`speed_coverage` record; "" when it has none (or no such side)."""
+def gap_pairs(coverage: Any, side: str) -> list[tuple[float, float]]:
+    """The well-formed gaps ``(a, b)`` [rad/s] of one side of a :func:`speed_coverage`
+    record (a file's record may be damaged: anything else is passed over)."""
     rec = coverage.get(side) if isinstance(coverage, dict) else None
     gaps = rec.get("gaps") if isinstance(rec, dict) else None
     pairs = [_pair({"g": g}, "g") for g in gaps or []]
+    return [p for p in pairs if p is not None]
+
+
+def gaps_note(coverage: Any, side: str) -> str:
+    """``"; nothing measured between a and b rad/s"`` for each gap of one side of a
+    :func:`speed_coverage` record; "" when it has none (or no such side)."""
     return "".join(
-        f"; nothing measured between {p[0]:.4g} and {p[1]:.4g} rad/s" for p in pairs if p
+        f"; nothing measured between {a:.4g} and {b:.4g} rad/s"
+        for a, b in gap_pairs(coverage, side)
     )
 
 
@@ -98,13 +108,14 @@ def coverage_text(coverage: Any) -> list[str]:
     if not isinstance(coverage, dict):
         return []
     lines = []
-    for side, label in _SIDES.items():
+    for side, label in SIDES.items():
         rec = coverage.get(side)
         pair = _pair(rec, "range") if isinstance(rec, dict) else None
         if pair is None:
             continue
-        gaps = [g for g in (rec.get("gaps") or []) if _pair({"g": g}, "g") is not None]
-        tail = "; ".join(f"nothing between {a:.4g} and {b:.4g}" for a, b in gaps)
+        tail = "; ".join(
+            f"nothing between {a:.4g} and {b:.4g}" for a, b in gap_pairs(coverage, side)
+        )
         lines.append(
             f"{label}: measured {pair[0]:.4g} to {pair[1]:.4g} rad/s"
             + (f" ({tail})" if tail else " (no gaps)")
@@ -118,12 +129,12 @@ def _coverage_violations(v: np.ndarray, coverage: dict) -> list[RangeViolation]:
     out = []
     for side, rec in coverage.items():
         pair = _pair(rec, "range") if isinstance(rec, dict) else None
-        if side not in _SIDES or pair is None:
+        if side not in SIDES or pair is None:
             continue
         mask = {"pos": v > 0, "neg": v < 0, "both": v != 0}[side]
         speed = np.abs(v)
         lo, hi = pair
-        where = f"measured {lo:.4g} to {hi:.4g} rad/s for {_SIDES[side]}"
+        where = f"measured {lo:.4g} to {hi:.4g} rad/s for {SIDES[side]}"
         below = mask & (speed < lo * (1 - RANGE_TOLERANCE))
         if below.any():
             w = float(v[below][np.argmin(speed[below])])
@@ -139,11 +150,7 @@ def _coverage_violations(v: np.ndarray, coverage: dict) -> list[RangeViolation]:
                     f"rad/s ({where}): the low-speed (Stribeck) region is extrapolated",
                 )
             )
-        for gap in rec.get("gaps") or []:
-            gp = _pair({"g": gap}, "g")
-            if gp is None:
-                continue
-            a, b = gp
+        for a, b in gap_pairs(coverage, side):
             inside = (
                 mask & (speed > a * (1 + RANGE_TOLERANCE)) & (speed < b * (1 - RANGE_TOLERANCE))
             )

@@ -150,7 +150,7 @@ from ...fitted import FittedModel
 from ...models import dahl, get_model, lugre
 from ...samples import RawLog, check_trajectory_log
 from ._data import DerivativeFilter, derivatives, dilate, uniform_series
-from ._filtered import DAHL, ParallelFilter, filtered_route
+from ._filtered import DAHL, LUGRE, ParallelFilter, filtered_route
 from ._outcome import (
     RATE_BIAS,
     PassivityWarning,
@@ -366,30 +366,14 @@ def fit_trajectory(
             "chirp)",
             file=log.source,
         )
-    if key == "dahl":
+    if key == "dahl" or (key == "lugre" and route == "filtered"):
         parallel = parallel or ParallelFilter()
-        say("filtered route: every Dahl parameter")
-        stage, y, r = _dahl_filtered(
-            series,
-            stage1,
-            static_tab,
-            (gravity, method, seed, max_evals, cluster_time),
-            n_sub,
-            parallel,
-            log.source,
-        )
-        yhat = y - r
-        _take_filtered(stage, stages, fits, final, bounds_out)
-        sim_info = {"parallel_filter": parallel.describe(rate), "n_sub": int(n_sub)}
-    elif key == "lugre" and route == "filtered":
-        parallel = parallel or ParallelFilter()
-        say("filtered route: every LuGre parameter")
-        start = np.array([1e4, 1.0] + [static_tab[n]["value"] for n in lugre.PARAM_NAMES[2:]])
-        order = [stage1.names.index(n) for n in ("tau_v", "tau_c", "tau_s", "w_s", "delta")]
+        say(f"filtered route: every {'Dahl' if key == 'dahl' else 'LuGre'} parameter")
+        start, box, law = (_dahl_start if key == "dahl" else _lugre_start)(stage1, static_tab)
         stage, y, r = filtered_route(
             series,
             start,
-            stage1.bounds[order],
+            box,
             gravity,
             method,
             seed,
@@ -398,15 +382,17 @@ def fit_trajectory(
             n_sub,
             parallel,
             log.source,
+            law=law,
         )
         yhat = y - r
-        _take_filtered(stage, stages, fits, final, bounds_out)
+        stages["filtered"] = stage
+        fits.append(("filtered", stage))
+        final.update(stage.table())
+        bounds_out.update({n: list(b) for n, b in zip(stage.names, stage.bounds, strict=True)})
         sim_info = {"parallel_filter": parallel.describe(rate), "n_sub": int(n_sub)}
-        if rate_bias == "warn":
+        if key == "lugre" and rate_bias == "warn":
             say("rate bias, by simulation at the estimate")
-            rb = _rate_bias(
-                series, stage, stage1.bounds[order], gravity, method, seed, n_sub, parallel
-            )
+            rb = _rate_bias(series, stage, box, gravity, method, seed, n_sub, parallel)
             sim_info["rate_bias"] = rb
             warn_rate_bias(stage, rb)
     elif key == "lugre":
@@ -488,36 +474,21 @@ def _stages(
     return say
 
 
-def _take_filtered(stage, stages: dict, fits: list, final: dict, bounds_out: dict) -> None:
-    """Record the filtered route's stage: its search, its parameter table and its box."""
-    stages["filtered"] = stage
-    fits.append(("filtered", stage))
-    final.update(stage.table())
-    bounds_out.update({n: list(b) for n, b in zip(stage.names, stage.bounds, strict=True)})
+def _lugre_start(stage1, static_tab):
+    """LuGre's start (sigma_0, sigma_1 at 1e4 and 1, the static levels from the regression),
+    the static levels' box from the regression's, and the law."""
+    start = np.array([1e4, 1.0] + [static_tab[n]["value"] for n in lugre.PARAM_NAMES[2:]])
+    order = [stage1.names.index(n) for n in ("tau_v", "tau_c", "tau_s", "w_s", "delta")]
+    return start, stage1.bounds[order], LUGRE
 
 
-def _dahl_filtered(series, stage1, static_tab, run, n_sub, parallel, source):
-    """Dahl's four parameters with J, p_x, p_y by the filtered route, started from the
-    ``coulomb_viscous`` regression (``run``: gravity, method, seed, max_evals, cluster_time)."""
-    gravity, method, seed, max_evals, cluster_time = run
+def _dahl_start(stage1, static_tab):
+    """Dahl's start and box (sigma_0, tau_c, alpha, sigma_2), from the ``coulomb_viscous``
+    regression, and the law."""
     order = [stage1.names.index(n) for n in ("f_c", "beta")]
     (c_lo, c_hi), (v_lo, v_hi) = stage1.bounds[order]
     alpha = next(p for p in dahl.PARAMETERS if p.name == "alpha")
     bounds = np.array([(max(c_lo, 1e-3 * c_hi), c_hi), (alpha.lower, alpha.upper), (v_lo, v_hi)])
     tau_c = float(np.clip(static_tab["tau_c"]["value"], *bounds[0]))
     sigma_2 = float(np.clip(static_tab["sigma_2"]["value"], *bounds[2]))
-    start = np.array([1e4, tau_c, alpha.default, sigma_2])
-    return filtered_route(
-        series,
-        start,
-        bounds,
-        gravity,
-        method,
-        seed,
-        max_evals,
-        cluster_time,
-        n_sub,
-        parallel,
-        source,
-        law=DAHL,
-    )
+    return np.array([1e4, tau_c, alpha.default, sigma_2]), bounds, DAHL
