@@ -34,6 +34,7 @@ PACKAGES = (
     "io",
     "models",
     "optim",
+    "robot",
     "extract",
     "sim",
     "fitted",

@@ -30,6 +30,7 @@ ROWS: tuple[tuple[str, ...], ...] = (
     ("io",),
     ("models",),
     ("optim",),
+    ("robot",),
     ("extract",),
     ("sim",),
     ("fitted",),
@@ -54,10 +55,12 @@ MAY_IMPORT: dict[str, tuple[tuple[str, ...], bool]] = {
     "io": (("samples",), True),
     "models": (("units", "errors", "_jit"), False),
     "optim": (("errors", "_jit"), False),
-    "extract": (("samples", "io", "units", "errors"), False),
-    "sim": (("samples", "models"), False),
+    # a whole arm's rigid-body dynamics from its (checked) URDF, by Pinocchio
+    "robot": (("io", "units", "errors"), False),
+    "extract": (("samples", "io", "units", "errors", "robot"), False),
+    "sim": (("samples", "models", "robot"), False),
     "fitted": (("models", "samples", "metrics", "io"), False),
-    "identify": (("fitted", "models", "optim", "samples", "metrics"), False),
+    "identify": (("fitted", "models", "optim", "samples", "metrics", "robot"), False),
     "workflow": (("identify", "extract", "io"), True),
     "experiments": (("workflow",), True),
     "report": (("experiments", "control"), True),  # "report may show control's results"

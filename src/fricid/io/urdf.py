@@ -51,7 +51,6 @@ from __future__ import annotations
 
 import math
 import os
-import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -65,54 +64,35 @@ __all__ = [
     "MASS_RANGE",
     "MAX_ANGLE",
     "MAX_BYTES",
+    "MAX_EFFORT",
+    "MAX_INERTIA",
     "MAX_LENGTH",
+    "MAX_SPEED",
     "MIN_AXIS_NORM",
     "STANDARD_GRAVITY",
     "GravityLoad",
+    "Limit",
     "Robot",
     "gravity_coefficients",
     "read_urdf",
     "urdf_gravity",
 ]
 
-#: m/s^2, the gravity used unless another is given.
-STANDARD_GRAVITY = 9.80665
-
-#: Largest magnitude [m] of a position coordinate (origins, centres of mass) and of an axis
-#: component: a kilometre is beyond any robot.
-MAX_LENGTH = 1e3
-
-#: Largest magnitude [rad] of an ``rpy`` angle.
-MAX_ANGLE = 1e3
-
-#: The masses [kg] a link may have besides 0 (a massless link).
-MASS_RANGE = (1e-9, 1e6)
-
-#: Smallest norm of a moving joint's axis (the axis is normalised).
-MIN_AXIS_NORM = 1e-6
-
-#: A plain decimal number: ASCII digits, optional sign, point and exponent.
-_NUMBER = re.compile(r"[-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][-+]?[0-9]+)?")
-
-_ROTATING = ("revolute", "continuous")
-_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
-
-
-@dataclass(frozen=True)
-class _Link:
-    mass: float
-    com: np.ndarray  # centre of mass in the link frame [m]
-
-
-@dataclass(frozen=True)
-class _Joint:
-    name: str
-    kind: str
-    parent: str
-    child: str
-    xyz: np.ndarray
-    rot: np.ndarray  # rotation of the origin (3 x 3)
-    axis: np.ndarray  # unit vector in the joint frame
+from ._urdf_reader import (
+    _ROTATING,
+    MASS_RANGE,
+    MAX_ANGLE,
+    MAX_EFFORT,
+    MAX_INERTIA,
+    MAX_LENGTH,
+    MAX_SPEED,
+    MIN_AXIS_NORM,
+    STANDARD_GRAVITY,
+    Limit,
+    _Joint,
+    _Link,
+    _Reader,
+)
 
 
 @dataclass(frozen=True, eq=False)
@@ -199,105 +179,10 @@ class GravityLoad:
         )
 
 
-def _rpy(r: float, p: float, y: float) -> np.ndarray:
-    """URDF's fixed-axis roll, pitch, yaw: ``Rz(y) Ry(p) Rx(r)``."""
-    cr, sr, cp, sp, cy, sy = (
-        math.cos(r),
-        math.sin(r),
-        math.cos(p),
-        math.sin(p),
-        math.cos(y),
-        math.sin(y),
-    )
-    return np.array(
-        [
-            [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
-            [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
-            [-sp, cp * sr, cp * cr],
-        ]
-    )
-
-
 def _about(axis: np.ndarray, angle: float) -> np.ndarray:
     """Rotation by ``angle`` about the unit vector ``axis`` (Rodrigues)."""
     k = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
     return np.eye(3) + math.sin(angle) * k + (1 - math.cos(angle)) * (k @ k)
-
-
-class _Reader:
-    """Attribute parsing with errors naming the file, the element and the attribute."""
-
-    def __init__(self, source: str) -> None:
-        self.source = source
-
-    def fail(self, where: str, what: str) -> DataError:
-        return DataError(f"{where}: {what}", file=self.source)
-
-    def numbers(
-        self, el, attr: str, where: str, count: int, default: str, bound: float
-    ) -> np.ndarray:
-        """``count`` plain decimal numbers (module notes) of magnitude at most ``bound``."""
-        text = el.get(attr, default) if el is not None else default
-        parts = text.split()
-        shown = f"{attr}='{text[:40]}'"
-        if len(parts) != count or not all(_NUMBER.fullmatch(p) for p in parts):
-            raise self.fail(where, f"{shown} is not {count} plain decimal numbers")
-        values = np.array([float(p) for p in parts], dtype=float)
-        if not np.isfinite(values).all():
-            raise self.fail(where, f"{shown} overflows a double")
-        if (np.abs(values) > bound).any():
-            raise self.fail(where, f"{shown} has a magnitude over {bound:g}")
-        return values
-
-    def name(self, el, where: str) -> str:
-        value = el.get("name")
-        if not value:
-            raise self.fail(where, "has no name")
-        return value
-
-    def link(self, el) -> tuple[str, _Link]:
-        name = self.name(el, "a <link>")
-        where = f"<link name='{name[:60]}'>"
-        inertial = el.find("inertial")
-        if inertial is None:
-            return name, _Link(0.0, np.zeros(3))
-        mass_el = inertial.find("mass")
-        if mass_el is None:
-            raise self.fail(where, "<inertial> has no <mass>")
-        at = f"{where} <inertial><mass>"
-        mass = float(self.numbers(mass_el, "value", at, 1, "", math.inf)[0])
-        low, high = MASS_RANGE
-        if mass != 0 and not low <= mass <= high:
-            raise self.fail(
-                at, f"value={mass!r} kg is not 0 (massless) nor within [{low:g}, {high:g}] kg"
-            )
-        com = self.numbers(
-            inertial.find("origin"), "xyz", f"{where} <inertial><origin>", 3, "0 0 0", MAX_LENGTH
-        )
-        return name, _Link(abs(mass), com)
-
-    def joint(self, el) -> _Joint:
-        name = self.name(el, "a <joint>")
-        where = f"<joint name='{name[:60]}'>"
-        kind = el.get("type", "")
-        if kind not in _TYPES:
-            raise self.fail(where, f"type='{kind[:40]}' is not one of {', '.join(_TYPES)}")
-        ends = []
-        for tag in ("parent", "child"):
-            end = el.find(tag)
-            if end is None or not end.get("link"):
-                raise self.fail(where, f"has no <{tag} link='...'>")
-            ends.append(end.get("link"))
-        if ends[0] == ends[1]:
-            raise self.fail(where, f"its parent and child are the same link '{ends[0][:60]}'")
-        origin = el.find("origin")
-        xyz = self.numbers(origin, "xyz", f"{where} <origin>", 3, "0 0 0", MAX_LENGTH)
-        rpy = self.numbers(origin, "rpy", f"{where} <origin>", 3, "0 0 0", MAX_ANGLE)
-        axis = self.numbers(el.find("axis"), "xyz", f"{where} <axis>", 3, "1 0 0", MAX_LENGTH)
-        norm = float(np.linalg.norm(axis))
-        if kind in ("revolute", "continuous", "prismatic") and not norm >= MIN_AXIS_NORM:
-            raise self.fail(f"{where} <axis>", f"xyz has norm {norm:.3g}, under {MIN_AXIS_NORM:g}")
-        return _Joint(name, kind, ends[0], ends[1], xyz, _rpy(*rpy), axis / (norm or 1.0))
 
 
 def read_urdf(path: str | os.PathLike[str]) -> Robot:
