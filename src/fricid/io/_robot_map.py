@@ -23,9 +23,18 @@ import re
 from collections.abc import Mapping, Sequence
 from typing import Any
 
+import numpy as np
+
 from ..errors import ConfigError, DataError
 
-__all__ = ["ALIASES", "check_names", "constants_for", "match_joints", "parse_name"]
+__all__ = [
+    "ALIASES",
+    "check_names",
+    "constants_for",
+    "match_joints",
+    "parse_name",
+    "velocity_from_position",
+]
 
 #: The spellings of each per-joint quantity in a column name (lower case).
 ALIASES: dict[str, tuple[str, ...]] = {
@@ -212,3 +221,16 @@ def constants_for(names: Sequence[str], torque_constants: Any) -> Any:
             + (f"; not a joint of the log: {', '.join(map(str, unknown))}" if unknown else "")
         )
     return [torque_constants[n] for n in names]
+
+
+def velocity_from_position(position: np.ndarray, time: np.ndarray, file: Any) -> np.ndarray:
+    """Velocities as the central difference of positions (:func:`numpy.gradient`: second
+    order inside, one-sided at the ends), for a file that logs none."""
+    if len(time) < 2:
+        raise DataError(
+            "the file has no velocities, and one row is too few to compute them from the positions",
+            file=file,
+            column="velocity",
+        )
+    with np.errstate(over="ignore", invalid="ignore"):  # RobotLog reports absurd values
+        return np.gradient(position, time, axis=0)
