@@ -229,9 +229,30 @@ def test_time_not_increasing_and_short_rows(tmp_path):
     assert info.value.row == 11 and info.value.column == "time [s]"
     lines[1 + 9] = ",".join(lines[1 + 9].split(",")[:4])  # a row cut short
     path.write_text("\n".join(lines) + "\n")
-    with pytest.raises(DataError) as info:
+    with pytest.raises(DataError, match="row has 4 fields, the header has 7") as info:
         read_robot_log(path)
-    assert info.value.file == str(path)
+    assert info.value.file == str(path) and info.value.row == 11
+
+
+def test_a_single_joint_rawlog_file_is_a_one_joint_robot(tmp_path):
+    from fricid.io import write_rawlog
+    from fricid.samples import RawLog
+
+    x = arm(1)
+    raw = RawLog(
+        time=T,
+        position=x["q"][:, 0],
+        velocity=x["dq"][:, 0],
+        temperature=28.0,
+        current=x["tau"][:, 0] / 0.2,
+        torque_constant=0.2,
+        joint="elbow",
+    )
+    log = read_robot_log(write_rawlog(raw, tmp_path / "elbow.csv"))
+    assert log.joints == ("elbow",) and log.torque_constants.tolist() == [0.2]
+    np.testing.assert_allclose(log.joint("elbow").motor_torque, raw.motor_torque, rtol=1e-15)
+    with pytest.raises(ConfigError, match="temperature columns and temperature= was given"):
+        read_robot_log(tmp_path / "elbow.csv", temperature=25.0)
 
 
 def test_options_of_another_reader_are_refused(tmp_path):

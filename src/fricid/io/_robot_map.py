@@ -108,6 +108,10 @@ def check_names(joints: Sequence[str]) -> list[str]:
     return names
 
 
+def _count(n: int) -> str:
+    return f"{n} joint" if n == 1 else f"{n} joints"
+
+
 def _by_name(wanted: str, found: list[str]) -> str | None:
     """The joint of the file named ``wanted``, exactly or else alone ignoring case."""
     if wanted in found:
@@ -182,8 +186,9 @@ def match_joints(
             return by_name, wanted  # type: ignore[return-value]
     if len(found) != len(wanted):
         raise DataError(
-            f"the file has {len(found)} joints ({has}) but {len(wanted)} were asked for "
-            f"({asked}); give joints= with one name per joint of the file",
+            f"the file has {_count(len(found))} ({has}) but {len(wanted)} "
+            f"{'was' if len(wanted) == 1 else 'were'} asked for ({asked}); give joints= with "
+            "one name per joint of the file",
             file=file,
         )
     numbers = [int(f) for f in found if _NUMBER.fullmatch(f)]
