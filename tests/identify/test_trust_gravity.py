@@ -16,7 +16,7 @@ import pytest
 
 from fricid.extract import extract
 from fricid.identify import fit
-from fricid.identify._diagnostics import LEFT_IN, between_run_excess, gravity_caveat
+from fricid.identify._diagnostics import LEFT_IN, OWN_SEM, between_run_excess, gravity_caveat
 from fricid.identify.trust import assess_trust
 from fricid.samples import FrictionSamples
 
@@ -129,3 +129,32 @@ def test_extraction_with_gravity_none_records_the_position_channel():
         res = extract(sweep_log([0.2, 0.4, 0.8]), gravity="none")
     assert res.samples.meta["extract"]["position_source"] == "channel"
     assert gravity_caveat(res.samples)[0].startswith(LEFT_IN)
+
+
+def test_the_samples_own_standard_errors_are_used_where_given():
+    """Raw samples so autocorrelated that std/sqrt(count) is 5x too small flag clean runs
+    (the caveat says autocorrelation may be why); the standard errors the samples carry
+    (``meta["sem"]``, autocorrelation-corrected, here the true 0.02 N m) do not."""
+    clean = _runs(5)
+    fooled = FrictionSamples(
+        velocity=clean.velocity,
+        load=None,
+        temperature=None,
+        friction=clean.friction,
+        std=clean.std,
+        count=clean.count * 25,
+    )
+    said = gravity_caveat(fooled)
+    assert len(said) == 1 and "far more autocorrelated than std/sqrt(count)" in said[0]
+    corrected = FrictionSamples(
+        velocity=clean.velocity,
+        load=None,
+        temperature=None,
+        friction=clean.friction,
+        std=clean.std,
+        count=clean.count * 25,
+        meta={"sem": [NOISE] * len(clean), "sem_method": "within-run, autocorrelation-corrected"},
+    )
+    excess = between_run_excess(corrected)
+    assert excess.within == OWN_SEM and 0.7 < excess.ratio < 1.4
+    assert gravity_caveat(corrected) == []

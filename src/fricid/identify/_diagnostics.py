@@ -278,18 +278,31 @@ def gravity_caveat(samples: FrictionSamples | None) -> list[str]:
     excess = between_run_excess(samples, EXCESS_ALPHA)
     if excess is None or excess.ratio <= EXCESS_RATIO or not excess.significant:
         return out
-    seen = (
-        "; they differ more than their raw samples scatter too, which no autocorrelation explains"
-        if excess.beyond_std
-        else ", unless the noise is far more autocorrelated than that assumes"
+    if excess.beyond_std:
+        seen = "; they differ more than the raw samples scatter, which no autocorrelation explains"
+    elif excess.within == STD_SQRT_COUNT:
+        seen = ", unless the noise is far more autocorrelated than std/sqrt(count) assumes"
+    else:
+        seen = ""
+    explain = (
+        "their std/sqrt(count) explains"
+        if excess.within == STD_SQRT_COUNT
+        else f"{excess.within} explain"
     )
     out.append(
         f"{LEFT_IN}: repeated runs at {excess.points} operating point(s) differ "
-        f"{excess.ratio:.3g}x more than their std/sqrt(count) explains, so something the "
-        "samples do not record changes between runs (the position, with gravity in the "
-        f"torque; drift){seen}; the scatter the error is graded against holds it"
+        f"{excess.ratio:.3g}x more than {explain}, so something the samples do not record "
+        "changes between runs (the position, with gravity in the torque; drift)"
+        f"{seen}; the scatter the error is graded against holds it"
     )
     return out
+
+
+#: ``RunExcess.within`` when the rows' standard errors are ``std / sqrt(count)``.
+STD_SQRT_COUNT = "std/sqrt(count)"
+
+#: ... when they are the samples' own (``meta["sem"]``, e.g. autocorrelation-corrected).
+OWN_SEM = "their own standard errors"
 
 
 @dataclass(frozen=True)
@@ -301,8 +314,8 @@ class RunExcess:
     ratio : float
         ``sqrt(SS / E[SS])``: ``SS = sum_g sum_(i in g) (y_i - ybar_g)^2`` over the repeated
         operating points ``g``, ``E[SS] = sum_g (1 - 1/n_g) sum_(i in g) se_i^2`` what it is
-        when each run's mean carries only its within-run noise ``se_i = std_i / sqrt(count_i)``
-        (about 1 then).
+        when each run's mean carries only its own noise, of standard error ``se_i`` (about 1
+        then).
     dof : int
         ``sum_g (n_g - 1)``: ``SS / E[SS]`` is about ``chi2(dof) / dof`` under that noise.
     points : int
@@ -313,6 +326,9 @@ class RunExcess:
         The runs' means scatter more than the raw samples themselves (``SS`` over
         ``sum_g (1 - 1/n_g) sum std_i^2``, at the same significance): the mean of correlated
         samples varies no more than one sample does, so no autocorrelation explains it.
+    within : str
+        Where ``se_i`` came from: :data:`OWN_SEM` (the samples' ``meta["sem"]``, given for
+        every repeated row) or :data:`STD_SQRT_COUNT`.
     """
 
     ratio: float
@@ -320,12 +336,27 @@ class RunExcess:
     points: int
     significant: bool
     beyond_std: bool
+    within: str = STD_SQRT_COUNT
+
+
+def _run_errors(samples: FrictionSamples) -> tuple[np.ndarray, str]:
+    """Each row's standard error: the samples' own ``meta["sem"]`` where every row has a
+    positive one, else ``std / sqrt(count)`` (NaN where neither is positive)."""
+    sem = samples.meta.get("sem") if isinstance(samples.meta, dict) else None
+    if sem is not None:
+        with contextlib.suppress(TypeError, ValueError):
+            own = np.array([np.nan if x is None else x for x in sem], dtype=float)
+            if own.shape == (len(samples),) and np.all(own > 0):
+                return own, OWN_SEM
+    ok = (samples.std > 0) & (samples.count > 0)
+    se = np.where(ok, samples.std / np.sqrt(np.where(ok, samples.count, 1.0)), np.nan)
+    return se, STD_SQRT_COUNT
 
 
 def between_run_excess(
     samples: FrictionSamples, alpha: float = 1e-3, rtol: float = LEVEL_RTOL
 ) -> RunExcess | None:
-    """The between-run scatter of repeated runs against their within-run ``std / sqrt(count)``.
+    """The between-run scatter of repeated runs against their within-run standard errors.
 
     Parameters
     ----------
@@ -339,8 +370,8 @@ def between_run_excess(
     Returns
     -------
     RunExcess or None
-        None when no operating point is repeated by runs that all carry a positive ``std``
-        and ``count``.
+        None when no operating point is repeated by runs that all carry a standard error
+        (``meta["sem"]``, or a positive ``std`` and ``count``).
 
     Notes
     -----
@@ -349,28 +380,30 @@ def between_run_excess(
     differ in something the samples do not record: the joint's position (gravity left in, eq.
     7 of the BAS-RBFNN paper, is an offset ``p_x cos q - p_y sin q`` at each run's position),
     drift, or noise far more autocorrelated than ``std / sqrt(count)`` assumes (a lower bound
-    of the standard error).
+    of the standard error; an autocorrelation-corrected ``meta["sem"]`` is used instead where
+    the samples carry one).
     """
     from scipy.stats import chi2
 
+    se, within = _run_errors(samples)
     group = _repeat_groups(samples, rtol)
     sizes = np.bincount(group)
-    carried = ((samples.std > 0) & (samples.count > 0)).astype(float)
-    ok = np.bincount(group, weights=carried) == sizes
+    ok = np.bincount(group, weights=np.isfinite(se).astype(float)) == sizes
     rep = (sizes > 1) & ok
     sel = rep[group]
     if not sel.any():
         return None
-    g, y = group[sel], samples.y[sel]
-    std, count = samples.std[sel], samples.count[sel].astype(float)
+    g, y, se, std = group[sel], samples.y[sel], se[sel], samples.std[sel]
     n = sizes[g].astype(float)
     mean = np.bincount(g, weights=y, minlength=sizes.size)[g] / n
     ss = float(np.sum((y - mean) ** 2))
     dof = int(np.sum(sizes[rep] - 1))
-    expected = float(np.sum((1.0 - 1.0 / n) * std**2 / count))
+    expected = float(np.sum((1.0 - 1.0 / n) * se**2))
     bound = float(np.sum((1.0 - 1.0 / n) * std**2))
     if not (expected > 0 and np.isfinite(ss)):
         return None
     critical = float(chi2.ppf(1.0 - alpha, dof)) / dof
-    significant, beyond = bool(ss / expected > critical), bool(ss / bound > critical)
-    return RunExcess(float(np.sqrt(ss / expected)), dof, int(rep.sum()), significant, beyond)
+    significant = bool(ss / expected > critical)
+    beyond = bool(bound > 0 and np.all(std > 0) and ss / bound > critical)
+    ratio = float(np.sqrt(ss / expected))
+    return RunExcess(ratio, dof, int(rep.sum()), significant, beyond, within)
