@@ -23,8 +23,11 @@ from ._scatter import LEVEL_RTOL, _repeat_groups, sample_weights
 __all__ = [
     "DOWN_WEIGHT",
     "DROPS",
+    "EXCESS_ALPHA",
     "EXCESS_RATIO",
     "LEFT_IN",
+    "OWN_SEM",
+    "STD_SQRT_COUNT",
     "RunExcess",
     "between_run_excess",
     "downweighted",
@@ -42,10 +45,11 @@ __all__ = [
 DOWN_WEIGHT = 1.0 / 3.0
 
 #: Repeated runs whose between-run scatter is more than this multiple of what their own
-#: ``std / sqrt(count)`` explains (and significantly so) differ in something the samples do not
-#: record (:func:`gravity_caveat`). Set from the statistics, not from a benchmark: runs that
-#: differ by their noise alone give about 1, with a 99.9 % upper limit of 2.3 at 3 degrees of
-#: freedom (the test then decides), 1.5 at 20 and 1.3 at 60 (this floor then does).
+#: standard errors explain (``meta["sem"]``, else ``std / sqrt(count)``; significantly so)
+#: differ in something the samples do not record (:func:`gravity_caveat`). Set from the
+#: statistics, not from a benchmark: runs that differ by their noise alone give about 1, with a
+#: 99.9 % upper limit of 2.3 at 3 degrees of freedom (the test then decides), 1.5 at 20 and
+#: 1.3 at 60 (this floor then does).
 EXCESS_RATIO = 2.0
 
 #: Significance of that excess (a one-sided chi-square test of the between-run sum of squares).
@@ -245,13 +249,14 @@ def gravity_caveat(samples: FrictionSamples | None) -> list[str]:
       ``"channel"``; its note in ``meta["notes"]``), or whose eq. 7 fit left a pattern along
       the position (``meta["gravity_residual"]["structured"]``).
     - The samples themselves: repeated runs of one operating point whose means differ more
-      than :data:`EXCESS_RATIO` times what their ``std / sqrt(count)`` explains, significantly
-      (:func:`between_run_excess`). Friction at one speed, load and temperature is
-      one number; gravity left in is an offset at each run's position, common to both
-      directions, so runs at different positions differ by it. The scatter between the runs
-      then holds it, and a model within that scatter is not shown to be within the noise.
-      Drift or noise far more autocorrelated than ``std / sqrt(count)`` assumes do the same
-      (the caveat says so), unless the runs' means differ more than the raw samples scatter.
+      than :data:`EXCESS_RATIO` times what their standard errors explain (``meta["sem"]``,
+      else ``std / sqrt(count)``), significantly (:func:`between_run_excess`). Friction at
+      one speed, load and temperature is one number; gravity left in is an offset at each
+      run's position, common to both directions, so runs at different positions differ by
+      it. The scatter between the runs then holds it, and a model within that scatter is not
+      shown to be within the noise. Drift or noise far more autocorrelated than
+      ``std / sqrt(count)`` assumes do the same (the caveat says so), unless the runs' means
+      differ more than the raw samples scatter.
 
     Without positions, provenance or a within-run noise, gravity left in at a fixed position
     is a constant offset that no data of friction against speed can tell from friction; no
