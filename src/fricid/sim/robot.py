@@ -184,8 +184,10 @@ def _pin_calls(model: RigidBodyModel) -> tuple[Any, Any]:
 class _Plant:
     """The split integrator (module notes) of one arm with friction."""
 
-    def __init__(self, model: RigidBodyModel, friction: ArmFriction | None, h: float) -> None:
-        self.friction, self.h = friction, h
+    def __init__(
+        self, model: RigidBodyModel, friction: ArmFriction | None, h: float, substeps: int
+    ) -> None:
+        self.friction, self.h, self.substeps = friction, h, substeps
         self.eye = np.eye(model.n)
         self._accel, self._minv = _pin_calls(model)
 
@@ -209,14 +211,15 @@ class _Plant:
         q = q + h / 6.0 * (v + 2.0 * v2 + 2.0 * v3 + v4)
         return q, v + h / 6.0 * (k1v + 2.0 * k2v + 2.0 * k3v + k4v)
 
-    def advance(self, q, v, u, substeps: int) -> tuple[np.ndarray, np.ndarray]:
+    def advance(self, q, v, u) -> tuple[np.ndarray, np.ndarray]:
         """The state one sample period later under the held command ``u`` (Strang splitting:
         half a friction step, then RK4 steps with full friction steps between them, then half
         a friction step)."""
         v = self._friction_step(q, v, 0.5 * self.h)
-        for i in range(substeps):
+        for i in range(self.substeps):
             q, v = self._rk4(q, v, u)
-            v = self._friction_step(q, v, self.h if i + 1 < substeps else 0.5 * self.h)
+            last = i + 1 == self.substeps
+            v = self._friction_step(q, v, 0.5 * self.h if last else self.h)
         return q, v
 
 
@@ -289,6 +292,7 @@ def run_robot(
     seed: int | np.random.Generator | None = None,
     integrator_step: float = DEFAULT_STEP,
     initial: tuple[Any, Any] | None = None,
+    plant: Any = None,
 ) -> RobotRun:
     """Simulate ``model`` tracking ``reference`` with ``friction`` (module notes).
 
@@ -324,6 +328,11 @@ def run_robot(
         Largest internal step [s]; the sample period is split into equal steps.
     initial : (q, dq), optional
         The initial state (default the reference's at ``t = 0``).
+    plant : object, optional
+        Another simulator of the same arm: ``plant.advance(q, dq, u) -> (q, dq)`` one sample
+        period on (``plant.step`` [s] its internal step); default this module's integrator.
+        ``friction`` is then only the truth record's law (it should be what ``plant``
+        simulates).
 
     Returns
     -------
@@ -351,7 +360,8 @@ def run_robot(
     if feedforward and controller == "pd":
         ff = model.inverse_dynamics(*ref)
     drive = _drive(model, controller, gains, q, v, rate, encoder_counts, bandwidth, velocity_filter)
-    plant = _Plant(model, friction, 1.0 / (rate * substeps))
+    if plant is None:
+        plant = _Plant(model, friction, 1.0 / (rate * substeps), substeps)
     out = {k: np.empty((count, n)) for k in ("q", "v", "qm", "vm", "u")}
     for k in range(count):
         qm, vm = drive.read(q)
@@ -361,8 +371,9 @@ def run_robot(
         if not (np.isfinite(q).all() and np.isfinite(v).all()):
             raise ConfigError(f"the simulation diverged at t = {time[k]:.4g} s")
         if k + 1 < count:
-            q, v = plant.advance(q, v, u, substeps)
-    return _assemble(model, friction, out, time, ref, noise, rng, plant.h, rate, encoder_counts)
+            q, v = plant.advance(q, v, u)
+    step = float(getattr(plant, "h", getattr(plant, "step", float("nan"))))
+    return _assemble(model, friction, out, time, ref, noise, rng, step, rate, encoder_counts)
 
 
 def _assemble(model, friction, out, time, ref, noise, rng, h, rate, counts) -> RobotRun:
