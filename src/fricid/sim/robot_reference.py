@@ -16,12 +16,13 @@ with the other joints held, each move a trapezoid of velocity (constant accelera
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
 from ..errors import ConfigError
 
-__all__ = ["FourierTrajectory", "SweepReference", "sweep_reference"]
+__all__ = ["FourierTrajectory", "SweepReference", "random_fourier", "sweep_reference"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -208,3 +209,50 @@ def sweep_reference(
         plateaus=plateaus,
         duration=float(t + dwell),
     )
+
+
+def random_fourier(
+    model: Any,
+    *,
+    harmonics: int = 5,
+    base_frequency: float = 0.1,
+    fraction: float = 0.5,
+    seed: int | np.random.Generator | None = 0,
+) -> FourierTrajectory:
+    """A random Fourier reference inside a fraction of the arm's position and speed limits.
+
+    Not a designed excitation (that optimises the coefficients): coefficients uniform in
+    ``[-1, 1]``, each joint's then scaled so that over a period ``|q - q0|`` stays within
+    ``fraction`` of half its range (``q0`` the middle; 1 rad where the URDF gives no range)
+    and ``|dq|`` within ``fraction`` of its velocity limit (2 rad/s where none).
+
+    Parameters
+    ----------
+    model : RigidBodyModel
+        Its ``joints``, ``lower``, ``upper`` and ``velocity_limit``.
+    harmonics : int
+        ``H``.
+    base_frequency : float
+        [Hz]; the period is its inverse.
+    fraction : float
+        In (0, 1].
+    seed : int, Generator or None
+    """
+    if not (isinstance(harmonics, int) and harmonics >= 1 and 0 < fraction <= 1):
+        raise ConfigError("random_fourier needs harmonics >= 1 and 0 < fraction <= 1")
+    if not (np.isfinite(base_frequency) and base_frequency > 0):
+        raise ConfigError(f"the base frequency must be > 0 Hz; got {base_frequency!r}")
+    rng = np.random.default_rng(seed)
+    lo, hi = np.asarray(model.lower, dtype=float), np.asarray(model.upper, dtype=float)
+    bounded = np.isfinite(lo) & np.isfinite(hi)
+    lo, hi = np.where(bounded, lo, -1.0), np.where(bounded, hi, 1.0)
+    q0, half = 0.5 * (lo + hi), 0.5 * (hi - lo)
+    vmax = np.asarray(model.velocity_limit, dtype=float)
+    vmax = np.where(np.isfinite(vmax) & (vmax > 0), vmax, 2.0)
+    n = len(model.joints)
+    a, b = rng.uniform(-1.0, 1.0, (2, n, harmonics))
+    w_f = 2.0 * np.pi * base_frequency
+    unit = FourierTrajectory(model.joints, w_f, q0, a, b)
+    q, dq, _ = unit.evaluate(np.linspace(0.0, unit.duration, 2000))
+    scale = np.minimum(fraction * half / np.abs(q - q0).max(0), fraction * vmax / np.abs(dq).max(0))
+    return FourierTrajectory(model.joints, w_f, q0, a * scale[:, None], b * scale[:, None])
