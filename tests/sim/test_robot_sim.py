@@ -15,7 +15,7 @@ from fricid.models import get_model
 from fricid.robot import RigidBodyModel, example_urdf
 from fricid.sim.robot import _pin_calls, default_gains, quantise, run_robot, simulate_robot
 from fricid.sim.robot_friction import ArmFriction, example_friction
-from fricid.sim.robot_reference import FourierTrajectory, sweep_reference
+from fricid.sim.robot_reference import FourierTrajectory, random_fourier, sweep_reference
 
 
 @cache
@@ -190,3 +190,43 @@ def test_default_gains_keep_the_panda_loop_stable():
     rate = np.linalg.eigvals(np.linalg.solve(model.mass_matrix(q0)[0], np.diag(kd))).real
     assert rate.max() * 1e-3 < 0.5
     assert (kp > 0).all()
+
+
+def test_sweeps_show_the_coupled_gravity_of_the_whole_arm():
+    """Constant-velocity sweeps of the double pendulum's first joint, the second held: on the
+    plateaus the noiseless torque of the moving joint minus its friction is the rigid-body
+    torque at zero acceleration, and the held joint's load varies with the first joint's
+    angle (coupled gravity, ``sin(q1 + q2)``), its residual within its static friction."""
+    model = arm("double_pendulum")
+    friction = example_friction(model.effort_limit)
+    ref = sweep_reference([0.0, 0.6], 0, [1.0], -0.6, 0.6, acceleration=5.0, dwell=0.1)
+    run = run_robot(model, ref, friction, controller="torque", bandwidth=10.0, torque_noise=0)
+    t = run.truth
+    on = np.zeros(t.time.size, bool)
+    for begin, end, _ in ref.plateaus:
+        on |= (t.time > begin + 0.1) & (t.time < end)
+    assert on.sum() > 1500
+    rigid = model.inverse_dynamics(t.position[on], t.velocity[on], np.zeros((on.sum(), 2)))
+    shown = t.torque[on] - rigid
+    moving = shown[:, 0] - friction(t.velocity[on])[:, 0]
+    # the drive's small accelerations (quantised velocity) average out on a plateau
+    assert abs(moving.mean()) < 0.01 * np.abs(rigid[:, 0]).max()
+    assert np.sqrt(np.mean(moving**2)) < 0.03 * np.abs(rigid[:, 0]).max()
+    static = max(friction.pos["tau_s"][1], friction.neg["tau_s"][1])
+    assert np.abs(shown[:, 1]).max() < 1.2 * static
+    assert np.ptp(rigid[:, 1]) > 2 * static  # the held joint's load follows q1
+
+
+def test_random_fourier_stays_inside_the_limits():
+    model = arm("panda")
+    ref = random_fourier(model, harmonics=4, base_frequency=0.2, fraction=0.8, seed=4)
+    q, dq, _ = ref.evaluate(np.linspace(0, ref.duration, 3000))
+    assert (q >= model.lower).all() and (q <= model.upper).all()
+    assert (np.abs(dq) <= 0.8 * model.velocity_limit * (1 + 1e-3)).all()
+    assert (
+        np.isclose(np.abs(dq).max(0) / model.velocity_limit, 0.8).any()
+        or np.isclose(np.abs(q - ref.q0).max(0) / (0.5 * (model.upper - model.lower)), 0.8).all()
+    )
+    assert np.array_equal(
+        ref.a, random_fourier(model, harmonics=4, base_frequency=0.2, fraction=0.8, seed=4).a
+    )

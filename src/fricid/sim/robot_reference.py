@@ -253,6 +253,6 @@ def random_fourier(
     a, b = rng.uniform(-1.0, 1.0, (2, n, harmonics))
     w_f = 2.0 * np.pi * base_frequency
     unit = FourierTrajectory(model.joints, w_f, q0, a, b)
-    q, dq, _ = unit.evaluate(np.linspace(0.0, unit.duration, 2000))
+    q, dq, _ = unit.evaluate(np.linspace(0.0, unit.duration, 200 * harmonics + 1))
     scale = np.minimum(fraction * half / np.abs(q - q0).max(0), fraction * vmax / np.abs(dq).max(0))
     return FourierTrajectory(model.joints, w_f, q0, a * scale[:, None], b * scale[:, None])
