@@ -69,3 +69,18 @@ def test_bad_options_are_one_line_and_no_file(tmp_path, args, message):
     assert not out.exists()
     bad = run("--robot", "double_pendulum", "--duration", 0.2, "--out", tmp_path / "log.txt")
     assert bad.exit_code == 2 and ".csv" in bad.output
+
+
+def test_a_lugre_joint(tmp_path):
+    out, truth, mjcf = tmp_path / "arm.csv", tmp_path / "truth.json", tmp_path / "arm.xml"
+    result = run(
+        "--robot", "double_pendulum", "--duration", 0.3, "--lugre", "joint2",
+        "--out", out, "--truth", truth, "--mjcf", mjcf,
+    )  # fmt: skip
+    assert result.exit_code == 0, result.output
+    record = json.loads(truth.read_text())
+    assert record["friction_models"] == {"joint1": "stribeck_asym", "joint2": "lugre"}
+    assert set(record["friction"]["joint2"]) >= {"sigma_0", "sigma_1", "sigma_2"}
+    assert "joint2: LuGre friction" in mjcf.read_text()
+    bad = run("--robot", "double_pendulum", "--duration", 0.2, "--lugre", "elbow", "--out", out)
+    assert bad.exit_code == 2 and "--lugre" in bad.output

@@ -106,6 +106,10 @@ def test_joint_friction_of_symmetric_coulomb_viscous_has_no_notes():
     assert joint_friction("j", {"tau_c": 0.3, "tau_v": 0.1}) == (0.3, 0.1, [])
     with pytest.raises(ExportError):
         joint_friction("j", {"w_s": 0.1})
+    lugre = {"sigma_0": 1e4, "sigma_1": 0.3, "sigma_2": 0.05, "tau_c": 0.12, "tau_s": 0.18}
+    fl, damping, notes = joint_friction("j", {**lugre, "w_s": 0.05, "delta": 2.0})
+    assert (fl, damping) == (0.12, 0.05)
+    assert any("LuGre" in n for n in notes) and any("Stribeck" in n for n in notes)
 
 
 def test_write_robot_mjcf_is_atomic_and_refuses_bad_friction(tmp_path):

@@ -230,3 +230,70 @@ def test_random_fourier_stays_inside_the_limits():
     assert np.array_equal(
         ref.a, random_fourier(model, harmonics=4, base_frequency=0.2, fraction=0.8, seed=4).a
     )
+
+
+LUGRE = {
+    "sigma_0": 1e4,
+    "sigma_1": 0.3,
+    "sigma_2": 0.05,
+    "tau_c": 0.12,
+    "tau_s": 0.18,
+    "w_s": 0.05,
+    "delta": 2.0,
+}
+
+
+def test_a_lugre_joint_slides_on_its_steady_state_and_is_named():
+    from fricid.models import lugre
+
+    model = arm("panda")
+    friction = example_friction(model.effort_limit)
+    ref = random_fourier(model, base_frequency=0.2, seed=3)
+    run = run_robot(
+        model, ref, friction, duration=1.5, torque_noise=0, lugre={"panda_joint7": LUGRE}
+    )
+    t = run.truth
+    theta = np.array([LUGRE[k] for k in lugre.PARAM_NAMES])
+    v = t.velocity[:, 6]
+    sliding = np.abs(v) > 0.1
+    assert sliding.mean() > 0.5
+    off = np.abs(t.friction_torque[sliding, 6] - lugre.steady_state(theta, v[sliding]))
+    assert np.median(off) < 1e-3 and (off < 0.01).mean() > 0.99
+    # the other joints keep their static law
+    assert np.allclose(t.friction_torque[:, :6], friction(t.velocity)[:, :6])
+    assert t.friction_models["panda_joint7"] == "lugre"
+    assert run.log.meta["friction"]["panda_joint7"] == LUGRE
+    assert run.log.meta["friction_models"]["panda_joint1"] == "stribeck_asym"
+    # the torque shows the bristles: command minus rigid-body torque is their mean friction
+    q = 0.5 * (t.position[1:] + t.position[:-1])
+    vm = 0.5 * (t.velocity[1:] + t.velocity[:-1])
+    shown = t.torque[:-1] - model.inverse_dynamics(q, vm, np.diff(t.velocity, axis=0) * 1e3)
+    mean = 0.5 * (t.friction_torque[1:] + t.friction_torque[:-1])
+    moving = np.abs(vm[:, 6]) > 0.05
+    assert np.abs(shown - mean)[moving, 6].max() < 0.2 * LUGRE["tau_s"]
+
+
+def test_lugre_options_are_checked():
+    model = arm("double_pendulum")
+    ref = fourier(model)
+    with pytest.raises(ConfigError, match="passive"):
+        run_robot(model, ref, None, duration=0.1, lugre={"joint1": {**LUGRE, "sigma_1": 5.0}})
+    with pytest.raises(ConfigError, match="not in the model"):
+        run_robot(model, ref, None, duration=0.1, lugre={"elbow": LUGRE})
+
+
+def test_lugre_like_keeps_the_steady_state_and_is_passive():
+    from fricid.models import lugre
+    from fricid.sim.robot_lugre import lugre_like
+
+    friction = example_friction([87.0, 12.0])
+    for j in range(2):
+        pos = {k[:-4]: x for k, x in friction.parameters(j).items() if k.endswith("_pos")}
+        law = lugre_like(pos)
+        theta = np.array([law[k] for k in lugre.PARAM_NAMES])
+        v = np.linspace(0.01, 2.0, 50)
+        vj = np.zeros((50, 2))
+        vj[:, j] = v
+        assert np.allclose(lugre.steady_state(theta, v), friction(vj)[:, j], rtol=1e-9)
+        assert lugre.passivity_margin(theta) > 0
+        assert law["sigma_0"] * 1e-4 == pytest.approx(pos["tau_s"])

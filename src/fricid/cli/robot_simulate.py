@@ -59,6 +59,7 @@ def _truth_json(run, model) -> dict:
         "joints": list(model.joints),
         "friction_model": "stribeck_asym",
         "friction": t.friction_parameters,
+        "friction_models": t.friction_models,
         "friction_smoothing_rad_s": None if t.friction is None else t.friction.smoothing,
         "inertial_parameter_names": list(model.parameter_names),
         "inertial_parameters": [float(x) for x in t.parameters],
@@ -118,6 +119,13 @@ def robot_simulate_command(
     mjcf: Annotated[
         Path | None, typer.Option(help="Also write the simulated arm as MJCF (for MuJoCo).")
     ] = None,
+    lugre: Annotated[
+        str | None,
+        typer.Option(
+            help="Give this joint LuGre friction instead (the example law's positive "
+            "direction as its steady state; bristles 0.1 mrad to break-away)."
+        ),
+    ] = None,
 ) -> None:
     """Simulate a whole arm tracking a random Fourier reference (or one joint's constant-
     velocity sweeps) with each joint's friction, 2^17-count encoders and torque noise, and
@@ -130,6 +138,7 @@ def robot_simulate_command(
     from ..io.atomic import atomic_write
     from ..sim.robot import run_robot
     from ..sim.robot_friction import example_friction
+    from ..sim.robot_lugre import lugre_like
 
     if friction not in ("example", "none"):
         raise ConfigError(f"--friction must be example or none; got {friction!r}")
@@ -140,6 +149,18 @@ def robot_simulate_command(
     model = _model(robot, urdf, joints)
     reference = _reference(model, sweep, velocities, harmonics, base_frequency, seed)
     law = example_friction(model.effort_limit) if friction == "example" else None
+    dynamic = None
+    if lugre is not None:
+        if lugre not in model.joints or law is None:
+            raise ConfigError(
+                f"--lugre: a joint of the model ({', '.join(model.joints)}) with --friction example"
+            )
+        j = model.joints.index(lugre)
+        dynamic = {
+            lugre: lugre_like(
+                {k[:-4]: x for k, x in law.parameters(j).items() if k.endswith("_pos")}
+            )
+        }
     start, cpu = time.perf_counter(), time.process_time()
     run = run_robot(
         model,
@@ -152,6 +173,7 @@ def robot_simulate_command(
         encoder_counts=encoder_counts,
         torque_noise=torque_noise,
         seed=seed,
+        lugre=dynamic,
     )
     wall, cpu = time.perf_counter() - start, time.process_time() - cpu
     path = write_robot_log(run.log, out)
@@ -163,7 +185,7 @@ def robot_simulate_command(
     if mjcf is not None:
         from ..export.robot_mjcf import write_robot_mjcf
 
-        written.append(str(write_robot_mjcf(model, mjcf, law)[0]))
+        written.append(str(write_robot_mjcf(model, mjcf, run.truth.friction_parameters)[0]))
     err_console.print(
         f"simulated {model.n} joints, {len(run.log)} samples ({duration:g} s at {rate:g} Hz) "
         f"in {wall:.1f} s ({cpu:.1f} s CPU); wrote {escape(', '.join(written))}",

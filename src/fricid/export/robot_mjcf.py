@@ -52,12 +52,19 @@ def joint_friction(joint: str, params: Mapping[str, float]) -> tuple[float, floa
     """``(frictionloss, damping, notes)`` of one joint's friction parameters.
 
     ``params`` in fricid's names: ``tau_c``, ``tau_v`` (and ``tau_s``, ``w_s``, ``delta``),
-    or their ``_pos``/``_neg`` pairs (``stribeck_asym``). The two directions are averaged.
+    or their ``_pos``/``_neg`` pairs (``stribeck_asym``), or a LuGre law's (``sigma_2`` the
+    viscous coefficient). The two directions are averaged.
     """
     coulomb, viscous = _levels(params, "tau_c"), _levels(params, "tau_v")
+    notes = []
+    if "sigma_0" in params:  # LuGre: sigma_2 is its viscous coefficient
+        viscous = viscous or _levels(params, "sigma_2")
+        notes.append(
+            f"joint {plain(joint)}: LuGre friction; its bristle dynamics (pre-sliding, "
+            "hysteresis) are lost here (MuJoCo 4's dcmotor lugre could hold them)"
+        )
     if not coulomb and not viscous:
         raise ExportError(f"joint {plain(joint)}: no tau_c or tau_v among {sorted(params)}")
-    notes = []
     if len(set(coulomb)) > 1 or len(set(viscous)) > 1:
         notes.append(
             f"joint {plain(joint)}: Coulomb {', '.join(f'{c:.4g}' for c in coulomb)} N m and "

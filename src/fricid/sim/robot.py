@@ -37,6 +37,7 @@ difference velocity (as drives log it) and the torque ``u + e``, ``e ~ N(0, torq
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -47,6 +48,7 @@ from ..robot import RigidBodyModel
 from ..robot._pin import pinocchio
 from ..samples import RobotLog
 from .robot_friction import ArmFriction
+from .robot_lugre import LuGreBristles
 
 __all__ = [
     "CONTROLLERS",
@@ -84,7 +86,9 @@ class RobotTruth:
     reference : tuple of three ndarray (N, n)
         The tracked ``q_r, dq_r, ddq_r``.
     friction : ArmFriction
-        The law; ``friction_parameters[joint]`` gives it in ``stribeck_asym`` names.
+        The static law; ``friction_parameters[joint]`` gives each joint's law in the names of
+        fricid's model ``friction_models[joint]`` (``stribeck_asym``, or ``lugre`` for the
+        LuGre joints, whose ``friction_torque`` comes from their bristle states).
     parameters : ndarray (10 n,)
         The true standard inertial parameters (``model.parameters()``).
     step : float
@@ -103,6 +107,7 @@ class RobotTruth:
     parameters: np.ndarray
     step: float
     friction_parameters: dict = field(default_factory=dict)
+    friction_models: dict = field(default_factory=dict)
 
 
 @dataclass(frozen=True, eq=False)
@@ -185,19 +190,46 @@ class _Plant:
     """The split integrator (module notes) of one arm with friction."""
 
     def __init__(
-        self, model: RigidBodyModel, friction: ArmFriction | None, h: float, substeps: int
+        self,
+        model: RigidBodyModel,
+        friction: ArmFriction | None,
+        h: float,
+        substeps: int,
+        bristles: LuGreBristles | None = None,
     ) -> None:
-        self.friction, self.h, self.substeps = friction, h, substeps
+        self.friction, self.h, self.substeps, self.bristles = friction, h, substeps, bristles
         self.eye = np.eye(model.n)
+        self.static = np.ones(model.n)  # 0 on the LuGre joints
+        if bristles is not None:
+            self.static[bristles.index] = 0.0
         self._accel, self._minv = _pin_calls(model)
+
+    def _static(self, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        if self.friction is None:
+            return np.zeros_like(v), np.zeros_like(v)
+        force, slope = self.friction.slope(v)
+        return force * self.static, slope * self.static
+
+    def friction_torque(self, v: np.ndarray) -> np.ndarray:
+        """Each joint's friction at the present state (the LuGre joints' from their bristles)."""
+        force = self._static(v)[0]
+        if self.bristles is not None:
+            force[self.bristles.index] = self.bristles.force(v[self.bristles.index])
+        return force
 
     def _friction_step(self, q: np.ndarray, v: np.ndarray, h: float) -> np.ndarray:
         """``v'`` of ``M (v' - v) = -h F(v')``, linearised about ``v`` (Rosenbrock-Euler)."""
-        if self.friction is None:
+        if self.friction is None and self.bristles is None:
             return v
         minv = self._minv(q)
-        force, slope = self.friction.slope(v)
-        return v + np.linalg.solve(self.eye + h * minv * slope, -h * (minv @ force))
+        force, slope = self._static(v)
+        lugre = self.bristles
+        if lugre is not None:
+            force[lugre.index], slope[lugre.index] = lugre.step_force(v[lugre.index], h)
+        v = v + np.linalg.solve(self.eye + h * minv * slope, -h * (minv @ force))
+        if lugre is not None:
+            lugre.commit(v[lugre.index], h)
+        return v
 
     def _rk4(self, q: np.ndarray, v: np.ndarray, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         h = self.h
@@ -293,6 +325,7 @@ def run_robot(
     integrator_step: float = DEFAULT_STEP,
     initial: tuple[Any, Any] | None = None,
     plant: Any = None,
+    lugre: Mapping[str, Any] | None = None,
 ) -> RobotRun:
     """Simulate ``model`` tracking ``reference`` with ``friction`` (module notes).
 
@@ -333,6 +366,10 @@ def run_robot(
         period on (``plant.step`` [s] its internal step); default this module's integrator.
         ``friction`` is then only the truth record's law (it should be what ``plant``
         simulates).
+    lugre : mapping, optional
+        Joint name -> LuGre parameters (:data:`fricid.models.lugre.PARAM_NAMES`, a mapping or
+        7 numbers): these joints get LuGre friction (:mod:`fricid.sim.robot_lugre`, bristles
+        at rest at the start) instead of ``friction``'s law.
 
     Returns
     -------
@@ -361,29 +398,47 @@ def run_robot(
         ff = model.inverse_dynamics(*ref)
     drive = _drive(model, controller, gains, q, v, rate, encoder_counts, bandwidth, velocity_filter)
     if plant is None:
-        plant = _Plant(model, friction, 1.0 / (rate * substeps), substeps)
-    out = {k: np.empty((count, n)) for k in ("q", "v", "qm", "vm", "u")}
+        bristles = LuGreBristles(model.joints, lugre) if lugre else None
+        plant = _Plant(model, friction, 1.0 / (rate * substeps), substeps, bristles)
+    elif lugre:
+        raise ConfigError("LuGre joints are simulated by fricid's own plant only")
+    out = {k: np.empty((count, n)) for k in ("q", "v", "qm", "vm", "u", "f")}
+    state_friction = getattr(plant, "friction_torque", None)
     for k in range(count):
         qm, vm = drive.read(q)
         u = drive.command(qm, (ref[0][k], ref[1][k], ref[2][k]), ff[k])
-        for key, value in zip(out, (q, v, qm, vm, u), strict=True):
+        f = state_friction(v) if state_friction is not None else 0.0
+        for key, value in zip(out, (q, v, qm, vm, u, f), strict=True):
             out[key][k] = value
         if not (np.isfinite(q).all() and np.isfinite(v).all()):
             raise ConfigError(f"the simulation diverged at t = {time[k]:.4g} s")
         if k + 1 < count:
             q, v = plant.advance(q, v, u)
+    if state_friction is None:
+        out["f"] = np.zeros_like(out["v"]) if friction is None else friction(out["v"])
     step = float(getattr(plant, "h", getattr(plant, "step", float("nan"))))
-    return _assemble(model, friction, out, time, ref, noise, rng, step, rate, encoder_counts)
+    bristles = _plant_lugre(plant)
+    lugre_params = {} if bristles is None else bristles.parameters()
+    return _assemble(
+        model, friction, lugre_params, out, time, ref, noise, rng, step, rate, encoder_counts
+    )
 
 
-def _assemble(model, friction, out, time, ref, noise, rng, h, rate, counts) -> RobotRun:
+def _plant_lugre(plant: Any) -> LuGreBristles | None:
+    """The LuGre joints of a plant, if it has any."""
+    return getattr(plant, "bristles", None)
+
+
+def _assemble(model, friction, lugre, out, time, ref, noise, rng, h, rate, counts) -> RobotRun:
     n = model.n
-    f_true = np.zeros_like(out["v"]) if friction is None else friction(out["v"])
+    f_true = out["f"]
     acc = model.forward_dynamics(out["q"], out["v"], out["u"] - f_true)
     torque = out["u"] + rng.standard_normal(out["u"].shape) * noise
     params = (
         {} if friction is None else {j: friction.parameters(i) for i, j in enumerate(model.joints)}
     )
+    params.update(lugre)
+    kinds = {j: "lugre" if j in lugre else "stribeck_asym" for j in params}
     truth = RobotTruth(
         joints=model.joints,
         time=time,
@@ -397,6 +452,7 @@ def _assemble(model, friction, out, time, ref, noise, rng, h, rate, counts) -> R
         parameters=model.parameters(),
         step=h,
         friction_parameters=params,
+        friction_models=kinds,
     )
     meta = {
         "simulated": "fricid.sim.robot",
@@ -406,6 +462,7 @@ def _assemble(model, friction, out, time, ref, noise, rng, h, rate, counts) -> R
         "integrator_step": float(h),
         "friction_model": "stribeck_asym",
         "friction": params,
+        "friction_models": kinds,
     }
     log = RobotLog(
         time=time,
