@@ -133,6 +133,7 @@ def test_friction_law_is_fricids_stribeck_asym():
     for x in (np.array([0.3, -0.01, 2e-3]), np.array([-0.7, 0.2, -4e-3])):
         numeric = (friction(x + eps) - friction(x - eps)) / (2 * eps)
         assert np.allclose(friction.slope(x)[1], numeric, rtol=1e-4)
+        assert np.allclose(np.array(friction.row_slope(x)), np.array(friction.slope(x)))
     assert np.all(friction(np.zeros(3)) == 0)
 
 

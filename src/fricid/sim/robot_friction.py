@@ -56,7 +56,9 @@ class ArmFriction:
     pos: dict
     neg: dict
     smoothing: float = DEFAULT_SMOOTHING
-    _table: np.ndarray = field(default=None, repr=False)  # (2, 5, n)
+    _table: np.ndarray = field(default=None, init=False, repr=False)  # (2, 5, n)
+    _flat: np.ndarray = field(default=None, init=False, repr=False)  # (5, 2 n)
+    _cols: np.ndarray = field(default=None, init=False, repr=False)
 
     def __post_init__(self) -> None:
         if not (np.isfinite(self.smoothing) and self.smoothing > 0):
@@ -77,6 +79,8 @@ class ArmFriction:
         if (c < 0).any() or (s < 0).any() or (v < 0).any() or (w <= 0).any() or (d <= 0).any():
             raise ConfigError("friction needs tau_c, tau_s, tau_v >= 0 and w_s, delta > 0")
         object.__setattr__(self, "_table", arr)
+        object.__setattr__(self, "_flat", np.concatenate([arr[0], arr[1]], axis=1))  # (5, 2n)
+        object.__setattr__(self, "_cols", np.arange(arr.shape[2]))
         object.__setattr__(self, "pos", {k: arr[0, i].copy() for i, k in enumerate(FRICTION_NAMES)})
         object.__setattr__(self, "neg", {k: arr[1, i].copy() for i, k in enumerate(FRICTION_NAMES)})
 
@@ -108,6 +112,17 @@ class ArmFriction:
         dsign = (1.0 - sign * sign) / self.smoothing
         dlevel = -excess * e * d * ratio ** (d - 1.0) / w * np.sign(v)  # d|v|/dv = sign(v)
         return sign * level + b * v, dsign * level + sign * dlevel + b
+
+    def row_slope(self, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`slope` of one velocity row ``v`` (n,), faster (the integrator's hot path)."""
+        c, s, w, b, d = self._flat[:, self._cols + self.n * (v < 0)]
+        ratio = np.maximum(np.abs(v) / w, 1e-12)
+        e = np.exp(-(ratio**d))
+        level = c + (s - c) * e
+        sign = np.tanh(v / self.smoothing)
+        dlevel = (c - s) * e * d * ratio ** (d - 1.0) / w * np.sign(v)
+        force = sign * level + b * v
+        return force, (1.0 - sign * sign) * level / self.smoothing + sign * dlevel + b
 
     def max_slope(self) -> np.ndarray:
         """Each joint's steepest slope of the smoothed sign, ``tau_s / v_eps + tau_v`` (n,)."""
