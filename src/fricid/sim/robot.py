@@ -213,13 +213,6 @@ class _Plant:
         force, slope = self.friction.row_slope(v)
         return force * self.static, slope * self.static
 
-    def friction_torque(self, v: np.ndarray) -> np.ndarray:
-        """Each joint's friction at the present state (the LuGre joints' from their bristles)."""
-        force = np.zeros_like(v) if self.friction is None else self.friction(v) * self.static
-        if self.bristles is not None:
-            force[self.bristles.index] = self.bristles.force(v[self.bristles.index])
-        return force
-
     def _friction_step(self, q: np.ndarray, v: np.ndarray, h: float) -> np.ndarray:
         """``v'`` of ``M (v' - v) = -h F(v')``, linearised about ``v`` (Rosenbrock-Euler)."""
         if self.friction is None and self.bristles is None:
@@ -409,23 +402,25 @@ def run_robot(
         plant = _Plant(model, friction, 1.0 / (rate * substeps), substeps, bristles)
     elif lugre:
         raise ConfigError("LuGre joints are simulated by fricid's own plant only")
-    out = {k: np.empty((count, n)) for k in ("q", "v", "qm", "vm", "u", "f")}
+    out = {k: np.empty((count, n)) for k in ("q", "v", "qm", "vm", "u")}
     # friction that depends on a state (LuGre bristles) is recorded as it goes
-    state_friction = plant.friction_torque if _plant_lugre(plant) is not None else None
+    bristles = _plant_lugre(plant)
+    lugre_f = np.zeros((count, 0 if bristles is None else bristles.index.size))
     for k in range(count):
         qm, vm = drive.read(q)
         u = drive.command(qm, (ref[0][k], ref[1][k], ref[2][k]), ff[k])
-        f = state_friction(v) if state_friction is not None else 0.0
-        for key, value in zip(out, (q, v, qm, vm, u, f), strict=True):
+        for key, value in zip(out, (q, v, qm, vm, u), strict=True):
             out[key][k] = value
+        if bristles is not None:
+            lugre_f[k] = bristles.force(v[bristles.index])
         if not (np.isfinite(q).all() and np.isfinite(v).all()):
             raise ConfigError(f"the simulation diverged at t = {time[k]:.4g} s")
         if k + 1 < count:
             q, v = plant.advance(q, v, u)
-    if state_friction is None:
-        out["f"] = np.zeros_like(out["v"]) if friction is None else friction(out["v"])
+    out["f"] = np.zeros_like(out["v"]) if friction is None else friction(out["v"])
+    if bristles is not None:
+        out["f"][:, bristles.index] = lugre_f
     step = float(getattr(plant, "h", getattr(plant, "step", float("nan"))))
-    bristles = _plant_lugre(plant)
     lugre_params = {} if bristles is None else bristles.parameters()
     return _assemble(
         model, friction, lugre_params, out, time, ref, noise, rng, step, rate, encoder_counts

@@ -10,13 +10,14 @@ velocity is frozen and ``z`` is solved exactly, as :func:`fricid.models.lugre.si
 ``z(tau) = z_ss + (z - z_ss) exp(-a tau)`` with ``a = sigma_0 |v| / g(v)`` and
 ``z_ss = sign(v) g(v) / sigma_0``, stable however stiff the bristles are. The step's mean
 friction ``sigma_0 mean(z) + sigma_1 (z(tau) - z) / tau + sigma_2 v`` and its derivative in
-``v`` (by central differences) enter the integrator's linearly implicit friction step, which
+``v`` (by a forward difference) enter the integrator's linearly implicit friction step, which
 then holds the bristle spring (``sigma_0 tau`` per rad/s) and damping implicitly too; the
 state advances with the step's new velocity.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from typing import Any
 
@@ -66,43 +67,50 @@ class LuGreBristles:
         self.index = np.array([joints.index(j) for j in self.joints], dtype=int)
         theta = np.array([_theta(j, laws[j]) for j in self.joints]).reshape(-1, 7)
         self.theta = theta
-        self.s0, self.s1, self.s2, self.tau_c, self.tau_s, self.w_s, self.delta = theta.T
+        self.s0, self.s1, self.s2, self.tau_c, self.tau_s, self.w_s, self.delta = (
+            [float(x) for x in col] for col in theta.T
+        )
         self.z = np.zeros(len(self.joints))
 
-    def _curve(self, v: np.ndarray) -> np.ndarray:
-        ratio = np.abs(v) / self.w_s
-        return self.tau_c + (self.tau_s - self.tau_c) * np.exp(-(ratio**self.delta))
+    def _curve(self, i: int, v: float) -> float:
+        tau_c, tau_s = self.tau_c[i], self.tau_s[i]
+        return tau_c + (tau_s - tau_c) * math.exp(-((abs(v) / self.w_s[i]) ** self.delta[i]))
 
-    def _advance(self, v: np.ndarray, tau: float) -> tuple[np.ndarray, np.ndarray]:
-        """``z(tau)`` and the mean of ``z`` over the step, at the frozen velocity ``v``."""
-        g = self._curve(v)
-        x = self.s0 * np.abs(v) / g * tau
-        z_ss = np.sign(v) * g / self.s0
-        decay = np.exp(-x)
-        share = np.where(x > 1e-12, -np.expm1(-x) / np.maximum(x, 1e-300), 1.0 - 0.5 * x)
-        z = self.z
+    def _advance(self, i: int, v: float, tau: float) -> tuple[float, float]:
+        """Joint ``i``'s ``z(tau)`` and the mean of ``z`` over the step at the frozen ``v``
+        (plain floats: a LuGre joint or two, where numpy's per-call cost would dominate)."""
+        s0, z = self.s0[i], self.z[i]
+        g = self._curve(i, v)
+        x = s0 * abs(v) / g * tau
+        z_ss = math.copysign(g / s0, v) if v != 0 else 0.0
+        share = -math.expm1(-x) / x if x > 1e-12 else 1.0 - 0.5 * x
         # mean of z: z_ss + (z - z_ss) (1 - e^-x) / x, i.e. z + v tau / 2 for small x
-        return z_ss + (z - z_ss) * decay, z_ss + (z - z_ss) * share
+        return z_ss + (z - z_ss) * math.exp(-x), z_ss + (z - z_ss) * share
 
-    def _mean_force(self, v: np.ndarray, tau: float) -> np.ndarray:
-        z_end, z_mean = self._advance(v, tau)
-        return self.s0 * z_mean + self.s1 * (z_end - self.z) / tau + self.s2 * v
+    def _mean_force(self, i: int, v: float, tau: float) -> float:
+        z_end, z_mean = self._advance(i, v, tau)
+        return self.s0[i] * z_mean + self.s1[i] * (z_end - self.z[i]) / tau + self.s2[i] * v
 
     def step_force(self, v: np.ndarray, tau: float) -> tuple[np.ndarray, np.ndarray]:
         """The mean friction over a step of ``tau`` [s] at the LuGre joints' velocities ``v``,
-        and its derivative in ``v``."""
-        force = self._mean_force(v, tau)
-        slope = (self._mean_force(v + _DV, tau) - self._mean_force(v - _DV, tau)) / (2 * _DV)
+        and its derivative in ``v`` (a forward difference)."""
+        force, slope = np.empty(len(v)), np.empty(len(v))
+        for i, vi in enumerate(map(float, v)):
+            force[i] = self._mean_force(i, vi, tau)
+            slope[i] = (self._mean_force(i, vi + _DV, tau) - force[i]) / _DV
         return force, slope
 
     def commit(self, v: np.ndarray, tau: float) -> None:
         """Advance the bristles over the step with the step's new velocities ``v``."""
-        self.z = self._advance(v, tau)[0]
+        self.z = np.array([self._advance(i, float(vi), tau)[0] for i, vi in enumerate(v)])
 
     def force(self, v: np.ndarray) -> np.ndarray:
         """The friction now: ``sigma_0 z + sigma_1 dz/dt + sigma_2 v``."""
-        dz = v - self.s0 * np.abs(v) / self._curve(v) * self.z
-        return self.s0 * self.z + self.s1 * dz + self.s2 * v
+        out = np.empty(len(v))
+        for i, vi in enumerate(map(float, v)):
+            dz = vi - self.s0[i] * abs(vi) / self._curve(i, vi) * self.z[i]
+            out[i] = self.s0[i] * self.z[i] + self.s1[i] * dz + self.s2[i] * vi
+        return out
 
     def parameters(self) -> dict[str, dict[str, float]]:
         """Joint -> its LuGre parameters (fricid's ``lugre`` names)."""
