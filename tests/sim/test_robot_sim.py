@@ -165,6 +165,16 @@ def test_references_are_consistent():
     assert [p[2] for p in sweep.plateaus] == [0.2, -0.2, 0.8, -0.8]
     with pytest.raises(ConfigError):
         sweep_reference(np.zeros(2), 0, [3.0], 0.0, 1.0)
+    drifting = sweep_reference(
+        np.zeros(7), 1, [0.5], -0.5, 0.6, drift=np.full(7, 0.3), drift_period=8.0
+    )
+    t = np.arange(0, drifting.duration, 1e-3)
+    q, dq, ddq = drifting.evaluate(t)
+    assert np.allclose(q[:, 0], 0.3 * np.sin(2 * np.pi * t / 8.0))
+    assert np.allclose(np.gradient(q, t, axis=0)[1:-1, 0], dq[1:-1, 0], atol=1e-5)
+    assert np.allclose(np.gradient(dq, t, axis=0)[1:-1, 0], ddq[1:-1, 0], atol=1e-5)
+    for begin, end, speed in drifting.plateaus:
+        assert np.allclose(drifting.evaluate(np.linspace(begin, end, 20))[1][:, 1], speed)
 
 
 def test_bad_options_are_config_errors():

@@ -17,7 +17,8 @@ Whole arms (imported from their modules, so that ``fricid`` starts without Pinoc
 :mod:`.robot` (``simulate_robot``/``run_robot``: a :class:`~fricid.robot.RigidBodyModel`
 tracking a reference with each joint's friction, quantised encoders and torque noise),
 :mod:`.robot_friction` (``ArmFriction``, per-joint, per-direction Stribeck laws),
-:mod:`.robot_reference` (``FourierTrajectory``, ``sweep_reference``).
+:mod:`.robot_lugre` (LuGre friction on chosen joints), :mod:`.robot_reference`
+(``FourierTrajectory``, ``random_fourier``, ``sweep_reference``).
 """
 
 from __future__ import annotations

@@ -100,6 +100,10 @@ class SweepReference:
         ``(t_begin, t_end, velocity)`` of each constant-velocity stretch, for extraction.
     duration : float
         [s]
+    drift : ndarray (n,) or None
+        Amplitudes [rad] of the other joints' slow motion ``hold + drift sin(2 pi t / T)``.
+    drift_period : float
+        ``T`` [s].
     """
 
     joint: int
@@ -112,6 +116,8 @@ class SweepReference:
     ends: np.ndarray
     plateaus: list
     duration: float
+    drift: np.ndarray | None = None
+    drift_period: float = 60.0
 
     def evaluate(self, t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``(q, dq, ddq)`` at the times ``t`` [s], each ``(len(t), n)``."""
@@ -130,6 +136,10 @@ class SweepReference:
         acc = np.where(inside, acc, 0.0)
         q = np.tile(self.hold, (t.size, 1))
         dq, ddq = np.zeros_like(q), np.zeros_like(q)
+        if self.drift is not None:
+            w = 2.0 * np.pi / self.drift_period
+            s, c = np.sin(w * t)[:, None], np.cos(w * t)[:, None]
+            q, dq, ddq = q + self.drift * s, self.drift * w * c, -self.drift * w**2 * s
         q[:, self.joint], dq[:, self.joint], ddq[:, self.joint] = pos, vel, acc
         return q, dq, ddq
 
@@ -145,6 +155,8 @@ def sweep_reference(
     *,
     acceleration: float = 2.0,
     dwell: float = 0.5,
+    drift=None,
+    drift_period: float = 60.0,
 ) -> SweepReference:
     """Bidirectional constant-velocity sweeps of joint ``joint`` between ``lower`` and ``upper``.
 
@@ -162,6 +174,10 @@ def sweep_reference(
         Cruise speeds [rad/s], > 0; each must be reachable (``v^2 / a < upper - lower``).
     lower, upper : float
         The sweep's ends [rad].
+    drift : array_like (n,), optional
+        The other joints move slowly instead of being held: ``hold + drift sin(2 pi t /
+        drift_period)`` [rad] (the moving joint's entry is ignored), so the sweeps see the
+        coupled gravity of many configurations.
 
     Raises
     ------
@@ -183,6 +199,11 @@ def sweep_reference(
             f"{acceleration:g} rad/s^2 ramps"
         )
     hold[joint] = lower
+    if drift is not None:
+        drift = np.asarray(drift, dtype=float).reshape(-1).copy()
+        if drift.shape != hold.shape or not np.isfinite(drift).all() or drift_period <= 0:
+            raise ConfigError(f"drift needs {hold.size} finite amplitudes and a period > 0")
+        drift[joint] = 0.0
     starts, q_starts, cruise, ends, plateaus = [], [], [], [], []
     t = 0.0
     for v in speeds:
@@ -208,6 +229,8 @@ def sweep_reference(
         ends=np.array(ends),
         plateaus=plateaus,
         duration=float(t + dwell),
+        drift=drift,
+        drift_period=float(drift_period),
     )
 
 
