@@ -30,7 +30,7 @@ from ._bag import (
     temperature_series,
     topic_connections,
 )
-from ._robot_map import constants_for, match_joints
+from ._robot_map import constants_for, match_joints, velocity_from_position
 
 __all__ = ["BagOptions", "read_robot_bag"]
 
@@ -195,7 +195,7 @@ def read_robot_bag(
     }
     velocity = _velocity(group, cols, options.velocity_unit, path)
     if velocity is None:
-        velocity = np.gradient(position, time, axis=0) if len(time) > 1 else position * 0.0
+        velocity = velocity_from_position(position, time, path)
         meta["velocity_from"] = "position (central difference)"
     effort = np.asarray(to_si(np.stack(group.effort)[:, cols], unit, options.effort), dtype=float)
     if temps is not None:

@@ -23,9 +23,18 @@ import re
 from collections.abc import Mapping, Sequence
 from typing import Any
 
+import numpy as np
+
 from ..errors import ConfigError, DataError
 
-__all__ = ["ALIASES", "check_names", "constants_for", "match_joints", "parse_name"]
+__all__ = [
+    "ALIASES",
+    "check_names",
+    "constants_for",
+    "match_joints",
+    "parse_name",
+    "velocity_from_position",
+]
 
 #: The spellings of each per-joint quantity in a column name (lower case).
 ALIASES: dict[str, tuple[str, ...]] = {
@@ -97,6 +106,10 @@ def check_names(joints: Sequence[str]) -> list[str]:
         twice = sorted({n for n in names if names.count(n) > 1})
         raise ConfigError(f"joints= names {', '.join(twice)} more than once")
     return names
+
+
+def _count(n: int) -> str:
+    return f"{n} joint" if n == 1 else f"{n} joints"
 
 
 def _by_name(wanted: str, found: list[str]) -> str | None:
@@ -173,8 +186,9 @@ def match_joints(
             return by_name, wanted  # type: ignore[return-value]
     if len(found) != len(wanted):
         raise DataError(
-            f"the file has {len(found)} joints ({has}) but {len(wanted)} were asked for "
-            f"({asked}); give joints= with one name per joint of the file",
+            f"the file has {_count(len(found))} ({has}) but {len(wanted)} "
+            f"{'was' if len(wanted) == 1 else 'were'} asked for ({asked}); give joints= with "
+            "one name per joint of the file",
             file=file,
         )
     numbers = [int(f) for f in found if _NUMBER.fullmatch(f)]
@@ -212,3 +226,16 @@ def constants_for(names: Sequence[str], torque_constants: Any) -> Any:
             + (f"; not a joint of the log: {', '.join(map(str, unknown))}" if unknown else "")
         )
     return [torque_constants[n] for n in names]
+
+
+def velocity_from_position(position: np.ndarray, time: np.ndarray, file: Any) -> np.ndarray:
+    """Velocities as the central difference of positions (:func:`numpy.gradient`: second
+    order inside, one-sided at the ends), for a file that logs none."""
+    if len(time) < 2:
+        raise DataError(
+            "the file has no velocities, and one row is too few to compute them from the positions",
+            file=file,
+            column="velocity",
+        )
+    with np.errstate(over="ignore", invalid="ignore"):  # RobotLog reports absurd values
+        return np.gradient(position, time, axis=0)

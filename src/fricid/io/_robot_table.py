@@ -34,7 +34,7 @@ from ._csv import (
     write_csv,
 )
 from ._parquet import open_parquet, parquet_doc, read_columns, schema_meta, write_parquet
-from ._robot_map import constants_for, match_joints, parse_name
+from ._robot_map import constants_for, match_joints, parse_name, velocity_from_position
 from ._tablefile import _csv_info, _parquet_info, _torque_constant, meta_of, table_format
 
 __all__ = ["ROBOTLOG_FORMAT", "read_robot_table", "write_robot_table"]
@@ -262,7 +262,7 @@ def read_robot_table(
         torque_constants = k_file[[ids.index(j) for j in order]]
     meta = meta_of(info, path)
     if "velocity" not in data:
-        data["velocity"] = np.gradient(data["position"], time, axis=0)
+        data["velocity"] = velocity_from_position(data["position"], time, path)
         meta["velocity_from"] = "position (central difference)"
     if order != names:
         meta["joint_map"] = dict(zip(order, names, strict=True))
