@@ -16,6 +16,12 @@ Table 2, discretisation error. The same run for ``convergence`` seconds at inter
 1, 0.5 and 0.25 ms against 0.1 ms (encoders of 2^40 counts, so that the quantiser does not
 amplify rounding differences): the largest position difference [mrad] and the RMS and largest
 command differences [N m] (to compare with the 0.05 N m torque noise).
+
+What it showed (``benchmarks/results/robot_sim.txt``; pin 4.1.0, mujoco 4.0.0, 2 cores shared
+at a load average of about 10): 60 s of the Panda cost 10.0 s of CPU (26.9 s wall) with
+fricid's integrator, 13.4 s with LuGre on joint 7, and 2.4 s with MuJoCo; the default 0.5 ms
+step is within 0.4 mrad and 0.002 N m RMS (0.015 N m at most) of 0.1 ms steps, second order
+(1 ms: 1.6 mrad, 0.013 N m RMS).
 """
 
 from __future__ import annotations
