@@ -4,9 +4,10 @@ the rigid-body dynamics, each joint's friction, a drive's tracking controller an
 The plant is ``M(q) ddq + C(q, dq) dq + g(q) = u - F(dq)``, the rigid-body dynamics of a
 :class:`~fricid.robot.RigidBodyModel` (by :meth:`~fricid.robot.RigidBodyModel.forward_dynamics`,
 Pinocchio's ABA) with the motor torque ``u`` and each joint's friction ``F``
-(:class:`~fricid.sim.robot_friction.ArmFriction`). Integration, per internal step ``h``
-(``integrator_step``, a divisor of the sample period), is split (Strang splitting, second
-order):
+(:class:`~fricid.sim.robot_friction.ArmFriction`; LuGre on chosen joints,
+:mod:`fricid.sim.robot_lugre`). Integration, per internal step ``h`` (the sample period split
+into equal steps of at most ``integrator_step``, default 0.5 ms), is split (Strang splitting,
+second order; ``benchmarks/bench_robot_sim.py`` measures it):
 
 1. friction, linearly implicit (Rosenbrock-Euler) over ``h / 2``:
    ``(M + h/2 D) dv = -h/2 F(v)`` with ``D = diag(dF_j / dv_j)``, so the steep smoothed sign at
@@ -20,11 +21,12 @@ kinetic energy over 2 s at 0.5 ms steps).
 The drive, at the log's ``rate``: the controller reads the quantised position (an encoder of
 ``encoder_counts`` per revolution: ``q_m = 2 pi / counts round(q counts / 2 pi)``) and the
 velocity by backward differences of it, low-pass filtered (first order, ``velocity_filter``
-Hz), and holds its command ``u`` for one period (zero-order hold). Controllers:
+Hz), and holds its command ``u`` for one period (zero-order hold). A prismatic joint's
+position is quantised in the same steps, read as metres. Controllers:
 
 - ``"pd"``: ``u = Kp (q_r - q_m) + Kd (dq_r - dq_m)`` (+ the model's inverse dynamics of the
-  reference with ``feedforward=True``), gains by default from ``M(q_0)``'s diagonal for a
-  ``bandwidth`` [Hz] and damping ratio 1;
+  reference with ``feedforward=True``), gains by default for a ``bandwidth`` [Hz] and damping
+  ratio 1 on the inertia each joint meets at ``q_0`` (:func:`default_gains`);
 - ``"torque"``: computed torque, ``u = ID(q_m, dq_m, ddq_r + w^2 e + 2 w de)``, ``w = 2 pi
   bandwidth``;
 - ``"none"``: ``u = 0`` (the arm falls freely; tests of the integrator).
@@ -32,6 +34,8 @@ Hz), and holds its command ``u`` for one period (zero-order hold). Controllers:
 The log (a :class:`~fricid.samples.RobotLog`) holds the quantised position, the raw backward-
 difference velocity (as drives log it) and the torque ``u + e``, ``e ~ N(0, torque_noise^2)``;
 :class:`RobotTruth` holds the true states, accelerations, friction, command and parameters.
+Another simulator of the same arm can take the integrator's place (``plant=``):
+``benchmarks/_robot_truth.py`` runs MuJoCo on the exported MJCF under the same drive.
 """
 
 from __future__ import annotations
@@ -393,6 +397,8 @@ def run_robot(
     ref = _evaluate(reference, time, n)
     q, v = (ref[0][0].copy(), ref[1][0].copy()) if initial is None else initial
     q, v = np.asarray(q, dtype=float).copy(), np.asarray(v, dtype=float).copy()
+    if q.shape != (n,) or v.shape != (n,) or not (np.isfinite(q).all() and np.isfinite(v).all()):
+        raise ConfigError(f"the initial state must be {n} finite positions and velocities")
     ff = np.zeros((count, n))
     if feedforward and controller == "pd":
         ff = model.inverse_dynamics(*ref)
