@@ -77,9 +77,14 @@ def reference(fragment: str) -> dict:
     }
 
 
-@pytest.mark.slow  # 2-3 s under load: the check, then the re-simulation step by step
-def test_the_recommended_timestep_holds_and_four_times_it_does_not(mujoco):
-    fragment = mjcf_text(lugre_model(), joint="j")
+#: The virtual joint's LuGre truth (``fricid simulate --trajectory``): stiffer bristles.
+VIRTUAL = dict(sigma_0=1e4, sigma_1=1.0, sigma_2=0.2, tau_c=0.5, tau_s=0.8, w_s=0.1, delta=1.0)
+
+
+@pytest.mark.slow  # 2-5 s under load: the check, then the re-simulation step by step
+@pytest.mark.parametrize("params", [LUGRE, VIRTUAL], ids=["test_joint", "virtual_joint"])
+def test_the_recommended_timestep_holds_and_four_times_it_does_not(mujoco, params):
+    fragment = mjcf_text(lugre_model(**params), joint="j", max_loss=1.0)
     advice = ms.check_timestep(fragment, J)
     assert advice.measured and advice.timestep is not None
     ref = reference(fragment)

@@ -27,8 +27,22 @@ monotone in the step: RK4 can break away right at 2 ms and wrong at 1 ms; the la
 coarse to fine and stops there), and the
 recommendation of the export the largest of those (ties in :data:`INTEGRATORS`' order,
 MuJoCo's default first). Signals are applied one sample per step (zero-order hold), the
-steps run inside MuJoCo (``mujoco.rollout``), and nothing is cached: about a second on two
-shared cores.
+steps run inside MuJoCo (``mujoco.rollout``), and nothing is cached: 0.75-3.3 s measured on
+two shared cores under a load of about 10 (the LuGre fragments' fine steps dominate; a static
+fragment passes at the coarse steps and stops there).
+
+Measured (mujoco 4.0.0, ``benchmarks/bench_mujoco_step.py``; break-away error % / trajectory
+error % of the span). The README's example (``fricid simulate --trajectory multisine
+--duration 10``, ``fricid fit --trajectory``: sigma_0 1.19e4 N m/rad, sigma_1 0.001, not
+determined; J 0.01 kg m^2): implicitfast, Euler and implicit break away 82-96 % low at every
+step from 5 ms to 0.2 ms (trajectory 2-79 %) and pass from 0.1 ms (0.42 / 0.57); RK4 passes
+from 0.2 ms (0.34 / 0.86), breaks away right at 2 ms (0.48 %) but diverges on the trajectory
+there, and 89 % low at 1 ms: recommended RK4 at 0.2 ms (implicitfast 0.1 ms); four times
+those steps miss (RK4 0.8 ms: 89.5 / 4.7; implicitfast 0.4 ms: 92 / 7.8). The virtual joint's
+truth (sigma_0 1e4, sigma_1 1): every integrator passes from 0.2 ms (implicitfast 0.42 /
+0.65). Static and Dahl fragments (``frictionloss``): 5 ms passes against the reference, but
+MuJoCo's soft ``frictionloss`` creeps so that the reference itself breaks away at 22-29 % of
+the friction (the comment says so).
 
 Without MuJoCo, :func:`default_timestep` gives the documented conservative default:
 ``implicitfast`` at the largest ladder step below ``0.05 sqrt(J / sigma_0)`` for a LuGre
