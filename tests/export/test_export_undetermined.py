@@ -13,6 +13,8 @@ from fricid.export import ExportError, refuse_undetermined, undetermined_paramet
 from fricid.fitted import FittedModel
 
 runner = CliRunner()
+#: The MuJoCo timestep check is tested in test_mujoco_step.py.
+NO_CHECK = ("--no-timestep-check",)
 LUGRE = dict(sigma_0=1e3, sigma_1=0.5, sigma_2=0.1, tau_c=0.3, tau_s=0.5, w_s=0.05, delta=2.0)
 NOTE = "not identified: the 95 % interval spans the whole search range [0.001, 1000]"
 
@@ -55,12 +57,15 @@ def test_cli_refuses_then_names_an_undetermined_parameter(tmp_path):
     assert res.exit_code == 2 and not out.exists()
     assert "--allow-undetermined" in " ".join(res.output.split())
     res = runner.invoke(
-        app, ["export", str(path), "--to", "mjcf", "-o", str(out), "--allow-undetermined"]
+        app,
+        ["export", str(path), "--to", "mjcf", "-o", str(out), "--allow-undetermined", *NO_CHECK],
     )
     assert res.exit_code == 0, res.output
     text = out.read_text()
     assert "NOT DETERMINED by the trajectory, exported as identified: sigma_1" in text
     determined = tmp_path / "determined.json"
     trajectory_model(()).save(determined)
-    res = runner.invoke(app, ["export", str(determined), "--to", "mjcf", "-o", str(out)])
+    res = runner.invoke(
+        app, ["export", str(determined), "--to", "mjcf", "-o", str(out), "--no-timestep-check"]
+    )
     assert res.exit_code == 0 and "NOT DETERMINED" not in out.read_text()

@@ -20,7 +20,21 @@ def report_command(
         Path,
         typer.Argument(help="Model file (JSON, from `fricid fit`)."),
     ],
-    samples: Annotated[Path, typer.Argument(help="Friction samples, CSV or Parquet.")],
+    samples: Annotated[
+        Path,
+        typer.Argument(
+            help="Friction samples, CSV or Parquet; for a model from `fricid fit --trajectory`, "
+            "the trajectory log (a fricid raw log)."
+        ),
+    ],
+    heldout: Annotated[
+        Path | None,
+        typer.Argument(
+            help="Trajectory models only: a second log the model was not identified from, "
+            "for held-out validation (nothing is refitted).",
+            show_default=False,
+        ),
+    ] = None,
     out: Annotated[
         Path | None,
         out_option(
@@ -62,6 +76,12 @@ def report_command(
     `fricid fit` or the fleet) when it was computed on the same samples with the same
     options, else computed now; the report renders it and computes no verdict of its own.
 
+    A model identified from a trajectory (`fricid fit --trajectory`) takes its log instead of
+    samples, and optionally a second log (HELDOUT): the report then shows the measured and
+    predicted torque over time, the residuals over time and against velocity, the friction's
+    hysteresis at the velocity reversals (against velocity, and against the position since
+    the reversal: pre-sliding), the error on the held-out log, and the parameters.
+
     Outputs in the folder: report.html (self-contained), report.md, one CSV per table and one
     PNG per figure, written all or nothing. Progress goes to stderr (the part being built:
     the trust record and its validation, each figure, the parameters, writing; no time left,
@@ -70,7 +90,6 @@ def report_command(
     from ..errors import ConfigError
     from ..fitted import FittedModel
     from ..identify.trust import assess_trust
-    from ..io import read_samples
     from ..report import model_report, write_document
     from ..units import UNITS
 
@@ -78,10 +97,23 @@ def report_command(
         raise ConfigError(
             f"--velocity-unit must be one of: {', '.join(UNITS['velocity'])}; got '{velocity_unit}'"
         )
-    check_paths(inputs={"MODEL": model, "SAMPLES": samples}, out_dirs={"--out": out})
+    inputs = {"MODEL": model, "SAMPLES": samples}
+    if heldout is not None:
+        inputs["HELDOUT"] = heldout
+    check_paths(inputs=inputs, out_dirs={"--out": out})
     fitted = FittedModel.load(model)
-    data = read_samples(samples)
     out = out or Path(f"{model.stem}-report")
+    from ..identify.trajectory_check import is_trajectory_model
+
+    if is_trajectory_model(fitted):
+        _trajectory_report(fitted, samples, heldout, out, quiet)
+        return
+    if heldout is not None:
+        raise ConfigError(
+            "a second data file (HELDOUT) is for a model identified from a trajectory; this "
+            f"model ('{fitted.model}') was fitted to friction samples"
+        )
+    data = _read_samples(samples)
     with tracker("report", None, quiet=quiet, timed=False) as track:
 
         def progress(part: str) -> None:
@@ -103,6 +135,70 @@ def report_command(
         path = write_document(doc, out)
     console.print(str(path), highlight=False, soft_wrap=True)
     err_console.print(str(doc.meta["trust"]), markup=False, highlight=False, soft_wrap=True)
+    err_console.print(
+        f"wrote {len(doc.tables())} tables and {len(doc.figures())} figures into {out}/"
+    )
+
+
+def _read_samples(path: Path):
+    """Friction samples, or a one-line error that says what a raw log is for here."""
+    from ..errors import DataError
+    from ..io import read_samples
+
+    try:
+        return read_samples(path)
+    except DataError as exc:
+        if "fricid-rawlog" not in exc.message:
+            raise
+        raise DataError(
+            "this is a raw joint log, not friction samples: `fricid extract` turns it into "
+            "samples for this model, or `fricid fit --trajectory` identifies a model from it "
+            "(whose report takes the log)",
+            file=path,
+        ) from None
+
+
+def _trajectory_report(fitted, log_path: Path, heldout: Path | None, out: Path, quiet: bool):
+    """The report of a model from a trajectory on its log (and a held-out one)."""
+    from ..identify.trajectory_check import predict_trajectory
+    from ..report import write_document
+    from ..report.trajectory import trajectory_report
+    from .trajectory import read_trajectory_log
+
+    with tracker("report", None, quiet=quiet, timed=False) as track:
+
+        def progress(part: str) -> None:
+            track.stage(f"report: {part}")
+
+        progress(f"the model along {log_path.name}")
+        prediction = predict_trajectory(fitted, read_trajectory_log(log_path))
+        held = None
+        if heldout is not None:
+            progress(f"the model along the held-out {heldout.name}")
+            held = predict_trajectory(fitted, read_trajectory_log(heldout))
+        doc = trajectory_report(
+            fitted,
+            prediction,
+            heldout=held,
+            log_label=log_path.name,
+            heldout_label=heldout.name if heldout is not None else "",
+            progress=progress,
+        )
+        progress(f"writing {out}/")
+        path = write_document(doc, out)
+    console.print(str(path), highlight=False, soft_wrap=True)
+    for label, pred in ((log_path.name, prediction), (getattr(heldout, "name", ""), held)):
+        if pred is None:
+            continue
+        m = pred.metrics()
+        err_console.print(
+            f"{label}: RMS torque error {m['rmse']:.4g} N m ({100 * m['relative']:.3g} % of the "
+            f"RMS torque {m['signal_rms']:.4g} N m), low-passed as the fit "
+            f"{m['rmse_filtered']:.4g} N m",
+            markup=False,
+            highlight=False,
+            soft_wrap=True,
+        )
     err_console.print(
         f"wrote {len(doc.tables())} tables and {len(doc.figures())} figures into {out}/"
     )

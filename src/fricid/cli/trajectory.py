@@ -19,7 +19,7 @@ from ..errors import ConfigError, DataError
 from ._app import console, err_console
 from ._progress import tracker
 
-__all__ = ["parse_reader_options", "run_trajectory", "trajectory_text"]
+__all__ = ["parse_reader_options", "read_trajectory_log", "run_trajectory", "trajectory_text"]
 
 
 def parse_reader_options(items: list[str] | None) -> dict:
@@ -71,18 +71,11 @@ def trajectory_text(fitted) -> str:
         lines.append(
             f"    rate bias at {rb['log_rate']:.6g} Hz (simulated at the estimate, "
             f"{rb['internal_rate']:.6g} Hz inside; not applied): "
-            + ", ".join(
-                f"{n} {100 * rb[n]['relative']:+.2g} % (corrected {rb[n]['corrected']:.4g})"
-                for n in ("sigma_0", "sigma_1")
-            )
+            + ", ".join(_rate_bias(n, rb[n], fitted.params.get(n)) for n in ("sigma_0", "sigma_1"))
         )
     p = info.get("passivity")
     if p:
-        lines.append(
-            f"    passivity: {'passive' if p['passive'] else 'NOT passive'} (margin "
-            f"{_margin(p['margin'])}; across the 95 % intervals: "
-            f"{'passive' if p['passive_across_ci95'] else 'not guaranteed'}); {p['condition']}"
-        )
+        lines.append(f"    passivity: {_passivity(p)}")
     return "\n".join(lines)
 
 
@@ -95,9 +88,66 @@ def _interval(row: dict, why: str) -> str:
     return f"+/- {se:.2g} (95 % CI [{low:.5g}, {high:.5g}])"
 
 
-def _margin(value) -> str:
-    """The passivity margin in sigma_1's unit, three significant digits."""
-    return "undefined" if value is None else f"{value:.3g} N m s/rad"
+#: Units of the parameters whose rate bias is estimated.
+_BIAS_UNITS = {"sigma_0": "N m/rad", "sigma_1": "N m s/rad"}
+
+
+def _rate_bias(name: str, row: dict, estimate) -> str:
+    """One parameter's rate bias: relative while the bias is smaller than the estimate, else
+    absolute (a relative one of 1e29 % says nothing); a corrected value outside the search
+    box is said to be so."""
+    from ..identify.dynamic._filtered import LOG_BOX
+
+    rel, corrected = row["relative"], row["corrected"]
+    if abs(rel) < 1.0 or estimate is None:
+        text = f"{name} {100 * rel:+.2g} % (corrected {corrected:.4g}"
+    else:
+        text = (
+            f"{name} {float(estimate) - corrected:+.3g} {_BIAS_UNITS.get(name, '')} (a factor "
+            f"{10.0 ** row['log10_bias']:.3g}; corrected {corrected:.4g}"
+        )
+    lo, hi = (10.0**x for x in LOG_BOX.get(name, (-math.inf, math.inf)))
+    if not lo * (1 - 1e-9) <= corrected <= hi * (1 + 1e-9):  # the box's edges are inside
+        text += f", outside the search box [{lo:.3g}, {hi:.3g}]: not a usable value"
+    return text + ")"
+
+
+def _passivity(p: dict) -> str:
+    """The passivity line: at the estimate, across the intervals, and the condition; a margin
+    the model file stores as null (infinite) said in words."""
+    margin, passive = p.get("margin"), p.get("passive")
+    if margin is not None:
+        at = f"{'passive' if passive else 'NOT passive'} (margin {margin:.3g} N m s/rad"
+    elif passive:
+        at = (
+            "passive for any sigma_1 (tau_s <= tau_c: no Stribeck peak, so the condition "
+            "bounds no damping"
+        )
+    else:
+        at = (
+            "NOT passive (a parameter outside its valid region: sigma_0, tau_c, w_s > 0 and "
+            "sigma_1, sigma_2 >= 0"
+        )
+    across = p.get("passive_across_ci95")
+    ci = {True: "passive", False: "not guaranteed", None: "no intervals"}[across]
+    return f"{at}; across the 95 % intervals: {ci}); {p.get('condition', '')}"
+
+
+def read_trajectory_log(path: Path, reader: str = "table", reader_options: dict | None = None):
+    """The whole log at ``path`` as one :class:`~fricid.samples.RawLog` (its chunks joined),
+    or a :class:`DataError` when the reader gives friction samples instead of a time series."""
+    from ..io import open_log
+    from ..samples import RawLog
+
+    opened = open_log(path, reader, reader_options or {})
+    if not isinstance(opened, RawLog) and not hasattr(opened, "__next__"):
+        raise DataError(
+            "this reader gives friction samples (steady-state means), not a time series: a "
+            "trajectory needs time, position, velocity and torque",
+            file=str(path),
+        )
+    chunks = list(opened)
+    return chunks[0] if len(chunks) == 1 else RawLog.concatenate(chunks)
 
 
 def run_trajectory(
@@ -117,18 +167,8 @@ def run_trajectory(
     """Open, identify, save and print (the ``--trajectory`` branch of ``fricid fit``), with
     the stage under way on stderr (:func:`fricid.cli._progress.tracker`; ``quiet``: none)."""
     from ..identify import fit
-    from ..io import open_log
-    from ..samples import RawLog
 
-    opened = open_log(log_path, reader, reader_options)
-    if not isinstance(opened, RawLog) and not hasattr(opened, "__next__"):
-        raise DataError(
-            "this reader gives friction samples (steady-state means), not a time series: a "
-            "trajectory needs time, position, velocity and torque",
-            file=str(log_path),
-        )
-    chunks = list(opened)
-    log = chunks[0] if len(chunks) == 1 else RawLog.concatenate(chunks)
+    log = read_trajectory_log(log_path, reader, reader_options)
     label = f"identifying {model} from the trajectory"
     with (
         warnings.catch_warnings(record=True) as caught,

@@ -1,0 +1,62 @@
+"""The printout of a trajectory fit: a rate bias larger than its estimate is given in the
+parameter's unit (not as 8.4e29 %), a corrected value outside the search box is said to be
+unusable, and an infinite passivity margin is a sentence, not "margin undefined"."""
+
+from __future__ import annotations
+
+from _trajectory import truth_model
+from fricid.cli.trajectory import trajectory_text
+
+
+def fitted_with(rate_bias: dict, passivity: dict):
+    fitted = truth_model(sigma_1=0.001)
+    fitted.provenance["trajectory"].update(
+        derivative={"method": "savgol", "source": "position"},
+        rate_bias={"log_rate": 1000.0, "internal_rate": 16000.0, **rate_bias},
+        passivity=passivity,
+    )
+    return fitted
+
+
+CONDITION = "sigma_1 <= 4 sigma_2 tau_c / (tau_s - tau_c) (Barabanov and Ortega 2000)"
+
+
+def test_a_huge_rate_bias_is_absolute_and_an_infinite_margin_a_sentence():
+    b = 27.92
+    text = trajectory_text(
+        fitted_with(
+            {
+                "sigma_0": {"log10_bias": -0.009, "relative": 10**-0.009 - 1, "corrected": 1.4e8},
+                "sigma_1": {"log10_bias": b, "relative": 10**b - 1, "corrected": 0.001 * 10**-b},
+            },
+            {"margin": None, "passive": True, "passive_across_ci95": None, "condition": CONDITION},
+        )
+    )
+    line = next(x for x in text.splitlines() if "rate bias" in x)
+    assert "e+29 %" not in line and "e+27 %" not in line
+    assert "sigma_0 -2.1 % (corrected 1.4e+08, outside the search box [100, 1e+07]" in line
+    assert "sigma_1 +0.001 N m s/rad (a factor 8.32e+27" in line
+    assert line.count("not a usable value") == 2
+    line = next(x for x in text.splitlines() if "passivity" in x)
+    assert "undefined" not in line
+    assert "passive for any sigma_1 (tau_s <= tau_c: no Stribeck peak" in line
+    assert "across the 95 % intervals: no intervals" in line
+
+
+def test_an_ordinary_rate_bias_stays_relative_and_the_box_edge_is_inside():
+    text = trajectory_text(
+        fitted_with(
+            {
+                "sigma_0": {"log10_bias": -0.0091, "relative": -0.0207, "corrected": 12156.7},
+                "sigma_1": {
+                    "log10_bias": 4e-10,
+                    "relative": 9.7e-10,
+                    "corrected": 0.000999999999030818,
+                },
+            },
+            {"margin": 1.39, "passive": True, "passive_across_ci95": False, "condition": CONDITION},
+        )
+    )
+    line = next(x for x in text.splitlines() if "rate bias" in x)
+    assert "sigma_0 -2.1 % (corrected 1.216e+04)" in line and "usable" not in line
+    assert "passive (margin 1.39 N m s/rad; across the 95 % intervals: not guaranteed)" in text

@@ -1,0 +1,66 @@
+"""A trajectory model run along a log (fricid.identify.trajectory_check): the true model on
+its own log predicts the torque to the noise, a wrong one does not, the low-passed residual at
+a fit's estimate is the route's own, and a model without a joint is refused."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from _trajectory import TRUTH, multisine_log, truth_model
+from fricid.errors import DataError
+from fricid.fitted import FittedModel
+from fricid.identify.trajectory_check import is_trajectory_model, predict_trajectory
+
+
+@pytest.fixture
+def log():
+    return multisine_log(5)
+
+
+def test_the_truth_predicts_its_own_log(log):
+    pred = predict_trajectory(truth_model(), log)
+    m = pred.metrics()
+    assert m["n"] == log.time.size - 1
+    # the low-passed residual (what the identification minimises) is at the noise: well
+    # under 1 % of the torque; the raw residual's median too, its RMS held up by the
+    # break-aways (the derivative filter's smoothing of the acceleration's jump)
+    assert m["rmse_filtered"] < 0.005 * m["signal_rms"]
+    assert m["median_abs_error"] < 0.02 * m["signal_rms"]
+    assert m["rmse"] > 3 * m["median_abs_error"]
+    assert np.isnan(pred.torque_filtered[:100]).all()  # the filter's start-up, trimmed
+    # the measured friction is the torque less inertia and gravity
+    np.testing.assert_allclose(
+        pred.friction - pred.friction_predicted, pred.residual, rtol=0, atol=1e-12
+    )
+    windows = pred.reversals()
+    assert len(windows) >= 5
+    for idx in windows:
+        v = pred.velocity[idx]
+        assert (v.min() < 0 < v.max()) and np.all(np.abs(v) < 0.1 * np.abs(pred.velocity).max())
+
+
+def test_a_wrong_model_misses(log):
+    good = predict_trajectory(truth_model(), log).metrics()["rmse_filtered"]
+    for changes in ({"sigma_0": 1e3}, {"tau_s": 0.6}, {"sigma_2": 0.1}):
+        bad = predict_trajectory(truth_model(**changes), log).metrics()["rmse_filtered"]
+        assert bad > 3 * good, changes
+
+
+def test_a_model_without_a_joint_is_refused(log):
+    plain = FittedModel.from_values("lugre", TRUTH.params())
+    assert not is_trajectory_model(plain) and is_trajectory_model(truth_model())
+    with pytest.raises(DataError, match="not identified from a trajectory"):
+        predict_trajectory(plain, log)
+
+
+@pytest.mark.slow  # a trajectory fit: 1-6 s under load
+@pytest.mark.filterwarnings("ignore::fricid.identify.dynamic.trajectory.PassivityWarning")
+def test_the_low_passed_residual_is_the_routes(log):
+    from fricid.identify import fit
+
+    fitted = fit(log, "lugre", seed=0)
+    route = fitted.provenance["trajectory"]["routes"]["filtered"]["rms"]["torque_filtered"]
+    mine = predict_trajectory(fitted, log).metrics()["rmse_filtered"]
+    # the route's RMS is over the decimated samples, this one over every sample
+    assert mine == pytest.approx(route, rel=0.05)
