@@ -45,22 +45,31 @@ __all__ = ["ArmSignals", "choose_cutoff", "encoder_step", "prepare_signals"]
 #: Butterworth order (doubled by the forward-backward pass).
 BUTTER_ORDER = 4
 #: Share of the velocity's power below the motion's bandwidth.
-SIGNAL_POWER = 0.995
+SIGNAL_POWER = 0.99
 #: Cut-off over the motion's bandwidth (bound 1).
-SIGNAL_FACTOR = 10.0
-#: Largest acceleration noise from the encoder, over the acceleration's RMS (bound 2).
-ENCODER_SHARE = 0.01
+SIGNAL_FACTOR = 8.0
+#: The cut-off is never below this many times the motion's bandwidth.
+MIN_OVER_MOTION = 3.0
+#: Largest torque noise from the encoder (its acceleration noise times the inertia), over
+#: the filtered torque noise (bound 2).
+ENCODER_SHARE = 0.5
 #: The log's rate over the cut-off, at least (bound 3).
 MIN_RATE_OVER_CUTOFF = 5.0
 #: The decimated rate over the cut-off.
 RATE_OVER_CUTOFF = 5.0
+#: The intermediate rate over the cut-off, at least.
+MID_RATE_OVER_CUTOFF = 10.0
+#: The anti-alias cut-off over the intermediate rate.
+ANTI_ALIAS_SHARE = 0.4
 #: Filter transient dropped at each end, in periods of the cut-off.
-EDGE_PERIODS = 2.0
+EDGE_PERIODS = 5.0
 
 
 @dataclass(frozen=True)
 class ArmSignals:
-    """Filtered, decimated signals of a robot log (module notes), shape (N, n) each."""
+    """A log's signals at the identification rate (module notes), shape (N, n) each: the
+    states ``q``, ``dq``, ``ddq`` the regressor is computed at, and the torque, already
+    through both filters."""
 
     time: np.ndarray
     q: np.ndarray
@@ -76,17 +85,36 @@ class ArmSignals:
     velocity_noise: np.ndarray
     #: the filtered velocity at the log's full rate (friction columns are computed on it)
     full_dq: np.ndarray
-    #: the filter's coefficients and the rows kept (edges cut, decimated)
-    ba: tuple[np.ndarray, np.ndarray]
+    #: the anti-alias filter, its decimation; the low-pass at the intermediate rate; the rows
+    #: kept there (edges cut, decimated)
+    anti_alias: tuple[np.ndarray, np.ndarray]
+    first: int
+    low_pass: tuple[np.ndarray, np.ndarray]
     keep: slice
+    #: the filtered states at the intermediate rate (the regressor is computed on them)
+    mid: tuple[np.ndarray, np.ndarray, np.ndarray]
+
+    def regressor(self, model, base) -> np.ndarray:
+        """The base regressor ``Y_b`` (N, n, r), computed at the intermediate rate and passed
+        through the low-pass like the torque (parallel filtering)."""
+        return self.parallel_mid(base.columns(model.regressor(*self.mid)))
 
     def parallel(self, x: np.ndarray) -> np.ndarray:
-        """``x`` (full rate, first axis time) through the same filter, edges cut, decimated:
-        the parallel filtering of a column of the regression (module notes)."""
-        x = np.asarray(x, dtype=float)
-        flat = np.ascontiguousarray(x.reshape(x.shape[0], -1).T)  # time last: contiguous runs
-        out = scipy.signal.filtfilt(*self.ba, flat, axis=-1)[:, self.keep].T
-        return out.reshape((out.shape[0], *x.shape[1:]))
+        """``x`` (full rate, first axis time) through the anti-alias filter, decimated, then
+        through :meth:`parallel_mid`: what the torque went through (module notes)."""
+        return self.parallel_mid(_filt(self.anti_alias, x)[:: self.first])
+
+    def parallel_mid(self, x: np.ndarray) -> np.ndarray:
+        """``x`` at the intermediate rate through the low-pass, edges cut, decimated."""
+        return _filt(self.low_pass, x)[self.keep]
+
+
+def _filt(ba: tuple[np.ndarray, np.ndarray], x: np.ndarray) -> np.ndarray:
+    """Zero-phase filter along the first axis (time), any trailing shape."""
+    x = np.asarray(x, dtype=float)
+    flat = np.ascontiguousarray(x.reshape(x.shape[0], -1).T)  # time last: contiguous runs
+    out = scipy.signal.filtfilt(*ba, flat, axis=-1).T
+    return out.reshape(x.shape)
 
 
 def encoder_step(position: np.ndarray, counts: int | None) -> np.ndarray:
@@ -103,11 +131,11 @@ def encoder_step(position: np.ndarray, counts: int | None) -> np.ndarray:
 
 
 def _bandwidth(q: np.ndarray, rate: float) -> float:
-    """The frequency below which :data:`SIGNAL_POWER` of the velocity's power lies [Hz]."""
+    """The frequency below which :data:`SIGNAL_POWER` of the velocity's power lies [Hz]
+    (Hann-windowed spectrum of the differenced position, summed over the joints)."""
     v = np.diff(q, axis=0) * rate
-    v = v - v.mean(axis=0)
-    spec = np.abs(np.fft.rfft(v, axis=0)) ** 2
-    total = spec.sum(axis=1)
+    v = (v - v.mean(axis=0)) * np.hanning(v.shape[0])[:, None]
+    total = (np.abs(np.fft.rfft(v, axis=0)) ** 2).sum(axis=1)
     cum = np.cumsum(total)
     if cum[-1] <= 0:
         return rate / 2
@@ -115,24 +143,31 @@ def _bandwidth(q: np.ndarray, rate: float) -> float:
     return float(freqs[min(np.searchsorted(cum, SIGNAL_POWER * cum[-1]), freqs.size - 1)])
 
 
-def choose_cutoff(q: np.ndarray, rate: float, step: np.ndarray) -> tuple[float, dict[str, float]]:
-    """The low-pass cut-off [Hz] and its three bounds (module notes)."""
+def torque_noise(torque: np.ndarray) -> np.ndarray:
+    """Each joint's torque noise at the log's rate [N m], from second differences (white
+    noise: ``var(d^2 tau) = 6 sigma^2``; a smooth torque adds little at 1 kHz)."""
+    d2 = np.diff(torque, 2, axis=0)
+    return np.sqrt(np.median(d2**2, axis=0) / 0.4549 / 6)  # median of chi^2_1 is 0.4549
+
+
+def choose_cutoff(
+    q: np.ndarray, rate: float, step: np.ndarray, noise: np.ndarray, inertia: np.ndarray
+) -> tuple[float, dict[str, float]]:
+    """The low-pass cut-off [Hz] and its bounds (module notes).
+
+    ``noise`` is each joint's torque noise at the log's rate, ``inertia`` its mean diagonal
+    of the mass matrix: the encoder's acceleration noise times the inertia is kept below
+    :data:`ENCODER_SHARE` times the filtered torque noise.
+    """
     f_m = max(_bandwidth(q, rate), 10.0 / (q.shape[0] / rate))
     signal = SIGNAL_FACTOR * f_m
     nyquist = rate / MIN_RATE_OVER_CUTOFF
-    # the acceleration's RMS, from a gentle estimate (cut at the signal bound)
-    b, a = scipy.signal.butter(BUTTER_ORDER, min(signal, nyquist) / (rate / 2))
-    qf = scipy.signal.filtfilt(b, a, q, axis=0)
-    acc = np.gradient(np.gradient(qf, axis=0), axis=0) * rate**2
-    rms = np.sqrt(np.mean(acc**2, axis=0))
-    moving = (step > 0) & (rms > 0)
+    ok = (step > 0) & (inertia > 0) & (noise > 0)
     encoder = np.inf
-    if moving.any():
-        # sigma_ddq(f_c) = ENCODER_SHARE * rms, solved for f_c per joint; the tightest joint
-        per = (ENCODER_SHARE * rms[moving]) ** 2 * 12 * 5 * rate / (2 * (2 * np.pi) ** 4)
-        encoder = float(np.min((per / step[moving] ** 2) ** 0.2))
-    cutoff = min(signal, nyquist, encoder)
-    cutoff = max(cutoff, 2.0 * f_m)  # never below the motion itself
+    if ok.any():
+        per = ENCODER_SHARE * noise[ok] * np.sqrt(60.0) / (inertia[ok] * step[ok] * (2 * np.pi) ** 2)
+        encoder = float(np.sqrt(per.min()))
+    cutoff = max(min(signal, nyquist, encoder), MIN_OVER_MOTION * f_m)
     return cutoff, {"signal": signal, "encoder": encoder, "rate": nyquist, "motion": f_m}
 
 
@@ -148,6 +183,7 @@ def prepare_signals(
     *,
     counts: int | None = None,
     cutoff: float | None = None,
+    inertia: np.ndarray | None = None,
     source: str | None = None,
 ) -> ArmSignals:
     """Filter, differentiate and decimate a log's position and torque (module notes).
@@ -160,6 +196,9 @@ def prepare_signals(
         Encoder counts per revolution (else read from the position's steps).
     cutoff : float, optional
         The low-pass cut-off [Hz] (else :func:`choose_cutoff`).
+    inertia : ndarray (n,), optional
+        Each joint's mean diagonal of the mass matrix [kg m^2] (the encoder bound; without
+        it, that bound is not applied).
     source : str, optional
         The log's file, named in errors.
     """
@@ -175,35 +214,47 @@ def prepare_signals(
     step = encoder_step(position, counts)
     bounds: dict[str, float] = {}
     if cutoff is None:
-        cutoff, bounds = choose_cutoff(position, rate, step)
+        inertia = np.zeros(position.shape[1]) if inertia is None else np.asarray(inertia)
+        cutoff, bounds = choose_cutoff(position, rate, step, torque_noise(torque), inertia)
     cutoff = min(float(cutoff), 0.45 * rate)
-    edge = int(np.ceil(EDGE_PERIODS * rate / cutoff))
-    if position.shape[0] < 4 * edge + 20:
+    low = scipy.signal.butter(BUTTER_ORDER, cutoff / (rate / 2))
+    qf = _filt(low, position)
+    dq = np.gradient(qf, axis=0) * rate
+    ddq = np.gradient(dq, axis=0) * rate
+    # stage 0: anti-alias far above the cut-off (no droop where the signals are), decimate
+    first = max(1, int(rate / (MID_RATE_OVER_CUTOFF * cutoff)))
+    mid_rate = rate / first
+    anti = scipy.signal.butter(BUTTER_ORDER, min(ANTI_ALIAS_SHARE * mid_rate, 0.9 * rate / 2) / (rate / 2))
+    # stage 1: the low-pass at the intermediate rate, on the torque and on every column
+    low_mid = scipy.signal.butter(BUTTER_ORDER, cutoff / (mid_rate / 2))
+    edge = int(np.ceil(EDGE_PERIODS * mid_rate / cutoff))
+    n_mid = len(range(0, position.shape[0], first))
+    if n_mid < 4 * edge + 20:
         raise DataError(
             f"the log is too short ({position.shape[0]} samples) for a low-pass at "
             f"{cutoff:.3g} Hz",
             file=source,
         )
-    b, a = scipy.signal.butter(BUTTER_ORDER, cutoff / (rate / 2))
-    q = scipy.signal.filtfilt(b, a, position, axis=0)
-    tau = scipy.signal.filtfilt(b, a, torque, axis=0)
-    dq = np.gradient(q, axis=0) * rate
-    ddq = np.gradient(dq, axis=0) * rate
-    factor = max(1, int(rate / (RATE_OVER_CUTOFF * cutoff)))
-    keep = slice(edge, position.shape[0] - edge, factor)
+    factor = max(1, int(mid_rate / (RATE_OVER_CUTOFF * cutoff)))
+    keep = slice(edge, n_mid - edge, factor)
+    tau = _filt(low_mid, _filt(anti, torque)[::first])[keep]
+    pick = np.arange(n_mid)[keep] * first
     return ArmSignals(
-        time=time[keep],
-        q=q[keep],
-        dq=dq[keep],
-        ddq=ddq[keep],
-        tau=tau[keep],
+        time=time[pick],
+        q=qf[pick],
+        dq=dq[pick],
+        ddq=ddq[pick],
+        tau=tau,
         rate=rate,
         cutoff=cutoff,
-        decimation=factor,
+        decimation=first * factor,
         encoder_step=step,
         bounds=bounds,
         velocity_noise=_velocity_noise(step, rate, cutoff),
         full_dq=dq,
-        ba=(b, a),
+        anti_alias=anti,
+        first=first,
+        low_pass=low_mid,
         keep=keep,
+        mid=(qf[::first], dq[::first], ddq[::first]),
     )

@@ -13,16 +13,17 @@ which no law of velocity says.
 * The Stribeck shapes ``(w_s, delta)`` of each joint and direction are found by variable
   projection (Golub and Pereyra 1973) one block at a time: with every other column fixed, the
   sum of squares with the excess column ``x`` is ``SSE_0 - (x' r_0)^2 / (x' (I - P_0) x)``,
-  evaluated for a grid of shapes at once, then on finer grids around the best; the blocks are
-  swept twice.
+  evaluated for a grid of shapes at once, then polished by Nelder-Mead over
+  ``(log w_s, delta)``; the blocks are swept twice.
 * Covariance (:func:`arm_covariance`): residuals of low-passed signals are correlated over
   about ``1 / f_c``, so 60 000 samples are far fewer independent ones. The correlation length
   ``L`` is the first lag at which the residuals' autocorrelation (averaged over the joints)
   falls below :data:`RHO_END`; the effective sample size per joint is ``m_j / (1 + 2 sum_{k
-  <= L} rho_k)``; the covariance is the cluster-robust sandwich (Liang and Zeger 1986;
-  :func:`fricid.identify.dynamic._data.cluster_covariance`) over contiguous blocks of
-  :data:`BLOCK_OVER_L` ``L`` instants (all joints of an instant in one cluster, so the
-  correlation between joints counts too), never below the plain estimate.
+  <= L} rho_k)``; the covariance is the sandwich of Newey and West (1987) with Bartlett
+  weights over :data:`LAGS_OVER_L` ``L`` instants (:func:`hac_covariance`), never below the
+  plain estimate. (The cluster-robust sandwich over contiguous blocks that
+  :mod:`._data` uses for one joint needs blocks many times ``L`` long and many of them; a
+  15 s log has too few, and its intervals came out too narrow.)
 """
 
 from __future__ import annotations
@@ -30,22 +31,23 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.optimize
 
 from ._arm_friction import DELTA_BOX, W_S_BOX, JointFriction
 from ._arm_signals import ArmSignals
-from ._data import cluster_covariance
+from ..static.uncertainty import covariance_svd
 
 __all__ = ["Stack", "arm_covariance", "search_shapes", "stack", "wls"]
 
 #: The autocorrelation below which residuals count as uncorrelated.
 RHO_END = 0.05
-#: Cluster length over the correlation length.
-BLOCK_OVER_L = 10
-#: Fewest clusters.
-MIN_CLUSTERS = 30
+#: The covariance's lags over the correlation length.
+LAGS_OVER_L = 5
 #: The first grid of Stribeck shapes.
 W_S_GRID = np.geomspace(2e-3, 0.6, 14)
 DELTA_GRID = np.array([0.5, 0.75, 1.0, 1.5, 2.0, 3.0])
+#: Most evaluations of a block's local polish.
+POLISH_EVALS = 60
 
 
 @dataclass
@@ -113,27 +115,64 @@ def wls(st: Stack, n: int) -> tuple[np.ndarray, np.ndarray]:
     return theta, noise(st, theta, n)
 
 
-def _gain(A: np.ndarray, y: np.ndarray, k: int, rows: np.ndarray, X: np.ndarray) -> np.ndarray:
+def _projector(A: np.ndarray, y: np.ndarray, k: int, rows: np.ndarray):
     """The drop of the sum of squares when column ``k`` of ``A`` is each column of ``X``
-    (non-zero on ``rows`` only; module notes)."""
+    (non-zero on ``rows`` only; module notes), as a function of ``X``."""
     Am = np.delete(A, k, axis=1)
     norms = np.linalg.norm(Am, axis=0)
     norms[norms == 0] = 1.0
     As = Am / norms
     beta, *_ = np.linalg.lstsq(As, y, rcond=1e-10)
-    r0 = y - As @ beta
-    G = np.linalg.pinv(As.T @ As, rcond=1e-12)
-    C = As[rows].T @ X
-    num = (X.T @ r0[rows]) ** 2
-    den = np.einsum("ik,ik->k", X, X) - np.einsum("ik,ij,jk->k", C, G, C)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        return np.where(den > 1e-12 * np.einsum("ik,ik->k", X, X), num / den, -np.inf)
+    r0 = y[rows] - As[rows] @ beta
+    G = np.linalg.pinv(As.T @ As, rcond=1e-12, hermitian=True)
+    Ar = As[rows]
+
+    def gain(X: np.ndarray) -> np.ndarray:
+        C = Ar.T @ X
+        xx = np.einsum("ik,ik->k", X, X)
+        den = xx - np.einsum("ik,ij,jk->k", C, G, C)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return np.where(den > 1e-12 * xx, (X.T @ r0) ** 2 / den, -np.inf)
+
+    return gain
 
 
 def _candidates(
     sig: ArmSignals, jf: JointFriction, j: int, d: str, w: np.ndarray, e: np.ndarray
 ) -> np.ndarray:
     return sig.parallel(jf.excess_column(sig.full_dq[:, j], d, w, e))
+
+
+def _block(sig, Yb, frictions, mask, sigma, j, k, d) -> None:
+    """One joint and direction's shapes: a grid, then a local polish (module notes)."""
+    jf = frictions[j]
+    st = stack(Yb, sig, frictions, mask)
+    A, y = st.weighted(sigma)
+    rows = np.flatnonzero(st.row_joint == j)
+    gain = _projector(A, y, st.offsets[j] + 3 * k + 1, rows)
+    t_rows = st.row_time[rows]
+
+    def gains(w: np.ndarray, e: np.ndarray) -> np.ndarray:
+        return gain(_candidates(sig, jf, j, d, w, e)[t_rows] / sigma[j])
+
+    w_grid, e_grid = (g.ravel() for g in np.meshgrid(W_S_GRID, DELTA_GRID))
+    g = gains(w_grid, e_grid)
+    if not np.isfinite(g).any():
+        return
+    best = int(np.argmax(g))
+    x0 = np.array([np.log(w_grid[best]), e_grid[best]])
+    box = [(np.log(W_S_BOX[0]), np.log(W_S_BOX[1])), DELTA_BOX]
+
+    def objective(x: np.ndarray) -> float:
+        v = gains(np.exp(x[:1]), x[1:])[0]
+        return -float(v) if np.isfinite(v) else 0.0
+
+    sol = scipy.optimize.minimize(
+        objective, x0, method="Nelder-Mead", bounds=box,
+        options={"xatol": 1e-3, "fatol": 1e-9 * abs(g[best]), "maxfev": POLISH_EVALS},
+    )
+    x = sol.x if sol.fun <= -g[best] else x0
+    jf.shapes[d] = (float(np.exp(x[0])), float(x[1]))
 
 
 def search_shapes(
@@ -145,33 +184,12 @@ def search_shapes(
     sweeps: int = 2,
 ) -> None:
     """Set each Stribeck joint's shapes by variable projection (module notes), in place."""
-    n = len(frictions)
     for _ in range(sweeps):
         for j, jf in enumerate(frictions):
             if not jf.stribeck or not mask[:, j].any():
                 continue
             for k, d in enumerate(jf.directions):
-                st = stack(Yb, sig, frictions, mask)
-                A, y = st.weighted(sigma)
-                col = st.offsets[j] + 3 * k + 1
-                rows = np.flatnonzero(st.row_joint == j)
-                t_rows = st.row_time[rows]
-                w_grid, e_grid = np.meshgrid(W_S_GRID, DELTA_GRID)
-                w_grid, e_grid = w_grid.ravel(), e_grid.ravel()
-                for zoom in (None, 1.6, 1.15):
-                    if zoom is not None:
-                        w0, e0 = jf.shapes[d]
-                        w_grid, e_grid = np.meshgrid(
-                            np.clip(w0 * zoom ** np.linspace(-2, 2, 7), *W_S_BOX),
-                            np.clip(e0 * zoom ** np.linspace(-1, 1, 5), *DELTA_BOX),
-                        )
-                        w_grid, e_grid = w_grid.ravel(), e_grid.ravel()
-                    X = _candidates(sig, jf, j, d, w_grid, e_grid)[t_rows] / sigma[j]
-                    gain = _gain(A, y, col, rows, X)
-                    if np.isfinite(gain).any():
-                        best = int(np.argmax(gain))
-                        jf.shapes[d] = (float(w_grid[best]), float(e_grid[best]))
-    del n
+                _block(sig, Yb, frictions, mask, sigma, j, k, d)
 
 
 def correlation_length(res: np.ndarray, row_joint: np.ndarray, row_time: np.ndarray, n: int):
@@ -198,12 +216,38 @@ def correlation_length(res: np.ndarray, row_joint: np.ndarray, row_time: np.ndar
     return L, counts / inflation
 
 
+def hac_covariance(J: np.ndarray, res: np.ndarray, times: np.ndarray, lags: int):
+    """Heteroscedasticity- and autocorrelation-consistent covariance (Newey and West 1987,
+    Bartlett weights over ``lags`` instants; each instant's score sums its joints' rows, so the
+    correlation between joints counts), never below the plain estimate; NaN where the data do
+    not determine a parameter. Returns (cov, stderr)."""
+    m, p = J.shape
+    plain, determined = covariance_svd(J, float(res @ res) / max(m - p, 1))
+    bread, _ = covariance_svd(J, 1.0)
+    bread = np.nan_to_num(bread)
+    T = int(times.max()) + 1
+    scores = np.zeros((T, p))
+    np.add.at(scores, times, J * res[:, None])
+    meat = scores.T @ scores
+    for lag in range(1, lags + 1):
+        gamma = scores[lag:].T @ scores[:-lag]
+        meat += (1 - lag / (lags + 1)) * (gamma + gamma.T)
+    cov = bread @ meat @ bread * m / max(m - p, 1)
+    with np.errstate(invalid="ignore"):
+        var = np.maximum(np.diag(cov), np.nan_to_num(np.diag(plain)))
+        se = np.where(determined, np.sqrt(np.clip(var, 0, None)), np.nan)
+        d = np.sqrt(np.clip(np.diag(cov), 0, None))
+        corr = cov / np.outer(d, d)
+        cov = corr * np.outer(se, se)
+    cov[~determined, :] = np.nan
+    cov[:, ~determined] = np.nan
+    return cov, se
+
+
 def arm_covariance(J: np.ndarray, res: np.ndarray, st: Stack, n: int):
-    """(cov, stderr, clusters, L, effective samples) of the weighted problem (module notes)."""
+    """(cov, stderr, dof, L, effective samples) of the weighted problem (module notes)."""
     L, n_eff = correlation_length(res, st.row_joint, st.row_time, n)
+    lags = LAGS_OVER_L * L
+    cov, se = hac_covariance(J, res, st.row_time, lags)
     T = int(st.row_time.max()) + 1
-    block = max(BLOCK_OVER_L * L, 1)
-    if T // block < MIN_CLUSTERS:
-        block = max(T // MIN_CLUSTERS, 1)
-    cov, se, g = cluster_covariance(J, res, st.row_time // block)
-    return cov, se, g, L, n_eff
+    return cov, se, max(T // (lags + 1), 2), L, n_eff

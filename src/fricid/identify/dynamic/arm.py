@@ -72,7 +72,13 @@ def _log_arrays(log: RobotLog, model: RigidBodyModel) -> tuple[np.ndarray, ...]:
 
 def _signals(log: RobotLog, model, counts, cutoff) -> ArmSignals:
     t, q, tau = _log_arrays(log, model)
-    return prepare_signals(t, q, tau, counts=counts, cutoff=cutoff, source=log.source)
+    inertia = None
+    if cutoff is None:  # the mean diagonal of the mass matrix over the log
+        rows = np.linspace(0, len(t) - 1, 25).astype(int)
+        inertia = np.diagonal(model.mass_matrix(q[rows]), axis1=1, axis2=2).mean(axis=0)
+    return prepare_signals(
+        t, q, tau, counts=counts, cutoff=cutoff, inertia=inertia, source=log.source
+    )
 
 
 def _moving(sig: ArmSignals) -> np.ndarray:
@@ -81,8 +87,7 @@ def _moving(sig: ArmSignals) -> np.ndarray:
 
 
 def _predict(model, bp, beta, frictions, sig: ArmSignals, theta_f: list[np.ndarray]):
-    Yb = bp.columns(model.regressor(sig.q, sig.dq, sig.ddq))
-    tau = Yb @ beta
+    tau = sig.regressor(model, bp) @ beta
     for j, jf in enumerate(frictions):
         cols = sig.parallel(jf.columns(sig.full_dq[:, j]))
         tau[:, j] += cols @ np.nan_to_num(theta_f[j])
@@ -224,7 +229,7 @@ def _fit_arm(
     if not moving.any():
         raise DataError("no joint moves in the log: nothing to identify", file=log.source)
     bp = base_parameters(model)
-    Yb = bp.columns(model.regressor(sig.q, sig.dq, sig.ddq))
+    Yb = sig.regressor(model, bp)
     n = model.n
     st = stack(Yb, sig, frictions, moving)
     theta, sigma = wls(st, n)
