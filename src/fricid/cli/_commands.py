@@ -19,6 +19,7 @@ MODULES = (
     "report",
     "reproduce",
     "fleet",
+    "robot_fit",
 )
 
 for _name in MODULES:

@@ -22,6 +22,7 @@ import numpy as np
 
 from ..errors import ConfigError, DataError
 from ..io._jsonfile import read_json
+from ..metrics import verdict
 from ._file import _clean
 from ._parameter import Parameter
 
@@ -124,9 +125,11 @@ class ArmFit:
                 "estimator": self.provenance.get("estimator"),
             },
             validation={
-                "scheme": check.get("source", ""),
+                "scheme": f"whole-arm held out: {check.get('source', '')}",
+                "rmse": check.get("rmse"),
+                "scatter": self.noise.get(joint),
                 "ratio": check.get("ratio"),
-                "verdict": check.get("level"),
+                "verdict": verdict(_nan(check.get("ratio"))),
             },
         )
 

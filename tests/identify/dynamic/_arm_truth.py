@@ -21,7 +21,7 @@ def reference(model, duration, rate, seed, *, f0=0.1, speed=1.0, hold=()):
     """(t, q, dq, ddq): a multi-sine per joint, about ``speed`` rad/s RMS, centred in the
     joint's range; joints in ``hold`` stay at their centre."""
     rng = np.random.default_rng(seed)
-    t = np.arange(int(round(duration * rate))) / rate
+    t = np.arange(round(duration * rate)) / rate
     lo = np.where(np.isfinite(model.lower), model.lower, -np.pi)
     hi = np.where(np.isfinite(model.upper), model.upper, np.pi)
     centre, half = (lo + hi) / 2, (hi - lo) / 2
@@ -71,9 +71,15 @@ def make_log(
     hold=(),
     speed=1.0,
     source="truth",
+    trajectory=None,
 ):
-    """A :class:`RobotLog` of the arm along its reference (module notes)."""
-    t, q, dq, ddq = reference(model, duration, rate, seed, speed=speed, hold=hold)
+    """A :class:`RobotLog` of the arm along its reference (module notes), or along
+    ``trajectory = (t, q, dq, ddq)`` when given (``duration``, ``rate``, ``speed``, ``hold``
+    then unused)."""
+    if trajectory is None:
+        trajectory = reference(model, duration, rate, seed, speed=speed, hold=hold)
+    t, q, dq, ddq = trajectory
+    rate = 1.0 / float(np.median(np.diff(t)))
     rng = np.random.default_rng(seed + 10_000)
     tau = model.inverse_dynamics(q, dq, ddq) + friction_torque(laws, dq)
     tau = tau + rng.normal(0.0, 1.0, tau.shape) * np.broadcast_to(noise, (model.n,))

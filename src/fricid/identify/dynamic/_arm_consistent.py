@@ -42,15 +42,18 @@ def _pi(theta: np.ndarray) -> np.ndarray:
     th = theta.reshape(theta.shape[0], -1, 10)
     alpha, d1, d2, d3, s12, s23, s13, t1, t2, t3 = np.moveaxis(th, -1, 0)
     zero = np.zeros_like(alpha)
-    U = np.stack(
-        [
-            np.stack([np.exp(d1), s12, s13, t1], -1),
-            np.stack([zero, np.exp(d2), s23, t2], -1),
-            np.stack([zero, zero, np.exp(d3), t3], -1),
-            np.stack([zero, zero, zero, zero + 1.0], -1),
-        ],
-        -2,
-    ) * np.exp(alpha)[..., None, None]
+    U = (
+        np.stack(
+            [
+                np.stack([np.exp(d1), s12, s13, t1], -1),
+                np.stack([zero, np.exp(d2), s23, t2], -1),
+                np.stack([zero, zero, np.exp(d3), t3], -1),
+                np.stack([zero, zero, zero, zero + 1.0], -1),
+            ],
+            -2,
+        )
+        * np.exp(alpha)[..., None, None]
+    )
     J = U @ np.swapaxes(U, -1, -2)
     sigma = J[..., :3, :3]
     tr = sigma[..., 0, 0] + sigma[..., 1, 1] + sigma[..., 2, 2]

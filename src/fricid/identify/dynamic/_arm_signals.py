@@ -165,7 +165,9 @@ def choose_cutoff(
     ok = (step > 0) & (inertia > 0) & (noise > 0)
     encoder = np.inf
     if ok.any():
-        per = ENCODER_SHARE * noise[ok] * np.sqrt(60.0) / (inertia[ok] * step[ok] * (2 * np.pi) ** 2)
+        per = (
+            ENCODER_SHARE * noise[ok] * np.sqrt(60.0) / (inertia[ok] * step[ok] * (2 * np.pi) ** 2)
+        )
         encoder = float(np.sqrt(per.min()))
     cutoff = max(min(signal, nyquist, encoder), MIN_OVER_MOTION * f_m)
     return cutoff, {"signal": signal, "encoder": encoder, "rate": nyquist, "motion": f_m}
@@ -224,15 +226,16 @@ def prepare_signals(
     # stage 0: anti-alias far above the cut-off (no droop where the signals are), decimate
     first = max(1, int(rate / (MID_RATE_OVER_CUTOFF * cutoff)))
     mid_rate = rate / first
-    anti = scipy.signal.butter(BUTTER_ORDER, min(ANTI_ALIAS_SHARE * mid_rate, 0.9 * rate / 2) / (rate / 2))
+    anti = scipy.signal.butter(
+        BUTTER_ORDER, min(ANTI_ALIAS_SHARE * mid_rate, 0.9 * rate / 2) / (rate / 2)
+    )
     # stage 1: the low-pass at the intermediate rate, on the torque and on every column
     low_mid = scipy.signal.butter(BUTTER_ORDER, cutoff / (mid_rate / 2))
     edge = int(np.ceil(EDGE_PERIODS * mid_rate / cutoff))
     n_mid = len(range(0, position.shape[0], first))
     if n_mid < 4 * edge + 20:
         raise DataError(
-            f"the log is too short ({position.shape[0]} samples) for a low-pass at "
-            f"{cutoff:.3g} Hz",
+            f"the log is too short ({position.shape[0]} samples) for a low-pass at {cutoff:.3g} Hz",
             file=source,
         )
     factor = max(1, int(mid_rate / (RATE_OVER_CUTOFF * cutoff)))

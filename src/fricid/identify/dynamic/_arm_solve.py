@@ -33,9 +33,9 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.optimize
 
+from ..static.uncertainty import covariance_svd
 from ._arm_friction import DELTA_BOX, W_S_BOX, JointFriction
 from ._arm_signals import ArmSignals
-from ..static.uncertainty import covariance_svd
 
 __all__ = ["Stack", "arm_covariance", "search_shapes", "stack", "wls"]
 
@@ -168,7 +168,10 @@ def _block(sig, Yb, frictions, mask, sigma, j, k, d) -> None:
         return -float(v) if np.isfinite(v) else 0.0
 
     sol = scipy.optimize.minimize(
-        objective, x0, method="Nelder-Mead", bounds=box,
+        objective,
+        x0,
+        method="Nelder-Mead",
+        bounds=box,
         options={"xatol": 1e-3, "fatol": 1e-9 * abs(g[best]), "maxfev": POLISH_EVALS},
     )
     x = sol.x if sol.fun <= -g[best] else x0

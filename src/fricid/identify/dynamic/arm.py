@@ -35,7 +35,7 @@ from typing import Any
 import numpy as np
 import scipy.stats
 
-from ...errors import ConfigError, DataError
+from ...errors import DataError
 from ...fitted.arm import ArmFit
 from ...metrics import NOISE_RATIO, verdict
 from ...models import get_model
@@ -44,9 +44,9 @@ from ...robot import RigidBodyModel, base_parameters
 from ...samples import RobotLog
 from ..trust import MISS_RATIO
 from ._arm_consistent import consistent_parameters
-from ._arm_friction import DELTA_BOX, W_S_BOX, JointFriction, friction_for
+from ._arm_friction import DELTA_BOX, W_S_BOX, friction_for
 from ._arm_signals import ArmSignals, prepare_signals
-from ._arm_solve import arm_covariance, lstsq, noise, search_shapes, stack, wls
+from ._arm_solve import arm_covariance, lstsq, search_shapes, stack, wls
 
 __all__ = ["HELDOUT_SHARE", "fit_arm"]
 
@@ -106,8 +106,10 @@ def _friction_records(frictions, theta, cov, st, joints, t, sig, moving, models_
         idx = list(range(lo, lo + k))
         values = theta[idx]
         if jf.stribeck:
-            shape_idx = [st.A.shape[1] + sum(2 * len(f.directions) for f in frictions[:j] if f.stribeck) + i
-                         for i in range(2 * len(jf.directions))]
+            shape_idx = [
+                st.A.shape[1] + sum(2 * len(f.directions) for f in frictions[:j] if f.stribeck) + i
+                for i in range(2 * len(jf.directions))
+            ]
             idx += shape_idx
             values = np.concatenate([values, [x for d in jf.directions for x in jf.shapes[d]]])
         sub = cov[np.ix_(idx, idx)]
@@ -218,8 +220,9 @@ def _fit_arm(
         An unknown friction family.
     """
     start = _time.perf_counter()
-    frictions = friction_for(model.joints, dict(friction) if isinstance(friction, Mapping)
-                             else friction)
+    frictions = friction_for(
+        model.joints, dict(friction) if isinstance(friction, Mapping) else friction
+    )
     source = "second log" if validate is not None else "last quarter of the log"
     if validate is None:
         cut = int(len(log) * (1 - HELDOUT_SHARE))
@@ -243,13 +246,16 @@ def _fit_arm(
     res = y - A @ theta
     shape_cols = [
         sig.parallel(jf.shape_jacobian(sig.full_dq[:, j], theta[st.offsets[j] :]))
-        for j, jf in enumerate(frictions) if jf.stribeck
+        for j, jf in enumerate(frictions)
+        if jf.stribeck
     ]
     J = A
     if shape_cols:
         extra = np.zeros((A.shape[0], sum(c.shape[1] for c in shape_cols)))
         col = 0
-        for j, c in zip([j for j, f in enumerate(frictions) if f.stribeck], shape_cols, strict=True):
+        for j, c in zip(
+            [j for j, f in enumerate(frictions) if f.stribeck], shape_cols, strict=True
+        ):
             rows = st.row_joint == j
             extra[rows, col : col + c.shape[1]] = c[st.row_time[rows]] / safe[j]
             col += c.shape[1]
@@ -263,7 +269,9 @@ def _fit_arm(
     if consistent:
         cons = consistent_parameters(beta_ls, cov[:r, :r], bp, model.parameters())
         standard.update(
-            values=cons["pi"].tolist(), consistent_ls=cons["ls_consistent"], d2=cons["d2"],
+            values=cons["pi"].tolist(),
+            consistent_ls=cons["ls_consistent"],
+            d2=cons["d2"],
             used="least squares" if cons["ls_consistent"] else "consistent",
         )
         if not cons["ls_consistent"]:
@@ -271,14 +279,24 @@ def _fit_arm(
             # the friction given the consistent inertial parameters
             fr = lstsq(A[:, r:], y - A[:, :r] @ beta)
             theta = np.concatenate([beta, fr])
-    units = {f: dict(zip(get_model(f).param_names, (p.unit for p in get_model(f).parameters),
-                         strict=True)) for f in {jf.family for jf in frictions}}
+    units = {
+        f: dict(
+            zip(get_model(f).param_names, (p.unit for p in get_model(f).parameters), strict=True)
+        )
+        for f in {jf.family for jf in frictions}
+    }
     fric = _friction_records(frictions, theta, cov, st, model.joints, t, sig, moving, units)
     # held-out validation with the same filter
     vsig = _signals(validate, model, encoder_counts, sig.cutoff)
     vmoving = _moving(vsig)
-    pred = _predict(model, bp, beta, frictions, vsig, [theta[o : o + len(jf.linear_names)]
-                                                       for o, jf in zip(st.offsets, frictions, strict=True)])
+    pred = _predict(
+        model,
+        bp,
+        beta,
+        frictions,
+        vsig,
+        [theta[o : o + len(jf.linear_names)] for o, jf in zip(st.offsets, frictions, strict=True)],
+    )
     err = vsig.tau - pred
     validation = {}
     for j, name in enumerate(model.joints):
@@ -289,8 +307,13 @@ def _fit_arm(
         nd = [p for p, rec in recs.items() if rec["not_determined"]]
         open_ = [p for p, rec in recs.items() if rec["note"].startswith("not bounded")]
         level, reasons = _grade(ratio, nd, open_, source, bool(moving[:, j].any()))
-        validation[name] = {"rmse": rmse, "ratio": ratio, "source": source, "level": level,
-                            "reasons": reasons}
+        validation[name] = {
+            "rmse": rmse,
+            "ratio": ratio,
+            "source": source,
+            "level": level,
+            "reasons": reasons,
+        }
     base_se = se[:r]
     return ArmFit(
         joints=model.joints,
