@@ -18,7 +18,10 @@ over the estimated noise, and the base inertial parameters' coverage and the sec
 identification.
 
 Truth: ``--truth own`` is the tests' generator (``tests/identify/dynamic/_arm_truth.py``: the
-arm follows the reference exactly, an open-loop measurement). ``--truth sim`` (the whole-arm
+arm follows the reference exactly, an open-loop measurement); ``--truth pd`` is its
+closed-loop variant (``make_pd_log``: a 10 Hz PD on the quantised position with the inverse
+dynamics as feed-forward, the arm integrated semi-implicitly at 4 kHz, friction not
+compensated, an optional torque ``--disturbance``). ``--truth sim`` (the whole-arm
 simulator with PD tracking, ``fricid.sim``) is used when that simulator is installed.
 """
 
@@ -77,13 +80,17 @@ def _logs(model, laws, seed, args, trajectory):
     if args.truth == "sim":
         raise SystemExit("--truth sim: the whole-arm simulator is not installed in this fricid")
     kw = {"duration": args.duration, "rate": args.rate, "noise": args.noise}
-    one = truth.make_log(model, laws, seed=seed, trajectory=trajectory, **kw)
-    two = truth.make_log(model, laws, seed=seed + 5_000, trajectory=trajectory, **kw)
+    make = truth.make_log
+    if args.truth == "pd":
+        make = truth.make_pd_log
+        kw["disturbance"] = args.disturbance
+    one = make(model, laws, seed=seed, trajectory=trajectory, **kw)
+    two = make(model, laws, seed=seed + 5_000, trajectory=trajectory, **kw)
     return one, two
 
 
 def run(args) -> None:
-    path, joints = example_urdf("panda")
+    path, joints = example_urdf(args.robot)
     model = RigidBodyModel.from_urdf(path, joints)
     beta_true = base_parameters(model).project(model.parameters())
     trajectory = _trajectory(args.trajectory, model) if args.trajectory else None
@@ -121,8 +128,8 @@ def run(args) -> None:
         print(f"seed {seed}: {seconds[-1]:.1f} s", file=sys.stderr, flush=True)
     kinds = [k for k in KINDS if any((j, k) in cov for j in model.joints)]
     print(
-        f"Panda, {args.seeds} seeds, {args.duration:g} s at {args.rate:g} Hz, 2^17 counts, noise "
-        f"{args.noise:g} N m, friction {args.friction}, truth {args.truth}"
+        f"{args.robot}, {args.seeds} seeds, {args.duration:g} s at {args.rate:g} Hz, 2^17 "
+        f"counts, noise {args.noise:g} N m, friction {args.friction}, truth {args.truth}"
         + (f", trajectory {args.trajectory.name}" if args.trajectory else ", multi-sine")
     )
     head = " ".join(f"{k + ' err/cov':>17}" for k in kinds)
@@ -149,6 +156,7 @@ def run(args) -> None:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seeds", type=int, default=10)
+    parser.add_argument("--robot", default="panda", help="an example robot (panda, ur5, ...)")
     parser.add_argument("--duration", type=float, default=60.0)
     parser.add_argument("--rate", type=float, default=1000.0)
     parser.add_argument("--noise", type=float, default=0.05)
@@ -156,7 +164,10 @@ def main() -> None:
         "--friction", choices=("stribeck_asym", "coulomb_viscous_asym"), default="stribeck_asym"
     )
     parser.add_argument("--trajectory", type=Path, default=None)
-    parser.add_argument("--truth", choices=("own", "sim"), default="own")
+    parser.add_argument("--truth", choices=("own", "pd", "sim"), default="own")
+    parser.add_argument(
+        "--disturbance", type=float, default=0.0, help="--truth pd: torque disturbance [N m]"
+    )
     run(parser.parse_args())
 
 

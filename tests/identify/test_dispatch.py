@@ -49,7 +49,7 @@ def test_the_kind_is_decided_by_the_data_and_the_model():
     assert all(kind_of(s, m) == "learned" for m in ("rbf", "hybrid", "gp"))
     assert kind_of(s, " Auto ") == "auto"
     assert kind_of(log, "lugre") == "dynamic"
-    with pytest.raises(ConfigError, match="FrictionSamples, a RawLog .* or a RobotLog"):
+    with pytest.raises(ConfigError, match=r"FrictionSamples, a RawLog .* or a RobotLog"):
         kind_of([1, 2, 3], "stribeck")
 
 

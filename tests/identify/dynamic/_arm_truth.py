@@ -104,3 +104,58 @@ def stribeck_law(rng, scale=1.0):
             f"delta{d}": rng.uniform(0.8, 2.0),
         }
     return "stribeck_asym", values
+
+
+def make_pd_log(
+    model,
+    laws,
+    *,
+    duration=20.0,
+    rate=1000.0,
+    seed=0,
+    counts=2**17,
+    noise=0.05,
+    disturbance=0.05,
+    bandwidth=10.0,
+    substeps=4,
+    source="truth-pd",
+    trajectory=None,
+):
+    """A :class:`RobotLog` of the arm tracking its reference in closed loop: a PD of
+    ``bandwidth`` Hz on the quantised position plus the model's inverse dynamics along the
+    reference as feed-forward (friction not compensated), a white torque ``disturbance``
+    [N m] acting on the arm, integrated semi-implicitly at ``substeps`` times the log's rate;
+    the logged torque is the command plus ``noise``."""
+    if trajectory is None:
+        trajectory = reference(model, duration, rate, seed)
+    t, q_r, dq_r, ddq_r = trajectory
+    rate = 1.0 / float(np.median(np.diff(t)))
+    rng = np.random.default_rng(seed + 20_000)
+    ff = model.inverse_dynamics(q_r, dq_r, ddq_r)
+    inertia = np.diagonal(model.mass_matrix(q_r[:: max(len(t) // 20, 1)]), axis1=1, axis2=2)
+    m = inertia.mean(axis=0)
+    w = 2 * np.pi * bandwidth
+    kp, kd = m * w**2, 2 * 0.7 * w * m
+    step = 2 * np.pi / counts
+    h = 1.0 / (rate * substeps)
+    q, dq = q_r[0].copy(), dq_r[0].copy()
+    pos = np.empty_like(q_r)
+    tau_log = np.empty_like(q_r)
+    q_prev = np.round(q / step) * step
+    for k in range(len(t)):
+        q_meas = np.round(q / step) * step
+        v_meas = (q_meas - q_prev) * rate if k else dq_r[0]
+        q_prev = q_meas
+        tau = ff[k] + kp * (q_r[k] - q_meas) + kd * (dq_r[k] - v_meas)
+        pos[k], tau_log[k] = q_meas, tau
+        for _ in range(substeps):
+            fr = friction_torque(laws, dq[None, :])[0]
+            dist = rng.normal(0.0, disturbance * np.sqrt(substeps), model.n)
+            acc = model.forward_dynamics(q[None, :], dq[None, :], (tau - fr + dist)[None, :])[0]
+            dq = dq + h * acc
+            q = q + h * dq
+    tau_log = tau_log + rng.normal(0.0, noise, tau_log.shape)
+    vel = np.gradient(pos, axis=0) * rate
+    return RobotLog(
+        time=t, joints=model.joints, position=pos, velocity=vel, torque=tau_log, source=source
+    )
