@@ -13,8 +13,8 @@ which no law of velocity says.
 * The Stribeck shapes ``(w_s, delta)`` of each joint and direction are found by variable
   projection (Golub and Pereyra 1973) one block at a time: with every other column fixed, the
   sum of squares with the excess column ``x`` is ``SSE_0 - (x' r_0)^2 / (x' (I - P_0) x)``,
-  evaluated for a grid of shapes at once, then polished by Nelder-Mead over
-  ``(log w_s, delta)``; the blocks are swept twice.
+  evaluated for a grid of shapes at once; the blocks are swept twice, the second time with
+  a polish by Nelder-Mead over ``(log w_s, delta)`` from the grid's best.
 * Covariance (:func:`arm_covariance`): residuals of low-passed signals are correlated over
   about ``1 / f_c``, so 60 000 samples are far fewer independent ones. The correlation length
   ``L`` is the first lag at which the residuals' autocorrelation (averaged over the joints)
@@ -47,7 +47,7 @@ LAGS_OVER_L = 5
 W_S_GRID = np.geomspace(2e-3, 0.6, 14)
 DELTA_GRID = np.array([0.5, 0.75, 1.0, 1.5, 2.0, 3.0])
 #: Most evaluations of a block's local polish.
-POLISH_EVALS = 60
+POLISH_EVALS = 40
 
 
 @dataclass
@@ -143,8 +143,9 @@ def _candidates(
     return sig.parallel(jf.excess_column(sig.full_dq[:, j], d, w, e))
 
 
-def _block(sig, Yb, frictions, mask, sigma, j, k, d) -> None:
-    """One joint and direction's shapes: a grid, then a local polish (module notes)."""
+def _block(sig, Yb, frictions, mask, sigma, j, k, d, polish: bool) -> None:
+    """One joint and direction's shapes: a grid, then (``polish``) a local polish (module
+    notes)."""
     jf = frictions[j]
     st = stack(Yb, sig, frictions, mask)
     A, y = st.weighted(sigma)
@@ -161,6 +162,9 @@ def _block(sig, Yb, frictions, mask, sigma, j, k, d) -> None:
         return
     best = int(np.argmax(g))
     x0 = np.array([np.log(w_grid[best]), e_grid[best]])
+    if not polish:
+        jf.shapes[d] = (float(w_grid[best]), float(e_grid[best]))
+        return
     box = [(np.log(W_S_BOX[0]), np.log(W_S_BOX[1])), DELTA_BOX]
 
     def objective(x: np.ndarray) -> float:
@@ -187,12 +191,12 @@ def search_shapes(
     sweeps: int = 2,
 ) -> None:
     """Set each Stribeck joint's shapes by variable projection (module notes), in place."""
-    for _ in range(sweeps):
+    for sweep in range(sweeps):
         for j, jf in enumerate(frictions):
             if not jf.stribeck or not mask[:, j].any():
                 continue
             for k, d in enumerate(jf.directions):
-                _block(sig, Yb, frictions, mask, sigma, j, k, d)
+                _block(sig, Yb, frictions, mask, sigma, j, k, d, polish=sweep == sweeps - 1)
 
 
 def correlation_length(res: np.ndarray, row_joint: np.ndarray, row_time: np.ndarray, n: int):
