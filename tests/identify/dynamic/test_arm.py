@@ -161,3 +161,23 @@ def test_the_one_public_fit_takes_a_robot_log(pendulum, pendulum_fit):
         fit(log, "arm", "lm", settings={"robot": pendulum})
     with pytest.raises(ConfigError, match="not: seed_count"):
         fit(log, "arm", settings={"robot": pendulum, "seed_count": 1})
+
+
+def test_friction_family_per_joint(pendulum):
+    laws = [
+        ("coulomb_viscous", {"f_c": 0.5, "beta": 0.3}),
+        CV_LAWS[1],
+    ]
+    log = make_log(pendulum, laws, duration=20.0, seed=7, noise=0.05)
+    fit = fit_arm(
+        log, pendulum, friction={"joint1": "coulomb_viscous", "joint2": "coulomb_viscous_asym"}
+    )
+    assert fit.friction["joint1"]["family"] == "coulomb_viscous"
+    assert set(fit.friction["joint1"]["parameters"]) == {"f_c", "beta"}
+    assert fit.friction["joint2"]["family"] == "coulomb_viscous_asym"
+    for joint, (_, truth) in zip(fit.joints, laws, strict=True):
+        for name, rec in fit.friction[joint]["parameters"].items():
+            assert not rec["not_determined"]
+            assert abs(rec["value"] - truth[name]) < 0.03 * truth[name], (joint, name)
+    with pytest.raises(ConfigError, match="not in the model"):
+        fit_arm(log, pendulum, friction={"elbow": "coulomb_viscous"})

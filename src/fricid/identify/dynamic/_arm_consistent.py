@@ -136,7 +136,7 @@ def consistent_parameters(
         with np.errstate(all="ignore"):
             pi = _pi(theta[None, :])[0]
         if not np.isfinite(pi).all():
-            return np.full(target.size + p, 1e150)
+            return np.full(target.size + p, 1e100)
         return np.concatenate([L @ (P @ pi - target), PRIOR_WEIGHT * (pi - pi0) / scale])
 
     def jacobian(theta: np.ndarray) -> np.ndarray:

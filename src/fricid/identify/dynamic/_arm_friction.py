@@ -26,7 +26,7 @@ import numpy as np
 
 from ...errors import ConfigError
 
-__all__ = ["FAMILIES", "JointFriction", "friction_for"]
+__all__ = ["FAMILIES", "JointFriction", "friction_for", "split_direction"]
 
 #: The families a joint's friction may take in a whole-arm fit.
 FAMILIES = ("coulomb_viscous", "coulomb_viscous_asym", "stribeck", "stribeck_asym")
@@ -137,7 +137,7 @@ class JointFriction:
         T = np.zeros((len(self.names), len(internal)))
         pos = {n: i for i, n in enumerate(internal)}
         for r, name in enumerate(self.names):
-            base, d = _split(name)
+            base, d = split_direction(name)
             if base in ("tau_c", "f_c"):
                 T[r, pos[f"coulomb{d}"]] = 1.0
             elif base == "tau_s":
@@ -150,7 +150,7 @@ class JointFriction:
             return T @ values, T @ cov @ T.T
 
 
-def _split(name: str) -> tuple[str, str]:
+def split_direction(name: str) -> tuple[str, str]:
     for d in ("_pos", "_neg"):
         if name.endswith(d):
             return name[: -len(d)], d

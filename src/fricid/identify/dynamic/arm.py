@@ -48,7 +48,7 @@ from ...robot import RigidBodyModel, base_parameters
 from ...samples import RobotLog
 from ..trust import MISS_RATIO
 from ._arm_consistent import consistent_parameters
-from ._arm_friction import DELTA_BOX, W_S_BOX, friction_for
+from ._arm_friction import DELTA_BOX, W_S_BOX, friction_for, split_direction
 from ._arm_signals import ArmSignals, prepare_signals
 from ._arm_solve import arm_covariance, lstsq, search_shapes, stack, wls
 
@@ -122,7 +122,17 @@ def _friction_records(frictions, theta, cov, st, joints, t, sig, moving, models_
         params = {}
         for i, pname in enumerate(jf.names):
             nd = not np.isfinite(se[i])
-            note = "not determined: the joint does not move in this direction" if nd else ""
+            note = ""
+            if nd:
+                # the direction's Coulomb column is empty when the joint never moves that way
+                _, d = split_direction(pname)
+                coulomb = jf.names.index(("tau_c" if jf.stribeck else "f_c") + d)
+                still = not np.isfinite(se[coulomb])
+                note = (
+                    "not determined: the joint does not move in this direction"
+                    if still
+                    else "not determined: the data do not inform it"
+                )
             rec = {
                 "value": None if nd else float(fam_values[i]),
                 "unit": models_units[jf.family].get(pname, ""),
