@@ -20,6 +20,7 @@ MODULES = (
     "reproduce",
     "fleet",
     "robot_simulate",
+    "robot_fit",
 )
 
 for _name in MODULES:
