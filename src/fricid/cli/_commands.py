@@ -19,6 +19,7 @@ MODULES = (
     "report",
     "reproduce",
     "fleet",
+    "robot_extract",
 )
 
 for _name in MODULES:
