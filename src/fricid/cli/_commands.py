@@ -20,6 +20,7 @@ MODULES = (
     "reproduce",
     "fleet",
     "robot_extract",
+    "robot_export",
 )
 
 for _name in MODULES:
