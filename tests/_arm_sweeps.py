@@ -77,11 +77,15 @@ def arm_sweeps(
     noise: float = 0.01,
     velocity_noise: float = 1e-3,
     rest: float = 0.3,
+    companion: float = 0.0,
     seed: int = 0,
 ) -> RobotLog:
     """Sweeps of the joints in ``spans`` (low, high [rad]); speed ``k`` of joint ``j`` is
     swept with the whole arm at ``poses[j][k % len(poses[j])]`` (its own entry replaced by
-    the sweep); torque from ``model`` (the truth) plus ``laws[j]`` and noise [N m]."""
+    the sweep); torque from ``model`` (the truth) plus the friction ``laws`` of every moving
+    joint and noise [N m]. With ``companion`` [rad/s] the other joints of ``laws`` are not
+    held but move at that constant speed through each move (the sign alternating with the
+    swept joint's direction)."""
     rng = np.random.default_rng(seed)
     dt = 1.0 / rate
     chunks_q, chunks_dq, chunks_ddq, chunks_f = [], [], [], []
@@ -97,13 +101,21 @@ def arm_sweeps(
                     v = np.concatenate([np.zeros(still), v])
                     acc = np.concatenate([np.zeros(still), acc])
                     q = np.tile(pose, (x.size, 1))
-                    q[:, j] = x
                     dq = np.zeros_like(q)
+                    others = [model.joints.index(o) for o in laws if o != joint]
+                    if companion:
+                        w = companion * np.sign(b - a)
+                        q[:, others] += w * dt * np.arange(x.size)[:, None]
+                        dq[:, others] = w
+                        pose = q[-1].copy()
+                    q[:, j] = x
                     dq[:, j] = v
                     ddq = np.zeros_like(q)
                     ddq[:, j] = acc
                     f = np.zeros_like(q)
-                    f[:, j] = laws[joint](v)
+                    for name, law in laws.items():
+                        k = model.joints.index(name)
+                        f[:, k] = law(dq[:, k])
                     chunks_q.append(q)
                     chunks_dq.append(dq)
                     chunks_ddq.append(ddq)

@@ -6,8 +6,10 @@ a :class:`~fricid.samples.RobotLog`, with gravity computed from the whole config
 every sample (:mod:`.arm_gravity`):
 
 1. each joint's steady passes, reduced to the moments of its base gravity regressor row and
-   its torque (the rigid-body torque that is not gravity, ``M ddq + C dq`` from the model, is
-   subtracted first: zero on the swept joint itself at constant speed, small elsewhere);
+   its torque (the rigid-body torque that is neither gravity nor the joint's own inertia is
+   subtracted first, from the model: the velocity products ``C dq``, zero on a joint swept
+   alone at constant speed, and the inertial coupling of other joints that accelerate
+   during the sweep, from the logged acceleration or else the velocity's derivative);
 2. the base gravity parameters and every (joint, set-point) friction identified jointly
    (:func:`~.arm_gravity.solve_levels`), or the URDF's parameters kept (``identify=False``);
 3. each joint's torque with the identified gravity removed, extracted again by
@@ -26,6 +28,7 @@ from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from scipy.signal import savgol_filter
 
 from ..errors import ConfigError, DataError
 from ..samples import FrictionSamples, RawLog, RobotLog
@@ -44,6 +47,10 @@ __all__ = ["ArmExtraction", "extract_arm"]
 
 #: Rows of the configuration evaluated by one call of the rigid-body model.
 CHUNK = 4096
+
+#: s, the span of the Savitzky-Golay derivative that estimates the joints' accelerations when
+#: the log has none (long against the noise of a velocity estimate, short against a ramp).
+ACCELERATION_WINDOW = 0.05
 
 #: ``samples.meta["extract"]["gravity"]`` of an arm extraction.
 ARM_MODE = "arm"
@@ -106,15 +113,37 @@ def _regressor_rows(model: RigidBodyModel, base, q: np.ndarray) -> np.ndarray:
     return out
 
 
+def _acceleration(arm: RobotLog) -> np.ndarray:
+    """rad/s^2, the logged acceleration, else the velocity's Savitzky-Golay derivative
+    (quadratic over about :data:`ACCELERATION_WINDOW` s; exactly zero where a joint is held
+    at zero velocity)."""
+    if arm.acceleration is not None:
+        return arm.acceleration
+    n = len(arm)
+    dt = float(np.median(np.diff(arm.time))) if n > 1 else 1.0
+    window = max(5, 2 * round(ACCELERATION_WINDOW / dt / 2) + 1)
+    if n < window:
+        return np.gradient(arm.velocity, arm.time, axis=0) if n > 1 else np.zeros_like(arm.velocity)
+    return savgol_filter(arm.velocity, window, 2, deriv=1, delta=dt, axis=0, mode="interp")
+
+
 def _other_dynamics(model: RigidBodyModel, arm: RobotLog) -> np.ndarray:
-    """``M(q) ddq + C(q, dq) dq`` [N m] at every row (``ddq`` the logged acceleration, zero
-    when none was logged: the steady parts are at constant speed)."""
+    """N m, the rigid-body torque on each joint that is neither gravity nor its own inertia:
+    ``M(q) ddq + C(q, dq) dq - M_jj(q) ddq_j`` at every row (:func:`_acceleration`). A swept
+    joint's own inertia is left out (its steady part is at constant speed, and a derivative
+    would only add noise); the others' accelerations (moves during a sweep) and the
+    velocity products are removed."""
     q, dq = arm.position, arm.velocity
-    ddq = np.zeros_like(q) if arm.acceleration is None else arm.acceleration
+    ddq = _acceleration(arm)
     out = np.empty_like(q)
     for a in range(0, q.shape[0], CHUNK):
         s = slice(a, a + CHUNK)
         out[s] = model.inverse_dynamics(q[s], dq[s], ddq[s]) - model.gravity_torque(q[s])
+    moving = np.flatnonzero((ddq != 0).any(axis=1))
+    for a in range(0, moving.size, CHUNK):
+        rows = moving[a : a + CHUNK]
+        own = np.diagonal(model.mass_matrix(q[rows]), axis1=1, axis2=2)
+        out[rows] -= own * ddq[rows]
     return out
 
 
