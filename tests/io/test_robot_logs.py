@@ -407,3 +407,18 @@ def test_channel_joints_of_mismatched_lengths_are_refused(tmp_path):
         read_robot_log(folder, channels=PATTERNS, units=UNITS)
     with pytest.raises(ConfigError, match="position pattern"):
         read_robot_log(folder, channels={"velocity": "vel_{joint}.txt"}, units=UNITS)
+
+
+def test_one_pattern_with_a_quantity_field(tmp_path):
+    folder, x = channel_folder(tmp_path / "q")
+    for old, new in (("pos", "position"), ("vel", "velocity"), ("tau", "torque")):
+        for j in (1, 2):
+            (folder / f"{old}_{j}.txt").rename(folder / f"{new}_{j}.txt")
+    log = read_robot_log(folder, channels="{quantity}_{joint}.txt", units=UNITS)
+    assert log.joints == ("1", "2") and "velocity_from" not in log.meta
+    np.testing.assert_array_equal(log.velocity, x["dq"])
+    no_velocity = {"position": "rad", "torque": "N m"}
+    log = read_robot_log(folder, channels="{quantity}_{joint}.txt", units=no_velocity)
+    assert log.meta["velocity_from"] == "position (central difference)"
+    with pytest.raises(ConfigError, match=r"needs a \{quantity\} field"):
+        read_robot_log(folder, channels="{joint}.txt", units=UNITS)

@@ -79,7 +79,7 @@ def read_robot_log(
     position_unit: str = "rad",
     velocity_unit: str = "rad/s",
     time_source: str = "auto",
-    channels: Mapping[str, str] | None = None,
+    channels: Mapping[str, str] | str | None = None,
     units: Mapping[str, str] | None = None,
     join: str = "nearest",
     tolerance: float | None = None,
@@ -113,8 +113,10 @@ def read_robot_log(
         as for :func:`fricid.io.iter_rosbag`.
     channels, units, join, tolerance, time_unit
         Per-channel folders: quantity -> file-name pattern with a ``{joint}`` field, quantity
-        -> unit, and the joining on time, as for :func:`fricid.io.read_channels`. A position
-        pattern is needed; the joints' files must share their time stamps.
+        -> unit, and the joining on time, as for :func:`fricid.io.read_channels`; or one
+        pattern with a ``{quantity}`` field too (``"{quantity}_{joint}.txt"``: files
+        ``position_1.txt``, ``torque_1.txt``...), written out for each quantity of ``units``.
+        A position pattern is needed; the joints' files must share their time stamps.
 
     Returns
     -------
@@ -191,7 +193,7 @@ def _read_channel_folder(
     from .channels import _runs, _sort_key, read_channels
 
     check_input(folder, folder=True, what="folder of per-channel files")
-    patterns = dict(options["channels"] or {})
+    patterns = _patterns(options["channels"], options["units"])
     if "position" not in patterns:
         raise ConfigError(
             "a robot's channel files need a position pattern (channels={'position': ...}), "
@@ -259,6 +261,19 @@ def _read_channel_folder(
     return RobotLog(
         time=time, joints=names, torque_constants=ks, source=str(folder), meta=meta, **stack
     )
+
+
+def _patterns(channels: Mapping[str, str] | str | None, units: Any) -> dict[str, str]:
+    """Quantity -> file-name pattern: ``channels`` itself, or one pattern with a
+    ``{quantity}`` field written out for each quantity that ``units`` gives a unit."""
+    if not isinstance(channels, str):
+        return dict(channels or {})
+    if "{quantity}" not in channels:
+        raise ConfigError(
+            f"channels= as one pattern needs a {{quantity}} field, got {channels!r} (or give "
+            "a mapping quantity -> pattern)"
+        )
+    return {q: channels.replace("{quantity}", q) for q in (units or {})}
 
 
 def _concatenate(logs: list[RobotLog]) -> RobotLog:
