@@ -18,6 +18,13 @@ every sample (:mod:`.arm_gravity`):
    (eq. 12) averaged over each set-point's samples, with eq. 7's sign: ``tau_g = -g(q)``
    (the motor torque is ``tau_f - tau_g``, eq. 8).
 
+The fit of step 2 takes the kept samples' unfiltered torque (the running median of
+``median_window`` still decides which samples are kept): the filter correlates neighbouring
+samples, and with few passes per set-point the cluster-robust standard errors cannot make up
+for the ordinary ones counting them as independent. Measured on the double pendulum's sweeps
+(30 seeds, 50 Hz, noise 0.01 N m): 95 % intervals covered 87 % of the set-point frictions and 91 % of
+the gravity parameters with the filtered torque, 97 % and 94 % with the unfiltered one.
+
 The single-joint eq. 7 is the special case of a one-joint robot (:mod:`.arm_gravity`).
 """
 
@@ -158,8 +165,10 @@ def _passes(raw: RawLog, w: np.ndarray, options: dict) -> list:
     samples (``w`` the joint's regressor rows, (N, m))."""
 
     def moments(seg, keep, tau):
+        # the unfiltered torque: the running median correlates neighbouring samples, which the
+        # ordinary standard errors would count as independent (module notes)
         rows = seg.row + np.flatnonzero(keep)
-        return arm_moments(w[rows], tau[keep])
+        return arm_moments(w[rows], seg.log.motor_torque[keep])
 
     acc = Accumulator(
         PositionBins(),
