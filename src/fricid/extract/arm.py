@@ -21,9 +21,10 @@ every sample (:mod:`.arm_gravity`):
 The fit of step 2 takes the kept samples' unfiltered torque (the running median of
 ``median_window`` still decides which samples are kept): the filter correlates neighbouring
 samples, and with few passes per set-point the cluster-robust standard errors cannot make up
-for the ordinary ones counting them as independent. Measured on the double pendulum's sweeps
-(30 seeds, 50 Hz, noise 0.01 N m): 95 % intervals covered 87 % of the set-point frictions and 91 % of
-the gravity parameters with the filtered torque, 97 % and 94 % with the unfiltered one.
+for the ordinary ones counting them as independent. Measured on the double pendulum's
+sweeps (30 seeds, 50 Hz, noise 0.01 N m): 95 % intervals covered 87 % of the set-point
+frictions and 91 % of the gravity parameters with the filtered torque, 97 % and 94 % with the
+unfiltered one.
 
 The single-joint eq. 7 is the special case of a one-joint robot (:mod:`.arm_gravity`).
 """
