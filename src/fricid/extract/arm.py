@@ -82,7 +82,8 @@ class ArmExtraction(Mapping):
         return len(self.results)
 
     def table(self) -> list[dict[str, Any]]:
-        """One row per swept joint: set-points, samples, friction range, residual, notes."""
+        """One row per swept joint: set-points, samples, the range of |friction|, the largest
+        |gravity torque| [N m] and the fit's residual RMS [N m]."""
         rows = []
         for joint, res in self.results.items():
             f = np.abs(res.by_direction.friction)
