@@ -50,7 +50,8 @@ def test_robot_extract_writes_samples_per_joint_and_gravity(pendulum_files):
         app, ["robot", "extract", str(log_path), "--urdf", str(urdf), "-o", str(out)]
     )
     assert res.exit_code == 0, res.output
-    assert "joint1" in res.stdout and "joint2" in res.stdout
+    # a table per joint (its set-points), then a row per joint
+    assert "joint1: 6 set-points" in res.stdout and "joint2: 6 set-points" in res.stdout
     assert "base gravity parameters (identified from the sweeps" in res.stdout
     doc = json.loads((out / "gravity.json").read_text(encoding="utf-8"))
     assert doc["method"] == "arm" and doc["identified"] is True

@@ -40,15 +40,34 @@ def _split(items: list[str] | None) -> list[str] | None:
     return [name.strip() for item in items for name in item.split(",") if name.strip()]
 
 
+def _joint_table(result, joint: str) -> list[str]:
+    """One joint's set-points: velocity, friction with its standard error (the joint fit's,
+    the gravity parameters' uncertainty included), gravity load, passes and samples."""
+    g = result.gravity
+    lines = [
+        f"{joint}: {len(g.joint_levels(joint))} set-points, residual "
+        f"{g.residual_rms.get(joint, float('nan')):.3g} N m",
+        f"  {'T [degC]':>8} {'v [rad/s]':>10} {'friction [N m]':>15} {'+- se':>9} "
+        f"{'load [N m]':>11} {'passes':>6} {'samples':>8}",
+    ]
+    for lv in sorted(g.joint_levels(joint), key=lambda r: (r["temperature"], r["velocity"])):
+        lines.append(
+            f"  {lv['temperature']:>8.4g} {lv['velocity']:>+10.4g} {lv['friction']:>+15.5g} "
+            f"{lv['friction_se']:>9.2g} {lv['load']:>+11.4g} {lv['passes']:>6} {lv['count']:>8}"
+        )
+    return lines
+
+
 def _tables(result) -> list[str]:
-    """The printed tables: one row per joint, then the base gravity parameters."""
-    rows = result.table()
+    """The printed tables: each joint's set-points, a row per joint, the base gravity
+    parameters."""
+    lines = [line for joint in result for line in (*_joint_table(result, joint), "")]
     head = (
         f"{'joint':<24} {'set-points':>10} {'samples':>8} {'|friction| [N m]':>20} "
         f"{'|gravity| max':>13} {'residual':>9}"
     )
-    lines = [head]
-    for r in rows:
+    lines.append(head)
+    for r in result.table():
         span = f"{r['friction min [N m]']:.4g} - {r['friction max [N m]']:.4g}"
         lines.append(
             f"{r['joint'][:24]:<24} {r['set-points']:>10} {r['samples']:>8} {span:>20} "
