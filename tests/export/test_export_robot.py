@@ -163,6 +163,9 @@ def test_cli_robot_export_from_a_folder_and_from_pairs(tmp_path):
     assert res.exit_code == 0, res.output
     doc = yaml.safe_load(yaml_out.read_text())
     assert doc["friction_compensation"]["ros__parameters"]["joints"] == ["shoulder_pan", "elbow"]
+    # --to yaml (the single-joint export's name) is the same, here to stdout
+    res = runner.invoke(app, ["robot", "export", *pairs, "--to", "yaml"])
+    assert res.exit_code == 0 and res.stdout == yaml_out.read_text()
     strict = ["--to", "ros2_control", "--max-loss", "0.01", "-o", str(tmp_path / "x.yaml")]
     res = runner.invoke(app, ["robot", "export", str(folder), *strict])
     # the first joint beyond the tolerance is named, on one line, and nothing is written

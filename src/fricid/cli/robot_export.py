@@ -66,7 +66,11 @@ def robot_export_command(
     ],
     to: Annotated[
         str,
-        typer.Option("--to", help="; ".join(f"{k}: {v}" for k, v in ROBOT_TARGETS.items()) + "."),
+        typer.Option(
+            "--to",
+            help="; ".join(f"{k}: {v}" for k, v in ROBOT_TARGETS.items())
+            + " (yaml: the same as ros2_control).",
+        ),
     ],
     out: Annotated[
         Path | None,
@@ -120,6 +124,7 @@ def robot_export_command(
     from ._paths import check_paths
 
     target = to.strip().lower()
+    target = "ros2_control" if target == "yaml" else target  # the single-joint export's name
     if target not in ROBOT_TARGETS:
         raise ConfigError(f"unknown target '{to}'; choose one of: {', '.join(ROBOT_TARGETS)}")
     check_paths(**{"out_dirs" if target == "c" else "out_files": {"--out": out}})
