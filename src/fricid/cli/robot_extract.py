@@ -121,6 +121,13 @@ def robot_extract_command(
         float | None,
         typer.Option(help="The temperature [degC] to record when the log has none."),
     ] = None,
+    torque_constant: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--torque-constant",
+            help="JOINT=K [N m/A] (repeatable): tau = K I (eq. 13) for a log of currents.",
+        ),
+    ] = None,
     reader: Annotated[
         str, typer.Option(help="Layout of LOG: auto, table, rosbag or channels.")
     ] = "auto",
@@ -142,10 +149,14 @@ def robot_extract_command(
     from ..io.tables import write_samples
     from ..io.urdf import read_urdf
     from ..robot import RigidBodyModel
+    from ._options import parse_assignments
 
     check_paths(inputs={"LOG": log, "--urdf": urdf}, folders=["LOG"], out_dirs={"--out": out})
     robot = read_urdf(urdf)
-    data = read_robot_log(log, reader=reader, topic=topic, temperature=temperature)
+    constants = parse_assignments(torque_constant, "--torque-constant") or None
+    data = read_robot_log(
+        log, reader=reader, topic=topic, temperature=temperature, torque_constants=constants
+    )
     moving = [
         n for n, j in robot.joints.items() if j.kind in ("revolute", "continuous", "prismatic")
     ]
