@@ -114,14 +114,6 @@ def _robot_rows(model: RigidBodyModel, log: RobotLog) -> RobotLog:
     return log.select(model.joints)
 
 
-def _regressor_rows(model: RigidBodyModel, base, q: np.ndarray) -> np.ndarray:
-    """``Y_b(q)``, shape (N, n, m): the base gravity regressor at every row."""
-    out = np.empty((q.shape[0], model.n, base.rank))
-    for a in range(0, q.shape[0], CHUNK):
-        out[a : a + CHUNK] = base.columns(model.gravity_regressor(q[a : a + CHUNK]))
-    return out
-
-
 def _acceleration(arm: RobotLog) -> np.ndarray:
     """rad/s^2, the logged acceleration, else the velocity's Savitzky-Golay derivative
     (quadratic over about :data:`ACCELERATION_WINDOW` s; exactly zero where a joint is held
@@ -136,24 +128,38 @@ def _acceleration(arm: RobotLog) -> np.ndarray:
     return savgol_filter(arm.velocity, window, 2, deriv=1, delta=dt, axis=0, mode="interp")
 
 
-def _other_dynamics(model: RigidBodyModel, arm: RobotLog) -> np.ndarray:
-    """N m, the rigid-body torque on each joint that is neither gravity nor its own inertia:
-    ``M(q) ddq + C(q, dq) dq - M_jj(q) ddq_j`` at every row (:func:`_acceleration`). A swept
-    joint's own inertia is left out (its steady part is at constant speed, and a derivative
-    would only add noise); the others' accelerations (moves during a sweep) and the
-    velocity products are removed."""
-    q, dq = arm.position, arm.velocity
-    ddq = _acceleration(arm)
-    out = np.empty_like(q)
-    for a in range(0, q.shape[0], CHUNK):
-        s = slice(a, a + CHUNK)
-        out[s] = model.inverse_dynamics(q[s], dq[s], ddq[s]) - model.gravity_torque(q[s])
-    moving = np.flatnonzero((ddq != 0).any(axis=1))
-    for a in range(0, moving.size, CHUNK):
-        rows = moving[a : a + CHUNK]
-        own = np.diagonal(model.mass_matrix(q[rows]), axis1=1, axis2=2)
-        out[rows] -= own * ddq[rows]
-    return out
+def _segment_rows(raw: RawLog, options: dict) -> np.ndarray:
+    """The rows of the joint's candidate steady segments (:func:`~.segment.iter_segments`,
+    found from the velocity alone): the only rows whose torque the extraction reads."""
+    parts = [
+        np.arange(seg.row, seg.row + len(seg.log))
+        for seg in iter_segments(
+            raw,
+            velocity_tolerance=options["velocity_tolerance"],
+            settle_time=options["settle_time"],
+            min_samples=int(options["min_samples"]),
+        )
+    ]
+    return np.concatenate(parts) if parts else np.zeros(0, dtype=np.intp)
+
+
+def _joint_dynamics(model: RigidBodyModel, base, arm: RobotLog, ddq, j: int, rows):
+    """At ``rows``: joint ``j``'s base gravity regressor row ``Y_b(q)[j]`` (R, m) and the
+    rigid-body torque on it that is neither gravity nor its own inertia (R,): the velocity
+    products ``C(q, dq) dq`` and the other joints' inertia ``sum_k!=j M_jk ddq_k``
+    (:func:`_acceleration`). Its own inertia is left out: its steady part is at constant
+    speed, and a derivative would only add noise."""
+    w = np.empty((rows.size, base.rank))
+    other = np.empty(rows.size)
+    for a in range(0, rows.size, CHUNK):
+        r = rows[a : a + CHUNK]
+        q = arm.position[r]
+        w[a : a + CHUNK] = base.columns(model.gravity_regressor(q))[:, j, :]
+        acc = ddq[r].copy()
+        acc[:, j] = 0.0
+        tau = model.inverse_dynamics(q, arm.velocity[r], acc) - model.gravity_torque(q)
+        other[a : a + CHUNK] = tau[:, j]
+    return w, other
 
 
 def _with_torque(raw: RawLog, torque: np.ndarray) -> RawLog:
@@ -162,14 +168,15 @@ def _with_torque(raw: RawLog, torque: np.ndarray) -> RawLog:
     return replace(raw, torque=torque, current=None, torque_constant=None, meta=meta)
 
 
-def _passes(raw: RawLog, w: np.ndarray, options: dict) -> list:
+def _passes(raw: RawLog, w: np.ndarray, where: np.ndarray, options: dict) -> list:
     """The set-point records of one joint, each with the :func:`arm_moments` of its kept
-    samples (``w`` the joint's regressor rows, (N, m))."""
+    samples (``w`` the joint's regressor rows at its segment rows, ``where`` each log row's
+    index into ``w``)."""
 
     def moments(seg, keep, tau):
         # the unfiltered torque: the running median correlates neighbouring samples, which the
         # ordinary standard errors would count as independent (module notes)
-        rows = seg.row + np.flatnonzero(keep)
+        rows = where[seg.row + np.flatnonzero(keep)]
         return arm_moments(w[rows], seg.log.motor_torque[keep])
 
     acc = Accumulator(
@@ -282,14 +289,19 @@ def extract_arm(
         )
     arm = _robot_rows(model, log)
     base = base_parameters(model, gravity_only=True)
-    W = _regressor_rows(model, base, arm.position)
-    known = _other_dynamics(model, arm)
+    ddq = _acceleration(arm)
     stats, keys, raws = [], [], {}
     for joint in wanted:
         j = model.joints.index(joint)
         raw = arm.joint(joint, temperature=temperature)
-        raw = _with_torque(raw, raw.motor_torque - known[:, j])
-        records = _passes(raw, W[:, j], options)
+        rows = _segment_rows(raw, options)
+        w, other = _joint_dynamics(model, base, arm, ddq, j, rows)
+        torque = raw.motor_torque.copy()
+        torque[rows] -= other
+        raw = _with_torque(raw, torque)
+        where = np.full(len(arm), -1, dtype=np.intp)
+        where[rows] = np.arange(rows.size)
+        records = _passes(raw, w, where, options) if rows.size else []
         if not records:
             if joints is not None:
                 raise DataError(
@@ -297,15 +309,15 @@ def extract_arm(
                     file=log.source,
                 )
             continue
-        raws[joint] = (j, raw)
+        raws[joint] = (raw, rows, w)
         stats.extend(r.extra for r in records)
         keys.extend(_levels(joint, records, options))
     if not raws:
         raise DataError("no joint of the robot log has a constant-velocity sweep", file=log.source)
     fit = _fit(stats, keys, base, model, identify, log.source)
     results = {
-        joint: _joint_result(raw, W[:, j] @ fit.beta, fit, options, joint)
-        for joint, (j, raw) in raws.items()
+        joint: _joint_result(raw, rows, w @ fit.beta, fit, options, joint)
+        for joint, (raw, rows, w) in raws.items()
     }
     return ArmExtraction(fit, results)
 
@@ -359,11 +371,14 @@ def _fit(stats, keys, base, model, identify, source) -> ArmGravityFit:
 
 
 def _joint_result(
-    raw: RawLog, gravity: np.ndarray, fit: ArmGravityFit, options: dict, joint: str
+    raw: RawLog, rows: np.ndarray, gravity: np.ndarray, fit: ArmGravityFit, options, joint: str
 ) -> ExtractionResult:
-    """One joint's samples: its torque with the arm's gravity removed, extracted as a
-    horizontal joint's; the load column is the gravity torque of the matching level."""
-    res = extract(_with_torque(raw, raw.motor_torque - gravity), gravity="none", **options)
+    """One joint's samples: its torque with the arm's gravity removed (at ``rows``, its
+    segments: the only rows read), extracted as a horizontal joint's; the load column is the
+    gravity torque of the matching level."""
+    torque = raw.motor_torque.copy()
+    torque[rows] -= gravity
+    res = extract(_with_torque(raw, torque), gravity="none", **options)
     levels = fit.joint_levels(joint)
     how = (
         "gravity from the whole configuration (base gravity parameters identified from the sweeps)"
