@@ -21,6 +21,8 @@ MODULES = (
     "fleet",
     "robot_simulate",
     "robot_fit",
+    "robot_extract",
+    "robot_export",
 )
 
 for _name in MODULES:
