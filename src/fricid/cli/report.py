@@ -18,15 +18,19 @@ from ._study_options import out_option, seed_option
 def report_command(
     model: Annotated[
         Path,
-        typer.Argument(help="Model file (JSON, from `fricid fit`)."),
-    ],
-    samples: Annotated[
-        Path,
         typer.Argument(
-            help="Friction samples, CSV or Parquet; for a model from `fricid fit --trajectory`, "
-            "the trajectory log (a fricid raw log)."
+            help="Model file (JSON, from `fricid fit`), or a whole-arm fit (from `fricid robot "
+            "fit`)."
         ),
     ],
+    samples: Annotated[
+        Path | None,
+        typer.Argument(
+            help="Friction samples, CSV or Parquet; for a model from `fricid fit --trajectory`, "
+            "the trajectory log (a fricid raw log); none for a whole-arm fit.",
+            show_default=False,
+        ),
+    ] = None,
     heldout: Annotated[
         Path | None,
         typer.Argument(
@@ -76,6 +80,11 @@ def report_command(
     `fricid fit` or the fleet) when it was computed on the same samples with the same
     options, else computed now; the report renders it and computes no verdict of its own.
 
+    A whole-arm fit (`fricid robot fit`) needs no data: its report has a row per joint (family,
+    held-out error over the noise, verdict and reasons), every joint's friction curve, the
+    friction parameters with their intervals, the base inertial parameters, the consistency
+    step and each link's mass, centre of mass and inertia.
+
     A model identified from a trajectory (`fricid fit --trajectory`) takes its log instead of
     samples, and optionally a second log (HELDOUT): the report then shows the measured and
     predicted torque over time, the residuals over time and against velocity, the friction's
@@ -97,12 +106,23 @@ def report_command(
         raise ConfigError(
             f"--velocity-unit must be one of: {', '.join(UNITS['velocity'])}; got '{velocity_unit}'"
         )
-    inputs = {"MODEL": model, "SAMPLES": samples}
-    if heldout is not None:
-        inputs["HELDOUT"] = heldout
-    check_paths(inputs=inputs, out_dirs={"--out": out})
-    fitted = FittedModel.load(model)
+    inputs = {"MODEL": model, "SAMPLES": samples, "HELDOUT": heldout}
+    check_paths(inputs={k: v for k, v in inputs.items() if v is not None}, out_dirs={"--out": out})
     out = out or Path(f"{model.stem}-report")
+    arm = _arm_fit(model)
+    if arm is not None:
+        if samples is not None:
+            raise ConfigError(
+                "a whole-arm fit's report takes no data file: the fit file holds what it shows"
+            )
+        _arm_report(arm, out, quiet)
+        return
+    if samples is None:
+        raise ConfigError(
+            "missing SAMPLES: the friction samples (or, for a model from a trajectory, its log) "
+            "the report shows the model on"
+        )
+    fitted = FittedModel.load(model)
     from ..identify.trajectory_check import is_trajectory_model
 
     if is_trajectory_model(fitted):
@@ -135,6 +155,45 @@ def report_command(
         path = write_document(doc, out)
     console.print(str(path), highlight=False, soft_wrap=True)
     err_console.print(str(doc.meta["trust"]), markup=False, highlight=False, soft_wrap=True)
+    err_console.print(
+        f"wrote {len(doc.tables())} tables and {len(doc.figures())} figures into {out}/"
+    )
+
+
+def _arm_fit(path: Path):
+    """The whole-arm fit ``path`` holds (its kind ``fricid-arm``), else None."""
+    from ..errors import DataError
+    from ..fitted.arm import ARM_KIND, ArmFit
+    from ..io._jsonfile import read_json
+
+    try:
+        doc = read_json(path, what="model file")
+    except DataError:
+        return None  # the model file's own reader says what is wrong
+    if isinstance(doc, dict) and doc.get("kind") == ARM_KIND:
+        return ArmFit.from_dict(doc, source=str(path))
+    return None
+
+
+def _arm_report(fit, out: Path, quiet: bool) -> None:
+    """The report of a whole-arm fit: a row per joint."""
+    from ..report import arm_report, write_document
+
+    with tracker("report", None, quiet=quiet, timed=False) as track:
+        track.stage("report: the joints, their friction and the inertial parameters")
+        doc = arm_report(fit)
+        track.stage(f"report: writing {out}/")
+        path = write_document(doc, out)
+    console.print(str(path), highlight=False, soft_wrap=True)
+    for joint in fit.joints:
+        check = fit.validation.get(joint, {})
+        reasons = "; ".join(map(str, check.get("reasons", [])))
+        err_console.print(
+            f"{joint}: {fit.verdict(joint)}" + (f" ({reasons})" if reasons else ""),
+            markup=False,
+            highlight=False,
+            soft_wrap=True,
+        )
     err_console.print(
         f"wrote {len(doc.tables())} tables and {len(doc.figures())} figures into {out}/"
     )

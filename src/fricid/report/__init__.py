@@ -9,7 +9,8 @@
 :mod:`.document` (the format-free content), :mod:`.render` (HTML, Markdown), :mod:`.writer`
 (the folder, written all or nothing), :mod:`.style`, :mod:`.plots` and :mod:`.paper_plots`
 (matplotlib figures created directly, Agg canvas, no pyplot), :mod:`.model` (the report of one
-identified model), :mod:`.trust` (its "Can I trust this?" section, rendered from the record
+identified model), :mod:`.arm` (the report of a whole arm's identification, a row per
+joint), :mod:`.trust` (its "Can I trust this?" section, rendered from the record
 :func:`fricid.identify.trust.assess_trust` computes; the report computes no validation or
 verdict), :mod:`.rbf` (the RBF network's part), :mod:`.studies` (the papers' studies
 from :mod:`fricid.experiments`, as text, files and documents) and :mod:`.reproduce`
@@ -18,6 +19,7 @@ from :mod:`fricid.experiments`, as text, files and documents) and :mod:`.reprodu
 
 from __future__ import annotations
 
+from .arm import arm_report
 from .document import Document, Figure, Note, Section, Table
 from .model import model_report
 from .render import render_html, render_markdown
@@ -29,6 +31,7 @@ __all__ = [
     "Note",
     "Section",
     "Table",
+    "arm_report",
     "model_report",
     "render_html",
     "render_markdown",
