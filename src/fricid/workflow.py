@@ -1,4 +1,8 @@
-"""One joint, from its raw log to fitted models: ``fricid extract`` then ``fricid fit``.
+"""One joint, from its raw log to fitted models: ``fricid extract`` then ``fricid fit``; or
+one whole robot, from its log of all joints and its URDF (:func:`run_robot`).
+
+This module is longer than 500 lines because the single-joint and the whole-robot paths that
+the commands and the fleet share belong in the one workflow unit of the layer table.
 
 The single-joint commands and ``fricid fleet`` run these functions, so a joint identified in a
 fleet is identified exactly as it would be by hand (DESIGN.md, "The flow of data"):
@@ -44,6 +48,7 @@ __all__ = [
     "fit_samples",
     "load_joint",
     "run_joint",
+    "run_robot",
     "select_direction",
     "select_samples",
 ]
@@ -498,3 +503,53 @@ def run_joint(
             run.errors[name] = exc
         run.fit_seconds[name] = time.perf_counter() - t1
     return run
+
+
+def run_robot(
+    log: str | os.PathLike[str],
+    urdf: str | os.PathLike[str],
+    *,
+    joints: Sequence[str] | None = None,
+    friction: str | Mapping[str, str] = "stribeck_asym",
+    validate: str | os.PathLike[str] | None = None,
+    consistent: bool = True,
+    encoder_counts: int | None = None,
+    cutoff: float | None = None,
+):
+    """Identify a whole robot as ``fricid robot fit`` does: the URDF's rigid-body model
+    (:meth:`fricid.robot.RigidBodyModel.from_urdf`), the log of its joints
+    (:func:`fricid.io.read_robot_log`), then
+    :func:`fricid.identify.dynamic.arm.fit_arm`.
+
+    Parameters
+    ----------
+    log, urdf : path-like
+        The log of all joints (CSV, Parquet, ROS 2 bag, folder) and the robot's URDF.
+    joints : sequence of str, optional
+        The joints to identify (default: the URDF's movable joints).
+    friction, consistent, encoder_counts, cutoff
+        As :func:`~fricid.identify.dynamic.arm.fit_arm` takes them.
+    validate : path-like, optional
+        A second log for held-out validation (default: the last quarter of ``log``).
+
+    Returns
+    -------
+    fricid.fitted.arm.ArmFit
+    """
+    from .identify.dynamic.arm import fit_arm
+    from .io import read_robot_log
+    from .robot import RigidBodyModel
+
+    model = RigidBodyModel.from_urdf(urdf, list(joints) if joints else None)
+    data = read_robot_log(log, joints=list(model.joints))
+    second = read_robot_log(validate, joints=list(model.joints)) if validate else None
+    return fit_arm(
+        data,
+        model,
+        friction=friction,
+        consistent=consistent,
+        encoder_counts=encoder_counts,
+        cutoff=cutoff,
+        validate=second,
+        urdf=Path(urdf).name,
+    )

@@ -29,7 +29,7 @@ def test_schema_is_valid_and_shipped_as_package_data():
 def test_fields_come_from_the_schema():
     assert list(FIELDS) == list(PROPERTIES)
     for name, spec in PROPERTIES.items():
-        assert spec["x-group"] in ("core", "fit", "extract", "reader"), name
+        assert spec["x-group"] in ("core", "fit", "extract", "reader", "robot"), name
         assert spec["description"] and spec["x-message"], name
         if "x-quantity" in spec:
             assert spec["x-quantity"] in UNITS, name
@@ -40,6 +40,9 @@ def test_schema_mirrors_the_registries():
     assert PROPERTIES["reader"]["enum"] == list(READERS)
     assert PROPERTIES["direction"]["enum"] == list(DIRECTIONS)
     assert PROPERTIES["samples"]["enum"] == list(SAMPLE_SETS)
+    from fricid.identify.dynamic._arm_friction import FAMILIES
+
+    assert PROPERTIES["friction"]["enum"] == sorted(FAMILIES)  # a robot row's families
     options = {o for opts in READER_OPTIONS.values() for o in opts}
     reader_fields = {f.option for f in FIELDS.values() if f.group == "reader"}
     assert reader_fields <= options  # every reader column fills some reader's option

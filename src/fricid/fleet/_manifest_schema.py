@@ -2,10 +2,10 @@
 
 ``fricid/schemas/manifest.schema.json`` (:data:`SCHEMA`) is the one description of the
 manifest: every column (:data:`FIELDS`), its type, range or choices, its group (``core``,
-``fit``, ``extract``, ``reader``), the quantity of its unit (``x-quantity``), how a text cell
-is read (``x-text``), the reader option a ``reader`` column fills (``x-option``, default its
-name; every option of :data:`fricid.io.READER_OPTIONS` has its column, which a test checks)
-and the message of a bad value (``x-message``); and the document's shape.
+``fit``, ``extract``, ``reader``, ``robot``), the quantity of its unit (``x-quantity``), how a
+text cell is read (``x-text``), the reader option a ``reader`` column fills (``x-option``,
+default its name; every option of :data:`fricid.io.READER_OPTIONS` has its column, which a
+test checks) and the message of a bad value (``x-message``); and the document's shape.
 This module reads a cell into the JSON value it writes (through :mod:`fricid.io.options`,
 the parsers the command line uses), validates a joint with ``jsonschema`` and turns the first
 error into one :class:`~fricid.errors.DataError` naming the manifest, the row and the column.
@@ -18,6 +18,7 @@ from __future__ import annotations
 import datetime as _dt
 import functools
 import json
+import os
 import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -44,8 +45,10 @@ __all__ = [
     "Entry",
     "Field",
     "describe_columns",
+    "manifest_path",
     "read_entry",
     "resolve_key",
+    "row_kind",
     "to_values",
     "validate",
     "validator",
@@ -80,7 +83,7 @@ class Field:
     """A manifest column, from the schema: its group, help, unit quantity and text form."""
 
     name: str
-    group: str  # "core", "fit", "extract" or "reader"
+    group: str  # "core", "fit", "extract", "reader" or "robot"
     help: str
     quantity: str | None = None  # a unit is required in the column name
     text: str | None = None  # how a text cell is read (the schema's x-text)
@@ -107,6 +110,7 @@ _GROUPS = {
     "fit": "fitting (fricid fit)",
     "extract": "extraction (fricid extract)",
     "reader": "reader options (fricid extract --format ...)",
+    "robot": "a whole robot (fricid robot fit; a row with a urdf)",
 }
 
 
@@ -160,6 +164,9 @@ def _read_cell(fld: Field, raw: Any) -> Any:
         return _BOOLEANS.get(raw.lower(), raw)
     if kind == "list":
         return [str(v).strip().lower() for v in split_list(raw, spaces=True)]
+    if kind == "names":  # names as written (a URDF's joint names are case-sensitive)
+        items = split_list(raw, spaces=True)
+        return [str(v).strip() if isinstance(v, str | int) else v for v in items]
     if kind == "grid":
         return parse_grid(raw)
     if kind == "assignments":
@@ -309,7 +316,58 @@ def to_values(entry: Entry, file: Path) -> dict[str, Any]:
     for name in ("seed", "max_evals", "chunk_rows", "median_window", "min_samples"):
         if name in got:
             got[name] = int(got[name])
-    for name in ("robot", "joint", "log", "log_joint"):
+    for name in ("robot", "joint", "log", "log_joint", "urdf"):
         if name in got:
             got[name] = str(got[name])
     return got
+
+
+# --------------------------------------------------------------------------- kinds of row
+
+
+#: The columns a robot row takes (the others are one joint's extraction, fit and reader).
+_ROBOT_COLUMNS = frozenset(
+    ("robot", "joint", "log", "date", *(n for n, f in FIELDS.items() if f.group == "robot"))
+)
+
+
+def row_kind(entry: Entry, own: set[str], file: Path) -> bool:
+    """Whether ``entry`` is a robot row (it has a ``urdf``). The columns of the other kind of
+    row are dropped when inherited from the defaults and refused when the row gives them
+    (``own``); a robot row's ``joint`` (its record's name) defaults to ``arm``."""
+    robot = "urdf" in entry.values
+    for name in list(entry.values):
+        if (name in _ROBOT_COLUMNS) if robot else FIELDS[name].group != "robot":
+            continue
+        if name not in own:
+            for values in (entry.values, entry.raw, entry.labels, entry.units):
+                values.pop(name, None)
+            continue
+        raise DataError(
+            f"'{name}' is a column of one joint's identification; a robot row (one with a "
+            f"'urdf') takes only: {', '.join(sorted(_ROBOT_COLUMNS))}"
+            if robot
+            else f"'{name}' is a column of a whole robot's row: give the row its 'urdf'",
+            file=file,
+            row=entry.row,
+            column=entry.labels.get(name, name),
+        )
+    if robot and "joint" not in entry.values:
+        entry.values["joint"] = entry.raw["joint"] = "arm"
+        entry.labels["joint"] = "joint"
+    return robot
+
+
+def manifest_path(text: str, entry: Entry, column: str, file: Path) -> Path:
+    """A path of the manifest (``log``, ``urdf``), absolute: relative to its folder."""
+    if "\0" in text:
+        raise DataError(
+            "a path cannot hold a NUL character",
+            file=file,
+            row=entry.row,
+            column=entry.labels.get(column, column),
+        )
+    path = Path(text).expanduser()
+    if not path.is_absolute():
+        path = file.parent / path
+    return Path(os.path.abspath(path))

@@ -29,8 +29,9 @@ _BLOCK = 1 << 20
 
 
 #: Readers that take a folder as a joint's log (an EPOS folder of recordings, a ROS 2 bag,
-#: a folder of per-channel files); the others read one file.
-FOLDER_READERS = ("epos", "rosbag", "channels")
+#: a folder of per-channel files; a whole robot's log: a bag or a folder of channels too); the
+#: others read one file.
+FOLDER_READERS = ("epos", "rosbag", "channels", "robot")
 
 
 def _regular(path: Path) -> None:

@@ -1,5 +1,7 @@
 """The work of one joint, as a worker runs it: hash the log, then
-:func:`fricid.workflow.run_joint`.
+:func:`fricid.workflow.run_joint`; or of one whole robot (a manifest row with a URDF):
+:func:`fricid.workflow.run_robot`, a results row per joint (:func:`arm_rows`) and the
+whole-arm fit file.
 
 :func:`run_job` never raises for a bad joint: an unreadable log, a failed extraction or a
 failed fit comes back as a :class:`JointOutcome` with the stage and the error (and, for an
@@ -26,7 +28,9 @@ import numpy as np
 
 from ..errors import FricidError
 from ..fitted import FittedModel
+from ..fitted.arm import ArmFit
 from ..identify.trust import Trust
+from ..metrics import verdict
 from ..samples import FrictionSamples
 from .hashing import input_hash
 from .manifest import JointSpec
@@ -34,6 +38,7 @@ from .manifest import JointSpec
 __all__ = [
     "JointJob",
     "JointOutcome",
+    "arm_rows",
     "failed_outcome",
     "fit_row",
     "run_job",
@@ -253,8 +258,79 @@ def failed_outcome(
     return JointOutcome(spec.robot, spec.joint, "failed", stage, error, tb, rows=rows, **kw)
 
 
+def _finite(value: Any) -> float | None:
+    return None if value is None or not np.isfinite(value) else float(value)
+
+
+def _arm_row(spec: JointSpec, fit: ArmFit, joint: str) -> dict[str, Any]:
+    """One joint of a whole-arm fit as a results row (its record, nothing recomputed)."""
+    entry = fit.friction[joint]
+    check = fit.validation.get(joint, {})
+    ratio = _finite(check.get("ratio"))
+    params = [fit.parameter(joint, name) for name in entry["parameters"]]
+    lo, hi = entry.get("velocity_range", (None, None))
+    row: dict[str, Any] = {
+        "robot": spec.robot,
+        "joint": joint,
+        "model": "arm",
+        "chosen": entry["family"],
+        "status": "ok",
+        "stage": None,
+        "error": None,
+        "log": spec.log_text,
+        "reader": spec.reader,
+        "method": fit.provenance.get("estimator"),
+        "trust": fit.verdict(joint),
+        "heldout_ratio": ratio,
+        "heldout_source": check.get("source"),
+        "heldout_scheme": "whole-arm",
+        "verdict": verdict(np.nan if ratio is None else ratio),
+        "n_not_determined": sum(p.not_determined for p in params),
+        "extrapolation_free_range": (
+            None if lo is None else f"velocity {float(lo):.4g} to {float(hi):.4g} rad/s"
+        ),
+        "reasons": "; ".join(map(str, check.get("reasons", []))) or None,
+        "n_samples": fit.provenance.get("samples"),
+        "rmse": _finite(check.get("rmse")),
+        "units": ";".join(f"{p.name}={p.unit}" for p in params),
+    }
+    row.update({f"param_{p.name}": _finite(p.value) for p in params})
+    row.update({f"stderr_{p.name}": _finite(p.stderr) for p in params})
+    row.update({f"ci95_{p.name}": _finite(p.ci95_halfwidth) for p in params})
+    return row
+
+
+def arm_rows(spec: JointSpec, fit: ArmFit) -> list[dict[str, Any]]:
+    """A whole robot's results rows, one per joint: robot, joint, ``model`` ``arm`` and the
+    joint's friction family (``chosen``), its parameters with standard errors and 95 %
+    half-widths, the held-out error over the noise, the verdict and its reasons, as the
+    identification recorded them (:class:`~fricid.fitted.arm.ArmFit`)."""
+    return [_arm_row(spec, fit, joint) for joint in fit.joints]
+
+
+def _compute_robot(spec: JointSpec, digest: str) -> JointOutcome:
+    from ..workflow import run_robot
+
+    t0 = time.perf_counter()
+    assert spec.urdf is not None  # a robot row
+    fit = run_robot(spec.log, spec.urdf, **spec.robot_kwargs())
+    seconds = time.perf_counter() - t0
+    rows = [{**row, "time_fit_s": seconds} for row in arm_rows(spec, fit)]
+    return JointOutcome(
+        spec.robot,
+        spec.joint,
+        "ok",
+        input_hash=digest,
+        rows=rows,
+        models={"arm": fit.to_dict()},
+    )
+
+
 def _compute(spec: JointSpec, digest: str) -> JointOutcome:
     from ..workflow import run_joint
+
+    if spec.is_robot:
+        return _compute_robot(spec, digest)
 
     run = run_joint(spec.log, **spec.run_kwargs())
     rows, models = [], {}

@@ -22,6 +22,21 @@ Every dimensional value names its unit in the column name, as fricid's tables do
 ``torque_constant [N m/A]``, ``nominal_torque [mN m]``, ``load [N m]``. Log paths are relative
 to the manifest's folder. Every error names the manifest, the row (its line) and the column.
 
+A whole robot
+    A row with ``urdf`` (the robot's URDF, relative to the manifest) is a whole robot: its
+    ``log`` holds every joint (a CSV or Parquet table with per-joint columns, a ROS 2 bag,
+    a folder of per-channel files: :func:`fricid.io.read_robot_log`), and its joints are
+    identified together as ``fricid robot fit`` does (:func:`fricid.workflow.run_robot`).
+    It takes the columns ``joints`` (default: the URDF's movable joints) and ``friction``
+    (one family for every joint), and ``joint`` names its record (default ``arm``); the
+    results table gets one row per joint of the robot. A column of a single joint's
+    extraction, fit or reader given on a robot row (or a robot column on another row) is an
+    error; one inherited from ``defaults`` does not apply to the other kind of row.
+
+This module is longer than 500 lines because the joint's spec, its names' checks and the
+reading of both kinds of row are one reader; the cell-level rules live in
+:mod:`._manifest_schema`.
+
 How a manifest is read
     The columns, their types, ranges and choices, and the document's shape are the JSON
     Schema ``fricid/schemas/manifest.schema.json`` (:data:`SCHEMA`; :data:`FIELDS` is built
@@ -52,12 +67,15 @@ from ._manifest_schema import (
     SCHEMA,
     Entry,
     Field,
+    manifest_path,
     read_entry,
+    row_kind,
     to_values,
     validate,
     validator,
 )
 from ._manifest_text import MAX_MANIFEST_BYTES, _csv_entries, _read_text, _yaml_lines, _yaml_load
+from .hashing import input_hash
 
 __all__ = [
     "FIELDS",
@@ -116,6 +134,11 @@ class JointSpec:
         As ``fricid fit`` takes them (:func:`fricid.workflow.run_joint`; ``f_scale`` in N m).
     chunk_rows : int
         Rows read at a time (memory, not results).
+    urdf, urdf_text : Path or None, str or None
+        A whole robot's URDF (absolute) and as the manifest writes it; None for one joint.
+    arm_joints, friction : tuple of str or None, str
+        A whole robot's joints to identify (None: the URDF's movable joints) and the
+        friction family of every joint (:func:`fricid.workflow.run_robot`).
     """
 
     robot: str
@@ -141,17 +164,48 @@ class JointSpec:
     weights: str = "none"
     intervals: str = "auto"
     chunk_rows: int = 1_000_000
+    urdf: Path | None = None
+    urdf_text: str | None = None
+    arm_joints: tuple[str, ...] | None = None
+    friction: str = "stribeck_asym"
 
     @property
     def key(self) -> str:
         return f"{self.robot}/{self.joint}"
 
+    @property
+    def is_robot(self) -> bool:
+        """Whether the row is a whole robot (it has a URDF)."""
+        return self.urdf is not None
+
+    def _robot_settings(self) -> dict[str, Any]:
+        try:
+            urdf_hash: str | None = input_hash(self.urdf, "table", {})
+        except OSError:  # the job fails at reading it, and a failed row always runs again
+            urdf_hash = None
+        return {
+            "kind": "robot",
+            "urdf_hash": urdf_hash,
+            "joints": None if self.arm_joints is None else list(self.arm_joints),
+            "friction": self.friction,
+        }
+
+    def robot_kwargs(self) -> dict[str, Any]:
+        """Keyword arguments of :func:`fricid.workflow.run_robot` for a robot row."""
+        return {
+            "joints": self.arm_joints,
+            "friction": self.friction,
+        }
+
     def settings(self) -> dict[str, Any]:
         """Everything that decides the results, JSON-ready (hashed to decide re-runs).
 
         The log's path, the date and ``chunk_rows`` are not settings: the log's content is
-        hashed separately, and the others do not change the numbers.
+        hashed separately, and the others do not change the numbers. A robot row's are its
+        URDF's content hash, its joints and its friction family.
         """
+        if self.is_robot:
+            return self._robot_settings()
         return {
             "reader": self.reader,
             "reader_options": self.reader_options,
@@ -287,10 +341,34 @@ def check_names(
 # --------------------------------------------------------------------------- reading
 
 
-def _spec(entry: Entry, file: Path) -> JointSpec:
-    """A validated joint entry (defaults merged) -> its :class:`JointSpec`."""
+def _robot_spec(entry: Entry, got: dict[str, Any], file: Path) -> JointSpec:
+    """A validated robot row -> its :class:`JointSpec`."""
+    spec = JointSpec(
+        robot=got["robot"],
+        joint=got["joint"],
+        log=manifest_path(got["log"], entry, "log", file),
+        log_text=got["log"],
+        row=entry.row,
+        date=got.get("date"),
+        reader="robot",
+        models=("arm",),
+        urdf=manifest_path(got["urdf"], entry, "urdf", file),
+        urdf_text=got["urdf"],
+        arm_joints=tuple(got["joints"]) if "joints" in got else None,
+        friction=got.get("friction", "stribeck_asym"),
+    )
+    check_names(spec, file, labels=entry.labels)
+    return spec
+
+
+def _spec(entry: Entry, file: Path, own: set[str] | None = None) -> JointSpec:
+    """A joint entry (defaults merged; ``own``: the columns the row gives itself, default
+    all) -> its :class:`JointSpec`, validated."""
+    robot = row_kind(entry, set(entry.values) if own is None else own, file)
     validate(entry, "joint", file)
     got = to_values(entry, file)
+    if robot:
+        return _robot_spec(entry, got, file)
     reader = got.get("reader", _DEFAULTS["reader"])
     reader_options: dict[str, Any] = {}
     extract_options: dict[str, Any] = {}
@@ -313,20 +391,10 @@ def _spec(entry: Entry, file: Path) -> JointSpec:
     if "joint" in READER_OPTIONS[reader] and "joint" not in reader_options:
         reader_options["joint"] = got["joint"]  # a bag's joint: the joint column by default
     log_text = got["log"]
-    if "\0" in log_text:
-        raise DataError(
-            "a path cannot hold a NUL character",
-            file=file,
-            row=entry.row,
-            column=entry.labels.get("log", "log"),
-        )
-    log = Path(log_text).expanduser()
-    if not log.is_absolute():
-        log = file.parent / log
     spec = JointSpec(
         robot=got["robot"],
         joint=got["joint"],
-        log=Path(os.path.abspath(log)),
+        log=manifest_path(log_text, entry, "log", file),
         log_text=log_text,
         row=entry.row,
         date=got.get("date"),
@@ -435,7 +503,8 @@ def read_manifest(path: str | os.PathLike[str]) -> Manifest:
         entry = Entry(row, dict(defaults.values), dict(defaults.raw), dict(defaults.labels))
         entry.units = dict(defaults.units)
         try:
-            spec = _spec(read_entry(mapping, path, row, entry), path)
+            own = set(read_entry(mapping, path, row, Entry(row)).values)
+            spec = _spec(read_entry(mapping, path, row, entry), path, own)
         except DataError as exc:  # every row is checked: all problems are told at once
             problems.append(exc)
             continue

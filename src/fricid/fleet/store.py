@@ -136,7 +136,9 @@ def _record_problem(record: dict[str, Any], spec: JointSpec) -> str | None:
     if not isinstance(rows, list) or not all(isinstance(r, dict) for r in rows):
         return "its rows are not a list of mappings"
     for row in rows:
-        if row.get("robot") != spec.robot or row.get("joint") != spec.joint:
+        # a robot row's record holds a row per joint of the robot
+        other = row.get("joint") != spec.joint and not spec.is_robot
+        if row.get("robot") != spec.robot or other:
             return "a row is of another joint"
         if not _iso_date(row.get("date")):
             return "a row's date is not a date (YYYY-MM-DD)"

@@ -13,7 +13,8 @@ Columns (SI units; each parameter's unit in ``units``):
   scatter), ``heldout_source`` (``lovo run here``, ``the fit's --validate``, ``the learned
   model's own CV`` or ``in-sample only``), ``heldout_scheme``, ``verdict`` (within noise, or
   misses by a factor), ``n_not_determined``,
-  ``extrapolation_free_range`` (the operating range, as text);
+  ``extrapolation_free_range`` (the operating range, as text); for a whole robot's joints,
+  ``reasons`` (why the verdict is not yes, as the identification gave them);
 - fit: ``fitness`` (R^2), ``sse`` [N^2 m^2], ``rmse``, ``mae``, ``max_abs_error`` [N m],
   ``rmspe`` (a fraction: 0.021 is 2.1 %, as in the model file; commands and reports print
   it in percent), ``nfev``, ``at_bound``, ``fixed``, ``units``, ``model_file``;
@@ -91,6 +92,7 @@ _STRINGS = (
     "heldout_scheme",
     "verdict",
     "extrapolation_free_range",
+    "reasons",
 )
 _INTS = ("seed", "n_samples", "nfev", "n_not_determined")
 _BOOLS = ("converged",)
