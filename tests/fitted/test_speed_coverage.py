@@ -96,3 +96,10 @@ def test_trust_text_and_compensate_use_the_per_direction_range(model):
     notes = compensation_study(model, config).notes
     assert any("below the identified speeds (|v| < 0.217 rad/s)" in n for n in notes), notes
     assert any("crosses a gap of the measured speeds" in n for n in notes), notes
+
+
+def test_one_speed_on_a_side_has_a_range_and_no_gap():
+    # one measured speed in one direction (a held-out fold of few levels): no step to compare
+    got = speed_coverage([0.2, 0.5, 1.0, -0.5], [1, 1, 1, -1])
+    assert got["neg"] == {"range": [0.5, 0.5], "gaps": []}
+    assert got["pos"]["range"] == [0.2, 1.0]

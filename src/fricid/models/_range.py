@@ -79,7 +79,7 @@ def speed_coverage(velocity, directions: Sequence[int] = ()) -> dict[str, dict[s
         limit = (
             max(np.log(GAP_MIN_RATIO), GAP_FACTOR * float(np.median(steps))) if steps.size else 0
         )
-        wide = np.diff(s) > GAP_FACTOR * float(np.median(np.diff(s))) if steps.size else steps
+        wide = np.diff(s) > GAP_FACTOR * float(np.median(np.diff(s))) if steps.size else steps > 0
         gaps = [[float(s[i]), float(s[i + 1])] for i in np.flatnonzero((steps > limit) & wide)]
         out[side] = {"range": [float(s[0]), float(s[-1])], "gaps": gaps}
     return out
