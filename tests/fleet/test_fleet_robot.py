@@ -139,3 +139,17 @@ def test_manifest_refuses_columns_of_the_other_kind_of_row(arm, row, column, wor
         read_manifest(manifest)
     assert info.value.row == 2 and info.value.column == column
     assert words in str(info.value)
+
+
+def test_drift_leaves_a_robots_joints_out_instead_of_failing():
+    import pandas as pd
+
+    from fricid.fleet import compare
+
+    row = {"robot": "dp", "joint": "joint1", "model": "arm", "chosen": "coulomb_viscous",
+           "status": "ok", "param_f_c": 0.2, "ci95_f_c": 0.01, "param_beta": 0.1,
+           "ci95_beta": 0.01}  # fmt: skip
+    before = pd.DataFrame([row])
+    now = pd.DataFrame([{**row, "param_f_c": 0.5}])
+    drift = compare(now, before)  # get_model("arm") would raise: no such family
+    assert len(drift.joints) == 0

@@ -8,6 +8,10 @@ the friction much; so the predicted friction of both fits is also compared over 
 operating range both identifications cover (velocity, load and temperature grid), and its
 largest change is reported. A joint has *drifted* when at least one parameter is flagged and
 the friction changed by at least ``min_change``.
+
+The joints of a whole robot's row (``model`` ``arm``) are not compared here: their rows hold
+no operating range on the grid's terms (load, temperature), so they are left out rather than
+compared on made-up ranges.
 """
 
 from __future__ import annotations
@@ -71,6 +75,7 @@ class Drift:
 def _ok(frame: pd.DataFrame) -> pd.DataFrame:
     if "status" in frame:
         frame = frame[frame["status"] == "ok"]
+    frame = frame[frame["model"] != "arm"]  # a whole robot's joints (module notes)
     return frame.drop_duplicates(_KEY, keep="last").set_index(_KEY)
 
 
@@ -117,7 +122,8 @@ def compare(
     Parameters
     ----------
     current, baseline : results tables (:func:`fricid.fleet.read_results`); only rows with
-        status ``ok`` are compared, matched by robot, joint and model.
+        status ``ok`` are compared, matched by robot, joint and model (a whole robot's joints
+        are left out: module notes).
     min_change : friction change [N m] below which a joint with flagged parameters is not
         counted as drifted (default 0: any flagged parameter).
     n_grid : velocities in the comparison grid (times 5 loads and 5 temperatures).
