@@ -168,3 +168,14 @@ def test_a_floating_base_is_refused(tmp_path):
     path.write_text(text)
     with pytest.raises(DataError, match="only fixed-base robots"):
         RigidBodyModel.from_urdf(path)
+
+
+def test_one_joint_regressor_keeps_its_joint_axis():
+    """A one-joint robot's regressor is (N, 1, 10) like any other's (Pinocchio returns its
+    1 x 10 matrix as a vector)."""
+    path, _ = example_urdf("double_pendulum")
+    model = RigidBodyModel.from_urdf(path, ["joint1"])
+    q = np.array([[0.1], [0.7], [-1.2]])
+    Y = model.gravity_regressor(q)
+    assert Y.shape == (3, 1, 10)
+    np.testing.assert_allclose(Y @ model.parameters(), model.gravity_torque(q), atol=1e-12)

@@ -20,6 +20,8 @@ MODULES = (
     "reproduce",
     "fleet",
     "robot_simulate",
+    "robot_extract",
+    "robot_export",
 )
 
 for _name in MODULES:

@@ -13,6 +13,9 @@
 >>> "<dynamics" in urdf_text(fitted, joint="elbow")  # <dynamics .../> and a comment
 True
 
+All joints of a robot at once (:mod:`fricid.export.robot`): one ros2_control YAML with a
+block per joint, one C header and source with a function per joint and a dispatcher.
+
 Targets that hold less than the model (URDF, MJCF and YAML hold Coulomb plus viscous
 friction) get the least-squares projection over the model's operating range, with its error
 and what is lost stated in the file; beyond a tolerance they refuse with an
@@ -50,6 +53,7 @@ from .descriptions import (
     write_text,
 )
 from .projection import Projection, operating_grid, project
+from .robot import RobotCCode, export_robot_c, robot_c_code, robot_ros2_yaml_text
 from .schema import model_schema, schema_path, validate_model_dict
 
 __all__ = [
@@ -60,12 +64,14 @@ __all__ = [
     "CCode",
     "ExportError",
     "Projection",
+    "RobotCCode",
     "Smoothing",
     "c_code",
     "clamp_inputs",
     "clamp_limits",
     "description_text",
     "export_c",
+    "export_robot_c",
     "file_sha256",
     "mjcf_text",
     "model_schema",
@@ -74,6 +80,8 @@ __all__ = [
     "plain",
     "project",
     "refuse_undetermined",
+    "robot_c_code",
+    "robot_ros2_yaml_text",
     "ros2_yaml_text",
     "schema_path",
     "smooth_predict",

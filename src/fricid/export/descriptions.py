@@ -208,6 +208,63 @@ def mjcf_text(
     return _xml(lines, *elements)
 
 
+def ros2_yaml_block(
+    fitted: FittedModel,
+    joint: str,
+    *,
+    max_loss: float = DEFAULT_MAX_LOSS,
+    source: str | None = None,
+    sha256: str | None = None,
+    **ranges,
+) -> tuple[str, list[str], dict[str, object]]:
+    """One joint of :func:`ros2_yaml_text`: the checked joint name, the comment lines and the
+    joint's parameters (per-direction Coulomb and viscous friction of the projection)."""
+    name = _check_joint(joint)
+    if name == "joints":
+        raise ExportError("joint name 'joints' is taken by the list of joints in the YAML")
+    proj = _checked(fitted, "the per-direction Coulomb-viscous YAML", True, max_loss, ranges)
+    lines = [*summary_lines(fitted, source, sha256), *proj.summary()]
+    write_lines_checked(lines, ())
+    c, b = proj.coulomb, proj.viscous
+    values = {
+        "coulomb_positive": c["positive"],
+        "coulomb_negative": c["negative"],
+        "viscous_positive": b["positive"],
+        "viscous_negative": b["negative"],
+        "projection_rms_error": proj.rms_error,
+    }
+    params: dict[str, object] = {key: float(fmt_float(value, key)) for key, value in values.items()}
+    params["source_model"] = model_name(fitted)
+    return name, lines, params
+
+
+#: The compensation law and units every ros2_control-style YAML states.
+ROS2_LAW_LINES = (
+    "tau_ff = coulomb_positive + viscous_positive * v (v > 0); "
+    "-coulomb_negative + viscous_negative * v (v < 0)",
+    "units: coulomb_* [N m] (magnitudes), viscous_* [N m s/rad], velocity [rad/s]",
+)
+
+
+def ros2_yaml_document(node: str, blocks: list[tuple[str, list[str], dict]]) -> str:
+    """The YAML of :func:`ros2_yaml_block` s: ``#`` comment lines (each joint's, then the
+    law), then ``<node>: ros__parameters: joints: [...]`` and a mapping per joint."""
+    node = _check_node(node)
+    names = [name for name, _, _ in blocks]
+    if len(set(names)) != len(names):
+        raise ExportError(f"a joint is named twice in {names}")
+    lines: list[str] = []
+    for name, block, _ in blocks:
+        lines.extend([f"joint {name}:"] if len(blocks) > 1 else [])
+        lines.extend(block)
+    lines.extend(ROS2_LAW_LINES)
+    params: dict[str, object] = {"joints": names}
+    params.update({name: joint_params for name, _, joint_params in blocks})
+    doc = {node: {"ros__parameters": params}}
+    body = yaml.safe_dump(doc, sort_keys=False, default_flow_style=False, allow_unicode=False)
+    return "".join(f"# {line}\n" for line in lines) + body
+
+
 def ros2_yaml_text(
     fitted: FittedModel,
     joint: str = "joint",
@@ -224,36 +281,14 @@ def ros2_yaml_text(
     ``-coulomb_negative + viscous_negative v`` for ``v < 0`` (``coulomb_*`` are magnitudes
     [N m], ``viscous_*`` in N m s/rad), under ``<node>: ros__parameters: <joint>:``. The
     document is written by :func:`yaml.safe_dump` under ``#`` comment lines; ``node`` must
-    be a plain ROS 2 node name. Other arguments as for :func:`urdf_text`.
+    be a plain ROS 2 node name. Other arguments as for :func:`urdf_text`. Several joints in
+    one file: :func:`fricid.export.robot.robot_ros2_yaml_text`.
     """
-    name = _check_joint(joint)
-    node = _check_node(node)
-    if name == "joints":
-        raise ExportError("joint name 'joints' is taken by the list of joints in the YAML")
-    proj = _checked(fitted, "the per-direction Coulomb-viscous YAML", True, max_loss, ranges)
-    lines = [
-        *summary_lines(fitted, source, sha256),
-        *proj.summary(),
-        "tau_ff = coulomb_positive + viscous_positive * v (v > 0); "
-        "-coulomb_negative + viscous_negative * v (v < 0)",
-        "units: coulomb_* [N m] (magnitudes), viscous_* [N m s/rad], velocity [rad/s]",
-    ]
-    write_lines_checked(lines, ())
-    c, b = proj.coulomb, proj.viscous
-    values = {
-        "coulomb_positive": c["positive"],
-        "coulomb_negative": c["negative"],
-        "viscous_positive": b["positive"],
-        "viscous_negative": b["negative"],
-        "projection_rms_error": proj.rms_error,
-    }
-    joint_params: dict[str, object] = {
-        key: float(fmt_float(value, key)) for key, value in values.items()
-    }
-    joint_params["source_model"] = model_name(fitted)
-    doc = {node: {"ros__parameters": {"joints": [name], name: joint_params}}}
-    body = yaml.safe_dump(doc, sort_keys=False, default_flow_style=False, allow_unicode=False)
-    return "".join(f"# {line}\n" for line in lines) + body
+    _check_node(node)
+    block = ros2_yaml_block(
+        fitted, joint, max_loss=max_loss, source=source, sha256=sha256, **ranges
+    )
+    return ros2_yaml_document(node, [block])
 
 
 #: The description targets, by name, with their text builder.

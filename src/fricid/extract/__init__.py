@@ -13,11 +13,15 @@ current and a torque sensor, or from a gravity load known from a URDF),
 :mod:`.quality` (the per-set-point quality table and its warnings), :mod:`.gravity_check`
 (does eq. 7 explain the position dependence?), :mod:`._gravity_mode` (which gravity mode, and
 the note when gravity is not removed), :mod:`.pipeline` (:func:`extract`), :mod:`.result`
-(what it returns).
+(what it returns), :mod:`.arm_gravity` (an arm's base gravity parameters and every joint's
+per-set-point friction, jointly) and :mod:`.arm` (:func:`extract_arm`: every joint of a robot
+log, gravity from the whole configuration).
 """
 
 from __future__ import annotations
 
+from .arm import ArmExtraction, extract_arm
+from .arm_gravity import ArmGravityFit
 from .bins import Cells, CellTable, Pooled, PositionBins, pool_cells
 from .gravity import GravityFit, fit_gravity, separate
 from .joint_gravity import JointGravityFit, fit_gravity_joint, moments
@@ -39,6 +43,8 @@ __all__ = [
     "SCATTER_RATIO",
     "SETTLE_SIGMAS",
     "SPIKE_SIGMAS",
+    "ArmExtraction",
+    "ArmGravityFit",
     "CellTable",
     "Cells",
     "Diagnostics",
@@ -54,6 +60,7 @@ __all__ = [
     "cluster",
     "current_as_torque",
     "extract",
+    "extract_arm",
     "fit_gravity",
     "fit_gravity_joint",
     "fit_torque_constant",

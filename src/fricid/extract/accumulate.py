@@ -10,6 +10,7 @@ is known.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -65,6 +66,7 @@ class Record:
     moments: np.ndarray | None = None  # :func:`.joint_gravity.moments` of the kept samples
     blocks: np.ndarray | None = None  # :func:`.gravity_check.block_stats` of the kept samples
     source: str | None = None  # the file the segment was read from
+    extra: np.ndarray | None = None  # the ``extra`` statistics of the kept samples
 
 
 class Accumulator:
@@ -84,6 +86,10 @@ class Accumulator:
         Fewest samples a segment must keep after the checks.
     moments : bool
         Also keep each segment's :func:`~.joint_gravity.moments` (for ``gravity="joint"``).
+    extra : callable, optional
+        ``extra(segment, keep, tau)`` -> statistics of the segment's kept samples (``keep`` a
+        boolean mask over the segment's rows, ``tau`` its filtered motor torque), kept in
+        :attr:`Record.extra` (the whole-configuration gravity of :mod:`.arm_gravity`).
     """
 
     def __init__(
@@ -95,8 +101,10 @@ class Accumulator:
         settle_sigmas: float | None = SETTLE_SIGMAS,
         min_samples: int = 20,
         moments: bool = False,
+        extra: Callable[[Segment, np.ndarray, np.ndarray], np.ndarray] | None = None,
     ) -> None:
         self.moments = moments
+        self.extra = extra
         self.bins = bins
         self.window = window
         self.outlier_sigmas = outlier_sigmas
@@ -153,6 +161,7 @@ class Accumulator:
                 moments=moments(log.position[keep], tau[keep]) if self.moments else None,
                 blocks=block_stats(log.position[keep], tau[keep]) if self.moments else None,
                 source=log.source,
+                extra=None if self.extra is None else self.extra(seg, keep, tau),
             )
         )
 

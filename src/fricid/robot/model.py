@@ -328,9 +328,9 @@ class RigidBodyModel:
         pin = pinocchio()
         q, dq, ddq = self._rows(q, dq, ddq)
         m, d = self._model, self._data
-        return np.array(
-            [pin.computeJointTorqueRegressor(m, d, *row) for row in zip(q, dq, ddq, strict=True)]
-        )
+        rows = [pin.computeJointTorqueRegressor(m, d, *row) for row in zip(q, dq, ddq, strict=True)]
+        # a one-joint robot's 1 x 10 matrix comes back from Pinocchio as a vector
+        return np.array(rows).reshape(q.shape[0], self.n, 10 * self.n)
 
     def gravity_regressor(self, q) -> np.ndarray:
         """``Y(q, 0, 0)``: the regressor of the gravity torque alone, shape (N, n, 10 n)."""

@@ -1,0 +1,160 @@
+"""Sweeps on arms: each joint's friction from constant-velocity sweeps with coupled gravity.
+
+Two arms, simulated by the sweep generator of the tests (``tests/_arm_sweeps.py``: inverse
+dynamics of the example-robot-data URDF plus per-direction Coulomb-viscous friction plus
+noise; each speed swept with the other joints in another pose), identified with a model
+whose bodies are 10-20 % off:
+
+- the double pendulum (noise 0.01 N m),
+- three joints of the Panda (2, 4, 6; the others locked at 0; noise 0.05 N m).
+
+Printed per joint: the RMS error of the per-direction friction samples [N m] by the arm path
+(gravity from the whole configuration, base gravity parameters identified), by the URDF's
+masses (not identified), by the single-joint path (eq. 7 of the BAS-RBFNN paper, joint fit),
+the RMS friction and the RMS standard error of the arm path; then, over ``--seeds`` seeds,
+the share of 95 % intervals (+-1.96 standard errors) that hold the truth, for the set-point
+frictions and the base gravity parameters.
+
+Run: ``python benchmarks/bench_arm_sweeps.py [--seeds 20]``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+from _arm_sweeps import Law, arm_sweeps, perturbed
+from fricid.extract import extract, extract_arm
+from fricid.robot import RigidBodyModel, base_parameters, example_urdf
+
+PANDA = ("panda_joint2", "panda_joint4", "panda_joint6")
+
+
+def pendulum():
+    path, joints = example_urdf("double_pendulum")
+    truth = RigidBodyModel.from_urdf(path, joints)
+    laws = {"joint1": Law(0.10, 0.08, 0.05, 0.04), "joint2": Law(0.06, 0.07, 0.03, 0.035)}
+    spans = {"joint1": (-1.2, 1.2), "joint2": (-1.2, 1.2)}
+    poses = {
+        "joint1": [np.array([0.0, q]) for q in (-0.9, 0.0, 0.9)],
+        "joint2": [np.array([q, 0.0]) for q in (-0.9, 0.0, 0.9)],
+    }
+    return "double pendulum", truth, laws, spans, poses, {"noise": 0.01, "rate": 100.0}
+
+
+def panda():
+    path, _ = example_urdf("panda")
+    truth = RigidBodyModel.from_urdf(path, PANDA)
+    laws = {
+        PANDA[0]: Law(1.0, 0.8, 0.5, 0.4),
+        PANDA[1]: Law(0.6, 0.7, 0.3, 0.35),
+        PANDA[2]: Law(0.3, 0.25, 0.1, 0.12),
+    }
+    spans = {PANDA[0]: (-1.2, 1.2), PANDA[1]: (-2.8, -0.4), PANDA[2]: (0.3, 3.3)}
+    poses = {
+        PANDA[0]: [np.array([0.0, a, b]) for a, b in ((-2.2, 1.0), (-1.6, 1.8), (-1.0, 2.6))],
+        PANDA[1]: [np.array([a, 0.0, b]) for a, b in ((-0.6, 1.0), (0.0, 1.8), (0.6, 2.6))],
+        PANDA[2]: [np.array([a, b, 0.0]) for a, b in ((-0.6, -2.2), (0.0, -1.6), (0.6, -1.0))],
+    }
+    return "Panda joints 2, 4, 6", truth, laws, spans, poses, {"noise": 0.05, "rate": 100.0}
+
+
+def rms(x) -> float:
+    return float(np.sqrt(np.mean(np.square(x))))
+
+
+def errors(case, seed: int):
+    """One seed: per joint (arm, URDF, eq. 7, friction, se) RMS, and the z-scores."""
+    _, truth, laws, spans, poses, options = case
+    ident = perturbed(truth, np.random.default_rng(100 + seed))
+    log = arm_sweeps(truth, spans, poses, laws, seed=seed, **options)
+    res = extract_arm(log, ident)
+    urdf = extract_arm(log, ident, identify=False)
+    rows = {}
+    for joint, law in laws.items():
+        bd = res[joint].by_direction
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            e7 = extract(log.joint(joint), gravity="joint").by_direction
+        se = [lv["friction_se"] for lv in res.gravity.joint_levels(joint)]
+        rows[joint] = (
+            rms(bd.friction - law(bd.velocity)),
+            rms(urdf[joint].by_direction.friction - law(bd.velocity)),
+            rms(e7.friction - law(e7.velocity)),
+            rms(law(bd.velocity)),
+            rms(se),
+        )
+    g = res.gravity
+    beta_true = base_parameters(ident, gravity_only=True).project(truth.parameters())
+    z_levels = [
+        (lv["friction"] - laws[lv["joint"]](lv["velocity"])) / lv["friction_se"] for lv in g.levels
+    ]
+    return rows, np.abs(z_levels), np.abs((g.beta - beta_true) / g.beta_se)
+
+
+def simulated() -> None:
+    """The whole-arm simulator's campaign: per joint the arm path's and eq. 7's RMS error."""
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "extract"))
+    from test_extract_arm_sim import _campaign, _friction
+
+    t0 = time.perf_counter()
+    path, joints = example_urdf("double_pendulum")
+    truth = RigidBodyModel.from_urdf(path, joints)
+    log = _campaign(truth)
+    pi = truth.parameters().reshape(2, 10)
+    ident = truth.with_parameters((pi * np.array([1.15, 0.85])[:, None]).ravel())
+    res = extract_arm(log, ident)
+    urdf = extract_arm(log, ident, identify=False)
+    print("\ndouble pendulum on fricid.sim.robot (N m RMS over the per-direction samples)")
+    print(f"{'joint':14s} {'arm':>8s} {'URDF':>8s} {'eq. 7':>8s} {'friction':>9s} {'se':>8s}")
+    for j, joint in enumerate(truth.joints):
+        bd = res[joint].by_direction
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            e7 = extract(log.joint(joint), gravity="joint").by_direction
+        ub = urdf[joint].by_direction
+        row = (
+            rms(bd.friction - _friction(j, bd.velocity)),
+            rms(ub.friction - _friction(j, ub.velocity)),
+            rms(e7.friction - _friction(j, e7.velocity)),
+            rms(_friction(j, bd.velocity)),
+            rms([lv["friction_se"] for lv in res.gravity.joint_levels(joint)]),
+        )
+        print(f"{joint:14s} " + " ".join(f"{x:8.4f}" for x in row))
+    print(f"{time.perf_counter() - t0:.0f} s")
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--seeds", type=int, default=20)
+    args = parser.parse_args()
+    for make in (pendulum, panda):
+        case = make()
+        t0 = time.perf_counter()
+        rows, _, _ = errors(case, 0)
+        print(f"\n{case[0]} (seed 0; N m RMS over the per-direction samples)")
+        print(f"{'joint':14s} {'arm':>8s} {'URDF':>8s} {'eq. 7':>8s} {'friction':>9s} {'se':>8s}")
+        for joint, r in rows.items():
+            print(f"{joint:14s} " + " ".join(f"{x:8.4f}" for x in r))
+        zl, zb = [], []
+        for seed in range(args.seeds):
+            _, a, b = errors(case, seed)
+            zl.extend(a)
+            zb.extend(b[np.isfinite(b)])
+        zl, zb = np.array(zl), np.array(zb)
+        print(
+            f"95 % interval coverage over {args.seeds} seeds: set-point frictions "
+            f"{np.mean(zl < 1.96):.3f} ({zl.size}), base gravity parameters "
+            f"{np.mean(zb < 1.96):.3f} ({zb.size}); {time.perf_counter() - t0:.0f} s"
+        )
+    simulated()
+
+
+if __name__ == "__main__":
+    main()

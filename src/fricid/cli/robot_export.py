@@ -1,0 +1,158 @@
+"""``fricid robot export``: every joint's model at once, as one ros2_control-style YAML or one
+C header and source with a function per joint and a dispatcher (:mod:`fricid.export.robot`).
+
+A command of its own rather than ``fricid export`` with several files: that command's
+argument is one model and its options describe one joint (``--joint``, ``--prefix``); a robot
+needs a mapping joint -> model file and a robot name, and its outputs are the robot's."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from ._app import err_console, handle_errors, robot_app
+from ._options import SmoothZone, out_option
+
+#: ``--to`` values and what each writes.
+ROBOT_TARGETS = {
+    "ros2_control": "one YAML, a block per joint (Coulomb-viscous per direction, projected)",
+    "c": "<robot>_friction.h and .c: a function per joint and <robot>_friction(joint, v, load, T)",
+}
+
+
+def _model_files(items: list[str]) -> dict[str, Path]:
+    """``JOINT=FILE``, a model file (joint = its stem) or a folder (its ``*.json`` files, by
+    name) -> joint -> file, in the order given."""
+    from ..errors import ConfigError
+
+    out: dict[str, Path] = {}
+
+    def add(joint: str, path: Path) -> None:
+        if joint in out:
+            raise ConfigError(f"joint '{joint}' is given twice ({out[joint]} and {path})")
+        if not path.is_file():
+            raise ConfigError(f"model file {path} for joint '{joint}' does not exist")
+        out[joint] = path
+
+    for item in items:
+        joint, sep, rest = item.partition("=")
+        if sep and joint.strip() and not Path(item).exists():
+            add(joint.strip(), Path(rest.strip()))
+            continue
+        path = Path(item)
+        if path.is_dir():
+            files = sorted(path.glob("*.json"))
+            if not files:
+                raise ConfigError(f"folder {path} holds no model file (*.json)")
+            for file in files:
+                add(file.stem, file)
+        else:
+            add(path.stem, path)
+    return out
+
+
+@robot_app.command("export")
+@handle_errors
+def robot_export_command(
+    models: Annotated[
+        list[str],
+        typer.Argument(
+            help="The joints' model files: JOINT=FILE, or FILE (the joint is its name without "
+            ".json), or a folder of them (every *.json, joints in file-name order)."
+        ),
+    ],
+    to: Annotated[
+        str,
+        typer.Option(
+            "--to",
+            help="; ".join(f"{k}: {v}" for k, v in ROBOT_TARGETS.items())
+            + " (yaml: the same as ros2_control).",
+        ),
+    ],
+    out: Annotated[
+        Path | None,
+        out_option(
+            "c: the folder to write <robot>_friction.h and .c into (default: the current "
+            "folder). ros2_control: the file to write (default: stdout)."
+        ),
+    ] = None,
+    robot_name: Annotated[
+        str,
+        typer.Option(
+            "--robot-name", help="c: the C name of the robot (files, dispatcher, functions)."
+        ),
+    ] = "fricid",
+    smooth: Annotated[
+        str, typer.Option(help="c: smoothing near zero velocity: none, tanh or linear.")
+    ] = "none",
+    zone: SmoothZone = 0.0,
+    clamp: Annotated[
+        bool,
+        typer.Option(
+            "--clamp/--no-clamp", help="c: hold each joint's inputs in its operating range."
+        ),
+    ] = False,
+    node: Annotated[
+        str, typer.Option(help="ros2_control: the ROS 2 node the parameters are under.")
+    ] = "friction_compensation",
+    max_loss: Annotated[
+        float,
+        typer.Option(help="ros2_control: largest projection error per joint (0.5 = 50 %)."),
+    ] = 0.5,
+    allow_undetermined: Annotated[
+        bool,
+        typer.Option(
+            "--allow-undetermined",
+            help="Export models whose records say some parameters are not determined.",
+        ),
+    ] = False,
+) -> None:
+    """Export every joint of a robot at once: one ros2_control-style YAML with a block per
+    joint, or one C header and source with a function per joint and a dispatcher
+    `double <robot>_friction(int joint, double velocity, double load, double temperature)`
+    (0 for an unknown joint). Each joint's part is its single-joint export (`fricid export`);
+    nothing is written unless every joint exports."""
+    from rich.markup import escape
+
+    from ..errors import ConfigError
+    from ..export import Smoothing, file_sha256, refuse_undetermined, write_text
+    from ..export.robot import export_robot_c, robot_ros2_yaml_text
+    from ..fitted import FittedModel
+    from ._paths import check_paths
+
+    target = to.strip().lower()
+    target = "ros2_control" if target == "yaml" else target  # the single-joint export's name
+    if target not in ROBOT_TARGETS:
+        raise ConfigError(f"unknown target '{to}'; choose one of: {', '.join(ROBOT_TARGETS)}")
+    check_paths(**{"out_dirs" if target == "c" else "out_files": {"--out": out}})
+    files = _model_files(models)
+    fitted = {joint: FittedModel.load(path) for joint, path in files.items()}
+    for model in fitted.values():
+        refuse_undetermined(model, allow_undetermined)
+    sources = {joint: path.name for joint, path in files.items()}
+    sha256 = {joint: file_sha256(path) for joint, path in files.items()}
+    if target == "c":
+        paths = export_robot_c(
+            fitted,
+            out or Path.cwd(),
+            Smoothing(smooth, zone),
+            robot=robot_name,
+            sources=sources,
+            sha256=sha256,
+            clamp=clamp,
+        )
+        for path in paths:
+            err_console.print(f"wrote {escape(str(path))}", highlight=False)
+        return
+    text = robot_ros2_yaml_text(
+        fitted, node=node, max_loss=max_loss, sources=sources, sha256=sha256
+    )
+    if out is None:
+        sys.stdout.write(text)
+        sys.stdout.flush()
+    else:
+        write_text(text, out)
+        err_console.print(f"wrote {escape(str(out))}", highlight=False)

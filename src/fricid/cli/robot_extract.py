@@ -1,0 +1,192 @@
+"""``fricid robot extract``: every joint's friction samples from constant-velocity sweeps of a
+whole arm, gravity computed from the whole configuration (:func:`fricid.extract.extract_arm`)."""
+
+from __future__ import annotations
+
+import json
+import re
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from ._app import console, err_console, handle_errors, robot_app
+from ._options import out_option
+from ._paths import check_paths
+
+#: The gravity parameters' file in the output folder.
+GRAVITY_FILE = "gravity.json"
+
+
+def _file_stem(joint: str) -> str:
+    """A joint's name as a file name: letters, digits, ``_ . -`` kept, anything else ``_``."""
+    stem = re.sub(r"[^A-Za-z0-9_.-]", "_", joint).strip(".") or "joint"
+    return stem[:100]
+
+
+def _stems(joints) -> dict[str, str]:
+    """Joint -> file stem, unique (a clash gets the joint's index appended)."""
+    out: dict[str, str] = {}
+    for i, joint in enumerate(joints):
+        stem = _file_stem(joint)
+        out[joint] = stem if stem not in out.values() else f"{stem}_{i + 1}"
+    return out
+
+
+def _split(items: list[str] | None) -> list[str] | None:
+    """``["a,b", "c"]`` -> ``["a", "b", "c"]``."""
+    if not items:
+        return None
+    return [name.strip() for item in items for name in item.split(",") if name.strip()]
+
+
+def _joint_table(result, joint: str) -> list[str]:
+    """One joint's set-points: velocity, friction with its standard error (the joint fit's,
+    the gravity parameters' uncertainty included), gravity load, passes and samples."""
+    g = result.gravity
+    lines = [
+        f"{joint}: {len(g.joint_levels(joint))} set-points, residual "
+        f"{g.residual_rms.get(joint, float('nan')):.3g} N m",
+        f"  {'T [degC]':>8} {'v [rad/s]':>10} {'friction [N m]':>15} {'+- se':>9} "
+        f"{'load [N m]':>11} {'passes':>6} {'samples':>8}",
+    ]
+    for lv in sorted(g.joint_levels(joint), key=lambda r: (r["temperature"], r["velocity"])):
+        lines.append(
+            f"  {lv['temperature']:>8.4g} {lv['velocity']:>+10.4g} {lv['friction']:>+15.5g} "
+            f"{lv['friction_se']:>9.2g} {lv['load']:>+11.4g} {lv['passes']:>6} {lv['count']:>8}"
+        )
+    return lines
+
+
+def _tables(result) -> list[str]:
+    """The printed tables: each joint's set-points, a row per joint, the base gravity
+    parameters."""
+    lines = [line for joint in result for line in (*_joint_table(result, joint), "")]
+    head = (
+        f"{'joint':<24} {'set-points':>10} {'samples':>8} {'|friction| [N m]':>20} "
+        f"{'|gravity| max':>13} {'residual':>9}"
+    )
+    lines.append(head)
+    for r in result.table():
+        span = f"{r['friction min [N m]']:.4g} - {r['friction max [N m]']:.4g}"
+        lines.append(
+            f"{r['joint'][:24]:<24} {r['set-points']:>10} {r['samples']:>8} {span:>20} "
+            f"{r['gravity max [N m]']:>13.4g} {r['residual [N m]']:>9.3g}"
+        )
+    g = result.gravity
+    what = "identified from the sweeps" if g.identified else "the URDF's (not identified)"
+    lines.append(f"base gravity parameters ({what}; value +- standard error, URDF):")
+    for name, b, se, u in zip(g.names, g.beta, g.beta_se, g.beta_urdf, strict=True):
+        lines.append(f"  {b:+.6g} +- {se:.2g}  (URDF {u:+.6g})  {name}")
+    return lines
+
+
+@robot_app.command("extract")
+@handle_errors
+def robot_extract_command(
+    log: Annotated[
+        Path,
+        typer.Argument(
+            help="The robot's sweeps: a wide CSV/Parquet table (q1, dq1, tau1, ... or "
+            "<joint>.position, ...), a ROS 2 bag with a JointState topic, or a folder of "
+            "per-channel files (fricid.io.read_robot_log)."
+        ),
+    ],
+    urdf: Annotated[Path, typer.Option("--urdf", help="The robot's URDF.")],
+    out: Annotated[
+        Path,
+        out_option(
+            "Folder to write: <joint>.csv per swept joint (its per-direction friction samples, "
+            f"load = gravity torque) and {GRAVITY_FILE} (the base gravity parameters with "
+            "standard errors and covariance, every set-point's friction); files of those names "
+            "are replaced."
+        ),
+    ] = Path("robot_samples"),
+    joints: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--joints",
+            help="Joints to extract (comma-separated or repeated); default every joint of the "
+            "log that has a constant-velocity sweep.",
+        ),
+    ] = None,
+    urdf_masses: Annotated[
+        bool,
+        typer.Option(
+            "--urdf-masses",
+            help="Keep the URDF's masses (gravity parameters not identified from the sweeps).",
+        ),
+    ] = False,
+    temperature: Annotated[
+        float | None,
+        typer.Option(help="The temperature [degC] to record when the log has none."),
+    ] = None,
+    torque_constant: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--torque-constant",
+            help="JOINT=K [N m/A] (repeatable): tau = K I (eq. 13) for a log of currents.",
+        ),
+    ] = None,
+    reader: Annotated[
+        str, typer.Option(help="Layout of LOG: auto, table, rosbag or channels.")
+    ] = "auto",
+    topic: Annotated[str, typer.Option(help="ROS 2 bags: the JointState topic.")] = "/joint_states",
+) -> None:
+    """Extract every joint's friction from constant-velocity sweeps of a whole arm.
+
+    Each joint's gravity torque is computed from the whole configuration at every sample (the
+    URDF's rigid-body model; on an arm the gravity of one joint depends on the others'
+    positions, which eq. 7 of one joint cannot represent), with the base gravity parameters
+    identified from the sweeps themselves (the URDF's masses are approximate) jointly with
+    every joint's friction per set-point, with cluster-robust intervals. Each joint's samples
+    are then fitted by `fricid fit` like a single joint's. The joints of the log that the URDF
+    has are modelled; the URDF's other moving joints are held at 0.
+    """
+    from ..extract import extract_arm
+    from ..io import read_robot_log
+    from ..io.atomic import atomic_write
+    from ..io.tables import write_samples
+    from ..io.urdf import read_urdf
+    from ..robot import RigidBodyModel
+    from ._options import parse_assignments
+
+    check_paths(inputs={"LOG": log, "--urdf": urdf}, folders=["LOG"], out_dirs={"--out": out})
+    robot = read_urdf(urdf)
+    constants = parse_assignments(torque_constant, "--torque-constant") or None
+    data = read_robot_log(
+        log, reader=reader, topic=topic, temperature=temperature, torque_constants=constants
+    )
+    moving = [
+        n for n, j in robot.joints.items() if j.kind in ("revolute", "continuous", "prismatic")
+    ]
+    modelled = [n for n in moving if n in data.joints]
+    if not modelled:
+        from ..errors import DataError
+
+        raise DataError(
+            f"no joint of the log ({', '.join(data.joints)}) is a moving joint of the URDF "
+            f"({', '.join(moving) or 'none'}); rename the log's columns to the URDF's names",
+            file=str(log),
+        )
+    model = RigidBodyModel.from_robot(robot, modelled)
+    result = extract_arm(data, model, joints=_split(joints), identify=not urdf_masses)
+    stems = _stems(result)
+    doc = {"urdf": urdf.name, "log": log.name, **result.gravity.as_meta()}
+    doc["files"] = {joint: f"{stems[joint]}.csv" for joint in result}
+    text = json.dumps(doc, indent=1, allow_nan=False) + "\n"
+    # everything is computed before the first file is written; each file is written atomically
+    out.mkdir(parents=True, exist_ok=True)
+    for joint, res in result.items():
+        write_samples(res.by_direction, out / f"{stems[joint]}.csv")
+    with atomic_write(out / GRAVITY_FILE) as fh:
+        fh.write(text)
+    for line in _tables(result):
+        console.print(line, markup=False, highlight=False)
+    for note in result.gravity.notes:
+        err_console.print(f"note: {note}", markup=False, highlight=False)
+    err_console.print(
+        f"wrote {len(result)} samples file(s) and {GRAVITY_FILE} into {out}",
+        markup=False,
+        highlight=False,
+    )
