@@ -43,13 +43,13 @@ def test_the_kind_is_decided_by_the_data_and_the_model():
         torque=np.zeros(5),
         temperature=np.full(5, 25.0),
     )
-    assert set(KINDS) == {"analytic", "learned", "dynamic", "auto"}
+    assert set(KINDS) == {"analytic", "learned", "dynamic", "auto", "arm"}
     assert kind_of(s, "stribeck") == "analytic"
     assert kind_of(s, "stribeck_temp_asym") == "analytic"
     assert all(kind_of(s, m) == "learned" for m in ("rbf", "hybrid", "gp"))
     assert kind_of(s, " Auto ") == "auto"
     assert kind_of(log, "lugre") == "dynamic"
-    with pytest.raises(ConfigError, match="FrictionSamples or a RawLog"):
+    with pytest.raises(ConfigError, match=r"FrictionSamples, a RawLog .* or a RobotLog"):
         kind_of([1, 2, 3], "stribeck")
 
 

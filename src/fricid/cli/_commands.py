@@ -22,6 +22,7 @@ MODULES = (
     "robot_simulate",
     "robot_extract",
     "robot_export",
+    "robot_fit",
 )
 
 for _name in MODULES:

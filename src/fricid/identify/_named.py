@@ -15,7 +15,7 @@ import numpy as np
 from ..errors import ConfigError
 from ..fitted import FittedModel
 from ..models import STATEFUL, FrictionModel
-from ..samples import FrictionSamples, RawLog
+from ..samples import FrictionSamples, RawLog, RobotLog
 
 __all__ = ["KINDS", "LEARNED", "SETTINGS", "fit_named", "kind_of"]
 
@@ -25,6 +25,7 @@ KINDS: dict[str, str] = {
     "learned": "fricid.identify.learned.train.fit_learned",
     "dynamic": "fricid.identify.dynamic.trajectory.fit_trajectory",
     "auto": "fricid.identify.static.select.select",
+    "arm": "fricid.identify.dynamic.arm.fit_arm",
 }
 
 #: The ``settings`` each kind (or learned model) takes; anything else is a ConfigError.
@@ -48,19 +49,23 @@ SETTINGS: dict[str, tuple[str, ...]] = {
         "progress",
     ),
     "auto": ("scheme", "scatter", "learned", "progress"),
+    "arm": ("robot", "friction", "consistent", "encoder_counts", "cutoff", "validate"),
 }
 
 #: The learned models (stored state, no named parameters).
 LEARNED = ("rbf", "hybrid", "gp")
 
 
-def kind_of(data: FrictionSamples | RawLog, model: str | FrictionModel) -> str:
+def kind_of(data: FrictionSamples | RawLog | RobotLog, model: str | FrictionModel) -> str:
     """The kind of identification for ``data`` and ``model`` (:data:`KINDS`)."""
     if isinstance(data, RawLog):
         return "dynamic"
+    if isinstance(data, RobotLog):
+        return "arm"
     if not isinstance(data, FrictionSamples):
         raise ConfigError(
-            f"fit takes FrictionSamples or a RawLog (a trajectory); got {type(data).__name__}"
+            "fit takes FrictionSamples, a RawLog (a trajectory) or a RobotLog (a whole arm); "
+            f"got {type(data).__name__}"
         )
     key = model.strip().lower() if isinstance(model, str) else None
     if key == "auto":

@@ -12,7 +12,12 @@ analytic  samples, a law of ``fricid.models``    :func:`.static.least_squares.fi
 learned   samples, ``rbf``, ``hybrid`` or ``gp``  :func:`.learned.train.fit_learned`
 dynamic   a trajectory log (``RawLog``)          :func:`.dynamic.trajectory.fit_trajectory`
 auto      samples, ``model="auto"``              :func:`.static.select.select`
+arm       a whole arm's log (``RobotLog``)       :func:`.dynamic.arm.fit_arm`
 ========  =====================================  ==========================================
+
+A whole arm returns an :class:`~fricid.fitted.arm.ArmFit` (every joint's friction as a
+``FittedModel`` through :meth:`~fricid.fitted.arm.ArmFit.joint_model`); the arm's rigid-body
+model goes in ``settings["robot"]``.
 """
 
 from __future__ import annotations
@@ -22,17 +27,19 @@ from typing import Any
 
 import numpy as np
 
+from ..errors import ConfigError
 from ..fitted import FittedModel
+from ..fitted.arm import ArmFit
 from ..models import FrictionModel
 from ..optim import OptimizeResult, one_blas_thread
-from ..samples import FrictionSamples, RawLog
+from ..samples import FrictionSamples, RawLog, RobotLog
 from ._named import KINDS, SETTINGS, _int_seed, _no_weights, _refuse, _settings, fit_named, kind_of
 
 __all__ = ["KINDS", "SETTINGS", "fit", "kind_of"]
 
 
 def fit(
-    data: FrictionSamples | RawLog,
+    data: FrictionSamples | RawLog | RobotLog,
     model: str | FrictionModel,
     method: str | None = None,
     *,
@@ -48,7 +55,7 @@ def fit(
     f_scale: float | None = None,
     weights: str | Any = "none",
     settings: Mapping[str, Any] | None = None,
-) -> FittedModel:
+) -> FittedModel | ArmFit:
     """Identify ``model`` from ``data`` with ``method``.
 
     Parameters
@@ -60,8 +67,11 @@ def fit(
         A law of :data:`fricid.models.MODELS` (eq. 1-4 of the BAS-RBFNN paper, Stribeck with
         exponent of the RWSAVSBAS paper's eq. 7; ``*_asym`` per direction, ``*_temp`` with an
         Arrhenius viscous term), an instance, a learned model (``"rbf"``, ``"hybrid"``,
-        ``"gp"``), ``"auto"`` (the family chosen by held-out error), or for a trajectory
-        ``"lugre"``, ``"dahl"``, ``"stribeck"`` or ``"coulomb_viscous"``.
+        ``"gp"``), ``"auto"`` (the family chosen by held-out error), for a trajectory
+        ``"lugre"``, ``"dahl"``, ``"stribeck"`` or ``"coulomb_viscous"``, and for a whole
+        arm's ``RobotLog`` the friction family of every joint (``"stribeck_asym"``,
+        ``"coulomb_viscous_asym"``, ``"coulomb_viscous"``, ``"stribeck"``) or ``"arm"``
+        (``settings["friction"]``, default ``stribeck_asym``).
     method : str, optional
         The optimiser. Analytic and dynamic: any of :data:`fricid.optim.METHODS` or
         ``"varpro"`` (analytic only); default ``"lm"``. ``rbf`` and ``hybrid``: ``"lsq"``
@@ -94,11 +104,14 @@ def fit(
         ``inputs``, ``max_points``, ``n_restarts``; dynamic: ``route``, ``gravity``, ...
         (:func:`fricid.identify.dynamic.trajectory.fit_trajectory`); ``auto``: ``scheme``
         (validation), ``scatter``, ``learned`` (try the learned families too), ``progress``
-        (``progress(i, n, candidate)``, :func:`.static.select.select`).
+        (``progress(i, n, candidate)``, :func:`.static.select.select`); ``arm``: ``robot``
+        (the :class:`fricid.robot.RigidBodyModel`, required), ``friction`` (a family or joint
+        -> family), ``consistent``, ``encoder_counts``, ``cutoff``, ``validate`` (a second
+        ``RobotLog``; :func:`fricid.identify.dynamic.arm.fit_arm`).
 
     Returns
     -------
-    FittedModel
+    FittedModel or ArmFit
         Parameters with their records (value, bounds, standard error, interval), the
         optimiser's record, metrics, convergence and provenance.
 
@@ -112,6 +125,23 @@ def fit(
     with one_blas_thread():  # every least-squares path on one BLAS thread
         kind = kind_of(data, model)
         extra = _settings(kind, model, settings)
+        if kind == "arm":
+            return _fit_arm(
+                data,
+                model,
+                method,
+                extra,
+                fixed=fixed,
+                bounds=bounds,
+                x0=x0,
+                options=options,
+                callback=callback,
+                max_evals=max_evals,
+                loss=loss != "l2",
+                weights=not _no_weights(weights),
+                f_scale=f_scale,
+                intervals=intervals != "auto",
+            )
         if kind == "dynamic":
             from .dynamic.trajectory import fit_trajectory
 
@@ -154,3 +184,21 @@ def fit(
             weights=weights,
             settings=settings,
         )
+
+
+def _fit_arm(data: RobotLog, model: Any, method: str | None, extra: dict, **given: Any) -> ArmFit:
+    """``fit`` of a whole arm: ``model`` is the friction family or ``"arm"``; nothing but
+    ``settings`` configures it."""
+    from .dynamic.arm import fit_arm
+
+    _refuse("arm", method=method, **given)
+    robot = extra.pop("robot", None)
+    if robot is None:
+        raise ConfigError("a whole arm needs its rigid-body model: settings={'robot': ...}")
+    if not isinstance(model, str):
+        raise ConfigError(f"a whole arm's model is a friction family or 'arm'; got {model!r}")
+    if model != "arm":
+        if "friction" in extra:
+            raise ConfigError("give the friction as model= or as settings['friction'], not both")
+        extra["friction"] = model
+    return fit_arm(data, robot, **extra)

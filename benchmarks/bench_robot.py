@@ -1,0 +1,175 @@
+"""Whole-arm identification of a simulated 7-joint Panda: the "done when" table.
+
+Usage::
+
+    python benchmarks/bench_robot.py [--seeds 10] [--duration 60] [--rate 1000]
+        [--noise 0.05] [--friction stribeck_asym] [--trajectory FILE] [--truth own]
+
+Per seed: each joint gets its own friction law per direction (``stribeck_asym``: Coulomb,
+static, Stribeck velocity and exponent, viscous drawn independently per joint and direction),
+the arm follows a multi-sine (or the designed trajectory of ``--trajectory``: a CSV with a
+``time`` column and one position column per joint, named as the URDF's joints), its torque is
+the inverse dynamics plus friction plus Gaussian noise (``--noise`` N m at the log's rate), the
+position is quantised to 2^17 counts per revolution. A second trajectory (other phases; for
+``--trajectory`` the same one with new noise) is the held-out log. :func:`fit_arm` identifies
+the whole arm; the table gives per joint the friction parameters' mean relative error and
+their 95 % intervals' coverage (over seeds, per parameter kind), the held-out torque error
+over the estimated noise, and the base inertial parameters' coverage and the seconds of the
+identification.
+
+Truth: ``--truth own`` is the tests' generator (``tests/identify/dynamic/_arm_truth.py``: the
+arm follows the reference exactly, an open-loop measurement); ``--truth pd`` is its
+closed-loop variant (``make_pd_log``: a 10 Hz PD on the quantised position with the inverse
+dynamics as feed-forward, the arm integrated semi-implicitly at 4 kHz, friction not
+compensated, an optional torque ``--disturbance``). ``--truth sim`` (the whole-arm
+simulator with PD tracking, ``fricid.sim``) is used when that simulator is installed.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from collections import defaultdict
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "tests" / "identify" / "dynamic"))
+import _arm_truth as truth  # noqa: E402
+
+from fricid.identify.dynamic.arm import fit_arm  # noqa: E402
+from fricid.robot import RigidBodyModel, base_parameters, example_urdf  # noqa: E402
+
+KINDS = ("tau_c", "tau_s", "w_s", "tau_v", "delta", "f_c", "beta")
+
+
+def _trajectory(path: Path, model: RigidBodyModel):
+    data = np.genfromtxt(path, delimiter=",", names=True)
+    names = data.dtype.names or ()
+    missing = [j for j in ("time", *model.joints) if j not in names]
+    if missing:
+        raise SystemExit(f"{path}: no column(s) {', '.join(missing)}")
+    t = np.asarray(data["time"], dtype=float)
+    q = np.column_stack([data[j] for j in model.joints]).astype(float)
+    dt = float(np.median(np.diff(t)))
+    dq = np.gradient(q, dt, axis=0)
+    return t, q, dq, np.gradient(dq, dt, axis=0)
+
+
+def _laws(model, seed, friction):
+    rng = np.random.default_rng(10_000 + seed)
+    if friction == "stribeck_asym":
+        return [truth.stribeck_law(rng) for _ in model.joints]
+    return [
+        (
+            "coulomb_viscous_asym",
+            {
+                "f_c_pos": rng.uniform(0.3, 1.0),
+                "beta_pos": rng.uniform(0.1, 0.6),
+                "f_c_neg": rng.uniform(0.3, 1.0),
+                "beta_neg": rng.uniform(0.1, 0.6),
+            },
+        )
+        for _ in model.joints
+    ]
+
+
+def _logs(model, laws, seed, args, trajectory):
+    if args.truth == "sim":
+        raise SystemExit("--truth sim: the whole-arm simulator is not installed in this fricid")
+    kw = {"duration": args.duration, "rate": args.rate, "noise": args.noise}
+    make = truth.make_log
+    if args.truth == "pd":
+        make = truth.make_pd_log
+        kw["disturbance"] = args.disturbance
+    one = make(model, laws, seed=seed, trajectory=trajectory, **kw)
+    two = make(model, laws, seed=seed + 5_000, trajectory=trajectory, **kw)
+    return one, two
+
+
+def run(args) -> None:
+    path, joints = example_urdf(args.robot)
+    model = RigidBodyModel.from_urdf(path, joints)
+    beta_true = base_parameters(model).project(model.parameters())
+    trajectory = _trajectory(args.trajectory, model) if args.trajectory else None
+    rel = defaultdict(list)  # (joint, kind) -> relative errors
+    cov = defaultdict(list)  # (joint, kind) -> covered
+    ratio = defaultdict(list)
+    levels = defaultdict(list)
+    base_cov, seconds = [], []
+    for seed in range(args.seeds):
+        laws = _laws(model, seed, args.friction)
+        log, held = _logs(model, laws, seed, args, trajectory)
+        start = time.perf_counter()
+        fit = fit_arm(log, model, friction=laws[0][0], validate=held)
+        seconds.append(time.perf_counter() - start)
+        for joint, (_, values) in zip(fit.joints, laws, strict=True):
+            for name, rec in fit.friction[joint]["parameters"].items():
+                kind = next(k for k in KINDS if name.startswith(k))
+                t = values[name]
+                if rec["value"] is None:
+                    cov[joint, kind].append(False)
+                    continue
+                rel[joint, kind].append(abs(rec["value"] - t) / abs(t))
+                cov[joint, kind].append(rec["ci95"][0] <= t <= rec["ci95"][1])
+            ratio[joint].append(fit.validation[joint]["ratio"])
+            levels[joint].append(fit.validation[joint]["level"])
+        ci = fit.base["ci95"]
+        base_cov.append(
+            np.mean(
+                [
+                    lo is not None and lo <= b <= hi
+                    for b, (lo, hi) in zip(beta_true, ci, strict=True)
+                ]
+            )
+        )
+        print(f"seed {seed}: {seconds[-1]:.1f} s", file=sys.stderr, flush=True)
+    kinds = [k for k in KINDS if any((j, k) in cov for j in model.joints)]
+    print(
+        f"{args.robot}, {args.seeds} seeds, {args.duration:g} s at {args.rate:g} Hz, 2^17 "
+        f"counts, noise {args.noise:g} N m, friction {args.friction}, truth {args.truth}"
+        + (f", trajectory {args.trajectory.name}" if args.trajectory else ", multi-sine")
+    )
+    head = " ".join(f"{k + ' err/cov':>17}" for k in kinds)
+    print(f"{'joint':<14}{head} {'held-out/noise':>15} {'verdicts (yes/cav/no)':>22}")
+    all_cov = []
+    for joint in model.joints:
+        cells = []
+        for k in kinds:
+            r, c = rel[joint, k], cov[joint, k]
+            all_cov += c
+            cells.append(f"{100 * np.median(r):7.2f}% {100 * np.mean(c):5.0f}%   ")
+        lv = levels[joint]
+        counts = f"{lv.count('yes')}/{lv.count('with caveats')}/{lv.count('no')}"
+        print(f"{joint:<14}{' '.join(cells)} {np.mean(ratio[joint]):15.2f} {counts:>22}")
+    print(
+        "friction intervals' coverage over all joints and parameters: "
+        f"{100 * np.mean(all_cov):.1f} %"
+    )
+    print(f"base inertial parameters' coverage: {100 * np.mean(base_cov):.1f} % (mean over seeds)")
+    print(f"seconds per identification: median {np.median(seconds):.1f}, max {np.max(seconds):.1f}")
+    print("(err: median relative error over seeds; cov: 95 % intervals covering the truth)")
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--seeds", type=int, default=10)
+    parser.add_argument("--robot", default="panda", help="an example robot (panda, ur5, ...)")
+    parser.add_argument("--duration", type=float, default=60.0)
+    parser.add_argument("--rate", type=float, default=1000.0)
+    parser.add_argument("--noise", type=float, default=0.05)
+    parser.add_argument(
+        "--friction", choices=("stribeck_asym", "coulomb_viscous_asym"), default="stribeck_asym"
+    )
+    parser.add_argument("--trajectory", type=Path, default=None)
+    parser.add_argument("--truth", choices=("own", "pd", "sim"), default="own")
+    parser.add_argument(
+        "--disturbance", type=float, default=0.0, help="--truth pd: torque disturbance [N m]"
+    )
+    run(parser.parse_args())
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,139 @@
+"""``fricid robot fit``: a whole arm's base inertial parameters and every joint's friction from
+one log of any trajectory (:func:`fricid.identify.dynamic.arm.fit_arm`)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import numpy as np
+import typer
+
+from ._app import console, handle_errors, robot_app
+from ._paths import check_paths
+
+
+def _split(text: str | None) -> list[str] | None:
+    if not text:
+        return None
+    return [p.strip() for p in text.split(",") if p.strip()]
+
+
+def _friction(text: str):
+    """``stribeck_asym`` or ``joint1=coulomb_viscous,joint2=stribeck_asym``."""
+    if "=" not in text:
+        return text
+    from ..errors import ConfigError
+
+    out = {}
+    for part in _split(text) or []:
+        name, sep, family = part.partition("=")
+        if not sep or not name.strip() or not family.strip():
+            raise ConfigError(f"--friction: expected JOINT=FAMILY, got {part!r}")
+        out[name.strip()] = family.strip()
+    return out
+
+
+def _pm(rec: dict) -> str:
+    if rec.get("not_determined") or rec.get("value") is None:
+        return "not determined"
+    low, high = rec["ci95"]
+    if low is None:
+        return f"{rec['value']:.4g}"
+    return f"{rec['value']:.4g} +- {(high - low) / 2:.2g}"
+
+
+def _table(fit) -> None:
+    from rich.table import Table
+
+    table = Table(title="Friction per joint (95 % intervals)")
+    table.add_column("joint")
+    table.add_column("family")
+    table.add_column("parameters")
+    table.add_column("held-out / noise", justify="right")
+    table.add_column("verdict")
+    for joint in fit.joints:
+        entry = fit.friction[joint]
+        params = "; ".join(f"{n} {_pm(r)}" for n, r in entry["parameters"].items())
+        check = fit.validation[joint]
+        ratio = check.get("ratio")
+        ratio_text = f"{ratio:.2f}" if ratio is not None and np.isfinite(ratio) else "-"
+        verdict = check["level"] + (f": {'; '.join(check['reasons'])}" if check["reasons"] else "")
+        table.add_row(joint, entry["family"], params, ratio_text, verdict)
+    console.print(table)
+    se = np.array([np.nan if s is None else s for s in fit.base["stderr"]], dtype=float)
+    values = np.asarray(fit.base["values"], dtype=float)
+    determined = np.isfinite(se)
+    well = determined & (np.abs(values) > 2 * np.nan_to_num(se, nan=np.inf))
+    console.print(
+        f"Base inertial parameters: {values.size}, {int(determined.sum())} determined, "
+        f"{int(well.sum())} well determined (|value| > 2 standard errors); standard parameters "
+        f"{fit.standard.get('used', 'not made consistent')}"
+        + (
+            f" (least squares already physical: {fit.standard['consistent_ls']})"
+            if "consistent_ls" in fit.standard
+            else ""
+        )
+    )
+    prov = fit.provenance
+    console.print(
+        f"Estimator {prov['estimator']}; low-pass {prov['cutoff']:.3g} Hz, decimation "
+        f"{prov['decimation']}, {prov['samples']} equations; {prov['seconds']:.1f} s"
+    )
+
+
+@robot_app.command("fit")
+@handle_errors
+def robot_fit_command(
+    log: Annotated[Path, typer.Argument(help="The robot log (CSV, Parquet, ROS 2 bag, folder).")],
+    urdf: Annotated[Path, typer.Option(help="The robot's URDF.")],
+    out: Annotated[Path, typer.Option("--out", "-o", help="The fit file to write (JSON).")],
+    joints: Annotated[
+        str | None,
+        typer.Option(help="Joints to identify, comma-separated (default: the URDF's movable)."),
+    ] = None,
+    friction: Annotated[
+        str,
+        typer.Option(
+            help="Friction family for every joint (stribeck_asym, coulomb_viscous_asym, "
+            "coulomb_viscous, stribeck) or JOINT=FAMILY,... per joint."
+        ),
+    ] = "stribeck_asym",
+    validate: Annotated[
+        Path | None,
+        typer.Option(help="A second log for held-out validation (default: the last quarter)."),
+    ] = None,
+    encoder_counts: Annotated[
+        int | None, typer.Option(help="Encoder counts per revolution (default: from the log).")
+    ] = None,
+    cutoff: Annotated[
+        float | None, typer.Option(help="Low-pass cut-off [Hz] (default: chosen from the log).")
+    ] = None,
+    consistent: Annotated[
+        bool, typer.Option(help="Make the inertial parameters physically consistent.")
+    ] = True,
+) -> None:
+    """Identify a whole arm from any trajectory: base inertial parameters and every joint's
+    friction together, with intervals and a held-out verdict per joint."""
+    from ..identify.dynamic.arm import fit_arm
+    from ..io import read_robot_log
+    from ..robot import RigidBodyModel
+
+    inputs = {"LOG": log, "--urdf": urdf, "--validate": validate}
+    check_paths(inputs=inputs, folders=["LOG", "--validate"], out_files={"--out": out})
+    model = RigidBodyModel.from_urdf(urdf, _split(joints))
+    data = read_robot_log(log, joints=list(model.joints))
+    second = read_robot_log(validate, joints=list(model.joints)) if validate else None
+    fit = fit_arm(
+        data,
+        model,
+        friction=_friction(friction),
+        consistent=consistent,
+        encoder_counts=encoder_counts,
+        cutoff=cutoff,
+        validate=second,
+        urdf=urdf.name,
+    )
+    fit.save(out)
+    _table(fit)
+    console.print(f"Wrote {out}")

@@ -1,0 +1,194 @@
+"""A whole arm's identified dynamics: :class:`ArmFit` and its JSON file.
+
+One record per robot: each joint's friction (family, parameters with 95 % intervals), the
+base inertial parameters with names and intervals, the physically consistent standard
+parameters, the noise per joint, the held-out error over the noise and the verdict per joint,
+and the provenance (log, URDF, filter, estimator). The file is JSON with ``"kind":
+"fricid-arm"`` and :data:`ARM_SCHEMA_VERSION`, written atomically and read strictly
+(:func:`fricid.io._jsonfile.read_json`). Each joint's friction is also a
+:class:`~fricid.fitted.FittedModel` (:meth:`ArmFit.joint_model`), so what works on one
+joint's model (predict, export) works on it.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field, fields
+from os import PathLike
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..errors import ConfigError, DataError
+from ..io._jsonfile import read_json
+from ..metrics import verdict
+from ._file import _clean
+from ._parameter import Parameter
+
+__all__ = ["ARM_KIND", "ARM_SCHEMA_VERSION", "ArmFit"]
+
+#: The file's kind and version.
+ARM_KIND = "fricid-arm"
+ARM_SCHEMA_VERSION = 1
+
+_NAN = float("nan")
+
+
+def _nan(value: Any) -> float:
+    return _NAN if value is None else float(value)
+
+
+@dataclass
+class ArmFit:
+    """A whole arm's identification (module notes).
+
+    Attributes
+    ----------
+    joints : tuple of str
+        The identified joints, in the model's order.
+    friction : dict
+        joint -> ``{"family": str, "parameters": {name: record}}``; a record holds ``value``,
+        ``unit``, ``stderr``, ``ci95`` (two ends) and ``not_determined``.
+    base : dict
+        ``names``, ``values``, ``stderr``, ``ci95`` (a pair per parameter), ``determined``.
+    standard : dict
+        ``names``, ``values`` (10 per joint, physical), ``consistent_ls`` (the least-squares
+        base parameters were already physical), ``d2`` (their Mahalanobis distance from the
+        consistent ones), ``used`` (``"least squares"`` or ``"consistent"``).
+    noise : dict
+        joint -> the torque noise [N m] after the filter.
+    validation : dict
+        joint -> ``{"rmse", "ratio", "source", "level", "reasons"}``.
+    provenance : dict
+        Log, URDF, filter cut-off and its bounds, decimation, estimator, samples, effective
+        samples, clusters, seconds, fricid version.
+    """
+
+    joints: tuple[str, ...]
+    friction: dict[str, dict[str, Any]] = field(default_factory=dict)
+    base: dict[str, Any] = field(default_factory=dict)
+    standard: dict[str, Any] = field(default_factory=dict)
+    noise: dict[str, float] = field(default_factory=dict)
+    validation: dict[str, dict[str, Any]] = field(default_factory=dict)
+    provenance: dict[str, Any] = field(default_factory=dict)
+
+    def verdict(self, joint: str) -> str:
+        """The joint's verdict level (``"yes"``, ``"with caveats"``, ``"no"``)."""
+        return str(self.validation.get(joint, {}).get("level", "no"))
+
+    def parameter(self, joint: str, name: str) -> Parameter:
+        """One friction parameter's record as a :class:`Parameter`."""
+        rec = self.friction[joint]["parameters"][name]
+        ci = rec.get("ci95") or (None, None)
+        return Parameter(
+            name,
+            _nan(rec.get("value")),
+            unit=str(rec.get("unit", "")),
+            stderr=_nan(rec.get("stderr")),
+            ci95=(_nan(ci[0]), _nan(ci[1])),
+            ci95_halfwidth=(_nan(ci[1]) - _nan(ci[0])) / 2,
+            note=str(rec.get("note", "")),
+            not_determined=bool(rec.get("not_determined", False)),
+        )
+
+    def joint_model(self, joint: str):
+        """The joint's friction as a :class:`~fricid.fitted.FittedModel` of its family.
+
+        Raises
+        ------
+        ConfigError
+            A parameter is not determined (no number to predict with).
+        """
+        from . import FittedModel
+
+        if joint not in self.friction:
+            raise ConfigError(f"no joint {joint!r} in this fit; joints: {', '.join(self.joints)}")
+        entry = self.friction[joint]
+        params = {n: self.parameter(joint, n) for n in entry["parameters"]}
+        missing = [n for n, p in params.items() if p.not_determined or not np.isfinite(p.value)]
+        if missing:
+            raise ConfigError(
+                f"joint {joint}: not determined by the data: {', '.join(missing)}; there is no "
+                "friction model to use"
+            )
+        check = self.validation.get(joint, {})
+        return FittedModel(
+            model=entry["family"],
+            parameters=params,
+            ci_method="cluster-robust",
+            operating_range={"velocity": list(entry.get("velocity_range", [-1.0, 1.0]))},
+            provenance={
+                "source": self.provenance.get("source"),
+                "joint": joint,
+                "arm_fit": True,
+                "estimator": self.provenance.get("estimator"),
+            },
+            validation={
+                "scheme": f"whole-arm held out: {check.get('source', '')}",
+                "rmse": check.get("rmse"),
+                "scatter": self.noise.get(joint),
+                "ratio": check.get("ratio"),
+                "verdict": verdict(_nan(check.get("ratio"))),
+            },
+        )
+
+    # -- file ----------------------------------------------------------------------------
+    def to_dict(self) -> dict[str, Any]:
+        """The file's JSON document."""
+        from .. import __version__
+
+        d = {f.name: getattr(self, f.name) for f in fields(self)}
+        d["joints"] = list(self.joints)
+        head = {"kind": ARM_KIND, "schema_version": ARM_SCHEMA_VERSION}
+        return _clean({**head, "fricid_version": __version__, **d})
+
+    @classmethod
+    def from_dict(cls, d: dict[str, Any], source: str | None = None) -> ArmFit:
+        """The fit a parsed file describes.
+
+        Raises
+        ------
+        DataError
+            Not a whole-arm fit file, a newer version, or a field missing or of the wrong type.
+        """
+        if not isinstance(d, dict) or d.get("kind") != ARM_KIND:
+            raise DataError(f"not a fricid whole-arm fit (no kind '{ARM_KIND}')", file=source)
+        version = d.get("schema_version")
+        if not isinstance(version, int) or not 1 <= version <= ARM_SCHEMA_VERSION:
+            raise DataError(
+                f"whole-arm fit schema version {version!r} is not one this fricid reads "
+                f"(1 to {ARM_SCHEMA_VERSION})",
+                file=source,
+            )
+        joints = d.get("joints")
+        if not isinstance(joints, list) or not all(isinstance(j, str) for j in joints):
+            raise DataError("field 'joints' must be a list of names", file=source)
+        kw: dict[str, Any] = {}
+        for f in fields(cls):
+            if f.name == "joints":
+                continue
+            value = d.get(f.name, {})
+            if not isinstance(value, dict):
+                raise DataError(f"field '{f.name}' must be an object", file=source)
+            kw[f.name] = value
+        for j in joints:
+            entry = kw["friction"].get(j)
+            if not isinstance(entry, dict) or not isinstance(entry.get("parameters"), dict):
+                raise DataError(f"field 'friction/{j}' must hold 'parameters'", file=source)
+        return cls(joints=tuple(joints), **kw)
+
+    def save(self, path: str | PathLike[str]) -> Path:
+        """Write the fit as JSON, atomically."""
+        from ..io.atomic import atomic_write
+
+        path = Path(path)
+        with atomic_write(path, "w") as fh:
+            json.dump(self.to_dict(), fh, indent=2)
+            fh.write("\n")
+        return path
+
+    @classmethod
+    def load(cls, path: str | PathLike[str]) -> ArmFit:
+        """Read a whole-arm fit file strictly (:func:`fricid.io._jsonfile.read_json`)."""
+        return cls.from_dict(read_json(path, what="whole-arm fit"), source=str(path))

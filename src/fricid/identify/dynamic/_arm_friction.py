@@ -1,0 +1,170 @@
+"""Each joint's friction as columns of the whole-arm regressor, per direction of motion.
+
+A joint's friction torque adds to the rigid-body torque, ``tau = Y_b beta + F_j(dq_j)``, and
+every family here is linear in all but the Stribeck shape (BAS-RBFNN paper eq. 1 and 2;
+RWSAVSBAS paper eq. 7), written per direction ``d`` (``+`` for ``dq >= 0``, ``-`` below, as
+:class:`fricid.models._asymmetric.Asymmetric` writes it: the negative set holds magnitudes):
+
+* ``coulomb_viscous``: ``f_c sign(v) + beta v``;
+* ``coulomb_viscous_asym``: ``s_d f_c,d + beta_d v`` on direction ``d``'s samples
+  (``s_+ = 1``, ``s_- = -1``);
+* ``stribeck_asym``: ``s_d [tau_c,d + (tau_s,d - tau_c,d) e_d] + tau_v,d v`` with
+  ``e_d = exp(-(|v| / w_s,d)^delta_d)``, linear in ``(tau_c, tau_s - tau_c, tau_v)`` once
+  ``(w_s, delta)`` are fixed (the separable structure that
+  :mod:`fricid.identify.static.varpro` uses for one joint); ``stribeck`` is the same with one
+  set for both directions.
+
+:class:`JointFriction` gives the linear columns for given shapes, the Jacobian columns of the
+shapes (for the intervals), and maps the internal linear parameters back to the family's.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ...errors import ConfigError
+
+__all__ = ["FAMILIES", "JointFriction", "friction_for", "split_direction"]
+
+#: The families a joint's friction may take in a whole-arm fit.
+FAMILIES = ("coulomb_viscous", "coulomb_viscous_asym", "stribeck", "stribeck_asym")
+
+#: Start and search box of the Stribeck velocity [rad/s] and exponent.
+W_S_START, W_S_BOX = 0.05, (1e-3, 1.0)
+DELTA_START, DELTA_BOX = 1.0, (0.3, 4.0)
+
+
+def _directions(family: str) -> tuple[str, ...]:
+    return ("_pos", "_neg") if family.endswith("_asym") else ("",)
+
+
+def _mask(v: np.ndarray, suffix: str) -> tuple[np.ndarray, np.ndarray]:
+    """(indicator, sign) of a direction's samples."""
+    if suffix == "_pos":
+        ind = (v > 0).astype(float)
+        return ind, ind
+    if suffix == "_neg":
+        ind = (v < 0).astype(float)
+        return ind, -ind
+    return (v != 0).astype(float), np.sign(v)
+
+
+def stribeck_shape(v: np.ndarray, w_s: float, delta: float) -> np.ndarray:
+    """``exp(-(|v| / w_s)^delta)`` (module notes)."""
+    return np.exp(-((np.abs(v) / w_s) ** delta))
+
+
+@dataclass
+class JointFriction:
+    """One joint's friction family and its current Stribeck shapes (module notes)."""
+
+    family: str
+    shapes: dict[str, tuple[float, float]] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        if self.family not in FAMILIES:
+            raise ConfigError(
+                f"friction family {self.family!r} is not one of {', '.join(FAMILIES)}"
+            )
+        if self.stribeck and not self.shapes:
+            self.shapes = {d: (W_S_START, DELTA_START) for d in self.directions}
+
+    @property
+    def stribeck(self) -> bool:
+        return self.family.startswith("stribeck")
+
+    @property
+    def directions(self) -> tuple[str, ...]:
+        return _directions(self.family)
+
+    @property
+    def linear_names(self) -> list[str]:
+        """Internal linear parameters: Coulomb, (Stribeck excess,) viscous per direction."""
+        mid = ["excess"] if self.stribeck else []
+        return [f"{n}{d}" for d in self.directions for n in ("coulomb", *mid, "viscous")]
+
+    @property
+    def names(self) -> list[str]:
+        """The family's parameter names (:mod:`fricid.models`)."""
+        base = ("tau_c", "tau_s", "w_s", "tau_v", "delta") if self.stribeck else ("f_c", "beta")
+        return [f"{n}{d}" for d in self.directions for n in base]
+
+    def columns(self, v: np.ndarray) -> np.ndarray:
+        """The linear columns at velocities ``v`` (N,), shape (N, len(linear_names))."""
+        out = []
+        for d in self.directions:
+            ind, sgn = _mask(v, d)
+            out.append(sgn)
+            if self.stribeck:
+                out.append(sgn * stribeck_shape(v, *self.shapes[d]))
+            out.append(ind * v)
+        return np.column_stack(out)
+
+    def excess_column(self, v: np.ndarray, d: str, w_s, delta) -> np.ndarray:
+        """The Stribeck column of direction ``d`` for shapes ``w_s``, ``delta`` (K,): (N, K)."""
+        _, sgn = _mask(v, d)
+        w = np.asarray(w_s, dtype=float)[None, :]
+        e = np.asarray(delta, dtype=float)[None, :]
+        return sgn[:, None] * np.exp(-((np.abs(v)[:, None] / w) ** e))
+
+    def shape_jacobian(self, v: np.ndarray, linear: np.ndarray) -> np.ndarray:
+        """d friction / d (w_s, delta) per direction, shape (N, 2 len(directions))."""
+        out = []
+        for k, d in enumerate(self.directions):
+            w_s, delta = self.shapes[d]
+            _, sgn = _mask(v, d)
+            a = np.abs(v) / w_s
+            with np.errstate(divide="ignore", invalid="ignore"):
+                ad = a**delta
+                e = np.exp(-ad)
+                log_a = np.where(a > 0, np.log(np.where(a > 0, a, 1.0)), 0.0)
+            excess = linear[3 * k + 1]
+            out.append(sgn * excess * e * ad * delta / w_s)
+            out.append(-sgn * excess * e * ad * log_a)
+        return np.column_stack(out)
+
+    def full_names(self) -> list[str]:
+        """The internal linear names then the shapes: the order of :meth:`to_family`'s input."""
+        shapes = [f"{n}{d}" for d in self.directions for n in ("w_s", "delta")]
+        return self.linear_names + (shapes if self.stribeck else [])
+
+    def to_family(self, values: np.ndarray, cov: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The family's parameters and their covariance from the internal ones (linear
+        then shapes, :meth:`full_names`): ``tau_s = coulomb + excess``, the rest as they are."""
+        internal = self.full_names()
+        T = np.zeros((len(self.names), len(internal)))
+        pos = {n: i for i, n in enumerate(internal)}
+        for r, name in enumerate(self.names):
+            base, d = split_direction(name)
+            if base in ("tau_c", "f_c"):
+                T[r, pos[f"coulomb{d}"]] = 1.0
+            elif base == "tau_s":
+                T[r, pos[f"coulomb{d}"]] = T[r, pos[f"excess{d}"]] = 1.0
+            elif base in ("tau_v", "beta"):
+                T[r, pos[f"viscous{d}"]] = 1.0
+            else:
+                T[r, pos[f"{base}{d}"]] = 1.0
+        with np.errstate(invalid="ignore"):
+            return T @ values, T @ cov @ T.T
+
+
+def split_direction(name: str) -> tuple[str, str]:
+    for d in ("_pos", "_neg"):
+        if name.endswith(d):
+            return name[: -len(d)], d
+    return name, ""
+
+
+def friction_for(joints: tuple[str, ...], friction) -> list[JointFriction]:
+    """Each joint's :class:`JointFriction` from one family name or a mapping joint -> family
+    (joints not named take ``stribeck_asym``)."""
+    if isinstance(friction, str):
+        return [JointFriction(friction) for _ in joints]
+    if not isinstance(friction, dict):
+        raise ConfigError(f"friction must be a family name or a mapping; got {friction!r}")
+    unknown = sorted(set(friction) - set(joints))
+    if unknown:
+        raise ConfigError(f"friction names joints not in the model: {', '.join(unknown)}")
+    return [JointFriction(friction.get(j, "stribeck_asym")) for j in joints]

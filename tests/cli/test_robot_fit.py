@@ -1,0 +1,78 @@
+"""``fricid robot fit``: a robot log file and a URDF in, the whole-arm fit file and a table out."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+pytest.importorskip("pinocchio")
+
+from fricid.cli import app
+from fricid.fitted.arm import ArmFit
+from fricid.io import write_robot_log
+from fricid.robot import RigidBodyModel, example_urdf
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "identify" / "dynamic"))
+from _arm_truth import make_log
+
+runner = CliRunner()
+
+LAWS = [
+    ("coulomb_viscous", {"f_c": 0.5, "beta": 0.3}),
+    ("coulomb_viscous", {"f_c": 0.7, "beta": 0.2}),
+]
+
+
+@pytest.fixture(scope="module")
+def pendulum_logs(tmp_path_factory):
+    path, joints = example_urdf("double_pendulum")
+    model = RigidBodyModel.from_urdf(path, joints)
+    folder = tmp_path_factory.mktemp("arm")
+    logs = []
+    for seed in (3, 4):
+        log = make_log(model, LAWS, duration=12.0, rate=250.0, seed=seed, noise=0.05)
+        logs.append(write_robot_log(log, folder / f"log{seed}.csv"))
+    return Path(path), logs
+
+
+def test_robot_fit_writes_the_file_and_prints_a_row_per_joint(pendulum_logs, tmp_path):
+    urdf, (log, second) = pendulum_logs
+    out = tmp_path / "arm.json"
+    res = runner.invoke(
+        app,
+        [
+            "robot",
+            "fit",
+            str(log),
+            "--urdf",
+            str(urdf),
+            "--friction",
+            "coulomb_viscous",
+            "--validate",
+            str(second),
+            "-o",
+            str(out),
+        ],
+    )
+    assert res.exit_code == 0, res.output
+    fit = ArmFit.load(out)
+    assert fit.validation["joint1"]["source"] == "second log"
+    assert fit.friction["joint2"]["parameters"]["f_c"]["value"] == pytest.approx(0.7, rel=0.03)
+    for joint in ("joint1", "joint2"):
+        assert joint in res.output
+    assert "Base inertial parameters:" in res.output
+    assert "IDIM-WLS" in res.output
+
+
+def test_robot_fit_bad_option_is_one_line_and_no_file(pendulum_logs, tmp_path):
+    urdf, (log, _) = pendulum_logs
+    out = tmp_path / "arm.json"
+    res = runner.invoke(
+        app, ["robot", "fit", str(log), "--urdf", str(urdf), "--friction", "lugre", "-o", str(out)]
+    )
+    assert res.exit_code == 2
+    assert "Traceback" not in res.output
+    assert not out.exists()

@@ -1,0 +1,161 @@
+"""A small truth generator for whole-arm identification, independent of ``fricid.sim``.
+
+The arm follows a smooth multi-sine reference exactly (no controller, no integrator): the
+torque is the model's inverse dynamics along it plus each joint's friction law
+(``fricid.models``) plus Gaussian noise; the logged position is the reference quantised to
+``counts`` per revolution, the logged velocity its finite differences.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from fricid.models import get_model
+from fricid.samples import RobotLog
+
+#: Harmonics of the reference's fundamental.
+HARMONICS = (1, 2, 3, 5, 7)
+
+
+def reference(model, duration, rate, seed, *, f0=0.1, speed=1.0, hold=()):
+    """(t, q, dq, ddq): a multi-sine per joint, about ``speed`` rad/s RMS, centred in the
+    joint's range; joints in ``hold`` stay at their centre."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(round(duration * rate)) / rate
+    lo = np.where(np.isfinite(model.lower), model.lower, -np.pi)
+    hi = np.where(np.isfinite(model.upper), model.upper, np.pi)
+    centre, half = (lo + hi) / 2, (hi - lo) / 2
+    n = model.n
+    q = np.tile(centre, (t.size, 1))
+    dq = np.zeros_like(q)
+    ddq = np.zeros_like(q)
+    for j in range(n):
+        if j in hold:
+            continue
+        w = 2 * np.pi * f0 * np.array(HARMONICS)
+        phase = rng.uniform(0, 2 * np.pi, w.size)
+        amp = 1.0 / w  # equal velocity amplitude per harmonic
+        arg = np.outer(t, w) + phase
+        v = np.cos(arg) @ (amp * w)
+        scale = speed / np.sqrt(np.mean(v**2))
+        pos = np.sin(arg) @ amp * scale
+        top = np.max(np.abs(pos))
+        if top > 0.6 * half[j]:  # keep within the range: slower there
+            scale *= 0.6 * half[j] / top
+        q[:, j] = centre[j] + np.sin(arg) @ amp * scale
+        dq[:, j] = np.cos(arg) @ (amp * w) * scale
+        ddq[:, j] = -np.sin(arg) @ (amp * w**2) * scale
+    return t, q, dq, ddq
+
+
+def friction_torque(laws, dq):
+    """Each joint's friction ``laws[j] = (family, {name: value})`` at velocities ``dq``."""
+    out = np.zeros_like(dq)
+    for j, (family, values) in enumerate(laws):
+        m = get_model(family)
+        theta = np.array([values[p] for p in m.param_names])
+        X = np.column_stack([dq[:, j], np.zeros(len(dq)), np.full(len(dq), 25.0)])
+        out[:, j] = m.predict(theta, X)
+    return out
+
+
+def make_log(
+    model,
+    laws,
+    *,
+    duration=20.0,
+    rate=1000.0,
+    seed=0,
+    counts=2**17,
+    noise=0.05,
+    hold=(),
+    speed=1.0,
+    source="truth",
+    trajectory=None,
+):
+    """A :class:`RobotLog` of the arm along its reference (module notes), or along
+    ``trajectory = (t, q, dq, ddq)`` when given (``duration``, ``rate``, ``speed``, ``hold``
+    then unused)."""
+    if trajectory is None:
+        trajectory = reference(model, duration, rate, seed, speed=speed, hold=hold)
+    t, q, dq, ddq = trajectory
+    rate = 1.0 / float(np.median(np.diff(t)))
+    rng = np.random.default_rng(seed + 10_000)
+    tau = model.inverse_dynamics(q, dq, ddq) + friction_torque(laws, dq)
+    tau = tau + rng.normal(0.0, 1.0, tau.shape) * np.broadcast_to(noise, (model.n,))
+    step = 2 * np.pi / counts
+    pos = np.round(q / step) * step
+    vel = np.gradient(pos, axis=0) * rate
+    return RobotLog(
+        time=t, joints=model.joints, position=pos, velocity=vel, torque=tau, source=source
+    )
+
+
+def stribeck_law(rng, scale=1.0):
+    """A Stribeck law per direction, different between directions (``stribeck_asym``)."""
+    values = {}
+    for d in ("_pos", "_neg"):
+        tau_c = scale * rng.uniform(0.3, 1.0)
+        values |= {
+            f"tau_c{d}": tau_c,
+            f"tau_s{d}": tau_c * rng.uniform(1.3, 1.8),
+            f"w_s{d}": rng.uniform(0.03, 0.12),
+            f"tau_v{d}": scale * rng.uniform(0.1, 0.6),
+            f"delta{d}": rng.uniform(0.8, 2.0),
+        }
+    return "stribeck_asym", values
+
+
+def make_pd_log(
+    model,
+    laws,
+    *,
+    duration=20.0,
+    rate=1000.0,
+    seed=0,
+    counts=2**17,
+    noise=0.05,
+    disturbance=0.05,
+    bandwidth=10.0,
+    substeps=4,
+    source="truth-pd",
+    trajectory=None,
+):
+    """A :class:`RobotLog` of the arm tracking its reference in closed loop: a PD of
+    ``bandwidth`` Hz on the quantised position plus the model's inverse dynamics along the
+    reference as feed-forward (friction not compensated), a white torque ``disturbance``
+    [N m] acting on the arm, integrated semi-implicitly at ``substeps`` times the log's rate;
+    the logged torque is the command plus ``noise``."""
+    if trajectory is None:
+        trajectory = reference(model, duration, rate, seed)
+    t, q_r, dq_r, ddq_r = trajectory
+    rate = 1.0 / float(np.median(np.diff(t)))
+    rng = np.random.default_rng(seed + 20_000)
+    ff = model.inverse_dynamics(q_r, dq_r, ddq_r)
+    inertia = np.diagonal(model.mass_matrix(q_r[:: max(len(t) // 20, 1)]), axis1=1, axis2=2)
+    m = inertia.mean(axis=0)
+    w = 2 * np.pi * bandwidth
+    kp, kd = m * w**2, 2 * 0.7 * w * m
+    step = 2 * np.pi / counts
+    h = 1.0 / (rate * substeps)
+    q, dq = q_r[0].copy(), dq_r[0].copy()
+    pos = np.empty_like(q_r)
+    tau_log = np.empty_like(q_r)
+    q_prev = np.round(q / step) * step
+    for k in range(len(t)):
+        q_meas = np.round(q / step) * step
+        v_meas = (q_meas - q_prev) * rate if k else dq_r[0]
+        q_prev = q_meas
+        tau = ff[k] + kp * (q_r[k] - q_meas) + kd * (dq_r[k] - v_meas)
+        pos[k], tau_log[k] = q_meas, tau
+        for _ in range(substeps):
+            fr = friction_torque(laws, dq[None, :])[0]
+            dist = rng.normal(0.0, disturbance * np.sqrt(substeps), model.n)
+            acc = model.forward_dynamics(q[None, :], dq[None, :], (tau - fr + dist)[None, :])[0]
+            dq = dq + h * acc
+            q = q + h * dq
+    tau_log = tau_log + rng.normal(0.0, noise, tau_log.shape)
+    vel = np.gradient(pos, axis=0) * rate
+    return RobotLog(
+        time=t, joints=model.joints, position=pos, velocity=vel, torque=tau_log, source=source
+    )

@@ -1,0 +1,182 @@
+"""Whole-arm identification (``fricid.identify.dynamic.arm.fit_arm``) against a truth of our own
+(``_arm_truth``: inverse dynamics along a multi-sine, friction per joint and direction, 2^17
+count encoders, torque noise)."""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from _arm_truth import make_log, stribeck_law
+
+pytest.importorskip("pinocchio")
+
+from fricid.errors import ConfigError, DataError
+from fricid.fitted import FittedModel
+from fricid.fitted.arm import ArmFit
+from fricid.identify.dynamic.arm import fit_arm
+from fricid.robot import RigidBodyModel, example_urdf
+
+CV_LAWS = [
+    ("coulomb_viscous_asym", {"f_c_pos": 0.5, "beta_pos": 0.3, "f_c_neg": 0.4, "beta_neg": 0.2}),
+    ("coulomb_viscous_asym", {"f_c_pos": 0.7, "beta_pos": 0.3, "f_c_neg": 0.4, "beta_neg": 0.3}),
+]
+
+
+@pytest.fixture(scope="module")
+def pendulum() -> RigidBodyModel:
+    path, joints = example_urdf("double_pendulum")
+    return RigidBodyModel.from_urdf(path, joints)
+
+
+@pytest.fixture(scope="module")
+def pendulum_fit(pendulum):
+    log = make_log(pendulum, CV_LAWS, duration=20.0, seed=3, noise=0.05)
+    return fit_arm(log, pendulum, friction="coulomb_viscous_asym")
+
+
+def _z(fit: ArmFit, laws) -> dict[str, float]:
+    out = {}
+    for joint, (_, truth) in zip(fit.joints, laws, strict=True):
+        for name, rec in fit.friction[joint]["parameters"].items():
+            out[f"{joint}:{name}"] = (rec["value"] - truth[name]) / rec["stderr"]
+    return out
+
+
+def test_double_pendulum_recovers_friction_within_intervals(pendulum_fit):
+    fit = pendulum_fit
+    for joint, (_, truth) in zip(fit.joints, CV_LAWS, strict=True):
+        for name, rec in fit.friction[joint]["parameters"].items():
+            low, high = rec["ci95"]
+            assert not rec["not_determined"]
+            assert low < rec["value"] < high
+            # the interval is informative: a few per cent of the value at most
+            assert high - low < 0.05 * abs(truth[name])
+            assert abs(rec["value"] - truth[name]) < 0.02 * abs(truth[name])
+    z = _z(fit, CV_LAWS)
+    assert max(abs(v) for v in z.values()) < 3.0, z
+    covered = sum(
+        rec["ci95"][0] <= truth[n] <= rec["ci95"][1]
+        for j, (_, truth) in zip(fit.joints, CV_LAWS, strict=True)
+        for n, rec in fit.friction[j]["parameters"].items()
+    )
+    assert covered >= 7
+    for joint in fit.joints:
+        assert fit.validation[joint]["ratio"] < 1.5
+        assert fit.verdict(joint) in ("yes", "with caveats")
+    assert fit.provenance["estimator"] == "IDIM-WLS"
+    assert fit.provenance["cutoff"] > 3 * fit.provenance["cutoff_bounds"]["motion"] - 1e-9
+    assert fit.standard["consistent_ls"] is True
+
+
+def test_base_parameters_cover_the_truth(pendulum, pendulum_fit):
+    from fricid.robot import base_parameters
+
+    truth = base_parameters(pendulum).project(pendulum.parameters())
+    base = pendulum_fit.base
+    assert len(base["names"]) == len(truth)
+    inside = [lo <= t <= hi for t, (lo, hi) in zip(truth, base["ci95"], strict=True)]
+    assert sum(inside) >= len(truth) - 1
+
+
+def test_a_joint_that_never_moves_is_not_determined(pendulum):
+    log = make_log(pendulum, CV_LAWS, duration=20.0, seed=5, noise=0.05, hold=(1,))
+    fit = fit_arm(log, pendulum, friction="coulomb_viscous_asym")
+    still = fit.joints[1]
+    params = fit.friction[still]["parameters"]
+    assert all(rec["not_determined"] and rec["value"] is None for rec in params.values())
+    assert fit.verdict(still) == "no"
+    assert "does not move" in " ".join(fit.validation[still]["reasons"])
+    with pytest.raises(ConfigError, match="not determined"):
+        fit.joint_model(still)
+    # the moving joint is still identified
+    moving = fit.friction[fit.joints[0]]["parameters"]
+    assert abs(moving["f_c_pos"]["value"] - 0.5) < 0.02
+
+
+def test_file_round_trip_and_joint_models(pendulum_fit, tmp_path):
+    path = pendulum_fit.save(tmp_path / "arm.json")
+    doc = json.loads(path.read_text())
+    assert doc["kind"] == "fricid-arm" and doc["schema_version"] == 1
+    back = ArmFit.load(path)
+    assert back.joints == pendulum_fit.joints
+    assert back.friction == json.loads(json.dumps(pendulum_fit.to_dict()))["friction"]
+    model = back.joint_model(back.joints[1])
+    assert model.model == "coulomb_viscous_asym"
+    f = model.predict(np.array([[0.5, 0.0, 25.0], [-0.5, 0.0, 25.0]]), warn=False)
+    assert f[0] == pytest.approx(0.7 + 0.3 * 0.5, rel=0.02)
+    assert f[1] == pytest.approx(-0.4 - 0.3 * 0.5, rel=0.02)
+    # the joint's model is an ordinary model file
+    again = FittedModel.load(model.save(tmp_path / "joint2.json"))
+    assert again.params == pytest.approx(model.params)
+
+
+def test_bad_inputs(pendulum, tmp_path):
+    log = make_log(pendulum, CV_LAWS, duration=5.0, seed=3)
+    with pytest.raises(ConfigError, match="family"):
+        fit_arm(log, pendulum, friction="lugre")
+    with pytest.raises(DataError, match="joint"):
+        fit_arm(log.rename({"joint1": "other"}), pendulum)
+    (tmp_path / "x.json").write_text('{"kind": "something"}')
+    with pytest.raises(DataError, match="whole-arm"):
+        ArmFit.load(tmp_path / "x.json")
+
+
+@pytest.mark.slow
+def test_panda_recovers_friction_per_joint_and_direction():
+    path, joints = example_urdf("panda")
+    model = RigidBodyModel.from_urdf(path, joints)
+    rng = np.random.default_rng(1)
+    laws = [stribeck_law(rng) for _ in model.joints]
+    log = make_log(model, laws, duration=40.0, seed=3, noise=0.05)
+    fit = fit_arm(log, model, friction="stribeck_asym")
+    for joint, (_, truth) in zip(fit.joints, laws, strict=True):
+        params = fit.friction[joint]["parameters"]
+        for name in ("tau_c_pos", "tau_c_neg", "tau_v_pos", "tau_v_neg"):
+            assert params[name]["value"] == pytest.approx(truth[name], rel=0.05), (joint, name)
+        assert fit.validation[joint]["ratio"] < 1.5
+        assert fit.verdict(joint) != "no"
+    z = _z(fit, laws)
+    linear = [v for k, v in z.items() if k.split(":")[1].startswith(("tau_c", "tau_v"))]
+    assert np.mean(np.abs(linear) < 1.96) >= 0.8
+
+
+def test_the_one_public_fit_takes_a_robot_log(pendulum, pendulum_fit):
+    from fricid.identify import fit, kind_of
+
+    log = make_log(pendulum, CV_LAWS, duration=20.0, seed=3, noise=0.05)
+    assert kind_of(log, "arm") == "arm"
+    out = fit(log, "coulomb_viscous_asym", settings={"robot": pendulum})
+    assert isinstance(out, ArmFit)
+    assert out.friction == pendulum_fit.friction
+    with pytest.raises(ConfigError, match="rigid-body model"):
+        fit(log, "arm")
+    with pytest.raises(ConfigError, match="does not take method"):
+        fit(log, "arm", "lm", settings={"robot": pendulum})
+    with pytest.raises(ConfigError, match="not: seed_count"):
+        fit(log, "arm", settings={"robot": pendulum, "seed_count": 1})
+
+
+def test_friction_family_per_joint(pendulum):
+    laws = [
+        ("coulomb_viscous", {"f_c": 0.5, "beta": 0.3}),
+        CV_LAWS[1],
+    ]
+    log = make_log(pendulum, laws, duration=20.0, seed=7, noise=0.05)
+    fit = fit_arm(
+        log, pendulum, friction={"joint1": "coulomb_viscous", "joint2": "coulomb_viscous_asym"}
+    )
+    assert fit.friction["joint1"]["family"] == "coulomb_viscous"
+    assert set(fit.friction["joint1"]["parameters"]) == {"f_c", "beta"}
+    assert fit.friction["joint2"]["family"] == "coulomb_viscous_asym"
+    for joint, (_, truth) in zip(fit.joints, laws, strict=True):
+        for name, rec in fit.friction[joint]["parameters"].items():
+            assert not rec["not_determined"]
+            assert abs(rec["value"] - truth[name]) < 0.03 * truth[name], (joint, name)
+    with pytest.raises(ConfigError, match="not in the model"):
+        fit_arm(log, pendulum, friction={"elbow": "coulomb_viscous"})
