@@ -24,6 +24,7 @@ SI_UNITS: dict[str, str] = {
     "current": "A",
     "temperature": "degC",
     "torque_constant": "N m/A",
+    "acceleration": "rad/s^2",
 }
 
 #: One degree in radians (the one copy in fricid).
@@ -45,6 +46,7 @@ UNITS: dict[str, dict[str, tuple[float, float]]] = {
     "current": {"A": (1.0, 0.0), "mA": (1e-3, 0.0)},
     "temperature": {"degC": (1.0, 0.0), "C": (1.0, 0.0), "K": (1.0, -273.15)},
     "torque_constant": {"N m/A": (1.0, 0.0), "Nm/A": (1.0, 0.0), "mNm/A": (1e-3, 0.0)},
+    "acceleration": {"rad/s^2": (1.0, 0.0), "rad/s2": (1.0, 0.0), "deg/s^2": (DEG, 0.0)},
 }
 
 

@@ -3,7 +3,8 @@
 Both hold SI units only (DESIGN.md, "Units") and validate themselves on construction, so a
 value of either type is always safe to use. Reading and writing them is :mod:`fricid.io`'s job.
 
-:class:`RawLog` is in :mod:`.rawlog`, the columns, units, ranges and column checks both
+:class:`RawLog` is in :mod:`.rawlog` (all joints of a robot, :class:`RobotLog`, in
+:mod:`.robot_log`), the columns, units, ranges and column checks both
 types share in :mod:`._columns`, and the checks a trajectory log passes before identification
 in :mod:`._trajectory_log`.
 """
@@ -31,16 +32,19 @@ from ._columns import (
 from ._standstill import drop_standstill, standstill_rows
 from ._trajectory_log import check_trajectory_log
 from .rawlog import RawLog
+from .robot_log import ROBOT_COLUMNS, RobotLog
 
 __all__ = [
     "DIRECTION_TOLERANCE",
     "LIMITS",
     "OPTIONAL_INPUTS",
     "RAWLOG_COLUMNS",
+    "ROBOT_COLUMNS",
     "ROW_META",
     "SAMPLE_COLUMNS",
     "FrictionSamples",
     "RawLog",
+    "RobotLog",
     "check_trajectory_log",
     "drop_standstill",
     "standstill_rows",

@@ -43,6 +43,7 @@ LIMITS: dict[str, tuple[float, float, str]] = {
     "time": (-1e10, 1e10, "s"),
     "position": (-1e12, 1e12, "rad"),
     "velocity": (-1e6, 1e6, "rad/s"),
+    "acceleration": (-1e12, 1e12, "rad/s^2"),
     "torque": (-1e9, 1e9, "N m"),
     "current": (-1e6, 1e6, "A"),
     "temperature": (-273.15, 1e4, "degC"),
