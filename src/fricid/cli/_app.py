@@ -41,6 +41,7 @@ __all__ = [
     "WideConsole",
     "app",
     "bench_app",
+    "robot_app",
     "console",
     "err_console",
     "handle_errors",
@@ -68,6 +69,15 @@ bench_app = typer.Typer(
     no_args_is_help=True,
 )
 app.add_typer(bench_app, name="bench")
+
+robot_app = typer.Typer(
+    help=(
+        "Whole robots from their URDF: design an excitation, identify every joint's friction "
+        "with the arm's rigid-body dynamics, export all joints."
+    ),
+    no_args_is_help=True,
+)
+app.add_typer(robot_app, name="robot")
 
 #: Columns of a console whose output is not a terminal (a pipe, a file, CI) and whose width
 #: ``COLUMNS`` does not set: wide enough that tables keep whole model names.
