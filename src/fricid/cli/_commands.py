@@ -19,6 +19,7 @@ MODULES = (
     "report",
     "reproduce",
     "fleet",
+    "robot_design",
 )
 
 for _name in MODULES:

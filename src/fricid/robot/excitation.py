@@ -1,0 +1,531 @@
+"""Excitation design: a periodic Fourier trajectory of every joint (Swevers et al. 1997, module
+:mod:`.trajectories`) whose stacked regressor is as well conditioned as the robot's limits
+allow, and constant-velocity sweeps of one joint (BAS-RBFNN paper section 2).
+
+The information matrix. At ``M`` instants of one period, the rows of every joint's torque
+``tau = Y_b(q, dq, ddq) beta + F(dq) phi`` are stacked into ``W = [Y_b F]`` (``M n`` rows):
+``Y_b`` the base regressor (:func:`fricid.robot.base.base_parameters`), ``F`` the friction
+columns of each joint (``coulomb_viscous_asym``: ``1[dq > 0]``, ``-1[dq < 0]`` and ``dq``;
+``coulomb_viscous``: ``sign(dq)`` and ``dq``; ``none``). The criterion is the condition
+number of ``W`` (Swevers 1997 eq. 27; Gautier and Khalil 1992) or, ``d-optimal``, ``-log det
+W^T W`` per row (the volume of the parameters' confidence ellipsoid). While optimising, the
+steps of the Coulomb columns are smoothed, ``tanh(dq / eps)``, so the criterion is smooth in
+the coefficients; the figures reported use the exact steps.
+
+The limits. Position ``[lo, hi]`` (the URDF's, narrowed by a workspace, less ``margin`` of its
+width at each end), velocity and acceleration ``|dq|, |ddq| <= (1 - margin)`` their limits at a
+fine grid of the period (all linear in the coefficients: exact gradients), and effort
+``|M ddq + C dq + g| <= (1 - margin) effort_limit`` at the ``M`` instants (by finite
+differences). SLSQP (:func:`scipy.optimize.minimize`) runs from the best of several random
+feasible designs.
+
+The standard errors. With independent torque noise of std ``sigma_j`` on joint ``j``, the
+least-squares estimate of ``(beta, phi)`` from the periodic part sampled at ``rate`` for
+``duration`` has covariance ``(W^T S^-1 W)^-1`` with ``S = diag(sigma_j^2)`` (one period's sum
+times the number of periods).
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.optimize
+
+from ..errors import ConfigError
+from .base import BaseParameters, base_parameters
+from .model import RigidBodyModel
+from .trajectories import FourierTrajectory, SweepTrajectory, fourier_basis
+
+__all__ = [
+    "CRITERIA",
+    "FRICTION_COLUMNS",
+    "ExcitationDesign",
+    "design_excitation",
+    "friction_columns",
+    "information_matrix",
+    "sweep_design",
+]
+
+#: The design criteria.
+CRITERIA = ("cond", "d-optimal")
+
+#: Friction regressor columns per joint, by law.
+FRICTION_COLUMNS = {
+    "coulomb_viscous_asym": ("Fc+", "Fc-", "Fv"),
+    "coulomb_viscous": ("Fc", "Fv"),
+    "none": (),
+}
+
+#: Where the URDF gives no position limit [rad]; no velocity limit [rad/s].
+DEFAULT_POSITION = np.pi
+DEFAULT_VELOCITY = 2.0
+
+#: Instants per period on the fine grid that checks the linear limits.
+GRID = 400
+
+#: Smoothing speed of the Coulomb steps while optimising [rad/s].
+SMOOTH = 1e-2
+
+
+def friction_columns(dq: np.ndarray, friction: str, smooth: float = 0.0) -> np.ndarray:
+    """The friction regressor ``F``, shape ``(N, n, c n)``: joint ``j``'s row holds its own
+    columns only (module notes); ``smooth > 0`` replaces the steps by ``tanh(dq / smooth)``."""
+    if friction not in FRICTION_COLUMNS:
+        raise ConfigError(f"friction must be one of {sorted(FRICTION_COLUMNS)}; got {friction!r}")
+    dq = np.atleast_2d(dq)
+    sign = np.tanh(dq / smooth) if smooth > 0 else np.sign(dq)
+    per = {
+        "coulomb_viscous_asym": (0.5 * (sign + np.abs(sign)), 0.5 * (sign - np.abs(sign)), dq),
+        "coulomb_viscous": (sign, dq),
+        "none": (),
+    }[friction]
+    c, (N, n) = len(per), dq.shape
+    F = np.zeros((N, n, c * n))
+    for j in range(n):
+        for i, col in enumerate(per):
+            F[:, j, c * j + i] = col[:, j]
+    return F
+
+
+def information_matrix(
+    model: RigidBodyModel, base: BaseParameters, q, dq, ddq, friction: str, smooth: float = 0.0
+) -> np.ndarray:
+    """``W = [Y_b F]`` stacked over samples and joints, shape ``(N n, r + c n)``."""
+    Y = base.columns(model.regressor(q, dq, ddq))
+    W = np.concatenate([Y, friction_columns(dq, friction, smooth)], axis=2)
+    return W.reshape(-1, W.shape[-1])
+
+
+def _criterion(W: np.ndarray, criterion: str) -> float:
+    s = np.linalg.svd(W, compute_uv=False)
+    if criterion == "cond":
+        return float(np.log(s[0] / s[-1])) if s[-1] > 0 else np.inf
+    return float(-2.0 * np.sum(np.log(s)) / W.shape[1]) if s[-1] > 0 else np.inf
+
+
+@dataclass(frozen=True)
+class ExcitationDesign:
+    """A designed excitation and what it promises (module notes).
+
+    Attributes
+    ----------
+    trajectory : FourierTrajectory
+    criterion, friction : str
+    names : tuple of str
+        The columns of ``W``: the base parameters, then ``<joint>:<friction column>``.
+    cond : float
+        The condition number of ``W`` at the design instants (exact Coulomb steps).
+    cond_start : float
+        The same for the best random feasible start.
+    logdet, logdet_start : float
+        ``log det W^T W / (rows)`` of the design and of the start.
+    limits : dict
+        ``lower``, ``upper``, ``velocity``, ``acceleration``, ``effort`` (n,) used, ``margin``.
+    margins : dict
+        Per quantity, each joint's peak over the fine grid as a fraction of its limit
+        (``position``: of the half-width about the middle).
+    samples, evaluations : int
+    seconds : float
+    converged : bool
+    message : str
+    """
+
+    trajectory: FourierTrajectory
+    criterion: str
+    friction: str
+    names: tuple[str, ...]
+    cond: float
+    cond_start: float
+    logdet: float
+    logdet_start: float
+    limits: dict = field(repr=False)
+    margins: dict = field(repr=False)
+    samples: int = 0
+    evaluations: int = 0
+    seconds: float = 0.0
+    converged: bool = False
+    message: str = ""
+    seed: int = 0
+
+    @property
+    def joints(self) -> tuple[str, ...]:
+        return self.trajectory.joints
+
+    def covariance(
+        self, model: RigidBodyModel, torque_noise, *, rate: float = 1000.0, duration=None
+    ) -> np.ndarray:
+        """The predicted covariance of ``(beta, phi)`` (module notes) with torque noise std
+        ``torque_noise`` [N m] (one number or one per joint), from the periodic part sampled
+        at ``rate`` [Hz] for ``duration`` s (default one period)."""
+        return predicted_covariance(
+            model, self.trajectory, self.friction, torque_noise, rate=rate, duration=duration
+        )
+
+    def standard_errors(self, model: RigidBodyModel, torque_noise, **kw) -> np.ndarray:
+        """The square roots of :meth:`covariance`'s diagonal, in :attr:`names`' order."""
+        return np.sqrt(np.diag(self.covariance(model, torque_noise, **kw)))
+
+
+def predicted_covariance(
+    model: RigidBodyModel,
+    trajectory: FourierTrajectory,
+    friction: str,
+    torque_noise,
+    *,
+    rate: float = 1000.0,
+    duration: float | None = None,
+) -> np.ndarray:
+    """``(W^T S^-1 W)^-1`` over ``duration`` s at ``rate`` Hz (module notes)."""
+    sigma = np.broadcast_to(np.asarray(torque_noise, dtype=float), (model.n,))
+    if not (np.isfinite(sigma).all() and (sigma > 0).all()):
+        raise ConfigError(f"the torque noise must be > 0 N m; got {torque_noise}")
+    if not (np.isfinite(rate) and rate > 0):
+        raise ConfigError(f"the rate must be > 0 Hz; got {rate}")
+    period = trajectory.period
+    duration = period if duration is None else float(duration)
+    t = np.arange(int(round(period * rate))) / rate
+    W = information_matrix(model, _base(model), *trajectory.evaluate(t), friction)
+    W = W / np.tile(sigma, t.size)[:, None]
+    info = (W.T @ W) * (duration / period)
+    return np.linalg.pinv(info)
+
+
+_BASE_CACHE: dict[int, tuple[RigidBodyModel, BaseParameters]] = {}
+
+
+def _base(model: RigidBodyModel) -> BaseParameters:
+    hit = _BASE_CACHE.get(id(model))
+    if hit is None or hit[0] is not model:
+        hit = (model, base_parameters(model))
+        _BASE_CACHE.clear()
+        _BASE_CACHE[id(model)] = hit
+    return hit[1]
+
+
+# -- limits ----------------------------------------------------------------------------------
+
+
+def resolve_limits(
+    model: RigidBodyModel,
+    workspace: Mapping[str, tuple[float, float]] | None,
+    acceleration: float | np.ndarray | None,
+    w_f: float,
+    harmonics: int,
+    margin: float,
+) -> dict:
+    """The limits a design obeys (module notes). The acceleration limit defaults to each
+    joint's velocity limit times ``w_f H`` (the acceleration of the highest harmonic at the
+    full speed)."""
+    if not 0.0 <= margin < 0.5:
+        raise ConfigError(f"margin must be in [0, 0.5); got {margin}")
+    lo = np.where(np.isfinite(model.lower), model.lower, -DEFAULT_POSITION)
+    hi = np.where(np.isfinite(model.upper), model.upper, DEFAULT_POSITION)
+    for name, pair in (workspace or {}).items():
+        if name not in model.joints:
+            raise ConfigError(f"workspace names joint '{name}', not one of {model.joints}")
+        a, b = (float(x) for x in pair)
+        i = model.joints.index(name)
+        if not (np.isfinite(a) and np.isfinite(b)) or b < a:
+            raise ConfigError(f"workspace of '{name}' must be lo <= hi; got {a}:{b}")
+        lo[i], hi[i] = max(lo[i], a), min(hi[i], b)
+        if hi[i] <= lo[i]:
+            raise ConfigError(
+                f"the workspace of '{name}' [{a:g}, {b:g}] leaves no room within its limits "
+                f"[{model.lower[i]:g}, {model.upper[i]:g}]: it cannot move"
+            )
+    width = hi - lo
+    lo, hi = lo + margin * width, hi - margin * width
+    vel = np.where(np.isfinite(model.velocity_limit), model.velocity_limit, DEFAULT_VELOCITY)
+    if acceleration is None:
+        acc = vel * w_f * harmonics
+    else:
+        acc = np.broadcast_to(np.asarray(acceleration, dtype=float), (model.n,)).copy()
+    if not (np.isfinite(acc).all() and (acc > 0).all()):
+        raise ConfigError(f"the acceleration limit must be > 0; got {acceleration}")
+    return {
+        "lower": lo,
+        "upper": hi,
+        "velocity": vel * (1.0 - margin),
+        "acceleration": acc * (1.0 - margin),
+        "effort": model.effort_limit * (1.0 - margin),
+        "margin": float(margin),
+    }
+
+
+def peak_fractions(model: RigidBodyModel, traj, limits: dict, rate: float) -> dict:
+    """Each joint's peak position (about the middle, of the half-width), speed, acceleration
+    and effort as fractions of the limits, at ``rate`` over the trajectory."""
+    t, (q, dq, ddq) = traj.sample(rate)
+    mid = 0.5 * (limits["upper"] + limits["lower"])
+    half = 0.5 * (limits["upper"] - limits["lower"])
+    tau = model.inverse_dynamics(q, dq, ddq)
+    eff = limits["effort"]
+    return {
+        "position": np.max(np.abs(q - mid), axis=0) / half,
+        "velocity": np.max(np.abs(dq), axis=0) / limits["velocity"],
+        "acceleration": np.max(np.abs(ddq), axis=0) / limits["acceleration"],
+        "effort": np.where(np.isfinite(eff), np.max(np.abs(tau), axis=0) / eff, 0.0),
+    }
+
+
+# -- the design ------------------------------------------------------------------------------
+
+
+def design_excitation(
+    model: RigidBodyModel,
+    *,
+    harmonics: int = 5,
+    period: float = 10.0,
+    samples: int = 40,
+    criterion: str = "cond",
+    friction: str = "coulomb_viscous_asym",
+    workspace: Mapping[str, tuple[float, float]] | None = None,
+    acceleration_limit: float | np.ndarray | None = None,
+    margin: float = 0.05,
+    at_rest: bool = False,
+    starts: int = 8,
+    seed: int = 0,
+    max_evaluations: int = 20000,
+    progress: Callable[[int, int], None] | None = None,
+) -> ExcitationDesign:
+    """A Fourier excitation of every joint of ``model`` optimised for ``criterion`` within
+    the limits (module notes).
+
+    Parameters
+    ----------
+    model : RigidBodyModel
+    harmonics : int
+        ``H``, harmonics of the base frequency ``w_f = 2 pi / period``.
+    period : float
+        The period [s].
+    samples : int
+        Instants per period at which ``W`` and the efforts are evaluated while optimising.
+    criterion : {"cond", "d-optimal"}
+    friction : str
+        A key of :data:`FRICTION_COLUMNS`.
+    workspace : mapping, optional
+        ``joint -> (lo, hi)`` [rad or m], within the URDF's limits.
+    acceleration_limit : float or array, optional
+        [rad/s^2]; default each joint's velocity limit times ``w_f H``.
+    margin : float
+        The fraction of each limit (of the position range's width at each end) kept free.
+    at_rest : bool
+        Every joint at rest at ``t = 0`` (and so at the end of every period).
+    starts : int
+        Random feasible designs drawn; the optimisation starts from the best.
+    seed : int
+    max_evaluations : int
+        Evaluations of the criterion (a gradient costs one per coefficient plus one).
+    progress : callable, optional
+        ``progress(evaluations, max_evaluations)`` after each iteration.
+    """
+    from ._design import Problem
+
+    if criterion not in CRITERIA:
+        raise ConfigError(f"criterion must be one of {CRITERIA}; got {criterion!r}")
+    if friction not in FRICTION_COLUMNS:
+        raise ConfigError(f"friction must be one of {sorted(FRICTION_COLUMNS)}; got {friction!r}")
+    if int(harmonics) < 1 or int(samples) < 2 or int(starts) < 1:
+        raise ConfigError(
+            f"need harmonics >= 1, samples >= 2, starts >= 1; got {harmonics}, {samples}, {starts}"
+        )
+    if not (np.isfinite(period) and period > 0):
+        raise ConfigError(f"the period must be > 0 s; got {period}")
+    t0 = time.perf_counter()
+    w_f = 2.0 * np.pi / float(period)
+    limits = resolve_limits(model, workspace, acceleration_limit, w_f, int(harmonics), margin)
+    base = _base(model)
+    names = base.names + tuple(f"{j}:{c}" for j in model.joints for c in FRICTION_COLUMNS[friction])
+    if len(names) > int(samples) * model.n:
+        raise ConfigError(
+            f"{samples} instants x {model.n} joints are fewer rows than the {len(names)} "
+            "parameters: raise samples"
+        )
+    grid = max(GRID, 20 * int(harmonics))
+    problem = Problem(
+        model,
+        base,
+        harmonics=int(harmonics),
+        w_f=w_f,
+        samples=int(samples),
+        grid=grid,
+        limits=limits,
+        friction=friction,
+        criterion=criterion,
+        smooth=SMOOTH,
+        measure=_criterion,
+        columns=friction_columns,
+    )
+    rng = np.random.default_rng(seed)
+    X = np.array([problem.random_start(rng, at_rest) for _ in range(int(starts))])
+    x_start = X[int(np.argmin(problem.value(X)))]
+    x = _optimise(problem, x_start, at_rest, max_evaluations, progress)
+    x = _feasible(problem, x, x_start, model, limits, rate=grid / float(period) * 4)
+    traj = problem.trajectory(x, model.joints)
+    start = problem.trajectory(x_start, model.joints)
+    exact = {
+        key: _exact(model, base, problem.t, tr, friction) for key, tr in (("x", traj), ("s", start))
+    }
+    return ExcitationDesign(
+        traj,
+        criterion,
+        friction,
+        names,
+        cond=exact["x"][0],
+        cond_start=exact["s"][0],
+        logdet=exact["x"][1],
+        logdet_start=exact["s"][1],
+        limits=limits,
+        margins=peak_fractions(model, traj, limits, rate=grid / float(period) * 4),
+        samples=int(samples),
+        evaluations=problem.evaluations,
+        seconds=time.perf_counter() - t0,
+        converged=bool(problem.converged),
+        message=problem.message,
+        seed=int(seed),
+    )
+
+
+def _exact(model, base, t, traj, friction) -> tuple[float, float]:
+    """Condition number and ``log det W^T W / rows`` with the exact Coulomb steps."""
+    W = information_matrix(model, base, *traj.evaluate(t), friction)
+    s = np.linalg.svd(W, compute_uv=False)
+    cond = float(s[0] / s[-1]) if s[-1] > 0 else np.inf
+    logdet = float(2.0 * np.sum(np.log(s)) - W.shape[1] * np.log(W.shape[0])) if s[-1] > 0 else -np.inf
+    return cond, logdet
+
+
+def _optimise(problem, x0, at_rest, max_evaluations, progress) -> np.ndarray:
+    """SLSQP from ``x0`` within the budget (module notes)."""
+    cons = [{"type": "ineq", "fun": problem.limits_fun, "jac": problem.limits_jac}]
+    if problem.finite_effort.any():
+        cons.append({"type": "ineq", "fun": problem.effort, "jac": problem.effort_jac})
+    if at_rest:
+        E = problem.at_rest()
+        cons.append({"type": "eq", "fun": lambda x: E @ x, "jac": lambda x: E})
+    maxiter = max(1, int(max_evaluations) // (problem.size + 1))
+
+    def step(xk: np.ndarray) -> None:
+        if progress is not None:
+            progress(min(problem.evaluations, int(max_evaluations)), int(max_evaluations))
+
+    res = scipy.optimize.minimize(
+        problem.fun,
+        x0,
+        jac=problem.jac,
+        method="SLSQP",
+        constraints=cons,
+        callback=step,
+        options={"maxiter": maxiter, "ftol": 1e-6},
+    )
+    problem.converged, problem.message = bool(res.success), str(res.message)
+    best = res.x if np.isfinite(res.fun) and res.fun <= problem.fun(x0) else x0
+    return np.asarray(best, dtype=float)
+
+
+def _feasible(problem, x, x_start, model, limits, rate) -> np.ndarray:
+    """``x`` with its oscillation about ``q0`` shrunk until every limit holds on a grid four
+    times finer than the constraints' (the optimiser may end a rounding outside); the start
+    when nothing smaller helps."""
+    traj = problem.trajectory(x, model.joints)
+    for _ in range(40):
+        peaks = peak_fractions(model, traj, limits, rate)
+        worst = max(float(np.max(v)) for v in peaks.values())
+        if worst <= 1.0:
+            return x
+        q0, c = problem.split(x.copy())
+        x = np.hstack([q0[:, None], c / max(worst, 1.0 + 1e-3)]).ravel()
+        x = _clip_q0(problem, x)
+        traj = problem.trajectory(x, model.joints)
+    return x_start
+
+
+def _clip_q0(problem, x: np.ndarray) -> np.ndarray:
+    lim = problem.limits
+    q0, c = problem.split(x.copy())
+    q0 = np.clip(q0, lim["lower"], lim["upper"])
+    return np.hstack([q0[:, None], c]).ravel()
+
+
+# -- constant-velocity sweeps ----------------------------------------------------------------
+
+
+def sweep_design(
+    model: RigidBodyModel,
+    joint: str,
+    speeds,
+    *,
+    hold: Mapping[str, float] | None = None,
+    workspace: Mapping[str, tuple[float, float]] | None = None,
+    acceleration_limit: float | None = None,
+    margin: float = 0.05,
+    dwell: float = 0.5,
+) -> SweepTrajectory:
+    """Constant-velocity sweeps of ``joint`` forward and back at each speed (BAS-RBFNN paper
+    section 2), the other joints held still, as a :class:`~.trajectories.SweepTrajectory`.
+
+    The joint starts at rest at the low end of its range (the URDF's limits narrowed by
+    ``workspace``, less ``margin`` of the width at each end); at each speed ``v`` it speeds up
+    to ``v`` by a half-cosine whose peak acceleration is the acceleration limit, crosses the
+    range at ``v``, stops at the high end, rests ``dwell`` s, and returns at ``-v`` the same
+    way, resting ``dwell`` s again.
+
+    Parameters
+    ----------
+    model : RigidBodyModel
+    joint : str
+    speeds : sequence of float
+        [rad/s or m/s], each > 0 and within the velocity limit less the margin.
+    hold : mapping, optional
+        Positions of the other joints (default the middle of their ranges).
+    workspace, margin : as :func:`design_excitation`.
+    acceleration_limit : float, optional
+        Default the joint's velocity limit (one second from rest to the top speed, about).
+    dwell : float
+        Rest [s] at each end.
+    """
+    if joint not in model.joints:
+        raise ConfigError(f"joint '{joint}' is not one of {model.joints}")
+    i = model.joints.index(joint)
+    speeds = np.atleast_1d(np.asarray(speeds, dtype=float))
+    limits = resolve_limits(model, workspace, acceleration_limit, 1.0, 1, margin)
+    vmax = limits["velocity"][i]
+    if speeds.size == 0 or not np.isfinite(speeds).all() or (speeds <= 0).any():
+        raise ConfigError(f"the sweep speeds must be > 0; got {speeds.tolist()}")
+    if (speeds > vmax).any():
+        raise ConfigError(
+            f"speeds {speeds[speeds > vmax].tolist()} exceed {joint}'s velocity limit "
+            f"less the margin, {vmax:.4g}"
+        )
+    if not (np.isfinite(dwell) and dwell >= 0):
+        raise ConfigError(f"dwell must be >= 0 s; got {dwell}")
+    amax = limits["acceleration"][i] if acceleration_limit is not None else vmax
+    lo, hi = limits["lower"][i], limits["upper"][i]
+    mid = 0.5 * (limits["lower"] + limits["upper"])
+    for name, value in (hold or {}).items():
+        if name not in model.joints:
+            raise ConfigError(f"hold names joint '{name}', not one of {model.joints}")
+        mid[model.joints.index(name)] = float(value)
+    mid[i] = lo
+    segments = []
+    for v in speeds:
+        ramp = v * np.pi / (2.0 * amax)  # the half-cosine's peak acceleration is amax
+        cruise = (hi - lo - v * ramp) / v
+        if cruise <= 0:
+            raise ConfigError(
+                f"{joint} cannot reach {v:g} rad/s within its range {hi - lo:.4g} at an "
+                f"acceleration of {amax:.4g}: lower the speed or raise the acceleration limit"
+            )
+        for sign, start in ((1.0, lo), (-1.0, hi)):
+            w = sign * v
+            segments += [
+                (ramp, start, 0.0, w),
+                (cruise, start + w * ramp / 2, w, w),
+                (ramp, start + w * (ramp / 2 + cruise), w, 0.0),
+            ]
+            if dwell > 0:
+                segments.append((dwell, hi if sign > 0 else lo, 0.0, 0.0))
+    return SweepTrajectory(model.joints, i, mid, np.array(segments, dtype=float))
