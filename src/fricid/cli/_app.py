@@ -41,13 +41,13 @@ __all__ = [
     "WideConsole",
     "app",
     "bench_app",
-    "robot_app",
     "console",
     "err_console",
     "handle_errors",
     "interrupt_exit",
     "main",
     "plural",
+    "robot_app",
     "signal_handlers",
 ]
 

@@ -329,10 +329,7 @@ class RigidBodyModel:
         q, dq, ddq = self._rows(q, dq, ddq)
         m, d = self._model, self._data
         return np.array(
-            [
-                pin.computeJointTorqueRegressor(m, d, *row)
-                for row in zip(q, dq, ddq, strict=True)
-            ]
+            [pin.computeJointTorqueRegressor(m, d, *row) for row in zip(q, dq, ddq, strict=True)]
         )
 
     def gravity_regressor(self, q) -> np.ndarray:
