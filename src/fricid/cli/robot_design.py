@@ -60,8 +60,7 @@ def _design_lines(design) -> list[str]:
         f"log det W'W/rows {design.logdet:.4g} (start {design.logdet_start:.4g}); "
         f"{design.evaluations} evaluations, {design.seconds:.1f} s, "
         f"{'converged' if design.converged else 'not converged: ' + design.message}",
-        "peak / limit (the limits less the margin of "
-        f"{100 * design.limits['margin']:.0f} %):",
+        f"peak / limit (the limits less the margin of {100 * design.limits['margin']:.0f} %):",
         f"  {'joint':<20} {'position':>9} {'velocity':>9} {'accel.':>9} {'effort':>9}",
     ]
     for i, j in enumerate(design.joints):

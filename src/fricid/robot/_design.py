@@ -46,7 +46,12 @@ class Problem:
         self.n = model.n
         self.width = 2 * harmonics + 1
         self.size = self.n * self.width
-        self.limits, self.friction, self.criterion, self.smooth = limits, friction, criterion, smooth
+        self.limits, self.friction, self.criterion, self.smooth = (
+            limits,
+            friction,
+            criterion,
+            smooth,
+        )
         self.measure, self.columns = measure, columns
         period = 2 * np.pi / w_f
         self.t = np.arange(samples) * period / samples
@@ -56,6 +61,7 @@ class Problem:
         self.evaluations = 0
         self.converged, self.message = False, ""
         self._cache: tuple[bytes, np.ndarray, np.ndarray] | None = None
+        self._steps: tuple[bytes, np.ndarray, np.ndarray] | None = None
         self.L, (self.centre, self.scale) = self._linear()
 
     # -- coefficients ------------------------------------------------------------------------
@@ -140,24 +146,31 @@ class Problem:
         self.evaluations += X.shape[0]
         return np.array([self.measure(w, self.criterion) for w in W]), tau
 
-    def _with_gradient(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def _point(self, x: np.ndarray) -> tuple[float, np.ndarray]:
+        """Criterion and torque (1, M, n) at ``x`` (cached: SLSQP asks for both)."""
         key = x.tobytes()
         if self._cache is None or self._cache[0] != key:
-            X = np.vstack([x, x + STEP * np.eye(self.size)])
-            f, tau = self._batch(X)
+            f, tau = self._batch(x[None, :])
             self._cache = (key, f, tau)
-        return self._cache[1], self._cache[2]
+        return float(self._cache[1][0]), self._cache[2]
+
+    def _perturbed(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Criterion (size,) and torque (size, M, n) at ``x`` plus each forward step."""
+        key = x.tobytes()
+        if self._steps is None or self._steps[0] != key:
+            f, tau = self._batch(x + STEP * np.eye(self.size))
+            self._steps = (key, f, tau)
+        return self._steps[1], self._steps[2]
 
     def value(self, X: np.ndarray) -> np.ndarray:
         """The criterion of designs ``X`` (k, size), without gradients."""
         return self._batch(np.atleast_2d(X))[0]
 
     def fun(self, x: np.ndarray) -> float:
-        return float(self._with_gradient(x)[0][0])
+        return self._point(x)[0]
 
     def jac(self, x: np.ndarray) -> np.ndarray:
-        f = self._with_gradient(x)[0]
-        return (f[1:] - f[0]) / STEP
+        return (self._perturbed(x)[0] - self._point(x)[0]) / STEP
 
     def _effort_peaks(self, tau: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Soft peak ``|tau| / effort`` over the instants per joint with an effort limit, of
@@ -172,13 +185,12 @@ class Problem:
 
     def effort(self, x: np.ndarray) -> np.ndarray:
         """``1 - soft peak |tau| / effort`` per joint with a finite effort limit."""
-        tau = self._with_gradient(x)[1]
-        return 1.0 - self._effort_peaks(tau[:1])[0][0]
+        return 1.0 - self._effort_peaks(self._point(x)[1])[0][0]
 
     def effort_jac(self, x: np.ndarray) -> np.ndarray:
-        tau = self._with_gradient(x)[1]
-        peak = self._effort_peaks(tau)[0]  # (size + 1, m): forward differences of the peaks
-        return -((peak[1:] - peak[0]) / STEP).T
+        peak0 = self._effort_peaks(self._point(x)[1])[0]
+        peak = self._effort_peaks(self._perturbed(x)[1])[0]  # (size, m)
+        return -((peak - peak0) / STEP).T
 
     def torque(self, X: np.ndarray) -> np.ndarray:
         """The torque (k, M, n) of designs ``X`` at the design instants (RNEA only)."""

@@ -37,7 +37,7 @@ import scipy.optimize
 from ..errors import ConfigError
 from .base import BaseParameters, base_parameters
 from .model import RigidBodyModel
-from .trajectories import FourierTrajectory, SweepTrajectory, fourier_basis
+from .trajectories import FourierTrajectory, SweepTrajectory
 
 __all__ = [
     "CRITERIA",
@@ -186,7 +186,7 @@ def predicted_covariance(
         raise ConfigError(f"the rate must be > 0 Hz; got {rate}")
     period = trajectory.period
     duration = period if duration is None else float(duration)
-    t = np.arange(int(round(period * rate))) / rate
+    t = np.arange(round(period * rate)) / rate
     W = information_matrix(model, _base(model), *trajectory.evaluate(t), friction)
     W = W / np.tile(sigma, t.size)[:, None]
     info = (W.T @ W) * (duration / period)
@@ -258,7 +258,7 @@ def resolve_limits(
 def peak_fractions(model: RigidBodyModel, traj, limits: dict, rate: float) -> dict:
     """Each joint's peak position (about the middle, of the half-width), speed, acceleration
     and effort as fractions of the limits, at ``rate`` over the trajectory."""
-    t, (q, dq, ddq) = traj.sample(rate)
+    _t, (q, dq, ddq) = traj.sample(rate)
     mid = 0.5 * (limits["upper"] + limits["lower"])
     half = 0.5 * (limits["upper"] - limits["lower"])
     tau = model.inverse_dynamics(q, dq, ddq)
@@ -322,6 +322,21 @@ def design_excitation(
     progress : callable, optional
         ``progress(evaluations, max_evaluations)`` after each iteration.
     """
+    from threadpoolctl import threadpool_limits
+
+    # many small SVDs: BLAS threads only cost (and oversubscribe a shared machine)
+    with threadpool_limits(limits=1, user_api="blas"):
+        return _design(
+            model, harmonics, period, samples, criterion, friction, workspace,
+            acceleration_limit, margin, at_rest, starts, seed, max_evaluations, progress,
+        )  # fmt: skip
+
+
+def _design(
+    model, harmonics, period, samples, criterion, friction, workspace, acceleration_limit,
+    margin, at_rest, starts, seed, max_evaluations, progress,
+) -> ExcitationDesign:  # fmt: skip
+    """:func:`design_excitation` with its arguments checked here."""
     from ._design import Problem
 
     if criterion not in CRITERIA:
@@ -394,7 +409,9 @@ def _exact(model, base, t, traj, friction) -> tuple[float, float]:
     W = information_matrix(model, base, *traj.evaluate(t), friction)
     s = np.linalg.svd(W, compute_uv=False)
     cond = float(s[0] / s[-1]) if s[-1] > 0 else np.inf
-    logdet = float(2.0 * np.sum(np.log(s)) - W.shape[1] * np.log(W.shape[0])) if s[-1] > 0 else -np.inf
+    logdet = (
+        float(2.0 * np.sum(np.log(s)) - W.shape[1] * np.log(W.shape[0])) if s[-1] > 0 else -np.inf
+    )
     return cond, logdet
 
 
@@ -411,6 +428,8 @@ def _optimise(problem, x0, at_rest, max_evaluations, progress) -> np.ndarray:
     def step(xk: np.ndarray) -> None:
         if progress is not None:
             progress(min(problem.evaluations, int(max_evaluations)), int(max_evaluations))
+        if problem.evaluations >= max_evaluations:
+            raise StopIteration  # the budget is spent: SLSQP returns its last iterate
 
     res = scipy.optimize.minimize(
         problem.fun,
@@ -421,7 +440,8 @@ def _optimise(problem, x0, at_rest, max_evaluations, progress) -> np.ndarray:
         callback=step,
         options={"maxiter": maxiter, "ftol": 1e-6},
     )
-    problem.converged, problem.message = bool(res.success), str(res.message)
+    problem.converged = bool(res.success) and problem.evaluations < max_evaluations
+    problem.message = str(res.message)
     best = res.x if np.isfinite(res.fun) and res.fun <= problem.fun(x0) else x0
     return np.asarray(best, dtype=float)
 

@@ -122,7 +122,7 @@ def write_joint_trajectory_yaml(
         "points:",
     ]
     for k in range(1, t.size):
-        ns = int(round(t[k] * 1e9))
+        ns = round(t[k] * 1e9)
         lines += [
             f"  - positions: {_vector(q[k])}",
             f"    velocities: {_vector(dq[k])}",

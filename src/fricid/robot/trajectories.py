@@ -181,9 +181,7 @@ class RampedTrajectory:
 
     def __post_init__(self) -> None:
         if int(self.periods) < 1 or not (np.isfinite(self.ramp) and self.ramp > 0):
-            raise ConfigError(
-                f"need periods >= 1 and ramp > 0 s; got {self.periods}, {self.ramp}"
-            )
+            raise ConfigError(f"need periods >= 1 and ramp > 0 s; got {self.periods}, {self.ramp}")
         object.__setattr__(self, "periods", int(self.periods))
         s0 = self.base.evaluate(0.0)
         s1 = self.base.evaluate(self.base.period * self.periods)
