@@ -24,7 +24,7 @@ _WHERE = {
     "to_log_cholesky": "consistency",
     "ExcitationDesign": "excitation",
     "design_excitation": "excitation",
-    "sweep_design": "excitation",
+    "sweep_design": "sweeps",
     "FourierTrajectory": "trajectories",
     "RampedTrajectory": "trajectories",
     "SweepTrajectory": "trajectories",

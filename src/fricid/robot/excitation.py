@@ -1,6 +1,6 @@
 """Excitation design: a periodic Fourier trajectory of every joint (Swevers et al. 1997, module
 :mod:`.trajectories`) whose stacked regressor is as well conditioned as the robot's limits
-allow, and constant-velocity sweeps of one joint (BAS-RBFNN paper section 2).
+allow (the sweeps of one joint at constant speeds are in :mod:`.sweeps`).
 
 The information matrix. At ``M`` instants of one period, the rows of every joint's torque
 ``tau = Y_b(q, dq, ddq) beta + F(dq) phi`` are stacked into ``W = [Y_b F]`` (``M n`` rows):
@@ -37,7 +37,7 @@ import scipy.optimize
 from ..errors import ConfigError
 from .base import BaseParameters, base_parameters
 from .model import RigidBodyModel
-from .trajectories import FourierTrajectory, SweepTrajectory
+from .trajectories import FourierTrajectory
 
 __all__ = [
     "CRITERIA",
@@ -46,7 +46,6 @@ __all__ = [
     "design_excitation",
     "friction_columns",
     "information_matrix",
-    "sweep_design",
 ]
 
 #: The design criteria.
@@ -65,6 +64,10 @@ DEFAULT_VELOCITY = 2.0
 
 #: Instants per period on the fine grid that checks the linear limits.
 GRID = 400
+
+#: A soft peak this far over a limit (a fraction) still counts as within it while optimising
+#: (SLSQP meets its constraints to a tolerance; :func:`_feasible` then shrinks the result).
+SLACK = 2e-3
 
 #: Smoothing speed of the Coulomb steps while optimising [rad/s].
 SMOOTH = 1e-2
@@ -424,8 +427,22 @@ def _optimise(problem, x0, at_rest, max_evaluations, progress) -> np.ndarray:
         E = problem.at_rest()
         cons.append({"type": "eq", "fun": lambda x: E @ x, "jac": lambda x: E})
     maxiter = max(1, int(max_evaluations) // (problem.size + 1))
+    best = [problem.fun(x0), x0]
+
+    def keep(x: np.ndarray) -> None:
+        """Remember ``x`` if it is within the limits and the best so far (SLSQP's iterates
+        may cross a limit on their way; its last one is not always its best)."""
+        inside = np.all(problem.limits_fun(x) >= -SLACK) and np.all(
+            problem.effort(x) >= -SLACK if problem.finite_effort.any() else True
+        )
+        if at_rest:
+            inside = inside and np.allclose(problem.at_rest() @ x, 0.0, atol=1e-9)
+        f = problem.fun(x)
+        if inside and np.isfinite(f) and f < best[0]:
+            best[:] = [f, np.array(x, dtype=float)]
 
     def step(xk: np.ndarray) -> None:
+        keep(xk)
         if progress is not None:
             progress(min(problem.evaluations, int(max_evaluations)), int(max_evaluations))
         if problem.evaluations >= max_evaluations:
@@ -442,8 +459,8 @@ def _optimise(problem, x0, at_rest, max_evaluations, progress) -> np.ndarray:
     )
     problem.converged = bool(res.success) and problem.evaluations < max_evaluations
     problem.message = str(res.message)
-    best = res.x if np.isfinite(res.fun) and res.fun <= problem.fun(x0) else x0
-    return np.asarray(best, dtype=float)
+    keep(np.asarray(res.x, dtype=float))
+    return best[1]
 
 
 def _feasible(problem, x, x_start, model, limits, rate) -> np.ndarray:
@@ -468,84 +485,3 @@ def _clip_q0(problem, x: np.ndarray) -> np.ndarray:
     q0, c = problem.split(x.copy())
     q0 = np.clip(q0, lim["lower"], lim["upper"])
     return np.hstack([q0[:, None], c]).ravel()
-
-
-# -- constant-velocity sweeps ----------------------------------------------------------------
-
-
-def sweep_design(
-    model: RigidBodyModel,
-    joint: str,
-    speeds,
-    *,
-    hold: Mapping[str, float] | None = None,
-    workspace: Mapping[str, tuple[float, float]] | None = None,
-    acceleration_limit: float | None = None,
-    margin: float = 0.05,
-    dwell: float = 0.5,
-) -> SweepTrajectory:
-    """Constant-velocity sweeps of ``joint`` forward and back at each speed (BAS-RBFNN paper
-    section 2), the other joints held still, as a :class:`~.trajectories.SweepTrajectory`.
-
-    The joint starts at rest at the low end of its range (the URDF's limits narrowed by
-    ``workspace``, less ``margin`` of the width at each end); at each speed ``v`` it speeds up
-    to ``v`` by a half-cosine whose peak acceleration is the acceleration limit, crosses the
-    range at ``v``, stops at the high end, rests ``dwell`` s, and returns at ``-v`` the same
-    way, resting ``dwell`` s again.
-
-    Parameters
-    ----------
-    model : RigidBodyModel
-    joint : str
-    speeds : sequence of float
-        [rad/s or m/s], each > 0 and within the velocity limit less the margin.
-    hold : mapping, optional
-        Positions of the other joints (default the middle of their ranges).
-    workspace, margin : as :func:`design_excitation`.
-    acceleration_limit : float, optional
-        Default the joint's velocity limit (one second from rest to the top speed, about).
-    dwell : float
-        Rest [s] at each end.
-    """
-    if joint not in model.joints:
-        raise ConfigError(f"joint '{joint}' is not one of {model.joints}")
-    i = model.joints.index(joint)
-    speeds = np.atleast_1d(np.asarray(speeds, dtype=float))
-    limits = resolve_limits(model, workspace, acceleration_limit, 1.0, 1, margin)
-    vmax = limits["velocity"][i]
-    if speeds.size == 0 or not np.isfinite(speeds).all() or (speeds <= 0).any():
-        raise ConfigError(f"the sweep speeds must be > 0; got {speeds.tolist()}")
-    if (speeds > vmax).any():
-        raise ConfigError(
-            f"speeds {speeds[speeds > vmax].tolist()} exceed {joint}'s velocity limit "
-            f"less the margin, {vmax:.4g}"
-        )
-    if not (np.isfinite(dwell) and dwell >= 0):
-        raise ConfigError(f"dwell must be >= 0 s; got {dwell}")
-    amax = limits["acceleration"][i] if acceleration_limit is not None else vmax
-    lo, hi = limits["lower"][i], limits["upper"][i]
-    mid = 0.5 * (limits["lower"] + limits["upper"])
-    for name, value in (hold or {}).items():
-        if name not in model.joints:
-            raise ConfigError(f"hold names joint '{name}', not one of {model.joints}")
-        mid[model.joints.index(name)] = float(value)
-    mid[i] = lo
-    segments = []
-    for v in speeds:
-        ramp = v * np.pi / (2.0 * amax)  # the half-cosine's peak acceleration is amax
-        cruise = (hi - lo - v * ramp) / v
-        if cruise <= 0:
-            raise ConfigError(
-                f"{joint} cannot reach {v:g} rad/s within its range {hi - lo:.4g} at an "
-                f"acceleration of {amax:.4g}: lower the speed or raise the acceleration limit"
-            )
-        for sign, start in ((1.0, lo), (-1.0, hi)):
-            w = sign * v
-            segments += [
-                (ramp, start, 0.0, w),
-                (cruise, start + w * ramp / 2, w, w),
-                (ramp, start + w * (ramp / 2 + cruise), w, 0.0),
-            ]
-            if dwell > 0:
-                segments.append((dwell, hi if sign > 0 else lo, 0.0, 0.0))
-    return SweepTrajectory(model.joints, i, mid, np.array(segments, dtype=float))
