@@ -5,6 +5,7 @@ Usage::
     python benchmarks/bench_verdicts.py [--cases 325] [--quick] [--jobs 2] [--seed-split 4]
         [--models stribeck,coulomb_viscous] [--auto-every 3] [--learned-every 10]
         [--cli-check K] [--json PATH] [--rows PATH] [--report-only] [--tables-from PATH]
+        [--classes gravity,regular]
 
 Cases (:mod:`_verdict_cases`, generators written for this benchmark, not ``fricid.sim``):
 friction laws outside fricid's families, regular, closely spaced (3-5 %), irregular,
@@ -35,7 +36,8 @@ all cases). Both sets go to ``--json``. ``--cli-check K``: K report cases throug
 first of ``--models``; cases with repeated runs first), agreement printed. ``--rows PATH``
 appends one JSON line per fit as it ends, so an interrupted run keeps what it did;
 ``--tables-from PATH`` prints the tables of such a file (or of a ``--json`` file) without
-running; ``--report-only`` skips the tuning cases.
+running; ``--report-only`` skips the tuning cases; ``--classes`` runs only the cases of the
+classes named (their ids and seeds as in the full run).
 
 Runtime is ``auto``'s: CPU seconds per fit and trust assessment (the last table prints
 them), measured over 60 cases on a shared machine: ``auto`` 18 (its own leave-one-level-out
@@ -104,7 +106,7 @@ def _tasks(args) -> list[tuple[int, str, int, tuple[str, ...]]]:
     models = tuple(args.models.split(","))
     out = []
     for cid, klass, seed in case_plan(args.cases):
-        if cid < args.first:
+        if cid < args.first or (args.classes and klass not in args.classes):
             continue
         if args.report_only and is_tuning(seed, args.seed_split):
             continue
@@ -356,6 +358,13 @@ def parse(argv: list[str] | None = None) -> argparse.Namespace:
     p.add_argument("--report-only", action="store_true", help="skip the tuning cases")
     p.add_argument("--first", type=int, default=0, help="start at this case (resume a run)")
     p.add_argument(
+        "--classes",
+        type=lambda text: tuple(c.strip() for c in text.split(",") if c.strip()),
+        default=(),
+        metavar="A,B",
+        help="only the cases of these classes (ids and seeds unchanged)",
+    )
+    p.add_argument(
         "--tables-from",
         type=Path,
         default=None,
@@ -363,6 +372,9 @@ def parse(argv: list[str] | None = None) -> argparse.Namespace:
         help="print the tables of a --rows file or --json file instead of running",
     )
     args = p.parse_args(argv)
+    unknown = [c for c in args.classes if c not in CLASSES]
+    if unknown:
+        p.error(f"unknown class(es) {', '.join(unknown)}; choose from {', '.join(CLASSES)}")
     if args.quick:
         args.cases, args.auto_every, args.learned_every = 13, 7, 0
     return args
@@ -394,7 +406,11 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
     if args.cli_check:
         from _verdict_cli import cli_check
 
-        plan = [c for c in case_plan(args.cases) if not is_tuning(c[2], args.seed_split)]
+        plan = [
+            c
+            for c in case_plan(args.cases)
+            if not is_tuning(c[2], args.seed_split) and (not args.classes or c[1] in args.classes)
+        ]
         # repeated runs first: a table of means carries no std, so only repeats give a scatter
         plan.sort(key=lambda c: c[1] not in ("repeats", "gravity"))
         cases = [make_case(*c) for c in plan[: args.cli_check]]

@@ -150,3 +150,25 @@ def test_bench_runs_end_to_end_with_json(tmp_path, capsys):
     data = json.loads(out.read_text())
     assert data["tuning_seeds"] == [1002] and len(data["rows"]) == 3
     assert data["report"]["rates"]["n"] == 2 == result["report"]["rates"]["n"]
+
+
+def test_classes_option_keeps_the_ids_and_seeds_of_the_full_run():
+    args = bv.parse(["--cases", "40", "--classes", "gravity,regular", "--auto-every", "0"])
+    tasks = bv._tasks(args)
+    assert [(t[0], t[1], t[2]) for t in tasks] == [
+        (c, k, s) for c, k, s in bv.case_plan(40) if k in ("gravity", "regular")
+    ]
+    assert [t[0] for t in tasks] == [0, 11, 13, 24, 26, 37, 39]
+    with pytest.raises(SystemExit):
+        bv.parse(["--classes", "gravitee"])
+
+
+def test_gravity_cases_get_the_gravity_caveat():
+    """Every gravity case's samples carry the signature (runs differing far beyond their
+    std/sqrt(count)); the repeats class, whose runs differ by noise, never does."""
+    from fricid.identify._diagnostics import gravity_caveat
+
+    for i in (11, 24, 37):
+        assert gravity_caveat(vc.make_case(i, "gravity", 1000 + i).samples)
+    for i in (7, 20, 33):
+        assert gravity_caveat(vc.make_case(i, "repeats", 1000 + i).samples) == []

@@ -19,6 +19,7 @@ MODULES = (
     "report",
     "reproduce",
     "fleet",
+    "robot_simulate",
     "robot_design",
 )
 

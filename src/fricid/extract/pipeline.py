@@ -291,6 +291,7 @@ def extract(
     if used != requested:
         options["gravity_requested"] = requested
     options["gravity"] = used
+    options["position_source"] = stream.position_source
     residual = residual_check(fit, kept, group, pooled, shape)
     if residual is not None:
         per = [residual.per_group.get(int(g), np.nan) for g in np.unique(group)]

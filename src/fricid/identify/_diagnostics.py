@@ -1,5 +1,6 @@
 """What a model file and its samples say about trust before any validation: parameters the
-data do not determine or bound, the operating range, and the samples' quality table.
+data do not determine or bound, the operating range, the samples' quality table, and whether
+gravity may be left in the friction (:func:`gravity_caveat`).
 
 Helpers of :mod:`fricid.identify.trust` (the verdict), kept apart so that the verdict's module
 stays readable; :func:`not_determined` is also the report's parameter table status.
@@ -8,6 +9,7 @@ stays readable; :func:`not_determined` is also the report's parameter table stat
 from __future__ import annotations
 
 import contextlib
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -16,12 +18,20 @@ from ..errors import ConfigError
 from ..fitted import FittedModel, Parameter
 from ..models._range import SIDES, coverage_text, gap_pairs, gaps_note
 from ..samples import FrictionSamples
-from ._scatter import sample_weights
+from ._scatter import LEVEL_RTOL, _repeat_groups, sample_weights
 
 __all__ = [
     "DOWN_WEIGHT",
     "DROPS",
+    "EXCESS_ALPHA",
+    "EXCESS_RATIO",
+    "LEFT_IN",
+    "OWN_SEM",
+    "STD_SQRT_COUNT",
+    "RunExcess",
+    "between_run_excess",
     "downweighted",
+    "gravity_caveat",
     "not_determined",
     "open_sides",
     "quality_rows",
@@ -33,6 +43,20 @@ __all__ = [
 #: ``|z| = 2.83`` scales, huber ``min(1, 1 / |z|)`` beyond 3 (``z`` the residual over the
 #: loss's scale, weighted as the fit weighs it), about 0.5 % of Gaussian noise either way.
 DOWN_WEIGHT = 1.0 / 3.0
+
+#: Repeated runs whose between-run scatter is more than this multiple of what their own
+#: standard errors explain (``meta["sem"]``, else ``std / sqrt(count)``; significantly so)
+#: differ in something the samples do not record (:func:`gravity_caveat`). Set from the
+#: statistics, not from a benchmark: runs that differ by their noise alone give about 1, with a
+#: 99.9 % upper limit of 2.3 at 3 degrees of freedom (the test then decides), 1.5 at 20 and
+#: 1.3 at 60 (this floor then does).
+EXCESS_RATIO = 2.0
+
+#: Significance of that excess (a one-sided chi-square test of the between-run sum of squares).
+EXCESS_ALPHA = 1e-3
+
+#: How the caveats of :func:`gravity_caveat` begin.
+LEFT_IN = "gravity may be left in"
 
 #: Down-weighted samples listed by name (the rest counted).
 _LISTED = 5
@@ -213,3 +237,178 @@ def _sample_name(samples: FrictionSamples, i: int, z: float) -> str:
     if np.isfinite(samples.temperature[i]):
         parts.append(f"{samples.temperature[i]:.4g} degC")
     return f"row {i}: {', '.join(parts)} (residual {z:.3g}x the loss's scale)"
+
+
+def gravity_caveat(samples: FrictionSamples | None) -> list[str]:
+    """Caveats that the friction may hold gravity torque (eq. 7 of the BAS-RBFNN paper,
+    ``p_x cos q - p_y sin q`` at the joint's position ``q``), one line each, from what the
+    samples carry.
+
+    - Provenance: an extraction from a log with a position channel that did not remove
+      gravity (``meta["extract"]``: ``gravity`` ``"none"``, ``position_source``
+      ``"channel"``; its note in ``meta["notes"]``), or whose eq. 7 fit left a pattern along
+      the position (``meta["gravity_residual"]["structured"]``).
+    - The samples themselves: repeated runs of one operating point whose means differ more
+      than :data:`EXCESS_RATIO` times what their standard errors explain (``meta["sem"]``,
+      else ``std / sqrt(count)``), significantly (:func:`between_run_excess`). Friction at
+      one speed, load and temperature is one number; gravity left in is an offset at each
+      run's position, common to both directions, so runs at different positions differ by
+      it. The scatter between the runs then holds it, and a model within that scatter is not
+      shown to be within the noise. Drift or noise far more autocorrelated than
+      ``std / sqrt(count)`` assumes do the same (the caveat says so), unless the runs' means
+      differ more than the raw samples scatter.
+
+    Without positions, provenance or a within-run noise, gravity left in at a fixed position
+    is a constant offset that no data of friction against speed can tell from friction; no
+    caveat is made of what cannot be seen.
+    """
+    if samples is None:
+        return []
+    out = []
+    meta = samples.meta if isinstance(samples.meta, dict) else {}
+    extract = meta.get("extract") if isinstance(meta.get("extract"), dict) else {}
+    if extract.get("gravity") == "none" and extract.get("position_source") == "channel":
+        out.append(
+            f"{LEFT_IN}: the extraction did not remove it though the log has a position "
+            "channel (gravity 'none'), so the friction includes any gravity torque"
+        )
+    residual = meta.get("gravity_residual")
+    if isinstance(residual, dict) and residual.get("structured"):
+        rms, noise = residual.get("pattern_rms"), residual.get("expected")
+        size = f" ({rms:.3g} N m RMS against {noise:.2g} from noise)" if rms and noise else ""
+        out.append(
+            f"{LEFT_IN} in part: the extraction's gravity fit (eq. 7, one link) leaves a pattern "
+            f"along the position{size}, e.g. gravity of other joints"
+        )
+    excess = between_run_excess(samples, EXCESS_ALPHA)
+    if excess is None or excess.ratio <= EXCESS_RATIO or not excess.significant:
+        return out
+    if excess.beyond_std:
+        seen = "; they differ more than the raw samples scatter, which no autocorrelation explains"
+    elif excess.within == STD_SQRT_COUNT:
+        seen = ", unless the noise is far more autocorrelated than std/sqrt(count) assumes"
+    else:
+        seen = ""
+    explain = (
+        "their std/sqrt(count) explains"
+        if excess.within == STD_SQRT_COUNT
+        else f"{excess.within} explain"
+    )
+    out.append(
+        f"{LEFT_IN}: repeated runs at {excess.points} operating point(s) differ "
+        f"{excess.ratio:.3g}x more than {explain}, so something the samples do not record "
+        "changes between runs (the position, with gravity in the torque; drift)"
+        f"{seen}; the scatter the error is graded against holds it"
+    )
+    return out
+
+
+#: ``RunExcess.within`` when the rows' standard errors are ``std / sqrt(count)``.
+STD_SQRT_COUNT = "std/sqrt(count)"
+
+#: ... when they are the samples' own (``meta["sem"]``, e.g. autocorrelation-corrected).
+OWN_SEM = "their own standard errors"
+
+
+@dataclass(frozen=True)
+class RunExcess:
+    """How far repeated runs of one operating point differ beyond their own within-run noise.
+
+    Attributes
+    ----------
+    ratio : float
+        ``sqrt(SS / E[SS])``: ``SS = sum_g sum_(i in g) (y_i - ybar_g)^2`` over the repeated
+        operating points ``g``, ``E[SS] = sum_g (1 - 1/n_g) sum_(i in g) se_i^2`` what it is
+        when each run's mean carries only its own noise, of standard error ``se_i`` (about 1
+        then).
+    dof : int
+        ``sum_g (n_g - 1)``: ``SS / E[SS]`` is about ``chi2(dof) / dof`` under that noise.
+    points : int
+        The operating points repeated.
+    significant : bool
+        ``SS / E[SS]`` exceeds the ``1 - alpha`` quantile of ``chi2(dof) / dof``.
+    beyond_std : bool
+        The runs' means scatter more than the raw samples themselves (``SS`` over
+        ``sum_g (1 - 1/n_g) sum std_i^2``, at the same significance): the mean of correlated
+        samples varies no more than one sample does, so no autocorrelation explains it.
+    within : str
+        Where ``se_i`` came from: :data:`OWN_SEM` (the samples' ``meta["sem"]``, given for
+        every repeated row) or :data:`STD_SQRT_COUNT`.
+    """
+
+    ratio: float
+    dof: int
+    points: int
+    significant: bool
+    beyond_std: bool
+    within: str = STD_SQRT_COUNT
+
+
+def _run_errors(samples: FrictionSamples) -> tuple[np.ndarray, str]:
+    """Each row's standard error: the samples' own ``meta["sem"]`` where every row has a
+    positive one, else ``std / sqrt(count)`` (NaN where neither is positive)."""
+    sem = samples.meta.get("sem") if isinstance(samples.meta, dict) else None
+    if sem is not None:
+        with contextlib.suppress(TypeError, ValueError):
+            own = np.array([np.nan if x is None else x for x in sem], dtype=float)
+            if own.shape == (len(samples),) and np.all(own > 0):
+                return own, OWN_SEM
+    ok = (samples.std > 0) & (samples.count > 0)
+    se = np.where(ok, samples.std / np.sqrt(np.where(ok, samples.count, 1.0)), np.nan)
+    return se, STD_SQRT_COUNT
+
+
+def between_run_excess(
+    samples: FrictionSamples, alpha: float = 1e-3, rtol: float = LEVEL_RTOL
+) -> RunExcess | None:
+    """The between-run scatter of repeated runs against their within-run standard errors.
+
+    Parameters
+    ----------
+    samples : FrictionSamples
+    alpha : float
+        Significance of ``significant`` and ``beyond_std`` (one-sided chi-square tests).
+    rtol : float
+        Repeats as :func:`._scatter.measurement_scatter` finds them
+        (:func:`._scatter._repeat_groups`).
+
+    Returns
+    -------
+    RunExcess or None
+        None when no operating point is repeated by runs that all carry a standard error
+        (``meta["sem"]``, or a positive ``std`` and ``count``).
+
+    Notes
+    -----
+    Friction at one speed, load and temperature is one number, so runs of one operating point
+    differ by their noise alone. Runs whose means differ far beyond their within-run noise
+    differ in something the samples do not record: the joint's position (gravity left in, eq.
+    7 of the BAS-RBFNN paper, is an offset ``p_x cos q - p_y sin q`` at each run's position),
+    drift, or noise far more autocorrelated than ``std / sqrt(count)`` assumes (a lower bound
+    of the standard error; an autocorrelation-corrected ``meta["sem"]`` is used instead where
+    the samples carry one).
+    """
+    from scipy.stats import chi2
+
+    se, within = _run_errors(samples)
+    group = _repeat_groups(samples, rtol)
+    sizes = np.bincount(group)
+    ok = np.bincount(group, weights=np.isfinite(se).astype(float)) == sizes
+    rep = (sizes > 1) & ok
+    sel = rep[group]
+    if not sel.any():
+        return None
+    g, y, se, std = group[sel], samples.y[sel], se[sel], samples.std[sel]
+    n = sizes[g].astype(float)
+    mean = np.bincount(g, weights=y, minlength=sizes.size)[g] / n
+    ss = float(np.sum((y - mean) ** 2))
+    dof = int(np.sum(sizes[rep] - 1))
+    expected = float(np.sum((1.0 - 1.0 / n) * se**2))
+    bound = float(np.sum((1.0 - 1.0 / n) * std**2))
+    if not (expected > 0 and np.isfinite(ss)):
+        return None
+    critical = float(chi2.ppf(1.0 - alpha, dof)) / dof
+    significant = bool(ss / expected > critical)
+    beyond = bool(bound > 0 and np.all(std > 0) and ss / bound > critical)
+    ratio = float(np.sqrt(ss / expected))
+    return RunExcess(ratio, dof, int(rep.sum()), significant, beyond, within)

@@ -77,11 +77,13 @@ def model_hash(fitted: FittedModel) -> str:
 
 
 def samples_detail_hash(samples: FrictionSamples) -> str:
-    """A hash of what the scatter and the quality table read besides the values: count, std
-    and ``meta`` ``sem``, ``sem_method``, ``sem_caveat``, ``setpoint`` and ``quality``."""
+    """A hash of what the scatter, the quality table and the gravity caveats read besides the
+    values: count, std and ``meta`` ``sem``, ``sem_method``, ``sem_caveat``, ``setpoint``,
+    ``quality``, ``extract`` and ``gravity_residual``."""
     meta = {k: samples.meta.get(k) for k in ("sem", "sem_method", "sem_caveat", "quality")}
-    if "setpoint" in samples.meta:
-        meta["setpoint"] = samples.meta["setpoint"]
+    for key in ("setpoint", "extract", "gravity_residual"):
+        if key in samples.meta:
+            meta[key] = samples.meta[key]
     doc = {"count": samples.count.tolist(), "std": samples.std.tolist(), "meta": meta}
     return _digest(json.loads(json.dumps(doc, default=_default)))
 

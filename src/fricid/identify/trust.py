@@ -38,7 +38,10 @@ when anything else above is short of clean (a parameter not determined or not bo
 error between :data:`fricid.metrics.NOISE_RATIO` and :data:`MISS_RATIO` times the scatter,
 no held-out error or no scatter, convergence not recorded, set-points flagged for scatter or
 with outliers dropped, a gap between the measured speeds (held-out validation leaves out
-measured levels and so says nothing of a gap)); ``"yes"`` otherwise. A model whose error
+measured levels and so says nothing of a gap), gravity possibly left in the friction
+(:func:`._diagnostics.gravity_caveat`: the extraction says it did not remove it or that eq.
+7 left a pattern along the position, or repeated runs differ far more than their own
+``std / sqrt(count)`` explains)); ``"yes"`` otherwise. A model whose error
 misses the scatter gets what to do (:func:`._advice.misfit_advice`).
 
 Reuse. The model file may carry the record (``FittedModel.trust``; ``fricid fit`` and the
@@ -65,6 +68,7 @@ from ._diagnostics import (
     DROPS,
     downweighted,
     gap_caveat,
+    gravity_caveat,
     not_determined,
     open_sides,
     quality_rows,
@@ -114,7 +118,7 @@ __all__ = [
 MISS_RATIO = 3.0
 
 #: Format of the record and of the rules behind it: a stored record of another is recomputed.
-TRUST_VERSION = 3
+TRUST_VERSION = 4
 
 #: ``Trust.heldout_source``: leave-one-velocity-out run by :func:`assess_trust`.
 RUN_HERE = "lovo run here"
@@ -365,7 +369,7 @@ def assess_trust(
             f"{fitted.loss['loss']} loss down-weighted left out; " + trust.validation_note
         )
     trust.quality, trust.quality_summary, quality_caveat = quality_rows(samples)
-    _grade(trust, fitted, quality_caveat)
+    _grade(trust, fitted, [quality_caveat, *gravity_caveat(samples)])
     if trust.converged is not False and trust.heldout_ratio > MISS_RATIO:
         from ._advice import misfit_advice
 
@@ -431,7 +435,7 @@ def _ratio(
     trust.verdict = verdict(trust.heldout_ratio)
 
 
-def _grade(trust: Trust, fitted: FittedModel, quality_caveat: str) -> None:
+def _grade(trust: Trust, fitted: FittedModel, sample_caveats: list[str]) -> None:
     """Set ``trust.level`` and ``trust.reasons`` (module notes)."""
     no, caveats = [], []
     free = fitted.free
@@ -464,8 +468,7 @@ def _grade(trust: Trust, fitted: FittedModel, quality_caveat: str) -> None:
             else "held out at the measured velocity levels only (the fit's own random-fold CV; "
             "between and beyond them untested)"
         )
-    if quality_caveat:
-        caveats.append(quality_caveat)
+    caveats += [c for c in sample_caveats if c]
     gaps = gap_caveat(fitted)
     if gaps:
         caveats.append(gaps)

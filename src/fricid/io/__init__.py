@@ -1,8 +1,8 @@
 """Readers and writers: fricid's CSV and Parquet tables, Maxon EPOS recorder CSV, ROS 2 bags
-and MCAP, generic column-mapped logs, per-channel ``time value`` files, MATLAB files; the
-registry of readers and their options (:mod:`.registry`: :data:`READERS`,
-:data:`READER_OPTIONS`, :func:`open_log`); the parsers of option values written as text
-(:mod:`.options`); atomic writes (:mod:`.atomic`).
+and MCAP, generic column-mapped logs, per-channel ``time value`` files, MATLAB files; robot
+logs of all joints at once (:mod:`.robot_logs`); the registry of readers and their options
+(:mod:`.registry`: :data:`READERS`, :data:`READER_OPTIONS`, :func:`open_log`); the parsers of
+option values written as text (:mod:`.options`); atomic writes (:mod:`.atomic`).
 
 Every reader converts to SI once, at the edge, and names the file, row and column of bad
 input (:class:`~fricid.errors.DataError`); every writer is atomic (DESIGN.md, "Files"). An
@@ -45,6 +45,8 @@ _WHERE = {
     "read_rosbag": "rosbag",
     "rosbag_joints": "rosbag",
     "rosbag_topics": "rosbag",
+    "read_robot_log": "robot_logs",
+    "write_robot_log": "robot_logs",
     "iter_rawlog": "tables",
     "read_rawlog": "tables",
     "read_samples": "tables",

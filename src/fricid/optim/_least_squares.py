@@ -37,7 +37,11 @@ option ``restart_above`` (``fit`` sets it from the measurement scatter: the resi
 the noise). Measured on the paper2
 Stribeck problem, the first start reached the optimum 160 times in 160 (issue 14), so the
 seven others were 8x the cost for nothing. ``restart="always"`` (``trf``, ``lm_minpack``)
-runs them all.
+runs them all. Restarted, ``lm`` stops once ``patience`` (3) starts in a row found nothing
+better than the best so far (lowered its SSE by under :data:`PATIENCE_RTOL`): a family that
+misses the measurement scatter by its shape, not by a local optimum, otherwise spent seven more
+starts reaching the same point (measured: ``fricid.identify.select``'s screening of 18 families
+on the 660 per-direction samples of paper1, ``benchmarks/bench_speed.py``).
 
 Every residual vector evaluated (each row of a batched Jacobian included) counts as one
 evaluation.
@@ -71,6 +75,10 @@ INSIDE = 1e-9
 #: A first start whose result lies within this of a face of the unit box is doubtful.
 AT_BOUND = 1e-6
 
+#: A start "finds something better" when it lowers the best SSE by more than this fraction
+#: (option ``patience``).
+PATIENCE_RTOL = 1e-9
+
 
 class _LeastSquares(Solver):
     uses_residuals = True
@@ -82,6 +90,7 @@ class _LeastSquares(Solver):
         "gtol": 1e-12,
         "restart": "always",
         "restart_above": None,
+        "patience": None,
     }
     scipy_method = "trf"
     #: scipy's ``x_scale``
@@ -96,6 +105,8 @@ class _LeastSquares(Solver):
         choice_option(self.opts, "restart", self.name, ("doubtful", "always"))
         if self.opts["restart_above"] is not None:
             positive_option(self.opts, "restart_above", self.name, allow_zero=True)
+        if self.opts["patience"] is not None:
+            positive_option(self.opts, "patience", self.name, integer=True)
 
     def doubtful(self, u0: np.ndarray, sol: Any) -> str:
         """Why the first start (from ``u0``) calls for the other starts ("" when it does not)."""
@@ -187,8 +198,15 @@ class _LeastSquares(Solver):
         jac = self._jacobian_fun() if self.batched_jacobian else "2-point"
         messages = []
         restarted = ""
+        best_message = "none"
         self.converged = False
+        patience, idle = self.opts["patience"], 0
         for i, u0 in enumerate(starts):
+            if patience is not None and restarted and idle >= patience:
+                return self.nit, (
+                    f"{self.nit} start(s){restarted}; the last {idle} found nothing better "
+                    f"(patience {patience}); best: {best_message}"
+                )
             before = float(obj.best_f[0])
             share = max(obj.remaining // (len(starts) - i), 1)
             if obj.remaining < 1:
@@ -209,6 +227,9 @@ class _LeastSquares(Solver):
                 messages.append(sol.message)
                 if float(obj.best_f[0]) < before:  # this start found the best point
                     self.converged = sol.status > 0
+                    best_message = sol.message
+                gain = before - float(obj.best_f[0])
+                idle = 0 if gain > PATIENCE_RTOL * abs(before) else idle + 1
                 if i == 0 and len(starts) > 1 and self.opts["restart"] == "doubtful":
                     why = self.doubtful(u0, sol)
                     if not why:
@@ -256,7 +277,11 @@ class LeastSquaresLM(_LeastSquares):
     )
     x_scale = "jac"
     batched_jacobian = True
-    options: ClassVar[dict[str, Any]] = {**_LeastSquares.options, "restart": "doubtful"}
+    options: ClassVar[dict[str, Any]] = {
+        **_LeastSquares.options,
+        "restart": "doubtful",
+        "patience": 3,
+    }
 
 
 @register

@@ -12,6 +12,13 @@ traverses), :mod:`.joint` (dynamics, noise, scenarios), :mod:`.simulate`, :mod:`
 :mod:`.oracle`, :mod:`.faults` (rest, settling, ramps, return moves, spike bursts, saturation;
 off by default, ``preset("paper1+faults")`` switches them on), :mod:`.trajectory` (any motion:
 sines, chirps, multi-sines, stick-slip, pre-sliding; static or LuGre truth).
+
+Whole arms (imported from their modules, so that ``fricid`` starts without Pinocchio):
+:mod:`.robot` (``simulate_robot``/``run_robot``: a :class:`~fricid.robot.RigidBodyModel`
+tracking a reference with each joint's friction, quantised encoders and torque noise),
+:mod:`.robot_friction` (``ArmFriction``, per-joint, per-direction Stribeck laws),
+:mod:`.robot_lugre` (LuGre friction on chosen joints), :mod:`.robot_reference`
+(``FourierTrajectory``, ``random_fourier``, ``sweep_reference``).
 """
 
 from __future__ import annotations

@@ -202,6 +202,11 @@ def select(
     return fitted
 
 
+#: ``lm``'s patience when screening a candidate (:mod:`fricid.optim._least_squares`): a
+#: restart that finds nothing better ends it; the chosen family is refitted with the default.
+SCREEN_PATIENCE = 1
+
+
 def _screening(
     samples: FrictionSamples,
     c: Candidate,
@@ -222,7 +227,7 @@ def _screening(
         "lm",
         seed=seed,
         fixed=c.fixed or None,
-        **{**options, "intervals": "none"},
+        **{**options, "intervals": "none", "options": {"patience": SCREEN_PATIENCE}},
     )
     return {**options, "start": {n: p.value for n, p in full.parameters.items() if not p.fixed}}
 

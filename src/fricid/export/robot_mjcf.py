@@ -1,0 +1,244 @@
+"""A whole arm as an MJCF model: its rigid-body dynamics and each joint's friction, for MuJoCo.
+
+:func:`robot_mjcf_text` writes the kinematic tree of a :class:`~fricid.robot.RigidBodyModel`
+as nested ``<body>`` elements, one per identified joint, each at the joint's placement in its
+parent's frame, with the joint (``hinge`` or ``slide``, its axis, its range where the URDF
+gives one), the body's inertial parameters (the model's, locked and fixed links merged:
+``<inertial pos mass fullinertia>`` about the centre of mass), and a ``<motor>`` actuator of
+gear 1 per joint (named ``<joint>_motor``) that applies a torque. No geometry is written: the
+model is for dynamics, not for looking at or for contacts (``contype``/``conaffinity`` 0).
+Angles are in radians (``<compiler angle="radian"/>``) and gravity is the model's.
+
+Friction goes to MuJoCo's joint ``frictionloss`` [N m] (dry friction, a soft constraint: see
+:data:`fricid.export.mjcf.FRICTIONLOSS_LINES`) and ``damping`` [N m s/rad] (viscous). MuJoCo
+cannot hold the rest of fricid's laws: a Stribeck rise (``tau_s`` above ``tau_c``) and
+different levels per direction are lost (the mean of the two directions is written); each
+loss is one of the returned notes and a line of the file's comment. Data never becomes code
+(:mod:`fricid.export._common`): numbers through :func:`fmt_float`, joint names checked
+against a strict pattern, text in comments through :func:`plain`; the XML is built by
+:mod:`xml.etree.ElementTree`, and the file is written atomically.
+"""
+
+from __future__ import annotations
+
+import os
+import xml.etree.ElementTree as ET
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..robot import RigidBodyModel
+from ..robot._pin import pinocchio
+from ..sim.robot_friction import ArmFriction
+from ._common import ExportError, fmt_float, plain
+from .descriptions import _check_joint, _xml, write_text
+from .mjcf import FRICTIONLOSS_LINES
+
+__all__ = ["joint_friction", "robot_mjcf_text", "write_robot_mjcf"]
+
+#: Mass [kg] and principal inertia [kg m^2] given to a moving body that has none (MuJoCo
+#: refuses massless moving bodies); a note says so.
+MIN_MASS, MIN_INERTIA = 1e-6, 1e-9
+
+
+def _levels(params: Mapping[str, float], key: str) -> list[float]:
+    vals = [params[k] for k in (key, f"{key}_pos", f"{key}_neg") if k in params]
+    return [float(v) for v in vals]
+
+
+def joint_friction(joint: str, params: Mapping[str, float]) -> tuple[float, float, list[str]]:
+    """``(frictionloss, damping, notes)`` of one joint's friction parameters.
+
+    ``params`` in fricid's names: ``tau_c``, ``tau_v`` (and ``tau_s``, ``w_s``, ``delta``),
+    or their ``_pos``/``_neg`` pairs (``stribeck_asym``), or a LuGre law's (``sigma_2`` the
+    viscous coefficient). The two directions are averaged.
+    """
+    coulomb, viscous = _levels(params, "tau_c"), _levels(params, "tau_v")
+    notes = []
+    if "sigma_0" in params:  # LuGre: sigma_2 is its viscous coefficient
+        viscous = viscous or _levels(params, "sigma_2")
+        notes.append(
+            f"joint {plain(joint)}: LuGre friction; its bristle dynamics (pre-sliding, "
+            "hysteresis) are lost here (MuJoCo 4's dcmotor lugre could hold them)"
+        )
+    if not coulomb and not viscous:
+        raise ExportError(f"joint {plain(joint)}: no tau_c or tau_v among {sorted(params)}")
+    if len(set(coulomb)) > 1 or len(set(viscous)) > 1:
+        notes.append(
+            f"joint {plain(joint)}: Coulomb {', '.join(f'{c:.4g}' for c in coulomb)} N m and "
+            f"viscous {', '.join(f'{v:.4g}' for v in viscous)} N m s/rad differ by direction; "
+            "MuJoCo has one level, the mean is written"
+        )
+    static = _levels(params, "tau_s")
+    for suffix in ("", "_pos", "_neg"):
+        s, c = params.get(f"tau_s{suffix}"), params.get(f"tau_c{suffix}")
+        if s is not None and c is not None and float(s) != float(c):
+            levels = ", ".join(f"{x:.4g}" for x in static)
+            notes.append(
+                f"joint {plain(joint)}: Stribeck friction (static {levels} N m above Coulomb at "
+                "low speed) is lost: MuJoCo's frictionloss is one level"
+            )
+            break
+    fl = float(np.mean(coulomb)) if coulomb else 0.0
+    damping = float(np.mean(viscous)) if viscous else 0.0
+    return fl, damping, notes
+
+
+def _frictions(model: RigidBodyModel, friction: Any) -> dict[str, dict[str, float]]:
+    if friction is None:
+        return {}
+    if isinstance(friction, ArmFriction):
+        if friction.n != model.n:
+            raise ExportError(f"the friction law has {friction.n} joints, the model {model.n}")
+        return {j: friction.parameters(i) for i, j in enumerate(model.joints)}
+    if isinstance(friction, Mapping):
+        unknown = [j for j in friction if j not in model.joints]
+        if unknown:
+            raise ExportError(f"friction for joints not in the model: {plain(unknown)}")
+        return {j: dict(p) for j, p in friction.items()}
+    raise ExportError("friction must be an ArmFriction or a mapping joint -> parameters")
+
+
+def _quat(rotation: np.ndarray) -> np.ndarray:
+    pin = pinocchio()
+    q = pin.Quaternion(rotation)
+    return np.array([q.w, q.x, q.y, q.z])
+
+
+def _inertial(inertia: Any, joint: str, notes: list[str]) -> dict[str, str]:
+    mass = float(inertia.mass)
+    com = np.asarray(inertia.lever, dtype=float)
+    rot = np.asarray(inertia.inertia, dtype=float)
+    if mass <= 0:
+        notes.append(
+            f"joint {plain(joint)}: its body has no mass; MuJoCo needs one: {MIN_MASS:g} kg "
+            f"and {MIN_INERTIA:g} kg m^2 written"
+        )
+        mass, rot = MIN_MASS, np.eye(3) * MIN_INERTIA
+    principal = np.linalg.eigvalsh(0.5 * (rot + rot.T))
+    tol = 1e-12 * max(principal.max(), 1e-12)
+    if principal.min() < -tol or principal[0] + principal[1] < principal[2] - tol:
+        raise ExportError(
+            f"joint {plain(joint)}: its body's inertia about the centre of mass (principal "
+            f"{', '.join(f'{x:.4g}' for x in principal)} kg m^2) is not physical (positive, "
+            "A + B >= C): MuJoCo refuses it"
+        )
+    full = (rot[0, 0], rot[1, 1], rot[2, 2], rot[0, 1], rot[0, 2], rot[1, 2])
+    return {
+        "pos": " ".join(fmt_float(x, "com") for x in com),
+        "mass": fmt_float(mass, "mass"),
+        "fullinertia": " ".join(fmt_float(x, "inertia") for x in full),
+    }
+
+
+def _joint_attributes(
+    model: RigidBodyModel, i: int, axis: np.ndarray, friction: Mapping[str, float] | None
+) -> tuple[dict[str, str], list[str]]:
+    name = model.joints[i]
+    attrs = {
+        "name": name,
+        "type": "slide" if model.kinds[i] == "prismatic" else "hinge",
+        "axis": " ".join(fmt_float(x, "axis") for x in axis),
+    }
+    lo, hi = float(model.lower[i]), float(model.upper[i])
+    if np.isfinite(lo) and np.isfinite(hi) and lo < hi:
+        attrs["range"] = f"{fmt_float(lo, 'lower')} {fmt_float(hi, 'upper')}"
+        attrs["limited"] = "true"
+    notes: list[str] = []
+    if friction is not None:
+        fl, damping, notes = joint_friction(name, friction)
+        attrs["frictionloss"] = fmt_float(fl, "frictionloss")
+        attrs["damping"] = fmt_float(damping, "damping")
+    return attrs, notes
+
+
+def robot_mjcf_text(
+    model: RigidBodyModel,
+    friction: ArmFriction | Mapping[str, Mapping[str, float]] | None = None,
+    *,
+    name: str = "fricid_robot",
+    timestep: float = 1e-3,
+) -> tuple[str, list[str]]:
+    """The MJCF text of ``model`` with ``friction``, and the notes on what MuJoCo cannot hold.
+
+    Parameters
+    ----------
+    model : RigidBodyModel
+        The arm; its inertial parameters are written (``model.with_parameters`` for others).
+    friction : ArmFriction or mapping, optional
+        Each joint's friction: the simulator's law, or ``joint -> parameters`` in fricid's
+        names (:func:`joint_friction`); none: no friction written.
+    name : str
+        The ``<mujoco model>`` name (checked like a joint name).
+    timestep : float
+        MuJoCo's ``option/timestep`` [s].
+
+    Returns
+    -------
+    (str, list of str)
+        The document and the notes (also in its first comment).
+
+    Raises
+    ------
+    ExportError
+        A joint name that is not a plain name, friction that does not fit the model, a
+        non-finite number.
+    """
+    pm = model._model
+    frictions = _frictions(model, friction)
+    for joint in model.joints:
+        _check_joint(joint)
+    notes: list[str] = []
+    root = ET.Element("mujoco", {"model": _check_joint(name)})
+    ET.SubElement(root, "compiler", {"angle": "radian", "autolimits": "true"})
+    gravity = " ".join(fmt_float(x, "gravity") for x in model.gravity)
+    ET.SubElement(root, "option", {"timestep": fmt_float(timestep, "timestep"), "gravity": gravity})
+    default = ET.SubElement(root, "default")
+    ET.SubElement(default, "geom", {"contype": "0", "conaffinity": "0"})
+    world = ET.SubElement(root, "worldbody")
+    bodies = {0: world}
+    actuators = ET.SubElement(root, "actuator")
+    for i in range(1, pm.njoints):
+        joint = model.joints[i - 1]
+        placement = pm.jointPlacements[i]
+        body = ET.SubElement(
+            bodies[pm.parents[i]],
+            "body",
+            {
+                "name": f"{joint}_body",
+                "pos": " ".join(fmt_float(x, "position") for x in placement.translation),
+                "quat": " ".join(fmt_float(x, "rotation") for x in _quat(placement.rotation)),
+            },
+        )
+        bodies[i] = body
+        ET.SubElement(body, "inertial", _inertial(pm.inertias[i], joint, notes))
+        axis = np.asarray(pm.joints[i].extract().axis, dtype=float)
+        attrs, joint_notes = _joint_attributes(model, i - 1, axis, frictions.get(joint))
+        notes.extend(joint_notes)
+        ET.SubElement(body, "joint", attrs)
+        ET.SubElement(actuators, "motor", {"name": f"{joint}_motor", "joint": joint, "gear": "1"})
+    lines = [
+        f"fricid export of a robot's rigid-body dynamics: {model.n} joints, source "
+        f"{plain(os.path.basename(model.source or 'unknown'))}",
+        "inertial parameters about each body's centre of mass in its joint frame; no geometry",
+        "friction: frictionloss = Coulomb [N m], damping = viscous [N m s/rad]"
+        if frictions
+        else "no friction written",
+        *(FRICTIONLOSS_LINES[:1] if frictions else ()),
+        *notes,
+    ]
+    ET.indent(root)
+    return _xml(lines, root), notes
+
+
+def write_robot_mjcf(
+    model: RigidBodyModel,
+    path: str | os.PathLike[str],
+    friction: ArmFriction | Mapping[str, Mapping[str, float]] | None = None,
+    **options: Any,
+) -> tuple[Path, list[str]]:
+    """Write :func:`robot_mjcf_text` to ``path`` atomically; the path and the notes."""
+    text, notes = robot_mjcf_text(model, friction, **options)
+    return write_text(text, path), notes
