@@ -291,7 +291,7 @@ def design_excitation(
     at_rest: bool = False,
     starts: int = 8,
     seed: int = 0,
-    max_evaluations: int = 20000,
+    max_evaluations: int = 10000,
     progress: Callable[[int, int], None] | None = None,
 ) -> ExcitationDesign:
     """A Fourier excitation of every joint of ``model`` optimised for ``criterion`` within

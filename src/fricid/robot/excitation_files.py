@@ -2,9 +2,11 @@
 ``trajectory_msgs/JointTrajectory`` YAML a robot can play, and the design as JSON that
 :func:`load_design` reads back. Every file is written atomically (:mod:`fricid.io.atomic`).
 
-The CSV has the columns of a robot log's wide table: ``time [s]`` then
-``<joint>.position [rad]``, ``<joint>.velocity [rad/s]``, ``<joint>.acceleration [rad/s^2]``
-(m, m/s, m/s^2 for a prismatic joint), so :func:`fricid.io.read_robot_log` reads it.
+The CSV has the columns of a robot log's wide table (:func:`fricid.io.write_robot_log`):
+``time [s]`` then ``<joint>.position [rad]``, ``<joint>.velocity [rad/s]``,
+``<joint>.acceleration [rad/s^2]`` (m, m/s, m/s^2 for a prismatic joint). It is a command, not
+a log: it has no torque, so it is not a :class:`~fricid.samples.RobotLog` until the robot's
+log of playing it adds one.
 """
 
 from __future__ import annotations
