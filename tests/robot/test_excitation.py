@@ -3,6 +3,7 @@ the files a robot plays."""
 
 from __future__ import annotations
 
+import dataclasses
 import json
 
 import numpy as np
@@ -21,7 +22,6 @@ from fricid.robot.excitation import (
     _exact,
     design_excitation,
     information_matrix,
-    resolve_limits,
 )
 from fricid.robot.excitation_files import (
     load_design,
@@ -101,10 +101,24 @@ def test_design_respects_the_limits_on_a_fine_grid(pendulum, design):
 
 
 def test_design_respects_effort_limits(pendulum):
-    path, joints = example_urdf("panda")
-    panda = RigidBodyModel.from_urdf(path, joints)
-    limits = resolve_limits(panda, None, None, 2 * np.pi / 10, 5, 0.05)
-    assert np.all(limits["effort"] == 0.95 * panda.effort_limit)
+    # effort limits the unconstrained design exceeds (its peaks: 0.77 and 0.35 N m)
+    limited = dataclasses.replace(pendulum, effort_limit=np.array([0.6, 0.3]))
+    d = design_excitation(limited, seed=3, **SMALL)
+    t = np.linspace(0.0, d.trajectory.period, 4001)
+    tau = limited.inverse_dynamics(*d.trajectory.evaluate(t))
+    assert np.all(np.abs(tau) <= 0.95 * limited.effort_limit + 1e-9)
+    assert np.max(np.abs(tau[:, 0])) > 0.8 * 0.95 * 0.6  # and the limit is used, not avoided
+    free = design_excitation(pendulum, seed=3, **SMALL)
+    free_tau = pendulum.inverse_dynamics(*free.trajectory.evaluate(t))
+    assert np.any(np.abs(free_tau).max(axis=0) > limited.effort_limit)
+
+
+def test_at_rest_designs_start_every_period_at_rest(pendulum):
+    d = design_excitation(pendulum, at_rest=True, seed=4, **SMALL)
+    _, dq, ddq = d.trajectory.evaluate(np.array([0.0, d.trajectory.period]))
+    np.testing.assert_allclose(dq, 0.0, atol=1e-8)
+    np.testing.assert_allclose(ddq, 0.0, atol=1e-8)
+    assert d.cond < d.cond_start
 
 
 def test_design_conditions_far_better_than_random_starts(pendulum):
