@@ -100,6 +100,23 @@ def test_design_respects_the_limits_on_a_fine_grid(pendulum, design):
     assert q[:, 0].max() - q[:, 0].min() > 0.5  # and the joint does move in it
 
 
+def test_ramps_stay_within_the_limits(design):
+    lim = design.limits
+    played = design.trajectory.repeated(2, ramp=1.0, limits=lim)
+    t0, t1 = played.excitation
+    t = np.concatenate([np.linspace(0.0, t0, 500), np.linspace(t1, played.duration, 500)])
+    q, dq, _ = played.evaluate(t)
+    assert np.all(q >= lim["lower"] - 1e-9) and np.all(q <= lim["upper"] + 1e-9)
+    assert np.all(np.abs(dq) <= lim["velocity"] + 1e-9)
+    np.testing.assert_allclose(dq[[0, -1]], 0.0, atol=1e-9)
+    # a joint moving at 1 rad/s at t = 0 cannot get up to speed within 0.01 rad of q(0)
+    one = FourierTrajectory(("a",), 1.0, [0.0], [[1.0]], [[0.0]])
+    tight = {"lower": np.array([-0.01]), "upper": np.array([0.01]), "velocity": np.array([2.0])}
+    with pytest.raises(ConfigError, match=r"a 1 s ramp cannot bring a .* lengthen the ramp"):
+        one.repeated(1, ramp=1.0, limits=tight)
+    one.repeated(1, ramp=1.0, limits={**tight, "lower": np.array([-1.0]), "upper": np.array([1.0])})
+
+
 def test_design_respects_effort_limits(pendulum):
     # effort limits the unconstrained design exceeds (its peaks: 0.77 and 0.35 N m)
     limited = dataclasses.replace(pendulum, effort_limit=np.array([0.6, 0.3]))

@@ -166,7 +166,7 @@ def design_command(
             progress=lambda done, total: t.update(done, total=total),
         )
     periods = max(1, math.ceil(duration / design.trajectory.period - 1e-9))
-    played = design.trajectory.repeated(periods, ramp=ramp)
+    played = design.trajectory.repeated(periods, ramp=ramp, limits=design.limits)
     lines = [f"{model.n} joints of {source}: {', '.join(model.joints)}", *_design_lines(design)]
     lines += _error_lines(design, model, torque_noise, rate, periods * design.trajectory.period)
     from ..robot.excitation import peak_fractions

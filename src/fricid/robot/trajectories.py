@@ -113,9 +113,12 @@ class FourierTrajectory:
         """Times ``k / rate`` over ``[0, duration]`` and the states there."""
         return _sample(self, rate)
 
-    def repeated(self, periods: int = 1, *, ramp: float = 1.0) -> RampedTrajectory:
-        """``periods`` periods, blended in from rest and out to rest over ``ramp`` s each."""
-        return RampedTrajectory(self, periods, ramp)
+    def repeated(
+        self, periods: int = 1, *, ramp: float = 1.0, limits: dict | None = None
+    ) -> RampedTrajectory:
+        """``periods`` periods, blended in from rest and out to rest over ``ramp`` s each
+        (within ``limits``' ``lower``, ``upper`` and ``velocity`` when given)."""
+        return RampedTrajectory(self, periods, ramp, limits)
 
 
 def _sample(traj, rate: float) -> tuple[np.ndarray, tuple[np.ndarray, ...]]:
@@ -153,14 +156,44 @@ def _poly(c: np.ndarray, s: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndar
     return powers @ c, d1 @ c, d2 @ c
 
 
-def _rest_point(duration: float, state: tuple[np.ndarray, ...]) -> np.ndarray:
+def _rest_point(
+    duration: float,
+    state: tuple[np.ndarray, ...],
+    lower: np.ndarray | None = None,
+    upper: np.ndarray | None = None,
+    velocity: np.ndarray | None = None,
+    names: tuple[str, ...] = (),
+) -> np.ndarray:
     """The rest position from which a quintic reaches ``state`` with the least squared
-    acceleration (the quintic is linear in its start; the integral is a quadratic in it)."""
+    acceleration (the quintic is linear in its start; the integral is a quadratic in it); with
+    limits, the best of the rest positions whose quintic stays within ``[lower, upper]`` and
+    ``|dq| <= velocity`` (a fine grid of candidates per joint)."""
     s = np.linspace(0.0, duration, 201)
     zero = np.zeros_like(state[0])
-    base = _poly(quintic(duration, zero, state), s)[2]
-    unit = _poly(quintic(duration, np.ones_like(zero), (zero, zero, zero)), s)[2]
-    return -np.sum(base * unit, axis=0) / np.sum(unit * unit, axis=0)
+    base = _poly(quintic(duration, zero, state), s)  # from rest at 0
+    unit = _poly(quintic(duration, np.ones_like(zero), (zero, zero, zero)), s)  # 1 -> 0
+    best = -np.sum(base[2] * unit[2], axis=0) / np.sum(unit[2] * unit[2], axis=0)
+    if lower is None or upper is None:
+        return best
+    vel = np.full_like(zero, np.inf) if velocity is None else np.asarray(velocity, dtype=float)
+    out = np.empty_like(best)
+    for j in range(best.size):
+        cand = np.concatenate([[best[j]], np.linspace(lower[j], upper[j], 401)])
+        p = base[0][:, j, None] + unit[0][:, j, None] * cand
+        v = base[1][:, j, None] + unit[1][:, j, None] * cand
+        a = base[2][:, j, None] + unit[2][:, j, None] * cand
+        ok = (p.min(axis=0) >= lower[j]) & (p.max(axis=0) <= upper[j])
+        ok &= np.abs(v).max(axis=0) <= vel[j]
+        if not ok.any():
+            raise ConfigError(
+                f"a {duration:g} s ramp cannot bring {names[j] if names else j + 1} between rest "
+                "and the "
+                "excitation within its position and velocity limits: lengthen the ramp, or "
+                "design the excitation at rest at its start"
+            )
+        cost = np.where(ok, np.sum(a * a, axis=0), np.inf)
+        out[j] = cand[int(np.argmin(cost))]
+    return out
 
 
 @dataclass(frozen=True)
@@ -169,13 +202,16 @@ class RampedTrajectory:
 
     The ramp in is the quintic from rest at ``start`` to the state at ``t = 0`` of the
     periodic part, with the rest position chosen for the least squared acceleration; the ramp
-    out the mirror image from the state at the end (module notes). Time 0 is the start of the
-    ramp in; the periodic part runs over ``[ramp, ramp + periods * period]``.
+    out the mirror image from the state at the end (module notes). With ``limits`` (``lower``,
+    ``upper``, ``velocity``), the rest positions are the best whose ramps keep within them.
+    Time 0 is the start of the ramp in; the periodic part runs over
+    ``[ramp, ramp + periods * period]``.
     """
 
     base: FourierTrajectory
     periods: int = 1
     ramp: float = 1.0
+    limits: dict | None = field(default=None, repr=False)
     start: np.ndarray = field(init=False, repr=False)
     stop: np.ndarray = field(init=False, repr=False)
 
@@ -185,9 +221,12 @@ class RampedTrajectory:
         object.__setattr__(self, "periods", int(self.periods))
         s0 = self.base.evaluate(0.0)
         s1 = self.base.evaluate(self.base.period * self.periods)
-        object.__setattr__(self, "start", _rest_point(self.ramp, tuple(x[0] for x in s0)))
+        lim = self.limits or {}
+        bounds = (lim.get("lower"), lim.get("upper"), lim.get("velocity"))
+        start = _rest_point(self.ramp, tuple(x[0] for x in s0), *bounds, self.joints)
         mirrored = (s1[0][0], -s1[1][0], s1[2][0])  # time runs backwards out of the end
-        object.__setattr__(self, "stop", _rest_point(self.ramp, mirrored))
+        object.__setattr__(self, "start", start)
+        object.__setattr__(self, "stop", _rest_point(self.ramp, mirrored, *bounds, self.joints))
 
     @property
     def joints(self) -> tuple[str, ...]:
