@@ -457,8 +457,11 @@ def _optimise(problem, x0, at_rest, max_evaluations, progress) -> np.ndarray:
         callback=step,
         options={"maxiter": maxiter, "ftol": 1e-6},
     )
-    problem.converged = bool(res.success) and problem.evaluations < max_evaluations
-    problem.message = str(res.message)
+    spent = problem.evaluations >= max_evaluations
+    problem.converged = bool(res.success) and not spent
+    problem.message = (
+        f"the budget of {max_evaluations} evaluations is spent" if spent else str(res.message)
+    )
     keep(np.asarray(res.x, dtype=float))
     return best[1]
 
