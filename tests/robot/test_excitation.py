@@ -284,3 +284,20 @@ def test_sweeps_reach_each_speed_within_the_range(pendulum):
         sweep_design(pendulum, "joint2", [5.0])
     with pytest.raises(ConfigError, match="cannot reach"):
         sweep_design(pendulum, "joint2", [1.5], workspace={"joint2": (0.0, 0.2)})
+
+
+@pytest.mark.slow
+def test_panda_design_conditions_far_better_than_random_starts():
+    # measured (10000 evaluations, about 45 s on 2 loaded cores): 56.5 against a median of
+    # 272.9 over 8 random feasible designs and 170.7 for the best of the optimiser's 8 starts
+    path, joints = example_urdf("panda")
+    panda = RigidBodyModel.from_urdf(path, joints)
+    random = [
+        design_excitation(panda, seed=100 + s, starts=1, max_evaluations=1).cond_start
+        for s in range(8)
+    ]
+    d = design_excitation(panda)
+    assert d.cond < 0.3 * np.median(random) and d.cond < 0.5 * d.cond_start
+    t = np.linspace(0.0, d.trajectory.period, 4001)
+    tau = panda.inverse_dynamics(*d.trajectory.evaluate(t))
+    assert np.all(np.abs(tau) <= 0.95 * panda.effort_limit)
