@@ -268,6 +268,17 @@ def test_a_bad_design_file_is_a_data_error(tmp_path):
     )
     with pytest.raises(DataError, match=r"bad\.json"):
         load_design(path)
+    good = {"format": "fricid-excitation/1", "joints": ["a"], "w_f": 1.0, "q0": [0.0]}
+    good |= {"criterion": "cond", "friction": "none"}
+    path.write_text(json.dumps({**good, "a": [[1.0]], "b": [[1.0]], "limits": {"upper": "x"}}))
+    with pytest.raises(DataError, match="bad limits"):
+        load_design(path)
+    path.write_text(json.dumps({**good, "a": [[1.0]], "b": [[1.0]], "friction": "stribeck"}))
+    with pytest.raises(DataError, match="friction must be one of"):
+        load_design(path)
+    path.write_text("{not json")
+    with pytest.raises(DataError, match="cannot read the design"):
+        load_design(path)
 
 
 def test_sweeps_reach_each_speed_within_the_range(pendulum):

@@ -206,7 +206,7 @@ def _field(doc: dict, key: str, path: Path) -> Any:
 def load_design(path: str | os.PathLike[str]) -> Any:
     """Read a design file written by :func:`save_design`; an
     :class:`~fricid.robot.excitation.ExcitationDesign` (its limits and margins as arrays)."""
-    from .excitation import ExcitationDesign
+    from .excitation import CRITERIA, FRICTION_COLUMNS, ExcitationDesign
 
     path = Path(path)
     try:
@@ -225,10 +225,16 @@ def load_design(path: str | os.PathLike[str]) -> Any:
         )
     except (TypeError, ValueError, ConfigError) as exc:
         raise DataError(f"bad coefficients: {exc}", file=path) from exc
-    arrays = {
-        key: {k: _unlisted(v) for k, v in (doc.get(key) or {}).items()}
-        for key in ("limits", "margins")
-    }
+    for key, allowed in (("criterion", CRITERIA), ("friction", tuple(FRICTION_COLUMNS))):
+        if _field(doc, key, path) not in allowed:
+            raise DataError(f"{key} must be one of {allowed}", file=path, column=key)
+    try:
+        arrays = {
+            key: {str(k): _unlisted(v) for k, v in dict(doc.get(key) or {}).items()}
+            for key in ("limits", "margins")
+        }
+    except (TypeError, ValueError) as exc:
+        raise DataError(f"bad limits or margins: {exc}", file=path) from exc
     return ExcitationDesign(
         traj,
         str(_field(doc, "criterion", path)),
