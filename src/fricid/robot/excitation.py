@@ -380,9 +380,13 @@ def _design(
     rng = np.random.default_rng(seed)
     X = np.array([problem.random_start(rng, at_rest) for _ in range(int(starts))])
     x_start = X[int(np.argmin(problem.value(X)))]
-    x = _optimise(problem, x_start, at_rest, max_evaluations, progress)
-    x = _feasible(problem, x, x_start, model, limits, rate=grid / float(period) * 4)
-    traj = problem.trajectory(x, model.joints)
+    rate = grid / float(period) * 4
+    found = _optimise(problem, x_start, at_rest, max_evaluations, progress)
+    options = [problem.trajectory(_feasible(problem, x, x_start, model, limits, rate), model.joints)
+               for x in found]  # fmt: skip
+    score = [_exact(model, base, problem.t, tr, friction) for tr in options]
+    pick = [c if criterion == "cond" else -d for c, d in score]
+    traj = options[int(np.argmin(pick))]
     start = problem.trajectory(x_start, model.joints)
     exact = {
         key: _exact(model, base, problem.t, tr, friction) for key, tr in (("x", traj), ("s", start))
@@ -418,8 +422,9 @@ def _exact(model, base, t, traj, friction) -> tuple[float, float]:
     return cond, logdet
 
 
-def _optimise(problem, x0, at_rest, max_evaluations, progress) -> np.ndarray:
-    """SLSQP from ``x0`` within the budget (module notes)."""
+def _optimise(problem, x0, at_rest, max_evaluations, progress) -> tuple[np.ndarray, np.ndarray]:
+    """SLSQP from ``x0`` within the budget (module notes): its best iterate within the limits
+    (``x0`` if none is) and its last (which :func:`_feasible` may have to shrink)."""
     cons = [{"type": "ineq", "fun": problem.limits_fun, "jac": problem.limits_jac}]
     if problem.finite_effort.any():
         cons.append({"type": "ineq", "fun": problem.effort, "jac": problem.effort_jac})
@@ -462,8 +467,11 @@ def _optimise(problem, x0, at_rest, max_evaluations, progress) -> np.ndarray:
     problem.message = (
         f"the budget of {max_evaluations} evaluations is spent" if spent else str(res.message)
     )
-    keep(np.asarray(res.x, dtype=float))
-    return best[1]
+    last = np.asarray(res.x, dtype=float)
+    if at_rest:  # onto E x = 0 exactly (SLSQP meets it to a tolerance)
+        last = last - E.T @ np.linalg.solve(E @ E.T, E @ last)
+    keep(last)
+    return best[1], last
 
 
 def _feasible(problem, x, x_start, model, limits, rate) -> np.ndarray:
