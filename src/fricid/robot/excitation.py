@@ -14,10 +14,18 @@ the coefficients; the figures reported use the exact steps.
 
 The limits. Position ``[lo, hi]`` (the URDF's, narrowed by a workspace, less ``margin`` of its
 width at each end), velocity and acceleration ``|dq|, |ddq| <= (1 - margin)`` their limits at a
-fine grid of the period (all linear in the coefficients: exact gradients), and effort
-``|M ddq + C dq + g| <= (1 - margin) effort_limit`` at the ``M`` instants (by finite
-differences). SLSQP (:func:`scipy.optimize.minimize`) runs from the best of several random
-feasible designs.
+fine grid of the period, and effort ``|M ddq + C dq + g| <= (1 - margin) effort_limit`` at
+the ``M`` instants. Each is one constraint per joint and quantity: its peak as a log-sum-exp
+(an upper bound of the maximum, within 0.2 % of the limit times ``log`` of the points), with
+exact gradients for the first three (linear in the coefficients) and forward differences for
+the effort. SLSQP (:func:`scipy.optimize.minimize`) runs from the best of several random
+feasible designs for a budget of criterion evaluations; the result is the better of its best
+iterate within the limits and its last iterate, either shrunk about ``q0`` until every limit
+holds on a grid four times finer (what the optimiser's tolerances leave over).
+
+The default acceleration limit is each joint's velocity limit times ``w_f H``: the
+acceleration of the highest harmonic at the full speed (the velocity limit times ``w_f`` alone
+would leave the higher harmonics almost no amplitude).
 
 The standard errors. With independent torque noise of std ``sigma_j`` on joint ``j``, the
 least-squares estimate of ``(beta, phi)`` from the periodic part sampled at ``rate`` for
@@ -36,6 +44,7 @@ import scipy.optimize
 
 from ..errors import ConfigError
 from .base import BaseParameters, base_parameters
+from .limits import peak_fractions, resolve_limits
 from .model import RigidBodyModel
 from .trajectories import FourierTrajectory
 
@@ -46,6 +55,8 @@ __all__ = [
     "design_excitation",
     "friction_columns",
     "information_matrix",
+    "peak_fractions",
+    "resolve_limits",
 ]
 
 #: The design criteria.
@@ -57,10 +68,6 @@ FRICTION_COLUMNS = {
     "coulomb_viscous": ("Fc", "Fv"),
     "none": (),
 }
-
-#: Where the URDF gives no position limit [rad]; no velocity limit [rad/s].
-DEFAULT_POSITION = np.pi
-DEFAULT_VELOCITY = 2.0
 
 #: Instants per period on the fine grid that checks the linear limits.
 GRID = 400
@@ -206,72 +213,6 @@ def _base(model: RigidBodyModel) -> BaseParameters:
         _BASE_CACHE.clear()
         _BASE_CACHE[id(model)] = hit
     return hit[1]
-
-
-# -- limits ----------------------------------------------------------------------------------
-
-
-def resolve_limits(
-    model: RigidBodyModel,
-    workspace: Mapping[str, tuple[float, float]] | None,
-    acceleration: float | np.ndarray | None,
-    w_f: float,
-    harmonics: int,
-    margin: float,
-) -> dict:
-    """The limits a design obeys (module notes). The acceleration limit defaults to each
-    joint's velocity limit times ``w_f H`` (the acceleration of the highest harmonic at the
-    full speed)."""
-    if not 0.0 <= margin < 0.5:
-        raise ConfigError(f"margin must be in [0, 0.5); got {margin}")
-    lo = np.where(np.isfinite(model.lower), model.lower, -DEFAULT_POSITION)
-    hi = np.where(np.isfinite(model.upper), model.upper, DEFAULT_POSITION)
-    for name, pair in (workspace or {}).items():
-        if name not in model.joints:
-            raise ConfigError(f"workspace names joint '{name}', not one of {model.joints}")
-        a, b = (float(x) for x in pair)
-        i = model.joints.index(name)
-        if not (np.isfinite(a) and np.isfinite(b)) or b < a:
-            raise ConfigError(f"workspace of '{name}' must be lo <= hi; got {a}:{b}")
-        lo[i], hi[i] = max(lo[i], a), min(hi[i], b)
-        if hi[i] <= lo[i]:
-            raise ConfigError(
-                f"the workspace of '{name}' [{a:g}, {b:g}] leaves no room within its limits "
-                f"[{model.lower[i]:g}, {model.upper[i]:g}]: it cannot move"
-            )
-    width = hi - lo
-    lo, hi = lo + margin * width, hi - margin * width
-    vel = np.where(np.isfinite(model.velocity_limit), model.velocity_limit, DEFAULT_VELOCITY)
-    if acceleration is None:
-        acc = vel * w_f * harmonics
-    else:
-        acc = np.broadcast_to(np.asarray(acceleration, dtype=float), (model.n,)).copy()
-    if not (np.isfinite(acc).all() and (acc > 0).all()):
-        raise ConfigError(f"the acceleration limit must be > 0; got {acceleration}")
-    return {
-        "lower": lo,
-        "upper": hi,
-        "velocity": vel * (1.0 - margin),
-        "acceleration": acc * (1.0 - margin),
-        "effort": model.effort_limit * (1.0 - margin),
-        "margin": float(margin),
-    }
-
-
-def peak_fractions(model: RigidBodyModel, traj, limits: dict, rate: float) -> dict:
-    """Each joint's peak position (about the middle, of the half-width), speed, acceleration
-    and effort as fractions of the limits, at ``rate`` over the trajectory."""
-    _t, (q, dq, ddq) = traj.sample(rate)
-    mid = 0.5 * (limits["upper"] + limits["lower"])
-    half = 0.5 * (limits["upper"] - limits["lower"])
-    tau = model.inverse_dynamics(q, dq, ddq)
-    eff = limits["effort"]
-    return {
-        "position": np.max(np.abs(q - mid), axis=0) / half,
-        "velocity": np.max(np.abs(dq), axis=0) / limits["velocity"],
-        "acceleration": np.max(np.abs(ddq), axis=0) / limits["acceleration"],
-        "effort": np.where(np.isfinite(eff), np.max(np.abs(tau), axis=0) / eff, 0.0),
-    }
 
 
 # -- the design ------------------------------------------------------------------------------

@@ -8,7 +8,7 @@ from collections.abc import Mapping
 import numpy as np
 
 from ..errors import ConfigError
-from .excitation import resolve_limits
+from .limits import resolve_limits
 from .model import RigidBodyModel
 from .trajectories import SweepTrajectory
 
