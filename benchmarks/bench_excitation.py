@@ -10,6 +10,12 @@ starts, ``--budget`` evaluations of the criterion), its wall and CPU seconds, th
 number and ``log det W'W / rows`` of the design, of its best random start, and the median of
 ``--random`` random feasible designs drawn the same way (other seeds), and the peak fraction of
 each limit reached.
+
+What it showed (``benchmarks/results/excitation.txt``; 2 cores shared at a load average of
+about 10): the Panda's design took 59 s wall, 9.6 s CPU, for 10,000 evaluations; condition
+number 56.5 against 170.7 for its best start and 272.9 for the median random design (3.0 and
+4.8 times lower), log det up from -73 to -26 (d-optimal: to +48, at a condition number of
+184). The double pendulum: 2.5 s, converged, 27.9 against 51.0 and 58.5.
 """
 
 from __future__ import annotations

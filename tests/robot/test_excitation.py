@@ -299,7 +299,7 @@ def test_sweeps_reach_each_speed_within_the_range(pendulum):
 
 @pytest.mark.slow
 def test_panda_design_conditions_far_better_than_random_starts():
-    # measured (10000 evaluations, about 45 s on 2 loaded cores): 56.5 against a median of
+    # measured (10000 evaluations, 46 to 59 s on 2 loaded cores): 56.5 against a median of
     # 272.9 over 8 random feasible designs and 170.7 for the best of the optimiser's 8 starts
     path, joints = example_urdf("panda")
     panda = RigidBodyModel.from_urdf(path, joints)
