@@ -9,7 +9,7 @@ import yaml
 from typer.testing import CliRunner
 
 from fricid.cli import app
-from fricid.cli.robot_design import parse_workspace
+from fricid.cli.robot_design import parse_noise, parse_workspace
 
 runner = CliRunner()
 
@@ -57,6 +57,7 @@ def test_design_writes_the_files_and_prints_the_errors(tmp_path):
     assert "joint2:Fc+" in res.output
     doc = json.loads(out.read_text())
     assert doc["joints"] == ["joint1", "joint2"] and doc["periods"] == 1
+    assert doc["locked"] == {}
     assert doc["limits"]["upper"][0] <= 1.0
     points = yaml.safe_load(ros.read_text())["points"]
     times = [p["time_from_start"]["sec"] + 1e-9 * p["time_from_start"]["nanosec"] for p in points]
@@ -81,6 +82,18 @@ def test_parse_workspace():
     for bad in ("a=1", "a:1", "=0:1", "a=x:1"):
         try:
             parse_workspace(bad)
+        except Exception as exc:
+            assert type(exc).__name__ == "ConfigError"
+        else:
+            raise AssertionError(bad)
+
+
+def test_parse_noise():
+    np.testing.assert_array_equal(parse_noise("0.05", 3), [0.05, 0.05, 0.05])
+    np.testing.assert_array_equal(parse_noise("0.1,0.2", 2), [0.1, 0.2])
+    for bad in ("0.1,0.2", "x", "-1", "nan"):
+        try:
+            parse_noise(bad, 3)
         except Exception as exc:
             assert type(exc).__name__ == "ConfigError"
         else:

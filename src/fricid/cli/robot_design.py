@@ -18,7 +18,7 @@ from ._options import out_option
 from ._paths import check_paths
 from ._progress import QuietOption, tracker
 
-__all__ = ["design_command", "parse_workspace"]
+__all__ = ["design_command", "parse_noise", "parse_workspace"]
 
 
 def parse_workspace(text: str | None) -> dict[str, tuple[float, float]]:
@@ -70,11 +70,26 @@ def _design_lines(design) -> list[str]:
     return lines
 
 
-def _error_lines(design, model, sigma: float, rate: float, duration: float) -> list[str]:
+def parse_noise(text: str, n: int) -> np.ndarray:
+    """``"0.05"`` or ``"0.05,0.1,..."`` (one per joint) -> the noise std per joint [N m]."""
+    try:
+        values = np.array([float(x) for x in text.split(",")])
+    except ValueError:
+        values = np.array([])
+    if values.size not in (1, n) or not (np.isfinite(values).all() and (values > 0).all()):
+        raise ConfigError(
+            f"--torque-noise takes one positive number or {n} (one per joint); got '{text}'"
+        )
+    return np.broadcast_to(values, (n,)).copy()
+
+
+def _error_lines(design, model, sigma: np.ndarray, rate: float, duration: float) -> list[str]:
     se = design.standard_errors(model, sigma, rate=rate, duration=duration)
+    shown = f"{sigma[0]:g} N m per joint" if np.all(sigma == sigma[0]) else (
+        "[" + ", ".join(f"{s:g}" for s in sigma) + "] N m"
+    )  # fmt: skip
     lines = [
-        f"predicted standard errors with torque noise {sigma:g} N m per joint, {duration:g} s "
-        f"at {rate:g} Hz:",
+        f"predicted standard errors with torque noise {shown}, {duration:g} s at {rate:g} Hz:",
     ]
     width = min(60, max(len(n) for n in design.names))
     for name, s in zip(design.names, se, strict=True):
@@ -113,8 +128,12 @@ def design_command(
         bool, typer.Option("--at-rest", help="Every joint at rest at the start of a period.")
     ] = False,
     torque_noise: Annotated[
-        float, typer.Option(help="Torque noise std per joint [N m], for the standard errors.")
-    ] = 0.05,
+        str,
+        typer.Option(
+            help="Torque noise std [N m] for the standard errors: one number, or one per joint "
+            "(comma-separated)."
+        ),
+    ] = "0.05",
     duration: Annotated[
         float, typer.Option(min=0.0, help="Seconds of excitation played (periods rounded up).")
     ] = 60.0,
@@ -168,7 +187,8 @@ def design_command(
     periods = max(1, math.ceil(duration / design.trajectory.period - 1e-9))
     played = design.trajectory.repeated(periods, ramp=ramp, limits=design.limits)
     lines = [f"{model.n} joints of {source}: {', '.join(model.joints)}", *_design_lines(design)]
-    lines += _error_lines(design, model, torque_noise, rate, periods * design.trajectory.period)
+    sigma = parse_noise(torque_noise, model.n)
+    lines += _error_lines(design, model, sigma, rate, periods * design.trajectory.period)
     from ..robot.excitation import peak_fractions
 
     whole = peak_fractions(model, played, design.limits, rate)
@@ -177,7 +197,8 @@ def design_command(
         f"played: {periods} periods with {ramp:g} s ramps, {played.duration:.2f} s; worst peak / "
         "limit " + ", ".join(f"{k} {100 * v:.1f} %" for k, v in worst.items())
     )
-    extra = {"source": source, "torque_noise": torque_noise, "periods": periods, "ramp": ramp}
+    extra = {"source": source, "torque_noise": sigma.tolist(), "periods": periods, "ramp": ramp}
+    extra["locked"] = {str(k): float(v) for k, v in model.locked.items()}
     written = [save_design(design, out, extra)]
     if csv is not None:
         written.append(write_trajectory_csv(played, csv, rate=rate, kinds=model.kinds))
