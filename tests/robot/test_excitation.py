@@ -281,7 +281,7 @@ def test_a_bad_design_file_is_a_data_error(tmp_path):
         load_design(path)
 
 
-def test_sweeps_reach_each_speed_within_the_range(pendulum):
+def test_sweeps_reach_each_speed_within_the_range(pendulum, tmp_path):
     sweep = sweep_design(pendulum, "joint2", [0.2, 1.0], workspace={"joint2": (-1.0, 1.0)})
     _t, (q, dq, _ddq) = sweep.sample(500.0)
     assert np.all(q[:, 0] == q[0, 0])  # the other joint held
@@ -291,6 +291,11 @@ def test_sweeps_reach_each_speed_within_the_range(pendulum):
         for s in (1, -1):
             assert np.sum(np.isclose(dq[:, 1], s * v)) > 100  # constant-speed stretches
     _check_derivatives(sweep, np.linspace(0.05, sweep.duration - 0.05, 300), 1e-4)
+    doc = yaml.safe_load(
+        write_joint_trajectory_yaml(sweep, tmp_path / "s.yaml", rate=2.0).read_text()
+    )
+    assert len(doc["points"]) == int(np.floor(sweep.duration * 2.0))
+    assert doc["points"][-1]["positions"][1] == pytest.approx(q[-1, 1], abs=1e-6)
     with pytest.raises(ConfigError, match="velocity limit"):
         sweep_design(pendulum, "joint2", [5.0])
     with pytest.raises(ConfigError, match="cannot reach"):
