@@ -23,6 +23,7 @@ MODULES = (
     "robot_extract",
     "robot_export",
     "robot_fit",
+    "robot_design",
 )
 
 for _name in MODULES:
