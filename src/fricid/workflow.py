@@ -173,11 +173,12 @@ def _design_hints(log: RawLog) -> dict[str, Any]:
 
 def _extract_stream(
     logs: Iterable[RawLog],
-    first: RawLog,
+    head: list[RawLog],
     options: Mapping[str, Any],
     on_chunk: Callable[[], None] | None,
 ) -> JointData:
-    """Extract a log stream whose first chunk is ``first`` (already read from ``logs``).
+    """Extract a log stream whose first chunk is ``head``'s one item (already read from
+    ``logs``; taken out of the list when extracted, so that no reference outlives it).
 
     Unset ``positions``, ``bin_halfwidth`` and ``gravity`` come from the design recorded with
     the log (as ``fricid extract`` does); ``gravity`` then defaults to ``"fit"`` with position
@@ -186,7 +187,7 @@ def _extract_stream(
     with a note saying so).
     """
     opts = dict(options)
-    hints = _design_hints(first)
+    hints = _design_hints(head[0])
     if opts.get("positions") is None and "positions_rad" in hints:
         opts["positions"] = np.asarray(hints["positions_rad"], dtype=float)
         if opts.get("bin_halfwidth") is None:
@@ -198,17 +199,20 @@ def _extract_stream(
         opts["positions"] = np.asarray(opts["positions"], dtype=float)
 
     def stream() -> Iterator[RawLog]:
-        for chunk in _chain(first, logs):
+        for chunk in _chain(head, logs):
             if on_chunk is not None:
                 on_chunk()
             yield chunk
+            del chunk  # not held while the next one is read
 
     result = extract(stream(), **opts)
     return JointData(result.samples, result.by_direction, result)
 
 
-def _chain(first: RawLog, rest: Iterable[RawLog]) -> Iterator[RawLog]:
-    yield first
+def _chain(head: list[RawLog], rest: Iterable[RawLog]) -> Iterator[RawLog]:
+    """``head``'s items (taken out of it), then ``rest``."""
+    while head:
+        yield head.pop(0)
     yield from rest
 
 
@@ -279,7 +283,9 @@ def load_joint(
     first = next(opened, None)
     if first is None:  # pragma: no cover - iter_rawlog raises on an empty log
         raise DataError("the log has no rows", file=path)
-    return _extract_stream(opened, first, eopts, on_chunk)
+    head = [first]
+    del first  # held by ``head`` alone, so the chunk is freed once extracted
+    return _extract_stream(opened, head, eopts, on_chunk)
 
 
 def select_direction(samples: FrictionSamples, direction: str = "all") -> FrictionSamples:

@@ -113,6 +113,7 @@ def as_log_stream(logs: RawLog | Iterable[RawLog]) -> Iterator[RawLog]:
                 f"extract: item {i} of 'logs' is a {type(log).__name__}, not a RawLog"
             )
         yield log
+        del log  # not held while the next chunk is read
 
 
 def _steady(
@@ -244,9 +245,11 @@ def iter_segments(
         if last < lc:  # the open run goes on through the whole chunk (``head`` holds it)
             carry = head.slice(last, n)
         else:
-            carry = chunk.slice(last - lc, len(chunk))
+            # a copy: a view would keep the whole chunk alive while the next is read
+            carry = RawLog.concatenate([chunk.slice(last - lc, len(chunk))])
             carry_sign = float(sign[last - lc])
         carry_row += last
+        chunk = head = log = sign = dt = None  # not held while the next chunk is read
     if carry is not None and len(carry) and abs(carry.velocity[0]) > REST_RESIDUE:
         found = _steady(carry, 0, len(carry), *options)
         if found is not None:
@@ -257,10 +260,10 @@ def iter_segments(
 
 
 def _sign(velocity: np.ndarray) -> np.ndarray:
-    """The sign of each velocity; 0 within :data:`REST_RESIDUE` of zero (float residue: not
-    moving)."""
-    sign = np.sign(velocity)
-    sign[np.abs(velocity) <= REST_RESIDUE] = 0.0
+    """The sign of each velocity (int8); 0 within :data:`REST_RESIDUE` of zero (float residue:
+    not moving)."""
+    sign = (velocity > REST_RESIDUE).view(np.int8)
+    sign -= velocity < -REST_RESIDUE
     return sign
 
 
