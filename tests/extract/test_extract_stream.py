@@ -17,6 +17,7 @@ from hypothesis import strategies as st
 from scipy.ndimage import median_filter as scipy_median_filter
 
 from fricid.errors import DataError
+from fricid.extract._stats import far_from_running_median
 from fricid.extract._stats import median as fast_median
 from fricid.extract._stats import median_filter as fast_median_filter
 from fricid.extract._stats import percentile as fast_percentile
@@ -133,6 +134,36 @@ def test_median_filter_long_quantised_signal():
     for size in (5, 31):
         ours = fast_median_filter(x, size)
         np.testing.assert_array_equal(ours, scipy_median_filter(x, size=size, mode="nearest"))
+
+
+@st.composite
+def _signals(draw) -> np.ndarray:
+    """Torque-like signals: noise around a trend, spikes and steps, quantised or not."""
+    n = draw(st.integers(1, 400))
+    rng = np.random.default_rng(draw(st.integers(0, 2**32 - 1)))
+    x = draw(st.sampled_from([0.0, 0.01, 1.0])) * rng.standard_normal(n)
+    x += draw(st.sampled_from([0.0, 1e-3])) * np.arange(n) + draw(_finite)
+    spikes = rng.random(n) < draw(st.sampled_from([0.0, 0.01, 0.2]))
+    x[spikes] += draw(st.sampled_from([0.5, 50.0])) * rng.standard_normal(int(spikes.sum()))
+    if draw(st.booleans()):
+        x[n // 2 :] += draw(_finite)  # a step
+    if draw(st.booleans()):
+        x = np.round(x, 2)
+    return x
+
+
+@settings(max_examples=300, deadline=None)
+@given(
+    st.one_of(_signals(), _samples.map(np.array)),
+    st.sampled_from([1, 3, 5, 31, 61]),
+    st.sampled_from([0.0, 1e-3, 0.05, 1.0, 8.0, np.inf]),
+)
+def test_far_from_running_median_is_the_filtered_test(x, size, threshold):
+    """Bounded by running minima and maxima, then the candidates' medians: the same mask as
+    filtering the whole signal (the outlier screen's second filter)."""
+    size = max(min(size, x.size - (1 - x.size % 2)), 1)
+    expected = np.abs(x - scipy_median_filter(x, size=size, mode="nearest")) > threshold
+    np.testing.assert_array_equal(far_from_running_median(x, size, threshold), expected)
 
 
 def _saturated_unique(torque: np.ndarray, min_share: float = 0.01, min_count: int = 5):

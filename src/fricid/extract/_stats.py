@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["median", "median_filter", "percentile"]
+__all__ = ["far_from_running_median", "median", "median_filter", "percentile"]
 
 
 def _kth_pair(x: np.ndarray, k: int) -> tuple[float, float]:
@@ -140,6 +140,61 @@ def _median5(x: np.ndarray) -> np.ndarray:
         np.maximum(c, f_, out=hi_)
         np.minimum(hi_, g_, out=hi_)
         np.maximum(lo_, hi_, out=out[start : start + m])
+    return out
+
+
+#: Share of samples above which :func:`far_from_running_median` filters the whole signal
+#: instead of taking the medians of the candidates' windows one by one.
+_CANDIDATE_SHARE = 0.125
+
+
+def far_from_running_median(x: np.ndarray, size: int, threshold: float) -> np.ndarray:
+    """``abs(x - median_filter(x, size)) > threshold``, exactly, mostly without the filter.
+
+    The running median of a window lies between the window's minimum and maximum, and
+    ``x - m`` rounds monotonically in ``m``; so a sample within ``threshold`` of both its
+    window's minimum and maximum is within it of the median too. Running minima and maxima
+    take a few passes of ``np.minimum`` and ``np.maximum`` (windows doubled in width); only
+    the remaining candidates need their window's median, a selection (the same value the
+    filter selects, whichever algorithm). When candidates are many (a quantised or
+    noiseless signal), the whole signal is filtered.
+
+    Parameters
+    ----------
+    x : numpy.ndarray
+        1-D float64, not empty (non-finite values: the whole signal is filtered).
+    size : int
+        Odd window (edges: the nearest sample repeated, as :func:`median_filter`).
+    threshold : float
+        The distance that marks a sample.
+
+    Returns
+    -------
+    numpy.ndarray
+        Boolean mask.
+    """
+    if not np.isfinite(x).all():
+        return np.abs(x - median_filter(x, size)) > threshold
+    half = size // 2
+    padded = np.concatenate((np.full(half, x[0]), x, np.full(half, x[-1])))
+    lo = hi = padded
+    width = 1
+    while 2 * width <= size:
+        lo = np.minimum(lo[:-width], lo[width:])
+        hi = np.maximum(hi[:-width], hi[width:])
+        width *= 2
+    shift = size - width  # windows of ``width`` at i and i + shift cover the window of size
+    if shift:
+        lo = np.minimum(lo[:-shift], lo[shift:])
+        hi = np.maximum(hi[:-shift], hi[shift:])
+    candidates = np.flatnonzero((np.abs(x - lo) > threshold) | (np.abs(x - hi) > threshold))
+    if candidates.size > _CANDIDATE_SHARE * x.size:
+        return np.abs(x - median_filter(x, size)) > threshold
+    out = np.zeros(x.shape, dtype=bool)
+    if candidates.size:
+        windows = np.lib.stride_tricks.sliding_window_view(padded, size)[candidates]
+        m = np.partition(windows, half, axis=1)[:, half]
+        out[candidates] = np.abs(x[candidates] - m) > threshold
     return out
 
 
