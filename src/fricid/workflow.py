@@ -177,8 +177,7 @@ def _extract_stream(
     options: Mapping[str, Any],
     on_chunk: Callable[[], None] | None,
 ) -> JointData:
-    """Extract a log stream whose first chunk is ``head``'s one item (already read from
-    ``logs``; taken out of the list when extracted, so that no reference outlives it).
+    """Extract a log stream whose first chunk, read from ``logs``, is ``head.pop()``.
 
     Unset ``positions``, ``bin_halfwidth`` and ``gravity`` come from the design recorded with
     the log (as ``fricid extract`` does); ``gravity`` then defaults to ``"fit"`` with position
@@ -198,19 +197,16 @@ def _extract_stream(
     if opts.get("positions") is not None:
         opts["positions"] = np.asarray(opts["positions"], dtype=float)
 
-    def stream() -> Iterator[RawLog]:
-        for chunk in _chain(head, logs):
-            if on_chunk is not None:
-                on_chunk()
-            yield chunk
-            del chunk  # not held while the next one is read
+    def tick(chunk: RawLog) -> RawLog:  # holds no chunk while the next one is read
+        if on_chunk is not None:
+            on_chunk()
+        return chunk
 
-    result = extract(stream(), **opts)
+    result = extract(map(tick, _chain(head, logs)), **opts)
     return JointData(result.samples, result.by_direction, result)
 
 
 def _chain(head: list[RawLog], rest: Iterable[RawLog]) -> Iterator[RawLog]:
-    """``head``'s items (taken out of it), then ``rest``."""
     while head:
         yield head.pop(0)
     yield from rest
@@ -280,11 +276,9 @@ def load_joint(
         return JointData(opened, opened, None)
     if chunk_map is not None:
         opened = map(chunk_map, opened)
-    first = next(opened, None)
-    if first is None:  # pragma: no cover - iter_rawlog raises on an empty log
+    head = [next(opened, None)]  # the list alone holds it: freed once extracted
+    if head[0] is None:  # pragma: no cover - iter_rawlog raises on an empty log
         raise DataError("the log has no rows", file=path)
-    head = [first]
-    del first  # held by ``head`` alone, so the chunk is freed once extracted
     return _extract_stream(opened, head, eopts, on_chunk)
 
 

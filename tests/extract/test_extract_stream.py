@@ -8,6 +8,7 @@ the two to the same answer, bit for bit, on random, tied and quantised inputs.
 from __future__ import annotations
 
 import itertools
+import weakref
 from dataclasses import replace
 
 import numpy as np
@@ -307,3 +308,24 @@ def test_segments_of_any_chunking_match_the_joined_reference(sizes, restart):
     ]
     for a, b in zip(ours, ref, strict=True):
         np.testing.assert_array_equal(a.log.time, b.log.time)
+
+
+def test_extraction_holds_one_chunk_at_a_time(tmp_path):
+    """Memory bounded by one chunk: when a chunk is read, every earlier chunk's columns are
+    already freed (no layer of the stream, from the reader to the segmentation, holds one)."""
+    from fricid.io import write_rawlog
+    from fricid.sim import preset, simulate
+    from fricid.workflow import load_joint
+
+    path = write_rawlog(simulate(preset("paper1", "quick"), seed=0), tmp_path / "log.parquet")
+    earlier: list[weakref.ref] = []
+    alive: list[int] = []
+
+    def watch(chunk: RawLog) -> RawLog:
+        alive.append(sum(ref() is not None for ref in earlier))
+        earlier.append(weakref.ref(chunk.time))
+        return chunk
+
+    data = load_joint(path, chunk_rows=20_000, chunk_map=watch)
+    assert data.extraction.diagnostics.chunks == len(earlier) > 3
+    assert alive == [0] * len(earlier)

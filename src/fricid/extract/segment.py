@@ -107,13 +107,15 @@ def as_log_stream(logs: RawLog | Iterable[RawLog]) -> Iterator[RawLog]:
     if isinstance(logs, RawLog):
         yield logs
         return
-    for i, log in enumerate(logs):
+    i = 0  # counted by hand: ``enumerate`` keeps its last item while fetching the next
+    for log in logs:
         if not isinstance(log, RawLog):
             raise ConfigError(
                 f"extract: item {i} of 'logs' is a {type(log).__name__}, not a RawLog"
             )
         yield log
         del log  # not held while the next chunk is read
+        i += 1  # noqa: SIM113 (see above)
 
 
 def _steady(
