@@ -111,6 +111,17 @@ def test_median_is_numpys_bit_for_bit(values):
 
 
 @settings(max_examples=300, deadline=None)
+@given(_samples)
+def test_median_in_place_is_numpys_bit_for_bit(values):
+    """Partitioned in place (the segmentation's time steps): the same value, zeros' signs
+    included, and the same values left in the array, reordered."""
+    x = np.array(values)
+    expected = np.median(x)
+    assert _bits(fast_median(x, overwrite=True)) == _bits(expected)
+    np.testing.assert_array_equal(np.sort(x), np.sort(np.array(values)))
+
+
+@settings(max_examples=300, deadline=None)
 @given(_samples, st.sampled_from([0.0, 1.0, 25.0, 50.0, 99.0, 99.9, 100.0]))
 def test_percentile_is_numpys_bit_for_bit(values, q):
     x = np.array(values)

@@ -22,19 +22,30 @@ import numpy as np
 __all__ = ["far_from_running_median", "median", "median_filter", "percentile"]
 
 
-def _kth_pair(x: np.ndarray, k: int) -> tuple[float, float]:
-    """The k-th and (k+1)-th smallest values of ``x`` (0-based; ``k + 1 < x.size``)."""
-    part = np.partition(x, k)
+def _kth_pair(x: np.ndarray, k: int, overwrite: bool = False) -> tuple[float, float]:
+    """The k-th and (k+1)-th smallest values of ``x`` (0-based; ``k + 1 < x.size``);
+    ``overwrite``: ``x`` is partitioned in place (no copy)."""
+    part = _partition(x, k, overwrite)
     return part[k], part[k + 1 :].min()
 
 
-def median(x: np.ndarray) -> float:
+def _partition(x: np.ndarray, k: int, overwrite: bool) -> np.ndarray:
+    """``np.partition(x, k)``, in place when ``overwrite`` (the same selection, no copy)."""
+    if not overwrite:
+        return np.partition(x, k)
+    x.partition(k)
+    return x
+
+
+def median(x: np.ndarray, overwrite: bool = False) -> float:
     """``float(np.median(x))`` of a 1-D float array, exactly.
 
     Parameters
     ----------
     x : numpy.ndarray
         1-D, float64; any size (empty gives NaN, as numpy's does with a warning).
+    overwrite : bool
+        Partition ``x`` in place (its order is lost; no copy of it is made).
 
     Returns
     -------
@@ -43,9 +54,14 @@ def median(x: np.ndarray) -> float:
     n = x.size
     if n < 3 or not np.isfinite(x).all():
         return float(np.median(x))
+    if overwrite and not _one_zero(x):  # numpy decides a zero's sign on the original order
+        return float(np.median(x))
     half = n // 2
     odd = n % 2
-    middle = np.partition(x, half)[half : half + 1] if odd else np.array(_kth_pair(x, half - 1))
+    if odd:
+        middle = _partition(x, half, overwrite)[half : half + 1]
+    else:
+        middle = np.array(_kth_pair(x, half - 1, overwrite))
     m = float(np.add.reduce(middle) / middle.size)  # numpy's mean of the middle value(s)
     # which of equal values (0.0 and -0.0) a partition selects is its own: a zero result's
     # sign is numpy's to decide when both zeros are present
