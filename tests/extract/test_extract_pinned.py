@@ -1,0 +1,111 @@
+"""Extraction's numbers, pinned bit for bit on the virtual joint and the real EPOS recordings.
+
+Every number extraction returns (samples, per-direction samples, the gravity fit, the
+quality table, the diagnostics, the notes) is put in a canonical form (floats by their exact
+hexadecimal value) and hashed. The digests were taken from the extraction before it was made
+faster; code that only makes extraction faster must leave them unchanged. A change in a digest
+is a change in results: make it on purpose, and say why, when updating the digest here.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import json
+import warnings
+from collections.abc import Iterator
+from dataclasses import replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+from fricid.extract import extract
+from fricid.samples import RawLog
+from fricid.sim import preset, simulate
+from fricid.workflow import load_joint
+
+#: The real lead-screw recordings, ``../shared/data/real/epos-leadscrew/`` beside the repo.
+LEADSCREW = Path(__file__).resolve().parents[2].parent / "shared" / "data" / "real"
+LEADSCREW = LEADSCREW / "epos-leadscrew"
+
+
+def canon(obj: Any) -> Any:
+    """``obj`` as nested lists, dicts, strings and ints; floats by ``float.hex`` (exact)."""
+    if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
+        return {
+            "__type__": type(obj).__name__,
+            **{f.name: canon(getattr(obj, f.name)) for f in dataclasses.fields(obj)},
+        }
+    if isinstance(obj, np.ndarray):
+        if obj.dtype == object:
+            return ["object", list(obj.shape), [canon(x) for x in obj.ravel().tolist()]]
+        return [str(obj.dtype), list(obj.shape), [canon(x) for x in obj.ravel().tolist()]]
+    if isinstance(obj, dict):
+        return {str(k): canon(v) for k, v in sorted(obj.items(), key=lambda kv: str(kv[0]))}
+    if isinstance(obj, list | tuple):
+        return [canon(x) for x in obj]
+    if isinstance(obj, np.generic):
+        return canon(obj.item())
+    if isinstance(obj, bool) or obj is None or isinstance(obj, int | str):
+        return obj
+    if isinstance(obj, float):
+        return float.hex(obj)
+    return repr(obj)
+
+
+def digest(obj: Any) -> str:
+    """16 hexadecimal digits of the SHA-256 of :func:`canon` of ``obj``."""
+    text = json.dumps(canon(obj), sort_keys=True, separators=(",", ":"))
+    return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+def _chunks(name: str, rows: int) -> Iterator[RawLog]:
+    """The virtual joint's campaign ``name`` (quick, seed 0), cut into chunks of ``rows``."""
+    for log in simulate(preset(name, "quick"), seed=0, chunk="experiment"):
+        for start in range(0, len(log), rows):
+            yield log.slice(start, min(start + rows, len(log)))
+
+
+def _simulated(name: str, rows: int = 50_000, **options) -> Any:
+    scenario = preset(name, "quick")
+    return extract(_chunks(name, rows), **{**scenario.extract_options(), **options})
+
+
+def _clipped() -> Any:
+    """The virtual joint with spikes and a current sensor clipping the fastest set-points'
+    steady torque (a rail under 0.6 of the typical range)."""
+    scenario = preset("paper1+spikes+saturation", "quick")
+    faults = replace(scenario.faults, current_range=0.6 * scenario.faults.current_range)
+    scenario = replace(scenario, faults=faults)
+    return extract(simulate(scenario, seed=0), **scenario.extract_options())
+
+
+def _epos(name: str) -> Any:
+    if not LEADSCREW.is_dir():
+        pytest.skip(f"real recordings not found at {LEADSCREW}")
+    return load_joint(LEADSCREW / name, "epos").extraction
+
+
+#: name -> (what is extracted, its digest)
+CASES = {
+    "paper1": (lambda: _simulated("paper1"), "4d72a29002bd635b"),
+    "paper1+faults": (lambda: _simulated("paper1+faults", 7_777), "f63e98b511696298"),
+    "paper1 joint": (lambda: _simulated("paper1", gravity="joint"), "b9ac57e32617c37a"),
+    "paper2+faults": (lambda: _simulated("paper2+faults"), "7eea695b64d26a31"),
+    "paper1 clipped": (_clipped, "3c3e70d9fa788f80"),
+    "epos 10.csv": (lambda: _epos("10.csv"), "4e0df278b6587816"),
+    "epos n200.csv": (lambda: _epos("n200.csv"), "855172372a137ea8"),
+}
+
+
+def run_case(name: str) -> Any:
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return CASES[name][0]()
+
+
+@pytest.mark.parametrize("name", list(CASES))
+def test_extraction_numbers_are_pinned(name):
+    assert digest(run_case(name)) == CASES[name][1]
