@@ -98,6 +98,38 @@ def errors(case, seed: int):
     return rows, np.abs(z_levels), np.abs((g.beta - beta_true) / g.beta_se)
 
 
+def simulated() -> None:
+    """The whole-arm simulator's campaign: per joint the arm path's and eq. 7's RMS error."""
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "extract"))
+    from test_extract_arm_sim import _campaign, _friction
+
+    t0 = time.perf_counter()
+    path, joints = example_urdf("double_pendulum")
+    truth = RigidBodyModel.from_urdf(path, joints)
+    log = _campaign(truth)
+    pi = truth.parameters().reshape(2, 10)
+    ident = truth.with_parameters((pi * np.array([1.15, 0.85])[:, None]).ravel())
+    res = extract_arm(log, ident)
+    urdf = extract_arm(log, ident, identify=False)
+    print("\ndouble pendulum on fricid.sim.robot (N m RMS over the per-direction samples)")
+    print(f"{'joint':14s} {'arm':>8s} {'URDF':>8s} {'eq. 7':>8s} {'friction':>9s} {'se':>8s}")
+    for j, joint in enumerate(truth.joints):
+        bd = res[joint].by_direction
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            e7 = extract(log.joint(joint), gravity="joint").by_direction
+        ub = urdf[joint].by_direction
+        row = (
+            rms(bd.friction - _friction(j, bd.velocity)),
+            rms(ub.friction - _friction(j, ub.velocity)),
+            rms(e7.friction - _friction(j, e7.velocity)),
+            rms(_friction(j, bd.velocity)),
+            rms([lv["friction_se"] for lv in res.gravity.joint_levels(joint)]),
+        )
+        print(f"{joint:14s} " + " ".join(f"{x:8.4f}" for x in row))
+    print(f"{time.perf_counter() - t0:.0f} s")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--seeds", type=int, default=20)
@@ -121,6 +153,7 @@ def main() -> None:
             f"{np.mean(zl < 1.96):.3f} ({zl.size}), base gravity parameters "
             f"{np.mean(zb < 1.96):.3f} ({zb.size}); {time.perf_counter() - t0:.0f} s"
         )
+    simulated()
 
 
 if __name__ == "__main__":

@@ -38,6 +38,21 @@ SMALLER: dict[str, tuple[list[str], str]] = {
         ["--dt", "0.001"],
         "the default step of 0.2 ms simulates 5x the steps for the same check",
     ),
+    "fricid robot design --robot panda --out design.json --csv traj.csv --ros-yaml traj.yaml": (
+        [
+            "--robot",
+            "double_pendulum",
+            "--max-evaluations",
+            "300",
+            "--duration",
+            "10",
+            "--rate",
+            "50",
+            "--yaml-rate",
+            "10",
+        ],
+        "the Panda's design takes 10 s of CPU (tests/robot/test_excitation.py runs it, slow)",
+    ),
     "fricid fleet manifest.csv --out results/ --cluster local:2": (
         ["--cluster", "", "--workers", "1"],
         "a Dask cluster takes seconds to start (tests/fleet/test_fleet.py runs one)",

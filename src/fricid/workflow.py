@@ -178,11 +178,11 @@ def _design_hints(log: RawLog) -> dict[str, Any]:
 
 def _extract_stream(
     logs: Iterable[RawLog],
-    first: RawLog,
+    head: list[RawLog],
     options: Mapping[str, Any],
     on_chunk: Callable[[], None] | None,
 ) -> JointData:
-    """Extract a log stream whose first chunk is ``first`` (already read from ``logs``).
+    """Extract a log stream whose first chunk, read from ``logs``, is ``head.pop()``.
 
     Unset ``positions``, ``bin_halfwidth`` and ``gravity`` come from the design recorded with
     the log (as ``fricid extract`` does); ``gravity`` then defaults to ``"fit"`` with position
@@ -191,7 +191,7 @@ def _extract_stream(
     with a note saying so).
     """
     opts = dict(options)
-    hints = _design_hints(first)
+    hints = _design_hints(head[0])
     if opts.get("positions") is None and "positions_rad" in hints:
         opts["positions"] = np.asarray(hints["positions_rad"], dtype=float)
         if opts.get("bin_halfwidth") is None:
@@ -202,18 +202,18 @@ def _extract_stream(
     if opts.get("positions") is not None:
         opts["positions"] = np.asarray(opts["positions"], dtype=float)
 
-    def stream() -> Iterator[RawLog]:
-        for chunk in _chain(first, logs):
-            if on_chunk is not None:
-                on_chunk()
-            yield chunk
+    def tick(chunk: RawLog) -> RawLog:  # holds no chunk while the next one is read
+        if on_chunk is not None:
+            on_chunk()
+        return chunk
 
-    result = extract(stream(), **opts)
+    result = extract(map(tick, _chain(head, logs)), **opts)
     return JointData(result.samples, result.by_direction, result)
 
 
-def _chain(first: RawLog, rest: Iterable[RawLog]) -> Iterator[RawLog]:
-    yield first
+def _chain(head: list[RawLog], rest: Iterable[RawLog]) -> Iterator[RawLog]:
+    while head:
+        yield head.pop(0)
     yield from rest
 
 
@@ -281,10 +281,10 @@ def load_joint(
         return JointData(opened, opened, None)
     if chunk_map is not None:
         opened = map(chunk_map, opened)
-    first = next(opened, None)
-    if first is None:  # pragma: no cover - iter_rawlog raises on an empty log
+    head = [next(opened, None)]  # the list alone holds it: freed once extracted
+    if head[0] is None:  # pragma: no cover - iter_rawlog raises on an empty log
         raise DataError("the log has no rows", file=path)
-    return _extract_stream(opened, first, eopts, on_chunk)
+    return _extract_stream(opened, head, eopts, on_chunk)
 
 
 def select_direction(samples: FrictionSamples, direction: str = "all") -> FrictionSamples:

@@ -8,6 +8,7 @@ the two to the same answer, bit for bit, on random, tied and quantised inputs.
 from __future__ import annotations
 
 import itertools
+import weakref
 from dataclasses import replace
 
 import numpy as np
@@ -17,6 +18,7 @@ from hypothesis import strategies as st
 from scipy.ndimage import median_filter as scipy_median_filter
 
 from fricid.errors import DataError
+from fricid.extract._stats import far_from_running_median
 from fricid.extract._stats import median as fast_median
 from fricid.extract._stats import median_filter as fast_median_filter
 from fricid.extract._stats import percentile as fast_percentile
@@ -109,6 +111,17 @@ def test_median_is_numpys_bit_for_bit(values):
 
 
 @settings(max_examples=300, deadline=None)
+@given(_samples)
+def test_median_in_place_is_numpys_bit_for_bit(values):
+    """Partitioned in place (the segmentation's time steps): the same value, zeros' signs
+    included, and the same values left in the array, reordered."""
+    x = np.array(values)
+    expected = np.median(x)
+    assert _bits(fast_median(x, overwrite=True)) == _bits(expected)
+    np.testing.assert_array_equal(np.sort(x), np.sort(np.array(values)))
+
+
+@settings(max_examples=300, deadline=None)
 @given(_samples, st.sampled_from([0.0, 1.0, 25.0, 50.0, 99.0, 99.9, 100.0]))
 def test_percentile_is_numpys_bit_for_bit(values, q):
     x = np.array(values)
@@ -133,6 +146,36 @@ def test_median_filter_long_quantised_signal():
     for size in (5, 31):
         ours = fast_median_filter(x, size)
         np.testing.assert_array_equal(ours, scipy_median_filter(x, size=size, mode="nearest"))
+
+
+@st.composite
+def _signals(draw) -> np.ndarray:
+    """Torque-like signals: noise around a trend, spikes and steps, quantised or not."""
+    n = draw(st.integers(1, 400))
+    rng = np.random.default_rng(draw(st.integers(0, 2**32 - 1)))
+    x = draw(st.sampled_from([0.0, 0.01, 1.0])) * rng.standard_normal(n)
+    x += draw(st.sampled_from([0.0, 1e-3])) * np.arange(n) + draw(_finite)
+    spikes = rng.random(n) < draw(st.sampled_from([0.0, 0.01, 0.2]))
+    x[spikes] += draw(st.sampled_from([0.5, 50.0])) * rng.standard_normal(int(spikes.sum()))
+    if draw(st.booleans()):
+        x[n // 2 :] += draw(_finite)  # a step
+    if draw(st.booleans()):
+        x = np.round(x, 2)
+    return x
+
+
+@settings(max_examples=300, deadline=None)
+@given(
+    st.one_of(_signals(), _samples.map(np.array)),
+    st.sampled_from([1, 3, 5, 31, 61]),
+    st.sampled_from([0.0, 1e-3, 0.05, 1.0, 8.0, np.inf]),
+)
+def test_far_from_running_median_is_the_filtered_test(x, size, threshold):
+    """Bounded by running minima and maxima, then the candidates' medians: the same mask as
+    filtering the whole signal (the outlier screen's second filter)."""
+    size = max(min(size, x.size - (1 - x.size % 2)), 1)
+    expected = np.abs(x - scipy_median_filter(x, size=size, mode="nearest")) > threshold
+    np.testing.assert_array_equal(far_from_running_median(x, size, threshold), expected)
 
 
 def _saturated_unique(torque: np.ndarray, min_share: float = 0.01, min_count: int = 5):
@@ -276,3 +319,24 @@ def test_segments_of_any_chunking_match_the_joined_reference(sizes, restart):
     ]
     for a, b in zip(ours, ref, strict=True):
         np.testing.assert_array_equal(a.log.time, b.log.time)
+
+
+def test_extraction_holds_one_chunk_at_a_time(tmp_path):
+    """Memory bounded by one chunk: when a chunk is read, every earlier chunk's columns are
+    already freed (no layer of the stream, from the reader to the segmentation, holds one)."""
+    from fricid.io import write_rawlog
+    from fricid.sim import preset, simulate
+    from fricid.workflow import load_joint
+
+    path = write_rawlog(simulate(preset("paper1", "quick"), seed=0), tmp_path / "log.parquet")
+    earlier: list[weakref.ref] = []
+    alive: list[int] = []
+
+    def watch(chunk: RawLog) -> RawLog:
+        alive.append(sum(ref() is not None for ref in earlier))
+        earlier.append(weakref.ref(chunk.time))
+        return chunk
+
+    data = load_joint(path, chunk_rows=20_000, chunk_map=watch)
+    assert data.extraction.diagnostics.chunks == len(earlier) > 3
+    assert alive == [0] * len(earlier)

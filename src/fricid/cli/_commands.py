@@ -20,9 +20,10 @@ MODULES = (
     "reproduce",
     "fleet",
     "robot_simulate",
-    "robot_fit",
     "robot_extract",
     "robot_export",
+    "robot_fit",
+    "robot_design",
 )
 
 for _name in MODULES:

@@ -19,22 +19,33 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["median", "median_filter", "percentile"]
+__all__ = ["far_from_running_median", "median", "median_filter", "percentile"]
 
 
-def _kth_pair(x: np.ndarray, k: int) -> tuple[float, float]:
-    """The k-th and (k+1)-th smallest values of ``x`` (0-based; ``k + 1 < x.size``)."""
-    part = np.partition(x, k)
+def _kth_pair(x: np.ndarray, k: int, overwrite: bool = False) -> tuple[float, float]:
+    """The k-th and (k+1)-th smallest values of ``x`` (0-based; ``k + 1 < x.size``);
+    ``overwrite``: ``x`` is partitioned in place (no copy)."""
+    part = _partition(x, k, overwrite)
     return part[k], part[k + 1 :].min()
 
 
-def median(x: np.ndarray) -> float:
+def _partition(x: np.ndarray, k: int, overwrite: bool) -> np.ndarray:
+    """``np.partition(x, k)``, in place when ``overwrite`` (the same selection, no copy)."""
+    if not overwrite:
+        return np.partition(x, k)
+    x.partition(k)
+    return x
+
+
+def median(x: np.ndarray, overwrite: bool = False) -> float:
     """``float(np.median(x))`` of a 1-D float array, exactly.
 
     Parameters
     ----------
     x : numpy.ndarray
         1-D, float64; any size (empty gives NaN, as numpy's does with a warning).
+    overwrite : bool
+        Partition ``x`` in place (its order is lost; no copy of it is made).
 
     Returns
     -------
@@ -43,9 +54,14 @@ def median(x: np.ndarray) -> float:
     n = x.size
     if n < 3 or not np.isfinite(x).all():
         return float(np.median(x))
+    if overwrite and not _one_zero(x):  # numpy decides a zero's sign on the original order
+        return float(np.median(x))
     half = n // 2
     odd = n % 2
-    middle = np.partition(x, half)[half : half + 1] if odd else np.array(_kth_pair(x, half - 1))
+    if odd:
+        middle = _partition(x, half, overwrite)[half : half + 1]
+    else:
+        middle = np.array(_kth_pair(x, half - 1, overwrite))
     m = float(np.add.reduce(middle) / middle.size)  # numpy's mean of the middle value(s)
     # which of equal values (0.0 and -0.0) a partition selects is its own: a zero result's
     # sign is numpy's to decide when both zeros are present
@@ -140,6 +156,61 @@ def _median5(x: np.ndarray) -> np.ndarray:
         np.maximum(c, f_, out=hi_)
         np.minimum(hi_, g_, out=hi_)
         np.maximum(lo_, hi_, out=out[start : start + m])
+    return out
+
+
+#: Share of samples above which :func:`far_from_running_median` filters the whole signal
+#: instead of taking the medians of the candidates' windows one by one.
+_CANDIDATE_SHARE = 0.125
+
+
+def far_from_running_median(x: np.ndarray, size: int, threshold: float) -> np.ndarray:
+    """``abs(x - median_filter(x, size)) > threshold``, exactly, mostly without the filter.
+
+    The running median of a window lies between the window's minimum and maximum, and
+    ``x - m`` rounds monotonically in ``m``; so a sample within ``threshold`` of both its
+    window's minimum and maximum is within it of the median too. Running minima and maxima
+    take a few passes of ``np.minimum`` and ``np.maximum`` (windows doubled in width); only
+    the remaining candidates need their window's median, a selection (the same value the
+    filter selects, whichever algorithm). When candidates are many (a quantised or
+    noiseless signal), the whole signal is filtered.
+
+    Parameters
+    ----------
+    x : numpy.ndarray
+        1-D float64, not empty (non-finite values: the whole signal is filtered).
+    size : int
+        Odd window (edges: the nearest sample repeated, as :func:`median_filter`).
+    threshold : float
+        The distance that marks a sample.
+
+    Returns
+    -------
+    numpy.ndarray
+        Boolean mask.
+    """
+    if not np.isfinite(x).all():
+        return np.abs(x - median_filter(x, size)) > threshold
+    half = size // 2
+    padded = np.concatenate((np.full(half, x[0]), x, np.full(half, x[-1])))
+    lo = hi = padded
+    width = 1
+    while 2 * width <= size:
+        lo = np.minimum(lo[:-width], lo[width:])
+        hi = np.maximum(hi[:-width], hi[width:])
+        width *= 2
+    shift = size - width  # windows of ``width`` at i and i + shift cover the window of size
+    if shift:
+        lo = np.minimum(lo[:-shift], lo[shift:])
+        hi = np.maximum(hi[:-shift], hi[shift:])
+    candidates = np.flatnonzero((np.abs(x - lo) > threshold) | (np.abs(x - hi) > threshold))
+    if candidates.size > _CANDIDATE_SHARE * x.size:
+        return np.abs(x - median_filter(x, size)) > threshold
+    out = np.zeros(x.shape, dtype=bool)
+    if candidates.size:
+        windows = np.lib.stride_tricks.sliding_window_view(padded, size)[candidates]
+        m = np.partition(windows, half, axis=1)[:, half]
+        out[candidates] = np.abs(x[candidates] - m) > threshold
     return out
 
 

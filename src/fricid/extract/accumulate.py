@@ -17,8 +17,8 @@ import numpy as np
 
 from ._stats import median, median_filter
 from .bins import Cells, CellTable, PositionBins
-from .gravity_check import block_stats
-from .joint_gravity import moments
+from .gravity_check import block_stats_of
+from .joint_gravity import moments_of, regressors
 from .quality import QUALITY_COLUMNS, QualityTable
 from .segment import Segment
 from .steady import OUTLIER_SIGMAS, SETTLE_SIGMAS, outliers, rest_threshold, saturated, settled
@@ -143,7 +143,15 @@ class Accumulator:
             self.quantum = min(self.quantum, float(step.min()))
         idx = self.bins.assign(log.position)
         idx = np.where(keep, idx, -1)
-        cells = Cells.of(idx, tau, log.position, log.velocity, log.temperature, self.bins.n_bins)
+        cos, sin = np.cos(log.position), np.sin(log.position)  # once, for cells and moments
+        cells = Cells.of(
+            idx, tau, log.position, log.velocity, log.temperature, self.bins.n_bins, cos, sin
+        )
+        stats = blocks = None
+        if self.moments:
+            theta = log.position[keep]
+            x = regressors(cos[keep], sin[keep], tau[keep])
+            stats, blocks = moments_of(x), block_stats_of(theta, x)
         self.records.append(
             Record(
                 speed=seg.speed,
@@ -158,8 +166,8 @@ class Accumulator:
                 kept=int(keep.sum()),
                 cells=cells,
                 spikes=spikes,
-                moments=moments(log.position[keep], tau[keep]) if self.moments else None,
-                blocks=block_stats(log.position[keep], tau[keep]) if self.moments else None,
+                moments=stats,
+                blocks=blocks,
                 source=log.source,
                 extra=None if self.extra is None else self.extra(seg, keep, tau),
             )

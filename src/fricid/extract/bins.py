@@ -92,8 +92,11 @@ class Cells:
     sin: np.ndarray | None = None  # mean sin(position)
 
     @classmethod
-    def of(cls, idx, torque, position, velocity, temperature, n_bins: int) -> Cells:
-        """Accumulate samples (bin index ``idx``, -1 skipped) with ``np.bincount``."""
+    def of(
+        cls, idx, torque, position, velocity, temperature, n_bins: int, cos=None, sin=None
+    ) -> Cells:
+        """Accumulate samples (bin index ``idx``, -1 skipped) with ``np.bincount``; ``cos``
+        and ``sin`` of the positions when already computed."""
         keep = idx >= 0
         idx = idx[keep]
         count = np.bincount(idx, minlength=n_bins).astype(float)
@@ -112,8 +115,8 @@ class Cells:
             mean(position),
             mean(velocity),
             mean(temperature),
-            mean(np.cos(position)),
-            mean(np.sin(position)),
+            mean(np.cos(position) if cos is None else cos),
+            mean(np.sin(position) if sin is None else sin),
         )
 
 

@@ -30,7 +30,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .joint_gravity import MOMENT_SIZE, moments
+from .joint_gravity import MOMENT_SIZE, moments_of, regressors
 
 __all__ = [
     "BLOCKS",
@@ -40,6 +40,7 @@ __all__ = [
     "GravityResidual",
     "block_noise",
     "block_stats",
+    "block_stats_of",
     "check_joint",
     "check_paired",
 ]
@@ -65,14 +66,19 @@ def block_stats(theta, tau, blocks: int = BLOCKS) -> np.ndarray:
     count; an empty part has count 0.
     """
     theta = np.asarray(theta, dtype=float)
-    tau = np.asarray(tau, dtype=float)
+    return block_stats_of(theta, regressors(np.cos(theta), np.sin(theta), tau), blocks)
+
+
+def block_stats_of(theta: np.ndarray, x: np.ndarray, blocks: int = BLOCKS) -> np.ndarray:
+    """:func:`block_stats` of the samples at positions ``theta`` whose
+    :func:`~.joint_gravity.regressors` are ``x`` (computed once for the whole pass)."""
     out = np.zeros((blocks, BLOCK_SIZE))
     n = theta.size
     for k in range(min(blocks, n)):  # a loop over the few blocks, not over samples
         a, b = (k * n) // blocks, ((k + 1) * n) // blocks
         if b > a:
-            out[k, 0] = theta[a:b].mean()
-            out[k, 1:] = moments(theta[a:b], tau[a:b])
+            out[k, 0] = np.add.reduce(theta[a:b]) / (b - a)  # ``theta[a:b].mean()``
+            out[k, 1:] = moments_of(x[:, a:b])
     return out
 
 

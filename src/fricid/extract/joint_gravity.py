@@ -50,7 +50,14 @@ from scipy import sparse
 
 from ..errors import DataError
 
-__all__ = ["MOMENT_SIZE", "JointGravityFit", "fit_gravity_joint", "moments"]
+__all__ = [
+    "MOMENT_SIZE",
+    "JointGravityFit",
+    "fit_gravity_joint",
+    "moments",
+    "moments_of",
+    "regressors",
+]
 
 #: Length of a pass's moment vector: count, means of (z1, z2, tau), co-moments
 #: (z1 z1, z1 z2, z2 z2, z1 tau, z2 tau, tau tau), with z = (-cos theta, sin theta).
@@ -78,19 +85,29 @@ def moments(theta, tau) -> np.ndarray:
         their sums of cross-products about those means (two-pass, so exact in floating point).
     """
     theta = np.asarray(theta, dtype=float)
-    n = theta.size
+    return moments_of(regressors(np.cos(theta), np.sin(theta), tau))
+
+
+def regressors(cos: np.ndarray, sin: np.ndarray, tau: np.ndarray) -> np.ndarray:
+    """The rows ``(-cos theta, sin theta, tau)`` of :func:`moments_of`, shape ``(3, n)``."""
+    x = np.empty((3, np.size(tau)))
+    np.negative(cos, out=x[0])
+    x[1] = sin
+    x[2] = tau
+    return x
+
+
+def moments_of(x: np.ndarray) -> np.ndarray:
+    """:func:`moments` of the samples whose :func:`regressors` are ``x`` (shape ``(3, n)``,
+    any view: it is not modified)."""
+    n = x.shape[1]
     out = np.zeros(MOMENT_SIZE)
     out[0] = n
     if n == 0:
         return out
-    x = np.empty((3, n))
-    np.cos(theta, out=x[0])
-    np.negative(x[0], out=x[0])
-    np.sin(theta, out=x[1])
-    x[2] = tau
-    mean = x.mean(axis=1)
-    x -= mean[:, None]
-    c = x @ x.T
+    mean = np.add.reduce(x, axis=1) / n  # ``x.mean(axis=1)``, bit for bit, without its wrapper
+    d = x - mean[:, None]
+    c = d @ d.T
     out[1:4] = mean
     out[4:] = c[_ROWS, _COLS]
     return out

@@ -69,6 +69,7 @@ class _Source:
                 meta = log.meta if isinstance(log.meta, dict) else {}
                 self.position_source = str(meta.get("position_source", "channel"))
             yield log
+            del log  # not held while the next chunk is read
 
 
 def _check_options(median_window, gravity, velocity_rtol, temperature_atol) -> None:
@@ -210,6 +211,7 @@ def extract(
     )
     for seg in segments:
         acc.add(seg)
+        del seg  # a view of its chunk: not held while the next chunk is read
     source = stream.name
     kinds = acc.classify()
     keep = kinds == "setpoint"

@@ -107,12 +107,15 @@ def as_log_stream(logs: RawLog | Iterable[RawLog]) -> Iterator[RawLog]:
     if isinstance(logs, RawLog):
         yield logs
         return
-    for i, log in enumerate(logs):
+    i = 0  # counted by hand: ``enumerate`` keeps its last item while fetching the next
+    for log in logs:
         if not isinstance(log, RawLog):
             raise ConfigError(
                 f"extract: item {i} of 'logs' is a {type(log).__name__}, not a RawLog"
             )
         yield log
+        del log  # not held while the next chunk is read
+        i += 1  # noqa: SIM113 (see above)
 
 
 def _steady(
@@ -223,10 +226,10 @@ def iter_segments(
         if lc and sign[0] != carry_sign:
             edges = np.concatenate(([lc], edges))
         if n > 2:  # a gap in the recording ends a run too
-            dt = np.diff(chunk.time)
-            if lc:
-                dt = np.concatenate((np.diff(carry.time), chunk.time[:1] - carry.time[-1], dt))
-            gaps = np.flatnonzero(dt > GAP_FACTOR * median(dt)) + 1
+            # the median partitions the steps in place, which are then taken again: one
+            # chunk-sized temporary at a time
+            limit = GAP_FACTOR * median(_steps(carry, chunk), overwrite=True)
+            gaps = np.flatnonzero(_steps(carry, chunk) > limit) + 1
             edges = np.union1d(edges, gaps)
         starts = np.concatenate(([0], edges))
         stops = np.concatenate((edges, [n]))
@@ -244,9 +247,11 @@ def iter_segments(
         if last < lc:  # the open run goes on through the whole chunk (``head`` holds it)
             carry = head.slice(last, n)
         else:
-            carry = chunk.slice(last - lc, len(chunk))
+            # a copy: a view would keep the whole chunk alive while the next is read
+            carry = RawLog.concatenate([chunk.slice(last - lc, len(chunk))])
             carry_sign = float(sign[last - lc])
         carry_row += last
+        chunk = head = log = sign = None  # not held while the next chunk is read
     if carry is not None and len(carry) and abs(carry.velocity[0]) > REST_RESIDUE:
         found = _steady(carry, 0, len(carry), *options)
         if found is not None:
@@ -257,11 +262,19 @@ def iter_segments(
 
 
 def _sign(velocity: np.ndarray) -> np.ndarray:
-    """The sign of each velocity; 0 within :data:`REST_RESIDUE` of zero (float residue: not
-    moving)."""
-    sign = np.sign(velocity)
-    sign[np.abs(velocity) <= REST_RESIDUE] = 0.0
+    """The sign of each velocity (int8); 0 within :data:`REST_RESIDUE` of zero (float residue:
+    not moving)."""
+    sign = (velocity > REST_RESIDUE).view(np.int8)
+    sign -= velocity < -REST_RESIDUE
     return sign
+
+
+def _steps(carry: RawLog | None, chunk: RawLog) -> np.ndarray:
+    """The time steps of ``carry`` (if any) followed by ``chunk``."""
+    dt = np.diff(chunk.time)
+    if carry is None or len(carry) == 0:
+        return dt
+    return np.concatenate((np.diff(carry.time), chunk.time[:1] - carry.time[-1], dt))
 
 
 def _join(carry: RawLog | None, chunk: RawLog, stop: int) -> RawLog:

@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._stats import median, median_filter
+from ._stats import far_from_running_median, median, median_filter
 
 __all__ = [
     "OUTLIER_SIGMAS",
@@ -320,8 +320,7 @@ def outliers(
         if nonzero.size == 0:
             return np.zeros(torque.shape, dtype=bool)
         scale = median(nonzero)
-    resid = torque - median_filter(torque, size)
-    return np.abs(resid) > sigmas * scale
+    return far_from_running_median(torque, size, sigmas * scale)
 
 
 def saturated(torque: np.ndarray, *, min_share: float = 0.01, min_count: int = 5) -> np.ndarray:

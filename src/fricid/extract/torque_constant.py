@@ -27,7 +27,6 @@ from collections.abc import Iterable
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import stats as _stats
 
 from ..errors import DataError
 from ..samples import RawLog
@@ -103,7 +102,9 @@ class TorqueConstantFit:
 
 
 def _ci(value: float, se: float, dof: int) -> tuple[float, float]:
-    t = float(_stats.t.ppf(0.975, max(dof, 1)))
+    from scipy import stats  # heavy: imported where used
+
+    t = float(stats.t.ppf(0.975, max(dof, 1)))
     return (value - t * se, value + t * se)
 
 
@@ -283,7 +284,9 @@ def torque_constant_from_gravity(
     k = float(b @ a) / norm
     grad = (b - 2 * k * a) / norm  # dK/da
     k_se = float(np.sqrt(np.sum((grad * a_se) ** 2)))
-    z = float(_stats.norm.ppf(0.975))
+    from scipy import stats  # heavy: imported where used
+
+    z = float(stats.norm.ppf(0.975))
     return TorqueConstantFit(
         K=k,
         K_se=k_se,

@@ -148,8 +148,8 @@ def check_record(pf: pq.ParquetFile, path: str | os.PathLike[str]) -> dict[str, 
 
 
 def _crc(values: np.ndarray, start: int = 0) -> int:
-    """CRC-32 of float64 values, little-endian (continuing from ``start``)."""
-    return zlib.crc32(np.ascontiguousarray(values, dtype="<f8").tobytes(), start)
+    """CRC-32 of float64 values, little-endian (continuing from ``start``), read in place."""
+    return zlib.crc32(memoryview(np.ascontiguousarray(values, dtype="<f8")).cast("B"), start)
 
 
 def _check_values(
@@ -293,8 +293,13 @@ def iter_columns(
     """
     crcs = check_record(pf, path)
     found = dict.fromkeys(labels, 0)
-    batches = pf.iter_batches(batch_size=min(chunk_rows, 1 << 20), columns=labels)
-    stream = rechunk(batches, chunk_rows)
+    types = pf.schema_arrow
+    if all(types.field(label).type == pa.float64() for label in labels):
+        batches = pf.iter_batches(batch_size=min(chunk_rows, STREAM_BATCH_ROWS), columns=labels)
+        stream = _filled(batches, labels, chunk_rows, pf.metadata.num_rows)
+    else:
+        batches = pf.iter_batches(batch_size=min(chunk_rows, 1 << 20), columns=labels)
+        stream = rechunk(batches, chunk_rows)
     start = 0
     while True:
         try:
@@ -304,10 +309,80 @@ def iter_columns(
             return
         except (pa.ArrowException, OSError, UnicodeError) as exc:
             raise DataError(f"cannot read Parquet data ({one_line(exc)})", file=path) from None
-        columns = _to_float(table, labels, path, start)
+        if isinstance(table, _Filled):
+            columns = table.checked(labels, path, start)
+        else:
+            columns = _to_float(table, labels, path, start)
         found = {label: _crc(columns[label], found[label]) for label in labels}
+        rows = len(columns[labels[0]])
+        del table
         yield start, columns
-        start += table.num_rows
+        del columns  # not held while the next chunk is read
+        start += rows
+
+
+#: Rows per record batch when streaming float64 columns into chunks: small, so the Arrow
+#: buffers held at once stay a few MB whatever the chunk size.
+STREAM_BATCH_ROWS = 1 << 16
+
+
+class _Filled(dict):
+    """A chunk of float64 columns filled batch by batch (label -> array), with the first null
+    row of each column that had one (``nulls``), checked by :meth:`checked`."""
+
+    def __init__(self, columns: dict[str, np.ndarray], nulls: dict[str, int]) -> None:
+        super().__init__(columns)
+        self.nulls = nulls
+
+    def checked(self, labels: list[str], path: Path, first: int) -> dict[str, np.ndarray]:
+        """The columns, checked as :func:`_to_float` checks a table: column by column, a
+        null first, then a non-finite value (``first``: 0-based index of the first record)."""
+        for label in labels:
+            if label in self.nulls:
+                row = first + self.nulls[label]
+                raise DataError("missing (null) value", file=path, row=row, column=label)
+            values = self[label]
+            if not np.isfinite(values).all():
+                row = int(np.flatnonzero(~np.isfinite(values))[0])
+                raise DataError(
+                    f"non-finite value {values[row]!r} (NaN and infinities are not data)",
+                    file=path,
+                    row=first + row,
+                    column=label,
+                )
+        return dict(self)
+
+
+def _filled(
+    batches: Iterable[pa.RecordBatch], labels: list[str], rows: int, total: int
+) -> Iterator[_Filled]:
+    """Float64 record batches (``total`` rows in all) copied into chunks of ``rows`` rows (the
+    last may be shorter): one fresh array per column and chunk, filled from small batches, so
+    no chunk-sized Arrow table is built next to it."""
+    chunk: dict[str, np.ndarray] = {}
+    nulls: dict[str, int] = {}
+    held = size = done = 0
+    for batch in batches:
+        offset = 0
+        while offset < batch.num_rows:
+            if not chunk:
+                size = max(min(rows, total - done), 1)
+                chunk = {label: np.empty(size) for label in labels}
+            take = min(size - held, batch.num_rows - offset)
+            for label in labels:
+                col = batch.column(label).slice(offset, take)
+                if col.null_count and label not in nulls:
+                    mask = col.is_null().to_numpy(zero_copy_only=False)
+                    nulls[label] = held + int(np.flatnonzero(mask)[0])
+                chunk[label][held : held + take] = col.to_numpy(zero_copy_only=False)
+            held += take
+            offset += take
+            if held == size:
+                yield _Filled(chunk, nulls)
+                done += held
+                chunk, nulls, held = {}, {}, 0
+    if held:  # fewer rows than the file's metadata counts (checked by the integrity record)
+        yield _Filled({label: values[:held] for label, values in chunk.items()}, nulls)
 
 
 # --------------------------------------------------------------------------- writing

@@ -192,31 +192,37 @@ def open_log(
     DataError
         Unreadable data, naming file, row and column where known.
     """
-    from .channels import read_channels
-    from .epos import epos_steady_samples, read_epos
-    from .generic import read_table_log
-    from .matlab import read_mat
-    from .rosbag import iter_rosbag, rosbag_joints
-    from .tables import iter_rawlog
-
+    # each reader imported where it is used: a raw log needs neither pandas nor the others
     path = Path(path)
     opts = dict(options or {})
     check_reader(reader, opts)
     if reader == "epos" and path.is_dir():
+        from .epos import epos_steady_samples
+
         return epos_steady_samples(path, **opts)
     if reader == "epos":
+        from .epos import read_epos
+
         extra = [k for k in EPOS_FOLDER_ONLY if k in opts]
         if extra:
             raise ConfigError(f"reader option '{extra[0]}' applies to a folder of EPOS recordings")
         return iter([read_epos(path, **opts)])
     if reader == "generic":
+        from .generic import read_table_log
+
         return iter([read_table_log(path, **opts)])
     if reader == "channels":
+        from .channels import read_channels
+
         return iter(read_channels(path, **opts))
     if reader == "mat":
+        from .matlab import read_mat
+
         got = read_mat(path, **opts)
         return got if isinstance(got, FrictionSamples) else iter([got])
     if reader == "rosbag":
+        from .rosbag import iter_rosbag, rosbag_joints
+
         if "joint" not in opts:
             topic = opts.get("topic", "/joint_states")
             raise ConfigError(
@@ -224,4 +230,6 @@ def open_log(
                 f"{', '.join(rosbag_joints(path, topic=topic))}"
             )
         return iter_rosbag(path, chunk_rows=chunk_rows, **opts)
+    from .tables import iter_rawlog
+
     return iter_rawlog(path, chunk_rows=chunk_rows)

@@ -241,7 +241,9 @@ def _iter_rawlog(opened: Opened, chunk_rows: int) -> Iterator[RawLog]:
                 column=opened.columns["time"].label,
             )
         last_time = float(log.time[-1])
+        del raw
         yield log
+        del log  # not held while the next chunk is read
     if last_time is None:
         raise DataError("no data rows after the header", file=opened.path)
 

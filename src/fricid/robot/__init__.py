@@ -1,6 +1,7 @@
 """Whole robots: a fixed-base arm's rigid-body dynamics from its URDF (:mod:`.model`), its base
 inertial parameters (:mod:`.base`), their physically consistent parametrisation
-(:mod:`.consistency`) and the example robots of ``example-robot-data`` (:mod:`.examples`).
+(:mod:`.consistency`), excitation design (:mod:`.excitation`, :mod:`.trajectories`,
+:mod:`.excitation_files`) and the example robots of ``example-robot-data`` (:mod:`.examples`).
 Pinocchio (PyPI ``pin``, the ``fricid[robot]`` extra) is imported on first use.
 """
 
@@ -21,6 +22,16 @@ _WHERE = {
     "is_consistent": "consistency",
     "pseudo_inertia": "consistency",
     "to_log_cholesky": "consistency",
+    "ExcitationDesign": "excitation",
+    "design_excitation": "excitation",
+    "sweep_design": "sweeps",
+    "FourierTrajectory": "trajectories",
+    "RampedTrajectory": "trajectories",
+    "SweepTrajectory": "trajectories",
+    "load_design": "excitation_files",
+    "save_design": "excitation_files",
+    "write_joint_trajectory_yaml": "excitation_files",
+    "write_trajectory_csv": "excitation_files",
     "EXAMPLE_ROBOTS": "examples",
     "example_urdf": "examples",
 }

@@ -4,7 +4,8 @@ A reference is anything with ``evaluate(t) -> (q, dq, ddq)`` (arrays of shape ``
 in rad, rad/s, rad/s^2; m for a prismatic joint) and a ``duration`` [s], or a plain callable
 ``reference(t) -> (q, dq, ddq)``; :func:`fricid.sim.robot.simulate_robot` takes either.
 
-:class:`FourierTrajectory` is the series of Swevers et al. (IEEE T-RA 13(5), 1997, eq. 25)::
+:class:`FourierTrajectory` (:mod:`fricid.robot.trajectories`, where excitation design makes
+them) is the series of Swevers et al. (IEEE T-RA 13(5), 1997, eq. 25)::
 
     q_i(t) = q0_i + sum_k a_ik / (w_f k) sin(w_f k t) - b_ik / (w_f k) cos(w_f k t)
 
@@ -21,66 +22,9 @@ from typing import Any
 import numpy as np
 
 from ..errors import ConfigError
+from ..robot.trajectories import FourierTrajectory
 
 __all__ = ["FourierTrajectory", "SweepReference", "random_fourier", "sweep_reference"]
-
-
-@dataclass(frozen=True, eq=False)
-class FourierTrajectory:
-    """A periodic Fourier series per joint (module notes).
-
-    Parameters
-    ----------
-    joints : tuple of str
-    w_f : float
-        Base frequency [rad/s]; the period is ``2 pi / w_f``.
-    q0 : array_like, shape (n,)
-        Offsets [rad].
-    a, b : array_like, shape (n, H)
-        Coefficients [rad/s].
-    """
-
-    joints: tuple[str, ...]
-    w_f: float
-    q0: np.ndarray
-    a: np.ndarray
-    b: np.ndarray
-
-    def __post_init__(self) -> None:
-        set_ = object.__setattr__
-        set_(self, "joints", tuple(self.joints))
-        n = len(self.joints)
-        q0 = np.asarray(self.q0, dtype=float).reshape(-1)
-        a, b = (np.atleast_2d(np.asarray(x, dtype=float)) for x in (self.a, self.b))
-        if q0.shape != (n,) or a.shape != b.shape or a.shape[0] != n:
-            raise ConfigError(
-                f"Fourier reference of {n} joints: q0 must be ({n},), a and b ({n}, H); got "
-                f"{q0.shape}, {a.shape}, {b.shape}"
-            )
-        finite = np.isfinite(q0).all() and np.isfinite(a).all() and np.isfinite(b).all()
-        if not (finite and np.isfinite(self.w_f) and self.w_f > 0):
-            raise ConfigError("Fourier reference: finite coefficients and w_f > 0 needed")
-        set_(self, "q0", q0)
-        set_(self, "a", a)
-        set_(self, "b", b)
-
-    @property
-    def duration(self) -> float:
-        """One period, ``2 pi / w_f`` [s]."""
-        return 2.0 * np.pi / self.w_f
-
-    def evaluate(self, t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """``(q, dq, ddq)`` at the times ``t`` [s], each ``(len(t), n)``."""
-        t = np.atleast_1d(np.asarray(t, dtype=float))[:, None, None]
-        wk = self.w_f * np.arange(1, self.a.shape[1] + 1)  # (H,)
-        s, c = np.sin(wk * t), np.cos(wk * t)  # (N, 1, H)
-        a, b = self.a[None], self.b[None]  # (1, n, H)
-        q = self.q0 + ((a * s - b * c) / wk).sum(-1)
-        dq = (a * c + b * s).sum(-1)
-        ddq = ((b * c - a * s) * wk).sum(-1)
-        return q, dq, ddq
-
-    __call__ = evaluate
 
 
 @dataclass(frozen=True, eq=False)

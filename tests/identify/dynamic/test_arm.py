@@ -142,7 +142,6 @@ def test_panda_recovers_friction_per_joint_and_direction():
         assert fit.validation[joint]["ratio"] < 1.5
         assert fit.verdict(joint) != "no"
     z = _z(fit, laws)
-    print({k: round(v, 1) for k, v in z.items()})
     linear = [v for k, v in z.items() if k.split(":")[1].startswith(("tau_c", "tau_v"))]
     assert np.mean(np.abs(linear) < 1.96) >= 0.8
 
