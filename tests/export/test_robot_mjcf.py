@@ -163,3 +163,21 @@ def test_non_physical_inertia_is_refused():
     pi[9] = 10 * (pi[4] + pi[6])  # Izz far above Ixx + Iyy: no body has that
     with pytest.raises(ExportError, match="joint1"):
         robot_mjcf_text(model.with_parameters(pi))
+
+
+def test_fitted_models_and_coulomb_viscous_names_are_exported():
+    """A joint's friction as a fitted model (any family: its Coulomb-viscous projection per
+    direction) or in the Coulomb-viscous families' names f_c, beta."""
+    from fricid.fitted import FittedModel
+
+    model = arm("double_pendulum")
+    cv = FittedModel.from_values(
+        "coulomb_viscous", {"f_c": 0.3, "beta": 0.1}, operating_range={"velocity": [-2, 2]}
+    )
+    text, notes = robot_mjcf_text(model, {"joint1": cv, "joint2": {"f_c": 0.2, "beta": 0.05}})
+    m = mujoco.MjModel.from_xml_string(text)
+    for joint, (fl, damping) in (("joint1", (0.3, 0.1)), ("joint2", (0.2, 0.05))):
+        jid = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, joint)
+        assert m.dof_frictionloss[jid] == pytest.approx(fl)
+        assert m.dof_damping[jid] == pytest.approx(damping)
+    assert notes == []

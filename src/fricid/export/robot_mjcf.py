@@ -29,12 +29,14 @@ from typing import Any
 
 import numpy as np
 
+from ..fitted import FittedModel
 from ..robot import RigidBodyModel
 from ..robot._pin import pinocchio
 from ..sim.robot_friction import ArmFriction
 from ._common import ExportError, fmt_float, plain
 from .descriptions import _check_joint, _xml, write_text
 from .mjcf import FRICTIONLOSS_LINES
+from .projection import project
 
 __all__ = ["joint_friction", "robot_mjcf_text", "write_robot_mjcf"]
 
@@ -48,14 +50,21 @@ def _levels(params: Mapping[str, float], key: str) -> list[float]:
     return [float(v) for v in vals]
 
 
+def _differ(levels: list[float]) -> bool:
+    """The two directions' levels differ beyond rounding (a projection's last digits)."""
+    return bool(levels) and max(levels) - min(levels) > 1e-9 * max(map(abs, levels))
+
+
 def joint_friction(joint: str, params: Mapping[str, float]) -> tuple[float, float, list[str]]:
     """``(frictionloss, damping, notes)`` of one joint's friction parameters.
 
     ``params`` in fricid's names: ``tau_c``, ``tau_v`` (and ``tau_s``, ``w_s``, ``delta``),
-    or their ``_pos``/``_neg`` pairs (``stribeck_asym``), or a LuGre law's (``sigma_2`` the
-    viscous coefficient). The two directions are averaged.
+    or their ``_pos``/``_neg`` pairs (``stribeck_asym``), the Coulomb-viscous families'
+    ``f_c``, ``beta`` (and pairs), or a LuGre law's (``sigma_2`` the viscous coefficient). The
+    two directions are averaged.
     """
-    coulomb, viscous = _levels(params, "tau_c"), _levels(params, "tau_v")
+    coulomb = _levels(params, "tau_c") or _levels(params, "f_c")  # coulomb_viscous: f_c, beta
+    viscous = _levels(params, "tau_v") or _levels(params, "beta")
     notes = []
     if "sigma_0" in params:  # LuGre: sigma_2 is its viscous coefficient
         viscous = viscous or _levels(params, "sigma_2")
@@ -64,8 +73,10 @@ def joint_friction(joint: str, params: Mapping[str, float]) -> tuple[float, floa
             "hysteresis) are lost here (MuJoCo 4's dcmotor lugre could hold them)"
         )
     if not coulomb and not viscous:
-        raise ExportError(f"joint {plain(joint)}: no tau_c or tau_v among {sorted(params)}")
-    if len(set(coulomb)) > 1 or len(set(viscous)) > 1:
+        raise ExportError(
+            f"joint {plain(joint)}: no tau_c/f_c or tau_v/beta among {sorted(params)}"
+        )
+    if _differ(coulomb) or _differ(viscous):
         notes.append(
             f"joint {plain(joint)}: Coulomb {', '.join(f'{c:.4g}' for c in coulomb)} N m and "
             f"viscous {', '.join(f'{v:.4g}' for v in viscous)} N m s/rad differ by direction; "
@@ -97,8 +108,22 @@ def _frictions(model: RigidBodyModel, friction: Any) -> dict[str, dict[str, floa
         unknown = [j for j in friction if j not in model.joints]
         if unknown:
             raise ExportError(f"friction for joints not in the model: {plain(unknown)}")
-        return {j: dict(p) for j, p in friction.items()}
+        return {j: _as_parameters(j, p) for j, p in friction.items()}
     raise ExportError("friction must be an ArmFriction or a mapping joint -> parameters")
+
+
+def _as_parameters(joint: str, friction: Any) -> dict[str, float]:
+    """A joint's parameters; a :class:`~fricid.fitted.FittedModel` by the Coulomb-viscous
+    projection over its operating range, per direction (:func:`fricid.export.project`), as
+    every other export that holds Coulomb plus viscous friction."""
+    if not isinstance(friction, FittedModel):
+        return dict(friction)
+    proj = project(friction, True)
+    out = {}
+    for side, key in (("pos", "positive"), ("neg", "negative")):
+        out[f"tau_c_{side}"] = float(proj.coulomb[key])
+        out[f"tau_v_{side}"] = float(proj.viscous[key])
+    return out
 
 
 def _quat(rotation: np.ndarray) -> np.ndarray:
