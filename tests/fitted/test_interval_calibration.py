@@ -102,3 +102,32 @@ def test_jackknife_scale_quantile_and_its_fall_back():
     assert few["scale"][1] == pytest.approx(stats.t.ppf(0.975, 9))
     assert few["scale"][0] == pytest.approx(np.quantile(np.abs(r[:12]), 0.9, method="weibull"))
     assert jackknife_scale(r[:12], np.zeros(12), 0.0, 9) is None
+
+
+def test_the_noise_term_is_never_below_the_measured_scatter():
+    # six speeds per direction whose residuals come out at a fraction of the scatter the
+    # samples state (std / sqrt(count)): a new sample still scatters by that much
+    rng = np.random.default_rng(3)
+    speeds = np.geomspace(0.05, 2.0, 6)
+    v = np.r_[speeds, -speeds]
+    y = _linear(v) + 0.005 * rng.standard_normal(v.size)
+    given = 0.03
+    s = FrictionSamples(
+        velocity=v,
+        load=np.zeros(v.size),
+        temperature=np.full(v.size, 25.0),
+        friction=y,
+        count=np.full(v.size, 25),
+        std=np.full(v.size, given * 5.0),
+    )
+    m = _fit(s)
+    rec = m.prediction_interval
+    assert rec["noise_std"] < given / 2
+    assert rec["noise_floor"] == pytest.approx(given)
+    X = np.array([[0.3, 0.0, 25.0], [-1.0, 0.0, 25.0]])
+    half = m.predict_interval(X, 0.95, warn=False).half_width
+    # six scores per direction are too few for the rank: the multiplier of the known
+    # noise is the normal quantile, not the Student-t one of 10 residual dof
+    assert rec["scale"]["student_t"] == [False, True]  # 12 scores: a rank at 90 %, not 95 %
+    assert np.all(half >= 1.959 * given)
+    assert np.all(half < stats.t.ppf(0.975, rec["dof"]) * given)

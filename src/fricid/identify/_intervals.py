@@ -29,6 +29,16 @@ few scores for the rank (under 19 at 95 %) ``k`` is the Student-t quantile with 
 degrees of freedom: the largest of a dozen scores, most of them pulled towards zero by a fit
 of 3-5 parameters, is no quantile.
 
+The noise term is never below the measured scatter of a sample (``noise_floor``: given
+with the samples, or from repeated runs; not the estimate from second differences): the
+residuals of 10-30 samples fitted by 2-5 parameters may come out well below the noise by
+chance, or because ``auto`` picked the family whose residuals did (``s`` at half the noise
+gave 80 % on a tuning case of six speed levels). The noise of a new sample is the scatter;
+``s`` above it holds misfit as well, and stays. ``C`` is scaled with it. Where the scatter
+sets the noise term and the multiplier is the Student-t fall-back, the multiplier is the
+normal quantile: the noise is then known from the raw measurements behind every sample,
+not estimated from ``n - p`` residuals.
+
 Where the family misses the law by several times the noise, no multiplier makes an interval
 centred on it cover 95 %: at each speed the new sample is the fixed bias plus noise, covered
 with probability near 0 or near 1, and the share of speeds covered follows the shape of the
@@ -83,15 +93,18 @@ def jackknife_scale(
     m = z.size
     if m < 3:
         return None
-    scale = []
+    scale, student = [], []
     for level in levels:
-        if (m + 1) * float(level) <= m:
+        ranked = (m + 1) * float(level) <= m
+        student.append(not ranked)
+        if ranked:
             scale.append(float(np.quantile(z, float(level), method="weibull")))
         else:
             scale.append(_t_ppf(0.5 + level / 2, max(dof, 1)))
     return {
         "levels": list(levels),
         "scale": scale,
+        "student_t": student,
         "scores": int(m),
         "gross": int(gross.sum()),
         "method": "normalised jackknife (leave-one-out residuals by leverage)",
@@ -99,10 +112,18 @@ def jackknife_scale(
 
 
 def delta_record(
-    model_name: str, theta: np.ndarray, free: Sequence[str], X: np.ndarray, y: np.ndarray
+    model_name: str,
+    theta: np.ndarray,
+    free: Sequence[str],
+    X: np.ndarray,
+    y: np.ndarray,
+    noise_floor: float | None = None,
 ) -> dict[str, Any] | None:
     """The model file's ``prediction_interval`` of an analytic fit (module notes), or None
-    when there are no spare observations (``n <= p``) or the Jacobian is not finite."""
+    when there are no spare observations (``n <= p``) or the Jacobian is not finite.
+
+    ``noise_floor`` [N m]: the measured scatter of a sample (given, or from repeated runs),
+    stored as ``noise_floor`` (module notes)."""
     free = list(free)
     n, p = len(y), len(free)
     if n <= p:
@@ -131,4 +152,6 @@ def delta_record(
     scale = jackknife_scale(r, h, float(np.sqrt(s2)), n - p)
     if scale is not None:
         out["scale"] = scale
+    if noise_floor is not None and np.isfinite(noise_floor) and noise_floor > 0:
+        out["noise_floor"] = float(noise_floor)
     return out
