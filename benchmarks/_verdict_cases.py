@@ -229,7 +229,10 @@ class Case:
     sigma : callable
         The true noise std [N m] of a sample at inputs ``(v, load, T)``.
     spec : dict
-        The factors (design, repeats, noise, given, gravity, levels per direction, ...).
+        The factors (design, repeats, noise, given, gravity, levels per direction, ...);
+        ``gravity_amp`` [N m] is the amplitude ``a`` of the gravity offset ``a sin(phi)``,
+        ``phi`` uniform in (-pi/2, pi/2), that every sample of a gravity case carries (0
+        otherwise): a new measured sample of the same process carries one too.
     ranges : dict
         The measured operating range: ``pos`` and ``neg`` speed ``(min, max)`` (absent for
         a direction not measured), ``load`` and ``temperature`` ``(min, max)`` or None.
@@ -290,6 +293,7 @@ def make_case(case_id: int, klass: str, seed: int) -> Case:
     if spec["noise"] == "outliers":
         bad = rng.choice(v.size, size=2, replace=False)
         y[bad] += np.sign(y[bad]) * rng.uniform(10, 20, 2) * sd[bad]
+    amp = 0.0
     if spec["gravity"]:  # eq. 7's gravity at each run's mean position, left in
         amp = rng.uniform(0.1, 0.4) * level
         y = y + amp * np.sin(rng.uniform(-np.pi / 2, np.pi / 2, v.size))
@@ -305,7 +309,13 @@ def make_case(case_id: int, klass: str, seed: int) -> Case:
         source=f"case{case_id}",
         **kw,
     )
-    spec = {**spec, "law": law.name, "levels_pos": int(pos.size), "levels_neg": int(neg.size)}
+    spec = {
+        **spec,
+        "law": law.name,
+        "levels_pos": int(pos.size),
+        "levels_neg": int(neg.size),
+        "gravity_amp": float(amp),
+    }
     ranges: dict[str, Any] = {
         "pos": (float(pos.min()), float(pos.max())),
         "neg": (float(neg.min()), float(neg.max())),

@@ -18,9 +18,16 @@ model ratio
     the noise (0 for a perfect model); kept in the JSON beside the true ratio.
 coverage
     The expected coverage of the model's 95 % prediction interval ``[lo, hi]`` of a fresh
-    Gaussian sample ``F + sigma z`` at each grid point, ``Phi((hi - F)/sigma) -
-    Phi((lo - F)/sigma)``, averaged over the grid (exact, no draw); None when the fitted
-    model exposes no interval (:func:`prediction_interval`).
+    sample of the case's measurement process at each grid point, averaged over the grid
+    (exact, no draw); None when the fitted model exposes no interval
+    (:func:`prediction_interval`). The fresh sample is ``F + sigma z``, coverage
+    ``Phi((hi - F)/sigma) - Phi((lo - F)/sigma)``; in the gravity class it is ``F + a sin(phi)
+    + sigma z``, ``phi`` uniform in (-pi/2, pi/2) as every sample of the case was drawn
+    (``spec["gravity_amp"]``), the coverage averaged over ``phi`` by the midpoint rule. A
+    prediction interval is a statement about new measurements of the process the samples
+    come from; the samples carry no position, so no model of them can tell the offset from
+    noise, and measured against ``F + sigma z`` alone every honest interval over-covers.
+    The true ratio stays against ``F`` (friction, the offset excluded).
 """
 
 from __future__ import annotations
@@ -161,10 +168,25 @@ def _gp_interval(fitted, X, mean, level):
     return (mean - half, mean + half), "gp std + noise_std"
 
 
+def _coverage(lo, hi, truth, sigma, offset_amp: float = 0.0, nodes: int = 256) -> np.ndarray:
+    """Expected coverage of ``[lo, hi]`` at each point (module notes, "coverage")."""
+    if offset_amp <= 0:
+        return norm.cdf((hi - truth) / sigma) - norm.cdf((lo - truth) / sigma)
+    phi = -np.pi / 2 + np.pi * (np.arange(nodes) + 0.5) / nodes
+    centre = truth[None, :] + offset_amp * np.sin(phi)[:, None]
+    cov = norm.cdf((hi - centre) / sigma) - norm.cdf((lo - centre) / sigma)
+    return cov.mean(axis=0)
+
+
 def true_scores(
-    pred: np.ndarray, truth: np.ndarray, sigma: np.ndarray, band: tuple | None
+    pred: np.ndarray,
+    truth: np.ndarray,
+    sigma: np.ndarray,
+    band: tuple | None,
+    offset_amp: float = 0.0,
 ) -> dict[str, Any]:
-    """True ratio, model ratio and coverage (module notes)."""
+    """True ratio, model ratio and coverage (module notes); ``offset_amp`` the amplitude of
+    the gravity offset a fresh sample carries (0: none)."""
     mse = float(np.mean((pred - truth) ** 2))
     s2 = float(np.mean(sigma**2))
     out: dict[str, Any] = {
@@ -174,8 +196,7 @@ def true_scores(
     }
     if band is not None:
         lo, hi = band
-        cov = norm.cdf((hi - truth) / sigma) - norm.cdf((lo - truth) / sigma)
-        out["coverage"] = float(np.mean(cov))
+        out["coverage"] = float(np.mean(_coverage(lo, hi, truth, sigma, offset_amp)))
     return out
 
 
@@ -214,7 +235,13 @@ def run_model(case: Any, model: str, grid: np.ndarray) -> dict[str, Any]:
         true_sigma=float(np.sqrt(np.mean(sigma**2))),
         interval=None if got is None else got[1],
         reasons=trust.reasons[:3],
-        **true_scores(pred, truth, sigma, None if got is None else got[0]),
+        **true_scores(
+            pred,
+            truth,
+            sigma,
+            None if got is None else got[0],
+            float(case.spec.get("gravity_amp", 0.0)),
+        ),
     )
     row["seconds"] = time.perf_counter() - t0
     row["cpu_seconds"] = time.process_time() - c0

@@ -99,6 +99,22 @@ def test_truth_scores_on_known_answers():
     assert bv.truth_class(1.51) == ">1.5"
 
 
+def test_gravity_coverage_counts_the_offset_a_fresh_sample_carries():
+    """A fresh sample of a gravity case is ``F + a sin(phi) + sigma z``: an interval of
+    +-a sin(phi0) about the truth, noise negligible, covers ``P(|sin phi| <= sin phi0) =
+    2 phi0 / pi``; the gravity-free measure gave 1.0 for it."""
+    truth, sigma = np.linspace(1.0, 2.0, 50), np.full(50, 1e-6)
+    a, phi0 = 0.3, np.pi / 6
+    band = (truth - a * np.sin(phi0), truth + a * np.sin(phi0))
+    got = ve.true_scores(truth, truth, sigma, band, offset_amp=a)
+    assert got["coverage"] == pytest.approx(2 * phi0 / np.pi, abs=0.01)
+    assert got["true_ratio"] == pytest.approx(1.0)  # the verdict's truth: friction only
+    assert ve.true_scores(truth, truth, sigma, band)["coverage"] == pytest.approx(1.0)
+    case = vc.make_case(11, "gravity", 1011)
+    assert case.spec["gravity_amp"] > 0
+    assert vc.make_case(0, "regular", 1000).spec["gravity_amp"] == 0.0
+
+
 class _Stub:
     """A fitted model with an interval method, as an interval API added later might be."""
 

@@ -120,9 +120,10 @@ class FittedModel:
     selection : ``fit(samples, "auto")``'s comparison of candidate models
         (:mod:`fricid.identify.static.select`): the table, the choice and why; None otherwise.
     prediction_interval : what an analytic model's prediction intervals need (the delta
-        method: ``free``, their ``covariance``, ``noise_std`` [N m], ``dof``;
-        :mod:`fricid.fitted._interval`); None for the learned models (their intervals are in
-        ``state``) and files from before it was stored.
+        method: ``free``, their ``covariance``, ``noise_std`` [N m], ``dof``, and ``scale``,
+        the multiplier calibrated at levels 0.9 and 0.95; :mod:`fricid.fitted._interval`);
+        None for the learned models (their intervals are in ``state``) and files from
+        before it was stored.
     trust : the trust verdict and where each of its numbers came from
         (:class:`fricid.identify.trust.Trust`, ``to_dict()``), with what it was computed on
         (samples and model hashes, options); None when not assessed. ``fricid fit`` and the
@@ -236,7 +237,8 @@ class FittedModel:
         new measured sample falls with probability ``level``, measurement noise included.
 
         Analytic models: the delta method from the parameters' covariance and the residual
-        variance stored at the fit; ``gp``: its posterior with the fitted noise; ``rbf`` and
+        variance stored at the fit, its multiplier calibrated on the fit's leave-one-out
+        residuals; ``gp``: its posterior with the fitted noise; ``rbf`` and
         ``hybrid``: the conformal half-widths stored with the network (levels 0.9 and 0.95).
         See :mod:`fricid.fitted._interval`. Warns as :meth:`predict` does; outside the
         operating range the interval is not backed by data.

@@ -5,10 +5,14 @@ probability ``level``, measurement noise included
 One rule per kind of model, each from what the model file stores:
 
 - **analytic** (``prediction_interval`` of the file, method ``"delta"``): the delta method,
-  ``F(x) -+ t(dof) sqrt(g^T C g + s^2)``, ``g`` the gradient of ``F(x)`` in the free
+  ``F(x) -+ k sqrt(g^T C g + s^2)``, ``g`` the gradient of ``F(x)`` in the free
   parameters (central differences, one batch call), ``C`` their covariance
   ``s^2 (J^T J)^+`` at the optimum and ``s^2`` the residual variance ``SSE / (n - p)``
-  (Seber & Wild, *Nonlinear Regression*, 1989, section 5.1, eq. 5.7);
+  (Seber & Wild, *Nonlinear Regression*, 1989, section 5.1, eq. 5.7); ``k`` the multiplier
+  calibrated on the fit's own leave-one-out residuals where stored at that level (``scale``,
+  :mod:`fricid.identify._intervals`: a family that misses the law, or a few gross outliers,
+  no longer give intervals that cover everything), else ``t(dof)``; ``s`` never below
+  the measured scatter stored with the fit (``noise_floor``), ``C`` scaled with it;
 - **gp**: the posterior standard deviation of the latent friction with the fitted white noise
   added, ``F(x) -+ k sqrt(std^2 + noise_std^2)`` (Rasmussen & Williams 2006, eq. 2.24 with
   the noise of the observation), ``k`` the held-out multiplier stored with each process
@@ -103,9 +107,34 @@ def analytic_half_width(
     """
     G = gradient(model_name, theta, record["free"], X)
     C = np.asarray(record["covariance"], dtype=float)
-    var = np.einsum("pn,pq,qn->n", G, C, G) + float(record["noise_std"]) ** 2
-    q = _t_ppf(0.5 + level / 2, max(int(record["dof"]), 1))
-    return q * np.sqrt(np.maximum(var, 0.0))
+    s = float(record["noise_std"])
+    floor = record.get("noise_floor")
+    known = isinstance(floor, int | float) and floor > s
+    noise = float(floor) if known else s
+    grow = (noise / s) ** 2 if s > 0 else 1.0
+    var = grow * np.einsum("pn,pq,qn->n", G, C, G) + noise**2
+    return _delta_multiplier(record, level, known) * np.sqrt(np.maximum(var, 0.0))
+
+
+def _delta_multiplier(record: Mapping[str, Any], level: float, known: bool = False) -> float:
+    """The multiplier of the delta method's standard deviation at ``level``: the jackknife
+    calibration stored with the fit (``scale``) where stored at that level, else the
+    Student-t quantile with the fit's residual degrees of freedom; the normal quantile in
+    place of the Student-t one where the measured scatter sets the noise (``known``)."""
+    cal = record.get("scale")
+    if isinstance(cal, Mapping):
+        levels = [float(x) for x in cal.get("levels") or ()]
+        scale = list(cal.get("scale") or ())
+        student = list(cal.get("student_t") or ())
+        hits = [j for j, lv in enumerate(levels) if abs(lv - level) < 1e-9]
+        if hits and hits[0] < len(scale):
+            j = hits[0]
+            if known and j < len(student) and student[j]:
+                return _norm_ppf(0.5 + level / 2)
+            return max(float(scale[j]), 0.0)
+    if known:
+        return _norm_ppf(0.5 + level / 2)
+    return _t_ppf(0.5 + level / 2, max(int(record["dof"]), 1))
 
 
 def _gp_scale(st: Mapping[str, Any], level: float) -> tuple[float, float]:

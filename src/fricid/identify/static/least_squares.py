@@ -273,7 +273,14 @@ def fit(
         operating_range=operating_range(samples, X),
         provenance=provenance(samples),
         statistics=fit_statistics(y, y_hat, problem.n_free, w),
-        prediction_interval=delta_record(model.name, theta, problem.free_names, X, y),
+        prediction_interval=delta_record(
+            model.name,
+            theta,
+            problem.free_names,
+            X,
+            y,
+            None if scatter.estimated else scatter.value,
+        ),
         loss={
             "loss": "l2" if problem.loss == "sse" else problem.loss,
             "f_scale": problem.f_scale,
