@@ -92,6 +92,16 @@ estimated by simulation at the estimate (:mod:`._trajectory_rate`), recorded wit
 corrected values, and warned about (:class:`RateBiasWarning`) with the rate that removes
 it; not applied, as the correction over-corrects sigma_1 by about half (module notes there).
 
+Measurement model (:mod:`._encoder`): the encoder's counts per revolution are read from the
+position steps (or given, ``encoder_counts``) and recorded with the velocity's form and its
+quantisation error. The simulation at the estimate reads its motion through that encoder and
+gives every parameter's bias (the rate's, the encoder's and the PD loop's together); an
+interval the bias exceeds by a standard error is widened by it, a parameter it biases grossly
+is flagged not determined (:func:`._outcome.calibrate`). When the encoder does not resolve
+the bristles' deflection at break-away, the filtered estimate is refined by the output error
+of the joint simulated along the measured motion (:mod:`._output`, DIDIM), and the result
+names the estimator used (``provenance["trajectory"]["estimator"]``).
+
 What it recovers (``benchmarks/bench_trajectory.py``, run for the report: LuGre
 truth, 60 s multi-sine at 1 kHz, trajectory noise, ``lm``, seeds 0-4; coverage by the closed
 95 % intervals; shared 2-core machine). ``filtered``: every interval closed (sigma_1 too, at
