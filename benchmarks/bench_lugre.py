@@ -122,8 +122,11 @@ def _identify(log, seed: int, max_evals: int | None) -> dict:
     for n, row in fitted.provenance["trajectory"]["joint"].items():
         est[n] = {"value": row["value"], "ci95": [row["ci95_low"], row["ci95_high"]]}
         est[n]["closed"] = True
+    info = fitted.provenance["trajectory"]
     return {
         "estimates": est,
+        "estimator": info.get("estimator", {}).get("name", ""),
+        "output_error": bool(info.get("output_error", {}).get("applied")),
         "converged": bool(fitted.converged),
         "seconds": seconds,
         "warnings": sorted({w.category.__name__ for w in caught}),

@@ -54,8 +54,10 @@ DAMPING = 0.7
 #: the bristles (the equation error's drive is then wrong by a sizeable part of it).
 RESOLVED_COUNTS = 10.0
 
-#: Evaluation budget of the output-error search when none is given.
-MAX_EVALS = 400
+#: Evaluation budget of the output-error search when none is given (400 left 4 of 18
+#: benchmark fits short of a certified optimum: the polish still moved them 0.2 standard
+#: errors).
+MAX_EVALS = 1000
 
 
 def needs_output_error(stage: _Stage, encoder: dict[str, Any], dt: float) -> dict[str, Any]:
