@@ -161,7 +161,7 @@ def test_the_result_names_its_encoder_and_estimator(tmp_path):
     assert said["name"].startswith("DIDIM output error") and said["bias"].startswith("checked")
 
 
-@pytest.mark.slow  # 4 s measured (one fit through the command line)
+@pytest.mark.slow  # 6 s measured under load (one fit through the command line)
 def test_cli_takes_the_encoder_counts(tmp_path):
     from fricid.io.tables import write_rawlog
 
@@ -175,7 +175,7 @@ def test_cli_takes_the_encoder_counts(tmp_path):
     assert "encoder: 1048576 counts/rev (given)" in res.output
 
 
-@pytest.mark.slow  # about a minute on 2 shared cores (two fits of a 20 s log, simulation route)
+@pytest.mark.slow  # 51 s measured under load (two fits of a 20 s log, one by output error)
 def test_output_error_recovers_what_a_coarse_encoder_hides_from_the_equation_error():
     """The independent simulator's geared joint, PD-tracked chirp, 2^17 counts/rev, 20 s:
     the equation error alone puts sigma_1 and tau_s off by more than a third; the output
