@@ -116,6 +116,12 @@ def test_output_error_is_needed_when_the_encoder_does_not_resolve_the_bristles()
     fine = needs_output_error(stage, {"quantum": 2 * math.pi / 2**24}, 1e-3)
     assert not fine["needed"] and fine["breakaway_counts"] > 200
     assert not needs_output_error(stage, {"quantum": None}, 1e-3)["needed"]
+    # the equation error's sigma_0, biased low by the coarse encoder, makes the deflection
+    # look resolved (12 counts); one count per sample, 0.048 rad/s, is still over half w_s
+    biased = stage_of({**values, "sigma_0": 4.3e3, "tau_s": 2.47, "w_s": 0.0686},
+                      dict.fromkeys(values, 0.01))  # fmt: skip
+    said = needs_output_error(biased, {"quantum": Q17}, 1e-3)
+    assert said["breakaway_counts"] > 10 and said["needed"]
 
 
 def test_bias_check_reads_the_simulation_through_the_logs_encoder(monkeypatch):
