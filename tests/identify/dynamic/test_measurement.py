@@ -57,6 +57,10 @@ def test_encoder_is_read_from_the_position_steps_or_given():
     assert given["counts_per_rev"] == 2**20 and given["source"] == "option"
     assert given["velocity_form"] == "central"
     assert measurement(q, np.cos(t), 1e-3, None)["source"] == "none found"
+    # a log written with 7 decimals: the steps a few thousandths of a count off, still read
+    written, v7 = np.round(qq, 7), np.round(v, 7)
+    read7 = measurement(written, v7, 1e-3, None)
+    assert read7["counts_per_rev"] == 2**17 and read7["velocity_form"] == "backward"
     with pytest.raises(ConfigError, match="encoder_counts"):
         measurement(qq, v, 1e-3, -5.0)
 

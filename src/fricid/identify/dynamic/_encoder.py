@@ -31,8 +31,14 @@ from ...errors import ConfigError
 
 __all__ = ["VELOCITY_FORMS", "encoder_quantum", "measurement", "quantise", "velocity_form"]
 
-#: Largest distance of a step's count from a whole number for the log to read as quantised.
-COUNT_TOLERANCE = 1e-3
+#: Largest distance of a step's count from a whole number for the log to read as quantised
+#: (a log written with 7 decimals puts a 2^17 count's steps up to 0.0022 off; a continuous
+#: position has steps at every fraction of a count).
+COUNT_TOLERANCE = 0.05
+
+#: Relative distance of the counts read from a power of two within which they are taken as
+#: that power (a log written with 7 decimals read 2^20 as 1048597: 2e-5 off).
+POWER_SNAP = 1e-4
 
 #: Fewest non-zero position steps from which a quantum is read.
 MIN_STEPS = 20
@@ -47,7 +53,7 @@ def encoder_quantum(position: np.ndarray) -> float | None:
 
     The smallest non-zero step is the candidate; the log is quantised when every step is a
     whole multiple of it (within :data:`COUNT_TOLERANCE` of a count: positions written with
-    12 significant digits keep that).
+    a few decimals keep that).
     """
     steps = np.abs(np.diff(np.asarray(position, dtype=float)))
     scale = float(np.max(np.abs(position))) if np.size(position) else 0.0
@@ -58,8 +64,15 @@ def encoder_quantum(position: np.ndarray) -> float | None:
     counts = nonzero / quantum
     if np.max(np.abs(counts - np.round(counts))) > COUNT_TOLERANCE:
         return None
-    # refine on the single-count steps (their mean is the quantum to rounding)
-    return float(np.mean(nonzero[np.round(counts) == 1]))
+    # refine by the positions themselves: q_k = offset + quantum c_k over the whole span of
+    # counts (a written log's rounding of each position then averages out)
+    q = np.asarray(position, dtype=float)
+    quantum = float(np.mean(nonzero[np.round(counts) == 1]))  # the single-count steps first
+    c = np.round((q - q[0]) / quantum)
+    if np.ptp(c) < 1:
+        return quantum
+    slope = np.polyfit(c, q, 1)[0]
+    return float(slope)
 
 
 def velocity_form(position: np.ndarray, velocity: np.ndarray, dt: float) -> str:
@@ -67,9 +80,10 @@ def velocity_form(position: np.ndarray, velocity: np.ndarray, dt: float) -> str:
     dt``), ``central`` (:func:`numpy.gradient`) or ``logged`` (neither: the drive's own)."""
     scale = max(float(np.max(np.abs(velocity))), 1e-12)
     back = np.diff(position) / dt
-    if np.max(np.abs(velocity[1:] - back)) <= 1e-6 * scale:
+    tol = 1e-3 * scale  # the columns' rounding in a written log
+    if np.max(np.abs(velocity[1:] - back)) <= tol:
         return "backward"
-    if np.max(np.abs(velocity - np.gradient(position, dt))) <= 1e-6 * scale:
+    if np.max(np.abs(velocity - np.gradient(position, dt))) <= tol:
         return "central"
     return "logged"
 
@@ -122,7 +136,10 @@ def measurement(
             "velocity_form": form,
         }
     counts = 2.0 * math.pi / quantum
-    if abs(counts - round(counts)) <= 1e-3 * counts:
+    power = 2.0 ** round(math.log2(counts))
+    if source != "option" and abs(counts / power - 1.0) <= POWER_SNAP:
+        counts, quantum = power, 2.0 * math.pi / power  # a binary encoder, read to rounding
+    elif abs(counts - round(counts)) <= 1e-3 * counts:
         counts = float(round(counts))
     offset = float(position[0] - np.round(position[0] / quantum) * quantum)
     std = quantum / math.sqrt(12.0)
