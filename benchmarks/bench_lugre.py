@@ -71,6 +71,14 @@ run on, geared trapezoid seed 1, re-run with ``--truths geared --kinds trapezoid
 --first-seed 1 --seeds 1``: covered 3 -> 5 of 10, sigma_1 x37 -> x15, tau_s +37 % -> +3.4 %,
 held-out torque 6.15 -> 2.67 times the noise.)
 
+The foreign logs (``--foreign-only``, 20 s each; before -> after, covered of 10): trapezoid
+2^17 5 -> 7 (sigma_0 x11 -> -6 %, sigma_1 -99.9 % -> +64 %, J +14 % -> -0.04 %, held-out
+equation error 22.8 -> 4.1, truth 3.84), chirp 2^17 5 -> 8 (tau_s +221 % -> +2 %, sigma_1
++146 % -> -3.7 %, 11.5 -> 3.75, truth 3.7), chirp 2^20 6 -> 8 (tau_s +221 % -> +1.7 %), but
+trapezoid 2^20 7 -> 5: the output error ran there (one count per sample over half the
+estimated w_s) and moved sigma_1 from +0.4 % to +61 % (the trapezoid's dwells, as on the
+2^17 logs); 23/40 -> 28/40 in all.
+
 Median errors, chirp, before -> after: sigma_0 -21 % -> -2.6 %, sigma_1 +107 % -> -0.6 %,
 sigma_2 -24 % -> -0.08 %, tau_c +41 % -> +0.01 %, J -0.07 % -> +0.001 %; trapezoid: sigma_0
 -59 % -> -23 %, sigma_1 +502 % -> +284 %, sigma_2 +7.7 % -> +0.24 %, tau_c -1.7 % -> -0.05
