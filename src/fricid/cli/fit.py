@@ -175,6 +175,14 @@ def fit_command(
         list[str] | None,
         typer.Option("--reader-option", help="--trajectory: a reader option KEY=VALUE."),
     ] = None,
+    encoder_counts: Annotated[
+        float | None,
+        typer.Option(
+            "--encoder-counts",
+            help="--trajectory: the encoder's counts per revolution (default: read from the "
+            "log's position steps; recorded in the model file).",
+        ),
+    ] = None,
 ) -> None:
     """Identify a friction model from samples (or, with --trajectory, a log) and write it as a
     JSON model file.
@@ -221,6 +229,7 @@ def fit_command(
             gravity="fit",
             out=out,
             quiet=quiet,
+            encoder_counts=encoder_counts,
         )
     from ..io import read_samples
     from ..workflow import fit_samples, select_direction

@@ -73,10 +73,37 @@ def trajectory_text(fitted) -> str:
             f"{rb['internal_rate']:.6g} Hz inside; not applied): "
             + ", ".join(_rate_bias(n, rb[n], fitted.params.get(n)) for n in ("sigma_0", "sigma_1"))
         )
+    lines.extend(_measurement_lines(info))
     p = info.get("passivity")
     if p:
         lines.append(f"    passivity: {_passivity(p)}")
     return "\n".join(lines)
+
+
+def _measurement_lines(info: dict) -> list[str]:
+    """The encoder, the output-error decision and the estimator, one line each."""
+    out = []
+    enc = info.get("encoder")
+    if enc and enc.get("counts_per_rev"):
+        out.append(
+            f"    encoder: {enc['counts_per_rev']:.10g} counts/rev (from the {enc['source']}"
+            if enc["source"] == "position steps"
+            else f"    encoder: {enc['counts_per_rev']:.10g} counts/rev (given"
+        )
+        out[-1] += f"), velocity {enc['velocity_form']}"
+        if enc.get("velocity_std") is not None:
+            out[-1] += f" (quantisation error {enc['velocity_std']:.3g} rad/s RMS)"
+    elif enc:
+        out.append("    encoder: no quantisation found in the position steps")
+    oe = info.get("output_error")
+    if oe and "breakaway_counts" in oe:
+        done = "applied" if oe["applied"] else "not applied"
+        out.append(f"    output error (DIDIM): {done}; {oe['why']}")
+    est = info.get("estimator")
+    if est:
+        out.append(f"    estimator: {est['name']}")
+        out.append(f"    closed-loop and quantisation bias: {est['bias']}")
+    return out
 
 
 def _interval(row: dict, why: str) -> str:
@@ -163,6 +190,7 @@ def run_trajectory(
     gravity: str,
     out: Path | None,
     quiet: bool = False,
+    encoder_counts: float | None = None,
 ) -> None:
     """Open, identify, save and print (the ``--trajectory`` branch of ``fricid fit``), with
     the stage under way on stderr (:func:`fricid.cli._progress.tracker`; ``quiet``: none)."""
@@ -189,7 +217,12 @@ def run_trajectory(
             method,
             seed=seed,
             max_evals=max_evals,
-            settings={"route": route, "gravity": gravity, "progress": progress},
+            settings={
+                "route": route,
+                "gravity": gravity,
+                "progress": progress,
+                **({"encoder_counts": encoder_counts} if encoder_counts is not None else {}),
+            },
         )
     lines = [f"{w.category.__name__}: {w.message}" for w in caught]
     if lines:

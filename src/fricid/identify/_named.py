@@ -46,6 +46,8 @@ SETTINGS: dict[str, tuple[str, ...]] = {
         "n_sub",
         "cluster_time",
         "rate_bias",
+        "encoder_counts",
+        "output_error",
         "progress",
     ),
     "auto": ("scheme", "scatter", "learned", "progress"),

@@ -1,10 +1,25 @@
 """What a trajectory identification reports beside its parameters: convergence of its stages
-(certified as an analytic fit's), LuGre's passivity (Barabanov and Ortega 2000), and the log
-rate's bias of sigma_0, sigma_1.
+(certified as an analytic fit's), LuGre's passivity (Barabanov and Ortega 2000), the bias of
+the log's rate, encoder and closed loop found by simulation at the estimate, and what it does
+to the intervals.
+
+Calibration by that bias (:func:`calibrate`). The simulation at the estimate
+(:mod:`._rate`: the joint with the estimate as its truth, tracking the measured motion under
+PD, logged at the log's rate through the log's encoder, identified again by the same route)
+gives each parameter's bias ``b`` in the search's coordinates (log10 for sigma_0, sigma_1).
+It is not subtracted (for sigma_1 it over-corrects by about half, :mod:`._rate`, and it is
+evaluated at a noisy estimate), but where it exceeds the parameter's standard error the 95 %
+interval is widened to cover the corrected one as well: ``[min(lo, lo - b), max(hi, hi -
+b)]`` (an interval for the truth under either reading: the estimate unbiased, or biased by
+``b``). Where the bias is gross (:data:`GROSS`: more than a factor of two on the log scale, more
+than the value itself on the linear one, or a corrected value outside the search box; not
+for p_x and p_y, which may be zero) the parameter is flagged not determined: the estimator
+cannot tell it from the log.
 """
 
 from __future__ import annotations
 
+import math
 import warnings
 from typing import Any
 
@@ -18,7 +33,9 @@ __all__ = [
     "RATE_BIAS_WARN",
     "PassivityWarning",
     "RateBiasWarning",
+    "calibrate",
     "converged",
+    "estimator",
     "passivity",
     "warn_rate_bias",
 ]
@@ -38,25 +55,122 @@ RATE_BIAS = ("warn", "off")
 #: Warn when the estimated rate bias exceeds this many standard errors (log10 scale).
 RATE_BIAS_WARN = 0.5
 
+#: Widen an interval when the simulated bias exceeds this many standard errors.
+WIDEN = 1.0
 
-def warn_rate_bias(stage, rb: dict[str, Any]) -> None:
-    """One line when the rate bias of sigma_0 or sigma_1 is a sizeable part of its interval."""
-    parts = []
+#: Gross biases (module notes): log10 scale, relative on the linear scale.
+GROSS = {"log10": math.log10(2.0), "linear": 1.0}
+
+
+def _search_se(stage, i: int, scale: str) -> float:
+    """The standard error of parameter ``i`` in the search's coordinates."""
+    se = float(stage.stderr[i])
+    return se / (float(stage.values[i]) * math.log(10.0)) if scale == "log10" else se
+
+
+def calibrate(stage, rb: dict[str, Any]) -> dict[str, str]:
+    """Widen ``stage``'s intervals (in place) by the simulated bias, or flag a parameter not
+    determined (module notes); returns the parameters' notes and records each verdict in
+    ``rb["parameters"][name]["verdict"]`` (``kept``, ``widened``, ``not determined``)."""
+    notes: dict[str, str] = {}
+    for i, name in enumerate(stage.names):
+        row = rb.get("parameters", {}).get(name)
+        if row is None:
+            continue
+        b, scale = row["bias"], row["scale"]
+        se = _search_se(stage, i, scale)
+        row["in_stderr"] = abs(b) / se if se > 0 else float("inf")
+        row["verdict"] = "kept"
+        if not (math.isfinite(se) and abs(b) > WIDEN * se):
+            continue
+        lo, hi, box = stage.low[i], stage.high[i], stage.bounds[i]
+        if scale == "log10":
+            lo, hi, box = np.log10(lo), np.log10(hi), np.log10(box)
+        size = abs(b) if scale == "log10" else abs(b) / max(abs(stage.values[i]), 1e-300)
+        corrected = stage.values[i] * 10.0 ** (-b) if scale == "log10" else stage.values[i] - b
+        outside = not (stage.bounds[i][0] <= corrected <= stage.bounds[i][1])
+        said = f"{100 * row['relative']:+.3g} %, {row['in_stderr']:.2g} standard errors"
+        if name not in ("p_x", "p_y") and (size > GROSS[scale] or outside):
+            row["verdict"] = "not determined"
+            notes[name] = (
+                f"not determined: the simulation at the estimate (the log's rate and encoder, "
+                f"PD-tracked) biases it by {said}"
+            )
+        else:
+            row["verdict"] = "widened"
+            notes[name] = f"interval widened by the bias simulated at the estimate ({said})"
+        lo, hi = max(min(lo, lo - b), box[0]), min(max(hi, hi - b), box[1])
+        if scale == "log10":
+            lo, hi = 10.0**lo, 10.0**hi
+        stage.low[i], stage.high[i] = lo, hi
+    return notes
+
+
+def warn_rate_bias(stage, rb: dict[str, Any], notes: dict[str, str] | None = None) -> None:
+    """One line when the simulated bias of a parameter is a sizeable part of its interval,
+    with the numbers and what was done to the intervals."""
     if "skipped" in rb:
         return
-    for i, n in enumerate(("sigma_0", "sigma_1")):
-        se_log = stage.stderr[i] / (stage.values[i] * np.log(10.0))
-        if abs(rb[n]["log10_bias"]) > RATE_BIAS_WARN * se_log:
-            parts.append(f"{n} {100 * rb[n]['relative']:+.2g} %")
-    if parts:
-        warnings.warn(
-            f"logging at {rb['log_rate']:.6g} Hz biases {', '.join(parts)}, as estimated by "
-            "simulation at the estimate (the break-away between samples; over half a "
-            "standard error; corrected values in the provenance): log at "
-            f"{10 * rb['log_rate']:.6g} Hz or faster to remove it",
-            RateBiasWarning,
-            stacklevel=user_stacklevel(),
+    rows = rb.get("parameters") or {n: {**rb[n], "bias": rb[n]["log10_bias"]} for n in LOG2}
+    parts = []
+    for i, n in enumerate(stage.names):
+        row = rows.get(n)
+        if row is None:
+            continue
+        se = _search_se(stage, i, row.get("scale", "log10"))
+        if abs(row["bias"]) > RATE_BIAS_WARN * se:
+            parts.append(f"{n} {100 * row['relative']:+.2g} % ({abs(row['bias']) / se:.2g} se)")
+    if not parts:
+        return
+    cpr = rb.get("quantised")
+    what = f"logging at {rb['log_rate']:.6g} Hz" + (
+        f" through an encoder of {cpr:.8g} counts/rev" if cpr else ""
+    )
+    done = sorted(notes or {})
+    warnings.warn(
+        f"{what} biases {', '.join(parts)}, as estimated by simulation at the estimate "
+        "under the log's drive (corrected values in the provenance, not applied)"
+        + (f"; intervals widened or flagged not determined: {', '.join(done)}" if done else "")
+        + f"; log at {10 * rb['log_rate']:.6g} Hz"
+        + (" with a finer encoder" if cpr else "")
+        + " to reduce it",
+        RateBiasWarning,
+        stacklevel=user_stacklevel(),
+    )
+
+
+#: sigma_0 and sigma_1, the parameters of a rate-bias record without every parameter's.
+LOG2 = ("sigma_0", "sigma_1")
+
+
+def estimator(key: str, route: str, sim_info: dict[str, Any]) -> dict[str, str]:
+    """Which estimator gave the parameters, and whether the bias of the log's rate, encoder
+    and closed loop was checked by simulation at the estimate."""
+    names = {
+        "filtered": "IDIM-LS: parallel-filtered equation error (Gautier, Janot and "
+        "Vandanjon 2013), the bristle state driven by the measured motion",
+        "two_stage": "equation-error regression, then simulation error in windows",
+        "joint": "simulation error in windows (every parameter)",
+        "regression": "equation-error regression on the sliding samples",
+    }
+    name = names.get(route if key != "dahl" else "filtered", route)
+    if (sim_info.get("output_error") or {}).get("applied"):
+        name = (
+            "DIDIM output error (Gautier, Janot and Vandanjon 2013): the joint simulated under "
+            "the measured torque with PD tracking of the measured position, started from "
+            + name.split(":")[0]
         )
+    rb = sim_info.get("rate_bias")
+    if rb is None:
+        check = "not checked: equation error under closed loop or a coarse encoder can be biased"
+    elif "skipped" in rb:
+        check = f"not checked: {rb['skipped']}"
+    else:
+        check = (
+            "checked by simulation at the estimate (PD tracking the measured motion, the "
+            "log's rate and encoder); intervals widened by it"
+        )
+    return {"name": name, "bias": check}
 
 
 def passivity(names: list[str], values, low, high) -> dict[str, Any]:

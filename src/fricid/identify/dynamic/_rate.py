@@ -40,6 +40,7 @@ one re-identification from the estimate: about the filtered route's own time aga
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import replace
 from typing import Any
 
@@ -48,6 +49,7 @@ import numpy as np
 from ...errors import FricidError
 from ...models import lugre
 from ._data import Series
+from ._encoder import measured_velocity, quantise
 from ._filtered import LOG_BOX, ParallelFilter, filtered_route
 from ._routes import _Stage
 
@@ -69,6 +71,8 @@ def rate_bias(
     seed: int,
     n_sub: int,
     filt: ParallelFilter,
+    encoder: dict[str, Any] | None = None,
+    refine: Callable[[Series, _Stage], tuple[_Stage, Any, Any]] | None = None,
 ) -> dict[str, Any]:
     """The filtered route's discretisation bias of sigma_0 and sigma_1 (module notes).
 
@@ -80,13 +84,24 @@ def rate_bias(
         The filtered route's estimate (LuGre's seven parameters, then J, p_x, p_y).
     static_bounds, gravity, method, seed, n_sub, filt
         As given to :func:`._trajectory_filtered.filtered_route`.
+    encoder : dict, optional
+        The log's measurement model (:func:`._encoder.measurement`): with a ``quantum`` the
+        simulated position is read by the same encoder and the velocity formed from it as the
+        log's was, so the bias includes the quantisation's.
+    refine : callable, optional
+        The step after the filtered route that gave ``stage`` (the output error,
+        :mod:`._output`), ``refine(series, stage) -> (stage, y, r)``: the re-identification
+        is then that step, from the estimate.
 
     Returns
     -------
     dict
         ``sigma_0`` and ``sigma_1``: ``{"log10_bias", "relative", "corrected"}`` (the bias on
         the log10 scale, as a relative change ``10**b - 1``, and ``10**(2 log10 theta_hat -
-        log10 theta*)``); ``internal_rate`` [Hz], ``log_rate`` [Hz], ``seconds`` of the
+        log10 theta*)``); ``parameters``: every parameter of the stage by name, ``{"bias",
+        "relative", "corrected", "scale"}`` (the bias in the search's coordinates, ``scale``
+        ``log10`` or ``linear``); ``quantised``: the encoder's counts per revolution
+        applied (None: none); ``internal_rate`` [Hz], ``log_rate`` [Hz], ``seconds`` of the
         re-identification's route; or, instead of the estimates, ``skipped`` with the reason
         (the simulation at the estimate diverged, or its identification failed).
     """
@@ -109,19 +124,28 @@ def rate_bias(
         gains=GAINS,
         n_sub=SUB_STEPS,
     )
+    quantum = (encoder or {}).get("quantum")
     out: dict[str, Any] = {"internal_rate": SUB_STEPS / dt, "log_rate": 1.0 / dt}
+    out["quantised"] = (encoder or {}).get("counts_per_rev") if quantum else None
     if not all(np.isfinite(sim[k]).all() for k in ("position", "velocity", "torque")):
         return {**out, "skipped": "the simulation at the estimate diverged"}
-    again = replace(
-        series, position=sim["position"], velocity=sim["velocity"], torque=sim["torque"]
-    )
+    position, velocity = sim["position"], sim["velocity"]
+    if quantum:
+        position = quantise(position, quantum, encoder.get("offset", 0.0))
+        velocity = measured_velocity(position, velocity, dt, encoder["velocity_form"])
+    again = replace(series, position=position, velocity=velocity, torque=sim["torque"])
     try:
-        redo, _, _ = filtered_route(
-            again, theta, static_bounds, gravity, method, seed, None, 0.5, n_sub, filt
-        )
+        if refine is None:
+            redo, _, _ = filtered_route(
+                again, theta, static_bounds, gravity, method, seed, None, 0.5, n_sub, filt
+            )
+        else:  # the step that gave the estimate, from it (the simulation's truth)
+            redo, _, _ = refine(again, stage)
+        seconds = redo.seconds
     except FricidError as exc:
         return {**out, "skipped": f"the re-identification failed: {exc}"}
-    out["seconds"] = redo.seconds
+    out["seconds"] = seconds
+    out["parameters"] = _biases(stage, redo)
     for i, name in enumerate(LOG_BOX):
         b = float(np.log10(redo.values[i]) - np.log10(theta[i]))
         out[name] = {
@@ -129,4 +153,25 @@ def rate_bias(
             "relative": float(10.0**b - 1.0),
             "corrected": float(theta[i] * 10.0 ** (-b)),
         }
+    return out
+
+
+def _biases(stage: _Stage, redo: _Stage) -> dict[str, dict[str, Any]]:
+    """Every parameter's bias ``redo - stage`` in the search's coordinates (log10 for those
+    of :data:`LOG_BOX`), as a relative change, and the value it corrects the estimate to."""
+    out = {}
+    for i, name in enumerate(stage.names):
+        v, w = float(stage.values[i]), float(redo.values[i])
+        if name in LOG_BOX:
+            b = float(np.log10(w) - np.log10(v))
+            out[name] = {
+                "bias": b,
+                "relative": float(10.0**b - 1.0),
+                "corrected": float(v * 10.0 ** (-b)),
+                "scale": "log10",
+            }
+        else:
+            b = w - v
+            rel = b / abs(v) if v != 0 else float("nan")
+            out[name] = {"bias": b, "relative": rel, "corrected": v - b, "scale": "linear"}
     return out

@@ -96,6 +96,7 @@ def build_result(
             bounds_out,
             None if convergence is None else convergence["converged"],
             note="" if ok else NO_INTERVAL,
+            notes=options.get("notes") or {},
         ),
         ci_method=(
             "cluster-robust" + (", two-step" if key == "lugre" and route != "filtered" else "")
@@ -129,8 +130,9 @@ def build_result(
     joint_tab = {
         n: row for n, row in (last_regression or [stage1])[-1].table().items() if n in JOINT_PARAMS
     }
-    if "filtered" in stages:
-        joint_tab = {n: r for n, r in stages["filtered"].table().items() if n in JOINT_PARAMS}
+    for name in ("filtered", "output_error"):
+        if name in stages:
+            joint_tab = {n: r for n, r in stages[name].table().items() if n in JOINT_PARAMS}
     if "simulation_joint" in stages:
         joint_tab.update(
             {n: r for n, r in stages["simulation_joint"].table().items() if n in JOINT_PARAMS}
@@ -197,11 +199,13 @@ def _records(
     bounds: dict[str, list[float]],
     converged: bool | None,
     note: str = "",
+    notes: dict[str, str] | None = None,
 ) -> dict[str, Parameter]:
     """One :class:`~fricid.fitted.Parameter` per name of the final table: value, standard
     error, the cluster-robust 95 % interval (its ends open where they reach the search box),
     and at a bound where the value is within ``1e-6`` relative of one; ``note`` says why an
-    interval is missing (an unconverged fit's: no end is then open). A parameter whose
+    interval is missing (an unconverged fit's: no end is then open); ``notes`` a parameter's
+    own (the bias check's: widened, or not determined). A parameter whose
     interval spans the whole search box is not identified, as an analytic fit says it."""
     out = {}
     for n in names:
@@ -210,7 +214,7 @@ def _records(
         low, high = float(row["ci95_low"]), float(row["ci95_high"])
         low_open = box is not None and not note and bool(low <= box[0])
         high_open = box is not None and not note and bool(high >= box[1])
-        why = note
+        why = note or (notes or {}).get(n, "")
         if low_open and high_open:  # as an analytic fit says it (static.uncertainty)
             why = (
                 "not identified: the 95 % interval spans the whole search range "

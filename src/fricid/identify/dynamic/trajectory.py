@@ -92,6 +92,16 @@ estimated by simulation at the estimate (:mod:`._trajectory_rate`), recorded wit
 corrected values, and warned about (:class:`RateBiasWarning`) with the rate that removes
 it; not applied, as the correction over-corrects sigma_1 by about half (module notes there).
 
+Measurement model (:mod:`._encoder`): the encoder's counts per revolution are read from the
+position steps (or given, ``encoder_counts``) and recorded with the velocity's form and its
+quantisation error. The simulation at the estimate reads its motion through that encoder and
+gives every parameter's bias (the rate's, the encoder's and the PD loop's together); an
+interval the bias exceeds by a standard error is widened by it, a parameter it biases grossly
+is flagged not determined (:func:`._outcome.calibrate`). When the encoder does not resolve
+the bristles' deflection at break-away, the filtered estimate is refined by the output error
+of the joint simulated along the measured motion (:mod:`._output`, DIDIM), and the result
+names the estimator used (``provenance["trajectory"]["estimator"]``).
+
 What it recovers (``benchmarks/bench_trajectory.py``, run for the report: LuGre
 truth, 60 s multi-sine at 1 kHz, trajectory noise, ``lm``, seeds 0-4; coverage by the closed
 95 % intervals; shared 2-core machine). ``filtered``: every interval closed (sigma_1 too, at
@@ -150,13 +160,18 @@ from ...fitted import FittedModel
 from ...models import dahl, get_model, lugre
 from ...samples import RawLog, check_trajectory_log
 from ._data import DerivativeFilter, derivatives, dilate, uniform_series
+from ._encoder import measurement
 from ._filtered import DAHL, LUGRE, ParallelFilter, filtered_route
 from ._outcome import (
     RATE_BIAS,
     PassivityWarning,
     RateBiasWarning,
+    calibrate,
+    estimator,
     warn_rate_bias,
 )
+from ._output import needs_output_error
+from ._output import output_error as _output_error
 from ._rate import rate_bias as _rate_bias
 from ._result import build_result
 from ._routes import JOINT_PARAMS, _regression
@@ -173,6 +188,9 @@ __all__ = [
 
 #: Routes of :func:`fit_trajectory` (the first is LuGre's default).
 ROUTES = ("filtered", "two_stage", "joint", "regression")
+
+#: Settings of the output-error step (``output_error=``).
+OUTPUT_ERROR = ("auto", "on", "off")
 
 #: Static models a trajectory identifies by regression.
 STATIC_MODELS = ("stribeck", "coulomb_viscous")
@@ -211,6 +229,8 @@ def fit_trajectory(
     seed: int = 0,
     max_evals: int | None = None,
     rate_bias: str = "warn",
+    encoder_counts: float | None = None,
+    output_error: str = "auto",
     progress: Callable[[int, int, str], Any] | None = None,
 ) -> FittedModel:
     """Identify a joint's friction, inertia and gravity from a trajectory (module notes).
@@ -262,7 +282,20 @@ def fit_trajectory(
         (:func:`._trajectory_rate.rate_bias`, about the route's own time again), recorded
         in ``provenance["trajectory"]["rate_bias"]`` with the corrected values (not
         applied), and warned about (:class:`RateBiasWarning`) when it exceeds
-        :data:`RATE_BIAS_WARN` standard errors; ``off`` skips it.
+        :data:`RATE_BIAS_WARN` standard errors; ``off`` skips it. The same simulation
+        reads the motion through the log's encoder (``encoder_counts``) and gives every
+        parameter's bias; an interval the bias exceeds by a standard error is widened by it,
+        a parameter biased grossly is flagged not determined (:func:`._outcome.calibrate`).
+    encoder_counts : float, optional
+        The encoder's counts per revolution; default: read from the position steps
+        (:func:`._encoder.encoder_quantum`; none when the steps share no quantum). Recorded
+        in ``provenance["trajectory"]["encoder"]``.
+    output_error : {"auto", "on", "off"}
+        LuGre's filtered route: refine every parameter by the output error of the joint
+        simulated along the measured motion (:mod:`._output`, DIDIM); ``auto`` (default) when
+        the encoder is too coarse for the equation error at its estimate
+        (:func:`._output.needs_output_error`). Recorded in
+        ``provenance["trajectory"]["output_error"]``.
     progress : callable, optional
         ``progress(i, n, label)`` as the ``i``-th (0-based) of the route's ``n`` stages
         starts (the log's derivatives, the regression, the filtered or simulation route,
@@ -300,6 +333,8 @@ def fit_trajectory(
         raise ConfigError("LuGre's sigma_0 and sigma_1 need the simulation route (two_stage)")
     if gravity not in ("fit", "none"):
         raise ConfigError(f"gravity must be 'fit' or 'none', got '{gravity}'")
+    if output_error not in OUTPUT_ERROR:
+        raise ConfigError(f"output_error must be auto, on or off, got '{output_error}'")
     if rate_bias not in RATE_BIAS:
         raise ConfigError(f"rate_bias must be 'warn' or 'off', got '{rate_bias}'")
     derivative = derivative or DerivativeFilter()
@@ -309,6 +344,7 @@ def fit_trajectory(
     check_trajectory_log(log)  # holes, grid size, stuck torque: before any allocation
     series = uniform_series(log)
     rate = 1.0 / series.dt
+    encoder = measurement(series.position, series.velocity, series.dt, encoder_counts)
     vf, acc = derivatives(series, derivative)
     half = (
         derivative.samples(rate) // 2
@@ -356,6 +392,7 @@ def fit_trajectory(
         if n in static_model.param_names
     }
     sim_info: dict[str, Any] = {}
+    notes: dict[str, str] = {}
     y, yhat = series.torque[mask], series.torque[mask] - r1
     if key in DYNAMIC_MODELS and not joint_vals["inertia"] > 0:
         row = stage1.table().get("inertia", {})
@@ -390,11 +427,35 @@ def fit_trajectory(
         final.update(stage.table())
         bounds_out.update({n: list(b) for n, b in zip(stage.names, stage.bounds, strict=True)})
         sim_info = {"parallel_filter": parallel.describe(rate), "n_sub": int(n_sub)}
+        refine = None
+        if key == "lugre":
+            say("output error, when the encoder is too coarse")
+            decide = needs_output_error(stage, encoder, series.dt)
+            decide["applied"] = output_error == "on" or (
+                output_error == "auto" and decide["needed"]
+            )
+            sim_info["output_error"] = decide
+            if decide["applied"]:
+
+                def refine(data, start):
+                    return _output_error(
+                        data, start, gravity, method, seed, max_evals, cluster_time, n_sub, parallel
+                    )
+
+                stage, y, r = refine(series, stage)
+                yhat = y - r
+                stages["output_error"] = stage
+                fits.append(("output_error", stage))
+                final.update(stage.table())
         if key == "lugre" and rate_bias == "warn":
             say("rate bias, by simulation at the estimate")
-            rb = _rate_bias(series, stage, box, gravity, method, seed, n_sub, parallel)
+            rb = _rate_bias(
+                series, stage, box, gravity, method, seed, n_sub, parallel, encoder, refine
+            )
             sim_info["rate_bias"] = rb
-            warn_rate_bias(stage, rb)
+            notes = calibrate(stage, rb)
+            final.update(stage.table())
+            warn_rate_bias(stage, rb, notes)
     elif key == "lugre":
         say(f"{route} route: sigma_0, sigma_1 by simulation error")
         sim_info, static_tab = simulation_route(
@@ -447,8 +508,9 @@ def fit_trajectory(
             "gravity": gravity,
             "t_start": t_start,
             "rename": rename,
+            "notes": notes,
         },
-        sim_info=sim_info,
+        sim_info={**sim_info, "encoder": encoder, "estimator": estimator(key, route, sim_info)},
     )
     say("done")
     return result
@@ -461,7 +523,7 @@ def _stages(
     (``i`` of ``n``: the log, the regression, the route's own stages, the intervals)."""
     n = 3
     if key == "lugre":
-        n += 1 + (route == "filtered" and rate_bias == "warn")
+        n += 1 + (route == "filtered") * (1 + (rate_bias == "warn"))
     elif key == "dahl":
         n += 1
     count = [0]
