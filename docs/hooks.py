@@ -64,6 +64,10 @@ PAPERS = {
         r"Quinonero-Candela",
         "Quinonero-Candela and Rasmussen 2005 (sparse Gaussian processes)",
     ),
+    "SW97": (
+        r"Swevers",
+        "Swevers et al. 1997 (optimal robot excitation and identification, IEEE T-RA 13(5))",
+    ),
     "ESL": (
         r"\bESL\b",
         "ESL (Hastie, Tibshirani and Friedman, The Elements of Statistical Learning)",

@@ -137,11 +137,12 @@ def robot_extract_command(
 
     Each joint's gravity torque is computed from the whole configuration at every sample (the
     URDF's rigid-body model; on an arm the gravity of one joint depends on the others'
-    positions, which eq. 7 of one joint cannot represent), with the base gravity parameters
-    identified from the sweeps themselves (the URDF's masses are approximate) jointly with
-    every joint's friction per set-point, with cluster-robust intervals. Each joint's samples
-    are then fitted by `fricid fit` like a single joint's. The joints of the log that the URDF
-    has are modelled; the URDF's other moving joints are held at 0.
+    positions, which the BAS-RBFNN paper's eq. 7 of one joint cannot represent), with the
+    base gravity parameters identified from the sweeps themselves (the URDF's masses are
+    approximate) jointly with every joint's friction per set-point, with cluster-robust
+    intervals. Each joint's samples are then fitted by `fricid fit` like a single joint's. The
+    joints of the log that the URDF has are modelled; the URDF's other moving joints are held
+    at 0.
     """
     from ..extract import extract_arm
     from ..io import read_robot_log

@@ -229,7 +229,8 @@ class _LeastSquares(Solver):
                     self.converged = sol.status > 0
                     best_message = sol.message
                 gain = before - float(obj.best_f[0])
-                idle = 0 if gain > PATIENCE_RTOL * abs(before) else idle + 1
+                # the first start always counts as finding the best (it is the first)
+                idle = 0 if i == 0 or gain > PATIENCE_RTOL * abs(before) else idle + 1
                 if i == 0 and len(starts) > 1 and self.opts["restart"] == "doubtful":
                     why = self.doubtful(u0, sol)
                     if not why:
