@@ -195,3 +195,23 @@ def test_not_physical_least_squares_is_replaced_by_a_consistent_solution(pendulu
     assert not np.allclose(fit.base["values"], fit.base["values_ls"])
     for joint in fit.joints:  # the held-out torque fit is barely worse
         assert fit.validation[joint]["rmse"] <= 1.1 * plain.validation[joint]["rmse"]
+
+
+def test_rows_near_a_reversal_are_left_out_over_the_filter_window():
+    # a joint reversing fast (10 rad/s^2 at the reversal: no sample of the filtered velocity
+    # falls below the threshold there) beside one always moving
+    from fricid.identify.dynamic._arm_signals import prepare_signals
+    from fricid.identify.dynamic.arm import WINDOW_PERIODS, _moving
+
+    rate, f = 1000.0, 0.25
+    t = np.arange(round(20 * rate)) / rate
+    q = np.column_stack([np.sin(2 * np.pi * f * t) / (2 * np.pi * f), 0.5 * t])
+    tau = np.random.default_rng(0).normal(0.0, 0.05, q.shape)
+    sig = prepare_signals(t, q, tau, counts=2**17, cutoff=10.0)
+    keep = _moving(sig)
+    reversals = (np.arange(10) + 0.5) / (2 * f)  # cos(2 pi f t) = 0
+    gap = np.min(np.abs(sig.time[:, None] - reversals[None, :]), axis=1)
+    window = WINDOW_PERIODS / sig.cutoff
+    assert not keep[gap < window - 2 / rate, 0].any()
+    assert keep[gap > window + 2 / rate, 0].all()
+    assert keep[:, 1].all()

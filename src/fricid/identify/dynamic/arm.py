@@ -23,11 +23,17 @@ practice of Gautier, Janot and Vandanjon 2013, IEEE T-CST 21(2)), for real senso
 The estimator is IDIM-WLS (recorded in the result's provenance). Torques recorded in closed
 loop carry the noise fed back by the controller into the motion, which biases least squares
 and which the instrumental-variable step IDIM-IV (Janot, Vandanjon and Gautier 2014) removes;
-it is not done here. Measured on a PD-tracked double pendulum (``make_pd_log`` of the tests:
-10 Hz PD with inverse-dynamics feed-forward, 20 s at 1 kHz): the Coulomb parameters came out
-4 to 8 standard errors low and the viscous ones 2 to 8 high (a few per cent), but as much without
-any torque disturbance as with 0.05 N m of it, and not at all with viscous friction alone, so
-the bias there is not the fed-back noise IDIM-IV addresses; its cause is not settled.
+it is not done here. A PD-tracked arm has another, larger bias, from its reversals: the
+low-pass spreads a reversal (the joint sticking while the drive builds up torque, the Coulomb
+step) over about a period of the cut-off, and the friction columns, computed from the
+filtered velocity, do not follow it there. Measured on a PD-tracked double pendulum
+(``make_pd_log`` of the tests: 10 Hz PD with inverse-dynamics feed-forward, 20 s at 1 kHz,
+no torque disturbance, no noise): with the true parameters the residual within 0.1 s of a
+reversal was 0.15-0.18 N m against the direction of motion, nil beyond 0.2 s, and the Coulomb
+levels came out 2 to 6 standard errors low, the viscous ones 2 to 5 high, with or without
+quantisation and disturbance. Rows within :data:`WINDOW_PERIODS` periods of the cut-off of a
+slow or reversing sample are therefore left out (:func:`_moving`); the IDIM-IV step for the
+fed-back noise remains undone.
 """
 
 from __future__ import annotations
@@ -37,6 +43,7 @@ from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
+import scipy.ndimage
 import scipy.stats
 
 from ...errors import DataError
@@ -60,6 +67,8 @@ HELDOUT_SHARE = 0.25
 VELOCITY_NOISE_FACTOR = 20.0
 #: ... and never slower than this [rad/s].
 MIN_SPEED = 1e-3
+#: Rows this many periods of the cut-off from a slow or reversing sample are left out.
+WINDOW_PERIODS = 1.0
 
 
 def _log_arrays(log: RobotLog, model: RigidBodyModel) -> tuple[np.ndarray, ...]:
@@ -86,8 +95,27 @@ def _signals(log: RobotLog, model, counts, cutoff) -> ArmSignals:
 
 
 def _moving(sig: ArmSignals) -> np.ndarray:
+    """The rows (N, n) each joint's friction law holds on: the joint's filtered velocity at
+    the log's rate stays above its threshold, without a reversal, for :data:`WINDOW_PERIODS`
+    periods of the cut-off on both sides of the row.
+
+    A velocity threshold on the row alone is not enough: the low-pass spreads what happens
+    at a reversal (a joint sticking while its drive builds up torque, a Coulomb step at a
+    time the filtered velocity does not place) over about a period of the cut-off on both
+    sides, into rows whose own velocity is well above any threshold; there the columns
+    ``sign(dq_f)`` of the filtered velocity are not the filtered ``sign(dq)`` of the true one,
+    and the Coulomb levels came out low and the viscous ones high by several standard errors
+    on arms tracked by a PD.
+    """
     v_min = np.maximum(VELOCITY_NOISE_FACTOR * sig.velocity_noise, MIN_SPEED)
-    return np.abs(sig.dq) >= v_min[None, :]
+    v = sig.full_dq
+    near = np.abs(v) < v_min[None, :]
+    flip = np.diff(np.sign(v), axis=0) != 0  # a reversal between two samples
+    near[1:] |= flip
+    near[:-1] |= flip
+    half = int(np.ceil(WINDOW_PERIODS * sig.rate / sig.cutoff))
+    near = scipy.ndimage.maximum_filter1d(near.astype(np.uint8), 2 * half + 1, axis=0) > 0
+    return ~near[sig.rows()]
 
 
 def _predict(model, bp, beta, frictions, sig: ArmSignals, theta_f: list[np.ndarray]):
