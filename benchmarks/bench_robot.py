@@ -26,7 +26,8 @@ simulator (:func:`fricid.sim.robot.run_robot`: its own split RK4 integrator of t
 joint's law with the sign smoothed over 1 mrad/s, a ``--bandwidth`` Hz PD on the quantised
 position with the inverse dynamics of the reference as feed-forward, the logged velocity the
 raw backward difference, the torque the command plus noise); it takes ``stribeck_asym`` laws
-(``coulomb_viscous_asym`` is given to it as a law without a Stribeck rise).
+(``coulomb_viscous_asym`` is given to it as a law without a Stribeck rise). The closed-loop
+truths are fitted with ``reversal_window=WINDOW_PERIODS`` (rows near reversals left out).
 """
 
 from __future__ import annotations
@@ -43,7 +44,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests" / "identify" / "dynamic"))
 import _arm_truth as truth  # noqa: E402
 
-from fricid.identify.dynamic.arm import fit_arm  # noqa: E402
+from fricid.identify.dynamic.arm import WINDOW_PERIODS, fit_arm  # noqa: E402
 from fricid.robot import RigidBodyModel, base_parameters, example_urdf  # noqa: E402
 from fricid.sim.robot import run_robot  # noqa: E402
 from fricid.sim.robot_friction import FRICTION_NAMES, ArmFriction  # noqa: E402
@@ -149,7 +150,8 @@ def run(args) -> None:
         laws = _laws(model, seed, args.friction)
         log, held = _logs(model, laws, seed, args, trajectory)
         start = time.perf_counter()
-        fit = fit_arm(log, model, friction=laws[0][0], validate=held)
+        window = WINDOW_PERIODS if args.truth in ("pd", "sim") else 0.0  # closed loop
+        fit = fit_arm(log, model, friction=laws[0][0], validate=held, reversal_window=window)
         seconds.append(time.perf_counter() - start)
         for joint, (_, values) in zip(fit.joints, laws, strict=True):
             for name, rec in fit.friction[joint]["parameters"].items():

@@ -208,10 +208,35 @@ def test_rows_near_a_reversal_are_left_out_over_the_filter_window():
     q = np.column_stack([np.sin(2 * np.pi * f * t) / (2 * np.pi * f), 0.5 * t])
     tau = np.random.default_rng(0).normal(0.0, 0.05, q.shape)
     sig = prepare_signals(t, q, tau, counts=2**17, cutoff=10.0)
-    keep = _moving(sig)
+    assert _moving(sig)[np.abs(sig.dq[:, 0]) > 0.01, 0].all()  # by default: the threshold
+    keep = _moving(sig, WINDOW_PERIODS)
     reversals = (np.arange(10) + 0.5) / (2 * f)  # cos(2 pi f t) = 0
     gap = np.min(np.abs(sig.time[:, None] - reversals[None, :]), axis=1)
     window = WINDOW_PERIODS / sig.cutoff
     assert not keep[gap < window - 2 / rate, 0].any()
     assert keep[gap > window + 2 / rate, 0].all()
     assert keep[:, 1].all()
+
+
+@pytest.mark.slow
+def test_closed_loop_coulomb_bias_is_removed_by_the_reversal_window(pendulum):
+    from _arm_truth import make_pd_log
+
+    from fricid.identify.dynamic.arm import WINDOW_PERIODS
+
+    rng = np.random.default_rng(10_001)
+    bounds = {"f_c_pos": (0.3, 1.0), "beta_pos": (0.1, 0.6)}
+    bounds |= {"f_c_neg": (0.3, 1.0), "beta_neg": (0.1, 0.6)}
+    laws = [
+        ("coulomb_viscous_asym", {k: rng.uniform(*b) for k, b in bounds.items()}) for _ in range(2)
+    ]
+    log = make_pd_log(pendulum, laws, seed=1, duration=20.0, disturbance=0.0)
+
+    def mean_z(window, kind):
+        fit = fit_arm(log, pendulum, friction="coulomb_viscous_asym", reversal_window=window)
+        z = _z(fit, laws)
+        return np.mean([v for k, v in z.items() if k.split(":")[1].startswith(kind)])
+
+    assert mean_z(0.0, "f_c") < -2.0  # the threshold alone: Coulomb several errors low
+    assert abs(mean_z(WINDOW_PERIODS, "f_c")) < 1.5
+    assert abs(mean_z(WINDOW_PERIODS, "beta")) < 1.5

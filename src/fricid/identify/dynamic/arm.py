@@ -32,8 +32,9 @@ no torque disturbance, no noise): with the true parameters the residual within 0
 reversal was 0.15-0.18 N m against the direction of motion, nil beyond 0.2 s, and the Coulomb
 levels came out 2 to 6 standard errors low, the viscous ones 2 to 5 high, with or without
 quantisation and disturbance. Rows within :data:`WINDOW_PERIODS` periods of the cut-off of a
-slow or reversing sample are therefore left out (:func:`_moving`); the IDIM-IV step for the
-fed-back noise remains undone.
+slow or reversing sample can be left out (``reversal_window``, :func:`_moving`): it removes
+that bias, and in open loop costs the Stribeck rise the rows it is seen on, so it is not the
+default. The IDIM-IV step for the fed-back noise remains undone.
 """
 
 from __future__ import annotations
@@ -67,7 +68,8 @@ HELDOUT_SHARE = 0.25
 VELOCITY_NOISE_FACTOR = 20.0
 #: ... and never slower than this [rad/s].
 MIN_SPEED = 1e-3
-#: Rows this many periods of the cut-off from a slow or reversing sample are left out.
+#: ``reversal_window`` for logs recorded in closed loop: rows this many periods of the
+#: cut-off from a slow or reversing sample are left out (:func:`_moving`).
 WINDOW_PERIODS = 1.0
 
 
@@ -94,26 +96,28 @@ def _signals(log: RobotLog, model, counts, cutoff) -> ArmSignals:
     )
 
 
-def _moving(sig: ArmSignals) -> np.ndarray:
-    """The rows (N, n) each joint's friction law holds on: the joint's filtered velocity at
-    the log's rate stays above its threshold, without a reversal, for :data:`WINDOW_PERIODS`
-    periods of the cut-off on both sides of the row.
+def _moving(sig: ArmSignals, window: float = 0.0) -> np.ndarray:
+    """The rows (N, n) each joint's friction law is fitted on: the joint's filtered velocity
+    above its threshold; with ``window > 0``, also without a slow sample or a reversal at the
+    log's rate within ``window`` periods of the cut-off on either side of the row.
 
-    A velocity threshold on the row alone is not enough: the low-pass spreads what happens
-    at a reversal (a joint sticking while its drive builds up torque, a Coulomb step at a
-    time the filtered velocity does not place) over about a period of the cut-off on both
-    sides, into rows whose own velocity is well above any threshold; there the columns
-    ``sign(dq_f)`` of the filtered velocity are not the filtered ``sign(dq)`` of the true one,
-    and the Coulomb levels came out low and the viscous ones high by several standard errors
-    on arms tracked by a PD.
+    A velocity threshold on the row alone is not enough in closed loop: the low-pass spreads
+    what happens at a reversal (a joint sticking while its drive builds up torque) over about
+    a period of the cut-off on both sides, into rows whose own velocity is well above any
+    threshold; there the columns ``sign(dq_f)`` of the filtered velocity are not the filtered
+    friction of the true motion, and the Coulomb levels came out low and the viscous ones
+    high by several standard errors on arms tracked by a PD. In open loop (no sticking) those
+    rows are right and carry the Stribeck rise, which the window then loses.
     """
     v_min = np.maximum(VELOCITY_NOISE_FACTOR * sig.velocity_noise, MIN_SPEED)
+    if window <= 0:
+        return np.abs(sig.dq) >= v_min[None, :]
     v = sig.full_dq
     near = np.abs(v) < v_min[None, :]
     flip = np.diff(np.sign(v), axis=0) != 0  # a reversal between two samples
     near[1:] |= flip
     near[:-1] |= flip
-    half = int(np.ceil(WINDOW_PERIODS * sig.rate / sig.cutoff))
+    half = int(np.ceil(window * sig.rate / sig.cutoff))
     near = scipy.ndimage.maximum_filter1d(near.astype(np.uint8), 2 * half + 1, axis=0) > 0
     return ~near[sig.rows()]
 
@@ -226,6 +230,7 @@ def _fit_arm(
     cutoff: float | None = None,
     validate: RobotLog | None = None,
     urdf: str | None = None,
+    reversal_window: float = 0.0,
 ) -> ArmFit:
     """Identify a whole arm's base inertial parameters and every joint's friction.
 
@@ -249,6 +254,11 @@ def _fit_arm(
         A second log for held-out validation (else the last :data:`HELDOUT_SHARE` of ``log``).
     urdf : str, optional
         The URDF's name, for the provenance (default ``model.source``).
+    reversal_window : float
+        Leave out the rows within this many periods of the cut-off of a slow or reversing
+        sample (:func:`_moving`; :data:`WINDOW_PERIODS` for a log recorded in closed loop,
+        where the joints stick at their reversals); 0, the default, uses the velocity
+        threshold alone.
 
     Returns
     -------
@@ -270,7 +280,7 @@ def _fit_arm(
         cut = int(len(log) * (1 - HELDOUT_SHARE))
         log, validate = log.slice(0, cut), log.slice(cut, len(log))
     sig = _signals(log, model, encoder_counts, cutoff)
-    moving = _moving(sig)
+    moving = _moving(sig, reversal_window)
     if not moving.any():
         raise DataError("no joint moves in the log: nothing to identify", file=log.source)
     bp = base_parameters(model)
@@ -330,7 +340,7 @@ def _fit_arm(
     fric = _friction_records(frictions, theta, cov, st, model.joints, t, sig, moving, units)
     # held-out validation with the same filter
     vsig = _signals(validate, model, encoder_counts, sig.cutoff)
-    vmoving = _moving(vsig)
+    vmoving = _moving(vsig, reversal_window)
     pred = _predict(
         model,
         bp,
