@@ -21,8 +21,13 @@ Truth: ``--truth own`` is the tests' generator (``tests/identify/dynamic/_arm_tr
 arm follows the reference exactly, an open-loop measurement); ``--truth pd`` is its
 closed-loop variant (``make_pd_log``: a 10 Hz PD on the quantised position with the inverse
 dynamics as feed-forward, the arm integrated semi-implicitly at 4 kHz, friction not
-compensated, an optional torque ``--disturbance``). ``--truth sim`` (the whole-arm
-simulator with PD tracking, ``fricid.sim``) is used when that simulator is installed.
+compensated, an optional torque ``--disturbance``). ``--truth sim`` is fricid's whole-arm
+simulator (:func:`fricid.sim.robot.run_robot`: its own split RK4 integrator of the arm, each
+joint's law with the sign smoothed over 1 mrad/s, a ``--bandwidth`` Hz PD on the quantised
+position with the inverse dynamics of the reference as feed-forward, the logged velocity the
+raw backward difference, the torque the command plus noise); it takes ``stribeck_asym`` laws
+(``coulomb_viscous_asym`` is given to it as a law without a Stribeck rise). The closed-loop
+truths are fitted with ``reversal_window=WINDOW_PERIODS`` (rows near reversals left out).
 """
 
 from __future__ import annotations
@@ -39,8 +44,10 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests" / "identify" / "dynamic"))
 import _arm_truth as truth  # noqa: E402
 
-from fricid.identify.dynamic.arm import fit_arm  # noqa: E402
+from fricid.identify.dynamic.arm import WINDOW_PERIODS, fit_arm  # noqa: E402
 from fricid.robot import RigidBodyModel, base_parameters, example_urdf  # noqa: E402
+from fricid.sim.robot import run_robot  # noqa: E402
+from fricid.sim.robot_friction import FRICTION_NAMES, ArmFriction  # noqa: E402
 
 KINDS = ("tau_c", "tau_s", "w_s", "tau_v", "delta", "f_c", "beta")
 
@@ -76,9 +83,49 @@ def _laws(model, seed, friction):
     ]
 
 
+def _direction(values: dict, d: str) -> dict:
+    """One direction's law in the simulator's names (Coulomb-viscous: no Stribeck rise)."""
+    if "f_c" + d in values:
+        f_c = values["f_c" + d]
+        return {"tau_c": f_c, "tau_s": f_c, "w_s": 1.0, "tau_v": values["beta" + d], "delta": 1.0}
+    return {k: values[k + d] for k in FRICTION_NAMES}
+
+
+def _arm_friction(laws) -> ArmFriction:
+    """The simulator's law of every joint's ``laws``."""
+    sides = []
+    for d in ("_pos", "_neg"):
+        rows = [_direction(values, d) for _, values in laws]
+        sides.append({k: np.array([r[k] for r in rows]) for k in FRICTION_NAMES})
+    return ArmFriction(*sides)
+
+
+def _sim_log(model, laws, seed, args, trajectory):
+    if trajectory is None:
+        trajectory = truth.reference(model, args.duration, args.rate, seed)
+    t, q, dq, ddq = trajectory
+    rate = 1.0 / float(np.median(np.diff(t)))
+    run = run_robot(
+        model,
+        lambda _t: (q, dq, ddq),
+        _arm_friction(laws),
+        rate=rate,
+        duration=len(t) / rate,
+        controller="pd",
+        feedforward=True,
+        bandwidth=args.bandwidth,
+        torque_noise=args.noise,
+        seed=seed + 20_000,
+    )
+    return run.log
+
+
 def _logs(model, laws, seed, args, trajectory):
     if args.truth == "sim":
-        raise SystemExit("--truth sim: the whole-arm simulator is not installed in this fricid")
+        return (
+            _sim_log(model, laws, seed, args, trajectory),
+            _sim_log(model, laws, seed + 5_000, args, trajectory),
+        )
     kw = {"duration": args.duration, "rate": args.rate, "noise": args.noise}
     make = truth.make_log
     if args.truth == "pd":
@@ -103,7 +150,8 @@ def run(args) -> None:
         laws = _laws(model, seed, args.friction)
         log, held = _logs(model, laws, seed, args, trajectory)
         start = time.perf_counter()
-        fit = fit_arm(log, model, friction=laws[0][0], validate=held)
+        window = WINDOW_PERIODS if args.truth in ("pd", "sim") else 0.0  # closed loop
+        fit = fit_arm(log, model, friction=laws[0][0], validate=held, reversal_window=window)
         seconds.append(time.perf_counter() - start)
         for joint, (_, values) in zip(fit.joints, laws, strict=True):
             for name, rec in fit.friction[joint]["parameters"].items():
@@ -167,6 +215,9 @@ def main() -> None:
     parser.add_argument("--truth", choices=("own", "pd", "sim"), default="own")
     parser.add_argument(
         "--disturbance", type=float, default=0.0, help="--truth pd: torque disturbance [N m]"
+    )
+    parser.add_argument(
+        "--bandwidth", type=float, default=5.0, help="--truth sim: the PD's bandwidth [Hz]"
     )
     run(parser.parse_args())
 

@@ -20,7 +20,7 @@ from fricid.errors import ConfigError, DataError
 from fricid.fitted import FittedModel
 from fricid.fitted.arm import ArmFit
 from fricid.identify.dynamic.arm import fit_arm
-from fricid.robot import RigidBodyModel, example_urdf
+from fricid.robot import RigidBodyModel, example_urdf, is_consistent
 
 CV_LAWS = [
     ("coulomb_viscous_asym", {"f_c_pos": 0.5, "beta_pos": 0.3, "f_c_neg": 0.4, "beta_neg": 0.2}),
@@ -180,3 +180,63 @@ def test_friction_family_per_joint(pendulum):
             assert abs(rec["value"] - truth[name]) < 0.03 * truth[name], (joint, name)
     with pytest.raises(ConfigError, match="not in the model"):
         fit_arm(log, pendulum, friction={"elbow": "coulomb_viscous"})
+
+
+def test_not_physical_least_squares_is_replaced_by_a_consistent_solution(pendulum):
+    # a short, slow, noisy log excites little: the least-squares base parameters come out
+    # where no physical links give them
+    log = make_log(pendulum, CV_LAWS, duration=6.0, seed=1, noise=1.0, speed=0.3)
+    fit = fit_arm(log, pendulum, friction="coulomb_viscous_asym")
+    plain = fit_arm(log, pendulum, friction="coulomb_viscous_asym", consistent=False)
+    assert fit.standard["used"] == "consistent"
+    assert not fit.standard["consistent_ls"] and fit.standard["d2"] > 1.0
+    assert is_consistent(np.array(fit.standard["values"])).all()
+    assert np.allclose(fit.base["values_ls"], plain.base["values"])
+    assert not np.allclose(fit.base["values"], fit.base["values_ls"])
+    for joint in fit.joints:  # the held-out torque fit is barely worse
+        assert fit.validation[joint]["rmse"] <= 1.1 * plain.validation[joint]["rmse"]
+
+
+def test_rows_near_a_reversal_are_left_out_over_the_filter_window():
+    # a joint reversing fast (10 rad/s^2 at the reversal: no sample of the filtered velocity
+    # falls below the threshold there) beside one always moving
+    from fricid.identify.dynamic._arm_signals import prepare_signals
+    from fricid.identify.dynamic.arm import WINDOW_PERIODS, _moving
+
+    rate, f = 1000.0, 0.25
+    t = np.arange(round(20 * rate)) / rate
+    q = np.column_stack([np.sin(2 * np.pi * f * t) / (2 * np.pi * f), 0.5 * t])
+    tau = np.random.default_rng(0).normal(0.0, 0.05, q.shape)
+    sig = prepare_signals(t, q, tau, counts=2**17, cutoff=10.0)
+    assert _moving(sig)[np.abs(sig.dq[:, 0]) > 0.01, 0].all()  # by default: the threshold
+    keep = _moving(sig, WINDOW_PERIODS)
+    reversals = (np.arange(10) + 0.5) / (2 * f)  # cos(2 pi f t) = 0
+    gap = np.min(np.abs(sig.time[:, None] - reversals[None, :]), axis=1)
+    window = WINDOW_PERIODS / sig.cutoff
+    assert not keep[gap < window - 2 / rate, 0].any()
+    assert keep[gap > window + 2 / rate, 0].all()
+    assert keep[:, 1].all()
+
+
+@pytest.mark.slow
+def test_closed_loop_coulomb_bias_is_removed_by_the_reversal_window(pendulum):
+    from _arm_truth import make_pd_log
+
+    from fricid.identify.dynamic.arm import WINDOW_PERIODS
+
+    rng = np.random.default_rng(10_001)
+    bounds = {"f_c_pos": (0.3, 1.0), "beta_pos": (0.1, 0.6)}
+    bounds |= {"f_c_neg": (0.3, 1.0), "beta_neg": (0.1, 0.6)}
+    laws = [
+        ("coulomb_viscous_asym", {k: rng.uniform(*b) for k, b in bounds.items()}) for _ in range(2)
+    ]
+    log = make_pd_log(pendulum, laws, seed=1, duration=20.0, disturbance=0.0)
+
+    def mean_z(window, kind):
+        fit = fit_arm(log, pendulum, friction="coulomb_viscous_asym", reversal_window=window)
+        z = _z(fit, laws)
+        return np.mean([v for k, v in z.items() if k.split(":")[1].startswith(kind)])
+
+    assert mean_z(0.0, "f_c") < -2.0  # the threshold alone: Coulomb several errors low
+    assert abs(mean_z(WINDOW_PERIODS, "f_c")) < 1.5
+    assert abs(mean_z(WINDOW_PERIODS, "beta")) < 1.5

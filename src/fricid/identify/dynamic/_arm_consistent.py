@@ -144,9 +144,10 @@ def consistent_parameters(
             D = np.nan_to_num(_pi_jacobian(theta))
         return np.vstack([L @ P @ D, PRIOR_WEIGHT * D / scale[:, None]])
 
-    sol = scipy.optimize.least_squares(
-        residual, _start(pi0), jac=jacobian, method="trf", x_scale="jac", max_nfev=MAX_NFEV
-    )
+    with np.errstate(over="ignore"):  # a trial step far out: an infinite cost, rejected
+        sol = scipy.optimize.least_squares(
+            residual, _start(pi0), jac=jacobian, method="trf", x_scale="jac", max_nfev=MAX_NFEV
+        )
     pi = _pi(sol.x[None, :])[0]
     bc = P @ pi
     d = bc - target

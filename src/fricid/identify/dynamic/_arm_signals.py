@@ -94,6 +94,11 @@ class ArmSignals:
     #: the filtered states at the intermediate rate (the regressor is computed on them)
     mid: tuple[np.ndarray, np.ndarray, np.ndarray]
 
+    def rows(self) -> np.ndarray:
+        """The samples of the log (indices at its full rate) the decimated rows stand for."""
+        n_mid = len(range(0, self.full_dq.shape[0], self.first))
+        return np.arange(n_mid)[self.keep] * self.first
+
     def regressor(self, model, base) -> np.ndarray:
         """The base regressor ``Y_b`` (N, n, r), computed at the intermediate rate and passed
         through the low-pass like the torque (parallel filtering)."""

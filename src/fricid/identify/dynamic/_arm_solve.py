@@ -4,8 +4,9 @@ variable projection, and covariances that respect correlated residuals.
 Rows are one joint at one (decimated) instant, ``(t, j)``; columns are the base inertial
 parameters (Gautier 1991; :func:`fricid.robot.base_parameters`) then each joint's friction
 (:mod:`._arm_friction`), zero on the other joints' rows. A joint's rows slower than its
-velocity threshold are left out: a joint at rest holds any torque within its static friction,
-which no law of velocity says.
+velocity threshold, or within a period of the cut-off of such a sample or a reversal, are
+left out (``arm._moving``): a joint at rest holds any torque within its static friction, which
+no law of velocity says, and the low-pass spreads a reversal over its neighbours.
 
 * Weighted least squares (Gautier and Poignet 2001): each joint's noise ``sigma_j`` is
   estimated from its ordinary least-squares residuals, ``sigma_j^2 = SSE_j / (m_j - p m_j /
