@@ -40,7 +40,7 @@ def test_schema_mirrors_the_registries():
     assert PROPERTIES["reader"]["enum"] == list(READERS)
     assert PROPERTIES["direction"]["enum"] == list(DIRECTIONS)
     assert PROPERTIES["samples"]["enum"] == list(SAMPLE_SETS)
-    from fricid.identify.dynamic._arm_friction import FAMILIES
+    from fricid.identify.dynamic.arm._friction import FAMILIES
 
     assert PROPERTIES["friction"]["enum"] == sorted(FAMILIES)  # a robot row's families
     options = {o for opts in READER_OPTIONS.values() for o in opts}

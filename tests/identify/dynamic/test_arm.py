@@ -200,8 +200,8 @@ def test_not_physical_least_squares_is_replaced_by_a_consistent_solution(pendulu
 def test_rows_near_a_reversal_are_left_out_over_the_filter_window():
     # a joint reversing fast (10 rad/s^2 at the reversal: no sample of the filtered velocity
     # falls below the threshold there) beside one always moving
-    from fricid.identify.dynamic._arm_signals import prepare_signals
     from fricid.identify.dynamic.arm import WINDOW_PERIODS, _moving
+    from fricid.identify.dynamic.arm._signals import prepare_signals
 
     rate, f = 1000.0, 0.25
     t = np.arange(round(20 * rate)) / rate

@@ -3,7 +3,7 @@ variable projection, and covariances that respect correlated residuals.
 
 Rows are one joint at one (decimated) instant, ``(t, j)``; columns are the base inertial
 parameters (Gautier 1991; :func:`fricid.robot.base_parameters`) then each joint's friction
-(:mod:`._arm_friction`), zero on the other joints' rows. A joint's rows slower than its
+(:mod:`._friction`), zero on the other joints' rows. A joint's rows slower than its
 velocity threshold, or within a period of the cut-off of such a sample or a reversal, are
 left out (``arm._moving``): a joint at rest holds any torque within its static friction, which
 no law of velocity says, and the low-pass spreads a reversal over its neighbours.
@@ -37,9 +37,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..static.uncertainty import covariance_svd
-from ._arm_friction import DELTA_BOX, W_S_BOX, JointFriction
-from ._arm_signals import ArmSignals
+from ...static.uncertainty import covariance_svd
+from ._friction import DELTA_BOX, W_S_BOX, JointFriction
+from ._signals import ArmSignals
 
 __all__ = ["Stack", "arm_covariance", "search_shapes", "stack", "wls"]
 

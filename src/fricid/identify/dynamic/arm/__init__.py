@@ -4,15 +4,15 @@ The inverse dynamic identification model with least squares (IDIM-LS, Gautier 19
 practice of Gautier, Janot and Vandanjon 2013, IEEE T-CST 21(2)), for real sensors:
 
 1. the quantised position and the torque are low-passed by the same zero-phase filter and
-   decimated (:mod:`._arm_signals`: the cut-off from the log's rate, the motion's bandwidth
+   decimated (:mod:`._signals`: the cut-off from the log's rate, the motion's bandwidth
    and the encoder step);
 2. the regressor is ``[Y_b | friction]``: the base columns of the rigid-body regressor
    (:func:`fricid.robot.base_parameters`) beside each joint's friction per direction
-   (:mod:`._arm_friction`), so inertial and friction parameters are solved together;
+   (:mod:`._friction`), so inertial and friction parameters are solved together;
 3. weighted least squares with each joint's noise from its residuals, the Stribeck shapes by
    variable projection, covariances robust to the residuals' correlation in time
-   (:mod:`._arm_solve`);
-4. physical consistency (:mod:`._arm_consistent`): the least-squares base parameters are
+   (:mod:`._solve`);
+4. physical consistency (:mod:`._consistent`): the least-squares base parameters are
    kept when some physical standard parameters give them (within their noise), else the
    nearest physical ones replace them (and the friction is solved again given them);
 5. a verdict per joint from held-out validation: the torque error on a second log (or on the
@@ -47,18 +47,18 @@ import numpy as np
 import scipy.ndimage
 import scipy.stats
 
-from ...errors import DataError
-from ...fitted.arm import ArmFit
-from ...metrics import NOISE_RATIO, verdict
-from ...models import get_model
-from ...optim import one_blas_thread
-from ...robot import RigidBodyModel, base_parameters
-from ...samples import RobotLog
-from ..trust import MISS_RATIO
-from ._arm_consistent import consistent_parameters
-from ._arm_friction import DELTA_BOX, W_S_BOX, friction_for, split_direction
-from ._arm_signals import ArmSignals, prepare_signals
-from ._arm_solve import arm_covariance, lstsq, search_shapes, stack, wls
+from ....errors import DataError
+from ....fitted.arm import ArmFit
+from ....metrics import NOISE_RATIO, verdict
+from ....models import get_model
+from ....optim import one_blas_thread
+from ....robot import RigidBodyModel, base_parameters
+from ....samples import RobotLog
+from ...trust import MISS_RATIO
+from ._consistent import consistent_parameters
+from ._friction import DELTA_BOX, W_S_BOX, friction_for, split_direction
+from ._signals import ArmSignals, prepare_signals
+from ._solve import arm_covariance, lstsq, search_shapes, stack, wls
 
 __all__ = ["HELDOUT_SHARE", "fit_arm"]
 
@@ -242,14 +242,14 @@ def _fit_arm(
     model : RigidBodyModel
         The arm from its URDF (:meth:`fricid.robot.RigidBodyModel.from_urdf`).
     friction : str or mapping
-        A family of :data:`._arm_friction.FAMILIES` for every joint, or joint -> family
+        A family of :data:`._friction.FAMILIES` for every joint, or joint -> family
         (others ``stribeck_asym``).
     consistent : bool
-        Make the inertial parameters physical (:mod:`._arm_consistent`).
+        Make the inertial parameters physical (:mod:`._consistent`).
     encoder_counts : int, optional
         Counts per revolution (else read from the position's smallest step).
     cutoff : float, optional
-        The low-pass cut-off [Hz] (else chosen: :func:`._arm_signals.choose_cutoff`).
+        The low-pass cut-off [Hz] (else chosen: :func:`._signals.choose_cutoff`).
     validate : RobotLog, optional
         A second log for held-out validation (else the last :data:`HELDOUT_SHARE` of ``log``).
     urdf : str, optional

@@ -38,7 +38,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.signal
 
-from ...errors import DataError
+from ....errors import DataError
 
 __all__ = ["ArmSignals", "choose_cutoff", "encoder_step", "prepare_signals"]
 

@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ...errors import ConfigError
+from ....errors import ConfigError
 
 __all__ = ["FAMILIES", "JointFriction", "friction_for", "split_direction"]
 

@@ -22,7 +22,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.optimize
 
-from ...robot import BaseParameters, is_consistent, to_log_cholesky
+from ....robot import BaseParameters, is_consistent, to_log_cholesky
 
 __all__ = ["CONSISTENT_D2", "consistent_parameters"]
 
