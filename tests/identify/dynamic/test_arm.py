@@ -240,3 +240,23 @@ def test_closed_loop_coulomb_bias_is_removed_by_the_reversal_window(pendulum):
     assert mean_z(0.0, "f_c") < -2.0  # the threshold alone: Coulomb several errors low
     assert abs(mean_z(WINDOW_PERIODS, "f_c")) < 1.5
     assert abs(mean_z(WINDOW_PERIODS, "beta")) < 1.5
+
+
+def test_a_friction_level_below_zero_is_not_printed_as_a_number(pendulum):
+    """A torque that pushes with the motion (a sign convention wrong on one joint's torque
+    channel, a drive's compensation left on) gives a Coulomb level below zero beyond its
+    interval: no family describes that as friction, so it is not determined, not a number."""
+    laws = [
+        CV_LAWS[0],
+        (
+            "coulomb_viscous_asym",
+            {"f_c_pos": -0.4, "beta_pos": 0.3, "f_c_neg": 0.4, "beta_neg": 0.3},
+        ),
+    ]
+    log = make_log(pendulum, laws, duration=20.0, seed=3, noise=0.05)
+    fit = fit_arm(log, pendulum, friction="coulomb_viscous_asym")
+    rec = fit.friction[fit.joints[1]]["parameters"]["f_c_pos"]
+    assert rec["not_determined"] and rec["value"] is None
+    assert "below zero" in rec["note"]
+    assert fit.verdict(fit.joints[1]) != "yes"
+    assert not fit.friction[fit.joints[0]]["parameters"]["f_c_pos"]["not_determined"]

@@ -130,6 +130,10 @@ def _predict(model, bp, beta, frictions, sig: ArmSignals, theta_f: list[np.ndarr
     return tau
 
 
+#: Friction levels [N m, N m s/rad]: physically never below zero.
+_LEVELS = ("f_c", "tau_c", "tau_s", "beta", "tau_v")
+
+
 def _interval(value, se, t):
     return [value - t * se, value + t * se] if np.isfinite(se) else [None, None]
 
@@ -173,6 +177,22 @@ def _friction_records(frictions, theta, cov, st, joints, t, sig, moving, models_
                 "not_determined": nd,
                 "note": note,
             }
+            if pname.startswith(_LEVELS) and not nd and rec["ci95"][1] < 0:
+                # a friction level below zero beyond its interval: the family does not describe
+                # this joint's data (or the joint barely moves); no number to trust
+                rec.update(
+                    value=None,
+                    stderr=None,
+                    ci95=[None, None],
+                    not_determined=True,
+                    note=(
+                        f"not determined: estimated {fam_values[i]:.4g} +- {t * se[i]:.2g}, "
+                        "a friction level below zero (the family does not describe this "
+                        "joint's data)"
+                    ),
+                )
+                params[pname] = rec
+                continue
             if pname.startswith(("w_s", "delta")) and not nd:
                 box = W_S_BOX if pname.startswith("w_s") else DELTA_BOX
                 lo_, hi_ = rec["ci95"]
