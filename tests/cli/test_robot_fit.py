@@ -65,6 +65,25 @@ def test_robot_fit_writes_the_file_and_prints_a_row_per_joint(pendulum_logs, tmp
         assert joint in res.output
     assert "Base inertial parameters:" in res.output
     assert "IDIM-WLS" in res.output
+    assert fit.provenance["reversal_window"] == 0.0
+    closed = tmp_path / "closed.json"
+    res = runner.invoke(
+        app,
+        [
+            "robot",
+            "fit",
+            str(log),
+            "--urdf",
+            str(urdf),
+            "--friction",
+            "coulomb_viscous",
+            "--closed-loop",
+            "-o",
+            str(closed),
+        ],
+    )
+    assert res.exit_code == 0, res.output
+    assert ArmFit.load(closed).provenance["reversal_window"] == 1.0
 
 
 def test_robot_fit_bad_option_is_one_line_and_no_file(pendulum_logs, tmp_path):

@@ -112,10 +112,23 @@ def robot_fit_command(
     consistent: Annotated[
         bool, typer.Option(help="Make the inertial parameters physically consistent.")
     ] = True,
+    closed_loop: Annotated[
+        bool,
+        typer.Option(
+            "--closed-loop",
+            help=(
+                "The log was recorded under position control (a PD loop): leave out the rows "
+                "within one period of the cut-off of every reversal, where the joint sticks "
+                "while the loop builds torque and the filtered friction columns do not hold "
+                "(measured on a PD-tracked arm: Coulomb levels 4 standard errors low without "
+                "it). Off, those rows carry the Stribeck rise of an open-loop log."
+            ),
+        ),
+    ] = False,
 ) -> None:
     """Identify a whole arm from any trajectory: base inertial parameters and every joint's
     friction together, with intervals and a held-out verdict per joint."""
-    from ..identify.dynamic.arm import fit_arm
+    from ..identify.dynamic.arm import WINDOW_PERIODS, fit_arm
     from ..io import read_robot_log
     from ..robot import RigidBodyModel
 
@@ -133,6 +146,7 @@ def robot_fit_command(
         cutoff=cutoff,
         validate=second,
         urdf=urdf.name,
+        reversal_window=WINDOW_PERIODS if closed_loop else 0.0,
     )
     fit.save(out)
     _table(fit)

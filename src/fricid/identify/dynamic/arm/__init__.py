@@ -411,6 +411,7 @@ def _fit_arm(
             "decimation": sig.decimation,
             "encoder_step": sig.encoder_step.tolist(),
             "estimator": "IDIM-WLS",
+            "reversal_window": float(reversal_window),
             "samples": int(st.A.shape[0]),
             "effective_samples": {nm: float(x) for nm, x in zip(model.joints, n_eff, strict=True)},
             "correlation_length": corr_len,
