@@ -95,3 +95,22 @@ def test_robot_fit_bad_option_is_one_line_and_no_file(pendulum_logs, tmp_path):
     assert res.exit_code == 2
     assert "Traceback" not in res.output
     assert not out.exists()
+
+
+@pytest.mark.slow
+def test_a_log_that_cannot_tell_the_friction_gets_no(tmp_path):
+    """The simulator's default double-pendulum log (20 s, seed 1) moves the joints too little
+    for ten Stribeck parameters each: Coulomb levels come out +- 7 to 93 N m. That is a "no"
+    with the reason, not "with caveats" (it was, before the Coulomb levels' width was judged)."""
+    from fricid.robot import example_urdf
+
+    urdf, _ = example_urdf("double_pendulum")
+    log, out = tmp_path / "a.parquet", tmp_path / "arm.json"
+    sim = ["robot", "simulate", "--robot", "double_pendulum", "--duration", "20"]
+    assert runner.invoke(app, [*sim, "--seed", "1", "--out", str(log)]).exit_code == 0
+    res = runner.invoke(app, ["robot", "fit", str(log), "--urdf", str(urdf), "-o", str(out)])
+    assert res.exit_code == 0, res.output
+    fit = ArmFit.load(out)
+    for joint in fit.joints:
+        assert fit.verdict(joint) == "no"
+        assert "do not determine the joint's friction" in " ".join(fit.validation[joint]["reasons"])

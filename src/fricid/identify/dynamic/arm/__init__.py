@@ -208,12 +208,38 @@ def _friction_records(frictions, theta, cov, st, joints, t, sig, moving, models_
     return out
 
 
-def _grade(ratio: float, nd: list[str], open_: list[str], source: str, moved: bool):
+def _loose_levels(recs: Mapping[str, Mapping[str, Any]], noise: float) -> list[str]:
+    """The Coulomb levels whose 95 % interval is wider, on either side, than both their
+    value and the joint's torque noise: the data do not tell the joint's friction."""
+    out = []
+    for name, rec in recs.items():
+        lo, hi = rec.get("ci95") or (None, None)
+        if not name.startswith(("f_c", "tau_c")) or rec["not_determined"] or lo is None:
+            continue
+        half = 0.5 * (hi - lo)
+        if half > max(abs(rec["value"]), noise):
+            out.append(f"{name} {rec['value']:.3g} +- {half:.2g} N m")
+    return out
+
+
+def _grade(
+    ratio: float,
+    nd: list[str],
+    open_: list[str],
+    source: str,
+    moved: bool,
+    loose: list[str] = (),
+):
     """A joint's verdict in :mod:`fricid.identify.trust`'s words and thresholds."""
     no, caveats = [], []
     if not moved:
         no.append("the joint does not move in the log, so its friction is not determined")
-    elif nd:
+    elif loose:
+        no.append(
+            "the data do not determine the joint's friction: the 95 % interval of its "
+            f"Coulomb level is wider than the level and the noise ({'; '.join(loose)})"
+        )
+    if moved and nd:
         caveats.append(f"not determined by the data: {', '.join(nd)}")
     if open_:
         caveats.append(f"not bounded by the data: {', '.join(open_)}")
@@ -378,7 +404,8 @@ def _fit_arm(
         recs = fric[name]["parameters"]
         nd = [p for p, rec in recs.items() if rec["not_determined"]]
         open_ = [p for p, rec in recs.items() if rec["note"].startswith("not bounded")]
-        level, reasons = _grade(ratio, nd, open_, source, bool(moving[:, j].any()))
+        loose = _loose_levels(recs, float(sigma[j]))
+        level, reasons = _grade(ratio, nd, open_, source, bool(moving[:, j].any()), loose)
         validation[name] = {
             "rmse": rmse,
             "ratio": ratio,
