@@ -114,3 +114,14 @@ def test_a_log_that_cannot_tell_the_friction_gets_no(tmp_path):
     for joint in fit.joints:
         assert fit.verdict(joint) == "no"
         assert "do not determine the joint's friction" in " ".join(fit.validation[joint]["reasons"])
+
+
+def test_robot_fit_takes_an_example_robot_or_says_what_it_needs(pendulum_logs, tmp_path):
+    _, (log, _) = pendulum_logs
+    out = tmp_path / "arm.json"
+    res = runner.invoke(app, ["robot", "fit", str(log), "-o", str(out)])
+    assert res.exit_code == 2 and "give --urdf" in res.output and not out.exists()
+    args = ["robot", "fit", str(log), "--robot", "double_pendulum", "--friction"]
+    res = runner.invoke(app, [*args, "coulomb_viscous", "-o", str(out)])
+    assert res.exit_code == 0, res.output
+    assert ArmFit.load(out).provenance["urdf"] == "double_pendulum.urdf"

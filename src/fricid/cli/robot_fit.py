@@ -9,8 +9,10 @@ from typing import Annotated
 import numpy as np
 import typer
 
+from ..errors import ConfigError
 from ._app import console, handle_errors, robot_app
 from ._paths import check_paths
+from .robot_simulate import _ROBOTS, _model
 
 
 def _split(text: str | None) -> list[str] | None:
@@ -23,8 +25,6 @@ def _friction(text: str):
     """``stribeck_asym`` or ``joint1=coulomb_viscous,joint2=stribeck_asym``."""
     if "=" not in text:
         return text
-    from ..errors import ConfigError
-
     out = {}
     for part in _split(text) or []:
         name, sep, family = part.partition("=")
@@ -86,8 +86,12 @@ def _table(fit) -> None:
 @handle_errors
 def robot_fit_command(
     log: Annotated[Path, typer.Argument(help="The robot log (CSV, Parquet, ROS 2 bag, folder).")],
-    urdf: Annotated[Path, typer.Option(help="The robot's URDF.")],
     out: Annotated[Path, typer.Option("--out", "-o", help="The fit file to write (JSON).")],
+    urdf: Annotated[Path | None, typer.Option(help="The robot's URDF.")] = None,
+    robot: Annotated[
+        str | None,
+        typer.Option(help=f"An example robot instead of --urdf: {_ROBOTS}."),
+    ] = None,
     joints: Annotated[
         str | None,
         typer.Option(help="Joints to identify, comma-separated (default: the URDF's movable)."),
@@ -130,11 +134,13 @@ def robot_fit_command(
     friction together, with intervals and a held-out verdict per joint."""
     from ..identify.dynamic.arm import WINDOW_PERIODS, fit_arm
     from ..io import read_robot_log
-    from ..robot import RigidBodyModel
 
+    if urdf is None and robot is None:
+        raise ConfigError("give --urdf (your robot's URDF) or --robot (an example robot)")
     inputs = {"LOG": log, "--urdf": urdf, "--validate": validate}
+    inputs = {k: v for k, v in inputs.items() if v is not None}
     check_paths(inputs=inputs, folders=["LOG", "--validate"], out_files={"--out": out})
-    model = RigidBodyModel.from_urdf(urdf, _split(joints))
+    model = _model(robot, urdf, joints)
     data = read_robot_log(log, joints=list(model.joints))
     second = read_robot_log(validate, joints=list(model.joints)) if validate else None
     fit = fit_arm(
@@ -145,7 +151,7 @@ def robot_fit_command(
         encoder_counts=encoder_counts,
         cutoff=cutoff,
         validate=second,
-        urdf=urdf.name,
+        urdf=Path(model.source).name if model.source else None,
         reversal_window=WINDOW_PERIODS if closed_loop else 0.0,
     )
     fit.save(out)
