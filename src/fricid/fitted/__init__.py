@@ -23,7 +23,6 @@ failure is one :class:`~fricid.errors.DataError` line naming the file given.
 
 from __future__ import annotations
 
-import json
 import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass, field, fields
@@ -472,13 +471,9 @@ class FittedModel:
 
     def save(self, path: str | PathLike[str]) -> Path:
         """Write the model as JSON, atomically."""
-        from ..io.atomic import atomic_write
+        from ..io._jsonfile import write_json
 
-        path = Path(path)
-        with atomic_write(path, "w") as fh:
-            json.dump(self.to_dict(), fh, indent=2)
-            fh.write("\n")
-        return path
+        return write_json(path, self.to_dict())
 
     @classmethod
     def load(cls, path: str | PathLike[str]) -> FittedModel:

@@ -12,7 +12,6 @@ joint's model (predict, export) works on it.
 
 from __future__ import annotations
 
-import json
 from dataclasses import dataclass, field, fields
 from os import PathLike
 from pathlib import Path
@@ -180,13 +179,9 @@ class ArmFit:
 
     def save(self, path: str | PathLike[str]) -> Path:
         """Write the fit as JSON, atomically."""
-        from ..io.atomic import atomic_write
+        from ..io._jsonfile import write_json
 
-        path = Path(path)
-        with atomic_write(path, "w") as fh:
-            json.dump(self.to_dict(), fh, indent=2)
-            fh.write("\n")
-        return path
+        return write_json(path, self.to_dict())
 
     @classmethod
     def load(cls, path: str | PathLike[str]) -> ArmFit:

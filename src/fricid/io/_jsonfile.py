@@ -22,6 +22,7 @@ import math
 import re
 from collections.abc import Mapping
 from os import PathLike
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -40,6 +41,7 @@ __all__ = [
     "check_document",
     "one_line",
     "read_json",
+    "write_json",
 ]
 
 #: Largest file read: 64 MiB.
@@ -115,6 +117,18 @@ def _object(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
         dup = next(k for k, _ in pairs if k in seen or seen.add(k))  # type: ignore[func-returns-value]
         raise _Refused(f"the key {one_line(repr(dup))[:80]} appears twice in one object")
     return out
+
+
+def write_json(path: str | PathLike[str], doc: Any) -> Path:
+    """Write ``doc`` as indented JSON with a final newline, atomically
+    (:func:`fricid.io.atomic.atomic_write`); the counterpart of :func:`read_json`."""
+    from .atomic import atomic_write
+
+    path = Path(path)
+    with atomic_write(path, "w") as fh:
+        json.dump(doc, fh, indent=2)
+        fh.write("\n")
+    return path
 
 
 def read_json(path: str | PathLike[str], *, what: str = "JSON file") -> Any:

@@ -48,7 +48,7 @@ import numpy as np
 
 from ...errors import ConfigError, DataError
 from ...samples import RawLog
-from ..static.uncertainty import covariance_svd
+from ..static.uncertainty import covariance_svd, floored_covariance
 
 __all__ = [
     "FILTERS",
@@ -243,11 +243,5 @@ def cluster_covariance(
     scale = g / max(g - 1, 1) * (n - 1) / dof
     with np.errstate(invalid="ignore"):
         cov = scale * bread @ meat @ bread
-        var = np.maximum(np.diag(cov), np.diag(plain))
-        se = np.where(determined, np.sqrt(np.clip(var, 0, None)), np.nan)
-        d = np.sqrt(np.clip(np.diag(cov), 0, None))
-        corr = cov / np.outer(d, d)
-        cov = corr * np.outer(se, se)
-    cov[~determined, :] = np.nan
-    cov[:, ~determined] = np.nan
+    cov, se = floored_covariance(cov, np.diag(plain), determined)
     return cov, se, g

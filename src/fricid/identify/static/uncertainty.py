@@ -40,6 +40,7 @@ __all__ = [
     "Uncertainty",
     "assess",
     "covariance_svd",
+    "floored_covariance",
     "jacobian",
     "jacobian_uncertainty",
     "null_directions",
@@ -111,6 +112,22 @@ def covariance_svd(J: np.ndarray, s2: float) -> tuple[np.ndarray, np.ndarray]:
     cov[~determined, :] = np.nan
     cov[:, ~determined] = np.nan
     return cov, determined
+
+
+def floored_covariance(
+    cov: np.ndarray, plain_var: np.ndarray, determined: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """A robust (sandwich) covariance never below the plain one: each variance raised to
+    ``plain_var`` where that is larger, the correlations kept, and NaN rows and columns for
+    the parameters not ``determined``. Returns (cov, stderr)."""
+    with np.errstate(invalid="ignore"):
+        var = np.maximum(np.diag(cov), plain_var)
+        se = np.where(determined, np.sqrt(np.clip(var, 0, None)), np.nan)
+        d = np.sqrt(np.clip(np.diag(cov), 0, None))
+        cov = cov / np.outer(d, d) * np.outer(se, se)
+    cov[~determined, :] = np.nan
+    cov[:, ~determined] = np.nan
+    return cov, se
 
 
 def jacobian_uncertainty(

@@ -37,7 +37,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...static.uncertainty import covariance_svd
+from ...static.uncertainty import covariance_svd, floored_covariance
 from ._friction import DELTA_BOX, W_S_BOX, JointFriction
 from ._signals import ArmSignals
 
@@ -293,15 +293,7 @@ def hac_covariance(J: np.ndarray, res: np.ndarray, times: np.ndarray, lags: int)
         gamma = scores[lag:].T @ scores[:-lag]
         meat += (1 - lag / (lags + 1)) * (gamma + gamma.T)
     cov = bread @ meat @ bread * m / max(m - p, 1)
-    with np.errstate(invalid="ignore"):
-        var = np.maximum(np.diag(cov), np.nan_to_num(np.diag(plain)))
-        se = np.where(determined, np.sqrt(np.clip(var, 0, None)), np.nan)
-        d = np.sqrt(np.clip(np.diag(cov), 0, None))
-        corr = cov / np.outer(d, d)
-        cov = corr * np.outer(se, se)
-    cov[~determined, :] = np.nan
-    cov[:, ~determined] = np.nan
-    return cov, se
+    return floored_covariance(cov, np.nan_to_num(np.diag(plain)), determined)
 
 
 def arm_covariance(J: np.ndarray, res: np.ndarray, st: Stack, n: int):
