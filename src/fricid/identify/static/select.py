@@ -21,6 +21,9 @@ The rules (issue 11, "Validation built in"):
 * the choice is the simplest candidate (fewest parameters, symmetric before ``_asym``) whose
   held-out RMSE is within :data:`PREFER_SIMPLER` (5 %) of the best, or within the noise
   (:data:`fricid.metrics.NOISE_RATIO` times the measurement scatter);
+* a candidate whose error on every sample already exceeds (by :data:`PRUNE_MARGIN`) the
+  held-out error a choice may have is listed "not validated" instead: its held-out error
+  cannot be lower (candidates are validated closest fit first);
 * on tiny data (at most :data:`TINY_SAMPLES` samples) the held-out RMSE of each candidate is
   itself noisy, so a simpler candidate is also kept when the best one's advantage is not
   significant: the mean over the samples of the paired difference of squared held-out errors
@@ -38,7 +41,7 @@ import numpy as np
 
 from ...errors import ConfigError
 from ...fitted import FittedModel
-from ...metrics import NOISE_RATIO
+from ...metrics import NOISE_RATIO, rmse
 from ...optim import single_blas_thread
 from ...samples import FrictionSamples
 from .._named import fit_named
@@ -50,6 +53,7 @@ __all__ = [
     "FAMILIES",
     "LEARNED",
     "PREFER_SIMPLER",
+    "PRUNE_MARGIN",
     "TINY_SAMPLES",
     "TINY_SIGMAS",
     "Candidate",
@@ -94,8 +98,8 @@ def select(
         default: validating one retrains it, its structure search included, for every fold
         (about 20 times an analytic family's time).
     progress : callable, optional
-        ``progress(i, n, label)`` before the ``i``-th (0-based) of the ``n`` candidates that
-        are validated (``label`` its name), and ``progress(n, n, label)`` before the chosen
+        ``progress(i, n, label)`` before the ``i``-th (0-based) of the ``n`` candidates is
+        fitted (``label`` its name), and ``progress(n, n, label)`` before the chosen
         family is refitted on all the samples.
     **fit_options
         Passed to every fit (``max_evals``, ``loss``, ``weights``, ...).
@@ -130,14 +134,37 @@ def select(
         fit_options.get("weights") not in (None, "none", "")
     )
     todo = [c.label for c in found.values() if not c.note]
-    for c in found.values():
+    plans: dict[str, tuple[Candidate, dict[str, Any], float]] = {}
+    for c in found.values():  # every candidate's fit on all the samples, its start
         if progress is not None and not c.note:
             progress(todo.index(c.label), len(todo), c.label)
         row: dict[str, Any] = {"model": c.label, "n_params": c.n_params}
         if c.model in LEARNED and robust and not c.note:
             c = Candidate(c.label, c.model, c.fixed, c.n_params, "trains by least squares only")
         if c.note:
-            table.append({**row, "heldout_rmse": None, "ratio": None, "note": c.note})
+            row.update(heldout_rmse=None, ratio=None, note=c.note)
+        else:
+            options, train = _screening(samples, c, method, seed, _options(c.model, fit_options))
+            plans[c.label] = (c, options, train)
+        table.append(row)
+    rows = {r["model"]: r for r in table}
+    prune = not robust and len(samples) > TINY_SAMPLES
+    noise = NOISE_RATIO * sc.value if np.isfinite(sc.value) else 0.0
+    best_rmse = np.inf
+    order = sorted(plans, key=lambda k: (not np.isfinite(plans[k][2]), np.nan_to_num(plans[k][2])))
+    for label in order:  # the closest fit first
+        c, options, train = plans[label]
+        bar = max(best_rmse * (1.0 + PREFER_SIMPLER), noise)
+        if prune and train > PRUNE_MARGIN * bar:
+            rows[label].update(
+                heldout_rmse=None,
+                ratio=None,
+                note=(
+                    f"not validated: its RMSE on every sample, {train:.3g} N m, already exceeds "
+                    f"{PRUNE_MARGIN:g}x the held-out error a choice may have ({bar:.3g} N m), "
+                    "and a held-out error is not below it"
+                ),
+            )
             continue
         v = validate(
             samples,
@@ -147,18 +174,17 @@ def select(
             scatter=sc,
             seed=seed,
             fixed=c.fixed,
-            **_screening(samples, c, method, seed, _options(c.model, fit_options)),
+            **options,
         )
-        runs[c.label] = v
+        runs[label] = v
         ok = np.isfinite(v.rmse) and v.failed == 0
-        table.append(
-            {
-                **row,
-                "heldout_rmse": float(v.rmse) if np.isfinite(v.rmse) else None,
-                "ratio": float(v.ratio) if np.isfinite(v.ratio) else None,
-                "note": v.verdict if ok else f"{v.failed} folds could not be fitted",
-            }
+        rows[label].update(
+            heldout_rmse=float(v.rmse) if np.isfinite(v.rmse) else None,
+            ratio=float(v.ratio) if np.isfinite(v.ratio) else None,
+            note=v.verdict if ok else f"{v.failed} folds could not be fitted",
         )
+        if ok:
+            best_rmse = min(best_rmse, float(v.rmse))
     scored = [r for r in table if r["heldout_rmse"] is not None and runs[r["model"]].failed == 0]
     if not scored:
         raise ConfigError(
@@ -167,7 +193,6 @@ def select(
         )
     best = min(scored, key=lambda r: r["heldout_rmse"])
     limit = best["heldout_rmse"] * (1.0 + PREFER_SIMPLER)
-    noise = NOISE_RATIO * sc.value if np.isfinite(sc.value) else 0.0
     ok = [r for r in scored if r["heldout_rmse"] <= max(limit, noise)]
     if len(samples) <= TINY_SAMPLES:
         best_pred = runs[best["model"]].predictions
@@ -206,6 +231,15 @@ def select(
 #: restart that finds nothing better ends it; the chosen family is refitted with the default.
 SCREEN_PATIENCE = 1
 
+#: A candidate whose RMSE on every sample exceeds this many times the held-out error a choice
+#: may have (within :data:`PREFER_SIMPLER` of the best so far, or within the noise) is not
+#: validated: its held-out error cannot be lower than its error on every sample (exact for
+#: linear least squares, where each left-out residual is ``(I - H)^-1`` times the in-sample
+#: one and ``H``'s eigenvalues lie in ``[0, 1)``); the margin covers the nonlinear families.
+#: Candidates are validated closest fit first. Only without weights or a robust loss (where the
+#: fit does not minimise the plain squared error) and above :data:`TINY_SAMPLES` samples.
+PRUNE_MARGIN = 1.1
+
 
 def _screening(
     samples: FrictionSamples,
@@ -213,14 +247,15 @@ def _screening(
     method: str,
     seed: int | np.random.Generator | None,
     options: dict[str, Any],
-) -> dict[str, Any]:
-    """The validation options of an analytic candidate fitted by the default ``lm`` without
-    optimiser options: every fold starts from the candidate's optimum on all the samples (one
-    fit without intervals), as a fold leaves out a little of the data, and the folds are
-    refitted together (:func:`fricid.identify.validate.validate`'s ``start``). Otherwise (a
-    learned family, another method, options given) ``options`` as they are."""
+) -> tuple[dict[str, Any], float]:
+    """The validation options of a candidate and its RMSE on every sample (N m; NaN when not
+    known). An analytic candidate fitted by the default ``lm`` without optimiser options is
+    fitted once on all the samples (no intervals): every fold starts from that optimum, as a
+    fold leaves out a little of the data, and the folds are refitted together
+    (:func:`fricid.identify.validate.validate`'s ``start``). Otherwise (a learned family,
+    another method, options given) ``options`` as they are."""
     if c.model in LEARNED or str(method).strip().lower() != "lm" or options.get("options"):
-        return options
+        return options, float("nan")
     full = fit_named(
         samples,
         c.model,
@@ -229,7 +264,9 @@ def _screening(
         fixed=c.fixed or None,
         **{**options, "intervals": "none", "options": {"patience": SCREEN_PATIENCE}},
     )
-    return {**options, "start": {n: p.value for n, p in full.parameters.items() if not p.fixed}}
+    start = {n: p.value for n, p in full.parameters.items() if not p.fixed}
+    train = rmse(samples.y, full.predict(samples.X, warn=False))
+    return {**options, "start": start}, float(train)
 
 
 def _better(best: np.ndarray, other: np.ndarray, y: np.ndarray) -> bool:
