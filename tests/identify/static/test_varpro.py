@@ -123,6 +123,7 @@ def test_varpro_reaches_the_optimum_of_held_out_laws(name, seed):
     assert f.converged and f.metrics["sse"] <= ref * (1 + EXACT), (f.metrics["sse"], ref)
 
 
+@pytest.mark.slow  # timing-sensitive: wall time against wall time, run by make test-all
 def test_varpro_costs_no_more_than_lm(study):
     """Wall time summed over the study and two held-out laws (each the fastest of 3 runs,
     measured in this process): varpro is not slower than the default lm."""
