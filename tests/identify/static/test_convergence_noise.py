@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from fricid.identify import IdentificationProblem
-from fricid.identify.static.convergence import RESOLVE_SE, certify
+from fricid.identify.static.convergence import RESOLVE_SE, certify, noise_ftol
 from fricid.models import get_model
 from fricid.optim import OptimizeResult, minimize
 from fricid.samples import FrictionSamples
@@ -61,3 +61,22 @@ def test_a_gain_of_standard_errors_is_not_converged_and_says_so(problem):
     assert "x lower" not in reason and "% lower" in reason
     moved = float(reason.split("move by ")[1].split(" standard errors")[0])
     assert 1.5 < moved < 2.5 and moved > RESOLVE_SE
+
+
+@pytest.mark.parametrize(("distance", "converged"), [(0.05, True), (0.3, False), (2.0, False)])
+def test_a_polish_stopped_at_the_resolution_gives_the_same_verdict(problem, distance, converged):
+    """``noise_tolerance``: the polish stops once a step gains under a tenth of what the
+    verdict resolves; the verdict is the full polish's at 0.05, 0.3 and 2 standard errors
+    from the optimum, in fewer evaluations."""
+    dof = problem.n_obs - problem.n_free
+    result = _at(problem, distance**2 / dof)  # an SSE gain of distance^2 s^2
+    full = certify(problem, result)
+    short = certify(problem, result, noise_tolerance=True)
+    assert full["converged"] is short["converged"] is converged
+    assert short["polish_nfev"] < full["polish_nfev"]
+
+
+def test_noise_ftol_is_the_resolution_per_degree_of_freedom(problem):
+    dof = problem.n_obs - problem.n_free
+    assert noise_ftol(problem) == pytest.approx(RESOLVE_SE**2 / dof)
+    assert noise_ftol(problem, 0.1) == pytest.approx(0.1 * RESOLVE_SE**2 / dof)

@@ -55,9 +55,10 @@ import numpy as np
 from ...errors import ConfigError, DataError
 from ...models import dahl, lugre
 from ..problem import ResidualProblem
+from ..static.convergence import noise_ftol
 from ..static.uncertainty import jacobian
 from ._data import Series, blocks, cluster_covariance
-from ._routes import JOINT_PARAMS, _run, _Stage, _t975
+from ._routes import JOINT_PARAMS, SEARCH_SHARE, _run, _Stage, _t975
 
 __all__ = ["DAHL", "LUGRE", "Law", "ParallelFilter", "filtered_route"]
 
@@ -269,7 +270,8 @@ def filtered_route(
     x0 = np.where(is_log, np.log10(np.maximum(start, 1e-300)), start)
     x0 = np.clip(x0, box[:, 0], box[:, 1])
     search = ResidualProblem(projected, box, law.names, y)
-    result = _run(search, method, x0, seed, max_evals, 1)
+    ftol = noise_ftol(search, SEARCH_SHARE)  # each evaluation a simulation (module notes)
+    result = _run(search, method, x0, seed, max_evals, 1, ftol)
     u_hat = np.asarray(result.x, dtype=float)
     c = np.linalg.lstsq(Phi, y - friction(u_hat)[0], rcond=None)[0]
 

@@ -39,10 +39,11 @@ import numpy as np
 
 from ...models import lugre
 from ..problem import ResidualProblem
+from ..static.convergence import noise_ftol
 from ..static.uncertainty import jacobian
 from ._data import Series, blocks, cluster_covariance
 from ._filtered import LOG_BOX, ParallelFilter
-from ._routes import JOINT_PARAMS, _run, _Stage, _t975
+from ._routes import JOINT_PARAMS, SEARCH_SHARE, _run, _Stage, _t975
 
 __all__ = ["BANDWIDTH", "DAMPING", "RESOLVED_COUNTS", "needs_output_error", "output_error"]
 
@@ -155,7 +156,8 @@ def output_error(
     box = _box(stage, is_log, start, float(np.max(np.abs(u))))
     x0 = np.clip(np.where(is_log, np.log10(np.maximum(start, 1e-300)), start), *box.T)
     search = ResidualProblem(residuals, box, names, y)
-    result = _run(search, method, x0, seed, max_evals or MAX_EVALS, 1)
+    ftol = noise_ftol(search, SEARCH_SHARE)  # each evaluation a simulation (module notes)
+    result = _run(search, method, x0, seed, max_evals or MAX_EVALS, 1, ftol)
     u_hat = np.asarray(result.x, dtype=float)
     Jm, r0 = jacobian(residuals, u_hat)
     labels = blocks(n, max(round(cluster_time * rate), 1))[keep]

@@ -30,6 +30,12 @@ __all__ = ["JOINT_PARAMS", "LSQ_STARTS"]
 #: defaults, or the first stage's estimate; the second at random in the box).
 LSQ_STARTS = 2
 
+#: The searches whose every evaluation simulates the joint over the whole log (the filtered and
+#: output-error routes) stop once a step lowers the SSE by under this share of what the
+#: convergence certificate resolves (``RESOLVE_SE^2 s^2``:
+#: :func:`fricid.identify.static.convergence.noise_ftol`), not at ``lm``'s 1e-12.
+SEARCH_SHARE = 0.1
+
 #: Starts of the least-squares methods on the simulation route: one, from the box centre
 #: (sigma_0 = 10^4.5 N m/rad, sigma_1 = 1 N m s/rad) or the two-stage estimate; on the virtual
 #: joint the simulation error was unimodal in log sigma_0 (scanned 1e3-1e5), and on the 5
@@ -80,9 +86,10 @@ def _t975(dof: int) -> float:
     return float(t.ppf(0.975, max(dof, 1)))
 
 
-def _run(problem: Problem, method, x0, seed, max_evals, starts=None):
+def _run(problem: Problem, method, x0, seed, max_evals, starts=None, ftol=None):
     """``minimize`` of ``problem`` over its box: with its residuals for the least-squares
-    methods (``starts`` of them, default :data:`LSQ_STARTS`), its loss for the others."""
+    methods (``starts`` of them, default :data:`LSQ_STARTS`; ``ftol`` their relative
+    tolerance on the SSE, default theirs), its loss for the others."""
     key = method.strip().lower()
     if key not in METHODS:
         raise ConfigError(f"unknown method '{method}'; choose one of: {', '.join(METHODS)}")
@@ -90,6 +97,8 @@ def _run(problem: Problem, method, x0, seed, max_evals, starts=None):
     if METHODS[key].uses_residuals:
         n = LSQ_STARTS if starts is None else starts
         options = {"n_starts": n} if "n_starts" in METHODS[key].options else None
+        if options is not None and ftol is not None:
+            options["ftol"] = float(ftol)
         return minimize(
             None,
             bounds,

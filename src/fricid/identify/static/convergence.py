@@ -33,7 +33,14 @@ import numpy as np
 from ...optim import OptimizeResult, minimize
 from ..problem import Problem
 
-__all__ = ["POLISH_EVALS_PER_PARAM", "POLISH_RTOL", "RESOLVE_SE", "advice", "certify"]
+__all__ = [
+    "POLISH_EVALS_PER_PARAM",
+    "POLISH_RTOL",
+    "RESOLVE_SE",
+    "advice",
+    "certify",
+    "noise_ftol",
+]
 
 #: Relative SSE decrease by the polish at or below which the fit counts as converged (exact
 #: data, where the residual variance is 0).
@@ -60,7 +67,19 @@ def advice(method: str) -> str:
     return "raise --max-evals, or start elsewhere (--seed, x0)"
 
 
-def certify(problem: Problem, result: OptimizeResult) -> dict[str, Any]:
+def noise_ftol(problem: Problem, share: float = 1.0) -> float:
+    """``lm``'s relative ``ftol`` at which a step's SSE gain is ``share`` times what the
+    certificate resolves (``RESOLVE_SE^2 s^2``, ``s^2 = SSE / (n - p)``): ``share *
+    RESOLVE_SE^2 / (n - p)``. A least-squares search stopped there is within the data's
+    resolution of its optimum (near it, a Gauss-Newton step gains the squared distance in
+    standard errors times ``s^2``): used where each evaluation is a simulation."""
+    dof = max(_n_obs(problem) - problem.n_free, 1)
+    return share * RESOLVE_SE**2 / dof
+
+
+def certify(
+    problem: Problem, result: OptimizeResult, *, noise_tolerance: bool = False
+) -> dict[str, Any]:
     """The convergence block of a fit (stored in ``FittedModel.convergence``).
 
     Parameters
@@ -71,6 +90,10 @@ def certify(problem: Problem, result: OptimizeResult) -> dict[str, Any]:
         protocol (:class:`~fricid.identify.problem.Problem`: a trajectory route's stage).
     result : OptimizeResult
         The optimiser's result.
+    noise_tolerance : bool, default False
+        The polish stops once a step gains under a tenth of what the verdict resolves
+        (:func:`noise_ftol`, ``share=0.1``) instead of at ``lm``'s own tolerances: for
+        problems whose evaluations are simulations (a trajectory's output-error stage).
 
     Returns
     -------
@@ -100,7 +123,7 @@ def certify(problem: Problem, result: OptimizeResult) -> dict[str, Any]:
         problem.bounds,
         method="lm",
         x0=np.clip(result.x, problem.bounds[:, 0], problem.bounds[:, 1]),
-        options={"n_starts": 1},
+        options={"n_starts": 1, **({"ftol": noise_ftol(problem, 0.1)} if noise_tolerance else {})},
         max_evals=POLISH_EVALS_PER_PARAM * (p + 1),
         residuals=problem.residuals,
         seed=0,
