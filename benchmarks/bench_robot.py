@@ -2,7 +2,7 @@
 
 Usage::
 
-    python benchmarks/bench_robot.py [--seeds 10] [--duration 60] [--rate 1000]
+    python benchmarks/bench_robot.py [--seeds 10] [--first 0] [--duration 60] [--rate 1000]
         [--noise 0.05] [--friction stribeck_asym] [--trajectory FILE] [--truth own]
 
 Per seed: each joint gets its own friction law per direction (``stribeck_asym``: Coulomb,
@@ -146,7 +146,7 @@ def run(args) -> None:
     ratio = defaultdict(list)
     levels = defaultdict(list)
     base_cov, seconds = [], []
-    for seed in range(args.seeds):
+    for seed in range(args.first, args.first + args.seeds):
         laws = _laws(model, seed, args.friction)
         log, held = _logs(model, laws, seed, args, trajectory)
         start = time.perf_counter()
@@ -176,7 +176,9 @@ def run(args) -> None:
         print(f"seed {seed}: {seconds[-1]:.1f} s", file=sys.stderr, flush=True)
     kinds = [k for k in KINDS if any((j, k) in cov for j in model.joints)]
     print(
-        f"{args.robot}, {args.seeds} seeds, {args.duration:g} s at {args.rate:g} Hz, 2^17 "
+        f"{args.robot}, {args.seeds} seeds"
+        + (f" from {args.first}" if args.first else "")
+        + f", {args.duration:g} s at {args.rate:g} Hz, 2^17 "
         f"counts, noise {args.noise:g} N m, friction {args.friction}, truth {args.truth}"
         + (f", trajectory {args.trajectory.name}" if args.trajectory else ", multi-sine")
     )
@@ -204,6 +206,7 @@ def run(args) -> None:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seeds", type=int, default=10)
+    parser.add_argument("--first", type=int, default=0, help="the first seed")
     parser.add_argument("--robot", default="panda", help="an example robot (panda, ur5, ...)")
     parser.add_argument("--duration", type=float, default=60.0)
     parser.add_argument("--rate", type=float, default=1000.0)
