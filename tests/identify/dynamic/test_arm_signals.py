@@ -97,3 +97,19 @@ def test_a_torque_held_between_samples_is_half_a_period_late(pendulum, delay):
     assert est == pytest.approx(delay, abs=0.02)
     res = sig.delayed(est).tau - sig.regressor(pendulum, bp) @ bp.project(pendulum.parameters())
     assert _rms(res) < 1e-3 * _rms(sig.tau)
+
+
+def test_a_stribeck_excess_below_zero_gains_nothing_in_the_shape_search():
+    """The Stribeck rise is a static level above the Coulomb one (``tau_s >= tau_c``): a shape
+    whose best excess is negative (a dip the data's other errors may ask for, which then
+    extrapolates wildly where the fit had no rows) explains nothing."""
+    from fricid.identify.dynamic.arm._solve import _projector
+
+    rng = np.random.default_rng(1)
+    A = rng.normal(size=(200, 4))
+    x = np.exp(-np.linspace(0, 5, 200))  # a candidate Stribeck column
+    y = A @ np.array([1.0, -2.0, 0.5, 3.0]) - 0.8 * x + 0.01 * rng.normal(size=200)
+    gain = _projector(np.column_stack([A, x]), y, 4, np.arange(200))
+    dip, rise = gain(np.column_stack([x, -x]))
+    assert dip == 0.0
+    assert rise > 0.0
