@@ -17,8 +17,9 @@ no law of velocity says, and the low-pass spreads a reversal over its neighbours
   evaluated for a grid of shapes at once (the current shapes among them, so that no step
   loses), a shape whose best excess ``tau_s - tau_c`` is below zero gaining nothing (the
   Stribeck rise is a static level above the Coulomb one; on a PD-tracked Panda such dips,
-  fitted where the closed loop's reversals left no rows, held out at 3 to 8 times the noise); the blocks are swept :data:`SWEEPS` times, after the first refined by Newton
-  steps over ``(log w_s, delta)`` from the grid's best (:func:`_newton`). The directions of
+  fitted where the closed loop's reversals left no rows, held out at 3 to 8 times the
+  noise); the blocks are swept :data:`SWEEPS` times, after the first refined by Newton steps
+  over ``(log w_s, delta)`` from the grid's best (:func:`_newton`). The directions of
   a joint are coupled near its reversals (the low-pass spreads both over them), so the
   descent converges slowly along a curved valley; noise-free, three sweeps leave the
   shapes a few per cent to tens of per cent off.
