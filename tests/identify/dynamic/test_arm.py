@@ -212,7 +212,7 @@ def test_rows_near_a_reversal_are_left_out_over_the_filter_window():
     t = np.arange(round(20 * rate)) / rate
     q = np.column_stack([np.sin(2 * np.pi * f * t) / (2 * np.pi * f), 0.5 * t])
     tau = np.random.default_rng(0).normal(0.0, 0.05, q.shape)
-    sig = prepare_signals(t, q, tau, counts=2**17, cutoff=10.0)
+    sig = prepare_signals(t, q, tau, counts=2**17, cutoff=10.0, stops=True)
     assert _moving(sig)[np.abs(sig.dq[:, 0]) > 0.01, 0].all()  # by default: the threshold
     keep = _moving(sig, WINDOW_PERIODS)
     reversals = (np.arange(10) + 0.5) / (2 * f)  # cos(2 pi f t) = 0

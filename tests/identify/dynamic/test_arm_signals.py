@@ -74,7 +74,9 @@ def test_friction_columns_follow_a_joint_that_stops(pendulum):
     jf = JointFriction("coulomb_viscous")
     theta = np.array([1.0, 0.2])  # f_c, beta
     friction = jf.columns(dq[:, 0]) @ theta
-    sig = prepare_signals(t, q, np.column_stack([friction, 0 * t]), counts=2**30, cutoff=CUTOFF)
+    sig = prepare_signals(
+        t, q, np.column_stack([friction, 0 * t]), counts=2**30, cutoff=CUTOFF, stops=True
+    )
     moving = _moving(sig, 1.0)[:, 0]
     assert 0.2 < moving.mean() < 0.9
     model = sig.parallel(jf.columns(sig.full_dq[:, 0])) @ theta

@@ -92,14 +92,14 @@ def _log_arrays(log: RobotLog, model: RigidBodyModel) -> tuple[np.ndarray, ...]:
     return sel.time, sel.position, sel.motor_torque
 
 
-def _signals(log: RobotLog, model, counts, cutoff) -> ArmSignals:
+def _signals(log: RobotLog, model, counts, cutoff, stops: bool = False) -> ArmSignals:
     t, q, tau = _log_arrays(log, model)
     inertia = None
     if cutoff is None:  # the mean diagonal of the mass matrix over the log
         rows = np.linspace(0, len(t) - 1, 25).astype(int)
         inertia = np.diagonal(model.mass_matrix(q[rows]), axis1=1, axis2=2).mean(axis=0)
     return prepare_signals(
-        t, q, tau, counts=counts, cutoff=cutoff, inertia=inertia, source=log.source
+        t, q, tau, counts=counts, cutoff=cutoff, inertia=inertia, source=log.source, stops=stops
     )
 
 
@@ -348,7 +348,8 @@ def _fit_arm(
     if validate is None:
         cut = int(len(log) * (1 - HELDOUT_SHARE))
         log, validate = log.slice(0, cut), log.slice(cut, len(log))
-    sig = _signals(log, model, encoder_counts, cutoff)
+    stops = reversal_window > 0  # recorded in closed loop: the joints stick at reversals
+    sig = _signals(log, model, encoder_counts, cutoff, stops)
     moving = _moving(sig, reversal_window)
     if not moving.any():
         raise DataError("no joint moves in the log: nothing to identify", file=log.source)
@@ -411,7 +412,7 @@ def _fit_arm(
     }
     fric = _friction_records(frictions, theta, cov, st, model.joints, t, sig, moving, units)
     # held-out validation with the same filter
-    vsig = _signals(validate, model, encoder_counts, sig.cutoff).delayed(torque_delay)
+    vsig = _signals(validate, model, encoder_counts, sig.cutoff, stops).delayed(torque_delay)
     vmoving = _moving(vsig, reversal_window)
     pred = _predict(
         model,

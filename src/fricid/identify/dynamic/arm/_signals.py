@@ -20,9 +20,11 @@ a real arm logs a quantised position (an encoder) and a noisy torque. Following 
 * each joint's friction is a law of the joint's *true* velocity, which is not smooth where a
   joint stops or reverses in closed loop (it sticks for some milliseconds, then breaks
   away), and the low-pass of ``F(v)`` is not ``F`` of the low-passed velocity there. The
-  friction columns are ``F`` of a velocity through a wider low-pass
+  friction columns of such a log (``stops``) are ``F`` of a velocity through a wider low-pass
   (:data:`FRICTION_OVER_CUTOFF` times the cut-off: its encoder noise stays far below any
-  Stribeck velocity), then through the torque's filter like the torque;
+  Stribeck velocity), then through the torque's filter like the torque. Where the joints do
+  not stick, the velocity through the cut-off itself times a reversal better (with the
+  wider one, on the open-loop truth, the held-out error of some joints grew by a third);
 * all are then decimated to a rate of about :data:`RATE_OVER_CUTOFF` times the cut-off, since
   the filtered signals carry nothing above it, and a filter transient of :data:`EDGE_PERIODS`
   periods of the cut-off is dropped at each end.
@@ -213,6 +215,7 @@ def prepare_signals(
     cutoff: float | None = None,
     inertia: np.ndarray | None = None,
     source: str | None = None,
+    stops: bool = False,
 ) -> ArmSignals:
     """Filter, differentiate and decimate a log's position and torque (module notes).
 
@@ -229,6 +232,11 @@ def prepare_signals(
         it, that bound is not applied).
     source : str, optional
         The log's file, named in errors.
+    stops : bool
+        The joints stop and stick (a log recorded in closed loop): the friction's velocity
+        through a low-pass :data:`FRICTION_OVER_CUTOFF` times wider than the cut-off, else
+        through the cut-off itself (a smooth motion's reversal is timed better by it than by
+        a wider low-pass of the encoder's steps).
     """
     dt = np.diff(time)
     rate = 1.0 / float(np.median(dt))
@@ -250,7 +258,7 @@ def prepare_signals(
     dq = np.gradient(qf, axis=0) * rate
     ddq = np.gradient(dq, axis=0) * rate
     # the friction's velocity: the same position through a wider low-pass (module notes)
-    f_cut = min(FRICTION_OVER_CUTOFF * cutoff, rate / MIN_RATE_OVER_CUTOFF)
+    f_cut = min(FRICTION_OVER_CUTOFF * cutoff, rate / MIN_RATE_OVER_CUTOFF) if stops else cutoff
     wide = scipy.signal.butter(BUTTER_ORDER, f_cut / (rate / 2))
     dq_friction = np.gradient(_filt(wide, position), axis=0) * rate
     # the anti-alias filter far above the cut-off (no droop where the signals are), decimate
