@@ -115,3 +115,30 @@ def test_a_stribeck_excess_below_zero_gains_nothing_in_the_shape_search():
     dip, rise = gain(np.column_stack([x, -x]))
     assert dip == 0.0
     assert rise > 0.0
+
+
+def test_a_stribeck_shape_the_data_do_not_see_gets_a_wide_profile_region(pendulum):
+    """Joints that never slow below 0.5 rad/s cannot show a Stribeck rise of 0.05 rad/s: the
+    profile region of the shape spans the grid's small Stribeck velocities, where the
+    linearised interval alone would say nothing of it."""
+    from fricid.identify.dynamic.arm._solve import W_S_GRID, shape_profiles, stack, wls
+
+    t = np.arange(int(8 * RATE)) / RATE
+    w = 2 * np.pi * 0.5
+    q = np.column_stack([0.8 * t + 0.1 * np.sin(w * t), 0.6 * t + 0.1 * np.cos(w * t)])
+    dq = np.column_stack([0.8 + 0.1 * w * np.cos(w * t), 0.6 - 0.1 * w * np.sin(w * t)])
+    ddq = np.column_stack([-0.1 * w**2 * np.sin(w * t), -0.1 * w**2 * np.cos(w * t)])
+    rise = 0.5 * np.exp(-dq / 0.05)  # nil at these speeds
+    tau = pendulum.inverse_dynamics(q, dq, ddq) + 0.4 + 0.2 * dq + rise
+    tau += np.random.default_rng(2).normal(0.0, 0.05, tau.shape)
+    sig = prepare_signals(t, q, tau, counts=2**17, cutoff=CUTOFF)
+    bp = base_parameters(pendulum)
+    frictions = friction_for(pendulum.joints, "stribeck_asym")
+    Yb = sig.regressor(pendulum, bp)
+    moving = _moving(sig)
+    _, sigma = wls(stack(Yb, sig, frictions, moving), 2)
+    profiles = shape_profiles(sig, Yb, frictions, moving, sigma, np.ones(2))
+    for j in range(2):
+        region = profiles[j, "_pos"]
+        assert region["w_s"][0] == W_S_GRID.min()
+        assert region["w_s"][1] >= 0.05

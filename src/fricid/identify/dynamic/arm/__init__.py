@@ -63,7 +63,7 @@ from ...trust import MISS_RATIO
 from ._consistent import consistent_parameters
 from ._friction import DELTA_BOX, W_S_BOX, friction_for, split_direction
 from ._signals import ArmSignals, prepare_signals
-from ._solve import arm_covariance, lstsq, search_shapes, stack, wls
+from ._solve import arm_covariance, lstsq, search_shapes, shape_profiles, stack, wls
 
 __all__ = ["HELDOUT_SHARE", "fit_arm"]
 
@@ -225,6 +225,19 @@ def _friction_records(frictions, theta, cov, st, joints, t, sig, moving, models_
             "velocity_range": [float(v.min()), float(v.max())] if v.size else [0.0, 0.0],
         }
     return out
+
+
+def _widen(recs: dict, d: str, prof: dict) -> None:
+    """Direction ``d``'s Stribeck intervals widened to their profile region
+    (:func:`._solve.shape_profiles`), ``tau_s`` by the region's excess over ``tau_c``."""
+    tau_c = recs["tau_c" + d]["value"]
+    ranges = {"w_s": prof["w_s"], "delta": prof["delta"]}
+    if tau_c is not None:
+        ranges["tau_s"] = (tau_c + prof["excess"][0], tau_c + prof["excess"][1])
+    for name, (lo, hi) in ranges.items():
+        rec = recs[name + d]
+        if rec["value"] is not None and rec["ci95"][0] is not None:
+            rec["ci95"] = [min(rec["ci95"][0], lo), max(rec["ci95"][1], hi)]
 
 
 def _loose_levels(recs: Mapping[str, Mapping[str, Any]], noise: float) -> list[str]:
@@ -411,6 +424,9 @@ def _fit_arm(
         for f in {jf.family for jf in frictions}
     }
     fric = _friction_records(frictions, theta, cov, st, model.joints, t, sig, moving, units)
+    inflation = np.bincount(st.row_joint, minlength=n) / np.maximum(n_eff, 1e-12)
+    for (j, d), prof in shape_profiles(sig, Yb, frictions, moving, safe, inflation).items():
+        _widen(fric[model.joints[j]]["parameters"], d, prof)
     # held-out validation with the same filter
     vsig = _signals(validate, model, encoder_counts, sig.cutoff, stops).delayed(torque_delay)
     vmoving = _moving(vsig, reversal_window)
