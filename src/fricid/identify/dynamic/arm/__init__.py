@@ -40,6 +40,14 @@ The torque's timing: a drive's logged command is held from one sample to the nex
 acts half a sample period after the positions it is logged with; on a 5 Hz PD-tracked Panda
 that half period left up to 2.5 times the filtered noise in the residual (with the true
 parameters). The delay is estimated by least squares (:func:`_torque_delay`) unless given.
+
+What remains in closed loop (fricid's simulator, ``benchmarks/bench_robot.py --truth sim``:
+a 5 Hz PD on 2^17-count encoders; its torque noise is logged, not fed back, so IDIM-IV's
+bias does not arise there): with the true parameters the filtered residual of the big joints
+is still about twice the filtered noise on rows far from their own reversals, none of it
+without friction; and a joint crosses its Stribeck velocities in some milliseconds, far
+below the low-pass's resolution, so the Stribeck shapes are determined weakly (their
+intervals are the profile regions, :func:`._solve.shape_profiles`).
 """
 
 from __future__ import annotations
