@@ -198,23 +198,31 @@ def test_not_physical_least_squares_is_replaced_by_a_consistent_solution(pendulu
 
 
 def test_rows_near_a_reversal_are_left_out_over_the_filter_window():
-    # a joint reversing fast (10 rad/s^2 at the reversal: no sample of the filtered velocity
-    # falls below the threshold there) beside one always moving
-    from fricid.identify.dynamic.arm import WINDOW_PERIODS, _moving
+    # a joint reversing (no decimated row of the filtered velocity falls below the threshold
+    # there) beside one always moving
+    from fricid.identify.dynamic.arm import (
+        MIN_SPEED,
+        VELOCITY_NOISE_FACTOR,
+        WINDOW_PERIODS,
+        _moving,
+    )
     from fricid.identify.dynamic.arm._signals import prepare_signals
 
     rate, f = 1000.0, 0.25
     t = np.arange(round(20 * rate)) / rate
     q = np.column_stack([np.sin(2 * np.pi * f * t) / (2 * np.pi * f), 0.5 * t])
     tau = np.random.default_rng(0).normal(0.0, 0.05, q.shape)
-    sig = prepare_signals(t, q, tau, counts=2**17, cutoff=10.0)
+    sig = prepare_signals(t, q, tau, counts=2**17, cutoff=10.0, stops=True)
     assert _moving(sig)[np.abs(sig.dq[:, 0]) > 0.01, 0].all()  # by default: the threshold
     keep = _moving(sig, WINDOW_PERIODS)
     reversals = (np.arange(10) + 0.5) / (2 * f)  # cos(2 pi f t) = 0
     gap = np.min(np.abs(sig.time[:, None] - reversals[None, :]), axis=1)
     window = WINDOW_PERIODS / sig.cutoff
     assert not keep[gap < window - 2 / rate, 0].any()
-    assert keep[gap > window + 2 / rate, 0].all()
+    # the slow samples about a reversal: the friction's velocity below its threshold
+    v_min = max(VELOCITY_NOISE_FACTOR * sig.friction_velocity_noise[0], MIN_SPEED)
+    slow = v_min / (2 * np.pi * f)  # |acceleration| 2 pi f at a reversal
+    assert keep[gap > window + slow + 2 / rate, 0].all()
     assert keep[:, 1].all()
 
 

@@ -35,6 +35,19 @@ quantisation and disturbance. Rows within :data:`WINDOW_PERIODS` periods of the 
 slow or reversing sample can be left out (``reversal_window``, :func:`_moving`): it removes
 that bias, and in open loop costs the Stribeck rise the rows it is seen on, so it is not the
 default. The IDIM-IV step for the fed-back noise remains undone.
+
+The torque's timing: a drive's logged command is held from one sample to the next, so it
+acts half a sample period after the positions it is logged with; on a 5 Hz PD-tracked Panda
+that half period left up to 2.5 times the filtered noise in the residual (with the true
+parameters). The delay is estimated by least squares (:func:`_torque_delay`) unless given.
+
+What remains in closed loop (fricid's simulator, ``benchmarks/bench_robot.py --truth sim``:
+a 5 Hz PD on 2^17-count encoders; its torque noise is logged, not fed back, so IDIM-IV's
+bias does not arise there): with the true parameters the filtered residual of the big joints
+is still about twice the filtered noise on rows far from their own reversals, none of it
+without friction; and a joint crosses its Stribeck velocities in some milliseconds, far
+below the low-pass's resolution, so the Stribeck shapes are determined weakly (their
+intervals are the profile regions, :func:`._solve.shape_profiles`).
 """
 
 from __future__ import annotations
@@ -58,7 +71,7 @@ from ...trust import MISS_RATIO
 from ._consistent import consistent_parameters
 from ._friction import DELTA_BOX, W_S_BOX, friction_for, split_direction
 from ._signals import ArmSignals, prepare_signals
-from ._solve import arm_covariance, lstsq, search_shapes, stack, wls
+from ._solve import arm_covariance, lstsq, search_shapes, shape_profiles, stack, wls
 
 __all__ = ["HELDOUT_SHARE", "fit_arm"]
 
@@ -71,6 +84,8 @@ MIN_SPEED = 1e-3
 #: ``reversal_window`` for logs recorded in closed loop: rows this many periods of the
 #: cut-off from a slow or reversing sample are left out (:func:`_moving`).
 WINDOW_PERIODS = 1.0
+#: The largest torque delay estimated [sample periods] (:func:`_torque_delay`).
+MAX_DELAY = 2.0
 
 
 def _log_arrays(log: RobotLog, model: RigidBodyModel) -> tuple[np.ndarray, ...]:
@@ -85,14 +100,14 @@ def _log_arrays(log: RobotLog, model: RigidBodyModel) -> tuple[np.ndarray, ...]:
     return sel.time, sel.position, sel.motor_torque
 
 
-def _signals(log: RobotLog, model, counts, cutoff) -> ArmSignals:
+def _signals(log: RobotLog, model, counts, cutoff, stops: bool = False) -> ArmSignals:
     t, q, tau = _log_arrays(log, model)
     inertia = None
     if cutoff is None:  # the mean diagonal of the mass matrix over the log
         rows = np.linspace(0, len(t) - 1, 25).astype(int)
         inertia = np.diagonal(model.mass_matrix(q[rows]), axis1=1, axis2=2).mean(axis=0)
     return prepare_signals(
-        t, q, tau, counts=counts, cutoff=cutoff, inertia=inertia, source=log.source
+        t, q, tau, counts=counts, cutoff=cutoff, inertia=inertia, source=log.source, stops=stops
     )
 
 
@@ -109,10 +124,11 @@ def _moving(sig: ArmSignals, window: float = 0.0) -> np.ndarray:
     high by several standard errors on arms tracked by a PD. In open loop (no sticking) those
     rows are right and carry the Stribeck rise, which the window then loses.
     """
-    v_min = np.maximum(VELOCITY_NOISE_FACTOR * sig.velocity_noise, MIN_SPEED)
     if window <= 0:
+        v_min = np.maximum(VELOCITY_NOISE_FACTOR * sig.velocity_noise, MIN_SPEED)
         return np.abs(sig.dq) >= v_min[None, :]
-    v = sig.full_dq
+    v = sig.full_dq  # the friction's velocity: a stop of some milliseconds shows in it
+    v_min = np.maximum(VELOCITY_NOISE_FACTOR * sig.friction_velocity_noise, MIN_SPEED)
     near = np.abs(v) < v_min[None, :]
     flip = np.diff(np.sign(v), axis=0) != 0  # a reversal between two samples
     near[1:] |= flip
@@ -120,6 +136,17 @@ def _moving(sig: ArmSignals, window: float = 0.0) -> np.ndarray:
     half = int(np.ceil(window * sig.rate / sig.cutoff))
     near = scipy.ndimage.maximum_filter1d(near.astype(np.uint8), 2 * half + 1, axis=0) > 0
     return ~near[sig.rows()]
+
+
+def _torque_delay(sig: ArmSignals, Yb, frictions, moving) -> float:
+    """The torque's delay behind the positions [sample periods], by least squares: the
+    torque's filtered change per sample is one more column, ``tau = Y theta + a dtau``
+    (:meth:`._signals.ArmSignals.delayed`), clipped to :data:`MAX_DELAY`. A command held from
+    one sample to the next (a drive's logged set point) acts half a period after its sample
+    (``a = 0.5``); a torque measured at the sample instants has none."""
+    st = stack(Yb, sig, frictions, moving)
+    x = lstsq(np.column_stack([st.A, sig.dtau[st.row_time, st.row_joint]]), st.y)
+    return float(np.clip(x[-1], -MAX_DELAY, MAX_DELAY))
 
 
 def _predict(model, bp, beta, frictions, sig: ArmSignals, theta_f: list[np.ndarray]):
@@ -208,6 +235,19 @@ def _friction_records(frictions, theta, cov, st, joints, t, sig, moving, models_
     return out
 
 
+def _widen(recs: dict, d: str, prof: dict) -> None:
+    """Direction ``d``'s Stribeck intervals widened to their profile region
+    (:func:`._solve.shape_profiles`), ``tau_s`` by the region's excess over ``tau_c``."""
+    tau_c = recs["tau_c" + d]["value"]
+    ranges = {"w_s": prof["w_s"], "delta": prof["delta"]}
+    if tau_c is not None:
+        ranges["tau_s"] = (tau_c + prof["excess"][0], tau_c + prof["excess"][1])
+    for name, (lo, hi) in ranges.items():
+        rec = recs[name + d]
+        if rec["value"] is not None and rec["ci95"][0] is not None:
+            rec["ci95"] = [min(rec["ci95"][0], lo), max(rec["ci95"][1], hi)]
+
+
 def _loose_levels(recs: Mapping[str, Mapping[str, Any]], noise: float) -> list[str]:
     """The Coulomb levels whose 95 % interval is wider, on either side, than both their
     value and the joint's torque noise: the data do not tell the joint's friction."""
@@ -277,6 +317,7 @@ def _fit_arm(
     validate: RobotLog | None = None,
     urdf: str | None = None,
     reversal_window: float = 0.0,
+    torque_delay: float | None = None,
 ) -> ArmFit:
     """Identify a whole arm's base inertial parameters and every joint's friction.
 
@@ -305,6 +346,9 @@ def _fit_arm(
         sample (:func:`_moving`; :data:`WINDOW_PERIODS` for a log recorded in closed loop,
         where the joints stick at their reversals); 0, the default, uses the velocity
         threshold alone.
+    torque_delay : float, optional
+        The torque's delay behind the positions [sample periods] (0.5 for a command held
+        from one sample to the next); default estimated from the data (:func:`_torque_delay`).
 
     Returns
     -------
@@ -325,13 +369,17 @@ def _fit_arm(
     if validate is None:
         cut = int(len(log) * (1 - HELDOUT_SHARE))
         log, validate = log.slice(0, cut), log.slice(cut, len(log))
-    sig = _signals(log, model, encoder_counts, cutoff)
+    stops = reversal_window > 0  # recorded in closed loop: the joints stick at reversals
+    sig = _signals(log, model, encoder_counts, cutoff, stops)
     moving = _moving(sig, reversal_window)
     if not moving.any():
         raise DataError("no joint moves in the log: nothing to identify", file=log.source)
     bp = base_parameters(model)
     Yb = sig.regressor(model, bp)
     n = model.n
+    if torque_delay is None:
+        torque_delay = _torque_delay(sig, Yb, frictions, moving)
+    sig = sig.delayed(torque_delay)
     st = stack(Yb, sig, frictions, moving)
     theta, sigma = wls(st, n)
     safe = np.where(np.isfinite(sigma) & (sigma > 0), sigma, 1.0)
@@ -384,8 +432,11 @@ def _fit_arm(
         for f in {jf.family for jf in frictions}
     }
     fric = _friction_records(frictions, theta, cov, st, model.joints, t, sig, moving, units)
+    inflation = np.bincount(st.row_joint, minlength=n) / np.maximum(n_eff, 1e-12)
+    for (j, d), prof in shape_profiles(sig, Yb, frictions, moving, safe, inflation).items():
+        _widen(fric[model.joints[j]]["parameters"], d, prof)
     # held-out validation with the same filter
-    vsig = _signals(validate, model, encoder_counts, sig.cutoff)
+    vsig = _signals(validate, model, encoder_counts, sig.cutoff, stops).delayed(torque_delay)
     vmoving = _moving(vsig, reversal_window)
     pred = _predict(
         model,
@@ -439,6 +490,7 @@ def _fit_arm(
             "encoder_step": sig.encoder_step.tolist(),
             "estimator": "IDIM-WLS",
             "reversal_window": float(reversal_window),
+            "torque_delay": float(torque_delay),
             "samples": int(st.A.shape[0]),
             "effective_samples": {nm: float(x) for nm, x in zip(model.joints, n_eff, strict=True)},
             "correlation_length": corr_len,

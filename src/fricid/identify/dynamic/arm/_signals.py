@@ -9,9 +9,23 @@ a real arm logs a quantised position (an encoder) and a noisy torque. Following 
 * the position is low-passed by a Butterworth filter of order 4 run forwards and backwards
   (``scipy.signal.filtfilt``: zero phase, order 8), and ``dq``, ``ddq`` are central
   differences of the filtered position;
-* the torque passes through the *same* filter (parallel filtering), so that the filter's
-  small amplitude distortion in the pass band acts alike on both sides of ``tau = Y beta``;
-* both are then decimated to a rate of about :data:`RATE_OVER_CUTOFF` times the cut-off, since
+* the torque passes through the *same* filter (parallel filtering), so that the filter acts
+  alike on both sides of ``tau = Y beta``: ``Y(q_f, dq_f, ddq_f) beta`` is, to first order
+  in the motion's high-frequency part, the low-passed rigid-body torque. The torque goes
+  through that low-pass exactly once, as the states did: a drive tracking a quantised
+  position in closed loop commands a broadband torque (its feedback of the encoder steps),
+  which the arm follows; where the torque went through a second low-pass at the same cut-off
+  that the states did not (or the reverse), that band's torque was left without its motion
+  (on a 5 Hz PD-tracked Panda: 2 to 5 times the filtered noise, with the true parameters);
+* each joint's friction is a law of the joint's *true* velocity, which is not smooth where a
+  joint stops or reverses in closed loop (it sticks for some milliseconds, then breaks
+  away), and the low-pass of ``F(v)`` is not ``F`` of the low-passed velocity there. The
+  friction columns of such a log (``stops``) are ``F`` of a velocity through a wider low-pass
+  (:data:`FRICTION_OVER_CUTOFF` times the cut-off: its encoder noise stays far below any
+  Stribeck velocity), then through the torque's filter like the torque. Where the joints do
+  not stick, the velocity through the cut-off itself times a reversal better (with the
+  wider one, on the open-loop truth, the held-out error of some joints grew by a third);
+* all are then decimated to a rate of about :data:`RATE_OVER_CUTOFF` times the cut-off, since
   the filtered signals carry nothing above it, and a filter transient of :data:`EDGE_PERIODS`
   periods of the cut-off is dropped at each end.
 
@@ -33,7 +47,7 @@ smallest non-zero change of each joint's logged position.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import scipy.signal
@@ -63,6 +77,8 @@ MID_RATE_OVER_CUTOFF = 10.0
 ANTI_ALIAS_SHARE = 0.4
 #: Filter transient dropped at each end, in periods of the cut-off.
 EDGE_PERIODS = 5.0
+#: The friction velocity's low-pass over the cut-off (module notes).
+FRICTION_OVER_CUTOFF = 6.0
 
 
 @dataclass(frozen=True)
@@ -81,18 +97,28 @@ class ArmSignals:
     decimation: int
     encoder_step: np.ndarray
     bounds: dict[str, float]
-    #: the velocity's noise standard deviation from the encoder after the filter [rad/s]
+    #: the filtered velocity's noise standard deviation from the encoder [rad/s]
     velocity_noise: np.ndarray
-    #: the filtered velocity at the log's full rate (friction columns are computed on it)
+    #: the same of the friction's velocity (``full_dq``) [rad/s]
+    friction_velocity_noise: np.ndarray
+    #: the friction's velocity at the log's full rate (friction columns are computed on it),
+    #: the position's derivative through a low-pass at ``friction_cutoff`` [Hz]
     full_dq: np.ndarray
-    #: the anti-alias filter, its decimation; the low-pass at the intermediate rate; the rows
-    #: kept there (edges cut, decimated)
+    friction_cutoff: float
+    #: the anti-alias filter and its decimation; the low-pass at the log's rate; the rows
+    #: kept after decimation (edges cut, decimated)
     anti_alias: tuple[np.ndarray, np.ndarray]
     first: int
     low_pass: tuple[np.ndarray, np.ndarray]
     keep: slice
-    #: the filtered states at the intermediate rate (the regressor is computed on them)
-    mid: tuple[np.ndarray, np.ndarray, np.ndarray]
+    #: the torque's change per sample through the same filters (:meth:`delayed`)
+    dtau: np.ndarray | None = None
+
+    def delayed(self, samples: float) -> ArmSignals:
+        """These signals with the torque read ``samples`` sample periods earlier, ``tau(t -
+        samples / rate)`` (to first order, which the low-pass makes exact to its pass band):
+        a command held from one sample to the next acts half a period after its sample."""
+        return replace(self, tau=self.tau - samples * self.dtau)
 
     def rows(self) -> np.ndarray:
         """The samples of the log (indices at its full rate) the decimated rows stand for."""
@@ -100,18 +126,15 @@ class ArmSignals:
         return np.arange(n_mid)[self.keep] * self.first
 
     def regressor(self, model, base) -> np.ndarray:
-        """The base regressor ``Y_b`` (N, n, r), computed at the intermediate rate and passed
-        through the low-pass like the torque (parallel filtering)."""
-        return self.parallel_mid(base.columns(model.regressor(*self.mid)))
+        """The base regressor ``Y_b`` (N, n, r) at the filtered states of the kept rows: the
+        states went through the low-pass, so ``Y_b(q_f) beta`` is the low-passed rigid-body
+        torque (to first order), as :meth:`parallel` gives the torque (module notes)."""
+        return base.columns(model.regressor(self.q, self.dq, self.ddq))
 
     def parallel(self, x: np.ndarray) -> np.ndarray:
-        """``x`` (full rate, first axis time) through the anti-alias filter, decimated, then
-        through :meth:`parallel_mid`: what the torque went through (module notes)."""
-        return self.parallel_mid(_filt(self.anti_alias, x)[:: self.first])
-
-    def parallel_mid(self, x: np.ndarray) -> np.ndarray:
-        """``x`` at the intermediate rate through the low-pass, edges cut, decimated."""
-        return _filt(self.low_pass, x)[self.keep]
+        """``x`` (full rate, first axis time) through what the torque went through: the
+        low-pass, the anti-alias filter, decimation, the kept rows (module notes)."""
+        return _filt(self.anti_alias, _filt(self.low_pass, x))[:: self.first][self.keep]
 
 
 def _filt(ba: tuple[np.ndarray, np.ndarray], x: np.ndarray) -> np.ndarray:
@@ -192,6 +215,7 @@ def prepare_signals(
     cutoff: float | None = None,
     inertia: np.ndarray | None = None,
     source: str | None = None,
+    stops: bool = False,
 ) -> ArmSignals:
     """Filter, differentiate and decimate a log's position and torque (module notes).
 
@@ -208,6 +232,11 @@ def prepare_signals(
         it, that bound is not applied).
     source : str, optional
         The log's file, named in errors.
+    stops : bool
+        The joints stop and stick (a log recorded in closed loop): the friction's velocity
+        through a low-pass :data:`FRICTION_OVER_CUTOFF` times wider than the cut-off, else
+        through the cut-off itself (a smooth motion's reversal is timed better by it than by
+        a wider low-pass of the encoder's steps).
     """
     dt = np.diff(time)
     rate = 1.0 / float(np.median(dt))
@@ -228,14 +257,16 @@ def prepare_signals(
     qf = _filt(low, position)
     dq = np.gradient(qf, axis=0) * rate
     ddq = np.gradient(dq, axis=0) * rate
-    # stage 0: anti-alias far above the cut-off (no droop where the signals are), decimate
+    # the friction's velocity: the same position through a wider low-pass (module notes)
+    f_cut = min(FRICTION_OVER_CUTOFF * cutoff, rate / MIN_RATE_OVER_CUTOFF) if stops else cutoff
+    wide = scipy.signal.butter(BUTTER_ORDER, f_cut / (rate / 2))
+    dq_friction = np.gradient(_filt(wide, position), axis=0) * rate
+    # the anti-alias filter far above the cut-off (no droop where the signals are), decimate
     first = max(1, int(rate / (MID_RATE_OVER_CUTOFF * cutoff)))
     mid_rate = rate / first
     anti = scipy.signal.butter(
         BUTTER_ORDER, min(ANTI_ALIAS_SHARE * mid_rate, 0.9 * rate / 2) / (rate / 2)
     )
-    # stage 1: the low-pass at the intermediate rate, on the torque and on every column
-    low_mid = scipy.signal.butter(BUTTER_ORDER, cutoff / (mid_rate / 2))
     edge = int(np.ceil(EDGE_PERIODS * mid_rate / cutoff))
     n_mid = len(range(0, position.shape[0], first))
     if n_mid < 4 * edge + 20:
@@ -245,7 +276,8 @@ def prepare_signals(
         )
     factor = max(1, int(mid_rate / (RATE_OVER_CUTOFF * cutoff)))
     keep = slice(edge, n_mid - edge, factor)
-    tau = _filt(low_mid, _filt(anti, torque)[::first])[keep]
+    tau = _filt(anti, _filt(low, torque))[::first][keep]
+    dtau = _filt(anti, _filt(low, np.gradient(torque, axis=0)))[::first][keep]
     pick = np.arange(n_mid)[keep] * first
     return ArmSignals(
         time=time[pick],
@@ -259,10 +291,12 @@ def prepare_signals(
         encoder_step=step,
         bounds=bounds,
         velocity_noise=_velocity_noise(step, rate, cutoff),
-        full_dq=dq,
+        friction_velocity_noise=_velocity_noise(step, rate, f_cut),
+        full_dq=dq_friction,
+        friction_cutoff=f_cut,
         anti_alias=anti,
         first=first,
-        low_pass=low_mid,
+        low_pass=low,
         keep=keep,
-        mid=(qf[::first], dq[::first], ddq[::first]),
+        dtau=dtau,
     )

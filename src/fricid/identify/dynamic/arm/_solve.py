@@ -15,8 +15,11 @@ no law of velocity says, and the low-pass spreads a reversal over its neighbours
   projection (Golub and Pereyra 1973) one block at a time: with every other column fixed, the
   sum of squares with the excess column ``x`` is ``SSE_0 - (x' r_0)^2 / (x' (I - P_0) x)``,
   evaluated for a grid of shapes at once (the current shapes among them, so that no step
-  loses); the blocks are swept :data:`SWEEPS` times, after the first refined by Newton
-  steps over ``(log w_s, delta)`` from the grid's best (:func:`_newton`). The directions of
+  loses), a shape whose best excess ``tau_s - tau_c`` is below zero gaining nothing (the
+  Stribeck rise is a static level above the Coulomb one; on a PD-tracked Panda such dips,
+  fitted where the closed loop's reversals left no rows, held out at 3 to 8 times the
+  noise); the blocks are swept :data:`SWEEPS` times, after the first refined by Newton steps
+  over ``(log w_s, delta)`` from the grid's best (:func:`_newton`). The directions of
   a joint are coupled near its reversals (the low-pass spreads both over them), so the
   descent converges slowly along a curved valley; noise-free, three sweeps leave the
   shapes a few per cent to tens of per cent off.
@@ -41,7 +44,7 @@ from ...static.uncertainty import covariance_svd, floored_covariance
 from ._friction import DELTA_BOX, W_S_BOX, JointFriction
 from ._signals import ArmSignals
 
-__all__ = ["Stack", "arm_covariance", "search_shapes", "stack", "wls"]
+__all__ = ["Stack", "arm_covariance", "search_shapes", "shape_profiles", "stack", "wls"]
 
 #: The autocorrelation below which residuals count as uncorrelated.
 RHO_END = 0.05
@@ -50,6 +53,8 @@ LAGS_OVER_L = 5
 #: The first grid of Stribeck shapes.
 W_S_GRID = np.geomspace(2e-3, 0.6, 14)
 DELTA_GRID = np.array([0.5, 0.75, 1.0, 1.5, 2.0, 3.0])
+#: ``chi2_1(0.95)``: the profile region's drop of the sum of squares (:func:`shape_profiles`).
+CHI2_1 = 3.841458820694124
 #: Sweeps over the Stribeck blocks (the first on the grid alone).
 SWEEPS = 3
 #: Full-rate candidate columns computed at once.
@@ -137,12 +142,14 @@ def _projector(A: np.ndarray, y: np.ndarray, k: int, rows: np.ndarray):
     G = np.linalg.pinv(As.T @ As, rcond=1e-12, hermitian=True)
     Ar = As[rows]
 
-    def gain(X: np.ndarray) -> np.ndarray:
+    def gain(X: np.ndarray, coefficients: bool = False):
         C = Ar.T @ X
         xx = np.einsum("ik,ik->k", X, X)
         den = xx - np.einsum("ik,ij,jk->k", C, G, C)
+        xr = X.T @ r0  # the sign of the column's coefficient
         with np.errstate(divide="ignore", invalid="ignore"):
-            return np.where(den > 1e-12 * xx, (X.T @ r0) ** 2 / den, -np.inf)
+            out = np.where(den > 1e-12 * xx, np.where(xr > 0, xr**2 / den, 0.0), -np.inf)
+            return (out, np.where(xr > 0, xr / den, 0.0)) if coefficients else out
 
     return gain
 
@@ -163,14 +170,42 @@ def _block_gains(sig, Yb, frictions, mask, sigma, j, k, d):
     gain = _projector(A, y, st.offsets[j] + 3 * k + 1, rows)
     t_rows = st.row_time[rows]
 
-    def gains(w: np.ndarray, e: np.ndarray) -> np.ndarray:
-        out = np.empty(np.size(w))
+    def gains(w: np.ndarray, e: np.ndarray, coefficients: bool = False):
+        out, coef = np.empty(np.size(w)), np.empty(np.size(w))
         for s in range(0, out.size, CHUNK):  # bounded memory: CHUNK full-rate columns
             cols = _candidates(sig, jf, j, d, w[s : s + CHUNK], e[s : s + CHUNK])
-            out[s : s + CHUNK] = gain(cols[t_rows] / sigma[j])
-        return out
+            out[s : s + CHUNK], coef[s : s + CHUNK] = gain(cols[t_rows] / sigma[j], True)
+        return (out, coef) if coefficients else out
 
     return gains
+
+
+def shape_profiles(sig, Yb, frictions, mask, sigma, inflation) -> dict:
+    """(joint, direction) -> the ranges of ``w_s``, ``delta`` and the Stribeck excess over
+    the shapes of the grid (and the current ones) whose weighted sum of squares, every linear
+    parameter fitted again, is within ``chi2_1(0.95)`` times the joint's ``inflation`` (its
+    rows over its effective samples) of the current shapes': a profile-likelihood region
+    (Venzon and Moolgavkar 1988) on the grid, for shapes the data determine only along a
+    curved valley, where the linearised interval is too narrow."""
+    out = {}
+    w_grid, e_grid = (g.ravel() for g in np.meshgrid(W_S_GRID, DELTA_GRID))
+    for j, jf in enumerate(frictions):
+        if not jf.stribeck or not mask[:, j].any():
+            continue
+        for k, d in enumerate(jf.directions):
+            gains = _block_gains(sig, Yb, frictions, mask, sigma, j, k, d)
+            w = np.append(w_grid, jf.shapes[d][0])
+            e = np.append(e_grid, jf.shapes[d][1])
+            g, c = gains(w, e, coefficients=True)
+            if not np.isfinite(g[-1]):
+                continue
+            near = g >= g[-1] - CHI2_1 * inflation[j]
+            out[j, d] = {
+                "w_s": (float(w[near].min()), float(w[near].max())),
+                "delta": (float(e[near].min()), float(e[near].max())),
+                "excess": (float(c[near].min()), float(c[near].max())),
+            }
+    return out
 
 
 def _newton(gains, x0: np.ndarray, g0: float) -> np.ndarray:
