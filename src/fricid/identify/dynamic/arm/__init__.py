@@ -249,12 +249,16 @@ def _widen(recs: dict, d: str, prof: dict) -> None:
 
 
 def _loose_levels(recs: Mapping[str, Mapping[str, Any]], noise: float) -> list[str]:
-    """The Coulomb levels whose 95 % interval is wider, on either side, than both their
-    value and the joint's torque noise: the data do not tell the joint's friction."""
+    """The Coulomb levels the data do not determine (not determined at all, or a 95 %
+    interval wider, on either side, than both their value and the joint's torque noise):
+    the data do not tell the joint's friction."""
     out = []
     for name, rec in recs.items():
+        if not name.startswith(("f_c", "tau_c")):
+            continue
         lo, hi = rec.get("ci95") or (None, None)
-        if not name.startswith(("f_c", "tau_c")) or rec["not_determined"] or lo is None:
+        if rec["not_determined"] or rec["value"] is None or lo is None:
+            out.append(f"{name} not determined")
             continue
         half = 0.5 * (hi - lo)
         if half > max(abs(rec["value"]), noise):
@@ -276,8 +280,9 @@ def _grade(
         no.append("the joint does not move in the log, so its friction is not determined")
     elif loose:
         no.append(
-            "the data do not determine the joint's friction: the 95 % interval of its "
-            f"Coulomb level is wider than the level and the noise ({'; '.join(loose)})"
+            "the data do not determine the joint's friction: its Coulomb level is not "
+            "determined, or its 95 % interval is wider than the level and the noise "
+            f"({'; '.join(loose)})"
         )
     if moved and nd:
         caveats.append(f"not determined by the data: {', '.join(nd)}")
