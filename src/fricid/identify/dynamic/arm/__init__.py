@@ -62,14 +62,13 @@ import scipy.stats
 
 from ....errors import DataError
 from ....fitted.arm import ArmFit
-from ....metrics import NOISE_RATIO, verdict
 from ....models import get_model
 from ....optim import one_blas_thread
 from ....robot import RigidBodyModel, base_parameters
 from ....samples import RobotLog
-from ...trust import MISS_RATIO
 from ._consistent import consistent_parameters
 from ._friction import DELTA_BOX, W_S_BOX, friction_for, split_direction
+from ._grade import grade, loose_levels
 from ._signals import ArmSignals, prepare_signals
 from ._solve import arm_covariance, lstsq, search_shapes, shape_profiles, stack, wls
 
@@ -248,62 +247,6 @@ def _widen(recs: dict, d: str, prof: dict) -> None:
             rec["ci95"] = [min(rec["ci95"][0], lo), max(rec["ci95"][1], hi)]
 
 
-def _loose_levels(recs: Mapping[str, Mapping[str, Any]], noise: float) -> list[str]:
-    """The Coulomb levels the data do not determine (not determined at all, or a 95 %
-    interval wider, on either side, than both their value and the joint's torque noise):
-    the data do not tell the joint's friction."""
-    out = []
-    for name, rec in recs.items():
-        if not name.startswith(("f_c", "tau_c")):
-            continue
-        lo, hi = rec.get("ci95") or (None, None)
-        if rec["not_determined"] or rec["value"] is None or lo is None:
-            out.append(f"{name} not determined")
-            continue
-        half = 0.5 * (hi - lo)
-        if half > max(abs(rec["value"]), noise):
-            out.append(f"{name} {rec['value']:.3g} +- {half:.2g} N m")
-    return out
-
-
-def _grade(
-    ratio: float,
-    nd: list[str],
-    open_: list[str],
-    source: str,
-    moved: bool,
-    loose: list[str] = (),
-):
-    """A joint's verdict in :mod:`fricid.identify.trust`'s words and thresholds."""
-    no, caveats = [], []
-    if not moved:
-        no.append("the joint does not move in the log, so its friction is not determined")
-    elif loose:
-        no.append(
-            "the data do not determine the joint's friction: its Coulomb level is not "
-            "determined, or its 95 % interval is wider than the level and the noise "
-            f"({'; '.join(loose)})"
-        )
-    if moved and nd:
-        caveats.append(f"not determined by the data: {', '.join(nd)}")
-    if open_:
-        caveats.append(f"not bounded by the data: {', '.join(open_)}")
-    if np.isfinite(ratio) and ratio > MISS_RATIO:
-        no.append(f"the held-out error {verdict(ratio)} the measurement scatter")
-    elif np.isfinite(ratio) and ratio > NOISE_RATIO:
-        caveats.append(f"the held-out error {verdict(ratio)} the measurement scatter")
-    elif not np.isfinite(ratio) and moved:
-        caveats.append("no held-out error to compare with the noise")
-    if no:
-        return "no", no + caveats
-    if caveats:
-        return "with caveats", caveats
-    return "yes", [
-        f"every parameter is determined and the held-out error ({source}) is within noise "
-        f"({ratio:.2f}x the scatter)"
-    ]
-
-
 def fit_arm(*args: Any, **kwargs: Any) -> ArmFit:
     """Identify a whole arm (:func:`_fit_arm`, on one BLAS thread: the problems are small and
     threads only contend on a shared machine)."""
@@ -460,8 +403,8 @@ def _fit_arm(
         recs = fric[name]["parameters"]
         nd = [p for p, rec in recs.items() if rec["not_determined"]]
         open_ = [p for p, rec in recs.items() if rec["note"].startswith("not bounded")]
-        loose = _loose_levels(recs, float(sigma[j]))
-        level, reasons = _grade(ratio, nd, open_, source, bool(moving[:, j].any()), loose)
+        loose = loose_levels(recs, float(sigma[j]))
+        level, reasons = grade(ratio, nd, open_, source, bool(moving[:, j].any()), loose)
         validation[name] = {
             "rmse": rmse,
             "ratio": ratio,
