@@ -41,22 +41,8 @@ def pendulum_logs(tmp_path_factory):
 def test_robot_fit_writes_the_file_and_prints_a_row_per_joint(pendulum_logs, tmp_path):
     urdf, (log, second) = pendulum_logs
     out = tmp_path / "arm.json"
-    res = runner.invoke(
-        app,
-        [
-            "robot",
-            "fit",
-            str(log),
-            "--urdf",
-            str(urdf),
-            "--friction",
-            "coulomb_viscous",
-            "--validate",
-            str(second),
-            "-o",
-            str(out),
-        ],
-    )
+    fit_cv = ["robot", "fit", str(log), "--urdf", str(urdf), "--friction", "coulomb_viscous"]
+    res = runner.invoke(app, [*fit_cv, "--validate", str(second), "-o", str(out)])
     assert res.exit_code == 0, res.output
     fit = ArmFit.load(out)
     assert fit.validation["joint1"]["source"] == "second log"
@@ -67,21 +53,7 @@ def test_robot_fit_writes_the_file_and_prints_a_row_per_joint(pendulum_logs, tmp
     assert "IDIM-WLS" in res.output
     assert fit.provenance["reversal_window"] == 0.0
     closed = tmp_path / "closed.json"
-    res = runner.invoke(
-        app,
-        [
-            "robot",
-            "fit",
-            str(log),
-            "--urdf",
-            str(urdf),
-            "--friction",
-            "coulomb_viscous",
-            "--closed-loop",
-            "-o",
-            str(closed),
-        ],
-    )
+    res = runner.invoke(app, [*fit_cv, "--closed-loop", "-o", str(closed)])
     assert res.exit_code == 0, res.output
     assert ArmFit.load(closed).provenance["reversal_window"] == 1.0
 

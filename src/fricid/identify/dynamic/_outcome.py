@@ -252,8 +252,8 @@ def converged(
     blocks = []
     for (name, stage), decides in zip(fits, _deciding(fits, rename or {}), strict=True):
         if decides:
-            cheap = name not in SIMULATED_STAGES  # else: stop the polish at the resolution
-            block = certify(stage.problem, stage.result, noise_tolerance=not cheap)
+            simulated = name in SIMULATED_STAGES  # its polish stops at the resolution
+            block = certify(stage.problem, stage.result, noise_tolerance=simulated)
             blocks.append({"stage": name, **block})
         else:
             r = stage.result
