@@ -2,7 +2,18 @@
 probability ``level``, measurement noise included
 (:meth:`fricid.fitted.FittedModel.predict_interval`).
 
-One rule per kind of model, each from what the model file stores:
+Where the file stores the local spread of the fit's held-out errors (``local``,
+:mod:`fricid.models._spread`; fits since it was added, wherever the scatter of a sample is
+known or estimated), every model's interval is ``F(x) -+ k sqrt(v(x) + p(x))``: ``v`` the
+local mean squared held-out error near ``x``, never below the scatter squared, ``p`` an
+analytic model's parameter term ``(noise / s)^2 g^T C g`` (a hybrid's backbone's), a GP's
+latent posterior variance (it grows away from the data: in a gap between measured speeds,
+or between measured loads and temperatures, where no held-out error was seen), ``k``
+the calibrated multiplier (:mod:`fricid.identify._intervals`, "Local spread"): narrow where
+the model follows the data, wide where it misses them. An analytic fit's record is
+``prediction_interval`` with method ``"delta"`` and ``local`` beside the delta method's
+fields; a learned model's has method ``"heldout"``. Otherwise, one rule per kind of model,
+each from what the model file stores:
 
 - **analytic** (``prediction_interval`` of the file, method ``"delta"``): the delta method,
   ``F(x) -+ k sqrt(g^T C g + s^2)``, ``g`` the gradient of ``F(x)`` in the free
@@ -37,6 +48,7 @@ import numpy as np
 
 from ..errors import ConfigError
 from ..models import get_model, get_predictor
+from ..models._spread import local_variance
 from ..models.gp import gp_sides
 from ..models.rbf import interval_half_width
 
@@ -66,7 +78,7 @@ class PredictionInterval:
     level : float
         The nominal coverage (0.95: 95 % of new samples inside).
     method : str
-        How the interval was made (``"delta"``, ``"gp"``, ``"conformal"``).
+        How the interval was made (``"delta"``, ``"heldout"``, ``"gp"``, ``"conformal"``).
     """
 
     friction: np.ndarray
@@ -108,12 +120,73 @@ def analytic_half_width(
     G = gradient(model_name, theta, record["free"], X)
     C = np.asarray(record["covariance"], dtype=float)
     s = float(record["noise_std"])
+    local = record.get("local")
+    if isinstance(local, Mapping):
+        check_local(local)
+        grow = (float(local["noise"]) / s) ** 2 if s > 0 else 1.0
+        return _local_half_width(local, X, level, grow * np.einsum("pn,pq,qn->n", G, C, G))
     floor = record.get("noise_floor")
     known = isinstance(floor, int | float) and floor > s
     noise = float(floor) if known else s
     grow = (noise / s) ** 2 if s > 0 else 1.0
     var = grow * np.einsum("pn,pq,qn->n", G, C, G) + noise**2
     return _delta_multiplier(record, level, known) * np.sqrt(np.maximum(var, 0.0))
+
+
+def _local_half_width(
+    local: Mapping[str, Any], X: np.ndarray, level: float, extra: np.ndarray | float = 0.0
+) -> np.ndarray:
+    """``k sqrt(v(x) + extra)``: ``v`` the local spread of the held-out errors
+    (:func:`fricid.models._spread.local_variance`), never below ``noise^2``; ``extra``
+    [N^2 m^2] the model's own uncertainty at ``x`` (an analytic model's parameter term, a
+    GP's latent posterior variance); ``k`` the multiplier calibrated at ``level``
+    (:func:`fricid.identify._intervals.local_record`), else the normal quantile."""
+    check_local(local)
+    noise = float(local["noise"])
+    v = local_variance(local, X)
+    v = np.maximum(np.where(np.isfinite(v), v, noise**2), noise**2)
+    var = v + np.maximum(extra, 0.0)
+    k = _norm_ppf(0.5 + level / 2)
+    levels = [float(x) for x in local.get("levels") or ()]
+    scale = list(local.get("scale") or ())
+    hits = [j for j, lv in enumerate(levels) if abs(lv - level) < 1e-9 and j < len(scale)]
+    if hits:
+        k = min(float(scale[hits[0]]), k)
+    return k * np.sqrt(var)
+
+
+def check_local(local: Mapping[str, Any]) -> None:
+    """Raise :class:`~fricid.errors.ConfigError` unless ``local`` is a well-formed local
+    spread (a model file from elsewhere: equal lengths, finite numbers, positive weights,
+    bandwidths and noise)."""
+    try:
+        cols = [np.asarray(local[k], dtype=float) for k in _LOCAL_COLUMNS]
+        n = len(cols[0])
+        bw = local["bandwidth"]
+        spans = list(local["spans"])
+        fine = (
+            n > 0
+            and all(c.ndim == 1 and len(c) == n and np.isfinite(c).all() for c in cols)
+            and (cols[3] >= 0).all()
+            and (cols[4] > 0).all()
+            and len(spans) == 2
+            and all(sp is None or (len(sp) == 2 and float(sp[1]) > float(sp[0])) for sp in spans)
+            and float(bw["decades"]) > 0
+            and float(bw["span"]) > 0
+            and float(local["noise"]) > 0
+            and np.isfinite([float(bw["decades"]), float(bw["span"]), float(local["noise"])]).all()
+        )
+    except (KeyError, TypeError, ValueError) as err:
+        raise ConfigError(f"the model file's local interval record is malformed ({err})") from None
+    if not fine:
+        raise ConfigError(
+            "the model file's local interval record is malformed (lengths, non-finite or "
+            "non-positive values)"
+        )
+
+
+#: The arrays of a local spread record, in :func:`check_local`'s order.
+_LOCAL_COLUMNS = ("velocity", "load", "temperature", "e2", "weight")
 
 
 def _delta_multiplier(record: Mapping[str, Any], level: float, known: bool = False) -> float:
@@ -184,7 +257,19 @@ def prediction_interval(fitted, X, level: float = 0.95) -> PredictionInterval:
     if not 0.0 < level < 1.0:
         raise ConfigError(f"the interval's level must lie in (0, 1); got {level!r}")
     X = np.asarray(X, dtype=float)
-    if fitted.model == "gp":
+    record = fitted.prediction_interval
+    if isinstance(record, Mapping) and record.get("method") == "heldout":
+        extra = 0.0
+        if fitted.model == "gp":  # its latent posterior variance: wider away from the data
+            F, std = fitted.predict(X, warn=False, return_std=True)
+            extra = np.asarray(std, dtype=float) ** 2
+        else:
+            F = fitted.predict(X, warn=False)
+        half = _local_half_width(record.get("local") or {}, X, level, extra)
+        if fitted.model == "hybrid":
+            half = _with_backbone(fitted.state, X, half, level)
+        method = "heldout"
+    elif fitted.model == "gp":
         F, std = fitted.predict(X, warn=False, return_std=True)
         half, method = _gp_half_width(fitted.state, std, X, level), "gp"
     elif get_predictor(fitted.model).stateful:
@@ -199,7 +284,6 @@ def prediction_interval(fitted, X, level: float = 0.95) -> PredictionInterval:
         if fitted.model == "hybrid":
             half = _with_backbone(fitted.state, X, half, level)
     else:
-        record = fitted.prediction_interval
         if not isinstance(record, Mapping) or record.get("method") != "delta":
             raise ConfigError(
                 f"model '{fitted.model}' stores no prediction interval (fit it again with "

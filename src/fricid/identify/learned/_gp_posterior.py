@@ -137,7 +137,7 @@ def heldout_scale(
     hyper: tuple[np.ndarray, float, float],
     y_scale: float,
     levels=INTERVAL_LEVELS,
-) -> dict:
+) -> tuple[dict, np.ndarray]:
     """Multipliers of the predictive standard deviation that make the GP's intervals cover
     held-out samples: the normalised (studentised) conformal scores of cross-validation
     (Lei et al. 2018, section 5.2; with cross-validation folds, the CV+ reading of Barber et
@@ -155,7 +155,9 @@ def heldout_scale(
     about ``level`` of new samples even where maximum likelihood drove the noise to zero and
     the standard deviation with it (ten samples per direction on three inputs: coverage
     0.54-0.84 with the multiplier alone). ``A`` is the raw basis of the least-squares mean,
-    ``As`` its standardised form (the correction's).
+    ``As`` its standardised form (the correction's). The held-out errors ``|g_i - mean_i|``
+    [N m] come back beside the record (the local spread of the model's intervals,
+    :func:`fricid.identify._intervals.local_record`).
     """
     lengths, s2, noise = hyper
     n = len(g)
@@ -182,4 +184,4 @@ def heldout_scale(
         "scale": scale,
         "half_width": conformal_half_widths(r, levels),
         "method": f"normalised conformal, {how} refits at the fitted hyperparameters (CV+)",
-    }
+    }, r

@@ -392,6 +392,7 @@ def choose_structure(
     (_, _, _, order), _ = best_of([(m, wf, stretch, o) for o in orders])
     (m, _, _, _), per_m = best_of([(g, wf, stretch, order) for g in grid])
     k, score, resid, per = cv.residuals(m, wf, stretch, order)
+    n = len(t)
     held = (
         "random folds"
         if len(per) == 1
@@ -407,6 +408,7 @@ def choose_structure(
         chosen_alpha=alphas[k],
         chosen_tail_order=order,
         cv_rmse_chosen=per[0],
+        heldout_errors=np.abs(resid[:n]),  # the random folds': every sample, in order
         prediction_interval={
             "levels": list(INTERVAL_LEVELS),
             "half_width": conformal_half_widths(resid),

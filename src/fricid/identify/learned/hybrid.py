@@ -356,4 +356,5 @@ def fit_hybrid(
         operating_range=res.operating_range,
         provenance={**res.provenance, "estimator": "fricid.identify.learned.hybrid.fit_hybrid"},
         state=state,
+        prediction_interval=res.prediction_interval,
     )

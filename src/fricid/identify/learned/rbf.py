@@ -99,6 +99,7 @@ from ...models.rbf import (
     tail_terms,
 )
 from ...samples import FrictionSamples
+from .._intervals import local_record
 from .._records import operating_range, provenance
 from .._scatter import measurement_scatter
 from ._rbf_estimator import LSQ_IGNORES, TRAINERS, RBFNetRegressor
@@ -252,8 +253,10 @@ def _model(
     ests: Sequence[RBFNetRegressor],
     state: dict[str, Any],
     samples: FrictionSamples,
+    errors: np.ndarray | None = None,
 ) -> FittedModel:
-    """The :class:`FittedModel` of trained networks whose state is ``state``."""
+    """The :class:`FittedModel` of trained networks whose state is ``state``; ``errors``
+    [N m] the samples' held-out errors (the local spread of its intervals), if any."""
     X = samples.X
     y_hat = predict_state(state, X)
     est = ests[0]
@@ -272,8 +275,10 @@ def _model(
     convergence, edf, how, validation = trust_records(ests, state, samples)
     statistics, note = learned_statistics(samples.y, y_hat, edf, how)
     scatter = measurement_scatter(samples)
+    local = None if errors is None else local_record(errors, X, scatter.value, source=HELD)
     return FittedModel(
         model="rbf",
+        prediction_interval=None if local is None else {"method": "heldout", "local": local},
         metrics=metrics(samples.y, y_hat, samples.direction, scatter.value),
         statistics=statistics,
         statistics_note=note,
@@ -384,6 +389,7 @@ def _train_side(
         X, t, {**params, "level_folds": level_folds}, speed_input=kept[0] == "velocity"
     )
     note["n_samples"] = len(t)
+    errors = note.pop("heldout_errors", None)  # the local spread's, not the file's
     params.update({k: v for k, v in chosen.items() if params.get(k) is None})
     notes["n_centers_selection"] = note
     if "prediction_interval" in note:
@@ -392,7 +398,18 @@ def _train_side(
     notes["edf"] = hat_trace(est, X)
     if est.linear_tail:  # the floor of the magnitude g (models.rbf notes)
         notes["magnitude_floor"] = 0.5 * max(float(np.min(est.predict(X))), 0.0)
-    return est, {**_state(est, kept), **notes}
+    held = None
+    if errors is not None:
+        held = np.full(len(samples.velocity), np.nan)
+        held[: len(errors)] = errors
+    return est, {**_state(est, kept), **notes, _ERRORS: held}
+
+
+#: A network's held-out errors while the model is assembled (never in the model file).
+_ERRORS = "_heldout_errors"
+
+#: What the local spread of a network's intervals is made of.
+HELD = "cross-validation errors of the chosen structure (random folds)"
 
 
 def _default_velocity_scale(X: np.ndarray) -> float | None:
@@ -451,7 +468,8 @@ def fit_rbf(
     symmetry = symmetry_for(samples)
     if symmetry != "per_direction":
         est, state = _train_side(samples, names, params, "")
-        return _model([est], {**state, "symmetry": symmetry}, samples)
+        errors = state.pop(_ERRORS)
+        return _model([est], {**state, "symmetry": symmetry}, samples, errors)
     ests, states = [], {}
     rs = params.get("random_state")
     shared = dict(params)
@@ -468,6 +486,12 @@ def fit_rbf(
             samples.subset(samples.direction == d), names, side_params, where
         )
         ests.append(est)
+    errors = np.full(len(samples.velocity), np.nan)
+    for side, d in (("pos", 1), ("neg", -1)):
+        held = states[side].pop(_ERRORS)
+        errors = None if held is None or errors is None else errors
+        if errors is not None:
+            errors[samples.direction == d] = held
     first = states["pos"]
     state = {
         "kind": STATE_KIND,
@@ -478,4 +502,4 @@ def fit_rbf(
         "encoding": first["encoding"],
         **states,
     }
-    return _model(ests, state, samples)
+    return _model(ests, state, samples, errors)

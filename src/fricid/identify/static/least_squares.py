@@ -280,6 +280,7 @@ def fit(
             X,
             y,
             None if scatter.estimated else scatter.value,
+            scatter.value,
         ),
         loss={
             "loss": "l2" if problem.loss == "sse" else problem.loss,

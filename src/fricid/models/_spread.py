@@ -1,0 +1,134 @@
+"""The local spread of a fit's held-out errors: how far a new measured sample falls from the
+model near an operating point, where the model follows the law and where it does not
+(:func:`local_variance`; the record ``prediction_interval["local"]`` of an analytic fit,
+built by :func:`fricid.identify._intervals.local_record`).
+
+A model whose family misses the law is off by a bias that varies along the speed axis: near
+zero where the family follows the data, several noise standard deviations where it does not
+(the Stribeck dip under a Coulomb-viscous line). One width for every speed, scaled by the
+root mean square of all the residuals, is then too wide where the model is right and too
+narrow where it is wrong. The spread here is local: the mean squared leave-one-out error of
+the samples near ``x`` (a Nadaraya-Watson kernel average, Gaussian kernel; Fan & Yao 1998 for
+variance functions, and the locally weighted scores of Lei et al. 2018, section 5.2), per
+direction of motion, in ``log10 |v|`` (:data:`BANDWIDTH_DECADES` decades) and, where the
+samples vary them, in load and temperature (:data:`BANDWIDTH_SPAN` of their measured span).
+It is never below the measured scatter: a new sample carries at least the noise.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+
+__all__ = [
+    "BANDWIDTH_DECADES",
+    "BANDWIDTH_SPAN",
+    "MAX_POINTS",
+    "input_spans",
+    "local_variance",
+    "spread_points",
+]
+
+#: Kernel standard deviation along the speed axis [decades of |v|].
+BANDWIDTH_DECADES = 0.1
+
+#: Kernel standard deviation along load and temperature [share of their measured span].
+BANDWIDTH_SPAN = 0.3
+
+#: More samples than this are pooled into cells before they are stored (the model file
+#: stays small on long logs; cells of 0.02 decades and a tenth of each span).
+MAX_POINTS = 2000
+
+#: Rows of ``X`` per kernel block (memory: rows x points x inputs doubles).
+_CHUNK = 1024
+
+
+def _coordinates(X: np.ndarray, spans: list[list[float] | None]) -> np.ndarray:
+    """``(n, 1 + k)``: ``log10 |v|``, then each input with a span, scaled to it (NaN: 0)."""
+    cols = [np.log10(np.maximum(np.abs(X[:, 0]), 1e-300))]
+    for j, span in zip((1, 2), spans, strict=True):
+        if span is None:
+            continue
+        lo, hi = span
+        col = (X[:, j] - lo) / (hi - lo)
+        cols.append(np.where(np.isfinite(col), col, 0.0))
+    return np.column_stack(cols)
+
+
+def input_spans(X: np.ndarray) -> list[list[float] | None]:
+    """The measured ``[min, max]`` of load and temperature, None for one that does not vary
+    (or is not measured)."""
+    out: list[list[float] | None] = []
+    for j in (1, 2):
+        col = X[:, j][np.isfinite(X[:, j])]
+        lo, hi = (float(col.min()), float(col.max())) if col.size else (0.0, 0.0)
+        out.append([lo, hi] if hi > lo else None)
+    return out
+
+
+def spread_points(
+    X: np.ndarray, e2: np.ndarray, spans: list[list[float] | None]
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The stored points ``(X, e2, weight)`` and each sample's point: every sample, or,
+    past :data:`MAX_POINTS`, the means of cells of 0.02 decades in speed and a tenth of
+    each span (coarser where that leaves more), weighted by their counts (the kernel
+    average is then the same to well under the bandwidth)."""
+    n = len(e2)
+    if n <= MAX_POINTS:
+        return X, e2, np.ones(n), np.arange(n)
+    c = _coordinates(X, spans)
+    cell = 1.0
+    while True:  # cells twice as coarse until they fit
+        key = np.column_stack(
+            [np.sign(X[:, 0]), np.floor(c[:, 0] / (0.02 * cell)), np.floor(c[:, 1:] * 10 / cell)]
+        )
+        _, inverse, counts = np.unique(key, axis=0, return_inverse=True, return_counts=True)
+        if counts.size <= MAX_POINTS:
+            break
+        cell *= 2
+    inverse = inverse.ravel()
+    Xm = np.column_stack(
+        [np.bincount(inverse, np.nan_to_num(X[:, j])) / counts for j in range(X.shape[1])]
+    )
+    e2m = np.bincount(inverse, e2) / counts
+    return Xm, e2m, counts.astype(float), inverse
+
+
+def local_variance(
+    record: Mapping[str, Any], X: np.ndarray, *, leave_out_self: bool = False
+) -> np.ndarray:
+    """The local mean squared held-out error [N^2 m^2] at each row of ``X`` (module notes),
+    from ``record`` (``velocity``, ``load``, ``temperature``, ``e2``, ``weight``, ``spans``,
+    ``bandwidth``); NaN where the record holds no sample of that direction.
+
+    ``leave_out_self``: ``X`` are the record's own points, each averaged without itself
+    (the leave-one-out spread, for the calibration of :func:`fricid.identify._intervals`).
+    """
+    P = np.column_stack(
+        [np.asarray(record[k], dtype=float) for k in ("velocity", "load", "temperature")]
+    )
+    e2 = np.asarray(record["e2"], dtype=float)
+    w = np.asarray(record["weight"], dtype=float)
+    spans = list(record["spans"])
+    bw = record["bandwidth"]
+    cp, cx = _coordinates(P, spans), _coordinates(np.asarray(X, dtype=float), spans)
+    scale = np.r_[float(bw["decades"]), [float(bw["span"])] * (cp.shape[1] - 1)]
+    out = np.full(len(cx), np.nan)
+    for sign in (1.0, -1.0):
+        mp, mx = np.sign(P[:, 0]) == sign, np.sign(X[:, 0]) == sign
+        if not mp.any() or not mx.any():
+            continue
+        cols, rows = np.flatnonzero(mp), np.flatnonzero(mx)
+        for start in range(0, rows.size, _CHUNK):
+            part = rows[start : start + _CHUNK]
+            d = (cx[part][:, None, :] - cp[cols][None, :, :]) / scale
+            d2 = np.einsum("ijk,ijk->ij", d, d)
+            if leave_out_self:
+                d2[part[:, None] == cols[None, :]] = np.inf
+            near = d2.min(axis=1, keepdims=True)
+            ok = np.isfinite(near[:, 0])
+            K = np.exp(-0.5 * (d2[ok] - near[ok])) * w[cols]  # scaled: never all underflow
+            out[part[ok]] = (K @ e2[cols]) / K.sum(axis=1)
+    return out

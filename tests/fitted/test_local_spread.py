@@ -1,0 +1,178 @@
+"""The prediction intervals' local spread (:mod:`fricid.models._spread`,
+:func:`fricid.identify._intervals.local_record`): narrow where the family follows the law,
+wide where it misses, about nominal coverage on a law outside the family, the same spread
+after pooling a long log, and a malformed record in a file refused by name."""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from scipy import stats
+
+from fricid.errors import ConfigError
+from fricid.fitted import FittedModel
+from fricid.identify import fit
+from fricid.identify._intervals import local_record
+from fricid.models._spread import MAX_POINTS, input_spans, local_variance, spread_points
+from fricid.samples import FrictionSamples
+
+SIGMA = 0.02
+
+
+def _dip(v: np.ndarray) -> np.ndarray:
+    """A Stribeck rise of 5 noise std at slow speeds that a Coulomb-viscous line cannot
+    follow (a Lorentzian, not fricid's exponential)."""
+    return np.sign(v) * (0.8 + 0.1 / (1 + (np.abs(v) / 0.03) ** 2)) + 0.3 * v
+
+
+def _samples(seed: int, n_speeds: int = 24) -> FrictionSamples:
+    rng = np.random.default_rng(seed)
+    s = np.geomspace(0.005, 3.0, n_speeds)
+    v = np.r_[s, -s]
+    y = _dip(v) + SIGMA * rng.standard_normal(v.size)
+    return FrictionSamples(
+        velocity=v,
+        load=None,
+        temperature=None,
+        friction=y,
+        std=np.full(v.size, SIGMA * np.sqrt(50)),
+        count=np.full(v.size, 50),
+    )
+
+
+def _fit(samples, model="coulomb_viscous"):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return fit(samples, model, intervals="none")
+
+
+def _grid() -> np.ndarray:
+    s = np.geomspace(0.005, 3.0, 400)
+    v = np.r_[s, -s]
+    return np.column_stack([v, np.zeros(v.size), np.full(v.size, 25.0)])
+
+
+def _coverage(model) -> float:
+    X = _grid()
+    pi = model.predict_interval(X, 0.95, warn=False)
+    F = _dip(X[:, 0])
+    return float(
+        np.mean(stats.norm.cdf((pi.high - F) / SIGMA) - stats.norm.cdf((pi.low - F) / SIGMA))
+    )
+
+
+def test_narrow_where_the_family_follows_and_wide_where_it_misses():
+    model = _fit(_samples(0))
+    assert "local" in model.prediction_interval
+    X = np.column_stack([[0.006, 2.0], [0.0, 0.0], [25.0, 25.0]])
+    half = model.predict_interval(X, 0.95, warn=False).half_width
+    assert half[0] > 1.5 * half[1] and half[0] > 4 * SIGMA  # the dip: the bias
+    assert half[1] < 3.5 * SIGMA  # the viscous range: the noise and a little misfit
+
+
+def test_a_family_that_misses_covers_about_nominal():
+    """Over 8 seeds the expected coverage of fresh samples on a dense grid lies within
+    90-98 %."""
+    cover = [_coverage(_fit(_samples(100 + seed))) for seed in range(8)]
+    assert 0.90 <= np.mean(cover) <= 0.98, cover
+
+
+def test_the_interval_round_trips_through_the_file(tmp_path):
+    model = _fit(_samples(1))
+    path = tmp_path / "m.json"
+    model.save(path)
+    again = FittedModel.load(path)
+    X = _grid()[::40]
+    assert np.allclose(
+        again.predict_interval(X, 0.95, warn=False).half_width,
+        model.predict_interval(X, 0.95, warn=False).half_width,
+    )
+
+
+@pytest.mark.parametrize(
+    "damage",
+    [
+        lambda r: r.update(e2=r["e2"][:-1]),
+        lambda r: r.update(weight=[0.0] * len(r["weight"])),
+        lambda r: r.update(noise=-1.0),
+        lambda r: r.pop("bandwidth"),
+        lambda r: r.update(spans=[[1.0, 0.0], None]),
+    ],
+)
+def test_a_malformed_local_record_is_refused(damage):
+    model = _fit(_samples(2))
+    damage(model.prediction_interval["local"])
+    with pytest.raises(ConfigError, match="local interval record is malformed"):
+        model.predict_interval(_grid()[:5], 0.95, warn=False)
+
+
+def test_pooling_a_long_log_keeps_the_spread():
+    rng = np.random.default_rng(3)
+    n = 3 * MAX_POINTS
+    v = np.r_[1, -1][rng.integers(0, 2, n)] * 10 ** rng.uniform(-2, 0.5, n)
+    X = np.column_stack([v, rng.uniform(0, 5, n), np.full(n, 25.0)])
+    e2 = (0.01 + np.abs(np.log10(np.abs(v)))) ** 2 * rng.chisquare(1, n)
+    spans = input_spans(X)
+    full = dict(
+        noise=0.01,
+        bandwidth={"decades": 0.1, "span": 0.3},
+        spans=spans,
+        velocity=X[:, 0],
+        load=X[:, 1],
+        temperature=X[:, 2],
+        e2=e2,
+        weight=np.ones(n),
+    )
+    P, e2p, w, point = spread_points(X, e2, spans)
+    assert len(w) <= MAX_POINTS and w.sum() == n and point.shape == (n,)
+    pooled = {**full, "velocity": P[:, 0], "load": P[:, 1], "temperature": P[:, 2]}
+    pooled.update(e2=e2p, weight=w)
+    at = X[:200]
+    assert np.allclose(local_variance(pooled, at), local_variance(full, at), rtol=0.1)
+
+
+def test_learned_models_keep_their_held_out_spread():
+    samples = _samples(4, n_speeds=16)
+    for name in ("gp", "rbf"):
+        model = _fit(samples, name)
+        record = model.prediction_interval
+        assert record["method"] == "heldout"
+        local = record["local"]
+        assert len(local["e2"]) + local["gross"] == len(samples.velocity)
+        assert "_heldout_errors" not in str(model.state)
+        half = model.predict_interval(_grid()[::50], 0.95, warn=False).half_width
+        assert np.all(half >= 0.95 * 1.96 * SIGMA)  # never below the scatter's
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    st.lists(
+        st.tuples(
+            st.floats(0.001, 10.0),
+            st.sampled_from([1.0, -1.0]),
+            st.floats(0.0, 4.0),
+        ),
+        min_size=3,
+        max_size=30,
+    ),
+    st.floats(-4.0, 2.0),
+)
+def test_the_spread_is_an_average_of_the_direction_s_errors(points, at):
+    """Nadaraya-Watson: a convex combination of the errors of the same direction, finite
+    anywhere on a direction with samples (far from all of them too), NaN on one without."""
+    speed, sign, e = (np.array(c) for c in zip(*points, strict=True))
+    X = np.column_stack([sign * speed, np.zeros(speed.size), np.full(speed.size, 25.0)])
+    record = local_record(e, X, 0.01)
+    assert record is not None
+    q = np.array([[10**at, 0.0, 25.0], [-(10**at), 0.0, 25.0]])
+    got = local_variance(record, q)
+    for k, s in enumerate((1.0, -1.0)):
+        side = np.asarray(record["e2"])[np.sign(record["velocity"]) == s]
+        if side.size:
+            assert side.min() * (1 - 1e-9) <= got[k] <= side.max() * (1 + 1e-9)
+        else:
+            assert np.isnan(got[k])
