@@ -176,3 +176,20 @@ def test_the_spread_is_an_average_of_the_direction_s_errors(points, at):
             assert side.min() * (1 - 1e-9) <= got[k] <= side.max() * (1 + 1e-9)
         else:
             assert np.isnan(got[k])
+
+
+def test_the_report_draws_the_band_where_the_file_has_an_interval():
+    from dataclasses import replace
+
+    from fricid.identify.trust import assess_trust
+    from fricid.report.model import model_report
+
+    samples = _samples(0)
+    model = _fit(samples)
+
+    def keys(m):
+        doc = model_report(m, samples, trust=assess_trust(m, samples))
+        return [f.name for f in doc.figures()]
+
+    assert "prediction_band" in keys(model)
+    assert "prediction_band" not in keys(replace(model, prediction_interval=None))

@@ -8,8 +8,9 @@ where it came from, operating range); the model and its parameters with their 95
 sides marked; for the RBF network, predicted friction with bootstrap intervals over the
 operating range, its weights in an appendix); fit metrics on the identification data and on the
 given samples, measured against predicted friction over velocity (one curve per temperature and
-load band), residuals against each input, predicted against measured, and the optimiser's
-convergence history where there is one.
+load band), the Stribeck region and the 95 % prediction interval against speed on a log axis,
+residuals against each input, predicted against measured, and the optimiser's convergence
+history where there is one.
 """
 
 from __future__ import annotations
@@ -21,6 +22,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from ..errors import ConfigError
 from ..fitted import FittedModel, Parameter
 from ..identify import evaluate
 from ..identify.trust import Trust, not_determined
@@ -300,6 +302,9 @@ def model_report(
                 ),
             )
         )
+        band = _prediction_band(fitted, moving, velocity_unit)
+        if band is not None:
+            sec.add(band)
     sec.add(
         Figure(
             "parity",
@@ -417,6 +422,37 @@ def model_report(
             )
         )
     return doc
+
+
+def _prediction_band(
+    fitted: FittedModel, moving: FrictionSamples, velocity_unit: str
+) -> Figure | None:
+    """The figure of the model's 95 % prediction interval against speed, or None when the
+    model file stores none (files from before, trajectory models)."""
+
+    def interval(X: np.ndarray):
+        pi = fitted.predict_interval(X, 0.95, warn=False)
+        return pi.friction, pi.low, pi.high
+
+    try:
+        interval(moving.X[:1])
+    except ConfigError:
+        return None
+    how = (
+        "the local spread of the fit's held-out errors"
+        if (fitted.prediction_interval or {}).get("local")
+        or (fitted.prediction_interval or {}).get("method") == "heldout"
+        else "the fit's residuals"
+    )
+    return Figure(
+        "prediction_band",
+        "Where a new measurement falls: the 95 % prediction interval",
+        plots.prediction_band(moving, interval, velocity_unit=velocity_unit),
+        caption="The band holds 95 % of new measured samples at each speed (noise "
+        f"included), at the median load and temperature; its width follows {how}: narrow "
+        "where the model follows the data, wide where it misses them. Inside a gap between "
+        "measured speeds it says nothing a measurement backs.",
+    )
 
 
 def _trust_section(doc: Document, trust: Trust) -> None:
