@@ -22,12 +22,12 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from ..errors import ConfigError
 from ..fitted import FittedModel, Parameter
 from ..identify import evaluate
 from ..identify.trust import Trust, not_determined
 from ..samples import FrictionSamples
 from . import interactive, plots
+from .band import prediction_band_figure
 from .document import Document, Figure, Note, Table
 from .trust import quality_frame, scatter_explanation, trust_text
 
@@ -302,7 +302,7 @@ def model_report(
                 ),
             )
         )
-        band = _prediction_band(fitted, moving, velocity_unit)
+        band = prediction_band_figure(fitted, moving, velocity_unit)
         if band is not None:
             sec.add(band)
     sec.add(
@@ -422,37 +422,6 @@ def model_report(
             )
         )
     return doc
-
-
-def _prediction_band(
-    fitted: FittedModel, moving: FrictionSamples, velocity_unit: str
-) -> Figure | None:
-    """The figure of the model's 95 % prediction interval against speed, or None when the
-    model file stores none (files from before, trajectory models)."""
-
-    def interval(X: np.ndarray):
-        pi = fitted.predict_interval(X, 0.95, warn=False)
-        return pi.friction, pi.low, pi.high
-
-    try:
-        interval(moving.X[:1])
-    except ConfigError:
-        return None
-    how = (
-        "the local spread of the fit's held-out errors"
-        if (fitted.prediction_interval or {}).get("local")
-        or (fitted.prediction_interval or {}).get("method") == "heldout"
-        else "the fit's residuals"
-    )
-    return Figure(
-        "prediction_band",
-        "Where a new measurement falls: the 95 % prediction interval",
-        plots.prediction_band(moving, interval, velocity_unit=velocity_unit),
-        caption="The band holds 95 % of new measured samples at each speed (noise "
-        f"included), at the median load and temperature; its width follows {how}: narrow "
-        "where the model follows the data, wide where it misses them. Inside a gap between "
-        "measured speeds it says nothing a measurement backs.",
-    )
 
 
 def _trust_section(doc: Document, trust: Trust) -> None:

@@ -6,7 +6,6 @@
 * :func:`residual_panels`: residuals against each input (BAS-RBFNN Fig. 8 b/d/f, RWSAVSBAS
   Fig. 7);
 * :func:`parity`: predicted against measured;
-* :func:`prediction_band`: the model's prediction interval against speed, measured beside it;
 * :func:`convergence`: best objective against evaluations (RWSAVSBAS Fig. 6, BAS-RBFNN Fig. 9);
 * :func:`surface`: friction over two factors (BAS-RBFNN Fig. 6 a-c).
 """
@@ -34,7 +33,6 @@ __all__ = [
     "convergence",
     "friction_curves",
     "parity",
-    "prediction_band",
     "residual_panels",
     "set_velocity_axis",
     "stribeck_region",
@@ -278,67 +276,6 @@ def stribeck_region(
         ax.set_xscale("log")
         if xlim is not None:
             ax.set_xlim(xlim[0] * vf, xlim[1] * vf)
-        ax.set_xlabel(f"speed |velocity| [{vunit}], log scale")
-        ax.set_ylabel(f"|friction torque| [{tunit}]")
-        ax.legend(loc="best")
-        fig.suptitle(title, fontweight="bold")
-        return png(fig)
-
-
-def prediction_band(
-    samples: FrictionSamples,
-    interval: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray, np.ndarray]],
-    *,
-    level: float = 0.95,
-    velocity_unit: str = "rad/s",
-    title: str = "Where a new measurement falls: the 95 % prediction interval",
-) -> bytes:
-    """The friction magnitude against speed on a log axis, per direction: the model
-    (line) and its ``level`` prediction interval (band) at the median load and temperature,
-    the measured samples (markers). ``interval(X)`` returns ``(friction, low, high)`` [N m]
-    (:meth:`fricid.fitted.FittedModel.predict_interval`)."""
-    vf, vunit = velocity_scale(velocity_unit)
-    tf, tunit = torque_scale(samples.friction)
-    with styled():
-        fig, axes = new_figure(1, 1, width=7.5, height=4.4)
-        ax = axes[0, 0]
-        for k, d in enumerate((1, -1)):
-            sel = np.sign(samples.velocity) == d
-            if not sel.any():
-                continue
-            label, marker, dash = _DIRECTION[d]
-            v = samples.velocity[sel]
-            grid = velocity_grid(v, log=True)
-            X = np.column_stack(
-                [
-                    grid,
-                    np.full_like(grid, np.median(samples.load)),
-                    np.full_like(grid, np.median(samples.temperature)),
-                ]
-            )
-            F, low, high = (d * np.asarray(a, dtype=float) * tf for a in interval(X))
-            speed = np.abs(grid) * vf
-            ax.fill_between(
-                speed,
-                np.minimum(low, high),
-                np.maximum(low, high),
-                color=COLORS[k],
-                alpha=0.18,
-                lw=0,
-                label=f"{level:.0%} interval, {label}",
-            )
-            ax.plot(speed, F, dash, color=COLORS[k], label=f"model, {label}")
-            ax.plot(
-                np.abs(v) * vf,
-                np.abs(samples.friction[sel]) * tf,
-                marker,
-                color=COLORS[k],
-                ms=4.5,
-                alpha=0.7,
-                mfc=COLORS[k] if d > 0 else "white",
-                label=f"measured, {label}",
-            )
-        ax.set_xscale("log")
         ax.set_xlabel(f"speed |velocity| [{vunit}], log scale")
         ax.set_ylabel(f"|friction torque| [{tunit}]")
         ax.legend(loc="best")

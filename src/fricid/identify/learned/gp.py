@@ -65,10 +65,10 @@ from ...metrics import metrics
 from ...models import INPUTS
 from ...models.gp import GP_KIND, predict_gp
 from ...samples import FrictionSamples
-from .._intervals import local_record
 from .._records import operating_range, provenance
 from .._scatter import measurement_scatter
 from ._gp_posterior import _posterior, _smoother_trace, heldout_scale
+from ._heldout import ERRORS, interval_record, take_errors
 from ._trust import learned_statistics, process_convergence
 
 __all__ = ["DEFAULT_MAX_POINTS", "farthest_points", "fit_gp"]
@@ -224,7 +224,7 @@ def _train_side(
         state["interval_scale"] = calibration
         held = np.full(len(samples.velocity), np.nan)
         held[moving] = errors
-        state[_ERRORS] = held  # taken out again by _fit: not stored
+        state[ERRORS] = held  # taken out again by _fit: not stored
     if dropped:
         state["dropped_inputs"] = dropped
     notes = sorted({str(w.message).split(". ")[0] for w in caught})
@@ -295,7 +295,7 @@ def _fit(
         }
     else:
         state = _train_side(samples, *args, seed0)
-    errors = _heldout_errors(samples, state, symmetry)
+    errors = take_errors(samples, state, symmetry)
     state = {"kind": GP_KIND, "symmetry": symmetry, **state}
     y_hat = predict_gp(state, samples.X)
     sides = [state["pos"], state["neg"]] if symmetry == "per_direction" else [state]
@@ -309,7 +309,6 @@ def _fit(
         "fitted by marginal likelihood are not counted",
     )
     scatter = measurement_scatter(samples)
-    local = None if errors is None else local_record(errors, samples.X, scatter.value, source=HELD)
     notes = sorted({n for s in sides for n in s.get("training_notes", [])})
     runs = [s["optimizer"] for s in sides]
     return FittedModel(
@@ -338,30 +337,9 @@ def _fit(
             },
         ),
         state=state,
-        prediction_interval=None if local is None else {"method": "heldout", "local": local},
+        prediction_interval=interval_record(errors, samples, scatter.value, HELD),
     )
 
 
-#: A side's held-out errors while the model is assembled (never in the model file).
-_ERRORS = "_heldout_errors"
-
 #: What the local spread of a GP's intervals is made of.
 HELD = "leave-one-out errors of refits at the fitted hyperparameters"
-
-
-def _heldout_errors(
-    samples: FrictionSamples, state: dict[str, Any], symmetry: str
-) -> np.ndarray | None:
-    """Every sample's held-out error [N m] (NaN at rest), taken out of the sides' states;
-    None when a side has none (the inducing-point approximation)."""
-    if symmetry != "per_direction":
-        return state.pop(_ERRORS, None)
-    out = np.full(len(samples.velocity), np.nan)
-    found = True
-    for side, d in (("pos", 1), ("neg", -1)):
-        held = state[side].pop(_ERRORS, None)
-        if held is None:
-            found = False
-        else:
-            out[samples.direction == d] = held
-    return out if found else None

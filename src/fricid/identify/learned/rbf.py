@@ -99,9 +99,9 @@ from ...models.rbf import (
     tail_terms,
 )
 from ...samples import FrictionSamples
-from .._intervals import local_record
 from .._records import operating_range, provenance
 from .._scatter import measurement_scatter
+from ._heldout import ERRORS, interval_record, take_errors
 from ._rbf_estimator import LSQ_IGNORES, TRAINERS, RBFNetRegressor
 from ._rbf_select import check_centres, choose_structure, drop_constant_inputs
 from ._trust import (
@@ -275,10 +275,9 @@ def _model(
     convergence, edf, how, validation = trust_records(ests, state, samples)
     statistics, note = learned_statistics(samples.y, y_hat, edf, how)
     scatter = measurement_scatter(samples)
-    local = None if errors is None else local_record(errors, X, scatter.value, source=HELD)
     return FittedModel(
         model="rbf",
-        prediction_interval=None if local is None else {"method": "heldout", "local": local},
+        prediction_interval=interval_record(errors, samples, scatter.value, HELD),
         metrics=metrics(samples.y, y_hat, samples.direction, scatter.value),
         statistics=statistics,
         statistics_note=note,
@@ -398,15 +397,8 @@ def _train_side(
     notes["edf"] = hat_trace(est, X)
     if est.linear_tail:  # the floor of the magnitude g (models.rbf notes)
         notes["magnitude_floor"] = 0.5 * max(float(np.min(est.predict(X))), 0.0)
-    held = None
-    if errors is not None:
-        held = np.full(len(samples.velocity), np.nan)
-        held[: len(errors)] = errors
-    return est, {**_state(est, kept), **notes, _ERRORS: held}
+    return est, {**_state(est, kept), **notes, ERRORS: errors}
 
-
-#: A network's held-out errors while the model is assembled (never in the model file).
-_ERRORS = "_heldout_errors"
 
 #: What the local spread of a network's intervals is made of.
 HELD = "cross-validation errors of the chosen structure (random folds)"
@@ -468,7 +460,7 @@ def fit_rbf(
     symmetry = symmetry_for(samples)
     if symmetry != "per_direction":
         est, state = _train_side(samples, names, params, "")
-        errors = state.pop(_ERRORS)
+        errors = take_errors(samples, state, symmetry)
         return _model([est], {**state, "symmetry": symmetry}, samples, errors)
     ests, states = [], {}
     rs = params.get("random_state")
@@ -486,12 +478,7 @@ def fit_rbf(
             samples.subset(samples.direction == d), names, side_params, where
         )
         ests.append(est)
-    errors = np.full(len(samples.velocity), np.nan)
-    for side, d in (("pos", 1), ("neg", -1)):
-        held = states[side].pop(_ERRORS)
-        errors = None if held is None or errors is None else errors
-        if errors is not None:
-            errors[samples.direction == d] = held
+    errors = take_errors(samples, states, "per_direction")
     first = states["pos"]
     state = {
         "kind": STATE_KIND,

@@ -1,0 +1,110 @@
+"""The model report's figure of the 95 % prediction interval against speed
+(:meth:`fricid.fitted.FittedModel.predict_interval`): where a new measurement falls, narrow
+where the model follows the data and wide where it misses them."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+from ..errors import ConfigError
+from ..fitted import FittedModel
+from ..samples import FrictionSamples
+from .document import Figure
+from .plots import _DIRECTION, velocity_grid
+from .style import COLORS, new_figure, png, styled, torque_scale, velocity_scale
+
+__all__ = ["prediction_band", "prediction_band_figure"]
+
+
+def prediction_band(
+    samples: FrictionSamples,
+    interval: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray, np.ndarray]],
+    *,
+    level: float = 0.95,
+    velocity_unit: str = "rad/s",
+    title: str = "Where a new measurement falls: the 95 % prediction interval",
+) -> bytes:
+    """The friction magnitude against speed on a log axis, per direction: the model
+    (line) and its ``level`` prediction interval (band) at the median load and temperature,
+    the measured samples (markers). ``interval(X)`` returns ``(friction, low, high)`` [N m]
+    (:meth:`fricid.fitted.FittedModel.predict_interval`)."""
+    vf, vunit = velocity_scale(velocity_unit)
+    tf, tunit = torque_scale(samples.friction)
+    with styled():
+        fig, axes = new_figure(1, 1, width=7.5, height=4.4)
+        ax = axes[0, 0]
+        for k, d in enumerate((1, -1)):
+            sel = np.sign(samples.velocity) == d
+            if not sel.any():
+                continue
+            label, marker, dash = _DIRECTION[d]
+            v = samples.velocity[sel]
+            grid = velocity_grid(v, log=True)
+            X = np.column_stack(
+                [
+                    grid,
+                    np.full_like(grid, np.median(samples.load)),
+                    np.full_like(grid, np.median(samples.temperature)),
+                ]
+            )
+            F, low, high = (d * np.asarray(a, dtype=float) * tf for a in interval(X))
+            speed = np.abs(grid) * vf
+            ax.fill_between(
+                speed,
+                np.minimum(low, high),
+                np.maximum(low, high),
+                color=COLORS[k],
+                alpha=0.18,
+                lw=0,
+                label=f"{level:.0%} interval, {label}",
+            )
+            ax.plot(speed, F, dash, color=COLORS[k], label=f"model, {label}")
+            ax.plot(
+                np.abs(v) * vf,
+                np.abs(samples.friction[sel]) * tf,
+                marker,
+                color=COLORS[k],
+                ms=4.5,
+                alpha=0.7,
+                mfc=COLORS[k] if d > 0 else "white",
+                label=f"measured, {label}",
+            )
+        ax.set_xscale("log")
+        ax.set_xlabel(f"speed |velocity| [{vunit}], log scale")
+        ax.set_ylabel(f"|friction torque| [{tunit}]")
+        ax.legend(loc="best")
+        fig.suptitle(title, fontweight="bold")
+        return png(fig)
+
+
+def prediction_band_figure(
+    fitted: FittedModel, moving: FrictionSamples, velocity_unit: str
+) -> Figure | None:
+    """The figure of the model's 95 % prediction interval against speed, or None when the
+    model file stores none (files from before, trajectory models)."""
+
+    def interval(X: np.ndarray):
+        pi = fitted.predict_interval(X, 0.95, warn=False)
+        return pi.friction, pi.low, pi.high
+
+    try:
+        interval(moving.X[:1])
+    except ConfigError:
+        return None
+    how = (
+        "the local spread of the fit's held-out errors"
+        if (fitted.prediction_interval or {}).get("local")
+        or (fitted.prediction_interval or {}).get("method") == "heldout"
+        else "the fit's residuals"
+    )
+    return Figure(
+        "prediction_band",
+        "Where a new measurement falls: the 95 % prediction interval",
+        prediction_band(moving, interval, velocity_unit=velocity_unit),
+        caption="The band holds 95 % of new measured samples at each speed (noise "
+        f"included), at the median load and temperature; its width follows {how}: narrow "
+        "where the model follows the data, wide where it misses them. Inside a gap between "
+        "measured speeds it says nothing a measurement backs.",
+    )
