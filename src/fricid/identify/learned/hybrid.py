@@ -213,6 +213,7 @@ def fit_backbone(
     table: list[dict[str, Any]] = []
     best: tuple[float, Any, Any] | None = None
     optima: dict[tuple[str, frozenset], dict[str, float]] = {}
+    lean_rows: list[tuple[float, float, str, dict[str, float], dict[str, float]]] = []
     for name, fixed in names:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
@@ -221,6 +222,7 @@ def fit_backbone(
                     warm = _warm_start(name, fixed, optima)
                     bic, rmse, fitted = _lean_fit(samples, name, fixed, warm)
                     optima[(name, _fixed_key(fixed))] = fitted
+                    lean_rows.append((bic, rmse, name, fixed, fitted))
                 else:
                     fitted = _fit.fit(samples, name, fixed=fixed or None)
                     bic = float(fitted.statistics.get("bic", np.inf))
@@ -235,8 +237,24 @@ def fit_backbone(
             best = (bic, (name, fixed, fitted), list(caught))
     if best is None:
         raise ConfigError("no analytic backbone could be fitted to these samples")
-    if lean and backbone is None:  # the lean winner: fitted in full, from its optimum
-        name, fixed, params = best[1]
+    if lean and backbone is None:
+        return _full_fit(samples, lean_rows, table)
+    return best[1][2], table, best[2]
+
+
+def _full_fit(
+    samples: FrictionSamples,
+    lean_rows: list[tuple[float, float, str, dict[str, float], dict[str, float]]],
+    table: list[dict[str, Any]],
+) -> tuple[FittedModel, list[dict[str, Any]], list[warnings.WarningMessage]]:
+    """The lean winner fitted in full, from its optimum; when that fit does not reproduce
+    the lean optimum (its RMS error 1 % above it: a degenerate optimum, such as an Arrhenius
+    energy of 10^5 K times a viscous coefficient of 10^-35 on data at one temperature,
+    that the full fit's box cannot hold), the next candidate by BIC, noted in ``table``."""
+    from ..static import least_squares as _fit
+
+    tried: list[tuple[float, FittedModel, list]] = []
+    for _, rmse, name, fixed, params in sorted(lean_rows, key=lambda row: row[0]):
         free = {k: v for k, v in params.items() if k not in fixed}
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
@@ -248,8 +266,15 @@ def fit_backbone(
                 intervals="none",
                 options={"n_starts": 1},
             )
-        return fitted, table, list(caught)
-    return best[1][2], table, best[2]
+        got = float(fitted.metrics["rmse"])
+        if got <= 1.01 * rmse + 1e-12:
+            return fitted, table, list(caught)
+        for row in table:
+            if row["model"] == name and row["fixed"] == fixed:
+                row["full_fit"] = f"RMSE {got:.3g} N m, not the lean {rmse:.3g}: not taken"
+        tried.append((got, fitted, list(caught)))
+    got, fitted, caught = min(tried, key=lambda t: t[0])
+    return fitted, table, caught
 
 
 def fit_hybrid(
