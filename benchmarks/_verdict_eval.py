@@ -19,8 +19,10 @@ model ratio
 coverage
     The expected coverage of the model's 95 % prediction interval ``[lo, hi]`` of a fresh
     sample of the case's measurement process at each grid point, averaged over the grid
-    (exact, no draw); None when the fitted model exposes no interval
-    (:func:`prediction_interval`). The fresh sample is ``F + sigma z``, coverage
+    (exact, no draw), over the grid points where the model gives one (fricid gives none
+    inside a gap between measured speeds: ``withheld`` is the share of the grid without);
+    None when the fitted model exposes no interval (:func:`prediction_interval`). The fresh
+    sample is ``F + sigma z``, coverage
     ``Phi((hi - F)/sigma) - Phi((lo - F)/sigma)``; in the gravity class it is ``F + a sin(phi)
     + sigma z``, ``phi`` uniform in (-pi/2, pi/2) as every sample of the case was drawn
     (``spec["gravity_amp"]``), the coverage averaged over ``phi`` by the midpoint rule. A
@@ -94,7 +96,11 @@ def _try(call, mean: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
             out = _split(call(), mean)
     except (FricidError, TypeError, ValueError, KeyError, NotImplementedError):
         return None
-    if out is None or not (np.all(np.isfinite(out[0])) and np.all(np.isfinite(out[1]))):
+    if out is None:
+        return None
+    lo, hi = out
+    # NaN ends where the model withholds its interval (gaps); infinite ends are no interval
+    if np.isinf(lo).any() or np.isinf(hi).any() or not (np.isfinite(lo) & np.isfinite(hi)).any():
         return None
     return out
 
@@ -195,8 +201,12 @@ def true_scores(
         "coverage": None,
     }
     if band is not None:
-        lo, hi = band
-        out["coverage"] = float(np.mean(_coverage(lo, hi, truth, sigma, offset_amp)))
+        lo, hi = (np.asarray(b, dtype=float) for b in band)
+        given = np.isfinite(lo) & np.isfinite(hi)
+        out["withheld"] = float(1.0 - np.mean(given))
+        if given.any():
+            cov = _coverage(lo[given], hi[given], truth[given], sigma[given], offset_amp)
+            out["coverage"] = float(np.mean(cov))
     return out
 
 

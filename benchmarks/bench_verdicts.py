@@ -27,7 +27,9 @@ and the true scatter, so a perfect model scores 1.0. Truth classes: ``<1.2`` (wi
 fricid's ``NOISE_RATIO``), ``1.2-1.5``, ``>1.5``. Goals (on the report cases): "Trust: yes"
 for at most 1 % of the fits whose true ratio exceeds 1.5, "Trust: no" for at most 5 % of those
 below 1.2; the 95 % prediction intervals of every model covering 90-98 % of fresh noisy samples
-on the grid, in every class ("n/a" for a model that exposes no interval).
+on the grid, in every class ("n/a" for a model that exposes no interval). fricid gives no
+interval inside a gap between measured speeds (nothing measured backs one there): coverage
+is over the grid points with an interval, and a table prints the share of the grid without.
 
 Seed split: a case whose seed is a multiple of ``--seed-split`` is a tuning case (to tune
 thresholds on); the tables are printed on the others, the report cases (``--seed-split 0``:
@@ -196,10 +198,11 @@ def rates(rows: list[dict[str, Any]]) -> dict[str, Any]:
 
 
 def coverage(
-    rows: list[dict[str, Any]], max_ratio: float | None = None
+    rows: list[dict[str, Any]], max_ratio: float | None = None, key: str = "coverage"
 ) -> dict[str, dict[str, float | None]]:
     """Model -> class -> mean coverage of its 95 % intervals (None: no interval); with
-    ``max_ratio``, over the fits whose true ratio is at most that only."""
+    ``max_ratio``, over the fits whose true ratio is at most that only; ``key="withheld"``:
+    the mean share of the grid without an interval (gaps between measured speeds)."""
     acc: dict[str, dict[str, list[float]]] = defaultdict(lambda: defaultdict(list))
     seen: dict[str, set[str]] = defaultdict(set)
     for r in rows:
@@ -208,8 +211,8 @@ def coverage(
         if max_ratio is not None and r["true_ratio"] > max_ratio:
             continue
         seen[r["model"]].add(r["class"])
-        if r.get("coverage") is not None:
-            acc[r["model"]][r["class"]].append(r["coverage"])
+        if r.get(key) is not None:
+            acc[r["model"]][r["class"]].append(r[key])
     out: dict[str, dict[str, float | None]] = {}
     for model, classes in seen.items():
         out[model] = {}
@@ -271,6 +274,9 @@ def print_coverage(rows: list[dict[str, Any]]) -> None:
     _coverage_table(coverage(rows))
     print("\nThe same, over the fits with true ratio <= 1.5 only (n = fits counted)")
     _coverage_table(coverage(rows, 1.5), rows)
+    if any(r.get("withheld") for r in rows):
+        print("\nShare of the grid with no interval (inside gaps between measured speeds)")
+        _coverage_table(coverage(rows, key="withheld"))
 
 
 def _coverage_table(cov, rows: list[dict[str, Any]] | None = None) -> None:
@@ -312,6 +318,7 @@ def summary(rows: list[dict[str, Any]]) -> dict[str, Any]:
         },
         "coverage": coverage(rows),
         "coverage_ratio_le_1_5": coverage(rows, 1.5),
+        "withheld": coverage(rows, key="withheld"),
         "seconds_per_model": {
             m: sum(r["seconds"] for r in rows if r["model"] == m)
             / max(1, sum(r["model"] == m for r in rows))

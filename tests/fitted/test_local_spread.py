@@ -193,3 +193,34 @@ def test_the_report_draws_the_band_where_the_file_has_an_interval():
 
     assert "prediction_band" in keys(model)
     assert "prediction_band" not in keys(replace(model, prediction_interval=None))
+
+
+def test_no_interval_inside_a_gap_between_measured_speeds(tmp_path):
+    """A decade with no sample: the interval is NaN there (nothing measured backs it),
+    finite on either side; ``fricid predict --interval`` writes nan and says why."""
+    from typer.testing import CliRunner
+
+    from fricid.cli import app
+
+    rng = np.random.default_rng(5)
+    s = np.r_[np.geomspace(0.005, 0.02, 6), np.geomspace(0.5, 3.0, 6)]
+    v = np.r_[s, -s]
+    samples = FrictionSamples(
+        velocity=v,
+        load=None,
+        temperature=None,
+        friction=_dip(v) + SIGMA * rng.standard_normal(v.size),
+        std=np.full(v.size, SIGMA * np.sqrt(50)),
+        count=np.full(v.size, 50),
+    )
+    model = _fit(samples, "stribeck")
+    X = np.column_stack([[0.01, 0.1, -0.1, 1.0], np.zeros(4), np.full(4, 25.0)])
+    pi = model.predict_interval(X, 0.95, warn=False)
+    assert np.isnan(pi.low[1:3]).all() and np.isnan(pi.high[1:3]).all()
+    assert np.isfinite(pi.low[[0, 3]]).all() and np.isfinite(pi.friction).all()
+    path = tmp_path / "m.json"
+    model.save(path)
+    args = ["predict", str(path), "--velocity", "0.1", "--velocity", "1", "--interval", "0.95"]
+    got = CliRunner().invoke(app, args)
+    assert got.exit_code == 0, got.output
+    assert "nan,nan" in got.stdout and "no prediction interval at 1 of 2 points" in got.stderr

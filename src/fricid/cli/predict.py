@@ -85,9 +85,10 @@ def predict_command(
         float | None,
         typer.Option(
             help="Also write the prediction interval at this level (e.g. 0.95): columns "
-            "'low' and 'high', where a new measured sample falls with that probability "
-            "(delta method for analytic models, the GP's posterior, conformal for rbf and "
-            "hybrid: levels 0.9 and 0.95)."
+            "'low' and 'high', where a new measured sample falls with that probability; "
+            "its width follows the fit's held-out errors near the point (levels 0.9 and "
+            "0.95 calibrated, others normal). nan inside a gap between measured speeds, "
+            "where nothing measured backs one."
         ),
     ] = None,
     digits: Annotated[
@@ -113,6 +114,8 @@ def predict_command(
     Examples: `fricid predict m.json --velocity 0.1 --velocity 0.5 --load 0.2 --temperature 30`;
     `fricid predict m.json --input points.csv --velocity-unit deg/s --out friction.csv`.
     """
+    import numpy as np
+
     from ..errors import ConfigError, ExtrapolationWarning
     from ..export import Smoothing, smooth_predict, write_text
     from ..export.points import points_matrix, points_table, read_points
@@ -162,6 +165,15 @@ def predict_command(
         if interval is not None:  # its half-width around the friction written
             half = fitted.predict_interval(X, interval, warn=False).half_width
             extra = {"low": friction - half, "high": friction + half}
+            if np.isnan(half).any():
+                err_console.print(
+                    f"note: no prediction interval at {int(np.isnan(half).sum())} of "
+                    f"{len(X)} points: they lie in a gap between measured speeds (above), "
+                    "where nothing measured backs one",
+                    markup=False,
+                    highlight=False,
+                    soft_wrap=True,
+                )
     units["friction"] = friction_unit
     if digits is None and out is None and sys.stdout.isatty():
         digits = DISPLAY_DIGITS

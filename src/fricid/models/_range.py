@@ -24,6 +24,7 @@ __all__ = [
     "coverage_text",
     "gap_pairs",
     "gaps_note",
+    "in_gap",
     "range_violations",
     "speed_coverage",
 ]
@@ -121,6 +122,22 @@ def coverage_text(coverage: Any) -> list[str]:
             + (f" ({tail})" if tail else " (no gaps)")
         )
     return lines
+
+
+def in_gap(velocity, coverage: Any) -> np.ndarray:
+    """Which ``velocity`` values [rad/s] lie in a gap between measured speeds of their
+    side of a :func:`speed_coverage` record (by the tolerance of :func:`range_violations`);
+    all False without a record."""
+    v = np.asarray(velocity, dtype=float)
+    out = np.zeros(v.shape, bool)
+    if not isinstance(coverage, dict):
+        return out
+    speed = np.abs(v)
+    for side in SIDES:
+        mask = {"pos": v > 0, "neg": v < 0, "both": v != 0}[side]
+        for a, b in gap_pairs(coverage, side):
+            out |= mask & (speed > a * (1 + RANGE_TOLERANCE)) & (speed < b * (1 - RANGE_TOLERANCE))
+    return out
 
 
 def _coverage_violations(v: np.ndarray, coverage: dict) -> list[RangeViolation]:
