@@ -105,6 +105,6 @@ def prediction_band_figure(
         prediction_band(moving, interval, velocity_unit=velocity_unit),
         caption="The band holds 95 % of new measured samples at each speed (noise "
         f"included), at the median load and temperature; its width follows {how}: narrow "
-        "where the model follows the data, wide where it misses them. Inside a gap between "
-        "measured speeds it says nothing a measurement backs.",
+        "where the model follows the data, wide where it misses them. There is no band inside "
+        "a gap between measured speeds: nothing measured backs one there.",
     )
