@@ -101,6 +101,8 @@ def test_the_interval_round_trips_through_the_file(tmp_path):
         lambda r: r.update(noise=-1.0),
         lambda r: r.pop("bandwidth"),
         lambda r: r.update(spans=[[1.0, 0.0], None]),
+        lambda r: r.update(scale=["x", 2.0]),
+        lambda r: r.update(scale=[1.6]),
     ],
 )
 def test_a_malformed_local_record_is_refused(damage):

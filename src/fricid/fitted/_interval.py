@@ -166,7 +166,7 @@ def _local_half_width(
 def check_local(local: Mapping[str, Any]) -> None:
     """Raise :class:`~fricid.errors.ConfigError` unless ``local`` is a well-formed local
     spread (a model file from elsewhere: equal lengths, finite numbers, positive weights,
-    bandwidths and noise)."""
+    bandwidths, noise and multipliers, one multiplier per level)."""
     try:
         cols = [np.asarray(local[k], dtype=float) for k in _LOCAL_COLUMNS]
         n = len(cols[0])
@@ -184,6 +184,10 @@ def check_local(local: Mapping[str, Any]) -> None:
             and float(local["noise"]) > 0
             and np.isfinite([float(bw["decades"]), float(bw["span"]), float(local["noise"])]).all()
         )
+        levels = np.asarray(local.get("levels") or [], dtype=float)
+        scale = np.asarray(local.get("scale") or [], dtype=float)
+        fine = fine and levels.shape == scale.shape and levels.ndim == 1
+        fine = fine and bool(np.isfinite(scale).all() and (scale > 0).all())
     except (KeyError, TypeError, ValueError) as err:
         raise ConfigError(f"the model file's local interval record is malformed ({err})") from None
     if not fine:
