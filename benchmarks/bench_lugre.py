@@ -162,12 +162,17 @@ def _identify(log, seed: int, max_evals: int | None) -> dict:
     for n, p in fitted.parameters.items():
         closed = not (p.low_open or p.high_open or p.not_determined)
         est[n] = {"value": p.value, "ci95": list(p.ci95), "closed": bool(closed)}
+        est[n]["nd"] = bool(p.not_determined)
     for n, row in fitted.provenance["trajectory"]["joint"].items():
         est[n] = {"value": row["value"], "ci95": [row["ci95_low"], row["ci95_high"]]}
         est[n]["closed"] = True
     info = fitted.provenance["trajectory"]
+    for n in PARAMS[-3:]:  # the pre-sliding route leaves J, p_x, p_y out: not determined
+        est.setdefault(n, {"value": math.nan, "ci95": [math.nan, math.nan], "closed": False})
+        est[n].setdefault("nd", n not in info["joint"])
     return {
         "estimates": est,
+        "route": info.get("route", ""),
         "estimator": info.get("estimator", {}).get("name", ""),
         "output_error": bool(info.get("output_error", {}).get("applied")),
         "converged": bool(fitted.converged),
@@ -240,7 +245,7 @@ def task(args: tuple) -> dict:
     out = {"truth": truth_name, "kind": kind, "rate": rate, "cpr": cpr, "seed": seed}
     out["n"] = int(fit_log.time.size)
     out.update(_identify(fit_log, seed, max_evals))
-    if "estimates" in out:
+    if "estimates" in out and out["route"] != "presliding":  # J, gravity: not determined
         out["heldout"] = heldout(out, truth.fricid_names(), held, truth.noise)
         out["heldout"]["simulated"] = simulated_heldout(
             out, truth, held_sim, (kind, duration, rate, cpr, seed + 1000)
@@ -264,7 +269,7 @@ def foreign_tasks(max_evals: int | None) -> list[dict]:
         row = {"truth": "foreign", "kind": meta["trajectory"], "rate": meta["rate_hz"]}
         row.update(cpr=meta["encoder_counts_per_rev"], seed=0, n=int(log.time.size), file=name)
         row.update(_identify(log, 0, max_evals))
-        if "estimates" in row:
+        if "estimates" in row and row["route"] != "presliding":
             row["heldout"] = heldout(row, truth, held, meta["torque_noise_std"])
         row["truth_values"] = truth
         rows.append(row)
@@ -279,6 +284,11 @@ def _truth_of(row: dict) -> dict:
 def _error(row: dict, n: str) -> float:
     t, v = _truth_of(row)[n], row["estimates"][n]["value"]
     return v - t if t == 0 else (v - t) / abs(t)
+
+
+def _nd(row: dict, n: str) -> bool:
+    """The fit reports ``n`` not determined (no claim to score), not a refusal."""
+    return "estimates" in row and bool(row["estimates"][n].get("nd"))
 
 
 def _covered(row: dict, n: str) -> bool:
@@ -305,27 +315,28 @@ def summary(rows: list[dict], key) -> list[str]:
     for r in rows:
         groups.setdefault(key(r), []).append(r)
     head = f"{'setting':42s} {'fits':>5s} " + " ".join(f"{s:>7s}" for s in SHORT)
-    lines = [head + "  cover  sim-held  eqn-held (truth)  s@60s/1kHz"]
+    lines = [head + "  cover(claimed+nd) sim-held  eqn-held (truth)  s@60s/1kHz"]
     for g, rs in groups.items():
         ok = [r for r in rs if "estimates" in r]
         errs = []
         for n in PARAMS:
-            vals = [_error(r, n) for r in ok]
+            vals = [_error(r, n) for r in ok if not _nd(r, n)]
             zero = bool(ok) and _truth_of(ok[0])[n] == 0
-            errs.append(_fmt_err(float(np.median(vals)), zero) if vals else "-")
+            errs.append(_fmt_err(float(np.median(vals)), zero) if vals else ("nd" if ok else "-"))
         cov = sum(_covered(r, n) for r in rs for n in PARAMS)
-        held = [r["heldout"]["fit"] for r in ok]
-        floor = [r["heldout"]["truth"] for r in ok]
+        nd = sum(_nd(r, n) for r in rs for n in PARAMS)
+        held = [r["heldout"]["fit"] for r in ok if "heldout" in r]
+        floor = [r["heldout"]["truth"] for r in ok if "heldout" in r]
         secs = [r["seconds"] * 60000.0 / r["n"] for r in rs]
         hl = f"{np.median(held):6.3g} ({np.median(floor):.3g})" if held else "   -"
-        sims = [r["heldout"].get("simulated", {}) for r in ok]
+        sims = [r["heldout"].get("simulated", {}) for r in ok if "heldout" in r]
         tq = [x["torque_over_noise"] for x in sims if "torque_over_noise" in x]
         qc = [x["position_counts"] for x in sims if "position_counts" in x]
         sim = f"{np.median(tq):.3g}" if tq else (f"{np.median(qc):.3g}cnt" if qc else "-")
         lines.append(
             f"{g:42s} {len(ok):2d}/{len(rs):<2d} "
             + " ".join(f"{e:>7s}" for e in errs)
-            + f"  {cov:3d}/{len(rs) * len(PARAMS):<3d} {sim:>8s} {hl:>17s}   "
+            + f"  {cov:3d}/{len(rs) * len(PARAMS) - nd:<3d}{f'+{nd}nd':>6s} {sim:>8s} {hl:>17s}   "
             + f"{np.median(secs):6.1f} (max {max(secs):.1f})"
         )
     return lines
@@ -336,13 +347,17 @@ def coverage_lines(rows: list[dict], key) -> list[str]:
     groups: dict = {}
     for r in rows:
         groups.setdefault(key(r), []).append(r)
-    lines = [f"{'group':24s} " + " ".join(f"{s:>6s}" for s in SHORT) + "  refused unconverged"]
+    lines = [f"{'group':24s} " + " ".join(f"{s:>9s}" for s in SHORT) + "  refused unconverged"]
     for g, rs in groups.items():
-        cells = [f"{sum(_covered(r, n) for r in rs)}/{len(rs)}" for n in PARAMS]
+        cells = []
+        for n in PARAMS:
+            nd = sum(_nd(r, n) for r in rs)
+            cell = f"{sum(_covered(r, n) for r in rs)}/{len(rs) - nd}"
+            cells.append(cell + (f"+{nd}nd" if nd else ""))
         refused = sum("refused" in r for r in rs)
         unconv = sum(("estimates" in r) and not r["converged"] for r in rs)
         lines.append(
-            f"{g:24s} " + " ".join(f"{c:>6s}" for c in cells) + f"  {refused:7d} {unconv:11d}"
+            f"{g:24s} " + " ".join(f"{c:>9s}" for c in cells) + f"  {refused:7d} {unconv:11d}"
         )
     return lines
 

@@ -70,8 +70,9 @@ import numpy as np
 
 from ...errors import DataError
 from ...models import lugre
+from ...optim import minimize
 from ..problem import ResidualProblem
-from ..static.convergence import noise_ftol
+from ..static.convergence import POLISH_EVALS_PER_PARAM, RESOLVE_SE, noise_ftol
 from ..static.uncertainty import jacobian
 from ._data import Series, blocks, cluster_covariance
 from ._encoder import quantise
@@ -110,10 +111,16 @@ CHI2_95 = 3.841
 NAMES = ("sigma_0", "sigma_1", "load_ratio", "torque_offset", "inertia")
 _LOG = np.array([True, True, False, False, True])
 
-#: Restarts of the search from its own result while they still lower the SSE by more than a
-#: thousandth of the residual variance (the convergence certificate's polish found lower
-#: points after lm's own stop).
-RESTARTS = 4
+#: The damping's search box as the lag ``sigma_1 / sigma_0`` it makes, in sample periods (at
+#: the start's sigma_0): from far below what any log resolves to far above a creep's lag.
+LAG_BOX = (1e-4, 100.0)
+
+#: Polishes of the search's result, as the convergence certificate polishes it
+#: (:func:`fricid.identify.static.convergence.certify`), while one still lowers the SSE by
+#: more than the certificate resolves: the residual is a simulation whose bristle rate is
+#: frozen over each sub-step, not smooth at the scale of a tenth of a standard error, and lm
+#: stopped short of points the certificate's polish then found.
+RESTARTS = 6
 
 #: Sub-steps per period of the check's simulation (as :data:`._rate.SUB_STEPS`).
 CHECK_SUB_STEPS = 16
@@ -233,7 +240,7 @@ def presliding_route(
     box = np.array(
         [
             LOG_BOX["sigma_0"],
-            LOG_BOX["sigma_1"],
+            tuple(math.log10(s0 * dt * r) for r in LAG_BOX),
             (0.0, 0.99),
             (float(w.min()), float(w.max())),
             tuple(math.log10(s0 * (dt / r) ** 2) for r in (RESONANCE_BOX[1], slowest)),
@@ -253,12 +260,21 @@ def presliding_route(
     ftol = noise_ftol(search, SEARCH_SHARE)
     result = _run(search, method, x0, seed, max_evals, 1, ftol)
     for _ in range(RESTARTS):  # lm stops early in the flat valleys of J and the load ratio
-        again = _run(search, method, result.x, seed, max_evals, 1, ftol)
+        again = minimize(  # as the convergence certificate polishes (convergence.certify)
+            search.evaluate,
+            box,
+            method="lm",
+            x0=np.clip(result.x, box[:, 0], box[:, 1]),
+            options={"n_starts": 1, "ftol": ftol},
+            max_evals=POLISH_EVALS_PER_PARAM * (len(NAMES) + 1),
+            residuals=search.residuals,
+            seed=0,
+        )
         again.nfev += result.nfev
         gained = float(result.fun) - float(again.fun)
-        result = again if gained > 0 else result
-        if gained <= 1e-3 * float(result.fun) / max(y.size - len(NAMES) - 1, 1):
-            break
+        if gained <= RESOLVE_SE**2 * float(again.fun) / max(y.size - len(NAMES), 1):
+            break  # kept where it was: the certificate's polish from there gains as little
+        result = again
     u_hat = np.asarray(result.x, dtype=float)
     r_hat = projected(u_hat)[0]
     labels = blocks(n, max(round(cluster_time * rate), 1))[keep]

@@ -80,6 +80,15 @@ def fit_presliding(
     )
     check = bias_check(series, stage, info, encoder, method, seed, cluster_time, n_sub, filt)
     notes = widen(stage, check, ("sigma_0", "sigma_1"))
+    for n in ("sigma_0", "sigma_1"):  # one end at the box: a bound, not an interval
+        i = stage.names.index(n)
+        (lo, hi), (b_lo, b_hi) = (stage.low[i], stage.high[i]), stage.bounds[i]
+        if (lo <= b_lo or hi >= b_hi) and not notes.get(n, "").startswith("not determined"):
+            end = f"lower end {b_lo:.4g}" if lo <= b_lo else f"upper end {b_hi:.4g}"
+            notes[n] = (
+                f"not determined: its 95 % interval [{lo:.4g}, {hi:.4g}] reaches the search "
+                f"box's {end}; the log bounds it on one side only"
+            )
     convergence = converged([("presliding", stage)], method, max_evals)
     ok = bool(convergence["converged"])
     table = stage.table()
