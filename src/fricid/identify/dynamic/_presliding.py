@@ -183,14 +183,18 @@ def presliding_route(
     span = float(np.ptp(q))
     levels = np.unique(q)
     if not quantum and levels.size <= MIN_SPAN_COUNTS:  # too few steps to read a quantum from
+        seen = (
+            f"takes {levels.size} distinct values over the whole log (steps of "
+            f"{np.min(np.diff(levels)):.3g} rad)"
+            if levels.size > 1
+            else f"never changes over the whole log ({levels[0]:.6g} rad)"
+        )
         raise DataError(
-            f"the position takes {levels.size} distinct values over the whole log (steps of "
-            f"{np.min(np.diff(levels)) if levels.size > 1 else 0.0:.3g} rad): the encoder "
-            "does not resolve the pre-sliding deflection; sigma_0 and sigma_1 need a finer "
-            "encoder or a larger torque below break-away",
+            f"the position {seen}: the encoder does not resolve the pre-sliding deflection; "
+            "sigma_0 and sigma_1 need a finer encoder or a larger torque below break-away",
             file=source,
         )
-    if quantum and span / quantum < MIN_SPAN_COUNTS:
+    if quantum and round(span / quantum) < MIN_SPAN_COUNTS:
         raise DataError(
             f"the position spans {span / quantum:.3g} counts of the encoder ({quantum:.3g} rad, "
             f"{encoder['counts_per_rev']:.10g} counts/rev) over the whole log: the encoder "
