@@ -123,3 +123,36 @@ def test_the_benchmark_counts_not_determined_apart_from_claims():
     assert bench._covered(row, "sigma_0") and not bench._nd(row, "sigma_0")
     lines = bench.coverage_lines([row], lambda r: r["kind"])
     assert "0/0+1nd" in lines[1] and "1/1" in lines[1]
+
+
+@pytest.mark.slow  # one fit, 4 s measured
+def test_sweeps_give_the_sliding_part_and_sigma_2_is_subtracted(tmp_path):
+    """static= (a stribeck fit from sweeps, here the truth's with 1 % errors): the sliding part
+    is taken from it, sigma_1 is the pre-sliding damping less its sigma_2."""
+    from fricid.fitted import FittedModel, Parameter
+    from fricid.identify.dynamic.trajectory import fit_trajectory
+
+    t = lt.TRUTHS["slow_stribeck"]
+    levels = dict(tau_c=t.Fc, tau_s=t.Fs, w_s=t.vs, tau_v=t.sigma2, delta=t.delta)
+    static = FittedModel(
+        model="stribeck",
+        parameters={
+            n: Parameter(n, v, stderr=0.01 * v, ci95=(0.98 * v, 1.02 * v), bounds=(0.0, 10 * v))
+            for n, v in levels.items()
+        },
+    )
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        fitted = fit_trajectory(_creep(tmp_path, "slow_stribeck", 2**20, 3), "lugre", static=static)
+    damping = fitted.provenance["trajectory"]["presliding"]["damping"]
+    s1 = fitted.parameters["sigma_1"]
+    assert s1.value == pytest.approx(damping["value"] - t.sigma2)
+    assert s1.ci95[0] <= t.sigma1 <= s1.ci95[1] and "less the sweeps' sigma_2" in s1.note
+    assert (
+        fitted.parameters["tau_s"].value == t.Fs and not fitted.parameters["tau_s"].not_determined
+    )
+    assert set(fitted.provenance["trajectory"]["presliding"]["not_determined"]) == {
+        "inertia",
+        "p_x",
+        "p_y",
+    }

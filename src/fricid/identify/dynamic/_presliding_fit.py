@@ -98,6 +98,7 @@ def fit_presliding(
     bounds = {n: [float(b) for b in stage.bounds[stage.names.index(n)]] for n in final}
     if static is not None:
         final.update(_from_sweeps(static, final["sigma_1"]))
+        notes.update({n: f"from the sweeps' stribeck fit ({s})" for n, s in _STRIBECK.items()})
         bounds.update({n: list(static.parameters[s].bounds or ()) for n, s in _STRIBECK.items()})
         bounds = {n: b for n, b in bounds.items() if b}
     else:
