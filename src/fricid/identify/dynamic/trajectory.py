@@ -366,7 +366,9 @@ def fit_trajectory(
     mask[:half], mask[mask.size - half :] = False, False  # the filter's edges: extrapolated
     slides = mask.sum() >= MIN_SLIDING
     if key == "lugre" and route in ("filtered", "two_stage", "presliding") and not slides:
-        return fit_presliding(  # a log that never slides: sigma_0, sigma_1 only (its notes)
+        if progress is not None:
+            progress(1, 2, "pre-sliding route: sigma_0, sigma_1 (the log never slides)")
+        fitted = fit_presliding(  # a log that never slides: sigma_0, sigma_1 only (its notes)
             log,
             series,
             encoder,
@@ -381,6 +383,9 @@ def fit_trajectory(
             gravity=gravity,
             t_start=t_start,
         )
+        if progress is not None:
+            progress(2, 2, "done")
+        return fitted
     if route == "presliding" and slides:
         raise DataError(
             f"{int(mask.sum())} samples slide faster than {v_slide:g} rad/s: the pre-sliding "
