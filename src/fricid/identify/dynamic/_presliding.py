@@ -52,6 +52,12 @@ encoder, identified again): a parameter's bias beyond one standard error widens 
 to cover the corrected value too, a gross one flags it not determined
 (:data:`._outcome.WIDEN`, :data:`._outcome.GROSS`: the conventions of the filtered route).
 
+Closed loop. A drive holding position under PD logs a torque that reacts to the encoder's
+rounding; the simulation takes the logged torque as the applied one, which it is, but the
+rounding then enters both the input and the output. Its effect on the simulated position is
+the loop's stiffness over sigma_0 (small for a loop softer than the bristles); the check by
+simulation is open-loop and does not measure it, and no closed-loop creep has been measured.
+
 The encoder. Rounding to ``Delta`` (2 pi / counts per revolution) is comparable to the
 deflection ``max |u - c| / sigma_0`` on a geared joint (2^17 counts/rev: 4.8e-5 rad against
 5e-5 rad at 1 N m and sigma_0 = 2e4 N m/rad): a log whose position spans fewer than
