@@ -156,3 +156,13 @@ def test_sweeps_give_the_sliding_part_and_sigma_2_is_subtracted(tmp_path):
         "p_x",
         "p_y",
     }
+
+
+@pytest.mark.slow  # the fixture's fit (see above)
+def test_no_torque_is_predicted_from_a_presliding_model(creep_fit, tmp_path):
+    """The report's torque along a log needs J and the gravity: refused, not made up."""
+    from fricid.identify.trajectory_check import predict_trajectory
+
+    fitted, _ = creep_fit
+    with pytest.raises(DataError, match=r"pre-sliding route .* no torque along a log"):
+        predict_trajectory(fitted, _creep(tmp_path, "slow_stribeck", 2**20, 4, seconds=2.0))
