@@ -114,21 +114,8 @@ PROFILE_POINTS = 4
 CHI2_95 = 3.841
 
 #: Searched parameters, in order (sigma_1: the damping with sigma_2 folded in).
-NAMES = ("sigma_0", "sigma_1", "load_ratio", "torque_offset", "inertia", "stribeck_speed")
-NAMES = (*NAMES, "gravity_stiffness")
-_LOG = np.array([True, True, False, False, True, True, False])
-
-#: The Stribeck curve's shape at pre-sliding speeds (a nuisance): ``tau_c`` this share of the
-#: level at rest, ``delta`` 1, so ``g(v) ~ g_0 (1 - |v| / (2 w_s))`` for ``|v| << w_s``; the
-#: searched ``w_s`` sets the slope (large: a constant level).
-TAU_C_SHARE = 0.5
-
-#: The gravity's stiffness at rest (``p_x sin q + p_y cos q``, a nuisance acting on the joint's
-#: creep, not on the bristles) is searched within this share of sigma_0 either way.
-GRAVITY_SHARE = 0.1
-
-#: The box of that ``w_s`` in multiples of the log's largest creep speed.
-STRIBECK_BOX = (0.3, 1e4)
+NAMES = ("sigma_0", "sigma_1", "load_ratio", "torque_offset", "inertia")
+_LOG = np.array([True, True, False, False, True])
 
 #: The damping's search box as the lag ``sigma_1 / sigma_0`` it makes, in sample periods (at
 #: the start's sigma_0): from far below what any log resolves to far above a creep's lag.
@@ -149,16 +136,15 @@ def _positions(U: np.ndarray, w: np.ndarray, dt: float, n_sub: int) -> np.ndarra
     """Simulated positions ``(k, n)`` of candidates ``U (k, 5)`` (search coordinates) under
     the torque ``w`` (before the offset), from rest at the force balance."""
     U = np.atleast_2d(U)
-    s0, d, J, w_s = 10.0 ** U[:, 0], 10.0 ** U[:, 1], 10.0 ** U[:, 4], 10.0 ** U[:, 5]
+    s0, d, J = 10.0 ** U[:, 0], 10.0 ** U[:, 1], 10.0 ** U[:, 4]
     rho, c = U[:, 2], U[:, 3]
     load = np.max(np.abs(w[None, :] - c[:, None]), axis=1)
     g0 = load / np.maximum(rho, 1e-9)
-    ones = np.ones(len(U))
-    theta = np.column_stack([s0, d, 0.0 * ones, TAU_C_SHARE * g0, g0, w_s, ones])
+    theta = np.column_stack([s0, d, np.zeros(len(U)), g0, g0, np.ones(len(U)), np.ones(len(U))])
     # the offset as a constant "gravity" p_x cos q, q within micro-radians of 0 (cos q = 1
     # to 1e-9): every candidate in one batch under the same torque
     sim = lugre.simulate_joint(
-        theta, J, -c, U[:, 6], dt, w, q0=0.0, v0=0.0, z0=(w[0] - c) / s0, n_sub=n_sub
+        theta, J, -c, 0.0, dt, w, q0=0.0, v0=0.0, z0=(w[0] - c) / s0, n_sub=n_sub
     )
     return np.atleast_2d(sim["position"])
 
@@ -242,10 +228,10 @@ def presliding_route(
     y = low(q)[keep] / scale
 
     def full(P):
-        """Residuals of ``P (k, 8)``: the searched seven and the position offset."""
+        """Residuals of ``P (k, 6)``: the searched five and the position offset."""
         P = np.atleast_2d(P)
-        sim = _positions(P[:, :7], w, dt, n_sub)
-        return y[None, :] - low(sim)[:, keep] / scale - P[:, 7:8] / scale
+        sim = _positions(P[:, :5], w, dt, n_sub)
+        return y[None, :] - low(sim)[:, keep] / scale - P[:, 5:6] / scale
 
     def projected(U):
         R = y[None, :] - low(_positions(U, w, dt, n_sub))[:, keep] / scale
@@ -260,7 +246,6 @@ def presliding_route(
             file=source,
         )
     s0 = 1.0 / slope
-    creep = max(float(np.max(np.abs(np.gradient(low(q), dt)))), 1e-12)
     slowest = max(RESONANCE_BOX[0], RESONANCE_OVER_CUTOFF * 2.0 * math.pi * filt.cutoff * dt)
     box = np.array(
         [
@@ -269,18 +254,14 @@ def presliding_route(
             (0.0, 0.99),
             (float(w.min()), float(w.max())),
             tuple(math.log10(s0 * (dt / r) ** 2) for r in (RESONANCE_BOX[1], slowest)),
-            tuple(math.log10(creep * r) for r in STRIBECK_BOX),
-            (-GRAVITY_SHARE * s0, GRAVITY_SHARE * s0),
         ]
     )
     search = ResidualProblem(projected, box, NAMES, y)
     if start is None:
         grid = [
-            [math.log10(s0), math.log10(s0 * dt * f), 0.3, float(np.median(w)), jl, vl, kg]
+            [math.log10(s0), math.log10(s0 * dt * f), 0.3, float(np.median(w)), jl]
             for f in (0.1, 1.0)
             for jl in (math.log10(s0 * (dt / r) ** 2) for r in (0.3, 1.0, 3.0))
-            for vl in (box[5, 1], box[5, 0] + 1.0)
-            for kg in (0.0,)
         ]
         grid = np.clip(np.array(grid), box[:, 0], box[:, 1])
         x0 = grid[int(np.argmin(search.evaluate(grid)))]
@@ -385,13 +366,11 @@ def _at_inertia(jl, u_hat, projected, full, offset_at, labels, box, y, method) -
         U = np.atleast_2d(U)
         return np.column_stack([U[:, :4], np.full(len(U), jl), U[:, 4:]])
 
-    free = [0, 1, 2, 3, 5, 6]  # all but J
-    names = [NAMES[i] for i in free]
-    sub = ResidualProblem(lambda U: projected(with_j(U)), box[free], names, y)
-    result = _run(sub, method, np.clip(u_hat[free], *box[free].T), 0, None, 1, noise_ftol(sub))
+    sub = ResidualProblem(lambda U: projected(with_j(U)), box[:4], NAMES[:4], y)
+    result = _run(sub, method, np.clip(u_hat[:4], *box[:4].T), 0, None, 1, noise_ftol(sub))
     u4 = np.asarray(result.x, dtype=float)
     p = np.concatenate([u4, [offset_at(with_j(u4)[0])]])
-    keep = [*free, 7]
+    keep = [0, 1, 2, 3, 5]
     _, _, _, lo, hi = _intervals(lambda P: full(with_j(P)), p, labels, box[keep])
     return {
         "sigma_0": 10.0 ** u4[0],
@@ -439,8 +418,8 @@ def bias_check(
 
     t0 = time.perf_counter()
     dt, w = series.dt, info["w"]
-    U = np.where(_LOG, np.log10(np.maximum(stage.values[:7], 1e-300)), stage.values[:7])
-    sim = _positions(U, w, dt, CHECK_SUB_STEPS)[0] + stage.values[7]
+    U = np.where(_LOG, np.log10(np.maximum(stage.values[:5], 1e-300)), stage.values[:5])
+    sim = _positions(U, w, dt, CHECK_SUB_STEPS)[0] + stage.values[5]
     if not np.isfinite(sim).all():
         return {"skipped": "the simulation at the estimate diverged"}
     rng = np.random.default_rng([int(seed), 17])
