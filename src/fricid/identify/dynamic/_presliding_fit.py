@@ -204,7 +204,7 @@ def _why(info: dict[str, Any], v_slide: float) -> dict[str, str]:
         "value); value 0",
         "tau_c": f"{never}; value: the bristles' level seen at rest",
         "tau_s": f"{never}; the level at rest ({info['bristle_level']:.4g} N m) sets only the "
-        "creep rate and may lie below tau_s; value: that level",
+        "creep rate and is tau_s only if the creep is slower than w_s; value: that level",
         "w_s": f"{never}; value: the model's default",
         "delta": f"{never}; value: the model's default",
         "inertia": "a creep excites nothing near the bristle resonance sqrt(sigma_0 / J); "
