@@ -168,7 +168,8 @@ def fit_command(
         typer.Option(
             "--route",
             help="--trajectory, lugre: filtered (every parameter by the parallel-filtered "
-            "equation error), two_stage or joint (simulation error).",
+            "equation error), two_stage or joint (simulation error), presliding (sigma_0 and "
+            "sigma_1 from a log that never slides; taken by default for such a log).",
         ),
     ] = "filtered",
     reader_option: Annotated[

@@ -45,9 +45,13 @@ def trajectory_text(fitted) -> str:
         "[[Trajectory]]",
         f"    route: {info.get('route')} (static part from {info.get('static_from')}); "
         f"{info.get('seconds', float('nan')):.2f} s",
-        f"    derivatives: {d.get('method')} of the {d.get('source')}, "
-        + ", ".join(f"{k} {v}" for k, v in d.items() if k not in ("method", "source")),
     ]
+    if d:
+        lines.append(
+            f"    derivatives: {d.get('method')} of the {d.get('source')}, "
+            + ", ".join(f"{k} {v}" for k, v in d.items() if k not in ("method", "source"))
+        )
+    lines.extend(_presliding_lines(info.get("presliding")))
     pf = info.get("parallel_filter")
     if pf:
         lines.append(
@@ -78,6 +82,28 @@ def trajectory_text(fitted) -> str:
     if p:
         lines.append(f"    passivity: {_passivity(p)}")
     return "\n".join(lines)
+
+
+def _presliding_lines(record: dict | None) -> list[str]:
+    """The pre-sliding route's record: what the log determines and why not the rest, the
+    encoder's resolution of the deflection, the timing the damping rests on, J's union."""
+    if not record:
+        return []
+    out = [f"    determined: {', '.join(record['determined'])}"]
+    out += [f"    not determined: {n}: {why}" for n, why in record["not_determined"].items()]
+    counts = record.get("deflection_counts")
+    resolved = f" = {counts:.3g} counts" if counts is not None else ""
+    out.append(
+        f"    largest bristle deflection {record['deflection']:.3g} rad{resolved} "
+        f"(resolved from {record['resolved_from_counts']:g} counts); bristles' level at rest "
+        f"{record['bristle_level']:.4g} N m"
+    )
+    out.append(f"    timing: {record['timing']}")
+    kept = [r for r in record.get("inertia_profile", []) if r["accepted"]]
+    if kept:
+        js = ", ".join(f"{r['inertia']:.3g}" for r in kept)
+        out.append(f"    intervals: union over J = {js} kg m^2 (the J the log does not reject)")
+    return out
 
 
 def _measurement_lines(info: dict) -> list[str]:

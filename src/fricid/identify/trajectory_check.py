@@ -154,6 +154,14 @@ def _joint(fitted: FittedModel, source: str | None) -> tuple[float, float, float
             "joint inertia and gravity): a log needs a model from `fricid fit --trajectory`",
             file=source,
         )
+    if fitted.provenance["trajectory"].get("route") == "presliding":
+        raise DataError(
+            "the model was identified by the pre-sliding route (a log that never slides), "
+            "which does not determine J, p_x, p_y or the sliding friction: no torque along a "
+            "log can be predicted from it (what it determines is in its parameter records and "
+            "provenance['trajectory']['presliding'])",
+            file=source,
+        )
     joint = fitted.provenance["trajectory"]["joint"]
 
     def value(name: str) -> float:

@@ -213,7 +213,7 @@ def _deciding(fits: list[tuple[str, Any]], rename: dict[str, str]) -> list[bool]
 #: The stages whose every evaluation simulates the joint over the whole log: their polish stops
 #: once a step gains under a tenth of what the certificate resolves
 #: (:func:`fricid.identify.static.convergence.certify`'s ``noise_tolerance``).
-SIMULATED_STAGES = ("filtered", "output_error")
+SIMULATED_STAGES = ("filtered", "output_error", "presliding")
 
 
 def converged(

@@ -39,6 +39,11 @@ Routes, recorded in the result's provenance (``provenance["trajectory"]``):
     ``tests/identify/dynamic/test_trajectory.py``); residuals the simulated minus the measured
     position and
     velocity, each channel scaled by its RMS at the start.
+``presliding`` (LuGre, a log that never slides; taken by the default when fewer than
+    :data:`MIN_SLIDING` samples slide)
+    sigma_0 and the pre-sliding damping (sigma_1 + sigma_2) by the output error of the joint
+    simulated under the logged torque below break-away, the other parameters reported not
+    determined, with the reasons (:mod:`._presliding`, :mod:`._presliding_fit`).
 
 Which, and why. ``route="filtered"`` by default: it is the standard of robot identification
 (IDIM) and, measured below, it determines every parameter, with intervals three to nine
@@ -172,6 +177,7 @@ from ._outcome import (
 )
 from ._output import needs_output_error
 from ._output import output_error as _output_error
+from ._presliding_fit import fit_presliding
 from ._rate import rate_bias as _rate_bias
 from ._result import build_result
 from ._routes import JOINT_PARAMS, _regression
@@ -186,8 +192,13 @@ __all__ = [
     "fit_trajectory",
 ]
 
-#: Routes of :func:`fit_trajectory` (the first is LuGre's default).
-ROUTES = ("filtered", "two_stage", "joint", "regression")
+#: Routes of :func:`fit_trajectory` (the first is LuGre's default; LuGre's ``presliding``
+#: is taken by the default too when the log never slides).
+ROUTES = ("filtered", "two_stage", "joint", "regression", "presliding")
+
+#: Fewest sliding samples (``|v| >= v_slide``, away from the stretches below it) for the
+#: routes that identify the sliding friction; below it LuGre takes the pre-sliding route.
+MIN_SLIDING = 50
 
 #: Settings of the output-error step (``output_error=``).
 OUTPUT_ERROR = ("auto", "on", "off")
@@ -353,7 +364,35 @@ def fit_trajectory(
     )
     mask = ~dilate(np.abs(vf) < v_slide, half, max(half, round(guard * rate)))
     mask[:half], mask[mask.size - half :] = False, False  # the filter's edges: extrapolated
-    if mask.sum() < 50:
+    slides = mask.sum() >= MIN_SLIDING
+    if key == "lugre" and route in ("filtered", "two_stage", "presliding") and not slides:
+        if progress is not None:
+            progress(1, 2, "pre-sliding route: sigma_0, sigma_1 (the log never slides)")
+        fitted = fit_presliding(  # a log that never slides: sigma_0, sigma_1 only (its notes)
+            log,
+            series,
+            encoder,
+            method=method,
+            seed=seed,
+            max_evals=max_evals,
+            cluster_time=cluster_time,
+            n_sub=n_sub,
+            parallel=parallel,
+            static=static,
+            v_slide=v_slide,
+            gravity=gravity,
+            t_start=t_start,
+        )
+        if progress is not None:
+            progress(2, 2, "done")
+        return fitted
+    if route == "presliding" and slides:
+        raise DataError(
+            f"{int(mask.sum())} samples slide faster than {v_slide:g} rad/s: the pre-sliding "
+            "route is for logs that never slide (route filtered or two_stage for this one)",
+            file=log.source,
+        )
+    if not slides:
         raise DataError(
             f"only {int(mask.sum())} samples slide faster than {v_slide:g} rad/s: too few for "
             "the static friction",
