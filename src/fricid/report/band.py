@@ -12,7 +12,7 @@ from ..errors import ConfigError
 from ..fitted import FittedModel
 from ..samples import FrictionSamples
 from .document import Figure
-from .plots import _DIRECTION, velocity_grid
+from .plots import plot_measured, speed_sides
 from .style import COLORS, new_figure, png, styled, torque_scale, velocity_scale
 
 __all__ = ["prediction_band", "prediction_band_figure"]
@@ -35,20 +35,7 @@ def prediction_band(
     with styled():
         fig, axes = new_figure(1, 1, width=7.5, height=4.4)
         ax = axes[0, 0]
-        for k, d in enumerate((1, -1)):
-            sel = np.sign(samples.velocity) == d
-            if not sel.any():
-                continue
-            label, marker, dash = _DIRECTION[d]
-            v = samples.velocity[sel]
-            grid = velocity_grid(v, log=True)
-            X = np.column_stack(
-                [
-                    grid,
-                    np.full_like(grid, np.median(samples.load)),
-                    np.full_like(grid, np.median(samples.temperature)),
-                ]
-            )
+        for k, d, sel, (label, _, dash), grid, X in speed_sides(samples):
             F, low, high = (d * np.asarray(a, dtype=float) * tf for a in interval(X))
             speed = np.abs(grid) * vf
             ax.fill_between(
@@ -61,16 +48,7 @@ def prediction_band(
                 label=f"{level:.0%} interval, {label}",
             )
             ax.plot(speed, F, dash, color=COLORS[k], label=f"model, {label}")
-            ax.plot(
-                np.abs(v) * vf,
-                np.abs(samples.friction[sel]) * tf,
-                marker,
-                color=COLORS[k],
-                ms=4.5,
-                alpha=0.7,
-                mfc=COLORS[k] if d > 0 else "white",
-                label=f"measured, {label}",
-            )
+            plot_measured(ax, samples, sel, k, d, vf, tf)
         ax.set_xscale("log")
         ax.set_xlabel(f"speed |velocity| [{vunit}], log scale")
         ax.set_ylabel(f"|friction torque| [{tunit}]")

@@ -212,6 +212,37 @@ def friction_curves(
         return png(fig)
 
 
+def speed_sides(samples: FrictionSamples):
+    """Per direction with samples: ``(k, d, sel, (label, marker, dash), grid, X)``, ``k`` its
+    colour index, ``d`` its sign, ``sel`` its rows, ``grid`` a log speed grid [rad/s] over
+    them and ``X`` the grid at the median load and temperature."""
+    for k, d in enumerate((1, -1)):
+        sel = np.sign(samples.velocity) == d
+        if not sel.any():
+            continue
+        grid = velocity_grid(samples.velocity[sel], log=True)
+        at = (np.median(samples.load), np.median(samples.temperature))
+        X = np.column_stack([grid, np.full_like(grid, at[0]), np.full_like(grid, at[1])])
+        yield k, d, sel, _DIRECTION[d], grid, X
+
+
+def plot_measured(
+    ax: Axes, samples: FrictionSamples, sel: np.ndarray, k: int, d: int, vf: float, tf: float
+) -> None:
+    """The measured |friction| of rows ``sel`` (direction ``d``, colour ``k``) against speed."""
+    label, marker, _ = _DIRECTION[d]
+    ax.plot(
+        np.abs(samples.velocity[sel]) * vf,
+        np.abs(samples.friction[sel]) * tf,
+        marker,
+        color=COLORS[k],
+        ms=4.5,
+        alpha=0.6,
+        mfc=COLORS[k] if d > 0 else "white",
+        label=f"measured, {label}",
+    )
+
+
 def stribeck_region(
     samples: FrictionSamples,
     predict: Predict,
@@ -230,30 +261,8 @@ def stribeck_region(
     with styled():
         fig, axes = new_figure(1, 1, width=7.5, height=4.4)
         ax = axes[0, 0]
-        for k, d in enumerate((1, -1)):
-            sel = np.sign(samples.velocity) == d
-            if not sel.any():
-                continue
-            label, marker, dash = _DIRECTION[d]
-            v = samples.velocity[sel]
-            ax.plot(
-                np.abs(v) * vf,
-                np.abs(samples.friction[sel]) * tf,
-                marker,
-                color=COLORS[k],
-                ms=4.5,
-                alpha=0.6,
-                mfc=COLORS[k] if d > 0 else "white",
-                label=f"measured, {label}",
-            )
-            grid = velocity_grid(v, log=True)
-            X = np.column_stack(
-                [
-                    grid,
-                    np.full_like(grid, np.median(samples.load)),
-                    np.full_like(grid, np.median(samples.temperature)),
-                ]
-            )
+        for k, d, sel, (label, _, dash), grid, X in speed_sides(samples):
+            plot_measured(ax, samples, sel, k, d, vf, tf)
             ax.plot(
                 np.abs(grid) * vf,
                 d * predict(X) * tf,
