@@ -226,3 +226,48 @@ def test_no_interval_inside_a_gap_between_measured_speeds(tmp_path):
     got = CliRunner().invoke(app, args)
     assert got.exit_code == 0, got.output
     assert "nan,nan" in got.stdout and "no prediction interval at 1 of 2 points" in got.stderr
+
+
+LEVELS = (0.5, 0.8, 0.89, 0.9, 0.91, 0.94, 0.95, 0.96, 0.99)
+
+
+@pytest.mark.parametrize("name", ["coulomb_viscous", "gp"])
+def test_a_higher_level_never_gives_a_narrower_interval(name):
+    """Levels between and beyond the calibrated 0.9 and 0.95 follow them (the reference
+    quantile times the calibrated ratio): at 0.94 the normal quantile alone was twice the
+    calibrated 0.95's on the lead screw."""
+    model = _fit(_samples(6), name)
+    X = _grid()[::80]
+    half = np.array([model.predict_interval(X, q, warn=False).half_width for q in LEVELS])
+    assert np.all(np.diff(half, axis=0) >= -1e-12)
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    st.lists(st.tuples(st.floats(0.05, 0.995), st.floats(0.01, 5.0)), min_size=1, max_size=4),
+    st.lists(st.floats(0.01, 0.999), min_size=2, max_size=6),
+)
+def test_nested_multipliers_grow_with_the_level(calibrated, asked):
+    from fricid.fitted._interval import _norm_ppf, nested_multiplier
+
+    levels, scale = (list(c) for c in zip(*calibrated, strict=True))
+    asked = sorted(asked)
+    k = [nested_multiplier(levels, scale, q, lambda q: _norm_ppf(0.5 + q / 2)) for q in asked]
+    assert np.all(np.diff(k) >= -1e-9)
+
+
+def test_predict_says_when_the_model_rests_on_undetermined_parameters(tmp_path):
+    from dataclasses import replace
+
+    from typer.testing import CliRunner
+
+    from fricid.cli import app
+
+    model = _fit(_samples(7), "stribeck")
+    loose = replace(model.parameters["w_s"], not_determined=True)
+    path = replace(model, parameters={**model.parameters, "w_s": loose}).save(tmp_path / "m.json")
+    got = CliRunner().invoke(app, ["predict", str(path), "--velocity", "0.1"])
+    assert got.exit_code == 0, got.output
+    assert "do not determine w_s" in got.stderr
+    clean = CliRunner().invoke(app, ["predict", str(model.save(tmp_path / "c.json")), "-v", "0.1"])
+    assert "do not determine" not in clean.stderr

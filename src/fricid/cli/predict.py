@@ -87,8 +87,9 @@ def predict_command(
             help="Also write the prediction interval at this level (e.g. 0.95): columns "
             "'low' and 'high', where a new measured sample falls with that probability; "
             "its width follows the fit's held-out errors near the point (levels 0.9 and "
-            "0.95 calibrated, others normal). nan inside a gap between measured speeds, "
-            "where nothing measured backs one."
+            "0.95 calibrated, others follow them); nan at rest (the friction is whatever "
+            "holds the joint) and inside a gap between measured speeds (nothing measured "
+            "backs one)."
         ),
     ] = None,
     digits: Annotated[
@@ -151,6 +152,16 @@ def predict_command(
             raise ConfigError("give the points: --velocity (repeatable), or --input FILE")
         X = points_matrix(fitted, si["velocity"], si["load"], si["temperature"])
     zone_si = float(to_si(zone, velocity_unit or "rad/s", "velocity"))
+    loose = [n for n, p in fitted.parameters.items() if p.not_determined and not p.fixed]
+    if loose and fitted.kind != "rbf":  # as export refuses them: said, not hidden
+        err_console.print(
+            f"warning: the model's data do not determine {', '.join(loose)}: the friction "
+            "predicted rests on values no measurement backs wherever they matter (the model "
+            "file's notes say why)",
+            markup=False,
+            highlight=False,
+            soft_wrap=True,
+        )
     for bad in fitted.range_check(X):  # one line each on stderr (issue 11, defect 8)
         err_console.print(
             f"warning: {bad.message} ({bad.count} of {len(X)} points)",
@@ -165,15 +176,22 @@ def predict_command(
         if interval is not None:  # its half-width around the friction written
             half = fitted.predict_interval(X, interval, warn=False).half_width
             extra = {"low": friction - half, "high": friction + half}
-            if np.isnan(half).any():
-                err_console.print(
-                    f"note: no prediction interval at {int(np.isnan(half).sum())} of "
-                    f"{len(X)} points: they lie in a gap between measured speeds (above), "
-                    "where nothing measured backs one",
-                    markup=False,
-                    highlight=False,
-                    soft_wrap=True,
-                )
+            rest = X[:, 0] == 0
+            why = {
+                "at rest, where the friction is whatever holds the joint, up to break-away": rest,
+                "in a gap between measured speeds (above), where nothing measured backs one": (
+                    np.isnan(half) & ~rest
+                ),
+            }
+            for reason, where in why.items():
+                if where.any():
+                    err_console.print(
+                        f"note: no prediction interval at {int(where.sum())} of {len(X)} "
+                        f"points: {reason}",
+                        markup=False,
+                        highlight=False,
+                        soft_wrap=True,
+                    )
     units["friction"] = friction_unit
     if digits is None and out is None and sys.stdout.isatty():
         digits = DISPLAY_DIGITS

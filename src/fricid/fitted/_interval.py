@@ -81,7 +81,8 @@ class PredictionInterval:
     Attributes
     ----------
     friction, low, high : ndarray (n,)
-        The prediction [N m] and the interval's ends [N m]; NaN ends inside a gap between
+        The prediction [N m] and the interval's ends [N m]; NaN ends at rest (``v = 0``: the
+        friction is whatever holds the joint, up to break-away) and inside a gap between
         measured speeds (module notes).
     level : float
         The nominal coverage (0.95: 95 % of new samples inside).
@@ -154,13 +155,36 @@ def _local_half_width(
     v = local_variance(local, X)
     v = np.maximum(np.where(np.isfinite(v), v, noise**2), noise**2)
     var = v + np.maximum(extra, 0.0)
-    k = _norm_ppf(0.5 + level / 2)
     levels = [float(x) for x in local.get("levels") or ()]
-    scale = list(local.get("scale") or ())
-    hits = [j for j, lv in enumerate(levels) if abs(lv - level) < 1e-9 and j < len(scale)]
-    if hits:
-        k = min(float(scale[hits[0]]), k)
+    scale = [float(x) for x in local.get("scale") or ()]
+    k = nested_multiplier(levels, scale, level, lambda q: _norm_ppf(0.5 + q / 2))
     return k * np.sqrt(var)
+
+
+def nested_multiplier(levels: list[float], scale: list[float], level: float, base) -> float:
+    """The multiplier at ``level`` from those calibrated at ``levels`` (``scale``), so that
+    a higher level never gives a narrower interval: at a calibrated level its own; below or
+    above them the reference quantile ``base(level)`` (normal, or Student-t) times the
+    calibrated multiplier's ratio to it at the nearest; between two, linear in the reference
+    quantile; ``base(level)`` without a calibration. The calibrated multipliers are taken
+    non-decreasing in level."""
+    pairs = sorted((lv, k) for lv, k in zip(levels, scale, strict=False) if 0 < lv < 1)
+    if not pairs:
+        return float(base(level))
+    at = np.array([p[0] for p in pairs])
+    ks = np.maximum.accumulate(np.array([max(p[1], 0.0) for p in pairs]))
+    hit = np.flatnonzero(np.abs(at - level) < 1e-9)
+    if hit.size:
+        return float(ks[hit[0]])
+    ref = np.array([base(lv) for lv in at])
+    b = float(base(level))
+    if level < at[0]:
+        return b * float(ks[0] / ref[0])
+    if level > at[-1]:
+        return b * float(ks[-1] / ref[-1])
+    j = int(np.searchsorted(at, level))  # at[j - 1] < level < at[j]: linear in the reference
+    t = (b - ref[j - 1]) / (ref[j] - ref[j - 1])
+    return float(ks[j - 1] + t * (ks[j] - ks[j - 1]))
 
 
 def check_local(local: Mapping[str, Any]) -> None:
@@ -206,20 +230,23 @@ def _delta_multiplier(record: Mapping[str, Any], level: float, known: bool = Fal
     calibration stored with the fit (``scale``) where stored at that level, else the
     Student-t quantile with the fit's residual degrees of freedom; the normal quantile in
     place of the Student-t one where the measured scatter sets the noise (``known``)."""
+    dof = max(int(record["dof"]), 1)
+
+    def base(q: float) -> float:
+        return _norm_ppf(0.5 + q / 2) if known else _t_ppf(0.5 + q / 2, dof)
+
     cal = record.get("scale")
-    if isinstance(cal, Mapping):
-        levels = [float(x) for x in cal.get("levels") or ()]
-        scale = list(cal.get("scale") or ())
-        student = list(cal.get("student_t") or ())
-        hits = [j for j, lv in enumerate(levels) if abs(lv - level) < 1e-9]
-        if hits and hits[0] < len(scale):
-            j = hits[0]
-            if known and j < len(student) and student[j]:
-                return _norm_ppf(0.5 + level / 2)
-            return max(float(scale[j]), 0.0)
-    if known:
-        return _norm_ppf(0.5 + level / 2)
-    return _t_ppf(0.5 + level / 2, max(int(record["dof"]), 1))
+    if not isinstance(cal, Mapping):
+        return base(level)
+    levels = [float(x) for x in cal.get("levels") or ()]
+    scale = [float(x) for x in cal.get("scale") or ()]
+    student = list(cal.get("student_t") or ())
+    # a Student-t fall-back stored where the measured scatter sets the noise: the normal one
+    scale = [
+        base(lv) if known and j < len(student) and student[j] else k
+        for j, (lv, k) in enumerate(zip(levels, scale, strict=False))
+    ]
+    return nested_multiplier(levels[: len(scale)], scale, level, base)
 
 
 def _gp_scale(st: Mapping[str, Any], level: float) -> tuple[float, float]:
@@ -325,7 +352,8 @@ def prediction_interval(fitted, X, level: float = 0.95) -> PredictionInterval:
             )
         F = fitted.predict(X, warn=False)
         half, method = analytic_half_width(fitted.model, fitted.theta(), record, X, level), "delta"
-    half = np.where(X[:, 0] == 0, 0.0, half)  # sign(0) = 0: no friction predicted at rest
-    # nothing measured inside a gap between measured speeds backs an interval there
-    half = np.where(in_gap(X[:, 0], (fitted.provenance or {}).get("speeds")), np.nan, half)
+    # at rest the friction is whatever holds the joint, up to break-away: no interval; nor
+    # inside a gap between measured speeds, where nothing measured backs one
+    rest = X[:, 0] == 0
+    half = np.where(rest | in_gap(X[:, 0], (fitted.provenance or {}).get("speeds")), np.nan, half)
     return PredictionInterval(F, F - half, F + half, level, method)

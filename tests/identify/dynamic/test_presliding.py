@@ -102,6 +102,9 @@ def test_a_deflection_of_about_one_count_is_flagged_and_sigma_1_not_claimed(tmp_
     s0 = fitted.parameters["sigma_0"]
     assert s0.ci95[0] <= lt.TRUTHS["geared"].sigma0 <= s0.ci95[1]
     assert fitted.parameters["sigma_1"].not_determined  # a lag of 0.17 ms under one count
+    # and the record, the printout and the warning say so too, not "determines sigma_1"
+    assert record["determined"] == ["sigma_0"] and "sigma_1" in record["not_determined"]
+    assert not record["not_determined"]["sigma_1"].startswith("not determined")
 
 
 def test_a_log_that_slides_is_refused_by_the_presliding_route(tmp_path):

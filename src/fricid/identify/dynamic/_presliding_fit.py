@@ -133,7 +133,12 @@ def fit_presliding(
         if n in why:
             parameters[n] = replace(parameters[n], note=notes[n], not_determined=True)
     y, resid = info["y"], info["residual"]
-    record = _record(stage, info, check, damping, encoder, why, series, filt, static)
+    lost = {
+        n: notes[n].removeprefix("not determined: ")
+        for n in ("sigma_0", "sigma_1")
+        if notes.get(n, "").startswith("not determined")
+    }
+    record = _record(stage, info, check, damping, encoder, {**lost, **why}, series, filt, static)
     fitted = FittedModel(
         model="lugre",
         parameters=parameters,
@@ -184,7 +189,7 @@ def fit_presliding(
             "estimator": {
                 "name": "pre-sliding output error (the joint simulated under the logged "
                 "torque, the position residual low-passed on both sides)",
-                "bias": _bias_text(check),
+                "bias": _bias_text(check, record["determined"]),
             },
             "presliding": record,
         },
@@ -237,7 +242,8 @@ def _record(stage, info, check, damping, encoder, why, series, filt, static) -> 
     """``provenance["trajectory"]["presliding"]``: what is determined and why, the nuisance
     estimates, the encoder's resolution, the timing the damping rests on, the check."""
     v = dict(zip(stage.names, stage.values, strict=True))
-    determined = ["sigma_0", "sigma_1"] + (list(_STRIBECK) if static is not None else [])
+    determined = [n for n in ("sigma_0", "sigma_1") if n not in why]  # an interval at the box
+    determined += list(_STRIBECK) if static is not None else []
     skip = () if static is None else tuple(_STRIBECK)
     lag = v["sigma_1"] / v["sigma_0"]
     return {
@@ -277,15 +283,19 @@ def _record(stage, info, check, damping, encoder, why, series, filt, static) -> 
     }
 
 
-def _bias_text(check: dict[str, Any]) -> str:
+def _bias_text(check: dict[str, Any], determined: list[str]) -> str:
+    """The bias check in a line: each determined parameter's estimate simulated again at
+    the estimate, its relative move and whether its interval was kept or widened."""
     if "skipped" in check:
         return f"not checked ({check['skipped']})"
     rows = check["parameters"]
     parts = [
-        f"{n} {100 * rows[n]['relative']:+.2g} % ({rows[n].get('verdict', 'kept')})"
+        f"{n} {100 * rows[n]['relative']:+.2g} % (interval {rows[n].get('verdict', 'kept')})"
         for n in ("sigma_0", "sigma_1")
-        if n in rows
+        if n in rows and n in determined
     ]
+    if not parts:
+        return "nothing determined to check"
     return "simulated at the estimate with the log's torque noise and encoder: " + ", ".join(parts)
 
 
