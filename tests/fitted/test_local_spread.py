@@ -271,3 +271,11 @@ def test_predict_says_when_the_model_rests_on_undetermined_parameters(tmp_path):
     assert "do not determine w_s" in got.stderr
     clean = CliRunner().invoke(app, ["predict", str(model.save(tmp_path / "c.json")), "-v", "0.1"])
     assert "do not determine" not in clean.stderr
+
+
+def test_a_trajectory_model_says_why_it_has_no_interval():
+    model = FittedModel.from_values(
+        "coulomb_viscous", {"f_c": 1.0, "beta": 0.1}, provenance={"trajectory": {"route": "x"}}
+    )
+    with pytest.raises(ConfigError, match="identified from a trajectory"):
+        model.predict_interval(_grid()[:3], 0.95, warn=False)

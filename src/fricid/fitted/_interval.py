@@ -346,6 +346,12 @@ def prediction_interval(fitted, X, level: float = 0.95) -> PredictionInterval:
             half = _with_backbone(fitted.state, X, half, level)
     else:
         if not isinstance(record, Mapping) or record.get("method") != "delta":
+            if (fitted.provenance or {}).get("trajectory"):
+                raise ConfigError(
+                    f"model '{fitted.model}' was identified from a trajectory: its torque "
+                    "is predicted along a motion (fricid report), and it gives no prediction "
+                    "interval of steady friction"
+                )
             raise ConfigError(
                 f"model '{fitted.model}' stores no prediction interval (fit it again with "
                 "this fricid to get one)"
