@@ -224,3 +224,17 @@ def test_get_model_names_cover_asym():
     # the per-direction variant of every family is exported through the same templates
     for family in PARAMS:
         assert get_model(f"{family}_asym").is_asymmetric
+
+
+def test_linear_smoothing_keeps_the_sign_of_a_per_direction_model():
+    """One chord from F(-zone) to F(+zone) crossed zero off the origin where the two
+    directions' levels differ: friction of the wrong sign at slow speeds (found by a new
+    user on the lead screw's stribeck_asym). Two lines through the origin never do."""
+    fitted = make_fitted("stribeck", True)
+    zone = 0.01
+    v = np.r_[-np.geomspace(1e-6, zone, 30)[::-1], 0.0, np.geomspace(1e-6, zone, 30)]
+    X = np.column_stack([v, np.zeros_like(v), np.full_like(v, 25.0)])
+    edges = fitted.predict(np.array([[zone, 0.0, 25.0], [-zone, 0.0, 25.0]]))
+    assert abs(edges[0]) != pytest.approx(abs(edges[1]), rel=1e-3)  # asymmetric levels
+    lin = smooth_predict(fitted, X, Smoothing("linear", zone))
+    assert np.all(np.sign(lin) == np.sign(v))

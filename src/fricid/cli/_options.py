@@ -91,8 +91,8 @@ SmoothKind = Annotated[
         "--smooth",
         help=(
             "Smoothing near zero velocity: none (the model as identified), tanh (sign(v) -> "
-            "tanh(v/zone), analytic models), linear (straight line between the model's values "
-            "at -zone and +zone, every model)."
+            "tanh(v/zone), analytic models), linear (straight lines from 0 at rest to the "
+            "model's values at -zone and +zone, every model)."
         ),
     ),
 ]

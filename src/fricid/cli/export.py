@@ -36,8 +36,8 @@ def export_command(
         typer.Option(
             help=(
                 "C only. Smoothing near zero velocity: none (the model as identified), tanh "
-                "(sign(v) -> tanh(v/zone), analytic models), linear (straight line between the "
-                "model's values at -zone and +zone, every model)."
+                "(sign(v) -> tanh(v/zone), analytic models), linear (straight lines from 0 at "
+                "rest to the model's values at -zone and +zone, every model)."
             )
         ),
     ] = "none",

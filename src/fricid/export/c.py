@@ -333,9 +333,8 @@ def _linear_zone(zone: float) -> str:
     z = fmt_float(zone, "zone")
     return (
         f"    if (fabs(velocity) < {z}) {{\n"
-        f"        const double fp = model({z}, load, temperature);\n"
-        f"        const double fm = model(-{z}, load, temperature);\n"
-        f"        return fm + (fp - fm) * (velocity + {z}) / (2.0 * {z});\n"
+        f"        const double edge = model(velocity >= 0.0 ? {z} : -{z}, load, temperature);\n"
+        f"        return edge * fabs(velocity) / {z};\n"
         "    }\n"
     )
 

@@ -20,9 +20,13 @@ Two smoothings are offered, each with a zone half-width ``zone`` [rad/s]; the C 
     :mod:`fricid.models.rbf`), smoothed as ``tanh(v / zone) g(|v|, load, T)``; only a network
     stored on signed velocity (symmetry ``"signed"``) has no sign term and refuses tanh.
 ``linear``
-    Inside ``|v| < zone`` the friction follows the straight line between the model's values at
-    ``-zone`` and ``+zone`` (at the same load and temperature); outside, the model is exact.
-    Works for every model, the RBF network included.
+    Inside ``|v| < zone`` the friction follows the straight line from 0 at rest to the model's
+    value at the zone's edge on the side of ``v`` (``+zone`` or ``-zone``, at the same load and
+    temperature); outside, the model is exact. For a model that is odd in ``v`` this is the
+    line between the values at ``-zone`` and ``+zone``; for a per-direction model, whose two
+    levels differ, that one chord crossed zero off the origin and gave friction of the wrong
+    sign at slow speeds, these two lines never do. Works for every model, the RBF network
+    included.
 
 This is model mathematics (DESIGN.md: ``models/`` owns "smoothing of sign(v) at zero"), so it
 imports only numpy, :mod:`fricid.errors` and the models; a fitted model is used through the
@@ -72,7 +76,8 @@ class FittedLike(Protocol):
 SMOOTHINGS: dict[str, str] = {
     "none": "the model as identified (sign(0) = 0)",
     "tanh": "sign(v) replaced by tanh(v / zone); viscous term unchanged",
-    "linear": "straight line between the model's values at -zone and +zone (every model)",
+    "linear": "straight lines from 0 at rest to the model's values at -zone and +zone "
+    "(every model)",
 }
 
 #: For each analytic model family, the name of its linear viscous coefficient ``c`` in
@@ -126,8 +131,8 @@ class Smoothing:
         if self.kind == "tanh":
             return f"tanh: sign(v) -> tanh(v / {self.zone:g} rad/s), viscous term unchanged"
         return (
-            f"linear: |v| < {self.zone:g} rad/s follows the line between the model's values "
-            f"at -{self.zone:g} and +{self.zone:g} rad/s"
+            f"linear: |v| < {self.zone:g} rad/s follows the line from 0 at rest to the "
+            f"model's value at +{self.zone:g} or -{self.zone:g} rad/s, on the side of v"
         )
 
 
@@ -217,14 +222,10 @@ def _linear(predict: Callable[[np.ndarray], np.ndarray], X: np.ndarray, zone: fl
     inside = np.abs(v) < zone
     if not inside.any():
         return exact
-    Xp = X[inside].copy()
-    Xm = X[inside].copy()
-    Xp[:, 0] = zone
-    Xm[:, 0] = -zone
-    fp = predict(Xp)
-    fm = predict(Xm)
+    edge = X[inside].copy()
+    edge[:, 0] = np.where(v[inside] >= 0, zone, -zone)  # the zone's edge on v's side
     out = exact.copy()
-    out[inside] = fm + (fp - fm) * (v[inside] + zone) / (2.0 * zone)
+    out[inside] = predict(edge) * np.abs(v[inside]) / zone
     return out
 
 
