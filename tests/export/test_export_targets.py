@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import re
+import warnings
 import xml.etree.ElementTree as ET
 
 import numpy as np
@@ -24,6 +25,8 @@ from fricid.export import (
     urdf_text,
 )
 from fricid.fitted import SCHEMA_VERSION, FittedModel, OptimizerRecord
+from fricid.identify import fit
+from fricid.samples import FrictionSamples
 
 runner = CliRunner()
 
@@ -310,3 +313,27 @@ def test_rbf_network_projects_and_predicts(tmp_path):
     # the network is sign(v) g(|v|) (issue 11, defect 1), so tanh smoothing applies to it
     assert res.exit_code == 0, res.output
     assert (tmp_path / "c" / "fricid_friction.c").exists()
+
+
+def test_learned_models_ask_only_for_the_inputs_they_use(tmp_path):
+    """A GP or hybrid whose processes or networks dropped load and temperature (constant in
+    the data) predicts without --load and --temperature, at the values they were measured
+    at; before, it demanded both and then ignored them."""
+    rng = np.random.default_rng(0)
+    s = np.geomspace(0.05, 3.0, 12)
+    v = np.r_[s, -s]
+    samples = FrictionSamples(
+        velocity=v,
+        load=np.full(v.size, 2.0),
+        temperature=np.full(v.size, 40.0),
+        friction=np.sign(v) * (0.5 + 0.2 * np.abs(v)) + 0.01 * rng.standard_normal(v.size),
+    )
+    for name in ("gp", "hybrid"):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            path = fit(samples, name).save(tmp_path / f"{name}.json")
+        res = run("predict", path, "--velocity", "0.5", "--interval", "0.95")
+        assert res.exit_code == 0, res.output
+        row = res.stdout.splitlines()[1].split(",")
+        assert (float(row[1]), float(row[2])) == (2.0, 40.0)  # as measured, no range warning
+        assert "outside the identified range" not in res.stderr

@@ -14,6 +14,7 @@ import io
 import os
 from collections.abc import Mapping
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -22,6 +23,7 @@ from ..fitted import FittedModel
 from ..io._columns import split_label
 from ..io._csv import read_numeric, read_preamble
 from ..io._parquet import open_parquet, read_columns, schema_meta
+from ..models import get_model
 from ..units import SI_UNITS, UNITS, from_si, to_si
 
 __all__ = ["INPUT_QUANTITY", "model_inputs", "points_matrix", "points_table", "read_points"]
@@ -34,14 +36,56 @@ INPUT_QUANTITY: dict[str, str] = {
 }
 
 
+def _leaves(state: Any) -> list[dict]:
+    """The networks or processes of a learned model's state that name their own inputs (a
+    direction's, a hybrid's residual's), not the containers of two of them."""
+    out, todo = [], [state]
+    while todo:
+        node = todo.pop()
+        if not isinstance(node, dict):
+            continue
+        kids = [node.get(k) for k in ("pos", "neg", "residual") if isinstance(node.get(k), dict)]
+        if kids:
+            todo.extend(kids)
+        elif isinstance(node.get("inputs"), list | tuple):
+            out.append(node)
+    return out
+
+
 def model_inputs(fitted: FittedModel) -> tuple[str, ...]:
-    """The inputs the model uses (the RBF network: those its state names, else all three)."""
-    if fitted.kind == "rbf":
-        names = (fitted.state or {}).get("inputs")
-        if isinstance(names, list | tuple) and all(n in INPUT_QUANTITY for n in names):
-            return tuple(names)
-        return tuple(INPUT_QUANTITY)
-    return tuple(fitted.friction_model().inputs)
+    """The inputs the model uses: a learned model's networks' or processes' own (an input
+    each dropped for not varying is not used; a hybrid's backbone's added), else those its
+    state names, else all three; an analytic model's ``inputs``."""
+    if fitted.kind != "rbf":
+        return tuple(fitted.friction_model().inputs)
+    state = fitted.state or {}
+    leaves = _leaves(state)
+    names: set[str] = set()
+    for leaf in leaves:
+        names.update(str(n) for n in leaf["inputs"])
+    backbone = state.get("backbone") if isinstance(state, dict) else None
+    if isinstance(backbone, dict) and isinstance(backbone.get("model"), str):
+        try:
+            names.update(get_model(backbone["model"]).inputs)
+        except ConfigError:
+            names.update(INPUT_QUANTITY)
+    if leaves and names <= set(INPUT_QUANTITY):
+        return tuple(n for n in INPUT_QUANTITY if n in names)
+    top = state.get("inputs") if isinstance(state, dict) else None
+    if isinstance(top, list | tuple) and all(n in INPUT_QUANTITY for n in top):
+        return tuple(top)
+    return tuple(INPUT_QUANTITY)
+
+
+def _dropped_value(fitted: FittedModel, name: str) -> float | None:
+    """The value at which every network or process that dropped ``name`` saw it constant,
+    when they agree (the point the model was identified at), else None."""
+    seen = {
+        float(leaf["dropped_inputs"][name])
+        for leaf in _leaves(fitted.state or {})
+        if isinstance(leaf.get("dropped_inputs"), dict) and name in leaf["dropped_inputs"]
+    }
+    return seen.pop() if len(seen) == 1 else None
 
 
 def _unit_of(name: str, label: str, given: str | None, path: Path, meta_units) -> str:
@@ -140,8 +184,8 @@ def points_matrix(
 ) -> np.ndarray:
     """Model inputs ``(n, 3)`` from SI values (arrays that broadcast, or None).
 
-    An input the model uses must be given; one it ignores defaults to 0 N m (load) or
-    25 degC (temperature).
+    An input the model uses must be given; one it ignores defaults to the constant value a
+    learned model dropped it at, else 0 N m (load) or 25 degC (temperature).
 
     Raises
     ------
@@ -158,7 +202,8 @@ def points_matrix(
                     f"model '{fitted.model}' depends on {name}; give --{name} (or a {name} "
                     "column in the input file)"
                 )
-            values[name] = defaults[name]
+            dropped = _dropped_value(fitted, name) if fitted.kind == "rbf" else None
+            values[name] = defaults[name] if dropped is None else dropped
     try:
         v, lo, t = np.broadcast_arrays(
             *(np.atleast_1d(np.asarray(values[k], dtype=float)) for k in INPUT_QUANTITY)
