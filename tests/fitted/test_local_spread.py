@@ -193,8 +193,8 @@ def test_the_report_draws_the_band_where_the_file_has_an_interval():
         doc = model_report(m, samples, trust=assess_trust(m, samples))
         return [f.name for f in doc.figures()]
 
-    assert "prediction_band" in keys(model)
-    assert "prediction_band" not in keys(replace(model, prediction_interval=None))
+    assert "prediction_interval" in keys(model)
+    assert "prediction_interval" not in keys(replace(model, prediction_interval=None))
 
 
 def test_no_interval_inside_a_gap_between_measured_speeds(tmp_path):

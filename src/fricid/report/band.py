@@ -78,7 +78,7 @@ def prediction_band_figure(
         else "the fit's residuals"
     )
     return Figure(
-        "prediction_band",
+        "prediction_interval",
         "Where a new measurement falls: the 95 % prediction interval",
         prediction_band(moving, interval, velocity_unit=velocity_unit),
         caption="The band holds 95 % of new measured samples at each speed (noise "
