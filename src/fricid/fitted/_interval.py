@@ -274,6 +274,19 @@ def _gp_half_width(state: Mapping[str, Any], std: np.ndarray, X: np.ndarray, lev
     return half
 
 
+def _backbone_gcg(state: Mapping[str, Any], X: np.ndarray):
+    """A hybrid backbone's ``g^T C g`` [N^2 m^2] at ``X`` and its delta record, or None
+    without a record."""
+    bb = state.get("backbone") if isinstance(state, Mapping) else None
+    record = bb.get("prediction_interval") if isinstance(bb, Mapping) else None
+    if not isinstance(record, Mapping) or record.get("method") != "delta":
+        return None
+    model = get_model(str(bb["model"]))
+    G = gradient(model.name, model.param_vector(dict(bb["params"])), record["free"], X)
+    var = np.einsum("pn,pq,qn->n", G, np.asarray(record["covariance"], dtype=float), G)
+    return np.maximum(var, 0.0), record
+
+
 def _backbone_variance(
     state: Mapping[str, Any], X: np.ndarray, local: Mapping[str, Any]
 ) -> np.ndarray | float:
@@ -282,32 +295,24 @@ def _backbone_variance(
     backbone's covariance ``C`` holds its own residual variance ``s^2``, the misfit that the
     network takes up included, and is scaled to the noise of a sample as an analytic fit's
     (:func:`analytic_half_width`); 0 without a backbone record."""
-    bb = state.get("backbone") if isinstance(state, Mapping) else None
-    record = bb.get("prediction_interval") if isinstance(bb, Mapping) else None
-    if not isinstance(record, Mapping) or record.get("method") != "delta":
+    got = _backbone_gcg(state, X)
+    if got is None:
         return 0.0
     check_local(local)
-    model = get_model(str(bb["model"]))
-    G = gradient(model.name, model.param_vector(dict(bb["params"])), record["free"], X)
-    var = np.einsum("pn,pq,qn->n", G, np.asarray(record["covariance"], dtype=float), G)
+    var, record = got
     s = float(record["noise_std"])
-    grow = (float(local["noise"]) / s) ** 2 if s > 0 else 1.0
-    return grow * np.maximum(var, 0.0)
+    return ((float(local["noise"]) / s) ** 2 if s > 0 else 1.0) * var
 
 
 def _with_backbone(state: Mapping[str, Any], X: np.ndarray, half: np.ndarray, level: float):
     """A hybrid's conformal half-width with its backbone's parameter uncertainty added in
     quadrature (:mod:`fricid.identify.learned.hybrid` notes); as it is without a record."""
-    bb = state.get("backbone") if isinstance(state, Mapping) else None
-    record = bb.get("prediction_interval") if isinstance(bb, Mapping) else None
-    if not isinstance(record, Mapping) or record.get("method") != "delta":
+    got = _backbone_gcg(state, X)
+    if got is None:
         return half
-    model = get_model(str(bb["model"]))
-    theta = model.param_vector(dict(bb["params"]))
-    G = gradient(model.name, theta, record["free"], X)
-    var = np.einsum("pn,pq,qn->n", G, np.asarray(record["covariance"], dtype=float), G)
+    var, record = got
     q = _t_ppf(0.5 + level / 2, max(int(record["dof"]), 1))
-    return np.sqrt(half**2 + q**2 * np.maximum(var, 0.0))
+    return np.sqrt(half**2 + q**2 * var)
 
 
 def prediction_interval(fitted, X, level: float = 0.95) -> PredictionInterval:

@@ -73,7 +73,7 @@ from typing import Any
 
 import numpy as np
 
-from ..fitted._interval import gradient
+from ..fitted._interval import _norm_ppf, gradient
 from ..models import get_model
 from ..models._spread import (
     BANDWIDTH_DECADES,
@@ -117,12 +117,6 @@ def _gross(e: np.ndarray) -> np.ndarray:
     return np.zeros(e.size, bool)
 
 
-def _normal_ppf(q: float) -> float:
-    from scipy import stats
-
-    return float(stats.norm.ppf(q))
-
-
 def local_record(
     e: np.ndarray,
     X: np.ndarray,
@@ -162,7 +156,7 @@ def local_record(
     z = np.sort(np.sqrt(e2 / own[point]))
     scale, ranked = [], []
     for level in levels:
-        gauss = _normal_ppf(0.5 + float(level) / 2)
+        gauss = _norm_ppf(0.5 + float(level) / 2)
         rank = (z.size + 1) * float(level) <= z.size
         ranked.append(rank)
         q = float(np.quantile(z, float(level), method="weibull")) if rank else gauss

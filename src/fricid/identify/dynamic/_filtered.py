@@ -138,6 +138,18 @@ class ParallelFilter:
         # a rate read from time stamps is a hair off (999.9999... Hz): round before the floor
         return max(int(np.floor(round(rate / (DECIMATED_RATE * self.cutoff), 6))), 1)
 
+    def lowpass(self, rate: float):
+        """The zero-phase low-pass at sample rate ``rate`` [Hz], along the last axis."""
+        from scipy import signal
+
+        sos = signal.butter(self.order, self.cutoff / (0.5 * rate), output="sos")
+        return lambda x: signal.sosfiltfilt(sos, x, axis=-1)
+
+    def kept(self, rate: float, n: int) -> np.ndarray:
+        """The rows of an ``n``-sample log kept: the trim left out at each end, decimated."""
+        m = round(self.trim * rate)
+        return np.arange(max(m, 1), n - m, self.factor(rate))
+
     def describe(self, rate: float) -> dict[str, Any]:
         """The settings, as recorded in provenance."""
         return {
@@ -216,7 +228,6 @@ def filtered_route(
     y, residual : ndarray
         The filtered torque and the residual at the estimate (decimated samples).
     """
-    from scipy import signal
 
     t0 = time.perf_counter()
     dt, n = series.dt, series.time.size
@@ -225,13 +236,7 @@ def filtered_route(
         raise ConfigError(
             f"parallel filter cut-off {filt.cutoff} Hz is not below Nyquist ({0.5 * rate:g} Hz)"
         )
-    sos = signal.butter(filt.order, filt.cutoff / (0.5 * rate), output="sos")
-
-    def low(x):
-        return signal.sosfiltfilt(sos, x, axis=-1)
-
-    m = round(filt.trim * rate)
-    keep = np.arange(max(m, 1), n - m, filt.factor(rate))
+    low, keep = filt.lowpass(rate), filt.kept(rate, n)
     if keep.size < 30:
         raise DataError(
             f"the log ({n} samples, {n * dt:.3g} s) is too short for the parallel filter: it "

@@ -105,17 +105,14 @@ def output_error(
     Returns the stage (LuGre's seven parameters then J, p_x, p_y as ``stage``'s), the
     filtered measured torque and the residual at the estimate (decimated samples).
     """
-    from scipy import signal
 
     t0 = time.perf_counter()
     dt, n = series.dt, series.time.size
     rate = 1.0 / dt
-    sos = signal.butter(filt.order, filt.cutoff / (0.5 * rate), output="sos")
-    m = round(filt.trim * rate)
-    keep = np.arange(max(m, 1), n - m, filt.factor(rate))
+    low, keep = filt.lowpass(rate), filt.kept(rate, n)
     q, u = series.position, series.torque
     reference = (q, np.gradient(q, dt))
-    y = signal.sosfiltfilt(sos, u)[keep]
+    y = low(u)[keep]
     names = list(stage.names)
     nd = len(names) - 7
     is_log = np.array([nm in LOG_BOX for nm in names])
@@ -150,7 +147,7 @@ def output_error(
         return np.atleast_2d(sim["torque"])
 
     def residuals(U):
-        R = y[None, :] - signal.sosfiltfilt(sos, simulated(U), axis=-1)[:, keep]
+        R = y[None, :] - low(simulated(U))[:, keep]
         return np.where(np.isfinite(R), R, 1e3 * (1.0 + np.abs(y).max()))
 
     box = _box(stage, is_log, start, float(np.max(np.abs(u))))

@@ -189,7 +189,6 @@ def presliding_route(
         Too short for the filter, a position that spans too few counts, or one that does
         not follow the torque.
     """
-    from scipy import signal
 
     t0 = time.perf_counter()
     dt, n = series.dt, series.time.size
@@ -219,13 +218,7 @@ def presliding_route(
             "break-away",
             file=source,
         )
-    sos = signal.butter(filt.order, filt.cutoff / (0.5 * rate), output="sos")
-
-    def low(x):
-        return signal.sosfiltfilt(sos, x, axis=-1)
-
-    m = round(filt.trim * rate)
-    keep = np.arange(max(m, 1), n - m, filt.factor(rate))
+    low, keep = filt.lowpass(rate), filt.kept(rate, n)
     if keep.size < 30:
         raise DataError(
             f"the log ({n * dt:.3g} s) is too short for the pre-sliding route's filter "
