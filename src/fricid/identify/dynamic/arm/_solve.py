@@ -29,9 +29,12 @@ no law of velocity says, and the low-pass spreads a reversal over its neighbours
   falls below :data:`RHO_END`; the effective sample size per joint is ``m_j / (1 + 2 sum_{k
   <= L} rho_k)``; the covariance is the sandwich of Newey and West (1987) with Bartlett
   weights over :data:`LAGS_OVER_L` ``L`` instants (:func:`hac_covariance`), never below the
-  plain estimate. (The cluster-robust sandwich over contiguous blocks that
-  :mod:`._data` uses for one joint needs blocks many times ``L`` long and many of them; a
-  15 s log has too few, and its intervals came out too narrow.)
+  plain estimate. That sandwich alone came out too narrow (the filtered noise stays
+  correlated over several periods of the cut-off): the covariance is the one the filter's
+  own correlation of white noise gives (:mod:`._filter_cov`), each interval widened to the
+  Newey-West one where that is wider. (The cluster-robust sandwich over contiguous blocks
+  that :mod:`._data` uses for one joint needs blocks many times ``L`` long and many of them;
+  a 15 s log has too few, and its intervals came out too narrow.)
 """
 
 from __future__ import annotations
@@ -39,8 +42,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.stats
 
 from ...static.uncertainty import covariance_svd, floored_covariance
+from ._filter_cov import filter_covariance
 from ._friction import DELTA_BOX, W_S_BOX, JointFriction
 from ._signals import ArmSignals
 
@@ -331,10 +336,19 @@ def hac_covariance(J: np.ndarray, res: np.ndarray, times: np.ndarray, lags: int)
     return floored_covariance(cov, np.nan_to_num(np.diag(plain)), determined)
 
 
-def arm_covariance(J: np.ndarray, res: np.ndarray, st: Stack, n: int):
-    """(cov, stderr, dof, L, effective samples) of the weighted problem (module notes)."""
+def arm_covariance(J: np.ndarray, res: np.ndarray, st: Stack, n: int, rho: np.ndarray):
+    """(cov, stderr, t, clusters, L, effective samples) of the weighted problem: the covariance
+    from the filter's correlation (:mod:`._filter_cov`) with the quantile of the normal, each
+    standard error raised where the residuals' own autocorrelation (:func:`hac_covariance`,
+    with Student's quantile over its clusters) gives a wider interval (module notes)."""
     L, n_eff = correlation_length(res, st.row_joint, st.row_time, n)
     lags = LAGS_OVER_L * L
-    cov, se = hac_covariance(J, res, st.row_time, lags)
     T = int(st.row_time.max()) + 1
-    return cov, se, max(T // (lags + 1), 2), L, n_eff
+    clusters = max(T // (lags + 1), 2)
+    _, se_h = hac_covariance(J, res, st.row_time, lags)
+    cov, se = filter_covariance(J, res, st.row_joint, st.row_time, n, rho)
+    z = float(scipy.stats.norm.ppf(0.975))
+    t_h = float(scipy.stats.t.ppf(0.975, clusters - 1))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        scale = np.where(np.isfinite(se) & (se > 0), np.fmax(t_h * se_h / (z * se), 1.0), 1.0)
+    return cov * np.outer(scale, scale), se * scale, z, clusters, L, n_eff
