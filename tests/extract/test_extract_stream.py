@@ -248,8 +248,7 @@ def _segments_joined(chunks, **options):
         if len(chunk) == 0:
             continue
         if carry is not None and chunk.time[0] <= carry.time[-1]:
-            found = sg._steady(carry, 0, len(carry), *opts)
-            if found is not None:
+            for found in sg._steady(carry, 0, len(carry), *opts):
                 out.append(sg._segment(carry, carry_row, *found))
             carry_row += len(carry)
             carry = None
@@ -265,13 +264,11 @@ def _segments_joined(chunks, **options):
             if sign[start] == 0:
                 counts.dropped_samples += int(stop - start)
                 continue
-            found = sg._steady(buf, int(start), int(stop), *opts)
-            if found is not None:
+            for found in sg._steady(buf, int(start), int(stop), *opts):
                 out.append(sg._segment(buf, carry_row, *found))
         carry, carry_row = buf.slice(int(starts[-1]), len(buf)), carry_row + int(starts[-1])
     if carry is not None and len(carry) and abs(carry.velocity[0]) > sg.REST_RESIDUE:
-        found = sg._steady(carry, 0, len(carry), *opts)
-        if found is not None:
+        for found in sg._steady(carry, 0, len(carry), *opts):
             out.append(sg._segment(carry, carry_row, *found))
     elif carry is not None:
         counts.dropped_samples += len(carry)

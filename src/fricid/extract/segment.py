@@ -10,7 +10,17 @@ band; its
 plateau (which drops the acceleration and deceleration ramps), minus ``settle_time`` at each
 end (what is left of a ramp, and the drive settling). Runs whose steady part is shorter than
 ``min_samples`` are dropped: dwells at rest, sign flicker of a noisy velocity near zero,
-aborted moves.
+aborted moves. (Where that median falls between two levels of equal length, so that too few
+samples are within its band, the plateau is the most populated band instead.)
+
+A run may hold several plateaus: a log that steps from one speed to the next without
+stopping (a staircase) is one run of one sign. Beside a run's plateau, the stretches before
+and after it are searched for more (recursively; the most populated velocity band of each),
+and a plateau found there is a *step* when it holds its speed: within the band, the medians of
+its first and last quarters are within :data:`STEP_TREND` of the band of each other, which an
+acceleration ramp crossing the band is not. The steps' runs partition the run (ramps between
+steps count as the neighbouring step's transient). Before, such a log kept one set-point (the
+median of its faster half) and dropped the others as transient.
 
 Logs may arrive in chunks: the last run of a chunk may continue in the next one, so it is
 carried over and finished there. A chunk whose time does not continue the previous one (a new
@@ -47,6 +57,11 @@ __all__ = [
 #: rest is decided later, relative to the log's own velocity scale and encoder step
 #: (:func:`fricid.extract.steady.rest_threshold`).
 REST_RESIDUE = 1e-9
+
+#: A step of a staircase (a plateau beside a run's own, module notes) holds its speed: the
+#: medians of the first and last quarters of its stretch within the velocity band are within
+#: this share of the band of each other (a ramp crossing the band drifts across 3/4 of it).
+STEP_TREND = 0.5
 
 #: A step in time longer than this many median sample periods is a gap in the recording (rows
 #: missing, or logs of separate moves joined) and ends a run like a change of sign does.
@@ -118,6 +133,88 @@ def as_log_stream(logs: RawLog | Iterable[RawLog]) -> Iterator[RawLog]:
         i += 1  # noqa: SIM113 (see above)
 
 
+def _find(
+    log: RawLog,
+    start: int,
+    stop: int,
+    velocity_tolerance: float,
+    settle_time: float,
+    min_samples: int,
+    counts: SegmentCounts | None = None,
+    step: bool = False,
+) -> tuple[int, int, int, int, float, float] | None:
+    """The plateau of ``start:stop`` of ``log``: (a, b, a2, b2, plateau, band fraction), the
+    samples ``a:b`` within the band and ``a2:b2`` its steady part; or None, the reason counted
+    in ``counts`` when given. A ``step`` (a stretch beside a run's plateau, module notes) must
+    also hold its speed: the first and last quarters of its stretch within the band within
+    :data:`STEP_TREND` of the band of each other, which a ramp through the band is not."""
+    if stop - start < min_samples:
+        if counts is not None:
+            counts.dropped_short_run += 1
+            counts.dropped_samples += stop - start
+        return None
+    v = log.velocity[start:stop]
+    # the median of the faster half: a rest (or slow drift) at either end of the run, with the
+    # sign of the move, must not pull the plateau towards zero
+    speed = np.abs(v)
+    if step:  # several levels: the most populated band, not a median between two of them
+        plateau = _densest(v, velocity_tolerance)
+    else:
+        plateau = median(v[speed >= 0.5 * percentile(speed, 99)])
+    inside = np.flatnonzero(np.abs(v - plateau) <= velocity_tolerance * abs(plateau))
+    if inside.size < min_samples and not step:  # a median fallen between two levels
+        plateau = _densest(v, velocity_tolerance)
+        inside = np.flatnonzero(np.abs(v - plateau) <= velocity_tolerance * abs(plateau))
+    if inside.size:
+        # refine: the run's median is pulled towards the ramps; the band's median is not
+        plateau = median(v[inside])
+        inside = np.flatnonzero(np.abs(v - plateau) <= velocity_tolerance * abs(plateau))
+    if plateau == 0.0 or inside.size == 0:
+        if counts is not None:
+            counts.dropped_no_plateau += 1
+            counts.unsteady_samples += stop - start
+        return None
+    a, b = start + int(inside[0]), start + int(inside[-1]) + 1
+    t = log.time[a:b]
+    a2 = a + int(np.searchsorted(t, t[0] + settle_time, side="left"))
+    b2 = a + int(np.searchsorted(t, t[-1] - settle_time, side="right"))
+    if b2 - a2 < min_samples:
+        if counts is not None:
+            counts.dropped_short_steady += 1
+            counts.unsteady_samples += stop - start
+        return None
+    if step:  # the stretch within the band: a ramp crosses it, a step stays
+        within = log.velocity[a:b]
+        q = max(len(within) // 4, 1)
+        drift = abs(median(within[-q:]) - median(within[:q]))
+        if drift > STEP_TREND * velocity_tolerance * abs(plateau):
+            return None
+    v2 = log.velocity[a2:b2]
+    band = float(np.mean(np.abs(v2 - plateau) <= velocity_tolerance * abs(plateau)))
+    return a, b, a2, b2, plateau, band
+
+
+def _densest(v: np.ndarray, velocity_tolerance: float) -> float:
+    """The velocity whose band (``velocity_tolerance`` of it either side) holds the most of
+    ``v`` (one sign)."""
+    x = np.sort(v)
+    width = velocity_tolerance * np.abs(x)
+    count = np.searchsorted(x, x + width, side="right") - np.searchsorted(x, x - width)
+    return float(x[int(np.argmax(count))])
+
+
+def _steps_in(log: RawLog, lo: int, hi: int, *options) -> list[tuple[int, ...]]:
+    """The steps of a staircase in ``lo:hi`` (module notes): (a2, b2, plateau, band, run_lo,
+    run_hi) each, in order; their runs ``run_lo:run_hi`` partition ``lo:hi`` when any."""
+    core = _find(log, lo, hi, *options, step=True)
+    if core is None:
+        return []
+    a, b, a2, b2, plateau, band = core
+    left, right = _steps_in(log, lo, a, *options), _steps_in(log, b, hi, *options)
+    own = (a2, b2, plateau, band, a if left else lo, b if right else hi)
+    return [*left, own, *right]
+
+
 def _steady(
     log: RawLog,
     start: int,
@@ -126,41 +223,23 @@ def _steady(
     settle_time: float,
     min_samples: int,
     counts: SegmentCounts,
-) -> tuple[int, int, float, int, float, float] | None:
-    """Steady part of the run ``start:stop`` of ``log``, or None: (start, stop, plateau, run
-    samples, band fraction, run duration)."""
+) -> list[tuple[int, int, float, int, float, float]]:
+    """The steady parts of the run ``start:stop`` of ``log`` (its plateau, and the steps of a
+    staircase beside it): (start, stop, plateau, run samples, band fraction, run duration)
+    each, the runs they stand for partitioning the run."""
     counts.runs += 1
-    if stop - start < min_samples:
-        counts.dropped_short_run += 1
-        counts.dropped_samples += stop - start
-        return None
-    v = log.velocity[start:stop]
-    # the median of the faster half: a rest (or slow drift) at either end of the run, with the
-    # sign of the move, must not pull the plateau towards zero
-    speed = np.abs(v)
-    plateau = median(v[speed >= 0.5 * percentile(speed, 99)])
-    inside = np.flatnonzero(np.abs(v - plateau) <= velocity_tolerance * abs(plateau))
-    if inside.size:
-        # refine: the run's median is pulled towards the ramps; the band's median is not
-        plateau = median(v[inside])
-        inside = np.flatnonzero(np.abs(v - plateau) <= velocity_tolerance * abs(plateau))
-    if plateau == 0.0 or inside.size == 0:
-        counts.dropped_no_plateau += 1
-        counts.unsteady_samples += stop - start
-        return None
-    a, b = start + int(inside[0]), start + int(inside[-1]) + 1
-    t = log.time[a:b]
-    a2 = a + int(np.searchsorted(t, t[0] + settle_time, side="left"))
-    b2 = a + int(np.searchsorted(t, t[-1] - settle_time, side="right"))
-    if b2 - a2 < min_samples:
-        counts.dropped_short_steady += 1
-        counts.unsteady_samples += stop - start
-        return None
-    counts.kept += 1
-    v2 = log.velocity[a2:b2]
-    band = float(np.mean(np.abs(v2 - plateau) <= velocity_tolerance * abs(plateau)))
-    duration = float(log.time[stop - 1] - log.time[start])
-    return a2, b2, plateau, stop - start, band, duration
+    options = (velocity_tolerance, settle_time, min_samples)
+    core = _find(log, start, stop, *options, counts=counts)
+    if core is None:
+        return []
+    a, b, a2, b2, plateau, band = core
+    left, right = _steps_in(log, start, a, *options), _steps_in(log, b, stop, *options)
+    parts = [*left, (a2, b2, plateau, band, a if left else start, b if right else stop), *right]
+    counts.kept += len(parts)
+    return [
+        (a2, b2, p, hi - lo, band, float(log.time[hi - 1] - log.time[lo]))
+        for a2, b2, p, band, lo, hi in parts
+    ]
 
 
 def iter_segments(
@@ -212,8 +291,7 @@ def iter_segments(
             continue
         if carry is not None and chunk.time[0] <= carry.time[-1]:
             # time restarts: a new file; the open run ends here
-            found = _steady(carry, 0, len(carry), *options)
-            if found is not None:
+            for found in _steady(carry, 0, len(carry), *options):
                 yield _segment(carry, carry_row, *found)
             carry_row += len(carry)
             carry = None
@@ -240,8 +318,7 @@ def iter_segments(
             if (carry_sign if i < in_carry else sign[start - lc]) == 0:
                 counts.dropped_samples += int(stop - start)
                 continue
-            found = _steady(log, int(start) - offset, int(stop) - offset, *options)
-            if found is not None:
+            for found in _steady(log, int(start) - offset, int(stop) - offset, *options):
                 yield _segment(log, carry_row + offset, *found)
         last = int(starts[-1])
         if last < lc:  # the open run goes on through the whole chunk (``head`` holds it)
@@ -253,8 +330,7 @@ def iter_segments(
         carry_row += last
         chunk = head = log = sign = None  # not held while the next chunk is read
     if carry is not None and len(carry) and abs(carry.velocity[0]) > REST_RESIDUE:
-        found = _steady(carry, 0, len(carry), *options)
-        if found is not None:
+        for found in _steady(carry, 0, len(carry), *options):
             yield _segment(carry, carry_row, *found)
     elif carry is not None:
         counts.dropped_samples += len(carry)
