@@ -3,19 +3,21 @@
 Usage::
 
     python benchmarks/bench_robot.py [--seeds 10] [--first 0] [--duration 60] [--rate 1000]
-        [--noise 0.05] [--friction stribeck_asym] [--trajectory FILE] [--truth own]
+        [--noise 0.05] [--friction stribeck_asym] [--trajectory FILE]
+        [--truth own|pd|sim|mujoco]
 
 Per seed: each joint gets its own friction law per direction (``stribeck_asym``: Coulomb,
 static, Stribeck velocity and exponent, viscous drawn independently per joint and direction),
-the arm follows a multi-sine (or the designed trajectory of ``--trajectory``: a CSV with a
-``time`` column and one position column per joint, named as the URDF's joints), its torque is
-the inverse dynamics plus friction plus Gaussian noise (``--noise`` N m at the log's rate), the
-position is quantised to 2^17 counts per revolution. A second trajectory (other phases; for
-``--trajectory`` the same one with new noise) is the held-out log. :func:`fit_arm` identifies
-the whole arm; the table gives per joint the friction parameters' mean relative error and
-their 95 % intervals' coverage (over seeds, per parameter kind), the held-out torque error
-over the estimated noise, and the base inertial parameters' coverage and the seconds of the
-identification.
+the arm follows a multi-sine (or the designed trajectory of ``--trajectory``: ``fricid robot
+design --csv``'s table, or a CSV with a ``time`` column and one position column per joint,
+named as the URDF's joints), its torque is the inverse dynamics plus friction plus Gaussian
+noise (``--noise`` N m at the log's rate), the position is quantised to 2^17 counts per
+revolution. The held-out log follows a second multi-sine (another seed's phases), so that with
+``--trajectory`` the design is identified and a motion it was not designed for is predicted.
+:func:`fit_arm` identifies the whole arm; the table gives per joint the friction parameters'
+mean relative error and their 95 % intervals' coverage (over seeds, per parameter kind), the
+held-out torque error over the estimated noise, and the base inertial parameters' coverage
+and the seconds of the identification.
 
 Truth: ``--truth own`` is the tests' generator (``tests/identify/dynamic/_arm_truth.py``: the
 arm follows the reference exactly, an open-loop measurement); ``--truth pd`` is its
@@ -32,7 +34,11 @@ inertias, about 1000 per second, were not resolved: noiseless, with the true par
 filtered residual of joints 5 to 7 was 0.009-0.037 N m at 0.5 ms, 0.002-0.007 at 0.125 ms
 and 0.001-0.007 at 0.05 ms, seed 100, 12 s); it takes ``stribeck_asym`` laws
 (``coulomb_viscous_asym`` is given to it as a law without a Stribeck rise). The closed-loop
-truths are fitted with ``reversal_window=WINDOW_PERIODS`` (rows near reversals left out).
+and ``--truth mujoco`` the same drive with MuJoCo stepping the exported MJCF
+(``benchmarks/_robot_truth.py``, 0.5 ms, ``implicitfast``): MuJoCo holds a Coulomb-viscous law
+alike in both directions (``frictionloss``, ``damping``: each joint's mean levels of the drawn
+law), which is the truth compared against. The closed-loop truths are fitted with
+``reversal_window=WINDOW_PERIODS`` (rows near reversals left out).
 """
 
 from __future__ import annotations
@@ -44,6 +50,7 @@ from collections import defaultdict
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests" / "identify" / "dynamic"))
@@ -62,16 +69,28 @@ KINDS = ("tau_c", "tau_s", "w_s", "tau_v", "delta", "f_c", "beta")
 
 
 def _trajectory(path: Path, model: RigidBodyModel):
-    data = np.genfromtxt(path, delimiter=",", names=True)
-    names = data.dtype.names or ()
-    missing = [j for j in ("time", *model.joints) if j not in names]
+    """(t, q, dq, ddq) of a trajectory table: fricid's (``fricid robot design --csv``: ``time
+    [s]``, ``<joint>.position [rad]``, velocity, acceleration) or a plain one (``time`` and a
+    position column per joint, differentiated here)."""
+    table = pd.read_csv(path, comment="#")
+    cols = {c.split(" [")[0]: c for c in table.columns}
+    missing = [c for c in ("time", *model.joints) if c not in cols and f"{c}.position" not in cols]
     if missing:
         raise SystemExit(f"{path}: no column(s) {', '.join(missing)}")
-    t = np.asarray(data["time"], dtype=float)
-    q = np.column_stack([data[j] for j in model.joints]).astype(float)
+
+    def column(joint, kind):
+        return table[cols[joint if joint in cols else f"{joint}.{kind}"]].to_numpy(float)
+
+    t = table[cols["time"]].to_numpy(float)
+    q = np.column_stack([column(j, "position") for j in model.joints])
     dt = float(np.median(np.diff(t)))
-    dq = np.gradient(q, dt, axis=0)
-    return t, q, dq, np.gradient(dq, dt, axis=0)
+    if all(f"{j}.acceleration" in cols for j in model.joints):
+        dq = np.column_stack([column(j, "velocity") for j in model.joints])
+        ddq = np.column_stack([column(j, "acceleration") for j in model.joints])
+    else:
+        dq = np.gradient(q, dt, axis=0)
+        ddq = np.gradient(dq, dt, axis=0)
+    return t, q, dq, ddq
 
 
 def _laws(model, seed, friction):
@@ -92,6 +111,20 @@ def _laws(model, seed, friction):
     ]
 
 
+def _mujoco_laws(model, laws):
+    """The law MuJoCo simulates for ``laws`` (``frictionloss`` and ``damping``: each joint's
+    mean Coulomb and viscous levels, both directions alike) as ``coulomb_viscous_asym``."""
+    from _robot_truth import mujoco_friction
+
+    law = mujoco_friction(model, _arm_friction(laws))
+    out = []
+    for j in range(model.n):
+        f_c, beta = float(law.pos["tau_c"][j]), float(law.pos["tau_v"][j])
+        values = {f"{k}{d}": v for d in ("_pos", "_neg") for k, v in (("f_c", f_c), ("beta", beta))}
+        out.append(("coulomb_viscous_asym", values))
+    return out
+
+
 def _direction(values: dict, d: str) -> dict:
     """One direction's law in the simulator's names (Coulomb-viscous: no Stribeck rise)."""
     if "f_c" + d in values:
@@ -110,11 +143,15 @@ def _arm_friction(laws) -> ArmFriction:
 
 
 def _sim_log(model, laws, seed, args, trajectory):
-    if trajectory is None:
-        trajectory = truth.reference(model, args.duration, args.rate, seed)
     t, q, dq, ddq = trajectory
     rate = 1.0 / float(np.median(np.diff(t)))
-    run = run_robot(
+    simulate = run_robot
+    options = {"integrator_step": args.integrator_step}
+    if args.truth == "mujoco":  # MuJoCo on the exported MJCF, at its own 0.5 ms step
+        from _robot_truth import simulate_robot_mujoco as simulate
+
+        options = {}
+    run = simulate(
         model,
         lambda _t: (q, dq, ddq),
         _arm_friction(laws),
@@ -125,24 +162,29 @@ def _sim_log(model, laws, seed, args, trajectory):
         bandwidth=args.bandwidth,
         torque_noise=args.noise,
         seed=seed + 20_000,
-        integrator_step=args.integrator_step,
+        **options,
     )
     return run.log
 
 
 def _logs(model, laws, seed, args, trajectory):
-    if args.truth == "sim":
+    """The identification log and the held-out one: along a second multi-sine (another seed;
+    with ``--trajectory``, the multi-sine of this seed: the design is identified, a motion it
+    was not designed for is predicted)."""
+    first = trajectory or truth.reference(model, args.duration, args.rate, seed)
+    second = truth.reference(model, args.duration, args.rate, seed + 5_000)
+    if args.truth in ("sim", "mujoco"):
         return (
-            _sim_log(model, laws, seed, args, trajectory),
-            _sim_log(model, laws, seed + 5_000, args, trajectory),
+            _sim_log(model, laws, seed, args, first),
+            _sim_log(model, laws, seed + 5_000, args, second),
         )
     kw = {"duration": args.duration, "rate": args.rate, "noise": args.noise}
     make = truth.make_log
     if args.truth == "pd":
         make = truth.make_pd_log
         kw["disturbance"] = args.disturbance
-    one = make(model, laws, seed=seed, trajectory=trajectory, **kw)
-    two = make(model, laws, seed=seed + 5_000, trajectory=trajectory, **kw)
+    one = make(model, laws, seed=seed, trajectory=first, **kw)
+    two = make(model, laws, seed=seed + 5_000, trajectory=second, **kw)
     return one, two
 
 
@@ -158,9 +200,11 @@ def run(args) -> None:
     base_cov, seconds = [], []
     for seed in range(args.first, args.first + args.seeds):
         laws = _laws(model, seed, args.friction)
+        if args.truth == "mujoco":
+            laws = _mujoco_laws(model, laws)
         log, held = _logs(model, laws, seed, args, trajectory)
         start = time.perf_counter()
-        window = WINDOW_PERIODS if args.truth in ("pd", "sim") else 0.0  # closed loop
+        window = WINDOW_PERIODS if args.truth != "own" else 0.0  # closed loop
         fit = fit_arm(log, model, friction=laws[0][0], validate=held, reversal_window=window)
         seconds.append(time.perf_counter() - start)
         for joint, (_, values) in zip(fit.joints, laws, strict=True):
@@ -225,7 +269,7 @@ def main() -> None:
         "--friction", choices=("stribeck_asym", "coulomb_viscous_asym"), default="stribeck_asym"
     )
     parser.add_argument("--trajectory", type=Path, default=None)
-    parser.add_argument("--truth", choices=("own", "pd", "sim"), default="own")
+    parser.add_argument("--truth", choices=("own", "pd", "sim", "mujoco"), default="own")
     parser.add_argument(
         "--disturbance", type=float, default=0.0, help="--truth pd: torque disturbance [N m]"
     )
