@@ -40,11 +40,12 @@ The torque's timing: a drive's logged command is held from one sample to the nex
 acts half a sample period after the positions it is logged with; on a 5 Hz PD-tracked Panda
 that half period left up to 2.5 times the filtered noise in the residual (with the true
 parameters). The delay is estimated by least squares (:func:`_torque_delay`) unless given,
-once more after the Stribeck shapes are found (and the shapes searched again from there):
-with the starting shapes, the misfit at the reversals is steep in time and leaks into the
-delay's column (open-loop truth, tuning seed 50, 30 s, no delay in the data: 0.069 samples
-with the starting shapes, 0.017 after them; the held-out error of joints 1 and 2 fell from
-1.42 and 1.45 times the noise to 1.26 and 1.25).
+once more after the Stribeck shapes are found: with the starting shapes, the misfit at the
+reversals is steep in time and leaks into the delay's column (open-loop truth, tuning seed
+50, 30 s, no delay in the data: 0.069 samples with the starting shapes, 0.017 after them;
+searching the shapes again after that (two more sweeps) moved the held-out errors by 0.02
+or less, and is not done); the held-out error of joints 1 and 2 fell from
+1.42 and 1.45 times the noise to 1.28 and 1.27).
 
 What remains in closed loop (fricid's simulator, ``benchmarks/bench_robot.py --truth sim``:
 a 5 Hz PD on 2^17-count encoders; its torque noise is logged, not fed back, so IDIM-IV's
@@ -345,7 +346,6 @@ def _fit_arm(
         if estimate_delay:  # again, with the shapes found (module notes)
             torque_delay = _torque_delay(undelayed, Yb, frictions, moving)
             sig = undelayed.delayed(torque_delay)
-            search_shapes(sig, Yb, frictions, moving, safe, sweeps=2)
         st = stack(Yb, sig, frictions, moving)
         theta, sigma = wls(st, n)
         safe = np.where(np.isfinite(sigma) & (sigma > 0), sigma, 1.0)
