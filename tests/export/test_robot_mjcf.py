@@ -157,6 +157,31 @@ def test_mujoco_truth_torque_is_inverse_dynamics_plus_friction_within_noise():
     assert np.abs(t.position - t.reference[0]).max() < 0.05
 
 
+def test_a_light_joint_slides_at_its_frictionloss():
+    """The Panda's wrist joint (frictionloss 0.6 N m, a few 1e-3 kg m^2 about its axis)
+    moving alone at 0.3 and 1 rad/s holds its frictionloss in MuJoCo with the exported
+    solreffriction; with MuJoCo's default time constant it held 0.19 and 0.70 of it."""
+    model = arm("panda")
+    fl = 0.6
+    friction = {j: {"f_c": fl, "beta": 0.2} for j in model.joints}
+    text, _ = robot_mjcf_text(model, friction)
+    assert 'solreffriction="0.002 1"' in text
+    m = mujoco.MjModel.from_xml_string(text)
+    d = mujoco.MjData(m)
+
+    def held(v: float) -> float:
+        mujoco.mj_resetData(m, d)
+        d.qpos[:] = 0.5 * (model.lower + model.upper)
+        d.qvel[6] = v
+        mujoco.mj_forward(m, d)
+        return -float(d.qfrc_constraint[6])
+
+    assert held(0.3) == pytest.approx(fl, rel=0.02)
+    assert held(1.0) == pytest.approx(fl, rel=0.02)
+    m.dof_solref[6] = (0.02, 1.0)  # MuJoCo's default
+    assert held(0.3) < 0.5 * fl
+
+
 def test_non_physical_inertia_is_refused():
     model = arm("double_pendulum")
     pi = model.parameters()
