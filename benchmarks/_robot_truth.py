@@ -5,10 +5,13 @@
 viscous levels of the two directions, the Stribeck rise lost), loads it in MuJoCo and runs
 :func:`fricid.sim.robot.run_robot` with MuJoCo as the plant: the same controller at the log's
 rate, the same quantised encoders and torque noise, one ``mj_step`` per internal step with
-the command on each joint's ``<joint>_motor``. The truth record's friction is the law MuJoCo
-holds (:func:`mujoco_friction`: Coulomb-viscous, the same level both ways); MuJoCo applies its
-``frictionloss`` as a soft constraint, exact while a joint slides, creeping while it should
-stick (:data:`fricid.export.mjcf.FRICTIONLOSS_LINES`).
+the command on each joint's ``<joint>_motor``, its ``solreffriction`` kept at two of the
+plant's steps as the export writes it for its own timestep. The truth record's friction is the
+law MuJoCo holds (:func:`mujoco_friction`: Coulomb-viscous, the same level both ways); MuJoCo
+applies its ``frictionloss`` as a soft constraint, at its level once a joint slides faster
+than a speed set by its inertia and the time constant (:mod:`fricid.export.robot_mjcf`: the
+wrist from about 0.03 rad/s at 0.125 ms steps), creeping while it should stick
+(:data:`fricid.export.mjcf.FRICTIONLOSS_LINES`).
 """
 
 from __future__ import annotations
@@ -43,6 +46,8 @@ class MujocoPlant:
         self.substeps = max(1, int(np.ceil(1.0 / (rate * step) - 1e-9)))
         self.step = 1.0 / (rate * self.substeps)
         self.model.opt.timestep = self.step
+        # the export's solreffriction, two timesteps, at this step (fricid.export.robot_mjcf)
+        self.model.dof_solref[:, 0] = 2 * self.step
         self.model.opt.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
         self.data = mujoco.MjData(self.model)
         find = mujoco.mj_name2id
