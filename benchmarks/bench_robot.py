@@ -33,9 +33,10 @@ first order, and at its default 0.5 ms the Stribeck slopes of these laws over th
 inertias, about 1000 per second, were not resolved: noiseless, with the true parameters, the
 filtered residual of joints 5 to 7 was 0.009-0.037 N m at 0.5 ms, 0.002-0.007 at 0.125 ms
 and 0.001-0.007 at 0.05 ms, seed 100, 12 s); it takes ``stribeck_asym`` laws
-(``coulomb_viscous_asym`` is given to it as a law without a Stribeck rise). The closed-loop
-and ``--truth mujoco`` the same drive with MuJoCo stepping the exported MJCF
-(``benchmarks/_robot_truth.py``, 0.5 ms, ``implicitfast``): MuJoCo holds a Coulomb-viscous law
+(``coulomb_viscous_asym`` is given to it as a law without a Stribeck rise); ``--truth
+mujoco`` is the same drive with MuJoCo stepping the exported MJCF
+(``benchmarks/_robot_truth.py``, ``implicitfast`` at ``--integrator-step``, its
+``solreffriction`` at two steps as the export writes it): MuJoCo holds a Coulomb-viscous law
 alike in both directions (``frictionloss``, ``damping``: each joint's mean levels of the drawn
 law), which is the truth compared against. The closed-loop truths are fitted with
 ``reversal_window=WINDOW_PERIODS`` (rows near reversals left out).
@@ -147,10 +148,8 @@ def _sim_log(model, laws, seed, args, trajectory):
     rate = 1.0 / float(np.median(np.diff(t)))
     simulate = run_robot
     options = {"integrator_step": args.integrator_step}
-    if args.truth == "mujoco":  # MuJoCo on the exported MJCF, at its own 0.5 ms step
+    if args.truth == "mujoco":  # MuJoCo on the exported MJCF
         from _robot_truth import simulate_robot_mujoco as simulate
-
-        options = {}
     run = simulate(
         model,
         lambda _t: (q, dq, ddq),
