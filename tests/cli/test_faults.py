@@ -418,6 +418,7 @@ def test_ctrl_c_is_one_line_and_130(data, tmp_path, args, library, delay):
     assert not out.exists() and _marked(tmp_path) == []
 
 
+@pytest.mark.slow  # 1.8 s, quiet machine (default run kept short)
 def test_ctrl_c_while_fitting_is_one_line_and_130(data, tmp_path):
     """Ctrl-C inside the optimiser's run (a hook holds the run until the signal lands, so
     neither a sleep nor the machine's load decides where it lands)."""

@@ -168,6 +168,7 @@ def test_compensate_never_claims_an_improvement_it_did_not_measure():
     assert good.improved and "x smaller" in good.verdict()
 
 
+@pytest.mark.slow  # 2.1 s, quiet machine (default run kept short)
 def test_cli_compensate_says_worse_on_stderr_and_titles_the_plot_so(tmp_path, monkeypatch):
     import fricid.control.plot as plot
 

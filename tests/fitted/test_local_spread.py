@@ -180,6 +180,7 @@ def test_the_spread_is_an_average_of_the_direction_s_errors(points, at):
             assert np.isnan(got[k])
 
 
+@pytest.mark.slow  # 2.1 s, quiet machine (default run kept short)
 def test_the_report_draws_the_band_where_the_file_has_an_interval():
     from dataclasses import replace
 

@@ -102,6 +102,7 @@ def test_report_on_real_leadscrew_per_direction(leadscrew, tmp_path):
     assert "mN m" in text or "N m" in text
 
 
+@pytest.mark.slow  # 1.7 s, quiet machine (default run kept short)
 def test_cli_report(leadscrew, tmp_path):
     fitted = fit(leadscrew, "stribeck_asym")
     model = fitted.save(tmp_path / "m.json")
@@ -187,6 +188,7 @@ def test_render_escapes_and_rejects_bad_items():
         Figure("ok", "x", b"GIF89a")
 
 
+@pytest.mark.slow  # 1.4 s, quiet machine (default run kept short)
 def test_report_for_the_rbf_network_with_bootstrap(paper1_samples, tmp_path):
     from fricid.fitted import FittedModel
     from fricid.identify.learned.rbf import fit_rbf

@@ -194,6 +194,7 @@ def test_what_a_person_sees_legends_units_and_panels(browser, which, request, tm
     assert speed[2] == "log"  # the speeds span three decades: the PNG's log axis
 
 
+@pytest.mark.slow  # 4.9 s with its page's set-up, quiet machine (default run kept short)
 def test_report_in_a_real_browser(browser, report, tmp_path):
     browser.get(report.as_uri())
     # every interactive figure drawn by plotly.js (inlined: the page is offline)

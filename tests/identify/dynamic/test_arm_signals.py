@@ -144,6 +144,7 @@ def test_a_stribeck_shape_the_data_do_not_see_gets_a_wide_profile_region(pendulu
         assert region["w_s"][1] >= 0.05
 
 
+@pytest.mark.slow  # 2.1 s, quiet machine (default run kept short)
 def test_the_regressor_goes_through_the_torques_filter_on_a_closed_loop_arm():
     """A PD-tracked Panda whose joints stop at their reversals (fricid's simulator, no torque
     noise): with the true parameters and the true friction, the regressor filtered as the

@@ -81,6 +81,7 @@ def test_what_a_creep_log_does_not_determine_is_said_and_not_given_an_interval(c
     assert "tau_c:" in report and "CI" not in report.split("tau_c:")[1].splitlines()[0]
 
 
+@pytest.mark.slow  # 2.2 s, quiet machine (default run kept short)
 def test_an_encoder_that_cannot_see_the_bristles_is_refused_with_its_numbers(tmp_path):
     """cdw95's creep (sigma_0 1e5 N m/rad) at 2^17 counts/rev: the position takes two values."""
     log = _creep(tmp_path, "cdw95", 2**17, 0, seconds=20.0)

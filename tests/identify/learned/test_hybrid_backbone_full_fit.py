@@ -10,6 +10,7 @@ from __future__ import annotations
 import warnings
 
 import numpy as np
+import pytest
 
 from fricid.identify import fit
 from fricid.samples import FrictionSamples
@@ -38,6 +39,7 @@ Y = np.array(
 )
 
 
+@pytest.mark.slow  # 1.9 s, quiet machine (default run kept short)
 def test_a_degenerate_lean_optimum_gives_way_to_the_next_backbone():
     samples = FrictionSamples(velocity=X[:, 0], load=X[:, 1], temperature=X[:, 2], friction=Y)
     with warnings.catch_warnings():

@@ -203,6 +203,7 @@ def test_model_without_linear_parameters_and_bad_options_are_refused():
         fit(samples, "stribeck", "varpro", options={"n_starts": 3})
 
 
+@pytest.mark.slow  # 1.4 s, quiet machine (default run kept short)
 def test_cli_lists_and_fits_with_varpro(tmp_path):
     runner = CliRunner()
     res = runner.invoke(app, ["methods"])
