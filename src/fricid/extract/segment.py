@@ -205,14 +205,25 @@ def _densest(v: np.ndarray, velocity_tolerance: float) -> float:
 
 def _steps_in(log: RawLog, lo: int, hi: int, *options) -> list[tuple[int, ...]]:
     """The steps of a staircase in ``lo:hi`` (module notes): (a2, b2, plateau, band, run_lo,
-    run_hi) each, in order; their runs ``run_lo:run_hi`` partition ``lo:hi`` when any."""
-    core = _find(log, lo, hi, *options, step=True)
-    if core is None:
+    run_hi) each, in order; their runs partition ``lo:hi`` when any (the stretch before a step
+    is its own, the stretch after the last the last's), searched with a stack rather than by
+    recursion, so that no log can run into Python's recursion limit."""
+    cores, todo = [], [(lo, hi)]
+    while todo:
+        start, stop = todo.pop()
+        core = _find(log, start, stop, *options, step=True)
+        if core is not None:
+            cores.append(core)
+            todo += [(start, core[0]), (core[1], stop)]
+    if not cores:
         return []
-    a, b, a2, b2, plateau, band = core
-    left, right = _steps_in(log, lo, a, *options), _steps_in(log, b, hi, *options)
-    own = (a2, b2, plateau, band, a if left else lo, b if right else hi)
-    return [*left, own, *right]
+    cores.sort()
+    ends = [b for _, b, *_ in cores[:-1]] + [hi]
+    begins = [lo, *ends[:-1]]
+    return [
+        (a2, b2, plateau, band, begin, end)
+        for (_, _, a2, b2, plateau, band), begin, end in zip(cores, begins, ends, strict=True)
+    ]
 
 
 def _steady(
