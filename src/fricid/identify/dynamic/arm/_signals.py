@@ -152,18 +152,8 @@ class ArmSignals:
         q = self.wide_position
         dq = np.gradient(q, axis=0) * self.rate
         ddq = np.gradient(dq, axis=0) * self.rate
-        Y = np.concatenate(
-            [
-                base.columns(
-                    model.regressor(
-                        q[k : k + REGRESSOR_CHUNK],
-                        dq[k:][:REGRESSOR_CHUNK],
-                        ddq[k:][:REGRESSOR_CHUNK],
-                    )
-                )
-                for k in range(0, q.shape[0], REGRESSOR_CHUNK)
-            ]
-        )
+        chunks = [slice(k, k + REGRESSOR_CHUNK) for k in range(0, q.shape[0], REGRESSOR_CHUNK)]
+        Y = np.concatenate([base.columns(model.regressor(q[c], dq[c], ddq[c])) for c in chunks])
         n, r = Y.shape[1:]
         return self.parallel(Y.reshape(Y.shape[0], n * r)).reshape(-1, n, r)
 
