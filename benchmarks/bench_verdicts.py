@@ -112,6 +112,8 @@ def _tasks(args) -> list[tuple[int, str, int, tuple[str, ...]]]:
             continue
         if args.report_only and is_tuning(seed, args.seed_split):
             continue
+        if args.tuning_only and not is_tuning(seed, args.seed_split):
+            continue
         extra: tuple[str, ...] = ()
         if args.auto_every and cid % args.auto_every == 0:
             extra += ("auto",)
@@ -332,10 +334,11 @@ def summary(rows: list[dict[str, Any]]) -> dict[str, Any]:
     }
 
 
-def report(rows: list[dict[str, Any]], split: int) -> None:
-    """Print every table on the report cases."""
-    rep = [r for r in rows if not is_tuning(r["seed"], split)]
-    print_confusion("Verdict against the true held-out ratio, all models, report cases", rep)
+def report(rows: list[dict[str, Any]], split: int, tuning: bool = False) -> None:
+    """Print every table on the report cases (``tuning``: on the tuning cases)."""
+    rep = [r for r in rows if is_tuning(r["seed"], split) == tuning]
+    which = "tuning" if tuning else "report"
+    print_confusion(f"Verdict against the true held-out ratio, all models, {which} cases", rep)
     for m in sorted({r["model"] for r in rep}):
         print_confusion(f"model {m}", [r for r in rep if r["model"] == m])
     print_classes(rep)
@@ -397,6 +400,9 @@ def parse(argv: list[str] | None = None) -> argparse.Namespace:
     p.add_argument("--json", type=Path, default=None, metavar="PATH")
     p.add_argument("--rows", type=Path, default=None, metavar="PATH", help="JSON lines as fits end")
     p.add_argument("--report-only", action="store_true", help="skip the tuning cases")
+    p.add_argument(
+        "--tuning-only", action="store_true", help="only the tuning cases, tables on them"
+    )
     p.add_argument("--first", type=int, default=0, help="start at this case (resume a run)")
     p.add_argument(
         "--classes",
@@ -416,6 +422,8 @@ def parse(argv: list[str] | None = None) -> argparse.Namespace:
     unknown = [c for c in args.classes if c not in CLASSES]
     if unknown:
         p.error(f"unknown class(es) {', '.join(unknown)}; choose from {', '.join(CLASSES)}")
+    if args.report_only and args.tuning_only:
+        p.error("--report-only and --tuning-only exclude each other")
     if args.quick:
         args.cases, args.auto_every, args.learned_every = 13, 7, 0
     return args
@@ -442,7 +450,7 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
     else:
         rows, seconds = run_all(args)
         print(f"ran in {seconds:.0f} s on {args.jobs} process(es)")
-    report(rows, args.seed_split)
+    report(rows, args.seed_split, args.tuning_only)
     cli_rows: list[dict[str, Any]] = []
     if args.cli_check:
         from _verdict_cli import cli_check

@@ -32,6 +32,7 @@ __all__ = [
     "between_run_excess",
     "downweighted",
     "gravity_caveat",
+    "listed_count",
     "not_determined",
     "open_sides",
     "quality_rows",
@@ -191,7 +192,8 @@ def _point_name(row: dict[str, Any]) -> str:
 def downweighted(
     fitted: FittedModel, samples: FrictionSamples | None
 ) -> tuple[np.ndarray | None, list[str]]:
-    """The samples a robust fit (``--loss soft_l1`` or ``huber``) down-weighted.
+    """The samples a robust fit (``--loss soft_l1`` or ``huber``) down-weighted, or a GP's
+    training left out as gross errors.
 
     Parameters
     ----------
@@ -208,6 +210,8 @@ def downweighted(
         The down-weighted samples by velocity, load and temperature with their residual in
         scales (the first few; then how many more).
     """
+    if fitted.model == "gp" and samples is not None:
+        return _left_out(fitted, samples)
     loss = (fitted.loss or {}).get("loss")
     scale = (fitted.loss or {}).get("f_scale")
     if samples is None or loss not in ("soft_l1", "huber") or not scale or scale <= 0:
@@ -223,20 +227,52 @@ def downweighted(
     if not low.any() or 2 * low.sum() >= low.size:
         return None, []
     rows = np.flatnonzero(low)[np.argsort(-z[low])]
-    names = [_sample_name(samples, int(i), float(z[i])) for i in rows[:_LISTED]]
-    if rows.size > _LISTED:
-        names.append(f"and {rows.size - _LISTED} more")
-    return low, names
+    return low, _listed(
+        [_sample_name(samples, int(i), f"residual {z[i]:.3g}x the loss's scale") for i in rows]
+    )
 
 
-def _sample_name(samples: FrictionSamples, i: int, z: float) -> str:
+def _left_out(fitted: FittedModel, samples: FrictionSamples) -> tuple[np.ndarray | None, list]:
+    """The samples a GP's training left out as gross errors (``state["left_out"]`` of each
+    process, :mod:`fricid.identify.learned.gp`), found in ``samples`` by velocity and
+    friction."""
+    state = fitted.state if isinstance(fitted.state, dict) else {}
+    low = np.zeros(len(samples.velocity), bool)
+    for side in (state, state.get("pos"), state.get("neg")):
+        out = side.get("left_out") if isinstance(side, dict) else None
+        if not isinstance(out, dict):
+            continue
+        for v, f in zip(out.get("velocity") or (), out.get("friction") or (), strict=False):
+            low |= np.isclose(samples.velocity, v, rtol=1e-12, atol=0) & np.isclose(
+                samples.friction, f, rtol=1e-12, atol=0
+            )
+    if not low.any() or 2 * low.sum() >= low.size:
+        return None, []
+    why = "held-out error beyond the gross-error limit"
+    return low, _listed([_sample_name(samples, int(i), why) for i in np.flatnonzero(low)])
+
+
+def _listed(names: list[str]) -> list[str]:
+    """The first :data:`_LISTED` names, then how many more."""
+    more = [f"and {len(names) - _LISTED} more"] if len(names) > _LISTED else []
+    return names[:_LISTED] + more
+
+
+def listed_count(names: list[str]) -> int:
+    """How many samples a list of :func:`downweighted` names stands for."""
+    if names and names[-1].startswith("and ") and names[-1].endswith(" more"):
+        return len(names) - 1 + int(names[-1].split()[1])
+    return len(names)
+
+
+def _sample_name(samples: FrictionSamples, i: int, why: str) -> str:
     """``"row 3: v = -0.0979 rad/s, load 0 N m, 25 degC (residual 12x the loss's scale)"``."""
     parts = [f"v = {samples.velocity[i]:+.4g} rad/s"]
     if np.isfinite(samples.load[i]):
         parts.append(f"load {samples.load[i]:.4g} N m")
     if np.isfinite(samples.temperature[i]):
         parts.append(f"{samples.temperature[i]:.4g} degC")
-    return f"row {i}: {', '.join(parts)} (residual {z:.3g}x the loss's scale)"
+    return f"row {i}: {', '.join(parts)} ({why})"
 
 
 def gravity_caveat(samples: FrictionSamples | None) -> list[str]:

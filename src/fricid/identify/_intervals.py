@@ -88,6 +88,7 @@ __all__ = [
     "GROSS_MIN",
     "INTERVAL_LEVELS",
     "delta_record",
+    "gross_errors",
     "jackknife_scale",
     "local_record",
 ]
@@ -109,8 +110,9 @@ def _t_ppf(q: float, dof: int) -> float:
     return float(stats.t.ppf(q, dof))
 
 
-def _gross(e: np.ndarray) -> np.ndarray:
-    """The gross errors among the scores ``e`` (module notes)."""
+def gross_errors(e: np.ndarray) -> np.ndarray:
+    """The gross errors among the absolute scores ``e``: beyond :data:`GROSS` robust standard
+    deviations (``1.4826 median``), looked for among :data:`GROSS_MIN` scores or more."""
     robust = 1.4826 * float(np.median(e)) if e.size else 0.0
     if robust > 0 and e.size >= GROSS_MIN:
         return e > GROSS * robust
@@ -135,7 +137,7 @@ def local_record(
     if not (np.isfinite(noise) and noise > 0) or ok.sum() < 3:
         return None
     e = e[ok]
-    gross = _gross(e)
+    gross = gross_errors(e)
     keep = ~gross
     Xk, e2 = X[ok][keep], e[keep] ** 2
     spans = input_spans(Xk)
@@ -175,7 +177,7 @@ def jackknife_scale(
     if s <= 0 or ok.sum() < 3:
         return None
     e = np.abs(r[ok]) / np.sqrt(1 - h[ok])
-    gross = _gross(e)
+    gross = gross_errors(e)
     z = np.sort(e[~gross] / s)
     m = z.size
     if m < 3:

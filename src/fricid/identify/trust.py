@@ -69,6 +69,7 @@ from ._diagnostics import (
     downweighted,
     gap_caveat,
     gravity_caveat,
+    listed_count,
     not_determined,
     open_sides,
     quality_rows,
@@ -364,9 +365,11 @@ def assess_trust(
             trust.validation, trust.heldout_source = val, KFOLD_HERE
             _ratio(trust, fitted, judged, inliers=low is not None)
     if low is not None:
+        loss = (fitted.loss or {}).get("loss")
+        how = f"the {loss} loss down-weighted" if loss else "the training took as gross errors"
         trust.validation_note = (
-            f"judged on the {len(judged)} inliers, the {int(low.sum())} sample(s) the "
-            f"{fitted.loss['loss']} loss down-weighted left out; " + trust.validation_note
+            f"judged on the {len(judged)} inliers, the {int(low.sum())} sample(s) {how} "
+            "left out; " + trust.validation_note
         )
     trust.quality, trust.quality_summary, quality_caveat = quality_rows(samples)
     _grade(trust, fitted, [quality_caveat, *gravity_caveat(samples)])
@@ -474,8 +477,9 @@ def _grade(trust: Trust, fitted: FittedModel, sample_caveats: list[str]) -> None
         caveats.append(gaps)
     if trust.downweighted:
         loss = (fitted.loss or {}).get("loss")
+        how = f"the {loss} loss down-weighted" if loss else "the training left out"
         caveats.append(
-            f"the {loss} loss down-weighted {len(trust.downweighted)} sample(s) as outliers "
+            f"{how} {listed_count(trust.downweighted)} sample(s) as outliers "
             f"({'; '.join(trust.downweighted)}), left out of the error graded"
         )
     estimated = trust.scatter_method == SECOND_DIFFERENCES and np.isfinite(ratio)
