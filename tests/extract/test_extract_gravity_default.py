@@ -123,11 +123,14 @@ def test_structured_gravity_residual_is_reported(mode):
 def test_scatter_of_a_whole_traverse_is_about_eq7_not_gravity_range():
     """One bin per traverse: the written std, standard error and the quality table's scatter
     measure the noise about eq. 7 (0.05 N m raw, less after the median filter), not gravity's
-    range along 2.4 rad (about 0.8 N m standard deviation)."""
+    range along 2.4 rad (about 0.8 N m standard deviation: standard errors of 0.02-0.05 N m
+    over these passes). The standard error holds the noise's correlation after the median
+    filter and the gravity fit's own error (0.002-0.005 N m here; 0.0009-0.0013 before, which
+    counted every filtered sample as independent)."""
     r = extract(sweep_log(SPEEDS, seed=1), gravity="joint")
     for s in (r.by_direction, r.samples):
         assert s.std.max() < 0.05
         sem = np.array(s.meta["sem"], dtype=float)
         np.testing.assert_allclose(sem, r.direction_sem if s is r.by_direction else r.sem)
-        assert sem.max() < 0.003
+        assert sem.max() < 0.01
     assert r.quality.scatter[r.quality.setpoints].max() < 0.05

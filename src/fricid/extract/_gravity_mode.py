@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .gravity import GravityFit
+from .gravity import GravityFit, gravity_se
 from .gravity_check import GravityResidual, block_noise, check_joint, check_paired
 from .joint_gravity import JointGravityFit
 
@@ -92,7 +92,8 @@ def std_about_gravity(fit, kept, group) -> dict[int, tuple[float, float]]:
     """N m, each set-point's sample scatter about eq. 7 (and the load-dependent friction of a
     joint fit) instead of about its mean torque, and the standard error of its friction, by
     set-point label: ``(std, sem)``; ``sem`` as :func:`~.bins.pool_cells` defines it (the
-    scatter of the passes' mean residuals, or ``std / sqrt(n)`` for one pass).
+    scatter of the passes' mean residuals, or for one pass its cells' :func:`~.bins.cell_sem`,
+    else ``std / sqrt(n)``).
 
     With one position bin per traverse the torque of a pass sweeps the whole gravity curve;
     its standard deviation about the mean is gravity's range, not noise. The residual
@@ -121,6 +122,33 @@ def std_about_gravity(fit, kept, group) -> dict[int, tuple[float, float]]:
         between = (n[sel] * (mean[sel] - grand) ** 2).sum()
         std = float(np.sqrt((m2[sel].sum() + between) / (total - 1)))
         passes = int(sel.sum())
-        sem = np.sqrt(between / total / (passes - 1)) if passes > 1 else std / np.sqrt(total)
+        if passes > 1:
+            sem = np.sqrt(between / total / (passes - 1))
+        else:
+            sem = _pass_sem(kept[int(np.flatnonzero(sel)[0])].cells, std / np.sqrt(total))
+        cos, sin = _mean_trig([kept[i].cells for i in np.flatnonzero(sel)])
+        sem = np.hypot(sem, gravity_se(fit, cos, sin))  # the removed eq. 7's own error
         out[int(g)] = (std, float(sem))
     return out
+
+
+def _mean_trig(cells: list) -> tuple[float, float]:
+    """The mean ``cos`` and ``sin`` of the position over the samples of these passes."""
+    n = np.concatenate([c.count for c in cells])
+    total = max(float(n.sum()), 1.0)
+    cos, sin = (
+        np.concatenate([np.nan_to_num(getattr(c, k)) for c in cells]) for k in ("cos", "sin")
+    )
+    return float(n @ cos / total), float(n @ sin / total)
+
+
+def _pass_sem(cells, fallback: float) -> float:
+    """The standard error of one pass's mean torque from its cells'
+    (:func:`~.bins.cell_sem`, independent bins), never below ``fallback`` (``std / sqrt(n)``,
+    as :func:`~.bins.pool_cells` takes the larger), which it is when a cell has none."""
+    n = cells.count
+    has = n > 0
+    sem = None if cells.sem is None else cells.sem[has]
+    if sem is None or not has.any() or not np.isfinite(sem).all():
+        return fallback
+    return max(float(np.sqrt(np.sum((n[has] * sem) ** 2)) / n[has].sum()), fallback)

@@ -214,6 +214,7 @@ class Accumulator:
                     "temperature",
                     "cos",
                     "sin",
+                    "sem",
                 )
             },
         )

@@ -15,7 +15,7 @@ import numpy as np
 
 from ..errors import DataError
 
-__all__ = ["GravityFit", "fit_gravity", "separate"]
+__all__ = ["GravityFit", "fit_gravity", "gravity_se", "separate"]
 
 
 def separate(tau_plus, tau_minus) -> tuple[np.ndarray, np.ndarray]:
@@ -27,6 +27,16 @@ def separate(tau_plus, tau_minus) -> tuple[np.ndarray, np.ndarray]:
     tp = np.asarray(tau_plus, dtype=float)
     tm = np.asarray(tau_minus, dtype=float)
     return 0.5 * (tp - tm), -0.5 * (tp + tm)
+
+
+def gravity_se(fit, cos, sin) -> np.ndarray:
+    """N m, the standard error of the fitted gravity torque (eq. 7) averaged over samples
+    whose mean ``cos`` and ``sin`` of the position are given, from the coefficients'
+    standard errors (``fit.p_x_se``, ``fit.p_y_se``; their correlation left out). A row of
+    friction with the fitted gravity removed carries it beside its own noise: it is common to
+    every speed at that position, which no friction law of the speed can follow."""
+    cos, sin = np.asarray(cos, dtype=float), np.asarray(sin, dtype=float)
+    return np.sqrt((cos * float(fit.p_x_se)) ** 2 + (sin * float(fit.p_y_se)) ** 2)
 
 
 @dataclass(frozen=True)

@@ -11,7 +11,7 @@ import numpy as np
 
 from ..errors import DataError
 from ..samples import FrictionSamples
-from .gravity import GravityFit, fit_gravity, separate
+from .gravity import GravityFit, fit_gravity, gravity_se, separate
 from .joint_gravity import JointGravityFit
 
 __all__ = ["SEM_CAVEAT", "SEM_METHOD", "assemble", "missing_message", "sem_meta"]
@@ -20,7 +20,10 @@ __all__ = ["SEM_CAVEAT", "SEM_METHOD", "assemble", "missing_message", "sem_meta"
 SEM_METHOD = "between passes (scatter of the per-pass means)"
 
 #: What that estimate leaves out (``samples.meta["sem_caveat"]``).
-SEM_CAVEAT = "a row measured in a single pass falls back to std/sqrt(count)"
+SEM_CAVEAT = (
+    "a row measured in a single pass: the autocorrelation-corrected error of its own samples "
+    "about their trend in position (offsets between runs are not in it)"
+)
 
 
 def sem_meta(sem: np.ndarray) -> dict:
@@ -124,10 +127,14 @@ def assemble(pooled, shape, t_set, v_set, gravity, source, meta, joint_fit, note
         with np.errstate(invalid="ignore"):
             load = np.nansum(np.where(h, load_dir * c_, 0.0), axis=1) / n_tot
         friction_dir = t_ + load_dir
-        # a row measured in one direction: its friction with the fitted gravity removed
+        e_ = np.sqrt(e_**2 + gravity_se(fit, cos_, sin_) ** 2)
+        # a row measured in one direction: its friction with the fitted gravity removed,
+        # which its standard error holds too
         friction = np.where(
             b2, friction, np.where(h[:, 1], friction_dir[:, 1], -friction_dir[:, 0])
         )
+        with np.errstate(invalid="ignore"):
+            sem_c = np.where(b2, sem_c, np.nanmax(np.where(h, e_, np.nan), axis=1))
     else:
         load = np.zeros_like(position)
         friction_dir = t_
