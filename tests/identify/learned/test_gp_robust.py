@@ -7,6 +7,7 @@ from __future__ import annotations
 import warnings
 
 import numpy as np
+import pytest
 
 from fricid.identify import fit
 from fricid.identify.trust import assess_trust
@@ -50,6 +51,7 @@ def test_the_white_noise_stays_above_the_measured_scatter():
         assert side["noise_std"] >= SIGMA * (1 - 1e-6)
 
 
+@pytest.mark.slow  # the verdict's leave-one-velocity-out refits the GP: 3 s
 def test_gross_errors_are_left_out_recorded_and_named():
     """One sample a direction 15 noise std off among 30: each process trains again without
     it, and follows the law within half the noise (with it: 0.89 noise std)."""
