@@ -95,3 +95,26 @@ def test_joint_sub_steps_converge_and_batches_match():
 def test_joint_reset_needs_measurements():
     with pytest.raises(ConfigError, match="measured"):
         lugre.simulate_joint(THETA, 0.01, 0, 0, 1e-3, np.zeros(5), reset=np.ones(5, bool))
+
+
+@pytest.mark.parametrize("threads", [2, 3])
+def test_rows_in_threads_are_the_rows_of_one_thread_bit_for_bit(monkeypatch, threads):
+    """A batch split over threads (:func:`fricid.models.lugre.in_row_threads`: a Jacobian's
+    columns) gives every row exactly as one thread does, for the joint and the friction
+    averaged over each period."""
+    rng = np.random.default_rng(0)
+    k, n = 5, 400
+    batch = THETA * np.exp(0.2 * rng.standard_normal((k, 7)))
+    t = np.arange(n) * 1e-3
+    tau = 0.9 * np.sin(2 * np.pi * 2 * t)
+    v = 0.3 * np.sin(2 * np.pi * 1.5 * np.arange(4 * (n - 1) + 1) * 2.5e-4)
+    runs = {}
+    for count in (1, threads):
+        monkeypatch.setattr(lugre, "ROW_THREADS", count)
+        joint = lugre.simulate_joint(
+            batch, 0.01, 0.1, 0.05, 1e-3, tau, reference=(t, 0 * t), gains=(5.0, 0.2)
+        )
+        runs[count] = (joint, lugre.mean_friction(batch, v, 1e-3, 4))
+    for key in runs[1][0]:
+        assert np.array_equal(runs[1][0][key], runs[threads][0][key], equal_nan=True)
+    assert np.array_equal(runs[1][1], runs[threads][1])

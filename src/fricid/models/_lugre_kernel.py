@@ -40,7 +40,7 @@ def run(theta, v, dt, z0, F, Z):  # pragma: no cover - compiled
     return 0
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def run_mean(theta, v, h, up, z0, F):  # pragma: no cover - compiled
     """Friction averaged over each sample period, for every row of ``theta``.
 
@@ -129,7 +129,7 @@ def _linear_step(s0, s1, s2, a, inv_j, beta, z, v, h):  # pragma: no cover - com
     return z_eq + nz, v_eq + nv, moved
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def run_joint(
     theta, phys, tau, qref, vref, gains, dt, n_sub, reset, q_meas, v_meas, a_meas, x0, Q, V, Z, F, U
 ):  # pragma: no cover - compiled

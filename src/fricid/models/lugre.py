@@ -53,6 +53,9 @@ consumer (export, ``fricid predict``) needs; the dynamics come from :func:`simul
 
 from __future__ import annotations
 
+import itertools
+import os
+
 import numpy as np
 
 from ..errors import ConfigError
@@ -61,7 +64,9 @@ from ._base import FrictionModel, Parameter, parameter_batch, simulation_inputs
 __all__ = [
     "PARAMETERS",
     "PARAM_NAMES",
+    "ROW_THREADS",
     "LuGre",
+    "in_row_threads",
     "mean_friction",
     "passivity_margin",
     "simulate",
@@ -201,7 +206,7 @@ def mean_friction(theta, v_sub, dt: float, up: int, z0=None) -> np.ndarray:
     F = np.empty((k, (v.size - 1) // up + 1))
     from ._lugre_kernel import run_mean  # lazy: importing numba takes a while
 
-    run_mean(batch, v, float(dt) / up, up, z0, F)
+    in_row_threads(lambda a, b: run_mean(batch[a:b], v, float(dt) / up, up, z0[a:b], F[a:b]), k)
     return F[0] if single else F
 
 
@@ -300,27 +305,52 @@ def simulate_joint(
     out["torque"] = np.empty((k, n))
     from ._lugre_kernel import run_joint  # lazy: importing numba takes a while
 
-    run_joint(
-        batch,
-        phys,
-        tau,
-        qref,
-        vref,
-        np.array([float(gains[0]), float(gains[1])]),
-        dt,
-        int(n_sub),
-        np.ascontiguousarray(flags),
-        qm,
-        vm,
-        am,
-        x0,
-        out["position"],
-        out["velocity"],
-        out["state"],
-        out["friction"],
-        out["torque"],
-    )
+    flags = np.ascontiguousarray(flags)
+    pd = np.array([float(gains[0]), float(gains[1])])
+    names = ("position", "velocity", "state", "friction", "torque")
+
+    def rows(a: int, b: int) -> None:  # rows a..b-1; contiguous slices: written in place
+        run_joint(
+            *(batch[a:b], phys[a:b], tau, qref, vref, pd, dt, int(n_sub), flags, qm, vm, am),
+            x0[a:b],
+            *(out[name][a:b] for name in names),
+        )
+
+    in_row_threads(rows, k)
     return {key: value[0] for key, value in out.items()} if single else out
+
+
+#: Threads of :func:`in_row_threads`; None: one per core the process may use.
+ROW_THREADS: int | None = None
+
+
+def _cores() -> int:
+    if ROW_THREADS is not None:
+        return max(int(ROW_THREADS), 1)
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # not on Linux
+        return os.cpu_count() or 1
+
+
+def in_row_threads(rows, k: int) -> None:
+    """``rows(a, b)`` over ``0..k`` cut into one contiguous block per core, the blocks in
+    threads (the compiled kernel releases the GIL: ``nogil=True``; the rows of a finite-
+    difference Jacobian are independent simulations). Plain Python threads, not numba's
+    ``parallel=True``: its default threading layer (workqueue) is neither thread- nor
+    fork-safe, and fleets run joints in threads and forked processes. The results are the
+    same bit for bit. Measured on 2 cores (``python benchmarks/bench_lugre_threads.py``,
+    ``benchmarks/results/lugre_threads.txt``): see there."""
+    workers = min(k, _cores())
+    if workers < 2:
+        rows(0, k)
+        return
+    from concurrent.futures import ThreadPoolExecutor
+
+    cuts = np.linspace(0, k, workers + 1).round().astype(int)
+    with ThreadPoolExecutor(workers) as pool:
+        for f in [pool.submit(rows, a, b) for a, b in itertools.pairwise(cuts)]:
+            f.result()
 
 
 class LuGre(FrictionModel):
