@@ -21,8 +21,8 @@ where the samples have both, ``g(|v|, load, T)`` with ``F = sign(v) g``:
    where the scatter is only estimated from the data). Without it a sample 15 noise std off
    was followed by a process whose white noise fell to 1e-3 of the scatter, and in a gap the
    posterior that interpolated every sample covered 60 % of new samples (tuning case 264 of
-   ``benchmarks/bench_verdicts.py``, its error 2.4 times the noise; with the floor 93 % and
-   1.44 times; over the 82 tuning cases the median error over the noise fell from 1.68 to
+   ``benchmarks/bench_verdicts.py``, true held-out ratio 2.4; with the floor 93 % and
+   1.44; over the 82 tuning cases the median true ratio fell from 1.68 to
    1.38 in the gaps class, 2.93 to 2.55 with gross outliers);
 4. the posterior, with the mean's coefficients estimated with it (R&W section 2.7: their
    uncertainty widens the band where the model extrapolates; the correction to the
