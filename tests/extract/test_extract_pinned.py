@@ -98,15 +98,16 @@ def _epos(name: str) -> Any:
 #: Every digest once more when a row's standard error took the noise's correlation and the
 #: removed gravity fit's error (:func:`fricid.extract.bins.cell_sem`,
 #: :func:`fricid.extract.gravity.gravity_se`): only ``sem``, ``direction_sem`` and the
-#: ``sem_caveat`` text changed (compared field by field), every friction is the same.
+#: ``sem_method`` and ``sem_caveat`` texts (now saying which method the rows took) changed
+#: (compared field by field), every friction is the same.
 CASES = {
-    "paper1": (lambda: _simulated("paper1"), "d853c0f48c9d9715"),
-    "paper1+faults": (lambda: _simulated("paper1+faults", 7_777), "4b49bb3a1abc16d3"),
-    "paper1 joint": (lambda: _simulated("paper1", gravity="joint"), "3a318cd447ded9bb"),
-    "paper2+faults": (lambda: _simulated("paper2+faults"), "96a45cb974ed2b9a"),
-    "paper1 clipped": (_clipped, "74942e549651880a"),
-    "epos 10.csv": (lambda: _epos("10.csv"), "989cec8e96881421"),
-    "epos n200.csv": (lambda: _epos("n200.csv"), "b6c2a303f289cb40"),
+    "paper1": (lambda: _simulated("paper1"), "378946370d1ca8d2"),
+    "paper1+faults": (lambda: _simulated("paper1+faults", 7_777), "6591218dddd8499e"),
+    "paper1 joint": (lambda: _simulated("paper1", gravity="joint"), "1c29cba681e58821"),
+    "paper2+faults": (lambda: _simulated("paper2+faults"), "3446e3c0c4f54470"),
+    "paper1 clipped": (_clipped, "48c5d3ae57b5feb2"),
+    "epos 10.csv": (lambda: _epos("10.csv"), "bae2753ecf9dca6b"),
+    "epos n200.csv": (lambda: _epos("n200.csv"), "61acd305ad52f130"),
 }
 
 

@@ -39,7 +39,7 @@ def test_the_down_weighted_samples_are_found_by_row_velocity_and_load(robust, sp
     low, names = downweighted(robust, spiked)
     assert np.flatnonzero(low).tolist() == TRIPLED
     for i in TRIPLED:
-        head = f"row {i}: v = {spiked.velocity[i]:+.4g} rad/s, load 0 N m"
+        head = f"sample {i + 1}: v = {spiked.velocity[i]:+.4g} rad/s, load 0 N m"
         assert sum(name.startswith(head) for name in names) == 1
     assert downweighted(fit(spiked, "coulomb_viscous"), spiked) == (None, [])  # least squares
 
@@ -53,6 +53,6 @@ def test_a_robust_fit_is_judged_on_its_inliers_and_names_its_outliers(robust, sp
     assert trust.level != "no" and trust.heldout_ratio < 1.5
     assert "soft_l1 loss down-weighted 2 sample(s)" in text
     for i in TRIPLED:
-        assert f"row {i}: v = {spiked.velocity[i]:+.4g} rad/s" in text
+        assert f"sample {i + 1}: v = {spiked.velocity[i]:+.4g} rad/s" in text
     assert trust.validation_note.startswith("judged on the 18 inliers")
     assert len(trust.downweighted) == 2

@@ -354,6 +354,11 @@ def fit_budget(
     return min(int(max_evals), natural) if scheduled else int(max_evals)
 
 
+#: Models trained without a fricid optimiser method (the GP by scikit-learn's marginal
+#: likelihood); the RBF networks and the hybrid name theirs (``--method``: BAS, GA, ...).
+_OWN_TRAINING = frozenset({"gp"})
+
+
 @contextmanager
 def fit_progress(
     model: str,
@@ -373,7 +378,8 @@ def fit_progress(
     from ..models import STATEFUL
 
     key = model.strip().lower()
-    label = f"fitting {key} ({method})"
+    # the learned models train by their own means: no optimiser method to name
+    label = f"fitting {key}" if key in _OWN_TRAINING else f"fitting {key} ({method})"
     budget = fit_budget(model, method, fixed, max_evals)
     with tracker(label, budget, unit="evaluations", quiet=quiet) as t:
         if key in STATEFUL or key == "auto" or t.mode == "quiet":

@@ -374,7 +374,7 @@ def _scatter_about_gravity(stats, group, samples, by_direction, quality):
     keep = np.isfinite(new[:, 0])
     d_std = np.where(keep, new[:, 0], by_direction.std)
     d_sem = np.where(keep, new[:, 1], np.asarray(by_direction.meta["sem"], dtype=float))
-    by_direction = replace(by_direction, std=d_std, meta={**by_direction.meta, **sem_meta(d_sem)})
+    by_direction = replace(by_direction, std=d_std, meta={**by_direction.meta, "sem": _sem(d_sem)})
     column = quality.scatter.copy()
     rows = np.flatnonzero(quality.setpoints)
     column[rows] = np.where(keep, new[:, 0], column[rows])
@@ -388,5 +388,10 @@ def _scatter_about_gravity(stats, group, samples, by_direction, quality):
     combined = np.sqrt(m2 / np.maximum(total - k, 1))[first]
     sem2 = np.bincount(pair, weights=d_sem**2)[first]
     sem = np.where(k[first] == 2, 0.5 * np.sqrt(sem2), np.sqrt(sem2))
-    samples = replace(samples, std=combined, meta={**samples.meta, **sem_meta(sem)})
+    samples = replace(samples, std=combined, meta={**samples.meta, "sem": _sem(sem)})
     return samples, by_direction, quality
+
+
+def _sem(sem: np.ndarray) -> list[float | None]:
+    """The per-row standard errors as ``meta["sem"]`` holds them (their method unchanged)."""
+    return sem_meta(sem)["sem"]

@@ -14,24 +14,37 @@ from ..samples import FrictionSamples
 from .gravity import GravityFit, fit_gravity, gravity_se, separate
 from .joint_gravity import JointGravityFit
 
-__all__ = ["SEM_CAVEAT", "SEM_METHOD", "assemble", "missing_message", "sem_meta"]
+__all__ = [
+    "SEM_CAVEAT",
+    "SEM_METHOD",
+    "SEM_SINGLE",
+    "assemble",
+    "missing_message",
+    "sem_meta",
+]
 
-#: How the extraction estimates each row's standard error (``samples.meta["sem_method"]``).
+#: How the extraction estimates a row's standard error (``samples.meta["sem_method"]``):
+#: measured in several passes, and in one (:func:`fricid.extract.bins.cell_sem`).
 SEM_METHOD = "between passes (scatter of the per-pass means)"
+SEM_SINGLE = "within one pass (autocorrelation-corrected, about the trend in position)"
 
-#: What that estimate leaves out (``samples.meta["sem_caveat"]``).
-SEM_CAVEAT = (
-    "a row measured in a single pass: the autocorrelation-corrected error of its own samples "
-    "about their trend in position (offsets between runs are not in it)"
-)
+#: What the single-pass estimate leaves out (``samples.meta["sem_caveat"]``).
+SEM_CAVEAT = "offsets between runs are not in a single pass's standard error"
 
 
-def sem_meta(sem: np.ndarray) -> dict:
+def sem_meta(sem: np.ndarray, passes: np.ndarray | None = None) -> dict:
     """The samples' ``meta`` entries of the per-row standard errors [N m] (``sem``, None where
     not finite; ``sem_method``, ``sem_caveat``), which
-    :func:`fricid.identify.validate.measurement_scatter` prefers to its own estimates."""
+    :func:`fricid.identify.validate.measurement_scatter` prefers to its own estimates;
+    ``passes`` (per row, the fewest of its directions) says which method the rows took."""
     values = [float(x) if np.isfinite(x) else None for x in np.asarray(sem, dtype=float)]
-    return {"sem": values, "sem_method": SEM_METHOD, "sem_caveat": SEM_CAVEAT}
+    many = None if passes is None else np.asarray(passes) > 1
+    if many is not None and many.all():
+        return {"sem": values, "sem_method": SEM_METHOD, "sem_caveat": ""}
+    if many is not None and not many.any():
+        return {"sem": values, "sem_method": SEM_SINGLE, "sem_caveat": SEM_CAVEAT}
+    method = f"{SEM_METHOD} where a row has several; {SEM_SINGLE} where one"
+    return {"sem": values, "sem_method": method, "sem_caveat": SEM_CAVEAT}
 
 
 def missing_message(has: np.ndarray, t_set, v_set) -> str:
@@ -68,7 +81,9 @@ def assemble(pooled, shape, t_set, v_set, gravity, source, meta, joint_fit, note
     def grid(x: np.ndarray) -> np.ndarray:
         return x.reshape(nt, nv, 2, nb).transpose(0, 1, 3, 2)  # (t, v, bin, direction)
 
-    count, tau, std, sem = (grid(getattr(pooled, k)) for k in ("count", "torque", "std", "sem"))
+    count, tau, std, sem, passes = (
+        grid(getattr(pooled, k)) for k in ("count", "torque", "std", "sem", "passes")
+    )
     pos, vel, temp, cos, sin = (
         grid(getattr(pooled, k)) for k in ("position", "velocity", "temperature", "cos", "sin")
     )
@@ -100,8 +115,8 @@ def assemble(pooled, shape, t_set, v_set, gravity, source, meta, joint_fit, note
     rows = np.argwhere(any_)  # (t, v, bin), C order = sorted
     sel = tuple(rows.T)
     # per row, columns (backward, forward): count, torque, std, sem, position, velocity, temp
-    c_, t_, s_, e_, p_, v_, T_, cos_, sin_ = (
-        a[sel] for a in (count, tau, std, sem, pos, vel, temp, cos, sin)
+    c_, t_, s_, e_, p_, v_, T_, cos_, sin_, k_ = (
+        a[sel] for a in (count, tau, std, sem, pos, vel, temp, cos, sin, passes)
     )
     h = has[sel]
     b2 = h[:, 0] & h[:, 1]
@@ -146,6 +161,8 @@ def assemble(pooled, shape, t_set, v_set, gravity, source, meta, joint_fit, note
         else (fit.as_meta() if isinstance(fit, JointGravityFit) else vars(fit)),
     }
     by_sem = e_.ravel()[h.ravel()]
+    by_passes = k_.ravel()[h.ravel()]
+    row_passes = np.where(h, k_, np.inf).min(axis=1)
     samples = FrictionSamples(
         velocity=velocity,
         load=load,
@@ -155,7 +172,7 @@ def assemble(pooled, shape, t_set, v_set, gravity, source, meta, joint_fit, note
         count=n_tot,
         std=std_c,
         source=source,
-        meta={**meta, **sem_meta(sem_c)},
+        meta={**meta, **sem_meta(sem_c, row_passes)},
     )
     dsel = h.ravel()  # (row, direction) pairs present, -1 before +1
     sign = np.tile([-1.0, 1.0], len(rows))
@@ -168,6 +185,6 @@ def assemble(pooled, shape, t_set, v_set, gravity, source, meta, joint_fit, note
         count=c_.ravel()[dsel],
         std=s_.ravel()[dsel],
         source=source,
-        meta={**meta, **sem_meta(by_sem)},
+        meta={**meta, **sem_meta(by_sem, by_passes)},
     )
     return samples, by_direction, fit, sem_c, by_sem, position

@@ -248,8 +248,14 @@ def _left_out(fitted: FittedModel, samples: FrictionSamples) -> tuple[np.ndarray
             )
     if not low.any() or 2 * low.sum() >= low.size:
         return None, []
-    why = "held-out error beyond the gross-error limit"
-    return low, _listed([_sample_name(samples, int(i), why) for i in np.flatnonzero(low)])
+    rows = np.flatnonzero(low)
+    off = samples.friction[rows] - fitted.predict(samples.X[rows], warn=False)
+    return low, _listed(
+        [
+            _sample_name(samples, int(i), f"{e:+.3g} N m from the process trained without it")
+            for i, e in zip(rows, off, strict=True)
+        ]
+    )
 
 
 def _listed(names: list[str]) -> list[str]:
@@ -266,13 +272,15 @@ def listed_count(names: list[str]) -> int:
 
 
 def _sample_name(samples: FrictionSamples, i: int, why: str) -> str:
-    """``"row 3: v = -0.0979 rad/s, load 0 N m, 25 degC (residual 12x the loss's scale)"``."""
+    """``"sample 4: v = -0.0979 rad/s, load 0 N m, 25 degC (residual 12x the loss's scale)"``:
+    the sample's place among the table's rows, counted from 1 (not the file's line, which
+    header and comment lines shift)."""
     parts = [f"v = {samples.velocity[i]:+.4g} rad/s"]
     if np.isfinite(samples.load[i]):
         parts.append(f"load {samples.load[i]:.4g} N m")
     if np.isfinite(samples.temperature[i]):
         parts.append(f"{samples.temperature[i]:.4g} degC")
-    return f"row {i}: {', '.join(parts)} ({why})"
+    return f"sample {i + 1}: {', '.join(parts)} ({why})"
 
 
 def gravity_caveat(samples: FrictionSamples | None) -> list[str]:

@@ -69,7 +69,7 @@ def test_gross_errors_are_left_out_recorded_and_named():
         trust = assess_trust(model, samples)
     said = " ".join(trust.reasons)
     assert "the training left out 2 sample(s) as outliers" in said
-    assert "row 10:" in said and "row 40:" in said
+    assert "sample 11:" in said and "sample 41:" in said
 
 
 def test_clean_samples_keep_every_sample():
