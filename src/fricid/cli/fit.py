@@ -340,7 +340,7 @@ def goodness_text(fitted, samples=None) -> str:
         if m.get("rmse_over_scatter") is not None:
             lines.append(
                 f"    RMSE / scatter     = {m['rmse_over_scatter']:.3g}: "
-                f"{verdict(m['rmse_over_scatter'])} (in-sample)"
+                f"{verdict(m['rmse_over_scatter'])} (in-sample{_with_outliers(fitted)})"
             )
     for d, label in (("pos", "v > 0"), ("neg", "v < 0"), ("comb", "combined")):
         if m.get(f"r2_magnitude_{d}") is not None:
@@ -476,3 +476,22 @@ def stateful_model_lines(stateful: dict) -> list[str]:
             bits.append("trained with --method lsq (default), bas (BAS-RBFNN) or ga (GA-RBFNN)")
         lines.append(f"  {name:<22} " + "; ".join(bits))
     return lines
+
+
+def _with_outliers(fitted) -> str:
+    """``", the 2 samples left out as outliers included"`` for a GP whose training left
+    samples out (``state["left_out"]``), or a robust loss's note: the in-sample numbers
+    count every sample, the trust verdict the inliers."""
+    state = fitted.state if isinstance(fitted.state, dict) else {}
+    sides = [state, state.get("pos"), state.get("neg")]
+    count = sum(
+        int(s["left_out"].get("count", 0))
+        for s in sides
+        if isinstance(s, dict) and isinstance(s.get("left_out"), dict)
+    )
+    if count:
+        return f", the {count} sample(s) its training left out as outliers included"
+    loss = (fitted.loss or {}).get("loss")
+    if loss in ("soft_l1", "huber"):
+        return f", the samples the {loss} loss down-weights included"
+    return ""

@@ -75,3 +75,22 @@ def test_gross_errors_are_left_out_recorded_and_named():
 def test_clean_samples_keep_every_sample():
     model = _fit(_samples(30, SIGMA, SIGMA))
     assert all(side.get("left_out") is None for side in _sides(model))
+
+
+@pytest.mark.slow  # a GP fit and its verdict through the command line: 4 s
+def test_fit_says_its_in_sample_numbers_hold_the_outliers(tmp_path):
+    """``fricid fit`` prints the in-sample RMSE over every sample beside a verdict on the
+    inliers; it says the outliers are in the former, and names them, counted from 1."""
+    from typer.testing import CliRunner
+
+    from fricid.cli import app
+    from fricid.io import write_samples
+
+    path = tmp_path / "samples.csv"
+    write_samples(_samples(30, SIGMA, SIGMA, gross=(10, 40)), path)
+    res = CliRunner().invoke(
+        app, ["fit", str(path), "--model", "gp", "-o", str(tmp_path / "m.json")]
+    )
+    assert res.exit_code == 0, res.output
+    assert "(in-sample, the 2 sample(s) its training left out as outliers included)" in res.output
+    assert "sample 11: v = +0.07148 rad/s" in res.output
