@@ -22,6 +22,7 @@ from ._options import (
 )
 from ._paths import check_paths
 from ._progress import QuietOption, fit_progress
+from ._trust_text import trust_lines
 
 
 def _method_help() -> str:
@@ -294,25 +295,6 @@ def _auto_progress(track):
 
     track.unit = "validated"
     return progress
-
-
-def trust_lines(trust) -> str:
-    """The ``[[Trust]]`` block of ``fricid fit``: the verdict line of the trust record stored
-    in the model file (:func:`fricid.identify.trust.assess_trust`), and where its error
-    ratio came from."""
-    import math
-
-    lines = ["[[Trust]]", f"    {trust.line()}"]
-    if math.isfinite(trust.heldout_ratio):
-        named = not trust.held_out or trust.heldout_scheme in trust.heldout_source
-        scheme = "" if named else f" ({trust.heldout_scheme})"
-        lines.append(
-            f"    error / scatter    = {trust.heldout_ratio:.3g}: {trust.verdict} "
-            f"[{trust.heldout_source}{scheme}]"
-        )
-    if trust.validation_note:
-        lines.append(f"    note: {trust.validation_note}")
-    return "\n".join(lines)
 
 
 def goodness_text(fitted, samples=None) -> str:

@@ -253,10 +253,18 @@ def run_trajectory(
     lines = [f"{w.category.__name__}: {w.message}" for w in caught]
     if lines:
         fitted.provenance["warnings"] = lines
+    from ..identify.trust import assess_trust
+    from ._trust_text import trust_lines
+
+    # the one verdict, from the file: convergence, what the log determines, the range (no
+    # held-out log here: `fricid report MODEL LOG HELDOUT` validates on a second one)
+    trust = assess_trust(fitted, None)
+    fitted.trust = trust.to_dict()
     out = out or Path(f"{log_path.stem}.{fitted.model}.json")
     fitted.save(out)
     console.print(fitted.report(), markup=False, highlight=False, soft_wrap=True)
     console.print(trajectory_text(fitted), markup=False, highlight=False, soft_wrap=True)
+    console.print(trust_lines(trust), markup=False, highlight=False, soft_wrap=True)
     for w in caught:
         warnings.showwarning(w.message, w.category, w.filename, w.lineno)
     err_console.print(f"wrote {escape(str(out))}")

@@ -180,6 +180,20 @@ def _log_figures(doc: Document, pred: TrajectoryPrediction, key: str, label: str
     )
 
 
+def _trust_line(fitted: FittedModel) -> str:
+    """The verdict line of the trust record the model file carries (``fricid fit
+    --trajectory`` stores it), "" without one."""
+    from ..identify.trust import Trust
+
+    record = fitted.trust
+    if not isinstance(record, dict):
+        return ""
+    try:
+        return Trust.from_dict(record).line()
+    except (KeyError, TypeError, ValueError):
+        return ""
+
+
 def trajectory_report(
     fitted: FittedModel,
     prediction: TrajectoryPrediction,
@@ -217,6 +231,9 @@ def trajectory_report(
             "created by fricid": fitted.provenance.get("fricid_version", "–"),
         },
     )
+    verdict = _trust_line(fitted)
+    if verdict:
+        doc.meta["trust"] = verdict
     columns = {log_label: prediction}
     if heldout is not None:
         h = heldout.metrics()
