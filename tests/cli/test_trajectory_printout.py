@@ -4,6 +4,8 @@ unusable, and an infinite passivity margin is a sentence, not "margin undefined"
 
 from __future__ import annotations
 
+import dataclasses
+
 from _trajectory import truth_model
 from fricid.cli.trajectory import trajectory_text
 
@@ -60,3 +62,24 @@ def test_an_ordinary_rate_bias_stays_relative_and_the_box_edge_is_inside():
     line = next(x for x in text.splitlines() if "rate bias" in x)
     assert "sigma_0 -2.1 % (corrected 1.216e+04)" in line and "usable" not in line
     assert "passive (margin 1.39 N m s/rad; across the 95 % intervals: not guaranteed)" in text
+
+
+def test_an_undetermined_parameter_gets_no_bias_and_passivity_says_what_it_rests_on():
+    """sigma_1 at the search box's edge, flagged not determined: no corrected value is
+    offered for it, and the passivity line says it rests on it (a new user's trial found
+    both printed as if sigma_1 were known)."""
+    fitted = fitted_with(
+        {
+            "sigma_0": {"log10_bias": -0.0091, "relative": -0.0207, "corrected": 12156.7},
+            "sigma_1": {"log10_bias": 0.2, "relative": 0.58, "corrected": 0.00158},
+        },
+        {"margin": 1.39, "passive": True, "passive_across_ci95": False, "condition": CONDITION},
+    )
+    par = fitted.parameters["sigma_1"]
+    fitted.parameters["sigma_1"] = dataclasses.replace(par, not_determined=True)
+    text = trajectory_text(fitted)
+    line = next(x for x in text.splitlines() if "rate bias" in x)
+    assert "sigma_1 not determined: no bias or corrected value to give" in line
+    assert "sigma_0 -2.1 % (corrected 1.216e+04)" in line
+    line = next(x for x in text.splitlines() if "passivity" in x)
+    assert line.endswith("(it rests on sigma_1, not determined)")

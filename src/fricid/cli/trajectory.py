@@ -68,6 +68,7 @@ def trajectory_text(fitted) -> str:
             f"    route {name}: {route.get('nfev')} evaluations, {route.get('seconds', 0):.2f} s, "
             f"converged {route.get('converged')}, residual RMS {rms}"
         )
+    undetermined = {n for n, par in fitted.parameters.items() if par.not_determined}
     rb = info.get("rate_bias")
     if rb and "skipped" in rb:
         lines.append(f"    rate bias: not estimated ({rb['skipped']})")
@@ -75,12 +76,19 @@ def trajectory_text(fitted) -> str:
         lines.append(
             f"    rate bias at {rb['log_rate']:.6g} Hz (simulated at the estimate, "
             f"{rb['internal_rate']:.6g} Hz inside; not applied): "
-            + ", ".join(_rate_bias(n, rb[n], fitted.params.get(n)) for n in ("sigma_0", "sigma_1"))
+            + ", ".join(
+                f"{n} not determined: no bias or corrected value to give"
+                if n in undetermined
+                else _rate_bias(n, rb[n], fitted.params.get(n))
+                for n in ("sigma_0", "sigma_1")
+            )
         )
     lines.extend(_measurement_lines(info))
     p = info.get("passivity")
     if p:
-        lines.append(f"    passivity: {_passivity(p)}")
+        rests = sorted(undetermined & {"sigma_0", "sigma_1", "sigma_2", "tau_c", "tau_s"})
+        caveat = f" (it rests on {', '.join(rests)}, not determined)" if rests else ""
+        lines.append(f"    passivity: {_passivity(p)}{caveat}")
     return "\n".join(lines)
 
 
