@@ -6,11 +6,13 @@ from __future__ import annotations
 
 import json
 
+import pytest
 from typer.testing import CliRunner
 
 from fricid.cli import app
 
 
+@pytest.mark.slow  # simulate, fit and report through the command line: 4.4 s
 def test_fit_trajectory_prints_stores_and_reports_the_verdict(tmp_path):
     log = tmp_path / "multisine.parquet"
     args = ["simulate", "--trajectory", "multisine", "--duration", "2", "-o", str(log), "-q"]

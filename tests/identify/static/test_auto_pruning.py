@@ -54,6 +54,7 @@ def test_a_pruned_candidate_could_not_have_been_chosen(monkeypatch):
     assert all(every[m]["heldout_rmse"] > bar for m in pruned)
 
 
+@pytest.mark.slow  # 3 s per option (the default suite's slowest)
 @pytest.mark.parametrize("options", [{"loss": "soft_l1"}, {"weights": "std"}])
 def test_no_pruning_where_the_fit_does_not_minimise_the_plain_squared_error(options):
     fitted = _auto(_stribeck(), **options)
