@@ -464,13 +464,10 @@ def _with_outliers(fitted) -> str:
     """``", the 2 samples left out as outliers included"`` for a GP whose training left
     samples out (``state["left_out"]``), or a robust loss's note: the in-sample numbers
     count every sample, the trust verdict the inliers."""
-    state = fitted.state if isinstance(fitted.state, dict) else {}
-    sides = [state, state.get("pos"), state.get("neg")]
-    count = sum(
-        int(s["left_out"].get("count", 0))
-        for s in sides
-        if isinstance(s, dict) and isinstance(s.get("left_out"), dict)
-    )
+    from ..models.gp import left_out
+
+    records = left_out(fitted.state) if fitted.model == "gp" else []
+    count = sum(int(r.get("count", 0)) for r in records)
     if count:
         return f", the {count} sample(s) its training left out as outliers included"
     loss = (fitted.loss or {}).get("loss")

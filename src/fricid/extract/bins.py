@@ -158,8 +158,10 @@ def cell_sem(idx: np.ndarray, torque: np.ndarray, position: np.ndarray, n_bins: 
     :data:`SEM_MIN_SAMPLES` samples.
     """
     out = np.full(n_bins, np.nan)
-    for b in np.unique(idx[idx >= 0]):
-        rows = np.flatnonzero(idx == b)
+    inside = np.flatnonzero(idx >= 0)
+    order = inside[np.argsort(idx[inside], kind="stable")]  # by bin, in time order within
+    counts = np.bincount(idx[inside], minlength=n_bins)
+    for b, rows in enumerate(np.split(order, np.cumsum(counts)[:-1])):
         n = rows.size
         if n < SEM_MIN_SAMPLES:
             continue

@@ -35,7 +35,7 @@ from .joint_gravity import JointGravityFit, fit_gravity_joint
 from .quality import flag_scatter, warn_quality
 from .result import Diagnostics, ExtractionResult
 from .segment import SegmentCounts, as_log_stream, cluster, iter_segments
-from .separation import assemble, sem_meta
+from .separation import assemble, sem_values
 from .steady import OUTLIER_SIGMAS, SETTLE_SIGMAS
 
 __all__ = ["GRAVITY_MODES", "SPIKE_SIGMAS", "Diagnostics", "ExtractionResult", "extract"]
@@ -374,7 +374,8 @@ def _scatter_about_gravity(stats, group, samples, by_direction, quality):
     keep = np.isfinite(new[:, 0])
     d_std = np.where(keep, new[:, 0], by_direction.std)
     d_sem = np.where(keep, new[:, 1], np.asarray(by_direction.meta["sem"], dtype=float))
-    by_direction = replace(by_direction, std=d_std, meta={**by_direction.meta, "sem": _sem(d_sem)})
+    d_meta = {**by_direction.meta, "sem": sem_values(d_sem)}
+    by_direction = replace(by_direction, std=d_std, meta=d_meta)
     column = quality.scatter.copy()
     rows = np.flatnonzero(quality.setpoints)
     column[rows] = np.where(keep, new[:, 0], column[rows])
@@ -388,10 +389,5 @@ def _scatter_about_gravity(stats, group, samples, by_direction, quality):
     combined = np.sqrt(m2 / np.maximum(total - k, 1))[first]
     sem2 = np.bincount(pair, weights=d_sem**2)[first]
     sem = np.where(k[first] == 2, 0.5 * np.sqrt(sem2), np.sqrt(sem2))
-    samples = replace(samples, std=combined, meta={**samples.meta, "sem": _sem(sem)})
+    samples = replace(samples, std=combined, meta={**samples.meta, "sem": sem_values(sem)})
     return samples, by_direction, quality
-
-
-def _sem(sem: np.ndarray) -> list[float | None]:
-    """The per-row standard errors as ``meta["sem"]`` holds them (their method unchanged)."""
-    return sem_meta(sem)["sem"]

@@ -21,6 +21,7 @@ __all__ = [
     "assemble",
     "missing_message",
     "sem_meta",
+    "sem_values",
 ]
 
 #: How the extraction estimates a row's standard error (``samples.meta["sem_method"]``):
@@ -37,7 +38,7 @@ def sem_meta(sem: np.ndarray, passes: np.ndarray | None = None) -> dict:
     not finite; ``sem_method``, ``sem_caveat``), which
     :func:`fricid.identify.validate.measurement_scatter` prefers to its own estimates;
     ``passes`` (per row, the fewest of its directions) says which method the rows took."""
-    values = [float(x) if np.isfinite(x) else None for x in np.asarray(sem, dtype=float)]
+    values = sem_values(sem)
     many = None if passes is None else np.asarray(passes) > 1
     if many is not None and many.all():
         return {"sem": values, "sem_method": SEM_METHOD, "sem_caveat": ""}
@@ -45,6 +46,11 @@ def sem_meta(sem: np.ndarray, passes: np.ndarray | None = None) -> dict:
         return {"sem": values, "sem_method": SEM_SINGLE, "sem_caveat": SEM_CAVEAT}
     method = f"{SEM_METHOD} where a row has several; {SEM_SINGLE} where one"
     return {"sem": values, "sem_method": method, "sem_caveat": SEM_CAVEAT}
+
+
+def sem_values(sem: np.ndarray) -> list[float | None]:
+    """The per-row standard errors as ``meta["sem"]`` holds them (None where not finite)."""
+    return [float(x) if np.isfinite(x) else None for x in np.asarray(sem, dtype=float)]
 
 
 def missing_message(has: np.ndarray, t_set, v_set) -> str:

@@ -17,6 +17,7 @@ import numpy as np
 from ..errors import ConfigError
 from ..fitted import FittedModel, Parameter
 from ..models._range import SIDES, coverage_text, gap_pairs, gaps_note
+from ..models.gp import left_out
 from ..samples import FrictionSamples
 from ._scatter import LEVEL_RTOL, _repeat_groups, sample_weights
 
@@ -236,12 +237,8 @@ def _left_out(fitted: FittedModel, samples: FrictionSamples) -> tuple[np.ndarray
     """The samples a GP's training left out as gross errors (``state["left_out"]`` of each
     process, :mod:`fricid.identify.learned.gp`), found in ``samples`` by velocity and
     friction."""
-    state = fitted.state if isinstance(fitted.state, dict) else {}
     low = np.zeros(len(samples.velocity), bool)
-    for side in (state, state.get("pos"), state.get("neg")):
-        out = side.get("left_out") if isinstance(side, dict) else None
-        if not isinstance(out, dict):
-            continue
+    for out in left_out(fitted.state):
         for v, f in zip(out.get("velocity") or (), out.get("friction") or (), strict=False):
             low |= np.isclose(samples.velocity, v, rtol=1e-12, atol=0) & np.isclose(
                 samples.friction, f, rtol=1e-12, atol=0

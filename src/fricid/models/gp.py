@@ -73,7 +73,15 @@ import numpy as np
 from ..errors import DataError
 from ._base import INPUTS, state_array
 
-__all__ = ["GP", "GP_KIND", "GP_SYMMETRIES", "GaussianProcess", "gp_sides", "predict_gp"]
+__all__ = [
+    "GP",
+    "GP_KIND",
+    "GP_SYMMETRIES",
+    "GaussianProcess",
+    "gp_sides",
+    "left_out",
+    "predict_gp",
+]
 
 #: ``state["kind"]`` of a Gaussian process in a model file.
 GP_KIND = "gaussian_process"
@@ -234,6 +242,15 @@ class _Side:
                     var = var + np.einsum("nq,nq->n", Rb @ self.cov, Rb)
                 sd[rows] = self.y_scale * np.sqrt(np.maximum(var, 0.0))
         return g, sd
+
+
+def left_out(state: Mapping[str, Any] | None) -> list[Mapping[str, Any]]:
+    """The record of the samples each process's training left out as gross errors
+    (``state["left_out"]``: count, velocity, friction, reason; written by
+    :mod:`fricid.identify.learned.gp`), one per process that has one."""
+    return [
+        st["left_out"] for st in gp_sides(state).values() if isinstance(st.get("left_out"), Mapping)
+    ]
 
 
 def predict_gp(
