@@ -17,7 +17,13 @@ from fricid.errors import ConfigError
 from fricid.fitted import FittedModel
 from fricid.identify import fit
 from fricid.identify._intervals import local_record
-from fricid.models._spread import MAX_POINTS, input_spans, local_variance, spread_points
+from fricid.models._spread import (
+    MAX_POINTS,
+    biased_half_width,
+    input_spans,
+    local_variance,
+    spread_points,
+)
 from fricid.samples import FrictionSamples
 
 SIGMA = 0.02
@@ -29,11 +35,16 @@ def _dip(v: np.ndarray) -> np.ndarray:
     return np.sign(v) * (0.8 + 0.1 / (1 + (np.abs(v) / 0.03) ** 2)) + 0.3 * v
 
 
-def _samples(seed: int, n_speeds: int = 24) -> FrictionSamples:
+def _deep_dip(v: np.ndarray) -> np.ndarray:
+    """A Lorentzian rise of 20 noise std: a bias that dwarfs the noise near the dip."""
+    return np.sign(v) * (0.8 + 0.4 / (1 + (np.abs(v) / 0.03) ** 2)) + 0.3 * v
+
+
+def _samples(seed: int, n_speeds: int = 24, law=_dip) -> FrictionSamples:
     rng = np.random.default_rng(seed)
     s = np.geomspace(0.005, 3.0, n_speeds)
     v = np.r_[s, -s]
-    y = _dip(v) + SIGMA * rng.standard_normal(v.size)
+    y = law(v) + SIGMA * rng.standard_normal(v.size)
     return FrictionSamples(
         velocity=v,
         load=None,
@@ -56,10 +67,10 @@ def _grid() -> np.ndarray:
     return np.column_stack([v, np.zeros(v.size), np.full(v.size, 25.0)])
 
 
-def _coverage(model) -> float:
+def _coverage(model, law=_dip) -> float:
     X = _grid()
     pi = model.predict_interval(X, 0.95, warn=False)
-    F = _dip(X[:, 0])
+    F = law(X[:, 0])
     return float(
         np.mean(stats.norm.cdf((pi.high - F) / SIGMA) - stats.norm.cdf((pi.low - F) / SIGMA))
     )
@@ -81,6 +92,28 @@ def test_a_family_that_misses_covers_about_nominal():
     assert 0.90 <= np.mean(cover) <= 0.98, cover
 
 
+def test_a_bias_many_times_the_noise_is_not_covered_twice():
+    """Where a Coulomb-viscous line misses a dip of 20 noise std, an interval of 1.96 times
+    the root mean square error there (about twice the bias) covered 99.9 % of new samples;
+    the bias-aware width (the local bias plus the noise's share) covers about nominal."""
+    cover = [_coverage(_fit(_samples(200 + seed, law=_deep_dip)), _deep_dip) for seed in range(8)]
+    assert 0.90 <= np.mean(cover) <= 0.98, cover
+
+
+@settings(max_examples=80, deadline=None)
+@given(st.floats(-50.0, 50.0), st.floats(0.01, 10.0), st.sampled_from([0.5, 0.9, 0.95, 0.99]))
+def test_the_bias_aware_width_holds_its_level(bias, std, level):
+    """``P(|N(b, s^2)| <= h) = level``; ``z s`` without bias; between ``|b| + z' s`` and
+    ``|b| + z s`` (``z'``, ``z`` the one- and two-sided normal quantiles)."""
+    h = float(biased_half_width(np.array([bias]), np.array([std]), level)[0])
+    held = stats.norm.cdf((h - bias) / std) - stats.norm.cdf((-h - bias) / std)
+    assert held == pytest.approx(level, abs=1e-9)
+    z1, z2 = stats.norm.ppf(level), stats.norm.ppf(0.5 + level / 2)
+    assert abs(bias) + z1 * std * (1 - 1e-9) <= h <= abs(bias) + z2 * std * (1 + 1e-9)
+    if bias == 0:
+        assert h == pytest.approx(z2 * std)
+
+
 def test_the_interval_round_trips_through_the_file(tmp_path):
     model = _fit(_samples(1))
     path = tmp_path / "m.json"
@@ -97,6 +130,8 @@ def test_the_interval_round_trips_through_the_file(tmp_path):
     "damage",
     [
         lambda r: r.update(e2=r["e2"][:-1]),
+        lambda r: r.update(e=r["e"][:-1]),
+        lambda r: r.update(e=[float("nan")] * len(r["e"])),
         lambda r: r.update(weight=[0.0] * len(r["weight"])),
         lambda r: r.update(noise=-1.0),
         lambda r: r.pop("bandwidth"),
@@ -145,6 +180,7 @@ def test_learned_models_keep_their_held_out_spread():
         assert record["method"] == "heldout"
         local = record["local"]
         assert len(local["e2"]) + local["gross"] == len(samples.velocity)
+        assert "e" not in local  # the spread about the model, no local bias (module notes)
         assert "_heldout_errors" not in str(model.state)
         half = model.predict_interval(_grid()[::50], 0.95, warn=False).half_width
         assert np.all(half >= 0.95 * 1.96 * SIGMA)  # never below the scatter's

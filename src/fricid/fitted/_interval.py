@@ -14,10 +14,14 @@ held-out error was seen; the whole variance added gave 94.9-97.5 % per class on 
 tuning cases of ``benchmarks/bench_verdicts.py`` with the GP's noise floor, the excess
 91.6-96.6 %), ``k``
 the calibrated multiplier (:mod:`fricid.identify._intervals`, "Local spread"): narrow where
-the model follows the data, wide where it misses them. An analytic fit's record is
-``prediction_interval`` with method ``"delta"`` and ``local`` beside the delta method's
-fields; a learned model's has method ``"heldout"``. Otherwise, one rule per kind of model,
-each from what the model file stores:
+the model follows the data, wide where it misses them. An analytic fit's record holds the
+signed errors too, and its interval is bias-aware: ``(k / z) h(m(x), s(x))``, ``h`` the
+folded normal's quantile of a new sample ``N(m, s^2)`` about the model, ``m`` the local bias
+and ``s^2 = max(v - m^2, noise^2) + p`` (:mod:`fricid.identify._intervals`, "Bias-aware";
+the same as above without bias, about ``|m| + 1.645 s`` where the bias dominates). An
+analytic fit's record is ``prediction_interval`` with method ``"delta"`` and ``local``
+beside the delta method's fields; a learned model's has method ``"heldout"``. Otherwise,
+one rule per kind of model, each from what the model file stores:
 
 - **analytic** (``prediction_interval`` of the file, method ``"delta"``): the delta method,
   ``F(x) -+ k sqrt(g^T C g + s^2)``, ``g`` the gradient of ``F(x)`` in the free
@@ -59,7 +63,7 @@ import numpy as np
 from ..errors import ConfigError
 from ..models import get_model, get_predictor
 from ..models._range import in_gap
-from ..models._spread import local_variance
+from ..models._spread import biased_half_width, local_bias_std, local_variance
 from ..models.gp import gp_sides
 from ..models.rbf import interval_half_width
 
@@ -155,14 +159,11 @@ def _local_half_width(
     GP's latent posterior variance); ``k`` the multiplier calibrated at ``level``
     (:func:`fricid.identify._intervals.local_record`), else the normal quantile."""
     check_local(local)
-    noise = float(local["noise"])
-    v = local_variance(local, X)
-    v = np.maximum(np.where(np.isfinite(v), v, noise**2), noise**2)
-    var = v + np.maximum(extra, 0.0)
+    m, sd = local_bias_std(local, X, extra)
     levels = [float(x) for x in local.get("levels") or ()]
     scale = [float(x) for x in local.get("scale") or ()]
     k = nested_multiplier(levels, scale, level, lambda q: _norm_ppf(0.5 + q / 2))
-    return k * np.sqrt(var)
+    return k / _norm_ppf(0.5 + level / 2) * biased_half_width(m, sd, level)
 
 
 def nested_multiplier(levels: list[float], scale: list[float], level: float, base) -> float:
@@ -212,6 +213,9 @@ def check_local(local: Mapping[str, Any]) -> None:
             and float(local["noise"]) > 0
             and np.isfinite([float(bw["decades"]), float(bw["span"]), float(local["noise"])]).all()
         )
+        if "e" in local:  # the signed errors of an analytic fit (its local bias)
+            bias = np.asarray(local["e"], dtype=float)
+            fine = fine and bias.shape == (n,) and bool(np.isfinite(bias).all())
         levels = np.asarray(local.get("levels") or [], dtype=float)
         scale = np.asarray(local.get("scale") or [], dtype=float)
         fine = fine and levels.shape == scale.shape and levels.ndim == 1

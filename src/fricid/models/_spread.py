@@ -12,7 +12,10 @@ the samples near ``x`` (a Nadaraya-Watson kernel average, Gaussian kernel; Fan &
 variance functions, and the locally weighted scores of Lei et al. 2018, section 5.2), per
 direction of motion, in ``log10 |v|`` (:data:`BANDWIDTH_DECADES` decades) and, where the
 samples vary them, in load and temperature (:data:`BANDWIDTH_SPAN` of their measured span).
-It is never below the measured scatter: a new sample carries at least the noise.
+It is never below the measured scatter: a new sample carries at least the noise. An
+analytic fit's record also holds the signed errors; their kernel average is the local bias
+``m(x)`` (:func:`local_bias_std`), and the interval holds a new sample ``N(m, s^2)``
+(:func:`biased_half_width`) rather than ``1.96 sqrt(v)``, about twice a dominant bias.
 """
 
 from __future__ import annotations
@@ -26,7 +29,10 @@ __all__ = [
     "BANDWIDTH_DECADES",
     "BANDWIDTH_SPAN",
     "MAX_POINTS",
+    "biased_half_width",
     "input_spans",
+    "local_bias_std",
+    "local_mean",
     "local_variance",
     "spread_points",
 ]
@@ -106,10 +112,18 @@ def local_variance(
     ``leave_out_self``: ``X`` are the record's own points, each averaged without itself
     (the leave-one-out spread, for the calibration of :func:`fricid.identify._intervals`).
     """
+    return local_mean(record, X, "e2", leave_out_self=leave_out_self)
+
+
+def local_mean(
+    record: Mapping[str, Any], X: np.ndarray, key: str, *, leave_out_self: bool = False
+) -> np.ndarray:
+    """The kernel average of the record's column ``key`` at each row of ``X``
+    (:func:`local_variance` for ``e2``; the local bias for the signed errors ``e``)."""
     P = np.column_stack(
         [np.asarray(record[k], dtype=float) for k in ("velocity", "load", "temperature")]
     )
-    e2 = np.asarray(record["e2"], dtype=float)
+    values = np.asarray(record[key], dtype=float)
     w = np.asarray(record["weight"], dtype=float)
     spans = list(record["spans"])
     bw = record["bandwidth"]
@@ -130,5 +144,48 @@ def local_variance(
             near = d2.min(axis=1, keepdims=True)
             ok = np.isfinite(near[:, 0])
             K = np.exp(-0.5 * (d2[ok] - near[ok])) * w[cols]  # scaled: never all underflow
-            out[part[ok]] = (K @ e2[cols]) / K.sum(axis=1)
+            out[part[ok]] = (K @ values[cols]) / K.sum(axis=1)
     return out
+
+
+def biased_half_width(bias: np.ndarray, std: np.ndarray, level: float) -> np.ndarray:
+    """The half-width ``h`` that holds a share ``level`` of a new sample ``N(bias, std^2)``
+    about 0: ``Phi((h - b) / s) - Phi((-h - b) / s) = level`` (the folded normal's quantile;
+    the critical value of a bias-aware interval, Armstrong and Kolesar 2020, eq. 6, with the
+    bias estimated locally). ``z s`` without bias (``z`` the normal quantile), about
+    ``|b| + z' s`` (``z'`` the one-sided one) when the bias dominates, where ``z sqrt(b^2 +
+    s^2)`` would be nearly twice the bias."""
+    from scipy.special import ndtr, ndtri
+
+    b = np.abs(np.asarray(bias, dtype=float))
+    s = np.maximum(np.asarray(std, dtype=float), 1e-300)
+    lo = np.zeros(np.broadcast(b, s).shape)
+    hi = b + float(ndtri(0.5 + level / 2)) * s  # covers at least ``level``
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        short = ndtr((mid - b) / s) - ndtr((-mid - b) / s) < level
+        lo, hi = np.where(short, mid, lo), np.where(short, hi, mid)
+    return hi
+
+
+def local_bias_std(
+    record: Mapping[str, Any],
+    X: np.ndarray,
+    extra: np.ndarray | float = 0.0,
+    *,
+    leave_out_self: bool = False,
+) -> tuple[np.ndarray, np.ndarray]:
+    """The local bias ``m(x)`` [N m] of the held-out errors and the spread about it ``s(x)``
+    [N m] at each row of ``X``: ``m`` the kernel average of the signed errors ``e`` (0 in a
+    record without them), ``s^2 = max(v - m^2, noise^2) + extra`` with ``v`` the local mean
+    square (:func:`local_variance`, never below ``noise^2``); ``extra`` [N^2 m^2] the
+    model's own zero-mean uncertainty (an analytic model's parameter term)."""
+    noise2 = float(record["noise"]) ** 2
+    v = local_variance(record, X, leave_out_self=leave_out_self)
+    v = np.maximum(np.where(np.isfinite(v), v, noise2), noise2)
+    if "e" in record:
+        m = local_mean(record, X, "e", leave_out_self=leave_out_self)
+        m = np.where(np.isfinite(m), m, 0.0)
+    else:
+        m = np.zeros_like(v)
+    return m, np.sqrt(np.maximum(v - m**2, noise2) + np.maximum(extra, 0.0))
