@@ -47,6 +47,11 @@ BANDWIDTH_SPAN = 0.3
 #: stays small on long logs; cells of 0.02 decades and a tenth of each span).
 MAX_POINTS = 2000
 
+#: Safeguarded Newton steps of :func:`biased_half_width` (quadratic from the bracket).
+_ROOT_STEPS = 12
+_ROOT_TOL = 1e-12
+_SQRT_2PI = 2.5066282746310002
+
 #: Rows of ``X`` per kernel block (memory: rows x points x inputs doubles).
 _CHUNK = 1024
 
@@ -159,13 +164,26 @@ def biased_half_width(bias: np.ndarray, std: np.ndarray, level: float) -> np.nda
 
     b = np.abs(np.asarray(bias, dtype=float))
     s = np.maximum(np.asarray(std, dtype=float), 1e-300)
-    lo = np.zeros(np.broadcast(b, s).shape)
-    hi = b + float(ndtri(0.5 + level / 2)) * s  # covers at least ``level``
-    for _ in range(60):
-        mid = 0.5 * (lo + hi)
-        short = ndtr((mid - b) / s) - ndtr((-mid - b) / s) < level
-        lo, hi = np.where(short, mid, lo), np.where(short, hi, mid)
-    return hi
+    b, s = np.broadcast_arrays(b, s)
+    c = 2.0 * b / s
+    if not c.any():  # no bias (a learned model's record): the normal quantile
+        return float(ndtri(0.5 + level / 2)) * s
+    # in x = (h - |b|) / s the root lies in [max(z', -|b| / s), z]; Newton from the lower
+    # end (g is concave for x >= 0, so from the left it climbs to the root and stays in the
+    # bracket), bisection where a step leaves it
+    lo = np.maximum(float(ndtri(level)), -0.5 * c)
+    hi = np.full(c.shape, float(ndtri(0.5 + level / 2)))
+    x = lo.copy()
+    for _ in range(_ROOT_STEPS):
+        g = ndtr(x) - ndtr(-x - c) - level
+        if not (np.abs(g) > 1e-14).any():
+            break
+        lo, hi = np.where(g < 0, x, lo), np.where(g < 0, hi, x)
+        slope = (np.exp(-0.5 * x * x) + np.exp(-0.5 * (x + c) ** 2)) / _SQRT_2PI
+        step = x - g / np.where(slope > 0, slope, np.inf)
+        inside = (step >= lo - _ROOT_TOL) & (step <= hi + _ROOT_TOL)  # rounding at an end
+        x = np.where(inside, np.clip(step, lo, hi), 0.5 * (lo + hi))
+    return b + x * s
 
 
 def local_bias_std(
