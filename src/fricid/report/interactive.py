@@ -173,9 +173,9 @@ def _band_cells(samples: FrictionSamples, max_bands: int) -> tuple[list[tuple], 
                 continue
             parts = []
             if len(l_bands) > 1:
-                parts.append(f"load {_span(*lb)} N m")
+                parts.append(_span(*lb, "N m", "load", prefix="load "))
             if len(t_bands) > 1:
-                parts.append(f"{_span(*tb)} °C")
+                parts.append(_span(*tb, "°C", "temperature"))
             cell = (0, i) if by_temp_in_a_row else (i, j)
             cells.append((cell, lb, tb, ", ".join(parts)))
     n_rows = 1 if by_temp_in_a_row else len(t_bands)
@@ -183,8 +183,12 @@ def _band_cells(samples: FrictionSamples, max_bands: int) -> tuple[list[tuple], 
     return cells, n_rows, n_cols
 
 
-def _span(low: float, high: float) -> str:
-    return f"{low:.3g}" if low == high else f"{low:.3g}–{high:.3g}"
+def _span(low: float, high: float, unit: str, name: str, prefix: str = "") -> str:
+    """A panel's band of load or temperature: ``prefix`` then ``1–2 N m``, or ``<name> not
+    measured`` for the band of samples without it (:func:`fricid.report.style.band_edges`)."""
+    if np.isnan(low):
+        return f"{name} not measured"
+    return prefix + (f"{low:.3g} {unit}" if low == high else f"{low:.3g}–{high:.3g} {unit}")
 
 
 def friction_figure(

@@ -127,11 +127,19 @@ def band_edges(values, max_bands: int) -> list[tuple[float, float]]:
     count; returns inclusive (low, high) per band.
 
     Values closer than 1/200 of their range count as one (a measured temperature scatters
-    around its set-point)."""
-    arr = np.asarray(values, dtype=float)
+    around its set-point). NaN values (not measured) get a band of their own, ``(nan, nan)``,
+    last (:func:`in_band`): a band whose end was NaN held no sample at all."""
+    every = np.asarray(values, dtype=float).ravel()
+    arr = every[np.isfinite(every)]
+    unmeasured = [(float("nan"), float("nan"))] if arr.size < every.size else []
     span = float(np.ptp(arr)) if arr.size else 0.0
     if span == 0.0:
-        return [(float(arr.min()), float(arr.max()))] if arr.size else []
+        return [(float(arr.min()), float(arr.max())), *unmeasured] if arr.size else unmeasured
+    return _finite_bands(arr, span, max_bands) + unmeasured
+
+
+def _finite_bands(arr: np.ndarray, span: float, max_bands: int) -> list[tuple[float, float]]:
+    """:func:`band_edges` of finite values spanning ``span > 0``."""
     distinct = np.unique(arr)
     # cluster: a gap larger than span/200 starts a new group
     starts = np.flatnonzero(np.diff(distinct) > span / 200.0) + 1

@@ -132,11 +132,16 @@ def trust_text(trust: Trust) -> str:
     )
     lines.append(f"- **Error against scatter**: {_error_line(trust)}.")
     if np.isfinite(trust.scatter):
+        table = (  # only where there is a table to point at
+            "; the readings' spread per set-point in the data-quality table is larger (each "
+            "sample averages many readings)"
+            if trust.quality
+            else ""
+        )
         lines.append(
             f"- **Measurement scatter** (the one number every comparison here uses): "
-            f"{trust.scatter:.3g} N m, the scatter of the samples the model was fitted to; "
-            "the readings' spread per set-point in the data-quality table is larger (each "
-            "sample averages many readings)."
+            f"{trust.scatter:.3g} N m, the scatter of the samples the model was fitted to"
+            f"{table}."
         )
     lines.append(
         f"- **Operating range** (predictions outside it are extrapolated): "
