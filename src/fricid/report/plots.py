@@ -44,8 +44,6 @@ Predict = Callable[[np.ndarray], np.ndarray]
 
 
 def _fmt(lo: float, hi: float, unit: str, digits: int = 3) -> str:
-    if np.isnan(lo):  # the band of samples without that input (style.band_edges)
-        return "temperature not measured" if unit == "°C" else "not measured"
     if np.isclose(lo, hi, rtol=0.01, atol=0.05 if unit == "°C" else 0.0):
         return f"{(lo + hi) / 2:.{digits}g} {unit}"
     return f"{lo:.{digits}g}–{hi:.{digits}g} {unit}"
@@ -198,7 +196,7 @@ def friction_curves(
                 ax.axhline(0, color="0.4", lw=0.6)
                 if (samples.velocity < 0).any():
                     ax.axvline(0, color="0.4", lw=0.6)
-            if len(l_bands) > 1 or not (np.isnan(lb[0]) or np.allclose(lb, 0)):
+            if len(l_bands) > 1 or not (np.isnan(lb[0]) or np.allclose(lb, 0)):  # no NaN title
                 ax.set_title(f"load {_fmt(*lb, 'N m')}", fontweight="normal", fontsize=10)
             if j == 0:
                 ax.set_ylabel(
