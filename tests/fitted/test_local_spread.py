@@ -279,6 +279,18 @@ def test_a_higher_level_never_gives_a_narrower_interval(name):
     assert np.all(np.diff(half, axis=0) >= -1e-12)
 
 
+def test_with_a_bias_a_higher_level_is_never_narrower_either():
+    """Where the bias dominates, the bias-aware width grows with the level by the one-sided
+    quantile only: a 0.95 multiplier calibrated below the normal one (light tails) and a
+    0.9 one at it made the 95 % interval narrower than the 90 % one at the dip."""
+    model = _fit(_samples(7, law=_deep_dip))
+    local = model.prediction_interval["local"]
+    local["scale"] = [stats.norm.ppf(0.95), 0.8 * stats.norm.ppf(0.975)]
+    X = _grid()[::20]
+    half = np.array([model.predict_interval(X, q, warn=False).half_width for q in LEVELS])
+    assert np.all(np.diff(half, axis=0) >= -1e-12)
+
+
 @settings(max_examples=200, deadline=None)
 @given(
     st.lists(st.tuples(st.floats(0.05, 0.995), st.floats(0.01, 5.0)), min_size=1, max_size=4),

@@ -153,15 +153,26 @@ def analytic_half_width(
 def _local_half_width(
     local: Mapping[str, Any], X: np.ndarray, level: float, extra: np.ndarray | float = 0.0
 ) -> np.ndarray:
-    """``k sqrt(v(x) + extra)``: ``v`` the local spread of the held-out errors
-    (:func:`fricid.models._spread.local_variance`), never below ``noise^2``; ``extra``
-    [N^2 m^2] the model's own uncertainty at ``x`` (an analytic model's parameter term, a
-    GP's latent posterior variance); ``k`` the multiplier calibrated at ``level``
-    (:func:`fricid.identify._intervals.local_record`), else the normal quantile."""
+    """``(k / z) h(m(x), s(x))``: ``h`` the half-width that holds ``level`` of a new sample
+    ``N(m, s^2)`` (:func:`fricid.models._spread.biased_half_width`; ``z s`` where ``m = 0``,
+    so ``k sqrt(v(x) + extra)`` for a record without signed errors), ``m`` the local bias and
+    ``s^2 = max(v - m^2, noise^2) + extra`` (:func:`fricid.models._spread.local_bias_std`),
+    ``extra`` [N^2 m^2] the model's own uncertainty at ``x`` (an analytic model's parameter
+    term, a GP's latent posterior variance); ``k`` the multiplier calibrated at ``level``
+    (:func:`fricid.identify._intervals.local_record`), else the normal quantile ``z``.
+
+    ``h`` grows more slowly with the level than ``z`` where the bias dominates, so with a
+    bias the calibrated ratios ``k / z`` are taken non-decreasing in level (a ratio below a
+    lower level's raised to it): a higher level then never gives a narrower interval."""
     check_local(local)
     m, sd = local_bias_std(local, X, extra)
     levels = [float(x) for x in local.get("levels") or ()]
     scale = [float(x) for x in local.get("scale") or ()]
+    if "e" in local and levels:
+        order = np.argsort(levels)
+        ref = np.array([_norm_ppf(0.5 + levels[i] / 2) for i in order])
+        ratio = np.maximum.accumulate(np.array([scale[i] for i in order]) / ref)
+        levels, scale = [levels[i] for i in order], list(ratio * ref)
     k = nested_multiplier(levels, scale, level, lambda q: _norm_ppf(0.5 + q / 2))
     return k / _norm_ppf(0.5 + level / 2) * biased_half_width(m, sd, level)
 
