@@ -156,7 +156,7 @@ def local_mean(
 def biased_half_width(bias: np.ndarray, std: np.ndarray, level: float) -> np.ndarray:
     """The half-width ``h`` that holds a share ``level`` of a new sample ``N(bias, std^2)``
     about 0: ``Phi((h - b) / s) - Phi((-h - b) / s) = level`` (the folded normal's quantile;
-    the critical value of a bias-aware interval, Armstrong and Kolesar 2020, eq. 6, with the
+    the critical value of a bias-aware interval, Armstrong and Kolesar 2020, with the
     bias estimated locally). ``z s`` without bias (``z`` the normal quantile), about
     ``|b| + z' s`` (``z'`` the one-sided one) when the bias dominates, where ``z sqrt(b^2 +
     s^2)`` would be nearly twice the bias."""
