@@ -97,6 +97,7 @@ def test_quick_steps_print_nothing_when_piped(tmp_path, samples_csv, monkeypatch
     assert progress_lines(res.stderr) == [], res.stderr
 
 
+@pytest.mark.slow  # 1.1 s, quiet machine (the default run kept under 3 minutes)
 def test_fit_population_method_counts_evaluations(no_grace, tmp_path, samples_csv):
     res = run(
         "fit", samples_csv, "--model", "stribeck", "--fix", "delta=1", "--method", "vsbas",

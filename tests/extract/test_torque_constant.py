@@ -215,6 +215,7 @@ def test_cli_urdf_refusals(current_only_log, tmp_path, extra, match):
     assert match in " ".join(res.output.split())
 
 
+@pytest.mark.slow  # 1.3 s, quiet machine (the default run kept under 3 minutes)
 def test_cli_urdf_generic_csv_without_k(current_only_log, tmp_path):
     """A CSV with current and no K cannot be extracted alone; with --urdf the samples come
     out in N m with the identified K (the same samples as the true K's, scaled)."""

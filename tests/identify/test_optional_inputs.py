@@ -57,6 +57,7 @@ def test_models_that_need_an_input_not_measured_say_so(tmp_path):
     assert np.isfinite(list(fitted.params.values())).all()
 
 
+@pytest.mark.slow  # 1.2 s, quiet machine (the default run kept under 3 minutes)
 def test_cli_fits_a_two_column_table(tmp_path):
     path = _two_column(tmp_path / "vf.csv")
     model = tmp_path / "m.json"

@@ -251,6 +251,7 @@ def test_trust_yes_for_a_converged_fit_within_noise(leadscrew, tmp_path):
     assert (params["value"] <= params["95% CI high"]).all()
 
 
+@pytest.mark.slow  # 1.2 s, quiet machine (the default run kept under 3 minutes)
 def test_verdict_and_figures_come_first_and_long_tables_are_folded(leadscrew, tmp_path):
     """The verdict, then the figures; the 32-row data-quality table folded, the scatter it
     shows named apart from the verdict's and explained."""
