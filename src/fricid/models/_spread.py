@@ -125,16 +125,24 @@ def local_mean(
 ) -> np.ndarray:
     """The kernel average of the record's column ``key`` at each row of ``X``
     (:func:`local_variance` for ``e2``; the local bias for the signed errors ``e``)."""
+    return _kernel_average(record, X, (key,), leave_out_self)[:, 0]
+
+
+def _kernel_average(
+    record: Mapping[str, Any], X: np.ndarray, keys: tuple[str, ...], leave_out_self: bool
+) -> np.ndarray:
+    """``(n, len(keys))``: the kernel averages of the record's columns ``keys`` at each row of
+    ``X``, one kernel for all of them; NaN on a direction without samples."""
     P = np.column_stack(
         [np.asarray(record[k], dtype=float) for k in ("velocity", "load", "temperature")]
     )
-    values = np.asarray(record[key], dtype=float)
+    values = np.column_stack([np.asarray(record[k], dtype=float) for k in keys])
     w = np.asarray(record["weight"], dtype=float)
     spans = list(record["spans"])
     bw = record["bandwidth"]
     cp, cx = _coordinates(P, spans), _coordinates(np.asarray(X, dtype=float), spans)
     scale = np.r_[float(bw["decades"]), [float(bw["span"])] * (cp.shape[1] - 1)]
-    out = np.full(len(cx), np.nan)
+    out = np.full((len(cx), len(keys)), np.nan)
     for sign in (1.0, -1.0):
         mp, mx = np.sign(P[:, 0]) == sign, np.sign(X[:, 0]) == sign
         if not mp.any() or not mx.any():
@@ -149,7 +157,7 @@ def local_mean(
             near = d2.min(axis=1, keepdims=True)
             ok = np.isfinite(near[:, 0])
             K = np.exp(-0.5 * (d2[ok] - near[ok])) * w[cols]  # scaled: never all underflow
-            out[part[ok]] = (K @ values[cols]) / K.sum(axis=1)
+            out[part[ok]] = (K @ values[cols]) / K.sum(axis=1)[:, None]
     return out
 
 
@@ -199,11 +207,8 @@ def local_bias_std(
     square (:func:`local_variance`, never below ``noise^2``); ``extra`` [N^2 m^2] the
     model's own zero-mean uncertainty (an analytic model's parameter term)."""
     noise2 = float(record["noise"]) ** 2
-    v = local_variance(record, X, leave_out_self=leave_out_self)
-    v = np.maximum(np.where(np.isfinite(v), v, noise2), noise2)
-    if "e" in record:
-        m = local_mean(record, X, "e", leave_out_self=leave_out_self)
-        m = np.where(np.isfinite(m), m, 0.0)
-    else:
-        m = np.zeros_like(v)
+    keys = ("e2", "e") if "e" in record else ("e2",)
+    avg = _kernel_average(record, X, keys, leave_out_self)  # one kernel for both
+    v = np.maximum(np.where(np.isfinite(avg[:, 0]), avg[:, 0], noise2), noise2)
+    m = np.nan_to_num(avg[:, 1]) if "e" in record else np.zeros_like(v)
     return m, np.sqrt(np.maximum(v - m**2, noise2) + np.maximum(extra, 0.0))
