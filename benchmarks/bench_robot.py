@@ -4,7 +4,7 @@ Usage::
 
     python benchmarks/bench_robot.py [--seeds 10] [--first 0] [--duration 60] [--rate 1000]
         [--noise 0.05] [--friction stribeck_asym] [--trajectory FILE]
-        [--truth own|pd|sim|mujoco]
+        [--truth own|pd|sim|mujoco] [--jobs 2]
 
 Per seed: each joint gets its own friction law per direction (``stribeck_asym``: Coulomb,
 static, Stribeck velocity and exponent, viscous drawn independently per joint and direction),
@@ -28,11 +28,11 @@ simulator (:func:`fricid.sim.robot.run_robot`: its own split RK4 integrator of t
 joint's law with the sign smoothed over 1 mrad/s, a ``--bandwidth`` Hz PD on the quantised
 position with the inverse dynamics of the reference as feed-forward, the logged velocity the
 raw backward difference, the torque the command plus noise), at internal steps of
-``--integrator-step`` (default :data:`SIM_STEP`, 0.125 ms: the simulator's friction step is
-first order, and at its default 0.5 ms the Stribeck slopes of these laws over the wrist's small
-inertias, about 1000 per second, were not resolved: noiseless, with the true parameters, the
-filtered residual of joints 5 to 7 was 0.009-0.037 N m at 0.5 ms, 0.002-0.007 at 0.125 ms
-and 0.001-0.007 at 0.05 ms, seed 100, 12 s); it takes ``stribeck_asym`` laws
+``--integrator-step`` (default :data:`SIM_STEP`, 0.125 ms: at its default 0.5 ms the
+Stribeck slopes of these laws over the wrist's small inertias, about 1000 per second, were not
+resolved: noiseless, with the true parameters, the filtered residual of joints 5 to 7 was
+0.009-0.037 N m at 0.5 ms, 0.002-0.007 at 0.125 ms and 0.001-0.007 at 0.05 ms, seed 100, 12 s,
+measured while the simulator's friction step was first order); it takes ``stribeck_asym`` laws
 (``coulomb_viscous_asym`` is given to it as a law without a Stribeck rise); ``--truth
 mujoco`` is the same drive with MuJoCo stepping the exported MJCF
 (``benchmarks/_robot_truth.py``, ``implicitfast`` at ``--integrator-step``, its
@@ -187,46 +187,65 @@ def _logs(model, laws, seed, args, trajectory):
     return one, two
 
 
-def run(args) -> None:
+def _seed(args, seed: int) -> dict:
+    """One seed's identification: per joint and parameter the relative error and whether the
+    interval covers the truth, the held-out ratio and verdict, the base coverage, the seconds."""
     path, joints = example_urdf(args.robot)
     model = RigidBodyModel.from_urdf(path, joints)
     beta_true = base_parameters(model).project(model.parameters())
     trajectory = _trajectory(args.trajectory, model) if args.trajectory else None
+    laws = _laws(model, seed, args.friction)
+    if args.truth == "mujoco":
+        laws = _mujoco_laws(model, laws)
+    log, held = _logs(model, laws, seed, args, trajectory)
+    start = time.perf_counter()
+    window = WINDOW_PERIODS if args.truth != "own" else 0.0  # closed loop
+    fit = fit_arm(log, model, friction=laws[0][0], validate=held, reversal_window=window)
+    out = {"seconds": time.perf_counter() - start, "params": [], "joints": {}}
+    for joint, (_, values) in zip(fit.joints, laws, strict=True):
+        for name, rec in fit.friction[joint]["parameters"].items():
+            kind = next(k for k in KINDS if name.startswith(k))
+            t = values[name]
+            if rec["value"] is None:
+                out["params"].append((joint, kind, None, False))
+                continue
+            covered = rec["ci95"][0] <= t <= rec["ci95"][1]
+            out["params"].append((joint, kind, abs(rec["value"] - t) / abs(t), covered))
+        out["joints"][joint] = (fit.validation[joint]["ratio"], fit.validation[joint]["level"])
+    ci = fit.base["ci95"]
+    out["base"] = float(
+        np.mean(
+            [lo is not None and lo <= b <= hi for b, (lo, hi) in zip(beta_true, ci, strict=True)]
+        )
+    )
+    print(f"seed {seed}: {out['seconds']:.1f} s", file=sys.stderr, flush=True)
+    return out
+
+
+def run(args) -> None:
+    path, joints = example_urdf(args.robot)
+    model = RigidBodyModel.from_urdf(path, joints)
+    seeds = range(args.first, args.first + args.seeds)
+    if args.jobs > 1:  # one process per seed: the seeds are independent
+        from concurrent.futures import ProcessPoolExecutor
+
+        with ProcessPoolExecutor(args.jobs) as pool:
+            results = list(pool.map(_seed, [args] * len(seeds), seeds))
+    else:
+        results = [_seed(args, seed) for seed in seeds]
     rel = defaultdict(list)  # (joint, kind) -> relative errors
     cov = defaultdict(list)  # (joint, kind) -> covered
-    ratio = defaultdict(list)
-    levels = defaultdict(list)
-    base_cov, seconds = [], []
-    for seed in range(args.first, args.first + args.seeds):
-        laws = _laws(model, seed, args.friction)
-        if args.truth == "mujoco":
-            laws = _mujoco_laws(model, laws)
-        log, held = _logs(model, laws, seed, args, trajectory)
-        start = time.perf_counter()
-        window = WINDOW_PERIODS if args.truth != "own" else 0.0  # closed loop
-        fit = fit_arm(log, model, friction=laws[0][0], validate=held, reversal_window=window)
-        seconds.append(time.perf_counter() - start)
-        for joint, (_, values) in zip(fit.joints, laws, strict=True):
-            for name, rec in fit.friction[joint]["parameters"].items():
-                kind = next(k for k in KINDS if name.startswith(k))
-                t = values[name]
-                if rec["value"] is None:
-                    cov[joint, kind].append(False)
-                    continue
-                rel[joint, kind].append(abs(rec["value"] - t) / abs(t))
-                cov[joint, kind].append(rec["ci95"][0] <= t <= rec["ci95"][1])
-            ratio[joint].append(fit.validation[joint]["ratio"])
-            levels[joint].append(fit.validation[joint]["level"])
-        ci = fit.base["ci95"]
-        base_cov.append(
-            np.mean(
-                [
-                    lo is not None and lo <= b <= hi
-                    for b, (lo, hi) in zip(beta_true, ci, strict=True)
-                ]
-            )
-        )
-        print(f"seed {seed}: {seconds[-1]:.1f} s", file=sys.stderr, flush=True)
+    ratio, levels = defaultdict(list), defaultdict(list)
+    for res in results:
+        for joint, kind, err, covered in res["params"]:
+            if err is not None:
+                rel[joint, kind].append(err)
+            cov[joint, kind].append(covered)
+        for joint, (r, level) in res["joints"].items():
+            ratio[joint].append(r)
+            levels[joint].append(level)
+    base_cov = [res["base"] for res in results]
+    seconds = [res["seconds"] for res in results]
     kinds = [k for k in KINDS if any((j, k) in cov for j in model.joints)]
     print(
         f"{args.robot}, {args.seeds} seeds"
@@ -236,24 +255,34 @@ def run(args) -> None:
         + (f", trajectory {args.trajectory.name}" if args.trajectory else ", multi-sine")
     )
     head = " ".join(f"{k + ' err/cov':>17}" for k in kinds)
-    print(f"{'joint':<14}{head} {'held-out/noise':>15} {'verdicts (yes/cav/no)':>22}")
+    print(
+        f"{'joint':<14}{head} {'joint cov':>10} {'held-out/noise':>15} "
+        f"{'verdicts (yes/cav/no)':>22}"
+    )
     all_cov = []
     for joint in model.joints:
-        cells = []
+        cells, joint_cov = [], []
         for k in kinds:
             r, c = rel[joint, k], cov[joint, k]
-            all_cov += c
+            joint_cov += c
             cells.append(f"{100 * np.median(r):7.2f}% {100 * np.mean(c):5.0f}%   ")
+        all_cov += joint_cov
         lv = levels[joint]
         counts = f"{lv.count('yes')}/{lv.count('with caveats')}/{lv.count('no')}"
-        print(f"{joint:<14}{' '.join(cells)} {np.mean(ratio[joint]):15.2f} {counts:>22}")
+        print(
+            f"{joint:<14}{' '.join(cells)} {100 * np.mean(joint_cov):9.1f}% "
+            f"{np.mean(ratio[joint]):15.2f} {counts:>22}"
+        )
     print(
         "friction intervals' coverage over all joints and parameters: "
         f"{100 * np.mean(all_cov):.1f} %"
     )
     print(f"base inertial parameters' coverage: {100 * np.mean(base_cov):.1f} % (mean over seeds)")
     print(f"seconds per identification: median {np.median(seconds):.1f}, max {np.max(seconds):.1f}")
-    print("(err: median relative error over seeds; cov: 95 % intervals covering the truth)")
+    print(
+        "(err: median relative error over seeds; cov: 95 % intervals covering the truth; "
+        "joint cov: all the joint's parameters)"
+    )
 
 
 def main() -> None:
@@ -280,6 +309,9 @@ def main() -> None:
         type=float,
         default=SIM_STEP,
         help="--truth sim: the simulator's largest internal step [s]",
+    )
+    parser.add_argument(
+        "--jobs", type=int, default=1, help="seeds identified at once (one process each)"
     )
     run(parser.parse_args())
 
