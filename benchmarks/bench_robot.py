@@ -199,7 +199,7 @@ def _seed(args, seed: int) -> dict:
         laws = _mujoco_laws(model, laws)
     log, held = _logs(model, laws, seed, args, trajectory)
     start = time.perf_counter()
-    window = WINDOW_PERIODS if args.truth != "own" else 0.0  # closed loop
+    window = args.window if args.truth != "own" else 0.0  # closed loop
     fit = fit_arm(log, model, friction=laws[0][0], validate=held, reversal_window=window)
     out = {"seconds": time.perf_counter() - start, "params": [], "joints": {}}
     for joint, (_, values) in zip(fit.joints, laws, strict=True):
@@ -207,11 +207,17 @@ def _seed(args, seed: int) -> dict:
             kind = next(k for k in KINDS if name.startswith(k))
             t = values[name]
             if rec["value"] is None:
-                out["params"].append((joint, kind, None, False))
+                out["params"].append((joint, kind, None, False, float("nan")))
                 continue
-            covered = rec["ci95"][0] <= t <= rec["ci95"][1]
-            out["params"].append((joint, kind, abs(rec["value"] - t) / abs(t), covered))
-        out["joints"][joint] = (fit.validation[joint]["ratio"], fit.validation[joint]["level"])
+            lo, hi = rec["ci95"]
+            z = (rec["value"] - t) / ((hi - lo) / 3.92) if hi > lo else float("nan")
+            out["params"].append((joint, kind, abs(rec["value"] - t) / abs(t), lo <= t <= hi, z))
+        window = fit.provenance.get("windows", {}).get(joint, window)
+        out["joints"][joint] = (
+            fit.validation[joint]["ratio"],
+            fit.validation[joint]["level"],
+            window,
+        )
     ci = fit.base["ci95"]
     out["base"] = float(
         np.mean(
@@ -235,15 +241,17 @@ def run(args) -> None:
         results = [_seed(args, seed) for seed in seeds]
     rel = defaultdict(list)  # (joint, kind) -> relative errors
     cov = defaultdict(list)  # (joint, kind) -> covered
-    ratio, levels = defaultdict(list), defaultdict(list)
+    ratio, levels, zs, windows = (defaultdict(list) for _ in range(4))
     for res in results:
-        for joint, kind, err, covered in res["params"]:
+        for joint, kind, err, covered, z in res["params"]:
             if err is not None:
                 rel[joint, kind].append(err)
             cov[joint, kind].append(covered)
-        for joint, (r, level) in res["joints"].items():
+            zs[joint].append(z)
+        for joint, (r, level, w) in res["joints"].items():
             ratio[joint].append(r)
             levels[joint].append(level)
+            windows[joint].append(w)
     base_cov = [res["base"] for res in results]
     seconds = [res["seconds"] for res in results]
     kinds = [k for k in KINDS if any((j, k) in cov for j in model.joints)]
@@ -256,7 +264,7 @@ def run(args) -> None:
     )
     head = " ".join(f"{k + ' err/cov':>17}" for k in kinds)
     print(
-        f"{'joint':<14}{head} {'joint cov':>10} {'held-out/noise':>15} "
+        f"{'joint':<14}{head} {'joint cov':>10} {'rms z':>6} {'window':>7} {'held-out/noise':>15} "
         f"{'verdicts (yes/cav/no)':>22}"
     )
     all_cov = []
@@ -271,6 +279,7 @@ def run(args) -> None:
         counts = f"{lv.count('yes')}/{lv.count('with caveats')}/{lv.count('no')}"
         print(
             f"{joint:<14}{' '.join(cells)} {100 * np.mean(joint_cov):9.1f}% "
+            f"{np.sqrt(np.nanmean(np.square(zs[joint]))):6.2f} {np.median(windows[joint]):7.2f} "
             f"{np.mean(ratio[joint]):15.2f} {counts:>22}"
         )
     print(
@@ -281,7 +290,9 @@ def run(args) -> None:
     print(f"seconds per identification: median {np.median(seconds):.1f}, max {np.max(seconds):.1f}")
     print(
         "(err: median relative error over seeds; cov: 95 % intervals covering the truth; "
-        "joint cov: all the joint's parameters)"
+        "joint cov: all the joint's parameters; rms z: of (estimate - truth) / (half-width / "
+        "1.96), 1 where the intervals are calibrated; window: the median over seeds of the joint's "
+        "reversal window, periods of the cut-off)"
     )
 
 
@@ -309,6 +320,12 @@ def main() -> None:
         type=float,
         default=SIM_STEP,
         help="--truth sim: the simulator's largest internal step [s]",
+    )
+    parser.add_argument(
+        "--window",
+        type=float,
+        default=WINDOW_PERIODS,
+        help="closed-loop truths: fit_arm's reversal_window [periods of the cut-off]",
     )
     parser.add_argument(
         "--jobs", type=int, default=1, help="seeds identified at once (one process each)"

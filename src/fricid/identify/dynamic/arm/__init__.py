@@ -34,7 +34,10 @@ levels came out 2 to 6 standard errors low, the viscous ones 2 to 5 high, with o
 quantisation and disturbance. Rows within :data:`WINDOW_PERIODS` periods of the cut-off of a
 slow or reversing sample can be left out (``reversal_window``, :func:`_moving`): it removes
 that bias, and in open loop costs the Stribeck rise the rows it is seen on, so it is not the
-default. The IDIM-IV step for the fed-back noise remains undone.
+default. How far a stick's misfit reaches depends on the joint (the wrist's small inertias
+stick longest), so each joint's window then grows from there to where its residuals no longer
+show it (:mod:`._rows`), on the identification log and on the held-out one alike. The
+IDIM-IV step for the fed-back noise remains undone.
 
 The torque's timing: a drive's logged command is held from one sample to the next, so it
 acts half a sample period after the positions it is logged with; on a 5 Hz PD-tracked Panda
@@ -65,7 +68,6 @@ from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
-import scipy.ndimage
 
 from ....errors import DataError
 from ....fitted.arm import ArmFit
@@ -77,19 +79,18 @@ from ._consistent import consistent_parameters
 from ._filter_cov import filter_correlation
 from ._friction import DELTA_BOX, W_S_BOX, friction_for, split_direction
 from ._grade import grade, loose_levels
+from ._rows import MIN_SPEED, VELOCITY_NOISE_FACTOR, adapted_windows, stop_distance
+from ._rows import moving_rows as _moving
 from ._signals import ArmSignals, prepare_signals
 from ._solve import arm_covariance, lstsq, search_shapes, shape_profiles, stack, wls
 
-__all__ = ["HELDOUT_SHARE", "fit_arm"]
+__all__ = ["HELDOUT_SHARE", "MIN_SPEED", "VELOCITY_NOISE_FACTOR", "fit_arm"]
 
 #: The share of a single log held out for validation (its end).
 HELDOUT_SHARE = 0.25
-#: A joint's rows slower than this many times its filtered velocity noise are left out.
-VELOCITY_NOISE_FACTOR = 20.0
-#: ... and never slower than this [rad/s].
-MIN_SPEED = 1e-3
 #: ``reversal_window`` for logs recorded in closed loop: rows this many periods of the
-#: cut-off from a slow or reversing sample are left out (:func:`_moving`).
+#: cut-off from a slow or reversing sample are left out (:func:`_moving`), at least; each
+#: joint's window grows from there (:func:`._rows.adapted_windows`).
 WINDOW_PERIODS = 1.0
 #: The largest torque delay estimated [sample periods] (:func:`_torque_delay`).
 MAX_DELAY = 2.0
@@ -116,33 +117,6 @@ def _signals(log: RobotLog, model, counts, cutoff, stops: bool = False) -> ArmSi
     return prepare_signals(
         t, q, tau, counts=counts, cutoff=cutoff, inertia=inertia, source=log.source, stops=stops
     )
-
-
-def _moving(sig: ArmSignals, window: float = 0.0) -> np.ndarray:
-    """The rows (N, n) each joint's friction law is fitted on: the joint's filtered velocity
-    above its threshold; with ``window > 0``, also without a slow sample or a reversal at the
-    log's rate within ``window`` periods of the cut-off on either side of the row.
-
-    A velocity threshold on the row alone is not enough in closed loop: the low-pass spreads
-    what happens at a reversal (a joint sticking while its drive builds up torque) over about
-    a period of the cut-off on both sides, into rows whose own velocity is well above any
-    threshold; there the columns ``sign(dq_f)`` of the filtered velocity are not the filtered
-    friction of the true motion, and the Coulomb levels came out low and the viscous ones
-    high by several standard errors on arms tracked by a PD. In open loop (no sticking) those
-    rows are right and carry the Stribeck rise, which the window then loses.
-    """
-    if window <= 0:
-        v_min = np.maximum(VELOCITY_NOISE_FACTOR * sig.velocity_noise, MIN_SPEED)
-        return np.abs(sig.dq) >= v_min[None, :]
-    v = sig.full_dq  # the friction's velocity: a stop of some milliseconds shows in it
-    v_min = np.maximum(VELOCITY_NOISE_FACTOR * sig.friction_velocity_noise, MIN_SPEED)
-    near = np.abs(v) < v_min[None, :]
-    flip = np.diff(np.sign(v), axis=0) != 0  # a reversal between two samples
-    near[1:] |= flip
-    near[:-1] |= flip
-    half = int(np.ceil(window * sig.rate / sig.cutoff))
-    near = scipy.ndimage.maximum_filter1d(near.astype(np.uint8), 2 * half + 1, axis=0) > 0
-    return ~near[sig.rows()]
 
 
 def _torque_delay(sig: ArmSignals, Yb, frictions, moving) -> float:
@@ -300,8 +274,9 @@ def _fit_arm(
     reversal_window : float
         Leave out the rows within this many periods of the cut-off of a slow or reversing
         sample (:func:`_moving`; :data:`WINDOW_PERIODS` for a log recorded in closed loop,
-        where the joints stick at their reversals); 0, the default, uses the velocity
-        threshold alone.
+        where the joints stick at their reversals), or more where a joint's residuals show
+        its sticks' misfit farther out (:mod:`._rows`; each joint's window is in the
+        provenance); 0, the default, uses the velocity threshold alone.
     torque_delay : float, optional
         The torque's delay behind the positions [sample periods] (0.5 for a command held
         from one sample to the next); default estimated from the data (:func:`_torque_delay`).
@@ -340,6 +315,15 @@ def _fit_arm(
     sig = undelayed.delayed(torque_delay)
     st = stack(Yb, sig, frictions, moving)
     theta, sigma = wls(st, n)
+    windows = np.full(n, float(reversal_window))
+    if reversal_window > 0:  # each joint's own window, from how far its sticks' misfit reaches
+        every = stack(Yb, sig, frictions, np.ones_like(moving))
+        residual = np.zeros(moving.shape)
+        residual[every.row_time, every.row_joint] = every.y - every.A @ theta
+        windows = adapted_windows(stop_distance(sig), residual, reversal_window)
+        moving = _moving(sig, windows)
+        st = stack(Yb, sig, frictions, moving)
+        theta, sigma = wls(st, n)
     safe = np.where(np.isfinite(sigma) & (sigma > 0), sigma, 1.0)
     if any(jf.stribeck for jf in frictions):
         search_shapes(sig, Yb, frictions, moving, safe)
@@ -397,7 +381,7 @@ def _fit_arm(
         _widen(fric[model.joints[j]]["parameters"], d, prof)
     # held-out validation with the same filter
     vsig = _signals(validate, model, encoder_counts, sig.cutoff, stops).delayed(torque_delay)
-    vmoving = _moving(vsig, reversal_window)
+    vmoving = _moving(vsig, windows)
     pred = _predict(
         model,
         bp,
@@ -407,6 +391,8 @@ def _fit_arm(
         [theta[o : o + len(jf.linear_names)] for o, jf in zip(st.offsets, frictions, strict=True)],
     )
     err = vsig.tau - pred
+    if reversal_window > 0:  # the held-out log's sticks reach as far as its motion makes them
+        vmoving = _moving(vsig, adapted_windows(stop_distance(vsig), err, windows))
     validation = {}
     for j, name in enumerate(model.joints):
         e = err[vmoving[:, j], j]
@@ -450,6 +436,7 @@ def _fit_arm(
             "encoder_step": sig.encoder_step.tolist(),
             "estimator": "IDIM-WLS",
             "reversal_window": float(reversal_window),
+            "windows": {nm: float(w) for nm, w in zip(model.joints, windows, strict=True)},
             "torque_delay": float(torque_delay),
             "samples": int(st.A.shape[0]),
             "effective_samples": {nm: float(x) for nm, x in zip(model.joints, n_eff, strict=True)},
