@@ -18,10 +18,12 @@ amplify rounding differences): the largest position difference [mrad] and the RM
 command differences [N m] (to compare with the 0.05 N m torque noise).
 
 What it showed (``benchmarks/results/robot_sim.txt``; pin 4.1.0, mujoco 4.0.0, 2 cores shared
-at a load average of about 10): 60 s of the Panda cost 10.0 s of CPU (26.9 s wall) with
-fricid's integrator, 13.4 s with LuGre on joint 7, and 2.4 s with MuJoCo; the default 0.5 ms
-step is within 0.4 mrad and 0.002 N m RMS (0.015 N m at most) of 0.1 ms steps, second order
-(1 ms: 1.6 mrad, 0.013 N m RMS).
+with a whole-arm benchmark): 60 s of the Panda cost 16.9 s of CPU (24.2 s wall) with fricid's
+integrator, 21.1 s with LuGre on joint 7, and 4.1 s with MuJoCo (4.1 times MuJoCo's cost, as
+the 10.0 against 2.4 s of an earlier run on a quieter machine with the first-order friction
+step: the theta-method costs the same); the default 0.5 ms step is within 0.5 mrad and
+0.002 N m RMS (0.010 N m at most) of 0.1 ms steps, and 0.25 ms within 0.06 mrad and
+0.0004 N m RMS (with the first-order friction step: 0.16 mrad and 0.0007 N m).
 """
 
 from __future__ import annotations

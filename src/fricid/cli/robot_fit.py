@@ -125,7 +125,9 @@ def robot_fit_command(
                 "within one period of the cut-off of every reversal, where the joint sticks "
                 "while the loop builds torque and the filtered friction columns do not hold "
                 "(measured on a PD-tracked arm: Coulomb levels 4 standard errors low without "
-                "it). Off, those rows carry the Stribeck rise of an open-loop log."
+                "it), up to 1.5 periods for a joint whose residuals show its sticks farther "
+                "out (each joint's window is in the fit file). Off, those rows carry the "
+                "Stribeck rise of an open-loop log."
             ),
         ),
     ] = False,
