@@ -8,13 +8,14 @@ the misfit is depends on the joint: on a PD-tracked Panda (``benchmarks/bench_ro
 --truth sim``, noiseless, the true parameters, seed 0) the residual within half a period of a
 stop was 3 to 5 times the filtered noise on joints 1-4 and 14 to 79 times on the wrist
 (joints 5-7), whose small inertias stick longest under the drive's gains; one period away
-it was still 0.8 to 1.5 times the noise there, and the wrist's friction intervals covered
-the truth 74-84 % of the time (20 seeds) instead of 95 %.
+it was still 0.8 to 1.5 times the noise there, and the friction intervals of joints 5 and 6
+covered the truth 74 and 84 % of the time (20 seeds) instead of 95 %.
 
 So the window is each joint's own (:func:`adapted_windows`): after a first fit with the
 given window, the joint's residuals are binned by their distance from its nearest stop or
-reversal, and the window grows to the nearest distance beyond which no bin's RMS exceeds the
-joint's far residual (beyond :data:`FAR_PERIODS`) by more than :data:`EXCESS`. The held-out
+reversal, and the window grows to the nearest step from which on no bin tested (one
+starting at each step) has an RMS above the joint's far residual (beyond
+:data:`FAR_PERIODS`) by more than :data:`EXCESS`. The held-out
 log is treated alike (its windows at least the fit's): how long a joint sticks depends on the
 motion, and rows within a stick's reach hold the stick, which no friction law predicts.
 
@@ -88,9 +89,9 @@ def moving_rows(sig: ArmSignals, window=0.0) -> np.ndarray:
 def adapted_windows(distance: np.ndarray, residual: np.ndarray, window) -> np.ndarray:
     """Each joint's window (n,) [periods] from its residuals (N, n) on all rows after a fit
     with ``window`` (one value, or one per joint; module notes): the smallest of
-    :data:`WINDOW_STEPS` (at least ``window``) beyond which every bin of :data:`BIN_PERIODS`
-    up to :data:`FAR_PERIODS` has an RMS residual within ``1 +`` :data:`EXCESS` of the far
-    rows'."""
+    :data:`WINDOW_STEPS` (at least ``window``) from which on every bin of :data:`BIN_PERIODS`
+    starting at a step has an RMS residual within ``1 +`` :data:`EXCESS` of the far rows'
+    (beyond :data:`FAR_PERIODS`)."""
     n = residual.shape[1]
     out = np.broadcast_to(np.asarray(window, dtype=float), (n,)).copy()
     for j in range(n):
