@@ -15,13 +15,9 @@ second order; ``benchmarks/bench_robot_sim.py`` measures it):
    trapezoidal rule, second order; on the steep smoothed sign at zero velocity (slope
    ``tau_s / v_eps``, ``z_j`` large) it is Rosenbrock-Euler, L-stable, so the sign neither
    limits the step nor makes the joint chatter. (Rosenbrock-Euler throughout held a sliding
-   joint's friction low by ``h D_j / 2 m_j`` relative: 0.85 % on the Panda's wrist at
-   0.125 ms, which whole-arm fits read as friction levels that low; ``tests/sim/
-   test_robot_sim.py`` measures the steady slide. ROS2, second order and L-stable throughout,
-   was tried: it changed how long the wrist sticks, away from what smaller steps give.)
-   Where a Stribeck fall makes ``z_j < 0``, ``1 + theta_j z_j`` stays within (1/2, 1): the
-   step is never singular. LuGre joints keep ``theta = 1`` (their bristle step is first
-   order);
+   joint's friction low by ``h D_j / 2 m_j``, 0.85 % on the Panda's wrist at 0.125 ms; ROS2
+   changed how long the wrist sticks, unlike smaller steps.) Where a Stribeck fall makes
+   ``z_j < 0``, ``1 + theta_j z_j`` stays in (1/2, 1); LuGre joints keep ``theta = 1``;
 2. the rest, classical Runge-Kutta (RK4) over ``h`` with ``u`` held: 4 ABA calls;
 3. friction over ``h / 2`` again (merged with the next step's first half inside a period).
 
