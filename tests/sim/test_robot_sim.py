@@ -325,6 +325,7 @@ ROTOR = """<robot name="rotor"><link name="base"/>
 </robot>"""
 
 
+@pytest.mark.slow  # two 2 s runs until the PD's transient has died out: 1.9 s
 def test_steady_sliding_torque_is_the_law_at_the_sampled_velocity(tmp_path):
     """A rotor (no gravity) tracking 2 rad/s: the held command equals the friction law at the
     sampled velocity to second order in the step. The linearly implicit Euler step held it
