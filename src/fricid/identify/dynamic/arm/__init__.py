@@ -302,7 +302,8 @@ def _fit_arm(
         log, validate = log.slice(0, cut), log.slice(cut, len(log))
     stops = reversal_window > 0  # recorded in closed loop: the joints stick at reversals
     sig = _signals(log, model, encoder_counts, cutoff, stops)
-    moving = _moving(sig, reversal_window)
+    distance = stop_distance(sig) if reversal_window > 0 else None
+    moving = _moving(sig, reversal_window, distance)
     if not moving.any():
         raise DataError("no joint moves in the log: nothing to identify", file=log.source)
     bp = base_parameters(model)
@@ -320,8 +321,8 @@ def _fit_arm(
         every = stack(Yb, sig, frictions, np.ones_like(moving))
         residual = np.zeros(moving.shape)
         residual[every.row_time, every.row_joint] = every.y - every.A @ theta
-        windows = adapted_windows(stop_distance(sig), residual, reversal_window)
-        moving = _moving(sig, windows)
+        windows = adapted_windows(distance, residual, reversal_window)
+        moving = _moving(sig, windows, distance)
         st = stack(Yb, sig, frictions, moving)
         theta, sigma = wls(st, n)
     safe = np.where(np.isfinite(sigma) & (sigma > 0), sigma, 1.0)
@@ -381,7 +382,8 @@ def _fit_arm(
         _widen(fric[model.joints[j]]["parameters"], d, prof)
     # held-out validation with the same filter
     vsig = _signals(validate, model, encoder_counts, sig.cutoff, stops).delayed(torque_delay)
-    vmoving = _moving(vsig, windows)
+    vdistance = stop_distance(vsig) if reversal_window > 0 else None
+    vmoving = _moving(vsig, windows, vdistance)
     pred = _predict(
         model,
         bp,
@@ -392,7 +394,7 @@ def _fit_arm(
     )
     err = vsig.tau - pred
     if reversal_window > 0:  # the held-out log's sticks reach as far as its motion makes them
-        vmoving = _moving(vsig, adapted_windows(stop_distance(vsig), err, windows))
+        vmoving = _moving(vsig, adapted_windows(vdistance, err, windows), vdistance)
     validation = {}
     for j, name in enumerate(model.joints):
         e = err[vmoving[:, j], j]

@@ -67,7 +67,7 @@ def stop_distance(sig: ArmSignals) -> np.ndarray:
     return out[sig.rows()] * sig.cutoff / sig.rate
 
 
-def moving_rows(sig: ArmSignals, window=0.0) -> np.ndarray:
+def moving_rows(sig: ArmSignals, window=0.0, distance: np.ndarray | None = None) -> np.ndarray:
     """The rows (N, n) each joint's friction law is fitted on: the joint's filtered velocity
     above its threshold; with ``window > 0`` (one value, or one per joint), also at least
     ``window`` periods of the cut-off from a slow sample or a reversal at the log's rate.
@@ -77,13 +77,14 @@ def moving_rows(sig: ArmSignals, window=0.0) -> np.ndarray:
     rows around it, whose own velocity is well above any threshold; there the columns
     ``sign(dq_f)`` are not the filtered friction of the true motion (module notes). In open
     loop (no sticking) those rows are right and carry the Stribeck rise, which the window
-    then loses.
+    then loses. ``distance``: :func:`stop_distance` of ``sig``, when already at hand.
     """
     window = np.broadcast_to(np.asarray(window, dtype=float), (sig.dq.shape[1],))
     if not (window > 0).any():
         v_min = np.maximum(VELOCITY_NOISE_FACTOR * sig.velocity_noise, MIN_SPEED)
         return np.abs(sig.dq) >= v_min[None, :]
-    return stop_distance(sig) >= window[None, :]
+    distance = stop_distance(sig) if distance is None else distance
+    return distance >= window[None, :]
 
 
 def adapted_windows(distance: np.ndarray, residual: np.ndarray, window) -> np.ndarray:
