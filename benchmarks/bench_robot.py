@@ -4,7 +4,7 @@ Usage::
 
     python benchmarks/bench_robot.py [--seeds 10] [--first 0] [--duration 60] [--rate 1000]
         [--noise 0.05] [--friction stribeck_asym] [--trajectory FILE]
-        [--truth own|pd|sim|mujoco] [--jobs 2]
+        [--truth own|pd|sim|mujoco] [--jobs 2] [--cache DIR] [--rows FILE]
 
 Per seed: each joint gets its own friction law per direction (``stribeck_asym``: Coulomb,
 static, Stribeck velocity and exponent, viscous drawn independently per joint and direction),
@@ -40,11 +40,18 @@ mujoco`` is the same drive with MuJoCo stepping the exported MJCF
 alike in both directions (``frictionloss``, ``damping``: each joint's mean levels of the drawn
 law), which is the truth compared against. The closed-loop truths are fitted with
 ``reversal_window=WINDOW_PERIODS`` (rows near reversals left out).
+
+``--cache DIR`` keeps each simulated log (``.npz``: time, position, velocity, torque, named by
+the settings and the seed) and reads it back on a later run with the same settings, so that
+fits are compared on the same logs without simulating them again (at its 0.125 ms step,
+fricid's simulator takes far longer than the fit); ``--rows FILE`` writes every seed's
+parameters (error, coverage, z), held-out ratios and windows as JSON lines.
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import sys
 import time
 from collections import defaultdict
@@ -59,6 +66,7 @@ import _arm_truth as truth  # noqa: E402
 
 from fricid.identify.dynamic.arm import WINDOW_PERIODS, fit_arm  # noqa: E402
 from fricid.robot import RigidBodyModel, base_parameters, example_urdf  # noqa: E402
+from fricid.samples import RobotLog  # noqa: E402
 from fricid.sim.robot import run_robot  # noqa: E402
 from fricid.sim.robot_friction import FRICTION_NAMES, ArmFriction  # noqa: E402
 
@@ -187,6 +195,53 @@ def _logs(model, laws, seed, args, trajectory):
     return one, two
 
 
+def _cached_logs(model, laws, seed, args, trajectory):
+    """:func:`_logs`, kept in ``--cache`` (one ``.npz`` per log: time, position, velocity,
+    torque) and read from there when a run with the same settings made them."""
+    if args.cache is None:
+        return _logs(model, laws, seed, args, trajectory)
+    key = "-".join(
+        str(x)
+        for x in (
+            args.robot,
+            args.truth,
+            args.friction,
+            args.trajectory.stem if args.trajectory else "multisine",
+            args.duration,
+            args.rate,
+            args.noise,
+            args.bandwidth,
+            args.integrator_step,
+            args.disturbance,
+            seed,
+        )
+    )
+    paths = [args.cache / f"{key}-{k}.npz" for k in ("fit", "held")]
+    if all(p.exists() for p in paths):
+        out = []
+        for p in paths:
+            with np.load(p) as z:
+                out.append(
+                    RobotLog(
+                        z["time"],
+                        model.joints,
+                        z["position"],
+                        z["velocity"],
+                        z["torque"],
+                        source=p.name,
+                    )
+                )
+        return tuple(out)
+    logs = _logs(model, laws, seed, args, trajectory)
+    args.cache.mkdir(parents=True, exist_ok=True)
+    for p, log in zip(paths, logs, strict=True):
+        sel = log.select(model.joints)
+        np.savez(
+            p, time=sel.time, position=sel.position, velocity=sel.velocity, torque=sel.motor_torque
+        )
+    return logs
+
+
 def _seed(args, seed: int) -> dict:
     """One seed's identification: per joint and parameter the relative error and whether the
     interval covers the truth, the held-out ratio and verdict, the base coverage, the seconds."""
@@ -197,7 +252,7 @@ def _seed(args, seed: int) -> dict:
     laws = _laws(model, seed, args.friction)
     if args.truth == "mujoco":
         laws = _mujoco_laws(model, laws)
-    log, held = _logs(model, laws, seed, args, trajectory)
+    log, held = _cached_logs(model, laws, seed, args, trajectory)
     start = time.perf_counter()
     window = args.window if args.truth != "own" else 0.0  # closed loop
     fit = fit_arm(log, model, friction=laws[0][0], validate=held, reversal_window=window)
@@ -207,11 +262,13 @@ def _seed(args, seed: int) -> dict:
             kind = next(k for k in KINDS if name.startswith(k))
             t = values[name]
             if rec["value"] is None:
-                out["params"].append((joint, kind, None, False, float("nan")))
+                out["params"].append((joint, kind, None, False, float("nan"), name))
                 continue
             lo, hi = rec["ci95"]
             z = (rec["value"] - t) / ((hi - lo) / 3.92) if hi > lo else float("nan")
-            out["params"].append((joint, kind, abs(rec["value"] - t) / abs(t), lo <= t <= hi, z))
+            out["params"].append(
+                (joint, kind, abs(rec["value"] - t) / abs(t), lo <= t <= hi, z, name)
+            )
         window = fit.provenance.get("windows", {}).get(joint, window)
         out["joints"][joint] = (
             fit.validation[joint]["ratio"],
@@ -239,11 +296,15 @@ def run(args) -> None:
             results = list(pool.map(_seed, [args] * len(seeds), seeds))
     else:
         results = [_seed(args, seed) for seed in seeds]
+    if args.rows:  # every seed's rows, for a closer look
+        with args.rows.open("w") as f:
+            for seed, res in zip(seeds, results, strict=True):
+                f.write(json.dumps({"seed": seed, **res}, default=lambda o: o.item()) + "\n")
     rel = defaultdict(list)  # (joint, kind) -> relative errors
     cov = defaultdict(list)  # (joint, kind) -> covered
     ratio, levels, zs, windows = (defaultdict(list) for _ in range(4))
     for res in results:
-        for joint, kind, err, covered, z in res["params"]:
+        for joint, kind, err, covered, z, _ in res["params"]:
             if err is not None:
                 rel[joint, kind].append(err)
             cov[joint, kind].append(covered)
@@ -330,6 +391,13 @@ def main() -> None:
     parser.add_argument(
         "--jobs", type=int, default=1, help="seeds identified at once (one process each)"
     )
+    parser.add_argument(
+        "--cache",
+        type=Path,
+        default=None,
+        help="keep the simulated logs here and reuse them (fits compared on the same logs)",
+    )
+    parser.add_argument("--rows", type=Path, default=None, help="every seed's rows (JSON lines)")
     run(parser.parse_args())
 
 
