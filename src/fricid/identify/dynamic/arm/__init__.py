@@ -36,8 +36,11 @@ slow or reversing sample can be left out (``reversal_window``, :func:`_moving`):
 that bias, and in open loop costs the Stribeck rise the rows it is seen on, so it is not the
 default. How far a stick's misfit reaches depends on the joint (the wrist's small inertias
 stick longest), so each joint's window then grows from there to where its residuals no longer
-show it (:mod:`._rows`), on the identification log and on the held-out one alike. The
-IDIM-IV step for the fed-back noise remains undone.
+show it (:mod:`._rows`), on the identification log and on the held-out one alike. Beyond the
+window the stick's tail remains, small but in the direction of the friction columns: each
+stop gets two nuisance columns that take it (:mod:`._sticks`, projected out of the joint's
+rows), in the fit and in the held-out error. The IDIM-IV step for the fed-back noise remains
+undone.
 
 The torque's timing: a drive's logged command is held from one sample to the next, so it
 acts half a sample period after the positions it is logged with; on a 5 Hz PD-tracked Panda
@@ -65,6 +68,7 @@ from __future__ import annotations
 
 import time as _time
 from collections.abc import Mapping
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -79,10 +83,25 @@ from ._consistent import consistent_parameters
 from ._filter_cov import filter_correlation
 from ._friction import DELTA_BOX, W_S_BOX, friction_for, split_direction
 from ._grade import grade, loose_levels
-from ._rows import MIN_SPEED, VELOCITY_NOISE_FACTOR, adapted_windows, stop_distance
+from ._rows import (
+    MIN_SPEED,
+    VELOCITY_NOISE_FACTOR,
+    adapted_windows,
+    near_stops,
+    stop_distance,
+)
 from ._rows import moving_rows as _moving
 from ._signals import ArmSignals, prepare_signals
-from ._solve import arm_covariance, lstsq, search_shapes, shape_profiles, stack, wls
+from ._solve import (
+    arm_covariance,
+    friction_block,
+    lstsq,
+    search_shapes,
+    shape_profiles,
+    stack,
+    wls,
+)
+from ._sticks import project_out, stick_columns
 
 __all__ = ["HELDOUT_SHARE", "MIN_SPEED", "VELOCITY_NOISE_FACTOR", "fit_arm"]
 
@@ -126,7 +145,8 @@ def _torque_delay(sig: ArmSignals, Yb, frictions, moving) -> float:
     one sample to the next (a drive's logged set point) acts half a period after its sample
     (``a = 0.5``); a torque measured at the sample instants has none."""
     st = stack(Yb, sig, frictions, moving)
-    x = lstsq(np.column_stack([st.A, sig.dtau[st.row_time, st.row_joint]]), st.y)
+    dtau = st.residualise(sig.dtau[st.row_time, st.row_joint])
+    x = lstsq(np.column_stack([st.A, dtau]), st.y)
     return float(np.clip(x[-1], -MAX_DELAY, MAX_DELAY))
 
 
@@ -302,7 +322,11 @@ def _fit_arm(
         log, validate = log.slice(0, cut), log.slice(cut, len(log))
     stops = reversal_window > 0  # recorded in closed loop: the joints stick at reversals
     sig = _signals(log, model, encoder_counts, cutoff, stops)
-    distance = stop_distance(sig) if reversal_window > 0 else None
+    distance = None
+    if reversal_window > 0:  # each stop's stick left to its own columns (._sticks)
+        near = near_stops(sig)
+        distance = stop_distance(sig, near)
+        sig = replace(sig, stick=stick_columns(sig, near))
     moving = _moving(sig, reversal_window, distance)
     if not moving.any():
         raise DataError("no joint moves in the log: nothing to identify", file=log.source)
@@ -321,7 +345,9 @@ def _fit_arm(
         every = stack(Yb, sig, frictions, np.ones_like(moving))
         residual = np.zeros(moving.shape)
         residual[every.row_time, every.row_joint] = every.y - every.A @ theta
-        windows = adapted_windows(distance, residual, reversal_window)
+        rho = filter_correlation(sig)
+        columns = [friction_block(sig, jf, j) for j, jf in enumerate(frictions)]
+        windows = adapted_windows(distance, residual, reversal_window, columns, rho)
         moving = _moving(sig, windows, distance)
         st = stack(Yb, sig, frictions, moving)
         theta, sigma = wls(st, n)
@@ -349,7 +375,7 @@ def _fit_arm(
             [j for j, f in enumerate(frictions) if f.stribeck], shape_cols, strict=True
         ):
             rows = st.row_joint == j
-            extra[rows, col : col + c.shape[1]] = c[st.row_time[rows]] / safe[j]
+            extra[rows, col : col + c.shape[1]] = st.project(j, c[st.row_time[rows]]) / safe[j]
             col += c.shape[1]
         J = np.hstack([A, extra])
     cov, se, t, clusters, corr_len, n_eff = arm_covariance(J, res, st, n, filter_correlation(sig))
@@ -382,7 +408,10 @@ def _fit_arm(
         _widen(fric[model.joints[j]]["parameters"], d, prof)
     # held-out validation with the same filter
     vsig = _signals(validate, model, encoder_counts, sig.cutoff, stops).delayed(torque_delay)
-    vdistance = stop_distance(vsig) if reversal_window > 0 else None
+    vdistance = vstick = None
+    if reversal_window > 0:
+        vnear = near_stops(vsig)
+        vdistance, vstick = stop_distance(vsig, vnear), stick_columns(vsig, vnear)
     vmoving = _moving(vsig, windows, vdistance)
     pred = _predict(
         model,
@@ -393,12 +422,17 @@ def _fit_arm(
         [theta[o : o + len(jf.linear_names)] for o, jf in zip(st.offsets, frictions, strict=True)],
     )
     err = vsig.tau - pred
-    if reversal_window > 0:  # the held-out log's sticks reach as far as its motion makes them
-        vmoving = _moving(vsig, adapted_windows(vdistance, err, windows), vdistance)
+    if vstick is not None:  # the held-out log's sticks reach as far as its motion makes them
+        free = np.column_stack([project_out(err[:, j], vstick[j])[0] for j in range(n)])
+        vcolumns = [friction_block(vsig, jf, j) for j, jf in enumerate(frictions)]
+        vwindows = adapted_windows(vdistance, free, windows, vcolumns, filter_correlation(vsig))
+        vmoving = _moving(vsig, vwindows, vdistance)
     validation = {}
     for j, name in enumerate(model.joints):
-        e = err[vmoving[:, j], j]
-        rmse = float(np.sqrt(np.mean(e**2))) if e.size else float("nan")
+        e, lost = err[vmoving[:, j], j], 0
+        if vstick is not None:  # what no friction law predicts, as in the fit (._sticks)
+            e, lost = project_out(e, vstick[j][vmoving[:, j]])
+        rmse = float(np.sqrt(e @ e / max(e.size - lost, 1))) if e.size else float("nan")
         ratio = rmse / sigma[j] if np.isfinite(sigma[j]) and sigma[j] > 0 else float("nan")
         recs = fric[name]["parameters"]
         nd = [p for p, rec in recs.items() if rec["not_determined"]]
@@ -439,6 +473,7 @@ def _fit_arm(
             "estimator": "IDIM-WLS",
             "reversal_window": float(reversal_window),
             "windows": {nm: float(w) for nm, w in zip(model.joints, windows, strict=True)},
+            "stick_columns": {nm: st.lost(j) for j, nm in enumerate(model.joints)},
             "torque_delay": float(torque_delay),
             "samples": int(st.A.shape[0]),
             "effective_samples": {nm: float(x) for nm, x in zip(model.joints, n_eff, strict=True)},

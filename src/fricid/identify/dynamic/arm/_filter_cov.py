@@ -28,19 +28,26 @@ import numpy as np
 from ...static.uncertainty import covariance_svd
 from ._signals import ArmSignals, _filt
 
-__all__ = ["filter_correlation", "filter_covariance"]
+__all__ = ["filter_correlation", "filter_covariance", "impulse_response"]
 
 #: The impulse response is taken over this many periods of the cut-off on each side.
 SUPPORT_PERIODS = 20.0
 
 
-def filter_correlation(sig: ArmSignals) -> np.ndarray:
-    """``rho[k]``: the correlation of white noise through the torque's filters between two
-    rows ``k`` decimated instants apart (module notes); zero beyond the returned length."""
+def impulse_response(sig: ArmSignals) -> np.ndarray:
+    """The torque's filters' response (2 half + 1,) at the log's rate to a unit sample at
+    ``half`` (:data:`SUPPORT_PERIODS` periods of the cut-off each side): what a sample of the
+    log adds to the filtered samples about it, before decimation."""
     half = int(np.ceil(SUPPORT_PERIODS * sig.rate / sig.cutoff))
     impulse = np.zeros((2 * half + 1, 1))
     impulse[half] = 1.0
-    h = _filt(sig.anti_alias, _filt(sig.low_pass, impulse))[:, 0]
+    return _filt(sig.anti_alias, _filt(sig.low_pass, impulse))[:, 0]
+
+
+def filter_correlation(sig: ArmSignals) -> np.ndarray:
+    """``rho[k]``: the correlation of white noise through the torque's filters between two
+    rows ``k`` decimated instants apart (module notes); zero beyond the returned length."""
+    h = impulse_response(sig)
     R = np.correlate(h, h, mode="full")[h.size - 1 :]
     rho = R[:: sig.decimation] / R[0]
     below = np.flatnonzero(np.abs(rho) < 1e-6)
@@ -54,9 +61,11 @@ def filter_covariance(
     row_time: np.ndarray,
     n: int,
     rho: np.ndarray,
+    lost: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """(cov, stderr) of the weighted problem ``J`` with residuals ``res`` (module notes); NaN
-    where the data do not determine a parameter."""
+    where the data do not determine a parameter. ``lost``: each joint's degrees of freedom
+    taken by columns projected out of its rows (:mod:`._sticks`)."""
     m, p = J.shape
     bread, determined = covariance_svd(J, 1.0)
     bread = np.nan_to_num(bread)
@@ -74,7 +83,8 @@ def filter_covariance(
         for k in range(1, min(rho.size, T)):
             gamma = X[k:].T @ X[:-k]
             block += rho[k] * (gamma + gamma.T)
-        s2 = float(res[rows] @ res[rows]) / max(m_j - p * m_j / m, 1.0)
+        dof = m_j - p * m_j / m - (0 if lost is None else lost[j])
+        s2 = float(res[rows] @ res[rows]) / max(dof, 1.0)
         meat[np.ix_(cols, cols)] += s2 * block
     cov = bread @ meat @ bread
     cov[~determined, :] = np.nan

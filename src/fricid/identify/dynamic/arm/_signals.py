@@ -131,6 +131,8 @@ class ArmSignals:
     dtau: np.ndarray | None = None
     #: the position at the log's rate through the regressor's wide low-pass (:meth:`regressor`)
     wide_position: np.ndarray | None = None
+    #: each joint's stick columns at the kept rows (:mod:`._sticks`), where the joints stick
+    stick: tuple[np.ndarray, ...] | None = None
 
     def delayed(self, samples: float) -> ArmSignals:
         """These signals with the torque read ``samples`` sample periods earlier, ``tau(t -

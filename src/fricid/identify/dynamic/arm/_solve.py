@@ -39,7 +39,7 @@ no law of velocity says, and the low-pass spreads a reversal over its neighbours
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.stats
@@ -48,6 +48,7 @@ from ...static.uncertainty import covariance_svd, floored_covariance
 from ._filter_cov import filter_covariance
 from ._friction import DELTA_BOX, W_S_BOX, JointFriction
 from ._signals import ArmSignals
+from ._sticks import stick_basis
 
 __all__ = ["Stack", "arm_covariance", "search_shapes", "shape_profiles", "stack", "wls"]
 
@@ -72,7 +73,8 @@ NEWTON_ITERATIONS = 30
 
 @dataclass
 class Stack:
-    """The stacked regression (module notes)."""
+    """The stacked regression (module notes), each joint's rows with its stick columns
+    (:mod:`._sticks`) projected out."""
 
     A: np.ndarray  # (m, p) unweighted
     y: np.ndarray  # (m,)
@@ -80,10 +82,30 @@ class Stack:
     row_time: np.ndarray  # (m,) index of the decimated instant
     offsets: list[int]  # first friction column of each joint
     n_base: int
+    #: each joint's orthonormal basis of its stick columns on its rows (or None)
+    bases: list[np.ndarray | None] = field(default_factory=list)
 
     def weighted(self, sigma: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         w = 1.0 / sigma[self.row_joint]
         return self.A * w[:, None], self.y * w
+
+    def lost(self, j: int) -> int:
+        """The degrees of freedom joint ``j``'s stick columns take."""
+        Q = self.bases[j] if j < len(self.bases) else None
+        return 0 if Q is None else Q.shape[1]
+
+    def project(self, j: int, X: np.ndarray) -> np.ndarray:
+        """``X`` (rows of joint ``j``, in the stack's order) with its stick columns out."""
+        Q = self.bases[j] if j < len(self.bases) else None
+        return X if Q is None else X - Q @ (Q.T @ X)
+
+    def residualise(self, X: np.ndarray) -> np.ndarray:
+        """``X`` (the stack's rows) with each joint's stick columns out."""
+        out = np.array(X, dtype=float, copy=True)
+        for j in range(len(self.bases)):
+            rows = np.flatnonzero(self.row_joint == j)
+            out[rows] = self.project(j, out[rows])
+        return out
 
 
 def friction_block(sig: ArmSignals, jf: JointFriction, j: int) -> np.ndarray:
@@ -94,7 +116,8 @@ def friction_block(sig: ArmSignals, jf: JointFriction, j: int) -> np.ndarray:
 def stack(
     Yb: np.ndarray, sig: ArmSignals, frictions: list[JointFriction], mask: np.ndarray
 ) -> Stack:
-    """Stack ``Yb`` (N, n, r) and the friction columns on the rows ``mask`` (N, n) keeps."""
+    """Stack ``Yb`` (N, n, r) and the friction columns on the rows ``mask`` (N, n) keeps,
+    each joint's stick columns (``sig.stick``) projected out of its rows."""
     N, n, r = Yb.shape
     widths = [len(jf.linear_names) for jf in frictions]
     offsets = list(r + np.concatenate([[0], np.cumsum(widths)[:-1]]).astype(int))
@@ -103,7 +126,14 @@ def stack(
     for j, jf in enumerate(frictions):
         A[:, j, offsets[j] : offsets[j] + widths[j]] = friction_block(sig, jf, j)
     t_idx, j_idx = np.nonzero(mask)
-    return Stack(A[t_idx, j_idx], sig.tau[t_idx, j_idx], j_idx, t_idx, offsets, r)
+    st = Stack(A[t_idx, j_idx], sig.tau[t_idx, j_idx], j_idx, t_idx, offsets, r)
+    if sig.stick is not None:
+        st.bases = [
+            stick_basis(sig.stick[j][t_idx[j_idx == j]]) if (j_idx == j).any() else None
+            for j in range(n)
+        ]
+        st.A, st.y = st.residualise(st.A), st.residualise(st.y)
+    return st
 
 
 def lstsq(A: np.ndarray, y: np.ndarray) -> np.ndarray:
@@ -122,7 +152,7 @@ def noise(st: Stack, theta: np.ndarray, n: int) -> np.ndarray:
     for j in range(n):
         rj = res[st.row_joint == j]
         if rj.size:
-            out[j] = np.sqrt(rj @ rj / max(rj.size * (1 - p / m), 1.0))
+            out[j] = np.sqrt(rj @ rj / max(rj.size * (1 - p / m) - st.lost(j), 1.0))
     return out
 
 
@@ -179,7 +209,8 @@ def _block_gains(sig, Yb, frictions, mask, sigma, j, k, d):
         out, coef = np.empty(np.size(w)), np.empty(np.size(w))
         for s in range(0, out.size, CHUNK):  # bounded memory: CHUNK full-rate columns
             cols = _candidates(sig, jf, j, d, w[s : s + CHUNK], e[s : s + CHUNK])
-            out[s : s + CHUNK], coef[s : s + CHUNK] = gain(cols[t_rows] / sigma[j], True)
+            x = st.project(j, cols[t_rows]) / sigma[j]
+            out[s : s + CHUNK], coef[s : s + CHUNK] = gain(x, True)
         return (out, coef) if coefficients else out
 
     return gains
@@ -346,7 +377,8 @@ def arm_covariance(J: np.ndarray, res: np.ndarray, st: Stack, n: int, rho: np.nd
     T = int(st.row_time.max()) + 1
     clusters = max(T // (lags + 1), 2)
     _, se_h = hac_covariance(J, res, st.row_time, lags)
-    cov, se = filter_covariance(J, res, st.row_joint, st.row_time, n, rho)
+    lost = np.array([st.lost(j) for j in range(n)])
+    cov, se = filter_covariance(J, res, st.row_joint, st.row_time, n, rho, lost)
     z = float(scipy.stats.norm.ppf(0.975))
     t_h = float(scipy.stats.t.ppf(0.975, clusters - 1))
     with np.errstate(invalid="ignore", divide="ignore"):
