@@ -44,7 +44,8 @@ law), which is the truth compared against. The closed-loop truths are fitted wit
 ``--cache DIR`` keeps each simulated log (``.npz``: time, position, velocity, torque, named by
 the settings and the seed) and reads it back on a later run with the same settings, so that
 fits are compared on the same logs without simulating them again (at its 0.125 ms step,
-fricid's simulator takes far longer than the fit); ``--rows FILE`` writes every seed's
+fricid's simulator takes far longer than the fit; the names do not say which version of the
+simulator made a log: empty the folder after changing it); ``--rows FILE`` writes every seed's
 parameters (error, coverage, z), held-out ratios and windows as JSON lines.
 """
 
@@ -275,6 +276,12 @@ def _seed(args, seed: int) -> dict:
             fit.validation[joint]["level"],
             window,
         )
+    limit = model.effort_limit
+    out["overload"] = [
+        kind
+        for kind, lg in (("fit", log), ("held-out", held))
+        if np.any(np.abs(lg.select(model.joints).motor_torque) > limit)
+    ]
     ci = fit.base["ci95"]
     out["base"] = float(
         np.mean(
@@ -325,7 +332,8 @@ def run(args) -> None:
     )
     head = " ".join(f"{k + ' err/cov':>17}" for k in kinds)
     print(
-        f"{'joint':<14}{head} {'joint cov':>10} {'rms z':>6} {'window':>7} {'held-out/noise':>15} "
+        f"{'joint':<14}{head} {'joint cov':>10} {'rms z':>6} {'window':>7} "
+        f"{'held-out/noise (median)':>24} "
         f"{'verdicts (yes/cav/no)':>22}"
     )
     all_cov = []
@@ -341,7 +349,7 @@ def run(args) -> None:
         print(
             f"{joint:<14}{' '.join(cells)} {100 * np.mean(joint_cov):9.1f}% "
             f"{np.sqrt(np.nanmean(np.square(zs[joint]))):6.2f} {np.median(windows[joint]):7.2f} "
-            f"{np.mean(ratio[joint]):15.2f} {counts:>22}"
+            f"{np.mean(ratio[joint]):15.2f} ({np.median(ratio[joint]):5.2f}) {counts:>22}"
         )
     print(
         "friction intervals' coverage over all joints and parameters: "
@@ -349,11 +357,17 @@ def run(args) -> None:
     )
     print(f"base inertial parameters' coverage: {100 * np.mean(base_cov):.1f} % (mean over seeds)")
     print(f"seconds per identification: median {np.median(seconds):.1f}, max {np.max(seconds):.1f}")
+    over = [f"{s} {k}" for s, res in zip(seeds, results, strict=True) for k in res["overload"]]
+    print(
+        "logs whose torque exceeds the URDF's effort limits (a drive cannot give it: the truth's "
+        f"controller unstable there): {', '.join(over) or 'none'}"
+    )
     print(
         "(err: median relative error over seeds; cov: 95 % intervals covering the truth; "
         "joint cov: all the joint's parameters; rms z: of (estimate - truth) / (half-width / "
         "1.96), 1 where the intervals are calibrated; window: the median over seeds of the joint's "
-        "reversal window, periods of the cut-off)"
+        "reversal window, periods of the cut-off; held-out/noise: the mean over seeds and the "
+        "median)"
     )
 
 
