@@ -17,6 +17,12 @@ indicator of the stop and a centred ramp over it, through the torque's filters
 joint's rows (Frisch-Waugh-Lovell: the estimate and its sandwich covariance are those of the
 regression with the columns in it; :class:`._solve.Stack`). They cost each joint a degree of
 freedom per column, which its noise estimate counts.
+
+Measured on the same logs with and without them (``benchmarks/results/robot.txt``, blocks 1
+and 1b, 4 and 4b): on MuJoCo (100 seeds) the intervals of joints 5 and 6 covered 94.5 and
+94.8 % instead of 89.0 and 90.5 %, on fricid's simulator (40 seeds) joint 6's 95.0 % instead
+of 85.0 %; the price is precision where the stops are many (joint 1's viscous coefficient
+0.35-0.37 % off in the median instead of 0.18-0.21 %).
 """
 
 from __future__ import annotations
