@@ -203,30 +203,6 @@ def test_default_gains_keep_the_panda_loop_stable():
     assert (kp > 0).all()
 
 
-def test_the_default_gains_hold_where_the_panda_s_joints_1_and_3_align():
-    """Joint 2 swept from -0.9 rad through zero (joints 1 and 3 aligned there), the others
-    held: gains for the inertia at the start drive the loop unstable, to torques no drive
-    gives; the default gains, for the least inertia along the reference, track it."""
-    model = arm("panda")
-    start = np.array([-0.828, -0.907, -0.136, -1.681, 0.878, 1.936, 0.005])
-    t = np.arange(2500) / 1000.0
-    s = np.clip((t - 0.2) / 2.0, 0.0, 1.0)  # 0 to 1 over 2 s, from rest
-    shape, speed = 3 * s**2 - 2 * s**3, 6 * s * (1 - s) / 2.0
-    q = np.tile(start, (t.size, 1))
-    dq, ddq = np.zeros_like(q), np.zeros_like(q)
-    q[:, 1] += 1.2 * shape
-    dq[:, 1] = 1.2 * speed
-    ddq[:, 1] = np.gradient(dq[:, 1], t)
-
-    def run(gains):
-        options = {"duration": 2.5, "controller": "pd", "feedforward": True, "gains": gains}
-        log = run_robot(model, lambda _t: (q, dq, ddq), None, torque_noise=0.0, **options).log
-        return np.abs(log.select(model.joints).motor_torque).max(axis=0)
-
-    assert (run(default_gains(model, start)) > model.effort_limit).any()
-    assert (run(None) < model.effort_limit).all()
-
-
 def test_sweeps_show_the_coupled_gravity_of_the_whole_arm():
     """Constant-velocity sweeps of the double pendulum's first joint, the second held: on the
     plateaus the noiseless torque of the moving joint minus its friction is the rigid-body

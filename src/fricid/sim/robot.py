@@ -32,7 +32,7 @@ position is quantised in the same steps, read as metres. Controllers:
 
 - ``"pd"``: ``u = Kp (q_r - q_m) + Kd (dq_r - dq_m)`` (+ the model's inverse dynamics of the
   reference with ``feedforward=True``), gains by default for a ``bandwidth`` [Hz] and damping
-  ratio 1 on the least inertia each joint meets along the reference (:func:`default_gains`);
+  ratio 1 on the inertia each joint meets at ``q_0`` (:func:`default_gains`);
 - ``"torque"``: computed torque, ``u = ID(q_m, dq_m, ddq_r + w^2 e + 2 w de)``, ``w = 2 pi
   bandwidth``;
 - ``"none"``: ``u = 0`` (the arm falls freely; tests of the integrator).
@@ -137,17 +137,16 @@ def quantise(position, counts: int) -> np.ndarray:
 def default_gains(
     model: RigidBodyModel, q0, bandwidth: float = 5.0, damping: float = 1.0
 ) -> tuple[np.ndarray, np.ndarray]:
-    """PD gains ``Kp = m_j w^2``, ``Kd = 2 zeta m_j w``, ``w = 2 pi bandwidth``, at ``q0``
-    (a configuration, or one per row). ``m_j = 1 / (M^-1)_jj`` is the inertia joint ``j``
-    meets with the other joints free, not ``M_jj``: on the Panda (joints 1 and 3 nearly
-    aligned) gains from ``M_jj`` give ``M^-1 Kd`` eigenvalues of thousands per second, which a
-    1 kHz drive loop cannot hold. Over several configurations, the least: ``diag(m) M^-1`` has
-    a diagonal of at most 1 at each (gains for the start alone drove a Panda to 14,000 N m).
+    """PD gains ``Kp = m_j w^2``, ``Kd = 2 zeta m_j w``, ``w = 2 pi bandwidth``, at ``q0``.
+
+    ``m_j = 1 / (M^-1)_jj`` is the inertia joint ``j`` meets with the other joints free, not
+    ``M_jj``: on an arm whose joints 1 and 3 are nearly aligned (the Panda's), gains from
+    ``M_jj`` give ``M^-1 Kd`` eigenvalues of thousands per second, and a 1 kHz drive loop
+    with them is unstable.
     """
     if not (bandwidth > 0 and damping > 0):
         raise ConfigError(f"bandwidth and damping must be > 0; got {bandwidth}, {damping}")
-    M_inv = np.linalg.inv(model.mass_matrix(np.atleast_2d(np.asarray(q0, dtype=float))))
-    m = 1.0 / np.diagonal(M_inv, axis1=1, axis2=2).max(axis=0)
+    m = 1.0 / np.diag(np.linalg.inv(model.mass_matrix(np.asarray(q0, dtype=float))[0]))
     w = 2.0 * math.pi * bandwidth
     return m * w**2, 2.0 * damping * m * w
 
@@ -309,7 +308,10 @@ def _drive(model, controller, gains, q0, v0, rate, counts, bandwidth, velocity_f
         raise ConfigError(f"controller must be one of {CONTROLLERS}; got {controller!r}")
     if not (isinstance(counts, int | np.integer) and counts >= 2):
         raise ConfigError(f"encoder_counts must be an integer >= 2; got {counts!r}")
-    kp, kd = (_per_joint(g, model.n, "gains") for g in gains)
+    if gains is None:
+        kp, kd = default_gains(model, q0, bandwidth)
+    else:
+        kp, kd = (_per_joint(g, model.n, "gains") for g in gains)
     if not velocity_filter > 0:
         raise ConfigError(f"velocity_filter must be > 0 Hz; got {velocity_filter!r}")
     alpha = 1.0 - math.exp(-2.0 * math.pi * velocity_filter / rate)
@@ -410,8 +412,6 @@ def run_robot(
     ff = np.zeros((count, n))
     if feedforward and controller == "pd":
         ff = model.inverse_dynamics(*ref)
-    if gains is None:  # for the least inertia each joint meets along the reference
-        gains = default_gains(model, np.vstack([q, ref[0][:: max(1, count // 500)]]), bandwidth)
     drive = _drive(model, controller, gains, q, v, rate, encoder_counts, bandwidth, velocity_filter)
     if plant is None:
         bristles = LuGreBristles(model.joints, lugre) if lugre else None
