@@ -341,11 +341,11 @@ def _fit_arm(
     st = stack(Yb, sig, frictions, moving)
     theta, sigma = wls(st, n)
     windows = np.full(n, float(reversal_window))
+    rho = filter_correlation(sig)  # the filters' own correlation of the rows
     if reversal_window > 0:  # each joint's own window, from how far its sticks' misfit reaches
         every = stack(Yb, sig, frictions, np.ones_like(moving))
         residual = np.zeros(moving.shape)
         residual[every.row_time, every.row_joint] = every.y - every.A @ theta
-        rho = filter_correlation(sig)
         columns = [friction_block(sig, jf, j) for j, jf in enumerate(frictions)]
         windows = adapted_windows(distance, residual, reversal_window, columns, rho)
         moving = _moving(sig, windows, distance)
@@ -378,7 +378,7 @@ def _fit_arm(
             extra[rows, col : col + c.shape[1]] = st.project(j, c[st.row_time[rows]]) / safe[j]
             col += c.shape[1]
         J = np.hstack([A, extra])
-    cov, se, t, clusters, corr_len, n_eff = arm_covariance(J, res, st, n, filter_correlation(sig))
+    cov, se, t, clusters, corr_len, n_eff = arm_covariance(J, res, st, n, rho)
     r = bp.rank
     beta_ls = theta[:r]
     standard: dict[str, Any] = {"names": list(model.parameter_names)}

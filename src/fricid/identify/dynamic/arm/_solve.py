@@ -89,14 +89,17 @@ class Stack:
         w = 1.0 / sigma[self.row_joint]
         return self.A * w[:, None], self.y * w
 
+    def _basis(self, j: int) -> np.ndarray | None:
+        return self.bases[j] if j < len(self.bases) else None
+
     def lost(self, j: int) -> int:
         """The degrees of freedom joint ``j``'s stick columns take."""
-        Q = self.bases[j] if j < len(self.bases) else None
+        Q = self._basis(j)
         return 0 if Q is None else Q.shape[1]
 
     def project(self, j: int, X: np.ndarray) -> np.ndarray:
         """``X`` (rows of joint ``j``, in the stack's order) with its stick columns out."""
-        Q = self.bases[j] if j < len(self.bases) else None
+        Q = self._basis(j)
         return X if Q is None else X - Q @ (Q.T @ X)
 
     def residualise(self, X: np.ndarray) -> np.ndarray:

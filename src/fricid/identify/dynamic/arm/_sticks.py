@@ -6,7 +6,7 @@ low-pass spreads that misfit over the rows about the stop (:mod:`._rows`), and t
 beyond the reversal window still hold its tail: on MuJoCo's stepping of the exported Panda
 (``benchmarks/bench_robot.py --truth mujoco``, tuning seeds 50-61) the Coulomb levels of
 joints 4 and 5 came out about one standard error high on average, their intervals covering
-83-85 % instead of 95 %, and a window of 1.5 periods for every joint removed that bias.
+83 % instead of 95 %, and a window of 1.5 periods for every joint removed that bias.
 
 Seen from a row a period of the cut-off or more away, a stick of some tens of milliseconds
 is nearly an impulse: the filtered misfit there is the filter's response to the misfit's
