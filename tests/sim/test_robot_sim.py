@@ -14,6 +14,7 @@ from fricid.errors import ConfigError
 from fricid.models import get_model
 from fricid.robot import RigidBodyModel, example_urdf
 from fricid.sim.robot import _pin_calls, default_gains, quantise, run_robot, simulate_robot
+from fricid.sim.robot_drive import STABLE_DAMPING
 from fricid.sim.robot_friction import ArmFriction, example_friction
 from fricid.sim.robot_reference import FourierTrajectory, random_fourier, sweep_reference
 
@@ -201,6 +202,45 @@ def test_default_gains_keep_the_panda_loop_stable():
     rate = np.linalg.eigvals(np.linalg.solve(model.mass_matrix(q0)[0], np.diag(kd))).real
     assert rate.max() * 1e-3 < 0.5
     assert (kp > 0).all()
+
+
+def test_the_default_gains_hold_where_the_panda_s_joints_1_and_3_align():
+    """Joint 2 swept from -0.9 rad through zero (joints 1 and 3 aligned there), the others
+    held: gains for the inertia at the start drive the loop unstable, to torques no drive
+    gives; the default gains, lowered where the inertia along the reference falls, track it
+    (and stay within the sampled loop's bound there)."""
+    model = arm("panda")
+    start = np.array([-0.828, -0.907, -0.136, -1.681, 0.878, 1.936, 0.005])
+    t = np.arange(2500) / 1000.0
+    s = np.clip((t - 0.2) / 2.0, 0.0, 1.0)  # 0 to 1 over 2 s, from rest
+    shape, speed = 3 * s**2 - 2 * s**3, 6 * s * (1 - s) / 2.0
+    q = np.tile(start, (t.size, 1))
+    dq, ddq = np.zeros_like(q), np.zeros_like(q)
+    q[:, 1] += 1.2 * shape
+    dq[:, 1] = 1.2 * speed
+    ddq[:, 1] = np.gradient(dq[:, 1], t)
+
+    def run(gains):
+        options = {"duration": 2.5, "controller": "pd", "feedforward": True, "gains": gains}
+        log = run_robot(model, lambda _t: (q, dq, ddq), None, torque_noise=0.0, **options).log
+        return np.abs(log.select(model.joints).motor_torque).max(axis=0)
+
+    assert (run(default_gains(model, start)) > model.effort_limit).any()
+    assert (run(None) < model.effort_limit).all()
+    kp, kd = default_gains(model, start, path=q, rate=1000.0)
+    reach = np.diagonal(np.linalg.inv(model.mass_matrix(q)), axis1=1, axis2=2).max(axis=0)
+    assert (kd * reach / 1000.0 <= STABLE_DAMPING + 1e-9).all()
+    assert np.allclose(kp / kd, default_gains(model, start)[0] / default_gains(model, start)[1])
+
+
+def test_the_default_gains_stay_where_the_inertia_barely_changes():
+    """The double pendulum's inertia varies by a quarter along its reference: far from the
+    sampled loop's bound, its gains are those of the start (lower ones let its joint 2 stick)."""
+    model = arm("double_pendulum")
+    t = np.arange(4000) / 1000.0
+    q = np.column_stack([0.3 * np.sin(t), 0.5 + 0.4 * np.sin(1.3 * t)])
+    along, start = default_gains(model, q[0], path=q, rate=1000.0), default_gains(model, q[0])
+    np.testing.assert_array_equal(np.array(along), np.array(start))
 
 
 def test_sweeps_show_the_coupled_gravity_of_the_whole_arm():

@@ -32,7 +32,8 @@ position is quantised in the same steps, read as metres. Controllers:
 
 - ``"pd"``: ``u = Kp (q_r - q_m) + Kd (dq_r - dq_m)`` (+ the model's inverse dynamics of the
   reference with ``feedforward=True``), gains by default for a ``bandwidth`` [Hz] and damping
-  ratio 1 on the inertia each joint meets at ``q_0`` (:func:`default_gains`);
+  ratio 1 on the inertia each joint meets at ``q_0``, lowered on a joint whose inertia along
+  the reference falls so far that the sampled loop would ring (:mod:`fricid.sim.robot_drive`);
 - ``"torque"``: computed torque, ``u = ID(q_m, dq_m, ddq_r + w^2 e + 2 w de)``, ``w = 2 pi
   bandwidth``;
 - ``"none"``: ``u = 0`` (the arm falls freely; tests of the integrator).
@@ -57,6 +58,7 @@ from ..errors import ConfigError
 from ..robot import RigidBodyModel
 from ..robot._pin import pinocchio
 from ..samples import RobotLog
+from .robot_drive import CONTROLLERS, default_gains, make_drive, per_joint, quantise
 from .robot_friction import ArmFriction
 from .robot_lugre import LuGreBristles
 
@@ -69,9 +71,6 @@ __all__ = [
     "run_robot",
     "simulate_robot",
 ]
-
-#: The drive's controllers (module notes).
-CONTROLLERS = ("pd", "torque", "none")
 
 #: Default internal step [s]: 60 s of the Panda at 1 kHz take about 10 s of CPU time.
 DEFAULT_STEP = 5e-4
@@ -128,29 +127,6 @@ class RobotRun:
     truth: RobotTruth
 
 
-def quantise(position, counts: int) -> np.ndarray:
-    """An encoder's reading of ``position`` [rad]: whole steps of ``2 pi / counts``."""
-    step = 2.0 * math.pi / counts
-    return np.round(np.asarray(position, dtype=float) / step) * step
-
-
-def default_gains(
-    model: RigidBodyModel, q0, bandwidth: float = 5.0, damping: float = 1.0
-) -> tuple[np.ndarray, np.ndarray]:
-    """PD gains ``Kp = m_j w^2``, ``Kd = 2 zeta m_j w``, ``w = 2 pi bandwidth``, at ``q0``.
-
-    ``m_j = 1 / (M^-1)_jj`` is the inertia joint ``j`` meets with the other joints free, not
-    ``M_jj``: on an arm whose joints 1 and 3 are nearly aligned (the Panda's), gains from
-    ``M_jj`` give ``M^-1 Kd`` eigenvalues of thousands per second, and a 1 kHz drive loop
-    with them is unstable.
-    """
-    if not (bandwidth > 0 and damping > 0):
-        raise ConfigError(f"bandwidth and damping must be > 0; got {bandwidth}, {damping}")
-    m = 1.0 / np.diag(np.linalg.inv(model.mass_matrix(np.asarray(q0, dtype=float))[0]))
-    w = 2.0 * math.pi * bandwidth
-    return m * w**2, 2.0 * damping * m * w
-
-
 def _evaluate(reference: Any, t: np.ndarray, n: int) -> tuple[np.ndarray, ...]:
     fn = getattr(reference, "evaluate", reference)
     if not callable(fn):
@@ -161,13 +137,6 @@ def _evaluate(reference: Any, t: np.ndarray, n: int) -> tuple[np.ndarray, ...]:
     if not all(np.isfinite(x).all() for x in out):
         raise ConfigError("the reference gives non-finite values")
     return out
-
-
-def _per_joint(value, n: int, name: str) -> np.ndarray:
-    arr = np.broadcast_to(np.asarray(value, dtype=float), (n,)).copy()
-    if not (np.isfinite(arr).all() and (arr >= 0).all()):
-        raise ConfigError(f"{name} must be finite and >= 0 (one value or one per joint)")
-    return arr
 
 
 def _substeps(rate: float, step: float) -> int:
@@ -269,58 +238,6 @@ class _Plant:
         return q, v
 
 
-@dataclass
-class _Drive:
-    """The controller's state and settings (module notes)."""
-
-    model: RigidBodyModel
-    kind: str
-    kp: np.ndarray
-    kd: np.ndarray
-    w: float
-    alpha: float
-    counts: int
-    rate: float
-    q_prev: np.ndarray
-    v_filt: np.ndarray
-
-    def read(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """The encoder's position and the backward-difference velocity (and filter them)."""
-        qm = quantise(q, self.counts)
-        vm = (qm - self.q_prev) * self.rate
-        self.q_prev = qm
-        self.v_filt = self.v_filt + self.alpha * (vm - self.v_filt)
-        return qm, vm
-
-    def command(self, qm: np.ndarray, ref: tuple[np.ndarray, ...], ff: np.ndarray) -> np.ndarray:
-        q_r, dq_r, ddq_r = ref
-        e, de = q_r - qm, dq_r - self.v_filt
-        if self.kind == "pd":
-            return ff + self.kp * e + self.kd * de
-        if self.kind == "torque":
-            a = ddq_r + self.w**2 * e + 2.0 * self.w * de
-            return self.model.inverse_dynamics(qm, self.v_filt, a)[0]
-        return np.zeros_like(qm)
-
-
-def _drive(model, controller, gains, q0, v0, rate, counts, bandwidth, velocity_filter) -> _Drive:
-    if controller not in CONTROLLERS:
-        raise ConfigError(f"controller must be one of {CONTROLLERS}; got {controller!r}")
-    if not (isinstance(counts, int | np.integer) and counts >= 2):
-        raise ConfigError(f"encoder_counts must be an integer >= 2; got {counts!r}")
-    if gains is None:
-        kp, kd = default_gains(model, q0, bandwidth)
-    else:
-        kp, kd = (_per_joint(g, model.n, "gains") for g in gains)
-    if not velocity_filter > 0:
-        raise ConfigError(f"velocity_filter must be > 0 Hz; got {velocity_filter!r}")
-    alpha = 1.0 - math.exp(-2.0 * math.pi * velocity_filter / rate)
-    q_prev = quantise(q0 - v0 / rate, int(counts))
-    return _Drive(
-        model, controller, kp, kd, 2 * math.pi * bandwidth, alpha, int(counts), rate, q_prev, v0
-    )
-
-
 def run_robot(
     model: RigidBodyModel,
     reference: Any,
@@ -401,7 +318,7 @@ def run_robot(
     count = round(float(duration) * rate)
     if count < 2:
         raise ConfigError(f"duration {duration!r} s at {rate!r} Hz gives fewer than 2 samples")
-    noise = _per_joint(torque_noise, n, "torque_noise")
+    noise = per_joint(torque_noise, n, "torque_noise")
     rng = np.random.default_rng(seed)
     time = np.arange(count) / rate
     ref = _evaluate(reference, time, n)
@@ -412,7 +329,9 @@ def run_robot(
     ff = np.zeros((count, n))
     if feedforward and controller == "pd":
         ff = model.inverse_dynamics(*ref)
-    drive = _drive(model, controller, gains, q, v, rate, encoder_counts, bandwidth, velocity_filter)
+    drive = make_drive(
+        model, controller, gains, q, v, rate, encoder_counts, bandwidth, velocity_filter, ref[0]
+    )
     if plant is None:
         bristles = LuGreBristles(model.joints, lugre) if lugre else None
         plant = _Plant(model, friction, 1.0 / (rate * substeps), substeps, bristles)
