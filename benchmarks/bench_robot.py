@@ -7,7 +7,11 @@ Usage::
         [--truth own|pd|sim|mujoco] [--jobs 2] [--cache DIR] [--rows FILE]
 
 Per seed: each joint gets its own friction law per direction (``stribeck_asym``: Coulomb,
-static, Stribeck velocity and exponent, viscous drawn independently per joint and direction),
+static, Stribeck velocity and exponent, viscous drawn independently per joint and direction;
+``coulomb_viscous_load_asym``: Coulomb friction growing with the joint's load, BAS-RBFNN paper
+eq. 3 as ``msk_asym`` without a Stribeck rise, the load the arm's gravity torque, ``--truth
+own`` and ``pd`` only; a joint that carries no load, the Panda's vertical first axis, has no
+load coefficient to cover),
 the arm follows a multi-sine (or the designed trajectory of ``--trajectory``: ``fricid robot
 design --csv``'s table, or a CSV with a ``time`` column and one position column per joint,
 named as the URDF's joints), its torque is the inverse dynamics plus friction plus Gaussian
@@ -75,7 +79,7 @@ from fricid.sim.robot_friction import FRICTION_NAMES, ArmFriction  # noqa: E402
 #: laws on the Panda's wrist (module notes).
 SIM_STEP = 1.25e-4
 
-KINDS = ("tau_c", "tau_s", "w_s", "tau_v", "delta", "f_c", "beta")
+KINDS = ("tau_c", "tau_s", "w_s", "tau_v", "delta", "f_ck", "f_c", "beta")
 
 
 def _trajectory(path: Path, model: RigidBodyModel):
@@ -107,6 +111,8 @@ def _laws(model, seed, friction):
     rng = np.random.default_rng(10_000 + seed)
     if friction == "stribeck_asym":
         return [truth.stribeck_law(rng) for _ in model.joints]
+    if friction == "coulomb_viscous_load_asym":  # msk_asym of the arm's gravity torque
+        return [truth.load_law(rng) for _ in model.joints]
     return [
         (
             "coulomb_viscous_asym",
@@ -256,11 +262,13 @@ def _seed(args, seed: int) -> dict:
     log, held = _cached_logs(model, laws, seed, args, trajectory)
     start = time.perf_counter()
     window = args.window if args.truth != "own" else 0.0  # closed loop
-    fit = fit_arm(log, model, friction=laws[0][0], validate=held, reversal_window=window)
+    fit = fit_arm(log, model, friction=args.friction, validate=held, reversal_window=window)
     out = {"seconds": time.perf_counter() - start, "params": [], "joints": {}}
     for joint, (_, values) in zip(fit.joints, laws, strict=True):
         for name, rec in fit.friction[joint]["parameters"].items():
             kind = next(k for k in KINDS if name.startswith(k))
+            if "carries no load" in rec["note"]:  # no load, no effect: nothing to cover
+                continue
             t = values[name]
             if rec["value"] is None:
                 out["params"].append((joint, kind, None, False, float("nan"), name))
@@ -380,7 +388,9 @@ def main() -> None:
     parser.add_argument("--rate", type=float, default=1000.0)
     parser.add_argument("--noise", type=float, default=0.05)
     parser.add_argument(
-        "--friction", choices=("stribeck_asym", "coulomb_viscous_asym"), default="stribeck_asym"
+        "--friction",
+        choices=("stribeck_asym", "coulomb_viscous_asym", "coulomb_viscous_load_asym"),
+        default="stribeck_asym",
     )
     parser.add_argument("--trajectory", type=Path, default=None)
     parser.add_argument("--truth", choices=("own", "pd", "sim", "mujoco"), default="own")
@@ -412,7 +422,10 @@ def main() -> None:
         help="keep the simulated logs here and reuse them (fits compared on the same logs)",
     )
     parser.add_argument("--rows", type=Path, default=None, help="every seed's rows (JSON lines)")
-    run(parser.parse_args())
+    args = parser.parse_args()
+    if args.friction == "coulomb_viscous_load_asym" and args.truth in ("sim", "mujoco"):
+        parser.error("the load law is simulated by --truth own and pd only")
+    run(args)
 
 
 if __name__ == "__main__":

@@ -100,7 +100,9 @@ def robot_fit_command(
         str,
         typer.Option(
             help="Friction family for every joint (stribeck_asym, coulomb_viscous_asym, "
-            "coulomb_viscous, stribeck) or JOINT=FAMILY,... per joint."
+            "coulomb_viscous, stribeck; coulomb_viscous_load(_asym): Coulomb friction growing "
+            "with the joint's load, eq. 3 of the BAS-RBFNN paper, the load being the log's "
+            "load channel or else the arm's gravity torque) or JOINT=FAMILY,... per joint."
         ),
     ] = "stribeck_asym",
     validate: Annotated[

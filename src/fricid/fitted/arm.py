@@ -12,7 +12,7 @@ joint's model (predict, export) works on it.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field, fields, replace
 from os import PathLike
 from pathlib import Path
 from typing import Any
@@ -36,6 +36,24 @@ _NAN = float("nan")
 
 def _nan(value: Any) -> float:
     return _NAN if value is None else float(value)
+
+
+#: The whole-arm load families and the model (BAS-RBFNN paper eq. 3, ``msk``) they are.
+_LOAD_FAMILIES = {"coulomb_viscous_load": "msk", "coulomb_viscous_load_asym": "msk_asym"}
+
+
+def _as_msk(params: dict[str, Parameter]) -> dict[str, Parameter]:
+    """A load family's parameters as ``msk``'s: ``f_s = f_c`` and ``f_sk = f_ck`` (no Stribeck
+    rise), so ``v_s`` and ``xi`` do not matter; they are fixed at 1."""
+    out: dict[str, Parameter] = {}
+    for d in ("_pos", "_neg") if "f_c_pos" in params else ("",):
+        for name, like in (("f_c", "f_c"), ("f_s", "f_c"), ("f_ck", "f_ck"), ("f_sk", "f_ck")):
+            out[f"{name}{d}"] = replace(params[f"{like}{d}"], name=f"{name}{d}")
+        for name, unit in (("v_s", "rad/s"), ("xi", "1")):
+            note = "no Stribeck rise (f_s = f_c): does not matter"
+            out[f"{name}{d}"] = Parameter(f"{name}{d}", 1.0, unit=unit, fixed=True, note=note)
+        out[f"beta{d}"] = params[f"beta{d}"]
+    return out
 
 
 @dataclass
@@ -105,6 +123,9 @@ class ArmFit:
             raise ConfigError(f"no joint {joint!r} in this fit; joints: {', '.join(self.joints)}")
         entry = self.friction[joint]
         params = {n: self.parameter(joint, n) for n in entry["parameters"]}
+        for n, p in params.items():  # a joint without load: the load term never acts
+            if n.startswith("f_ck") and "carries no load" in p.note:
+                params[n] = replace(p, value=0.0, fixed=True, not_determined=False)
         missing = [n for n, p in params.items() if p.not_determined or not np.isfinite(p.value)]
         if missing:
             raise ConfigError(
@@ -112,11 +133,15 @@ class ArmFit:
                 "friction model to use"
             )
         check = self.validation.get(joint, {})
+        family, ranges = entry["family"], {"velocity": list(entry.get("velocity_range", [-1, 1]))}
+        if family in _LOAD_FAMILIES:  # eq. 3's msk without its Stribeck rise
+            family, params = _LOAD_FAMILIES[family], _as_msk(params)
+            ranges["load"] = list(entry.get("load_range", [0.0, 0.0]))
         return FittedModel(
-            model=entry["family"],
+            model=family,
             parameters=params,
             ci_method="cluster-robust",
-            operating_range={"velocity": list(entry.get("velocity_range", [-1.0, 1.0]))},
+            operating_range=ranges,
             provenance={
                 "source": self.provenance.get("source"),
                 "joint": joint,

@@ -48,13 +48,15 @@ def reference(model, duration, rate, seed, *, f0=0.1, speed=1.0, hold=()):
     return t, q, dq, ddq
 
 
-def friction_torque(laws, dq):
-    """Each joint's friction ``laws[j] = (family, {name: value})`` at velocities ``dq``."""
+def friction_torque(laws, dq, load=None):
+    """Each joint's friction ``laws[j] = (family, {name: value})`` at velocities ``dq`` (and
+    load torques ``load``, same shape, for the load families; default 0)."""
     out = np.zeros_like(dq)
+    load = np.zeros_like(dq) if load is None else load
     for j, (family, values) in enumerate(laws):
         m = get_model(family)
         theta = np.array([values[p] for p in m.param_names])
-        X = np.column_stack([dq[:, j], np.zeros(len(dq)), np.full(len(dq), 25.0)])
+        X = np.column_stack([dq[:, j], load[:, j], np.full(len(dq), 25.0)])
         out[:, j] = m.predict(theta, X)
     return out
 
@@ -81,7 +83,7 @@ def make_log(
     t, q, dq, ddq = trajectory
     rate = 1.0 / float(np.median(np.diff(t)))
     rng = np.random.default_rng(seed + 10_000)
-    tau = model.inverse_dynamics(q, dq, ddq) + friction_torque(laws, dq)
+    tau = model.inverse_dynamics(q, dq, ddq) + friction_torque(laws, dq, _load(model, laws, q))
     tau = tau + rng.normal(0.0, 1.0, tau.shape) * np.broadcast_to(noise, (model.n,))
     step = 2 * np.pi / counts
     pos = np.round(q / step) * step
@@ -89,6 +91,24 @@ def make_log(
     return RobotLog(
         time=t, joints=model.joints, position=pos, velocity=vel, torque=tau, source=source
     )
+
+
+def _load(model, laws, q):
+    """The load torque of the load laws (``msk``): the arm's gravity torque at ``q`` (as
+    the BAS-RBFNN paper's eq. 7 defines the load), None when no law needs it."""
+    return model.gravity_torque(q) if any(f.startswith("msk") for f, _ in laws) else None
+
+
+def load_law(rng, scale=1.0):
+    """A joint-load law per direction (``msk_asym`` without a Stribeck rise: ``f_s = f_c``,
+    ``f_sk = f_ck``), different between directions: Coulomb 0.2-0.6 N m plus 1-4 % of the
+    gravity torque."""
+    values = {}
+    for d in ("_pos", "_neg"):
+        f_c, f_ck = scale * rng.uniform(0.2, 0.6), rng.uniform(0.01, 0.04)
+        values |= {f"f_c{d}": f_c, f"f_s{d}": f_c, f"f_ck{d}": f_ck, f"f_sk{d}": f_ck}
+        values |= {f"v_s{d}": 0.1, f"xi{d}": 1.0, f"beta{d}": scale * rng.uniform(0.1, 0.6)}
+    return "msk_asym", values
 
 
 def stribeck_law(rng, scale=1.0):
@@ -149,7 +169,7 @@ def make_pd_log(
         tau = ff[k] + kp * (q_r[k] - q_meas) + kd * (dq_r[k] - v_meas)
         pos[k], tau_log[k] = q_meas, tau
         for _ in range(substeps):
-            fr = friction_torque(laws, dq[None, :])[0]
+            fr = friction_torque(laws, dq[None, :], _load(model, laws, q[None, :]))[0]
             dist = rng.normal(0.0, disturbance * np.sqrt(substeps), model.n)
             acc = model.forward_dynamics(q[None, :], dq[None, :], (tau - fr + dist)[None, :])[0]
             dq = dq + h * acc

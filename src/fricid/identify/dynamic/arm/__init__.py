@@ -81,8 +81,10 @@ from ....robot import RigidBodyModel, base_parameters
 from ....samples import RobotLog
 from ._consistent import consistent_parameters
 from ._filter_cov import filter_correlation
-from ._friction import DELTA_BOX, W_S_BOX, friction_for, split_direction
+from ._friction import MODEL_OF, NO_LOAD, friction_for
 from ._grade import grade, loose_levels
+from ._load import FROM_FIT, FROM_LOG, FROM_URDF, joint_load, log_load
+from ._records import friction_records, interval, widen
 from ._rows import (
     MIN_SPEED,
     VELOCITY_NOISE_FACTOR,
@@ -127,15 +129,19 @@ def _log_arrays(log: RobotLog, model: RigidBodyModel) -> tuple[np.ndarray, ...]:
     return sel.time, sel.position, sel.motor_torque
 
 
-def _signals(log: RobotLog, model, counts, cutoff, stops: bool = False) -> ArmSignals:
+def _signals(log: RobotLog, model, counts, cutoff, stops=False, load_model=None) -> ArmSignals:
     t, q, tau = _log_arrays(log, model)
     inertia = None
     if cutoff is None:  # the mean diagonal of the mass matrix over the log
         rows = np.linspace(0, len(t) - 1, 25).astype(int)
         inertia = np.diagonal(model.mass_matrix(q[rows]), axis1=1, axis2=2).mean(axis=0)
-    return prepare_signals(
+    sig = prepare_signals(
         t, q, tau, counts=counts, cutoff=cutoff, inertia=inertia, source=log.source, stops=stops
     )
+    if load_model is None:
+        return sig
+    own = log_load(log, model.joints)  # the load families' load (._load)
+    return replace(sig, full_load=own if own is not None else joint_load(load_model, q))
 
 
 def _torque_delay(sig: ArmSignals, Yb, frictions, moving) -> float:
@@ -153,107 +159,22 @@ def _torque_delay(sig: ArmSignals, Yb, frictions, moving) -> float:
 def _predict(model, bp, beta, frictions, sig: ArmSignals, theta_f: list[np.ndarray]):
     tau = sig.regressor(model, bp) @ beta
     for j, jf in enumerate(frictions):
-        cols = sig.parallel(jf.columns(sig.full_dq[:, j]))
+        cols = sig.parallel(sig.friction_columns(jf, j))
         tau[:, j] += cols @ np.nan_to_num(theta_f[j])
     return tau
 
 
-#: Friction levels [N m, N m s/rad]: physically never below zero.
-_LEVELS = ("f_c", "tau_c", "tau_s", "beta", "tau_v")
-
-
-def _interval(value, se, t):
-    return [value - t * se, value + t * se] if np.isfinite(se) else [None, None]
-
-
-def _friction_records(frictions, theta, cov, st, joints, t, sig, moving, models_units):
-    out = {}
-    for j, (name, jf) in enumerate(zip(joints, frictions, strict=True)):
-        lo = st.offsets[j]
-        k = len(jf.linear_names)
-        idx = list(range(lo, lo + k))
-        values = theta[idx]
-        if jf.stribeck:
-            shape_idx = [
-                st.A.shape[1] + sum(2 * len(f.directions) for f in frictions[:j] if f.stribeck) + i
-                for i in range(2 * len(jf.directions))
-            ]
-            idx += shape_idx
-            values = np.concatenate([values, [x for d in jf.directions for x in jf.shapes[d]]])
-        sub = cov[np.ix_(idx, idx)]
-        fam_values, fam_cov = jf.to_family(values, sub)
-        se = np.sqrt(np.clip(np.diag(fam_cov), 0, None))
-        params = {}
-        for i, pname in enumerate(jf.names):
-            nd = not np.isfinite(se[i])
-            note = ""
-            if nd:
-                # the direction's Coulomb column is empty when the joint never moves that way
-                _, d = split_direction(pname)
-                coulomb = jf.names.index(("tau_c" if jf.stribeck else "f_c") + d)
-                still = not np.isfinite(se[coulomb])
-                note = (
-                    "not determined: the joint does not move in this direction"
-                    if still
-                    else "not determined: the data do not inform it"
-                )
-            rec = {
-                "value": None if nd else float(fam_values[i]),
-                "unit": models_units[jf.family].get(pname, ""),
-                "stderr": None if nd else float(se[i]),
-                "ci95": [None, None] if nd else _interval(fam_values[i], se[i], t),
-                "not_determined": nd,
-                "note": note,
-            }
-            if pname.startswith(_LEVELS) and not nd and rec["ci95"][1] < 0:
-                # a friction level below zero beyond its interval: the family does not describe
-                # this joint's data (or the joint barely moves); no number to trust
-                rec.update(
-                    value=None,
-                    stderr=None,
-                    ci95=[None, None],
-                    not_determined=True,
-                    note=(
-                        f"not determined: estimated {fam_values[i]:.4g} +- {t * se[i]:.2g}, "
-                        "a friction level below zero (the family does not describe this "
-                        "joint's data)"
-                    ),
-                )
-                params[pname] = rec
-                continue
-            if pname.startswith(("w_s", "delta")) and not nd:
-                box = W_S_BOX if pname.startswith("w_s") else DELTA_BOX
-                lo_, hi_ = rec["ci95"]
-                if lo_ < box[0] or hi_ > box[1] or se[i] > abs(fam_values[i]):
-                    rec["note"] = "not bounded by the data (interval beyond the search box)"
-            params[pname] = rec
-        v = sig.dq[moving[:, j], j]
-        out[name] = {
-            "family": jf.family,
-            "parameters": params,
-            "velocity_range": [float(v.min()), float(v.max())] if v.size else [0.0, 0.0],
-        }
-    return out
-
-
-def _widen(recs: dict, d: str, prof: dict) -> None:
-    """Direction ``d``'s Stribeck intervals widened to their profile region
-    (:func:`._solve.shape_profiles`), ``tau_s`` by the region's excess over ``tau_c``."""
-    tau_c = recs["tau_c" + d]["value"]
-    ranges = {"w_s": prof["w_s"], "delta": prof["delta"]}
-    if tau_c is not None:
-        ranges["tau_s"] = (tau_c + prof["excess"][0], tau_c + prof["excess"][1])
-    for name, (lo, hi) in ranges.items():
-        rec = recs[name + d]
-        if rec["value"] is not None and rec["ci95"][0] is not None:
-            rec["ci95"] = [min(rec["ci95"][0], lo), max(rec["ci95"][1], hi)]
-
-
-def fit_arm(*args: Any, **kwargs: Any) -> ArmFit:
+def fit_arm(log: RobotLog, model: RigidBodyModel, **kwargs: Any) -> ArmFit:
     """Identify a whole arm (:func:`_fit_arm`, on one BLAS thread: the problems are small and
-    threads only contend on a shared machine)."""
+    threads only contend on a shared machine). With a load family and no load channel in the
+    log, twice: the second time with the load of the first fit's arm (:mod:`._load`)."""
     with one_blas_thread():
-        return _fit_arm(*args, **kwargs)
+        fit = _fit_arm(log, model, **kwargs)
+        values = fit.standard.get("values")
+        if fit.provenance["load"] == FROM_URDF and values is not None:
+            refined = model.with_parameters(np.asarray(values, dtype=float))
+            fit = _fit_arm(log, model, load_model=refined, **kwargs)
+        return fit
 
 
 def _fit_arm(
@@ -268,6 +189,7 @@ def _fit_arm(
     urdf: str | None = None,
     reversal_window: float = 0.0,
     torque_delay: float | None = None,
+    load_model: RigidBodyModel | None = None,
 ) -> ArmFit:
     """Identify a whole arm's base inertial parameters and every joint's friction.
 
@@ -300,6 +222,9 @@ def _fit_arm(
     torque_delay : float, optional
         The torque's delay behind the positions [sample periods] (0.5 for a command held
         from one sample to the next); default estimated from the data (:func:`_torque_delay`).
+    load_model : RigidBodyModel, optional
+        The arm whose gravity torque is the load families' load where the log has no load
+        channel (default ``model``, the URDF's parameters; :mod:`._load`).
 
     Returns
     -------
@@ -321,7 +246,15 @@ def _fit_arm(
         cut = int(len(log) * (1 - HELDOUT_SHARE))
         log, validate = log.slice(0, cut), log.slice(cut, len(log))
     stops = reversal_window > 0  # recorded in closed loop: the joints stick at reversals
-    sig = _signals(log, model, encoder_counts, cutoff, stops)
+    if any(jf.load for jf in frictions):
+        load_model = load_model or model
+        load_from = FROM_LOG if log_load(log, model.joints) is not None else FROM_URDF
+        load_from = FROM_FIT if load_from == FROM_URDF and load_model is not model else load_from
+    else:
+        load_model = load_from = None
+    sig = _signals(log, model, encoder_counts, cutoff, stops, load_model)
+    for j, jf in enumerate(frictions):  # a load family's joint without load (._friction)
+        jf.unloaded = jf.load and bool(np.abs(sig.full_load[:, j]).max() <= NO_LOAD)
     distance = None
     if reversal_window > 0:  # each stop's stick left to its own columns (._sticks)
         near = near_stops(sig)
@@ -398,16 +331,21 @@ def _fit_arm(
             theta = np.concatenate([beta, fr])
     units = {
         f: dict(
-            zip(get_model(f).param_names, (p.unit for p in get_model(f).parameters), strict=True)
+            zip(
+                get_model(MODEL_OF.get(f, f)).param_names,
+                (p.unit for p in get_model(MODEL_OF.get(f, f)).parameters),
+                strict=True,
+            )
         )
         for f in {jf.family for jf in frictions}
     }
-    fric = _friction_records(frictions, theta, cov, st, model.joints, t, sig, moving, units)
+    fric = friction_records(frictions, theta, cov, st, model.joints, t, sig, moving, units)
     inflation = np.bincount(st.row_joint, minlength=n) / np.maximum(n_eff, 1e-12)
     for (j, d), prof in shape_profiles(sig, Yb, frictions, moving, safe, inflation).items():
-        _widen(fric[model.joints[j]]["parameters"], d, prof)
+        widen(fric[model.joints[j]]["parameters"], d, prof)
     # held-out validation with the same filter
-    vsig = _signals(validate, model, encoder_counts, sig.cutoff, stops).delayed(torque_delay)
+    vsig = _signals(validate, model, encoder_counts, sig.cutoff, stops, load_model)
+    vsig = vsig.delayed(torque_delay)
     vdistance = vstick = None
     if reversal_window > 0:
         vnear = near_stops(vsig)
@@ -437,7 +375,7 @@ def _fit_arm(
         recs = fric[name]["parameters"]
         nd = [p for p, rec in recs.items() if rec["not_determined"]]
         open_ = [p for p, rec in recs.items() if rec["note"].startswith("not bounded")]
-        loose = loose_levels(recs, float(sigma[j]))
+        loose = loose_levels(recs, float(sigma[j]), fric[name].get("load_range"))
         level, reasons = grade(ratio, nd, open_, source, bool(moving[:, j].any()), loose)
         validation[name] = {
             "rmse": rmse,
@@ -455,7 +393,7 @@ def _fit_arm(
             "values": beta.tolist(),
             "values_ls": beta_ls.tolist(),
             "stderr": base_se.tolist(),
-            "ci95": [_interval(b, s, t) for b, s in zip(beta, base_se, strict=True)],
+            "ci95": [interval(b, s, t) for b, s in zip(beta, base_se, strict=True)],
             "determined": np.isfinite(base_se).tolist(),
         },
         standard=standard,
@@ -475,6 +413,7 @@ def _fit_arm(
             "windows": {nm: float(w) for nm, w in zip(model.joints, windows, strict=True)},
             "stick_columns": {nm: st.lost(j) for j, nm in enumerate(model.joints)},
             "torque_delay": float(torque_delay),
+            "load": load_from,
             "samples": int(st.A.shape[0]),
             "effective_samples": {nm: float(x) for nm, x in zip(model.joints, n_eff, strict=True)},
             "correlation_length": corr_len,

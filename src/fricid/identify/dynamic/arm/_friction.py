@@ -8,6 +8,9 @@ RWSAVSBAS paper eq. 7), written per direction ``d`` (``+`` for ``dq >= 0``, ``-`
 * ``coulomb_viscous``: ``f_c sign(v) + beta v``;
 * ``coulomb_viscous_asym``: ``s_d f_c,d + beta_d v`` on direction ``d``'s samples
   (``s_+ = 1``, ``s_- = -1``);
+* ``coulomb_viscous_load`` (``_asym``): ``s_d (f_c,d + f_ck,d |tau_l|) + beta_d v``, the joint-load
+  model of BAS-RBFNN paper eq. 3 without its Stribeck rise (``F_s = F_c``, ``F_sk = F_ck``),
+  linear in all three; ``tau_l`` the joint's load torque (:mod:`._load`);
 * ``stribeck_asym``: ``s_d [tau_c,d + (tau_s,d - tau_c,d) e_d] + tau_v,d v`` with
   ``e_d = exp(-(|v| / w_s,d)^delta_d)``, linear in ``(tau_c, tau_s - tau_c, tau_v)`` once
   ``(w_s, delta)`` are fixed (the separable structure that
@@ -26,10 +29,26 @@ import numpy as np
 
 from ....errors import ConfigError
 
-__all__ = ["FAMILIES", "JointFriction", "friction_for", "split_direction"]
+__all__ = ["FAMILIES", "MODEL_OF", "JointFriction", "friction_for", "split_direction"]
 
 #: The families a joint's friction may take in a whole-arm fit.
-FAMILIES = ("coulomb_viscous", "coulomb_viscous_asym", "stribeck", "stribeck_asym")
+FAMILIES = (
+    "coulomb_viscous",
+    "coulomb_viscous_asym",
+    "coulomb_viscous_load",
+    "coulomb_viscous_load_asym",
+    "stribeck",
+    "stribeck_asym",
+)
+
+#: A joint whose load never exceeds this [N m] carries none: its load coefficient has no
+#: column and is not determined (on the Panda's vertical first axis gravity's torque is 1e-14
+#: N m of rounding, which as a column gave a coefficient of 1e11).
+NO_LOAD = 1e-9
+
+#: The fricid model (:mod:`fricid.models`) whose parameter names and units a family's take:
+#: the load families are eq. 3's ``msk`` with ``f_s = f_c``, ``f_sk = f_ck``.
+MODEL_OF = {"coulomb_viscous_load": "msk", "coulomb_viscous_load_asym": "msk_asym"}
 
 #: Start and search box of the Stribeck velocity [rad/s] and exponent.
 W_S_START, W_S_BOX = 0.05, (1e-3, 1.0)
@@ -62,6 +81,8 @@ class JointFriction:
 
     family: str
     shapes: dict[str, tuple[float, float]] = field(default_factory=dict)
+    #: a load family's joint that carries no load (:data:`NO_LOAD`): no load column
+    unloaded: bool = False
 
     def __post_init__(self) -> None:
         if self.family not in FAMILIES:
@@ -76,29 +97,46 @@ class JointFriction:
         return self.family.startswith("stribeck")
 
     @property
+    def load(self) -> bool:
+        """The family has a load term (its columns need the joint's load torque)."""
+        return self.family.startswith("coulomb_viscous_load")
+
+    @property
+    def load_term(self) -> bool:
+        """The joint's columns include the load's."""
+        return self.load and not self.unloaded
+
+    @property
     def directions(self) -> tuple[str, ...]:
         return _directions(self.family)
 
     @property
     def linear_names(self) -> list[str]:
         """Internal linear parameters: Coulomb, (Stribeck excess,) viscous per direction."""
-        mid = ["excess"] if self.stribeck else []
+        mid = ["excess"] if self.stribeck else ["load"] if self.load_term else []
         return [f"{n}{d}" for d in self.directions for n in ("coulomb", *mid, "viscous")]
 
     @property
     def names(self) -> list[str]:
         """The family's parameter names (:mod:`fricid.models`)."""
         base = ("tau_c", "tau_s", "w_s", "tau_v", "delta") if self.stribeck else ("f_c", "beta")
+        if self.load:
+            base = ("f_c", "f_ck", "beta")
         return [f"{n}{d}" for d in self.directions for n in base]
 
-    def columns(self, v: np.ndarray) -> np.ndarray:
-        """The linear columns at velocities ``v`` (N,), shape (N, len(linear_names))."""
+    def columns(self, v: np.ndarray, load: np.ndarray | None = None) -> np.ndarray:
+        """The linear columns at velocities ``v`` (N,), shape (N, len(linear_names)); the
+        load families need the joint's load torque ``load`` (N,) [N m]."""
+        if self.load_term and load is None:
+            raise ConfigError(f"the {self.family} family needs the joint's load torque")
         out = []
         for d in self.directions:
             ind, sgn = _mask(v, d)
             out.append(sgn)
             if self.stribeck:
                 out.append(sgn * stribeck_shape(v, *self.shapes[d]))
+            if self.load_term:
+                out.append(sgn * np.abs(load))
             out.append(ind * v)
         return np.column_stack(out)
 
@@ -140,6 +178,10 @@ class JointFriction:
             base, d = split_direction(name)
             if base in ("tau_c", "f_c"):
                 T[r, pos[f"coulomb{d}"]] = 1.0
+            elif base == "f_ck" and self.unloaded:  # no load: not determined
+                T[r, :] = np.nan
+            elif base == "f_ck":
+                T[r, pos[f"load{d}"]] = 1.0
             elif base == "tau_s":
                 T[r, pos[f"coulomb{d}"]] = T[r, pos[f"excess{d}"]] = 1.0
             elif base in ("tau_v", "beta"):

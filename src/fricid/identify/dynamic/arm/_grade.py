@@ -15,21 +15,35 @@ from ...trust import MISS_RATIO
 __all__ = ["grade", "loose_levels"]
 
 
-def loose_levels(recs: Mapping[str, Mapping[str, Any]], noise: float) -> list[str]:
+def _level(recs: Mapping[str, Mapping[str, Any]], name: str) -> float:
+    """The Coulomb level beside load coefficient ``name`` (same direction), 0 if unknown."""
+    rec = recs.get("f_c" + name[len("f_ck") :], {})
+    return abs(rec.get("value") or 0.0)
+
+
+def loose_levels(recs: Mapping[str, Mapping[str, Any]], noise: float, load_range=None) -> list[str]:
     """The Coulomb levels the data do not determine (not determined at all, or a 95 %
     interval wider, on either side, than both their value and the joint's torque noise):
-    the data do not tell the joint's friction."""
+    the data do not tell the joint's friction. A load coefficient ``f_ck`` counts by the
+    torque it adds at the largest load of ``load_range``: loose when that torque's interval
+    is wider than both the Coulomb level beside it and the noise (a coefficient of a small
+    load is loose and harmless); one not determined because the joint carries no load is no
+    part of its friction."""
     out = []
+    top = max((abs(x) for x in load_range or ()), default=0.0)
     for name, rec in recs.items():
-        if not name.startswith(("f_c", "tau_c")):
+        load = name.startswith("f_ck")
+        if not name.startswith(("f_c", "tau_c")) or (load and "carries no load" in rec["note"]):
             continue
         lo, hi = rec.get("ci95") or (None, None)
         if rec["not_determined"] or rec["value"] is None or lo is None:
             out.append(f"{name} not determined")
             continue
-        half = 0.5 * (hi - lo)
-        if half > max(abs(rec["value"]), noise):
-            out.append(f"{name} {rec['value']:.3g} +- {half:.2g} N m")
+        scale, value = (top, _level(recs, name)) if load else (1.0, abs(rec["value"]))
+        half = 0.5 * (hi - lo) * scale
+        if half > max(value, noise):
+            at = f" (at {top:.3g} N m of load)" if load else " N m"
+            out.append(f"{name} {rec['value']:.3g} +- {half / scale:.2g}{at}")
     return out
 
 

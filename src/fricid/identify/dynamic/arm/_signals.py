@@ -133,6 +133,9 @@ class ArmSignals:
     wide_position: np.ndarray | None = None
     #: each joint's stick columns at the kept rows (:mod:`._sticks`), where the joints stick
     stick: tuple[np.ndarray, ...] | None = None
+    #: each joint's load torque at the log's full rate [N m] (:mod:`._load`), for the load
+    #: families' columns
+    full_load: np.ndarray | None = None
 
     def delayed(self, samples: float) -> ArmSignals:
         """These signals with the torque read ``samples`` sample periods earlier, ``tau(t -
@@ -158,6 +161,12 @@ class ArmSignals:
         Y = np.concatenate([base.columns(model.regressor(q[c], dq[c], ddq[c])) for c in chunks])
         n, r = Y.shape[1:]
         return self.parallel(Y.reshape(Y.shape[0], n * r)).reshape(-1, n, r)
+
+    def friction_columns(self, jf, j: int) -> np.ndarray:
+        """Joint ``j``'s friction columns (``jf``: its :class:`._friction.JointFriction`) at
+        the log's full rate, from ``full_dq`` (and ``full_load``)."""
+        load = None if self.full_load is None else self.full_load[:, j]
+        return jf.columns(self.full_dq[:, j], load)
 
     def parallel(self, x: np.ndarray) -> np.ndarray:
         """``x`` (full rate, first axis time) through what the torque went through: the

@@ -113,7 +113,7 @@ class Stack:
 
 def friction_block(sig: ArmSignals, jf: JointFriction, j: int) -> np.ndarray:
     """Joint ``j``'s friction columns at the log's rate, parallel-filtered and decimated."""
-    return sig.parallel(jf.columns(sig.full_dq[:, j]))
+    return sig.parallel(sig.friction_columns(jf, j))
 
 
 def stack(

@@ -1,0 +1,107 @@
+"""Each joint's friction parameters as the fit file records them: value, standard error,
+95 % interval, and why a parameter is not determined (:func:`fricid.identify.dynamic.arm.fit_arm`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ._friction import DELTA_BOX, W_S_BOX, split_direction
+
+__all__ = ["friction_records", "interval", "widen"]
+
+
+#: Friction levels [N m, N m s/rad]: physically never below zero.
+_LEVELS = ("f_c", "tau_c", "tau_s", "beta", "tau_v")
+
+
+def interval(value, se, t):
+    return [value - t * se, value + t * se] if np.isfinite(se) else [None, None]
+
+
+def friction_records(frictions, theta, cov, st, joints, t, sig, moving, models_units):
+    out = {}
+    for j, (name, jf) in enumerate(zip(joints, frictions, strict=True)):
+        lo = st.offsets[j]
+        k = len(jf.linear_names)
+        idx = list(range(lo, lo + k))
+        values = theta[idx]
+        if jf.stribeck:
+            shape_idx = [
+                st.A.shape[1] + sum(2 * len(f.directions) for f in frictions[:j] if f.stribeck) + i
+                for i in range(2 * len(jf.directions))
+            ]
+            idx += shape_idx
+            values = np.concatenate([values, [x for d in jf.directions for x in jf.shapes[d]]])
+        sub = cov[np.ix_(idx, idx)]
+        fam_values, fam_cov = jf.to_family(values, sub)
+        se = np.sqrt(np.clip(np.diag(fam_cov), 0, None))
+        params = {}
+        for i, pname in enumerate(jf.names):
+            nd = not np.isfinite(se[i])
+            note = ""
+            if nd:
+                # the direction's Coulomb column is empty when the joint never moves that way
+                _, d = split_direction(pname)
+                coulomb = jf.names.index(("tau_c" if jf.stribeck else "f_c") + d)
+                still = not np.isfinite(se[coulomb])
+                note = (
+                    "not determined: the joint does not move in this direction"
+                    if still
+                    else "not determined: the data do not inform it"
+                )
+                if jf.unloaded and pname.startswith("f_ck"):
+                    note = "not determined: the joint carries no load (|load| <= 1e-9 N m)"
+            rec = {
+                "value": None if nd else float(fam_values[i]),
+                "unit": models_units[jf.family].get(pname, ""),
+                "stderr": None if nd else float(se[i]),
+                "ci95": [None, None] if nd else interval(fam_values[i], se[i], t),
+                "not_determined": nd,
+                "note": note,
+            }
+            if pname.startswith(_LEVELS) and not nd and rec["ci95"][1] < 0:
+                # a friction level below zero beyond its interval: the family does not describe
+                # this joint's data (or the joint barely moves); no number to trust
+                rec.update(
+                    value=None,
+                    stderr=None,
+                    ci95=[None, None],
+                    not_determined=True,
+                    note=(
+                        f"not determined: estimated {fam_values[i]:.4g} +- {t * se[i]:.2g}, "
+                        "a friction level below zero (the family does not describe this "
+                        "joint's data)"
+                    ),
+                )
+                params[pname] = rec
+                continue
+            if pname.startswith(("w_s", "delta")) and not nd:
+                box = W_S_BOX if pname.startswith("w_s") else DELTA_BOX
+                lo_, hi_ = rec["ci95"]
+                if lo_ < box[0] or hi_ > box[1] or se[i] > abs(fam_values[i]):
+                    rec["note"] = "not bounded by the data (interval beyond the search box)"
+            params[pname] = rec
+        v = sig.dq[moving[:, j], j]
+        out[name] = {
+            "family": jf.family,
+            "parameters": params,
+            "velocity_range": [float(v.min()), float(v.max())] if v.size else [0.0, 0.0],
+        }
+        if jf.load:  # the load the rows saw [N m]
+            load = sig.full_load[sig.rows()[moving[:, j]], j]
+            out[name]["load_range"] = [float(load.min()), float(load.max())] if v.size else [0, 0]
+    return out
+
+
+def widen(recs: dict, d: str, prof: dict) -> None:
+    """Direction ``d``'s Stribeck intervals widened to their profile region
+    (:func:`._solve.shape_profiles`), ``tau_s`` by the region's excess over ``tau_c``."""
+    tau_c = recs["tau_c" + d]["value"]
+    ranges = {"w_s": prof["w_s"], "delta": prof["delta"]}
+    if tau_c is not None:
+        ranges["tau_s"] = (tau_c + prof["excess"][0], tau_c + prof["excess"][1])
+    for name, (lo, hi) in ranges.items():
+        rec = recs[name + d]
+        if rec["value"] is not None and rec["ci95"][0] is not None:
+            rec["ci95"] = [min(rec["ci95"][0], lo), max(rec["ci95"][1], hi)]
