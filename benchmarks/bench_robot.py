@@ -25,7 +25,8 @@ and the seconds of the identification.
 
 Truth: ``--truth own`` is the tests' generator (``tests/identify/dynamic/_arm_truth.py``: the
 arm follows the reference exactly, an open-loop measurement); ``--truth pd`` is its
-closed-loop variant (``make_pd_log``: a 10 Hz PD on the quantised position with the inverse
+closed-loop variant (``make_pd_log``: a 10 Hz PD, gains for the least inertia each joint meets
+with the others free, on the quantised position with the inverse
 dynamics as feed-forward, the arm integrated semi-implicitly at 4 kHz, friction not
 compensated, an optional torque ``--disturbance``). ``--truth sim`` is fricid's whole-arm
 simulator (:func:`fricid.sim.robot.run_robot`: its own split RK4 integrator of the arm, each
@@ -197,6 +198,7 @@ def _logs(model, laws, seed, args, trajectory):
     if args.truth == "pd":
         make = truth.make_pd_log
         kw["disturbance"] = args.disturbance
+        kw["inertia"] = "free"  # the Panda's joints 1 and 3 align (make_pd_log's notes)
     one = make(model, laws, seed=seed, trajectory=first, **kw)
     two = make(model, laws, seed=seed + 5_000, trajectory=second, **kw)
     return one, two
@@ -350,6 +352,9 @@ def run(args) -> None:
         for k in kinds:
             r, c = rel[joint, k], cov[joint, k]
             joint_cov += c
+            if not c:  # nothing to cover (a load coefficient of a joint without load)
+                cells.append(f"{'-':>8} {'-':>6}   ")
+                continue
             cells.append(f"{100 * np.median(r):7.2f}% {100 * np.mean(c):5.0f}%   ")
         all_cov += joint_cov
         lv = levels[joint]

@@ -140,20 +140,27 @@ def make_pd_log(
     substeps=4,
     source="truth-pd",
     trajectory=None,
+    inertia=None,
 ):
     """A :class:`RobotLog` of the arm tracking its reference in closed loop: a PD of
     ``bandwidth`` Hz on the quantised position plus the model's inverse dynamics along the
     reference as feed-forward (friction not compensated), a white torque ``disturbance``
     [N m] acting on the arm, integrated semi-implicitly at ``substeps`` times the log's rate;
-    the logged torque is the command plus ``noise``."""
+    the logged torque is the command plus ``noise``. The gains are for ``inertia`` per joint
+    (default the mean diagonal of the mass matrix along the reference; ``"free"``: the least
+    inertia each joint meets with the others free, ``1 / (M^-1)_jj``, which a Panda whose
+    joints 1 and 3 align needs: with the diagonal's its loop diverges there)."""
     if trajectory is None:
         trajectory = reference(model, duration, rate, seed)
     t, q_r, dq_r, ddq_r = trajectory
     rate = 1.0 / float(np.median(np.diff(t)))
     rng = np.random.default_rng(seed + 20_000)
     ff = model.inverse_dynamics(q_r, dq_r, ddq_r)
-    inertia = np.diagonal(model.mass_matrix(q_r[:: max(len(t) // 20, 1)]), axis1=1, axis2=2)
-    m = inertia.mean(axis=0)
+    M = model.mass_matrix(q_r[:: max(len(t) // 200, 1)])
+    if inertia == "free":
+        m = 1.0 / np.diagonal(np.linalg.inv(M), axis1=1, axis2=2).max(axis=0)
+    else:
+        m = np.diagonal(M[::10], axis1=1, axis2=2).mean(axis=0)
     w = 2 * np.pi * bandwidth
     kp, kd = m * w**2, 2 * 0.7 * w * m
     step = 2 * np.pi / counts
