@@ -84,6 +84,7 @@ from ._filter_cov import filter_correlation
 from ._friction import MODEL_OF, NO_LOAD, friction_for
 from ._grade import grade, loose_levels
 from ._load import FROM_FIT, FROM_LOG, FROM_URDF, joint_load, log_load
+from ._polish import polish_shapes
 from ._records import friction_records, interval, widen
 from ._rows import (
     MIN_SPEED,
@@ -285,8 +286,10 @@ def _fit_arm(
         st = stack(Yb, sig, frictions, moving)
         theta, sigma = wls(st, n)
     safe = np.where(np.isfinite(sigma) & (sigma > 0), sigma, 1.0)
+    polish: dict[str, float] = {}
     if any(jf.stribeck for jf in frictions):
         search_shapes(sig, Yb, frictions, moving, safe)
+        polish = polish_shapes(sig, Yb, frictions, moving, safe)  # all at once (._polish)
         if estimate_delay:  # again, with the shapes found (module notes)
             torque_delay = _torque_delay(undelayed, Yb, frictions, moving)
             sig = undelayed.delayed(torque_delay)
@@ -414,6 +417,7 @@ def _fit_arm(
             "stick_columns": {nm: st.lost(j) for j, nm in enumerate(model.joints)},
             "torque_delay": float(torque_delay),
             "load": load_from,
+            "shape_polish": polish,
             "samples": int(st.A.shape[0]),
             "effective_samples": {nm: float(x) for nm, x in zip(model.joints, n_eff, strict=True)},
             "correlation_length": corr_len,

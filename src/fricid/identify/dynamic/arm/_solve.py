@@ -22,7 +22,8 @@ no law of velocity says, and the low-pass spreads a reversal over its neighbours
   over ``(log w_s, delta)`` from the grid's best (:func:`_newton`). The directions of
   a joint are coupled near its reversals (the low-pass spreads both over them), so the
   descent converges slowly along a curved valley; noise-free, three sweeps leave the
-  shapes a few per cent to tens of per cent off.
+  shapes a few per cent to tens of per cent off, and :mod:`._polish` then moves all of them
+  (and the torque's delay) together.
 * Covariance (:func:`arm_covariance`): residuals of low-passed signals are correlated over
   about ``1 / f_c``, so 60 000 samples are far fewer independent ones. The correlation length
   ``L`` is the first lag at which the residuals' autocorrelation (averaged over the joints)
