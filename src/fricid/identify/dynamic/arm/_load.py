@@ -14,8 +14,8 @@ mass, so it comes from the rigid-body model:
    which).
 
 ``g(q)`` is smooth at a log's rate: it is computed at every :data:`STRIDE`-th sample of the
-position through the regressor's wide low-pass and interpolated between them (linear; on
-the Panda at 1 kHz the interpolation error is below 1e-6 of the load).
+logged position and interpolated between them (linear; on a Panda multi-sine of 1 rad/s RMS
+per joint at 1 kHz, within 2 mN m of the exact 39 N m at most, 6e-5 of it).
 """
 
 from __future__ import annotations
