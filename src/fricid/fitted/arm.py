@@ -25,7 +25,7 @@ from ..metrics import verdict
 from ._file import _clean
 from ._parameter import Parameter
 
-__all__ = ["ARM_KIND", "ARM_SCHEMA_VERSION", "ArmFit"]
+__all__ = ["ARM_KIND", "ARM_SCHEMA_VERSION", "LOAD_FAMILIES", "ArmFit"]
 
 #: The file's kind and version.
 ARM_KIND = "fricid-arm"
@@ -38,8 +38,9 @@ def _nan(value: Any) -> float:
     return _NAN if value is None else float(value)
 
 
-#: The whole-arm load families and the model (BAS-RBFNN paper eq. 3, ``msk``) they are.
-_LOAD_FAMILIES = {"coulomb_viscous_load": "msk", "coulomb_viscous_load_asym": "msk_asym"}
+#: The whole-arm load families and the model (BAS-RBFNN paper eq. 3, ``msk``) they are: its
+#: parameter names and units, with ``f_s = f_c`` and ``f_sk = f_ck``.
+LOAD_FAMILIES = {"coulomb_viscous_load": "msk", "coulomb_viscous_load_asym": "msk_asym"}
 
 
 def _as_msk(params: dict[str, Parameter]) -> dict[str, Parameter]:
@@ -133,9 +134,10 @@ class ArmFit:
                 "friction model to use"
             )
         check = self.validation.get(joint, {})
-        family, ranges = entry["family"], {"velocity": list(entry.get("velocity_range", [-1, 1]))}
-        if family in _LOAD_FAMILIES:  # eq. 3's msk without its Stribeck rise
-            family, params = _LOAD_FAMILIES[family], _as_msk(params)
+        velocity = list(entry.get("velocity_range", [-1.0, 1.0]))
+        family, ranges = entry["family"], {"velocity": velocity}
+        if family in LOAD_FAMILIES:  # eq. 3's msk without its Stribeck rise
+            family, params = LOAD_FAMILIES[family], _as_msk(params)
             ranges["load"] = list(entry.get("load_range", [0.0, 0.0]))
         return FittedModel(
             model=family,

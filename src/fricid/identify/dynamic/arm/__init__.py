@@ -74,14 +74,14 @@ from typing import Any
 import numpy as np
 
 from ....errors import DataError
-from ....fitted.arm import ArmFit
+from ....fitted.arm import LOAD_FAMILIES, ArmFit
 from ....models import get_model
 from ....optim import one_blas_thread
 from ....robot import RigidBodyModel, base_parameters
 from ....samples import RobotLog
 from ._consistent import consistent_parameters
 from ._filter_cov import filter_correlation
-from ._friction import MODEL_OF, NO_LOAD, friction_for
+from ._friction import NO_LOAD, friction_for
 from ._grade import grade, loose_levels
 from ._load import FROM_FIT, FROM_LOG, FROM_URDF, joint_load, log_load
 from ._polish import polish_shapes
@@ -101,6 +101,7 @@ from ._solve import (
     lstsq,
     search_shapes,
     shape_profiles,
+    shape_rows,
     stack,
     wls,
 )
@@ -247,12 +248,17 @@ def _fit_arm(
         cut = int(len(log) * (1 - HELDOUT_SHARE))
         log, validate = log.slice(0, cut), log.slice(cut, len(log))
     stops = reversal_window > 0  # recorded in closed loop: the joints stick at reversals
+    load_from = None
     if any(jf.load for jf in frictions):
+        refined = load_model is not None
         load_model = load_model or model
-        load_from = FROM_LOG if log_load(log, model.joints) is not None else FROM_URDF
-        load_from = FROM_FIT if load_from == FROM_URDF and load_model is not model else load_from
-    else:
-        load_model = load_from = None
+        load_from = (
+            FROM_LOG
+            if log_load(log, model.joints) is not None
+            else FROM_FIT
+            if refined
+            else FROM_URDF
+        )
     sig = _signals(log, model, encoder_counts, cutoff, stops, load_model)
     for j, jf in enumerate(frictions):  # a load family's joint without load (._friction)
         jf.unloaded = jf.load and bool(np.abs(sig.full_load[:, j]).max() <= NO_LOAD)
@@ -298,22 +304,8 @@ def _fit_arm(
         safe = np.where(np.isfinite(sigma) & (sigma > 0), sigma, 1.0)
     A, y = st.weighted(safe)
     res = y - A @ theta
-    shape_cols = [
-        sig.parallel(jf.shape_jacobian(sig.full_dq[:, j], theta[st.offsets[j] :]))
-        for j, jf in enumerate(frictions)
-        if jf.stribeck
-    ]
-    J = A
-    if shape_cols:
-        extra = np.zeros((A.shape[0], sum(c.shape[1] for c in shape_cols)))
-        col = 0
-        for j, c in zip(
-            [j for j, f in enumerate(frictions) if f.stribeck], shape_cols, strict=True
-        ):
-            rows = st.row_joint == j
-            extra[rows, col : col + c.shape[1]] = st.project(j, c[st.row_time[rows]]) / safe[j]
-            col += c.shape[1]
-        J = np.hstack([A, extra])
+    stribeck = [j for j, jf in enumerate(frictions) if jf.stribeck]
+    J = np.hstack([A, shape_rows(sig, frictions, st, theta, safe, stribeck)]) if stribeck else A
     cov, se, t, clusters, corr_len, n_eff = arm_covariance(J, res, st, n, rho)
     r = bp.rank
     beta_ls = theta[:r]
@@ -333,13 +325,7 @@ def _fit_arm(
             fr = lstsq(A[:, r:], y - A[:, :r] @ beta)
             theta = np.concatenate([beta, fr])
     units = {
-        f: dict(
-            zip(
-                get_model(MODEL_OF.get(f, f)).param_names,
-                (p.unit for p in get_model(MODEL_OF.get(f, f)).parameters),
-                strict=True,
-            )
-        )
+        f: {p.name: p.unit for p in get_model(LOAD_FAMILIES.get(f, f)).parameters}
         for f in {jf.family for jf in frictions}
     }
     fric = friction_records(frictions, theta, cov, st, model.joints, t, sig, moving, units)

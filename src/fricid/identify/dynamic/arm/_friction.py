@@ -29,7 +29,7 @@ import numpy as np
 
 from ....errors import ConfigError
 
-__all__ = ["FAMILIES", "MODEL_OF", "JointFriction", "friction_for", "split_direction"]
+__all__ = ["FAMILIES", "JointFriction", "friction_for", "split_direction"]
 
 #: The families a joint's friction may take in a whole-arm fit.
 FAMILIES = (
@@ -46,9 +46,6 @@ FAMILIES = (
 #: N m of rounding, which as a column gave a coefficient of 1e11).
 NO_LOAD = 1e-9
 
-#: The fricid model (:mod:`fricid.models`) whose parameter names and units a family's take:
-#: the load families are eq. 3's ``msk`` with ``f_s = f_c``, ``f_sk = f_ck``.
-MODEL_OF = {"coulomb_viscous_load": "msk", "coulomb_viscous_load_asym": "msk_asym"}
 
 #: Start and search box of the Stribeck velocity [rad/s] and exponent.
 W_S_START, W_S_BOX = 0.05, (1e-3, 1.0)

@@ -11,8 +11,7 @@ sweeps still 34 times.
 
 :func:`polish_shapes` then moves all the shapes together by Levenberg-Marquardt on the
 variable-projection residual (Golub and Pereyra 1973), with Kaufman's (1975) Jacobian: the
-shapes' columns (:meth:`._friction.JointFriction.shape_jacobian`, through the torque's
-filters, each joint's stick columns out, weighted as the rows) less their projection on the
+shapes' columns (:func:`._solve.shape_rows`, as the intervals use them) less their projection on the
 linear columns. The shapes are searched as ``(log w_s, delta)`` inside the search box; a step
 is taken only when it lowers the weighted sum of squares, so the polish never loses.
 
@@ -30,7 +29,7 @@ import numpy as np
 
 from ._friction import DELTA_BOX, W_S_BOX, JointFriction
 from ._signals import ArmSignals
-from ._solve import lstsq, stack
+from ._solve import lstsq, shape_rows, stack
 
 __all__ = ["polish_shapes"]
 
@@ -75,21 +74,6 @@ def _state(sig, Yb, frictions, mask, sigma):
     return st, A, theta, r, float(r @ r)
 
 
-def _jacobian(sig, frictions, blocks, st, theta, sigma) -> np.ndarray:
-    """d(model)/d(log w_s, delta) of every block on the stack's weighted rows."""
-    J = np.zeros((st.A.shape[0], 2 * len(blocks)))
-    col = 0
-    for j in sorted({j for j, _ in blocks}):
-        jf = frictions[j]
-        c = sig.parallel(jf.shape_jacobian(sig.full_dq[:, j], theta[st.offsets[j] :]))
-        for k, d in enumerate(jf.directions):
-            c[:, 2 * k] *= jf.shapes[d][0]  # d / d log w_s
-        rows = np.flatnonzero(st.row_joint == j)
-        J[rows, col : col + c.shape[1]] = st.project(j, c[st.row_time[rows]]) / sigma[j]
-        col += c.shape[1]
-    return J
-
-
 def polish_shapes(
     sig: ArmSignals,
     Yb: np.ndarray,
@@ -103,11 +87,12 @@ def polish_shapes(
     blocks = _blocks(frictions, mask)
     if not blocks:
         return {}
+    joints = sorted({j for j, _ in blocks})
     st, A, theta, r, ssr = _state(sig, Yb, frictions, mask, sigma)
     start, lam, taken = ssr, 1e-3, 0
     for _ in range(ITERATIONS):
         taken += 1
-        J = _jacobian(sig, frictions, blocks, st, theta, sigma)
+        J = shape_rows(sig, frictions, st, theta, sigma, joints, log_w=True)
         norms = np.linalg.norm(A, axis=0)
         norms[norms == 0] = 1.0
         coef, *_ = np.linalg.lstsq(A / norms, J, rcond=1e-10)

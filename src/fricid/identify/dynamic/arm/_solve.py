@@ -51,7 +51,15 @@ from ._friction import DELTA_BOX, W_S_BOX, JointFriction
 from ._signals import ArmSignals
 from ._sticks import stick_basis
 
-__all__ = ["Stack", "arm_covariance", "search_shapes", "shape_profiles", "stack", "wls"]
+__all__ = [
+    "Stack",
+    "arm_covariance",
+    "search_shapes",
+    "shape_profiles",
+    "shape_rows",
+    "stack",
+    "wls",
+]
 
 #: The autocorrelation below which residuals count as uncorrelated.
 RHO_END = 0.05
@@ -138,6 +146,34 @@ def stack(
         ]
         st.A, st.y = st.residualise(st.A), st.residualise(st.y)
     return st
+
+
+def shape_rows(
+    sig: ArmSignals,
+    frictions: list[JointFriction],
+    st: Stack,
+    theta: np.ndarray,
+    sigma: np.ndarray,
+    joints: list[int],
+    log_w: bool = False,
+) -> np.ndarray:
+    """The Stribeck shapes' columns of ``joints`` on the stack's weighted rows: d friction /
+    d (w_s, delta) per direction (d / d log w_s with ``log_w``), through the torque's filters,
+    each joint's stick columns out, divided by its ``sigma``; shape (m, 2 directions per
+    joint)."""
+    widths = [2 * len(frictions[j].directions) for j in joints]
+    out = np.zeros((st.A.shape[0], sum(widths)))
+    col = 0
+    for j, width in zip(joints, widths, strict=True):
+        jf = frictions[j]
+        c = sig.parallel(jf.shape_jacobian(sig.full_dq[:, j], theta[st.offsets[j] :]))
+        if log_w:
+            for k, d in enumerate(jf.directions):
+                c[:, 2 * k] *= jf.shapes[d][0]
+        rows = np.flatnonzero(st.row_joint == j)
+        out[rows, col : col + width] = st.project(j, c[st.row_time[rows]]) / sigma[j]
+        col += width
+    return out
 
 
 def lstsq(A: np.ndarray, y: np.ndarray) -> np.ndarray:
