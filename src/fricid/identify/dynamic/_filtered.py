@@ -55,7 +55,7 @@ import numpy as np
 from ...errors import ConfigError, DataError
 from ...models import dahl, lugre
 from ..problem import ResidualProblem
-from ..static.convergence import noise_ftol
+from ..static.convergence import noise_ftol, settle
 from ..static.uncertainty import jacobian
 from ._data import Series, blocks, cluster_covariance
 from ._routes import JOINT_PARAMS, SEARCH_SHARE, _run, _Stage, _t975
@@ -277,6 +277,7 @@ def filtered_route(
     search = ResidualProblem(projected, box, law.names, y)
     ftol = noise_ftol(search, SEARCH_SHARE)  # each evaluation a simulation (module notes)
     result = _run(search, method, x0, seed, max_evals, 1, ftol)
+    result = settle(search, result, method, max_evals)
     u_hat = np.asarray(result.x, dtype=float)
     c = np.linalg.lstsq(Phi, y - friction(u_hat)[0], rcond=None)[0]
 

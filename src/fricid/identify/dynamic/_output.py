@@ -39,7 +39,7 @@ import numpy as np
 
 from ...models import lugre
 from ..problem import ResidualProblem
-from ..static.convergence import noise_ftol
+from ..static.convergence import noise_ftol, settle
 from ..static.uncertainty import jacobian
 from ._data import Series, blocks, cluster_covariance
 from ._filtered import LOG_BOX, ParallelFilter
@@ -155,6 +155,7 @@ def output_error(
     search = ResidualProblem(residuals, box, names, y)
     ftol = noise_ftol(search, SEARCH_SHARE)  # each evaluation a simulation (module notes)
     result = _run(search, method, x0, seed, max_evals or MAX_EVALS, 1, ftol)
+    result = settle(search, result, method, max_evals)
     u_hat = np.asarray(result.x, dtype=float)
     Jm, r0 = jacobian(residuals, u_hat)
     labels = blocks(n, max(round(cluster_time * rate), 1))[keep]

@@ -73,9 +73,14 @@ Convergence: each stage's search is a problem of the problem protocol
 (:class:`fricid.identify.problem.Problem`), and every stage whose estimate is reported is
 certified as an analytic fit is (:func:`fricid.identify.static.convergence.certify`, a short
 local least-squares polish from its result; a stage that only started a later search of all
-its parameters is recorded, not polished: :func:`._outcome.converged`). When one is not
-certified the fit warns (``ConvergenceWarning``) and withholds every standard error and
-interval. The polish adds its evaluations to the time (measured on the virtual joint, 2
+its parameters is recorded, not polished: :func:`._outcome.converged`). A simulated stage's
+least-squares search on its default budget is first carried on from the certificate's polish
+while that polish still gains (:func:`fricid.identify.static.convergence.settle`: 21 of 108
+fits on ``benchmarks/bench_lugre.py``'s logs were uncertified without it, 1 with it). When
+one is not certified the fit warns (``ConvergenceWarning``) and withholds every standard
+error and interval. Where ``w_s`` is not bounded below by the data, ``tau_s`` and ``delta``
+are reported not determined (:func:`._result.unresolved_rise`). The polish adds its
+evaluations to the time (measured on the virtual joint, 2
 shared cores: about 0.3-0.45 s on a ``two_stage`` fit of 1.0-1.1 s, 0-0.5 s on a ``filtered``
 one of 3.3-3.5 s without the rate bias).
 
