@@ -18,10 +18,11 @@ no parameter, nor any combination of them, by more than a tenth of its standard 
 below what the data resolve. (An SSE gain of 0.011 % on 60 samples is 0.007 ``s^2``:
 converged.) Otherwise the fit had not converged, and the block says by how much (relative
 SSE gain and standard errors); either way the result is a local optimum whatever the
-optimiser's status (certified) or it is not. The fit keeps the optimiser's own point either way (a
-paper's BAS run stays a BAS run); the polish only measures. Any problem of the problem
-protocol (:class:`fricid.identify.problem.Problem`) is certified alike: the analytic fits'
-and each stage of a trajectory identification.
+optimiser's status (certified) or it is not. The fit keeps the optimiser's own point
+either way (a paper's BAS run stays a BAS run); the polish only measures, but in
+:func:`settle`, where a trajectory stage's least-squares search on its default budget carries
+on from it. Any problem of the problem protocol (:class:`fricid.identify.problem.Problem`) is
+certified alike: the analytic fits' and each stage of a trajectory identification.
 """
 
 from __future__ import annotations
@@ -119,8 +120,7 @@ def certify_polish(
     problem: Problem, result: OptimizeResult, *, noise_tolerance: bool = False
 ) -> tuple[dict[str, Any], OptimizeResult | None]:
     """:func:`certify`'s block and the polish's own result (None when nothing was polished:
-    no finite objective), for a search that carries on from the polish (a trajectory stage's
-    :func:`fricid.identify.dynamic._routes.settle`)."""
+    no finite objective), for a search that carries on from the polish (:func:`settle`)."""
     sse = float(result.fun)
     block: dict[str, Any] = {
         "converged": False,
