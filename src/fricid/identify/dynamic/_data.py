@@ -57,6 +57,7 @@ __all__ = [
     "cluster_covariance",
     "derivatives",
     "low_speed_windows",
+    "torque_noise",
     "uniform_series",
 ]
 
@@ -245,3 +246,10 @@ def cluster_covariance(
         cov = scale * bread @ meat @ bread
     cov, se = floored_covariance(cov, np.diag(plain), determined)
     return cov, se, g
+
+
+def torque_noise(u: np.ndarray) -> float:
+    """The torque's white-noise level [N m]: the median absolute deviation of its sample
+    differences over sqrt(2) (a smooth signal's differences are far smaller)."""
+    d = np.diff(u)
+    return float(1.4826 * np.median(np.abs(d - np.median(d))) / np.sqrt(2.0))

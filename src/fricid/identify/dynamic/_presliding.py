@@ -90,7 +90,7 @@ from ...optim import minimize
 from ..problem import ResidualProblem
 from ..static.convergence import POLISH_EVALS_PER_PARAM, RESOLVE_SE, noise_ftol
 from ..static.uncertainty import jacobian
-from ._data import Series, blocks, cluster_covariance
+from ._data import Series, blocks, cluster_covariance, torque_noise
 from ._encoder import quantise
 from ._filtered import LOG_BOX, ParallelFilter
 from ._outcome import GROSS, WIDEN
@@ -332,7 +332,7 @@ def presliding_route(
     info = {
         "filter": filt.describe(rate),
         "inertia_profile": profile,
-        "torque_noise": _noise(u),
+        "torque_noise": torque_noise(u),
         "span_counts": span / quantum if quantum else None,
         "deflection": load / s0_hat,
         "deflection_counts": load / s0_hat / quantum if quantum else None,
@@ -395,13 +395,6 @@ def _long_run(r: np.ndarray) -> float:
         return 1.0
     ac = [float(r[:-k] @ r[k:]) / var for k in range(1, lags + 1)]
     return max(1.0, 1.0 + 2.0 * sum((1 - k / (lags + 1)) * a for k, a in enumerate(ac, 1)))
-
-
-def _noise(u: np.ndarray) -> float:
-    """The torque's white-noise level [N m]: the median absolute deviation of its sample
-    differences over sqrt(2) (a smooth signal's differences are far smaller)."""
-    d = np.diff(u)
-    return float(1.4826 * np.median(np.abs(d - np.median(d))) / math.sqrt(2.0))
 
 
 def bias_check(

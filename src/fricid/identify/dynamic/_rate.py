@@ -53,7 +53,7 @@ from ._encoder import measured_velocity, quantise
 from ._filtered import LOG_BOX, ParallelFilter, filtered_route
 from ._routes import _Stage
 
-__all__ = ["GAINS", "SUB_STEPS", "rate_bias"]
+__all__ = ["GAINS", "SUB_STEPS", "rate_bias", "simulated_log"]
 
 #: Sub-steps per logged period of the simulation at the estimate (as the virtual joint's).
 SUB_STEPS = 16
@@ -106,34 +106,12 @@ def rate_bias(
         (the simulation at the estimate diverged, or its identification failed).
     """
     theta = np.asarray(stage.values[:7], dtype=float)
-    joint = [*stage.values[7:], 0.0, 0.0]
-    dt, q = series.dt, series.position
-    sim = lugre.simulate_joint(
-        theta,
-        joint[0],
-        joint[1],
-        joint[2],
-        np.full(q.size, dt),
-        series.torque,
-        q0=q[0],
-        v0=series.velocity[0],
-        z0=np.sign(series.velocity[0])
-        * lugre.stribeck_curve(theta, series.velocity[:1])[0]
-        / theta[0],
-        reference=(q, np.gradient(q, dt)),
-        gains=GAINS,
-        n_sub=SUB_STEPS,
-    )
     quantum = (encoder or {}).get("quantum")
-    out: dict[str, Any] = {"internal_rate": SUB_STEPS / dt, "log_rate": 1.0 / dt}
+    out: dict[str, Any] = {"internal_rate": SUB_STEPS / series.dt, "log_rate": 1.0 / series.dt}
     out["quantised"] = (encoder or {}).get("counts_per_rev") if quantum else None
-    if not all(np.isfinite(sim[k]).all() for k in ("position", "velocity", "torque")):
+    again = simulated_log(series, stage.values, encoder)
+    if again is None:
         return {**out, "skipped": "the simulation at the estimate diverged"}
-    position, velocity = sim["position"], sim["velocity"]
-    if quantum:
-        position = quantise(position, quantum, encoder.get("offset", 0.0))
-        velocity = measured_velocity(position, velocity, dt, encoder["velocity_form"])
-    again = replace(series, position=position, velocity=velocity, torque=sim["torque"])
     try:
         if refine is None:
             redo, _, _ = filtered_route(
@@ -154,6 +132,48 @@ def rate_bias(
             "corrected": float(theta[i] * 10.0 ** (-b)),
         }
     return out
+
+
+def simulated_log(
+    series: Series,
+    values: np.ndarray,
+    encoder: dict[str, Any] | None = None,
+    feed: np.ndarray | None = None,
+    noise: np.ndarray | None = None,
+) -> Series | None:
+    """The log a joint with ``values`` (LuGre's seven, then J, p_x, p_y) would have given:
+    simulated at :data:`SUB_STEPS` sub-steps per period under ``feed`` (default the logged
+    torque) with PD tracking (:data:`GAINS`) of the measured position, read through the log's
+    ``encoder`` (its velocity formed as the log's was), the applied torque logged plus
+    ``noise`` (``(n,)``, default none). None when the simulation diverges."""
+    theta = np.asarray(values[:7], dtype=float)
+    joint = [*values[7:], 0.0, 0.0]
+    dt, q = series.dt, series.position
+    sim = lugre.simulate_joint(
+        theta,
+        joint[0],
+        joint[1],
+        joint[2],
+        np.full(q.size, dt),
+        series.torque if feed is None else feed,
+        q0=q[0],
+        v0=series.velocity[0],
+        z0=np.sign(series.velocity[0])
+        * lugre.stribeck_curve(theta, series.velocity[:1])[0]
+        / theta[0],
+        reference=(q, np.gradient(q, dt)),
+        gains=GAINS,
+        n_sub=SUB_STEPS,
+    )
+    if not all(np.isfinite(sim[k]).all() for k in ("position", "velocity", "torque")):
+        return None
+    position, velocity = sim["position"], sim["velocity"]
+    quantum = (encoder or {}).get("quantum")
+    if quantum:
+        position = quantise(position, quantum, encoder.get("offset", 0.0))
+        velocity = measured_velocity(position, velocity, dt, encoder["velocity_form"])
+    torque = sim["torque"] if noise is None else sim["torque"] + noise
+    return replace(series, position=position, velocity=velocity, torque=torque)
 
 
 def _biases(stage: _Stage, redo: _Stage) -> dict[str, dict[str, Any]]:
