@@ -95,22 +95,17 @@ for log10 sigma_0 and sigma_1 (40/40); 270/280 covered. The cluster jackknife (C
 the standard errors by 0.5-1.5 % and no coverage: CR1 is kept
 (:mod:`._trajectory_data`).
 
-Rate bias (``rate_bias="warn"``, the default of the filtered route): the break-away between
-samples biases sigma_0 up and sigma_1 down at 1 kHz (seeds 10-49, 60 s: +2.9 % and -18 %
-on average, inside their intervals; noise-free 20 s: +3.8 % and -21 %, outside them). It is
-estimated by simulation at the estimate (:mod:`._trajectory_rate`), recorded with the
-corrected values, and warned about (:class:`RateBiasWarning`) with the rate that removes
-it; not applied, as the correction over-corrects sigma_1 by about half (module notes there).
-
-Measurement model (:mod:`._encoder`): the encoder's counts per revolution are read from the
-position steps (or given, ``encoder_counts``) and recorded with the velocity's form and its
-quantisation error. The simulation at the estimate reads its motion through that encoder and
-gives every parameter's bias (the rate's, the encoder's and the PD loop's together); an
-interval the bias exceeds by a standard error is widened by it, a parameter it biases grossly
-is flagged not determined (:func:`._outcome.calibrate`). When the encoder does not resolve
-the bristles' deflection at break-away, the filtered estimate is refined by the output error
-of the joint simulated along the measured motion (:mod:`._output`, DIDIM), and the result
-names the estimator used (``provenance["trajectory"]["estimator"]``).
+Rate bias and measurement (``rate_bias="warn"``, the default of the filtered route): the
+break-away between samples biases sigma_0 up and sigma_1 down at 1 kHz (seeds 10-49, 60 s:
++2.9 % and -18 %; noise-free 20 s: +3.8 % and -21 %). The encoder's counts per revolution are
+read from the position steps or given (``encoder_counts``, :mod:`._encoder`). A simulation at
+the estimate through that encoder (:mod:`._rate`) gives every parameter's bias, recorded and
+warned about (:class:`RateBiasWarning`; not applied, it over-corrects sigma_1 by about half);
+an interval it exceeds by a standard error is widened, one it biases grossly is flagged not
+determined (:func:`._outcome.calibrate`); sigma_1 is flagged where it does not follow a moved
+truth (:mod:`._response`). Where the encoder does not resolve the bristles' deflection at
+break-away the filtered estimate is refined by the output error (:mod:`._output`, DIDIM);
+the result names the estimator (``provenance["trajectory"]["estimator"]``).
 
 What it recovers (``benchmarks/bench_trajectory.py``, run for the report: LuGre
 truth, 60 s multi-sine at 1 kHz, trajectory noise, ``lm``, seeds 0-4; coverage by the closed
@@ -184,6 +179,7 @@ from ._output import needs_output_error
 from ._output import output_error as _output_error
 from ._presliding_fit import fit_presliding
 from ._rate import rate_bias as _rate_bias
+from ._response import follows, response_notes
 from ._result import build_result
 from ._routes import JOINT_PARAMS, _regression
 from ._simroute import simulation_route
@@ -293,15 +289,12 @@ def fit_trajectory(
     seed, max_evals
         As for :func:`fricid.optim.minimize` (the budget is per stage).
     rate_bias : {"warn", "off"}
-        ``warn`` (default): the ``filtered`` route's bias of sigma_0 and sigma_1 at the
-        log's rate is estimated by simulation at the estimate
-        (:func:`._trajectory_rate.rate_bias`, about the route's own time again), recorded
-        in ``provenance["trajectory"]["rate_bias"]`` with the corrected values (not
-        applied), and warned about (:class:`RateBiasWarning`) when it exceeds
-        :data:`RATE_BIAS_WARN` standard errors; ``off`` skips it. The same simulation
-        reads the motion through the log's encoder (``encoder_counts``) and gives every
-        parameter's bias; an interval the bias exceeds by a standard error is widened by it,
-        a parameter biased grossly is flagged not determined (:func:`._outcome.calibrate`).
+        ``warn`` (default): every parameter's bias by simulation at the estimate through
+        the log's rate and encoder (:func:`._rate.rate_bias`), recorded in
+        ``provenance["trajectory"]["rate_bias"]``, warned about (:class:`RateBiasWarning`)
+        beyond :data:`RATE_BIAS_WARN` standard errors, intervals widened or flagged by it
+        (:func:`._outcome.calibrate`), and sigma_1 flagged where it does not follow a moved
+        truth (:mod:`._response`, ``provenance["trajectory"]["follows"]``); ``off`` skips it.
     encoder_counts : float, optional
         The encoder's counts per revolution; default: read from the position steps
         (:func:`._encoder.encoder_quantum`; none when the steps share no quantum). Recorded
@@ -500,6 +493,12 @@ def fit_trajectory(
             notes = calibrate(stage, rb)
             final.update(stage.table())
             warn_rate_bias(stage, rb, notes)
+            say("whether the estimate follows a shifted truth")
+            sim_info["follows"] = check = follows(
+                series, stage, encoder, seed, refine is not None, box, gravity, method,
+                cluster_time, n_sub, parallel,
+            )  # fmt: skip
+            notes = {**notes, **response_notes(stage, check)}
     elif key == "lugre":
         say(f"{route} route: sigma_0, sigma_1 by simulation error")
         sim_info, static_tab = simulation_route(
@@ -567,7 +566,7 @@ def _stages(
     (``i`` of ``n``: the log, the regression, the route's own stages, the intervals)."""
     n = 3
     if key == "lugre":
-        n += 1 + (route == "filtered") * (1 + (rate_bias == "warn"))
+        n += 1 + (route == "filtered") * (1 + 2 * (rate_bias == "warn"))
     elif key == "dahl":
         n += 1
     count = [0]

@@ -1,0 +1,124 @@
+"""Whether a LuGre estimate follows the truth (:mod:`fricid.identify.dynamic._response`): the
+bristle damping identified again from logs simulated at shifted truths, and flagged not
+determined where the re-estimates stay put; checked on a log of the independent simulator of
+``benchmarks/bench_lugre.py`` where the interval missed the truth by a factor of four."""
+
+from __future__ import annotations
+
+import sys
+import warnings
+
+import numpy as np
+import pytest
+from tests._paths import REPO
+
+from fricid.identify.dynamic._data import Series, torque_noise
+from fricid.identify.dynamic._filtered import ParallelFilter
+from fricid.identify.dynamic._response import (
+    FOLLOW,
+    MAX_SHIFT,
+    SHIFT,
+    follows,
+    response_notes,
+)
+from fricid.identify.dynamic._routes import _Stage
+from fricid.models import lugre
+
+sys.path.insert(0, str(REPO / "benchmarks"))
+import _lugre_truth as lt
+
+NAMES = [*lugre.PARAM_NAMES, "inertia", "p_x", "p_y"]
+VALUES = np.array([2e4, 3.0, 0.4, 1.2, 1.8, 0.05, 2.0, 0.05, 0.3, 2.0])
+
+
+def _stage(half_log10: dict[str, float]) -> _Stage:
+    """A stage at :data:`VALUES` whose sigma_0 and sigma_1 intervals are ``10**(+/- half)``."""
+    low, high = VALUES * 0.9, VALUES * 1.1
+    for name, half in half_log10.items():
+        i = NAMES.index(name)
+        low[i], high[i] = VALUES[i] * 10**-half, VALUES[i] * 10**half
+    n = len(NAMES)
+    return _Stage(
+        NAMES, VALUES.copy(), (high - low) / 3.92, low, high, np.eye(n), None, 0.0, 20, {},
+        np.column_stack([VALUES * 0.01, VALUES * 100]),
+    )  # fmt: skip
+
+
+def _series(seed: int = 0) -> Series:
+    """Two seconds of a tracked sine at 1 kHz with a noisy torque."""
+    t = np.arange(2000) / 1000.0
+    q = 0.3 * np.sin(2 * np.pi * t)
+    rng = np.random.default_rng(seed)
+    u = 1.5 * np.sign(np.cos(2 * np.pi * t)) + 2.0 * np.cos(q) + 0.02 * rng.standard_normal(t.size)
+    return Series(t, q, np.gradient(q, t), u, np.zeros_like(t), 1e-3, False)
+
+
+def test_an_estimate_that_stays_put_is_flagged_and_the_shifts_are_bounded():
+    stage = _stage({"sigma_0": 0.05, "sigma_1": 0.5})
+    seen = []
+
+    def stays(data, start):
+        seen.append(data)
+        return start
+
+    route = (None, "sin_cos", "lm", 0.5, 16, ParallelFilter())
+    check = follows(_series(), stage, None, 0, True, *route, reidentify=stays)
+    assert len(check["shifts"]) == 2 and len(seen) == 2
+    assert check["noise"] == pytest.approx(torque_noise(_series().torque))
+    first, second = check["shifts"]
+    assert first["sigma_0"]["shift"] == pytest.approx(SHIFT * 0.05)
+    assert first["sigma_1"]["shift"] == pytest.approx(-MAX_SHIFT)  # 3 x 0.5 capped
+    assert second["sigma_0"]["shift"] < 0 < second["sigma_1"]["shift"]
+    for rows in check["shifts"]:
+        for row in rows.values():
+            assert row["miss"] == pytest.approx(-row["shift"])
+    notes = response_notes(stage, check)
+    assert set(notes) == {"sigma_1"}  # sigma_0 is shifted, not judged
+    note = notes["sigma_1"]
+    assert note.startswith("not determined") and "tell the two apart" in note
+    # the simulated logs carry the shifted truths' motion, not the measured torque
+    assert not np.allclose(seen[0].torque, _series().torque)
+
+
+@pytest.mark.parametrize(
+    ("miss", "flagged"),
+    [(-0.5, False), (-0.59, False), (-0.61, True), (-0.9, True), (0.1, False), (0.9, False)],
+)
+def test_a_re_estimate_that_moves_less_than_half_the_shift_is_flagged(miss, flagged):
+    """The truth shifted by +0.6 (log10): a miss of -0.5 moved a sixth of the way, -0.61
+    and -0.9 moved the other way; +0.1 and +0.9 moved past it (told apart; the bias is the
+    other joint's)."""
+    stage = _stage({"sigma_0": 0.1, "sigma_1": 0.1})
+    row = {"shift": 0.6, "truth": 1.0, "estimate": 10**miss, "miss": miss}
+    notes = response_notes(stage, {"shifts": [{"sigma_1": row}]})
+    assert ("sigma_1" in notes) is flagged
+    assert row["followed"] == pytest.approx((miss + 0.6) / 0.6)
+    assert FOLLOW == 0.0
+
+
+def test_a_skipped_check_flags_nothing():
+    stage = _stage({"sigma_0": 0.1, "sigma_1": 0.1})
+    assert response_notes(stage, {"skipped": "the simulation at a shifted truth diverged"}) == {}
+
+
+def _fit(truth: str, kind: str, rate: float, cpr: int, seed: int, tmp_path):
+    from fricid.identify import fit
+    from fricid.io import read_rawlog
+
+    t = lt.TRUTHS[truth]
+    path = lt.write_log(lt.simulate(t, kind, 10.0, rate, cpr, seed), tmp_path / "a.csv", t, {})
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return fit(read_rawlog(path), "lugre", seed=seed), t.fricid_names()
+
+
+@pytest.mark.slow  # about 10 s: a 10 s log at 1 kHz identified
+def test_damping_the_log_cannot_tell_is_not_claimed(tmp_path):
+    """slow_stribeck, PD-tracked trapezoid, 1 kHz, 2^17 counts/rev: sigma_1 was claimed as
+    19.8 [15.5, 25.3] against 5, and the check at the estimate read -0.5 %."""
+    fitted, truth = _fit("slow_stribeck", "trapezoid_pd", 1000.0, 2**17, 0, tmp_path)
+    p = fitted.parameters["sigma_1"]
+    assert p.not_determined and "tell the two apart" in p.note
+    assert not (p.ci95[0] <= truth["sigma_1"] <= p.ci95[1])  # what would have been claimed
+    check = fitted.provenance["trajectory"]["follows"]
+    assert min(r["sigma_1"]["followed"] for r in check["shifts"]) < FOLLOW
