@@ -127,7 +127,7 @@ same 108 settings; not tuned on), sigma_1's claims covered, before -> after: chi
 18 covered); every other parameter unchanged. Median seconds scaled to 60 s at 1 kHz, before
 (the earlier run) -> after (this run, nothing else running): chirp 29 -> 46, trapezoid 42 ->
 60, torque steps 40 -> 59; the two re-identifications at the full output-error budget had
-made it 61, 77 and 77.
+made it 61, 77 and 77 (the test suite running beside it part of the time).
 
 Left: w_s claims cover the truth in 14 of 86, the trapezoid's sigma_1 in 3 of 29 (too high by
 a factor of 3-30 at 2^17 and 2^20 counts/rev alike, and right at 2^24: the quantisation, which

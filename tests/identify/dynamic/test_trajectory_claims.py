@@ -6,21 +6,15 @@ independent simulator of ``benchmarks/bench_lugre.py`` where they failed before.
 
 from __future__ import annotations
 
-import sys
-import warnings
-
 import numpy as np
 import pytest
-from tests._paths import REPO
+from _bench_fit import fit_bench_log
 
 from fricid.fitted import Parameter
 from fricid.identify.dynamic._result import unresolved_rise
 from fricid.identify.problem import ResidualProblem
 from fricid.identify.static.convergence import certify, settle
 from fricid.optim import OptimizeResult
-
-sys.path.insert(0, str(REPO / "benchmarks"))
-import _lugre_truth as lt
 
 
 def _line_problem():
@@ -109,22 +103,11 @@ def test_tau_s_kept_when_the_rise_is_bounded_below(w_s):
     assert not out["tau_s"].not_determined and out["tau_s"] is params["tau_s"]
 
 
-def _fit(truth: str, kind: str, rate: float, cpr: int, seed: int, tmp_path):
-    from fricid.identify import fit
-    from fricid.io import read_rawlog
-
-    t = lt.TRUTHS[truth]
-    path = lt.write_log(lt.simulate(t, kind, 10.0, rate, cpr, seed), tmp_path / "a.csv", t, {})
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        return fit(read_rawlog(path), "lugre", seed=seed), t.fricid_names()
-
-
 @pytest.mark.slow  # about 3 s: a 10 s log at 1 kHz identified
 def test_break_away_below_the_resolution_is_not_claimed(tmp_path):
     """cdw95 (w_s = 1 mrad/s) through 2^17 counts/rev at 1 kHz: tau_s came out at tau_c,
     1.0002 [0.9925, 1.0079] against 1.5, 127 half-widths off; now not determined."""
-    fitted, truth = _fit("cdw95", "chirp_pd", 1000.0, 2**17, 1, tmp_path)
+    fitted, truth = fit_bench_log("cdw95", "chirp_pd", 1000.0, 2**17, 1, tmp_path)
     p = fitted.parameters["tau_s"]
     assert p.not_determined and "w_s" in p.note
     assert not (p.ci95[0] <= truth["tau_s"] <= p.ci95[1])  # what would have been claimed
@@ -135,7 +118,7 @@ def test_short_search_settles_and_intervals_are_given(tmp_path):
     """geared, PD-tracked chirp at 200 Hz through 2^17 counts/rev: the output-error search
     stopped 1.97 standard errors short and every interval was withheld; now certified, and
     the intervals cover the truth."""
-    fitted, truth = _fit("geared", "chirp_pd", 200.0, 2**17, 0, tmp_path)
+    fitted, truth = fit_bench_log("geared", "chirp_pd", 200.0, 2**17, 0, tmp_path)
     assert fitted.converged
     covered = [
         n

@@ -5,15 +5,11 @@ determined where the re-estimates stay put; checked on a log of the independent 
 
 from __future__ import annotations
 
-import sys
-import warnings
-
 import numpy as np
 import pytest
-from tests._paths import REPO
+from _bench_fit import fit_bench_log
 
 from fricid.identify.dynamic._data import Series, torque_noise
-from fricid.identify.dynamic._filtered import ParallelFilter
 from fricid.identify.dynamic._response import (
     FOLLOW,
     MAX_SHIFT,
@@ -23,9 +19,6 @@ from fricid.identify.dynamic._response import (
 )
 from fricid.identify.dynamic._routes import _Stage
 from fricid.models import lugre
-
-sys.path.insert(0, str(REPO / "benchmarks"))
-import _lugre_truth as lt
 
 NAMES = [*lugre.PARAM_NAMES, "inertia", "p_x", "p_y"]
 VALUES = np.array([2e4, 3.0, 0.4, 1.2, 1.8, 0.05, 2.0, 0.05, 0.3, 2.0])
@@ -61,8 +54,7 @@ def test_an_estimate_that_stays_put_is_flagged_and_the_shifts_are_bounded():
         seen.append(data)
         return start
 
-    route = (None, "sin_cos", "lm", 0.5, 16, ParallelFilter())
-    check = follows(_series(), stage, None, 0, True, *route, reidentify=stays)
+    check = follows(_series(), stage, None, 20.0, 0, stays)
     assert len(check["shifts"]) == 2 and len(seen) == 2
     assert check["noise"] == pytest.approx(torque_noise(_series().torque))
     first, second = check["shifts"]
@@ -101,22 +93,11 @@ def test_a_skipped_check_flags_nothing():
     assert response_notes(stage, {"skipped": "the simulation at a shifted truth diverged"}) == {}
 
 
-def _fit(truth: str, kind: str, rate: float, cpr: int, seed: int, tmp_path):
-    from fricid.identify import fit
-    from fricid.io import read_rawlog
-
-    t = lt.TRUTHS[truth]
-    path = lt.write_log(lt.simulate(t, kind, 10.0, rate, cpr, seed), tmp_path / "a.csv", t, {})
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        return fit(read_rawlog(path), "lugre", seed=seed), t.fricid_names()
-
-
 @pytest.mark.slow  # about 10 s: a 10 s log at 1 kHz identified
 def test_damping_the_log_cannot_tell_is_not_claimed(tmp_path):
     """slow_stribeck, PD-tracked trapezoid, 1 kHz, 2^17 counts/rev: sigma_1 was claimed as
     19.8 [15.5, 25.3] against 5, and the check at the estimate read -0.5 %."""
-    fitted, truth = _fit("slow_stribeck", "trapezoid_pd", 1000.0, 2**17, 0, tmp_path)
+    fitted, truth = fit_bench_log("slow_stribeck", "trapezoid_pd", 1000.0, 2**17, 0, tmp_path)
     p = fitted.parameters["sigma_1"]
     assert p.not_determined and "tell the two apart" in p.note
     assert not (p.ci95[0] <= truth["sigma_1"] <= p.ci95[1])  # what would have been claimed

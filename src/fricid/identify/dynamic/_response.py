@@ -27,8 +27,9 @@ apart, and the bias is the other joint's (fricid's virtual joint, 10 s multi-sin
 11-12, sigma_1 = 1: the truth shifted to 0.25 came back at the search range's lower end,
 while every interval at the estimate covered the truth).
 
-Measured (``benchmarks/bench_lugre.py``, 10 s logs, the tuning seeds 0-2, 108 fits; claims
-covered before -> after, of the fits that claimed): sigma_1 on the PD-tracked trapezoid 3/28
+Measured (``benchmarks/bench_lugre.py``, 10 s logs, the tuning seeds 0-2, 108 fits, every
+re-estimate recorded; the rules below applied to those records afterwards; claims covered
+before -> after, of the fits that claimed): sigma_1 on the PD-tracked trapezoid 3/28
 -> 2/10, on the chirp 24/30 -> 18/22, on the torque steps 19/32 -> 6/12. Judging sigma_0 the
 same way removed as many covered claims as misses (chirp 30/36 -> 25/30, torque steps 23/34
 -> 18/28), and a threshold of half the shift removed more covered sigma_1 claims (chirp 24/30
@@ -45,16 +46,24 @@ from collections.abc import Callable
 from typing import Any
 
 import numpy as np
-from scipy.signal import butter, sosfiltfilt
 
 from ...errors import FricidError
 from ._data import Series, torque_noise
-from ._filtered import filtered_route
+from ._filtered import ParallelFilter, filtered_route
 from ._output import output_error
 from ._rate import simulated_log
 from ._routes import _Stage
 
-__all__ = ["CHECK_EVALS", "FOLLOW", "JUDGED", "MAX_SHIFT", "SHIFT", "follows", "response_notes"]
+__all__ = [
+    "CHECK_EVALS",
+    "FOLLOW",
+    "JUDGED",
+    "MAX_SHIFT",
+    "SHIFT",
+    "follows",
+    "reidentifier",
+    "response_notes",
+]
 
 #: The shift of each truth, in half-widths of its 95 % interval (log10 scale).
 SHIFT = 3.0
@@ -80,42 +89,49 @@ CHECK_EVALS = 200
 SHIFTED = {"sigma_0": (1.0, -1.0), "sigma_1": (-1.0, 1.0)}
 
 
+def reidentifier(
+    refined: bool,
+    box: np.ndarray,
+    gravity: str,
+    method: str,
+    seed: int,
+    cluster_time: float,
+    n_sub: int,
+    filt: ParallelFilter,
+) -> Callable[[Series, _Stage], _Stage]:
+    """``reidentify(series, start)``: the step that gave the estimate, started from ``start``
+    (the output error when ``refined``, with :data:`CHECK_EVALS` evaluations; else the
+    filtered route), with the settings the identification was given."""
+
+    def reidentify(data: Series, start: _Stage) -> _Stage:
+        if refined:
+            return output_error(
+                data, start, gravity, method, seed, CHECK_EVALS, cluster_time, n_sub, filt
+            )[0]
+        theta = start.values[:7]
+        return filtered_route(data, theta, box, gravity, method, seed, None, 0.5, n_sub, filt)[0]
+
+    return reidentify
+
+
 def follows(
     series: Series,
     stage: _Stage,
     encoder: dict[str, Any] | None,
+    cutoff: float,
     seed: int,
-    refined: bool,
-    *route: Any,
-    reidentify: Callable[[Series, _Stage], _Stage] | None = None,
+    reidentify: Callable[[Series, _Stage], _Stage],
 ) -> dict[str, Any]:
     """sigma_0 and sigma_1 identified again from two logs at shifted truths (module notes).
 
-    ``route`` is what the filtered route was given (``box, gravity, method, cluster_time,
-    n_sub, filt``); the re-identification is the step that gave ``stage`` (the output error
-    when ``refined``, with :data:`CHECK_EVALS` evaluations; else the filtered route), started
-    from ``stage``, or ``reidentify(series, start)`` when given. Returns ``{"noise",
-    "seconds", "shifts": [{name: {"shift", "truth", "estimate", "miss"}}]}`` (``shift``
-    and ``miss`` log10), or ``{"skipped": why}``.
+    ``cutoff`` [Hz] is the route's low-pass; ``reidentify(series, start)`` the step that gave
+    ``stage`` (:func:`reidentifier`). Returns ``{"noise", "seconds", "shifts": [{name:
+    {"shift", "truth", "estimate", "miss"}}]}`` (``shift`` and ``miss`` log10), or
+    ``{"skipped": why}``.
     """
-    box, gravity, method, cluster_time, n_sub, filt = route
-    if reidentify is None:
-
-        def reidentify(data: Series, start: _Stage) -> _Stage:
-            if refined:
-                return output_error(
-                    data, start, gravity, method, seed, CHECK_EVALS, cluster_time, n_sub, filt
-                )[0]
-            theta = start.values[:7]
-            return filtered_route(data, theta, box, gravity, method, seed, None, 0.5, n_sub, filt)[
-                0
-            ]
-
-    cutoff = filt.cutoff
     t0 = time.perf_counter()
     rate = 1.0 / series.dt
-    sos = butter(4, min(FEED_CUTOFF * cutoff, 0.4 * rate), fs=rate, output="sos")
-    feed = sosfiltfilt(sos, series.torque)
+    feed = ParallelFilter(min(FEED_CUTOFF * cutoff, 0.4 * rate)).lowpass(rate)(series.torque)
     noise = torque_noise(series.torque)
     rng = np.random.default_rng([int(seed), 29])
     out: dict[str, Any] = {"noise": noise, "shifts": []}

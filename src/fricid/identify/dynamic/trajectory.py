@@ -179,7 +179,7 @@ from ._output import needs_output_error
 from ._output import output_error as _output_error
 from ._presliding_fit import fit_presliding
 from ._rate import rate_bias as _rate_bias
-from ._response import follows, response_notes
+from ._response import follows, reidentifier, response_notes
 from ._result import build_result
 from ._routes import JOINT_PARAMS, _regression
 from ._simroute import simulation_route
@@ -494,10 +494,11 @@ def fit_trajectory(
             final.update(stage.table())
             warn_rate_bias(stage, rb, notes)
             say("whether the estimate follows a shifted truth")
-            sim_info["follows"] = check = follows(
-                series, stage, encoder, seed, refine is not None, box, gravity, method,
-                cluster_time, n_sub, parallel,
-            )  # fmt: skip
+            again = reidentifier(
+                refine is not None, box, gravity, method, seed, cluster_time, n_sub, parallel
+            )
+            check = follows(series, stage, encoder, parallel.cutoff, seed, again)
+            sim_info["follows"] = check
             notes = {**notes, **response_notes(stage, check)}
     elif key == "lugre":
         say(f"{route} route: sigma_0, sigma_1 by simulation error")
