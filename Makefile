@@ -1,9 +1,13 @@
 # fricid: two commands on a fresh machine, `make demo` and `make test`.
 # `make test` leaves out the tests marked slow (a few minutes on two cores); `make test-all`
 # runs the whole suite, as CI (.ci/run) does; `make docs` builds the documentation site.
+# Both run the tests in TEST_JOBS processes (pytest-xdist), a test file to a process so that a
+# module's fixtures are built once: `make test TEST_JOBS=1` runs them in one.
 PYTHON ?= python3
 VENV   ?= .venv
 BIN    := $(VENV)/bin
+TEST_JOBS ?= 2
+PYTEST := $(BIN)/python -m pytest -n $(TEST_JOBS) --dist loadfile
 STAMP  := $(VENV)/.installed
 DEVSTAMP := $(VENV)/.installed-dev
 DOCSTAMP := $(VENV)/.installed-docs
@@ -30,10 +34,10 @@ demo: $(STAMP)
 	$(BIN)/fricid demo
 
 test: $(DEVSTAMP)
-	$(BIN)/python -m pytest
+	$(PYTEST)
 
 test-all: $(DEVSTAMP)
-	$(BIN)/python -m pytest -m ""
+	$(PYTEST) -m ""
 
 lint: $(DEVSTAMP)
 	$(BIN)/ruff check src tests benchmarks docs

@@ -8,9 +8,18 @@ with a reason naming the folder, where the folder is absent (a bare clone elsewh
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import pytest
+
+# A pytest-xdist worker (``make test`` runs two) starts with COLUMNS=80 and LINES=24 in its
+# environment, which a terminal session does not have; rich would then fix its consoles at 80
+# columns when fricid.cli is imported, and the tests of fricid's own width rule (tables keep whole
+# names in a pipe) would test the worker instead. The suite runs as a user's pipe does.
+if os.environ.get("PYTEST_XDIST_WORKER"):
+    for _name in ("COLUMNS", "LINES"):
+        os.environ.pop(_name, None)
 
 #: The repository's root (this file is ``<root>/tests/conftest.py``).
 REPO = Path(__file__).resolve().parents[1]
