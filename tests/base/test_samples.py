@@ -31,8 +31,11 @@ def test_motor_torque_from_current_eq13():
 
 
 def test_non_monotonic_time_names_row_and_column():
-    with pytest.raises(DataError, match=r"log.csv, row 3, column 'time': time is not strictly"):
+    with pytest.raises(
+        DataError, match=r"log.csv, row 3, column 'time': time is not strictly"
+    ) as e:
         _log(time=np.array([0.0, 1.0, 2.0, 1.5, 3.0]))
+    assert "(2.0 then 1.5)" in str(e.value)  # the numbers as a user writes them, no np.float64
 
 
 def test_nan_names_row_and_column():

@@ -227,6 +227,7 @@ def test_time_not_increasing_and_short_rows(tmp_path):
     with pytest.raises(DataError, match="not strictly increasing") as info:
         read_robot_log(path)
     assert info.value.row == 11 and info.value.column == "time [s]"
+    assert "(0.08 then 0.05)" in str(info.value)  # the numbers, not np.float64(...)
     lines[1 + 9] = ",".join(lines[1 + 9].split(",")[:4])  # a row cut short
     path.write_text("\n".join(lines) + "\n")
     with pytest.raises(DataError, match="row has 4 fields, the header has 7") as info:

@@ -148,7 +148,7 @@ def _read_two_columns(path: Path, quantity: str) -> tuple[np.ndarray, np.ndarray
     if (dt <= 0).any():
         i = int(np.flatnonzero(dt <= 0)[0]) + 1
         raise DataError(
-            f"time is not strictly increasing ({t[i - 1]!r} then {t[i]!r})",
+            f"time is not strictly increasing ({float(t[i - 1])!r} then {float(t[i])!r})",
             file=path,
             row=int(body.index[i]),
             column="time",

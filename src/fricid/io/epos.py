@@ -231,7 +231,8 @@ def _read(
     if (dt <= 0).any():
         i = int(np.flatnonzero(dt <= 0)[0]) + 1
         raise DataError(
-            f"time is not strictly increasing ({rec.data[i - 1, 0]!r} then {rec.data[i, 0]!r})",
+            "time is not strictly increasing "
+            f"({float(rec.data[i - 1, 0])!r} then {float(rec.data[i, 0])!r})",
             file=path,
             row=int(rec.lines[i]),
             column="time",

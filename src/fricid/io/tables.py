@@ -235,7 +235,8 @@ def _iter_rawlog(opened: Opened, chunk_rows: int) -> Iterator[RawLog]:
         log = _rawlog(opened, opened.si(raw), start)
         if last_time is not None and log.time[0] <= last_time:
             raise DataError(
-                f"time is not strictly increasing ({last_time!r} then {log.time[0]!r})",
+                "time is not strictly increasing "
+                f"({float(last_time)!r} then {float(log.time[0])!r})",
                 file=opened.path,
                 row=opened.to_row(start),
                 column=opened.columns["time"].label,
@@ -319,7 +320,8 @@ def _rawlog_tables(first: RawLog, chunks: Iterator[RawLog]) -> Iterator[pa.Table
             )
         if len(chunk) and last_time is not None and chunk.time[0] <= last_time:
             raise DataError(
-                f"chunk {i} does not continue in time ({last_time!r} then {chunk.time[0]!r})",
+                "chunk {i} does not continue in time "
+                f"({float(last_time)!r} then {float(chunk.time[0])!r})",
                 file=chunk.source,
                 column="time",
             )

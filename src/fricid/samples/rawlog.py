@@ -121,7 +121,8 @@ class RawLog:
             if bad.size:
                 row = int(bad[0]) + 1
                 raise DataError(
-                    f"time is not strictly increasing ({time[row - 1]!r} then {time[row]!r})",
+                    "time is not strictly increasing "
+                    f"({float(time[row - 1])!r} then {float(time[row])!r})",
                     file=src,
                     row=row,
                     column="time",
@@ -200,7 +201,8 @@ class RawLog:
         for log in logs:
             if len(log) and last is not None and not log.time[0] > last:
                 raise DataError(
-                    f"time is not strictly increasing ({last!r} then {log.time[0]!r})",
+                    "time is not strictly increasing "
+                    f"({float(last)!r} then {float(log.time[0])!r})",
                     file=first.source,
                     row=row,
                     column="time",

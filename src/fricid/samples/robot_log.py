@@ -233,7 +233,8 @@ class RobotLog:
         if bad.size:
             row = int(bad[0]) + 1
             raise DataError(
-                f"time is not strictly increasing ({time[row - 1]!r} then {time[row]!r})",
+                "time is not strictly increasing "
+                f"({float(time[row - 1])!r} then {float(time[row])!r})",
                 file=src,
                 row=row,
                 column="time",

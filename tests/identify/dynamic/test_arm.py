@@ -268,3 +268,26 @@ def test_a_friction_level_below_zero_is_not_printed_as_a_number(pendulum):
     assert "below zero" in rec["note"]
     assert fit.verdict(fit.joints[1]) != "yes"
     assert not fit.friction[fit.joints[0]]["parameters"]["f_c_pos"]["not_determined"]
+
+
+def test_a_level_below_zero_within_its_interval_is_not_determined_either(pendulum):
+    """A viscous level the data barely see comes out below zero with an interval that reaches
+    zero: the data bound it, they do not tell it. It is not determined (the joint's verdict is
+    not "yes"), and the joint's model is refused with its name, not written for a later
+    command to reject as outside the family's valid region."""
+    laws = [
+        CV_LAWS[0],
+        (
+            "coulomb_viscous_asym",
+            {"f_c_pos": 0.4, "beta_pos": -0.002, "f_c_neg": 0.4, "beta_neg": 0.3},
+        ),
+    ]
+    log = make_log(pendulum, laws, duration=20.0, seed=3, noise=0.2)
+    fit = fit_arm(log, pendulum, friction="coulomb_viscous_asym")
+    rec = fit.friction[fit.joints[1]]["parameters"]["beta_pos"]
+    assert rec["not_determined"] and rec["value"] is None, rec
+    assert "below zero" in rec["note"] and "reaches zero" in rec["note"]
+    assert fit.verdict(fit.joints[1]) != "yes"
+    with pytest.raises(ConfigError, match="beta_pos"):
+        fit.joint_model(fit.joints[1])
+    assert not fit.friction[fit.joints[0]]["parameters"]["beta_pos"]["not_determined"]

@@ -11,7 +11,10 @@ from ._friction import DELTA_BOX, W_S_BOX, split_direction
 __all__ = ["friction_records", "interval", "widen"]
 
 
-#: Friction levels [N m, N m s/rad]: physically never below zero.
+#: Friction levels [N m, N m s/rad]: physically never below zero. Any parameter below zero
+#: beyond its interval is not determined (friction that drives the joint); a level is not
+#: determined below zero within its interval too, while a load coefficient may be (at a small
+#: load it is loose and harmless: :func:`._grade.loose_levels`).
 _LEVELS = ("f_c", "tau_c", "tau_s", "beta", "tau_v")
 
 
@@ -60,9 +63,17 @@ def friction_records(frictions, theta, cov, st, joints, t, sig, moving, models_u
                 "not_determined": nd,
                 "note": note,
             }
-            if pname.startswith(_LEVELS) and not nd and rec["ci95"][1] < 0:
-                # a friction level below zero beyond its interval: the family does not describe
-                # this joint's data (or the joint barely moves); no number to trust
+            level = split_direction(pname)[0] in _LEVELS
+            if not nd and (rec["ci95"][1] < 0 or (level and fam_values[i] < 0)):
+                # a friction level below zero: friction that drives the joint. Beyond its
+                # interval, the family does not describe this joint's data (or the joint
+                # barely moves); within it, the data say the level is small, not what it is.
+                # Either way no number to predict or export with.
+                why = (
+                    "the family does not describe this joint's data"
+                    if rec["ci95"][1] < 0
+                    else "its interval reaches zero: the data bound it, they do not tell it"
+                )
                 rec.update(
                     value=None,
                     stderr=None,
@@ -70,8 +81,7 @@ def friction_records(frictions, theta, cov, st, joints, t, sig, moving, models_u
                     not_determined=True,
                     note=(
                         f"not determined: estimated {fam_values[i]:.4g} +- {t * se[i]:.2g}, "
-                        "a friction level below zero (the family does not describe this "
-                        "joint's data)"
+                        f"a friction level below zero ({why})"
                     ),
                 )
                 params[pname] = rec

@@ -284,6 +284,13 @@ def prepare_signals(
             file=source,
             column="time",
         )
+    shortest = 3 * (BUTTER_ORDER + 1) + 1  # scipy's filtfilt pads 3 filter lengths
+    if position.shape[0] < shortest:
+        raise DataError(
+            f"the log is too short ({position.shape[0]} samples) for the zero-phase low-pass "
+            f"of whole-arm identification (it needs far more than {shortest})",
+            file=source,
+        )
     step = encoder_step(position, counts)
     bounds: dict[str, float] = {}
     if cutoff is None:
