@@ -299,3 +299,14 @@ def test_report_names_each_part_and_takes_quiet(no_grace, tmp_path, samples_csv)
     assert not any(" left" in ln for ln in lines), lines  # parts of unequal cost: not timed
     res = run("report", model, samples_csv, "--out", tmp_path / "rep2", "-q")
     assert res.exit_code == 0 and not progress_lines(res.stderr), res.stderr
+
+
+def test_names_from_files_are_not_turned_into_emoji():
+    """rich reads ``:m:`` as an emoji code; a base parameter named from a joint, ``joint2:m``,
+    before a colon printed as ``joint2Ⓜ``. fricid's consoles print names as they are."""
+    from fricid.cli._app import console, err_console
+
+    for con in (console, err_console):
+        with con.capture() as cap:
+            con.print("joint1:mz +0.1 joint2:m: the URDF's values", markup=False)
+        assert "joint2:m: the" in cap.get()

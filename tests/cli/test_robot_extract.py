@@ -15,6 +15,7 @@ from _arm_sweeps import Law, arm_sweeps
 from fricid.cli import app
 from fricid.io import read_samples, write_robot_log
 from fricid.robot import RigidBodyModel, example_urdf
+from fricid.samples import RobotLog
 
 runner = CliRunner()
 LAWS = {"joint1": Law(0.10, 0.08, 0.05, 0.04), "joint2": Law(0.06, 0.07, 0.03, 0.035)}
@@ -53,6 +54,7 @@ def test_robot_extract_writes_samples_per_joint_and_gravity(pendulum_files):
     # a table per joint (its set-points), then a row per joint
     assert "joint1: 6 set-points" in res.stdout and "joint2: 6 set-points" in res.stdout
     assert "base gravity parameters (identified from the sweeps" in res.stdout
+    assert "nan" not in res.stdout  # an undetermined parameter says so, not "+- nan"
     doc = json.loads((out / "gravity.json").read_text(encoding="utf-8"))
     assert doc["method"] == "arm" and doc["identified"] is True
     assert set(doc["files"]) == {"joint1", "joint2"}
@@ -100,3 +102,24 @@ def test_robot_extract_urdf_masses_keeps_the_urdf(pendulum_files):
     err = samples.friction - LAWS["joint2"](samples.velocity)
     # measured: 0.025 N m RMS, a third of the friction 0.081 N m (0.0005 when identified)
     assert np.sqrt(np.mean(err**2)) > 0.01
+
+
+def test_a_log_without_temperature_names_the_option(pendulum_files, tmp_path):
+    """Sweeps without a temperature channel: the error names the command's --temperature
+    (a command-line user gets the option, not only the Python argument)."""
+    from fricid.io import read_robot_log
+
+    log_path, urdf, _ = pendulum_files
+    log = read_robot_log(log_path)
+    bare = RobotLog(
+        time=log.time,
+        joints=log.joints,
+        position=log.position,
+        velocity=log.velocity,
+        torque=log.torque,
+        source="bare",
+    )
+    path = write_robot_log(bare, tmp_path / "bare.csv")
+    res = runner.invoke(app, ["robot", "extract", str(path), "--urdf", str(urdf)])
+    assert res.exit_code == 2, res.output
+    assert "has no temperature" in res.output and "--temperature" in res.output

@@ -102,8 +102,10 @@ class WideConsole(Console):
         Console.size.fset(self, new_size)  # type: ignore[attr-defined]
 
 
-console = WideConsole()
-err_console = WideConsole(stderr=True)
+#: Neither console turns ``:name:`` into an emoji: joint and parameter names come from files
+#: (``joint2:m: ...`` printed as ``joint2Ⓜ ...``), and fricid's own text uses none.
+console = WideConsole(emoji=False)
+err_console = WideConsole(stderr=True, emoji=False)
 
 #: Exit status of a command stopped by a signal: 128 + the signal number, as a shell reports.
 EXIT_INTERRUPTED = 130

@@ -303,7 +303,8 @@ class RobotLog:
             temp = temperature
         else:
             raise DataError(
-                f"the log has no temperature; give joint('{name}', temperature=...) [degC]",
+                "the log has no temperature; give one [degC] (on the command line "
+                f"--temperature, in Python joint('{name}', temperature=...))",
                 file=self.source,
                 column=joint_column(name, "temperature"),
             )
