@@ -320,7 +320,7 @@ def _rawlog_tables(first: RawLog, chunks: Iterator[RawLog]) -> Iterator[pa.Table
             )
         if len(chunk) and last_time is not None and chunk.time[0] <= last_time:
             raise DataError(
-                "chunk {i} does not continue in time "
+                f"chunk {i} does not continue in time "
                 f"({float(last_time)!r} then {float(chunk.time[0])!r})",
                 file=chunk.source,
                 column="time",
