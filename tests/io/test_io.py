@@ -681,3 +681,14 @@ def test_generic_map_name_shared_by_two_columns_is_refused(tmp_path):
         read_table_log(
             path, columns={"time": "t", "velocity": "dq", "torque": "tau"}, temperature=25.0
         )
+
+
+def test_chunks_that_go_back_in_time_are_named_with_their_times(tmp_path):
+    """Writing chunks: the second starting before the first ends names the chunk and both
+    times as numbers."""
+    first = _log()
+    with pytest.raises(
+        DataError, match=r"chunk 1 does not continue in time \(0\.009\d* then 0\.0\)"
+    ):
+        write_rawlog(iter([first, _log()]), tmp_path / "c.parquet")
+    assert not (tmp_path / "c.parquet").exists()
