@@ -423,3 +423,15 @@ def test_one_pattern_with_a_quantity_field(tmp_path):
     assert log.meta["velocity_from"] == "position (central difference)"
     with pytest.raises(ConfigError, match=r"needs a \{quantity\} field"):
         read_robot_log(folder, channels="{joint}.txt", units=UNITS)
+
+
+def test_more_numbered_joints_than_asked_say_how_to_name_them():
+    """A file of three numbered joints read for a two-joint URDF: the error says why numbers
+    cannot be matched and how to name the columns (a command-line user has no joints=)."""
+    from fricid.io._robot_map import match_joints
+
+    with pytest.raises(DataError, match="numbered columns cannot say which is which") as info:
+        match_joints(["1", "2", "3"], ["shoulder", "elbow"], file="arm.csv")
+    assert "'<joint>.position [rad]'" in str(info.value) and info.value.file == "arm.csv"
+    with pytest.raises(DataError, match="not all by name"):
+        match_joints(["shoulder", "wrist", "x"], ["shoulder", "elbow"], file="arm.csv")

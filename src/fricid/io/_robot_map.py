@@ -185,10 +185,13 @@ def match_joints(
         if all(by_name):
             return by_name, wanted  # type: ignore[return-value]
     if len(found) != len(wanted):
+        numbered = all(_NUMBER.fullmatch(f) for f in found)
+        why = "numbered columns cannot say which is which" if numbered else "not all by name"
         raise DataError(
             f"the file has {_count(len(found))} ({has}) but {len(wanted)} "
-            f"{'was' if len(wanted) == 1 else 'were'} asked for ({asked}); give joints= with "
-            "one name per joint of the file",
+            f"{'was' if len(wanted) == 1 else 'were'} asked for ({asked}), {why}: name the "
+            "file's columns after the joints (e.g. '<joint>.position [rad]'), or in Python "
+            "give joints= with one name per joint of the file",
             file=file,
         )
     numbers = [int(f) for f in found if _NUMBER.fullmatch(f)]
