@@ -2,12 +2,14 @@
 # `make test` leaves out the tests marked slow (a few minutes on two cores); `make test-all`
 # runs the whole suite, as CI (.ci/run) does; `make docs` builds the documentation site.
 # Both run the tests in TEST_JOBS processes (pytest-xdist), a test file to a process so that a
-# module's fixtures are built once: `make test TEST_JOBS=1` runs them in one.
+# module's fixtures are built once (`make test TEST_JOBS=1` runs them in one), then the tests
+# marked serial alone: they send signals at moments that the other process's load shifts.
 PYTHON ?= python3
 VENV   ?= .venv
 BIN    := $(VENV)/bin
 TEST_JOBS ?= 2
-PYTEST := $(BIN)/python -m pytest -n $(TEST_JOBS) --dist loadfile
+PYTEST := $(BIN)/python -m pytest
+PARALLEL := -n $(TEST_JOBS) --dist loadfile
 STAMP  := $(VENV)/.installed
 DEVSTAMP := $(VENV)/.installed-dev
 DOCSTAMP := $(VENV)/.installed-docs
@@ -34,10 +36,12 @@ demo: $(STAMP)
 	$(BIN)/fricid demo
 
 test: $(DEVSTAMP)
-	$(PYTEST)
+	$(PYTEST) $(PARALLEL) -m "not slow and not serial"
+	$(PYTEST) -m "serial and not slow"
 
 test-all: $(DEVSTAMP)
-	$(PYTEST) -m ""
+	$(PYTEST) $(PARALLEL) -m "not serial"
+	$(PYTEST) -m serial
 
 lint: $(DEVSTAMP)
 	$(BIN)/ruff check src tests benchmarks docs

@@ -68,6 +68,9 @@ main()
 """
 N_JOINTS = 6
 
+#: Signals sent at set moments: run alone, after the parallel tests (Makefile).
+pytestmark = pytest.mark.serial
+
 
 # --------------------------------------------------------------------------- helpers
 

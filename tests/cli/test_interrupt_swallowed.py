@@ -10,6 +10,9 @@ import pytest
 
 from fricid.cli import _app
 
+#: Signals sent at set moments: run alone, after the parallel tests (Makefile).
+pytestmark = pytest.mark.serial
+
 
 def _swallowed_interrupt() -> None:
     def callback() -> None:
