@@ -4,6 +4,7 @@ gravity parameters, with a table per joint."""
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -15,7 +16,6 @@ from _arm_sweeps import Law, arm_sweeps
 from fricid.cli import app
 from fricid.io import read_samples, write_robot_log
 from fricid.robot import RigidBodyModel, example_urdf
-from fricid.samples import RobotLog
 
 runner = CliRunner()
 LAWS = {"joint1": Law(0.10, 0.08, 0.05, 0.04), "joint2": Law(0.06, 0.07, 0.03, 0.035)}
@@ -110,15 +110,7 @@ def test_a_log_without_temperature_names_the_option(pendulum_files, tmp_path):
     from fricid.io import read_robot_log
 
     log_path, urdf, _ = pendulum_files
-    log = read_robot_log(log_path)
-    bare = RobotLog(
-        time=log.time,
-        joints=log.joints,
-        position=log.position,
-        velocity=log.velocity,
-        torque=log.torque,
-        source="bare",
-    )
+    bare = replace(read_robot_log(log_path), temperature=None, source="bare")
     path = write_robot_log(bare, tmp_path / "bare.csv")
     res = runner.invoke(app, ["robot", "extract", str(path), "--urdf", str(urdf)])
     assert res.exit_code == 2, res.output

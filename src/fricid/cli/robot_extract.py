@@ -4,11 +4,11 @@ whole arm, gravity computed from the whole configuration (:func:`fricid.extract.
 from __future__ import annotations
 
 import json
+import math
 import re
 from pathlib import Path
 from typing import Annotated
 
-import numpy as np
 import typer
 
 from ._app import console, err_console, handle_errors, robot_app
@@ -78,7 +78,7 @@ def _tables(result) -> list[str]:
     what = "identified from the sweeps" if g.identified else "the URDF's (not identified)"
     lines.append(f"base gravity parameters ({what}; value +- standard error, URDF):")
     for name, b, se, u in zip(g.names, g.beta, g.beta_se, g.beta_urdf, strict=True):
-        told = f"+- {se:.2g}" if np.isfinite(se) else "(not determined by the sweeps)"
+        told = f"+- {se:.2g}" if math.isfinite(se) else "(not determined by the sweeps)"
         lines.append(f"  {b:+.6g} {told}  (URDF {u:+.6g})  {name}")
     return lines
 
