@@ -7,7 +7,7 @@ from typing import Annotated
 
 import typer
 
-from ._app import app, console, err_console, handle_errors
+from ._app import app, console, err_console, handle_errors, plural
 from ._paths import check_paths
 from ._progress import QuietOption, tracker
 from ._study_options import out_option, seed_option
@@ -155,9 +155,7 @@ def report_command(
         path = write_document(doc, out)
     console.print(str(path), highlight=False, soft_wrap=True)
     err_console.print(str(doc.meta["trust"]), markup=False, highlight=False, soft_wrap=True)
-    err_console.print(
-        f"wrote {len(doc.tables())} tables and {len(doc.figures())} figures into {out}/"
-    )
+    err_console.print(_wrote(doc, out))
 
 
 def _arm_fit(path: Path):
@@ -194,9 +192,7 @@ def _arm_report(fit, out: Path, quiet: bool) -> None:
             highlight=False,
             soft_wrap=True,
         )
-    err_console.print(
-        f"wrote {len(doc.tables())} tables and {len(doc.figures())} figures into {out}/"
-    )
+    err_console.print(_wrote(doc, out))
 
 
 def _read_samples(path: Path):
@@ -258,6 +254,12 @@ def _trajectory_report(fitted, log_path: Path, heldout: Path | None, out: Path, 
             highlight=False,
             soft_wrap=True,
         )
-    err_console.print(
-        f"wrote {len(doc.tables())} tables and {len(doc.figures())} figures into {out}/"
+    err_console.print(_wrote(doc, out))
+
+
+def _wrote(doc, out: Path) -> str:
+    """What a report wrote: ``wrote 1 table and 3 figures into out/``."""
+    return (
+        f"wrote {plural(len(doc.tables()), 'table')} and "
+        f"{plural(len(doc.figures()), 'figure')} into {out}/"
     )

@@ -7,7 +7,7 @@ from typing import Annotated
 
 import typer
 
-from ._app import app, console, err_console, handle_errors
+from ._app import app, console, err_console, handle_errors, plural
 from ._progress import QuietOption, tracker
 from ._study_options import out_option, quick_option, seed_option
 
@@ -53,7 +53,7 @@ def reproduce_command(
         bar.update(len(steps))
     console.print(str(result.html), highlight=False, soft_wrap=True)
     err_console.print(
-        f"{len(result.document.tables())} tables and "
-        f"{len(result.document.figures())} figures in {result.out}/ "
+        f"{plural(len(result.document.tables()), 'table')} and "
+        f"{plural(len(result.document.figures()), 'figure')} in {result.out}/ "
         f"({result.seconds:.1f} s)"
     )
