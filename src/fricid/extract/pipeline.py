@@ -14,13 +14,14 @@
 from __future__ import annotations
 
 import logging
+import warnings
 from collections.abc import Iterable, Iterator
 from dataclasses import replace
 
 import numpy as np
 
-from ..errors import ConfigError, DataError
-from ..samples import RawLog
+from ..errors import ConfigError, DataError, DataQualityWarning, user_stacklevel
+from ..samples import RawLog, velocity_mismatch
 from ._gravity_mode import (
     AUTO,
     explicit_none_note,
@@ -53,21 +54,30 @@ GRAVITY_MODES = ("fit", "joint", "none")
 
 
 class _Source:
-    """Passes a log stream through, remembering the first log's source name and where its
+    """Passes a log stream through, remembering the first log's source name, where its
     position came from (``meta["position_source"]``; a reader that integrates the velocity
-    says so there, a position channel is assumed otherwise)."""
+    says so there, a position channel is assumed otherwise) and, per source, a logged
+    velocity that is not its position channel's derivative (``problems``:
+    :func:`fricid.samples.velocity_mismatch`, judged on each log or chunk that moves)."""
 
     def __init__(self, logs: RawLog | Iterable[RawLog]) -> None:
         self.logs = logs
         self.name: str | None = None
         self.position_source: str | None = None
+        self.problems: dict[str, str] = {}
 
     def __iter__(self) -> Iterator[RawLog]:
         for log in as_log_stream(self.logs):
+            meta = log.meta if isinstance(log.meta, dict) else {}
             if self.name is None:
                 self.name = log.source
-                meta = log.meta if isinstance(log.meta, dict) else {}
                 self.position_source = str(meta.get("position_source", "channel"))
+            source = log.source or "the log"
+            own = meta.get("position_source", "channel") == "channel"
+            if own and "velocity_from" not in meta and source not in self.problems:
+                wrong = velocity_mismatch(log.time, log.position, log.velocity)
+                if wrong:
+                    self.problems[source] = f"{source}: {wrong}"
             yield log
             del log  # not held while the next chunk is read
 
@@ -318,12 +328,20 @@ def extract(
                 "extract": options,
                 **({"notes": list(notes)} if notes else {}),
                 **({} if residual is None else {"gravity_residual": residual.as_meta()}),
+                **({"channel_problems": list(stream.problems.values())} if stream.problems else {}),
             },
         )
         for x in (samples, by_direction)
     )
     for note in notes:
         logger.info("%s", note)
+    for problem in stream.problems.values():
+        warnings.warn(
+            f"the velocity is not the position's derivative, {problem}; the samples' "
+            "velocities are as logged and a model fitted on them is not trusted",
+            DataQualityWarning,
+            stacklevel=user_stacklevel(),
+        )
     passes = pooled.passes[pooled.count > 0]
     binned = int(sum(r.cells.count.sum() for r in kept))
     diagnostics = Diagnostics(

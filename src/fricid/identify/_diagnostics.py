@@ -280,6 +280,18 @@ def _sample_name(samples: FrictionSamples, i: int, why: str) -> str:
     return f"sample {i + 1}: {', '.join(parts)} ({why})"
 
 
+def channel_problems(samples: FrictionSamples | None) -> list[str]:
+    """Reasons for ``no``: the extraction found a logged velocity that is not its position
+    channel's derivative (``meta["channel_problems"]``, :func:`fricid.samples.
+    velocity_mismatch`: a unit, a sign or a gear ratio), so the samples' velocities are off by
+    the factor and so is every coefficient fitted on them."""
+    meta = samples.meta if samples is not None and isinstance(samples.meta, dict) else {}
+    found = meta.get("channel_problems")
+    if not isinstance(found, list):
+        return []
+    return [f"the log's velocity is not its position's derivative: {p}" for p in found]
+
+
 def gravity_caveat(samples: FrictionSamples | None) -> list[str]:
     """Caveats that the friction may hold gravity torque (eq. 7 of the BAS-RBFNN paper,
     ``p_x cos q - p_y sin q`` at the joint's position ``q``), one line each, from what the

@@ -79,9 +79,9 @@ def model_hash(fitted: FittedModel) -> str:
 def samples_detail_hash(samples: FrictionSamples) -> str:
     """A hash of what the scatter, the quality table and the gravity caveats read besides the
     values: count, std and ``meta`` ``sem``, ``sem_method``, ``sem_caveat``, ``setpoint``,
-    ``quality``, ``extract`` and ``gravity_residual``."""
+    ``quality``, ``extract``, ``gravity_residual`` and ``channel_problems``."""
     meta = {k: samples.meta.get(k) for k in ("sem", "sem_method", "sem_caveat", "quality")}
-    for key in ("setpoint", "extract", "gravity_residual"):
+    for key in ("setpoint", "extract", "gravity_residual", "channel_problems"):
         if key in samples.meta:
             meta[key] = samples.meta[key]
     doc = {"count": samples.count.tolist(), "std": samples.std.tolist(), "meta": meta}

@@ -32,9 +32,11 @@ reads the model file (and, where given, the samples the model was identified on)
   the reasons (:data:`ESTIMATED`), whatever the level;
 - the operating range, outside which predictions are extrapolated.
 
-The level is ``"no"`` when the fit did not converge, no free parameter is determined, or the
-model misses the data by more than :data:`MISS_RATIO` times the scatter; ``"with caveats"``
-when anything else above is short of clean (a parameter not determined or not bounded, an
+The level is ``"no"`` when the fit did not converge, no free parameter is determined, the
+model misses the data by more than :data:`MISS_RATIO` times the scatter, or the samples were
+extracted from a log whose velocity is not its position's derivative (a unit, a sign or a
+gear ratio between them: :func:`._diagnostics.channel_problems`); ``"with caveats"`` when
+anything else above is short of clean (a parameter not determined or not bounded, an
 error between :data:`fricid.metrics.NOISE_RATIO` and :data:`MISS_RATIO` times the scatter,
 no held-out error or no scatter, convergence not recorded, set-points flagged for scatter or
 with outliers dropped, a gap between the measured speeds (held-out validation leaves out
@@ -66,6 +68,7 @@ from ..metrics import NOISE_RATIO, rmse, verdict
 from ..samples import FrictionSamples
 from ._diagnostics import (
     DROPS,
+    channel_problems,
     downweighted,
     gap_caveat,
     gravity_caveat,
@@ -119,7 +122,7 @@ __all__ = [
 MISS_RATIO = 3.0
 
 #: Format of the record and of the rules behind it: a stored record of another is recomputed.
-TRUST_VERSION = 4
+TRUST_VERSION = 5
 
 #: ``Trust.heldout_source``: leave-one-velocity-out run by :func:`assess_trust`.
 RUN_HERE = "lovo run here"
@@ -372,7 +375,7 @@ def assess_trust(
             "left out; " + trust.validation_note
         )
     trust.quality, trust.quality_summary, quality_caveat = quality_rows(samples)
-    _grade(trust, fitted, [quality_caveat, *gravity_caveat(samples)])
+    _grade(trust, fitted, [quality_caveat, *gravity_caveat(samples)], channel_problems(samples))
     if trust.converged is not False and trust.heldout_ratio > MISS_RATIO:
         from ._advice import misfit_advice
 
@@ -438,9 +441,9 @@ def _ratio(
     trust.verdict = verdict(trust.heldout_ratio)
 
 
-def _grade(trust: Trust, fitted: FittedModel, sample_caveats: list[str]) -> None:
-    """Set ``trust.level`` and ``trust.reasons`` (module notes)."""
-    no, caveats = [], []
+def _grade(trust: Trust, fitted: FittedModel, sample_caveats: list[str], no: list[str]) -> None:
+    """Set ``trust.level`` and ``trust.reasons`` (module notes); ``no``: reasons for "no"."""
+    no, caveats = list(no), []
     free = fitted.free
     if trust.converged is False:
         no.append(f"the fit did NOT converge ({trust.advice or 'see the convergence block'})")

@@ -6,7 +6,8 @@ value of either type is always safe to use. Reading and writing them is :mod:`fr
 :class:`RawLog` is in :mod:`.rawlog` (all joints of a robot, :class:`RobotLog`, in
 :mod:`.robot_log`), the columns, units, ranges and column checks both
 types share in :mod:`._columns`, and the checks a trajectory log passes before identification
-in :mod:`._trajectory_log`.
+in :mod:`._trajectory_log`, whether a log's velocity is its position's derivative in
+:mod:`._agreement`.
 """
 
 from __future__ import annotations
@@ -19,6 +20,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import ConfigError, DataError
+from ._agreement import velocity_mismatch
 from ._columns import (
     DIRECTION_TOLERANCE,
     LIMITS,
@@ -48,6 +50,7 @@ __all__ = [
     "check_trajectory_log",
     "drop_standstill",
     "standstill_rows",
+    "velocity_mismatch",
 ]
 
 

@@ -1,6 +1,7 @@
 """Checks of a trajectory log before identification allocates anything: time holes and
-steps out of order, the size of the uniform grid, and a torque or current channel stuck
-while the joint moves (each a :class:`~fricid.errors.DataError` naming the row).
+steps out of order, the size of the uniform grid, a torque or current channel stuck
+while the joint moves (each a :class:`~fricid.errors.DataError` naming the row), and a logged
+velocity that is not the position's derivative (:mod:`._agreement`).
 """
 
 from __future__ import annotations
@@ -8,6 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import DataError
+from ._agreement import velocity_mismatch
 from ._columns import RAWLOG_COLUMNS
 from .rawlog import RawLog
 
@@ -45,7 +47,11 @@ def check_trajectory_log(log: RawLog) -> None:
     - a torque or current channel that varies: one value in every row, or (a channel in
       steps of at most :data:`STUCK_QUANTUM` of its range) one value over
       :data:`STUCK_MIN_SAMPLES` rows or more while the velocity sweeps :data:`STUCK_SWEEP` of
-      its range, is a stuck sensor (or a saturated drive), refused with the rows named.
+      its range, is a stuck sensor (or a saturated drive), refused with the rows named;
+    - a logged velocity (not one a reader computed from the position, ``meta["velocity_from"]``)
+      that is not the position's derivative: a unit, a sign or a gear ratio between the two
+      (:func:`._agreement.velocity_mismatch`), refused with the factor and its likely cause,
+      since the fit reads both and would be off by the factor.
 
     Parameters
     ----------
@@ -59,6 +65,15 @@ def check_trajectory_log(log: RawLog) -> None:
     """
     _check_time_grid(log)
     _check_stuck_effort(log)
+    if "velocity_from" not in log.meta:
+        wrong = velocity_mismatch(log.time, log.position, log.velocity)
+        if wrong:
+            raise DataError(
+                f"{wrong}; correct the unit or sign in the column's header (a motor-side "
+                "velocity: divide it by the gear ratio)",
+                file=log.source,
+                column="velocity",
+            )
 
 
 def _check_time_grid(log: RawLog) -> None:

@@ -8,6 +8,7 @@ naming the file, the row and the column, before anything is resampled."""
 from __future__ import annotations
 
 import dataclasses
+import re
 import tracemalloc
 
 import numpy as np
@@ -160,3 +161,30 @@ def test_the_first_sample_does_not_steer_the_fit(clean, where):
     inertia = [f.provenance["trajectory"]["joint"]["inertia"]["value"] for f in (got, base)]
     assert inertia[0] == pytest.approx(inertia[1], rel=0.05)
     assert got.params["tau_c"] == pytest.approx(base.params["tau_c"], rel=0.02)
+
+
+@pytest.mark.parametrize(
+    ("factor", "words"),
+    [(180 / np.pi, "degrees against radians"), (-1.0, "sign reversed"), (12.0, "gear ratio")],
+)
+def test_a_velocity_that_is_not_the_position_derivative(clean, tmp_path, factor, words):
+    """A velocity in deg/s labelled rad/s, one of reversed sign, a motor-side one: the fit
+    would read it as it is, so the log is refused with the factor and its likely cause."""
+    path = damaged(clean, tmp_path, f"velocity{factor:.3g}", velocity=clean.velocity * factor)
+    line = refused_by_fit(path, "column 'velocity'", words)
+    said = re.search(r"the position changes by (\S+)x the integral of the velocity", line)
+    assert said and float(said.group(1)) == pytest.approx(1 / factor, rel=0.02), line
+
+
+@pytest.mark.parametrize("flip", ["torque", "motion"])
+def test_a_reversed_sign_is_refused(clean, tmp_path, flip):
+    """The torque's sign reversed, or the position's and velocity's together (the velocity
+    check cannot see that): friction would have to feed energy in, so the log is refused."""
+    if flip == "torque":
+        columns = {"current": -clean.current}
+    else:
+        columns = {"position": -clean.position, "velocity": -clean.velocity}
+    path = damaged(clean, tmp_path, f"reversed_{flip}", **columns)
+    line = refused_by_fit(path, "the torque works against friction", "flip one")
+    level = float(re.search(r"Coulomb level of (\S+)", line).group(1))
+    assert level < 0

@@ -253,3 +253,43 @@ def torque_noise(u: np.ndarray) -> float:
     differences over sqrt(2) (a smooth signal's differences are far smaller)."""
     d = np.diff(u)
     return float(1.4826 * np.median(np.abs(d - np.median(d))) / np.sqrt(2.0))
+
+
+#: A Coulomb level this many cluster-robust standard errors below zero is a reversed sign.
+REVERSED_T = 5.0
+
+
+def check_dissipates(
+    series: Series, vf: np.ndarray, acc: np.ndarray, mask: np.ndarray, cluster_n: int, source
+) -> None:
+    """Refuse a log whose torque works against its own friction (a reversed sign).
+
+    Friction dissipates, so on the sliding samples (``mask``) the torque left after inertia
+    and gravity has the velocity's sign. The linear regression ``u = J a + p_x cos q - p_y
+    sin q + c + F_c sign(v) + F_v v`` (no bounds, cluster-robust errors over blocks of
+    ``cluster_n``) gives ``F_c`` far below zero (:data:`REVERSED_T` standard errors) only
+    when the torque's sign, or the position's and velocity's, is reversed; a bounded fit
+    would then clamp the friction to 0 and fit nothing, with a verdict of caveats.
+
+    Raises
+    ------
+    DataError
+        Naming ``source``, the Coulomb and viscous levels found and what to flip.
+    """
+    v, q, u = vf[mask], series.position[mask], series.torque[mask]
+    if v.size < 8:
+        return
+    A = np.column_stack([acc[mask], np.cos(q), np.sin(q), np.ones_like(v), np.sign(v), v])
+    theta, *_ = np.linalg.lstsq(A, u, rcond=None)
+    _cov, se, _g = cluster_covariance(A, u - A @ theta, blocks(v.size, cluster_n))
+    f_c, f_v = float(theta[4]), float(theta[5])
+    if not (np.isfinite(se[4]) and se[4] > 0 and f_c < -REVERSED_T * se[4]):
+        return
+    raise DataError(
+        f"the torque works against friction: after inertia and gravity it has the opposite "
+        f"sign to the velocity (a linear fit gives a Coulomb level of {f_c:.3g} +- "
+        f"{se[4]:.2g} N m and a viscous one of {f_v:.3g} N m s/rad; friction only "
+        "dissipates): the torque's (or current's) sign, or the position's and the "
+        "velocity's, is reversed; flip one",
+        file=source,
+    )

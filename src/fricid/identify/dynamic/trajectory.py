@@ -37,8 +37,7 @@ Routes, recorded in the result's provenance (``provenance["trajectory"]``):
     from the measured motion while the bristle state carries on (multiple shooting;
     restarting z too from a force balance hid sigma_1 entirely:
     ``tests/identify/dynamic/test_trajectory.py``); residuals the simulated minus the measured
-    position and
-    velocity, each channel scaled by its RMS at the start.
+    position and velocity, each channel scaled by its RMS at the start.
 ``presliding`` (LuGre, a log that never slides; taken by the default when fewer than
     :data:`MIN_SLIDING` samples slide)
     sigma_0 and the pre-sliding damping (sigma_1 + sigma_2) by the output error of the joint
@@ -164,7 +163,7 @@ from ...errors import ConfigError, DataError
 from ...fitted import FittedModel
 from ...models import dahl, get_model, lugre
 from ...samples import RawLog, check_trajectory_log
-from ._data import DerivativeFilter, derivatives, dilate, uniform_series
+from ._data import DerivativeFilter, check_dissipates, derivatives, dilate, uniform_series
 from ._encoder import measurement
 from ._filtered import DAHL, LUGRE, ParallelFilter, filtered_route
 from ._outcome import (
@@ -322,7 +321,7 @@ def fit_trajectory(
     ConfigError
         An unknown model, route, gravity option or method.
     DataError
-        Too short a log, too few sliding samples, or (LuGre) no low-speed stretch.
+        Too short a log, too few sliding, a reversed sign, or (LuGre) no low-speed stretch.
     """
     key = str(model).strip().lower()
     if key not in (*DYNAMIC_MODELS, *STATIC_MODELS):
@@ -403,6 +402,7 @@ def fit_trajectory(
             raise ConfigError(f"static= must be a stribeck fit, got '{static.model}'")
         fixed = static.theta()
     cluster_n = max(round(cluster_time * rate), 1)
+    check_dissipates(series, vf, acc, mask, cluster_n, log.source)
     say("regression: static friction, inertia, gravity")
     stage1, _theta_s, c, r1 = _regression(
         series, vf, acc, mask, static_model, gravity, method, seed, max_evals, cluster_n, fixed

@@ -79,6 +79,7 @@ from ....models import get_model
 from ....optim import one_blas_thread
 from ....robot import RigidBodyModel, base_parameters
 from ....samples import RobotLog
+from ._channels import channel_problems, check_live_torque
 from ._consistent import consistent_parameters
 from ._filter_cov import filter_correlation
 from ._friction import NO_LOAD, friction_for
@@ -235,7 +236,8 @@ def _fit_arm(
     Raises
     ------
     DataError
-        Joints missing from the log, a non-uniform or too short log, no joint moving.
+        Joints missing from the log, a non-uniform or too short log, no joint moving, a
+        torque (or current) with one value in every row (:mod:`._channels`).
     ConfigError
         An unknown friction family.
     """
@@ -244,6 +246,8 @@ def _fit_arm(
         model.joints, dict(friction) if isinstance(friction, Mapping) else friction
     )
     source = "second log" if validate is not None else "last quarter of the log"
+    check_live_torque(log, model.joints)
+    problems = channel_problems(log, model)
     if validate is None:
         cut = int(len(log) * (1 - HELDOUT_SHARE))
         log, validate = log.slice(0, cut), log.slice(cut, len(log))
@@ -365,7 +369,9 @@ def _fit_arm(
         nd = [p for p, rec in recs.items() if rec["not_determined"]]
         open_ = [p for p, rec in recs.items() if rec["note"].startswith("not bounded")]
         loose = loose_levels(recs, float(sigma[j]), fric[name].get("load_range"))
-        level, reasons = grade(ratio, nd, open_, source, bool(moving[:, j].any()), loose)
+        level, reasons = grade(
+            ratio, nd, open_, source, bool(moving[:, j].any()), loose, problems[name]
+        )
         validation[name] = {
             "rmse": rmse,
             "ratio": ratio,

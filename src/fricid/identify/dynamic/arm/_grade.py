@@ -54,9 +54,11 @@ def grade(
     source: str,
     moved: bool,
     loose: list[str] = (),
+    problems: list[str] = (),
 ):
-    """A joint's verdict in :mod:`fricid.identify.trust`'s words and thresholds."""
-    no, caveats = [], []
+    """A joint's verdict in :mod:`fricid.identify.trust`'s words and thresholds; each of
+    ``problems`` (channels that disagree, :mod:`._channels`) is a reason for ``no``."""
+    no, caveats = [f"the log's channels disagree: {p}" for p in problems], []
     if not moved:
         no.append("the joint does not move in the log, so its friction is not determined")
     elif loose:

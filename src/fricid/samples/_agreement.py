@@ -1,0 +1,124 @@
+"""Do a log's position and velocity agree? A units or sign mistake that nothing else catches.
+
+A velocity column is the derivative of the position column, whatever the log's units, once
+both are in SI. A column labelled in the wrong unit (radians labelled degrees), a sign
+reversed on one channel, or a motor-side velocity beside a joint-side position breaks that,
+and every fit that reads both columns (or reads the position for the dynamics) then returns
+numbers off by the factor, with a good fit and no warning. :func:`velocity_mismatch` measures
+the factor ``s`` in ``delta position = s * integral of velocity`` over :data:`WINDOWS` windows
+of the log (the median of the windows' ratios, so a wrapped angle or a spike in one window
+does not move it; the integral averages the velocity's noise out) and names the likely cause
+when ``s`` is outside :data:`AGREEMENT`: a known unit factor (:data:`UNIT_FACTORS`), a
+reversed sign, else a gear ratio or an unknown unit.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+__all__ = ["AGREEMENT", "UNIT_FACTORS", "WINDOWS", "velocity_mismatch", "velocity_scale"]
+
+#: The windows the log is cut into for the ratios.
+WINDOWS = 40
+#: The factors accepted as agreement (a drive's filtered velocity, a delay, the integration).
+AGREEMENT = (0.8, 1.25)
+#: A window counts when its integrated velocity is at least this share of the largest one.
+MIN_SHARE = 0.1
+#: Windows needed for a judgement (fewer: the log does not move enough to tell).
+MIN_WINDOWS = 5
+#: Known unit factors between a position and a velocity channel, and what each means.
+UNIT_FACTORS: dict[float, str] = {
+    180.0 / math.pi: "degrees against radians",
+    2.0 * math.pi: "revolutions against radians",
+    60.0: "per minute against per second",
+    60.0 / (2.0 * math.pi): "rpm against rad/s",
+    1000.0: "milli-units against units (mm or mrad)",
+}
+#: Relative tolerance for a known unit factor (the nearest one; 57.3 and 60 are 4.7 % apart).
+FACTOR_TOLERANCE = 0.02
+
+
+def velocity_scale(time, position, velocity) -> float | None:
+    """The factor ``s`` with ``delta position = s * integral of velocity`` (module notes).
+
+    Parameters
+    ----------
+    time, position, velocity : array_like, shape (n,)
+        One joint's columns in SI units, time strictly increasing.
+
+    Returns
+    -------
+    float or None
+        The median ratio over the windows that move; None when fewer than
+        :data:`MIN_WINDOWS` windows move (nothing to judge).
+    """
+    t = np.asarray(time, dtype=float)
+    q = np.asarray(position, dtype=float)
+    v = np.asarray(velocity, dtype=float)
+    n = t.size
+    if n < 2 * MIN_WINDOWS:
+        return None
+    integral = np.concatenate([[0.0], np.cumsum(0.5 * (v[1:] + v[:-1]) * np.diff(t))])
+    edges = np.unique(np.linspace(0, n - 1, min(WINDOWS, n // 2) + 1).astype(int))
+    dq, di = np.diff(q[edges]), np.diff(integral[edges])
+    top = float(np.max(np.abs(di)))
+    if not top > 0:
+        return None
+    keep = np.abs(di) >= MIN_SHARE * top
+    if keep.sum() < MIN_WINDOWS:
+        return None
+    return float(np.median(dq[keep] / di[keep]))
+
+
+def _cause(scale: float) -> str:
+    """The likely cause of a factor outside :data:`AGREEMENT`."""
+    size = abs(scale)
+    if size == 0:
+        return "the position does not change while the velocity says the joint moves"
+    sign = "reversed sign and " if scale < 0 else ""
+    candidates = [
+        (f, meaning, *pair)
+        for factor, meaning in UNIT_FACTORS.items()
+        for f, pair in ((factor, ("position", "velocity")), (1 / factor, ("velocity", "position")))
+    ]
+    f, meaning, big, small = min(candidates, key=lambda c: abs(math.log(size / c[0])))
+    if abs(math.log(size / f)) <= math.log1p(FACTOR_TOLERANCE):
+        return (
+            f"{sign}units {meaning} (the {big} is {max(f, 1 / f):.4g}x too large for the "
+            f"{small}, or the {small} as much too small)"
+        )
+    if scale < 0 and abs(size - 1.0) <= 1.0 - AGREEMENT[0]:
+        return "one of the two columns has its sign reversed"
+    return (
+        f"{sign}a factor that is no known unit: a gear ratio between a motor-side and a "
+        "joint-side channel, or a wrong unit or scale"
+    )
+
+
+def velocity_mismatch(time, position, velocity, *, column: str | None = None) -> str | None:
+    """What is wrong when the velocity is not the position's derivative, else None.
+
+    Parameters
+    ----------
+    time, position, velocity : array_like, shape (n,)
+        One joint's columns in SI units.
+    column : str, optional
+        The joint's name, to begin the message with (``"elbow: ..."``).
+
+    Returns
+    -------
+    str or None
+        E.g. ``"the position changes by 0.0175x the integral of the velocity (expected 1):
+        units degrees against radians (...)"``; None when they agree or the log does not
+        move enough to tell.
+    """
+    scale = velocity_scale(time, position, velocity)
+    if scale is None or AGREEMENT[0] <= scale <= AGREEMENT[1]:
+        return None
+    prefix = f"{column}: " if column else ""
+    return (
+        f"{prefix}the position changes by {scale:.3g}x the integral of the velocity "
+        f"(expected 1): {_cause(scale)}"
+    )

@@ -1,0 +1,97 @@
+"""A robot log whose channels disagree (a unit, a sign, a dead torque channel) gets no
+"yes" from the whole-arm fit (``fricid.identify.dynamic.arm._channels``): each case is made
+from a correct log of ``_arm_truth`` by the mistake a user makes."""
+
+from __future__ import annotations
+
+import sys
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from _arm_truth import make_log
+
+pytest.importorskip("pinocchio")
+
+from fricid.errors import DataError
+from fricid.identify.dynamic.arm import fit_arm
+from fricid.identify.dynamic.arm._channels import channel_problems
+from fricid.robot import RigidBodyModel, example_urdf
+
+LAWS = [
+    ("coulomb_viscous_asym", {"f_c_pos": 0.5, "beta_pos": 0.3, "f_c_neg": 0.4, "beta_neg": 0.2}),
+    ("coulomb_viscous_asym", {"f_c_pos": 0.7, "beta_pos": 0.3, "f_c_neg": 0.4, "beta_neg": 0.3}),
+]
+
+
+@pytest.fixture(scope="module")
+def pendulum() -> RigidBodyModel:
+    path, joints = example_urdf("double_pendulum")
+    return RigidBodyModel.from_urdf(path, joints)
+
+
+@pytest.fixture(scope="module")
+def log(pendulum):
+    return make_log(pendulum, LAWS, duration=12.0, seed=7, noise=0.05)
+
+
+def _only_first(log, array, factor):
+    out = array.copy()
+    out[:, 0] *= factor
+    return out
+
+
+def test_a_correct_log_has_no_problems(pendulum, log):
+    assert channel_problems(log, pendulum) == {j: [] for j in pendulum.joints}
+
+
+def test_radians_labelled_degrees_make_the_verdict_no(pendulum, log):
+    # the reader multiplied a column of radians by pi/180: the position is 57x too small
+    wrong = replace(log, position=_only_first(log, log.position, np.pi / 180))
+    fit = fit_arm(wrong, pendulum, friction="coulomb_viscous_asym")
+    first = fit.joints[0]
+    assert fit.verdict(first) == "no"
+    reasons = " ".join(fit.validation[first]["reasons"])
+    assert "degrees against radians" in reasons and "0.0175x" in reasons
+
+
+def test_degrees_labelled_radians_and_a_reversed_velocity_are_named(pendulum, log):
+    degrees = replace(log, position=_only_first(log, log.position, 180 / np.pi))
+    found = channel_problems(degrees, pendulum)[pendulum.joints[0]]
+    assert any("degrees against radians" in f for f in found)
+    reversed_ = replace(log, velocity=_only_first(log, log.velocity, -1.0))
+    (text,) = channel_problems(reversed_, pendulum)[pendulum.joints[0]]
+    assert "sign reversed" in text
+    assert channel_problems(reversed_, pendulum)[pendulum.joints[1]] == []
+
+
+def test_a_velocity_from_the_position_is_not_checked_against_it(pendulum, log):
+    wrong = replace(log, velocity=_only_first(log, log.velocity, 3.0))
+    assert channel_problems(wrong, pendulum)[pendulum.joints[0]]
+    said = replace(wrong, meta={"velocity_from": "position (central difference)"})
+    assert channel_problems(said, pendulum)[pendulum.joints[0]] == []
+
+
+def test_a_position_past_the_urdf_limits_is_named(pendulum, log):
+    # the example has no limits: give it the range the log moves in, then log degrees
+    lo, hi = log.position.min(axis=0), log.position.max(axis=0)
+    limited = replace(pendulum, lower=lo - 0.01, upper=hi + 0.01)
+    assert channel_problems(log, limited) == {j: [] for j in pendulum.joints}
+    degrees = log.position.copy()
+    degrees[:, 1] *= 180 / np.pi
+    said = {"velocity_from": "position (central difference)"}  # not the velocity check
+    found = channel_problems(replace(log, position=degrees, meta=said), limited)
+    (text,) = found[pendulum.joints[1]]
+    assert "beyond the URDF's limits" in text and "degrees labelled radians" in text
+    assert found[pendulum.joints[0]] == []
+
+
+def test_a_torque_channel_never_logged_is_refused(pendulum, log):
+    dead = log.torque.copy()
+    dead[:, 1] = 0.0
+    with pytest.raises(DataError, match="in every one of the") as err:
+        fit_arm(replace(log, torque=dead), pendulum)
+    assert err.value.column == f"{pendulum.joints[1]}.torque"

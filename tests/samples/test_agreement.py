@@ -1,0 +1,94 @@
+"""Whether a log's velocity is its position's derivative (``fricid.samples._agreement``):
+a motion of its own (a sum of sines, not the virtual joint's), with what real sensors do
+(quantised position, a noisy velocity, an angle wrapped to one turn)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from fricid.samples import velocity_mismatch
+from fricid.samples._agreement import UNIT_FACTORS, velocity_scale
+
+
+def motion(seed: int, n: int = 4000, rate: float = 500.0, noise: float = 0.02):
+    """(t, q, v): a random sum of sines, the position quantised to 2^14 counts per turn, the
+    velocity its exact derivative plus white noise [rad/s]."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(n) / rate
+    w = rng.uniform(0.5, 6.0, 4)
+    a = rng.uniform(0.2, 1.0, 4) / w
+    phase = rng.uniform(0, 2 * np.pi, 4)
+    q = np.sin(np.outer(t, w) + phase) @ a
+    v = np.cos(np.outer(t, w) + phase) @ (a * w) + rng.normal(0, noise, n)
+    step = 2 * np.pi / 2**14
+    return t, np.round(q / step) * step, v
+
+
+@settings(max_examples=40, deadline=None)
+@given(seed=st.integers(0, 10_000), scale=st.floats(0.85, 1.18))
+def test_agreeing_channels_pass(seed, scale):
+    t, q, v = motion(seed)
+    assert velocity_mismatch(t, q, v * scale) is None
+    assert abs(velocity_scale(t, q, v * scale) * scale - 1) < 0.02
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    seed=st.integers(0, 10_000),
+    factor=st.sampled_from(sorted(UNIT_FACTORS)),
+    sign=st.sampled_from([1.0, -1.0]),
+    inverse=st.booleans(),
+)
+def test_unit_factors_and_signs_are_named(seed, factor, sign, inverse):
+    t, q, v = motion(seed)
+    k = sign * (1 / factor if inverse else factor)
+    text = velocity_mismatch(t, q * k, v, column="elbow")
+    assert text is not None and text.startswith("elbow: ")
+    assert UNIT_FACTORS[factor] in text
+    assert ("reversed sign" in text) == (sign < 0)
+
+
+def test_a_reversed_sign_alone_and_an_unknown_factor():
+    t, q, v = motion(3)
+    assert "sign reversed" in velocity_mismatch(t, q, -v)
+    assert "gear ratio" in velocity_mismatch(t, q, 23.0 * v)
+
+
+def test_a_wrapped_angle_and_a_spike_do_not_move_the_factor():
+    t, q, v = motion(5)
+    turning = q + 3.0 * t  # continuous rotation, wrapped to [-pi, pi)
+    wrapped = (turning + np.pi) % (2 * np.pi) - np.pi
+    v = v + 3.0
+    v[1000] = 1e4
+    assert velocity_mismatch(t, wrapped, v) is None
+
+
+def test_a_position_that_never_changes():
+    t, q, v = motion(8)
+    assert "position does not change" in velocity_mismatch(t, np.zeros_like(q), v)
+
+
+def test_a_log_that_does_not_move_is_not_judged():
+    t = np.arange(1000) / 100.0
+    assert velocity_scale(t, np.zeros_like(t), np.zeros_like(t)) is None
+    assert velocity_scale(t[:6], t[:6], np.ones(6)) is None
+
+
+def test_the_foreign_logs_agree():
+    """The independent simulator's logs (2^17 and 2^20 count encoders, finite-difference
+    velocity, PD loop) pass: the check does not refuse what real drives log."""
+    from fricid.io import read_rawlog
+
+    repo = Path(__file__).resolve().parents[2]
+    files = sorted((repo.parent / "shared" / "data" / "foreign" / "lugre").glob("*.csv"))
+    if not files:
+        pytest.skip("../shared/data/foreign/lugre not found beside the repository")
+    for path in files:
+        log = read_rawlog(path)
+        assert velocity_mismatch(log.time, log.position, log.velocity) is None, path.name
+        assert abs(velocity_scale(log.time, log.position, log.velocity) - 1) < 0.01
