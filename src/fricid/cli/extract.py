@@ -370,8 +370,8 @@ def extract_command(
         "gravity": gravity,
     }
     given = {option for _, (param, option) in READER_FLAGS.items() if _given(ctx, param)}
-    if fmt == "table":
-        reader_options: dict = {}
+    if fmt == "table":  # the temperature of a log without its column
+        reader_options: dict = {"temperature": temperature} if "temperature" in given else {}
     elif fmt == "generic":
         columns, units = parse_column_map(column_map)
         reader_options = {"columns": columns, "units": units, "torque_constant": torque_constant}

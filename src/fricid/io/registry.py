@@ -43,7 +43,7 @@ READERS: tuple[str, ...] = ("table", "generic", "rosbag", "epos", "channels", "m
 
 #: Options each reader accepts (SI units), passed to its :mod:`fricid.io` function.
 READER_OPTIONS: dict[str, tuple[str, ...]] = {
-    "table": (),
+    "table": ("temperature",),
     "generic": ("columns", "units", "torque_constant", "temperature"),
     "rosbag": (
         "joint",
@@ -232,4 +232,4 @@ def open_log(
         return iter_rosbag(path, chunk_rows=chunk_rows, **opts)
     from .tables import iter_rawlog
 
-    return iter_rawlog(path, chunk_rows=chunk_rows)
+    return iter_rawlog(path, chunk_rows=chunk_rows, **opts)

@@ -122,9 +122,24 @@ def read_samples(path: PathLike) -> FrictionSamples:
     return drop_standstill(samples, stacklevel=2)
 
 
-def _open_rawlog(path: PathLike) -> Opened:
-    """Open a raw-log table; a DataError if it has neither a torque nor a current column."""
-    opened = open_table(path, _RAWLOG_SCHEMA, _RAWLOG_REQUIRED, RAWLOG_FORMAT)
+def _open_rawlog(path: PathLike, temperature: float | None = None) -> Opened:
+    """Open a raw-log table; a DataError if it has neither a torque nor a current column, or
+    no temperature column and no constant ``temperature`` given (a ConfigError if both)."""
+    opened = open_table(path, _RAWLOG_SCHEMA, _RAWLOG_REQUIRED[:-1], RAWLOG_FORMAT)
+    has = "temperature" in opened.columns
+    if has and temperature is not None:
+        raise ConfigError(
+            f"{opened.path} has a temperature column; the temperature option is for a log "
+            "without one"
+        )
+    if not has and temperature is None:
+        raise DataError(
+            "missing required column 'temperature' (e.g. 'temperature [degC]'); a log without "
+            "one: give its constant temperature [degC] (fricid extract --temperature 25; fricid "
+            "fit --trajectory --reader-option temperature=25; Python: temperature=25.0)",
+            file=opened.path,
+            column="temperature",
+        )
     if "torque" not in opened.columns and "current" not in opened.columns:
         raise DataError(
             "missing required column 'torque' (e.g. 'torque [N m]') or 'current' "
@@ -135,15 +150,18 @@ def _open_rawlog(path: PathLike) -> Opened:
     return opened
 
 
-def _rawlog(opened: Opened, cols: dict[str, np.ndarray], first_record: int) -> RawLog:
-    """A :class:`RawLog` of SI columns; its validation errors located in the file."""
+def _rawlog(
+    opened: Opened, cols: dict[str, np.ndarray], first_record: int, temperature=None
+) -> RawLog:
+    """A :class:`RawLog` of SI columns (``temperature`` where the file has none); its
+    validation errors located in the file."""
     info = opened.info
     try:
         return RawLog(
             time=cols["time"],
             position=cols["position"],
             velocity=cols["velocity"],
-            temperature=cols["temperature"],
+            temperature=cols.get("temperature", temperature),
             torque=cols.get("torque"),
             current=cols.get("current"),
             torque_constant=info.torque_constant,
@@ -155,7 +173,7 @@ def _rawlog(opened: Opened, cols: dict[str, np.ndarray], first_record: int) -> R
         raise relocate(err, opened, first_record) from None
 
 
-def read_rawlog(path: PathLike) -> RawLog:
+def read_rawlog(path: PathLike, *, temperature: float | None = None) -> RawLog:
     """Read a whole raw joint log from a CSV or Parquet file.
 
     Parameters
@@ -164,6 +182,8 @@ def read_rawlog(path: PathLike) -> RawLog:
         A ``.csv``, ``.parquet`` or ``.pq`` file written by :func:`write_rawlog`, or any
         table with the columns time, position, velocity, temperature and torque or current,
         with explicit units.
+    temperature : float, optional
+        The constant temperature [degC] of a log without a temperature column.
 
     Returns
     -------
@@ -173,7 +193,8 @@ def read_rawlog(path: PathLike) -> RawLog:
     Raises
     ------
     ConfigError
-        A suffix other than ``.csv``, ``.parquet``, ``.pq``.
+        A suffix other than ``.csv``, ``.parquet``, ``.pq``; ``temperature`` given for a
+        log with a temperature column.
     DataError
         No data rows, a missing column or unit, an unknown unit, a non-numeric or
         non-finite value, time not strictly increasing (file, row and column named).
@@ -183,14 +204,16 @@ def read_rawlog(path: PathLike) -> RawLog:
     iter_rawlog : the same log in chunks, for files too large for memory.
     write_rawlog : the inverse.
     """
-    opened = _open_rawlog(path)
-    log = _rawlog(opened, opened.si(opened.read_all()), 0)
+    opened = _open_rawlog(path, temperature)
+    log = _rawlog(opened, opened.si(opened.read_all()), 0, temperature)
     if len(log) == 0:
         raise DataError("no data rows after the header", file=opened.path)
     return log
 
 
-def iter_rawlog(path: PathLike, chunk_rows: int = 1_000_000) -> Iterator[RawLog]:
+def iter_rawlog(
+    path: PathLike, chunk_rows: int = 1_000_000, *, temperature: float | None = None
+) -> Iterator[RawLog]:
     """Read a raw log in chunks.
 
     Memory stays bounded by a few chunks whatever the file size: Parquet is read batch by
@@ -225,14 +248,15 @@ def iter_rawlog(path: PathLike, chunk_rows: int = 1_000_000) -> Iterator[RawLog]
         raise ConfigError(f"chunk_rows must be a positive integer, got {chunk_rows!r}")
     if chunk_rows < 1:
         raise ConfigError(f"chunk_rows must be a positive integer, got {chunk_rows!r}")
-    return _iter_rawlog(_open_rawlog(path), int(chunk_rows))
+    opened = _open_rawlog(path, temperature)
+    return _iter_rawlog(opened, int(chunk_rows), temperature)
 
 
-def _iter_rawlog(opened: Opened, chunk_rows: int) -> Iterator[RawLog]:
+def _iter_rawlog(opened: Opened, chunk_rows: int, temperature=None) -> Iterator[RawLog]:
     """The chunks of an opened raw log, time checked across their boundaries."""
     last_time: float | None = None
     for start, raw in opened.iterate(chunk_rows):
-        log = _rawlog(opened, opened.si(raw), start)
+        log = _rawlog(opened, opened.si(raw), start, temperature)
         if last_time is not None and log.time[0] <= last_time:
             raise DataError(
                 "time is not strictly increasing "
