@@ -692,3 +692,12 @@ def test_chunks_that_go_back_in_time_are_named_with_their_times(tmp_path):
     ):
         write_rawlog(iter([first, _log()]), tmp_path / "c.parquet")
     assert not (tmp_path / "c.parquet").exists()
+
+
+def test_the_generic_reader_without_columns_says_what_it_needs(tmp_path):
+    from fricid.io import open_log
+
+    path = tmp_path / "run.csv"
+    path.write_text("t,dq\n0,1\n")
+    with pytest.raises(ConfigError, match=r"needs the option 'columns'.*--map time=t:ms"):
+        open_log(path, "generic", {"temperature": 25.0})

@@ -146,11 +146,18 @@ def check_reader(reader: str, options: Mapping[str, Any]) -> None:
     Raises
     ------
     ConfigError
-        Listing the readers, or the reader's options.
+        Listing the readers, or the reader's options; ``generic`` without ``columns``.
     """
     if reader not in READERS:
         raise ConfigError(f"unknown reader '{reader}'; choose one of: {', '.join(READERS)}")
     check_keys(options, READER_OPTIONS[reader], f"option of reader '{reader}'")
+    if reader == "generic" and "columns" not in options:
+        raise ConfigError(
+            "reader 'generic' needs the option 'columns', each quantity's column in the file "
+            "(fricid extract: --map time=t:ms --map velocity=dq:deg/s ...; fit --trajectory: "
+            '--reader-option \'columns={"time": "t", "velocity": "dq", ...}\' with '
+            "--reader-option 'units={...}')"
+        )
 
 
 def open_log(
