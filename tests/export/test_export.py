@@ -238,3 +238,20 @@ def test_linear_smoothing_keeps_the_sign_of_a_per_direction_model():
     assert abs(edges[0]) != pytest.approx(abs(edges[1]), rel=1e-3)  # asymmetric levels
     lin = smooth_predict(fitted, X, Smoothing("linear", zone))
     assert np.all(np.sign(lin) == np.sign(v))
+
+
+def test_a_dahl_model_exported_to_mjcf_says_what_it_leaves_out():
+    """Its steady state is Coulomb-viscous, exactly: no velocity shape is lost, the error is
+    "0 %", and the comment says the bristle dynamics are not exported (it is not static)."""
+    from fricid.export import mjcf_text
+
+    dahl = FittedModel.from_values(
+        "dahl",
+        {"sigma_0": 1000.0, "tau_c": 0.5, "alpha": 1.0, "sigma_2": 0.1},
+        operating_range={"velocity": [-1.0, 1.0]},
+    )
+    text = mjcf_text(dahl)
+    assert "(0 % of the RMS friction" in text
+    assert "velocity shape" not in text and "static model" not in text
+    assert "steady state of a Dahl model (dynamic)" in text
+    assert 'frictionloss="0.5' in text

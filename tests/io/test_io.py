@@ -637,7 +637,7 @@ def test_open_log_generic_is_one_chunk(tmp_path):
     ("reader", "options", "message"),
     [
         ("nope", {}, "unknown reader 'nope'; choose one of: table, generic, rosbag, epos"),
-        ("table", {"joint": "a"}, "unknown option of reader 'table' 'joint'; allowed: none"),
+        ("table", {"joint": "a"}, "unknown option of reader 'table' 'joint'; allowed: temperature"),
         ("generic", {"topic": "/x"}, "allowed: columns, units, torque_constant, temperature"),
         ("epos", {"pattern": "*.csv"}, "'pattern' applies to a folder of EPOS recordings"),
     ],

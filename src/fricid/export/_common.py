@@ -50,6 +50,7 @@ __all__ = [
     "model_name",
     "model_sha256",
     "operating_pair",
+    "percent",
     "plain",
     "range_lines",
     "summary_lines",
@@ -338,3 +339,9 @@ def ensure_out_file(path: str | os.PathLike[str]) -> Path:
     if path.is_dir():
         raise ExportError(f"--out {path} is a directory; give the file to write")
     return path
+
+
+def percent(share: float) -> str:
+    """A relative error as a percentage, ``"1.23 %"``; below 1e-6 % (the rounding of an exact
+    projection: a Coulomb-viscous model projects onto itself) ``"0 %"``."""
+    return "0 %" if abs(share) < 1e-8 else f"{100 * share:.3g} %"

@@ -32,7 +32,7 @@ from ._common import (
     summary_lines,
     write_lines_checked,
 )
-from .mjcf import FRICTIONLOSS_LINES, is_lugre, mjcf_lugre_elements
+from .mjcf import frictionloss_lines, is_lugre, mjcf_lugre_elements
 from .projection import Projection, project
 
 __all__ = [
@@ -149,7 +149,7 @@ def mjcf_text(
     MuJoCo's ``frictionloss`` is the Coulomb (dry) friction [N m] and ``damping`` the viscous
     coefficient [N m s/rad]; copy both attributes onto the joint of your model. The comment
     says how MuJoCo applies ``frictionloss`` (a soft constraint:
-    :data:`fricid.export.mjcf.FRICTIONLOSS_LINES`). Other arguments as for
+    :func:`fricid.export.mjcf.frictionloss_lines`). Other arguments as for
     :func:`urdf_text`.
 
     A LuGre model (``model == "lugre"``) exports instead to a ``<joint damping=/>`` and an
@@ -182,7 +182,7 @@ def mjcf_text(
         lines = [
             *summary_lines(fitted, source, sha256),
             *proj.summary(),
-            *FRICTIONLOSS_LINES,
+            *frictionloss_lines(fitted),
             "copy frictionloss [N m] and damping [N m s/rad] onto your <joint>",
         ]
         elements = [

@@ -50,6 +50,7 @@ __all__ = [
     "FRICTIONLOSS_LINES",
     "MUJOCO_STRIBECK_EXPONENT",
     "LuGreMapping",
+    "frictionloss_lines",
     "is_lugre",
     "lugre_mapping",
     "mjcf_lugre_elements",
@@ -66,6 +67,19 @@ FRICTIONLOSS_LINES = (
     "MuJoCo >= 4.0 also has LuGre friction (dcmotor actuator, lugre attribute): a dynamic "
     "model (fricid's lugre) exports to it; this static model has no bristle dynamics",
 )
+
+
+def frictionloss_lines(fitted: FittedModel) -> tuple[str, ...]:
+    """:data:`FRICTIONLOSS_LINES` for ``fitted``; a Dahl model's second line says that its
+    bristle dynamics are what the steady-state projection leaves out (it is not static)."""
+    if isinstance(fitted.model, str) and fitted.model.strip().lower() == "dahl":
+        return (
+            FRICTIONLOSS_LINES[0],
+            "this is the steady state of a Dahl model (dynamic): its bristle stiffness sigma_0 "
+            "(pre-sliding, the lag after each reversal) is not exported, frictionloss has none; "
+            "MuJoCo >= 4.0's LuGre (dcmotor actuator) carries it for a lugre model",
+        )
+    return FRICTIONLOSS_LINES
 
 
 def is_lugre(fitted: FittedModel) -> bool:

@@ -27,7 +27,7 @@ import numpy as np
 
 from ..errors import DataError
 from ..fitted import FittedModel
-from ._common import ExportError, model_name
+from ._common import ExportError, model_name, percent
 
 __all__ = ["N_LEVELS", "N_VELOCITY", "Projection", "operating_grid", "project"]
 
@@ -73,7 +73,7 @@ class Projection:
             f"load {v['load'][0]:.4g} to {v['load'][1]:.4g} N m, "
             f"temperature {v['temperature'][0]:.4g} to {v['temperature'][1]:.4g} degC",
             f"projection error: RMS {self.rms_error:.4g} N m "
-            f"({100 * self.relative_error:.3g} % of the RMS friction {self.rms_friction:.4g} N m), "
+            f"({percent(self.relative_error)} of the RMS friction {self.rms_friction:.4g} N m), "
             f"max {self.max_error:.4g} N m at velocity {self.max_at[0]:.4g} rad/s, "
             f"load {self.max_at[1]:.4g} N m, temperature {self.max_at[2]:.4g} degC",
         ]
@@ -171,7 +171,8 @@ def _lost(
     if fitted.kind == "rbf":
         what = "RBF network" if fitted.model == "rbf" else "Gaussian process"
         lost.append(f"the {what}'s shape (only F_c and b remain)")
-    elif model_name(fitted).split("_asym")[0] != "coulomb_viscous":
+    elif model_name(fitted).split("_asym")[0] not in ("coulomb_viscous", "dahl"):
+        # (a Dahl model's steady state is Coulomb-viscous: its dynamics are said by the format)
         v = X[:, 0]
         slow = np.abs(v) == np.abs(v).min()
         lost.append(

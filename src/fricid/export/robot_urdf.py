@@ -38,6 +38,7 @@ from ._common import (
     file_sha256,
     fmt_float,
     model_name,
+    percent,
     plain,
     write_lines_checked,
 )
@@ -160,7 +161,7 @@ def robot_urdf_text(
             "dynamics",
             element,
             f"fricid: Coulomb-viscous projection of model {plain(model_name(fitted))}, "
-            f"{_percent(proj.relative_error)} RMS from it over its operating range",
+            f"{percent(proj.relative_error)} RMS from it over its operating range",
         )
     if frictions:
         lines.append("friction: <dynamics> of " + ", ".join(map(plain, frictions)))
@@ -186,9 +187,3 @@ def write_robot_urdf(
     with atomic_write(out) as fh:
         fh.write(text)
     return out
-
-
-def _percent(share: float) -> str:
-    """A relative error as a percentage; below 1e-6 % (rounding of an exact projection:
-    a Coulomb-viscous model projects onto itself) as "0 %"."""
-    return "0 %" if abs(share) < 1e-8 else f"{100 * share:.3g} %"
