@@ -55,7 +55,12 @@ def test_design_writes_the_files_and_prints_the_errors(tmp_path):
     assert "condition number" in res.output and "best random start" in res.output
     assert "predicted standard errors with torque noise 0.05 N m" in res.output
     assert "joint2:Fc+" in res.output
+    # the pendulum's URDF has no limits: what is assumed is said, no effort fraction made up
+    assert "no limit in the URDF, so assumed: position +-3.142 rad for joint1, joint2" in res.output
+    assert "effort not checked for joint1, joint2" in res.output
+    assert " no limit" in res.output and "effort 0.0" not in res.output
     doc = json.loads(out.read_text())
+    assert doc["margins"]["effort"] == [None, None]
     assert doc["joints"] == ["joint1", "joint2"] and doc["periods"] == 1
     assert doc["locked"] == {}
     assert doc["limits"]["upper"][0] <= 1.0

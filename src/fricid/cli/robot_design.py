@@ -64,9 +64,10 @@ def _design_lines(design) -> list[str]:
         f"  {'joint':<20} {'position':>9} {'velocity':>9} {'accel.':>9} {'effort':>9}",
     ]
     for i, j in enumerate(design.joints):
-        row = [m[k][i] for k in ("position", "velocity", "acceleration", "effort")]
-        flag = "  <- at a limit" if max(row) > 0.98 else ""
-        lines.append(f"  {j:<20} " + " ".join(f"{100 * v:8.1f}%" for v in row) + flag)
+        row = [float(m[k][i]) for k in ("position", "velocity", "acceleration", "effort")]
+        flag = "  <- at a limit" if max(v for v in row if v == v) > 0.98 else ""
+        shown = (f"{100 * v:8.1f}%" if v == v else " no limit" for v in row)
+        lines.append(f"  {j:<20} " + " ".join(shown) + flag)
     return lines
 
 
@@ -190,13 +191,17 @@ def design_command(
     sigma = parse_noise(torque_noise, model.n)
     lines += _error_lines(design, model, sigma, rate, periods * design.trajectory.period)
     from ..robot.excitation import peak_fractions
+    from ..robot.limits import assumed_limits
 
     whole = peak_fractions(model, played, design.limits, rate)
-    worst = {k: float(np.max(v)) for k, v in whole.items()}
+    worst = {k: float(np.nanmax(v)) for k, v in whole.items() if np.isfinite(v).any()}
     lines.append(
         f"played: {periods} periods with {ramp:g} s ramps, {played.duration:.2f} s; worst peak / "
         "limit " + ", ".join(f"{k} {100 * v:.1f} %" for k, v in worst.items())
     )
+    assumed = assumed_limits(model)
+    if assumed:
+        lines.append("no limit in the URDF, so assumed: " + "; ".join(assumed))
     extra = {"source": source, "torque_noise": sigma.tolist(), "periods": periods, "ramp": ramp}
     extra["locked"] = {str(k): float(v) for k, v in model.locked.items()}
     written = [save_design(design, out, extra)]

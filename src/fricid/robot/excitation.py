@@ -422,7 +422,7 @@ def _feasible(problem, x, x_start, model, limits, rate) -> np.ndarray:
     traj = problem.trajectory(x, model.joints)
     for _ in range(40):
         peaks = peak_fractions(model, traj, limits, rate)
-        worst = max(float(np.max(v)) for v in peaks.values())
+        worst = max(float(np.nanmax(np.r_[v, 0.0])) for v in peaks.values())
         if worst <= 1.0:
             return x
         q0, c = problem.split(x.copy())

@@ -11,7 +11,13 @@ import numpy as np
 from ..errors import ConfigError
 from .model import RigidBodyModel
 
-__all__ = ["DEFAULT_POSITION", "DEFAULT_VELOCITY", "peak_fractions", "resolve_limits"]
+__all__ = [
+    "DEFAULT_POSITION",
+    "DEFAULT_VELOCITY",
+    "assumed_limits",
+    "peak_fractions",
+    "resolve_limits",
+]
 
 #: Where the URDF gives no position limit [rad]; no velocity limit [rad/s].
 DEFAULT_POSITION = np.pi
@@ -65,9 +71,25 @@ def resolve_limits(
     }
 
 
+def assumed_limits(model: RigidBodyModel) -> list[str]:
+    """What :func:`resolve_limits` assumes where the URDF gives no limit (none, or 0, which
+    the URDF reader reads as none), one line per quantity, for the user to check."""
+    out = []
+    for quantity, values, assumed in (
+        ("position", model.upper - model.lower, f"+-{DEFAULT_POSITION:.4g} rad"),
+        ("velocity", model.velocity_limit, f"{DEFAULT_VELOCITY:g} rad/s"),
+        ("effort", model.effort_limit, "not checked"),
+    ):
+        joints = [j for j, v in zip(model.joints, values, strict=True) if not np.isfinite(v)]
+        if joints:
+            out.append(f"{quantity} {assumed} for {', '.join(joints)}")
+    return out
+
+
 def peak_fractions(model: RigidBodyModel, traj, limits: dict, rate: float) -> dict:
     """Each joint's peak position (about the middle, of the half-width), speed, acceleration
-    and effort as fractions of the limits, at ``rate`` over the trajectory."""
+    and effort as fractions of the limits, at ``rate`` over the trajectory; the effort NaN
+    where there is no effort limit."""
     _t, (q, dq, ddq) = traj.sample(rate)
     mid = 0.5 * (limits["upper"] + limits["lower"])
     half = 0.5 * (limits["upper"] - limits["lower"])
@@ -77,5 +99,5 @@ def peak_fractions(model: RigidBodyModel, traj, limits: dict, rate: float) -> di
         "position": np.max(np.abs(q - mid), axis=0) / half,
         "velocity": np.max(np.abs(dq), axis=0) / limits["velocity"],
         "acceleration": np.max(np.abs(ddq), axis=0) / limits["acceleration"],
-        "effort": np.where(np.isfinite(eff), np.max(np.abs(tau), axis=0) / eff, 0.0),
+        "effort": np.where(np.isfinite(eff), np.max(np.abs(tau), axis=0) / eff, np.nan),
     }
