@@ -95,3 +95,11 @@ def test_a_torque_channel_never_logged_is_refused(pendulum, log):
     with pytest.raises(DataError, match="in every one of the") as err:
         fit_arm(replace(log, torque=dead), pendulum)
     assert err.value.column == f"{pendulum.joints[1]}.torque"
+
+
+def test_a_log_too_short_names_the_part_and_the_file_length(pendulum, log):
+    """The fit holds out the last quarter: a short log fails on a part, and says which."""
+    short = log.slice(0, 40)
+    with pytest.raises(DataError, match="of the log's 40 samples is too short") as err:
+        fit_arm(short, pendulum, friction="coulomb_viscous_asym")
+    assert "quarter" in str(err.value)

@@ -132,14 +132,24 @@ def _log_arrays(log: RobotLog, model: RigidBodyModel) -> tuple[np.ndarray, ...]:
     return sel.time, sel.position, sel.motor_torque
 
 
-def _signals(log: RobotLog, model, counts, cutoff, stops=False, load_model=None) -> ArmSignals:
+def _signals(
+    log: RobotLog, model, counts, cutoff, stops=False, load_model=None, part="the log"
+) -> ArmSignals:
     t, q, tau = _log_arrays(log, model)
     inertia = None
     if cutoff is None:  # the mean diagonal of the mass matrix over the log
         rows = np.linspace(0, len(t) - 1, 25).astype(int)
         inertia = np.diagonal(model.mass_matrix(q[rows]), axis1=1, axis2=2).mean(axis=0)
     sig = prepare_signals(
-        t, q, tau, counts=counts, cutoff=cutoff, inertia=inertia, source=log.source, stops=stops
+        t,
+        q,
+        tau,
+        counts=counts,
+        cutoff=cutoff,
+        inertia=inertia,
+        source=log.source,
+        stops=stops,
+        part=part,
     )
     if load_model is None:
         return sig
@@ -246,11 +256,16 @@ def _fit_arm(
         model.joints, dict(friction) if isinstance(friction, Mapping) else friction
     )
     source = "second log" if validate is not None else "last quarter of the log"
+    parts = ("the log", "the second log (held out)")
     check_live_torque(log, model.joints)
     problems = channel_problems(log, model)
     if validate is None:
         cut = int(len(log) * (1 - HELDOUT_SHARE))
         log, validate = log.slice(0, cut), log.slice(cut, len(log))
+        parts = tuple(
+            f"{p} of the log's {cut + len(validate)} samples"
+            for p in ("the identified first three quarters", "the held-out last quarter")
+        )
     stops = reversal_window > 0  # recorded in closed loop: the joints stick at reversals
     load_from = None
     if any(jf.load for jf in frictions):
@@ -263,7 +278,7 @@ def _fit_arm(
             if refined
             else FROM_URDF
         )
-    sig = _signals(log, model, encoder_counts, cutoff, stops, load_model)
+    sig = _signals(log, model, encoder_counts, cutoff, stops, load_model, parts[0])
     for j, jf in enumerate(frictions):  # a load family's joint without load (._friction)
         jf.unloaded = jf.load and bool(np.abs(sig.full_load[:, j]).max() <= NO_LOAD)
     distance = None
@@ -337,7 +352,7 @@ def _fit_arm(
     for (j, d), prof in shape_profiles(sig, Yb, frictions, moving, safe, inflation).items():
         widen(fric[model.joints[j]]["parameters"], d, prof)
     # held-out validation with the same filter
-    vsig = _signals(validate, model, encoder_counts, sig.cutoff, stops, load_model)
+    vsig = _signals(validate, model, encoder_counts, sig.cutoff, stops, load_model, parts[1])
     vsig = vsig.delayed(torque_delay)
     vdistance = vstick = None
     if reversal_window > 0:

@@ -253,8 +253,10 @@ def prepare_signals(
     inertia: np.ndarray | None = None,
     source: str | None = None,
     stops: bool = False,
+    part: str = "the log",
 ) -> ArmSignals:
-    """Filter, differentiate and decimate a log's position and torque (module notes).
+    """Filter, differentiate and decimate a log's position and torque (module notes);
+    ``part`` names the rows in a "too short" message (e.g. the held-out part).
 
     Parameters
     ----------
@@ -287,7 +289,7 @@ def prepare_signals(
     shortest = 3 * (BUTTER_ORDER + 1) + 1  # scipy's filtfilt pads 3 filter lengths
     if position.shape[0] < shortest:
         raise DataError(
-            f"the log is too short ({position.shape[0]} samples) for the zero-phase low-pass "
+            f"{part} is too short ({position.shape[0]} samples) for the zero-phase low-pass "
             f"of whole-arm identification (it needs far more than {shortest})",
             file=source,
         )
@@ -317,7 +319,7 @@ def prepare_signals(
     n_mid = len(range(0, position.shape[0], first))
     if n_mid < 4 * edge + 20:
         raise DataError(
-            f"the log is too short ({position.shape[0]} samples) for a low-pass at {cutoff:.3g} Hz",
+            f"{part} is too short ({position.shape[0]} samples) for a low-pass at {cutoff:.3g} Hz",
             file=source,
         )
     factor = max(1, int(mid_rate / (RATE_OVER_CUTOFF * cutoff)))
