@@ -103,3 +103,26 @@ def test_a_log_too_short_names_the_part_and_the_file_length(pendulum, log):
     with pytest.raises(DataError, match="of the log's 40 samples is too short") as err:
         fit_arm(short, pendulum, friction="coulomb_viscous_asym")
     assert "quarter" in str(err.value)
+
+
+def test_a_coarse_encoder_is_not_read_as_motion(pendulum):
+    """2^14 counts at 1 kHz: the differenced position's quantisation noise, rising to
+    Nyquist, had put the motion's bandwidth at hundreds of Hz, the cut-off at 450 Hz and
+    every joint under its velocity-noise threshold ("no joint moves"). Its expected
+    periodogram is now taken out: the bandwidth is the motion's (harmonics up to 0.7 Hz)."""
+    from fricid.identify.dynamic.arm._signals import choose_cutoff, encoder_step, torque_noise
+
+    coarse = make_log(pendulum, LAWS, duration=12.0, seed=7, counts=2**14)
+    step = encoder_step(coarse.position, None)
+    _cut, bounds = choose_cutoff(
+        coarse.position, 1000.0, step, torque_noise(coarse.torque), np.ones(2)
+    )
+    assert bounds["motion"] < 2.0, bounds
+    fit = fit_arm(coarse, pendulum, friction="coulomb_viscous_asym")
+    assert all(fit.friction[j]["parameters"]["f_c_pos"]["value"] is not None for j in fit.joints)
+
+
+def test_motion_under_the_encoder_noise_says_what_to_do(pendulum):
+    coarse = make_log(pendulum, LAWS, duration=12.0, seed=7, counts=2**14)
+    with pytest.raises(DataError, match=r"velocity noise lets it be seen.*lower --cutoff"):
+        fit_arm(coarse, pendulum, friction="coulomb_viscous_asym", cutoff=450.0)

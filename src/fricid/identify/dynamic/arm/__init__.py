@@ -157,6 +157,23 @@ def _signals(
     return replace(sig, full_load=own if own is not None else joint_load(load_model, q))
 
 
+def _still_text(sig: ArmSignals) -> str:
+    """Why no row is kept: no motion, or motion hidden under the encoder's velocity noise
+    after the low-pass (a coarse encoder: a lower cut-off lets the motion through)."""
+    fastest = np.abs(sig.dq).max(axis=0)
+    floor = np.maximum(VELOCITY_NOISE_FACTOR * sig.velocity_noise, MIN_SPEED)
+    if not (fastest >= MIN_SPEED).any():
+        return "no joint moves in the log: nothing to identify"
+    return (
+        "no joint moves faster than its encoder's velocity noise lets it be seen: fastest "
+        f"filtered speeds {np.array2string(fastest, precision=3)} rad/s against "
+        f"{np.array2string(floor, precision=3)} ({VELOCITY_NOISE_FACTOR:g}x the noise of "
+        f"encoder steps {np.array2string(sig.encoder_step, precision=3)} rad after the "
+        f"low-pass at {sig.cutoff:.3g} Hz); a coarse encoder: give a lower --cutoff (a few "
+        "times the motion's highest frequency) or --encoder-counts"
+    )
+
+
 def _torque_delay(sig: ArmSignals, Yb, frictions, moving) -> float:
     """The torque's delay behind the positions [sample periods], by least squares: the
     torque's filtered change per sample is one more column, ``tau = Y theta + a dtau``
@@ -288,7 +305,7 @@ def _fit_arm(
         sig = replace(sig, stick=stick_columns(sig, near))
     moving = _moving(sig, reversal_window, distance)
     if not moving.any():
-        raise DataError("no joint moves in the log: nothing to identify", file=log.source)
+        raise DataError(_still_text(sig), file=log.source)
     bp = base_parameters(model)
     Yb = sig.regressor(model, bp)
     n = model.n

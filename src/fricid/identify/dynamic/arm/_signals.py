@@ -45,7 +45,8 @@ The cut-off ``f_c`` (:func:`choose_cutoff`) is the smallest of three bounds:
 
 1. ``SIGNAL_FACTOR`` times the motion's bandwidth ``f_m`` (the frequency below which
    :data:`SIGNAL_POWER` of the velocity's power lies, from the differenced position's
-   spectrum): the dynamics must pass undistorted;
+   spectrum less the encoder's expected quantisation noise): the dynamics must pass
+   undistorted;
 2. the encoder bound: an encoder step ``Delta`` is uniform quantisation noise of variance
    ``Delta^2 / 12``, white up to ``f_s / 2``; twice differentiated and low-passed at ``f_c``
    its acceleration noise is ``sigma_ddq^2 = Delta^2 / 12 * 2 / f_s * (2 pi)^4 f_c^5 / 5``.
@@ -72,6 +73,10 @@ __all__ = ["ArmSignals", "choose_cutoff", "encoder_step", "prepare_signals"]
 BUTTER_ORDER = 4
 #: Share of the velocity's power below the motion's bandwidth.
 SIGNAL_POWER = 0.99
+#: Times its expected periodogram the encoder's noise is taken out of the velocity's spectrum
+#: (a periodogram bin of noise alone is exponential: exceeding 5 times its mean has
+#: probability e^-5).
+NOISE_MARGIN = 5.0
 #: Cut-off over the motion's bandwidth (bound 1).
 SIGNAL_FACTOR = 8.0
 #: The cut-off is never below this many times the motion's bandwidth.
@@ -195,16 +200,25 @@ def encoder_step(position: np.ndarray, counts: int | None) -> np.ndarray:
     return out
 
 
-def _bandwidth(q: np.ndarray, rate: float) -> float:
+def _bandwidth(q: np.ndarray, rate: float, step: np.ndarray | None = None) -> float:
     """The frequency below which :data:`SIGNAL_POWER` of the velocity's power lies [Hz]
-    (Hann-windowed spectrum of the differenced position, summed over the joints)."""
+    (Hann-windowed spectrum of the differenced position, summed over the joints), with each
+    joint's encoder noise taken out: ``step`` quantisation, white of variance ``step^2 / 12``,
+    differenced has the expected periodogram ``sum(w^2) step^2 / 12 f_s^2 4 sin^2(pi f /
+    f_s)``, and :data:`NOISE_MARGIN` times it is subtracted (floored at 0), so that a coarse
+    encoder's noise, which rises to Nyquist, is not read as motion (a 2^14-count encoder at
+    1 kHz had put the bandwidth at 479 Hz and every joint below its noise threshold)."""
     v = np.diff(q, axis=0) * rate
-    v = (v - v.mean(axis=0)) * np.hanning(v.shape[0])[:, None]
-    total = (np.abs(np.fft.rfft(v, axis=0)) ** 2).sum(axis=1)
-    cum = np.cumsum(total)
+    w = np.hanning(v.shape[0])
+    v = (v - v.mean(axis=0)) * w[:, None]
+    power = np.abs(np.fft.rfft(v, axis=0)) ** 2
+    freqs = np.fft.rfftfreq(v.shape[0], 1.0 / rate)
+    if step is not None:
+        shape = (w @ w) * rate**2 * 4 * np.sin(np.pi * freqs / rate) ** 2 / 12
+        power = np.maximum(power - NOISE_MARGIN * shape[:, None] * step[None, :] ** 2, 0.0)
+    cum = np.cumsum(power.sum(axis=1))
     if cum[-1] <= 0:
         return rate / 2
-    freqs = np.fft.rfftfreq(v.shape[0], 1.0 / rate)
     return float(freqs[min(np.searchsorted(cum, SIGNAL_POWER * cum[-1]), freqs.size - 1)])
 
 
@@ -224,7 +238,7 @@ def choose_cutoff(
     of the mass matrix: the encoder's acceleration noise times the inertia is kept below
     :data:`ENCODER_SHARE` times the filtered torque noise.
     """
-    f_m = max(_bandwidth(q, rate), 10.0 / (q.shape[0] / rate))
+    f_m = max(_bandwidth(q, rate, step), 10.0 / (q.shape[0] / rate))
     signal = SIGNAL_FACTOR * f_m
     nyquist = rate / MIN_RATE_OVER_CUTOFF
     ok = (step > 0) & (inertia > 0) & (noise > 0)
