@@ -12,7 +12,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from fricid.samples import velocity_mismatch
-from fricid.samples._agreement import UNIT_FACTORS, velocity_scale
+from fricid.samples._agreement import UNIT_FACTORS, velocity_scale, wrapped_rows
 
 
 def motion(seed: int, n: int = 4000, rate: float = 500.0, noise: float = 0.02):
@@ -92,3 +92,18 @@ def test_the_foreign_logs_agree():
         log = read_rawlog(path)
         assert velocity_mismatch(log.time, log.position, log.velocity) is None, path.name
         assert abs(velocity_scale(log.time, log.position, log.velocity) - 1) < 0.01
+
+
+@settings(max_examples=30, deadline=None)
+@given(seed=st.integers(0, 10_000), speed=st.floats(1.0, 20.0), origin=st.sampled_from([0, 1]))
+def test_wrapped_rows_are_the_wraps(seed, speed, origin):
+    """A joint turning at up to 20 rad/s (0.04 rad per sample), wrapped to [-pi, pi) or
+    [0, 2 pi): every jump found, nothing in the unwrapped angle."""
+    t, q, v = motion(seed)
+    turning, v = q + speed * t, v + speed
+    low = -np.pi if origin == 0 else 0.0
+    wrapped = (turning - low) % (2 * np.pi) + low
+    expected = np.flatnonzero(np.abs(np.diff(wrapped)) > np.pi) + 1
+    assert expected.size >= 1
+    np.testing.assert_array_equal(wrapped_rows(t, wrapped, v), expected)
+    assert wrapped_rows(t, turning, v).size == 0

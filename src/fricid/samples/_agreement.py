@@ -9,7 +9,9 @@ the factor ``s`` in ``delta position = s * integral of velocity`` over :data:`WI
 of the log (the median of the windows' ratios, so a wrapped angle or a spike in one window
 does not move it; the integral averages the velocity's noise out) and names the likely cause
 when ``s`` is outside :data:`AGREEMENT`: a known unit factor (:data:`UNIT_FACTORS`), a
-reversed sign, else a gear ratio or an unknown unit.
+reversed sign, else a gear ratio or an unknown unit. :func:`wrapped_rows` finds an angle
+wrapped to one turn (a jump the velocity does not explain, which the median above ignores but
+a derivative filter does not).
 """
 
 from __future__ import annotations
@@ -18,7 +20,14 @@ import math
 
 import numpy as np
 
-__all__ = ["AGREEMENT", "UNIT_FACTORS", "WINDOWS", "velocity_mismatch", "velocity_scale"]
+__all__ = [
+    "AGREEMENT",
+    "UNIT_FACTORS",
+    "WINDOWS",
+    "velocity_mismatch",
+    "velocity_scale",
+    "wrapped_rows",
+]
 
 #: The windows the log is cut into for the ratios.
 WINDOWS = 40
@@ -122,3 +131,21 @@ def velocity_mismatch(time, position, velocity, *, column: str | None = None) ->
         f"{prefix}the position changes by {scale:.3g}x the integral of the velocity "
         f"(expected 1): {_cause(scale)}"
     )
+
+
+def wrapped_rows(time, position, velocity) -> np.ndarray:
+    """The rows where the position jumps by more than pi from the row before while the mean
+    of the two velocities times the step explains less than half of it: an angle wrapped to
+    one turn (``[-pi, pi)`` or ``[0, 2 pi)``), or a glitch of the position channel.
+
+    Returns
+    -------
+    ndarray of int
+        Row indices (the row after each jump), empty when there is none.
+    """
+    t = np.asarray(time, dtype=float)
+    q = np.asarray(position, dtype=float)
+    v = np.asarray(velocity, dtype=float)
+    dq = np.diff(q)
+    moved = 0.5 * (v[1:] + v[:-1]) * np.diff(t)
+    return np.flatnonzero((np.abs(dq) > math.pi) & (np.abs(dq - moved) > 0.5 * np.abs(dq))) + 1

@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import DataError
-from ._agreement import velocity_mismatch
+from ._agreement import velocity_mismatch, wrapped_rows
 from ._columns import RAWLOG_COLUMNS
 from .rawlog import RawLog
 
@@ -51,7 +51,9 @@ def check_trajectory_log(log: RawLog) -> None:
     - a logged velocity (not one a reader computed from the position, ``meta["velocity_from"]``)
       that is not the position's derivative: a unit, a sign or a gear ratio between the two
       (:func:`._agreement.velocity_mismatch`), refused with the factor and its likely cause,
-      since the fit reads both and would be off by the factor.
+      since the fit reads both and would be off by the factor; a position that jumps by
+      more than pi where the velocity does not (an angle wrapped to one turn:
+      :func:`._agreement.wrapped_rows`), refused with the row.
 
     Parameters
     ----------
@@ -65,6 +67,18 @@ def check_trajectory_log(log: RawLog) -> None:
     """
     _check_time_grid(log)
     _check_stuck_effort(log)
+    wraps = wrapped_rows(log.time, log.position, log.velocity)
+    if wraps.size:
+        row = int(wraps[0])
+        raise DataError(
+            f"the position jumps by {float(log.position[row] - log.position[row - 1]):.4g} rad "
+            f"while the velocity says {float(log.velocity[row]):.4g} rad/s ({wraps.size} such "
+            "jumps): an angle wrapped to one turn; unwrap it (numpy.unwrap) before the fit, "
+            "which differentiates the position",
+            file=log.source,
+            row=row,
+            column="position",
+        )
     if "velocity_from" not in log.meta:
         wrong = velocity_mismatch(log.time, log.position, log.velocity)
         if wrong:

@@ -126,3 +126,18 @@ def test_motion_under_the_encoder_noise_says_what_to_do(pendulum):
     coarse = make_log(pendulum, LAWS, duration=12.0, seed=7, counts=2**14)
     with pytest.raises(DataError, match=r"velocity noise lets it be seen.*lower --cutoff"):
         fit_arm(coarse, pendulum, friction="coulomb_viscous_asym", cutoff=450.0)
+
+
+def test_a_wrapped_angle_makes_the_joint_no(pendulum, log):
+    turning = log.position.copy()
+    turning[:, 0] += 4.0 * (log.time - log.time[0])
+    velocity = log.velocity.copy()
+    velocity[:, 0] += 4.0
+    wrapped = turning.copy()
+    wrapped[:, 0] = (turning[:, 0] + np.pi) % (2 * np.pi) - np.pi
+    assert channel_problems(replace(log, position=turning, velocity=velocity), pendulum) == {
+        j: [] for j in pendulum.joints
+    }
+    found = channel_problems(replace(log, position=wrapped, velocity=velocity), pendulum)
+    (text,) = found[pendulum.joints[0]]
+    assert "wrapped to one turn" in text

@@ -188,3 +188,13 @@ def test_a_reversed_sign_is_refused(clean, tmp_path, flip):
     line = refused_by_fit(path, "the torque works against friction", "flip one")
     level = float(re.search(r"Coulomb level of (\S+)", line).group(1))
     assert level < 0
+
+
+def test_an_angle_wrapped_to_one_turn_is_refused(clean, tmp_path):
+    """A joint that turns on (the multi-sine plus 6 rad/s), its angle logged in [-pi, pi):
+    the fit differentiates the position, so each wrap would be a huge false acceleration."""
+    turning = clean.position + 6.0 * (clean.time - clean.time[0])
+    wrapped = (turning + np.pi) % (2 * np.pi) - np.pi
+    first = int(np.flatnonzero(np.abs(np.diff(wrapped)) > np.pi)[0]) + 1
+    path = damaged(clean, tmp_path, "wrapped", position=wrapped, velocity=clean.velocity + 6.0)
+    refused_by_fit(path, f"row {first}", "column 'position'", "wrapped to one turn")

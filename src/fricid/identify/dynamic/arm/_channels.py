@@ -8,9 +8,10 @@ before it:
   (:func:`check_live_torque`), since its rows would pull every shared inertial parameter;
 - a logged velocity that is not the position's derivative (:func:`fricid.samples.
   velocity_mismatch`: a unit, a sign, a gear ratio) and a position beyond the URDF's limits by
-  more than :data:`LIMIT_SLACK` of their span (degrees labelled radians, an offset zero,
-  another robot's URDF) make the joint's verdict ``no`` with the reason
-  (:func:`channel_problems`).
+  more than :data:`LIMIT_SLACK` of their span plus :data:`LIMIT_MARGIN` (degrees labelled
+  radians, an offset zero, another robot's URDF), and a position that jumps by more than pi
+  where the velocity does not (an angle wrapped to one turn) make the joint's verdict ``no``
+  with the reason (:func:`channel_problems`).
 """
 
 from __future__ import annotations
@@ -20,12 +21,16 @@ import numpy as np
 from ....errors import DataError
 from ....robot import RigidBodyModel
 from ....samples import RobotLog, velocity_mismatch
+from ....samples._agreement import wrapped_rows
 from ....samples.robot_log import joint_column
 
-__all__ = ["LIMIT_SLACK", "channel_problems", "check_live_torque"]
+__all__ = ["LIMIT_MARGIN", "LIMIT_SLACK", "channel_problems", "check_live_torque"]
 
-#: How far past a URDF limit a logged position may go, as a share of the limits' span.
-LIMIT_SLACK = 0.1
+#: How far past a URDF limit a logged position may go: this share of the limits' span plus
+#: :data:`LIMIT_MARGIN` [rad or m] (a joint at its hard stop, an encoder's offset of a few
+#: counts); an offset zero of 0.35-0.58 rad had passed under a slack of 10 %.
+LIMIT_SLACK = 0.02
+LIMIT_MARGIN = 0.02
 
 
 def check_live_torque(log: RobotLog, joints: tuple[str, ...]) -> None:
@@ -61,9 +66,16 @@ def channel_problems(log: RobotLog, model: RigidBodyModel) -> dict[str, list[str
         found = []
         if logged_velocity:
             found.append(velocity_mismatch(log.time, q, log.velocity[:, k], column=name))
+        wraps = wrapped_rows(log.time, q, log.velocity[:, k])
+        if wraps.size:
+            found.append(
+                f"{name}: the position jumps by more than pi at {wraps.size} rows (first at row "
+                f"{int(wraps[0])}) where the velocity does not: an angle wrapped to one turn; "
+                "unwrap it (numpy.unwrap)"
+            )
         lo, hi = float(model.lower[j]), float(model.upper[j])
         if np.isfinite(lo) and np.isfinite(hi) and hi > lo:
-            slack = LIMIT_SLACK * (hi - lo)
+            slack = LIMIT_SLACK * (hi - lo) + LIMIT_MARGIN
             qmin, qmax = float(q.min()), float(q.max())
             if qmin < lo - slack or qmax > hi + slack:
                 found.append(
