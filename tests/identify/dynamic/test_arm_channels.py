@@ -141,3 +141,15 @@ def test_a_wrapped_angle_makes_the_joint_no(pendulum, log):
     found = channel_problems(replace(log, position=wrapped, velocity=velocity), pendulum)
     (text,) = found[pendulum.joints[0]]
     assert "wrapped to one turn" in text
+
+
+def test_a_failed_fit_names_the_channels_that_disagree(pendulum, log):
+    short = log.slice(0, 40)
+    wrong = replace(short, velocity=_only_first(short, short.velocity, 180 / np.pi))
+    with pytest.raises(DataError, match="too short") as err:
+        fit_arm(wrong, pendulum, friction="coulomb_viscous_asym")
+    assert "channels also disagree, which may be why" in str(err.value)
+    assert "degrees against radians" in str(err.value)
+    with pytest.raises(DataError) as clean:
+        fit_arm(short, pendulum, friction="coulomb_viscous_asym")
+    assert "disagree" not in str(clean.value)

@@ -174,6 +174,23 @@ def _still_text(sig: ArmSignals) -> str:
     )
 
 
+def _with_channels(err: DataError, log: RobotLog, model: RigidBodyModel) -> DataError:
+    """``err`` with the channels' disagreements (:mod:`._channels`) added, which may be its
+    cause (positions in degrees labelled radians make a log look too short or still)."""
+    try:
+        found = [p for joint in channel_problems(log, model).values() for p in joint]
+    except DataError:
+        return err
+    if not found:
+        return err
+    return DataError(
+        f"{err.message}; the log's channels also disagree, which may be why: {'; '.join(found)}",
+        file=err.file,
+        row=err.row,
+        column=err.column,
+    )
+
+
 def _torque_delay(sig: ArmSignals, Yb, frictions, moving) -> float:
     """The torque's delay behind the positions [sample periods], by least squares: the
     torque's filtered change per sample is one more column, ``tau = Y theta + a dtau``
@@ -199,7 +216,10 @@ def fit_arm(log: RobotLog, model: RigidBodyModel, **kwargs: Any) -> ArmFit:
     threads only contend on a shared machine). With a load family and no load channel in the
     log, twice: the second time with the load of the first fit's arm (:mod:`._load`)."""
     with one_blas_thread():
-        fit = _fit_arm(log, model, **kwargs)
+        try:
+            fit = _fit_arm(log, model, **kwargs)
+        except DataError as err:  # a unit or sign mistake can be why: say so
+            raise _with_channels(err, log, model) from None
         values = fit.standard.get("values")
         if fit.provenance["load"] == FROM_URDF and values is not None:
             refined = model.with_parameters(np.asarray(values, dtype=float))
