@@ -65,3 +65,16 @@ def test_a_log_in_chunks_is_judged_once_per_source(campaign):
         got = extract(chunks, **spec.extract_options())
     (problem,) = got.samples.meta["channel_problems"]
     assert "reversed sign and units rpm against rad/s" in problem
+
+
+def test_a_reversed_torque_sign_is_named_instead_of_misfit_advice(campaign):
+    spec, log = campaign
+    flipped = replace(log, current=-log.current)
+    got = extract(flipped, **spec.extract_options())
+    trust = _trust(got.samples)
+    assert trust.level == "no"
+    assert "the friction opposes the velocity at" in trust.reasons[0]
+    assert "sign is reversed" in trust.reasons[0]
+    assert trust.what_to_do == ""  # not "fit a learned model"
+    clean = extract(log, **spec.extract_options())
+    assert not any("opposes" in r for r in _trust(clean.samples).reasons)

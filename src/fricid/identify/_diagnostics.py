@@ -281,15 +281,43 @@ def _sample_name(samples: FrictionSamples, i: int, why: str) -> str:
 
 
 def channel_problems(samples: FrictionSamples | None) -> list[str]:
-    """Reasons for ``no``: the extraction found a logged velocity that is not its position
-    channel's derivative (``meta["channel_problems"]``, :func:`fricid.samples.
-    velocity_mismatch`: a unit, a sign or a gear ratio), so the samples' velocities are off by
-    the factor and so is every coefficient fitted on them."""
+    """Reasons for ``no`` that the samples show of their log's channels:
+
+    - the extraction found a logged velocity that is not its position channel's derivative
+      (``meta["channel_problems"]``, :func:`fricid.samples.velocity_mismatch`: a unit, a
+      sign or a gear ratio), so the samples' velocities are off by the factor and so is every
+      coefficient fitted on them;
+    - friction against the motion at most set-points (:func:`reversed_friction`): friction
+      only dissipates, so the torque's (or current's) sign is reversed.
+    """
     meta = samples.meta if samples is not None and isinstance(samples.meta, dict) else {}
     found = meta.get("channel_problems")
-    if not isinstance(found, list):
-        return []
-    return [f"the log's velocity is not its position's derivative: {p}" for p in found]
+    out = (
+        []
+        if not isinstance(found, list)
+        else [f"the log's velocity is not its position's derivative: {p}" for p in found]
+    )
+    reversed_ = reversed_friction(samples)
+    return out + ([reversed_] if reversed_ else [])
+
+
+def reversed_friction(samples: FrictionSamples | None) -> str:
+    """A reason when friction opposes the velocity at more than half of the moving samples
+    (friction only dissipates: the torque's or current's sign is reversed), else ``""``.
+    Gravity left in can turn the friction of one direction at a few slow set-points; it does
+    not turn most of them."""
+    if samples is None or len(samples) == 0:
+        return ""
+    v, f = samples.velocity, samples.friction
+    moving = v != 0
+    against = int(np.sum(np.sign(f[moving]) == -np.sign(v[moving])))
+    if not moving.any() or against <= 0.5 * int(moving.sum()):
+        return ""
+    return (
+        f"the friction opposes the velocity at {against} of {int(moving.sum())} samples, and "
+        "friction only dissipates: the torque's (or current's) sign is reversed; negate it "
+        "(fricid extract --format epos --flip-sign, or the column) and extract again"
+    )
 
 
 def gravity_caveat(samples: FrictionSamples | None) -> list[str]:

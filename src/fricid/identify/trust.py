@@ -33,9 +33,9 @@ reads the model file (and, where given, the samples the model was identified on)
 - the operating range, outside which predictions are extrapolated.
 
 The level is ``"no"`` when the fit did not converge, no free parameter is determined, the
-model misses the data by more than :data:`MISS_RATIO` times the scatter, or the samples were
-extracted from a log whose velocity is not its position's derivative (a unit, a sign or a
-gear ratio between them: :func:`._diagnostics.channel_problems`); ``"with caveats"`` when
+model misses the data by more than :data:`MISS_RATIO` times the scatter, or the samples
+show a velocity that is not the position's derivative or friction against the motion
+(:func:`._diagnostics.channel_problems`, which replace the misfit advice); ``"with caveats"`` when
 anything else above is short of clean (a parameter not determined or not bounded, an
 error between :data:`fricid.metrics.NOISE_RATIO` and :data:`MISS_RATIO` times the scatter,
 no held-out error or no scatter, convergence not recorded, set-points flagged for scatter or
@@ -375,8 +375,9 @@ def assess_trust(
             "left out; " + trust.validation_note
         )
     trust.quality, trust.quality_summary, quality_caveat = quality_rows(samples)
-    _grade(trust, fitted, [quality_caveat, *gravity_caveat(samples)], channel_problems(samples))
-    if trust.converged is not False and trust.heldout_ratio > MISS_RATIO:
+    problems = channel_problems(samples)
+    _grade(trust, fitted, [quality_caveat, *gravity_caveat(samples)], problems)
+    if trust.converged is not False and trust.heldout_ratio > MISS_RATIO and not problems:
         from ._advice import misfit_advice
 
         held = trust.validation if trust.held_out else None
