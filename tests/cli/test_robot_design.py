@@ -103,3 +103,22 @@ def test_parse_noise():
             assert type(exc).__name__ == "ConfigError"
         else:
             raise AssertionError(bad)
+
+
+def test_ramps_too_short_for_the_limits_are_lengthened(tmp_path):
+    """A quintic from rest to full speed in 0.1 s asks for far more acceleration than the
+    design allows: the ramps are lengthened until the played trajectory keeps its limits."""
+    import re
+
+    out = tmp_path / "d.json"
+    res = runner.invoke(app, ["robot", "design", *QUICK, "--ramp", "0.1", "--out", str(out)])
+    assert res.exit_code == 0, res.output
+    said = re.search(
+        r"ramps lengthened from 0.1 s: with them the peaks were .*acceleration "
+        r"([\d.]+) %",
+        res.output,
+    )
+    assert said and float(said.group(1)) > 100.0, res.output
+    played = re.search(r"played: .* acceleration ([\d.]+) %", res.output)
+    assert float(played.group(1)) <= 100.0
+    assert json.loads(out.read_text())["ramp"] > 0.1
