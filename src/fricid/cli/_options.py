@@ -113,7 +113,11 @@ TorqueConstantOption = Annotated[
 #: ``--temperature``: a constant temperature [degC] for a log that records none.
 TemperatureOption = Annotated[
     float,
-    typer.Option("--temperature", help="The temperature [degC] to record when the log has none."),
+    typer.Option(
+        "--temperature",
+        help="The temperature [degC] to record when the log has none (a table log without a "
+        "temperature column: give it explicitly; the default is for the other readers).",
+    ),
 ]
 
 

@@ -216,7 +216,30 @@ def fit_command(
     rbf = key in ("rbf", "hybrid")
     method = method or ("lsq" if rbf else "lm")
     if trajectory:  # delegated (cli/trajectory.py)
+        from ..errors import ConfigError
         from .trajectory import parse_reader_options, run_trajectory
+
+        samples_only = {
+            "--validate": validate,
+            "--loss": None if loss == "l2" else loss,
+            "--f-scale": f_scale,
+            "--weights": None if weights == "none" else weights,
+            "--intervals": None if intervals == "auto" else intervals,
+            "--direction": None if direction == "all" else direction,
+            "--fix": fix or None,
+            "--bound": bound or None,
+            "--centers": centers,
+            "--inputs": inputs,
+            "--learned": learned or None,
+            "--backbone": backbone,
+        }
+        ignored = [flag for flag, value in samples_only.items() if value is not None]
+        if ignored:
+            raise ConfigError(
+                f"{', '.join(ignored)} {'applies' if len(ignored) == 1 else 'apply'} to friction "
+                "samples, not to --trajectory (a "
+                "trajectory model is validated on a second log: fricid report MODEL LOG HELDOUT)"
+            )
 
         check_paths(inputs={"LOG": samples}, folders=True, out_files={"--out": out})
         return run_trajectory(

@@ -198,3 +198,13 @@ def test_an_angle_wrapped_to_one_turn_is_refused(clean, tmp_path):
     first = int(np.flatnonzero(np.abs(np.diff(wrapped)) > np.pi)[0]) + 1
     path = damaged(clean, tmp_path, "wrapped", position=wrapped, velocity=clean.velocity + 6.0)
     refused_by_fit(path, f"row {first}", "column 'position'", "wrapped to one turn")
+
+
+def test_sample_options_with_trajectory_are_refused(clean, tmp_path):
+    path = tmp_path / "clean.parquet"
+    write_rawlog(clean, path)
+    args = ["fit", str(path), "--trajectory", "--validate", "kfold", "--loss", "huber"]
+    res = CliRunner().invoke(app, [*args, "--out", str(tmp_path / "x.json")])
+    assert res.exit_code == 2, res.output
+    assert "--validate, --loss apply to friction samples, not to --trajectory" in res.output
+    assert not (tmp_path / "x.json").exists()
