@@ -72,7 +72,7 @@ def test_gravity_left_in_is_said_in_one_line(tmp_path):
     res, _ = _run("extract", log, "-o", tmp_path / "a.csv", "--gravity", "none")
     assert res.exit_code == 0, res.output
     lines = [ln for ln in res.output.splitlines() if "gravity not removed" in ln]
-    assert len(lines) == 1 and "gravity='none' was asked for" in lines[0]
+    assert len(lines) == 1 and "asked for or in the log's design metadata" in lines[0]
     table = tmp_path / "vendor.csv"
     rows = zip(raw.time, raw.velocity, raw.torque, strict=True)
     table.write_text(

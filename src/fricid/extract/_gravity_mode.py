@@ -42,8 +42,9 @@ def explicit_none_note(position_source: str | None) -> str:
     if position_source == INTEGRATED:
         return ""
     return (
-        "gravity not removed (gravity='none' was asked for): the log has a position channel, "
-        "but the friction written includes any gravity torque; omit --gravity to remove it"
+        "gravity not removed (gravity='none', asked for or in the log's design metadata): the "
+        "log has a position channel, but the friction written includes any gravity torque; "
+        "give --gravity joint (or fit, with --positions) to remove it"
     )
 
 
