@@ -78,3 +78,13 @@ def test_a_reversed_torque_sign_is_named_instead_of_misfit_advice(campaign):
     assert trust.what_to_do == ""  # not "fit a learned model"
     clean = extract(log, **spec.extract_options())
     assert not any("opposes" in r for r in _trust(clean.samples).reasons)
+
+
+def test_a_coarse_encoder_velocity_is_warned_at_extraction(campaign):
+    spec, log = campaign
+    step = 2 * np.pi / 2**12
+    q = np.round(log.position / step) * step
+    dt = float(np.median(np.diff(log.time)))
+    coarse = replace(log, position=q, velocity=np.r_[0.0, np.diff(q) / dt])
+    with pytest.warns(DataQualityWarning, match="finite difference at a coarse encoder"):
+        extract(coarse, **spec.extract_options())

@@ -11,7 +11,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from fricid.samples import velocity_mismatch
+from fricid.samples import coarse_velocity, velocity_mismatch
 from fricid.samples._agreement import UNIT_FACTORS, velocity_scale, wrapped_rows
 
 
@@ -107,3 +107,24 @@ def test_wrapped_rows_are_the_wraps(seed, speed, origin):
     assert expected.size >= 1
     np.testing.assert_array_equal(wrapped_rows(t, wrapped, v), expected)
     assert wrapped_rows(t, turning, v).size == 0
+
+
+def _slow_steps(central: bool):
+    """A slow ramp with rests, a 2^12-count encoder at 250 Hz, the velocity its finite
+    difference (one-sided or central)."""
+    t = np.arange(5000) / 250.0
+    q = 0.05 * t * (np.sin(0.3 * t) > -0.5)  # moving at 0.05 rad/s, resting a third of it
+    step = 2 * np.pi / 2**12
+    qq = np.round(q / step) * step
+    v = np.gradient(qq, t) if central else np.r_[0.0, np.diff(qq) * 250.0]
+    return t, qq, v
+
+
+@pytest.mark.parametrize("central", [False, True])
+def test_a_coarse_finite_difference_velocity_is_named(central):
+    t, q, v = _slow_steps(central)
+    text = coarse_velocity(t, q, v)
+    assert text is not None and "coarse encoder (steps of 0.00153 rad at 250 Hz)" in text
+    smooth = np.gradient(0.05 * t * (np.sin(0.3 * t) > -0.5), t)  # a drive's estimate
+    assert coarse_velocity(t, q, smooth) is None
+    assert coarse_velocity(t, np.zeros_like(t), np.zeros_like(t)) is None  # at rest

@@ -21,7 +21,7 @@ from dataclasses import replace
 import numpy as np
 
 from ..errors import ConfigError, DataError, DataQualityWarning, user_stacklevel
-from ..samples import RawLog, velocity_mismatch
+from ..samples import RawLog, coarse_velocity, velocity_mismatch
 from ._gravity_mode import (
     AUTO,
     explicit_none_note,
@@ -58,13 +58,15 @@ class _Source:
     position came from (``meta["position_source"]``; a reader that integrates the velocity
     says so there, a position channel is assumed otherwise) and, per source, a logged
     velocity that is not its position channel's derivative (``problems``:
-    :func:`fricid.samples.velocity_mismatch`, judged on each log or chunk that moves)."""
+    :func:`fricid.samples.velocity_mismatch`, judged on each log or chunk that moves) and
+    a coarse encoder's finite-difference velocity (``coarse``: judged on the first chunk)."""
 
     def __init__(self, logs: RawLog | Iterable[RawLog]) -> None:
         self.logs = logs
         self.name: str | None = None
         self.position_source: str | None = None
         self.problems: dict[str, str] = {}
+        self.coarse: dict[str, str | None] = {}  # per source: coarse_velocity's finding
 
     def __iter__(self) -> Iterator[RawLog]:
         for log in as_log_stream(self.logs):
@@ -78,6 +80,8 @@ class _Source:
                 wrong = velocity_mismatch(log.time, log.position, log.velocity)
                 if wrong:
                     self.problems[source] = f"{source}: {wrong}"
+            if own and source not in self.coarse:
+                self.coarse[source] = coarse_velocity(log.time, log.position, log.velocity)
             yield log
             del log  # not held while the next chunk is read
 
@@ -335,6 +339,9 @@ def extract(
     )
     for note in notes:
         logger.info("%s", note)
+    for source, coarse in stream.coarse.items():
+        if coarse:
+            warnings.warn(f"{source}: {coarse}", DataQualityWarning, stacklevel=user_stacklevel())
     for problem in stream.problems.values():
         warnings.warn(
             f"the velocity is not the position's derivative, {problem}; the samples' "

@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import ConfigError, DataError
-from ._agreement import velocity_mismatch
+from ._agreement import coarse_velocity, velocity_mismatch
 from ._columns import (
     DIRECTION_TOLERANCE,
     LIMITS,
@@ -48,6 +48,7 @@ __all__ = [
     "RawLog",
     "RobotLog",
     "check_trajectory_log",
+    "coarse_velocity",
     "drop_standstill",
     "standstill_rows",
     "velocity_mismatch",

@@ -11,7 +11,8 @@ does not move it; the integral averages the velocity's noise out) and names the 
 when ``s`` is outside :data:`AGREEMENT`: a known unit factor (:data:`UNIT_FACTORS`), a
 reversed sign, else a gear ratio or an unknown unit. :func:`wrapped_rows` finds an angle
 wrapped to one turn (a jump the velocity does not explain, which the median above ignores but
-a derivative filter does not).
+a derivative filter does not). :func:`coarse_velocity` recognises a velocity that is a coarse
+encoder's finite difference (zero between steps while the joint moves).
 """
 
 from __future__ import annotations
@@ -24,6 +25,7 @@ __all__ = [
     "AGREEMENT",
     "UNIT_FACTORS",
     "WINDOWS",
+    "coarse_velocity",
     "velocity_mismatch",
     "velocity_scale",
     "wrapped_rows",
@@ -149,3 +151,47 @@ def wrapped_rows(time, position, velocity) -> np.ndarray:
     dq = np.diff(q)
     moved = 0.5 * (v[1:] + v[:-1]) * np.diff(t)
     return np.flatnonzero((np.abs(dq) > math.pi) & (np.abs(dq - moved) > 0.5 * np.abs(dq))) + 1
+
+
+#: Half-width [samples] of the window over which the position is seen to move.
+MOVE_WINDOW = 10
+#: A velocity reading 0 at this share of the rows where the position moves is coarse.
+COARSE_ZEROS = 0.3
+
+
+def coarse_velocity(time, position, velocity) -> str | None:
+    """What is wrong when the velocity is a coarse encoder's finite difference, else None.
+
+    Such a velocity is a whole number of ``step / dt`` (or half that, central differences)
+    and reads 0 between steps while the joint moves slowly, so steady-state detection takes
+    slow runs for rest. Judged where the position changes by a step or more over
+    ``2`` :data:`MOVE_WINDOW` rows: when the velocity is 0 at over :data:`COARSE_ZEROS` of
+    them and its non-zero values are such multiples (90 % within 1 %).
+    """
+    t = np.asarray(time, dtype=float)
+    q = np.asarray(position, dtype=float)
+    v = np.asarray(velocity, dtype=float)
+    m = MOVE_WINDOW
+    if q.size <= 2 * m + 1:
+        return None
+    d = np.abs(np.diff(q))
+    d = d[d > 1e-12]
+    if not d.size:
+        return None
+    step, dt = float(d.min()), float(np.median(np.diff(t)))
+    moves = np.zeros(q.size, dtype=bool)
+    moves[m:-m] = np.abs(q[2 * m :] - q[: -2 * m]) >= 0.999 * step
+    if moves.sum() < 10 * m:
+        return None
+    zeros = float(np.mean(v[moves] == 0))
+    quantum = step / (2 * dt)
+    k = v[moves & (v != 0)] / quantum
+    whole = float(np.mean(np.abs(k - np.round(k)) < 0.01)) if k.size else 0.0
+    if zeros <= COARSE_ZEROS or whole < 0.9:
+        return None
+    return (
+        f"the velocity is the position's finite difference at a coarse encoder (steps of "
+        f"{step:.3g} rad at {1 / dt:.4g} Hz): it reads 0 at {100 * zeros:.0f} % of the rows "
+        "where the joint moves, so slow runs look like rest; log the drive's velocity "
+        "estimate, or a position with more counts per turn"
+    )
