@@ -128,3 +128,13 @@ def test_a_coarse_finite_difference_velocity_is_named(central):
     smooth = np.gradient(0.05 * t * (np.sin(0.3 * t) > -0.5), t)  # a drive's estimate
     assert coarse_velocity(t, q, smooth) is None
     assert coarse_velocity(t, np.zeros_like(t), np.zeros_like(t)) is None  # at rest
+
+
+def test_a_joint_at_rest_with_a_noisy_velocity_is_not_judged():
+    """Held still (a quantised constant position) while the velocity sensor reads white
+    noise: the noise integrates to a random walk, which says nothing of the units."""
+    rng = np.random.default_rng(4)
+    t = np.arange(200_000) / 1000.0
+    v = rng.normal(0.0, 0.01, t.size)
+    assert velocity_scale(t, np.full(t.size, 0.25), v) is None
+    assert velocity_mismatch(t, np.full(t.size, 0.25), v) is None

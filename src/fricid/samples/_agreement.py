@@ -39,6 +39,9 @@ AGREEMENT = (0.8, 1.25)
 MIN_SHARE = 0.1
 #: Windows needed for a judgement (fewer: the log does not move enough to tell).
 MIN_WINDOWS = 5
+#: ... each with an integrated velocity over this many times the random walk its white
+#: noise alone would give it.
+NOISE_SIGMAS = 10.0
 #: Known unit factors between a position and a velocity channel, and what each means.
 UNIT_FACTORS: dict[float, str] = {
     180.0 / math.pi: "degrees against radians",
@@ -77,7 +80,12 @@ def velocity_scale(time, position, velocity) -> float | None:
     top = float(np.max(np.abs(di)))
     if not top > 0:
         return None
-    keep = np.abs(di) >= MIN_SHARE * top
+    # a window's integral must stand out of what the velocity's white noise alone gives it
+    # (a joint at rest with a noisy velocity sensor integrates to a random walk)
+    dv = np.diff(v)
+    noise = 1.4826 * float(np.median(np.abs(dv - np.median(dv)))) / math.sqrt(2.0)
+    walk = NOISE_SIGMAS * noise * np.sqrt(np.diff(edges)) * float(np.median(np.diff(t)))
+    keep = (np.abs(di) >= MIN_SHARE * top) & (np.abs(di) > walk)
     if keep.sum() < MIN_WINDOWS:
         return None
     return float(np.median(dq[keep] / di[keep]))
