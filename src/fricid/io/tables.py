@@ -58,7 +58,7 @@ _SAMPLES_SCHEMA: dict[str, str | None] = {
 }
 _SAMPLES_REQUIRED = ("velocity", "friction")  # load, temperature: absent is not measured
 _RAWLOG_SCHEMA: dict[str, str | None] = {name: name for name in RAWLOG_COLUMNS}
-_RAWLOG_REQUIRED = ("time", "position", "velocity", "temperature")
+_RAWLOG_REQUIRED = ("time", "position", "velocity")  # and temperature, or its constant
 
 
 # --------------------------------------------------------------------------- reading
@@ -125,7 +125,7 @@ def read_samples(path: PathLike) -> FrictionSamples:
 def _open_rawlog(path: PathLike, temperature: float | None = None) -> Opened:
     """Open a raw-log table; a DataError if it has neither a torque nor a current column, or
     no temperature column and no constant ``temperature`` given (a ConfigError if both)."""
-    opened = open_table(path, _RAWLOG_SCHEMA, _RAWLOG_REQUIRED[:-1], RAWLOG_FORMAT)
+    opened = open_table(path, _RAWLOG_SCHEMA, _RAWLOG_REQUIRED, RAWLOG_FORMAT)
     has = "temperature" in opened.columns
     if has and temperature is not None:
         raise ConfigError(

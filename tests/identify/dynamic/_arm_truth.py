@@ -13,6 +13,12 @@ import numpy as np
 from fricid.models import get_model
 from fricid.samples import RobotLog
 
+#: A Coulomb-viscous law per direction for each joint of the double pendulum.
+CV_LAWS = [
+    ("coulomb_viscous_asym", {"f_c_pos": 0.5, "beta_pos": 0.3, "f_c_neg": 0.4, "beta_neg": 0.2}),
+    ("coulomb_viscous_asym", {"f_c_pos": 0.7, "beta_pos": 0.3, "f_c_neg": 0.4, "beta_neg": 0.3}),
+]
+
 #: Harmonics of the reference's fundamental.
 HARMONICS = (1, 2, 3, 5, 7)
 

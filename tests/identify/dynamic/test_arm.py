@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _arm_truth import make_log, stribeck_law
+from _arm_truth import CV_LAWS, make_log, stribeck_law
 
 pytest.importorskip("pinocchio")
 
@@ -21,11 +21,6 @@ from fricid.fitted import FittedModel
 from fricid.fitted.arm import ArmFit
 from fricid.identify.dynamic.arm import fit_arm
 from fricid.robot import RigidBodyModel, example_urdf, is_consistent
-
-CV_LAWS = [
-    ("coulomb_viscous_asym", {"f_c_pos": 0.5, "beta_pos": 0.3, "f_c_neg": 0.4, "beta_neg": 0.2}),
-    ("coulomb_viscous_asym", {"f_c_pos": 0.7, "beta_pos": 0.3, "f_c_neg": 0.4, "beta_neg": 0.3}),
-]
 
 
 @pytest.fixture(scope="module")

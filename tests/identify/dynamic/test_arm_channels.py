@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+from _arm_truth import CV_LAWS as LAWS
 from _arm_truth import make_log
 
 pytest.importorskip("pinocchio")
@@ -20,11 +21,6 @@ from fricid.errors import DataError
 from fricid.identify.dynamic.arm import fit_arm
 from fricid.identify.dynamic.arm._channels import channel_problems
 from fricid.robot import RigidBodyModel, example_urdf
-
-LAWS = [
-    ("coulomb_viscous_asym", {"f_c_pos": 0.5, "beta_pos": 0.3, "f_c_neg": 0.4, "beta_neg": 0.2}),
-    ("coulomb_viscous_asym", {"f_c_pos": 0.7, "beta_pos": 0.3, "f_c_neg": 0.4, "beta_neg": 0.3}),
-]
 
 
 @pytest.fixture(scope="module")

@@ -20,8 +20,7 @@ import numpy as np
 
 from ....errors import DataError
 from ....robot import RigidBodyModel
-from ....samples import RobotLog, velocity_mismatch
-from ....samples._agreement import wrapped_rows
+from ....samples import RobotLog, velocity_mismatch, wrapped_rows
 from ....samples.robot_log import joint_column
 
 __all__ = ["LIMIT_MARGIN", "LIMIT_SLACK", "channel_problems", "check_live_torque"]
