@@ -264,8 +264,11 @@ def _seed(args, seed: int) -> dict:
     log, held = _cached_logs(model, laws, seed, args, trajectory)
     start = time.perf_counter()
     window = args.window if args.truth != "own" else 0.0  # closed loop
+    if args.detect:  # fricid decides from the residuals near the reversals
+        window = None
     fit = fit_arm(log, model, friction=args.friction, validate=held, reversal_window=window)
     out = {"seconds": time.perf_counter() - start, "params": [], "joints": {}}
+    out["closed_loop"] = fit.provenance.get("closed_loop") or "given"
     for joint, (_, values) in zip(fit.joints, laws, strict=True):
         for name, rec in fit.friction[joint]["parameters"].items():
             kind = next(k for k in KINDS if name.startswith(k))
@@ -370,6 +373,13 @@ def run(args) -> None:
     )
     print(f"base inertial parameters' coverage: {100 * np.mean(base_cov):.1f} % (mean over seeds)")
     print(f"seconds per identification: median {np.median(seconds):.1f}, max {np.max(seconds):.1f}")
+    if args.detect:
+        found = [
+            s
+            for s, res in zip(seeds, results, strict=True)
+            if res["closed_loop"].startswith("detected")
+        ]
+        print(f"closed loop detected (--detect): {len(found)} of {len(results)} seeds {found}")
     over = [f"{s} {k}" for s, res in zip(seeds, results, strict=True) for k in res["overload"]]
     print(
         "logs whose torque exceeds the URDF's effort limits (a drive cannot give it: the truth's "
@@ -416,6 +426,11 @@ def main() -> None:
         type=float,
         default=WINDOW_PERIODS,
         help="closed-loop truths: fit_arm's reversal_window [periods of the cut-off]",
+    )
+    parser.add_argument(
+        "--detect",
+        action="store_true",
+        help="let fit_arm decide closed loop or not from the residuals (reversal_window=None)",
     )
     parser.add_argument(
         "--jobs", type=int, default=1, help="seeds identified at once (one process each)"

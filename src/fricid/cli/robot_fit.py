@@ -80,6 +80,8 @@ def _table(fit) -> None:
         f"Estimator {prov['estimator']}; low-pass {prov['cutoff']:.3g} Hz, decimation "
         f"{prov['decimation']}, {prov['samples']} equations; {prov['seconds']:.1f} s"
     )
+    if str(prov.get("closed_loop", "")).startswith("detected"):
+        console.print(f"Closed loop {prov['closed_loop']}.")
 
 
 @robot_app.command("fit")
@@ -119,20 +121,22 @@ def robot_fit_command(
         bool, typer.Option(help="Make the inertial parameters physically consistent.")
     ] = True,
     closed_loop: Annotated[
-        bool,
+        bool | None,
         typer.Option(
-            "--closed-loop",
+            "--closed-loop/--open-loop",
             help=(
-                "The log was recorded under position control (a PD loop): leave out the rows "
-                "within one period of the cut-off of every reversal, where the joint sticks "
-                "while the loop builds torque and the filtered friction columns do not hold "
-                "(measured on a PD-tracked arm: Coulomb levels 4 standard errors low without "
-                "it), up to 1.5 periods for a joint whose residuals show its sticks farther "
-                "out (each joint's window is in the fit file). Off, those rows carry the "
-                "Stribeck rise of an open-loop log."
+                "--closed-loop: the log was recorded under position control (a PD loop): leave "
+                "out the rows within one period of the cut-off of every reversal, where the "
+                "joint sticks while the loop builds torque and the filtered friction columns do "
+                "not hold (measured on a PD-tracked arm: Coulomb levels 4 standard errors low "
+                "without it), up to 1.5 periods for a joint whose residuals show its sticks "
+                "farther out (each joint's window is in the fit file). --open-loop: keep those "
+                "rows, which carry the Stribeck rise of an open-loop log. Default: decided from "
+                "the data, closed loop when a joint's residuals near its reversals show sticks "
+                "(the fit file's provenance says which, and the printout)."
             ),
         ),
-    ] = False,
+    ] = None,
 ) -> None:
     """Identify a whole arm from any trajectory: base inertial parameters and every joint's
     friction together, with intervals and a held-out verdict per joint."""
@@ -156,7 +160,7 @@ def robot_fit_command(
         cutoff=cutoff,
         validate=second,
         urdf=Path(model.source).name if model.source else None,
-        reversal_window=WINDOW_PERIODS if closed_loop else 0.0,
+        reversal_window=None if closed_loop is None else WINDOW_PERIODS * closed_loop,
     )
     fit.save(out)
     _table(fit)

@@ -235,14 +235,35 @@ def test_closed_loop_coulomb_bias_is_removed_by_the_reversal_window(pendulum):
     ]
     log = make_pd_log(pendulum, laws, seed=1, duration=20.0, disturbance=0.0)
 
+    fits = {}
+
     def mean_z(window, kind):
-        fit = fit_arm(log, pendulum, friction="coulomb_viscous_asym", reversal_window=window)
+        fits[window] = fit = fit_arm(
+            log, pendulum, friction="coulomb_viscous_asym", reversal_window=window
+        )
         z = _z(fit, laws)
         return np.mean([v for k, v in z.items() if k.split(":")[1].startswith(kind)])
 
     assert mean_z(0.0, "f_c") < -2.0  # the threshold alone: Coulomb several errors low
     assert abs(mean_z(WINDOW_PERIODS, "f_c")) < 1.5
     assert abs(mean_z(WINDOW_PERIODS, "beta")) < 1.5
+    # not told: the sticks at the reversals show in the first fit's residuals
+    assert abs(mean_z(None, "f_c")) < 1.5
+    prov = fits[None].provenance
+    assert prov["reversal_window"] == WINDOW_PERIODS
+    assert prov["closed_loop"].startswith("detected: the residuals of joint1, joint2")
+    assert "closed_loop" not in fits[0.0].provenance  # told: nothing decided
+    assert fits[0.0].provenance["stick_signature"] == prov["stick_signature"]
+
+
+def test_an_open_loop_log_is_not_taken_for_a_closed_loop_one(pendulum_fit):
+    """The residuals of an arm that follows its reference exactly (no loop, no sticks) near
+    its reversals are no larger than elsewhere: the rows there stay in."""
+    prov = pendulum_fit.provenance
+    assert prov["closed_loop"].startswith("not detected")
+    assert prov["reversal_window"] == 0.0
+    for joint in prov["stick_signature"]:
+        assert joint["p"] > 0.01 and joint["excess"] < 0.5, prov["stick_signature"]
 
 
 def test_a_friction_level_below_zero_is_not_printed_as_a_number(pendulum):

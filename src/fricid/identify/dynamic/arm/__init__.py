@@ -33,10 +33,13 @@ reversal was 0.15-0.18 N m against the direction of motion, nil beyond 0.2 s, an
 levels came out 2 to 6 standard errors low, the viscous ones 2 to 5 high, with or without
 quantisation and disturbance. Rows within :data:`WINDOW_PERIODS` periods of the cut-off of a
 slow or reversing sample can be left out (``reversal_window``, :func:`_moving`): it removes
-that bias, and in open loop costs the Stribeck rise the rows it is seen on, so it is not the
-default. How far a stick's misfit reaches depends on the joint (the wrist's small inertias
-stick longest), so each joint's window then grows from there to where its residuals no longer
-show it (:mod:`._rows`), on the identification log and on the held-out one alike. Beyond the
+that bias, and in open loop costs the Stribeck rise the rows it is seen on, so it is used
+where the data show sticks: unless told, a first fit keeps those rows, and when a joint's
+residuals near its reversals show the sticks' misfit (:func:`._rows.sticking`) the arm is
+fitted again with the window (the provenance's ``closed_loop`` says which). How far a
+stick's misfit reaches depends on the joint (the wrist's small inertias stick longest), so
+each joint's window then grows from there to where its residuals no longer show it
+(:mod:`._rows`), on the identification log and on the held-out one alike. Beyond the
 window the stick's tail remains, small but in the direction of the friction columns: each
 stop gets two nuisance columns that take it (:mod:`._sticks`, projected out of the joint's
 rows), in the fit and in the held-out error. The IDIM-IV step for the fed-back noise remains
@@ -91,7 +94,10 @@ from ._rows import (
     MIN_SPEED,
     VELOCITY_NOISE_FACTOR,
     adapted_windows,
+    closed_loop_text,
     near_stops,
+    stick_signature,
+    sticking,
     stop_distance,
 )
 from ._rows import moving_rows as _moving
@@ -218,12 +224,23 @@ def fit_arm(log: RobotLog, model: RigidBodyModel, **kwargs: Any) -> ArmFit:
     with one_blas_thread():
         try:
             fit = _fit_arm(log, model, **kwargs)
+            if kwargs.get("reversal_window") is None:  # closed loop or not, from the sticks
+                stuck = sticking(fit.provenance["stick_signature"])
+                if stuck:
+                    kwargs["reversal_window"] = WINDOW_PERIODS
+                    first = fit.provenance["stick_signature"]
+                    fit = _fit_arm(log, model, **kwargs)
+                    fit.provenance["stick_signature"] = first
+                fit.provenance["closed_loop"] = closed_loop_text(stuck, model.joints)
         except DataError as err:  # a unit or sign mistake can be why: say so
             raise _with_channels(err, log, model) from None
         values = fit.standard.get("values")
         if fit.provenance["load"] == FROM_URDF and values is not None:
             refined = model.with_parameters(np.asarray(values, dtype=float))
-            fit = _fit_arm(log, model, load_model=refined, **kwargs)
+            again = _fit_arm(log, model, load_model=refined, **kwargs)
+            for key in ("closed_loop", "stick_signature"):  # decided by the first fit
+                again.provenance[key] = fit.provenance.get(key)
+            fit = again
         return fit
 
 
@@ -237,7 +254,7 @@ def _fit_arm(
     cutoff: float | None = None,
     validate: RobotLog | None = None,
     urdf: str | None = None,
-    reversal_window: float = 0.0,
+    reversal_window: float | None = None,
     torque_delay: float | None = None,
     load_model: RigidBodyModel | None = None,
 ) -> ArmFit:
@@ -263,12 +280,14 @@ def _fit_arm(
         A second log for held-out validation (else the last :data:`HELDOUT_SHARE` of ``log``).
     urdf : str, optional
         The URDF's name, for the provenance (default ``model.source``).
-    reversal_window : float
+    reversal_window : float, optional
         Leave out the rows within this many periods of the cut-off of a slow or reversing
         sample (:func:`_moving`; :data:`WINDOW_PERIODS` for a log recorded in closed loop,
         where the joints stick at their reversals), or more where a joint's residuals show
         its sticks' misfit farther out (:mod:`._rows`; each joint's window is in the
-        provenance); 0, the default, uses the velocity threshold alone.
+        provenance); 0 uses the velocity threshold alone. None, the default, decides from
+        the data: 0, and :data:`WINDOW_PERIODS` when a joint's residuals near its reversals
+        show sticks (:func:`._rows.sticking`; the provenance's ``closed_loop`` says which).
     torque_delay : float, optional
         The torque's delay behind the positions [sample periods] (0.5 for a command held
         from one sample to the next); default estimated from the data (:func:`_torque_delay`).
@@ -289,6 +308,7 @@ def _fit_arm(
         An unknown friction family.
     """
     start = _time.perf_counter()
+    reversal_window = float(reversal_window or 0.0)
     frictions = friction_for(
         model.joints, dict(friction) if isinstance(friction, Mapping) else friction
     )
@@ -358,6 +378,13 @@ def _fit_arm(
         st = stack(Yb, sig, frictions, moving)
         theta, sigma = wls(st, n)
         safe = np.where(np.isfinite(sigma) & (sigma > 0), sigma, 1.0)
+    signature = None
+    if reversal_window == 0:  # sticks at the reversals: a log recorded in closed loop?
+        every = stack(Yb, sig, frictions, np.ones_like(moving))
+        residual = np.zeros(moving.shape)
+        residual[every.row_time, every.row_joint] = every.y - every.A @ theta
+        columns = [friction_block(sig, jf, j) for j, jf in enumerate(frictions)]
+        signature = stick_signature(stop_distance(sig), residual, moving, columns, rho)
     A, y = st.weighted(safe)
     res = y - A @ theta
     stribeck = [j for j, jf in enumerate(frictions) if jf.stribeck]
@@ -460,6 +487,7 @@ def _fit_arm(
             "windows": {nm: float(w) for nm, w in zip(model.joints, windows, strict=True)},
             "stick_columns": {nm: st.lost(j) for j, nm in enumerate(model.joints)},
             "torque_delay": float(torque_delay),
+            "stick_signature": signature,
             "load": load_from,
             "shape_polish": polish,
             "samples": int(st.A.shape[0]),
