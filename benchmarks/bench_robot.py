@@ -4,7 +4,8 @@ Usage::
 
     python benchmarks/bench_robot.py [--seeds 10] [--first 0] [--duration 60] [--rate 1000]
         [--noise 0.05] [--friction stribeck_asym] [--trajectory FILE]
-        [--truth own|pd|sim|mujoco] [--jobs 2] [--cache DIR] [--rows FILE]
+        [--truth own|pd|sim|mujoco] [--window 1.0] [--detect] [--jobs 2] [--cache DIR]
+        [--rows FILE]
 
 Per seed: each joint gets its own friction law per direction (``stribeck_asym``: Coulomb,
 static, Stribeck velocity and exponent, viscous drawn independently per joint and direction;
@@ -44,7 +45,9 @@ mujoco`` is the same drive with MuJoCo stepping the exported MJCF
 ``solreffriction`` at two steps as the export writes it): MuJoCo holds a Coulomb-viscous law
 alike in both directions (``frictionloss``, ``damping``: each joint's mean levels of the drawn
 law), which is the truth compared against. The closed-loop truths are fitted with
-``reversal_window=WINDOW_PERIODS`` (rows near reversals left out).
+``reversal_window=WINDOW_PERIODS`` (rows near reversals left out; ``--window`` another), the
+open-loop one with 0; with ``--detect`` every truth is fitted with ``reversal_window=None``,
+fit_arm deciding from the residuals, and the table says on which seeds it found a closed loop.
 
 ``--cache DIR`` keeps each simulated log (``.npz``: time, position, velocity, torque, named by
 the settings and the seed) and reads it back on a later run with the same settings, so that
