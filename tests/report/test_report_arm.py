@@ -166,3 +166,15 @@ def test_simulate_fit_report_end_to_end(tmp_path):
     assert list(joints["Trust"]) == [arm.verdict(j) for j in arm.joints]
     assert len(pd.read_csv(out / "base_parameters.csv")) == len(arm.base["names"])
     assert "Whole-arm identification" in (out / "report.md").read_text()
+
+
+def test_the_header_says_how_closed_loop_was_decided():
+    """Whether the rows near the reversals were left out, and whether fricid decided it from
+    the data or was told, is part of what the numbers mean."""
+    told = arm_report(arm_fit()).meta
+    assert told["closed loop"] == "as told"
+    doc = arm_fit().to_dict()
+    doc["provenance"] |= {"reversal_window": 1.0, "closed_loop": "detected: the residuals of x"}
+    decided = arm_report(ArmFit.from_dict(doc)).meta
+    assert decided["closed loop"] == "detected: the residuals of x"
+    assert decided["rows near reversals left out [periods]"] == "1"

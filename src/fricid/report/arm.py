@@ -200,6 +200,8 @@ def _meta(fit: ArmFit) -> dict[str, str]:
         "filter": text("filter"),
         "filter cut-off [Hz]": text("cutoff", "{:.4g}"),
         "decimation": text("decimation"),
+        "rows near reversals left out [periods]": text("reversal_window", "{:g}"),
+        "closed loop": text("closed_loop") if "closed_loop" in prov else "as told",
         "identification [s]": text("seconds", "{:.3g}"),
     }
 
