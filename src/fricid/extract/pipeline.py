@@ -21,7 +21,8 @@ from dataclasses import replace
 import numpy as np
 
 from ..errors import ConfigError, DataError, DataQualityWarning, user_stacklevel
-from ..samples import RawLog, coarse_velocity, velocity_mismatch
+from ..samples import RawLog, coarse_velocity, velocity_mismatch, windowed_velocity
+from ..samples._agreement import WINDOW_COUNTS
 from ._gravity_mode import (
     AUTO,
     explicit_none_note,
@@ -67,6 +68,7 @@ class _Source:
         self.position_source: str | None = None
         self.problems: dict[str, str] = {}
         self.coarse: dict[str, str | None] = {}  # per source: coarse_velocity's finding
+        self.window: dict[str, tuple[int, int]] = {}  # per coarse source: the windows used
 
     def __iter__(self) -> Iterator[RawLog]:
         for log in as_log_stream(self.logs):
@@ -82,6 +84,13 @@ class _Source:
                     self.problems[source] = f"{source}: {wrong}"
             if own and source not in self.coarse:
                 self.coarse[source] = coarse_velocity(log.time, log.position, log.velocity)
+                if self.coarse[source] and source not in self.problems:
+                    self.window[source] = (np.inf, 0)
+            if source in self.window:  # the position's difference over windows instead
+                velocity, (short, long) = windowed_velocity(log.time, log.position, log.velocity)
+                seen = self.window[source]
+                self.window[source] = (min(seen[0], short), max(seen[1], long))
+                log = replace(log, velocity=velocity, meta={**meta, "velocity_from": "position"})
             yield log
             del log  # not held while the next chunk is read
 
@@ -340,6 +349,14 @@ def extract(
     for note in notes:
         logger.info("%s", note)
     for source, coarse in stream.coarse.items():
+        if coarse and source in stream.window:
+            coarse = coarse.split(": it reads 0")[0]
+            coarse += (
+                "; the velocity used instead is the position's difference over windows of "
+                f"{stream.window[source][0]}-{stream.window[source][1]} rows each side, each "
+                f"spanning {WINDOW_COUNTS} steps where the joint moves (a run's mean velocity is "
+                "then its position change over its duration)"
+            )
         if coarse:
             warnings.warn(f"{source}: {coarse}", DataQualityWarning, stacklevel=user_stacklevel())
     for problem in stream.problems.values():

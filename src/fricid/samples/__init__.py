@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import ConfigError, DataError
-from ._agreement import coarse_velocity, velocity_mismatch, wrapped_rows
+from ._agreement import coarse_velocity, velocity_mismatch, windowed_velocity, wrapped_rows
 from ._columns import (
     DIRECTION_TOLERANCE,
     LIMITS,
@@ -52,6 +52,7 @@ __all__ = [
     "drop_standstill",
     "standstill_rows",
     "velocity_mismatch",
+    "windowed_velocity",
     "wrapped_rows",
 ]
 
