@@ -21,7 +21,13 @@ from dataclasses import replace
 import numpy as np
 
 from ..errors import ConfigError, DataError, DataQualityWarning, user_stacklevel
-from ..samples import RawLog, coarse_velocity, velocity_mismatch, windowed_velocity
+from ..samples import (
+    RawLog,
+    coarse_velocity,
+    position_unit_problem,
+    velocity_mismatch,
+    windowed_velocity,
+)
 from ..samples._agreement import WINDOW_COUNTS
 from ._gravity_mode import (
     AUTO,
@@ -67,8 +73,13 @@ class _Source:
         self.name: str | None = None
         self.position_source: str | None = None
         self.problems: dict[str, str] = {}
+        self.units: dict[str, str | None] = {}  # per source: position_unit_problem's finding
         self.coarse: dict[str, str | None] = {}  # per source: coarse_velocity's finding
         self.window: dict[str, tuple[int, int]] = {}  # per coarse source: the windows used
+
+    def found(self) -> list[str]:
+        """Every channel problem found, velocity's then position units'."""
+        return [*self.problems.values(), *(u for u in self.units.values() if u)]
 
     def __iter__(self) -> Iterator[RawLog]:
         for log in as_log_stream(self.logs):
@@ -82,6 +93,9 @@ class _Source:
                 wrong = velocity_mismatch(log.time, log.position, log.velocity)
                 if wrong:
                     self.problems[source] = f"{source}: {wrong}"
+            if own and source not in self.units:
+                unit = position_unit_problem(log.position)
+                self.units[source] = f"{source}: the position: {unit}" if unit else None
             if own and source not in self.coarse:
                 self.coarse[source] = coarse_velocity(log.time, log.position, log.velocity)
                 if self.coarse[source] and source not in self.problems:
@@ -341,7 +355,7 @@ def extract(
                 "extract": options,
                 **({"notes": list(notes)} if notes else {}),
                 **({} if residual is None else {"gravity_residual": residual.as_meta()}),
-                **({"channel_problems": list(stream.problems.values())} if stream.problems else {}),
+                **({"channel_problems": stream.found()} if stream.found() else {}),
             },
         )
         for x in (samples, by_direction)
@@ -359,6 +373,14 @@ def extract(
             )
         if coarse:
             warnings.warn(f"{source}: {coarse}", DataQualityWarning, stacklevel=user_stacklevel())
+    for problem in stream.units.values():
+        if problem:
+            warnings.warn(
+                f"{problem}; the samples' positions (and, in the same unit, velocities) are "
+                "as logged and a model fitted on them is not trusted",
+                DataQualityWarning,
+                stacklevel=user_stacklevel(),
+            )
     for problem in stream.problems.values():
         warnings.warn(
             f"the velocity is not the position's derivative, {problem}; the samples' "

@@ -286,7 +286,9 @@ def channel_problems(samples: FrictionSamples | None) -> list[str]:
     - the extraction found a logged velocity that is not its position channel's derivative
       (``meta["channel_problems"]``, :func:`fricid.samples.velocity_mismatch`: a unit, a
       sign or a gear ratio), so the samples' velocities are off by the factor and so is every
-      coefficient fitted on them;
+      coefficient fitted on them, or a position whose encoder steps show it in another unit
+      than its label (:func:`fricid.samples.position_unit_problem`), which gravity's
+      ``cos q`` and ``sin q`` read;
     - friction against the motion at most set-points (:func:`reversed_friction`): friction
       only dissipates, so the torque's (or current's) sign is reversed.
     """
@@ -295,7 +297,12 @@ def channel_problems(samples: FrictionSamples | None) -> list[str]:
     out = (
         []
         if not isinstance(found, list)
-        else [f"the log's velocity is not its position's derivative: {p}" for p in found]
+        else [
+            p
+            if "the position: its steps" in p
+            else f"the log's velocity is not its position's derivative: {p}"
+            for p in found
+        ]
     )
     reversed_ = reversed_friction(samples)
     return out + ([reversed_] if reversed_ else [])

@@ -31,6 +31,7 @@ from ._columns import (
     _check_range,
     _optional_column,
 )
+from ._encoder_steps import encoder_quantum, position_unit_problem
 from ._standstill import drop_standstill, standstill_rows
 from ._trajectory_log import check_trajectory_log
 from .rawlog import RawLog
@@ -50,6 +51,8 @@ __all__ = [
     "check_trajectory_log",
     "coarse_velocity",
     "drop_standstill",
+    "encoder_quantum",
+    "position_unit_problem",
     "standstill_rows",
     "velocity_mismatch",
     "windowed_velocity",

@@ -11,7 +11,16 @@ import numpy as np
 from ..errors import DataError
 from ._agreement import velocity_mismatch, wrapped_rows
 from ._columns import RAWLOG_COLUMNS
+from ._encoder_steps import position_unit_problem
 from .rawlog import RawLog
+
+
+def own_position(log: RawLog) -> bool:
+    """The position is the log's own channel (not integrated from the velocity by a reader:
+    ``meta["position_source"]``)."""
+    meta = log.meta if isinstance(log.meta, dict) else {}
+    return meta.get("position_source", "channel") == "channel"
+
 
 #: A time step over this many times the median step is a hole in a trajectory log.
 HOLE_FACTOR = 5.0
@@ -53,7 +62,10 @@ def check_trajectory_log(log: RawLog) -> None:
       (:func:`._agreement.velocity_mismatch`), refused with the factor and its likely cause,
       since the fit reads both and would be off by the factor; a position that jumps by
       more than pi where the velocity does not (an angle wrapped to one turn:
-      :func:`._agreement.wrapped_rows`), refused with the row.
+      :func:`._agreement.wrapped_rows`), refused with the row; a position whose steps are
+      a binary encoder's counts in degrees or revolutions labelled radians
+      (:func:`._encoder_steps.position_unit_problem`: its velocity, in the same unit,
+      agrees with it), refused naming the unit.
 
     Parameters
     ----------
@@ -88,6 +100,14 @@ def check_trajectory_log(log: RawLog) -> None:
                 file=log.source,
                 column="velocity",
             )
+    unit = position_unit_problem(log.position) if own_position(log) else None
+    if unit:
+        raise DataError(
+            f"{unit}; give the column's unit in its header ('position [deg]', and the "
+            "velocity's if it is in the same unit), or the reader's unit option",
+            file=log.source,
+            column="position",
+        )
 
 
 def _check_time_grid(log: RawLog) -> None:

@@ -80,9 +80,14 @@ def test_a_position_past_the_urdf_limits_is_named(pendulum, log):
     degrees[:, 1] *= 180 / np.pi
     said = {"velocity_from": "position (central difference)"}  # not the velocity check
     found = channel_problems(replace(log, position=degrees, meta=said), limited)
-    (text,) = found[pendulum.joints[1]]
-    assert "beyond the URDF's limits" in text and "degrees labelled radians" in text
+    limits, steps = sorted(found[pendulum.joints[1]])  # both say it
+    assert "beyond the URDF's limits" in limits and "degrees labelled radians" in limits
+    assert "131072-count encoder with the column in degrees" in steps, steps
     assert found[pendulum.joints[0]] == []
+    # the encoder's steps tell it without limits, too
+    unlimited = channel_problems(replace(log, position=degrees, meta=said), pendulum)
+    (text,) = unlimited[pendulum.joints[1]]
+    assert "in degrees labelled radians" in text
 
 
 def test_a_torque_channel_never_logged_is_refused(pendulum, log):

@@ -208,3 +208,19 @@ def test_sample_options_with_trajectory_are_refused(clean, tmp_path):
     assert res.exit_code == 2, res.output
     assert "--validate, --loss apply to friction samples, not to --trajectory" in res.output
     assert not (tmp_path / "x.json").exists()
+
+
+@pytest.mark.parametrize(
+    ("unit", "factor"), [("degrees", 180 / np.pi), ("revolutions", 0.5 / np.pi)]
+)
+def test_a_position_and_velocity_both_in_another_unit_are_refused(clean, tmp_path, unit, factor):
+    """Position and velocity both in degrees (or revolutions) labelled radians agree with each
+    other, and the fit gave an inertia 57.3^2 times off with caveats only. The steps of a
+    2^16-count encoder give it away: 2 pi / step reads 1143.8 counts per revolution, a power
+    of two only in degrees. The same log in radians passes."""
+    step = 2 * np.pi / 2**16
+    counted = np.round(clean.position / step) * step
+    check_trajectory_log(dataclasses.replace(clean, position=counted))
+    columns = {"position": counted * factor, "velocity": clean.velocity * factor}
+    path = damaged(clean, tmp_path, f"in_{unit}", **columns)
+    refused_by_fit(path, "column 'position'", "65536-count encoder", f"in {unit} labelled radians")

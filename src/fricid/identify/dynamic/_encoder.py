@@ -28,51 +28,16 @@ from typing import Any
 import numpy as np
 
 from ...errors import ConfigError
+from ...samples import encoder_quantum
 
 __all__ = ["VELOCITY_FORMS", "encoder_quantum", "measurement", "quantise", "velocity_form"]
-
-#: Largest distance of a step's count from a whole number for the log to read as quantised
-#: (a log written with 7 decimals puts a 2^17 count's steps up to 0.0022 off; a continuous
-#: position has steps at every fraction of a count).
-COUNT_TOLERANCE = 0.05
 
 #: Relative distance of the counts read from a power of two within which they are taken as
 #: that power (a log written with 7 decimals read 2^20 as 1048597: 2e-5 off).
 POWER_SNAP = 1e-4
 
-#: Fewest non-zero position steps from which a quantum is read.
-MIN_STEPS = 20
-
 #: How the logged velocity can be formed from the positions.
 VELOCITY_FORMS = ("backward", "central", "logged")
-
-
-def encoder_quantum(position: np.ndarray) -> float | None:
-    """The encoder's quantum [rad] read from the position steps, or None when the steps have
-    no common quantum (a continuous or interpolated position) or are too few.
-
-    The smallest non-zero step is the candidate; the log is quantised when every step is a
-    whole multiple of it (within :data:`COUNT_TOLERANCE` of a count: positions written with
-    a few decimals keep that).
-    """
-    steps = np.abs(np.diff(np.asarray(position, dtype=float)))
-    scale = float(np.max(np.abs(position))) if np.size(position) else 0.0
-    nonzero = steps[steps > 1e-12 * max(scale, 1.0)]
-    if nonzero.size < MIN_STEPS:
-        return None
-    quantum = float(np.min(nonzero))
-    counts = nonzero / quantum
-    if np.max(np.abs(counts - np.round(counts))) > COUNT_TOLERANCE:
-        return None
-    # refine by the positions themselves: q_k = offset + quantum c_k over the whole span of
-    # counts (a written log's rounding of each position then averages out)
-    q = np.asarray(position, dtype=float)
-    quantum = float(np.mean(nonzero[np.round(counts) == 1]))  # the single-count steps first
-    c = np.round((q - q[0]) / quantum)
-    if np.ptp(c) < 1:
-        return quantum
-    slope = np.polyfit(c, q, 1)[0]
-    return float(slope)
 
 
 def velocity_form(position: np.ndarray, velocity: np.ndarray, dt: float) -> str:

@@ -20,7 +20,7 @@ import numpy as np
 
 from ....errors import DataError
 from ....robot import RigidBodyModel
-from ....samples import RobotLog, velocity_mismatch, wrapped_rows
+from ....samples import RobotLog, position_unit_problem, velocity_mismatch, wrapped_rows
 from ....samples.robot_log import joint_column
 
 __all__ = ["LIMIT_MARGIN", "LIMIT_SLACK", "channel_problems", "check_live_torque"]
@@ -72,6 +72,9 @@ def channel_problems(log: RobotLog, model: RigidBodyModel) -> dict[str, list[str
                 f"{int(wraps[0])}) where the velocity does not: an angle wrapped to one turn; "
                 "unwrap it (numpy.unwrap)"
             )
+        unit = position_unit_problem(q)
+        if unit:
+            found.append(f"{name}: the position: {unit}")
         lo, hi = float(model.lower[j]), float(model.upper[j])
         if np.isfinite(lo) and np.isfinite(hi) and hi > lo:
             slack = LIMIT_SLACK * (hi - lo) + LIMIT_MARGIN

@@ -1,0 +1,101 @@
+"""The encoder behind a position column: its quantum read from the position's own steps, and
+what the quantum says of the column's unit.
+
+A drive logs the position quantised to its encoder, ``q_k = c_k Delta`` with ``c_k`` an
+integer count and ``Delta = 2 pi / N`` for ``N`` counts per revolution (in the column's
+unit: ``360 / N`` in degrees). :func:`encoder_quantum` finds ``Delta`` from the steps (every
+step a whole multiple of the smallest). Read in radians, ``2 pi / Delta`` is then ``N``,
+a power of two for a binary encoder. A column in degrees labelled radians reads
+``N pi / 180`` counts per revolution instead (2287.6 for 2^17), in revolutions ``2 pi N``:
+:func:`position_unit_problem` names that mistake where the counts read are no power of two
+and the counts in degrees or revolutions are one (or, a column in radians labelled degrees,
+``180 N / pi``). The position and velocity of such a log
+agree with each other (both in the wrong unit, :func:`fricid.samples.velocity_mismatch`
+sees nothing), and a trajectory fit then returns an inertia 57.3^2 times off with a good
+fit.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+__all__ = ["encoder_quantum", "position_unit_problem"]
+
+#: Largest distance of a step's count from a whole number for the log to read as quantised
+#: (a log written with 7 decimals puts a 2^17 count's steps up to 0.0022 off; a continuous
+#: position has steps at every fraction of a count).
+COUNT_TOLERANCE = 0.05
+
+#: Fewest non-zero position steps from which a quantum is read.
+MIN_STEPS = 20
+
+#: Relative distance from a power of two within which counts read are taken as it (a log
+#: written with 7 decimals read 2^20 as 1048597: 2e-5 off).
+POWER_SNAP = 1e-4
+
+#: Mistakes of a position column's unit: (the column is in ..., the counts per revolution
+#: read in SI over the encoder's counts).
+MISREAD = (
+    ("degrees labelled radians", math.pi / 180.0),
+    ("revolutions labelled radians", 2.0 * math.pi),
+    ("radians labelled degrees", 180.0 / math.pi),
+)
+
+
+def encoder_quantum(position: np.ndarray) -> float | None:
+    """The encoder's quantum [rad] read from the position steps, or None when the steps have
+    no common quantum (a continuous or interpolated position) or are too few.
+
+    The smallest non-zero step is the candidate; the log is quantised when every step is a
+    whole multiple of it (within :data:`COUNT_TOLERANCE` of a count: positions written with
+    a few decimals keep that).
+    """
+    steps = np.abs(np.diff(np.asarray(position, dtype=float)))
+    scale = float(np.max(np.abs(position))) if np.size(position) else 0.0
+    nonzero = steps[steps > 1e-12 * max(scale, 1.0)]
+    if nonzero.size < MIN_STEPS:
+        return None
+    quantum = float(np.min(nonzero))
+    counts = nonzero / quantum
+    if np.max(np.abs(counts - np.round(counts))) > COUNT_TOLERANCE:
+        return None
+    # refine by the positions themselves: q_k = offset + quantum c_k over the whole span of
+    # counts (a written log's rounding of each position then averages out)
+    q = np.asarray(position, dtype=float)
+    quantum = float(np.mean(nonzero[np.round(counts) == 1]))  # the single-count steps first
+    c = np.round((q - q[0]) / quantum)
+    if np.ptp(c) < 1:
+        return quantum
+    slope = np.polyfit(c, q, 1)[0]
+    return float(slope)
+
+
+def _power_of_two(counts: float) -> int | None:
+    """``counts`` as the power of two it is within :data:`POWER_SNAP`, else None."""
+    if not (math.isfinite(counts) and counts >= 2):
+        return None
+    power = 2 ** round(math.log2(counts))
+    return power if abs(counts / power - 1.0) <= POWER_SNAP else None
+
+
+def position_unit_problem(position) -> str | None:
+    """What is wrong with a position column [rad, as read] whose steps are a binary
+    encoder's counts in another unit (:data:`MISREAD`, module notes), else None (no quantum
+    found, or the counts read a power of two, or no mistake makes them one)."""
+    quantum = encoder_quantum(np.asarray(position, dtype=float))
+    if quantum is None:
+        return None
+    counts = 2.0 * math.pi / quantum
+    if _power_of_two(counts) is not None:
+        return None
+    for mistake, factor in MISREAD:
+        encoder = _power_of_two(counts / factor)
+        if encoder is not None:
+            return (
+                f"its steps are the counts of a {encoder}-count encoder with the column in "
+                f"{mistake} ({counts:.6g} counts per revolution as read, a power of two "
+                "the other way)"
+            )
+    return None
