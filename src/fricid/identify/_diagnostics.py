@@ -57,8 +57,9 @@ EXCESS_RATIO = 2.0
 #: Significance of that excess (a one-sided chi-square test of the between-run sum of squares).
 EXCESS_ALPHA = 1e-3
 
-#: How the caveats of :func:`gravity_caveat` begin.
+#: How the caveats of :func:`gravity_caveat` begin; how a velocity mismatch's.
 LEFT_IN = "gravity may be left in"
+NOT_DERIVATIVE = "the log's velocity is not its position's derivative"
 
 #: Down-weighted samples listed by name (the rest counted).
 _LISTED = 5
@@ -286,24 +287,15 @@ def channel_problems(samples: FrictionSamples | None) -> list[str]:
     - the extraction found a logged velocity that is not its position channel's derivative
       (``meta["channel_problems"]``, :func:`fricid.samples.velocity_mismatch`: a unit, a
       sign or a gear ratio), so the samples' velocities are off by the factor and so is every
-      coefficient fitted on them, or a position whose encoder steps show it in another unit
-      than its label (:func:`fricid.samples.position_unit_problem`), which gravity's
-      ``cos q`` and ``sin q`` read;
+      coefficient fitted on them; or a position in another unit than its label
+      (:func:`fricid.samples.position_unit_problem`);
     - friction against the motion at most set-points (:func:`reversed_friction`): friction
       only dissipates, so the torque's (or current's) sign is reversed.
     """
     meta = samples.meta if samples is not None and isinstance(samples.meta, dict) else {}
     found = meta.get("channel_problems")
-    out = (
-        []
-        if not isinstance(found, list)
-        else [
-            p
-            if "the position: its steps" in p
-            else f"the log's velocity is not its position's derivative: {p}"
-            for p in found
-        ]
-    )
+    found = found if isinstance(found, list) else []
+    out = [p if "position: its steps" in p else f"{NOT_DERIVATIVE}: {p}" for p in found]
     reversed_ = reversed_friction(samples)
     return out + ([reversed_] if reversed_ else [])
 

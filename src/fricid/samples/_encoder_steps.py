@@ -31,6 +31,9 @@ COUNT_TOLERANCE = 0.05
 #: Fewest non-zero position steps from which a quantum is read.
 MIN_STEPS = 20
 
+#: The smallest step is tried as 1, 2, ... up to this many counts.
+MAX_SPLIT = 4
+
 #: Relative distance from a power of two within which counts read are taken as it (a log
 #: written with 7 decimals read 2^20 as 1048597: 2e-5 off).
 POWER_SNAP = 1e-4
@@ -48,8 +51,9 @@ def encoder_quantum(position: np.ndarray) -> float | None:
     """The encoder's quantum [rad] read from the position steps, or None when the steps have
     no common quantum (a continuous or interpolated position) or are too few.
 
-    The smallest non-zero step is the candidate; the log is quantised when every step is a
-    whole multiple of it (within :data:`COUNT_TOLERANCE` of a count: positions written with
+    The smallest non-zero step, or its half, third or quarter (a fast motion may never move
+    by one count between samples), is the candidate; the log is quantised when every step is
+    a whole multiple of it (within :data:`COUNT_TOLERANCE` of a count: positions written with
     a few decimals keep that).
     """
     steps = np.abs(np.diff(np.asarray(position, dtype=float)))
@@ -57,14 +61,17 @@ def encoder_quantum(position: np.ndarray) -> float | None:
     nonzero = steps[steps > 1e-12 * max(scale, 1.0)]
     if nonzero.size < MIN_STEPS:
         return None
-    quantum = float(np.min(nonzero))
-    counts = nonzero / quantum
-    if np.max(np.abs(counts - np.round(counts))) > COUNT_TOLERANCE:
+    for split in range(1, MAX_SPLIT + 1):
+        quantum = float(np.min(nonzero)) / split
+        counts = np.round(nonzero / quantum)
+        if np.max(np.abs(nonzero / quantum - counts)) <= COUNT_TOLERANCE:
+            break
+    else:
         return None
     # refine by the positions themselves: q_k = offset + quantum c_k over the whole span of
     # counts (a written log's rounding of each position then averages out)
     q = np.asarray(position, dtype=float)
-    quantum = float(np.mean(nonzero[np.round(counts) == 1]))  # the single-count steps first
+    quantum = float(np.mean(nonzero / counts))
     c = np.round((q - q[0]) / quantum)
     if np.ptp(c) < 1:
         return quantum
