@@ -369,7 +369,7 @@ def extract(
                 "; the velocity used instead is the position's difference over windows of "
                 f"{stream.window[source][0]}-{stream.window[source][1]} rows each side, each "
                 f"spanning {WINDOW_COUNTS} steps where the joint moves (a run's mean velocity is "
-                "then its position change over its duration)"
+                "then close to its position change over its duration)"
             )
         if coarse:
             warnings.warn(f"{source}: {coarse}", DataQualityWarning, stacklevel=user_stacklevel())
