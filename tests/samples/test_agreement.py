@@ -150,8 +150,9 @@ def test_a_joint_at_rest_with_a_noisy_velocity_is_not_judged():
 def test_a_windowed_velocity_resolves_a_coarse_encoder(speed, counts, rate, sign):
     """A 10 s run at one speed between rests, read through an encoder of ``counts`` per turn,
     fast enough to move 20 counts in 2 s: inside the run (2 s from its ends) every row is
-    within 5 % of the speed, at rest far from it the logged 0, and the inside's mean is the
-    speed to 2 %, whatever the encoder."""
+    within 8 % of the speed (7 % at worst over a grid: a speed just above a whole count per
+    sample), at rest far from it the logged 0, and the inside's mean is the speed to 0.5 %,
+    whatever the encoder."""
     step = 2 * np.pi / counts
     assume(speed * 2.0 >= 20 * step)
     t = np.arange(round(18.0 * rate)) / rate
@@ -161,10 +162,10 @@ def test_a_windowed_velocity_resolves_a_coarse_encoder(speed, counts, rate, sign
     v, (short, long) = windowed_velocity(t, qq, logged)
     assert 1 <= short <= long <= round(2 * rate)
     inner = (t >= 5.0) & (t < 11.0)
-    assert np.all(np.abs(v[inner] - sign * speed) <= 0.05 * speed)
+    assert np.all(np.abs(v[inner] - sign * speed) <= 0.08 * speed)
     assert np.all(v[t < 0.9] == 0) and np.all(v[t > 15.1] == 0)
-    # the windows follow the run's median speed, not each row's count: a selection bias of
-    # 1.2 % at worst over a grid of 1,563 runs, at the resolvable limit (with each row's own
-    # window, 1 % at 0.94 rad/s through 2^10 counts, far from it)
-    assert abs(np.mean(v[inner]) - sign * speed) <= max(2 * step / 6.0, 0.02 * speed)
+    # the windows follow the run's median speed, not each row's count, and the slope
+    # averages every row's rounding: 0.13 % at worst over a grid of 939 runs (with each
+    # row's own window and end-to-end differences, 1 % at 0.94 rad/s through 2^10 counts)
+    assert abs(np.mean(v[inner]) - sign * speed) <= max(2 * step / 6.0, 0.005 * speed)
     assert np.isfinite(v).all()

@@ -166,8 +166,16 @@ def wrapped_rows(time, position, velocity) -> np.ndarray:
 
 #: Half-width [samples] of the window over which the position is seen to move.
 MOVE_WINDOW = 10
-#: A velocity reading 0 at this share of the rows where the position moves is coarse.
+#: A velocity reading 0 at this share of the rows where the position moves is coarse ...
 COARSE_ZEROS = 0.3
+#: ... as is one of fewer steps per sample than this (median, where it is not 0): each
+#: reading is then a whole number of steps over 5 % apart, and runs at 0.45 and 0.55 rad/s
+#: through 2^12 counts at 250 Hz (1.2 and 1.4 steps per sample, few zeros) read one speed.
+COARSE_STEPS = 20.0
+#: ... when its readings change from one moving row to the next at over this share of them
+#: (a speed between two whole counts per sample: a simulated ramp's exact velocity, a whole
+#: number of its own steps per sample, does not flicker and is left as it is).
+FLICKER = 0.2
 
 
 def coarse_velocity(time, position, velocity) -> str | None:
@@ -175,9 +183,12 @@ def coarse_velocity(time, position, velocity) -> str | None:
 
     Such a velocity is a whole number of ``step / dt`` (or half that, central differences)
     and reads 0 between steps while the joint moves slowly, so steady-state detection takes
-    slow runs for rest. Judged where the position changes by a step or more over
-    ``2`` :data:`MOVE_WINDOW` rows: when the velocity is 0 at over :data:`COARSE_ZEROS` of
-    them and its non-zero values are such multiples (90 % within 1 %).
+    slow runs for rest, and at a few steps per sample its readings are so far apart that
+    runs a few per cent apart read one speed. Judged where the position changes by a step
+    or more over ``2`` :data:`MOVE_WINDOW` rows: when its non-zero values are such multiples
+    (90 % within 1 %) and it is 0 at over :data:`COARSE_ZEROS` of them or moves fewer than
+    :data:`COARSE_STEPS` steps per sample (the median) with readings that flicker
+    (:data:`FLICKER`).
     """
     t = np.asarray(time, dtype=float)
     q = np.asarray(position, dtype=float)
@@ -198,60 +209,85 @@ def coarse_velocity(time, position, velocity) -> str | None:
     quantum = step / (2 * dt)
     k = v[moves & (v != 0)] / quantum
     whole = float(np.mean(np.abs(k - np.round(k)) < 0.01)) if k.size else 0.0
-    if zeros <= COARSE_ZEROS or whole < 0.9:
+    per_sample = float(np.median(np.abs(k))) / 2 if k.size else 0.0  # steps per sample
+    both = moves[1:] & moves[:-1]
+    flicker = float(np.mean(v[1:][both] != v[:-1][both])) if both.any() else 0.0
+    few = per_sample < COARSE_STEPS and flicker > FLICKER
+    if whole < 0.9 or (zeros <= COARSE_ZEROS and not few):
         return None
     return (
         f"the velocity is the position's finite difference at a coarse encoder (steps of "
         f"{step:.3g} rad at {1 / dt:.4g} Hz): it reads 0 at {100 * zeros:.0f} % of the rows "
-        "where the joint moves, so slow runs look like rest; log the drive's velocity "
-        "estimate, or a position with more counts per turn"
+        f"where the joint moves and a median {per_sample:.3g} steps per sample elsewhere, so "
+        "slow runs look like rest and runs a few per cent apart read one speed; log the "
+        "drive's velocity estimate, or a position with more counts per turn"
     )
 
 
-#: Encoder steps each row's window spans (one step is then at most 5 % of the row's
-#: velocity). Tuned on a new-user trial's campaign (2^12 counts at 250 Hz, gravity, six
-#: speeds, 2 s runs at 0.066 rad/s), checked on ``tests/extract``'s own generator. On the
-#: trial's campaign 20 gave the clean log's six set-points within 0.02 %; 50, four (the
-#: slow runs' plateaus lost, a spurious one at 0.004 rad/s); 10, seven (0.6 rad/s split in
-#: two, frictions 0.066 and 0.080 against 0.088); 5, six but 0.069 rad/s for 0.066.
+#: Encoder steps each row's window spans. Tuned on a new-user trial's campaign (2^12 counts
+#: at 250 Hz, gravity, six speeds, 2 s runs at 0.066 rad/s) and a second trial's campaigns
+#: (2^10 and 2^12 counts, 100 Hz-1 kHz, runs 2 % apart, staircases), checked on
+#: ``tests/extract``'s own generator. 20 gave every set-point the encoder resolves, within
+#: 0.33 % of its speed and 1.7 mN m of its friction; 50 lost the first campaign's
+#: 0.01 rad/s; 10 read 2.015 for 2 rad/s and merged runs 2 % apart; 5 did as 20 on the
+#: first campaign.
 WINDOW_COUNTS = 20
+#: A row's window is used where its two halves move alike: counts within this many, or this
+#: share of the whole (a constant speed; near a run's end one half reaches into the ramp or
+#: the rest, and the row keeps the logged velocity, which steady-state detection trims).
+SIDE_COUNTS = 2.0
+SIDE_SHARE = 0.1
 #: The longest half-window [s] (rows slower than ``WINDOW_COUNTS`` steps in it: rest, or
 #: nearly).
 MAX_HALF_WINDOW = 2.0
 
 
-def window_difference(t: np.ndarray, q: np.ndarray, half: np.ndarray) -> np.ndarray:
-    """``(q[i + h] - q[i - h]) / (t[i + h] - t[i - h])`` with each row's half-window ``h``
-    (``half``), cut short at the ends."""
-    i = np.arange(q.size)
-    lo, hi = np.maximum(i - half, 0), np.minimum(i + half, q.size - 1)
-    span = t[hi] - t[lo]
-    return np.divide(q[hi] - q[lo], span, out=np.zeros(q.size), where=span > 0)
+def window_slope(t: np.ndarray, q: np.ndarray, half: np.ndarray) -> np.ndarray:
+    """The least-squares slope of ``q`` over rows ``i - h .. i + h`` (each row's ``h`` in
+    ``half``, cut short symmetrically at the ends; the sample period the median): a
+    Savitzky-Golay first derivative of order one, from cumulative sums. Unlike the window's
+    end-to-end difference, whose values are whole steps over the window (levels 5 % apart at
+    20 steps: runs 2 % apart read one level), it averages every row's rounding."""
+    n = q.size
+    i = np.arange(n)
+    h = np.minimum(np.minimum(half, i), n - 1 - i)
+    dt = float(np.median(np.diff(t)))
+    x = q - q[0]
+    s0 = np.concatenate([[0.0], np.cumsum(x)])
+    s1 = np.concatenate([[0.0], np.cumsum(i * x)])
+    lo, hi = i - h, i + h + 1
+    moment = (s1[hi] - s1[lo]) - i * (s0[hi] - s0[lo])  # sum of (k - i) x_k
+    norm = h * (h + 1) * (2 * h + 1) / 3.0
+    return np.divide(moment, norm * dt, out=np.zeros(n), where=norm > 0)
 
 
 def windowed_velocity(time, position, velocity) -> tuple[np.ndarray, tuple[int, int]]:
     """The velocity as the position's difference over a window per row, and the shortest and
     longest half-windows used [rows].
 
-    The M/T method of encoder speed measurement: each row's window spans
-    :data:`WINDOW_COUNTS` encoder steps, so one step is at most 5 % of the velocity. A row's
-    window is found in two passes: the shortest of 1, 2, 4, ... rows each side over which
-    the position changes by that many steps gives a rough speed; its median over that
-    window gives the half-window ``ceil(WINDOW_COUNTS step / (2 dt speed))``. Chosen by each
-    row's own count instead, a run whose speed sits near a threshold had rows that reach
-    the count by a quantisation step and rows that miss it, and the run's mean came out 1 %
-    fast (a 2^10-count encoder at 0.94 rad/s). The choice still depends on the quantised
-    position, so a run at a speed where the window flips between two lengths keeps a small
-    bias: over 1,563 runs (200 speeds from 0.01 to 3 rad/s, 2^10 to 2^14 counts, 100 Hz to
-    1 kHz; those moving 20 steps in 2 s) the mean within a run was its speed to 0.001 % at
-    the median, 0.16 % at the 99th percentile and 1.2 % at worst (0.064 rad/s through 2^10
-    counts at 1 kHz: 21 steps in the longest window). A mean over four windows instead of
-    the median did as well on that grid (0.69 % at worst) but split runs of one speed on a
-    2^12-count campaign with gravity into set-points 4 % apart. Rows within a window of a
-    run's ends mix in its neighbours, which steady-state detection trims.
+    The M/T method of encoder speed measurement, with the least-squares slope over the
+    window (:func:`window_slope`) in place of its end-to-end difference: each row's window
+    spans :data:`WINDOW_COUNTS` encoder steps. A row's window is found in two passes: the
+    shortest of 1, 2, 4, ... rows each side over which the position changes by that many
+    steps gives a rough speed; its median over that window gives the half-window
+    ``ceil(WINDOW_COUNTS step / (2 dt speed))``. Chosen by each row's own count instead, a
+    run whose speed sits near a threshold had rows that reach the count by a quantisation
+    step and rows that miss it, and the run's mean came out 1 % fast (a 2^10-count encoder
+    at 0.94 rad/s); the end-to-end difference's values are whole steps over the window,
+    levels 5 % apart, and runs 2 % apart read one level. Over 939 runs (120 speeds from
+    0.01 to 3 rad/s, 2^10 to 2^14 counts, 100 Hz to 1 kHz; those moving 20 steps in 2 s)
+    the mean within a run was its speed to 0.001 % at the median, 0.04 % at the 99th
+    percentile and 0.13 % at worst; a row, to 0.45 %, 4.7 % and 7 % (at a speed just above
+    a whole count per sample, whose rounding beats more slowly than the window). Rows
+    within a window of a run's ends mix in its neighbours, which steady-state detection
+    trims.
 
-    A row that does not reach the count within :data:`MAX_HALF_WINDOW` s keeps the logged
-    ``velocity`` (at rest, 0). Given the longest window instead, rows at rest beside a run
+    A row whose window's two halves do not move alike (:data:`SIDE_COUNTS`,
+    :data:`SIDE_SHARE`: the window reaches past the run's end into a ramp or a rest) keeps
+    the logged ``velocity``: near the end of a 4 s run at 0.01 rad/s through 2^12 counts at
+    1 kHz, such rows had put the set-point 5.5 % slow. So does a row that does not reach
+    the count within :data:`MAX_HALF_WINDOW` s (at rest, 0). Given the longest window
+    instead, rows at rest beside a run
     read one small speed for as long as the window reached into the run: a steady run to the
     steady-state detection (a 2^10-count encoder: 0.0092 rad/s at rest, kept as a set-point
     with the friction of rest). At the log's ends the windows are cut short (a window kept
@@ -278,7 +314,7 @@ def windowed_velocity(time, position, velocity) -> tuple[np.ndarray, tuple[int, 
         level[(level == len(ladder)) & (np.abs(change) >= WINDOW_COUNTS * step)] = k
     still = level == len(ladder)
     first = np.array(ladder)[np.minimum(level, len(ladder) - 1)]
-    rough = np.abs(window_difference(t, q, first))
+    rough = np.abs(window_slope(t, q, first))
     speed = rough.copy()
     for k, half in enumerate(ladder):  # the median speed within the row's first window
         rows = (level == k) & ~still
@@ -287,7 +323,11 @@ def windowed_velocity(time, position, velocity) -> tuple[np.ndarray, tuple[int, 
     with np.errstate(divide="ignore"):
         need = np.ceil(WINDOW_COUNTS * step / (2.0 * dt * np.maximum(speed, 1e-300)))
     wide = np.clip(need, 1, top).astype(int)
+    lo, hi = np.maximum(i - wide, 0), np.minimum(i + wide, n - 1)
+    left, right = (q[i] - q[lo]) / step, (q[hi] - q[i]) / step
+    even = np.abs(left - right) <= np.maximum(SIDE_COUNTS, SIDE_SHARE * np.abs(left + right))
+    use = ~still & even
     v = np.asarray(velocity, dtype=float).copy()
-    v[~still] = window_difference(t, q, wide)[~still]
-    moved = wide[~still]
+    v[use] = window_slope(t, q, wide)[use]
+    moved = wide[use]
     return v, (int(moved.min()), int(moved.max())) if moved.size else (top, top)
