@@ -54,13 +54,13 @@ def test_robot_fit_writes_the_file_and_prints_a_row_per_joint(pendulum_logs, tmp
     assert fit.provenance["reversal_window"] == 0.0
     assert fit.provenance["closed_loop"].startswith("not detected")  # decided from the data
     assert "Closed loop detected" not in res.output
-    for flag, window in (("--closed-loop", 1.0), ("--open-loop", 0.0)):
+    for flag, window, kind in (("--closed-loop", 1.0, "closed"), ("--open-loop", 0.0, "open")):
         told = tmp_path / f"{flag}.json"
         res = runner.invoke(app, [*fit_cv, flag, "-o", str(told)])
         assert res.exit_code == 0, res.output
         prov = ArmFit.load(told).provenance
         assert prov["reversal_window"] == window
-        assert "closed_loop" not in prov
+        assert prov["closed_loop"] == f"given: {kind} loop"
 
 
 def test_robot_fit_bad_option_is_one_line_and_no_file(pendulum_logs, tmp_path):

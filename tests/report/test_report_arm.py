@@ -170,9 +170,9 @@ def test_simulate_fit_report_end_to_end(tmp_path):
 
 def test_the_header_says_how_closed_loop_was_decided():
     """Whether the rows near the reversals were left out, and whether fricid decided it from
-    the data or was told, is part of what the numbers mean."""
-    told = arm_report(arm_fit()).meta
-    assert told["closed loop"] == "as told"
+    the data or was told ("given: ..."), is part of what the numbers mean."""
+    older = arm_report(arm_fit()).meta  # a file from before the decision was recorded
+    assert older["closed loop"] == "not recorded"
     doc = arm_fit().to_dict()
     doc["provenance"] |= {"reversal_window": 1.0, "closed_loop": "detected: the residuals of x"}
     decided = arm_report(ArmFit.from_dict(doc)).meta

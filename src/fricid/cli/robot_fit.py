@@ -133,7 +133,8 @@ def robot_fit_command(
                 "farther out (each joint's window is in the fit file). --open-loop: keep those "
                 "rows, which carry the Stribeck rise of an open-loop log. Default: decided from "
                 "the data, closed loop when a joint's residuals near its reversals show sticks "
-                "(the fit file's provenance says which, and the printout)."
+                "(the fit file's provenance says which, and the printout; a law without a "
+                "Stribeck rise leaves such a misfit in open loop too, and the printout says so)."
             ),
         ),
     ] = None,

@@ -201,7 +201,7 @@ def _meta(fit: ArmFit) -> dict[str, str]:
         "filter cut-off [Hz]": text("cutoff", "{:.4g}"),
         "decimation": text("decimation"),
         "rows near reversals left out [periods]": text("reversal_window", "{:g}"),
-        "closed loop": text("closed_loop") if "closed_loop" in prov else "as told",
+        "closed loop": text("closed_loop") if "closed_loop" in prov else "not recorded",
         "identification [s]": text("seconds", "{:.3g}"),
     }
 

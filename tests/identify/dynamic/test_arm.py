@@ -252,8 +252,22 @@ def test_closed_loop_coulomb_bias_is_removed_by_the_reversal_window(pendulum):
     prov = fits[None].provenance
     assert prov["reversal_window"] == WINDOW_PERIODS
     assert prov["closed_loop"].startswith("detected: the residuals of joint1, joint2")
-    assert "closed_loop" not in fits[0.0].provenance  # told: nothing decided
+    assert fits[0.0].provenance["closed_loop"] == "given: open loop"  # told: nothing decided
     assert fits[0.0].provenance["stick_signature"] == prov["stick_signature"]
+
+
+def test_a_law_without_the_stribeck_rise_is_named_beside_a_closed_loop(pendulum):
+    """An open-loop arm with Stribeck friction fitted with a Coulomb-viscous law: the law's
+    missing rise leaves a misfit near the reversals as sticks do, and the decision says that
+    it may be either (a new-user trial had read "joint sticking while a position loop builds
+    torque" on such logs)."""
+    rng = np.random.default_rng(7)
+    laws = [stribeck_law(rng) for _ in range(2)]
+    log = make_log(pendulum, laws, duration=20.0, seed=7, noise=0.05)
+    text = fit_arm(log, pendulum, friction="coulomb_viscous_asym").provenance["closed_loop"]
+    assert text.startswith("detected") and "without the Stribeck rise" in text, text
+    same = fit_arm(log, pendulum, friction="stribeck_asym").provenance["closed_loop"]
+    assert same.startswith("not detected"), same
 
 
 def test_an_open_loop_log_is_not_taken_for_a_closed_loop_one(pendulum_fit):

@@ -98,6 +98,7 @@ from ._rows import (
     near_stops,
     stick_signature,
     sticking,
+    still_text,
     stop_distance,
 )
 from ._rows import moving_rows as _moving
@@ -163,23 +164,6 @@ def _signals(
     return replace(sig, full_load=own if own is not None else joint_load(load_model, q))
 
 
-def _still_text(sig: ArmSignals) -> str:
-    """Why no row is kept: no motion, or motion hidden under the encoder's velocity noise
-    after the low-pass (a coarse encoder: a lower cut-off lets the motion through)."""
-    fastest = np.abs(sig.dq).max(axis=0)
-    floor = np.maximum(VELOCITY_NOISE_FACTOR * sig.velocity_noise, MIN_SPEED)
-    if not (fastest >= MIN_SPEED).any():
-        return "no joint moves in the log: nothing to identify"
-    return (
-        "no joint moves faster than its encoder's velocity noise lets it be seen: fastest "
-        f"filtered speeds {np.array2string(fastest, precision=3)} rad/s against "
-        f"{np.array2string(floor, precision=3)} ({VELOCITY_NOISE_FACTOR:g}x the noise of "
-        f"encoder steps {np.array2string(sig.encoder_step, precision=3)} rad after the "
-        f"low-pass at {sig.cutoff:.3g} Hz); a coarse encoder: give a lower --cutoff (a few "
-        "times the motion's highest frequency) or --encoder-counts"
-    )
-
-
 def _with_channels(err: DataError, log: RobotLog, model: RigidBodyModel) -> DataError:
     """``err`` with the channels' disagreements (:mod:`._channels`) added, which may be its
     cause (positions in degrees labelled radians make a log look too short or still)."""
@@ -231,7 +215,11 @@ def fit_arm(log: RobotLog, model: RigidBodyModel, **kwargs: Any) -> ArmFit:
                     first = fit.provenance["stick_signature"]
                     fit = _fit_arm(log, model, **kwargs)
                     fit.provenance["stick_signature"] = first
-                fit.provenance["closed_loop"] = closed_loop_text(stuck, model.joints)
+                rise = [fit.friction[j]["family"].startswith("stribeck") for j in model.joints]
+                fit.provenance["closed_loop"] = closed_loop_text(stuck, model.joints, rise)
+            else:
+                told = "closed loop" if kwargs["reversal_window"] > 0 else "open loop"
+                fit.provenance["closed_loop"] = f"given: {told}"
         except DataError as err:  # a unit or sign mistake can be why: say so
             raise _with_channels(err, log, model) from None
         values = fit.standard.get("values")
@@ -345,7 +333,7 @@ def _fit_arm(
         sig = replace(sig, stick=stick_columns(sig, near))
     moving = _moving(sig, reversal_window, distance)
     if not moving.any():
-        raise DataError(_still_text(sig), file=log.source)
+        raise DataError(still_text(sig, reversal_window), file=log.source)
     bp = base_parameters(model)
     Yb = sig.regressor(model, bp)
     n = model.n

@@ -62,6 +62,7 @@ __all__ = [
     "moving_rows",
     "near_stops",
     "sticking",
+    "still_text",
     "stop_distance",
 ]
 
@@ -225,13 +226,50 @@ def sticking(signature: list[dict[str, float]]) -> list[int]:
     ]
 
 
-def closed_loop_text(stuck: list[int], joints: tuple[str, ...]) -> str:
-    """The fit's ``closed_loop`` provenance when fricid decided it (:func:`sticking`)."""
+def closed_loop_text(stuck: list[int], joints: tuple[str, ...], rise: list[bool]) -> str:
+    """The fit's ``closed_loop`` provenance when fricid decided it (:func:`sticking`);
+    ``rise[j]``: joint ``j``'s family has a Stribeck rise. Without one, the misfit near the
+    reversals may be the rise the law misses as well as a stick (open-loop logs fitted with
+    a Coulomb-viscous law were taken for closed loop), and the text says both."""
     if not stuck:
         return "not detected: no joint's residual shows sticks at its reversals"
     names = ", ".join(joints[j] for j in stuck)
+    text = (
+        f"detected: the residuals of {names} near their reversals hold a misfit, as a joint "
+        "sticking while a position loop builds torque leaves, so the rows there were left "
+        "out as for --closed-loop"
+    )
+    if all(rise[j] for j in stuck):
+        return text
     return (
-        f"detected: the residuals of {names} near their reversals show the joint sticking "
-        "while a position loop builds torque, so the rows there were left out as for "
-        "--closed-loop"
+        f"{text}; a friction law without the Stribeck rise the data show leaves such a misfit "
+        "too (on an open-loop log: --open-loop with a Stribeck family, e.g. --friction "
+        "stribeck_asym)"
+    )
+
+
+def still_text(sig: ArmSignals, window: float = 0.0) -> str:
+    """Why no row is kept: no motion, motion hidden under the encoder's velocity noise after
+    the low-pass (a coarse encoder: a lower cut-off lets the motion through), or, with a
+    reversal ``window``, no row that far from a stop."""
+    fastest = np.abs(sig.dq).max(axis=0)
+    floor = np.maximum(VELOCITY_NOISE_FACTOR * sig.velocity_noise, MIN_SPEED)
+    if not (fastest >= MIN_SPEED).any():
+        return "no joint moves in the log: nothing to identify"
+    if window > 0 and (fastest >= floor).any():
+        return (
+            f"no row is {window:g} periods of the cut-off ({window / sig.cutoff:.3g} s at "
+            f"{sig.cutoff:.3g} Hz) from its joint's nearest slow sample or reversal, so the "
+            "closed-loop window leaves nothing to fit; the slow samples are those under "
+            f"{np.array2string(floor, precision=3)} rad/s ({VELOCITY_NOISE_FACTOR:g}x the "
+            "encoder's velocity noise): give a lower --cutoff (the noise falls with it), "
+            "or fit without --closed-loop"
+        )
+    return (
+        "no joint moves faster than its encoder's velocity noise lets it be seen: fastest "
+        f"filtered speeds {np.array2string(fastest, precision=3)} rad/s against "
+        f"{np.array2string(floor, precision=3)} ({VELOCITY_NOISE_FACTOR:g}x the noise of "
+        f"encoder steps {np.array2string(sig.encoder_step, precision=3)} rad after the "
+        f"low-pass at {sig.cutoff:.3g} Hz); a coarse encoder: give a lower --cutoff (a few "
+        "times the motion's highest frequency) or --encoder-counts"
     )
