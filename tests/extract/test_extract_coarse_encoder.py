@@ -62,7 +62,7 @@ def test_set_points_through_a_coarse_encoder_are_the_commanded_speeds(counts, ra
     0.055 rad/s apart); the slower ones, whose counts cannot show a plateau, are dropped as
     such, not kept at a wrong speed."""
     log, _ = campaign(counts, rate, seed)
-    with pytest.warns(DataQualityWarning, match="position's difference over windows"):
+    with pytest.warns(DataQualityWarning, match="position's least-squares slope over windows"):
         result = extract(log, gravity="none")
     s = result.by_direction
     truth = np.array([x * d for x in SPEEDS for d in (1.0, -1.0)])

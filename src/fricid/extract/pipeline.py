@@ -100,7 +100,7 @@ class _Source:
                 self.coarse[source] = coarse_velocity(log.time, log.position, log.velocity)
                 if self.coarse[source] and source not in self.problems:
                     self.window[source] = (np.inf, 0)
-            if source in self.window:  # the position's difference over windows instead
+            if source in self.window:  # the position's slope over windows instead
                 velocity, (short, long) = windowed_velocity(log.time, log.position, log.velocity)
                 seen = self.window[source]
                 self.window[source] = (min(seen[0], short), max(seen[1], long))
@@ -366,7 +366,7 @@ def extract(
         if coarse and source in stream.window:
             coarse = coarse.split(": it reads 0")[0]
             coarse += (
-                "; the velocity used instead is the position's difference over windows of "
+                "; the velocity used instead is the position's least-squares slope over windows of "
                 f"{stream.window[source][0]}-{stream.window[source][1]} rows each side, each "
                 f"spanning {WINDOW_COUNTS} steps where the joint moves (a run's mean velocity is "
                 "then close to its position change over its duration)"

@@ -13,8 +13,8 @@ reversed sign, else a gear ratio or an unknown unit. :func:`wrapped_rows` finds 
 wrapped to one turn (a jump the velocity does not explain, which the median above ignores but
 a derivative filter does not). :func:`coarse_velocity` recognises a velocity that is a coarse
 encoder's finite difference (zero between steps while the joint moves), and
-:func:`windowed_velocity` gives the velocity to use instead: the position's difference over a
-window long enough for its counts to resolve the log's slowest runs.
+:func:`windowed_velocity` gives the velocity to use instead: the position's least-squares
+slope over a window per row that spans enough encoder steps to resolve the row's speed.
 """
 
 from __future__ import annotations
@@ -262,8 +262,8 @@ def window_slope(t: np.ndarray, q: np.ndarray, half: np.ndarray) -> np.ndarray:
 
 
 def windowed_velocity(time, position, velocity) -> tuple[np.ndarray, tuple[int, int]]:
-    """The velocity as the position's difference over a window per row, and the shortest and
-    longest half-windows used [rows].
+    """The velocity as the position's least-squares slope over a window per row, and the
+    shortest and longest half-windows used [rows].
 
     The M/T method of encoder speed measurement, with the least-squares slope over the
     window (:func:`window_slope`) in place of its end-to-end difference: each row's window
@@ -287,12 +287,11 @@ def windowed_velocity(time, position, velocity) -> tuple[np.ndarray, tuple[int, 
     the logged ``velocity``: near the end of a 4 s run at 0.01 rad/s through 2^12 counts at
     1 kHz, such rows had put the set-point 5.5 % slow. So does a row that does not reach
     the count within :data:`MAX_HALF_WINDOW` s (at rest, 0). Given the longest window
-    instead, rows at rest beside a run
-    read one small speed for as long as the window reached into the run: a steady run to the
-    steady-state detection (a 2^10-count encoder: 0.0092 rad/s at rest, kept as a set-point
-    with the friction of rest). At the log's ends the windows are cut short (a window kept
-    long but one-sided there made the first second of a log that starts at rest one flat,
-    wrong velocity).
+    instead, rows at rest beside a run read one small speed for as long as the window
+    reached into the run: a steady run to the steady-state detection (a 2^10-count encoder:
+    0.0092 rad/s at rest, kept as a set-point with the friction of rest). At the log's ends
+    the windows are cut short (a window kept long but one-sided there made the first second
+    of a log that starts at rest one flat, wrong velocity).
     """
     from scipy.ndimage import median_filter
 
