@@ -49,6 +49,17 @@ def leadscrew_dir(real_data: Path) -> Path:
     return _folder_or_skip(real_data / "epos-leadscrew")
 
 
+@pytest.fixture(scope="module")
+def pendulum():
+    """The example double pendulum's rigid-body model, for the whole-arm tests (skipped
+    without Pinocchio)."""
+    pytest.importorskip("pinocchio")
+    from fricid.robot import RigidBodyModel, example_urdf
+
+    path, joints = example_urdf("double_pendulum")
+    return RigidBodyModel.from_urdf(path, joints)
+
+
 # -- every model the suite fits and saves, for tests/models/test_friction_sign.py -----------
 
 #: ``(model dict, samples or None)`` of every model file a test wrote through

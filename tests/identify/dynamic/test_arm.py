@@ -24,12 +24,6 @@ from fricid.robot import RigidBodyModel, example_urdf, is_consistent
 
 
 @pytest.fixture(scope="module")
-def pendulum() -> RigidBodyModel:
-    path, joints = example_urdf("double_pendulum")
-    return RigidBodyModel.from_urdf(path, joints)
-
-
-@pytest.fixture(scope="module")
 def pendulum_fit(pendulum):
     log = make_log(pendulum, CV_LAWS, duration=20.0, seed=3, noise=0.05)
     return fit_arm(log, pendulum, friction="coulomb_viscous_asym")

@@ -20,13 +20,6 @@ pytest.importorskip("pinocchio")
 from fricid.errors import DataError
 from fricid.identify.dynamic.arm import fit_arm
 from fricid.identify.dynamic.arm._channels import channel_problems
-from fricid.robot import RigidBodyModel, example_urdf
-
-
-@pytest.fixture(scope="module")
-def pendulum() -> RigidBodyModel:
-    path, joints = example_urdf("double_pendulum")
-    return RigidBodyModel.from_urdf(path, joints)
 
 
 @pytest.fixture(scope="module")

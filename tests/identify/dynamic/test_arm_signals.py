@@ -17,12 +17,6 @@ RATE = 1000.0
 CUTOFF = 6.0
 
 
-@pytest.fixture(scope="module")
-def pendulum() -> RigidBodyModel:
-    path, joints = example_urdf("double_pendulum")
-    return RigidBodyModel.from_urdf(path, joints)
-
-
 def _motion(t: np.ndarray, jitter: float = 0.0):
     """(q, dq, ddq) of both joints: slow sines, plus (``jitter`` rad/s^2) an 8 Hz and a 11 Hz
     acceleration, the band just above the cut-off that a PD on a quantised position fills."""

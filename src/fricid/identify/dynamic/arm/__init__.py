@@ -193,6 +193,15 @@ def _torque_delay(sig: ArmSignals, Yb, frictions, moving) -> float:
     return float(np.clip(x[-1], -MAX_DELAY, MAX_DELAY))
 
 
+def _every_row(Yb, sig: ArmSignals, frictions, theta, shape) -> tuple[np.ndarray, list]:
+    """The residual of ``theta`` on every row (``shape``: rows, joints), not only the fitted
+    ones, and each joint's friction columns: what the stick tests read (:mod:`._rows`)."""
+    every = stack(Yb, sig, frictions, np.ones(shape, dtype=bool))
+    residual = np.zeros(shape)
+    residual[every.row_time, every.row_joint] = every.y - every.A @ theta
+    return residual, [friction_block(sig, jf, j) for j, jf in enumerate(frictions)]
+
+
 def _predict(model, bp, beta, frictions, sig: ArmSignals, theta_f: list[np.ndarray]):
     tau = sig.regressor(model, bp) @ beta
     for j, jf in enumerate(frictions):
@@ -347,10 +356,7 @@ def _fit_arm(
     windows = np.full(n, float(reversal_window))
     rho = filter_correlation(sig)  # the filters' own correlation of the rows
     if reversal_window > 0:  # each joint's own window, from how far its sticks' misfit reaches
-        every = stack(Yb, sig, frictions, np.ones_like(moving))
-        residual = np.zeros(moving.shape)
-        residual[every.row_time, every.row_joint] = every.y - every.A @ theta
-        columns = [friction_block(sig, jf, j) for j, jf in enumerate(frictions)]
+        residual, columns = _every_row(Yb, sig, frictions, theta, moving.shape)
         windows = adapted_windows(distance, residual, reversal_window, columns, rho)
         moving = _moving(sig, windows, distance)
         st = stack(Yb, sig, frictions, moving)
@@ -368,10 +374,7 @@ def _fit_arm(
         safe = np.where(np.isfinite(sigma) & (sigma > 0), sigma, 1.0)
     signature = None
     if reversal_window == 0:  # sticks at the reversals: a log recorded in closed loop?
-        every = stack(Yb, sig, frictions, np.ones_like(moving))
-        residual = np.zeros(moving.shape)
-        residual[every.row_time, every.row_joint] = every.y - every.A @ theta
-        columns = [friction_block(sig, jf, j) for j, jf in enumerate(frictions)]
+        residual, columns = _every_row(Yb, sig, frictions, theta, moving.shape)
         signature = stick_signature(stop_distance(sig), residual, moving, columns, rho)
     A, y = st.weighted(safe)
     res = y - A @ theta
