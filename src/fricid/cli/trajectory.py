@@ -37,6 +37,33 @@ def parse_reader_options(items: list[str] | None) -> dict:
     return out
 
 
+def _derivative_lines(d: dict) -> list[str]:
+    """The derivative filter's settings, and the window's predicted biases
+    (:mod:`fricid.identify.dynamic._window`)."""
+    shown = {k: v for k, v in d.items() if k not in ("method", "source", "bias")}
+    if "window" in shown:
+        shown["window"] = f"{1e3 * shown['window']:.0f} ms"
+    lines = [
+        f"    derivatives: {d.get('method')} of the {d.get('source')}, "
+        + ", ".join(f"{k} {v}" for k, v in shown.items())
+    ]
+    b = d.get("bias")
+    if b:
+        worst = max(b["over_stderr"], key=b["over_stderr"].get)
+        wider = (
+            f"widened from {1e3 * b['widened_from']:.0f} ms for the encoder's noise; "
+            if b.get("widened_from")
+            else ""
+        )
+        lines.append(
+            f"    derivative window: {wider}the noise is {100 * b['noise_share']:.2f} % of the "
+            f"acceleration's variance, the filter bends the motion {100 * b['distortion']:+.2f} "
+            f"%: predicted inertia bias {100 * b['relative']:+.2f} %, the largest "
+            f"{b['over_stderr'][worst]:.2f} standard errors ({worst})"
+        )
+    return lines
+
+
 def trajectory_text(fitted) -> str:
     """The trajectory block of the report: filter, routes, joint parameters, passivity."""
     info = fitted.provenance.get("trajectory", {})
@@ -47,10 +74,7 @@ def trajectory_text(fitted) -> str:
         f"{info.get('seconds', float('nan')):.2f} s",
     ]
     if d:
-        lines.append(
-            f"    derivatives: {d.get('method')} of the {d.get('source')}, "
-            + ", ".join(f"{k} {v}" for k, v in d.items() if k not in ("method", "source"))
-        )
+        lines.extend(_derivative_lines(d))
     lines.extend(_presliding_lines(info.get("presliding")))
     pf = info.get("parallel_filter")
     if pf:

@@ -38,6 +38,7 @@ __all__ = [
     "open_sides",
     "quality_rows",
     "range_text",
+    "recorded_caveats",
 ]
 
 #: A sample whose weight under a robust loss is below this is reported as down-weighted and
@@ -105,20 +106,21 @@ def open_sides(fitted: FittedModel, *, include_zero: bool = False) -> dict[str, 
     return out
 
 
-def gap_caveat(fitted: FittedModel) -> str:
-    """``"no speed measured between 1 and 4 rad/s (v > 0): the model is untested there"``
-    for each gap between measured speeds that the file records (``provenance["speeds"]``,
-    :func:`fricid.models._range.speed_coverage`): held-out validation leaves out measured
-    levels, so it says nothing of a gap; "" when there is none."""
+def recorded_caveats(fitted: FittedModel) -> list[str]:
+    """Caveats of what the file records: ``"no speed measured between 1 and 4 rad/s (v > 0):
+    the model is untested there"`` for the gaps between measured speeds
+    (``provenance["speeds"]``, :func:`fricid.models._range.speed_coverage`: held-out
+    validation leaves out measured levels, so it says nothing of a gap), then a trajectory
+    fit's own (``provenance["trajectory"]["caveats"]``: :mod:`.dynamic._window`)."""
     coverage = (fitted.provenance or {}).get("speeds")
     parts = [
         f"between {a:.4g} and {b:.4g} rad/s ({label})"
         for side, label in SIDES.items()
         for a, b in gap_pairs(coverage, side)
     ]
-    if not parts:
-        return ""
-    return f"no speed measured {', '.join(parts)}: the model is untested there"
+    gaps = [f"no speed measured {', '.join(parts)}: the model is untested there"] if parts else []
+    own = ((fitted.provenance or {}).get("trajectory") or {}).get("caveats")
+    return gaps + ([str(c) for c in own] if isinstance(own, list) else [])
 
 
 def range_text(fitted: FittedModel) -> str:

@@ -70,13 +70,13 @@ from ._diagnostics import (
     DROPS,
     channel_problems,
     downweighted,
-    gap_caveat,
     gravity_caveat,
     listed_count,
     not_determined,
     open_sides,
     quality_rows,
     range_text,
+    recorded_caveats,
 )
 from ._fingerprint import canonical, check_record_types, json_ready, record_key, trust_options
 from ._heldout import (
@@ -476,9 +476,7 @@ def _grade(trust: Trust, fitted: FittedModel, sample_caveats: list[str], no: lis
             "between and beyond them untested)"
         )
     caveats += [c for c in sample_caveats if c]
-    gaps = gap_caveat(fitted)
-    if gaps:
-        caveats.append(gaps)
+    caveats += recorded_caveats(fitted)
     if trust.downweighted:
         loss = (fitted.loss or {}).get("loss")
         how = f"the {loss} loss down-weighted" if loss else "the training left out"

@@ -57,6 +57,7 @@ __all__ = [
     "cluster_covariance",
     "derivatives",
     "low_speed_windows",
+    "sliding",
     "torque_noise",
     "uniform_series",
 ]
@@ -168,6 +169,20 @@ def derivatives(series: Series, filt: DerivativeFilter) -> tuple[np.ndarray, np.
     vf = signal.filtfilt(b, a_, v)
     acc = signal.filtfilt(b, a_, np.gradient(vf, series.dt))
     return vf, acc
+
+
+def sliding(
+    series: Series, filt: DerivativeFilter, v_slide: float, guard: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The derivatives (:func:`derivatives`) and the samples that slide: ``|v| >= v_slide``
+    away from the stretches below it (by half the filter's window before, and ``guard``
+    seconds or that after), the filter's extrapolated edges left out."""
+    rate = 1.0 / series.dt
+    vf, acc = derivatives(series, filt)
+    half = filt.samples(rate) // 2 if filt.method == "savgol" else int(rate / filt.cutoff)
+    mask = ~dilate(np.abs(vf) < v_slide, half, max(half, round(guard * rate)))
+    mask[:half], mask[mask.size - half :] = False, False
+    return vf, acc, mask
 
 
 def dilate(mask: np.ndarray, before: int, after: int) -> np.ndarray:

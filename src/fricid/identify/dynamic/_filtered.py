@@ -60,7 +60,7 @@ from ..static.uncertainty import jacobian
 from ._data import Series, blocks, cluster_covariance
 from ._routes import JOINT_PARAMS, SEARCH_SHARE, _run, _Stage, _t975
 
-__all__ = ["DAHL", "LUGRE", "Law", "ParallelFilter", "filtered_route"]
+__all__ = ["DAHL", "LUGRE", "Law", "ParallelFilter", "dahl_start", "filtered_route", "lugre_start"]
 
 #: Output rate of the decimation, in multiples of the cut-off.
 DECIMATED_RATE = 5.0
@@ -319,3 +319,23 @@ def filtered_route(
         search,
     )
     return stage, y, r0
+
+
+def lugre_start(stage1, static_tab):
+    """LuGre's start (sigma_0, sigma_1 at 1e4 and 1, the static levels from the regression),
+    the static levels' box from the regression's, and the law."""
+    start = np.array([1e4, 1.0] + [static_tab[n]["value"] for n in lugre.PARAM_NAMES[2:]])
+    order = [stage1.names.index(n) for n in ("tau_v", "tau_c", "tau_s", "w_s", "delta")]
+    return start, stage1.bounds[order], LUGRE
+
+
+def dahl_start(stage1, static_tab):
+    """Dahl's start and box (sigma_0, tau_c, alpha, sigma_2), from the ``coulomb_viscous``
+    regression, and the law."""
+    order = [stage1.names.index(n) for n in ("f_c", "beta")]
+    (c_lo, c_hi), (v_lo, v_hi) = stage1.bounds[order]
+    alpha = next(p for p in dahl.PARAMETERS if p.name == "alpha")
+    bounds = np.array([(max(c_lo, 1e-3 * c_hi), c_hi), (alpha.lower, alpha.upper), (v_lo, v_hi)])
+    tau_c = float(np.clip(static_tab["tau_c"]["value"], *bounds[0]))
+    sigma_2 = float(np.clip(static_tab["sigma_2"]["value"], *bounds[2]))
+    return np.array([1e4, tau_c, alpha.default, sigma_2]), bounds, DAHL

@@ -143,9 +143,12 @@ def warn_rate_bias(stage, rb: dict[str, Any], notes: dict[str, str] | None = Non
 LOG2 = ("sigma_0", "sigma_1")
 
 
-def estimator(key: str, route: str, sim_info: dict[str, Any]) -> dict[str, str]:
+def estimator(
+    key: str, route: str, sim_info: dict[str, Any], window: bool = False
+) -> dict[str, str]:
     """Which estimator gave the parameters, and whether the bias of the log's rate, encoder
-    and closed loop was checked by simulation at the estimate."""
+    and closed loop was checked by simulation at the estimate (or, ``window``, the encoder's
+    bias of a static model's regression by its derivative window: :mod:`._window`)."""
     names = {
         "filtered": "IDIM-LS: parallel-filtered equation error (Gautier, Janot and "
         "Vandanjon 2013), the bristle state driven by the measured motion",
@@ -161,7 +164,12 @@ def estimator(key: str, route: str, sim_info: dict[str, Any]) -> dict[str, str]:
             + name.split(":")[0]
         )
     rb = sim_info.get("rate_bias")
-    if rb is None:
+    if rb is None and window:
+        check = (
+            "the encoder's noise in the acceleration checked (the derivative window's predicted "
+            "biases); closed loop not checked: equation error under closed loop can be biased"
+        )
+    elif rb is None:
         check = "not checked: equation error under closed loop or a coarse encoder can be biased"
     elif "skipped" in rb:
         check = f"not checked: {rb['skipped']}"

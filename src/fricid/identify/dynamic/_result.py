@@ -28,6 +28,7 @@ from ...samples import RawLog
 from ._data import Series
 from ._outcome import PassivityWarning, converged, passivity
 from ._routes import JOINT_PARAMS
+from ._window import bias_caveat
 
 __all__ = ["build_result"]
 
@@ -147,7 +148,7 @@ def build_result(
         "static_from": "sweeps"
         if static is not None
         else ("the same joint estimate" if route == "filtered" else "regression"),
-        "derivative": derivative.describe(rate),
+        "derivative": {**derivative.describe(rate), **_bias(options.get("window_bias"))},
         "resampled": series.resampled,
         "sample_rate": rate,
         "v_slide": v_slide,
@@ -167,6 +168,9 @@ def build_result(
         "seconds": time.perf_counter() - t_start,
         **sim_info,
     }
+    caveat = bias_caveat(options.get("window_bias"))
+    if caveat:
+        info["caveats"] = [caveat]
     if key == "lugre":
         info["passivity"] = passivity(param_names, values, low, high)
         if not info["passivity"]["passive"]:
@@ -185,6 +189,11 @@ def build_result(
         "trajectory": info,
     }
     return fitted
+
+
+def _bias(record: dict[str, Any] | None) -> dict[str, Any]:
+    """The derivative window's predicted biases, for the provenance (:mod:`._window`)."""
+    return {} if record is None else {"bias": record}
 
 
 def _budget(fits: list, max_evals: int | None) -> int | None:

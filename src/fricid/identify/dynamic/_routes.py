@@ -65,6 +65,9 @@ class _Stage:
     rms: dict[str, float]
     bounds: np.ndarray
     problem: Problem | None = None
+    #: the regression's columns (its predictions' derivatives, ``(n, p)``), for
+    #: :func:`._window.predicted_bias`
+    columns: np.ndarray | None = None
 
     def table(self) -> dict[str, dict[str, float]]:
         return {
@@ -165,7 +168,7 @@ def _regression(series, vf, acc, mask, model, gravity, method, seed, max_evals, 
     high = np.minimum(p_hat + tq * se, box[:, 1])
     rms = {"torque": float(np.sqrt(np.mean(r0**2)))}
     seconds = time.perf_counter() - t0
-    stage = _Stage(names, p_hat, se, low, high, cov, result, seconds, g, rms, box, search)
+    stage = _Stage(names, p_hat, se, low, high, cov, result, seconds, g, rms, box, search, -Jm)
     return stage, theta, c, r0
 
 

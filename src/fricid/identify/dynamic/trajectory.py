@@ -157,15 +157,13 @@ import time
 from collections.abc import Callable
 from typing import Any
 
-import numpy as np
-
 from ...errors import ConfigError, DataError
 from ...fitted import FittedModel
-from ...models import dahl, get_model, lugre
+from ...models import get_model
 from ...samples import RawLog, check_trajectory_log
-from ._data import DerivativeFilter, check_dissipates, derivatives, dilate, uniform_series
+from ._data import DerivativeFilter, check_dissipates, sliding, uniform_series
 from ._encoder import measurement
-from ._filtered import DAHL, LUGRE, ParallelFilter, filtered_route
+from ._filtered import ParallelFilter, dahl_start, filtered_route, lugre_start
 from ._outcome import (
     RATE_BIAS,
     PassivityWarning,
@@ -182,9 +180,11 @@ from ._response import follows, reidentifier, response_notes
 from ._result import build_result
 from ._routes import JOINT_PARAMS, _regression
 from ._simroute import simulation_route
+from ._window import DerivativeBiasWarning, choose_window
 
 __all__ = [
     "ROUTES",
+    "DerivativeBiasWarning",
     "DerivativeFilter",
     "ParallelFilter",
     "PassivityWarning",
@@ -345,7 +345,7 @@ def fit_trajectory(
         raise ConfigError(f"output_error must be auto, on or off, got '{output_error}'")
     if rate_bias not in RATE_BIAS:
         raise ConfigError(f"rate_bias must be 'warn' or 'off', got '{rate_bias}'")
-    derivative = derivative or DerivativeFilter()
+    derivative, chosen = derivative or DerivativeFilter(), derivative is None
     t_start = time.perf_counter()
     say = _stages(key, route, rate_bias, progress)
     say("checking the log, derivatives")
@@ -353,14 +353,7 @@ def fit_trajectory(
     series = uniform_series(log)
     rate = 1.0 / series.dt
     encoder = measurement(series.position, series.velocity, series.dt, encoder_counts)
-    vf, acc = derivatives(series, derivative)
-    half = (
-        derivative.samples(rate) // 2
-        if derivative.method == "savgol"
-        else int(rate / derivative.cutoff)
-    )
-    mask = ~dilate(np.abs(vf) < v_slide, half, max(half, round(guard * rate)))
-    mask[:half], mask[mask.size - half :] = False, False  # the filter's edges: extrapolated
+    vf, acc, mask = sliding(series, derivative, v_slide, guard)
     slides = mask.sum() >= MIN_SLIDING
     if key == "lugre" and route in ("filtered", "two_stage", "presliding") and not slides:
         if progress is not None:
@@ -404,9 +397,21 @@ def fit_trajectory(
     cluster_n = max(round(cluster_time * rate), 1)
     check_dissipates(series, vf, acc, mask, cluster_n, log.source)
     say("regression: static friction, inertia, gravity")
-    stage1, _theta_s, c, r1 = _regression(
-        series, vf, acc, mask, static_model, gravity, method, seed, max_evals, cluster_n, fixed
-    )
+    args = (static_model, gravity, method, seed, max_evals, cluster_n, fixed)
+
+    def regress(filt: DerivativeFilter):  # the regression at a derivative window
+        vf, acc, mask = sliding(series, filt, v_slide, guard)
+        if mask.sum() < MIN_SLIDING:
+            return None
+        return (vf, acc, mask, *_regression(series, vf, acc, mask, *args))
+
+    fit, window_bias = regress(derivative), None
+    if key in STATIC_MODELS:  # J and the static law are the regression's (._window)
+        say("derivative window: the encoder's noise in the acceleration")
+        derivative, fit, window_bias = choose_window(
+            series, derivative, fit, regress if chosen else lambda filt: None
+        )
+    vf, acc, mask, stage1, _theta_s, c, r1 = fit
     stages = {"regression": stage1}
     rename = {"lugre": _STATIC_OF_LUGRE, "dahl": _STATIC_OF_DAHL}.get(key, {})
     joint_vals = dict(zip(JOINT_PARAMS, [*list(c), 0.0, 0.0], strict=False))
@@ -443,7 +448,7 @@ def fit_trajectory(
     if key == "dahl" or (key == "lugre" and route == "filtered"):
         parallel = parallel or ParallelFilter()
         say(f"filtered route: every {'Dahl' if key == 'dahl' else 'LuGre'} parameter")
-        start, box, law = (_dahl_start if key == "dahl" else _lugre_start)(stage1, static_tab)
+        start, box, law = (dahl_start if key == "dahl" else lugre_start)(stage1, static_tab)
         stage, y, r = filtered_route(
             series,
             start,
@@ -553,8 +558,13 @@ def fit_trajectory(
             "t_start": t_start,
             "rename": rename,
             "notes": notes,
+            "window_bias": window_bias,
         },
-        sim_info={**sim_info, "encoder": encoder, "estimator": estimator(key, route, sim_info)},
+        sim_info={
+            **sim_info,
+            "encoder": encoder,
+            "estimator": estimator(key, route, sim_info, window_bias is not None),
+        },
     )
     say("done")
     return result
@@ -568,7 +578,7 @@ def _stages(
     n = 3
     if key == "lugre":
         n += 1 + (route == "filtered") * (1 + 2 * (rate_bias == "warn"))
-    elif key == "dahl":
+    else:  # Dahl's filtered route; a static model's derivative window
         n += 1
     count = [0]
 
@@ -578,23 +588,3 @@ def _stages(
         count[0] += 1
 
     return say
-
-
-def _lugre_start(stage1, static_tab):
-    """LuGre's start (sigma_0, sigma_1 at 1e4 and 1, the static levels from the regression),
-    the static levels' box from the regression's, and the law."""
-    start = np.array([1e4, 1.0] + [static_tab[n]["value"] for n in lugre.PARAM_NAMES[2:]])
-    order = [stage1.names.index(n) for n in ("tau_v", "tau_c", "tau_s", "w_s", "delta")]
-    return start, stage1.bounds[order], LUGRE
-
-
-def _dahl_start(stage1, static_tab):
-    """Dahl's start and box (sigma_0, tau_c, alpha, sigma_2), from the ``coulomb_viscous``
-    regression, and the law."""
-    order = [stage1.names.index(n) for n in ("f_c", "beta")]
-    (c_lo, c_hi), (v_lo, v_hi) = stage1.bounds[order]
-    alpha = next(p for p in dahl.PARAMETERS if p.name == "alpha")
-    bounds = np.array([(max(c_lo, 1e-3 * c_hi), c_hi), (alpha.lower, alpha.upper), (v_lo, v_hi)])
-    tau_c = float(np.clip(static_tab["tau_c"]["value"], *bounds[0]))
-    sigma_2 = float(np.clip(static_tab["sigma_2"]["value"], *bounds[2]))
-    return np.array([1e4, tau_c, alpha.default, sigma_2]), bounds, DAHL
