@@ -242,7 +242,10 @@ def cluster_covariance(
     -------
     cov : ndarray (p, p)
         Covariance (NaN rows and columns for undetermined parameters), its diagonal raised to
-        the plain estimate's where that is larger.
+        the plain estimate's where that is larger. The determined parameters' covariance is
+        taken with the others held at their estimates (a Stribeck law fitted to a log without
+        a rise leaves ``w_s`` and ``delta`` without effect; their NaN rows had made every
+        standard error NaN, J's and the gravity's too).
     stderr : ndarray (p,)
     clusters : int
         The number of clusters G (the t quantile takes G - 1 degrees of freedom).
@@ -250,6 +253,11 @@ def cluster_covariance(
     n, p = J.shape
     dof = max(n - p, 1)
     plain, determined = covariance_svd(J, float(r @ r) / dof)
+    if 0 < determined.sum() < p:
+        sub, sub_se, g = cluster_covariance(J[:, determined], r, labels)
+        cov, se = np.full((p, p), np.nan), np.full(p, np.nan)
+        cov[np.ix_(determined, determined)], se[determined] = sub, sub_se
+        return cov, se, g
     bread, _ = covariance_svd(J, 1.0)
     uniq, inv = np.unique(labels, return_inverse=True)
     g = len(uniq)
