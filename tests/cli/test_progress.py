@@ -279,9 +279,10 @@ def test_fit_trajectory_names_each_stage_and_its_place(no_grace, tmp_path):
     res = run(*args)
     assert res.exit_code == 0, res.output
     lines = progress_lines(res.stderr)
-    assert any("[1/3] checking the log" in ln for ln in lines), lines
-    assert any("[2/3] regression: static friction, inertia, gravity" in ln for ln in lines)
-    assert any("[3/3] intervals, passivity" in ln for ln in lines), lines
+    assert any("[1/4] checking the log" in ln for ln in lines), lines
+    assert any("[2/4] regression: static friction, inertia, gravity" in ln for ln in lines)
+    assert any("[3/4] derivative window: the encoder's noise" in ln for ln in lines), lines
+    assert any("[4/4] intervals, passivity" in ln for ln in lines), lines
     assert not any(" left" in ln for ln in lines), lines
     res = run(*args[:-2], "-q", "--out", tmp_path / "q.json")
     assert res.exit_code == 0 and not progress_lines(res.stderr)

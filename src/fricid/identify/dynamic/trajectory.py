@@ -180,7 +180,7 @@ from ._response import follows, reidentifier, response_notes
 from ._result import build_result
 from ._routes import JOINT_PARAMS, _regression
 from ._simroute import simulation_route
-from ._window import DerivativeBiasWarning, choose_window
+from ._window import DerivativeBiasWarning, choose_window, corrected
 
 __all__ = [
     "ROUTES",
@@ -412,6 +412,7 @@ def fit_trajectory(
             series, derivative, fit, regress if chosen else lambda filt: None
         )
     vf, acc, mask, stage1, _theta_s, c, r1 = fit
+    stage1 = corrected(stage1, window_bias)
     stages = {"regression": stage1}
     rename = {"lugre": _STATIC_OF_LUGRE, "dahl": _STATIC_OF_DAHL}.get(key, {})
     joint_vals = dict(zip(JOINT_PARAMS, [*list(c), 0.0, 0.0], strict=False))
