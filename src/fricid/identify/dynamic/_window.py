@@ -74,6 +74,7 @@ import numpy as np
 from scipy import signal
 
 from ...errors import FricidWarning, user_stacklevel
+from ..static.uncertainty import DETERMINED_RCOND
 from ._data import DerivativeFilter, Series
 
 __all__ = [
@@ -168,7 +169,12 @@ def predicted_bias(series: Series, filt: DerivativeFilter, stage, mask) -> dict[
     j = stage.names.index("inertia")
     acc, noise = _noise(series, filt)
     bend = _distortion(series, filt, acc, noise)[mask]
-    c_noise, c_bend = np.linalg.lstsq(cols, np.column_stack([noise[mask], bend]), rcond=None)[0].T
+    norms = np.linalg.norm(cols, axis=0)
+    norms[norms == 0] = 1.0
+    errors = np.column_stack([noise[mask], bend])  # the directions the data see, as the intervals
+    c_noise, c_bend = (np.linalg.lstsq(cols / norms, errors, rcond=DETERMINED_RCOND)[0].T) / norms
+    seen = np.isfinite(stage.stderr) & (stage.stderr > 0)
+    c_noise, c_bend = np.where(seen, c_noise, 0.0), np.where(seen, c_bend, 0.0)
     c = c_noise + c_bend
     inertia = stage.values[j] / (1.0 - min(c[j], MAX_SHARE))
     se = np.where(stage.stderr > 0, stage.stderr, np.inf)
@@ -238,7 +244,8 @@ def choose_window(
 
 
 def corrected(stage, record: dict[str, Any] | None):
-    """``stage`` less its predicted biases (``record``, :func:`predicted_bias`), each
+    """``stage`` less its predicted biases (``record``, :func:`predicted_bias`; within the
+    search box), each
     standard error widened by :data:`CORRECTION_ERROR` of its correction (in quadrature)
     and each interval by the same factor about the corrected value, within the search box;
     ``record["applied"]`` set."""
@@ -248,7 +255,7 @@ def corrected(stage, record: dict[str, Any] | None):
     se = np.sqrt(stage.stderr**2 + (CORRECTION_ERROR * b) ** 2)
     with np.errstate(invalid="ignore", divide="ignore"):
         grow = np.where(stage.stderr > 0, se / stage.stderr, 1.0)
-    values = stage.values - b
+    values = np.clip(stage.values - b, stage.bounds[:, 0], stage.bounds[:, 1])
     low = np.maximum(values - (stage.values - stage.low) * grow, stage.bounds[:, 0])
     high = np.minimum(values + (stage.high - stage.values) * grow, stage.bounds[:, 1])
     cov = stage.cov + np.diag((CORRECTION_ERROR * b) ** 2)

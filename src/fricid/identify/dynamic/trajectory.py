@@ -56,7 +56,8 @@ there, and sees the Stribeck region only outside guards around the reversals; th
 route uses every sample with LuGre's own friction. ``route="joint"`` refines everything by
 the simulation error from the two-stage estimate. ``static=`` (a ``stribeck`` fit from
 sweeps) takes the static part from the sweeps; it runs ``two_stage`` (only J, p_x, p_y are
-then regressed). Static models (``stribeck``, ``coulomb_viscous``) take the regression.
+then regressed). Static models (``stribeck``, ``coulomb_viscous`` and their per-direction
+``_asym`` forms) take the regression.
 Dahl (:mod:`fricid.models.dahl`) takes the filtered route only, started from a
 ``coulomb_viscous`` regression (its steady state: tau_c, sigma_2 = the viscous coefficient),
 sigma_0 searched as log10 as LuGre's; no rate-bias estimate (that simulation is LuGre's).
@@ -204,7 +205,7 @@ MIN_SLIDING = 50
 OUTPUT_ERROR = ("auto", "on", "off")
 
 #: Static models a trajectory identifies by regression.
-STATIC_MODELS = ("stribeck", "coulomb_viscous")
+STATIC_MODELS = ("stribeck", "coulomb_viscous", "stribeck_asym", "coulomb_viscous_asym")
 
 #: Dynamic models a trajectory identifies.
 DYNAMIC_MODELS = ("lugre", "dahl")
@@ -251,7 +252,8 @@ def fit_trajectory(
     log : RawLog
         Time, position, velocity, torque (or current with K), temperature; any reader's.
     model : str
-        ``lugre`` or ``dahl`` (dynamic), or a static model: ``stribeck``, ``coulomb_viscous``.
+        ``lugre`` or ``dahl`` (dynamic), or a static model: ``stribeck``, ``coulomb_viscous``
+        or either per direction (``stribeck_asym``, ``coulomb_viscous_asym``).
     method : str
         Any fricid optimiser (:data:`fricid.optim.METHODS`), used by both routes.
     route : str
