@@ -13,7 +13,9 @@ Printed per joint: the RMS error of the per-direction friction samples [N m] by 
 masses (not identified), by the single-joint path (eq. 7 of the BAS-RBFNN paper, joint fit),
 the RMS friction and the RMS standard error of the arm path; then, over ``--seeds`` seeds,
 the share of 95 % intervals (+-1.96 standard errors) that hold the truth, for the set-point
-frictions and the base gravity parameters.
+frictions and the base gravity parameters; and each joint's per-direction Coulomb-viscous law
+fitted to its extracted samples (``coulomb_viscous_asym``): per parameter the median relative
+error and the share of 95 % intervals that hold the truth.
 
 Run: ``python benchmarks/bench_arm_sweeps.py [--seeds 20]``.
 """
@@ -31,6 +33,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 from _arm_sweeps import Law, arm_sweeps, perturbed
 from fricid.extract import extract, extract_arm
+from fricid.identify import fit
 from fricid.robot import RigidBodyModel, base_parameters, example_urdf
 
 PANDA = ("panda_joint2", "panda_joint4", "panda_joint6")
@@ -91,11 +94,41 @@ def errors(case, seed: int):
             rms(se),
         )
     g = res.gravity
+    params = {joint: law_fit(res[joint], law) for joint, law in laws.items()}
     beta_true = base_parameters(ident, gravity_only=True).project(truth.parameters())
     z_levels = [
         (lv["friction"] - laws[lv["joint"]](lv["velocity"])) / lv["friction_se"] for lv in g.levels
     ]
-    return rows, np.abs(z_levels), np.abs((g.beta - beta_true) / g.beta_se)
+    return rows, np.abs(z_levels), np.abs((g.beta - beta_true) / g.beta_se), params
+
+
+#: The per-direction Coulomb-viscous law's parameters and the truth's fields.
+LAW_PARAMS = {"f_c_pos": "fc_pos", "beta_pos": "fv_pos", "f_c_neg": "fc_neg", "beta_neg": "fv_neg"}
+
+
+def law_fit(samples, law) -> dict[str, tuple[float, bool]]:
+    """The joint's ``coulomb_viscous_asym`` fit to its extracted samples: each parameter's
+    relative error and whether its 95 % interval holds the truth."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        fitted = fit(samples, "coulomb_viscous_asym")
+    out = {}
+    for name, field in LAW_PARAMS.items():
+        p, truth = fitted.parameters[name], getattr(law, field)
+        out[name] = (p.value / truth - 1.0, bool(p.ci95[0] <= truth <= p.ci95[1]))
+    return out
+
+
+def law_table(per_seed: list[dict]) -> None:
+    """Per joint and parameter: the median relative error and the intervals' coverage."""
+    print(f"{'joint':14s} " + " ".join(f"{n + ' err/cov':>19s}" for n in LAW_PARAMS))
+    for joint in per_seed[0]:
+        cells = []
+        for name in LAW_PARAMS:
+            err = [abs(s[joint][name][0]) for s in per_seed]
+            cov = [s[joint][name][1] for s in per_seed]
+            cells.append(f"{100 * np.median(err):9.2f}% {100 * np.mean(cov):7.1f}%")
+        print(f"{joint:14s} " + " ".join(f"{c:>19s}" for c in cells))
 
 
 def simulated() -> None:
@@ -137,22 +170,25 @@ def main() -> None:
     for make in (pendulum, panda):
         case = make()
         t0 = time.perf_counter()
-        rows, _, _ = errors(case, 0)
+        rows, _, _, _ = errors(case, 0)
         print(f"\n{case[0]} (seed 0; N m RMS over the per-direction samples)")
         print(f"{'joint':14s} {'arm':>8s} {'URDF':>8s} {'eq. 7':>8s} {'friction':>9s} {'se':>8s}")
         for joint, r in rows.items():
             print(f"{joint:14s} " + " ".join(f"{x:8.4f}" for x in r))
-        zl, zb = [], []
+        zl, zb, laws = [], [], []
         for seed in range(args.seeds):
-            _, a, b = errors(case, seed)
+            _, a, b, params = errors(case, seed)
             zl.extend(a)
             zb.extend(b[np.isfinite(b)])
+            laws.append(params)
         zl, zb = np.array(zl), np.array(zb)
         print(
             f"95 % interval coverage over {args.seeds} seeds: set-point frictions "
             f"{np.mean(zl < 1.96):.3f} ({zl.size}), base gravity parameters "
             f"{np.mean(zb < 1.96):.3f} ({zb.size}); {time.perf_counter() - t0:.0f} s"
         )
+        print(f"each joint's coulomb_viscous_asym fit to its samples, over {args.seeds} seeds:")
+        law_table(laws)
     simulated()
 
 

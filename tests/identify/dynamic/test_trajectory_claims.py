@@ -9,11 +9,14 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from _bench_fit import fit_bench_log
+from tests._paths import REPO
 
 from fricid.fitted import Parameter
+from fricid.identify.dynamic._outcome import LUGRE_COVERAGE
 from fricid.identify.dynamic._result import unresolved_rise
 from fricid.identify.problem import ResidualProblem
 from fricid.identify.static.convergence import certify, settle
+from fricid.identify.trust import assess_trust
 from fricid.optim import OptimizeResult
 
 
@@ -126,3 +129,39 @@ def test_short_search_settles_and_intervals_are_given(tmp_path):
         if not p.not_determined and p.ci95[0] <= truth[n] <= p.ci95[1]
     ]
     assert len(covered) >= 6
+
+
+@pytest.mark.slow  # about 2 s: a 10 s log at 200 Hz identified
+def test_a_lugre_fit_says_its_intervals_are_not_calibrated_on_foreign_logs(tmp_path):
+    fitted, _ = fit_bench_log("geared", "chirp_pd", 200.0, 2**17, 0, tmp_path)
+    trust = assess_trust(fitted)
+    assert trust.level != "yes"
+    assert any(r.startswith("LuGre's intervals are not calibrated") for r in trust.reasons)
+
+
+def _last_block(lines: list[str], title: str) -> dict[str, list[str]]:
+    """The rows of the last table headed ``title`` in the benchmark's results file."""
+    start = max(i for i, line in enumerate(lines) if line.startswith(title))
+    rows = {}
+    for line in lines[start + 2 :]:
+        if not line.strip():
+            break
+        rows[line.split()[0]] = line.split()[1:]
+    return rows
+
+
+def test_the_quoted_coverage_is_the_benchmarks_last_result():
+    """The caveat's numbers (``LUGRE_COVERAGE``) are the last report block of
+    ``benchmarks/results/lugre_claims.txt``, not typed apart from it."""
+    lines = (REPO / "benchmarks" / "results" / "lugre_claims.txt").read_text().splitlines()
+    kinds = _last_block(lines, "## per kind")
+    names = {"PD-tracked chirps": "chirp_pd", "PD-tracked trapezoids": "trapezoid_pd"}
+    names["open-loop torque steps"] = "torque_steps"
+    for label, (covered, claimed) in LUGRE_COVERAGE["kinds"].items():
+        cell = kinds[names[label]][11]  # after the fits and the ten parameters' errors
+        assert cell.split("+")[0] == f"{covered}/{claimed}", (label, cell)
+    per = _last_block(lines, "## coverage of the 95 % intervals per parameter, per kind")
+    columns = {"sigma_1": 1, "tau_s": 4, "w_s": 5, "delta": 6}
+    for name, (covered, claimed) in LUGRE_COVERAGE["parameters"].items():
+        cells = [row[columns[name]].split("+")[0].split("/") for row in per.values()]
+        assert (sum(int(c) for c, _ in cells), sum(int(n) for _, n in cells)) == (covered, claimed)

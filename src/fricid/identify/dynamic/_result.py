@@ -26,7 +26,7 @@ from ...metrics import fit_statistics, metrics
 from ...models import get_model, lugre
 from ...samples import RawLog
 from ._data import Series
-from ._outcome import PassivityWarning, converged, passivity
+from ._outcome import PassivityWarning, converged, lugre_caveat, passivity
 from ._routes import JOINT_PARAMS
 from ._window import bias_caveat
 
@@ -168,9 +168,9 @@ def build_result(
         "seconds": time.perf_counter() - t_start,
         **sim_info,
     }
-    caveat = bias_caveat(options.get("window_bias"))
-    if caveat:
-        info["caveats"] = [caveat]
+    caveats = [bias_caveat(options.get("window_bias")), lugre_caveat() if key == "lugre" else ""]
+    if any(caveats):
+        info["caveats"] = [c for c in caveats if c]
     if key == "lugre":
         info["passivity"] = passivity(param_names, values, low, high)
         if not info["passivity"]["passive"]:
