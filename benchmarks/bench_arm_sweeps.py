@@ -94,7 +94,7 @@ def errors(case, seed: int):
             rms(se),
         )
     g = res.gravity
-    params = {joint: law_fit(res[joint], law) for joint, law in laws.items()}
+    params = {joint: law_fit(res[joint].by_direction, law) for joint, law in laws.items()}
     beta_true = base_parameters(ident, gravity_only=True).project(truth.parameters())
     z_levels = [
         (lv["friction"] - laws[lv["joint"]](lv["velocity"])) / lv["friction_se"] for lv in g.levels
