@@ -60,6 +60,7 @@ def _derivative_lines(d: dict) -> list[str]:
             f"acceleration's variance, the filter bends the motion {100 * b['distortion']:+.2f} "
             f"%: predicted inertia bias {100 * b['relative']:+.2f} %, the largest "
             f"{b['over_stderr'][worst]:.2f} standard errors ({worst})"
+            + ("; corrected" if b.get("applied") else "")
         )
     return lines
 
