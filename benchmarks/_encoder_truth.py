@@ -15,8 +15,16 @@ from fricid.samples import RawLog
 TRUTH = {"inertia": 0.02, "f_c": 0.4, "beta": 0.15, "p_x": -0.25, "p_y": 0.08}
 
 
-def encoder_log(seed: int, counts: float, rate: float = 1000.0, seconds: float = 20.0) -> RawLog:
-    """A joint moved along three sines of random frequency (0.2-0.9 Hz), its torque
+def encoder_log(
+    seed: int,
+    counts: float,
+    rate: float = 1000.0,
+    seconds: float = 20.0,
+    band: tuple[float, float] = (0.2, 0.9),
+    amplitudes: tuple[float, float, float] = (0.5, 0.3, 0.2),
+) -> RawLog:
+    """A joint moved along three sines of random frequency in ``band`` [Hz] and the
+    ``amplitudes`` [rad], its torque
     ``J qdd + f_c tanh(v / 2e-3) + beta v - (p_x cos q - p_y sin q)`` (fricid's gravity sign)
     plus 5 mN m of noise, the
     position read through an encoder of ``counts`` per revolution (rounded: a floor would move
@@ -26,7 +34,7 @@ def encoder_log(seed: int, counts: float, rate: float = 1000.0, seconds: float =
     q = np.zeros_like(t)
     v = np.zeros_like(t)
     a = np.zeros_like(t)
-    sines = zip((0.5, 0.3, 0.2), rng.uniform(0.2, 0.9, 3), rng.uniform(0, 6.3, 3), strict=True)
+    sines = zip(amplitudes, rng.uniform(*band, 3), rng.uniform(0, 6.3, 3), strict=True)
     for amp, f, ph in sines:
         w = 2 * np.pi * f
         q += amp * np.sin(w * t + ph)

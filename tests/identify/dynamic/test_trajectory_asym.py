@@ -56,3 +56,11 @@ def test_stribeck_per_direction_keeps_every_value_in_its_box_and_interval():
         if p.ci95[0] is not None and np.isfinite(p.ci95[0]):
             assert p.ci95[0] <= p.value <= p.ci95[1], (name, p)
     assert fitted.parameters["tau_c_neg"].value == pytest.approx(TRUTH["f_c_neg"], rel=0.02)
+
+
+def test_a_symmetric_law_on_per_direction_friction_says_so():
+    """Fitted with coulomb_viscous, a per-direction law's difference went into p_x (16.6
+    half-widths off on a new user's log) with no caveat."""
+    fitted = fit_trajectory(asymmetric_log(5), "coulomb_viscous")
+    caveats = fitted.provenance["trajectory"].get("caveats", [])
+    assert any("differs by direction" in c and "coulomb_viscous_asym" in c for c in caveats)

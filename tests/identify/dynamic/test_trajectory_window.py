@@ -47,6 +47,8 @@ def test_a_coarse_encoder_gets_a_wider_window_and_intervals_that_cover(seed):
     assert low <= TRUTH["inertia"] <= high and abs(got["inertia"][0] / TRUTH["inertia"] - 1) < 0.03
     z = {n: (v - TRUTH[n]) / ((hi - lo) / 3.92) for n, (v, lo, hi) in got.items()}
     assert all(abs(x) < 3.0 for x in z.values()), z  # before: J's z about -70
+    caveats = fitted.provenance["trajectory"].get("caveats", [])
+    assert not any("differs by direction" in c for c in caveats), caveats
 
 
 def test_a_given_window_is_kept_corrected_and_warned_about():
@@ -72,3 +74,32 @@ def test_a_fine_encoder_keeps_the_default_window():
     assert d["window"] == pytest.approx(0.021) and "widened_from" not in d["bias"]
     got = estimates(fitted)
     assert all(lo <= TRUTH[n] <= hi for n, (_, lo, hi) in got.items()), got
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_a_fast_small_oscillation_keeps_its_samples(seed):
+    """2-5 Hz through about 50 counts of 4096: the joint slows down every 0.1 s, and the 0.2 s
+    guard after each slow stretch had left 365-886 of 20000 samples (J 0.0015-0.0047 for
+    0.02); the guard is now a quarter of the median sliding stretch at most."""
+    log = encoder_log(seed, 4096, band=(2.0, 5.0), amplitudes=(0.02, 0.012, 0.008))
+    fitted = fit_trajectory(log, "coulomb_viscous")
+    assert fitted.statistics["ndata"] > 0.4 * log.time.size
+    got = estimates(fitted)
+    assert abs(got["inertia"][0] / TRUTH["inertia"] - 1) < 0.05
+    assert abs(got["f_c"][0] / TRUTH["f_c"] - 1) < 0.02
+
+
+def test_stribeck_without_a_rise_keeps_every_interval_around_its_value():
+    """A correction is not applied where the interval reaches the search box: a delta with a
+    standard error of 25 in [0.2, 4] had been moved to the far bound, its interval [0.2,
+    0.2]."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        fitted = fit_trajectory(encoder_log(0, 4096), "stribeck")
+    for name, p in fitted.parameters.items():
+        if p.stderr is not None and p.stderr > 0 and p.ci95[0] is not None:
+            assert p.ci95[0] < p.ci95[1] and p.ci95[0] <= p.value <= p.ci95[1], (name, p)
+    bias = fitted.provenance["trajectory"]["derivative"]["bias"]
+    assert "delta" in bias["not_applied"]
+    low, high = fitted.parameters["tau_c"].ci95
+    assert low <= TRUTH["f_c"] <= high

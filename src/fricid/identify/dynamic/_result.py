@@ -168,7 +168,11 @@ def build_result(
         "seconds": time.perf_counter() - t_start,
         **sim_info,
     }
-    caveats = [bias_caveat(options.get("window_bias")), lugre_caveat() if key == "lugre" else ""]
+    caveats = [
+        bias_caveat(options.get("window_bias")),
+        options.get("direction", ""),
+        lugre_caveat() if key == "lugre" else "",
+    ]
     if any(caveats):
         info["caveats"] = [c for c in caveats if c]
     if key == "lugre":

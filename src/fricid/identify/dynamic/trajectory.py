@@ -170,6 +170,7 @@ from ._outcome import (
     PassivityWarning,
     RateBiasWarning,
     calibrate,
+    direction_caveat,
     estimator,
     warn_rate_bias,
 )
@@ -181,7 +182,7 @@ from ._response import follows, reidentifier, response_notes
 from ._result import build_result
 from ._routes import JOINT_PARAMS, _regression
 from ._simroute import simulation_route
-from ._window import DerivativeBiasWarning, choose_window, corrected
+from ._window import DerivativeBiasWarning, choose_window, corrected, per_direction
 
 __all__ = [
     "ROUTES",
@@ -355,7 +356,7 @@ def fit_trajectory(
     series = uniform_series(log)
     rate = 1.0 / series.dt
     encoder = measurement(series.position, series.velocity, series.dt, encoder_counts)
-    vf, acc, mask = sliding(series, derivative, v_slide, guard)
+    vf, acc, mask = sliding(series, derivative, v_slide, guard, short=key in STATIC_MODELS)
     slides = mask.sum() >= MIN_SLIDING
     if key == "lugre" and route in ("filtered", "two_stage", "presliding") and not slides:
         if progress is not None:
@@ -402,7 +403,7 @@ def fit_trajectory(
     args = (static_model, gravity, method, seed, max_evals, cluster_n, fixed)
 
     def regress(filt: DerivativeFilter):  # the regression at a derivative window
-        vf, acc, mask = sliding(series, filt, v_slide, guard)
+        vf, acc, mask = sliding(series, filt, v_slide, guard, short=key in STATIC_MODELS)
         if mask.sum() < MIN_SLIDING:
             return None
         return (vf, acc, mask, *_regression(series, vf, acc, mask, *args))
@@ -411,10 +412,12 @@ def fit_trajectory(
     if key in STATIC_MODELS:  # J and the static law are the regression's (._window)
         say("derivative window: the encoder's noise in the acceleration")
         derivative, fit, window_bias = choose_window(
-            series, derivative, fit, regress if chosen else lambda filt: None
+            series, derivative, fit, regress if chosen else lambda filt: None, static_model
         )
     vf, acc, mask, stage1, _theta_s, c, r1 = fit
-    stage1 = corrected(stage1, window_bias)
+    stage1, direction = corrected(stage1, window_bias), ""
+    if key == "coulomb_viscous":  # a per-direction law fits better? (._outcome)
+        direction = direction_caveat(per_direction(series, derivative, vf, acc, mask, args))
     stages = {"regression": stage1}
     rename = {"lugre": _STATIC_OF_LUGRE, "dahl": _STATIC_OF_DAHL}.get(key, {})
     joint_vals = dict(zip(JOINT_PARAMS, [*list(c), 0.0, 0.0], strict=False))
@@ -562,6 +565,7 @@ def fit_trajectory(
             "rename": rename,
             "notes": notes,
             "window_bias": window_bias,
+            "direction": direction,
         },
         sim_info={
             **sim_info,
