@@ -61,9 +61,9 @@ counts   inertia      f_c          beta         p_x          p_y          J's me
 ======== ============ ============ ============ ============ ============ ==================
 
 (p_x's 16 of 20 at 16384 and 2^20 counts is these seeds' luck: over seeds 100-139 its error
-over its standard error has an RMS of 1.01-1.05 at 16384, 2^17 and 2^20 counts.) The seconds of a static trajectory fit
-grow up to 5 times (a regression per window tried: a tenth of a second each for
-``coulomb_viscous``).
+over its standard error has an RMS of 1.01-1.05 at 16384, 2^17 and 2^20 counts.) The seconds
+of a static trajectory fit grow up to 5 times (a regression per window tried: a tenth of a
+second each for ``coulomb_viscous``).
 """
 
 from __future__ import annotations
