@@ -90,8 +90,8 @@ __all__ = [
     "predicted_bias",
 ]
 
-#: Largest predicted bias from the encoder's noise, over the parameter's standard error, in
-#: the window chosen; and the total predicted bias above which it is warned about.
+#: Largest predicted bias, over the parameter's standard error, at which a window is kept
+#: (:func:`choose_window`).
 BIAS_SHARE = 0.5
 #: Ratio of one window of the ladder to the next; bisections between the two that bracket
 #: J's predicted bias changing sign.
@@ -122,24 +122,22 @@ class DerivativeBiasWarning(FricidWarning):
 
 
 def _noise(series: Series, filt: DerivativeFilter) -> tuple[np.ndarray, ...]:
-    """The filtered acceleration, its noise, and the filtered velocity's noise (the same
-    way): the filter's output less its output on the
-    position smoothed over :data:`REFERENCE` windows (the encoder's steps and any noise
-    are what that smoothing takes out, white or not; the motion it bends is bent far less
-    in the acceleration than the noise share :data:`BIAS_SHARE` is about). On the log of
-    the module notes this share matched J's error within a tenth of itself from 45 % down to
-    5 %; the white-noise formula ``Delta^2 / 12 sum h^2`` had overstated it twofold, as the
-    quantisation error of a joint moving less than a count per sample is not white."""
+    """The filtered acceleration and its noise, the filtered velocity and its noise: each the
+    filter's output less its output on the position smoothed over :data:`REFERENCE` windows
+    (the encoder's steps and any noise are what that smoothing takes out, white or not; the
+    motion it bends is bent far less than the noise share :data:`BIAS_SHARE` is about). On
+    the log of the module notes this share matched J's error within a tenth of itself from
+    45 % down to 5 %; the white-noise formula ``Delta^2 / 12 sum h^2`` had overstated it
+    twofold, as the quantisation error of a joint moving less than a count per sample is not
+    white."""
     m, dt = filt.samples(1.0 / series.dt), series.dt
     wide = min(REFERENCE * m, series.position.size - (series.position.size + 1) % 2)
     reference = signal.savgol_filter(series.position, wide | 1, filt.order + REFERENCE_ORDER)
-    acc = signal.savgol_filter(series.position, m, filt.order, deriv=2, delta=dt)
-    vel = signal.savgol_filter(series.position, m, filt.order, deriv=1, delta=dt)
-    return (
-        acc,
-        acc - signal.savgol_filter(reference, m, filt.order, deriv=2, delta=dt),
-        vel - signal.savgol_filter(reference, m, filt.order, deriv=1, delta=dt),
-    )
+    out = []
+    for deriv in (2, 1):
+        x = signal.savgol_filter(series.position, m, filt.order, deriv=deriv, delta=dt)
+        out += [x, x - signal.savgol_filter(reference, m, filt.order, deriv=deriv, delta=dt)]
+    return tuple(out)
 
 
 def _distortion(series: Series, filt: DerivativeFilter, acc, noise) -> np.ndarray:
@@ -183,14 +181,12 @@ def predicted_bias(
     if filt.method != "savgol" or cols is None or "inertia" not in stage.names:
         return None
     j = stage.names.index("inertia")
-    acc, noise, v_noise = _noise(series, filt)
+    acc, noise, vel, v_noise = _noise(series, filt)
     bend = _distortion(series, filt, acc, noise)[mask]
     friction = np.zeros(int(mask.sum()))
     if model is not None and stage.names[: model.n_params] == list(model.param_names):
         theta = stage.values[None, : model.n_params]
-        m = filt.samples(1 / series.dt)
-        vf = signal.savgol_filter(series.position, m, filt.order, deriv=1, delta=series.dt)[mask]
-        temperature = series.temperature[mask]
+        vf, temperature = vel[mask], series.temperature[mask]
         X = [np.column_stack([v, 0 * v, temperature]) for v in (vf, vf - v_noise[mask])]
         friction = model.predict(theta, X[0])[0] - model.predict(theta, X[1])[0]
     norms = np.linalg.norm(cols, axis=0)
@@ -287,13 +283,12 @@ def choose_window(
 
 
 def corrected(stage, record: dict[str, Any] | None):
-    """``stage`` less its predicted biases (``record``, :func:`predicted_bias`; within the
-    search box, and not for a parameter whose interval reaches the box: a stribeck delta with
-    a standard error of 25 in [0.2, 4] was moved by 31 to the far bound, its interval
-    [0.2, 0.2]), each
-    standard error widened by :data:`CORRECTION_ERROR` of its correction (in quadrature)
-    and each interval by the same factor about the corrected value, within the search box;
-    ``record["applied"]`` set."""
+    """``stage`` less its predicted biases (``record``, :func:`predicted_bias`), each standard
+    error widened by :data:`CORRECTION_ERROR` of its correction (in quadrature) and each
+    interval by the same factor about the corrected value, within the search box;
+    ``record["applied"]`` set. Not for a parameter whose interval reaches the box
+    (``record["not_applied"]``): a stribeck delta with a standard error of 25 in [0.2, 4]
+    had been moved by 31 to the far bound, its interval [0.2, 0.2]."""
     if record is None:
         return stage
     b = np.array([record["parameters"][n] for n in stage.names])
@@ -318,7 +313,12 @@ def bias_caveat(record: dict[str, Any] | None) -> str:
     (the interval is then more the correction's than the data's); '' otherwise."""
     if record is None:
         return ""
-    over = {n: r for n, r in record["over_stderr"].items() if CORRECTION_ERROR * r > 1.0}
+    skipped = set(record.get("not_applied", ()))
+    over = {
+        n: r
+        for n, r in record["over_stderr"].items()
+        if CORRECTION_ERROR * r > 1.0 and n not in skipped
+    }
     if not over:
         return ""
     named = ", ".join(f"{n} {record['parameters'][n]:+.3g} ({r:.1f} se)" for n, r in over.items())
