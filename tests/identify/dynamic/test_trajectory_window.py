@@ -16,6 +16,7 @@ import warnings
 import pytest
 from tests._paths import REPO
 
+from fricid.errors import ConfigError
 from fricid.identify.dynamic.trajectory import (
     DerivativeBiasWarning,
     DerivativeFilter,
@@ -103,3 +104,12 @@ def test_stribeck_without_a_rise_keeps_every_interval_around_its_value():
     assert "delta" in bias["not_applied"]
     low, high = fitted.parameters["tau_c"].ci95
     assert low <= TRUTH["f_c"] <= high
+
+
+def test_counts_coarser_than_the_position_are_refused():
+    """A 4096-count log given as 1024 counts per revolution had been accepted silently."""
+    log = encoder_log(0, 4096)
+    with pytest.raises(ConfigError, match=r"steps of 0\.001534 rad"):
+        fit_trajectory(log, "coulomb_viscous", encoder_counts=1024)
+    fitted = fit_trajectory(log, "coulomb_viscous", encoder_counts=4096)
+    assert fitted.provenance["trajectory"]["encoder"]["source"] == "option"

@@ -36,6 +36,10 @@ __all__ = ["VELOCITY_FORMS", "encoder_quantum", "measurement", "quantise", "velo
 #: that power (a log written with 7 decimals read 2^20 as 1048597: 2e-5 off).
 POWER_SNAP = 1e-4
 
+#: Relative amount by which the position's steps may be finer than the counts given before
+#: the counts are refused (a 4096-count log taken for 1024 had been accepted without a word).
+FINER = 0.01
+
 #: How the logged velocity can be formed from the positions.
 VELOCITY_FORMS = ("backward", "central", "logged")
 
@@ -84,13 +88,23 @@ def measurement(
     Raises
     ------
     ConfigError
-        ``encoder_counts`` not a positive finite number.
+        ``encoder_counts`` not a positive finite number, or coarser than the position's own
+        steps.
     """
     form = velocity_form(position, velocity, dt)
     if encoder_counts is not None:
         if not (math.isfinite(encoder_counts) and encoder_counts > 0):
             raise ConfigError(f"encoder_counts must be a positive number, got {encoder_counts}")
         quantum, source = 2.0 * math.pi / float(encoder_counts), "option"
+        seen = encoder_quantum(position)
+        if seen is not None and seen < quantum * (1.0 - FINER):
+            own = 2.0 * math.pi / seen
+            raise ConfigError(
+                f"{encoder_counts:g} encoder counts per revolution give steps of {quantum:.4g} "
+                f"rad, but the position moves in steps of {seen:.4g} rad ({own:.6g} counts per "
+                "revolution): leave the counts out to read them from the position, or give the "
+                "encoder's own"
+            )
     else:
         quantum, source = encoder_quantum(position), "position steps"
     if quantum is None:
