@@ -53,6 +53,8 @@ def _derivative_lines(d: dict) -> list[str]:
         wider = (
             f"widened from {1e3 * b['widened_from']:.0f} ms for the encoder's noise; "
             if b.get("widened_from")
+            else f"narrowed from {1e3 * b['narrowed_from']:.0f} ms for the motion; "
+            if b.get("narrowed_from")
             else ""
         )
         lines.append(

@@ -113,3 +113,15 @@ def test_counts_coarser_than_the_position_are_refused():
         fit_trajectory(log, "coulomb_viscous", encoder_counts=1024)
     fitted = fit_trajectory(log, "coulomb_viscous", encoder_counts=4096)
     assert fitted.provenance["trajectory"]["encoder"]["source"] == "option"
+
+
+def test_a_noise_free_fast_log_gets_a_narrower_window():
+    """Where the filter's bending outweighs the noise already, narrower windows are tried
+    (the trial's noise-free logs had been warned about at 21 ms)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        fitted = fit_trajectory(encoder_log(0, 2.0**40, band=(1.0, 3.0)), "coulomb_viscous")
+    d = fitted.provenance["trajectory"]["derivative"]
+    assert d["window"] < 0.015 and d["bias"]["narrowed_from"] == pytest.approx(0.021)
+    got = estimates(fitted)
+    assert all(lo <= TRUTH[n] <= hi for n, (_, lo, hi) in got.items()), got

@@ -37,7 +37,8 @@ position.) On the generator of ``benchmarks/bench_window.py`` (seeds 0-11, 4096 
 prediction put at -1.6).
 
 So: :func:`choose_window` widens the window by :data:`LADDER` steps while the noise outweighs
-the bending and some predicted bias exceeds :data:`BIAS_SHARE` of its standard error, then
+the bending and some predicted bias exceeds :data:`BIAS_SHARE` of its standard error (or
+narrows it while the bending outweighs the noise: a noise-free log's fast motion), then
 bisects to where J's predicted bias changes sign (the regression run again at each window
 tried); :func:`corrected` subtracts the predicted biases there and adds
 :data:`CORRECTION_ERROR` of each correction to its standard error. A window given by the
@@ -242,35 +243,45 @@ def choose_window(
     """The regression at the derivative window whose predicted biases cancel (module notes),
     ``fit`` being the regression at ``filt`` and ``regress`` running one at another window
     (None when too few samples slide there). Kept: ``filt`` when no predicted bias exceeds
-    :data:`BIAS_SHARE` of its standard error there, or when the bending already outweighs
-    the noise. Otherwise windows grow by :data:`LADDER` (at most :data:`MAX_WINDOW` s and
-    :data:`MAX_LOG_SHARE` of the log) until the biases are within that share or J's changes
-    sign, which :data:`BISECT` bisections then close in on; of the windows tried, the one of
-    the smallest largest bias is returned, with its fit and its :func:`predicted_bias`
-    (``widened_from``: ``filt``'s window)."""
+    :data:`BIAS_SHARE` of its standard error there. Otherwise windows grow by :data:`LADDER`
+    (at most :data:`MAX_WINDOW` s and :data:`MAX_LOG_SHARE` of the log), or shrink by it
+    where the bending outweighs the noise already (to the order's fewest samples), until
+    the biases are within that share or J's changes sign, which :data:`BISECT` bisections
+    then close in on; of the windows tried, the one of the smallest largest bias is
+    returned, with its fit and its :func:`predicted_bias` (``widened_from`` or
+    ``narrowed_from``: ``filt``'s window)."""
     record = predicted_bias(series, filt, fit[3], fit[2], model)
-    if record is None or _worst(record) <= BIAS_SHARE or record["relative"] > 0:
+    if record is None or _worst(record) <= BIAS_SHARE:
         return filt, fit, record
     rate = 1.0 / series.dt
     tried = [(filt, fit, record)]
+    narrower = record["relative"] > 0  # the bending outweighs the noise already
+    step = 1.0 / LADDER if narrower else LADDER
+    key = "narrowed_from" if narrower else "widened_from"
 
     def attempt(window: float) -> bool:
         """Regress at ``window``; whether the ladder or bisection can go on."""
-        wider = replace(filt, window=window)
-        again = regress(wider)
+        other = replace(filt, window=window)
+        again = regress(other)
         if again is None:
             return False
-        rec = predicted_bias(series, wider, again[3], again[2], model)
-        rec["widened_from"] = filt.window
-        tried.append((wider, again, rec))
+        rec = predicted_bias(series, other, again[3], again[2], model)
+        rec[key] = filt.window
+        tried.append((other, again, rec))
         return _worst(rec) > BIAS_SHARE
 
     longest = min(MAX_WINDOW, MAX_LOG_SHARE * series.time.size * series.dt)
+    shortest = (filt.order + 2) / rate
+
+    def within(window: float) -> bool:
+        differs = replace(filt, window=window).samples(rate) != tried[-1][0].samples(rate)
+        return shortest <= window <= longest and differs
+
     window = filt.window
-    while window * LADDER <= longest and attempt(window * LADDER):
-        window *= LADDER
-        if tried[-1][2]["relative"] > 0:  # past the crossing: bisect back
-            low, high = window / LADDER, window
+    while within(window * step) and attempt(window * step):
+        window *= step
+        if (tried[-1][2]["relative"] > 0) != narrower:  # past the crossing: bisect back
+            low, high = sorted((window / step, window))
             for _ in range(BISECT):
                 mid = np.sqrt(low * high)
                 if replace(filt, window=mid).samples(rate) in {
