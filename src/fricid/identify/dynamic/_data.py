@@ -190,12 +190,12 @@ def sliding(
     rate = 1.0 / series.dt
     vf, acc = derivatives(series, filt)
     half = filt.samples(rate) // 2 if filt.method == "savgol" else int(rate / filt.cutoff)
-    slow = dilate(np.abs(vf) < v_slide, half, half)
+    below = np.abs(vf) < v_slide
     after = round(guard * rate)
-    stretches = [b - a for a, b in runs(~slow)]
-    if short and stretches:
+    stretches = [b - a for a, b in runs(~dilate(below, half, half))] if short else []
+    if stretches:
         after = min(after, round(GUARD_SHARE * float(np.median(stretches))))
-    mask = ~dilate(np.abs(vf) < v_slide, half, max(half, after))
+    mask = ~dilate(below, half, max(half, after))
     mask[:half], mask[mask.size - half :] = False, False
     return vf, acc, mask
 

@@ -78,8 +78,10 @@ import numpy as np
 from scipy import signal
 
 from ...errors import FricidWarning, user_stacklevel
+from ...models import get_model
 from ..static.uncertainty import DETERMINED_RCOND
 from ._data import DerivativeFilter, Series
+from ._routes import _regression
 
 __all__ = [
     "BIAS_SHARE",
@@ -221,9 +223,6 @@ def per_direction(series: Series, filt: DerivativeFilter, vf, acc, mask, args: t
     is (:func:`corrected`): for :func:`._outcome.direction_caveat`. Uncorrected, the noise of
     a 1024-count encoder at 100 Hz had put a symmetric truth's levels (0.3 N m) at 0.19 and
     0.36 both ways, a difference of p = 1e-8."""
-    from ...models import get_model
-    from ._routes import _regression
-
     model = get_model("coulomb_viscous_asym")
     stage = _regression(series, vf, acc, mask, model, *args[1:])[0]
     return corrected(stage, predicted_bias(series, filt, stage, mask, model))
