@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import Annotated
 
@@ -68,6 +69,20 @@ def report_command(
             "options (--validate, the default, as fit computes it).",
         ),
     ] = True,
+    log_format: Annotated[
+        str,
+        typer.Option(
+            "--format", help="Trajectory models: the logs' reader (fricid.io.READERS), as in fit."
+        ),
+    ] = "table",
+    reader_option: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--reader-option",
+            help="Trajectory models: a reader option KEY=VALUE for both logs, as given to "
+            "`fricid fit --trajectory` (e.g. temperature=25 for a log without that column).",
+        ),
+    ] = None,
     quiet: QuietOption = False,
 ) -> None:
     """Write a report of MODEL on SAMPLES: first "Can I trust this?" (a one-line verdict, data
@@ -126,8 +141,16 @@ def report_command(
     from ..identify.trajectory_check import is_trajectory_model
 
     if is_trajectory_model(fitted):
-        _trajectory_report(fitted, samples, heldout, out, quiet)
+        from .trajectory import parse_reader_options
+
+        reader = (log_format, parse_reader_options(reader_option))
+        _trajectory_report(fitted, samples, heldout, out, quiet, reader)
         return
+    if reader_option or log_format != "table":
+        raise ConfigError(
+            "--format and --reader-option read a trajectory log; this model "
+            f"('{fitted.model}') was fitted to friction samples"
+        )
     if heldout is not None:
         raise ConfigError(
             "a second data file (HELDOUT) is for a model identified from a trajectory; this "
@@ -213,8 +236,11 @@ def _read_samples(path: Path):
         ) from None
 
 
-def _trajectory_report(fitted, log_path: Path, heldout: Path | None, out: Path, quiet: bool):
-    """The report of a model from a trajectory on its log (and a held-out one)."""
+def _trajectory_report(
+    fitted, log_path: Path, heldout: Path | None, out: Path, quiet: bool, reader: tuple
+):
+    """The report of a model from a trajectory on its log (and a held-out one); ``reader``:
+    the reader's name and options for both."""
     from ..identify.trajectory_check import predict_trajectory
     from ..report import write_document
     from ..report.trajectory import trajectory_report
@@ -226,11 +252,11 @@ def _trajectory_report(fitted, log_path: Path, heldout: Path | None, out: Path, 
             track.stage(f"report: {part}")
 
         progress(f"the model along {log_path.name}")
-        prediction = predict_trajectory(fitted, read_trajectory_log(log_path))
+        prediction = predict_trajectory(fitted, read_trajectory_log(log_path, *reader))
         held = None
         if heldout is not None:
             progress(f"the model along the held-out {heldout.name}")
-            held = predict_trajectory(fitted, read_trajectory_log(heldout))
+            held = predict_trajectory(fitted, read_trajectory_log(heldout, *reader))
         doc = trajectory_report(
             fitted,
             prediction,
@@ -245,16 +271,27 @@ def _trajectory_report(fitted, log_path: Path, heldout: Path | None, out: Path, 
     for label, pred in ((log_path.name, prediction), (getattr(heldout, "name", ""), held)):
         if pred is None:
             continue
-        m = pred.metrics()
         err_console.print(
-            f"{label}: RMS torque error {m['rmse']:.4g} N m ({100 * m['relative']:.3g} % of the "
-            f"RMS torque {m['signal_rms']:.4g} N m), low-passed as the fit "
-            f"{m['rmse_filtered']:.4g} N m",
+            _error_line(label, pred.metrics()),
             markup=False,
             highlight=False,
             soft_wrap=True,
         )
     err_console.print(_wrote(doc, out))
+
+
+def _error_line(label: str, m: dict) -> str:
+    """A log's torque errors on one line: the raw one, where it slides, low-passed (those
+    that exist)."""
+    parts = [
+        f"{label}: RMS torque error {m['rmse']:.4g} N m ({100 * m['relative']:.3g} % of the RMS "
+        f"torque {m['signal_rms']:.4g} N m)"
+    ]
+    if m["n_sliding"] > 0:
+        parts.append(f"where it slides {m['rmse_sliding']:.4g} N m")
+    if math.isfinite(m["rmse_filtered"]):
+        parts.append(f"low-passed as the fit {m['rmse_filtered']:.4g} N m")
+    return ", ".join(parts)
 
 
 def _wrote(doc, out: Path) -> str:

@@ -39,6 +39,8 @@ METRICS = {
     "relative": "RMS error / RMS torque",
     "fitness": "fitness R²",
     "rmse_filtered": "RMS torque error, low-passed as the fit [N m]",
+    "n_sliding": "sample periods sliding (those a regression fits)",
+    "rmse_sliding": "RMS torque error where it slides [N m]",
 }
 
 
@@ -227,6 +229,7 @@ def trajectory_report(
             "identification data": fitted.provenance.get("source") or "–",
             "log in this report": f"{log_label} ({int(m['n'])} sample periods)",
             "RMS torque error on it [N m]": m["rmse"],
+            "RMS torque error on it where it slides [N m]": m["rmse_sliding"],
             "RMS of its torque [N m]": m["signal_rms"],
             "created by fricid": fitted.provenance.get("fricid_version", "–"),
         },
@@ -239,6 +242,7 @@ def trajectory_report(
         h = heldout.metrics()
         doc.meta["held-out log"] = f"{heldout_label} ({int(h['n'])} sample periods)"
         doc.meta["RMS torque error on the held-out log [N m]"] = h["rmse"]
+        doc.meta["RMS torque error on the held-out log where it slides [N m]"] = h["rmse_sliding"]
         columns[heldout_label] = heldout
     say("figures: torque and residuals")
     sec = doc.section("Prediction error")
