@@ -160,6 +160,10 @@ def _measurement_lines(info: dict) -> list[str]:
     if oe and "breakaway_counts" in oe:
         done = "applied" if oe["applied"] else "not applied"
         out.append(f"    output error (DIDIM): {done}; {oe['why']}")
+        starts = oe.get("starts_sse")
+        if starts:
+            sse = ", ".join(f"{k} {v:.4g}" for k, v in starts.items())
+            out.append(f"    output error's starts (SSE; the lower carried on): {sse}")
     est = info.get("estimator")
     if est:
         out.append(f"    estimator: {est['name']}")

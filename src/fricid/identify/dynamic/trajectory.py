@@ -484,13 +484,14 @@ def fit_trajectory(
             )
             sim_info["output_error"] = decide
             if decide["applied"]:
+                args = (gravity, method, seed, max_evals, cluster_time, n_sub, parallel)
 
-                def refine(data, start):
-                    return _output_error(
-                        data, start, gravity, method, seed, max_evals, cluster_time, n_sub, parallel
-                    )
+                def refine(data, start):  # from an estimate (the rate bias's truth)
+                    return _output_error(data, start, *args)
 
-                stage, y, r = refine(series, stage)
+                second = {n: row["value"] for n, row in static_tab.items()}  # regression's
+                stage, y, r = _output_error(series, stage, *args, second)
+                decide["starts_sse"] = stage.result.get("starts")
                 yhat = y - r
                 stages["output_error"] = stage
                 fits.append(("output_error", stage))
