@@ -12,7 +12,7 @@ import pytest
 from tests._paths import REPO
 
 from fricid.identify import fit
-from fricid.identify.dynamic._output import _box
+from fricid.identify.dynamic._output import _box, _doubtful
 from fricid.samples import RawLog
 
 sys.path.insert(0, str(REPO / "benchmarks"))
@@ -35,6 +35,19 @@ def test_the_gravity_box_holds_zero():
         low, high = box[NAMES.index(name)]
         assert low <= 0.0 <= high
         assert low <= start[NAMES.index(name)] <= high
+
+
+def test_the_second_start_runs_only_for_a_doubtful_first():
+    """As ``lm``'s ``restart="doubtful"``: a first start that began or ended on a face of the
+    box, or did not converge (fricid's ``success``; its status 0 is convergence: the first
+    version read a status <= 0 as unconverged and ran the second start after every converged
+    first one, and never after a spent budget)."""
+    box = np.array([[0.0, 1.0], [-3.0, 3.0]])
+    inside, face = np.array([0.5, 0.0]), np.array([0.5, -3.0])
+    converged, spent = SimpleNamespace(success=True), SimpleNamespace(success=False)
+    assert not _doubtful(inside, inside, box, converged)
+    assert _doubtful(inside, inside, box, spent)
+    assert _doubtful(face, inside, box, converged) and _doubtful(inside, face, box, converged)
 
 
 @pytest.mark.slow  # a 20 s log at 1 kHz identified by output error: about 6 s

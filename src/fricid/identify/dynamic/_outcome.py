@@ -54,10 +54,10 @@ __all__ = [
 LUGRE_COVERAGE = {
     "kinds": {
         "PD-tracked chirps": (184, 240),
-        "PD-tracked trapezoids": (184, 290),
+        "PD-tracked trapezoids": (181, 289),
         "open-loop torque steps": (162, 281),
     },
-    "parameters": {"w_s": (9, 76), "delta": (7, 30), "tau_s": (13, 34), "sigma_1": (25, 48)},
+    "parameters": {"w_s": (9, 76), "delta": (7, 30), "tau_s": (12, 33), "sigma_1": (25, 48)},
 }
 
 

@@ -214,7 +214,7 @@ def _doubtful(x0: np.ndarray, x: np.ndarray, box: np.ndarray, result: Any) -> bo
     def on_face(p: np.ndarray) -> bool:
         return bool(np.any(np.minimum(p - box[:, 0], box[:, 1] - p) <= AT_FACE * width))
 
-    return on_face(x0) or on_face(x) or int(result.status) <= 0
+    return on_face(x0) or on_face(x) or not result.success
 
 
 def _second_start(
