@@ -234,8 +234,8 @@ def _second_start(
 
 def _box(stage: _Stage, is_log: np.ndarray, start: np.ndarray, torque_span: float) -> np.ndarray:
     """The search box in the search's coordinates: the filtered route's for the law (log10
-    for sigma_0, sigma_1), J within a factor of five, p_x and p_y within half their value or
-    5 % of the torque span."""
+    for sigma_0, sigma_1), J within a factor of five, p_x and p_y within the gravity vector's
+    length ``hypot(p_x, p_y)`` (so both reach zero) or 5 % of the torque span."""
     rows = []
     names = list(stage.names)
     gravity = math.hypot(*(start[names.index(n)] for n in ("p_x", "p_y") if n in names))
