@@ -85,7 +85,12 @@ def _convergence_line(
             tail = f"; backbone {_convergence_line(base)}" if isinstance(base, dict) else ""
             return f"converged ({by}{tail})"
         return f"converged (certified by the {by}; {polish})"
-    return f"NOT CONVERGED ({polish}; {nfev} of {max_evals} evaluations)"
+    spent = (
+        f"{nfev} evaluations, budget {max_evals}"  # carried on past it from a polish
+        if nfev is not None and max_evals is not None and nfev > max_evals
+        else f"{nfev} of {max_evals} evaluations"
+    )
+    return f"NOT CONVERGED ({polish}; {spent})"
 
 
 @lru_cache(maxsize=1)

@@ -80,3 +80,19 @@ def test_noise_ftol_is_the_resolution_per_degree_of_freedom(problem):
     dof = problem.n_obs - problem.n_free
     assert noise_ftol(problem) == pytest.approx(RESOLVE_SE**2 / dof)
     assert noise_ftol(problem, 0.1) == pytest.approx(0.1 * RESOLVE_SE**2 / dof)
+
+
+def test_a_search_carried_past_its_budget_says_so(problem):
+    """A search carried on from the certificate's polish (``settle``) spent more than its
+    budget: the texts said "2315 of 1000 evaluations"."""
+    from fricid.fitted._file import _convergence_line
+
+    result = _at(problem, 4.0 / 58)
+    result["nfev"], result["max_evals"] = 2315, 1000
+    conv = certify(problem, result)
+    assert not conv["converged"]
+    assert "2315 evaluations (budget 1000, carried on" in conv["reason"]
+    assert "of 1000" not in conv["reason"]
+    line = _convergence_line(conv, 2315, 1000)
+    assert "2315 evaluations, budget 1000" in line and "of 1000" not in line
+    assert "500 of 500 evaluations" in _convergence_line(conv, 500, 500)

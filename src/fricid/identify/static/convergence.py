@@ -157,8 +157,13 @@ def certify_polish(
     method = str(result.method)
     max_evals = int(result.get("max_evals", result.nfev))
     gain = 100.0 * (sse - best) / sse
+    spent = (
+        f"{result.nfev} of {max_evals} evaluations"
+        if result.nfev <= max_evals  # else carried on past its budget by :func:`settle`
+        else f"{result.nfev} evaluations (budget {max_evals}, carried on while a polish gained)"
+    )
     block["reason"] = (
-        f"method '{method}' ended after {result.nfev} of {max_evals} evaluations "
+        f"method '{method}' ended after {spent} "
         f"(status {int(result.status)}: {result.message}) at SSE {sse:.6g}, but a local "
         f"least-squares polish from there reaches {best:.6g} ({gain:.3g} % lower: the "
         f"parameters move by {_se_text(moved)}, more than the {RESOLVE_SE:g} below which the data "
