@@ -6,7 +6,8 @@ The plant is ``M(q) ddq + C(q, dq) dq + g(q) = u - F(dq)``, the rigid-body dynam
 Pinocchio's ABA) with the motor torque ``u`` and each joint's friction ``F``
 (:class:`~fricid.sim.robot_friction.ArmFriction`; LuGre on chosen joints,
 :mod:`fricid.sim.robot_lugre`). Integration, per internal step ``h`` (the sample period split
-into equal steps of at most ``integrator_step``, default 0.5 ms), is split (Strang splitting,
+into equal steps of at most ``integrator_step``, default 0.5 ms, less with LuGre joints: see
+:func:`fricid.sim.robot_lugre.bristle_step`), is split (Strang splitting,
 second order; ``benchmarks/bench_robot_sim.py`` measures it):
 
 1. friction over ``tau = h / 2`` by a linearly implicit theta-method, ``(M + tau Theta D) dv =
@@ -60,7 +61,7 @@ from ..robot._pin import pinocchio
 from ..samples import RobotLog
 from .robot_drive import CONTROLLERS, default_gains, make_drive, per_joint, quantise
 from .robot_friction import ArmFriction
-from .robot_lugre import LuGreBristles
+from .robot_lugre import LuGreBristles, bristle_step
 
 __all__ = [
     "CONTROLLERS",
@@ -289,7 +290,9 @@ def run_robot(
     seed : int, Generator or None
         The noise's generator (the dynamics are deterministic).
     integrator_step : float
-        Largest internal step [s]; the sample period is split into equal steps.
+        Largest internal step [s]; the sample period is split into equal steps. LuGre joints
+        lower it until their bristles' ringing is resolved
+        (:func:`fricid.sim.robot_lugre.bristle_step`; ``truth.step`` holds the step taken).
     initial : (q, dq), optional
         The initial state (default the reference's at ``t = 0``).
     plant : object, optional
@@ -334,6 +337,11 @@ def run_robot(
     )
     if plant is None:
         bristles = LuGreBristles(model.joints, lugre) if lugre else None
+        if bristles is not None:  # resolve the bristles' ringing (fricid.sim.robot_lugre)
+            rows = ref[0][:: max(count // 25, 1)]
+            least = 1.0 / np.diagonal(np.linalg.inv(model.mass_matrix(rows)), axis1=1, axis2=2)
+            step = bristle_step(bristles, least.min(axis=0))
+            substeps = max(substeps, _substeps(rate, step))
         plant = _Plant(model, friction, 1.0 / (rate * substeps), substeps, bristles)
     elif lugre:
         raise ConfigError("LuGre joints are simulated by fricid's own plant only")

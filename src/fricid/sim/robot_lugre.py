@@ -13,6 +13,20 @@ friction ``sigma_0 mean(z) + sigma_1 (z(tau) - z) / tau + sigma_2 v`` and its de
 ``v`` (by a forward difference) enter the integrator's linearly implicit friction step, which
 then holds the bristle spring (``sigma_0 tau`` per rad/s) and damping implicitly too; the
 state advances with the step's new velocity.
+
+The joint rings on its bristles, the least inertia ``m`` it meets (``1 / (M^-1)_jj``, the
+other joints free) on the spring ``sigma_0``, at ``omega = sqrt(sigma_0 / m)`` (1,270 rad/s
+on the Panda's joint 7 with ``sigma_0 = 1e4`` N m/rad), and the arm's split step resolves
+that ringing only when ``omega h`` is small: :func:`bristle_step` gives the largest step,
+:data:`BRISTLE_RESOLUTION` over ``omega``, and :func:`fricid.sim.robot.run_robot` takes no
+larger. Measured (``benchmarks/bench_robot_sim.py``, table 3: the double pendulum's second
+joint with ``lugre_like`` of the example law, sigma_0 = 1325 N m/rad, omega = 1314 rad/s,
+PD-tracked, 5 s at 1 kHz), the mean friction of the samples at 0.02-0.04 rad/s against 0.105
+N m at 6.25 us steps: 0.020 N m at the arm's default 0.5 ms (``omega h`` 0.66), 0.065 at
+0.125 ms (0.16), 0.085 at 50 us (0.066), 0.108 at 25 us (0.033); at 0.005-0.02 rad/s 0.002,
+0.036, 0.070 and 0.080 against 0.072. The Panda's 60 s with a LuGre wrist then takes 40 us
+steps and 133 s of CPU (21 s at the 0.5 ms it took before). Stepping the friction alone finer (the rigid body at 0.5 ms, twenty friction steps within
+each) did not cure it, so the whole step is refined.
 """
 
 from __future__ import annotations
@@ -26,10 +40,15 @@ import numpy as np
 from ..errors import ConfigError
 from ..models import lugre
 
-__all__ = ["LuGreBristles", "lugre_like"]
+__all__ = ["BRISTLE_RESOLUTION", "LuGreBristles", "bristle_step", "lugre_like"]
 
 #: Velocity step [rad/s] of the central difference of the mean friction.
 _DV = 1e-7
+
+#: The largest ``omega h`` of the bristles' ringing the arm's step may take (module notes:
+#: 0.033 held the friction at 0.02-0.15 rad/s within 3 % of a four times finer step, 0.066
+#: was 19 % low at 0.02-0.04 rad/s).
+BRISTLE_RESOLUTION = 0.025
 
 
 def _theta(joint: str, value: Any) -> np.ndarray:
@@ -118,6 +137,15 @@ class LuGreBristles:
             j: dict(zip(lugre.PARAM_NAMES, map(float, t), strict=True))
             for j, t in zip(self.joints, self.theta, strict=True)
         }
+
+
+def bristle_step(bristles: LuGreBristles, least_inertia: np.ndarray) -> float:
+    """The largest internal step [s] that resolves the bristles' ringing (module notes):
+    :data:`BRISTLE_RESOLUTION` over the fastest ``sqrt(sigma_0 / m)``, ``least_inertia`` the
+    least inertia [kg m^2] each of the arm's joints meets (all joints, the model's order)."""
+    m = np.asarray(least_inertia, dtype=float)[bristles.index]
+    omega = np.sqrt(np.asarray(bristles.s0) / np.maximum(m, 1e-12))
+    return float(BRISTLE_RESOLUTION / omega.max())
 
 
 def lugre_like(pos: Mapping[str, float], *, presliding: float = 1e-4) -> dict[str, float]:
