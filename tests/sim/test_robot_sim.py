@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import warnings
 from functools import cache
 
 import numpy as np
@@ -437,3 +438,37 @@ def test_steady_sliding_torque_is_the_law_at_the_sampled_velocity(tmp_path):
         errors.append(np.abs(truth.torque[tail] / friction(truth.velocity[tail]) - 1).max())
     assert errors[1] < 1e-4
     assert errors[0] / errors[1] > 3.0  # second order, not first
+
+
+def test_a_light_arm_chattering_at_a_coarse_step_is_warned_of():
+    """The double pendulum's light joints overshoot zero velocity at every friction step of
+    0.5 ms (the linearised smoothed sign is flat away from zero): their true velocity flips
+    sign from sample to sample. The simulator says so, and not at a fine enough step; the
+    truth's acceleration is its velocity's differences, not ``M^-1 (u - ... - F(dq))``,
+    which read hundreds of rad/s^2 where the joints stick."""
+    from fricid.errors import DataQualityWarning
+
+    model = arm("double_pendulum")
+    ref = fourier(model, amplitude=0.5)
+    friction = example_friction([87.0, 12.0])
+    with pytest.warns(DataQualityWarning, match=r"joint1 \(\d+ %\).*integrator_step = 31.2 us"):
+        coarse = run_robot(model, ref, friction, duration=2.0, feedforward=True)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", DataQualityWarning)
+        fine = run_robot(
+            model, ref, friction, duration=2.0, feedforward=True, integrator_step=31.25e-6
+        )
+    for t in (coarse.truth, fine.truth):
+        np.testing.assert_allclose(t.acceleration, np.gradient(t.velocity, axis=0) * 1e3)
+    v = fine.truth.velocity
+    assert np.sqrt(np.mean(np.diff(v, axis=0) ** 2)) < 0.2 * np.sqrt(
+        np.mean(np.diff(coarse.truth.velocity, axis=0) ** 2)
+    )
+
+
+def test_the_panda_at_its_default_step_does_not_chatter():
+    model = arm("panda")
+    ref = random_fourier(model, seed=0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        run_robot(model, ref, example_friction(model.effort_limit), duration=1.0, feedforward=True)

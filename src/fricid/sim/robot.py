@@ -49,13 +49,14 @@ Another simulator of the same arm can take the integrator's place (``plant=``):
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
-from ..errors import ConfigError
+from ..errors import ConfigError, DataQualityWarning, user_stacklevel
 from ..robot import RigidBodyModel
 from ..robot._pin import pinocchio
 from ..samples import RobotLog
@@ -73,6 +74,10 @@ __all__ = [
     "simulate_robot",
 ]
 
+#: A sign change of the true velocity between consecutive samples, both beyond this speed
+#: [rad/s], in more than this share of the samples is chatter (:func:`_warn_chatter`).
+CHATTER_SPEED, CHATTER_SHARE = 0.01, 0.05
+
 #: Default internal step [s]: 60 s of the Panda at 1 kHz take about 10 s of CPU time.
 DEFAULT_STEP = 5e-4
 
@@ -88,7 +93,11 @@ class RobotTruth:
     position, velocity : ndarray (N, n)
         The true states at the sample instants [rad, rad/s].
     acceleration : ndarray (N, n)
-        ``M^-1 (u - C dq - g - F)`` just after each sample (with that sample's command).
+        The true velocity's central difference over the neighbouring samples [rad/s^2] (one-
+        sided at the ends). ``M^-1 (u - C dq - g - F(dq))`` at the sample, what this held
+        before, is not the motion where a joint sticks: the smoothed sign at the sampled
+        velocity is not the friction holding it (a PD-tracked double pendulum: RMS 240 and 411
+        rad/s^2 against 4 and 9 of its velocity's differences).
     torque : ndarray (N, n)
         The motor command ``u`` held from each sample to the next, noiseless [N m].
     friction_torque : ndarray (N, n)
@@ -360,6 +369,7 @@ def run_robot(
             raise ConfigError(f"the simulation diverged at t = {time[k]:.4g} s")
         if k + 1 < count:
             q, v = plant.advance(q, v, u)
+    _warn_chatter(out["v"], model.joints, float(getattr(plant, "h", getattr(plant, "step", 0))))
     out["f"] = np.zeros_like(out["v"]) if friction is None else friction(out["v"])
     if bristles is not None:
         out["f"][:, bristles.index] = lugre_f
@@ -370,6 +380,30 @@ def run_robot(
     )
 
 
+def _warn_chatter(v: np.ndarray, joints: tuple[str, ...], step: float) -> None:
+    """Warn of joints whose true velocity changes sign between consecutive samples, both
+    beyond :data:`CHATTER_SPEED`, in more than :data:`CHATTER_SHARE` of the samples: a joint
+    that sticks does not, an integrator step too coarse for a light joint's friction does
+    (the double pendulum at 0.5 ms: 36 % and 19 % of the samples of its two joints, 0.9 % and
+    4 % at 62.5 us; the Panda at 0.5 ms: none)."""
+    if len(v) < 3:
+        return
+    big = np.abs(v) > CHATTER_SPEED
+    flips = ((v[1:] * v[:-1] < 0) & big[1:] & big[:-1]).mean(axis=0)
+    bad = [
+        f"{j} ({100 * x:.0f} %)" for j, x in zip(joints, flips, strict=True) if x > CHATTER_SHARE
+    ]
+    if bad:
+        warnings.warn(
+            f"the simulated velocity of {', '.join(bad)} changes sign from one sample to the "
+            f"next (the share of samples): the joints chatter at an internal step of "
+            f"{1e6 * step:.3g} us, too coarse for their friction and inertia; the truth is "
+            f"not the law's motion there: give integrator_step = {1e6 * step / 16:.3g} us or less",
+            DataQualityWarning,
+            stacklevel=user_stacklevel(),
+        )
+
+
 def _plant_lugre(plant: Any) -> LuGreBristles | None:
     """The LuGre joints of a plant, if it has any."""
     return getattr(plant, "bristles", None)
@@ -378,7 +412,7 @@ def _plant_lugre(plant: Any) -> LuGreBristles | None:
 def _assemble(model, friction, lugre, out, time, ref, noise, rng, h, rate, counts) -> RobotRun:
     n = model.n
     f_true = out["f"]
-    acc = model.forward_dynamics(out["q"], out["v"], out["u"] - f_true)
+    acc = np.gradient(out["v"], axis=0) * rate if len(time) > 1 else np.zeros_like(out["v"])
     torque = out["u"] + rng.standard_normal(out["u"].shape) * noise
     params = (
         {} if friction is None else {j: friction.parameters(i) for i, j in enumerate(model.joints)}

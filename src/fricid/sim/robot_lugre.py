@@ -25,8 +25,9 @@ PD-tracked, 5 s at 1 kHz), the mean friction of the samples at 0.02-0.04 rad/s a
 N m at 6.25 us steps: 0.020 N m at the arm's default 0.5 ms (``omega h`` 0.66), 0.065 at
 0.125 ms (0.16), 0.085 at 50 us (0.066), 0.108 at 25 us (0.033); at 0.005-0.02 rad/s 0.002,
 0.036, 0.070 and 0.080 against 0.072. The Panda's 60 s with a LuGre wrist then takes 40 us
-steps and 133 s of CPU (21 s at the 0.5 ms it took before). Stepping the friction alone finer (the rigid body at 0.5 ms, twenty friction steps within
-each) did not cure it, so the whole step is refined.
+steps and 133 s of CPU (21 s at the 0.5 ms it took before). Stepping the friction alone
+finer (the rigid body at 0.5 ms, twenty friction steps within each) did not cure it, so the
+whole step is refined.
 """
 
 from __future__ import annotations
