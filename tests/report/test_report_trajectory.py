@@ -12,7 +12,8 @@ from typer.testing import CliRunner
 from _trajectory import multisine_log, truth_model
 from fricid.cli import app
 from fricid.fitted import FittedModel
-from fricid.identify.trajectory_check import predict_trajectory
+from fricid.identify.trajectory_check import PRESLIDING_UNGRADED, predict_trajectory
+from fricid.identify.trust import Trust
 from fricid.io import write_rawlog
 from fricid.report.trajectory import METRICS, trajectory_report
 
@@ -22,7 +23,9 @@ runner = CliRunner()
 @pytest.fixture
 def files(tmp_path):
     model = tmp_path / "lugre.json"
-    truth_model().save(model)
+    fitted = truth_model()
+    fitted.trust = Trust("with caveats", ["x"], converged=True, convergence="").to_dict()
+    fitted.save(model)
     logs = []
     for seed in (5, 6):
         path = tmp_path / f"traj{seed}.parquet"
@@ -61,6 +64,9 @@ def test_cli_reports_a_trajectory_model_with_a_held_out_log(files, tmp_path):
             assert got[label] == pytest.approx(want[key], rel=1e-3), key
     err = " ".join(res.stderr.split())
     assert f"{log.name}: RMS torque error" in err and f"{held.name}: RMS torque error" in err
+    # the verdict graded on the held-out log: a LuGre law where it slides, with the caveat
+    assert f"Trust: with caveats, because {PRESLIDING_UNGRADED}" in err
+    assert f"on {held.name}, graded where it slides" in err
     assert "Traceback" not in res.output
 
 

@@ -277,6 +277,8 @@ def _trajectory_report(
             highlight=False,
             soft_wrap=True,
         )
+    if held is not None and "trust" in doc.meta:  # graded on the held-out log
+        err_console.print(str(doc.meta["trust"]), markup=False, highlight=False, soft_wrap=True)
     err_console.print(_wrote(doc, out))
 
 
