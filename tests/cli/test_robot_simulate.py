@@ -59,6 +59,7 @@ def test_sweeps_of_one_joint(tmp_path):
         (("--robot", "double_pendulum", "--friction", "lugre"), "--friction"),
         (("--robot", "double_pendulum", "--controller", "p"), "controller"),
         (("--robot", "double_pendulum", "--duration", -1), "--duration"),
+        (("--robot", "double_pendulum", "--integrator-step", 1), "--integrator-step"),
     ],
 )
 def test_bad_options_are_one_line_and_no_file(tmp_path, args, message):
@@ -69,6 +70,17 @@ def test_bad_options_are_one_line_and_no_file(tmp_path, args, message):
     assert not out.exists()
     bad = run("--robot", "double_pendulum", "--duration", 0.2, "--out", tmp_path / "log.txt")
     assert bad.exit_code == 2 and ".csv" in bad.output
+
+
+def test_the_integrator_step_is_the_one_taken(tmp_path):
+    """The chatter warning's advice can be followed from the command line."""
+    out, truth = tmp_path / "arm.csv", tmp_path / "truth.json"
+    result = run(
+        "--robot", "double_pendulum", "--duration", 0.2, "--integrator-step", 1.25e-4,
+        "--out", out, "--truth", truth,
+    )  # fmt: skip
+    assert result.exit_code == 0, result.output
+    assert json.loads(truth.read_text())["integrator_step_s"] == pytest.approx(1.25e-4)
 
 
 def test_a_lugre_joint(tmp_path):

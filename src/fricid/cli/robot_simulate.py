@@ -90,6 +90,13 @@ def robot_simulate_command(
     torque_noise: Annotated[
         float, typer.Option(help="Std of the logged torque's Gaussian noise [N m].")
     ] = 0.05,
+    integrator_step: Annotated[
+        float,
+        typer.Option(
+            help="Largest internal step of the simulation [s]; a light arm whose joints "
+            "chatter at the default (a warning says so) needs a smaller one."
+        ),
+    ] = 5e-4,
     friction: Annotated[
         str,
         typer.Option(
@@ -145,6 +152,8 @@ def robot_simulate_command(
 
     if friction not in ("example", "none"):
         raise ConfigError(f"--friction must be example or none; got {friction!r}")
+    if not (1e-7 <= integrator_step <= 0.01):
+        raise ConfigError(f"--integrator-step must lie in [1e-7, 0.01] s; got {integrator_step!r}")
     if not (0 < duration <= 3600):
         raise ConfigError(f"--duration must lie in (0, 3600] s; got {duration!r}")
     if out.suffix.lower() not in (".csv", ".parquet", ".pq"):
@@ -176,6 +185,7 @@ def robot_simulate_command(
         encoder_counts=encoder_counts,
         torque_noise=torque_noise,
         seed=seed,
+        integrator_step=integrator_step,
         lugre=dynamic,
     )
     wall, cpu = time.perf_counter() - start, time.process_time() - cpu

@@ -398,7 +398,8 @@ def _warn_chatter(v: np.ndarray, joints: tuple[str, ...], step: float) -> None:
             f"the simulated velocity of {', '.join(bad)} changes sign from one sample to the "
             f"next (the share of samples): the joints chatter at an internal step of "
             f"{1e6 * step:.3g} us, too coarse for their friction and inertia; the truth is "
-            f"not the law's motion there: give integrator_step = {1e6 * step / 16:.3g} us or less",
+            f"not the law's motion there: give integrator_step = {1e6 * step / 16:.3g} us or less "
+            f"(fricid robot simulate --integrator-step {step / 16:.3g})",
             DataQualityWarning,
             stacklevel=user_stacklevel(),
         )
