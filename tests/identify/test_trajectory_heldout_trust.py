@@ -16,6 +16,7 @@ from fricid.fitted import FittedModel
 from fricid.identify import fit
 from fricid.identify.trajectory_check import (
     PRESLIDING_UNGRADED,
+    heldout_grading,
     heldout_trust,
     predict_trajectory,
     torque_scatter,
@@ -113,3 +114,17 @@ def test_on_another_simulator_s_log_the_truth_passes_and_a_wrong_law_does_not():
     high = _foreign_truth(tau_c=0.78)
     bad = heldout_trust(high, predict_trajectory(high, log))
     assert bad.heldout_ratio > 3.0 and bad.level == "no"
+
+
+def test_a_second_log_that_hardly_slides_is_not_graded_or_says_how_little_was(static_fit):
+    """A log that never slides (pre-sliding only, a joint at rest) grades nothing, and says
+    so, rather than keeping the fit's reason; one that slides on a fifth of its samples is
+    graded there with a caveat naming the share."""
+    pred = predict_trajectory(static_fit, multisine_log(2, 6.0))
+    still = dataclasses.replace(pred, sliding=np.zeros_like(pred.sliding))
+    graded, why = heldout_grading(static_fit, still)
+    assert graded is None and why.startswith("not graded: 0 of its")
+    few = pred.sliding & (np.arange(pred.sliding.size) < 0.25 * pred.sliding.size)
+    graded, scope = heldout_grading(static_fit, dataclasses.replace(pred, sliding=few))
+    assert graded.level == "with caveats" and "graded where it slides" in scope
+    assert any(r.startswith("the second log grades it on") for r in graded.reasons)

@@ -66,7 +66,7 @@ def test_cli_reports_a_trajectory_model_with_a_held_out_log(files, tmp_path):
     assert f"{log.name}: RMS torque error" in err and f"{held.name}: RMS torque error" in err
     # the verdict graded on the held-out log: a LuGre law where it slides, with the caveat
     assert f"Trust: with caveats, because {PRESLIDING_UNGRADED}" in err
-    assert f"on {held.name}, graded where it slides" in err
+    assert f"held-out {held.name}: graded where it slides" in err
     assert "Traceback" not in res.output
 
 

@@ -277,8 +277,12 @@ def _trajectory_report(
             highlight=False,
             soft_wrap=True,
         )
-    if held is not None and "trust" in doc.meta:  # graded on the held-out log
-        err_console.print(str(doc.meta["trust"]), markup=False, highlight=False, soft_wrap=True)
+    if held is not None:  # the verdict graded on the held-out log, or why not
+        lines = [f"held-out {doc.meta['held-out grading']}"]
+        if "torque scatter of the held-out log [N m]" in doc.meta:
+            lines.append(str(doc.meta["trust"]))
+        for line in lines:
+            err_console.print(line, markup=False, highlight=False, soft_wrap=True)
     err_console.print(_wrote(doc, out))
 
 

@@ -99,10 +99,13 @@ from .trust import SECOND_LOG, Trust, _grade
 
 __all__ = [
     "DYNAMIC",
+    "MIN_GRADED",
+    "MIN_SHARE",
     "MIN_TRIPLES",
     "PRESLIDING_UNGRADED",
     "REVERSAL_SPEED",
     "TrajectoryPrediction",
+    "heldout_grading",
     "heldout_trust",
     "is_trajectory_model",
     "predict_trajectory",
@@ -341,6 +344,10 @@ PRESLIDING_UNGRADED = (
     "(see the report's low-passed error and hysteresis loops)"
 )
 
+#: Fewest sliding samples a second log grades a model on, and the share of its samples below
+#: which the verdict says how few were graded.
+MIN_GRADED, MIN_SHARE = 200, 0.5
+
 #: Fewest runs of three sliding samples a scatter is estimated from.
 MIN_TRIPLES = 50
 
@@ -360,34 +367,51 @@ def torque_scatter(prediction: TrajectoryPrediction) -> float:
     return 1.4826 * mad / math.sqrt(6.0)
 
 
-def heldout_trust(fitted: FittedModel, heldout: TrajectoryPrediction) -> Trust | None:
+def heldout_grading(fitted: FittedModel, heldout: TrajectoryPrediction) -> tuple[Trust | None, str]:
     """The file's verdict graded again with the held-out error over the held-out log's torque
-    scatter (module notes); None when the file holds no trust record or the log gives no
-    scatter (too few sliding samples)."""
+    scatter (module notes), and one line on what was graded; ``(None, why)`` when the file
+    holds no trust record or the log cannot grade it (fewer than :data:`MIN_GRADED` sliding
+    samples, no scatter)."""
     record = fitted.trust
     if not isinstance(record, dict):
-        return None
+        return None, "the model file holds no verdict to grade"
     try:
         trust = Trust.from_dict(record)
     except (KeyError, TypeError, ValueError):
-        return None
+        return None, "the model file's verdict is not readable"
+    slide = heldout.sliding if heldout.sliding is not None else np.zeros(0, dtype=bool)
+    n, total = int(slide.sum()), int(heldout.residual.size)
     scatter = torque_scatter(heldout)
-    m = heldout.metrics()
-    error = m["rmse_sliding"]
-    if not (math.isfinite(scatter) and scatter > 0 and math.isfinite(error)):
-        return None
+    error = heldout.metrics()["rmse_sliding"]
+    if n < MIN_GRADED or not (math.isfinite(scatter) and scatter > 0 and math.isfinite(error)):
+        return None, (
+            f"not graded: {n} of its {total} samples slide away from the slow stretches "
+            f"(at least {MIN_GRADED} needed, with a torque scatter to compare with)"
+        )
     trust.heldout_rmse, trust.scatter = float(error), float(scatter)
     trust.heldout_ratio = float(error / scatter)
     trust.heldout_source = SECOND_LOG
-    speed = np.abs(np.asarray(heldout.velocity, dtype=float)[heldout.sliding])
     trust.heldout_scheme = "sliding samples"
+    speed = np.abs(np.asarray(heldout.velocity, dtype=float)[slide])
+    share = n / total
     trust.range = (
-        f"graded where it slides: {speed.size} samples at {speed.min():.3g} rad/s and faster, "
-        f"torque scatter {scatter:.3g} N m"
+        f"graded where it slides: {n} of {total} samples ({100 * share:.0f} %), at "
+        f"{speed.min():.3g} rad/s and faster; error {error:.3g} N m, "
+        f"{trust.heldout_ratio:.2f}x the torque's scatter {scatter:.3g} N m"
     )
     trust.scatter_method = SECOND_DIFFERENCES
     trust.verdict = verdict(trust.heldout_ratio)
     trust.validation_note = ""
-    dynamic = fitted.model in DYNAMIC
-    _grade(trust, fitted, [PRESLIDING_UNGRADED if dynamic else ""], [])
-    return trust
+    caveats = [PRESLIDING_UNGRADED if fitted.model in DYNAMIC else ""]
+    if share < MIN_SHARE:
+        caveats.append(
+            f"the second log grades it on {100 * share:.0f} % of its samples only (those that "
+            "slide); the rest are not graded"
+        )
+    _grade(trust, fitted, caveats, [])
+    return trust, trust.range
+
+
+def heldout_trust(fitted: FittedModel, heldout: TrajectoryPrediction) -> Trust | None:
+    """The graded verdict of :func:`heldout_grading` (None where it gives none)."""
+    return heldout_grading(fitted, heldout)[0]

@@ -19,7 +19,7 @@ import numpy as np
 import pandas as pd
 
 from ..fitted import FittedModel
-from ..identify.trajectory_check import REVERSAL_SPEED, TrajectoryPrediction, heldout_trust
+from ..identify.trajectory_check import REVERSAL_SPEED, TrajectoryPrediction, heldout_grading
 from .document import Document, Figure, Note, Table
 from .model import parameter_table
 from .style import COLORS, new_figure, png, styled, torque_scale
@@ -243,9 +243,10 @@ def trajectory_report(
         doc.meta["held-out log"] = f"{heldout_label} ({int(h['n'])} sample periods)"
         doc.meta["RMS torque error on the held-out log [N m]"] = h["rmse"]
         doc.meta["RMS torque error on the held-out log where it slides [N m]"] = h["rmse_sliding"]
-        graded = heldout_trust(fitted, heldout)
+        graded, scope = heldout_grading(fitted, heldout)
+        doc.meta["held-out grading"] = f"{heldout_label}: {scope}"
         if graded is not None:
-            doc.meta["trust"] = f"{graded.line()} (on {heldout_label}, {graded.range})"
+            doc.meta["trust"] = graded.line()
             doc.meta["torque scatter of the held-out log [N m]"] = graded.scatter
         columns[heldout_label] = heldout
     say("figures: torque and residuals")
