@@ -128,3 +128,14 @@ def test_a_second_log_that_hardly_slides_is_not_graded_or_says_how_little_was(st
     graded, scope = heldout_grading(static_fit, dataclasses.replace(pred, sliding=few))
     assert graded.level == "with caveats" and "graded where it slides" in scope
     assert any(r.startswith("the second log grades it on") for r in graded.reasons)
+
+
+def test_a_torque_low_passed_before_it_was_logged_is_not_graded(static_fit):
+    """Its second differences measure the filter, not the noise (a 1,550-fold "miss")."""
+    from scipy import signal
+
+    pred = predict_trajectory(static_fit, multisine_log(2, 6.0))
+    sos = signal.butter(4, 5.0 * 2 * 1e-3, output="sos")
+    smooth = dataclasses.replace(pred, torque=signal.sosfiltfilt(sos, pred.torque))
+    graded, why = heldout_grading(static_fit, smooth)
+    assert graded is None and "smooth from one sample to the next" in why

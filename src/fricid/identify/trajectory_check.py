@@ -66,9 +66,11 @@ both:
 - the scatter: the torque's own sample-to-sample scatter on the same log's sliding samples,
   from its second differences (``u[k+1] - 2 u[k] + u[k-1]`` has variance ``6 sigma^2`` for
   white noise of ``sigma``; the motion's own share at 1 kHz is negligible), robustly (the
-  median absolute deviation, so the steps of break-away do not inflate it). A drive that logs
-  a low-passed torque hides part of its noise from second differences: the scatter is then
-  low and the verdict strict, never lenient.
+  median absolute deviation, so the steps of break-away do not inflate it). A torque
+  low-passed before it was logged hides its noise from second differences (a 5 Hz low-pass:
+  7.5e-5 N m, which read as a 1,550-fold miss); its third differences then fall far below
+  what noise gives beside the second ones (:func:`_smooth_share`), and such a log is not
+  graded, with the reason.
 
 The verdict says which samples were graded (``Trust.range``: a static law's error below them,
 in the Stribeck region, is not graded; the independent simulator's PD-tracked chirp at 2^20
@@ -108,6 +110,7 @@ __all__ = [
     "MIN_TRIPLES",
     "PRESLIDING_UNGRADED",
     "REVERSAL_SPEED",
+    "WHITE_SHARE",
     "TrajectoryPrediction",
     "heldout_grading",
     "heldout_trust",
@@ -352,8 +355,27 @@ PRESLIDING_UNGRADED = (
 #: which the verdict says how few were graded.
 MIN_GRADED, MIN_SHARE = 200, 0.5
 
+#: :func:`_smooth_share` below which the torque is taken for low-passed, not noisy (white
+#: noise gives about 1: the virtual joint 1.03, the independent simulator's PD logs 1.00-1.01,
+#: 100 Hz 0.94; low-passed at 5 Hz, 0.006).
+WHITE_SHARE = 0.7
+
 #: Fewest runs of three sliding samples a scatter is estimated from.
 MIN_TRIPLES = 50
+
+
+def _runs(slide: np.ndarray, k: int) -> np.ndarray:
+    """Where ``k`` consecutive samples all slide (entry ``i``: samples ``i .. i + k - 1``)."""
+    inside = slide[: slide.size - k + 1].copy()
+    for j in range(1, k):
+        inside &= slide[j : slide.size - k + 1 + j]
+    return inside
+
+
+def _mad_scatter(d: np.ndarray, white_variance: float) -> float:
+    if d.size < MIN_TRIPLES:
+        return math.nan
+    return 1.4826 * float(np.median(np.abs(d - np.median(d)))) / math.sqrt(white_variance)
 
 
 def torque_scatter(prediction: TrajectoryPrediction) -> float:
@@ -361,14 +383,18 @@ def torque_scatter(prediction: TrajectoryPrediction) -> float:
     than :data:`MIN_TRIPLES` runs of three consecutive sliding samples."""
     u = np.asarray(prediction.torque, dtype=float)
     slide = prediction.sliding
-    if slide is None or u.size < 3:
+    if slide is None or u.size < 4:
         return math.nan
-    inside = slide[:-2] & slide[1:-1] & slide[2:]
-    d2 = (u[2:] - 2.0 * u[1:-1] + u[:-2])[inside]
-    if d2.size < MIN_TRIPLES:
-        return math.nan
-    mad = float(np.median(np.abs(d2 - np.median(d2))))
-    return 1.4826 * mad / math.sqrt(6.0)
+    return _mad_scatter((u[2:] - 2.0 * u[1:-1] + u[:-2])[_runs(slide, 3)], 6.0)
+
+
+def _smooth_share(prediction: TrajectoryPrediction) -> float:
+    """The third differences' scatter over the second's, each scaled for white noise: about 1
+    for a torque whose sample-to-sample content is noise, far below for one low-passed before
+    it was logged (its second differences then measure the filter, not the noise)."""
+    u = np.asarray(prediction.torque, dtype=float)
+    d3 = (u[3:] - 3.0 * u[2:-1] + 3.0 * u[1:-2] - u[:-3])[_runs(prediction.sliding, 4)]
+    return _mad_scatter(d3, 20.0) / torque_scatter(prediction)
 
 
 def heldout_grading(fitted: FittedModel, heldout: TrajectoryPrediction) -> tuple[Trust | None, str]:
@@ -387,6 +413,14 @@ def heldout_grading(fitted: FittedModel, heldout: TrajectoryPrediction) -> tuple
     n, total = int(slide.sum()), int(heldout.residual.size)
     scatter = torque_scatter(heldout)
     error = heldout.metrics()["rmse_sliding"]
+    if n >= MIN_GRADED and math.isfinite(scatter) and scatter > 0:
+        white = _smooth_share(heldout)
+        if not white >= WHITE_SHARE:
+            return None, (
+                f"not graded: its torque is smooth from one sample to the next (third "
+                f"differences {white:.2g} of what noise gives beside its second ones): low-passed "
+                "before it was logged, so its scatter cannot be told from its differences"
+            )
     if n < MIN_GRADED or not (math.isfinite(scatter) and scatter > 0 and math.isfinite(error)):
         return None, (
             f"not graded: {n} of its {total} samples slide away from the slow stretches "
