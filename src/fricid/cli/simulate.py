@@ -29,6 +29,37 @@ def design_hints(scenario) -> dict:
     return hints
 
 
+#: ``--duration``'s default [s].
+DEFAULT_DURATION = 20.0
+
+
+def _check_kind(trajectory, preset: str, size: str, coverage: str, duration: float) -> None:
+    """Refuse options of the other kind of log (they would be ignored without a word: a
+    ``--preset paper2`` trajectory log was byte for byte the default's)."""
+    from ..errors import ConfigError
+
+    if trajectory is not None:
+        given = [
+            f"--{name} {value}"
+            for name, value, default in (
+                ("preset", preset, "paper1"),
+                ("size", size, "reduced"),
+                ("coverage", coverage, "both"),
+            )
+            if value != default
+        ]
+        if given:
+            raise ConfigError(
+                f"{', '.join(given)}: not for --trajectory, which simulates one experiment on the "
+                "documented joint; drop them, or drop --trajectory for a campaign"
+            )
+    elif duration != DEFAULT_DURATION:
+        raise ConfigError(
+            "--duration is the length of a --trajectory experiment; a campaign's length comes "
+            "from --preset and --size"
+        )
+
+
 def _trajectory_log(kind: str, duration: float, seed: int):
     """The log of one trajectory experiment on the documented joint (see simulate's help)."""
     import inspect
@@ -95,7 +126,7 @@ def simulate_command(
     ] = None,
     duration: Annotated[
         float, typer.Option(help="--trajectory: the experiment's length [s], sampled at 1 kHz.")
-    ] = 20.0,
+    ] = DEFAULT_DURATION,
     quiet: QuietOption = False,
 ) -> None:
     """Simulate a bidirectional constant-velocity campaign on the virtual joint and write its
@@ -106,6 +137,7 @@ def simulate_command(
     p_y 0.1 N m, LuGre friction with the defaults of fricid.sim.trajectory.LuGreTruth)."""
     from ..io import write_rawlog
 
+    _check_kind(trajectory, preset, size, coverage, duration)
     if trajectory is not None:
         write_rawlog(_trajectory_log(trajectory, duration, seed), out)
         err_console.print(

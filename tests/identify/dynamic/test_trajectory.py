@@ -399,6 +399,13 @@ def test_simulate_trajectory_refuses_an_unknown_experiment_and_writes_nothing(tm
         app, ["simulate", "--trajectory", "sine", "--duration", "0", "--out", str(out)]
     )
     assert res.exit_code == 2 and "--duration must be between 1 and 3600 s" in res.output
+    # options of the other kind of log are refused, not ignored
+    res = CliRunner().invoke(
+        app, ["simulate", "--trajectory", "sine", "--preset", "paper2", "--out", str(out)]
+    )
+    assert res.exit_code == 2 and "--preset paper2: not for --trajectory" in res.output
+    res = CliRunner().invoke(app, ["simulate", "--duration", "5", "--out", str(out)])
+    assert res.exit_code == 2 and "--duration is the length of a --trajectory" in res.output
     assert not out.exists()
 
 
