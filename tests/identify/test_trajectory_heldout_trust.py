@@ -110,7 +110,7 @@ def test_on_another_simulator_s_log_the_truth_passes_and_a_wrong_law_does_not():
 
     log = read_trajectory_log(FOREIGN / "chirp_pd_1000Hz_1048576cpr.csv")
     good = heldout_trust(_foreign_truth(), predict_trajectory(_foreign_truth(), log))
-    assert good.heldout_ratio < 1.2 and "graded where it slides" in good.range
+    assert good.heldout_ratio < 1.2 and "graded where it slides" in good.heldout_scheme
     high = _foreign_truth(tau_c=0.78)
     bad = heldout_trust(high, predict_trajectory(high, log))
     assert bad.heldout_ratio > 3.0 and bad.level == "no"

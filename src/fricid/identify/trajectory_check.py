@@ -72,16 +72,16 @@ both:
   what noise gives beside the second ones (:func:`_smooth_share`), and such a log is not
   graded, with the reason.
 
-The verdict says which samples were graded (``Trust.range``: a static law's error below them,
-in the Stribeck region, is not graded; the independent simulator's PD-tracked chirp at 2^20
-counts/rev (``../shared/data/foreign/lugre``), whose Stribeck velocity is 0.02 rad/s: a
+The verdict says which samples were graded (``Trust.heldout_scheme``: a static law's error
+below them, in the Stribeck region, is not graded; the independent simulator's PD-tracked chirp
+at 2^20 counts/rev (``../shared/data/foreign/lugre``), whose Stribeck velocity is 0.02 rad/s: a
 ``coulomb_viscous`` fit from its trapezoid run along it, 0.032 N m where it slides, as the
 truth's LuGre law, against a scatter of 0.043 N m, the drive's own sample-to-sample torque,
-four times the logged noise). On those logs (``tests/identify/test_trajectory_heldout_trust.py``'s
-setup: the truth's steady-state law with its joint, run along each) the ratio was 0.74-0.75
-on the chirps and 1.26-1.28 on the trapezoids (both encoders); with the Coulomb level 5 %
-high, 1.02 and 1.84; 30 % high, 4.3 and 8.1. The ratio of the two is graded with the
-thresholds of every other verdict
+four times the logged noise). On those logs
+(``tests/identify/test_trajectory_heldout_trust.py``'s setup: the truth's steady-state law with
+its joint, run along each) the ratio was 0.74-0.75 on the chirps and 1.26-1.28 on the
+trapezoids (both encoders); with the Coulomb level 5 % high, 1.02 and 1.84; 30 % high, 4.3 and
+8.1. The ratio of the two is graded with the thresholds of every other verdict
 (:mod:`fricid.identify.trust`: within ``NOISE_RATIO`` "yes" as far as the error goes, beyond
 ``MISS_RATIO`` "no"), with the file's own reasons (convergence, determination) kept.
 """
@@ -429,10 +429,9 @@ def heldout_grading(fitted: FittedModel, heldout: TrajectoryPrediction) -> tuple
     trust.heldout_rmse, trust.scatter = float(error), float(scatter)
     trust.heldout_ratio = float(error / scatter)
     trust.heldout_source = SECOND_LOG
-    trust.heldout_scheme = "sliding samples"
     speed = np.abs(np.asarray(heldout.velocity, dtype=float)[slide])
     share = n / total
-    trust.range = (
+    trust.heldout_scheme = (
         f"graded where it slides: {n} of {total} samples ({100 * share:.0f} %), at "
         f"{speed.min():.3g} rad/s and faster; error {error:.3g} N m, "
         f"{trust.heldout_ratio:.2f}x the torque's scatter {scatter:.3g} N m"
@@ -447,7 +446,7 @@ def heldout_grading(fitted: FittedModel, heldout: TrajectoryPrediction) -> tuple
             "slide); the rest are not graded"
         )
     _grade(trust, fitted, caveats, [])
-    return trust, trust.range
+    return trust, trust.heldout_scheme
 
 
 def heldout_trust(fitted: FittedModel, heldout: TrajectoryPrediction) -> Trust | None:

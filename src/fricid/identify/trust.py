@@ -174,7 +174,7 @@ class Trust:
         :data:`RUN_HERE`, :data:`FROM_FIT`, :data:`OWN_CV`, :data:`IN_SAMPLE`, or ``""``
         (no ratio at all).
     heldout_scheme : str
-        The held-out scheme (``"lovo"``, ``"kfold:5"``, ``"levels:4"``), ``""`` in-sample.
+        The scheme (``"lovo"``, ``"kfold:5"``, ``"levels:4"``, a second log's scope; ``""``: none).
     verdict : str
         :func:`fricid.metrics.verdict` of the ratio.
     validation : dict or None
