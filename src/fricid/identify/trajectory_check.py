@@ -388,13 +388,14 @@ def torque_scatter(prediction: TrajectoryPrediction) -> float:
     return _mad_scatter((u[2:] - 2.0 * u[1:-1] + u[:-2])[_runs(slide, 3)], 6.0)
 
 
-def _smooth_share(prediction: TrajectoryPrediction) -> float:
+def _smooth_share(prediction: TrajectoryPrediction, scatter: float) -> float:
     """The third differences' scatter over the second's, each scaled for white noise: about 1
     for a torque whose sample-to-sample content is noise, far below for one low-passed before
-    it was logged (its second differences then measure the filter, not the noise)."""
+    it was logged (its second differences then measure the filter, not the noise); ``scatter``
+    the second differences' (:func:`torque_scatter`)."""
     u = np.asarray(prediction.torque, dtype=float)
     d3 = (u[3:] - 3.0 * u[2:-1] + 3.0 * u[1:-2] - u[:-3])[_runs(prediction.sliding, 4)]
-    return _mad_scatter(d3, 20.0) / torque_scatter(prediction)
+    return _mad_scatter(d3, 20.0) / scatter
 
 
 def heldout_grading(fitted: FittedModel, heldout: TrajectoryPrediction) -> tuple[Trust | None, str]:
@@ -414,7 +415,7 @@ def heldout_grading(fitted: FittedModel, heldout: TrajectoryPrediction) -> tuple
     scatter = torque_scatter(heldout)
     error = heldout.metrics()["rmse_sliding"]
     if n >= MIN_GRADED and math.isfinite(scatter) and scatter > 0:
-        white = _smooth_share(heldout)
+        white = _smooth_share(heldout, scatter)
         if not white >= WHITE_SHARE:
             return None, (
                 f"not graded: its torque is smooth from one sample to the next (third "

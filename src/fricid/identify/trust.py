@@ -137,7 +137,7 @@ OWN_CV = "the learned model's own CV"
 IN_SAMPLE = "in-sample only"
 #: Said in the reasons when the scatter is estimated (:func:`._scatter.second_difference_scatter`).
 ESTIMATED = "estimated from second differences: no repeated runs, so not measured"
-SECOND_LOG = "a second log"  #: ... a trajectory model run along one (:mod:`.trajectory_trust`)
+SECOND_LOG = "a second log"  #: ... run along by :func:`.trajectory_check.heldout_grading`
 #: The sources whose ratio is a held-out one.
 HELD_OUT = (RUN_HERE, FROM_FIT, OWN_CV, KFOLD_HERE, SECOND_LOG)
 

@@ -60,7 +60,14 @@ from ..errors import ConfigError, DataQualityWarning, user_stacklevel
 from ..robot import RigidBodyModel
 from ..robot._pin import pinocchio
 from ..samples import RobotLog
-from .robot_drive import CONTROLLERS, default_gains, make_drive, per_joint, quantise
+from .robot_drive import (
+    CONTROLLERS,
+    default_gains,
+    least_inertia,
+    make_drive,
+    per_joint,
+    quantise,
+)
 from .robot_friction import ArmFriction
 from .robot_lugre import LuGreBristles, bristle_step
 
@@ -347,9 +354,7 @@ def run_robot(
     if plant is None:
         bristles = LuGreBristles(model.joints, lugre) if lugre else None
         if bristles is not None:  # resolve the bristles' ringing (fricid.sim.robot_lugre)
-            rows = ref[0][:: max(count // 25, 1)]
-            least = 1.0 / np.diagonal(np.linalg.inv(model.mass_matrix(rows)), axis1=1, axis2=2)
-            step = bristle_step(bristles, least.min(axis=0))
+            step = bristle_step(bristles, least_inertia(model, ref[0][:: max(count // 25, 1)]))
             substeps = max(substeps, _substeps(rate, step))
         plant = _Plant(model, friction, 1.0 / (rate * substeps), substeps, bristles)
     elif lugre:
@@ -369,11 +374,11 @@ def run_robot(
             raise ConfigError(f"the simulation diverged at t = {time[k]:.4g} s")
         if k + 1 < count:
             q, v = plant.advance(q, v, u)
-    _warn_chatter(out["v"], model.joints, float(getattr(plant, "h", getattr(plant, "step", 0))))
+    step = float(getattr(plant, "h", getattr(plant, "step", float("nan"))))
+    _warn_chatter(out["v"], model.joints, step)
     out["f"] = np.zeros_like(out["v"]) if friction is None else friction(out["v"])
     if bristles is not None:
         out["f"][:, bristles.index] = lugre_f
-    step = float(getattr(plant, "h", getattr(plant, "step", float("nan"))))
     lugre_params = {} if bristles is None else bristles.parameters()
     return _assemble(
         model, friction, lugre_params, out, time, ref, noise, rng, step, rate, encoder_counts

@@ -18,7 +18,14 @@ import numpy as np
 from ..errors import ConfigError
 from ..robot import RigidBodyModel
 
-__all__ = ["CONTROLLERS", "MAX_RISE", "STABLE_DAMPING", "default_gains", "quantise"]
+__all__ = [
+    "CONTROLLERS",
+    "MAX_RISE",
+    "STABLE_DAMPING",
+    "default_gains",
+    "least_inertia",
+    "quantise",
+]
 
 #: The drive's controllers (:mod:`fricid.sim.robot` module notes).
 CONTROLLERS = ("pd", "torque", "none")
@@ -49,6 +56,12 @@ def per_joint(value, n: int, name: str) -> np.ndarray:
     return arr
 
 
+def least_inertia(model: RigidBodyModel, rows: np.ndarray) -> np.ndarray:
+    """The least inertia each joint meets over the configurations ``rows`` (k, n), the other
+    joints free: ``1 / max_k (M(q_k)^-1)_jj`` [kg m^2] (n,)."""
+    return 1.0 / np.diagonal(np.linalg.inv(model.mass_matrix(rows)), axis1=1, axis2=2).max(axis=0)
+
+
 def default_gains(
     model: RigidBodyModel,
     q0,
@@ -77,7 +90,7 @@ def default_gains(
     if path is not None and rate is not None:
         path = np.atleast_2d(np.asarray(path, dtype=float))
         rows = path[:: max(1, len(path) // 2000)]
-        reach = np.diagonal(np.linalg.inv(model.mass_matrix(rows)), axis1=1, axis2=2).max(axis=0)
+        reach = 1.0 / least_inertia(model, rows)
         bound = max(STABLE_DAMPING, MAX_RISE * 2.0 * damping * w / rate)
         scale = np.minimum(1.0, bound * rate / (kd * reach))
         kp, kd = kp * scale, kd * scale
