@@ -29,8 +29,9 @@ def case():
 
 
 def _shape_errors(fit, laws) -> list[float]:
+    """Each shape's relative error; infinite where the fit gives none (not determined)."""
     return [
-        abs(fit.friction[joint]["parameters"][name]["value"] / truth[name] - 1)
+        abs((fit.friction[joint]["parameters"][name]["value"] or np.inf) / truth[name] - 1)
         for joint, (_, truth) in zip(fit.joints, laws, strict=True)
         for name in truth
         if name.startswith(("w_s", "delta"))

@@ -64,7 +64,12 @@ torque, :mod:`._signals`); a joint crosses its Stribeck velocities in some milli
 far below the low-pass's resolution, and the reversal window leaves most of those rows out,
 so the Stribeck shapes are determined weakly (their intervals are the profile regions,
 :func:`._solve.shape_profiles`) and predicted with errors the intervals carry but the
-held-out ratio shows.
+held-out ratio shows. Two guards keep such a shape from predicting nonsense: each excess
+``tau_s - tau_c`` is held between zero and the largest torque the joint's drive applied
+beyond gravity (:func:`._friction.excess_cap`, :func:`._solve.bounded_lstsq`), and a
+direction whose rise the fitted rows see only through the low-pass from the slow rows left
+out (:func:`._solve.unseen_rises`) gets no rise (not determined, and the verdict says so).
+``benchmarks/results/robot.txt`` (block 2) gives the held-out ratios before and after.
 """
 
 from __future__ import annotations
@@ -82,14 +87,14 @@ from ....models import get_model
 from ....optim import one_blas_thread
 from ....robot import RigidBodyModel, base_parameters
 from ....samples import RobotLog
-from ._channels import channel_problems, check_live_torque
+from ._channels import channel_problems, check_live_torque, with_channel_problems
 from ._consistent import consistent_parameters
 from ._filter_cov import filter_correlation
-from ._friction import NO_LOAD, friction_for
-from ._grade import grade, loose_levels
+from ._friction import NO_LOAD, excess_cap, friction_for
+from ._grade import grade, loose_levels, unseen_rise_reasons
 from ._load import FROM_FIT, FROM_LOG, FROM_URDF, joint_load, log_load
 from ._polish import polish_shapes
-from ._records import friction_records, interval, widen
+from ._records import friction_records, interval, mark_held, widen
 from ._rows import (
     MIN_SPEED,
     VELOCITY_NOISE_FACTOR,
@@ -105,12 +110,15 @@ from ._rows import moving_rows as _moving
 from ._signals import ArmSignals, prepare_signals
 from ._solve import (
     arm_covariance,
+    bounded_lstsq,
+    excess_bounds,
     friction_block,
     lstsq,
     search_shapes,
     shape_profiles,
     shape_rows,
     stack,
+    unseen_rises,
     wls,
 )
 from ._sticks import project_out, stick_columns
@@ -164,23 +172,6 @@ def _signals(
     return replace(sig, full_load=own if own is not None else joint_load(load_model, q))
 
 
-def _with_channels(err: DataError, log: RobotLog, model: RigidBodyModel) -> DataError:
-    """``err`` with the channels' disagreements (:mod:`._channels`) added, which may be its
-    cause (positions in degrees labelled radians make a log look too short or still)."""
-    try:
-        found = [p for joint in channel_problems(log, model).values() for p in joint]
-    except DataError:
-        return err
-    if not found:
-        return err
-    return DataError(
-        f"{err.message}; the log's channels also disagree, which may be why: {'; '.join(found)}",
-        file=err.file,
-        row=err.row,
-        column=err.column,
-    )
-
-
 def _torque_delay(sig: ArmSignals, Yb, frictions, moving) -> float:
     """The torque's delay behind the positions [sample periods], by least squares: the
     torque's filtered change per sample is one more column, ``tau = Y theta + a dtau``
@@ -230,7 +221,7 @@ def fit_arm(log: RobotLog, model: RigidBodyModel, **kwargs: Any) -> ArmFit:
                 told = "closed loop" if kwargs["reversal_window"] > 0 else "open loop"
                 fit.provenance["closed_loop"] = f"given: {told}"
         except DataError as err:  # a unit or sign mistake can be why: say so
-            raise _with_channels(err, log, model) from None
+            raise with_channel_problems(err, log, model) from None
         values = fit.standard.get("values")
         if fit.provenance["load"] == FROM_URDF and values is not None:
             refined = model.with_parameters(np.asarray(values, dtype=float))
@@ -333,6 +324,10 @@ def _fit_arm(
             else FROM_URDF
         )
     sig = _signals(log, model, encoder_counts, cutoff, stops, load_model, parts[0])
+    if any(jf.stribeck for jf in frictions):
+        _, q, tau = _log_arrays(log, model)
+        for jf, cap in zip(frictions, excess_cap(tau, model.gravity_torque(q)), strict=True):
+            jf.excess_max = float(cap)
     for j, jf in enumerate(frictions):  # a load family's joint without load (._friction)
         jf.unloaded = jf.load and bool(np.abs(sig.full_load[:, j]).max() <= NO_LOAD)
     distance = None
@@ -369,8 +364,9 @@ def _fit_arm(
         if estimate_delay:  # again, with the shapes found (module notes)
             torque_delay = _torque_delay(undelayed, Yb, frictions, moving)
             sig = undelayed.delayed(torque_delay)
+        unseen_rises(sig, frictions, moving)
         st = stack(Yb, sig, frictions, moving)
-        theta, sigma = wls(st, n)
+        theta, sigma = wls(st, n, excess_bounds(st, frictions))
         safe = np.where(np.isfinite(sigma) & (sigma > 0), sigma, 1.0)
     signature = None
     if reversal_window == 0:  # sticks at the reversals: a log recorded in closed loop?
@@ -380,6 +376,8 @@ def _fit_arm(
     res = y - A @ theta
     stribeck = [j for j, jf in enumerate(frictions) if jf.stribeck]
     J = np.hstack([A, shape_rows(sig, frictions, st, theta, safe, stribeck)]) if stribeck else A
+    held = [k for k, lo_hi in excess_bounds(st, frictions).items() if theta[k] in lo_hi]
+    J[:, held] = 0.0  # an excess held at a bound is no estimate (_records.mark_held)
     cov, se, t, clusters, corr_len, n_eff = arm_covariance(J, res, st, n, rho)
     r = bp.rank
     beta_ls = theta[:r]
@@ -396,16 +394,18 @@ def _fit_arm(
         if not cons["ls_consistent"]:
             beta = cons["beta"]
             # the friction given the consistent inertial parameters
-            fr = lstsq(A[:, r:], y - A[:, :r] @ beta)
+            bounds = {k - r: b for k, b in excess_bounds(st, frictions).items()}
+            fr = bounded_lstsq(A[:, r:], y - A[:, :r] @ beta, bounds)
             theta = np.concatenate([beta, fr])
     units = {
         f: {p.name: p.unit for p in get_model(LOAD_FAMILIES.get(f, f)).parameters}
         for f in {jf.family for jf in frictions}
     }
     fric = friction_records(frictions, theta, cov, st, model.joints, t, sig, moving, units)
+    mark_held(fric, frictions, st, theta, held, model.joints)
     inflation = np.bincount(st.row_joint, minlength=n) / np.maximum(n_eff, 1e-12)
     for (j, d), prof in shape_profiles(sig, Yb, frictions, moving, safe, inflation).items():
-        widen(fric[model.joints[j]]["parameters"], d, prof)
+        widen(fric[model.joints[j]]["parameters"], d, prof, frictions[j].excess_max)
     # held-out validation with the same filter
     vsig = _signals(validate, model, encoder_counts, sig.cutoff, stops, load_model, parts[1])
     vsig = vsig.delayed(torque_delay)
@@ -442,6 +442,7 @@ def _fit_arm(
         level, reasons = grade(
             ratio, nd, open_, source, bool(moving[:, j].any()), loose, problems[name]
         )
+        reasons += unseen_rise_reasons(frictions[j])
         validation[name] = {
             "rmse": rmse,
             "ratio": ratio,
@@ -481,6 +482,9 @@ def _fit_arm(
             "stick_signature": signature,
             "load": load_from,
             "shape_polish": polish,
+            "stribeck_leaks": {
+                nm: dict(jf.leaks) for nm, jf in zip(model.joints, frictions, strict=True)
+            },
             "samples": int(st.A.shape[0]),
             "effective_samples": {nm: float(x) for nm, x in zip(model.joints, n_eff, strict=True)},
             "correlation_length": corr_len,

@@ -23,7 +23,13 @@ from ....robot import RigidBodyModel
 from ....samples import RobotLog, position_unit_problem, velocity_mismatch, wrapped_rows
 from ....samples.robot_log import joint_column
 
-__all__ = ["LIMIT_MARGIN", "LIMIT_SLACK", "channel_problems", "check_live_torque"]
+__all__ = [
+    "LIMIT_MARGIN",
+    "LIMIT_SLACK",
+    "channel_problems",
+    "check_live_torque",
+    "with_channel_problems",
+]
 
 #: How far past a URDF limit a logged position may go: this share of the limits' span plus
 #: :data:`LIMIT_MARGIN` [rad or m] (a joint at its hard stop, an encoder's offset of a few
@@ -87,3 +93,20 @@ def channel_problems(log: RobotLog, model: RigidBodyModel) -> dict[str, list[str
                 )
         out[name] = [f for f in found if f]
     return out
+
+
+def with_channel_problems(err: DataError, log: RobotLog, model: RigidBodyModel) -> DataError:
+    """``err`` with the channels' disagreements (:func:`channel_problems`) added, which may be its
+    cause (positions in degrees labelled radians make a log look too short or still)."""
+    try:
+        found = [p for joint in channel_problems(log, model).values() for p in joint]
+    except DataError:
+        return err
+    if not found:
+        return err
+    return DataError(
+        f"{err.message}; the log's channels also disagree, which may be why: {'; '.join(found)}",
+        file=err.file,
+        row=err.row,
+        column=err.column,
+    )

@@ -29,7 +29,7 @@ import numpy as np
 
 from ....errors import ConfigError
 
-__all__ = ["FAMILIES", "JointFriction", "friction_for", "split_direction"]
+__all__ = ["FAMILIES", "JointFriction", "excess_cap", "friction_for", "split_direction"]
 
 #: The families a joint's friction may take in a whole-arm fit.
 FAMILIES = (
@@ -80,6 +80,12 @@ class JointFriction:
     shapes: dict[str, tuple[float, float]] = field(default_factory=dict)
     #: a load family's joint that carries no load (:data:`NO_LOAD`): no load column
     unloaded: bool = False
+    #: the largest Stribeck excess ``tau_s - tau_c`` the log allows [N m] (:func:`excess_cap`)
+    excess_max: float = np.inf
+    #: direction -> the share of its Stribeck column on the fitted rows that leaks there
+    #: through the filters from rows left out (``_solve.unseen_rises``); above
+    #: ``_solve.LEAK_MAX`` the rise is not seen and its excess held at zero
+    leaks: dict[str, float] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         if self.family not in FAMILIES:
@@ -185,8 +191,28 @@ class JointFriction:
                 T[r, pos[f"viscous{d}"]] = 1.0
             else:
                 T[r, pos[f"{base}{d}"]] = 1.0
+        # a parameter the data do not determine (NaN) voids only the family's parameters
+        # made from it, not the others (0 x NaN would)
+        bad = np.isnan(np.diag(cov))
+        voided = np.isnan(T).any(axis=1) | (np.nan_to_num(np.abs(T[:, bad])) > 0).any(axis=1)
         with np.errstate(invalid="ignore"):
-            return T @ values, T @ cov @ T.T
+            fam_values = T @ values
+        T = np.nan_to_num(T)
+        fam_cov = T @ np.nan_to_num(cov) @ T.T
+        fam_cov[voided, :] = np.nan
+        fam_cov[:, voided] = np.nan
+        return fam_values, fam_cov
+
+
+def excess_cap(tau: np.ndarray, gravity: np.ndarray) -> np.ndarray:
+    """Per joint, the largest torque its drive applied beyond gravity, ``max_t |tau - g(q)|``
+    [N m]: a joint that broke away met no static friction above it, so no Stribeck excess
+    (``tau_s - tau_c``) above it is physical. Without it, a shape the data do not bound
+    could take any excess: on a PD-tracked Panda (``benchmarks/bench_robot.py --truth sim
+    --friction stribeck_asym``, seed 1) joint 1's ``w_s`` went to the box's 1 mrad/s with an
+    excess of 16,000 N m (truth 0.15), a spike at the reversals the window leaves out that
+    leaked through the low-pass into the held-out rows: 635 times the noise."""
+    return np.max(np.abs(tau - gravity), axis=0)
 
 
 def split_direction(name: str) -> tuple[str, str]:

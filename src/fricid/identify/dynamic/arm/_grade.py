@@ -11,8 +11,9 @@ import numpy as np
 
 from ....metrics import NOISE_RATIO, verdict
 from ...trust import MISS_RATIO
+from ._solve import LEAK_MAX
 
-__all__ = ["grade", "loose_levels"]
+__all__ = ["grade", "loose_levels", "unseen_rise_reasons"]
 
 
 def _level(recs: Mapping[str, Mapping[str, Any]], name: str) -> float:
@@ -84,4 +85,18 @@ def grade(
     return "yes", [
         f"every parameter is determined and the held-out error ({source}) is within noise "
         f"({ratio:.2f}x the scatter)"
+    ]
+
+
+def unseen_rise_reasons(jf) -> list[str]:
+    """What a joint's held-out error may hold that its fit could not know: the directions
+    whose Stribeck rise the fitted rows did not see (``JointFriction.leaks`` above
+    :data:`._solve.LEAK_MAX`), fitted without it."""
+    unseen = [d.strip("_") or "both" for d, x in jf.leaks.items() if x > LEAK_MAX]
+    if not unseen:
+        return []
+    return [
+        f"no Stribeck rise fitted in direction(s) {', '.join(unseen)}: the rows fitted do not "
+        "see it (it lies in the slow rows left out near the reversals), so slow sliding that "
+        "way is predicted without it"
     ]

@@ -13,7 +13,8 @@ sweeps still 34 times.
 variable-projection residual (Golub and Pereyra 1973), with Kaufman's (1975) Jacobian: the
 shapes' columns (:func:`._solve.shape_rows`, as the intervals use them) less their projection on the
 linear columns. The shapes are searched as ``(log w_s, delta)`` inside the search box; a step
-is taken only when it lowers the weighted sum of squares, so the polish never loses.
+is taken only when it lowers the weighted sum of squares, so the polish never loses, and
+keeps every Stribeck excess within what the log allows (:func:`._friction.excess_cap`).
 
 The torque's delay (``arm._torque_delay``) is one more linear column here, the torque's
 change per sample: estimated with the starting shapes, a delay held fixed kept the shapes in
@@ -74,6 +75,16 @@ def _state(sig, Yb, frictions, mask, sigma):
     return st, A, theta, r, float(r @ r)
 
 
+def _within_caps(frictions: list[JointFriction], st, theta: np.ndarray) -> bool:
+    """Every Stribeck excess at most what the log allows (``JointFriction.excess_max``)."""
+    return all(
+        theta[st.offsets[j] + 3 * k + 1] <= jf.excess_max
+        for j, jf in enumerate(frictions)
+        if jf.stribeck
+        for k in range(len(jf.directions))
+    )
+
+
 def polish_shapes(
     sig: ArmSignals,
     Yb: np.ndarray,
@@ -90,6 +101,7 @@ def polish_shapes(
     joints = sorted({j for j, _ in blocks})
     st, A, theta, r, ssr = _state(sig, Yb, frictions, mask, sigma)
     start, lam, taken = ssr, 1e-3, 0
+    within = _within_caps(frictions, st, theta)
     for _ in range(ITERATIONS):
         taken += 1
         J = shape_rows(sig, frictions, st, theta, sigma, joints, log_w=True)
@@ -105,8 +117,9 @@ def polish_shapes(
             step = np.linalg.lstsq(H + lam * damp, g, rcond=None)[0]
             _put(frictions, blocks, (x + step).reshape(-1, 2))
             trial = _state(sig, Yb, frictions, mask, sigma)
-            if trial[-1] < ssr:
-                improved = True
+            inside = _within_caps(frictions, trial[0], trial[2])
+            if trial[-1] < ssr and (inside or not within):  # never out of the caps
+                improved, within = True, inside
                 break
             lam *= 4.0
         if not improved:

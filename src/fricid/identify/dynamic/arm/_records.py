@@ -7,8 +7,9 @@ from __future__ import annotations
 import numpy as np
 
 from ._friction import DELTA_BOX, W_S_BOX, split_direction
+from ._solve import LEAK_MAX
 
-__all__ = ["friction_records", "interval", "widen"]
+__all__ = ["friction_records", "held_at_bound", "interval", "mark_held", "widen"]
 
 
 #: Friction levels [N m, N m s/rad]: physically never below zero. Any parameter below zero
@@ -91,6 +92,8 @@ def friction_records(frictions, theta, cov, st, joints, t, sig, moving, models_u
                 lo_, hi_ = rec["ci95"]
                 if lo_ < box[0] or hi_ > box[1] or se[i] > abs(fam_values[i]):
                     rec["note"] = "not bounded by the data (interval beyond the search box)"
+                # no shape outside the box was searched: the interval ends at its faces
+                rec["ci95"] = [max(lo_, box[0]), min(hi_, box[1])]
             params[pname] = rec
         v = sig.dq[moving[:, j], j]
         out[name] = {
@@ -104,9 +107,12 @@ def friction_records(frictions, theta, cov, st, joints, t, sig, moving, models_u
     return out
 
 
-def widen(recs: dict, d: str, prof: dict) -> None:
+def widen(recs: dict, d: str, prof: dict, cap: float = np.inf) -> None:
     """Direction ``d``'s Stribeck intervals widened to their profile region
-    (:func:`._solve.shape_profiles`), ``tau_s`` by the region's excess over ``tau_c``."""
+    (:func:`._solve.shape_profiles`), ``tau_s`` by the region's excess over ``tau_c``, and
+    ended where the search ends: ``tau_s`` at zero and at ``tau_c`` plus the largest excess
+    the log allows (``cap``, :func:`._friction.excess_cap`). A ``tau_s`` whose ``w_s`` the data
+    do not bound is not bounded either (its excess trades against the shape)."""
     tau_c = recs["tau_c" + d]["value"]
     ranges = {"w_s": prof["w_s"], "delta": prof["delta"]}
     if tau_c is not None:
@@ -115,3 +121,50 @@ def widen(recs: dict, d: str, prof: dict) -> None:
         rec = recs[name + d]
         if rec["value"] is not None and rec["ci95"][0] is not None:
             rec["ci95"] = [min(rec["ci95"][0], lo), max(rec["ci95"][1], hi)]
+    rec = recs["tau_s" + d]
+    if tau_c is None or rec["value"] is None or rec["ci95"][0] is None:
+        return
+    rec["ci95"] = [max(rec["ci95"][0], 0.0), min(rec["ci95"][1], tau_c + cap)]
+    if recs["w_s" + d]["note"].startswith("not bounded") and not rec["note"]:
+        rec["note"] = "not bounded by the data (nor is its Stribeck velocity w_s)"
+
+
+def held_at_bound(recs: dict, d: str, excess: float, cap: float, leak: float = 0.0) -> None:
+    """Direction ``d``'s Stribeck records when its excess ``tau_s - tau_c`` was held at a
+    bound (:func:`._solve.bounded_lstsq`): at zero the data show no rise the search allows
+    (nor a shape to it), or the fitted rows do not see it (``leak`` above
+    :data:`._solve.LEAK_MAX`: :func:`._solve.unseen_rises`); at ``cap`` one as large as the
+    log allows; no estimate either way."""
+    if excess <= 0.0:
+        rise = (
+            f"the rows fitted do not see the Stribeck rise ({leak:.0%} of its column there "
+            "leaks in through the low-pass from the slow rows left out)"
+            if leak > LEAK_MAX
+            else "the data show no Stribeck rise"
+        )
+        why = {
+            "tau_s": f"not determined: {rise}; its excess held at zero",
+            "w_s": "not determined: no Stribeck rise fitted, so no shape to it",
+            "delta": "not determined: no Stribeck rise fitted, so no shape to it",
+        }
+    else:
+        why = {
+            "tau_s": (
+                f"not determined: its excess reached the largest the log allows ({cap:.4g} N m, "
+                "the largest torque beyond gravity)"
+            )
+        }
+    for name, note in why.items():
+        recs[name + d].update(
+            value=None, stderr=None, ci95=[None, None], not_determined=True, note=note
+        )
+
+
+def mark_held(fric: dict, frictions, st, theta: np.ndarray, held: list[int], joints) -> None:
+    """Every direction whose excess column (``st``'s) is among ``held``: its records by
+    :func:`held_at_bound`."""
+    for j, jf in enumerate(frictions):
+        for k, d in enumerate(jf.directions if jf.stribeck else ()):
+            if (col := st.offsets[j] + 3 * k + 1) in held:
+                recs = fric[joints[j]]["parameters"]
+                held_at_bound(recs, d, theta[col], jf.excess_max, jf.leaks.get(d, 0.0))
