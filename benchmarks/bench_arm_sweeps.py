@@ -15,7 +15,12 @@ the RMS friction and the RMS standard error of the arm path; then, over ``--seed
 the share of 95 % intervals (+-1.96 standard errors) that hold the truth, for the set-point
 frictions and the base gravity parameters; and each joint's per-direction Coulomb-viscous law
 fitted to its extracted samples (``coulomb_viscous_asym``): per parameter the median relative
-error and the share of 95 % intervals that hold the truth.
+error and the share of 95 % intervals that hold the truth; then that law held out on a second
+campaign (another seed, every other joint 0.3 rad from the first campaign's poses: a second
+trajectory): the RMS over its set-points of (law - set-point friction) / the set-point's
+standard error (the mean torque's noise there; 1 where the law predicts within the noise),
+the mean and the largest over seeds, and the seconds of one identification (extraction with
+the base gravity parameters, then the law).
 
 Run: ``python benchmarks/bench_arm_sweeps.py [--seeds 20]``.
 """
@@ -77,7 +82,9 @@ def errors(case, seed: int):
     _, truth, laws, spans, poses, options = case
     ident = perturbed(truth, np.random.default_rng(100 + seed))
     log = arm_sweeps(truth, spans, poses, laws, seed=seed, **options)
-    res = extract_arm(log, ident)
+    start = time.perf_counter()
+    res = extract_arm(log, ident)  # timed with the laws below: the identification
+    seconds = time.perf_counter() - start
     urdf = extract_arm(log, ident, identify=False)
     rows = {}
     for joint, law in laws.items():
@@ -94,7 +101,20 @@ def errors(case, seed: int):
             rms(se),
         )
     g = res.gravity
-    params = {joint: law_fit(res[joint].by_direction, law) for joint, law in laws.items()}
+    start = time.perf_counter()
+    params, fitted = {}, {}
+    for joint, law in laws.items():
+        params[joint], fitted[joint] = law_fit(res[joint].by_direction, law)
+    params["seconds"] = seconds + time.perf_counter() - start
+    shifted = {j: [p + 0.3 for p in ps] for j, ps in poses.items()}
+    held = extract_arm(arm_sweeps(truth, spans, shifted, laws, seed=seed + 1000, **options), ident)
+    for joint in laws:
+        levels = held.gravity.joint_levels(joint)
+        v = np.array([lv["velocity"] for lv in levels])
+        z = (fitted[joint].predict_point(v) - [lv["friction"] for lv in levels]) / np.array(
+            [lv["friction_se"] for lv in levels]
+        )
+        params[joint]["held-out"] = rms(z)
     beta_true = base_parameters(ident, gravity_only=True).project(truth.parameters())
     z_levels = [
         (lv["friction"] - laws[lv["joint"]](lv["velocity"])) / lv["friction_se"] for lv in g.levels
@@ -106,9 +126,9 @@ def errors(case, seed: int):
 LAW_PARAMS = {"f_c_pos": "fc_pos", "beta_pos": "fv_pos", "f_c_neg": "fc_neg", "beta_neg": "fv_neg"}
 
 
-def law_fit(samples, law) -> dict[str, tuple[float, bool]]:
+def law_fit(samples, law):
     """The joint's ``coulomb_viscous_asym`` fit to its extracted samples: each parameter's
-    relative error and whether its 95 % interval holds the truth."""
+    relative error and whether its 95 % interval holds the truth; and the fitted model."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         fitted = fit(samples, "coulomb_viscous_asym")
@@ -116,19 +136,25 @@ def law_fit(samples, law) -> dict[str, tuple[float, bool]]:
     for name, field in LAW_PARAMS.items():
         p, truth = fitted.parameters[name], getattr(law, field)
         out[name] = (p.value / truth - 1.0, bool(p.ci95[0] <= truth <= p.ci95[1]))
-    return out
+    return out, fitted
 
 
 def law_table(per_seed: list[dict]) -> None:
-    """Per joint and parameter: the median relative error and the intervals' coverage."""
-    print(f"{'joint':14s} " + " ".join(f"{n + ' err/cov':>19s}" for n in LAW_PARAMS))
-    for joint in per_seed[0]:
+    """Per joint and parameter: the median relative error and the intervals' coverage; the
+    held-out ratio's mean and largest; the seconds."""
+    head = " ".join(f"{n + ' err/cov':>19s}" for n in LAW_PARAMS)
+    print(f"{'joint':14s} {head} {'held-out/se (max)':>18s}")
+    for joint in (j for j in per_seed[0] if j != "seconds"):
         cells = []
         for name in LAW_PARAMS:
             err = [abs(s[joint][name][0]) for s in per_seed]
             cov = [s[joint][name][1] for s in per_seed]
             cells.append(f"{100 * np.median(err):9.2f}% {100 * np.mean(cov):7.1f}%")
+        held = [s[joint]["held-out"] for s in per_seed]
+        cells.append(f"{np.mean(held):10.2f} ({np.max(held):5.2f})")
         print(f"{joint:14s} " + " ".join(f"{c:>19s}" for c in cells))
+    sec = [s["seconds"] for s in per_seed]
+    print(f"seconds per identification: median {np.median(sec):.2f}, max {np.max(sec):.2f}")
 
 
 def simulated() -> None:

@@ -107,6 +107,16 @@ def export_command(
             ),
         ),
     ] = False,
+    allow_untrusted: Annotated[
+        bool,
+        typer.Option(
+            "--allow-untrusted",
+            help=(
+                "Export a model whose recorded trust verdict is 'no' (refused otherwise); the "
+                "file's comment says so."
+            ),
+        ),
+    ] = False,
 ) -> None:
     """Export a model for a controller or a simulator.
 
@@ -129,6 +139,7 @@ def export_command(
         export_c,
         file_sha256,
         refuse_undetermined,
+        refuse_untrusted,
         write_text,
     )
     from ..export.mjcf import is_lugre, lugre_mapping
@@ -142,6 +153,7 @@ def export_command(
         raise ConfigError(f"unknown export target '{to}'; choose one of: {', '.join(TARGETS)}")
     fitted = FittedModel.load(model)
     refuse_undetermined(fitted, allow_undetermined)
+    refuse_untrusted(fitted, allow_untrusted)
     sha256 = file_sha256(model)
     try:
         if target == "c":

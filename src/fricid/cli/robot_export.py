@@ -23,6 +23,32 @@ ROBOT_TARGETS = {
 }
 
 
+def _joint_models(files: dict[str, Path]) -> tuple[dict, dict[str, str], dict[str, str]]:
+    """joint -> (its FittedModel, its source's name, the SHA-256 of that file's bytes); a
+    whole-arm fit file (``fricid robot fit``'s output) gives every joint of the arm, in the
+    URDF's order (:meth:`fricid.fitted.arm.ArmFit.joint_model`)."""
+    from ..errors import ConfigError
+    from ..export import file_sha256
+    from ..fitted import FittedModel
+    from ..fitted.arm import ARM_KIND, ArmFit
+    from ..io._jsonfile import read_json
+
+    fitted, sources, sha256 = {}, {}, {}
+    for joint, path in files.items():
+        doc = read_json(path, what="model file")
+        if isinstance(doc, dict) and doc.get("kind") == ARM_KIND:
+            arm = ArmFit.from_dict(doc, source=str(path))
+            named = {j: arm.joint_model(j) for j in arm.joints}
+        else:
+            named = {joint: FittedModel.load(path)}
+        for name, model in named.items():
+            if name in fitted:
+                raise ConfigError(f"joint '{name}' is given twice ({sources[name]} and {path})")
+            fitted[name], sha256[name] = model, file_sha256(path)
+            sources[name] = path.name if len(named) == 1 else f"{path.name} ({name})"
+    return fitted, sources, sha256
+
+
 def _model_files(items: list[str]) -> dict[str, Path]:
     """``JOINT=FILE``, a model file (joint = its stem) or a folder (its ``*.json`` files, by
     name) -> joint -> file, in the order given."""
@@ -61,7 +87,8 @@ def robot_export_command(
         list[str],
         typer.Argument(
             help="The joints' model files: JOINT=FILE, or FILE (the joint is its name without "
-            ".json), or a folder of them (every *.json, joints in file-name order)."
+            ".json), or a folder of them (every *.json, joints in file-name order), or a "
+            "whole-arm fit (fricid robot fit's output: every joint, in the URDF's order)."
         ),
     ],
     to: Annotated[
@@ -109,6 +136,16 @@ def robot_export_command(
             help="Export models whose records say some parameters are not determined.",
         ),
     ] = False,
+    allow_untrusted: Annotated[
+        bool,
+        typer.Option(
+            "--allow-untrusted",
+            help=(
+                "Export a model whose recorded trust verdict is 'no' (refused otherwise); the "
+                "file's comment says so."
+            ),
+        ),
+    ] = False,
 ) -> None:
     """Export every joint of a robot at once: one ros2_control-style YAML with a block per
     joint, or one C header and source with a function per joint and a dispatcher
@@ -118,9 +155,8 @@ def robot_export_command(
     from rich.markup import escape
 
     from ..errors import ConfigError
-    from ..export import Smoothing, file_sha256, refuse_undetermined, write_text
+    from ..export import Smoothing, refuse_undetermined, refuse_untrusted, write_text
     from ..export.robot import export_robot_c, robot_ros2_yaml_text
-    from ..fitted import FittedModel
     from ._paths import check_paths
 
     target = to.strip().lower()
@@ -128,12 +164,10 @@ def robot_export_command(
     if target not in ROBOT_TARGETS:
         raise ConfigError(f"unknown target '{to}'; choose one of: {', '.join(ROBOT_TARGETS)}")
     check_paths(**{"out_dirs" if target == "c" else "out_files": {"--out": out}})
-    files = _model_files(models)
-    fitted = {joint: FittedModel.load(path) for joint, path in files.items()}
-    for model in fitted.values():
+    fitted, sources, sha256 = _joint_models(_model_files(models))
+    for joint, model in fitted.items():
         refuse_undetermined(model, allow_undetermined)
-    sources = {joint: path.name for joint, path in files.items()}
-    sha256 = {joint: file_sha256(path) for joint, path in files.items()}
+        refuse_untrusted(model, allow_untrusted, joint)
     if target == "c":
         paths = export_robot_c(
             fitted,

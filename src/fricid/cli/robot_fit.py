@@ -40,7 +40,12 @@ def _pm(rec: dict) -> str:
     low, high = rec["ci95"]
     if low is None:
         return f"{rec['value']:.4g}"
-    return f"{rec['value']:.4g} +- {(high - low) / 2:.2g}"
+    half, mid = (high - low) / 2, (high + low) / 2
+    if abs(mid - rec["value"]) <= 0.05 * half:  # symmetric about the value
+        text = f"{rec['value']:.4g} +- {half:.2g}"
+    else:  # one-sided (a search box's face, zero, a profile region): its two ends
+        text = f"{rec['value']:.4g} [{low:.3g}, {high:.3g}]"
+    return text + (" (not bounded)" if rec.get("note", "").startswith("not bounded") else "")
 
 
 def _table(fit) -> None:

@@ -39,6 +39,7 @@ from ._common import (
     model_sha256,
     plain,
     refuse_undetermined,
+    refuse_untrusted,
     undetermined_parameters,
 )
 from .c import CCode, c_code, export_c
@@ -80,6 +81,7 @@ __all__ = [
     "plain",
     "project",
     "refuse_undetermined",
+    "refuse_untrusted",
     "robot_c_code",
     "robot_ros2_yaml_text",
     "ros2_yaml_text",

@@ -242,7 +242,47 @@ def summary_lines(
             "NOT DETERMINED by the trajectory, exported as identified: "
             + ", ".join(plain(n) for n in undetermined)
         )
+    level, reasons = trust_of(fitted)
+    if level is not None:
+        why = f": {plain(reasons[0])}" if reasons else ""
+        lines.append(
+            f"trust verdict: {'NO, exported anyway' if level == 'no' else plain(level)}{why}"
+        )
     return lines
+
+
+def trust_of(fitted: FittedModel) -> tuple[str | None, list[str]]:
+    """The model's trust level (``yes``, ``with caveats``, ``no``) and its reasons as its file
+    records them: its trust verdict (:class:`fricid.identify.trust.Trust`) or, for a joint of
+    a whole-arm fit, its validation's; ``(None, [])`` when it records none."""
+    for rec in (fitted.trust, fitted.validation):
+        if isinstance(rec, dict) and isinstance(rec.get("level"), str):
+            reasons = rec.get("reasons")
+            return rec["level"], [str(r) for r in reasons] if isinstance(reasons, list) else []
+    return None, []
+
+
+def refuse_untrusted(fitted: FittedModel, allow: bool, joint: str | None = None) -> None:
+    """Refuse to export a model whose recorded verdict is ``no`` unless ``allow`` (then
+    :func:`summary_lines` says so in the file's comment); ``joint`` names it in the message.
+
+    Raises
+    ------
+    ExportError
+        Such a model, not allowed.
+    """
+    level, reasons = trust_of(fitted)
+    if level == "no" and not allow:
+        # printable characters only (no terminal controls from a file), at most 300
+        why = "; ".join("".join(c if c.isprintable() else "?" for c in r) for r in reasons[:3])
+        why = (why[:300] + " ...") if len(why) > 300 else why or "no reason recorded"
+        whose = f"joint {plain(joint)}: the" if joint else "the"
+        raise ExportError(
+            f"{whose} '{model_name(fitted)}' model's trust verdict is 'no' ({why}): a controller "
+            "or simulator would run on a model its own check rejects; record better data or "
+            "fit another model, or export anyway with --allow-untrusted (the file's comment "
+            "then says so)"
+        )
 
 
 def undetermined_parameters(fitted: FittedModel) -> list[str]:

@@ -57,6 +57,22 @@ def _as_msk(params: dict[str, Parameter]) -> dict[str, Parameter]:
     return out
 
 
+def _without_rise(params: dict[str, Parameter], entry: dict[str, Any]) -> dict[str, Parameter]:
+    """A Stribeck family's directions whose excess the fit held at zero (its record's
+    ``held_at``: the fitted rows showed no rise, or did not see it) as the law the fit used:
+    ``tau_s = tau_c``, so that ``w_s`` and ``delta`` do not matter (fixed at 1)."""
+    out = dict(params)
+    for d in ("_pos", "_neg", ""):
+        rec = entry["parameters"].get(f"tau_s{d}", {})
+        if rec.get("held_at") != 0.0:
+            continue
+        note = "no Stribeck rise fitted (tau_s = tau_c): does not matter"
+        out[f"tau_s{d}"] = replace(params[f"tau_c{d}"], name=f"tau_s{d}", note=rec["note"])
+        for name, unit in (("w_s", "rad/s"), ("delta", "1")):
+            out[f"{name}{d}"] = Parameter(f"{name}{d}", 1.0, unit=unit, fixed=True, note=note)
+    return out
+
+
 @dataclass
 class ArmFit:
     """A whole arm's identification (module notes).
@@ -123,7 +139,7 @@ class ArmFit:
         if joint not in self.friction:
             raise ConfigError(f"no joint {joint!r} in this fit; joints: {', '.join(self.joints)}")
         entry = self.friction[joint]
-        params = {n: self.parameter(joint, n) for n in entry["parameters"]}
+        params = _without_rise({n: self.parameter(joint, n) for n in entry["parameters"]}, entry)
         for n, p in params.items():  # a joint without load: the load term never acts
             if n.startswith("f_ck") and "carries no load" in p.note:
                 params[n] = replace(p, value=0.0, fixed=True, not_determined=False)
@@ -156,6 +172,9 @@ class ArmFit:
                 "scatter": self.noise.get(joint),
                 "ratio": check.get("ratio"),
                 "verdict": verdict(_nan(check.get("ratio"))),
+                # the joint's trust level, every reason counted (not the ratio's alone)
+                "level": str(check.get("level", "no")),
+                "reasons": [str(r) for r in check.get("reasons", [])],
             },
         )
 

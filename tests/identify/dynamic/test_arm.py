@@ -296,7 +296,7 @@ def test_a_friction_level_below_zero_is_not_printed_as_a_number(pendulum):
 
 def test_a_level_below_zero_within_its_interval_is_not_determined_either(pendulum):
     """A viscous level the data barely see comes out below zero with an interval that reaches
-    zero: the data bound it, they do not tell it. It is not determined (the joint's verdict is
+    zero: the data say it is small, not how small. It is not determined (the joint's verdict is
     not "yes"), and the joint's model is refused with its name, not written for a later
     command to reject as outside the family's valid region."""
     laws = [

@@ -91,7 +91,7 @@ from ._channels import channel_problems, check_live_torque, with_channel_problem
 from ._consistent import consistent_parameters
 from ._filter_cov import filter_correlation
 from ._friction import NO_LOAD, excess_cap, friction_for
-from ._grade import grade, loose_levels, unseen_rise_reasons
+from ._grade import MIN_EFFECTIVE, grade, loose_levels, unseen_rise_reasons
 from ._load import FROM_FIT, FROM_LOG, FROM_URDF, joint_load, log_load
 from ._polish import polish_shapes
 from ._records import friction_records, interval, mark_held, widen
@@ -439,9 +439,10 @@ def _fit_arm(
         nd = [p for p, rec in recs.items() if rec["not_determined"]]
         open_ = [p for p, rec in recs.items() if rec["note"].startswith("not bounded")]
         loose = loose_levels(recs, float(sigma[j]), fric[name].get("load_range"))
-        level, reasons = grade(
-            ratio, nd, open_, source, bool(moving[:, j].any()), loose, problems[name]
-        )
+        moved = bool(moving[:, j].any())
+        level, reasons = grade(ratio, nd, open_, source, moved, loose, problems[name], n_eff[j])
+        if moved and n_eff[j] < MIN_EFFECTIVE:  # no ratio from a noise of so few samples
+            ratio = float("nan")
         reasons += unseen_rise_reasons(frictions[j])
         validation[name] = {
             "rmse": rmse,

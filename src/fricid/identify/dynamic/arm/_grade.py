@@ -13,7 +13,12 @@ from ....metrics import NOISE_RATIO, verdict
 from ...trust import MISS_RATIO
 from ._solve import LEAK_MAX
 
-__all__ = ["grade", "loose_levels", "unseen_rise_reasons"]
+__all__ = ["MIN_EFFECTIVE", "grade", "loose_levels", "unseen_rise_reasons"]
+
+#: The fewest independent samples a joint's rows may hold for a verdict other than ``no``
+#: (a double pendulum's joint that barely moved had 3, its noise 6e-16 N m and its held-out
+#: ratio 6e13).
+MIN_EFFECTIVE = 20
 
 
 def _level(recs: Mapping[str, Mapping[str, Any]], name: str) -> float:
@@ -56,12 +61,20 @@ def grade(
     moved: bool,
     loose: list[str] = (),
     problems: list[str] = (),
+    effective: float = np.inf,
 ):
     """A joint's verdict in :mod:`fricid.identify.trust`'s words and thresholds; each of
-    ``problems`` (channels that disagree, :mod:`._channels`) is a reason for ``no``."""
+    ``problems`` (channels that disagree, :mod:`._channels`) is a reason for ``no``, and so
+    are fewer than :data:`MIN_EFFECTIVE` ``effective`` (independent) samples."""
     no, caveats = [f"the log's channels disagree: {p}" for p in problems], []
     if not moved:
         no.append("the joint does not move in the log, so its friction is not determined")
+    elif effective < MIN_EFFECTIVE:
+        no.append(
+            f"the joint slides on only {effective:.0f} independent samples (at least "
+            f"{MIN_EFFECTIVE} are needed to tell its friction and noise): make it move more"
+        )
+        ratio = np.nan  # a noise from so few samples grades nothing
     elif loose:
         no.append(
             "the data do not determine the joint's friction: its Coulomb level is not "
@@ -76,7 +89,7 @@ def grade(
         no.append(f"the held-out error {verdict(ratio)} the measurement scatter")
     elif np.isfinite(ratio) and ratio > NOISE_RATIO:
         caveats.append(f"the held-out error {verdict(ratio)} the measurement scatter")
-    elif not np.isfinite(ratio) and moved:
+    elif not np.isfinite(ratio) and moved and effective >= MIN_EFFECTIVE:
         caveats.append("no held-out error to compare with the noise")
     if no:
         return "no", no + caveats

@@ -73,7 +73,7 @@ def friction_records(frictions, theta, cov, st, joints, t, sig, moving, models_u
                 why = (
                     "the family does not describe this joint's data"
                     if rec["ci95"][1] < 0
-                    else "its interval reaches zero: the data bound it, they do not tell it"
+                    else "its interval reaches zero: the data say it is small, not how small"
                 )
                 rec.update(
                     value=None,
@@ -87,11 +87,16 @@ def friction_records(frictions, theta, cov, st, joints, t, sig, moving, models_u
                 )
                 params[pname] = rec
                 continue
+            if level and not nd and rec["ci95"][0] < 0:  # a level is never below zero
+                rec["ci95"] = [0.0, rec["ci95"][1]]
             if pname.startswith(("w_s", "delta")) and not nd:
                 box = W_S_BOX if pname.startswith("w_s") else DELTA_BOX
                 lo_, hi_ = rec["ci95"]
                 if lo_ < box[0] or hi_ > box[1] or se[i] > abs(fam_values[i]):
-                    rec["note"] = "not bounded by the data (interval beyond the search box)"
+                    rec["note"] = (
+                        "not bounded by the data (its interval reaches the searched range's "
+                        f"limit, {box[0]:g} to {box[1]:g})"
+                    )
                 # no shape outside the box was searched: the interval ends at its faces
                 rec["ci95"] = [max(lo_, box[0]), min(hi_, box[1])]
             params[pname] = rec
@@ -158,6 +163,8 @@ def held_at_bound(recs: dict, d: str, excess: float, cap: float, leak: float = 0
         recs[name + d].update(
             value=None, stderr=None, ci95=[None, None], not_determined=True, note=note
         )
+    if excess <= 0.0:  # the law fitted is the one without a rise (ArmFit.joint_model)
+        recs["tau_s" + d]["held_at"] = 0.0
 
 
 def mark_held(fric: dict, frictions, st, theta: np.ndarray, held: list[int], joints) -> None:

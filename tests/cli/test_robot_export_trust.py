@@ -1,0 +1,144 @@
+"""Exports say what a model's verdict is and refuse a ``no`` unless told
+(``fricid export``, ``fricid robot export``, which also takes a whole-arm fit file), and a
+whole-arm joint whose Stribeck rise the fit held at zero exports as the law it fitted."""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+pytest.importorskip("pinocchio")
+
+from fricid.cli import app
+from fricid.cli.robot_fit import _pm
+from fricid.fitted.arm import ArmFit
+from fricid.identify.dynamic.arm._grade import MIN_EFFECTIVE, grade
+from fricid.io import write_robot_log
+from fricid.robot import RigidBodyModel, example_urdf
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "identify" / "dynamic"))
+from _arm_truth import make_log
+
+runner = CliRunner()
+
+LAWS = [
+    ("coulomb_viscous", {"f_c": 0.5, "beta": 0.3}),
+    ("coulomb_viscous", {"f_c": 0.7, "beta": 0.2}),
+]
+
+
+@pytest.fixture(scope="module")
+def arm_file(tmp_path_factory):
+    path, joints = example_urdf("double_pendulum")
+    model = RigidBodyModel.from_urdf(path, joints)
+    folder = tmp_path_factory.mktemp("arm")
+    logs = [
+        write_robot_log(
+            make_log(model, LAWS, duration=12.0, rate=250.0, seed=s, noise=0.05),
+            folder / f"log{s}.csv",
+        )
+        for s in (3, 4)
+    ]
+    out = folder / "arm.json"
+    fit = ["robot", "fit", str(logs[0]), "--urdf", path, "--friction", "coulomb_viscous"]
+    res = runner.invoke(app, [*fit, "--validate", str(logs[1]), "-o", str(out)])
+    assert res.exit_code == 0, res.output
+    return out
+
+
+def _with_joint2_no(arm_file: Path, tmp_path: Path) -> Path:
+    doc = json.loads(arm_file.read_text())
+    doc["validation"]["joint2"].update(level="no", reasons=["the held-out error misses by 9x"])
+    out = tmp_path / "arm_no.json"
+    out.write_text(json.dumps(doc))
+    return out
+
+
+def test_a_whole_arm_fit_exports_every_joint_in_the_urdf_order(arm_file, tmp_path):
+    levels = [ArmFit.load(arm_file).verdict(j) for j in ("joint1", "joint2")]
+    assert "no" not in levels
+    res = runner.invoke(app, ["robot", "export", str(arm_file), "--to", "c", "-o", str(tmp_path)])
+    assert res.exit_code == 0, res.output
+    header = (tmp_path / "fricid_friction.h").read_text()
+    assert header.index("joint 0: joint1") < header.index("joint 1: joint2")
+    source = (tmp_path / "fricid_friction.c").read_text()
+    for level in levels:  # each joint's comment gives its verdict
+        assert f"trust verdict: {level}" in source
+    assert source.count("trust verdict:") == 2 and "arm.json (joint2)" in source
+
+
+def test_a_joint_whose_verdict_is_no_is_not_exported_unless_told(arm_file, tmp_path):
+    arm = _with_joint2_no(arm_file, tmp_path)
+    out = tmp_path / "c"
+    res = runner.invoke(app, ["robot", "export", str(arm), "--to", "c", "-o", str(out)])
+    assert res.exit_code != 0
+    assert "joint joint2" in res.output and "--allow-untrusted" in res.output
+    assert not out.exists() or not any(out.iterdir())  # nothing written
+    res = runner.invoke(
+        app, ["robot", "export", str(arm), "--to", "c", "-o", str(out), "--allow-untrusted"]
+    )
+    assert res.exit_code == 0, res.output
+    assert "trust verdict: NO, exported anyway" in (out / "fricid_friction.c").read_text()
+
+
+def test_the_single_joint_export_refuses_a_no_too(arm_file, tmp_path):
+    model = ArmFit.load(_with_joint2_no(arm_file, tmp_path)).joint_model("joint2")
+    path = tmp_path / "joint2.json"
+    model.save(path)
+    res = runner.invoke(app, ["export", str(path), "--to", "urdf", "-o", str(tmp_path / "j.urdf")])
+    assert res.exit_code != 0 and "trust verdict is 'no'" in res.output
+    assert not (tmp_path / "j.urdf").exists()
+    flags = ["--to", "urdf", "-o", str(tmp_path / "j.urdf"), "--allow-untrusted"]
+    assert runner.invoke(app, ["export", str(path), *flags]).exit_code == 0
+    assert "NO, exported anyway" in (tmp_path / "j.urdf").read_text()
+
+
+def _record(value, lo=None, hi=None, note="", nd=False):
+    return {"value": value, "unit": "", "stderr": None, "ci95": [lo, hi], "note": note,
+            "not_determined": nd}  # fmt: skip
+
+
+def test_a_rise_held_at_zero_exports_as_the_law_without_it():
+    held = "not determined: the data show no Stribeck rise; its excess held at zero"
+    params = {}
+    for d, nd in (("_pos", False), ("_neg", True)):
+        params |= {
+            f"tau_c{d}": _record(0.4, 0.39, 0.41),
+            f"tau_s{d}": _record(None, nd=True, note=held) if nd else _record(0.6, 0.55, 0.65),
+            f"w_s{d}": _record(None, nd=True) if nd else _record(0.05, 0.04, 0.06),
+            f"tau_v{d}": _record(0.2, 0.19, 0.21),
+            f"delta{d}": _record(None, nd=True) if nd else _record(1.2, 1.0, 1.4),
+        }
+    params["tau_s_neg"]["held_at"] = 0.0
+    fit = ArmFit(
+        joints=("j",),
+        friction={"j": {"family": "stribeck_asym", "parameters": params}},
+        noise={"j": 0.01},
+        validation={"j": {"rmse": 0.01, "ratio": 1.0, "level": "with caveats", "reasons": []}},
+    )
+    model = fit.joint_model("j")
+    v = np.array([-1.0, -0.05, -0.001, 0.001, 0.05, 1.0])
+    negative = -(0.4 + 0.2 * np.abs(v[:3]))  # Coulomb-viscous: no rise that way
+    np.testing.assert_allclose(model.predict_point(v)[:3], negative, rtol=1e-12)
+    assert model.predict_point(0.001) > 0.59  # the positive rise is kept
+    assert model.validation["level"] == "with caveats"
+
+
+def test_a_joint_on_too_few_independent_samples_gets_no_and_no_ratio():
+    level, reasons = grade(6e13, [], [], "second log", True, effective=3.0)
+    assert level == "no" and "only 3 independent samples" in reasons[0]
+    assert not any("misses" in r for r in reasons)
+    level, _ = grade(1.0, [], [], "second log", True, effective=MIN_EFFECTIVE)
+    assert level == "yes"
+
+
+def test_a_one_sided_interval_is_printed_with_its_ends():
+    assert _pm(_record(0.05, 0.0, 0.06)) == "0.05 [0, 0.06]"
+    assert _pm(_record(1.0, 0.9, 1.1)) == "1 +- 0.1"
+    note = "not bounded by the data (its interval reaches the searched range's limit)"
+    assert _pm(_record(4.0, 0.3, 4.0, note=note)) == "4 [0.3, 4] (not bounded)"
