@@ -22,14 +22,9 @@ from fricid.io import write_robot_log
 from fricid.robot import RigidBodyModel, example_urdf
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "identify" / "dynamic"))
-from _arm_truth import make_log
+from _arm_truth import CV_LAWS, make_log
 
 runner = CliRunner()
-
-LAWS = [
-    ("coulomb_viscous", {"f_c": 0.5, "beta": 0.3}),
-    ("coulomb_viscous", {"f_c": 0.7, "beta": 0.2}),
-]
 
 
 @pytest.fixture(scope="module")
@@ -39,13 +34,13 @@ def arm_file(tmp_path_factory):
     folder = tmp_path_factory.mktemp("arm")
     logs = [
         write_robot_log(
-            make_log(model, LAWS, duration=12.0, rate=250.0, seed=s, noise=0.05),
+            make_log(model, CV_LAWS, duration=12.0, rate=250.0, seed=s, noise=0.05),
             folder / f"log{s}.csv",
         )
         for s in (3, 4)
     ]
     out = folder / "arm.json"
-    fit = ["robot", "fit", str(logs[0]), "--urdf", path, "--friction", "coulomb_viscous"]
+    fit = ["robot", "fit", str(logs[0]), "--urdf", path, "--friction", "coulomb_viscous_asym"]
     res = runner.invoke(app, [*fit, "--validate", str(logs[1]), "-o", str(out)])
     assert res.exit_code == 0, res.output
     return out

@@ -22,6 +22,7 @@ from ..errors import ConfigError
 from ..io import options as _parse
 
 __all__ = [
+    "AllowUntrusted",
     "BoundOption",
     "DirectionOption",
     "FixOption",
@@ -100,6 +101,18 @@ SmoothKind = Annotated[
 #: ``--zone``: half-width of the smoothing zone [rad/s].
 SmoothZone = Annotated[
     float, typer.Option("--zone", help="Half-width of the smoothing zone [rad/s].")
+]
+
+#: ``--allow-untrusted``: export a model whose recorded trust verdict is "no".
+AllowUntrusted = Annotated[
+    bool,
+    typer.Option(
+        "--allow-untrusted",
+        help=(
+            "Export a model whose recorded trust verdict is 'no' (refused otherwise); the "
+            "file's comment says so."
+        ),
+    ),
 ]
 
 #: ``--torque-constant``: K of tau = K I when the effort is a motor current.

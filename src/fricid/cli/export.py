@@ -9,7 +9,7 @@ from typing import Annotated
 import typer
 
 from ._app import app, err_console, handle_errors
-from ._options import ModelFile, SmoothZone, out_option
+from ._options import AllowUntrusted, ModelFile, SmoothZone, out_option
 from ._paths import check_paths
 
 
@@ -107,16 +107,7 @@ def export_command(
             ),
         ),
     ] = False,
-    allow_untrusted: Annotated[
-        bool,
-        typer.Option(
-            "--allow-untrusted",
-            help=(
-                "Export a model whose recorded trust verdict is 'no' (refused otherwise); the "
-                "file's comment says so."
-            ),
-        ),
-    ] = False,
+    allow_untrusted: AllowUntrusted = False,
 ) -> None:
     """Export a model for a controller or a simulator.
 

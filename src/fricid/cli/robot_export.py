@@ -14,7 +14,7 @@ from typing import Annotated
 import typer
 
 from ._app import err_console, handle_errors, robot_app
-from ._options import SmoothZone, out_option
+from ._options import AllowUntrusted, SmoothZone, out_option
 
 #: ``--to`` values and what each writes.
 ROBOT_TARGETS = {
@@ -136,16 +136,7 @@ def robot_export_command(
             help="Export models whose records say some parameters are not determined.",
         ),
     ] = False,
-    allow_untrusted: Annotated[
-        bool,
-        typer.Option(
-            "--allow-untrusted",
-            help=(
-                "Export a model whose recorded trust verdict is 'no' (refused otherwise); the "
-                "file's comment says so."
-            ),
-        ),
-    ] = False,
+    allow_untrusted: AllowUntrusted = False,
 ) -> None:
     """Export every joint of a robot at once: one ros2_control-style YAML with a block per
     joint, or one C header and source with a function per joint and a dispatcher
