@@ -137,3 +137,13 @@ def test_a_one_sided_interval_is_printed_with_its_ends():
     assert _pm(_record(1.0, 0.9, 1.1)) == "1 +- 0.1"
     note = "not bounded by the data (its interval reaches the searched range's limit)"
     assert _pm(_record(4.0, 0.3, 4.0, note=note)) == "4 [0.3, 4] (not bounded)"
+
+
+def test_the_single_joint_export_points_a_whole_arm_fit_to_robot_export(arm_file, tmp_path):
+    res = runner.invoke(app, ["export", str(arm_file), "--to", "urdf", "-o", str(tmp_path / "x")])
+    assert res.exit_code != 0 and "fricid robot export" in res.output
+    res = runner.invoke(
+        app, ["robot", "export", str(arm_file), str(arm_file), "--to", "c", "-o", str(tmp_path)]
+    )
+    assert res.exit_code != 0 and "is given twice" in res.output
+    assert not (tmp_path / "fricid_friction.c").exists()

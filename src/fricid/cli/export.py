@@ -19,6 +19,15 @@ def _targets_help() -> str:
     return "Target: " + "; ".join(f"{name}: {line}" for name, line in TARGETS.items()) + "."
 
 
+def _is_arm_fit(path: Path) -> bool:
+    """The file is a whole-arm fit (its ``kind``), which ``fricid robot export`` takes."""
+    from ..fitted.arm import ARM_KIND
+    from ..io._jsonfile import read_json
+
+    doc = read_json(path, what="model file")
+    return isinstance(doc, dict) and doc.get("kind") == ARM_KIND
+
+
 @app.command("export")
 @handle_errors
 def export_command(
@@ -142,6 +151,12 @@ def export_command(
     )
     if target not in TARGETS:
         raise ConfigError(f"unknown export target '{to}'; choose one of: {', '.join(TARGETS)}")
+    if _is_arm_fit(model):
+        raise ConfigError(
+            f"{model} is a whole-arm fit (fricid robot fit's output): export its joints with "
+            f"fricid robot export {model} --to c (or ros2_control); the whole robot's URDF and "
+            "MJCF are written from Python (the robots how-to)"
+        )
     fitted = FittedModel.load(model)
     refuse_undetermined(fitted, allow_undetermined)
     refuse_untrusted(fitted, allow_untrusted)

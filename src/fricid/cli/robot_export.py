@@ -57,6 +57,8 @@ def _model_files(items: list[str]) -> dict[str, Path]:
     out: dict[str, Path] = {}
 
     def add(joint: str, path: Path) -> None:
+        if path.resolve() in {p.resolve() for p in out.values()}:
+            raise ConfigError(f"{path} is given twice")
         if joint in out:
             raise ConfigError(f"joint '{joint}' is given twice ({out[joint]} and {path})")
         if not path.is_file():

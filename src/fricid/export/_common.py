@@ -242,11 +242,21 @@ def summary_lines(
             "NOT DETERMINED by the trajectory, exported as identified: "
             + ", ".join(plain(n) for n in undetermined)
         )
-    level, reasons = trust_of(fitted)
-    if level is not None:
-        why = f": {plain(reasons[0])}" if reasons else ""
+    level, _ = trust_of(fitted)
+    if level in ("yes", "with caveats", "no"):  # fixed words and a number only
+        ratio = next(
+            (
+                r.get(key)
+                for r, key in ((fitted.trust, "heldout_ratio"), (fitted.validation, "ratio"))
+                if isinstance(r, dict) and isinstance(r.get(key), int | float)
+            ),
+            None,
+        )
+        shown = _display(ratio)
         lines.append(
-            f"trust verdict: {'NO, exported anyway' if level == 'no' else plain(level)}{why}"
+            f"trust verdict: {'NO, exported anyway' if level == 'no' else level}"
+            + (f" (held-out error {shown} times the scatter)" if shown is not None else "")
+            + "; the model file gives the reasons"
         )
     return lines
 

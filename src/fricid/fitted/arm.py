@@ -147,7 +147,8 @@ class ArmFit:
         if missing:
             raise ConfigError(
                 f"joint {joint}: not determined by the data: {', '.join(missing)}; there is no "
-                "friction model to use"
+                "number to predict or export with (fit a family the data tell, such as "
+                "coulomb_viscous_asym, or record the joint moving more, slower and both ways)"
             )
         check = self.validation.get(joint, {})
         velocity = list(entry.get("velocity_range", [-1.0, 1.0]))

@@ -68,7 +68,11 @@ def grade(
     are fewer than :data:`MIN_EFFECTIVE` ``effective`` (independent) samples."""
     no, caveats = [f"the log's channels disagree: {p}" for p in problems], []
     if not moved:
-        no.append("the joint does not move in the log, so its friction is not determined")
+        no.append(
+            "no row of the joint's motion is left to fit (it does not move, or moves only near "
+            "its reversals, which a closed-loop fit leaves out), so its friction is not "
+            "determined"
+        )
     elif effective < MIN_EFFECTIVE:
         no.append(
             f"the joint slides on only {effective:.0f} independent samples (at least "
