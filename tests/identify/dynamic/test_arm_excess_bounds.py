@@ -129,3 +129,18 @@ def test_a_rise_seen_only_through_the_filter_from_rows_left_out_is_not_determine
             assert rec["value"] is None and "do not see the Stribeck rise" in rec["note"]
             assert params[f"w_s{d}"]["value"] is None
     assert unseen >= 1  # joint 1's positive rise (its leak 100 %)
+
+
+def test_no_shape_is_given_where_its_rise_is_not_determined():
+    from fricid.identify.dynamic.arm._records import shapes_follow_rises
+
+    def rec(value, nd=False):
+        ci = [None, None] if nd else [0.05, 0.15]
+        return {"value": value, "stderr": None, "ci95": ci, "note": "", "not_determined": nd}
+
+    recs = {f"{n}{d}": rec(0.1) for n in ("tau_s", "w_s", "delta") for d in ("_pos", "_neg")}
+    recs["tau_s_neg"] = rec(None, nd=True)
+    shapes_follow_rises(recs, ("_pos", "_neg"))
+    assert recs["w_s_neg"]["value"] is None and recs["delta_neg"]["not_determined"]
+    assert "tau_s_neg is not" in recs["w_s_neg"]["note"]
+    assert recs["w_s_pos"]["value"] == 0.1 and not recs["delta_pos"]["not_determined"]

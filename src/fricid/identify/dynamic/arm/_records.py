@@ -9,7 +9,14 @@ import numpy as np
 from ._friction import DELTA_BOX, W_S_BOX, split_direction
 from ._solve import LEAK_MAX
 
-__all__ = ["friction_records", "held_at_bound", "interval", "mark_held", "widen"]
+__all__ = [
+    "friction_records",
+    "held_at_bound",
+    "interval",
+    "mark_held",
+    "shapes_follow_rises",
+    "widen",
+]
 
 
 #: Friction levels [N m, N m s/rad]: physically never below zero. Any parameter below zero
@@ -100,6 +107,8 @@ def friction_records(frictions, theta, cov, st, joints, t, sig, moving, models_u
                 # no shape outside the box was searched: the interval ends at its faces
                 rec["ci95"] = [max(lo_, box[0]), min(hi_, box[1])]
             params[pname] = rec
+        if jf.stribeck:
+            shapes_follow_rises(params, jf.directions)
         v = sig.dq[moving[:, j], j]
         out[name] = {
             "family": jf.family,
@@ -110,6 +119,24 @@ def friction_records(frictions, theta, cov, st, joints, t, sig, moving, models_u
             load = sig.full_load[sig.rows()[moving[:, j]], j]
             out[name]["load_range"] = [float(load.min()), float(load.max())] if v.size else [0, 0]
     return out
+
+
+def shapes_follow_rises(recs: dict, directions) -> None:
+    """A direction whose ``tau_s`` is not determined has no shape ``w_s``, ``delta`` either
+    (a double pendulum's joint had printed ``w_s`` 0.12 [0.088, 0.161] beside a ``tau_c``
+    and ``tau_s`` not determined), in place."""
+    for d in directions:
+        if not recs["tau_s" + d]["not_determined"]:
+            continue
+        for shape in ("w_s", "delta"):
+            if not recs[shape + d]["not_determined"]:
+                recs[shape + d].update(
+                    value=None,
+                    stderr=None,
+                    ci95=[None, None],
+                    not_determined=True,
+                    note=f"not determined: tau_s{d} is not, so its shape is not either",
+                )
 
 
 def widen(recs: dict, d: str, prof: dict, cap: float = np.inf) -> None:
