@@ -69,7 +69,7 @@ held-out ratio shows. Two guards keep such a shape from predicting nonsense: eac
 beyond gravity (:func:`._friction.excess_cap`, :func:`._solve.bounded_lstsq`), and a
 direction whose rise the fitted rows see only through the low-pass from the slow rows left
 out (:func:`._solve.unseen_rises`) gets no rise (not determined, and the verdict says so).
-``benchmarks/results/robot.txt`` (block 2) gives the held-out ratios before and after.
+``benchmarks/results/robot.txt`` (block 2b) gives the held-out ratios before and after.
 """
 
 from __future__ import annotations
