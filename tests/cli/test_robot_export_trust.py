@@ -61,10 +61,13 @@ def test_a_whole_arm_fit_exports_every_joint_in_the_urdf_order(arm_file, tmp_pat
     assert res.exit_code == 0, res.output
     header = (tmp_path / "fricid_friction.h").read_text()
     assert header.index("joint 0: joint1") < header.index("joint 1: joint2")
+    for joint, level in zip(("joint1", "joint2"), levels, strict=True):  # the header says
+        assert f"{joint} -> fricid_{joint}_friction (trust verdict: {level})" in header
     source = (tmp_path / "fricid_friction.c").read_text()
     for level in levels:  # each joint's comment gives its verdict
         assert f"trust verdict: {level}" in source
-    assert source.count("trust verdict:") == 2 and "arm.json (joint2)" in source
+    assert source.count("the model file gives the reasons") == 2  # one line per joint
+    assert "arm.json (joint2)" in source and "identified by IDIM-WLS (whole arm)" in source
 
 
 def test_a_joint_whose_verdict_is_no_is_not_exported_unless_told(arm_file, tmp_path):

@@ -23,7 +23,7 @@ from ..errors import ConfigError, DataError
 from ..io._jsonfile import read_json
 from ..metrics import verdict
 from ._file import _clean
-from ._parameter import Parameter
+from ._parameter import OptimizerRecord, Parameter
 
 __all__ = ["ARM_KIND", "ARM_SCHEMA_VERSION", "LOAD_FAMILIES", "ArmFit"]
 
@@ -156,10 +156,12 @@ class ArmFit:
         if family in LOAD_FAMILIES:  # eq. 3's msk without its Stribeck rise
             family, params = LOAD_FAMILIES[family], _as_msk(params)
             ranges["load"] = list(entry.get("load_range", [0.0, 0.0]))
+        estimator = str(self.provenance.get("estimator") or "IDIM-WLS")
         return FittedModel(
             model=family,
             parameters=params,
             ci_method="cluster-robust",
+            optimizer=OptimizerRecord(method=f"{estimator} (whole arm)"),
             operating_range=ranges,
             provenance={
                 "source": self.provenance.get("source"),
