@@ -150,3 +150,14 @@ def test_the_single_joint_export_points_a_whole_arm_fit_to_robot_export(arm_file
     )
     assert res.exit_code != 0 and "is given twice" in res.output
     assert not (tmp_path / "fricid_friction.c").exists()
+
+
+def test_a_cut_or_incomplete_arm_file_is_named_with_what_is_wrong(arm_file, tmp_path):
+    bare, cut = tmp_path / "bare.json", tmp_path / "cut.json"
+    bare.write_text('{"kind": "fricid-arm"}')
+    cut.write_text(arm_file.read_text()[:300])
+    for path, why in ((bare, "'schema_version' is missing"), (cut, "not valid JSON")):
+        res = runner.invoke(app, ["robot", "export", str(path), "--to", "c", "-o", str(tmp_path)])
+        assert res.exit_code != 0 and path.name in res.output and why in res.output
+    assert "character" in res.output  # where in the line the cut file stops
+    assert not (tmp_path / "fricid_friction.c").exists()

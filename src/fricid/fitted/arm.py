@@ -203,6 +203,12 @@ class ArmFit:
         if not isinstance(d, dict) or d.get("kind") != ARM_KIND:
             raise DataError(f"not a fricid whole-arm fit (no kind '{ARM_KIND}')", file=source)
         version = d.get("schema_version")
+        if version is None:
+            raise DataError(
+                "field 'schema_version' is missing: fricid robot fit writes it, so the file "
+                "is incomplete or not fricid's",
+                file=source,
+            )
         if not isinstance(version, int) or not 1 <= version <= ARM_SCHEMA_VERSION:
             raise DataError(
                 f"whole-arm fit schema version {version!r} is not one this fricid reads "

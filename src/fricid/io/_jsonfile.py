@@ -179,7 +179,11 @@ def read_json(path: str | PathLike[str], *, what: str = "JSON file") -> Any:
             object_pairs_hook=_object,
         )
     except json.JSONDecodeError as exc:
-        raise DataError(f"not valid JSON: {exc.msg}", file=path, row=exc.lineno) from None
+        raise DataError(
+            f"not valid JSON: {exc.msg}: character {exc.colno} of the line",
+            file=path,
+            row=exc.lineno,
+        ) from None
     except _Refused as exc:
         raise DataError(f"not a valid {what}: {exc}", file=path) from None
     except (ValueError, RecursionError) as exc:  # int() limits; nesting the scan missed
