@@ -244,15 +244,11 @@ def summary_lines(
         )
     level, _ = trust_of(fitted)
     if level in ("yes", "with caveats", "no"):  # fixed words and a number only
-        ratio = next(
-            (
-                r.get(key)
-                for r, key in ((fitted.trust, "heldout_ratio"), (fitted.validation, "ratio"))
-                if isinstance(r, dict) and isinstance(r.get(key), int | float)
-            ),
-            None,
-        )
-        shown = _display(ratio)
+        shown = None
+        for rec, key in ((fitted.trust, "heldout_ratio"), (fitted.validation, "ratio")):
+            if isinstance(rec, dict) and isinstance(rec.get(key), int | float):
+                shown = _display(rec[key])
+                break
         lines.append(
             f"trust verdict: {'NO, exported anyway' if level == 'no' else level}"
             + (f" (held-out error {shown} times the scatter)" if shown is not None else "")

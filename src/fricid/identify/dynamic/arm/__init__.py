@@ -376,7 +376,8 @@ def _fit_arm(
     res = y - A @ theta
     stribeck = [j for j, jf in enumerate(frictions) if jf.stribeck]
     J = np.hstack([A, shape_rows(sig, frictions, st, theta, safe, stribeck)]) if stribeck else A
-    held = [k for k, lo_hi in excess_bounds(st, frictions).items() if theta[k] in lo_hi]
+    bounds = excess_bounds(st, frictions)  # the Stribeck excesses' (._solve)
+    held = [k for k, lo_hi in bounds.items() if theta[k] in lo_hi]
     J[:, held] = 0.0  # an excess held at a bound is no estimate (_records.mark_held)
     cov, se, t, clusters, corr_len, n_eff = arm_covariance(J, res, st, n, rho)
     r = bp.rank
@@ -394,8 +395,8 @@ def _fit_arm(
         if not cons["ls_consistent"]:
             beta = cons["beta"]
             # the friction given the consistent inertial parameters
-            bounds = {k - r: b for k, b in excess_bounds(st, frictions).items()}
-            fr = bounded_lstsq(A[:, r:], y - A[:, :r] @ beta, bounds)
+            friction_bounds = {k - r: b for k, b in bounds.items()}
+            fr = bounded_lstsq(A[:, r:], y - A[:, :r] @ beta, friction_bounds)
             theta = np.concatenate([beta, fr])
     units = {
         f: {p.name: p.unit for p in get_model(LOAD_FAMILIES.get(f, f)).parameters}

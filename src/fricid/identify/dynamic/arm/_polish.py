@@ -30,7 +30,7 @@ import numpy as np
 
 from ._friction import DELTA_BOX, W_S_BOX, JointFriction
 from ._signals import ArmSignals
-from ._solve import lstsq, shape_rows, stack
+from ._solve import excess_index, lstsq, shape_rows, stack
 
 __all__ = ["polish_shapes"]
 
@@ -78,7 +78,7 @@ def _state(sig, Yb, frictions, mask, sigma):
 def _within_caps(frictions: list[JointFriction], st, theta: np.ndarray) -> bool:
     """Every Stribeck excess at most what the log allows (``JointFriction.excess_max``)."""
     return all(
-        theta[st.offsets[j] + 3 * k + 1] <= jf.excess_max
+        theta[excess_index(st, j, k)] <= jf.excess_max
         for j, jf in enumerate(frictions)
         if jf.stribeck
         for k in range(len(jf.directions))

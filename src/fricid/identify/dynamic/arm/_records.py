@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from ._friction import DELTA_BOX, W_S_BOX, split_direction
-from ._solve import LEAK_MAX
+from ._solve import LEAK_MAX, excess_index
 
 __all__ = [
     "friction_records",
@@ -199,6 +199,6 @@ def mark_held(fric: dict, frictions, st, theta: np.ndarray, held: list[int], joi
     :func:`held_at_bound`."""
     for j, jf in enumerate(frictions):
         for k, d in enumerate(jf.directions if jf.stribeck else ()):
-            if (col := st.offsets[j] + 3 * k + 1) in held:
+            if (col := excess_index(st, j, k)) in held:
                 recs = fric[joints[j]]["parameters"]
                 held_at_bound(recs, d, theta[col], jf.excess_max, jf.leaks.get(d, 0.0))

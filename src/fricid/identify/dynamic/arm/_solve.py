@@ -59,6 +59,7 @@ __all__ = [
     "arm_covariance",
     "bounded_lstsq",
     "excess_bounds",
+    "excess_index",
     "search_shapes",
     "shape_profiles",
     "shape_rows",
@@ -67,8 +68,7 @@ __all__ = [
     "wls",
 ]
 
-#: The largest share of a Stribeck column on the fitted rows that may leak there from rows
-#: left out (:func:`unseen_rises`).
+#: The largest share of a Stribeck column on the fitted rows leaked in (:func:`unseen_rises`).
 LEAK_MAX = 0.5
 #: The autocorrelation below which residuals count as uncorrelated.
 RHO_END = 0.05
@@ -205,12 +205,17 @@ def noise(st: Stack, theta: np.ndarray, n: int) -> np.ndarray:
     return out
 
 
+def excess_index(st: Stack, j: int, k: int) -> int:
+    """The column of joint ``j``'s Stribeck excess in direction ``k`` (:mod:`._friction`)."""
+    return st.offsets[j] + 3 * k + 1
+
+
 def excess_bounds(st: Stack, frictions: list[JointFriction]) -> dict[int, tuple[float, float]]:
     """Column -> (lower, upper) of each Stribeck excess ``tau_s - tau_c``: from zero (a rise,
     not a dip: module notes) to what the log allows (:func:`._friction.excess_cap`); zero
     where the fitted rows do not see the rise (:func:`unseen_rises`)."""
     return {
-        st.offsets[j] + 3 * k + 1: (0.0, 0.0 if jf.leaks.get(d, 0.0) > LEAK_MAX else jf.excess_max)
+        excess_index(st, j, k): (0.0, 0.0 if jf.leaks.get(d, 0.0) > LEAK_MAX else jf.excess_max)
         for j, jf in enumerate(frictions)
         if jf.stribeck
         for k, d in enumerate(jf.directions)
@@ -219,14 +224,10 @@ def excess_bounds(st: Stack, frictions: list[JointFriction]) -> dict[int, tuple[
 
 def unseen_rises(sig: ArmSignals, frictions: list[JointFriction], mask: np.ndarray) -> None:
     """Each Stribeck direction's leak (``JointFriction.leaks``), in place: the share of its
-    column's energy on the rows ``mask`` keeps that comes through the filters from samples on
-    rows it leaves out. Near the closed loop's reversals the window leaves out the slow
-    samples, where the rise is; a rise seen only through that leak is not seen: on a
-    PD-tracked Panda (``benchmarks/bench_robot.py --truth sim --friction stribeck_asym``,
-    seed 6) joint 1's positive rise leaked 100 % (the fitted shape's column 0.027 N m over
-    the kept rows, per unit excess), its excess went to the largest the log allows, 13 N m,
-    and the held-out log, whose kept rows did slide slowly that way, missed by 326 times
-    the noise."""
+    column's energy on the rows ``mask`` keeps that comes through the filters from rows it
+    leaves out (near the closed loop's reversals, the slow ones where the rise is). On a
+    PD-tracked Panda (``bench_robot.py --truth sim --friction stribeck_asym``, seed 6) joint
+    1's positive rise leaked 100 %, went to the cap (13 N m) and missed by 326x held out."""
     rows = sig.rows()
     nearest = np.clip(np.searchsorted(rows, np.arange(sig.full_dq.shape[0])), 0, rows.size - 1)
     for j, jf in enumerate(frictions):
@@ -315,7 +316,7 @@ def _block_gains(sig, Yb, frictions, mask, sigma, j, k, d):
     st = stack(Yb, sig, frictions, mask)
     A, y = st.weighted(sigma)
     rows = np.flatnonzero(st.row_joint == j)
-    gain = _projector(A, y, st.offsets[j] + 3 * k + 1, rows, jf.excess_max)
+    gain = _projector(A, y, excess_index(st, j, k), rows, jf.excess_max)
     t_rows = st.row_time[rows]
 
     def gains(w: np.ndarray, e: np.ndarray, coefficients: bool = False):
