@@ -340,6 +340,8 @@ def _fit(stats, keys, base, model, identify, source) -> ArmGravityFit:
                 "load": -float(sol.level_load[i]),  # tau_g of eq. 8: minus g(q)
                 "count": int(sol.count[i]),
                 "passes": int(sol.passes[i]),
+                # d friction / d beta = -regressor: the error every level shares
+                "regressor": [float(x) for x in sol.level_regressor[i]],
             }
         )
     joint_of = np.array([t[0] for t in unique])
@@ -400,7 +402,6 @@ def _joint_meta(fit: ArmGravityFit, joint: str) -> dict:
     meta = fit.as_meta()
     meta["levels"] = [row for row in meta["levels"] if row["joint"] == joint]
     meta["residual_rms"] = meta["residual_rms"].get(joint)
-    meta.pop("covariance")
     return meta
 
 

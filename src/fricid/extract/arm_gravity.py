@@ -99,6 +99,9 @@ class ArmSolution:
     level_load : numpy.ndarray
         ``(K,)``, the mean of ``w . beta`` over each level's samples (the gravity torque, the
         load of eq. 12).
+    level_regressor : numpy.ndarray
+        ``(K, m)``, the mean regressor row ``wbar`` of each level: a level's friction moves by
+        ``-wbar . d_beta`` when ``beta`` does (the error the levels share).
     rss : numpy.ndarray
         ``(K,)``, each level's residual sum of squares.
     covariance : numpy.ndarray
@@ -115,6 +118,7 @@ class ArmSolution:
     count: np.ndarray
     passes: np.ndarray
     level_load: np.ndarray
+    level_regressor: np.ndarray
     rss: np.ndarray
     covariance: np.ndarray = field(repr=False)
 
@@ -243,6 +247,7 @@ def solve_levels(
         count=count,
         passes=np.bincount(level, minlength=k),
         level_load=load,
+        level_regressor=wbar,
         rss=rss_k,
         covariance=cov,
     )
@@ -288,7 +293,9 @@ class ArmGravityFit:
         One per (joint, temperature, velocity, direction): ``joint``, ``temperature`` [degC],
         ``velocity`` [rad/s, signed], ``direction``, ``friction`` and ``friction_se`` [N m,
         signed], ``load`` [N m, the mean gravity torque over its samples, ``tau_g = -g(q)``
-        as in eq. 8], ``count``, ``passes``.
+        as in eq. 8], ``count``, ``passes``, ``regressor`` [the mean base regressor row over
+        its samples: the friction moves by ``-regressor . d_beta``; a fit of the joint's law
+        adds this shared error to its intervals, :mod:`fricid.identify.static.shared_error`].
     residual_rms : dict
         N m, per swept joint, the RMS residual of its steady samples.
     covariance : numpy.ndarray

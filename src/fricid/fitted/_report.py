@@ -67,6 +67,7 @@ def fit_report(fitted: Any, min_correl: float = MIN_CORREL) -> str:
     for name, p in fitted.parameters.items():
         lines.append(f"    {name + ':':<{width}} {p.value: .8g} {p.unit}")
         lines[-1] = lines[-1].rstrip() + _variable_note(p, fitted.ci_method)
+    lines += _shared_lines(fitted.provenance.get("shared_error"))
     lines += _correlation_lines(fitted, min_correl)
     return "\n".join(lines)
 
@@ -99,6 +100,21 @@ def _variable_note(p: Parameter, ci_method: str) -> str:
     if p.note:
         flags.append(p.note.removeprefix("not determined: "))
     return note + "".join(f" [{f}]" for f in flags)
+
+
+def _shared_lines(shared: Any) -> list[str]:
+    """What the standard errors and intervals include beyond the residuals' scatter: an
+    error every sample shares (``provenance["shared_error"]``), with each share of variance."""
+    if not isinstance(shared, dict):
+        return []
+    share = shared.get("variance_share") or {}
+    parts = ", ".join(
+        f"{name} {100 * float(s):.0f} %" for name, s in share.items() if isinstance(s, int | float)
+    )
+    return [
+        f"    # the errors above include one every sample shares: {shared.get('source', '')}"
+        + (f" (share of variance: {parts})" if parts else "")
+    ]
 
 
 def _correlation_lines(fitted: Any, min_correl: float) -> list[str]:

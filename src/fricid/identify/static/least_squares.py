@@ -38,6 +38,7 @@ from ..problem import ROBUST_LOSSES, IdentificationProblem
 from .checks import check_identifiable
 from .convergence import certify
 from .informed import uninformed
+from .shared_error import shared_covariance
 from .uncertainty import INTERVALS, Uncertainty, assess
 from .varpro import varpro
 
@@ -217,6 +218,7 @@ def fit(
             stacklevel=user_stacklevel(),
         )
     theta = problem.expand(result.x)[0]
+    shared = shared_covariance(samples)
     unc = assess(
         problem,
         result.x,
@@ -224,6 +226,7 @@ def fit(
         reason=convergence.get("reason", ""),
         intervals=key_i,
         units=model.units,
+        shared=shared if shared is not None and shared.shape[0] == problem.n_obs else None,
     )
     if unc.identifiability:
         warnings.warn(
@@ -271,7 +274,7 @@ def fit(
         convergence=convergence,
         metrics=metrics(y, y_hat, samples.direction, scatter.value),
         operating_range=operating_range(samples, X),
-        provenance=provenance(samples),
+        provenance=provenance(samples, **_shared_record(problem, unc)),
         statistics=fit_statistics(y, y_hat, problem.n_free, w),
         prediction_interval=delta_record(
             model.name,
@@ -289,6 +292,23 @@ def fit(
             "scatter": scatter.to_dict(),
         },
     )
+
+
+def _shared_record(problem: IdentificationProblem, unc: Uncertainty) -> dict[str, Any]:
+    """``provenance["shared_error"]``: what the intervals include beyond the residuals' scatter
+    (the arm's identified gravity, :mod:`~fricid.identify.static.shared_error`), with each free
+    parameter's share of variance from it; nothing when there is none."""
+    if unc.shared is None:
+        return {}
+    return {
+        "shared_error": {
+            "source": "the arm's base gravity parameters, identified from the sweeps and "
+            "removed from every sample",
+            "variance_share": {
+                n: round(float(s), 4) for n, s in zip(problem.free_names, unc.shared, strict=True)
+            },
+        }
+    }
 
 
 def _records(

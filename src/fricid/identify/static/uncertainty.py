@@ -34,6 +34,8 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy import stats
 
+from .shared_error import propagate
+
 __all__ = [
     "INTERVALS",
     "PROFILE_AUTO_MAX",
@@ -210,6 +212,9 @@ class Uncertainty:
         "do not bound ..."), for the warning.
     lower_sse : float
         The lowest SSE a profile re-fit found (below the fit's: not at the optimum), or NaN.
+    shared : ndarray (p,) or None
+        The share of each variance that comes from an error the samples share
+        (:mod:`fricid.identify.static.shared_error`), or None when there is none.
     """
 
     stderr: np.ndarray
@@ -222,6 +227,7 @@ class Uncertainty:
     notes: dict[str, str] = field(default_factory=dict)
     identifiability: list[str] = field(default_factory=list)
     lower_sse: float = float("nan")
+    shared: np.ndarray | None = None
 
 
 def _strongest(cov: np.ndarray | None, j: int, names: list[str]) -> str:
@@ -245,6 +251,7 @@ def assess(
     reason: str = "",
     intervals: str = "auto",
     units: dict[str, str] | None = None,
+    shared: np.ndarray | None = None,
 ) -> Uncertainty:
     """Standard errors and 95 % intervals of a least-squares fit, or why there are none.
 
@@ -262,6 +269,11 @@ def assess(
         See :data:`INTERVALS`.
     units : dict, optional
         Parameter units, for the messages.
+    shared : ndarray (n, n), optional
+        The covariance of an error all the samples share, which their residuals cannot show
+        (:func:`~fricid.identify.static.shared_error.shared_covariance`): propagated through
+        the fit, added to the covariance, and each interval side widened by it in quadrature
+        (Welch-Satterthwaite degrees of freedom).
 
     Returns
     -------
@@ -300,16 +312,51 @@ def assess(
     lo_b, hi_b = problem.bounds[:, 0], problem.bounds[:, 1]
     out = Uncertainty(se, half, nan.copy(), nan.copy(), np.zeros((p, 2), bool), cov=cov)
     key = str(intervals).strip().lower()
-    if key == "none":
-        return out
     if key == "profile" or (key == "auto" and p <= PROFILE_AUTO_MAX):
         _profile(out, problem, x, float(r0 @ r0), checked=key == "auto")
-    else:
+    elif key != "none":
         out.low, out.high = np.maximum(x - half, lo_b), np.minimum(x + half, hi_b)
         out.open = np.column_stack([x - half <= lo_b, x + half >= hi_b])
         out.method = "jacobian"
-    _name_open_sides(out, problem, x, names, units or {})
+    if shared is not None:
+        w = problem.weights
+        extra, seen = propagate(J, None if w is None else np.sqrt(w), shared)
+        sse = float(r0 @ r0)
+        own = max(sse - seen, 0.0) / sse if sse > 0 else 1.0
+        _add_shared(out, problem, x, extra, (float(stats.t.ppf(0.975, dof)), dof, own))
+    if key != "none":
+        _name_open_sides(out, problem, x, names, units or {})
     return out
+
+
+def _add_shared(out: Uncertainty, problem, x: np.ndarray, extra: np.ndarray, scale: tuple) -> None:
+    """``out`` with the shared error's covariance ``extra`` added. ``scale`` is ``(tq, dof,
+    own)``: the fit's t point and degrees of freedom, and the share of its residual variance
+    that is its own (the part of the shared error the residuals do show taken out, so it is
+    not counted twice). Each interval side, read as ``tq`` times a standard error, becomes
+    ``t_eff`` times that error (scaled by ``own``) and the shared one in quadrature,
+    ``t_eff`` with the Welch-Satterthwaite degrees of freedom (the shared error comes from a
+    fit of many samples, its own degrees of freedom taken as infinite), never shorter than it
+    was; a side cut at the search box is open."""
+    tq, dof, own_share = scale
+    var = np.clip(np.diag(extra), 0.0, None)
+    own = out.stderr**2 * own_share
+    total = own + var
+    with np.errstate(invalid="ignore", divide="ignore"):
+        out.shared = np.where(total > 0, var / total, 0.0)
+        nu = np.where(own > 0, dof * (total / own) ** 2, np.inf)
+    t_eff = np.asarray(stats.t.ppf(0.975, nu), dtype=float)
+    out.cov = None if out.cov is None else out.cov * own_share + extra
+    out.stderr = np.sqrt(total)
+    out.ci95 = np.maximum(t_eff * out.stderr, out.ci95)
+    if not out.method:
+        return
+    lo_b, hi_b = problem.bounds[:, 0], problem.bounds[:, 1]
+    k = own_share / tq**2
+    low = x - np.maximum(t_eff * np.sqrt((x - out.low) ** 2 * k + var), x - out.low)
+    high = x + np.maximum(t_eff * np.sqrt((out.high - x) ** 2 * k + var), out.high - x)
+    out.open = out.open | np.column_stack([low <= lo_b, high >= hi_b])
+    out.low, out.high = np.maximum(low, lo_b), np.minimum(high, hi_b)
 
 
 def _profile(out: Uncertainty, problem, x: np.ndarray, sse: float, checked: bool) -> None:
