@@ -14,6 +14,7 @@ from fricid.identify.dynamic._response import (
     FOLLOW,
     MAX_SHIFT,
     SHIFT,
+    STRIBECK_FOLLOW,
     follows,
     response_notes,
 )
@@ -64,10 +65,14 @@ def test_an_estimate_that_stays_put_is_flagged_and_the_shifts_are_bounded():
     for rows in check["shifts"]:
         for row in rows.values():
             assert row["miss"] == pytest.approx(-row["shift"])
+    half_ws = np.log10(1.1 / 0.9) / 2
+    assert first["w_s"]["shift"] == pytest.approx(SHIFT * half_ws) == -second["w_s"]["shift"]
     notes = response_notes(stage, check)
-    assert set(notes) == {"sigma_1"}  # sigma_0 is shifted, not judged
-    note = notes["sigma_1"]
-    assert note.startswith("not determined") and "tell the two apart" in note
+    # sigma_0 is shifted, not judged; w_s stayed put, so the rise is not determined
+    assert set(notes) == {"sigma_1", "w_s", "tau_s", "delta"}
+    for note in notes.values():
+        assert note.startswith("not determined") and "tell the two apart" in note
+    assert "Stribeck rise" in notes["delta"] and "w_s = " in notes["tau_s"]
     # the simulated logs carry the shifted truths' motion, not the measured torque
     assert not np.allclose(seen[0].torque, _series().torque)
 
@@ -86,6 +91,49 @@ def test_a_re_estimate_that_moves_less_than_half_the_shift_is_flagged(miss, flag
     assert ("sigma_1" in notes) is flagged
     assert row["followed"] == pytest.approx((miss + 0.6) / 0.6)
     assert FOLLOW == 0.0
+
+
+@pytest.mark.parametrize(
+    ("miss", "flagged"),
+    [(-0.2, False), (-0.29, False), (-0.31, True), (-0.6, True), (-0.9, True), (0.2, False)],
+)
+def test_a_stribeck_velocity_that_moves_less_than_half_its_shift_voids_the_rise(miss, flagged):
+    """w_s shifted by +0.6 (log10): a miss of -0.2 moved two thirds of the way, -0.31 less
+    than half; the rise's three parameters go together."""
+    stage = _stage({"sigma_0": 0.1, "sigma_1": 0.1})
+    row = {"shift": 0.6, "truth": 0.2, "estimate": 0.2 * 10**miss, "miss": miss}
+    notes = response_notes(stage, {"shifts": [{"w_s": row}]})
+    assert set(notes) == ({"w_s", "tau_s", "delta"} if flagged else set())
+    assert STRIBECK_FOLLOW == 0.5
+    if flagged:
+        assert f"it moved {(miss + 0.6) / 0.6:.0%} of the way" in notes["w_s"]
+
+
+def test_a_log_whose_sigma_0_went_astray_is_not_read_for_the_stribeck_velocity():
+    """A re-identification that moved sigma_0 the wrong way says nothing of w_s (the rise's
+    intervals had held the truth in the bench's case); the other log is still read."""
+    stage = _stage({"sigma_0": 0.1, "sigma_1": 0.1})
+
+    def rows(s0_miss: float, ws_miss: float) -> dict:
+        return {
+            "sigma_0": {"shift": 0.3, "truth": 1.0, "estimate": 1.0, "miss": s0_miss},
+            "w_s": {"shift": 0.3, "truth": 0.1, "estimate": 0.1, "miss": ws_miss},
+        }
+
+    assert response_notes(stage, {"shifts": [rows(-0.4, -0.4), rows(0.0, 0.0)]}) == {}
+    flagged = response_notes(stage, {"shifts": [rows(-0.4, -0.4), rows(0.0, -0.3)]})
+    assert set(flagged) == {"w_s", "tau_s", "delta"}
+
+
+def test_a_stribeck_velocity_without_an_interval_is_not_shifted():
+    """w_s with no finite interval keeps its value; the damping's check still runs."""
+    stage = _stage({"sigma_0": 0.05, "sigma_1": 0.5})
+    i = NAMES.index("w_s")
+    stage.low[i], stage.high[i] = np.nan, np.nan
+    check = follows(_series(), stage, None, 20.0, 0, lambda data, start: start)
+    assert "skipped" not in check
+    assert all(set(rows) == {"sigma_0", "sigma_1"} for rows in check["shifts"])
+    assert set(response_notes(stage, check)) == {"sigma_1"}
 
 
 def test_a_skipped_check_flags_nothing():

@@ -47,17 +47,17 @@ __all__ = [
 #: The claimed 95 % intervals of LuGre fits from a trajectory that held the truth, on an
 #: independent simulator's logs (``benchmarks/bench_lugre.py --seeds 3 --first-seed 10
 #: --duration 10 --kinds chirp_pd,trapezoid_pd,torque_steps --rates 1000,200 --cprs
-#: 131072,1048576 --no-foreign``, last rerun when the output error got its second start;
+#: 131072,1048576 --no-foreign``, last rerun when the Stribeck rise got its follow check;
 #: ``benchmarks/results/lugre_claims.txt``): per
 #: kind of log over all parameters, then per parameter over the three kinds (covered,
 #: claimed). On the virtual joint's logs they held it 336 of 350 times; on no one else's.
 LUGRE_COVERAGE = {
     "kinds": {
-        "PD-tracked chirps": (184, 240),
-        "PD-tracked trapezoids": (181, 289),
-        "open-loop torque steps": (162, 281),
+        "PD-tracked chirps": (185, 233),
+        "PD-tracked trapezoids": (173, 248),
+        "open-loop torque steps": (161, 254),
     },
-    "parameters": {"w_s": (9, 76), "delta": (7, 30), "tau_s": (12, 33), "sigma_1": (25, 48)},
+    "parameters": {"w_s": (7, 32), "delta": (2, 12), "tau_s": (10, 17), "sigma_1": (26, 51)},
 }
 
 
