@@ -574,3 +574,22 @@ def test_a_failed_write_leaves_nothing(tmp_path, monkeypatch):
     with pytest.raises(OSError, match="disk full"):
         write_text(urdf_text(stribeck()), tmp_path / "u" / "robot.urdf")
     assert not any((tmp_path / "u").iterdir())
+
+
+def test_the_trust_line_names_an_in_sample_error_as_such():
+    """A verdict graded on its own samples (no held-out validation) is not called held-out in
+    the exported file, and its ratio is printed to three digits (a trial's URDF said
+    'held-out error 0.0102572 times the scatter' beside 'in-sample error only')."""
+    from dataclasses import replace
+
+    from fricid.export._common import summary_lines
+    from fricid.fitted import FittedModel
+
+    base = FittedModel(model="coulomb_viscous")
+    trust = {"level": "with caveats", "reasons": ["no held-out validation (in-sample error only)"]}
+    own = replace(base, trust={**trust, "heldout_ratio": 0.0102572, "heldout_source": "in-sample"})
+    held = replace(base, trust={**trust, "heldout_ratio": 1.23456, "heldout_source": "kfold:5"})
+    (line,) = [x for x in summary_lines(own) if x.startswith("trust verdict")]
+    assert "in-sample (no held-out validation) error 0.0103 times the scatter" in line
+    (line,) = [x for x in summary_lines(held) if x.startswith("trust verdict")]
+    assert "(held-out error 1.23 times the scatter)" in line

@@ -244,14 +244,17 @@ def summary_lines(
         )
     level, _ = trust_of(fitted)
     if level in ("yes", "with caveats", "no"):  # fixed words and a number only
-        shown = None
+        shown, which = None, "held-out"
         for rec, key in ((fitted.trust, "heldout_ratio"), (fitted.validation, "ratio")):
             if isinstance(rec, dict) and isinstance(rec.get(key), int | float):
-                shown = _display(rec[key])
+                ratio = float(rec[key])
+                shown = f"{ratio:.3g}" if math.isfinite(ratio) else None
+                if str(rec.get("heldout_source", "")).startswith("in-sample"):
+                    which = "in-sample (no held-out validation)"
                 break
         lines.append(
             f"trust verdict: {'NO, exported anyway' if level == 'no' else level}"
-            + (f" (held-out error {shown} times the scatter)" if shown is not None else "")
+            + (f" ({which} error {shown} times the scatter)" if shown is not None else "")
             + "; the model file gives the reasons"
         )
     return lines

@@ -177,3 +177,34 @@ def test_coverage_with_the_shared_error_is_nominal():
             )
     assert 0.90 <= np.mean(hits["with"]) <= 0.98
     assert np.mean(hits["without"]) < 0.80
+
+
+def test_the_levels_own_errors_floor_a_residual_variance_of_zero():
+    """Samples that fit the law exactly (no spare sample in a direction: a trial's arm had
+    two set-points left there) leave no residual scatter; the levels' own standard errors, as
+    the arm's fit measured them, still count: se^2 = X^+ diag(own) X^+T + the shared part."""
+    from fricid.identify.static.shared_error import own_variance
+
+    v = _velocity()
+    meta = _meta(v)
+    level_se = 0.02  # noise and shared part together, as the arm fit records it
+    for lv in meta["gravity"]["levels"]:
+        lv["friction_se"] = level_se
+    exact = _fs(v, _law(v), meta)
+    sigma = shared_covariance(exact)
+    own = own_variance(exact, sigma)
+    np.testing.assert_allclose(own, level_se**2 - np.diag(sigma))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        f = fit(exact, "coulomb_viscous_asym", intervals="jacobian")
+    pos, neg = v > 0, v < 0
+    X = np.zeros((v.size, 4))
+    X[pos, 0], X[pos, 1] = 1.0, v[pos]
+    X[neg, 2], X[neg, 3] = -1.0, v[neg]
+    a_map = np.linalg.pinv(X)
+    want = np.diag(a_map @ (np.diag(own) + sigma) @ a_map.T)
+    for k, name in enumerate(["f_c_pos", "beta_pos", "f_c_neg", "beta_neg"]):
+        p = f.parameters[name]
+        assert p.stderr == pytest.approx(np.sqrt(want[k]), rel=1e-4), name
+        # both parts known, not estimated: the normal point
+        assert p.ci95_halfwidth == pytest.approx(stats.norm.ppf(0.975) * p.stderr, rel=1e-4)

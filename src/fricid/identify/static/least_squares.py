@@ -38,7 +38,7 @@ from ..problem import ROBUST_LOSSES, IdentificationProblem
 from .checks import check_identifiable
 from .convergence import certify
 from .informed import uninformed
-from .shared_error import shared_covariance
+from .shared_error import own_variance, shared_covariance
 from .uncertainty import INTERVALS, Uncertainty, assess
 from .varpro import varpro
 
@@ -219,6 +219,8 @@ def fit(
         )
     theta = problem.expand(result.x)[0]
     shared = shared_covariance(samples)
+    if shared is not None and shared.shape[0] != problem.n_obs:
+        shared = None
     unc = assess(
         problem,
         result.x,
@@ -226,7 +228,8 @@ def fit(
         reason=convergence.get("reason", ""),
         intervals=key_i,
         units=model.units,
-        shared=shared if shared is not None and shared.shape[0] == problem.n_obs else None,
+        shared=shared,
+        own=None if shared is None else own_variance(samples, shared),
     )
     if unc.identifiability:
         warnings.warn(
