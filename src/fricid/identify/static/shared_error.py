@@ -10,7 +10,7 @@ the samples as independent, leave it out. Measured on the 2-DOF sweeps of
 ``benchmarks/bench_arm_sweeps.py`` (100 seeds): the Coulomb levels' 95 % intervals covered
 88-91 % on the double pendulum's first joint and the Panda's second; with the true masses (no
 ``beta`` identified) the same fits covered 95 %. With the shared error added, over 300 seeds,
-the Coulomb levels cover 95.7-98.0 % and every parameter 90.3-98.0 %
+the Coulomb levels cover 95.7-98.0 % and every parameter 92.7-98.0 %
 (``benchmarks/results/arm_sweeps.txt``).
 
 :func:`shared_covariance` reads the shared error from the samples' ``meta["gravity"]`` (each
