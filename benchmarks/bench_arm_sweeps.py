@@ -25,7 +25,10 @@ quadrature, the mean over seeds (1 where the intervals are right: the law fitted
 campaign carries an error of about the set-point's size, so ``held-out/se`` is above 1 even for
 a calibrated fit); ``torque``, the held-out campaign's torque at its set-point speeds
 predicted by the first campaign's model (its gravity parameters and the law), RMS error over
-the torque noise, the largest over seeds (the issue's "held-out torque error / noise"); and
+the torque noise, the largest over seeds (the issue's "held-out torque error / noise");
+``PI95``, the share of the held-out campaign's set-point frictions, measured with the true
+gravity (a new sample: the truth plus its noise), inside the law's 95 % prediction interval
+(:meth:`fricid.fitted.FittedModel.predict_interval`, the shared gravity error included); and
 the seconds of one identification (extraction with the base gravity parameters, then the
 law).
 
@@ -117,6 +120,7 @@ def errors(case, seed: int):
     shifted = {j: [p + 0.3 for p in ps] for j, ps in poses.items()}
     held_log = arm_sweeps(truth, spans, shifted, laws, seed=seed + 1000, **options)
     held = extract_arm(held_log, ident)
+    truly = extract_arm(held_log, truth, identify=False)
     base = base_parameters(ident, gravity_only=True)
     for joint in laws:
         params[joint]["held-out torque"] = torque_ratio(
@@ -128,6 +132,11 @@ def errors(case, seed: int):
         se = np.array([lv["friction_se"] for lv in levels])
         params[joint]["held-out"] = rms(err / se)
         params[joint]["held-out z"] = rms(err / np.hypot(se, prediction_se(fitted[joint], v)))
+        # a new measured sample: the held-out campaign's set-points with the true gravity
+        new = truly[joint].by_direction
+        band = fitted[joint].predict_interval(new.X, warn=False)
+        inside = (band.low <= new.friction) & (new.friction <= band.high)
+        params[joint]["interval"] = (int(inside.sum()), int(inside.size))
     beta_true = base_parameters(ident, gravity_only=True).project(truth.parameters())
     z_levels = [
         (lv["friction"] - laws[lv["joint"]](lv["velocity"])) / lv["friction_se"] for lv in g.levels
@@ -190,7 +199,7 @@ def law_table(per_seed: list[dict]) -> None:
     """Per joint and parameter: the median relative error and the intervals' coverage; the
     held-out ratio's mean and largest; the seconds."""
     head = " ".join(f"{n + ' err/cov':>19s}" for n in LAW_PARAMS)
-    print(f"{'joint':14s} {head} {'held-out/se (max)':>18s} {'z':>5s} {'torque':>7s}")
+    print(f"{'joint':14s} {head} {'held-out/se (max)':>18s} {'z':>5s} {'torque':>7s} {'PI95':>6s}")
     for joint in (j for j in per_seed[0] if j != "seconds"):
         cells = []
         for name in LAW_PARAMS:
@@ -201,7 +210,12 @@ def law_table(per_seed: list[dict]) -> None:
         cells.append(f"{np.mean(held):10.2f} ({np.max(held):5.2f})")
         z = np.mean([s[joint]["held-out z"] for s in per_seed])
         torque = np.max([s[joint]["held-out torque"] for s in per_seed])
-        print(f"{joint:14s} " + " ".join(f"{c:>19s}" for c in cells) + f" {z:5.2f} {torque:7.4f}")
+        inside = np.sum([s[joint]["interval"] for s in per_seed], axis=0)
+        print(
+            f"{joint:14s} "
+            + " ".join(f"{c:>19s}" for c in cells)
+            + f" {z:5.2f} {torque:7.4f} {100 * inside[0] / inside[1]:5.1f}%"
+        )
     sec = [s["seconds"] for s in per_seed]
     print(f"seconds per identification: median {np.median(sec):.2f}, max {np.max(sec):.2f}")
 

@@ -31,7 +31,11 @@ one rule per kind of model, each from what the model file stores:
   calibrated on the fit's own leave-one-out residuals where stored at that level (``scale``,
   :mod:`fricid.identify._intervals`: a family that misses the law, or a few gross outliers,
   no longer give intervals that cover everything), else ``t(dof)``; ``s`` never below
-  the measured scatter stored with the fit (``noise_floor``), ``C`` scaled with it;
+  the measured scatter stored with the fit (``noise_floor``), ``C`` scaled with it; where
+  the samples share an error the residuals never show (an arm's identified gravity,
+  :mod:`fricid.identify.static.shared_error`), its covariance ``S`` (``shared_covariance``)
+  adds ``g^T S g`` unscaled, in this rule and in the local spread's parameter term
+  (measured in ``benchmarks/bench_arm_sweeps.py``, column ``PI95``);
 - **gp**: the posterior standard deviation of the latent friction with the fitted white noise
   added, ``F(x) -+ k sqrt(std^2 + noise_std^2)`` (Rasmussen & Williams 2006, eq. 2.24 with
   the noise of the observation), ``k`` the held-out multiplier stored with each process
@@ -137,17 +141,40 @@ def analytic_half_width(
     G = gradient(model_name, theta, record["free"], X)
     C = np.asarray(record["covariance"], dtype=float)
     s = float(record["noise_std"])
+    shared = _shared_variance(record, G)
     local = record.get("local")
     if isinstance(local, Mapping):
         check_local(local)
         grow = (float(local["noise"]) / s) ** 2 if s > 0 else 1.0
-        return _local_half_width(local, X, level, grow * np.einsum("pn,pq,qn->n", G, C, G))
+        extra = grow * np.einsum("pn,pq,qn->n", G, C, G) + shared
+        return _local_half_width(local, X, level, extra)
     floor = record.get("noise_floor")
     known = isinstance(floor, int | float) and floor > s
     noise = float(floor) if known else s
     grow = (noise / s) ** 2 if s > 0 else 1.0
-    var = grow * np.einsum("pn,pq,qn->n", G, C, G) + noise**2
+    var = grow * np.einsum("pn,pq,qn->n", G, C, G) + shared + noise**2
     return _delta_multiplier(record, level, known) * np.sqrt(np.maximum(var, 0.0))
+
+
+def _shared_variance(record: Mapping[str, Any], G: np.ndarray) -> np.ndarray | float:
+    """``g^T S g`` [N^2 m^2] at each column of ``G`` (p, n), ``S`` the record's
+    ``shared_covariance`` (an error every sample of the fit shares, such as an arm's
+    identified gravity: not in the residuals, so added as it is, not scaled with the noise);
+    0 without one. A malformed one (a model file from elsewhere) raises ConfigError."""
+    raw = record.get("shared_covariance")
+    if raw is None:
+        return 0.0
+    p = G.shape[0]
+    try:
+        S = np.asarray(raw, dtype=float)
+    except (TypeError, ValueError) as err:
+        raise ConfigError(f"the model file's shared_covariance is malformed ({err})") from None
+    if S.shape != (p, p) or not np.isfinite(S).all() or (np.diag(S) < 0).any():
+        raise ConfigError(
+            f"the model file's shared_covariance must be a finite {p} x {p} matrix with a "
+            "non-negative diagonal (one row and column per free parameter)"
+        )
+    return np.maximum(np.einsum("pn,pq,qn->n", G, S, G), 0.0)
 
 
 def _local_half_width(

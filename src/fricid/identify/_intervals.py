@@ -229,6 +229,7 @@ def delta_record(
     y: np.ndarray,
     noise_floor: float | None = None,
     scatter: float | None = None,
+    shared: np.ndarray | None = None,
 ) -> dict[str, Any] | None:
     """The model file's ``prediction_interval`` of an analytic fit (module notes), or None
     when there are no spare observations (``n <= p``) or the Jacobian is not finite.
@@ -236,7 +237,11 @@ def delta_record(
     ``noise_floor`` [N m]: the measured scatter of a sample (given, or from repeated runs),
     stored as ``noise_floor`` (module notes); ``scatter`` [N m]: the scatter the trust
     verdict uses, measured or estimated (from second differences), the noise of the local
-    spread (``local``; none without it)."""
+    spread (``local``; none without it); ``shared`` ``(p, p)``: the free parameters'
+    covariance from an error every sample shares (an arm's identified gravity,
+    :mod:`fricid.identify.static.shared_error`), stored as ``shared_covariance`` and added to
+    the interval's variance as it is: the residuals never show it, so neither the residual
+    variance nor the measured scatter scales it."""
     free = list(free)
     n, p = len(y), len(free)
     if n <= p:
@@ -265,6 +270,8 @@ def delta_record(
     scale = jackknife_scale(r, h, float(np.sqrt(s2)), n - p)
     if scale is not None:
         out["scale"] = scale
+    if shared is not None and np.shape(shared) == (p, p) and np.isfinite(shared).all():
+        out["shared_covariance"] = np.asarray(shared, dtype=float).tolist()
     if noise_floor is not None and np.isfinite(noise_floor) and noise_floor > 0:
         out["noise_floor"] = float(noise_floor)
     noise = noise_floor if "noise_floor" in out else scatter

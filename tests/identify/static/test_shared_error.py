@@ -208,3 +208,64 @@ def test_the_levels_own_errors_floor_a_residual_variance_of_zero():
         assert p.stderr == pytest.approx(np.sqrt(want[k]), rel=1e-4), name
         # both parts known, not estimated: the normal point
         assert p.ci95_halfwidth == pytest.approx(stats.norm.ppf(0.975) * p.stderr, rel=1e-4)
+
+
+def test_the_prediction_interval_adds_the_shared_error_unscaled():
+    """The model file keeps the shared part of the parameters' covariance apart; the
+    prediction interval's variance gains exactly ``g^T S g`` over the same fit without the
+    record (the residual-based part and its multiplier are the plain fit's)."""
+    from fricid.fitted import FittedModel
+    from fricid.fitted._interval import _delta_multiplier, gradient
+
+    rng = np.random.default_rng(3)
+    v = _velocity()
+    samples = _samples(rng, 0.002, _meta(v))
+    plain = _fs(v, samples.friction)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        a = fit(samples, "coulomb_viscous_asym", intervals="jacobian")
+        b = fit(plain, "coulomb_viscous_asym", intervals="jacobian")
+    rec = a.prediction_interval
+    S = np.asarray(rec["shared_covariance"])
+    assert S.shape == (4, 4) and np.all(np.diag(S) > 0)
+    assert "shared_covariance" not in b.prediction_interval
+    X = np.column_stack([np.array([0.3, 0.6, -0.3, -0.6]), np.zeros((4, 2))])
+    theta = np.array([a.parameters[n].value for n in a.parameters])
+    G = gradient(a.model, theta, rec["free"], X)
+    gsg = np.einsum("pn,pq,qn->n", G, S, G)
+    # the same record without the shared part gives the plain rule's half-width
+    bare = FittedModel.from_dict(
+        {
+            **a.to_dict(),
+            "prediction_interval": {k: val for k, val in rec.items() if k != "shared_covariance"},
+        }
+    )
+    h_with = a.predict_interval(X, warn=False).half_width
+    h_without = bare.predict_interval(X, warn=False).half_width
+    assert np.all(h_with > h_without)
+    # exactly g^T S g more in the variance the rule's multiplier applies to (samples
+    # without a measured scatter: the delta rule, s the residual standard deviation)
+    assert "local" not in rec and "noise_floor" not in rec
+    s2 = rec["noise_std"] ** 2
+    var = np.einsum("pn,pq,qn->n", G, np.asarray(rec["covariance"]), G) + s2
+    k = _delta_multiplier(rec, 0.95)
+    np.testing.assert_allclose(h_without, k * np.sqrt(var), rtol=1e-9)
+    np.testing.assert_allclose(h_with, k * np.sqrt(var + gsg), rtol=1e-9)
+    assert np.all(gsg > s2)  # the shared part dominates here: the interval is wider by it
+
+
+@pytest.mark.parametrize("bad", [[[1.0]], [[np.nan] * 4] * 4, (-np.eye(4)).tolist(), "abc"])
+def test_a_malformed_shared_covariance_is_refused(bad):
+    from fricid.errors import ConfigError, DataError
+    from fricid.fitted import FittedModel
+
+    rng = np.random.default_rng(4)
+    v = _velocity()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        a = fit(_samples(rng, 0.002, _meta(v)), "coulomb_viscous_asym", intervals="jacobian")
+    d = a.to_dict()
+    d["prediction_interval"] = {**d["prediction_interval"], "shared_covariance": bad}
+    with pytest.raises((ConfigError, DataError), match="shared_covariance"):
+        # refused when read (a number that is not finite) or when used (its shape or sign)
+        FittedModel.from_dict(d).predict_interval(np.array([[0.3, 0.0, 0.0]]), warn=False)

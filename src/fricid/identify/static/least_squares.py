@@ -287,6 +287,7 @@ def fit(
             y,
             None if scatter.estimated else scatter.value,
             scatter.value,
+            shared=unc.shared_cov,
         ),
         loss={
             "loss": "l2" if problem.loss == "sse" else problem.loss,

@@ -215,6 +215,9 @@ class Uncertainty:
     shared : ndarray (p,) or None
         The share of each variance that comes from an error the samples share
         (:mod:`fricid.identify.static.shared_error`), or None when there is none.
+    shared_cov : ndarray (p, p) or None
+        That shared error's covariance of the free parameters (part of ``cov``), for the
+        prediction interval, which adds it apart from the noise's share.
     """
 
     stderr: np.ndarray
@@ -228,6 +231,7 @@ class Uncertainty:
     identifiability: list[str] = field(default_factory=list)
     lower_sse: float = float("nan")
     shared: np.ndarray | None = None
+    shared_cov: np.ndarray | None = None
 
 
 def _strongest(cov: np.ndarray | None, j: int, names: list[str]) -> str:
@@ -361,6 +365,7 @@ def _add_shared(out: Uncertainty, problem, x: np.ndarray, extra: np.ndarray, sca
         ratio = np.where(out.stderr > 0, np.sqrt(own) / out.stderr, 0.0)
     alone = np.diag(np.where(out.stderr > 0, 0.0, own))  # no residual-based row: known only
     out.cov = None if out.cov is None else out.cov * np.outer(ratio, ratio) + alone + extra
+    out.shared_cov = 0.5 * (extra + extra.T)
     out.stderr = np.sqrt(total)
     out.ci95 = np.maximum(t_eff * out.stderr, out.ci95)
     if not out.method:
