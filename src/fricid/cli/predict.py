@@ -87,9 +87,10 @@ def predict_command(
             help="Also write the prediction interval at this level (e.g. 0.95): columns "
             "'low' and 'high', where a new measured sample falls with that probability; "
             "its width follows the fit's held-out errors near the point (levels 0.9 and "
-            "0.95 calibrated, others follow them); nan at rest (the friction is whatever "
-            "holds the joint) and inside a gap between measured speeds (nothing measured "
-            "backs one)."
+            "0.95 calibrated, others follow them), plus, for samples from an arm's sweeps, "
+            "the error of the identified gravity they all share; nan at rest (the friction "
+            "is whatever holds the joint) and inside a gap between measured speeds (nothing "
+            "measured backs one)."
         ),
     ] = None,
     digits: Annotated[
@@ -119,6 +120,7 @@ def predict_command(
 
     from ..errors import ConfigError, ExtrapolationWarning
     from ..export import Smoothing, smooth_predict, write_text
+    from ..export._common import trust_of
     from ..export.points import points_matrix, points_table, read_points
     from ..fitted import FittedModel
     from ..units import to_si
@@ -162,6 +164,16 @@ def predict_command(
             highlight=False,
             soft_wrap=True,
         )
+    level, reasons = trust_of(fitted)
+    if level == "no":  # as export refuses it: said, not hidden
+        why = "; ".join("".join(c if c.isprintable() else "?" for c in r) for r in reasons[:2])
+        err_console.print(
+            f"warning: the model's trust verdict is 'no' ({why[:300] or 'no reason recorded'}): "
+            "its own check rejects it, so neither the friction nor its interval is backed",
+            markup=False,
+            highlight=False,
+            soft_wrap=True,
+        )
     for bad in fitted.range_check(X):  # one line each on stderr (issue 11, defect 8)
         err_console.print(
             f"warning: {bad.message} ({bad.count} of {len(X)} points)",
@@ -174,7 +186,10 @@ def predict_command(
         friction = smooth_predict(fitted, X, Smoothing(smooth, zone_si))
         extra = None
         if interval is not None:  # its half-width around the friction written
-            half = fitted.predict_interval(X, interval, warn=False).half_width
+            try:
+                half = fitted.predict_interval(X, interval, warn=False).half_width
+            except ConfigError as err:  # a malformed record: named with its file
+                raise ConfigError(f"{model}: {err}") from None
             extra = {"low": friction - half, "high": friction + half}
             rest = X[:, 0] == 0
             why = {

@@ -169,10 +169,18 @@ def _shared_variance(record: Mapping[str, Any], G: np.ndarray) -> np.ndarray | f
         S = np.asarray(raw, dtype=float)
     except (TypeError, ValueError) as err:
         raise ConfigError(f"the model file's shared_covariance is malformed ({err})") from None
-    if S.shape != (p, p) or not np.isfinite(S).all() or (np.diag(S) < 0).any():
+    if S.shape != (p, p) or not np.isfinite(S).all():
         raise ConfigError(
-            f"the model file's shared_covariance must be a finite {p} x {p} matrix with a "
-            "non-negative diagonal (one row and column per free parameter)"
+            f"the model file's shared_covariance must be a finite {p} x {p} matrix (one row "
+            "and column per free parameter)"
+        )
+    scale = float(np.max(np.abs(S), initial=0.0))
+    if not np.allclose(S, S.T, rtol=0.0, atol=1e-9 * scale) or (
+        p and float(np.linalg.eigvalsh(0.5 * (S + S.T))[0]) < -1e-9 * scale
+    ):
+        raise ConfigError(
+            "the model file's shared_covariance is not a covariance (symmetric and positive "
+            "semi-definite)"
         )
     return np.maximum(np.einsum("pn,pq,qn->n", G, S, G), 0.0)
 

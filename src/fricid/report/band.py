@@ -11,7 +11,7 @@ import numpy as np
 from ..errors import ConfigError
 from ..fitted import FittedModel
 from ..samples import FrictionSamples
-from .document import Figure
+from .document import Figure, Note
 from .plots import plot_measured, speed_sides
 from .style import COLORS, new_figure, png, styled, torque_scale, velocity_scale
 
@@ -59,9 +59,10 @@ def prediction_band(
 
 def prediction_band_figure(
     fitted: FittedModel, moving: FrictionSamples, velocity_unit: str
-) -> Figure | None:
-    """The figure of the model's 95 % prediction interval against speed, or None when the
-    model file stores none (files from before, trajectory models)."""
+) -> Figure | Note | None:
+    """The figure of the model's 95 % prediction interval against speed; None when the
+    model file stores none (files from before, trajectory models); a warning note saying why
+    when it stores one that cannot be used (a malformed record)."""
 
     def interval(X: np.ndarray):
         pi = fitted.predict_interval(X, 0.95, warn=False)
@@ -69,14 +70,21 @@ def prediction_band_figure(
 
     try:
         interval(moving.X[:1])
-    except ConfigError:
-        return None
+    except ConfigError as err:
+        if not fitted.prediction_interval:
+            return None
+        return Note(f"No prediction interval is drawn: {err}.", kind="warning")
+    record = fitted.prediction_interval or {}
     how = (
         "the local spread of the fit's held-out errors"
-        if (fitted.prediction_interval or {}).get("local")
-        or (fitted.prediction_interval or {}).get("method") == "heldout"
+        if record.get("local") or record.get("method") == "heldout"
         else "the fit's residuals"
     )
+    if record.get("shared_covariance") is not None:
+        how += (
+            ", and the error every sample shares (the arm's identified gravity, which the "
+            "residuals cannot show), added as it is"
+        )
     return Figure(
         "prediction_interval",
         "Where a new measurement falls: the 95 % prediction interval",

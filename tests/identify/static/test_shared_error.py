@@ -254,7 +254,13 @@ def test_the_prediction_interval_adds_the_shared_error_unscaled():
     assert np.all(gsg > s2)  # the shared part dominates here: the interval is wider by it
 
 
-@pytest.mark.parametrize("bad", [[[1.0]], [[np.nan] * 4] * 4, (-np.eye(4)).tolist(), "abc"])
+ASYMMETRIC = (np.eye(4) * 1e-4 + np.triu(np.ones((4, 4)), 1) * 1e-4).tolist()
+INDEFINITE = (np.eye(4) * 1e-4 + (np.ones((4, 4)) - np.eye(4)) * 2e-4).tolist()
+
+
+@pytest.mark.parametrize(
+    "bad", [[[1.0]], [[np.nan] * 4] * 4, (-np.eye(4)).tolist(), "abc", ASYMMETRIC, INDEFINITE]
+)
 def test_a_malformed_shared_covariance_is_refused(bad):
     from fricid.errors import ConfigError, DataError
     from fricid.fitted import FittedModel
@@ -269,3 +275,52 @@ def test_a_malformed_shared_covariance_is_refused(bad):
     with pytest.raises((ConfigError, DataError), match="shared_covariance"):
         # refused when read (a number that is not finite) or when used (its shape or sign)
         FittedModel.from_dict(d).predict_interval(np.array([[0.3, 0.0, 0.0]]), warn=False)
+
+
+def test_predict_names_the_file_and_says_a_no_verdict(tmp_path):
+    """`fricid predict`: a malformed shared_covariance is refused naming the model file; a
+    model whose own check says 'no' is predicted with a warning saying so."""
+    from typer.testing import CliRunner
+
+    from fricid.cli import app
+    from fricid.fitted import FittedModel
+
+    rng = np.random.default_rng(5)
+    v = _velocity()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        a = fit(_samples(rng, 0.002, _meta(v)), "coulomb_viscous_asym", intervals="jacobian")
+    d = a.to_dict()
+    d["prediction_interval"] = {**d["prediction_interval"], "shared_covariance": INDEFINITE}
+    bad = FittedModel.from_dict(d).save(tmp_path / "bad.json")
+    args = ["-v", "0.3", "--interval", "0.95"]
+    res = CliRunner().invoke(app, ["predict", str(bad), *args])
+    assert res.exit_code == 2
+    assert "bad.json" in res.output and "shared_covariance" in res.output
+    d = a.to_dict()
+    d["trust"] = {**(d.get("trust") or {}), "level": "no", "reasons": ["misses the law"]}
+    untrusted = FittedModel.from_dict(d).save(tmp_path / "no.json")
+    res = CliRunner().invoke(app, ["predict", str(untrusted), *args])
+    assert res.exit_code == 0, res.output
+    assert "trust verdict is 'no' (misses the law)" in res.stderr
+
+
+def test_the_report_band_says_why_it_is_missing_and_names_the_shared_error():
+    from fricid.fitted import FittedModel
+    from fricid.report.band import prediction_band_figure
+    from fricid.report.document import Figure, Note
+
+    rng = np.random.default_rng(6)
+    v = _velocity()
+    samples = _samples(rng, 0.002, _meta(v))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        a = fit(samples, "coulomb_viscous_asym", intervals="jacobian")
+    good = prediction_band_figure(a, samples, "rad/s")
+    assert isinstance(good, Figure) and "error every sample shares" in good.caption
+    d = a.to_dict()
+    d["prediction_interval"] = {**d["prediction_interval"], "shared_covariance": ASYMMETRIC}
+    note = prediction_band_figure(FittedModel.from_dict(d), samples, "rad/s")
+    assert isinstance(note, Note) and note.kind == "warning" and "shared_covariance" in note.text
+    d["prediction_interval"] = None
+    assert prediction_band_figure(FittedModel.from_dict(d), samples, "rad/s") is None
