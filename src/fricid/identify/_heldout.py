@@ -39,6 +39,7 @@ __all__ = [
     "own_cv",
     "run_kfold",
     "run_validation",
+    "shared_mse",
     "worse_kfold",
 ]
 
@@ -224,7 +225,12 @@ def worse_kfold(
 ) -> tuple[dict[str, Any] | None, str]:
     """On tiny data, random folds (:func:`run_kfold`) beside the held-out ``ratio`` already
     found (``scheme``; NaN when none): a flexible model can pass the level folds of a handful
-    of speeds and still miss single held-out samples by far.
+    of speeds and still miss single held-out samples by far. Not graded when a fold could not
+    be fitted without its samples: the design then determines the model with little to spare,
+    and the folds that were fitted predict from as few samples, so their errors are the
+    leverage of the noise, not the model's (an arm's per-direction Coulomb-viscous law on three
+    speeds a direction, ``benchmarks/bench_arm_sweeps.py``: a correct law was judged "no" on
+    25 of 75 joints, by the one fold of three that could be fitted).
 
     Returns
     -------
@@ -237,6 +243,13 @@ def worse_kfold(
     val, how = run_kfold(fitted, samples, max_work)
     if val is None or val.get("ratio") is None:
         return None, how
+    failed = int(val.get("failed") or 0)
+    if failed:  # the rest are held out from as few samples: their errors are leverage
+        return None, (
+            f"{len(samples)} samples, so random folds too: {how}, but {failed} of "
+            f"{len(val.get('folds') or [])} could not be fitted without their samples (the "
+            "design determines the model with little to spare), so they are not graded"
+        )
     k_ratio = float(val["ratio"])
     note = f"{len(samples)} samples, so random folds too: {how} ({k_ratio:.3g}x"
     if np.isfinite(ratio) and k_ratio <= ratio:
@@ -244,3 +257,52 @@ def worse_kfold(
     if np.isfinite(ratio):
         return val, f"{note}, worse than {scheme}'s {ratio:.3g}x: graded)"
     return val, f"{note})"
+
+
+def shared_mse(
+    fitted: FittedModel, samples: FrictionSamples | None, validation: dict[str, Any] | None
+) -> float:
+    """N^2 m^2, the mean squared error an error every sample shares (an arm's identified
+    gravity, :mod:`fricid.identify.static.shared_error`) puts into the errors the verdict
+    grades; 0 without one. Held out (``validation``): its folds as the validation dealt them
+    (``lovo``'s interior ones when it grades those, :func:`graded_rmse`), each fold's
+    prediction linearised at the fit, ``e_h = J_h J_t^+ eps_t - eps_h``, averaged over the
+    held-out samples of ``trace(B Sigma B^T)``; in-sample, ``trace((I - H) Sigma (I - H)) /
+    n``. No fit removes this error (a law fitted on other samples carries it too, except its
+    offset), so a correct law's held-out error shows it beside the noise (module notes of
+    :mod:`fricid.identify.trust`, "Shared error")."""
+    from ..fitted._interval import gradient
+    from ..models import get_model
+    from .static.shared_error import shared_covariance
+    from .validate import fold_labels
+
+    if samples is None or fitted.kind == "rbf" or not fitted.free:
+        return 0.0
+    sigma = shared_covariance(samples)
+    n = len(samples)
+    if sigma is None or sigma.shape != (n, n):
+        return 0.0
+    names = get_model(fitted.model).param_names
+    theta = np.array([fitted.params[name] for name in names], dtype=float)
+    J = gradient(fitted.model, theta, fitted.free, samples.X).T  # (n, p)
+    if not np.isfinite(J).all():
+        return 0.0
+    if not validation:
+        B = np.eye(n) - J @ np.linalg.pinv(J)
+        return float(np.trace(B @ sigma @ B.T)) / n
+    scheme = str(validation.get("scheme") or "")
+    try:
+        labels = fold_labels(samples, scheme, 0)
+    except FricidError:
+        return 0.0
+    folds = np.unique(labels)
+    if scheme == "lovo" and graded_rmse(validation)[1] == LOVO_INTERIOR:
+        folds = folds[1:-1]  # the labels run slowest first: the end levels are not graded
+    total, count = 0.0, 0
+    for fold in folds:
+        held = labels == fold
+        B = -np.eye(n)[held]
+        B[:, ~held] += J[held] @ np.linalg.pinv(J[~held])
+        total += float(np.trace(B @ sigma @ B.T))
+        count += int(held.sum())
+    return total / count if count else 0.0

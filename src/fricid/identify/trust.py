@@ -53,6 +53,16 @@ computed by this record format (:data:`TRUST_VERSION`) on the same samples (thei
 std, ``meta`` sem and quality), with the same options (``validate``, the work limits), for
 the same model (every field of the file but ``trust`` and the provenance's source, time,
 version and warnings); anything else is computed again. A record that does not parse is ignored.
+
+Shared error. Samples from an arm's sweeps (:func:`fricid.extract.extract_arm`) carry one error
+of the identified gravity (:mod:`fricid.identify.static.shared_error`) that no fit removes: a
+law fitted on some of them carries it into its predictions of the others, apart from the part
+its offset absorbs. The scatter the error is graded against is then the measurement scatter
+and that error's share of the graded errors together, in quadrature
+(:func:`._heldout.shared_mse`, ``Trust.shared_rms``), and the reasons say so.
+
+This module is longer than 500 lines because the record, its reuse and the grading rules are
+one verdict, computed in one place.
 """
 
 from __future__ import annotations
@@ -88,6 +98,7 @@ from ._heldout import (
     graded_rmse,
     own_cv,
     run_validation,
+    shared_mse,
     worse_kfold,
 )
 from ._scatter import SECOND_DIFFERENCES, measurement_scatter
@@ -123,7 +134,7 @@ __all__ = [
 MISS_RATIO = 3.0
 
 #: Format of the record and of the rules behind it: a stored record of another is recomputed.
-TRUST_VERSION = 5
+TRUST_VERSION = 6
 
 #: ``Trust.heldout_source``: leave-one-velocity-out run by :func:`assess_trust`.
 RUN_HERE = "lovo run here"
@@ -221,6 +232,7 @@ class Trust:
     heldout_rmse: float = float("nan")
     scatter: float = float("nan")
     scatter_method: str = ""
+    shared_rms: float = float("nan")
     heldout_source: str = ""
     heldout_scheme: str = ""
     verdict: str = ""
@@ -269,7 +281,7 @@ class Trust:
         """
         known = {f.name for f in fields(cls)} - {"reused"}
         kwargs = {k: v for k, v in dict(d).items() if k in known}
-        for key in ("heldout_ratio", "heldout_rmse", "scatter"):
+        for key in ("heldout_ratio", "heldout_rmse", "scatter", "shared_rms"):
             value = kwargs.get(key)
             if value is not None and (
                 isinstance(value, bool) or not isinstance(value, int | float)
@@ -441,6 +453,11 @@ def _ratio(
                 trust.scatter = sc.value
                 trust.heldout_ratio = trust.heldout_rmse / sc.value
                 trust.heldout_source = IN_SAMPLE
+    shared = shared_mse(fitted, samples, v if trust.held_out else None)
+    if shared > 0 and np.isfinite(trust.scatter) and trust.scatter > 0:  # "Shared error"
+        trust.shared_rms = float(np.sqrt(shared))
+        trust.scatter = float(np.hypot(trust.scatter, trust.shared_rms))
+        trust.heldout_ratio = trust.heldout_rmse / trust.scatter
     trust.verdict = verdict(trust.heldout_ratio)
 
 
@@ -488,6 +505,11 @@ def _grade(trust: Trust, fitted: FittedModel, sample_caveats: list[str], no: lis
         )
     estimated = trust.scatter_method == SECOND_DIFFERENCES and np.isfinite(ratio)
     said = [f"the scatter is {ESTIMATED}"] if estimated else []
+    if np.isfinite(trust.shared_rms) and np.isfinite(ratio):
+        said.append(
+            f"the scatter, {trust.scatter:.3g} N m, includes {trust.shared_rms:.3g} N m RMS of "
+            "an error every sample shares (the arm's identified gravity), which no fit removes"
+        )
     if no:
         trust.level, trust.reasons = "no", no + caveats + said
         return
@@ -495,6 +517,8 @@ def _grade(trust: Trust, fitted: FittedModel, sample_caveats: list[str], no: lis
         trust.level, trust.reasons = "with caveats", caveats + said
         return
     which = f"the scatter {ESTIMATED}" if estimated else "the scatter"
+    if np.isfinite(trust.shared_rms):
+        which += f" with {trust.shared_rms:.3g} N m of the error every sample shares"
     held = f"{kind} error is within noise ({ratio:.2f}x {which})"
     det = "every parameter is determined" if free else "the network fits"
     trust.level, trust.reasons = "yes", [f"the fit converged, {det} and the {held}"]

@@ -324,3 +324,51 @@ def test_the_report_band_says_why_it_is_missing_and_names_the_shared_error():
     assert isinstance(note, Note) and note.kind == "warning" and "shared_covariance" in note.text
     d["prediction_interval"] = None
     assert prediction_band_figure(FittedModel.from_dict(d), samples, "rad/s") is None
+
+
+def _with_scatter(meta: dict, se: float) -> dict:
+    for lv in meta["gravity"]["levels"]:
+        lv["friction_se"] = se
+    return meta
+
+
+def test_the_verdict_counts_the_shared_error_in_the_scatter_and_grades_no_leverage():
+    """Six samples (three speeds a direction) and a correct per-direction law: random folds
+    that cannot all be fitted are not graded (the one fold left predicts from two samples a
+    direction: its error is leverage), and the scatter graded against includes the shared
+    error, as much as the trace formula gives; a wrong (symmetric) law is still 'no'."""
+    from fricid.identify._heldout import shared_mse
+    from fricid.identify.trust import assess_trust
+
+    rng = np.random.default_rng(0)
+    v = _velocity()
+    noisy = _samples(rng, 0.002, _with_scatter(_meta(v), 0.002))
+    # each sample the mean of 400 with std 0.04: a standard error of 0.002, the noise's
+    samples = FrictionSamples(
+        v,
+        None,
+        25.0,
+        noisy.friction,
+        count=np.full(v.size, 400),
+        std=np.full(v.size, 0.04),
+        meta=noisy.meta,
+    )
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        right = fit(samples, "coulomb_viscous_asym")
+        wrong = fit(samples, "coulomb_viscous")
+        t = assess_trust(right, samples)
+        w = assess_trust(wrong, samples)
+    assert t.level != "no", t.reasons
+    assert "not graded" in t.validation_note
+    S = shared_covariance(samples)
+    pos, neg = v > 0, v < 0
+    X = np.zeros((v.size, 4))
+    X[pos, 0], X[pos, 1] = 1.0, v[pos]
+    X[neg, 2], X[neg, 3] = -1.0, v[neg]
+    B = np.eye(v.size) - X @ np.linalg.pinv(X)
+    expected = np.trace(B @ S @ B.T) / v.size
+    assert shared_mse(right, samples, None) == pytest.approx(expected, rel=1e-4)
+    assert t.shared_rms == pytest.approx(np.sqrt(expected), rel=1e-4)
+    assert any("every sample shares" in r for r in t.reasons)
+    assert w.level == "no"
