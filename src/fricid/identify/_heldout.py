@@ -225,12 +225,14 @@ def worse_kfold(
 ) -> tuple[dict[str, Any] | None, str]:
     """On tiny data, random folds (:func:`run_kfold`) beside the held-out ``ratio`` already
     found (``scheme``; NaN when none): a flexible model can pass the level folds of a handful
-    of speeds and still miss single held-out samples by far. Not graded when a fold could not
-    be fitted without its samples: the design then determines the model with little to spare,
-    and the folds that were fitted predict from as few samples, so their errors are the
-    leverage of the noise, not the model's (an arm's per-direction Coulomb-viscous law on three
-    speeds a direction, ``benchmarks/bench_arm_sweeps.py``: a correct law was judged "no" on
-    25 of 75 joints, by the one fold of three that could be fitted).
+    of speeds and still miss single held-out samples by far. For an analytic model, not
+    graded when a fold could not be fitted without its samples: the design then determines
+    the model with little to spare, and the folds that were fitted predict from as few
+    samples, so their errors are the leverage of the noise, not the model's (an arm's
+    per-direction Coulomb-viscous law on three speeds a direction,
+    ``benchmarks/bench_arm_sweeps.py``: a correct law was judged "no" on 25 of 75 joints, by
+    the one fold of three that could be fitted). A learned model's folds still count: it is
+    the flexible model they are there to catch.
 
     Returns
     -------
@@ -244,7 +246,7 @@ def worse_kfold(
     if val is None or val.get("ratio") is None:
         return None, how
     failed = int(val.get("failed") or 0)
-    if failed:  # the rest are held out from as few samples: their errors are leverage
+    if failed and fitted.kind == "analytic":  # the rest predict from as few: leverage
         return None, (
             f"{len(samples)} samples, so random folds too: {how}, but {failed} of "
             f"{len(val.get('folds') or [])} could not be fitted without their samples (the "
