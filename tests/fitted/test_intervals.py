@@ -133,3 +133,17 @@ def test_cli_predict_writes_the_interval(stribeck, tmp_path):
     _, _, _, f, low, high = (float(x) for x in row.split(","))
     pi = stribeck.predict_interval(np.array([[0.5, 0.0, 25.0]]))
     assert (low, f, high) == pytest.approx((pi.low[0], pi.friction[0], pi.high[0]))
+
+
+def test_no_interval_for_a_fit_without_spare_samples_says_why():
+    """Four samples for four free parameters: no residual, no interval; the refusal says so
+    (not "fit it again", which would give the same)."""
+    v = np.array([-0.8, -0.2, 0.2, 0.8])
+    y = np.sign(v) * (0.1 + 0.05 * np.abs(v)) + np.array([1e-3, -2e-3, 2e-3, -1e-3])
+    s = FrictionSamples(velocity=v, load=0.0, temperature=25.0, friction=y)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        f = fit(s, "coulomb_viscous_asym")
+    assert f.prediction_interval is None
+    with pytest.raises(ConfigError, match="4 samples for 4 free parameters leave no residual"):
+        f.predict_interval(np.array([[0.5, 0.0, 25.0]]))

@@ -445,6 +445,14 @@ def prediction_interval(fitted, X, level: float = 0.95) -> PredictionInterval:
                     "is predicted along a motion (fricid report), and it gives no prediction "
                     "interval of steady friction"
                 )
+            stats = fitted.statistics or {}
+            n, p = stats.get("ndata"), stats.get("nvarys")
+            if isinstance(n, int | float) and isinstance(p, int | float) and n <= p:
+                raise ConfigError(
+                    f"model '{fitted.model}' stores no prediction interval: its {n:g} "
+                    f"samples for {p:g} free parameters leave no residual to measure the "
+                    "scatter by (measure more speeds, or fit a family with fewer parameters)"
+                )
             raise ConfigError(
                 f"model '{fitted.model}' stores no prediction interval (fit it again with "
                 "this fricid to get one)"
