@@ -127,3 +127,31 @@ def test_repeats_are_found_when_load_and_temperature_were_not_measured():
         sc = measurement_scatter(samples)
         assert sc.method == "between repeated runs"
         assert 0.5 * NOISE < sc.value < 2.0 * NOISE
+
+
+def test_an_exact_copy_of_a_row_is_not_a_repeated_run():
+    """A row pasted twice (every column equal) would give a between-runs scatter of 0 and an
+    error ratio of infinity; it is not counted as a repeat, and the caveat says so. A true
+    repeat (the friction differs by its noise) still is."""
+    from fricid.identify._scatter import exact_copies, measurement_scatter
+
+    v = np.array([0.2, 0.5, 1.0, -0.2, -0.5, -1.0])
+    y = np.sign(v) * (0.1 + 0.05 * np.abs(v))
+    std, count = np.full(6, 0.02), np.full(6, 400)
+    pasted = FrictionSamples(
+        np.r_[v, v[0]], 0.0, 25.0, np.r_[y, y[0]], count=np.r_[count, 400], std=np.r_[std, 0.02]
+    )
+    assert exact_copies(pasted).tolist() == [False] * 6 + [True]
+    sc = measurement_scatter(pasted)
+    assert sc.method == "within-run, std/sqrt(count)" and sc.value > 0
+    assert "1 row(s) exact copies" in sc.caveat
+    repeated = FrictionSamples(
+        np.r_[v, v[0]],
+        0.0,
+        25.0,
+        np.r_[y, y[0] + 0.001],
+        count=np.r_[count, 400],
+        std=np.r_[std, 0.02],
+    )
+    assert not exact_copies(repeated).any()
+    assert measurement_scatter(repeated).method == "between repeated runs"

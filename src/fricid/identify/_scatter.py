@@ -45,6 +45,7 @@ __all__ = [
     "SECOND_DIFFERENCES",
     "WEIGHTS",
     "Scatter",
+    "exact_copies",
     "level_labels",
     "measurement_scatter",
     "sample_weights",
@@ -295,21 +296,45 @@ def measurement_scatter(
             "within-run, autocorrelation-corrected",
             "one run per set-point: offsets between runs are not in it",
         )
+    copy = exact_copies(samples)
+    said = (
+        f"; {int(copy.sum())} row(s) exact copies of others (a copy is not a repeated run): "
+        "not counted as repeats"
+        if copy.any()
+        else ""
+    )
     group = _repeat_groups(samples, rtol)
-    sizes = np.bincount(group)
+    sizes = np.bincount(group[~copy], minlength=int(group.max()) + 1)
     if (sizes > 1).any():
-        means = np.bincount(group, weights=samples.y) / sizes
-        dof = float(np.sum(sizes - 1))
-        s = float(np.sqrt(np.sum((samples.y - means[group]) ** 2) / dof))
+        ys, gs = samples.y[~copy], group[~copy]
+        means = np.bincount(gs, weights=ys, minlength=sizes.size) / np.maximum(sizes, 1)
+        dof = float(np.sum(np.maximum(sizes - 1, 0)))
+        s = float(np.sqrt(np.sum((ys - means[gs]) ** 2) / dof))
         k = int((sizes > 1).sum())
-        return _scatter(np.full(n, s), "between repeated runs", f"{k} operating points repeated")
+        return _scatter(
+            np.full(n, s), "between repeated runs", f"{k} operating points repeated{said}"
+        )
     if (samples.std > 0).any():
         return _scatter(
             samples.std / np.sqrt(samples.count),
             "within-run, std/sqrt(count)",
-            "ignores autocorrelation of the raw samples: a lower bound",
+            f"ignores autocorrelation of the raw samples: a lower bound{said}",
         )
-    return second_difference_scatter(samples)
+    out = second_difference_scatter(samples)
+    return Scatter(out.value, out.per_sample, out.method, out.caveat + said) if said else out
+
+
+def exact_copies(samples: FrictionSamples) -> np.ndarray:
+    """Rows equal in every column (velocity, load, temperature, friction, count, std) to an
+    earlier row: a copy (a pasted row, a file joined twice), never a repeated run, whose
+    friction would differ by its noise. (n,) bool."""
+    cols = np.column_stack(
+        [samples.velocity, samples.load, samples.temperature, samples.y, samples.count, samples.std]
+    )
+    _, first = np.unique(cols, axis=0, return_index=True)
+    copy = np.ones(len(samples), dtype=bool)
+    copy[first] = False
+    return copy
 
 
 def _lines(samples: FrictionSamples) -> list[np.ndarray]:
