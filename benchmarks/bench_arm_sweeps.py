@@ -30,7 +30,9 @@ the torque noise, the largest over seeds (the issue's "held-out torque error / n
 gravity (a new sample: the truth plus its noise), inside the law's 95 % prediction interval
 (:meth:`fricid.fitted.FittedModel.predict_interval`, the shared gravity error included); and
 the seconds of one identification (extraction with the base gravity parameters, then the
-law).
+law); then, per joint, the trust verdicts (:func:`fricid.identify.trust.assess_trust`) over
+the seeds on that law (right) and on a symmetric ``coulomb_viscous`` one (wrong: the truth
+differs between the directions).
 
 Run: ``python benchmarks/bench_arm_sweeps.py [--seeds 20]``.
 """
@@ -50,6 +52,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 from _arm_sweeps import Law, arm_sweeps, perturbed
 from fricid.extract import extract, extract_arm
 from fricid.identify import fit
+from fricid.identify.trust import assess_trust
 from fricid.robot import RigidBodyModel, base_parameters, example_urdf
 
 PANDA = ("panda_joint2", "panda_joint4", "panda_joint6")
@@ -117,6 +120,15 @@ def errors(case, seed: int):
     for joint, law in laws.items():
         params[joint], fitted[joint] = law_fit(res[joint].by_direction, law)
     params["seconds"] = seconds + time.perf_counter() - start
+    for joint in laws:  # the trust verdict on the right law and on a wrong (symmetric) one
+        samples = res[joint].by_direction
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            wrong = fit(samples, "coulomb_viscous")
+            params[joint]["verdict"] = (
+                assess_trust(fitted[joint], samples).level,
+                assess_trust(wrong, samples).level,
+            )
     shifted = {j: [p + 0.3 for p in ps] for j, ps in poses.items()}
     held_log = arm_sweeps(truth, spans, shifted, laws, seed=seed + 1000, **options)
     held = extract_arm(held_log, ident)
@@ -216,6 +228,12 @@ def law_table(per_seed: list[dict]) -> None:
             + " ".join(f"{c:>19s}" for c in cells)
             + f" {z:5.2f} {torque:7.4f} {100 * inside[0] / inside[1]:5.1f}%"
         )
+    levels = ("yes", "with caveats", "no")
+    for k, which in enumerate(("coulomb_viscous_asym (right)", "coulomb_viscous (wrong)")):
+        for joint in (j for j in per_seed[0] if j != "seconds"):
+            got = [s[joint]["verdict"][k] for s in per_seed]
+            counts = "/".join(str(got.count(lv)) for lv in levels)
+            print(f"trust verdict yes/with caveats/no, {which}, {joint}: {counts}")
     sec = [s["seconds"] for s in per_seed]
     print(f"seconds per identification: median {np.median(sec):.2f}, max {np.max(sec):.2f}")
 
