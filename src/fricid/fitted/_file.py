@@ -117,6 +117,7 @@ def _validate_schema(d: dict[str, Any], source: str | None) -> None:
     describes every version this fricid reads; the message names the document's)."""
     from jsonschema.exceptions import best_match
 
+    _check_sizes(d, _schema_validator().schema, source)
     # the first errors suffice to name one; a hostile file may have millions
     error = best_match(itertools.islice(_schema_validator().iter_errors(d), 1000))
     if error is None:
@@ -134,6 +135,43 @@ def _validate_schema(d: dict[str, Any], source: str | None) -> None:
         f"{message}",
         file=source,
     )
+
+
+def _max_items(schema: Any) -> int | None:
+    """The largest ``maxItems`` a field's schema allows an array (over ``oneOf``/``anyOf``/
+    ``allOf`` alternatives); None when an alternative sets no limit."""
+    if not isinstance(schema, dict):
+        return None
+    alternatives = [a for k in ("oneOf", "anyOf") for a in schema.get(k, [])]
+    if alternatives:
+        limits = [_max_items(a) for a in alternatives if a.get("type") != "null"]
+        return None if not limits or None in limits else max(limits)
+    limits = [_max_items(a) for a in schema.get("allOf", [])] + [schema.get("maxItems")]
+    known = [x for x in limits if isinstance(x, int)]
+    return min(known) if known else None
+
+
+def _check_sizes(d: Any, schema: Any, source: str | None, path: str = "", depth: int = 0) -> None:
+    """The schema's array size limits on the named fields, checked before the schema's own
+    walk, which descends into every item first (a 1500 x 1500 covariance took it 31 s to
+    refuse): a :class:`DataError` naming the field, as :func:`_validate_schema` would."""
+    if not isinstance(d, dict) or not isinstance(schema, dict) or depth > 3:
+        return
+    props = schema.get("properties") or {}
+    for name, sub in props.items():
+        value = d.get(name)
+        where = f"{path}/{name}" if path else name
+        limit = _max_items(sub)
+        if isinstance(value, list) and limit is not None and len(value) > limit:
+            raise DataError(
+                f"field '{where}' does not match the model file schema (version "
+                f"{SCHEMA_VERSION}): {_LIMITS['maxItems'].format(limit)}",
+                file=source,
+            )
+        if isinstance(value, dict):
+            alts = [sub] + [a for k in ("oneOf", "anyOf") for a in sub.get(k, [])]
+            for alt in alts:
+                _check_sizes(value, alt, source, where, depth + 1)
 
 
 def _probe_inputs(operating_range: dict[str, list[float]]) -> np.ndarray:

@@ -372,3 +372,25 @@ def test_the_verdict_counts_the_shared_error_in_the_scatter_and_grades_no_levera
     assert t.shared_rms == pytest.approx(np.sqrt(expected), rel=1e-4)
     assert any("every sample shares" in r for r in t.reasons)
     assert w.level == "no"
+
+
+def test_an_oversized_matrix_is_refused_before_the_schema_walks_it(tmp_path):
+    """The schema's size limits on named fields are checked first: a covariance of more
+    rows than it allows is refused naming the field (before, the schema's own walk
+    descended into every item: 31 s for 1500 x 1500)."""
+    import json
+
+    from fricid.errors import DataError
+    from fricid.fitted import FittedModel
+
+    rng = np.random.default_rng(7)
+    v = _velocity()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        a = fit(_samples(rng, 0.002, _meta(v)), "coulomb_viscous_asym", intervals="jacobian")
+    d = json.loads(json.dumps(a.to_dict()))
+    d["prediction_interval"]["shared_covariance"] = [[0.0]] * 1001
+    path = tmp_path / "big.json"
+    path.write_text(json.dumps(d))
+    with pytest.raises(DataError, match="prediction_interval/shared_covariance.*more than 1000"):
+        FittedModel.load(path)
