@@ -392,5 +392,5 @@ def test_an_oversized_matrix_is_refused_before_the_schema_walks_it(tmp_path):
     d["prediction_interval"]["shared_covariance"] = [[0.0]] * 1001
     path = tmp_path / "big.json"
     path.write_text(json.dumps(d))
-    with pytest.raises(DataError, match="prediction_interval/shared_covariance.*more than 1000"):
+    with pytest.raises(DataError, match=r"prediction_interval/shared_covariance.*more than 1000"):
         FittedModel.load(path)
