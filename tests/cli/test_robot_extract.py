@@ -115,3 +115,25 @@ def test_a_log_without_temperature_names_the_option(pendulum_files, tmp_path):
     res = runner.invoke(app, ["robot", "extract", str(path), "--urdf", str(urdf)])
     assert res.exit_code == 2, res.output
     assert "has no temperature" in res.output and "--temperature" in res.output
+
+
+def test_runs_left_out_of_the_set_points_are_listed_with_their_speeds():
+    """A requested speed missing from a joint's table (a stick-slip run, no steady plateau)
+    shows under it: the kind, what it means and the speed; flagged set-points too."""
+    from fricid.cli.robot_extract import _not_averaged
+    from fricid.extract import extract_arm
+
+    path, joints = example_urdf("double_pendulum")
+    truth = RigidBodyModel.from_urdf(path, joints)
+    poses = {"joint2": [np.array([q, 0.0]) for q in (-0.9, 0.0, 0.9)]}
+    log = arm_sweeps(truth, {"joint2": (-1.2, 1.2)}, poses, {"joint2": LAWS["joint2"]}, rate=50.0)
+    q = extract_arm(log, truth)["joint2"].quality
+    assert _not_averaged(q) == []  # every run averaged, nothing flagged
+    kind, flagged, velocity = q.kind.copy(), q.flagged.copy(), q.velocity.copy()
+    first, second = np.flatnonzero(q.setpoints)[:2]
+    kind[first], velocity[first] = "unsteady", -0.2
+    flagged[second] = True
+    lines = _not_averaged(replace(q, kind=kind, flagged=flagged, velocity=velocity))
+    assert lines[0].startswith("  not averaged: 1 unsteady run(s) (no steady plateau")
+    assert lines[0].endswith("at -0.2 rad/s")
+    assert lines[1].startswith("  flagged (scatter far above their neighbours): ")

@@ -56,6 +56,36 @@ def _joint_table(result, joint: str) -> list[str]:
             f"  {lv['temperature']:>8.4g} {lv['velocity']:>+10.4g} {lv['friction']:>+15.5g} "
             f"{lv['friction_se']:>9.2g} {lv['load']:>+11.4g} {lv['passes']:>6} {lv['count']:>8}"
         )
+    return lines + _not_averaged(result[joint].quality)
+
+
+#: What each kind of run left out of the set-points was (the quality table's kinds).
+_LEFT_OUT = {
+    "rest": "standstill",
+    "unsteady": "no steady plateau: return moves, stick-slip, aborted moves",
+}
+
+
+def _not_averaged(quality) -> list[str]:
+    """The runs the extraction did not average into a set-point, by kind, with their speeds,
+    and the set-points flagged for scatter: a requested speed missing from the table above
+    shows here (the whole record is the samples file's quality table)."""
+    if quality is None:
+        return []
+    lines = []
+    for kind, what in _LEFT_OUT.items():
+        rows = quality.kind == kind
+        if rows.any():
+            speeds = sorted({round(float(v), 3) for v in quality.velocity[rows]})
+            shown = ", ".join(f"{v:+.3g}" if v else "0" for v in speeds[:12])
+            more = f" and {len(speeds) - 12} more" if len(speeds) > 12 else ""
+            lines.append(
+                f"  not averaged: {int(rows.sum())} {kind} run(s) ({what}) at {shown}{more} rad/s"
+            )
+    flagged = quality.setpoints & quality.flagged
+    if flagged.any():
+        speeds = ", ".join(f"{float(v):+.3g}" for v in quality.velocity[flagged])
+        lines.append(f"  flagged (scatter far above their neighbours): {speeds} rad/s")
     return lines
 
 
