@@ -63,3 +63,21 @@ def test_on_tiny_data_only_a_significant_gain_beats_the_simpler_family():
     best = y + rng.normal(0.0, 0.05, 12)
     assert not _better(best, y + rng.normal(0.0, 0.06, 12), y)  # noise apart
     assert _better(best, y + 0.5, y)  # every sample worse by far
+
+
+def test_a_family_with_more_parameters_than_samples_is_noted_not_fitted():
+    """Nine samples whose load differs at every one (an arm's gravity torque): the operating
+    points are nine, enough for one direction of the load-dependent family, but its
+    per-direction variant has 14 parameters; it is listed with the reason, and 'auto' fits
+    the rest instead of failing on it."""
+    speed = np.array([0.2, 0.35, 0.5, 0.75, 1.0])
+    v = np.r_[speed, -speed[:4]]
+    load = np.linspace(-0.05, 0.09, v.size)
+    y = np.sign(v) * (0.08 + 0.02 * np.abs(v)) + 0.001 * np.cos(7 * v)
+    s = FrictionSamples(v, load, 25.0, y, count=np.full(v.size, 100), std=np.full(v.size, 0.01))
+    by = {c.model: c for c in candidates(s)}
+    assert by["msk_asym"].note == "9 samples for 14 parameters"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        chosen = fit(s, "auto")
+    assert chosen.model != "msk_asym"

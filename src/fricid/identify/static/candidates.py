@@ -146,6 +146,8 @@ def candidates(samples: FrictionSamples, learned: bool = False) -> list[Candidat
                     have, what = _support(samples, levels, family, asym, temp, points)
                     if have <= (p if temp else need):
                         reason = f"{have} {what} for {p if temp else need} parameters"
+                if not reason and len(samples) <= p:  # the operating points count both sides
+                    reason = f"{len(samples)} samples for {p} parameters"
                 label = name + (
                     f" ({', '.join(f'{k}={v:g}' for k, v in fixed.items())})" if fixed else ""
                 )
