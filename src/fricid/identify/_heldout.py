@@ -33,6 +33,7 @@ __all__ = [
     "LEARNED_VALIDATE_WORK",
     "LOVO_INTERIOR",
     "MIN_LEVELS",
+    "RANK_RTOL",
     "TINY_SAMPLES",
     "VALIDATE_WORK",
     "graded_rmse",
@@ -261,6 +262,11 @@ def worse_kfold(
     return val, f"{note})"
 
 
+#: A fold whose training Jacobian (columns scaled to unit norm) has a singular value below
+#: this fraction of its largest is left out of :func:`shared_mse`.
+RANK_RTOL = 1e-6
+
+
 def shared_mse(
     fitted: FittedModel, samples: FrictionSamples | None, validation: dict[str, Any] | None
 ) -> float:
@@ -269,10 +275,11 @@ def shared_mse(
     grades; 0 without one. Held out (``validation``): its folds as the validation dealt them
     (``lovo``'s interior ones when it grades those, :func:`graded_rmse`), each fold's
     prediction linearised at the fit, ``e_h = J_h J_t^+ eps_t - eps_h``, averaged over the
-    held-out samples of ``trace(B Sigma B^T)``; in-sample, ``trace((I - H) Sigma (I - H)) /
-    n``. No fit removes this error (a law fitted on other samples carries it too, except its
-    offset), so a correct law's held-out error shows it beside the noise (module notes of
-    :mod:`fricid.identify.trust`, "Shared error")."""
+    held-out samples of ``trace(B Sigma B^T)`` (a fold whose training samples leave the
+    law's Jacobian rank-deficient is left out: its linear reading amplifies without bound);
+    in-sample, ``trace((I - H) Sigma (I - H)) / n``. No fit removes this error (a law fitted
+    on other samples carries it too, except its offsets), so a correct law's error shows it
+    beside the noise (module notes of :mod:`fricid.identify.trust`, "Shared error")."""
     from ..fitted._interval import gradient
     from ..models import get_model
     from .static.shared_error import shared_covariance
@@ -300,9 +307,14 @@ def shared_mse(
     folds = np.unique(labels)
     if scheme == "lovo" and graded_rmse(validation)[1] == LOVO_INTERIOR:
         folds = folds[1:-1]  # the labels run slowest first: the end levels are not graded
+    norms = np.linalg.norm(J, axis=0)
+    J = J / np.where(norms > 0, norms, 1.0)  # each parameter on its own scale
     total, count = 0.0, 0
     for fold in folds:
         held = labels == fold
+        sv = np.linalg.svd(J[~held], compute_uv=False)
+        if sv.size < J.shape[1] or not sv[-1] > RANK_RTOL * sv[0]:
+            continue  # the fold's training leaves the law undetermined: no linear reading
         B = -np.eye(n)[held]
         B[:, ~held] += J[held] @ np.linalg.pinv(J[~held])
         total += float(np.trace(B @ sigma @ B.T))

@@ -57,9 +57,17 @@ version and warnings); anything else is computed again. A record that does not p
 Shared error. Samples from an arm's sweeps (:func:`fricid.extract.extract_arm`) carry one error
 of the identified gravity (:mod:`fricid.identify.static.shared_error`) that no fit removes: a
 law fitted on some of them carries it into its predictions of the others, apart from the part
-its offset absorbs. The scatter the error is graded against is then the measurement scatter
-and that error's share of the graded errors together, in quadrature
-(:func:`._heldout.shared_mse`, ``Trust.shared_rms``), and the reasons say so.
+its offsets absorb (:func:`._heldout.shared_mse`, ``Trust.shared_rms``). It never makes an
+error pass: the grade stays against the measurement scatter. Where the error misses that
+scatter but not the scatter and the shared error together (in quadrature, by
+:data:`MISS_RATIO`), the verdict is "with caveats", saying the samples cannot tell the law's
+misfit from the shared error, not "no" (a per-direction offset of the gravity looks like an
+asymmetric Coulomb level: with the gravity parameters poorly told by the sweeps, a symmetric
+law and the per-direction one fit equally well). Where that error is larger than the
+scatter, an error within the scatter is not a "yes" either: a misfit of its size would not
+show. Counting it in the scatter instead passed a wrong symmetric law as "yes" (0.10x) on a
+sweep whose gravity the sweeps hardly told (the realised error had cancelled the truth's
+asymmetry: 0.77x the measurement scatter alone).
 
 This module is longer than 500 lines because the record, its reuse and the grading rules are
 one verdict, computed in one place.
@@ -453,12 +461,32 @@ def _ratio(
                 trust.scatter = sc.value
                 trust.heldout_ratio = trust.heldout_rmse / sc.value
                 trust.heldout_source = IN_SAMPLE
-    shared = shared_mse(fitted, samples, v if trust.held_out else None)
+    shared = (
+        0.0 if trust.not_determined else shared_mse(fitted, samples, v if trust.held_out else None)
+    )
     if shared > 0 and np.isfinite(trust.scatter) and trust.scatter > 0:  # "Shared error"
         trust.shared_rms = float(np.sqrt(shared))
-        trust.scatter = float(np.hypot(trust.scatter, trust.shared_rms))
-        trust.heldout_ratio = trust.heldout_rmse / trust.scatter
     trust.verdict = verdict(trust.heldout_ratio)
+
+
+def _shared_reading(trust: Trust) -> str:
+    """What the error every sample shares says of an error that misses the scatter (module
+    notes, "Shared error"): ``""`` when there is none, or the miss stands without it; else the
+    clause saying the samples cannot tell the law's misfit from it."""
+    ratio, shared = trust.heldout_ratio, trust.shared_rms
+    if not (np.isfinite(ratio) and np.isfinite(shared) and ratio > NOISE_RATIO):
+        return ""
+    total = trust.heldout_rmse / float(np.hypot(trust.scatter, shared))
+    advice = (
+        f" ({shared:.3g} N m RMS of the arm's identified gravity, which no fit removes): these "
+        "samples cannot tell a misfit of this law from it (sweep the other joints at more "
+        "poses, or keep the URDF's masses: fricid robot extract --urdf-masses)"
+    )
+    if total <= NOISE_RATIO:
+        return ", within what an error every sample shares explains" + advice
+    if ratio > MISS_RATIO >= total:
+        return f", {total:.3g}x with an error every sample shares counted" + advice
+    return ""
 
 
 def _grade(trust: Trust, fitted: FittedModel, sample_caveats: list[str], no: list[str]) -> None:
@@ -477,12 +505,20 @@ def _grade(trust: Trust, fitted: FittedModel, sample_caveats: list[str], no: lis
         caveats.append(f"not bounded by the data: {', '.join(trust.open_sides)}")
     ratio = trust.heldout_ratio
     kind = "held-out" if trust.held_out else "in-sample"
-    if np.isfinite(ratio) and ratio > MISS_RATIO:
+    shared = _shared_reading(trust)
+    if np.isfinite(ratio) and ratio > MISS_RATIO and not shared:
         no.append(f"the {kind} error {trust.verdict} the measurement scatter")
     elif np.isfinite(ratio) and ratio > NOISE_RATIO:
-        caveats.append(f"the {kind} error {trust.verdict} the measurement scatter")
+        caveats.append(f"the {kind} error {trust.verdict} the measurement scatter{shared}")
     elif not np.isfinite(ratio):
         caveats.append("no measurement scatter to compare the error with")
+    if not shared and np.isfinite(ratio) and trust.shared_rms > trust.scatter:
+        caveats.append(
+            f"the samples share an error larger than their scatter ({trust.shared_rms:.3g} N m "
+            f"RMS in this law's errors against {trust.scatter:.3g} N m: the arm's identified "
+            "gravity): a misfit of that size would not show (sweep the other joints at more "
+            "poses, or keep the URDF's masses: fricid robot extract --urdf-masses)"
+        )
     if np.isfinite(ratio) and not trust.held_out and not no:
         caveats.append("no held-out validation (in-sample error only)")
     elif np.isfinite(ratio) and trust.heldout_source == OWN_CV and not no:
@@ -505,11 +541,7 @@ def _grade(trust: Trust, fitted: FittedModel, sample_caveats: list[str], no: lis
         )
     estimated = trust.scatter_method == SECOND_DIFFERENCES and np.isfinite(ratio)
     said = [f"the scatter is {ESTIMATED}"] if estimated else []
-    if np.isfinite(trust.shared_rms) and np.isfinite(ratio):
-        said.append(
-            f"the scatter, {trust.scatter:.3g} N m, includes {trust.shared_rms:.3g} N m RMS of "
-            "an error every sample shares (the arm's identified gravity), which no fit removes"
-        )
+
     if no:
         trust.level, trust.reasons = "no", no + caveats + said
         return
@@ -517,8 +549,6 @@ def _grade(trust: Trust, fitted: FittedModel, sample_caveats: list[str], no: lis
         trust.level, trust.reasons = "with caveats", caveats + said
         return
     which = f"the scatter {ESTIMATED}" if estimated else "the scatter"
-    if np.isfinite(trust.shared_rms):
-        which += f" with {trust.shared_rms:.3g} N m of the error every sample shares"
     held = f"{kind} error is within noise ({ratio:.2f}x {which})"
     det = "every parameter is determined" if free else "the network fits"
     trust.level, trust.reasons = "yes", [f"the fit converged, {det} and the {held}"]
