@@ -326,6 +326,15 @@ def test_the_report_band_says_why_it_is_missing_and_names_the_shared_error():
     assert prediction_band_figure(FittedModel.from_dict(d), samples, "rad/s") is None
 
 
+def _measured(v: np.ndarray, friction: np.ndarray, std: float = 0.02) -> FrictionSamples:
+    """Samples each the mean of 400 with ``std`` (a standard error of std / 20), with the
+    shared gravity error's record."""
+    n = v.size
+    return FrictionSamples(
+        v, None, 25.0, friction, count=np.full(n, 400), std=np.full(n, std), meta=_meta(v)
+    )
+
+
 def _with_scatter(meta: dict, se: float) -> dict:
     for lv in meta["gravity"]["levels"]:
         lv["friction_se"] = se
@@ -385,15 +394,7 @@ def test_a_miss_the_shared_error_explains_is_a_caveat_never_a_pass():
     g = -np.array([lv["regressor"] for lv in _levels(v)])
     law = np.where(v > 0, 0.10 + 0.08 * v, -(0.088 + 0.08 * -v))  # 0.012 N m asymmetric
     friction = law + g @ rng.normal(0.0, SE_BETA) + rng.normal(0.0, 0.001, v.size)
-    samples = FrictionSamples(
-        v,
-        None,
-        25.0,
-        friction,
-        count=np.full(v.size, 400),
-        std=np.full(v.size, 0.02),
-        meta=_meta(v),
-    )
+    samples = _measured(v, friction)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         sym = fit(samples, "coulomb_viscous")
@@ -434,15 +435,7 @@ def test_a_shared_error_larger_than_the_scatter_is_never_a_pass():
     v = _velocity()
     law = np.sign(v) * (0.10 + 0.08 * np.abs(v))  # symmetric: coulomb_viscous is right
     friction = law + rng.normal(0.0, 0.0005, v.size)  # this draw of the shared error: 0
-    samples = FrictionSamples(
-        v,
-        None,
-        25.0,
-        friction,
-        count=np.full(v.size, 400),
-        std=np.full(v.size, 0.02),
-        meta=_meta(v),
-    )
+    samples = _measured(v, friction)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         t = assess_trust(fit(samples, "coulomb_viscous"), samples)
