@@ -256,9 +256,9 @@ def worse_kfold(
     k_ratio = float(val["ratio"])
     note = f"{len(samples)} samples, so random folds too: {how} ({k_ratio:.3g}x"
     if np.isfinite(ratio) and k_ratio <= ratio:
-        return None, f"{note}; {scheme}'s {ratio:.3g}x is the worse and graded)"
+        return None, f"{note}; {scheme} ({ratio:.3g}x) is the worse and graded)"
     if np.isfinite(ratio):
-        return val, f"{note}, worse than {scheme}'s {ratio:.3g}x: graded)"
+        return val, f"{note}, worse than {scheme} ({ratio:.3g}x): graded)"
     return val, f"{note})"
 
 
