@@ -120,7 +120,7 @@ def predict_command(
 
     from ..errors import ConfigError, ExtrapolationWarning
     from ..export import Smoothing, smooth_predict, write_text
-    from ..export._common import trust_of
+    from ..export._common import printable_reasons, trust_of
     from ..export.points import points_matrix, points_table, read_points
     from ..fitted import FittedModel
     from ..units import to_si
@@ -166,7 +166,7 @@ def predict_command(
         )
     level, reasons = trust_of(fitted)
     if level == "no":  # as export refuses it: said, not hidden
-        why = "; ".join("".join(c if c.isprintable() else "?" for c in r) for r in reasons[:2])
+        why = printable_reasons(reasons[:2])
         err_console.print(
             f"warning: the model's trust verdict is 'no' ({why[:300] or 'no reason recorded'}): "
             "its own check rejects it, so neither the friction nor its interval is backed",

@@ -271,6 +271,12 @@ def trust_of(fitted: FittedModel) -> tuple[str | None, list[str]]:
     return None, []
 
 
+def printable_reasons(reasons: list[str]) -> str:
+    """A record's reasons joined by ``"; "``, each character that is not printable (a
+    terminal control from a file) shown as ``?``."""
+    return "; ".join("".join(c if c.isprintable() else "?" for c in r) for r in reasons)
+
+
 def refuse_untrusted(fitted: FittedModel, allow: bool, joint: str | None = None) -> None:
     """Refuse to export a model whose recorded verdict is ``no`` unless ``allow`` (then
     :func:`summary_lines` says so in the file's comment); ``joint`` names it in the message.
@@ -283,7 +289,7 @@ def refuse_untrusted(fitted: FittedModel, allow: bool, joint: str | None = None)
     level, reasons = trust_of(fitted)
     if level == "no" and not allow:
         # printable characters only (no terminal controls from a file), at most 300
-        why = "; ".join("".join(c if c.isprintable() else "?" for c in r) for r in reasons[:3])
+        why = printable_reasons(reasons[:3])
         why = (why[:300] + " ...") if len(why) > 300 else why or "no reason recorded"
         whose = f"joint {plain(joint)}: the" if joint else "the"
         raise ExportError(

@@ -281,7 +281,6 @@ def shared_mse(
     on other samples carries it too, except its offsets), so a correct law's error shows it
     beside the noise (module notes of :mod:`fricid.identify.trust`, "Shared error")."""
     from ..fitted._interval import gradient
-    from ..models import get_model
     from .static.shared_error import shared_covariance
     from .validate import fold_labels
 
@@ -291,9 +290,7 @@ def shared_mse(
     n = len(samples)
     if sigma is None or sigma.shape != (n, n):
         return 0.0
-    names = get_model(fitted.model).param_names
-    theta = np.array([fitted.params[name] for name in names], dtype=float)
-    J = gradient(fitted.model, theta, fitted.free, samples.X).T  # (n, p)
+    J = gradient(fitted.model, fitted.theta(), fitted.free, samples.X).T  # (n, p)
     if not np.isfinite(J).all():
         return 0.0
     if not validation:

@@ -541,7 +541,6 @@ def _grade(trust: Trust, fitted: FittedModel, sample_caveats: list[str], no: lis
         )
     estimated = trust.scatter_method == SECOND_DIFFERENCES and np.isfinite(ratio)
     said = [f"the scatter is {ESTIMATED}"] if estimated else []
-
     if no:
         trust.level, trust.reasons = "no", no + caveats + said
         return

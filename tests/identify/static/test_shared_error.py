@@ -73,6 +73,20 @@ def _samples(rng, noise: float, meta: dict | None, shared: bool = True) -> Frict
     return _fs(v, friction, meta or {})
 
 
+def _law_fit(samples: FrictionSamples):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return fit(samples, "coulomb_viscous_asym", intervals="jacobian")
+
+
+def _with_and_without(seed: int):
+    """Samples with the shared error's record, and the law fitted to them with it and to
+    the same frictions without it: ``(velocity, samples, with, without)``."""
+    v = _velocity()
+    samples = _samples(np.random.default_rng(seed), 0.002, _meta(v))
+    return v, samples, _law_fit(samples), _law_fit(_fs(v, samples.friction))
+
+
 def test_the_covariance_is_the_levels_regressors_through_beta():
     v = _velocity()
     s = _fs(v, _law(v), _meta(v))
@@ -120,14 +134,7 @@ def test_intervals_widen_by_the_propagated_error_in_quadrature():
     sd_shared), sd_shared from X^+ G Sigma G^T X^+T and se' the plain fit's scaled by the
     residual variance's own share (SSE - tr((I - H) G Sigma G^T)) / SSE, and the interval's
     half-width t_eff times it, t_eff with the Welch-Satterthwaite degrees of freedom."""
-    rng = np.random.default_rng(0)
-    v = _velocity()
-    samples = _samples(rng, 0.002, _meta(v))
-    plain = _fs(v, samples.friction)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        a = fit(samples, "coulomb_viscous_asym", intervals="jacobian")
-        b = fit(plain, "coulomb_viscous_asym", intervals="jacobian")
+    v, samples, a, b = _with_and_without(0)
     pos, neg = v > 0, v < 0
     X = np.zeros((v.size, 4))
     X[pos, 0], X[pos, 1] = 1.0, v[pos]
@@ -217,14 +224,7 @@ def test_the_prediction_interval_adds_the_shared_error_unscaled():
     from fricid.fitted import FittedModel
     from fricid.fitted._interval import _delta_multiplier, gradient
 
-    rng = np.random.default_rng(3)
-    v = _velocity()
-    samples = _samples(rng, 0.002, _meta(v))
-    plain = _fs(v, samples.friction)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        a = fit(samples, "coulomb_viscous_asym", intervals="jacobian")
-        b = fit(plain, "coulomb_viscous_asym", intervals="jacobian")
+    _, _, a, b = _with_and_without(3)
     rec = a.prediction_interval
     S = np.asarray(rec["shared_covariance"])
     assert S.shape == (4, 4) and np.all(np.diag(S) > 0)
@@ -265,11 +265,7 @@ def test_a_malformed_shared_covariance_is_refused(bad):
     from fricid.errors import ConfigError, DataError
     from fricid.fitted import FittedModel
 
-    rng = np.random.default_rng(4)
-    v = _velocity()
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        a = fit(_samples(rng, 0.002, _meta(v)), "coulomb_viscous_asym", intervals="jacobian")
+    a = _law_fit(_samples(np.random.default_rng(4), 0.002, _meta(_velocity())))
     d = a.to_dict()
     d["prediction_interval"] = {**d["prediction_interval"], "shared_covariance": bad}
     with pytest.raises((ConfigError, DataError), match="shared_covariance"):
@@ -285,11 +281,7 @@ def test_predict_names_the_file_and_says_a_no_verdict(tmp_path):
     from fricid.cli import app
     from fricid.fitted import FittedModel
 
-    rng = np.random.default_rng(5)
-    v = _velocity()
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        a = fit(_samples(rng, 0.002, _meta(v)), "coulomb_viscous_asym", intervals="jacobian")
+    a = _law_fit(_samples(np.random.default_rng(5), 0.002, _meta(_velocity())))
     d = a.to_dict()
     d["prediction_interval"] = {**d["prediction_interval"], "shared_covariance": INDEFINITE}
     bad = FittedModel.from_dict(d).save(tmp_path / "bad.json")
@@ -413,11 +405,7 @@ def test_an_oversized_matrix_is_refused_before_the_schema_walks_it(tmp_path):
     from fricid.errors import DataError
     from fricid.fitted import FittedModel
 
-    rng = np.random.default_rng(7)
-    v = _velocity()
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        a = fit(_samples(rng, 0.002, _meta(v)), "coulomb_viscous_asym", intervals="jacobian")
+    a = _law_fit(_samples(np.random.default_rng(7), 0.002, _meta(_velocity())))
     d = json.loads(json.dumps(a.to_dict()))
     d["prediction_interval"]["shared_covariance"] = [[0.0]] * 1001
     path = tmp_path / "big.json"
