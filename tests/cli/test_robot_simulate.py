@@ -96,3 +96,21 @@ def test_a_lugre_joint(tmp_path):
     assert "joint2: LuGre friction" in mjcf.read_text()
     bad = run("--robot", "double_pendulum", "--duration", 0.2, "--lugre", "elbow", "--out", out)
     assert bad.exit_code == 2 and "--lugre" in bad.output
+
+
+def test_a_sweep_runs_its_whole_plan_unless_cut_short(tmp_path):
+    """Without --duration the sweeps run every speed both ways; a shorter --duration is warned
+    of with the speeds it still holds (60 s held one of the five default speeds)."""
+    from fricid.cli.robot_simulate import _duration, _model, _reference
+
+    model = _model("double_pendulum", None, None)
+    reference = _reference(model, "joint1", "0.5,1", 5, 0.1, 0)
+    assert _duration(reference, None) == reference.duration > 6
+    out = tmp_path / "short.parquet"
+    result = run(
+        "--robot", "double_pendulum", "--sweep", "joint1", "--velocities", "1,0.5",
+        "--duration", 6, "--out", out, "--friction", "none", "--controller", "torque",
+    )  # fmt: skip
+    assert result.exit_code == 0, result.output
+    message = " ".join(result.output.split())
+    assert "cuts the sweeps short" in message and "both directions of 1 rad/s only" in message

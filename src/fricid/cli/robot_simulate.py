@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import time
+import warnings
 from pathlib import Path
 from typing import Annotated
 
@@ -53,6 +54,40 @@ def _reference(model, sweep: str | None, velocities: str, harmonics: int, base: 
     return sweep_reference(0.5 * (lo + hi), j, speeds, mid - half, mid + half)
 
 
+def _duration(reference, duration: float | None) -> float:
+    """The simulated time [s]: as given, else 60 s, or a sweep's whole length; a sweep cut
+    short is warned of with the speeds it covers (60 s covered one of the five default speeds
+    of the double pendulum's first joint, 129 s long)."""
+    from ..errors import ConfigError, DataQualityWarning
+    from ..sim.robot_reference import SweepReference
+
+    if not isinstance(reference, SweepReference):
+        return 60.0 if duration is None else duration
+    plan = reference.duration
+    if duration is None:
+        if plan > 3600:
+            raise ConfigError(
+                f"the sweeps take {plan:.0f} s, over the 3600 s a run may take; give fewer or "
+                "faster --velocities"
+            )
+        return float(plan)
+    if duration < plan:
+        ended = {(round(abs(v), 9), v > 0) for _, t1, v in reference.plateaus if t1 <= duration}
+        done = sorted(v for v, up in ended if up and (v, False) in ended)
+        covered = (
+            f"holds both directions of {', '.join(f'{v:g}' for v in done)} rad/s only"
+            if done
+            else "holds both directions of none of the speeds"
+        )
+        warnings.warn(
+            f"--duration {duration:g} s cuts the sweeps short: they take {plan:.0f} s; the log "
+            f"{covered} (leave --duration out to run them all)",
+            DataQualityWarning,
+            stacklevel=2,
+        )
+    return duration
+
+
 def _truth_json(run, model) -> dict:
     t = run.truth
     return {
@@ -81,7 +116,13 @@ def robot_simulate_command(
     joints: Annotated[
         str | None, typer.Option(help="The joints to simulate, comma-separated (default all).")
     ] = None,
-    duration: Annotated[float, typer.Option(help="[s]")] = 60.0,
+    duration: Annotated[
+        float | None,
+        typer.Option(
+            help="[s]; default 60, or with --sweep the sweeps' own length (every speed, both "
+            "directions)."
+        ),
+    ] = None,
     rate: Annotated[float, typer.Option(help="Samples and controller updates per second.")] = (
         1000.0
     ),
@@ -154,12 +195,13 @@ def robot_simulate_command(
         raise ConfigError(f"--friction must be example or none; got {friction!r}")
     if not (1e-7 <= integrator_step <= 0.01):
         raise ConfigError(f"--integrator-step must lie in [1e-7, 0.01] s; got {integrator_step!r}")
-    if not (0 < duration <= 3600):
+    if duration is not None and not (0 < duration <= 3600):
         raise ConfigError(f"--duration must lie in (0, 3600] s; got {duration!r}")
     if out.suffix.lower() not in (".csv", ".parquet", ".pq"):
         raise ConfigError(f"--out must end in .csv, .parquet or .pq; got '{out.name}'")
     model = _model(robot, urdf, joints)
     reference = _reference(model, sweep, velocities, harmonics, base_frequency, seed)
+    duration = _duration(reference, duration)
     law = example_friction(model.effort_limit) if friction == "example" else None
     dynamic = None
     if lugre is not None:
