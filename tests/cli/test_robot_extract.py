@@ -65,6 +65,29 @@ def test_robot_extract_writes_samples_per_joint_and_gravity(pendulum_files):
         assert np.sqrt(np.mean(err**2)) < 0.003, (joint, err)
 
 
+def test_the_printed_set_points_are_the_samples_written(pendulum_files):
+    """Each joint's printed table lists exactly the rows of its samples file: velocity,
+    friction, load and samples as written (the arm fit's levels, one per row)."""
+    log_path, urdf, folder = pendulum_files
+    out = folder / "table"
+    res = runner.invoke(
+        app, ["robot", "extract", str(log_path), "--urdf", str(urdf), "-o", str(out)]
+    )
+    assert res.exit_code == 0, res.output
+    lines = res.stdout.splitlines()
+    for joint in LAWS:
+        start = next(i for i, line in enumerate(lines) if line.startswith(f"{joint}:")) + 2
+        printed = [line.split() for line in lines[start : start + 6]]
+        samples = read_samples(out / f"{joint}.csv")
+        order = np.lexsort((samples.velocity, samples.temperature))
+        for cells, i in zip(printed, order, strict=True):
+            v, f, se, load, passes, count = (float(c) for c in cells[1:])
+            assert v == pytest.approx(samples.velocity[i], rel=1e-3)
+            assert f == pytest.approx(samples.friction[i], rel=1e-4)
+            assert load == pytest.approx(samples.load[i], rel=1e-3, abs=1e-4)
+            assert count == samples.count[i] and se > 0 and passes >= 1
+
+
 def test_robot_extract_bad_joint_is_one_line(pendulum_files):
     log_path, urdf, folder = pendulum_files
     out = folder / "bad"

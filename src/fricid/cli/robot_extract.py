@@ -42,8 +42,9 @@ def _split(items: list[str] | None) -> list[str] | None:
 
 
 def _joint_table(result, joint: str) -> list[str]:
-    """One joint's set-points: velocity, friction with its standard error (the joint fit's,
-    the gravity parameters' uncertainty included), gravity load, passes and samples."""
+    """One joint's set-points as its samples file holds them: velocity, friction with its
+    standard error (the arm fit's, the gravity parameters' uncertainty included), gravity
+    load, passes and samples."""
     g = result.gravity
     lines = [
         f"{joint}: {len(g.joint_levels(joint))} set-points, residual "
@@ -51,10 +52,11 @@ def _joint_table(result, joint: str) -> list[str]:
         f"  {'T [degC]':>8} {'v [rad/s]':>10} {'friction [N m]':>15} {'+- se':>9} "
         f"{'load [N m]':>11} {'passes':>6} {'samples':>8}",
     ]
-    for lv in sorted(g.joint_levels(joint), key=lambda r: (r["temperature"], r["velocity"])):
+    for row in result.setpoints(joint):
+        se = f"{row['friction_se']:>9.2g}" if math.isfinite(row["friction_se"]) else f"{'-':>9}"
         lines.append(
-            f"  {lv['temperature']:>8.4g} {lv['velocity']:>+10.4g} {lv['friction']:>+15.5g} "
-            f"{lv['friction_se']:>9.2g} {lv['load']:>+11.4g} {lv['passes']:>6} {lv['count']:>8}"
+            f"  {row['temperature']:>8.4g} {row['velocity']:>+10.4g} {row['friction']:>+15.5g} "
+            f"{se} {row['load']:>+11.4g} {row['passes'] or '-':>6} {row['count']:>8}"
         )
     return lines + _not_averaged(result[joint].quality)
 
@@ -108,7 +110,13 @@ def _tables(result) -> list[str]:
     what = "identified from the sweeps" if g.identified else "the URDF's (not identified)"
     lines.append(f"base gravity parameters ({what}; value +- standard error, URDF):")
     for name, b, se, u in zip(g.names, g.beta, g.beta_se, g.beta_urdf, strict=True):
-        told = f"+- {se:.2g}" if math.isfinite(se) else "(not determined by the sweeps)"
+        told = (
+            f"+- {se:.2g}"
+            if math.isfinite(se)
+            else "(not determined by the sweeps)"
+            if g.identified
+            else "(kept)"
+        )
         lines.append(f"  {b:+.6g} {told}  (URDF {u:+.6g})  {name}")
     return lines
 
@@ -177,6 +185,7 @@ def robot_extract_command(
     at 0.
     """
     from ..extract import extract_arm
+    from ..extract.arm import CONFOUNDED
     from ..io import read_robot_log
     from ..io.atomic import atomic_write
     from ..io.tables import write_samples
@@ -217,6 +226,8 @@ def robot_extract_command(
     for line in _tables(result):
         console.print(line, markup=False, highlight=False)
     for note in result.gravity.notes:
+        if note.startswith(CONFOUNDED):  # warned already
+            continue
         err_console.print(f"note: {note}", markup=False, highlight=False)
     err_console.print(
         f"wrote {len(result)} samples file(s) and {GRAVITY_FILE} into {out}",

@@ -31,6 +31,7 @@ The single-joint eq. 7 is the special case of a one-joint robot (:mod:`.arm_grav
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any
@@ -38,13 +39,13 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from scipy.signal import savgol_filter
 
-from ..errors import ConfigError, DataError
+from ..errors import ConfigError, DataError, DataQualityWarning, user_stacklevel
 from ..samples import FrictionSamples, RawLog, RobotLog
 from ._gravity_mode import explicit_none_note
 from .accumulate import Accumulator
 from .arm_gravity import ArmGravityFit, arm_moments, solve_levels
 from .bins import PositionBins
-from .pipeline import VELOCITY_RTOL, ExtractionResult, extract
+from .pipeline import VELOCITY_RTOL, ExtractionResult, extract, velocity_from_position
 from .segment import cluster, iter_segments
 from .steady import OUTLIER_SIGMAS, SETTLE_SIGMAS
 
@@ -59,6 +60,13 @@ CHUNK = 4096
 #: s, the span of the Savitzky-Golay derivative that estimates the joints' accelerations when
 #: the log has none (long against the noise of a velocity estimate, short against a ramp).
 ACCELERATION_WINDOW = 0.05
+
+#: A joint whose longest steady run travels under this share of the longest run of any joint
+#: is held, not swept (:func:`_held`).
+HELD_SHARE = 0.02
+
+#: How the note (and warning) begins when the sweeps barely tell gravity from friction.
+CONFOUNDED = "the sweeps barely tell the arm's gravity from the friction"
 
 #: ``samples.meta["extract"]["gravity"]`` of an arm extraction.
 ARM_MODE = "arm"
@@ -80,6 +88,35 @@ class ArmExtraction(Mapping):
 
     def __len__(self) -> int:
         return len(self.results)
+
+    def setpoints(self, joint: str) -> list[dict[str, Any]]:
+        """One joint's per-direction samples as written (``by_direction``), a dict per row
+        sorted by temperature and velocity: ``temperature``, ``velocity``, ``friction``,
+        ``load``, ``count``, and from the arm fit's level of that row (the one whose friction
+        and count it took) ``friction_se`` (the gravity parameters' error included) and
+        ``passes``; NaN and 0 for a row no level matched one to one."""
+        bd = self.results[joint].by_direction
+        levels = self.gravity.joint_levels(joint)
+        rows = []
+        for i in range(len(bd)):
+            count = None if bd.count is None else int(bd.count[i])
+            match = [
+                lv
+                for lv in levels
+                if lv["friction"] == float(bd.friction[i]) and lv["count"] == count
+            ]
+            rows.append(
+                {
+                    "temperature": float(bd.temperature[i]),
+                    "velocity": float(bd.velocity[i]),
+                    "friction": float(bd.friction[i]),
+                    "friction_se": match[0]["friction_se"] if match else float("nan"),
+                    "load": float(bd.load[i]),
+                    "passes": match[0]["passes"] if match else 0,
+                    "count": count,
+                }
+            )
+        return sorted(rows, key=lambda r: (r["temperature"], r["velocity"]))
 
     def table(self) -> list[dict[str, Any]]:
         """One row per swept joint: set-points, samples, the range of |friction|, the largest
@@ -112,6 +149,26 @@ def _robot_rows(model: RigidBodyModel, log: RobotLog) -> RobotLog:
             file=log.source,
         )
     return log.select(model.joints)
+
+
+def _velocities(arm: RobotLog) -> tuple[RobotLog, set[str], list[str]]:
+    """``arm`` with each joint's coarse-encoder finite-difference velocity replaced by its
+    position's least-squares slope (:func:`~.pipeline.velocity_from_position`), the joints
+    replaced and the warnings: the arm fit's segments and levels and each joint's samples
+    (:func:`~.pipeline.extract`) then read one velocity. With the finite difference, a 2^17-
+    count encoder at 1 kHz put a 0.05 rad/s sweep's levels at 0.096 rad/s (two counts per
+    sample) while the samples file, re-estimated, had nine set-points at 0.052-0.064."""
+    velocity = arm.velocity.copy()
+    replaced, found = set(), []
+    for j, name in enumerate(arm.joints):
+        raw = replace(arm.joint(name, temperature=0.0), source=f"{arm.source or 'the log'}, {name}")
+        raw, note = velocity_from_position(raw)
+        if raw.meta.get("velocity_from") == "position":
+            velocity[:, j] = raw.velocity
+            replaced.add(name)
+        if note:
+            found.append(note)
+    return (replace(arm, velocity=velocity) if replaced else arm), replaced, found
 
 
 def _acceleration(arm: RobotLog) -> np.ndarray:
@@ -196,6 +253,28 @@ def _passes(raw: RawLog, w: np.ndarray, where: np.ndarray, options: dict) -> lis
         acc.add(seg)
     kinds = acc.classify()
     return [r for r, k in zip(acc.records, kinds, strict=True) if k == "setpoint"]
+
+
+def _held(records: dict[str, list]) -> dict[str, str]:
+    """The joints whose steady runs are a held joint's creep, not a sweep, and why: the
+    longest run travels under :data:`HELD_SHARE` of the longest of any joint. The double
+    pendulum's second joint, held by its PD drive while the first was swept over 1.5 rad,
+    crept with the first joint's gravity: 37 "set-points" at 0.2-0.7 mrad/s, none over
+    0.005 rad, with frictions against the motion (0.25 N m with the gravity identified)."""
+    travel = {
+        joint: max(float(r.speed) * float(r.duration) for r in recs)
+        for joint, recs in records.items()
+    }
+    top = max(travel.values())
+    return {
+        joint: (
+            f"not swept, left out: its steady runs travel at most {t:.2g} rad, under "
+            f"{100 * HELD_SHARE:g} % of the longest sweep's {top:.2g} rad: a held joint's "
+            "creep (name it in joints= or --joints to extract it anyway)"
+        )
+        for joint, t in travel.items()
+        if t < HELD_SHARE * top
+    }
 
 
 def _levels(joint: str, records: list, options: dict) -> list[dict]:
@@ -287,13 +366,17 @@ def extract_arm(
             f"joint(s) {', '.join(unknown)} not in the robot model; it has "
             + ", ".join(model.joints)
         )
-    arm = _robot_rows(model, log)
+    arm, replaced, coarse = _velocities(_robot_rows(model, log))
+    for note in coarse:
+        warnings.warn(note, DataQualityWarning, stacklevel=user_stacklevel())
     base = base_parameters(model, gravity_only=True)
     ddq = _acceleration(arm)
-    stats, keys, raws = [], [], {}
+    found = {}
     for joint in wanted:
         j = model.joints.index(joint)
         raw = arm.joint(joint, temperature=temperature)
+        if joint in replaced:
+            raw = replace(raw, meta={**raw.meta, "velocity_from": "position"})
         rows = _segment_rows(raw, options)
         w, other = _joint_dynamics(model, base, arm, ddq, j, rows)
         torque = raw.motor_torque.copy()
@@ -309,12 +392,22 @@ def extract_arm(
                     file=log.source,
                 )
             continue
-        raws[joint] = (raw, rows, w)
-        stats.extend(r.extra for r in records)
-        keys.extend(_levels(joint, records, options))
-    if not raws:
+        found[joint] = (raw, rows, w, records)
+    if not found:
         raise DataError("no joint of the robot log has a constant-velocity sweep", file=log.source)
+    held = {} if joints is not None else _held({j: f[3] for j, f in found.items()})
+    stats, keys, raws = [], [], {}
+    for joint, (raw, rows, w, records) in found.items():
+        if joint not in held:
+            raws[joint] = (raw, rows, w)
+            stats.extend(r.extra for r in records)
+            keys.extend(_levels(joint, records, options))
     fit = _fit(stats, keys, base, model, identify, log.source)
+    if held:
+        fit = replace(fit, notes=(*fit.notes, *(f"{j}: {why}" for j, why in held.items())))
+    for note in fit.notes:
+        if note.startswith(CONFOUNDED):
+            warnings.warn(note, DataQualityWarning, stacklevel=user_stacklevel())
     results = {
         joint: _joint_result(raw, rows, w @ fit.beta, fit, options, joint)
         for joint, (raw, rows, w) in raws.items()
@@ -349,7 +442,8 @@ def _fit(stats, keys, base, model, identify, source) -> ArmGravityFit:
         j: float(np.sqrt(sol.rss[joint_of == j].sum() / sol.count[joint_of == j].sum()))
         for j in dict.fromkeys(joint_of)
     }
-    notes = []
+    notes = [_confounded(sol, joint_of, residual)] if identify else []
+    notes = [n for n in notes if n]
     if identify and not sol.determined.all():
         names = [n for n, d in zip(base.names, sol.determined, strict=True) if not d]
         notes.append(
@@ -369,6 +463,33 @@ def _fit(stats, keys, base, model, identify, source) -> ArmGravityFit:
         residual_rms=residual,
         covariance=sol.covariance[k:, k:],
         notes=tuple(notes),
+    )
+
+
+def _confounded(sol, joint_of: np.ndarray, residual: dict[str, float]) -> str | None:
+    """What to know when the gravity parameters' error alone moves some joint's set-point
+    frictions by more than its samples' scatter (the sweeps barely tell gravity from
+    friction), else None. On the sweeps of ``tests/_arm_sweeps.py`` (every joint swept with
+    the others in three poses) it moved them by at most 0.07 of the scatter; sweeping only
+    the double pendulum's first joint, by 36 times (joint 2's parameters confounded with the
+    set-point frictions: 1.05 +- 1.8 N m for a true 0.066)."""
+    k = sol.level.size
+    wbar = sol.level_regressor
+    shared = np.sqrt(np.maximum(np.einsum("ki,ij,kj->k", wbar, sol.covariance[k:, k:], wbar), 0))
+    worst = []
+    for joint in dict.fromkeys(joint_of):
+        own = residual[joint]
+        top = float(shared[joint_of == joint].max())
+        if np.isfinite(top) and own > 0 and top > own:
+            worst.append(f"{joint} by up to {top:.2g} N m ({top / own:.3g}x its scatter)")
+    if not worst:
+        return None
+    return (
+        CONFOUNDED + ": the gravity parameters' "
+        "standard errors alone move the set-point frictions of " + ", ".join(worst) + "; "
+        "those frictions are not determined. Sweep every joint over its range with the other "
+        "joints in several poses, or keep the URDF's masses (--urdf-masses; "
+        "identify=False) if they are right"
     )
 
 
@@ -410,15 +531,26 @@ def _with_load(
 ) -> FrictionSamples:
     """``samples`` with each row's load the gravity torque of its level (the nearest in speed
     and temperature with the row's direction; for a combined row, the count-weighted mean of
-    both directions' levels) and the arm's ``meta``."""
+    both directions' levels) and the arm's ``meta``.
+
+    A per-direction row (``combined=False``) takes its level's friction and count as well
+    (its own mean velocity, that direction's, is kept): the set-point the arm fit estimated,
+    whose standard error and shared gravity error ``meta`` records. The row's own mean
+    is of the median-filtered torque, over samples the filter's outlier test chose about the
+    gravity-free torque, and differed from the level's by up to 0.7 of its standard error on
+    the Panda's sweeps (``tests/_arm_sweeps.py``, seed 0)."""
     speed = np.array([abs(r["velocity"]) for r in levels])
     temp = np.array([r["temperature"] for r in levels])
     sign = np.array([r["direction"] for r in levels])
     load = np.array([r["load"] for r in levels])
     count = np.array([r["count"] for r in levels], dtype=float)
     out = np.zeros(len(samples))
+    chosen = []
+    n_rows = np.full(len(samples), -1.0) if samples.count is None else samples.count
     for i, (v, t) in enumerate(zip(samples.velocity, samples.temperature, strict=True)):
         near = np.abs(speed - abs(v)) / max(abs(v), 1e-12) + np.abs(temp - t)
+        if not combined:  # the same set-point's samples: one count, speeds summarised apart
+            near = near + (count != n_rows[i])
         signs = (1, -1) if combined else (1 if v > 0 else -1,)
         picks = [
             int(np.flatnonzero(sign == s)[np.argmin(near[sign == s])])
@@ -427,4 +559,22 @@ def _with_load(
         ]
         if picks:
             out[i] = np.average(load[picks], weights=count[picks])
-    return replace(samples, load=out, meta={**samples.meta, **meta})
+        chosen.append(picks[0] if len(picks) == 1 else -1)
+    if combined:
+        return replace(samples, load=out, meta={**samples.meta, **meta})
+    friction = samples.friction.copy()
+    rows = None if samples.count is None else samples.count.copy()
+    chosen = np.array(chosen, dtype=np.intp)
+    once = np.bincount(chosen[chosen >= 0], minlength=len(levels)) == 1
+    for i, k in enumerate(chosen):
+        if k >= 0 and once[k]:  # one row per level: never two rows made copies of one
+            friction[i] = levels[k]["friction"]
+            if rows is not None:
+                rows[i] = count[k]
+    return replace(
+        samples,
+        friction=friction,
+        count=rows,
+        load=out,
+        meta={**samples.meta, **meta},
+    )

@@ -77,6 +77,23 @@ class _Source:
         self.coarse: dict[str, str | None] = {}  # per source: coarse_velocity's finding
         self.window: dict[str, tuple[int, int]] = {}  # per coarse source: the windows used
 
+    def coarse_findings(self) -> list[str]:
+        """Per source whose velocity is a coarse encoder's finite difference, what is wrong and
+        (where the position's slope replaced it) what was used instead."""
+        out = []
+        for source, coarse in self.coarse.items():
+            if coarse and source in self.window:
+                short, long = self.window[source]
+                coarse = coarse.split(": it reads 0")[0] + (
+                    "; the velocity used instead is the position's least-squares slope over "
+                    f"windows of {short}-{long} rows each side, each spanning {WINDOW_COUNTS} "
+                    "steps where the joint moves (a run's mean velocity is then close to its "
+                    "position change over its duration)"
+                )
+            if coarse:
+                out.append(f"{source}: {coarse}")
+        return out
+
     def found(self) -> list[str]:
         """Every channel problem found, velocity's then position units'."""
         return [*self.problems.values(), *(u for u in self.units.values() if u)]
@@ -107,6 +124,17 @@ class _Source:
                 log = replace(log, velocity=velocity, meta={**meta, "velocity_from": "position"})
             yield log
             del log  # not held while the next chunk is read
+
+
+def velocity_from_position(log: RawLog) -> tuple[RawLog, str | None]:
+    """``log`` with a coarse encoder's finite-difference velocity replaced by its position's
+    least-squares slope (as :func:`extract` does), and the warning that says so (None when
+    the velocity is kept): for callers that segment a log before :func:`extract` sees it
+    (:func:`fricid.extract.arm.extract_arm`), so both read one velocity."""
+    stream = _Source(log)
+    (out,) = list(stream)
+    found = stream.coarse_findings()
+    return out, (found[0] if found else None)
 
 
 def _check_options(median_window, gravity, velocity_rtol, temperature_atol) -> None:
@@ -362,17 +390,8 @@ def extract(
     )
     for note in notes:
         logger.info("%s", note)
-    for source, coarse in stream.coarse.items():
-        if coarse and source in stream.window:
-            coarse = coarse.split(": it reads 0")[0]
-            coarse += (
-                "; the velocity used instead is the position's least-squares slope over windows of "
-                f"{stream.window[source][0]}-{stream.window[source][1]} rows each side, each "
-                f"spanning {WINDOW_COUNTS} steps where the joint moves (a run's mean velocity is "
-                "then close to its position change over its duration)"
-            )
-        if coarse:
-            warnings.warn(f"{source}: {coarse}", DataQualityWarning, stacklevel=user_stacklevel())
+    for coarse in stream.coarse_findings():
+        warnings.warn(coarse, DataQualityWarning, stacklevel=user_stacklevel())
     for problem in stream.units.values():
         if problem:
             warnings.warn(

@@ -71,16 +71,37 @@ def _parameter_covariance(gravity: Mapping[str, Any], m: int) -> np.ndarray | No
 
 
 def _matches(samples: FrictionSamples, levels: list, atol: float) -> list[list[int]] | None:
-    """Each sample's level(s): the nearest in speed of its direction (a combined row: one of
-    each direction), within :data:`MATCH_RTOL` and ``atol`` degC; ``[]`` for none."""
+    """Each sample's level(s): the one whose friction and count it holds (the arm
+    extraction's rows, :func:`fricid.extract.arm.extract_arm`), else the nearest in speed of
+    its direction (a combined row: one of each direction), within :data:`MATCH_RTOL` and
+    ``atol`` degC; ``[]`` for none."""
     try:
         speed = np.array([abs(float(lv["velocity"])) for lv in levels])
         temp = np.array([float(lv["temperature"]) for lv in levels])
         sign = np.array([int(lv["direction"]) for lv in levels])
     except (KeyError, TypeError, ValueError):
         return None
+    try:
+        key = {
+            (float(lv["friction"]), int(lv["count"])): i
+            for i, lv in enumerate(levels)
+            if lv.get("friction") is not None and lv.get("count") is not None
+        }
+    except (TypeError, ValueError):
+        key = {}
+    counts = [None] * len(samples) if samples.count is None else samples.count
     out = []
-    for v, t, d in zip(samples.velocity, samples.temperature, samples.direction, strict=True):
+    for v, t, d, f, n in zip(
+        samples.velocity,
+        samples.temperature,
+        samples.direction,
+        samples.friction,
+        counts,
+        strict=True,
+    ):
+        if d != 0 and n is not None and (float(f), int(n)) in key:
+            out.append([key[float(f), int(n)]])  # the row the arm extraction wrote for it
+            continue
         rel = np.abs(speed - abs(v)) / max(abs(v), 1e-12)
         near = (rel <= MATCH_RTOL) & ~(np.abs(temp - t) > atol)
         out.append(
