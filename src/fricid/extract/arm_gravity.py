@@ -24,12 +24,13 @@ As there, the levels are eliminated (Schur complement): ``beta`` solves ``S beta
 least-squares ones and the cluster-robust (sandwich, CR1) ones with passes as clusters: the
 samples of one pass share its offset and coloured noise.
 
-Reading chosen: combinations of ``beta`` the sweeps do not inform (``S`` singular: a joint
-never swept, or the other joints held at too few positions) keep the URDF's values (the
-minimum-norm correction of the URDF's ``beta``), and are reported as undetermined (standard
-error NaN). The load-dependent friction of the single-joint fit (eq. 3) is not modelled: with
-both directions measured over the same configurations it cancels from ``beta`` (as eq. 11
-pairing cancels it), and its mean stays in each set-point's friction.
+Reading chosen: combinations of ``beta`` the sweeps do not inform (``S`` singular or nearly,
+:data:`RCOND`: a joint never swept, or the other joints held at too few positions) keep the
+URDF's values (the minimum-norm correction of the URDF's ``beta``), and are reported as
+undetermined (standard error NaN). The load-dependent friction of the single-joint fit
+(eq. 3) is not modelled: with both directions measured over the same configurations it
+cancels from ``beta`` (as eq. 11 pairing cancels it), and its mean stays in each set-point's
+friction.
 """
 
 from __future__ import annotations
@@ -44,8 +45,16 @@ from ..errors import DataError
 __all__ = ["ArmGravityFit", "ArmSolution", "arm_moments", "solve_levels"]
 
 #: A direction of the scaled within-set-point information matrix whose eigenvalue is below
-#: this fraction of the largest is not informed by the sweeps.
-RCOND = 1e-9
+#: this fraction of the largest is not informed by the sweeps: the gravity torque it moves
+#: varies along them by under 1 % (the square root) of the strongest direction's, so a model
+#: error of 1 % of the gravity torque (a held joint creeping, a coupling torque misread)
+#: moves it a hundredfold and more. Sweeping one joint of the double pendulum with the other
+#: held (fricid's simulator) left two directions at 2e-7 to 1.2e-5, identified at -1.8 +- 0.86
+#: for a URDF's (and the truth's) 0.043 and set-point frictions 0.03-0.05 N m off (one of
+#: them of the wrong sign), or +1.05 +- 1.8 N m for 0.066 on a shorter log; sweeps of every
+#: joint with the others in three poses had none below 1.7e-2 (``tests/_arm_sweeps.py``: the
+#: double pendulum and three joints of the Panda).
+RCOND = 1e-4
 
 
 def arm_moments(w, tau) -> np.ndarray:
