@@ -135,3 +135,24 @@ def test_directions_the_sweeps_barely_vary_keep_the_urdf(pendulum):
     rows = result.setpoints("joint1")
     v, f, se = (np.array([r[k] for r in rows]) for k in ("velocity", "friction", "friction_se"))
     assert np.all(np.abs(f - LAWS["joint1"](v)) < 3 * se)
+
+
+def test_a_swept_joint_s_creep_while_another_sweeps_is_left_out(pendulum):
+    """Both joints swept in one log, each creeping at 2 mrad/s while the other sweeps: those
+    creeping runs are no set-points (their torque holds the joint; it does not slide), so
+    each joint keeps its swept speeds only, in the fit and in its samples, with a note."""
+    spans = {"joint1": (-1.2, 1.2), "joint2": (-1.2, 1.2)}
+    log = arm_sweeps(
+        pendulum, spans, EVERY_POSE, LAWS, rate=50.0, seed=2, companion=0.002,
+        velocity_noise=1e-5,
+    )  # fmt: skip
+    result, _ = _extract(log, pendulum)
+    assert list(result) == ["joint1", "joint2"]
+    for joint in result:
+        speeds = {round(abs(lv["velocity"]), 2) for lv in result.gravity.joint_levels(joint)}
+        assert speeds == {0.2, 0.4, 0.8}, (joint, speeds)
+        assert np.all(np.abs(result[joint].by_direction.velocity) > 0.1)
+        assert any(
+            n.startswith(f"{joint}: ") and "left out of its set-points" in n
+            for n in result.gravity.notes
+        )

@@ -65,6 +65,9 @@ ACCELERATION_WINDOW = 0.05
 #: is held, not swept (:func:`_held`).
 HELD_SHARE = 0.02
 
+#: A samples row belongs to a level within this share of its speed (:func:`_at_levels`).
+LEVEL_RTOL = 0.05
+
 #: How the note (and warning) begins when the sweeps barely tell gravity from friction.
 CONFOUNDED = "the sweeps barely tell the arm's gravity from the friction"
 
@@ -255,26 +258,46 @@ def _passes(raw: RawLog, w: np.ndarray, where: np.ndarray, options: dict) -> lis
     return [r for r, k in zip(acc.records, kinds, strict=True) if k == "setpoint"]
 
 
-def _held(records: dict[str, list]) -> dict[str, str]:
-    """The joints whose steady runs are a held joint's creep, not a sweep, and why: the
-    longest run travels under :data:`HELD_SHARE` of the longest of any joint. The double
-    pendulum's second joint, held by its PD drive while the first was swept over 1.5 rad,
-    crept with the first joint's gravity: 37 "set-points" at 0.2-0.7 mrad/s, none over
-    0.005 rad, with frictions against the motion (0.25 N m with the gravity identified)."""
-    travel = {
-        joint: max(float(r.speed) * float(r.duration) for r in recs)
-        for joint, recs in records.items()
-    }
-    top = max(travel.values())
-    return {
-        joint: (
-            f"not swept, left out: its steady runs travel at most {t:.2g} rad, under "
-            f"{100 * HELD_SHARE:g} % of the longest sweep's {top:.2g} rad: a held joint's "
-            "creep (name it in joints= or --joints to extract it anyway)"
+def _travel(record) -> float:
+    """rad, how far a steady run moved."""
+    return float(record.speed) * float(record.duration)
+
+
+def _held(records: dict[str, list], asked: bool) -> tuple[dict[str, list], dict[str, str]]:
+    """Each joint's runs that sweep, and what was left out as a held joint's creep: a run
+    that travels under :data:`HELD_SHARE` of the longest run of any joint. A joint with no
+    other run is left out whole (unless ``asked``: named by the caller); a swept joint keeps
+    its other runs. The double pendulum's second joint, held by its PD drive while the first
+    was swept over 1.5 rad, crept with the first joint's gravity: 37 "set-points" at 0.2-0.7
+    mrad/s, none over 0.005 rad, with frictions against the motion (0.25 N m with the gravity
+    identified); in a log of both joints' sweeps each held joint's creep (+-2 mrad/s) made
+    set-points of its holding torque."""
+    top = max(_travel(r) for recs in records.values() for r in recs)
+    kept, notes = {}, {}
+    for joint, recs in records.items():
+        sweeps = [r for r in recs if _travel(r) >= HELD_SHARE * top]
+        creep = [r for r in recs if _travel(r) < HELD_SHARE * top]
+        longest = max(_travel(r) for r in creep) if creep else 0.0
+        why = (
+            f"travel at most {longest:.2g} rad, under {100 * HELD_SHARE:g} % of the longest "
+            f"sweep's {top:.2g} rad: a held joint's creep"
         )
-        for joint, t in travel.items()
-        if t < HELD_SHARE * top
-    }
+        if asked or (sweeps and not creep):
+            kept[joint] = recs
+        elif not sweeps:
+            notes[joint] = (
+                f"not swept, left out: its steady runs {why} (name it in joints= or --joints "
+                "to extract it anyway)"
+            )
+        else:
+            kept[joint] = sweeps
+            speeds = sorted({round(float(r.speed) * r.direction, 4) for r in creep})
+            shown = ", ".join(f"{v:+.3g}" for v in speeds[:8]) + (" ..." if len(speeds) > 8 else "")
+            notes[joint] = (
+                f"{len(creep)} steady run(s) at {shown} rad/s left out of its set-points: they "
+                f"{why} while another joint was swept"
+            )
+    return kept, notes
 
 
 def _levels(joint: str, records: list, options: dict) -> list[dict]:
@@ -395,13 +418,13 @@ def extract_arm(
         found[joint] = (raw, rows, w, records)
     if not found:
         raise DataError("no joint of the robot log has a constant-velocity sweep", file=log.source)
-    held = {} if joints is not None else _held({j: f[3] for j, f in found.items()})
+    kept, held = _held({j: f[3] for j, f in found.items()}, asked=joints is not None)
     stats, keys, raws = [], [], {}
-    for joint, (raw, rows, w, records) in found.items():
-        if joint not in held:
-            raws[joint] = (raw, rows, w)
-            stats.extend(r.extra for r in records)
-            keys.extend(_levels(joint, records, options))
+    for joint, records in kept.items():
+        raw, rows, w, _ = found[joint]
+        raws[joint] = (raw, rows, w)
+        stats.extend(r.extra for r in records)
+        keys.extend(_levels(joint, records, options))
     fit = _fit(stats, keys, base, model, identify, log.source)
     if held:
         fit = replace(fit, notes=(*fit.notes, *(f"{j}: {why}" for j, why in held.items())))
@@ -512,10 +535,26 @@ def _joint_result(
     opts = {**res.options, "gravity": ARM_MODE}
     meta = {"extract": opts, "gravity": {**_joint_meta(fit, joint)}, "notes": list(notes)}
     samples, by_direction = (
-        _with_load(x, levels, meta, combined=c)
+        _with_load(_at_levels(x, levels, options, combined=c), levels, meta, combined=c)
         for x, c in ((res.samples, True), (res.by_direction, False))
     )
     return replace(res, samples=samples, by_direction=by_direction, options=opts, notes=notes)
+
+
+def _at_levels(samples: FrictionSamples, levels: list[dict], options: dict, *, combined: bool):
+    """The rows of ``samples`` the arm fit has a level for: one of the row's direction (a
+    combined row: either) within :data:`LEVEL_RTOL` of its speed and ``temperature_atol`` of
+    its temperature. The others are runs the fit left out (a held joint's creep,
+    :func:`_held`), which the joint's own extraction found again."""
+    speed = np.array([abs(r["velocity"]) for r in levels])
+    temp = np.array([r["temperature"] for r in levels])
+    sign = np.array([r["direction"] for r in levels])
+    keep = np.zeros(len(samples), dtype=bool)
+    for i, (v, t) in enumerate(zip(samples.velocity, samples.temperature, strict=True)):
+        near = np.abs(speed - abs(v)) <= LEVEL_RTOL * abs(v)
+        near &= np.abs(temp - t) <= options["temperature_atol"]
+        keep[i] = bool((near if combined else near & (sign == np.sign(v))).any())
+    return samples if keep.all() or not keep.any() else samples.subset(keep)
 
 
 def _joint_meta(fit: ArmGravityFit, joint: str) -> dict:
