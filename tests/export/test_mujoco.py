@@ -171,3 +171,25 @@ def test_lugre_export_refuses_bad_names_and_values():
         mjcf_text(lugre_model(sigma_0=float("nan")))
     with pytest.raises(ExportError, match="needs the parameters"):
         mjcf_text(FittedModel.from_values("lugre", {"sigma_0": 1.0}))
+
+
+def test_a_trajectory_model_s_comment_names_its_estimator_and_residual():
+    """A model identified from a trajectory: the comment names the estimator and says the
+    fit's error is of the residual the estimator fitted (low-passed, or a simulation's), not
+    the torque error on the log (a new user compared it with the report's, 15x larger)."""
+    fitted = lugre_model()
+    fitted.metrics = {"rmse": 0.00205, "max_abs_error": 0.0068}
+    fitted.provenance = {
+        "trajectory": {"estimator": "DIDIM output error <script>"},
+        "source": "chirp.csv",
+    }
+    text = mjcf_text(fitted)
+    assert "estimator: DIDIM output error" in text and "<script>" not in text
+    assert "of the residual the estimator fitted" in text
+    static = FittedModel.from_values(
+        "stribeck",
+        dict(tau_c=0.1, tau_s=0.2, w_s=0.1, tau_v=0.01, delta=1.0),
+        operating_range={"velocity": [-2.0, 2.0]},
+    )
+    static.metrics = {"rmse": 0.01}
+    assert "estimator" not in mjcf_text(static)

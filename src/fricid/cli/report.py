@@ -296,7 +296,7 @@ def _error_line(label: str, m: dict) -> str:
     if m["n_sliding"] > 0:
         parts.append(f"where it slides {m['rmse_sliding']:.4g} N m")
     if math.isfinite(m["rmse_filtered"]):
-        parts.append(f"low-passed as the fit {m['rmse_filtered']:.4g} N m")
+        parts.append(f"low-passed at the fit's cut-off {m['rmse_filtered']:.4g} N m")
     return ", ".join(parts)
 
 

@@ -234,7 +234,17 @@ def summary_lines(
         shown = _display(metrics.get(key))
         if shown is not None:
             parts.append(f"{key} {shown}")
-    if parts:
+    trajectory = prov.get("trajectory") if isinstance(prov.get("trajectory"), dict) else {}
+    estimator = trajectory.get("estimator")
+    if isinstance(estimator, str) and estimator:
+        lines.append(f"estimator: {plain(estimator)}")
+    if parts and trajectory:
+        lines.append(
+            "fit on its data: " + ", ".join(parts) + " (rmse, max error in N m, of the residual "
+            "the estimator fitted: low-passed and decimated, or a simulation's; fricid report "
+            "gives the torque error on a log)"
+        )
+    elif parts:
         lines.append("fit on its data: " + ", ".join(parts) + " (rmse, max error in N m)")
     undetermined = undetermined_parameters(fitted)
     if undetermined:

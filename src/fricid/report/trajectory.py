@@ -38,7 +38,7 @@ METRICS = {
     "signal_rms": "RMS of the measured torque about its mean [N m]",
     "relative": "RMS error / RMS torque",
     "fitness": "fitness R²",
-    "rmse_filtered": "RMS torque error, low-passed as the fit [N m]",
+    "rmse_filtered": "RMS torque error (the equation's), low-passed at the fit's cut-off [N m]",
     "n_sliding": "sample periods sliding (those a regression fits)",
     "rmse_sliding": "RMS torque error where it slides [N m]",
 }

@@ -161,7 +161,9 @@ def test_the_quoted_coverage_is_the_benchmarks_last_result():
         cell = kinds[names[label]][11]  # after the fits and the ten parameters' errors
         assert cell.split("+")[0] == f"{covered}/{claimed}", (label, cell)
     per = _last_block(lines, "## coverage of the 95 % intervals per parameter, per kind")
-    columns = {"sigma_1": 1, "tau_s": 4, "w_s": 5, "delta": 6}
+    order = ("sigma_0", "sigma_1", "sigma_2", "tau_c", "tau_s", "w_s", "delta", "J", "p_x", "p_y")
+    columns = {name: i for i, name in enumerate(order)}
+    assert set(LUGRE_COVERAGE["parameters"]) == set(order)
     for name, (covered, claimed) in LUGRE_COVERAGE["parameters"].items():
         cells = [row[columns[name]].split("+")[0].split("/") for row in per.values()]
         assert (sum(int(c) for c, _ in cells), sum(int(n) for _, n in cells)) == (covered, claimed)
