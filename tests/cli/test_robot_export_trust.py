@@ -84,6 +84,26 @@ def test_a_joint_whose_verdict_is_no_is_not_exported_unless_told(arm_file, tmp_p
     assert "trust verdict: NO, exported anyway" in (out / "fricid_friction.c").read_text()
 
 
+def test_every_refused_joint_is_named_and_an_unkept_number_is_explained(arm_file, tmp_path):
+    """Joint 1 with a parameter the fit did not determine (no number kept) and joint 2 with a
+    'no': one error names both; the flags say what they can and cannot do, and the advice is
+    a family other than the one fitted."""
+    doc = json.loads(_with_joint2_no(arm_file, tmp_path).read_text())
+    doc["friction"]["joint1"]["parameters"]["beta_pos"].update(value=None, not_determined=True)
+    arm = tmp_path / "arm_both.json"
+    arm.write_text(json.dumps(doc))
+    args = ["robot", "export", str(arm), "--to", "c", "-o", str(tmp_path / "c")]
+    res = runner.invoke(app, [*args, "--allow-undetermined", "--allow-untrusted"])
+    assert res.exit_code != 0
+    text = " ".join(res.output.split())
+    assert "joint joint1: not determined by the data: beta_pos" in text
+    assert "keeps no number" in text and "even when allowed" in text
+    assert "fit coulomb_viscous (one set for both directions) instead" in text
+    res = runner.invoke(app, args)
+    text = " ".join(res.output.split())
+    assert res.exit_code != 0 and "2 joints refused" in text and "joint joint2" in text
+
+
 def test_the_single_joint_export_refuses_a_no_too(arm_file, tmp_path):
     model = ArmFit.load(_with_joint2_no(arm_file, tmp_path)).joint_model("joint2")
     path = tmp_path / "joint2.json"

@@ -23,22 +23,24 @@ ROBOT_TARGETS = {
 }
 
 
-def _joint_models(files: dict[str, Path]) -> tuple[dict, dict[str, str], dict[str, str]]:
-    """joint -> (its FittedModel, its source's name, the SHA-256 of that file's bytes); a
-    whole-arm fit file (``fricid robot fit``'s output) gives every joint of the arm, in the
-    URDF's order (:meth:`fricid.fitted.arm.ArmFit.joint_model`)."""
+def _joint_models(files: dict[str, Path]) -> tuple[dict, dict[str, str], dict[str, str], list]:
+    """joint -> (its FittedModel, its source's name, the SHA-256 of that file's bytes), and
+    the joints refused (one message each); a whole-arm fit file (``fricid robot fit``'s
+    output) gives every joint of the arm, in the URDF's order
+    (:meth:`fricid.fitted.arm.ArmFit.joint_model`)."""
     from ..errors import ConfigError
     from ..export import file_sha256
     from ..fitted import FittedModel
     from ..fitted.arm import ARM_KIND, ArmFit
     from ..io._jsonfile import read_json
 
-    fitted, sources, sha256 = {}, {}, {}
+    fitted, sources, sha256, refused = {}, {}, {}, []
     for joint, path in files.items():
         doc = read_json(path, what="model file")
         if isinstance(doc, dict) and doc.get("kind") == ARM_KIND:
             arm = ArmFit.from_dict(doc, source=str(path))
-            named = {j: arm.joint_model(j) for j in arm.joints}
+            named, why = _every_joint(arm.joints, arm.joint_model)
+            refused.extend(why)
         else:
             named = {joint: FittedModel.load(path)}
         for name, model in named.items():
@@ -46,7 +48,30 @@ def _joint_models(files: dict[str, Path]) -> tuple[dict, dict[str, str], dict[st
                 raise ConfigError(f"joint '{name}' is given twice ({sources[name]} and {path})")
             fitted[name], sha256[name] = model, file_sha256(path)
             sources[name] = path.name if len(named) == 1 else f"{path.name} ({name})"
-    return fitted, sources, sha256
+    return fitted, sources, sha256, refused
+
+
+def _every_joint(joints, check) -> tuple[dict, list[str]]:
+    """``check(joint)`` for every joint, and every joint's refusal (not the first alone)."""
+    from ..errors import ConfigError
+
+    out, refused = {}, []
+    for joint in joints:
+        try:
+            out[joint] = check(joint)
+        except ConfigError as exc:
+            refused.append(str(exc))
+    return out, refused
+
+
+def _refuse(refused: list[str]) -> None:
+    """One error for every joint refused, a line each."""
+    from ..errors import ConfigError
+
+    if len(refused) == 1:
+        raise ConfigError(refused[0])
+    if refused:
+        raise ConfigError(f"{len(refused)} joints refused:\n  " + "\n  ".join(refused))
 
 
 def _model_files(items: list[str]) -> dict[str, Path]:
@@ -157,10 +182,16 @@ def robot_export_command(
     if target not in ROBOT_TARGETS:
         raise ConfigError(f"unknown target '{to}'; choose one of: {', '.join(ROBOT_TARGETS)}")
     check_paths(**{"out_dirs" if target == "c" else "out_files": {"--out": out}})
-    fitted, sources, sha256 = _joint_models(_model_files(models))
-    for joint, model in fitted.items():
-        refuse_undetermined(model, allow_undetermined)
-        refuse_untrusted(model, allow_untrusted, joint)
+    fitted, sources, sha256, refused = _joint_models(_model_files(models))
+
+    def refuse(joint: str) -> None:
+        try:
+            refuse_undetermined(fitted[joint], allow_undetermined)
+        except ConfigError as exc:
+            raise type(exc)(f"joint {joint}: {exc}") from None
+        refuse_untrusted(fitted[joint], allow_untrusted, joint)
+
+    _refuse(refused + _every_joint(fitted, refuse)[1])
     if target == "c":
         paths = export_robot_c(
             fitted,

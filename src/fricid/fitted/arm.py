@@ -73,6 +73,19 @@ def _without_rise(params: dict[str, Parameter], entry: dict[str, Any]) -> dict[s
     return out
 
 
+def _simpler(family: str) -> str:
+    """What to do when a joint's ``family`` leaves parameters undetermined: a family with
+    fewer parameters where there is one, else more informative data."""
+    more = "or record the joint moving more, slower and both ways"
+    if family.startswith("stribeck"):
+        return f"fit coulomb_viscous{'_asym' if family.endswith('_asym') else ''} instead, {more}"
+    if family.endswith("_asym"):
+        return f"fit {family[: -len('_asym')]} (one set for both directions) instead, {more}"
+    if family.startswith("coulomb_viscous_load"):
+        return f"fit coulomb_viscous instead, {more}"
+    return more[3:]
+
+
 @dataclass
 class ArmFit:
     """A whole arm's identification (module notes).
@@ -146,9 +159,9 @@ class ArmFit:
         missing = [n for n, p in params.items() if p.not_determined or not np.isfinite(p.value)]
         if missing:
             raise ConfigError(
-                f"joint {joint}: not determined by the data: {', '.join(missing)}; there is no "
-                "number to predict or export with (fit a family the data tell, such as "
-                "coulomb_viscous_asym, or record the joint moving more, slower and both ways)"
+                f"joint {joint}: not determined by the data: {', '.join(missing)}; the arm fit "
+                "keeps no number for such a parameter, so there is none to predict or export "
+                f"with, even when allowed ({_simpler(entry['family'])})"
             )
         check = self.validation.get(joint, {})
         velocity = list(entry.get("velocity_range", [-1.0, 1.0]))
