@@ -158,6 +158,8 @@ import time
 from collections.abc import Callable
 from typing import Any
 
+import numpy as np
+
 from ...errors import ConfigError, DataError
 from ...fitted import FittedModel
 from ...models import get_model
@@ -356,9 +358,15 @@ def fit_trajectory(
     series = uniform_series(log)
     rate = 1.0 / series.dt
     encoder = measurement(series.position, series.velocity, series.dt, encoder_counts)
-    vf, acc, mask = sliding(series, derivative, v_slide, guard, short=key in STATIC_MODELS)
+    short = key in STATIC_MODELS
+    vf, acc, mask = sliding(series, derivative, v_slide, guard, short=short)
+    moving = int(np.sum(np.abs(vf) >= v_slide))  # before the guards
+    if mask.sum() < MIN_SLIDING <= moving and not short:  # slips shorter than the guard
+        short = True  # (stick-slip: the 0.2 s guard after each stick had left none)
+        vf, acc, mask = sliding(series, derivative, v_slide, guard, short=short)
     slides = mask.sum() >= MIN_SLIDING
-    if key == "lugre" and route in ("filtered", "two_stage", "presliding") and not slides:
+    never = moving < MIN_SLIDING
+    if key == "lugre" and route in ("filtered", "two_stage", "presliding") and never:
         if progress is not None:
             progress(1, 2, "pre-sliding route: sigma_0, sigma_1 (the log never slides)")
         fitted = fit_presliding(  # a log that never slides: sigma_0, sigma_1 only (its notes)
@@ -387,8 +395,8 @@ def fit_trajectory(
         )
     if not slides:
         raise DataError(
-            f"only {int(mask.sum())} samples slide faster than {v_slide:g} rad/s: too few for "
-            "the static friction",
+            f"only {int(mask.sum())} samples slide faster than {v_slide:g} rad/s away from the "
+            f"slower stretches ({moving} before the guards): too few for the static friction",
             file=log.source,
         )
     static_model = get_model({"lugre": "stribeck", "dahl": "coulomb_viscous"}.get(key, key))
@@ -403,7 +411,7 @@ def fit_trajectory(
     args = (static_model, gravity, method, seed, max_evals, cluster_n, fixed)
 
     def regress(filt: DerivativeFilter):  # the regression at a derivative window
-        vf, acc, mask = sliding(series, filt, v_slide, guard, short=key in STATIC_MODELS)
+        vf, acc, mask = sliding(series, filt, v_slide, guard, short=short)
         if mask.sum() < MIN_SLIDING:
             return None
         return (vf, acc, mask, *_regression(series, vf, acc, mask, *args))
