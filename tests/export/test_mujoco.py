@@ -193,3 +193,16 @@ def test_a_trajectory_model_s_comment_names_its_estimator_and_residual():
     )
     static.metrics = {"rmse": 0.01}
     assert "estimator" not in mjcf_text(static)
+
+
+def test_inputs_the_model_does_not_read_are_not_given_a_range():
+    """A law of velocity alone: its projection comment says load and temperature are not read
+    (an arm fit's export had said "temperature 0 to 0 degC")."""
+    fitted = FittedModel.from_values(
+        "stribeck",
+        dict(tau_c=0.1, tau_s=0.2, w_s=0.1, tau_v=0.01, delta=1.0),
+        operating_range={"velocity": [-2.0, 2.0]},
+    )
+    text = mjcf_text(fitted)
+    assert "load: not read by the model, temperature: not read by the model" in text
+    assert "0 to 0 degC" not in text and "temperature 0 degC" not in text

@@ -66,16 +66,30 @@ class Projection:
     def summary(self) -> list[str]:
         """Lines for a comment in the exported file."""
         v = self.ranges
+        unused = v.get("unused", [])
+
+        def span(name: str, unit: str) -> str:
+            if name in unused:
+                return f"{name}: not read by the model"
+            return f"{name} {v[name][0]:.4g} to {v[name][1]:.4g} {unit}"
+
+        at = [f"velocity {self.max_at[0]:.4g} rad/s"]
+        at += [
+            f"{name} {x:.4g} {unit}"
+            for name, x, unit in (
+                ("load", self.max_at[1], "N m"),
+                ("temperature", self.max_at[2], "degC"),
+            )
+            if name not in unused
+        ]
         lines = [
             "least-squares Coulomb-viscous projection (F_c, b >= 0) over the operating range: "
             f"|velocity| {v['speed'][0]:.4g} to {v['speed'][1]:.4g} rad/s"
             f"{' (mirrored: direction-combined model)' if v['mirrored'] else ''}, "
-            f"load {v['load'][0]:.4g} to {v['load'][1]:.4g} N m, "
-            f"temperature {v['temperature'][0]:.4g} to {v['temperature'][1]:.4g} degC",
+            f"{span('load', 'N m')}, {span('temperature', 'degC')}",
             f"projection error: RMS {self.rms_error:.4g} N m "
             f"({percent(self.relative_error)} of the RMS friction {self.rms_friction:.4g} N m), "
-            f"max {self.max_error:.4g} N m at velocity {self.max_at[0]:.4g} rad/s, "
-            f"load {self.max_at[1]:.4g} N m, temperature {self.max_at[2]:.4g} degC",
+            f"max {self.max_error:.4g} N m at " + ", ".join(at),
         ]
         if self.lost:
             lines.append("lost in this format: " + "; ".join(self.lost))
@@ -122,13 +136,14 @@ def operating_grid(
         a, b = 0.0, max(-v_lo, v_hi)
     if b <= 0:
         raise ExportError("the velocity range is zero; there is no motion to project over")
-    levels = {}
+    levels, unused = {}, []
     used = _inputs(fitted)
     for name, override in (("load", load_range), ("temperature", temperature_range)):
         if override is None and name not in used and name not in (fitted.operating_range or {}):
             # an input the model does not read (a Stribeck model fitted on velocity alone):
             # one placeholder level, never used by the prediction
             levels[name] = np.zeros(1)
+            unused.append(name)
             continue
         lo, hi = _range(fitted, name, override)
         levels[name] = np.linspace(lo, hi, N_LEVELS) if hi > lo else np.array([lo])
@@ -140,6 +155,7 @@ def operating_grid(
         "mirrored": mirrored,
         "load": (float(levels["load"][0]), float(levels["load"][-1])),
         "temperature": (float(levels["temperature"][0]), float(levels["temperature"][-1])),
+        "unused": unused,
     }
     return X, info
 
