@@ -409,6 +409,43 @@ def coverage_lines(rows: list[dict], key) -> list[str]:
     return lines
 
 
+#: Parameters on a log10 scale (their intervals are formed there).
+LOG_SCALE = ("sigma_0", "sigma_1")
+
+
+def _needed(row: dict, n: str) -> float | None:
+    """How many times its half-width toward the truth a claimed closed interval would need to
+    hold it (1 or less: it holds it); None for no claim. On a log10 scale for
+    :data:`LOG_SCALE`, as fricid forms those intervals."""
+    r = row.get("estimates", {}).get(n)
+    if r is None or r.get("nd") or not r.get("closed"):
+        return None
+    (lo, hi), v, t = r["ci95"], r["value"], _truth_of(row)[n]
+    if n in LOG_SCALE:
+        if not (lo > 0 and v > 0 and t > 0):
+            return None
+        lo, hi, v, t = (math.log10(x) for x in (lo, hi, v, t))
+    side = hi - v if t > v else v - lo
+    return abs(t - v) / side if side > 0 else (0.0 if t == v else math.inf)
+
+
+def widening_lines(rows: list[dict]) -> list[str]:
+    """Per parameter, over the closed claims: the widening of each interval (about its
+    estimate, toward the truth) that would have held the truth, at its quantiles; the 0.95
+    quantile is the factor that makes 95 % of these claims hold it."""
+    lines = [
+        f"{'parameter':10s} {'claims':>6s} "
+        + " ".join(f"{q:>6s}" for q in ("q50", "q80", "q90", "q95"))
+    ]
+    for n in PARAMS:
+        k = np.array([x for x in (_needed(r, n) for r in rows) if x is not None])
+        if not k.size:
+            continue
+        qs = [float(np.quantile(k, q, method="inverted_cdf")) for q in (0.5, 0.8, 0.9, 0.95)]
+        lines.append(f"{n:10s} {k.size:6d} " + " ".join(f"{q:6.3g}" for q in qs))
+    return lines
+
+
 def main() -> None:
     a = parse()
     from fricid import _jit  # noqa: F401  (numba imported once in the parent)
@@ -455,6 +492,8 @@ def main() -> None:
     print("\n".join(coverage_lines(rows, lambda r: r["kind"])))
     print("\n## coverage per truth")
     print("\n".join(coverage_lines(rows, lambda r: r["truth"])))
+    print("\n## widening each closed claim needs to hold the truth (quantiles over claims)")
+    print("\n".join(widening_lines(rows)))
     refusals = sorted({f"{r['kind']}: {r['refused']}" for r in rows if "refused" in r})
     if refusals:
         print("\n## refusals\n" + "\n".join(refusals))

@@ -111,6 +111,13 @@ def trajectory_text(fitted) -> str:
             )
         )
     lines.extend(_measurement_lines(info))
+    cal = info.get("calibration")
+    if isinstance(cal, dict) and cal.get("factors"):
+        factors = ", ".join(f"{n} x{k:g}" for n, k in cal["factors"].items())
+        lines.append(
+            f"    intervals: calibrated on an independent simulator's logs, each side widened "
+            f"({factors}; sigma_0 on a log scale; before: provenance 'calibration')"
+        )
     p = info.get("passivity")
     if p:
         rests = sorted(undetermined & {"sigma_0", "sigma_1", "sigma_2", "tau_c", "tau_s"})

@@ -175,6 +175,7 @@ from ._outcome import (
     direction_caveat,
     estimator,
     warn_rate_bias,
+    widen_calibrated,
 )
 from ._output import needs_output_error
 from ._output import output_error as _output_error
@@ -520,6 +521,9 @@ def fit_trajectory(
             check = follows(series, stage, encoder, parallel.cutoff, seed, again)
             sim_info["follows"] = check
             notes = {**notes, **response_notes(stage, check)}
+        if key == "lugre":
+            sim_info["calibration"] = widen_calibrated(stage)
+            final.update(stage.table())
     elif key == "lugre":
         say(f"{route} route: sigma_0, sigma_1 by simulation error")
         sim_info, static_tab = simulation_route(
