@@ -180,7 +180,7 @@ def test_a_trajectory_model_s_comment_names_its_estimator_and_residual():
     fitted = lugre_model()
     fitted.metrics = {"rmse": 0.00205, "max_abs_error": 0.0068}
     fitted.provenance = {
-        "trajectory": {"estimator": "DIDIM output error <script>"},
+        "trajectory": {"estimator": {"name": "DIDIM output error <script>", "bias": "x"}},
         "source": "chirp.csv",
     }
     text = mjcf_text(fitted)

@@ -236,6 +236,8 @@ def summary_lines(
             parts.append(f"{key} {shown}")
     trajectory = prov.get("trajectory") if isinstance(prov.get("trajectory"), dict) else {}
     estimator = trajectory.get("estimator")
+    if isinstance(estimator, dict):  # {"name": ..., "bias": ...}
+        estimator = estimator.get("name")
     if isinstance(estimator, str) and estimator:
         lines.append(f"estimator: {plain(estimator)}")
     if parts and trajectory:

@@ -200,6 +200,22 @@ def sliding(
     return vf, acc, mask
 
 
+def guarded_sliding(
+    series: Series, filt: DerivativeFilter, v_slide: float, guard: float, short: bool, least: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, bool, int]:
+    """:func:`sliding`, and with ``short`` guards when the full ones leave fewer than
+    ``least`` of the samples faster than ``v_slide`` (slips shorter than the guard: fricid's
+    own stick-slip log, whose 0.2 s guard after each stick had left none, went to the
+    pre-sliding route); also whether the guards were cut short and how many samples move
+    faster than ``v_slide`` before the guards."""
+    vf, acc, mask = sliding(series, filt, v_slide, guard, short=short)
+    moving = int(np.sum(np.abs(vf) >= v_slide))
+    if mask.sum() < least <= moving and not short:
+        short = True
+        vf, acc, mask = sliding(series, filt, v_slide, guard, short=short)
+    return vf, acc, mask, short, moving
+
+
 def dilate(mask: np.ndarray, before: int, after: int) -> np.ndarray:
     """``mask`` grown by ``before`` samples to the left and ``after`` to the right."""
     out = mask.copy()

@@ -64,12 +64,10 @@ sigma_0 searched as log10 as LuGre's; no rate-bias estimate (that simulation is 
 
 Uncertainty: cluster-robust covariances (:func:`._trajectory_data.cluster_covariance`; blocks
 of ``cluster_time`` seconds, or the simulation windows), t quantiles with G - 1 degrees of
-freedom; sigma_0 and sigma_1 are searched and their intervals formed on a log scale
-(asymmetric intervals; the standard error shown is the delta method's). Every fricid
-optimiser works on every route (through :func:`fricid.optim.minimize`; least-squares
-methods get the residuals). LuGre's intervals on the ``filtered`` route are then widened by
-factors calibrated on an independent simulator (:func:`._outcome.widen_calibrated`): the
-coverage figures below, on fricid's own simulator, are of the intervals before it.
+freedom; sigma_0 and sigma_1 are searched and their intervals formed on a log scale (asymmetric
+intervals; the standard error shown is the delta method's). Every fricid optimiser works on
+every route (through :func:`fricid.optim.minimize`; least-squares methods get the residuals);
+LuGre's intervals are then widened, :func:`._outcome.widen_calibrated`.
 
 Convergence: each stage's search is a problem of the problem protocol
 (:class:`fricid.identify.problem.Problem`), and every stage whose estimate is reported is
@@ -82,20 +80,18 @@ fits on ``benchmarks/bench_lugre.py``'s logs were uncertified without it, 1 with
 one is not certified the fit warns (``ConvergenceWarning``) and withholds every standard
 error and interval. Where ``w_s`` is not bounded below by the data, ``tau_s`` and ``delta``
 are reported not determined (:func:`._result.unresolved_rise`). The polish adds its
-evaluations to the time (measured on the virtual joint, 2
-shared cores: about 0.3-0.45 s on a ``two_stage`` fit of 1.0-1.1 s, 0-0.5 s on a ``filtered``
-one of 3.3-3.5 s without the rate bias).
+evaluations to the time (on the virtual joint, 2 shared cores: 0.3-0.45 s on a ``two_stage``
+fit of 1.0-1.1 s, 0-0.5 s on a ``filtered`` one of 3.3-3.5 s without the rate bias).
 
 Passivity ([BO00], :func:`fricid.models.lugre.passivity_margin`) is checked at the estimate
-and at the corner of the 95 % intervals least favourable to it, reported in the provenance,
-and warned about (:class:`PassivityWarning`) when the estimate is not passive.
+and at the least favourable corner of the 95 % intervals, reported in the provenance, and
+warned about (:class:`PassivityWarning`) when the estimate is not passive.
 
-Calibration of the intervals (``benchmarks/calib_trajectory.py``, seeds 10-49, 60 s): the
-Monte-Carlo spread of the filtered route's estimates over the mean reported standard error
-is 0.98-1.05 for the static part, J, p_x and p_y (coverage 37-39/40 each), 0.75 and 0.70
-for log10 sigma_0 and sigma_1 (40/40); 270/280 covered. The cluster jackknife (CR3) changed
-the standard errors by 0.5-1.5 % and no coverage: CR1 is kept
-(:mod:`._trajectory_data`).
+Calibration of the intervals before the widening (``benchmarks/calib_trajectory.py``, seeds 10-49,
+60 s): the Monte-Carlo spread of the filtered route's estimates over the mean reported standard
+error is 0.98-1.05 for the static part, J, p_x and p_y (coverage 37-39/40 each), 0.75 and 0.70 for
+log10 sigma_0 and sigma_1 (40/40); 270/280 covered. The cluster jackknife (CR3) changed the
+standard errors by 0.5-1.5 % and no coverage: CR1 is kept (:mod:`._trajectory_data`).
 
 Rate bias and measurement (``rate_bias="warn"``, the default of the filtered route): the
 break-away between samples biases sigma_0 up and sigma_1 down at 1 kHz (seeds 10-49, 60 s:
@@ -109,27 +105,24 @@ truth (:mod:`._response`). Where the encoder does not resolve the bristles' defl
 break-away the filtered estimate is refined by the output error (:mod:`._output`, DIDIM);
 the result names the estimator (``provenance["trajectory"]["estimator"]``).
 
-What it recovers (``benchmarks/bench_trajectory.py``, run for the report: LuGre
-truth, 60 s multi-sine at 1 kHz, trajectory noise, ``lm``, seeds 0-4; coverage by the closed
-95 % intervals; shared 2-core machine). ``filtered``: every interval closed (sigma_1 too, at
-the light damping ratio 0.05); covered sigma_0 4/5, sigma_1 5/5, sigma_2 4/5, tau_c 4/5,
-tau_s 3/5, w_s 3/5, delta 3/5 (26/35); seed 0 tau_s 0.793 [0.781, 0.805], w_s 0.103
-[0.099, 0.108], sigma_0 9.5e3 [8.5e3, 1.07e4], sigma_1 1.07 [0.72, 1.61]; static
-intervals overlapping the sweeps' 23/25; 3.8-5.5 s per identification with the rate bias
-(1.7-2.7 s of it; estimated sigma_0 +2.9 to +4.2 %, sigma_1 -15 to -39 %), 1.0-2.5 s
-without (earlier runs: the same table). ``two_stage``, same
-run conditions (``--route two_stage``): sigma_1 open on 3/5 seeds, covered 24/32 closed
-(tau_s 2/5), seed 0 tau_s 0.734 [0.674, 0.793], half-widths 3-9 times the filtered route's,
-overlap 19/25, 4.1-5.7 s. Seeds 0-4 are the unlucky ones: on seeds 10-59 (not the
-benchmark's, ``filtered``; ``python benchmarks/calib_trajectory.py --first 10 --seeds 50``)
-336/350 intervals covered (96 %; every parameter 47-50/50; p_x 45/50, p_y 46/50), the
+What it recovers, before the calibrated widening (``benchmarks/bench_trajectory.py``, run for the
+report: LuGre truth, 60 s multi-sine at 1 kHz, trajectory noise, ``lm``, seeds 0-4; coverage by the
+closed 95 % intervals; shared 2-core machine). ``filtered``: every interval closed (sigma_1 too, at
+the light damping ratio 0.05); covered sigma_0 4/5, sigma_1 5/5, sigma_2 4/5, tau_c 4/5, tau_s 3/5,
+w_s 3/5, delta 3/5 (26/35); seed 0 tau_s 0.793 [0.781, 0.805], w_s 0.103 [0.099, 0.108], sigma_0
+9.5e3 [8.5e3, 1.07e4], sigma_1 1.07 [0.72, 1.61]; static intervals overlapping the sweeps' 23/25;
+3.8-5.5 s per identification with the rate bias (1.7-2.7 s of it; estimated sigma_0 +2.9 to +4.2 %,
+sigma_1 -15 to -39 %), 1.0-2.5 s without. ``two_stage`` (``--route two_stage``): sigma_1 open on
+3/5 seeds, covered 24/32 closed (tau_s 2/5), seed 0 tau_s 0.734 [0.674, 0.793], half-widths 3-9
+times the filtered route's, overlap 19/25, 4.1-5.7 s. Seeds 0-4 are the unlucky ones: on seeds
+10-59 (not the benchmark's, ``filtered``; ``python benchmarks/calib_trajectory.py --first 10
+--seeds 50``) 336/350 intervals covered (96 %; every parameter 47-50/50; p_x 45/50, p_y 46/50), the
 misses clustered on a few seeds where the Stribeck trio misses together (their estimates are
 correlated), as on seeds 0-4. The cut-off: 20 Hz; at 40 and 60 Hz (seeds 10-29) the intervals
 halved but sigma_0 was covered on 4/20 and 2/20 seeds: the bristle drive's error at 1 kHz
-(:mod:`._trajectory_filtered`: noise-free, 20 s, sigma_0 +3.5 %, sigma_1 -20 %, the static
-part and J within 1.5 per mille; at 10 kHz every parameter within 0.3 per mille) then exceeds
-the intervals. With ``--sigma1 8`` (damping ratio 0.4; seeds 10-19) 69/70 covered, sigma_1's
-half-width 1.7 %.
+(:mod:`._trajectory_filtered`: noise-free, 20 s, sigma_0 +3.5 %, sigma_1 -20 %, the static part and
+J within 1.5 per mille; at 10 kHz every parameter within 0.3 per mille) then exceeds the intervals.
+With ``--sigma1 8`` (damping ratio 0.4; seeds 10-19) 69/70 covered, sigma_1's half-width 1.7 %.
 
 A designed experiment for the Stribeck shape (:func:`fricid.sim.trajectory.slow_multisine`,
 ``bench_trajectory.py --experiment slow_multisine``: the same 60 s, its first half
@@ -160,13 +153,11 @@ import time
 from collections.abc import Callable
 from typing import Any
 
-import numpy as np
-
 from ...errors import ConfigError, DataError
 from ...fitted import FittedModel
 from ...models import get_model
 from ...samples import RawLog, check_trajectory_log
-from ._data import DerivativeFilter, check_dissipates, sliding, uniform_series
+from ._data import DerivativeFilter, check_dissipates, guarded_sliding, sliding, uniform_series
 from ._encoder import measurement
 from ._filtered import ParallelFilter, dahl_start, filtered_route, lugre_start
 from ._outcome import (
@@ -361,14 +352,10 @@ def fit_trajectory(
     series = uniform_series(log)
     rate = 1.0 / series.dt
     encoder = measurement(series.position, series.velocity, series.dt, encoder_counts)
-    short = key in STATIC_MODELS
-    vf, acc, mask = sliding(series, derivative, v_slide, guard, short=short)
-    moving = int(np.sum(np.abs(vf) >= v_slide))  # before the guards
-    if mask.sum() < MIN_SLIDING <= moving and not short:  # slips shorter than the guard
-        short = True  # (stick-slip: the 0.2 s guard after each stick had left none)
-        vf, acc, mask = sliding(series, derivative, v_slide, guard, short=short)
-    slides = mask.sum() >= MIN_SLIDING
-    never = moving < MIN_SLIDING
+    vf, acc, mask, short, moving = guarded_sliding(
+        series, derivative, v_slide, guard, key in STATIC_MODELS, MIN_SLIDING
+    )
+    slides, never = mask.sum() >= MIN_SLIDING, moving < MIN_SLIDING
     if key == "lugre" and route in ("filtered", "two_stage", "presliding") and never:
         if progress is not None:
             progress(1, 2, "pre-sliding route: sigma_0, sigma_1 (the log never slides)")
