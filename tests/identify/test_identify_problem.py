@@ -313,3 +313,16 @@ def test_problem_docstring_example_runs():
     import fricid.identify.problem as module
 
     assert doctest.testmod(module).failed == 0
+
+
+def test_a_fit_with_as_many_parameters_as_samples_says_its_reduced_chi_square_is_undefined():
+    """Four samples and a four-parameter law: no degrees of freedom, so the report says the
+    reduced chi-square is undefined instead of printing nan."""
+    samples = FrictionSamples(
+        velocity=[-1.0, -0.5, 0.5, 1.0], load=0.0, temperature=25.0,
+        friction=[-0.3, -0.25, 0.25, 0.3],
+    )  # fmt: skip
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        text = fit(samples, "coulomb_viscous_asym", "lm").report()
+    assert "reduced chi-square = undefined" in text and "nan" not in text.lower()

@@ -7,6 +7,7 @@ per parameter record, and the correlations.
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
@@ -57,7 +58,13 @@ def fit_report(fitted: Any, min_correl: float = MIN_CORREL) -> str:
         ("R-squared", st.get("rsquared", fitted.metrics.get("fitness"))),
         ("RMSE [N m]", fitted.metrics.get("rmse")),
     )
-    lines += [f"    {k:<18} = {_num(v):.8g}" for k, v in rows if v is not None]
+    for k, v in rows:
+        if v is None:
+            continue
+        if k == "reduced chi-square" and not math.isfinite(_num(v)):  # n = p: no dof
+            lines.append(f"    {k:<18} = undefined (no more data points than variables)")
+        else:
+            lines.append(f"    {k:<18} = {_num(v):.8g}")
     model = get_predictor(fitted.model)
     if model.stateful:
         lines += ["[[Network]]", f"    {model.describe(fitted.state)}"]
