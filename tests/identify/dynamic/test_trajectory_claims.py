@@ -132,11 +132,15 @@ def test_short_search_settles_and_intervals_are_given(tmp_path):
 
 
 @pytest.mark.slow  # about 2 s: a 10 s log at 200 Hz identified
-def test_a_lugre_fit_says_its_intervals_are_not_calibrated_on_foreign_logs(tmp_path):
+def test_a_lugre_fit_says_how_often_its_intervals_held_on_foreign_logs(tmp_path):
+    """The widened intervals still held the truth less than 95 % of the time on the
+    independent simulator's report seeds, and every LuGre fit's verdict says so."""
     fitted, _ = fit_bench_log("geared", "chirp_pd", 200.0, 2**17, 0, tmp_path)
     trust = assess_trust(fitted)
     assert trust.level != "yes"
-    assert any(r.startswith("LuGre's intervals are not calibrated") for r in trust.reasons)
+    said = [r for r in trust.reasons if r.startswith("LuGre's intervals are widened")]
+    assert said and "not 95 % everywhere" in said[0]
+    assert fitted.provenance["trajectory"]["calibration"]["factors"]["sigma_0"] > 1
 
 
 def _last_block(lines: list[str], title: str) -> dict[str, list[str]]:
