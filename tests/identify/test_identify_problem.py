@@ -326,3 +326,16 @@ def test_a_fit_with_as_many_parameters_as_samples_says_its_reduced_chi_square_is
         warnings.simplefilter("ignore")
         text = fit(samples, "coulomb_viscous_asym", "lm").report()
     assert "reduced chi-square = undefined" in text and "nan" not in text.lower()
+
+
+def test_an_interval_far_wider_than_the_standard_error_says_so():
+    """A profile interval at a bound, 4.6 times the curvature's +/- 1.96 se on one side: the
+    report says to read the interval (a new user had read the +/- as 17 % precision); one as
+    wide as the +/- says nothing more."""
+    from fricid.fitted import Parameter
+    from fricid.fitted._report import _variable_note
+
+    wide = Parameter("beta_pos", 0.0215, stderr=0.00357, ci95=(0.0, 0.0537))
+    assert "4.6x +/- 1.96 standard errors: read it" in _variable_note(wide, "profile")
+    usual = Parameter("beta_pos", 0.0215, stderr=0.00357, ci95=(0.0145, 0.0285))
+    assert "standard errors: read it" not in _variable_note(usual, "profile")
