@@ -445,8 +445,8 @@ def _confounded(sol, joint_of: np.ndarray, residual: dict[str, float]) -> str | 
     frictions by more than its samples' scatter (the sweeps barely tell gravity from
     friction), else None. On the sweeps of ``tests/_arm_sweeps.py`` (every joint swept with
     the others in three poses) it moved them by at most 0.07 of the scatter; sweeping only
-    the double pendulum's first joint, by 36 times (joint 2's parameters confounded with the
-    set-point frictions: 1.05 +- 1.8 N m for a true 0.066)."""
+    the double pendulum's first joint, by 12.8 times (joint 2's parameters confounded with
+    the set-point frictions: 1.05 +- 1.8 N m for a true 0.066)."""
     k = sol.level.size
     wbar = sol.level_regressor
     shared = np.sqrt(np.maximum(np.einsum("ki,ij,kj->k", wbar, sol.covariance[k:, k:], wbar), 0))
