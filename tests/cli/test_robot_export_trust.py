@@ -181,3 +181,30 @@ def test_a_cut_or_incomplete_arm_file_is_named_with_what_is_wrong(arm_file, tmp_
         assert res.exit_code != 0 and path.name in res.output and why in res.output
     assert "character" in res.output  # where in the line the cut file stops
     assert not (tmp_path / "fricid_friction.c").exists()
+
+
+def test_a_whole_arm_fit_exports_as_the_robot_s_urdf_and_mjcf(arm_file, tmp_path):
+    """`robot export --to urdf` rewrites the URDF with the identified inertials and each
+    joint's <dynamics>; `--to mjcf` writes MuJoCo's model; both need the URDF and a file."""
+    import xml.etree.ElementTree as ET
+
+    path, _ = example_urdf("double_pendulum")
+    out = tmp_path / "identified.urdf"
+    args = ["robot", "export", str(arm_file), "--to", "urdf", "--urdf", str(path), "-o", str(out)]
+    res = runner.invoke(app, args)
+    assert res.exit_code == 0, res.output
+    root = ET.parse(out).getroot()
+    dynamics = {j.get("name"): j.find("dynamics") for j in root.findall("joint")}
+    assert dynamics["joint1"] is not None and float(dynamics["joint2"].get("friction")) > 0
+    fit = ArmFit.load(arm_file)
+    masses = [float(m.get("value")) for m in root.iter("mass")]
+    assert any(np.isclose(m, v) for m in masses for v in fit.standard["values"][::10])
+    xml = tmp_path / "arm.xml"
+    res = runner.invoke(app, [*args[:4], "mjcf", "--robot", "double_pendulum", "-o", str(xml)])
+    assert res.exit_code == 0, res.output
+    assert "frictionloss" in xml.read_text()
+    mujoco = pytest.importorskip("mujoco")
+    assert mujoco.MjModel.from_xml_path(str(xml)).njnt == 2
+    res = runner.invoke(app, [*args[:5], "-o", str(tmp_path / "x.urdf")])
+    assert res.exit_code == 2 and "give --urdf or --robot" in res.output
+    assert not (tmp_path / "x.urdf").exists()

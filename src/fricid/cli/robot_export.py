@@ -11,6 +11,7 @@ import sys
 from pathlib import Path
 from typing import Annotated
 
+import numpy as np
 import typer
 
 from ._app import err_console, handle_errors, robot_app
@@ -20,6 +21,10 @@ from ._options import AllowUntrusted, SmoothZone, out_option
 ROBOT_TARGETS = {
     "ros2_control": "one YAML, a block per joint (Coulomb-viscous per direction, projected)",
     "c": "<robot>_friction.h and .c: a function per joint and <robot>_friction(joint, v, load, T)",
+    "urdf": "a whole-arm fit as the robot's URDF (--urdf or --robot): the identified inertials "
+    "and each joint's <dynamics> (its friction's Coulomb-viscous projection)",
+    "mjcf": "a whole-arm fit as MJCF for MuJoCo (--urdf or --robot): the identified inertials, "
+    "each joint's frictionloss and damping",
 }
 
 
@@ -72,6 +77,30 @@ def _refuse(refused: list[str]) -> None:
         raise ConfigError(refused[0])
     if refused:
         raise ConfigError(f"{len(refused)} joints refused:\n  " + "\n  ".join(refused))
+
+
+def _whole_arm(files: dict[str, Path], fitted: dict, urdf: Path | None, robot: str | None, out):
+    """The rigid-body model of the one whole-arm fit in ``files``, built from ``urdf`` (or the
+    example ``robot``), and its identified standard inertial parameters."""
+    from ..errors import ConfigError
+    from ..fitted.arm import ARM_KIND, ArmFit
+    from ..io._jsonfile import read_json
+    from .robot_simulate import _model
+
+    paths = set(files.values())
+    doc = read_json(next(iter(paths)), what="model file") if len(paths) == 1 else None
+    if not (isinstance(doc, dict) and doc.get("kind") == ARM_KIND):
+        raise ConfigError("--to urdf and mjcf take one whole-arm fit (fricid robot fit's file)")
+    if (urdf is None) == (robot is None):
+        raise ConfigError("--to urdf and mjcf need the robot's URDF: give --urdf or --robot")
+    if out is None:
+        raise ConfigError("--to urdf and mjcf write a file: give --out")
+    arm = ArmFit.from_dict(doc, source=str(next(iter(paths))))
+    values = arm.standard.get("values")
+    if values is None:
+        raise ConfigError("the arm fit has no standard inertial parameters to write")
+    model = _model(robot, urdf, ",".join(arm.joints))
+    return model, np.asarray(values, dtype=float)
 
 
 def _model_files(items: list[str]) -> dict[str, Path]:
@@ -130,7 +159,8 @@ def robot_export_command(
         Path | None,
         out_option(
             "c: the folder to write <robot>_friction.h and .c into (default: the current "
-            "folder). ros2_control: the file to write (default: stdout)."
+            "folder). ros2_control: the file to write (default: stdout). urdf, mjcf: the file "
+            "to write."
         ),
     ] = None,
     robot_name: Annotated[
@@ -164,6 +194,12 @@ def robot_export_command(
         ),
     ] = False,
     allow_untrusted: AllowUntrusted = False,
+    urdf: Annotated[
+        Path | None, typer.Option(help="urdf, mjcf: the robot's URDF the arm was fitted with.")
+    ] = None,
+    robot: Annotated[
+        str | None, typer.Option(help="urdf, mjcf: an example robot's URDF instead.")
+    ] = None,
 ) -> None:
     """Export every joint of a robot at once: one ros2_control-style YAML with a block per
     joint, or one C header and source with a function per joint and a dispatcher
@@ -181,8 +217,10 @@ def robot_export_command(
     target = "ros2_control" if target == "yaml" else target  # the single-joint export's name
     if target not in ROBOT_TARGETS:
         raise ConfigError(f"unknown target '{to}'; choose one of: {', '.join(ROBOT_TARGETS)}")
-    check_paths(**{"out_dirs" if target == "c" else "out_files": {"--out": out}})
-    fitted, sources, sha256, refused = _joint_models(_model_files(models))
+    where = {"out_dirs" if target == "c" else "out_files": {"--out": out}}
+    check_paths(inputs={"--urdf": urdf} if urdf is not None else {}, **where)
+    files = _model_files(models)
+    fitted, sources, sha256, refused = _joint_models(files)
 
     def refuse(joint: str) -> None:
         try:
@@ -192,6 +230,21 @@ def robot_export_command(
         refuse_untrusted(fitted[joint], allow_untrusted, joint)
 
     _refuse(refused + _every_joint(fitted, refuse)[1])
+    if target in ("urdf", "mjcf"):
+        model, standard = _whole_arm(files, fitted, urdf, robot, out)
+        if target == "urdf":
+            from ..export.robot_urdf import write_robot_urdf
+
+            written = write_robot_urdf(out, model, standard, fitted, max_loss=max_loss)
+        else:
+            from ..export.robot_mjcf import write_robot_mjcf
+
+            levels = {j: {n: p.value for n, p in m.parameters.items()} for j, m in fitted.items()}
+            written, notes = write_robot_mjcf(model.with_parameters(standard), out, levels)
+            for note in notes:
+                err_console.print(f"note: {escape(note)}", highlight=False)
+        err_console.print(f"wrote {escape(str(written))}", highlight=False)
+        return
     if target == "c":
         paths = export_robot_c(
             fitted,
