@@ -88,6 +88,20 @@ def test_the_printed_set_points_are_the_samples_written(pendulum_files):
             assert count == samples.count[i] and se > 0 and passes >= 1
 
 
+def test_an_example_robot_stands_for_its_urdf(pendulum_files):
+    """--robot names an example robot's URDF as robot fit's does; neither or both is one line."""
+    log_path, urdf, folder = pendulum_files
+    out = folder / "example"
+    res = runner.invoke(
+        app, ["robot", "extract", str(log_path), "--robot", "double_pendulum", "-o", str(out)]
+    )
+    assert res.exit_code == 0, res.output
+    assert json.loads((out / "gravity.json").read_text())["urdf"] == "double_pendulum.urdf"
+    for extra in ([], ["--robot", "double_pendulum", "--urdf", str(urdf)]):
+        res = runner.invoke(app, ["robot", "extract", str(log_path), *extra])
+        assert res.exit_code == 2 and "--urdf" in res.output and "Traceback" not in res.output
+
+
 def test_robot_extract_bad_joint_is_one_line(pendulum_files):
     log_path, urdf, folder = pendulum_files
     out = folder / "bad"

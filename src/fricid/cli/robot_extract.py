@@ -132,7 +132,15 @@ def robot_extract_command(
             "per-channel files (fricid.io.read_robot_log)."
         ),
     ],
-    urdf: Annotated[Path, typer.Option("--urdf", help="The robot's URDF.")],
+    urdf: Annotated[Path | None, typer.Option("--urdf", help="The robot's URDF.")] = None,
+    robot_name: Annotated[
+        str | None,
+        typer.Option(
+            "--robot",
+            help="An example robot instead of --urdf: panda, ur5 or double_pendulum (the "
+            "example-robot-data URDFs).",
+        ),
+    ] = None,
     out: Annotated[
         Path,
         out_option(
@@ -193,6 +201,14 @@ def robot_extract_command(
     from ..robot import RigidBodyModel
     from ._options import parse_assignments
 
+    if (urdf is None) == (robot_name is None):
+        from ..errors import ConfigError
+
+        raise ConfigError("give the robot's URDF (--urdf) or an example robot (--robot), one")
+    if urdf is None:
+        from ..robot import example_urdf
+
+        urdf = example_urdf(robot_name)[0]
     check_paths(inputs={"LOG": log, "--urdf": urdf}, folders=["LOG"], out_dirs={"--out": out})
     robot = read_urdf(urdf)
     constants = parse_assignments(torque_constant, "--torque-constant") or None
