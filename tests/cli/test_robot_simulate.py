@@ -100,7 +100,7 @@ def test_a_lugre_joint(tmp_path):
 
 def test_a_sweep_runs_its_whole_plan_unless_cut_short(tmp_path):
     """Without --duration the sweeps run every speed both ways; a shorter --duration is warned
-    of with the speeds it still holds (60 s held one of the five default speeds)."""
+    of with the speeds it still holds (60 s held none of the five default speeds both ways)."""
     from fricid.cli.robot_simulate import _duration, _model, _reference
 
     model = _model("double_pendulum", None, None)

@@ -79,7 +79,7 @@ def _refuse(refused: list[str]) -> None:
         raise ConfigError(f"{len(refused)} joints refused:\n  " + "\n  ".join(refused))
 
 
-def _whole_arm(files: dict[str, Path], fitted: dict, urdf: Path | None, robot: str | None, out):
+def _whole_arm(files: dict[str, Path], urdf: Path | None, robot: str | None, out):
     """The rigid-body model of the one whole-arm fit in ``files``, built from ``urdf`` (or the
     example ``robot``), and its identified standard inertial parameters."""
     from ..errors import ConfigError
@@ -231,7 +231,7 @@ def robot_export_command(
 
     _refuse(refused + _every_joint(fitted, refuse)[1])
     if target in ("urdf", "mjcf"):
-        model, standard = _whole_arm(files, fitted, urdf, robot, out)
+        model, standard = _whole_arm(files, urdf, robot, out)
         if target == "urdf":
             from ..export.robot_urdf import write_robot_urdf
 

@@ -56,8 +56,8 @@ def _reference(model, sweep: str | None, velocities: str, harmonics: int, base: 
 
 def _duration(reference, duration: float | None) -> float:
     """The simulated time [s]: as given, else 60 s, or a sweep's whole length; a sweep cut
-    short is warned of with the speeds it covers (60 s covered one of the five default speeds
-    of the double pendulum's first joint, 129 s long)."""
+    short is warned of with the speeds it covers (the double pendulum's first joint's five
+    default speeds take 129 s; 60 s held none of them both ways)."""
     from ..errors import ConfigError, DataQualityWarning
     from ..sim.robot_reference import SweepReference
 

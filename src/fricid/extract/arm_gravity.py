@@ -51,9 +51,10 @@ __all__ = ["ArmGravityFit", "ArmSolution", "arm_moments", "solve_levels"]
 #: moves it a hundredfold and more. Sweeping one joint of the double pendulum with the other
 #: held (fricid's simulator) left two directions at 2e-7 to 1.2e-5, identified at -1.8 +- 0.86
 #: for a URDF's (and the truth's) 0.043 and set-point frictions 0.03-0.05 N m off (one of
-#: them of the wrong sign), or +1.05 +- 1.8 N m for 0.066 on a shorter log; sweeps of every
-#: joint with the others in three poses had none below 1.7e-2 (``tests/_arm_sweeps.py``: the
-#: double pendulum and three joints of the Panda).
+#: them of the wrong sign), or +1.05 +- 1.8 N m for 0.066 on a shorter log. Sweeps of every
+#: joint with the others in three poses had none below 7e-2 (``tests/_arm_sweeps.py``: the
+#: double pendulum and three joints of the Panda), the double pendulum's first joint swept
+#: alone with the second at three poses none below 1.7e-2.
 RCOND = 1e-4
 
 
