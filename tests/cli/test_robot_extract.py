@@ -174,3 +174,34 @@ def test_runs_left_out_of_the_set_points_are_listed_with_their_speeds():
     assert lines[0].startswith("  not averaged: 1 unsteady run(s) (no steady plateau")
     assert lines[0].endswith("at -0.2 rad/s")
     assert lines[1].startswith("  flagged (scatter far above their neighbours): ")
+
+
+def test_one_recording_per_joint_is_read_as_one_log(pendulum_files, tmp_path):
+    """Joint 1's sweeps in one file and joint 2's in another: both joints' samples, the
+    gravity identified once from both, the files named in gravity.json; a file at another
+    rate is refused with both rates and its name."""
+    from fricid.io import read_robot_log
+
+    log_path, urdf, _ = pendulum_files
+    whole = read_robot_log(log_path)
+    half = int(np.flatnonzero(whole.velocity[:, 1] != 0)[0]) - 1  # joint 2's sweeps begin
+    first = write_robot_log(whole.slice(0, half), tmp_path / "joint1.csv")
+    second = write_robot_log(whole.slice(half, len(whole)), tmp_path / "joint2.csv")
+    out = tmp_path / "out"
+    args = ["robot", "extract", str(first), str(second), "--urdf", str(urdf), "-o", str(out)]
+    res = runner.invoke(app, args)
+    assert res.exit_code == 0, res.output
+    assert "joint1: 6 set-points" in res.stdout and "joint2: 6 set-points" in res.stdout
+    doc = json.loads((out / "gravity.json").read_text(encoding="utf-8"))
+    assert doc["log"] == "joint1.csv + joint2.csv"
+    for joint, law in LAWS.items():
+        samples = read_samples(out / doc["files"][joint])
+        err = samples.friction - law(samples.velocity)
+        assert np.sqrt(np.mean(err**2)) < 0.003, (joint, err)
+    fast = whole.slice(half, len(whole))
+    fast = replace(fast, time=fast.time[0] + (fast.time - fast.time[0]) / 2)
+    other = write_robot_log(fast, tmp_path / "fast.csv")
+    res = runner.invoke(app, [*args[:3], str(other), *args[4:-1], str(tmp_path / "no")])
+    assert res.exit_code == 2, res.output
+    assert "fast.csv is sampled at 100 Hz" in res.output and "50 Hz" in res.output
+    assert not (tmp_path / "no").exists()

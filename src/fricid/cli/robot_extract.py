@@ -124,12 +124,15 @@ def _tables(result) -> list[str]:
 @robot_app.command("extract")
 @handle_errors
 def robot_extract_command(
-    log: Annotated[
-        Path,
+    logs: Annotated[
+        list[Path],
         typer.Argument(
             help="The robot's sweeps: a wide CSV/Parquet table (q1, dq1, tau1, ... or "
             "<joint>.position, ...), a ROS 2 bag with a JointState topic, or a folder of "
-            "per-channel files (fricid.io.read_robot_log)."
+            "per-channel files (fricid.io.read_robot_log). Several recordings of one robot "
+            "(one joint swept per file, say) are read as one log, each after the previous: "
+            "same joints and rate, and the gravity they share identified from all.",
+            metavar="LOG",
         ),
     ],
     urdf: Annotated[Path | None, typer.Option("--urdf", help="The robot's URDF.")] = None,
@@ -199,6 +202,7 @@ def robot_extract_command(
     from ..io.tables import write_samples
     from ..io.urdf import read_urdf
     from ..robot import RigidBodyModel
+    from ..samples import join_robot_logs
     from ._options import parse_assignments
 
     if (urdf is None) == (robot_name is None):
@@ -209,11 +213,21 @@ def robot_extract_command(
         from ..robot import example_urdf
 
         urdf = example_urdf(robot_name)[0]
-    check_paths(inputs={"LOG": log, "--urdf": urdf}, folders=["LOG"], out_dirs={"--out": out})
+    names = ["LOG"] if len(logs) == 1 else [f"LOG {k + 1}" for k in range(len(logs))]
+    check_paths(
+        inputs={**dict(zip(names, logs, strict=True)), "--urdf": urdf},
+        folders=names,
+        out_dirs={"--out": out},
+    )
     robot = read_urdf(urdf)
     constants = parse_assignments(torque_constant, "--torque-constant") or None
-    data = read_robot_log(
-        log, reader=reader, topic=topic, temperature=temperature, torque_constants=constants
+    data = join_robot_logs(
+        [
+            read_robot_log(
+                log, reader=reader, topic=topic, temperature=temperature, torque_constants=constants
+            )
+            for log in logs
+        ]
     )
     moving = [
         n for n, j in robot.joints.items() if j.kind in ("revolute", "continuous", "prismatic")
@@ -225,12 +239,13 @@ def robot_extract_command(
         raise DataError(
             f"no joint of the log ({', '.join(data.joints)}) is a moving joint of the URDF "
             f"({', '.join(moving) or 'none'}); rename the log's columns to the URDF's names",
-            file=str(log),
+            file=data.source,
         )
     model = RigidBodyModel.from_robot(robot, modelled)
     result = extract_arm(data, model, joints=_split(joints), identify=not urdf_masses)
     stems = _stems(result)
-    doc = {"urdf": urdf.name, "log": log.name, **result.gravity.as_meta()}
+    doc = {"urdf": urdf.name, "log": " + ".join(log.name for log in logs)}
+    doc.update(result.gravity.as_meta())
     doc["files"] = {joint: f"{stems[joint]}.csv" for joint in result}
     text = json.dumps(doc, indent=1, allow_nan=False) + "\n"
     # everything is computed before the first file is written; each file is written atomically

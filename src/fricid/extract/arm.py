@@ -37,7 +37,6 @@ from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from scipy.signal import savgol_filter
 
 from ..errors import ConfigError, DataError, DataQualityWarning, user_stacklevel
 from ..samples import RawLog, RobotLog
@@ -45,8 +44,9 @@ from ._gravity_mode import explicit_none_note
 from .accumulate import Accumulator
 from .arm_gravity import ArmGravityFit, arm_moments, solve_levels
 from .arm_rows import at_levels, held_runs, with_load
+from .arm_signals import acceleration, joint_chunks, named_pieces, velocities
 from .bins import PositionBins
-from .pipeline import VELOCITY_RTOL, ExtractionResult, extract, velocity_from_position
+from .pipeline import VELOCITY_RTOL, ExtractionResult, extract
 from .segment import cluster, iter_segments
 from .steady import OUTLIER_SIGMAS, SETTLE_SIGMAS
 
@@ -57,10 +57,6 @@ __all__ = ["ArmExtraction", "extract_arm"]
 
 #: Rows of the configuration evaluated by one call of the rigid-body model.
 CHUNK = 4096
-
-#: s, the span of the Savitzky-Golay derivative that estimates the joints' accelerations when
-#: the log has none (long against the noise of a velocity estimate, short against a ramp).
-ACCELERATION_WINDOW = 0.05
 
 #: How the note (and warning) begins when the sweeps barely tell gravity from friction.
 CONFOUNDED = "the sweeps barely tell the arm's gravity from the friction"
@@ -148,39 +144,6 @@ def _robot_rows(model: RigidBodyModel, log: RobotLog) -> RobotLog:
     return log.select(model.joints)
 
 
-def _velocities(arm: RobotLog) -> tuple[RobotLog, set[str], list[str]]:
-    """``arm`` with each joint's coarse-encoder finite-difference velocity replaced by its
-    position's least-squares slope (:func:`~.pipeline.velocity_from_position`), the joints
-    replaced and the warnings: the arm fit's segments and levels and each joint's samples
-    (:func:`~.pipeline.extract`) then read one velocity (with the finite difference, a 2^17-
-    count encoder at 1 kHz had put a 0.05 rad/s sweep's levels at 0.096 rad/s)."""
-    velocity = arm.velocity.copy()
-    replaced, found = set(), []
-    for j, name in enumerate(arm.joints):
-        raw = replace(arm.joint(name, temperature=0.0), source=f"{arm.source or 'the log'}, {name}")
-        raw, note = velocity_from_position(raw)
-        if raw.meta.get("velocity_from") == "position":
-            velocity[:, j] = raw.velocity
-            replaced.add(name)
-        if note:
-            found.append(note)
-    return (replace(arm, velocity=velocity) if replaced else arm), replaced, found
-
-
-def _acceleration(arm: RobotLog) -> np.ndarray:
-    """rad/s^2, the logged acceleration, else the velocity's Savitzky-Golay derivative
-    (quadratic over about :data:`ACCELERATION_WINDOW` s; exactly zero where a joint is held
-    at zero velocity)."""
-    if arm.acceleration is not None:
-        return arm.acceleration
-    n = len(arm)
-    dt = float(np.median(np.diff(arm.time))) if n > 1 else 1.0
-    window = max(5, 2 * round(ACCELERATION_WINDOW / dt / 2) + 1)
-    if n < window:
-        return np.gradient(arm.velocity, arm.time, axis=0) if n > 1 else np.zeros_like(arm.velocity)
-    return savgol_filter(arm.velocity, window, 2, deriv=1, delta=dt, axis=0, mode="interp")
-
-
 def _segment_rows(raw: RawLog, options: dict) -> np.ndarray:
     """The rows of the joint's candidate steady segments (:func:`~.segment.iter_segments`,
     found from the velocity alone): the only rows whose torque the extraction reads."""
@@ -200,7 +163,7 @@ def _joint_dynamics(model: RigidBodyModel, base, arm: RobotLog, ddq, j: int, row
     """At ``rows``: joint ``j``'s base gravity regressor row ``Y_b(q)[j]`` (R, m) and the
     rigid-body torque on it that is neither gravity nor its own inertia (R,): the velocity
     products ``C(q, dq) dq`` and the other joints' inertia ``sum_k!=j M_jk ddq_k``
-    (:func:`_acceleration`). Its own inertia is left out: its steady part is at constant
+    (:func:`.arm_signals.acceleration`). Its own inertia is left out: its steady part is at constant
     speed, and a derivative would only add noise."""
     w = np.empty((rows.size, base.rank))
     other = np.empty(rows.size)
@@ -340,11 +303,12 @@ def extract_arm(
             f"joint(s) {', '.join(unknown)} not in the robot model; it has "
             + ", ".join(model.joints)
         )
-    arm, replaced, coarse = _velocities(_robot_rows(model, log))
+    arm, replaced, coarse = velocities(_robot_rows(model, log))
     for note in coarse:
         warnings.warn(note, DataQualityWarning, stacklevel=user_stacklevel())
     base = base_parameters(model, gravity_only=True)
-    ddq = _acceleration(arm)
+    ddq = acceleration(arm)
+    named = named_pieces(arm)
     found = {}
     for joint in wanted:
         j = model.joints.index(joint)
@@ -383,7 +347,7 @@ def extract_arm(
         if note.startswith(CONFOUNDED):
             warnings.warn(note, DataQualityWarning, stacklevel=user_stacklevel())
     results = {
-        joint: _joint_result(raw, rows, w @ fit.beta, fit, options, joint)
+        joint: _joint_result(raw, rows, w @ fit.beta, fit, options, joint, named)
         for joint, (raw, rows, w) in raws.items()
     }
     return ArmExtraction(fit, results)
@@ -468,14 +432,22 @@ def _confounded(sol, joint_of: np.ndarray, residual: dict[str, float]) -> str | 
 
 
 def _joint_result(
-    raw: RawLog, rows: np.ndarray, gravity: np.ndarray, fit: ArmGravityFit, options, joint: str
+    raw: RawLog,
+    rows: np.ndarray,
+    gravity: np.ndarray,
+    fit: ArmGravityFit,
+    options,
+    joint: str,
+    named: list[tuple[slice, str]],
 ) -> ExtractionResult:
     """One joint's samples: its torque with the arm's gravity removed (at ``rows``, its
-    segments: the only rows read), extracted as a horizontal joint's; the load column is the
-    gravity torque of the matching level."""
+    segments: the only rows read), extracted as a horizontal joint's, each recording of a
+    joined log as its own source (``named``, :func:`.arm_signals.named_pieces`); the load
+    column is the gravity torque of the matching level."""
     torque = raw.motor_torque.copy()
     torque[rows] -= gravity
-    res = extract(_with_torque(raw, torque), gravity="none", **options)
+    chunks = joint_chunks(_with_torque(raw, torque), named)
+    res = extract(chunks, gravity="none", **options)
     levels = fit.joint_levels(joint)
     how = (
         "gravity from the whole configuration (base gravity parameters identified from the sweeps)"
@@ -486,7 +458,10 @@ def _joint_result(
     opts = {**res.options, "gravity": ARM_MODE}
     meta = {"extract": opts, "gravity": {**_joint_meta(fit, joint)}, "notes": list(notes)}
     samples, by_direction = (
-        with_load(at_levels(x, levels, options, combined=c), levels, meta, combined=c)
+        replace(
+            with_load(at_levels(x, levels, options, combined=c), levels, meta, combined=c),
+            source=raw.source,  # a joined log's name, not its first recording's
+        )
         for x, c in ((res.samples, True), (res.by_direction, False))
     )
     return replace(res, samples=samples, by_direction=by_direction, options=opts, notes=notes)

@@ -4,10 +4,10 @@ Both hold SI units only (DESIGN.md, "Units") and validate themselves on construc
 value of either type is always safe to use. Reading and writing them is :mod:`fricid.io`'s job.
 
 :class:`RawLog` is in :mod:`.rawlog` (all joints of a robot, :class:`RobotLog`, in
-:mod:`.robot_log`), the columns, units, ranges and column checks both
-types share in :mod:`._columns`, and the checks a trajectory log passes before identification
-in :mod:`._trajectory_log`, whether a log's velocity is its position's derivative in
-:mod:`._agreement`.
+:mod:`.robot_log`; several recordings of one robot joined into one by :mod:`.robot_join`),
+the columns, units, ranges and column checks both types share in :mod:`._columns`, the
+checks a trajectory log passes before identification in :mod:`._trajectory_log`, whether a
+log's velocity is its position's derivative in :mod:`._agreement`.
 """
 
 from __future__ import annotations
@@ -35,6 +35,7 @@ from ._encoder_steps import encoder_quantum, position_unit_problem
 from ._standstill import drop_standstill, standstill_rows
 from ._trajectory_log import check_trajectory_log
 from .rawlog import RawLog
+from .robot_join import join_robot_logs
 from .robot_log import ROBOT_COLUMNS, RobotLog
 
 __all__ = [
@@ -52,6 +53,7 @@ __all__ = [
     "coarse_velocity",
     "drop_standstill",
     "encoder_quantum",
+    "join_robot_logs",
     "position_unit_problem",
     "standstill_rows",
     "velocity_mismatch",
