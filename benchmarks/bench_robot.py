@@ -312,14 +312,20 @@ def run(args) -> None:
     path, joints = example_urdf(args.robot)
     model = RigidBodyModel.from_urdf(path, joints)
     seeds = range(args.first, args.first + args.seeds)
-    if args.jobs > 1:  # one process per seed: the seeds are independent
+    if args.from_rows:  # saved runs (--rows), printed together: no identification
+        saved = [json.loads(line) for path in args.from_rows for line in path.open()]
+        saved = list({r["seed"]: r for r in saved}.values())  # one row per seed
+        seeds = [r.pop("seed") for r in saved]
+        results = saved
+        args.seeds, args.first = len(seeds), min(seeds)
+    elif args.jobs > 1:  # one process per seed: the seeds are independent
         from concurrent.futures import ProcessPoolExecutor
 
         with ProcessPoolExecutor(args.jobs) as pool:
             results = list(pool.map(_seed, [args] * len(seeds), seeds))
     else:
         results = [_seed(args, seed) for seed in seeds]
-    if args.rows:  # every seed's rows, for a closer look
+    if args.rows and not args.from_rows:  # every seed's rows, for a closer look
         with args.rows.open("w") as f:
             for seed, res in zip(seeds, results, strict=True):
                 f.write(json.dumps({"seed": seed, **res}, default=lambda o: o.item()) + "\n")
@@ -451,6 +457,14 @@ def main() -> None:
         help="keep the simulated logs here and reuse them (fits compared on the same logs)",
     )
     parser.add_argument("--rows", type=Path, default=None, help="every seed's rows (JSON lines)")
+    parser.add_argument(
+        "--from-rows",
+        type=Path,
+        nargs="+",
+        default=None,
+        help="print the table of saved --rows files (their seeds together) instead of running; "
+        "give the settings they ran with",
+    )
     args = parser.parse_args()
     if args.friction == "coulomb_viscous_load_asym" and args.truth in ("sim", "mujoco"):
         parser.error("the load law is simulated by --truth own and pd only")
