@@ -203,5 +203,5 @@ def test_one_recording_per_joint_is_read_as_one_log(pendulum_files, tmp_path):
     other = write_robot_log(fast, tmp_path / "fast.csv")
     res = runner.invoke(app, [*args[:3], str(other), *args[4:-1], str(tmp_path / "no")])
     assert res.exit_code == 2, res.output
-    assert "fast.csv is sampled at 100 Hz" in res.output and "50 Hz" in res.output
+    assert "fast.csv: sampled at 100 Hz" in res.output and "at 50 Hz" in res.output
     assert not (tmp_path / "no").exists()

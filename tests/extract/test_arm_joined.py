@@ -31,8 +31,10 @@ EVERY_POSE = {
 }
 
 
-def _log(n: int, joints=("a", "b"), t0: float = 0.0, rate: float = 100.0, **extra) -> RobotLog:
-    rng = np.random.default_rng(n)
+def _log(
+    n: int, joints=("a", "b"), t0: float = 0.0, rate: float = 100.0, seed=None, **extra
+) -> RobotLog:
+    rng = np.random.default_rng(n if seed is None else seed)
     k = len(joints)
     return RobotLog(
         time=t0 + np.arange(n) / rate,
@@ -116,12 +118,16 @@ def test_coarse_velocities_are_replaced_piece_by_piece(pendulum):
 
 
 def test_recordings_that_do_not_match_are_refused_with_their_names():
-    with pytest.raises(DataError, match=r"rec30\.csv does not log the joints of rec20\.csv.*c"):
+    with pytest.raises(
+        DataError, match=r"rec30\.csv: its joints are not those of rec20\.csv.*no column for b.*c"
+    ):
         join_robot_logs([_log(20), _log(30, joints=("a", "c"))])
-    with pytest.raises(DataError, match=r"rec30\.csv is sampled at 200 Hz and rec20\.csv at 100"):
+    with pytest.raises(DataError, match=r"rec30\.csv: sampled at 200 Hz, rec20\.csv at 100 Hz"):
         join_robot_logs([_log(20), _log(30, rate=200.0)])
-    with pytest.raises(DataError, match=r"rec30\.csv has no temperature"):
+    with pytest.raises(DataError, match=r"rec30\.csv: no temperature, and rec20\.csv has one"):
         join_robot_logs([_log(20, temperature=25.0), _log(30)])
+    with pytest.raises(DataError, match=r"rec20\.csv: the same samples as rec20\.csv"):
+        join_robot_logs([_log(20), _log(30), _log(20)])
     with pytest.raises(DataError, match="no robot log"):
         join_robot_logs([])
 
@@ -145,9 +151,10 @@ def test_columns_in_another_order_a_current_and_a_missing_acceleration():
     starts=st.lists(st.floats(-1e4, 1e4, allow_nan=False), min_size=5, max_size=5),
 )
 def test_joining_keeps_every_row_in_order_and_the_seams_are_gaps(sizes, starts):
-    logs = [_log(n, t0=t0) for n, t0 in zip(sizes, starts, strict=False)]
+    logs = [_log(n, t0=t0, seed=k) for k, (n, t0) in enumerate(zip(sizes, starts, strict=False))]
     joined = join_robot_logs(logs)
     assert len(joined) == sum(sizes)
+    np.testing.assert_array_equal(joined.time[: sizes[0]], logs[0].time)  # its own clock
     assert np.all(np.diff(joined.time) > 0)
     np.testing.assert_array_equal(joined.position, np.concatenate([g.position for g in logs]))
     steps = np.diff(joined.time)

@@ -21,6 +21,7 @@ extraction then differentiates the velocity, piece by piece), and the log's ``me
 
 from __future__ import annotations
 
+import hashlib
 from collections.abc import Sequence
 
 import numpy as np
@@ -45,9 +46,7 @@ def _name(log: RobotLog, k: int) -> str:
 
 def _period(log: RobotLog, k: int) -> float:
     if len(log) < 2:
-        raise DataError(
-            f"{_name(log, k)} has {len(log)} sample(s): nothing to join", file=log.source
-        )
+        raise DataError(f"{len(log)} sample(s): nothing to join", file=_name(log, k))
     return float(np.median(np.diff(log.time)))
 
 
@@ -58,9 +57,9 @@ def _same_joints(first: RobotLog, log: RobotLog, k: int) -> RobotLog:
         parts = [f"no column for {', '.join(missing)}"] if missing else []
         parts += [f"joints the first log has not: {', '.join(extra)}"] if extra else []
         raise DataError(
-            f"{_name(log, k)} does not log the joints of {_name(first, 0)} "
-            f"({'; '.join(parts)}): every recording of one robot must log the same joints",
-            file=log.source,
+            f"its joints are not those of {_name(first, 0)} ({'; '.join(parts)}): every "
+            "recording of one robot must log the same joints",
+            file=_name(log, k),
         )
     return log.select(first.joints)
 
@@ -81,8 +80,9 @@ def join_robot_logs(logs: Sequence[RobotLog]) -> RobotLog:
     Returns
     -------
     RobotLog
-        One log: the joints in the first recording's order; each recording's time shifted to
-        begin :data:`SEAM_PERIODS` sample periods after the previous one ends; the source the
+        One log: the joints in the first recording's order; the first recording's time as it
+        is, each other's shifted to begin :data:`SEAM_PERIODS` sample periods after the
+        previous one ends; the source the
         recordings' names joined by ``" + "``; ``meta["joined"]`` the recordings' sources,
         where each begins in the joined time (``"starts"``) and any column left out. A single
         recording is returned as it is.
@@ -90,7 +90,8 @@ def join_robot_logs(logs: Sequence[RobotLog]) -> RobotLog:
     Raises
     ------
     DataError
-        No recording; a recording with fewer than two samples; joints that differ (each
+        No recording; a recording with fewer than two samples; one given twice (the same
+        positions and torques); joints that differ (each
         missing or extra one named, with the file); sample rates that differ by more than
         :data:`RATE_RTOL` (both named); a temperature in some recordings and not in others.
     """
@@ -105,21 +106,32 @@ def join_robot_logs(logs: Sequence[RobotLog]) -> RobotLog:
     for k, (log, period) in enumerate(zip(aligned, periods, strict=True)):
         if abs(period - periods[0]) > RATE_RTOL * periods[0]:
             raise DataError(
-                f"{_name(log, k)} is sampled at {1 / period:.6g} Hz and {_name(first, 0)} at "
-                f"{1 / periods[0]:.6g} Hz: recordings joined into one log need one rate "
-                "(resample one, or extract them separately)",
-                file=log.source,
+                f"sampled at {1 / period:.6g} Hz, {_name(first, 0)} at {1 / periods[0]:.6g} Hz: "
+                "recordings joined into one log need one rate (resample one, or extract them "
+                "separately)",
+                file=_name(log, k),
             )
+    seen: dict[bytes, int] = {}
+    for k, log in enumerate(aligned):
+        digest = hashlib.sha256(log.position.tobytes() + log.motor_torque.tobytes()).digest()
+        if digest in seen:
+            raise DataError(
+                f"the same samples as {_name(aligned[seen[digest]], seen[digest])}: "
+                "given twice, every run would count twice (and its intervals shrink as if it "
+                "had been measured twice); give each recording once",
+                file=_name(log, k),
+            )
+        seen[digest] = k
     with_temperature = [log.temperature is not None for log in aligned]
     if any(with_temperature) and not all(with_temperature):
         k = with_temperature.index(False)
         raise DataError(
-            f"{_name(aligned[k], k)} has no temperature and "
-            f"{_name(aligned[with_temperature.index(True)], 0)} has: give every recording its "
-            "temperature column, or none (then --temperature holds for all)",
-            file=aligned[k].source,
+            f"no temperature, and {_name(aligned[with_temperature.index(True)], 0)} has one: "
+            "give every recording its temperature column, or none (then --temperature holds "
+            "for all)",
+            file=_name(aligned[k], k),
         )
-    times, starts, t_next = [], [], 0.0
+    times, starts, t_next = [], [], float(first.time[0])  # the first keeps its clock
     for log in aligned:
         shift = t_next - float(log.time[0])
         times.append(log.time + shift)
