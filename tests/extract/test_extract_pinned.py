@@ -102,12 +102,17 @@ def _epos(name: str) -> Any:
 #: (compared field by field), every friction is the same. paper2+faults once more when the
 #: note of gravity 'none' on a log with positions was reworded (it may come from the log's
 #: design metadata): with the old text the digest is the old one, every number the same.
+#: The virtual joint's five once more when the settle cut at a run's ends took a thousandth of
+#: a sample period of slack (:func:`fricid.extract.segment`: the cut had followed the clock's
+#: rounding, so a shifted clock changed the samples): the per-direction frictions moved by at
+#: most 0.09 % (paper2+faults, three set-points 10 samples larger), paper1's not at all (its
+#: trimming counts did); the EPOS recordings' are unchanged.
 CASES = {
-    "paper1": (lambda: _simulated("paper1"), "378946370d1ca8d2"),
-    "paper1+faults": (lambda: _simulated("paper1+faults", 7_777), "6591218dddd8499e"),
-    "paper1 joint": (lambda: _simulated("paper1", gravity="joint"), "1c29cba681e58821"),
-    "paper2+faults": (lambda: _simulated("paper2+faults"), "9cd831fe27dfc593"),
-    "paper1 clipped": (_clipped, "48c5d3ae57b5feb2"),
+    "paper1": (lambda: _simulated("paper1"), "d5946fcb1251c6ce"),
+    "paper1+faults": (lambda: _simulated("paper1+faults", 7_777), "4cbc27f79a2e92b4"),
+    "paper1 joint": (lambda: _simulated("paper1", gravity="joint"), "cd6df3ebeb9746be"),
+    "paper2+faults": (lambda: _simulated("paper2+faults"), "517b95c6cae1396f"),
+    "paper1 clipped": (_clipped, "20c0adfd25667556"),
     "epos 10.csv": (lambda: _epos("10.csv"), "bae2753ecf9dca6b"),
     "epos n200.csv": (lambda: _epos("n200.csv"), "61acd305ad52f130"),
 }

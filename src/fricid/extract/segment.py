@@ -176,8 +176,13 @@ def _find(
         return None
     a, b = start + int(inside[0]), start + int(inside[-1]) + 1
     t = log.time[a:b]
-    a2 = a + int(np.searchsorted(t, t[0] + settle_time, side="left"))
-    b2 = a + int(np.searchsorted(t, t[-1] - settle_time, side="right"))
+    # a sample within a thousandth of a period of the settle time counts as at it: the
+    # comparison is otherwise decided by the rounding of the clock (a log's time shifted by
+    # 31.3 s had trimmed one sample more, and a knife-edge block of the settle test then
+    # kept 119 samples of a sweep instead of 40)
+    slack = 1e-3 * (t[-1] - t[0]) / max(t.size - 1, 1)
+    a2 = a + int(np.searchsorted(t, t[0] + settle_time - slack, side="left"))
+    b2 = a + int(np.searchsorted(t, t[-1] - settle_time + slack, side="right"))
     if b2 - a2 < min_samples:
         if counts is not None:
             counts.dropped_short_steady += 1
