@@ -222,6 +222,7 @@ def _identify(log, seed: int, max_evals: int | None) -> dict:
         "estimator": info.get("estimator", {}).get("name", ""),
         "output_error": bool(info.get("output_error", {}).get("applied")),
         "follows": info.get("follows", {}).get("shifts"),
+        "starts": info.get("output_error", {}).get("starts_sse"),
         "converged": bool(fitted.converged),
         "seconds": seconds,
         "warnings": sorted({w.category.__name__ for w in caught}),
