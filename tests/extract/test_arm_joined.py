@@ -126,8 +126,11 @@ def test_recordings_that_do_not_match_are_refused_with_their_names():
         join_robot_logs([_log(20), _log(30, rate=200.0)])
     with pytest.raises(DataError, match=r"rec30\.csv: no temperature, and rec20\.csv has one"):
         join_robot_logs([_log(20, temperature=25.0), _log(30)])
-    with pytest.raises(DataError, match=r"rec20\.csv: the same samples as rec20\.csv"):
+    with pytest.raises(DataError, match=r"rec20\.csv: 20 of its 20 rows in motion are rows of"):
         join_robot_logs([_log(20), _log(30), _log(20)])
+    part = replace(_log(40).slice(5, 25), source="part.csv")  # a copy of part of one
+    with pytest.raises(DataError, match=r"part\.csv: 20 of its 20 rows.*rec40\.csv"):
+        join_robot_logs([_log(40), _log(30), part])
     with pytest.raises(DataError, match="no robot log"):
         join_robot_logs([])
 

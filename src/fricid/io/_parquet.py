@@ -84,7 +84,13 @@ def open_parquet(path: str | os.PathLike[str]) -> pq.ParquetFile:
 
 
 def _damaged(what: str, path: str | os.PathLike[str]) -> DataError:
-    return DataError(f"damaged file: {what} (fricid's integrity record)", file=path)
+    return DataError(
+        f"damaged or changed file: {what} (fricid's integrity record): the file is not as "
+        "fricid wrote it. If you changed it on purpose (another tool, such as pandas, kept "
+        f"fricid's metadata, which promises the record), save it without the schema's "
+        f"'{META_KEY.decode()}' metadata",
+        file=path,
+    )
 
 
 def check_record(pf: pq.ParquetFile, path: str | os.PathLike[str]) -> dict[str, int] | None:

@@ -21,7 +21,6 @@ extraction then differentiates the velocity, piece by piece), and the log's ``me
 
 from __future__ import annotations
 
-import hashlib
 from collections.abc import Sequence
 
 import numpy as np
@@ -29,12 +28,16 @@ import numpy as np
 from ..errors import DataError
 from .robot_log import RobotLog
 
-__all__ = ["RATE_RTOL", "SEAM_PERIODS", "join_robot_logs"]
+__all__ = ["RATE_RTOL", "SEAM_PERIODS", "SHARED_ROWS", "join_robot_logs"]
 
 #: Sample periods between the last sample of one recording and the first of the next: ten
 #: times the extraction's gap (``GAP_FACTOR`` = 10 periods), so a rate at the edge of
 #: :data:`RATE_RTOL` still reads it as a gap.
 SEAM_PERIODS = 100
+
+#: Rows in motion two recordings may share (bit for bit) before one is taken for a copy of
+#: the other (all of a recording's rows in motion when it has fewer).
+SHARED_ROWS = 10
 
 #: Relative difference of the recordings' median sample periods that is still one rate.
 RATE_RTOL = 0.01
@@ -64,6 +67,32 @@ def _same_joints(first: RobotLog, log: RobotLog, k: int) -> RobotLog:
     return log.select(first.joints)
 
 
+def _moving_rows(log: RobotLog) -> set[bytes]:
+    """Each row where a joint moves, as the bytes of its positions and torques."""
+    rows = np.flatnonzero(np.any(log.velocity != 0.0, axis=1))
+    both = np.ascontiguousarray(np.hstack([log.position[rows], log.motor_torque[rows]]))
+    return {row.tobytes() for row in both}
+
+
+def _no_shared_samples(logs: list[RobotLog]) -> None:
+    """Refuse a recording that holds samples of another: the same file twice, or a copy of
+    part of one (the first half saved apart, say). Rows where a joint moves are compared
+    whole (every joint's position and torque, bit for bit): two recordings share such a row
+    only by copying, as a joint at rest may repeat its quantised position and torque."""
+    seen = [_moving_rows(log) for log in logs]
+    for k in range(1, len(logs)):
+        for i in range(k):
+            shared = len(seen[k] & seen[i])
+            if shared >= min(SHARED_ROWS, max(len(seen[k]), 1)):
+                raise DataError(
+                    f"{shared} of its {len(seen[k])} rows in motion are rows of "
+                    f"{_name(logs[i], i)}, bit for bit: the same recording given twice, or a "
+                    "copy of part of one; every shared run would count twice (its interval "
+                    "shrinking as if it had been measured twice). Give each recording once",
+                    file=_name(logs[k], k),
+                )
+
+
 def _stacked(logs: list[RobotLog], name: str) -> np.ndarray | None:
     columns = [getattr(log, name) for log in logs]
     return None if any(c is None for c in columns) else np.concatenate(columns)
@@ -90,8 +119,9 @@ def join_robot_logs(logs: Sequence[RobotLog]) -> RobotLog:
     Raises
     ------
     DataError
-        No recording; a recording with fewer than two samples; one given twice (the same
-        positions and torques); joints that differ (each
+        No recording; a recording with fewer than two samples; one that holds
+        :data:`SHARED_ROWS` rows in motion of another (given twice, or a partial copy);
+        joints that differ (each
         missing or extra one named, with the file); sample rates that differ by more than
         :data:`RATE_RTOL` (both named); a temperature in some recordings and not in others.
     """
@@ -111,17 +141,7 @@ def join_robot_logs(logs: Sequence[RobotLog]) -> RobotLog:
                 "separately)",
                 file=_name(log, k),
             )
-    seen: dict[bytes, int] = {}
-    for k, log in enumerate(aligned):
-        digest = hashlib.sha256(log.position.tobytes() + log.motor_torque.tobytes()).digest()
-        if digest in seen:
-            raise DataError(
-                f"the same samples as {_name(aligned[seen[digest]], seen[digest])}: "
-                "given twice, every run would count twice (and its intervals shrink as if it "
-                "had been measured twice); give each recording once",
-                file=_name(log, k),
-            )
-        seen[digest] = k
+    _no_shared_samples(aligned)
     with_temperature = [log.temperature is not None for log in aligned]
     if any(with_temperature) and not all(with_temperature):
         k = with_temperature.index(False)
