@@ -205,3 +205,45 @@ def test_one_recording_per_joint_is_read_as_one_log(pendulum_files, tmp_path):
     assert res.exit_code == 2, res.output
     assert "fast.csv: sampled at 100 Hz" in res.output and "at 50 Hz" in res.output
     assert not (tmp_path / "no").exists()
+
+
+def test_temperature_is_for_the_recordings_without_one(pendulum_files, tmp_path):
+    """One recording with a temperature column, one without: --temperature is recorded for
+    the one without (the table reader had refused the first: "temperature= was given")."""
+    from fricid.io import read_robot_log
+
+    log_path, urdf, _ = pendulum_files
+    whole = read_robot_log(log_path)
+    half = int(np.flatnonzero(whole.velocity[:, 1] != 0)[0]) - 1
+    first = write_robot_log(whole.slice(0, half), tmp_path / "with.csv")
+    bare = replace(whole.slice(half, len(whole)), temperature=None)
+    second = write_robot_log(bare, tmp_path / "without.csv")
+    out = tmp_path / "out"
+    args = ["robot", "extract", str(first), str(second), "--urdf", str(urdf)]
+    res = runner.invoke(app, [*args, "--temperature", "25", "-o", str(out)])
+    assert res.exit_code == 0, res.output
+    assert "joint1: 6 set-points" in res.stdout and "joint2: 6 set-points" in res.stdout
+
+
+def test_numbered_columns_are_the_urdf_s_moving_joints_in_order(pendulum_files, tmp_path):
+    """A table of q1, dq1, tau1, q2, ... (as --help offers) with --urdf: joint 1 is the
+    URDF's first moving joint (before: "no joint of the log (1, 2) is a moving joint")."""
+    import pandas as pd
+
+    from fricid.io import read_robot_log
+
+    log_path, urdf, _ = pendulum_files
+    log = read_robot_log(log_path)
+    table = {"time [s]": log.time, "temperature [degC]": log.temperature[:, 0]}
+    for k in range(2):
+        table[f"q{k + 1} [rad]"] = log.position[:, k]
+        table[f"dq{k + 1} [rad/s]"] = log.velocity[:, k]
+        table[f"tau{k + 1} [N m]"] = log.torque[:, k]
+    path = tmp_path / "numbered.csv"
+    pd.DataFrame(table).to_csv(path, index=False)
+    res = runner.invoke(
+        app, ["robot", "extract", str(path), "--urdf", str(urdf), "-o", str(tmp_path / "o")]
+    )
+    assert res.exit_code == 0, res.output
+    assert "read as the URDF's moving joints in order: joint1, joint2" in res.output
+    assert "joint1: 6 set-points" in res.stdout and "joint2: 6 set-points" in res.stdout

@@ -6,6 +6,7 @@ from __future__ import annotations
 import json
 import math
 import re
+from dataclasses import replace
 from pathlib import Path
 from typing import Annotated
 
@@ -32,6 +33,14 @@ def _stems(joints) -> dict[str, str]:
         stem = _file_stem(joint)
         out[joint] = stem if stem not in out.values() else f"{stem}_{i + 1}"
     return out
+
+
+def _with_temperature(log, temperature: float | None):
+    """``log`` with ``temperature`` [degC] where it logged none (--temperature is for the
+    recordings without a temperature column: with several files, some may have one)."""
+    if log.temperature is not None or temperature is None:
+        return log
+    return replace(log, temperature=temperature)
 
 
 def _split(items: list[str] | None) -> list[str] | None:
@@ -171,7 +180,7 @@ def robot_extract_command(
     ] = False,
     temperature: Annotated[
         float | None,
-        typer.Option(help="The temperature [degC] to record when the log has none."),
+        typer.Option(help="The temperature [degC] to record for each log that has none."),
     ] = None,
     torque_constant: Annotated[
         list[str] | None,
@@ -222,17 +231,22 @@ def robot_extract_command(
     )
     robot = read_urdf(urdf)
     constants = parse_assignments(torque_constant, "--torque-constant") or None
-    data = join_robot_logs(
-        [
-            read_robot_log(
-                log, reader=reader, topic=topic, temperature=temperature, torque_constants=constants
-            )
-            for log in logs
-        ]
-    )
     moving = [
         n for n, j in robot.joints.items() if j.kind in ("revolute", "continuous", "prismatic")
     ]
+    options = {"reader": reader, "topic": topic, "torque_constants": constants}
+    read = [read_robot_log(p, **options) for p in logs]
+    if all(j.isdigit() and j not in moving for log in read for j in log.joints):
+        # numbered columns (q1, dq1, tau1, ...): the URDF's moving joints in order, as
+        # `robot fit` reads them (every moving joint logged, or the reader says what is not)
+        read = [read_robot_log(p, joints=moving, **options) for p in logs]
+        err_console.print(
+            "note: the log's joints 1-"
+            f"{len(moving)} read as the URDF's moving joints in order: {', '.join(moving)}",
+            markup=False,
+            highlight=False,
+        )
+    data = join_robot_logs([_with_temperature(log, temperature) for log in read])
     modelled = [n for n in moving if n in data.joints]
     if not modelled:
         from ..errors import DataError
