@@ -12,8 +12,9 @@ stay two runs.
 
 What has to agree: the joints (any column order; each recording's missing or extra joints are
 named), the sample rate (within :data:`RATE_RTOL`: the extraction reads gaps against the
-median period), and whether a temperature was logged (a log without one takes the command
-line's ``--temperature``, which cannot tell a mixed set apart). A torque logged in one file and
+median period), and whether a temperature was logged (all or none: ``fricid robot extract
+--temperature`` fills it in for the recordings without one before they are joined). No
+recording may hold rows of another (:data:`SHARED_ROWS`). A torque logged in one file and
 a current with its torque constant in another are both read as motor torque (eq. 13 of the
 BAS-RBFNN paper); an acceleration or load column that not every file has is left out (the
 extraction then differentiates the velocity, piece by piece), and the log's ``meta`` says so.
