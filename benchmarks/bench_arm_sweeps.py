@@ -34,7 +34,9 @@ law); then, per joint, the trust verdicts (:func:`fricid.identify.trust.assess_t
 the seeds on that law (right) and on a symmetric ``coulomb_viscous`` one (wrong: the truth
 differs between the directions).
 
-Run: ``python benchmarks/bench_arm_sweeps.py [--seeds 20]``.
+Run: ``python benchmarks/bench_arm_sweeps.py [--seeds 20] [--per-joint-files]``
+(``--per-joint-files``: each joint's sweeps a recording of its own, joined, as ``fricid robot
+extract`` reads one file per joint).
 """
 
 from __future__ import annotations
@@ -43,6 +45,7 @@ import argparse
 import sys
 import time
 import warnings
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -54,6 +57,7 @@ from fricid.extract import extract, extract_arm
 from fricid.identify import fit
 from fricid.identify.trust import assess_trust
 from fricid.robot import RigidBodyModel, base_parameters, example_urdf
+from fricid.samples import join_robot_logs
 
 PANDA = ("panda_joint2", "panda_joint4", "panda_joint6")
 
@@ -91,11 +95,32 @@ def rms(x) -> float:
     return float(np.sqrt(np.mean(np.square(x))))
 
 
+#: ``--per-joint-files``: each joint's sweeps simulated as a recording of its own (its own
+#: noise) and the recordings joined (:func:`fricid.samples.join_robot_logs`), as
+#: ``fricid robot extract`` reads one file per joint.
+PER_JOINT_FILES = False
+
+
+def _campaign(truth, spans, poses, laws, seed: int, options):
+    """The sweeps of ``spans``: one log, or one recording per joint joined
+    (:data:`PER_JOINT_FILES`)."""
+    if not PER_JOINT_FILES:
+        return arm_sweeps(truth, spans, poses, laws, seed=seed, **options)
+    files = [
+        replace(
+            arm_sweeps(truth, {j: span}, poses, laws, seed=10_000 * (k + 1) + seed, **options),
+            source=f"{j}.csv",
+        )
+        for k, (j, span) in enumerate(spans.items())
+    ]
+    return join_robot_logs(files)
+
+
 def errors(case, seed: int):
     """One seed: per joint (arm, URDF, eq. 7, friction, se) RMS, and the z-scores."""
     _, truth, laws, spans, poses, options = case
     ident = perturbed(truth, np.random.default_rng(100 + seed))
-    log = arm_sweeps(truth, spans, poses, laws, seed=seed, **options)
+    log = _campaign(truth, spans, poses, laws, seed, options)
     start = time.perf_counter()
     res = extract_arm(log, ident)  # timed with the laws below: the identification
     seconds = time.perf_counter() - start
@@ -130,7 +155,7 @@ def errors(case, seed: int):
                 assess_trust(wrong, samples).level,
             )
     shifted = {j: [p + 0.3 for p in ps] for j, ps in poses.items()}
-    held_log = arm_sweeps(truth, spans, shifted, laws, seed=seed + 1000, **options)
+    held_log = _campaign(truth, spans, shifted, laws, seed + 1000, options)
     held = extract_arm(held_log, ident)
     truly = extract_arm(held_log, truth, identify=False)
     base = base_parameters(ident, gravity_only=True)
@@ -273,7 +298,15 @@ def simulated() -> None:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--seeds", type=int, default=20)
+    parser.add_argument(
+        "--per-joint-files",
+        action="store_true",
+        help="each joint's sweeps a recording of its own, joined (PER_JOINT_FILES); the "
+        "whole-arm simulator's campaign is skipped",
+    )
     args = parser.parse_args()
+    global PER_JOINT_FILES
+    PER_JOINT_FILES = args.per_joint_files
     for make in (pendulum, panda):
         case = make()
         t0 = time.perf_counter()
@@ -296,7 +329,8 @@ def main() -> None:
         )
         print(f"each joint's coulomb_viscous_asym fit to its samples, over {args.seeds} seeds:")
         law_table(laws)
-    simulated()
+    if not PER_JOINT_FILES:
+        simulated()
 
 
 if __name__ == "__main__":
