@@ -81,8 +81,8 @@ def test_one_joint_per_recording_gives_every_joint_and_the_shared_gravity(pendul
 def test_the_derivatives_stop_at_a_seam(pendulum):
     """A held joint stays at zero acceleration across the seam, though the other recording
     moves it (a Savitzky-Golay window across the seam differentiated the jump: it gave
-    joint 2 an acceleration of order 10 rad/s^2 on the last rows of the first file, which the
-    arm's inertia coupling then put into joint 1's torque)."""
+    joint 2 2.0 and 3.0 rad/s^2 on the first file's last two rows, which the arm's inertia
+    coupling then put into joint 1's torque)."""
     first = arm_sweeps(pendulum, {"joint1": (-1.2, 1.2)}, EVERY_POSE, LAWS, rate=50.0, seed=6)
     second = arm_sweeps(pendulum, {"joint2": (-1.2, 1.2)}, EVERY_POSE, LAWS, rate=50.0, seed=7)
     cut = first.time.size - 3  # the first recording ends while joint 1 is still moving
