@@ -178,7 +178,7 @@ def _find(
     t = log.time[a:b]
     # a sample within a thousandth of a period of the settle time counts as at it: the
     # comparison is otherwise decided by the rounding of the clock (a log's time shifted by
-    # 31.3 s had trimmed one sample more, and a knife-edge block of the settle test then
+    # 31.3 s had moved the cut by a sample, and a knife-edge block of the settle test then
     # kept 119 samples of a sweep instead of 40)
     slack = 1e-3 * (t[-1] - t[0]) / max(t.size - 1, 1)
     a2 = a + int(np.searchsorted(t, t[0] + settle_time - slack, side="left"))
