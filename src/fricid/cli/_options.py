@@ -139,6 +139,23 @@ def out_option(help: str, **kwargs: Any) -> Any:
     return typer.Option("--out", "-o", help=help, **kwargs)
 
 
+def robot_urdf(
+    urdf: Path | None, robot: str | None, context: str = ""
+) -> tuple[Path, list[str] | None]:
+    """The URDF of ``--urdf FILE`` or of the example robot ``--robot NAME`` (exactly one), and
+    the example's default joints (None for ``--urdf``); ``context`` leads the error."""
+    if (urdf is None) == (robot is None):
+        raise ConfigError(
+            f"{context}give --urdf or --robot, one of them (--urdf FILE: the robot's URDF; "
+            "--robot NAME: an example robot)"
+        )
+    if urdf is not None:
+        return urdf, None
+    from ..robot import example_urdf
+
+    return example_urdf(robot)
+
+
 def _flag(parse: Callable[[Any], T], value: Any, flag: str) -> T:
     try:
         return parse(value)

@@ -14,7 +14,7 @@ from rich.markup import escape
 
 from ..errors import ConfigError
 from ._app import console, handle_errors, robot_app
-from ._options import out_option
+from ._options import out_option, robot_urdf
 from ._paths import check_paths
 from ._progress import QuietOption, tracker
 
@@ -40,15 +40,11 @@ def parse_workspace(text: str | None) -> dict[str, tuple[float, float]]:
 
 
 def _model(urdf: Path | None, robot: str | None, joints: str | None):
-    from ..robot import RigidBodyModel, example_urdf
+    from ..robot import RigidBodyModel
 
-    if (urdf is None) == (robot is None):
-        raise ConfigError("give one of --urdf FILE or --robot NAME")
+    path, default = robot_urdf(urdf, robot)
     if urdf is not None:
         check_paths(inputs={"--urdf": urdf})
-        path, default = urdf, None
-    else:
-        path, default = example_urdf(robot)
     names = [j.strip() for j in joints.split(",") if j.strip()] if joints else default
     return RigidBodyModel.from_urdf(path, names), str(path)
 

@@ -85,21 +85,21 @@ def _whole_arm(files: dict[str, Path], urdf: Path | None, robot: str | None, out
     from ..errors import ConfigError
     from ..fitted.arm import ARM_KIND, ArmFit
     from ..io._jsonfile import read_json
-    from .robot_simulate import _model
+    from ..robot import RigidBodyModel
+    from ._options import robot_urdf
 
     paths = set(files.values())
     doc = read_json(next(iter(paths)), what="model file") if len(paths) == 1 else None
     if not (isinstance(doc, dict) and doc.get("kind") == ARM_KIND):
         raise ConfigError("--to urdf and mjcf take one whole-arm fit (fricid robot fit's file)")
-    if (urdf is None) == (robot is None):
-        raise ConfigError("--to urdf and mjcf need the robot's URDF: give --urdf or --robot")
+    path = robot_urdf(urdf, robot, "--to urdf and mjcf need the robot's URDF: ")[0]
     if out is None:
         raise ConfigError("--to urdf and mjcf write a file: give --out")
     arm = ArmFit.from_dict(doc, source=str(next(iter(paths))))
     values = arm.standard.get("values")
     if values is None:
         raise ConfigError("the arm fit has no standard inertial parameters to write")
-    model = _model(robot, urdf, ",".join(arm.joints))
+    model = RigidBodyModel.from_urdf(path, list(arm.joints))
     return model, np.asarray(values, dtype=float)
 
 

@@ -213,16 +213,9 @@ def robot_extract_command(
     from ..io.urdf import read_urdf
     from ..robot import RigidBodyModel
     from ..samples import join_robot_logs
-    from ._options import parse_assignments
+    from ._options import parse_assignments, robot_urdf
 
-    if (urdf is None) == (robot_name is None):
-        from ..errors import ConfigError
-
-        raise ConfigError("give the robot's URDF (--urdf) or an example robot (--robot), one")
-    if urdf is None:
-        from ..robot import example_urdf
-
-        urdf = example_urdf(robot_name)[0]
+    urdf = robot_urdf(urdf, robot_name)[0]
     names = ["LOG"] if len(logs) == 1 else [f"LOG {k + 1}" for k in range(len(logs))]
     check_paths(
         inputs={**dict(zip(names, logs, strict=True)), "--urdf": urdf},
