@@ -16,7 +16,7 @@ from fricid.io import write_robot_log
 from fricid.robot import RigidBodyModel, example_urdf
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "identify" / "dynamic"))
-from _arm_truth import make_log
+from _arm_truth import make_log, make_lugre_log
 
 runner = CliRunner()
 
@@ -67,7 +67,7 @@ def test_robot_fit_bad_option_is_one_line_and_no_file(pendulum_logs, tmp_path):
     urdf, (log, _) = pendulum_logs
     out = tmp_path / "arm.json"
     res = runner.invoke(
-        app, ["robot", "fit", str(log), "--urdf", str(urdf), "--friction", "lugre", "-o", str(out)]
+        app, ["robot", "fit", str(log), "--urdf", str(urdf), "--friction", "dahl", "-o", str(out)]
     )
     assert res.exit_code == 2
     assert "Traceback" not in res.output
@@ -102,3 +102,24 @@ def test_robot_fit_takes_an_example_robot_or_says_what_it_needs(pendulum_logs, t
     res = runner.invoke(app, [*args, "coulomb_viscous", "-o", str(out)])
     assert res.exit_code == 0, res.output
     assert ArmFit.load(out).provenance["urdf"] == "double_pendulum.urdf"
+
+
+@pytest.mark.slow  # about 15 s
+def test_robot_fit_a_lugre_joint(tmp_path):
+    """``--friction joint2=lugre``: the table shows the joint's LuGre row with its intervals
+    (or why not), the file keeps the family and the second stage's record."""
+    path, joints = example_urdf("double_pendulum")
+    model = RigidBodyModel.from_urdf(path, joints)
+    law = dict(sigma_0=1e4, sigma_1=2.0, sigma_2=0.3, tau_c=0.6, tau_s=0.9, w_s=0.08, delta=2.0)
+    log = write_robot_log(
+        make_lugre_log(model, LAWS, {1: law}, duration=20.0, seed=5), tmp_path / "lugre.csv"
+    )
+    out = tmp_path / "arm.json"
+    args = ["robot", "fit", str(log), "--urdf", str(path), "--friction", "joint2=lugre"]
+    res = runner.invoke(app, [*args, "-o", str(out)], terminal_width=250)
+    assert res.exit_code == 0, res.output
+    assert "lugre" in res.output and "sigma_0" in res.output
+    fit = ArmFit.load(out)
+    assert fit.friction["joint2"]["family"] == "lugre"
+    assert fit.friction["joint1"]["family"] == "stribeck_asym"
+    assert set(fit.provenance["lugre"]) == {"joint2"}

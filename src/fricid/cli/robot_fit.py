@@ -109,7 +109,10 @@ def robot_fit_command(
             help="Friction family for every joint (stribeck_asym, coulomb_viscous_asym, "
             "coulomb_viscous, stribeck; coulomb_viscous_load(_asym): Coulomb friction growing "
             "with the joint's load, eq. 3 of the BAS-RBFNN paper, the load being the log's "
-            "load channel or else the arm's gravity torque) or JOINT=FAMILY,... per joint."
+            "load channel or else the arm's gravity torque; lugre: dynamic friction, its "
+            "bristles identified from every row given the arm's rigid body, each parameter "
+            "reported not determined where the log does not inform it) or JOINT=FAMILY,... "
+            "per joint."
         ),
     ] = "stribeck_asym",
     validate: Annotated[

@@ -77,6 +77,11 @@ def _simpler(family: str) -> str:
     """What to do when a joint's ``family`` leaves parameters undetermined: a family with
     fewer parameters where there is one, else more informative data."""
     more = "or record the joint moving more, slower and both ways"
+    if family == "lugre":
+        return (
+            "fit stribeck (LuGre's steady state) instead, or record the joint reversing "
+            "slowly, many times, with a finer encoder"
+        )
     if family.startswith("stribeck"):
         return f"fit coulomb_viscous{'_asym' if family.endswith('_asym') else ''} instead, {more}"
     if family.endswith("_asym"):

@@ -108,7 +108,7 @@ def test_file_round_trip_and_joint_models(pendulum_fit, tmp_path):
 def test_bad_inputs(pendulum, tmp_path):
     log = make_log(pendulum, CV_LAWS, duration=5.0, seed=3)
     with pytest.raises(ConfigError, match="family"):
-        fit_arm(log, pendulum, friction="lugre")
+        fit_arm(log, pendulum, friction="dahl")
     with pytest.raises(DataError, match="joint"):
         fit_arm(log.rename({"joint1": "other"}), pendulum)
     (tmp_path / "x.json").write_text('{"kind": "something"}')

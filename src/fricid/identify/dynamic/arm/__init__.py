@@ -70,6 +70,15 @@ beyond gravity (:func:`._friction.excess_cap`, :func:`._solve.bounded_lstsq`), a
 direction whose rise the fitted rows see only through the low-pass from the slow rows left
 out (:func:`._solve.unseen_rises`) gets no rise (not determined, and the verdict says so).
 ``benchmarks/results/robot.txt`` (block 2b) gives the held-out ratios before and after.
+
+LuGre joints (``friction="lugre"`` or ``{joint: "lugre"}``): the arm is identified with each
+at its steady state (``stribeck``), then each LuGre joint's seven parameters from every row of
+its torque given the arm's base parameters (:mod:`._lugre`), their intervals the profile
+likelihood's (:mod:`._lugre_profile`); the held-out error predicts that joint with its LuGre
+law on every row.
+
+This module is longer than 500 lines because these notes carry the measured record behind
+each step of the fit, which the code below follows in order.
 """
 
 from __future__ import annotations
@@ -93,6 +102,7 @@ from ._filter_cov import filter_correlation
 from ._friction import NO_LOAD, excess_cap, friction_for
 from ._grade import MIN_EFFECTIVE, grade, loose_levels, unseen_rise_reasons
 from ._load import FROM_FIT, FROM_LOG, FROM_URDF, joint_load, log_load
+from ._lugre import lugre_stage, stand_ins
 from ._polish import polish_shapes
 from ._records import friction_records, interval, mark_held, widen
 from ._rows import (
@@ -193,9 +203,12 @@ def _every_row(Yb, sig: ArmSignals, frictions, theta, shape) -> tuple[np.ndarray
     return residual, [friction_block(sig, jf, j) for j, jf in enumerate(frictions)]
 
 
-def _predict(model, bp, beta, frictions, sig: ArmSignals, theta_f: list[np.ndarray]):
+def _predict(model, bp, beta, frictions, sig: ArmSignals, theta_f: list[np.ndarray], lugre):
     tau = sig.regressor(model, bp) @ beta
     for j, jf in enumerate(frictions):
+        if j in lugre:  # its second stage's law (._lugre)
+            tau[:, j] += lugre[j].predict(sig)
+            continue
         cols = sig.parallel(sig.friction_columns(jf, j))
         tau[:, j] += cols @ np.nan_to_num(theta_f[j])
     return tau
@@ -204,18 +217,23 @@ def _predict(model, bp, beta, frictions, sig: ArmSignals, theta_f: list[np.ndarr
 def fit_arm(log: RobotLog, model: RigidBodyModel, **kwargs: Any) -> ArmFit:
     """Identify a whole arm (:func:`_fit_arm`, on one BLAS thread: the problems are small and
     threads only contend on a shared machine). With a load family and no load channel in the
-    log, twice: the second time with the load of the first fit's arm (:mod:`._load`)."""
+    log, twice: the second time with the load of the first fit's arm (:mod:`._load`). LuGre
+    joints' second stage (:mod:`._lugre`) runs on the pass whose first stage is kept."""
     with one_blas_thread():
         try:
-            fit = _fit_arm(log, model, **kwargs)
-            if kwargs.get("reversal_window") is None:  # closed loop or not, from the sticks
+            auto = kwargs.get("reversal_window") is None
+            lugre = bool(stand_ins(model.joints, kwargs.get("friction", ""))[1])
+            # LuGre's second stage once, on the pass whose first stage is kept (._lugre)
+            fit = _fit_arm(log, model, second_stage=not auto, **kwargs)
+            if auto:  # closed loop or not, from the sticks
                 stuck = sticking(fit.provenance["stick_signature"])
-                if stuck:
-                    kwargs["reversal_window"] = WINDOW_PERIODS
+                if stuck or lugre:
+                    kwargs["reversal_window"] = WINDOW_PERIODS if stuck else 0.0
                     first = fit.provenance["stick_signature"]
                     fit = _fit_arm(log, model, **kwargs)
                     fit.provenance["stick_signature"] = first
-                rise = [fit.friction[j]["family"].startswith("stribeck") for j in model.joints]
+                rises = ("stribeck", "lugre")
+                rise = [fit.friction[j]["family"].startswith(rises) for j in model.joints]
                 fit.provenance["closed_loop"] = closed_loop_text(stuck, model.joints, rise)
             else:
                 told = "closed loop" if kwargs["reversal_window"] > 0 else "open loop"
@@ -245,6 +263,7 @@ def _fit_arm(
     reversal_window: float | None = None,
     torque_delay: float | None = None,
     load_model: RigidBodyModel | None = None,
+    second_stage: bool = True,
 ) -> ArmFit:
     """Identify a whole arm's base inertial parameters and every joint's friction.
 
@@ -256,8 +275,8 @@ def _fit_arm(
     model : RigidBodyModel
         The arm from its URDF (:meth:`fricid.robot.RigidBodyModel.from_urdf`).
     friction : str or mapping
-        A family of :data:`._friction.FAMILIES` for every joint, or joint -> family
-        (others ``stribeck_asym``).
+        A family of :data:`._friction.FAMILIES` or ``lugre`` (:mod:`._lugre`) for every
+        joint, or joint -> family (others ``stribeck_asym``).
     consistent : bool
         Make the inertial parameters physical (:mod:`._consistent`).
     encoder_counts : int, optional
@@ -297,6 +316,7 @@ def _fit_arm(
     """
     start = _time.perf_counter()
     reversal_window = float(reversal_window or 0.0)
+    friction, lugre_names = stand_ins(model.joints, friction)  # LuGre: a second stage
     frictions = friction_for(
         model.joints, dict(friction) if isinstance(friction, Mapping) else friction
     )
@@ -407,6 +427,9 @@ def _fit_arm(
     inflation = np.bincount(st.row_joint, minlength=n) / np.maximum(n_eff, 1e-12)
     for (j, d), prof in shape_profiles(sig, Yb, frictions, moving, safe, inflation).items():
         widen(fric[model.joints[j]]["parameters"], d, prof, frictions[j].excess_max)
+    lugre = {}
+    if second_stage:  # else the fit is a first pass (fit_arm), its stand-ins reported
+        lugre = lugre_stage(sig, Yb, beta, cov[:r, :r], lugre_names, model.joints, fric, sigma, rho)
     # held-out validation with the same filter
     vsig = _signals(validate, model, encoder_counts, sig.cutoff, stops, load_model, parts[1])
     vsig = vsig.delayed(torque_delay)
@@ -415,6 +438,7 @@ def _fit_arm(
         vnear = near_stops(vsig)
         vdistance, vstick = stop_distance(vsig, vnear), stick_columns(vsig, vnear)
     vmoving = _moving(vsig, windows, vdistance)
+    vmoving[:, list(lugre)] = True  # LuGre models the reversals (._lugre)
     pred = _predict(
         model,
         bp,
@@ -422,6 +446,7 @@ def _fit_arm(
         frictions,
         vsig,
         [theta[o : o + len(jf.linear_names)] for o, jf in zip(st.offsets, frictions, strict=True)],
+        lugre,
     )
     err = vsig.tau - pred
     if vstick is not None:  # the held-out log's sticks reach as far as its motion makes them
@@ -429,10 +454,11 @@ def _fit_arm(
         vcolumns = [friction_block(vsig, jf, j) for j, jf in enumerate(frictions)]
         vwindows = adapted_windows(vdistance, free, windows, vcolumns, filter_correlation(vsig))
         vmoving = _moving(vsig, vwindows, vdistance)
+        vmoving[:, list(lugre)] = True
     validation = {}
     for j, name in enumerate(model.joints):
         e, lost = err[vmoving[:, j], j], 0
-        if vstick is not None:  # what no friction law predicts, as in the fit (._sticks)
+        if vstick is not None and j not in lugre:  # what no law predicts, as in the fit
             e, lost = project_out(e, vstick[j][vmoving[:, j]])
         rmse = float(np.sqrt(e @ e / max(e.size - lost, 1))) if e.size else float("nan")
         ratio = rmse / sigma[j] if np.isfinite(sigma[j]) and sigma[j] > 0 else float("nan")
@@ -444,7 +470,7 @@ def _fit_arm(
         level, reasons = grade(ratio, nd, open_, source, moved, loose, problems[name], n_eff[j])
         if moved and n_eff[j] < MIN_EFFECTIVE:  # no ratio from a noise of so few samples
             ratio = float("nan")
-        reasons += unseen_rise_reasons(frictions[j])
+        reasons += lugre[j].reasons() if j in lugre else unseen_rise_reasons(frictions[j])
         validation[name] = {
             "rmse": rmse,
             "ratio": ratio,
@@ -487,6 +513,7 @@ def _fit_arm(
             "stribeck_leaks": {
                 nm: dict(jf.leaks) for nm, jf in zip(model.joints, frictions, strict=True)
             },
+            "lugre": {lj.joint: lj.provenance for lj in lugre.values()},
             "samples": int(st.A.shape[0]),
             "effective_samples": {nm: float(x) for nm, x in zip(model.joints, n_eff, strict=True)},
             "correlation_length": corr_len,
