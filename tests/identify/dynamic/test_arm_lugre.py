@@ -14,7 +14,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _arm_truth import CV_LAWS, lugre_torque, make_lugre_log, reference
 
 from fricid.errors import ConfigError
-from fricid.identify.dynamic.arm._lugre import friction_at_samples, stand_ins
+from fricid.identify.dynamic.arm._lugre import _unresolved_rise, friction_at_samples, stand_ins
 from fricid.identify.dynamic.arm._lugre_profile import Better, profile_interval
 from fricid.models.lugre import PARAM_NAMES
 
@@ -28,6 +28,26 @@ def test_stand_ins_replace_lugre_by_its_steady_state():
     mapping, lugre = stand_ins(joints, {"a": "coulomb_viscous", "b": " LuGre "})
     assert mapping == {"a": "coulomb_viscous", "b": "stribeck"}
     assert lugre == ["b"]
+
+
+def _records(w_s_ci):
+    rec = {"unit": "", "stderr": 0.1, "not_determined": False, "note": ""}
+    out = {n: {**rec, "value": 1.0, "ci95": [0.5, 2.0]} for n in PARAM_NAMES}
+    out["w_s"] = {**rec, "value": 0.01, "ci95": list(w_s_ci)}
+    return out
+
+
+def test_an_unresolved_stribeck_velocity_leaves_the_bristles_and_rise_undetermined():
+    resolved = _records([0.005, 0.02])
+    _unresolved_rise(resolved, 1e-3)
+    assert not any(r["not_determined"] for r in resolved.values())
+    for ci in ([1e-3, 0.02], [0.002, 0.2]):  # at the box's lower end; over a factor of 30
+        recs = _records(ci)
+        _unresolved_rise(recs, 1e-3)
+        nd = {n for n, r in recs.items() if r["not_determined"]}
+        assert nd == {"sigma_0", "sigma_1", "tau_s", "w_s", "delta"}
+        assert recs["tau_s"]["value"] is None
+        assert "Stribeck velocity is not resolved" in recs["sigma_0"]["note"]
 
 
 def test_friction_at_samples_matches_an_independent_integrator(pendulum):

@@ -17,7 +17,9 @@ uncertainty) to the variance without them (what the correlated rows add,
 until the profile crosses; the crossing is then interpolated on the signed root of the
 profile (twice). A side that reaches the search box's end below the threshold is open. A
 profile point below the least cost means the search had stopped short or in another valley:
-the fit restarts from it (:class:`Better`).
+the fit restarts from it (:class:`Better`), a few times at most; then the profiles are taken
+about the best point the search found (an interval about a point above the least cost is
+wider than the least cost's).
 
 sigma_0 and sigma_1 are profiled over a grid across their whole box instead
 (:func:`grid_interval`): their valleys are long and flat (sigma_1's cost changed by a few
@@ -42,9 +44,10 @@ MAX_DOUBLINGS = 8
 #: tolerance on the cost (a threshold is some units on a cost of as many units as rows).
 POINT_EVALS = 60
 POINT_FTOL = 1e-6
-#: A profile point this share of the threshold below the least cost is a better fit (less
-#: is the searches' own tolerance: counted as at the least cost).
-BETTER = 0.05
+#: A profile point this share of the threshold below the least cost is a better fit to
+#: restart from. Less is counted as at the least cost: a base above the least cost widens
+#: the interval, never narrows it.
+BETTER = 0.25
 
 
 class Better(Exception):
@@ -60,6 +63,7 @@ class _Profile:
     residual: Callable[[np.ndarray], np.ndarray]
     lo: np.ndarray
     hi: np.ndarray
+    restart: bool = True
     calls: int = 0
 
     def cost(self, x: np.ndarray, k: int, value: float) -> tuple[float, np.ndarray]:
@@ -84,6 +88,14 @@ class _Profile:
         return 2.0 * float(sol.cost), z
 
 
+def _cross(inside: float, r_in: float, out: float, r_out: float, limit: float) -> float:
+    """Where the profile's signed root reaches ``sqrt(limit)``, linearly between a point
+    inside (root ``r_in``) and one outside (``r_out``); halfway when they do not differ."""
+    if not r_out > r_in:
+        return 0.5 * (inside + out)
+    return inside + (math.sqrt(limit) - r_in) / (r_out - r_in) * (out - inside)
+
+
 def _side(p: _Profile, x, k, d, half, limit, base) -> float | None:
     end = p.hi[k] if d > 0 else p.lo[k]
     inside, r_in, x_in = x[k], 0.0, x
@@ -93,20 +105,20 @@ def _side(p: _Profile, x, k, d, half, limit, base) -> float | None:
         last = d * (v - end) >= 0
         v = end if last else v
         c, z = p.cost(x_in, k, v)
-        if c < base - BETTER * limit:
+        if p.restart and c < base - BETTER * limit:
             raise Better(z)
         if c - base > limit:
             out, r_out = v, math.sqrt(c - base)
             for _ in range(2):  # the signed root is about linear in the parameter
-                mid = inside + (math.sqrt(limit) - r_in) / (r_out - r_in) * (out - inside)
+                mid = _cross(inside, r_in, out, r_out, limit)
                 cm, zm = p.cost(x_in, k, mid)
-                if cm < base - BETTER * limit:
+                if p.restart and cm < base - BETTER * limit:
                     raise Better(zm)
                 if cm - base > limit:
                     out, r_out = mid, math.sqrt(cm - base)
                 else:
                     inside, r_in, x_in = mid, math.sqrt(max(cm - base, 0.0)), zm
-            return inside + (math.sqrt(limit) - r_in) / (r_out - r_in) * (out - inside)
+            return _cross(inside, r_in, out, r_out, limit)
         if last:
             return None
         inside, r_in, x_in = v, math.sqrt(max(c - base, 0.0)), z
@@ -114,7 +126,9 @@ def _side(p: _Profile, x, k, d, half, limit, base) -> float | None:
     return None
 
 
-def profile_interval(residual, x, k, half, limit, lo, hi) -> tuple[float | None, float | None, int]:
+def profile_interval(
+    residual, x, k, half, limit, lo, hi, restart: bool = True
+) -> tuple[float | None, float | None, int]:
     """(lower end, upper end, evaluations) of parameter ``k``'s profile interval about the
     estimate ``x``: where the least ``sum r^2`` with ``x[k]`` fixed stays within ``limit`` of
     ``sum r^2`` at ``x`` (module notes); None for a side open to the box ``lo``, ``hi``.
@@ -123,9 +137,10 @@ def profile_interval(residual, x, k, half, limit, lo, hi) -> tuple[float | None,
     Raises
     ------
     Better
-        A profile point fits better than ``x``.
+        A profile point fits better than ``x`` (unless ``restart`` is false: the interval is
+        then taken about ``x``, wider than about the better point).
     """
-    p = _Profile(residual, lo, hi)
+    p = _Profile(residual, lo, hi, restart)
     r = residual(x)
     base = float(r @ r)
     half = max(float(half), 1e-6 * (hi[k] - lo[k]) if np.isfinite(hi[k] - lo[k]) else 1e-6)
@@ -134,7 +149,9 @@ def profile_interval(residual, x, k, half, limit, lo, hi) -> tuple[float | None,
     return lower, upper, p.calls
 
 
-def grid_interval(residual, x, k, grid, limit, lo, hi) -> tuple[float | None, float | None, int]:
+def grid_interval(
+    residual, x, k, grid, limit, lo, hi, restart: bool = True
+) -> tuple[float | None, float | None, int]:
     """:func:`profile_interval` for parameter ``k`` from its profile on ``grid`` (ascending,
     across the box), walked out from the estimate both ways with warm starts; the ends
     interpolated on the signed root between grid points, then once more.
@@ -142,9 +159,10 @@ def grid_interval(residual, x, k, grid, limit, lo, hi) -> tuple[float | None, fl
     Raises
     ------
     Better
-        A grid point fits better than ``x`` (the best one is given).
+        A grid point fits better than ``x`` (the best one is given), unless ``restart`` is
+        false.
     """
-    p = _Profile(residual, lo, hi)
+    p = _Profile(residual, lo, hi, restart)
     r = residual(x)
     base = float(r @ r)
     grid = np.asarray(grid, dtype=float)
@@ -157,7 +175,7 @@ def grid_interval(residual, x, k, grid, limit, lo, hi) -> tuple[float | None, fl
             costs[i], points[i] = p.cost(start, k, float(grid[i]))
             start = points[i]
     best = int(np.nanargmin(costs))
-    if costs[best] < base - BETTER * limit:
+    if p.restart and costs[best] < base - BETTER * limit:
         raise Better(points[best])
     root = np.sqrt(np.clip(costs - base, 0.0, None))
     ends: list[float | None] = []
@@ -171,12 +189,12 @@ def grid_interval(residual, x, k, grid, limit, lo, hi) -> tuple[float | None, fl
             ends.append(None)
             continue
         out_v, r_out = grid[i], root[i]
-        mid = inside_v + (math.sqrt(limit) - r_in) / (r_out - r_in) * (out_v - inside_v)
+        mid = _cross(inside_v, r_in, out_v, r_out, limit)
         cm, _ = p.cost(x_in, k, mid)
         rm = math.sqrt(max(cm - base, 0.0))
         if cm - base > limit:
             out_v, r_out = mid, rm
         else:
             inside_v, r_in = mid, rm
-        ends.append(inside_v + (math.sqrt(limit) - r_in) / (r_out - r_in) * (out_v - inside_v))
+        ends.append(_cross(inside_v, r_in, out_v, r_out, limit))
     return ends[0], ends[1], p.calls
