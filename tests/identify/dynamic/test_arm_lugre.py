@@ -148,3 +148,16 @@ def test_lugre_joint_model_refuses_what_is_not_determined(lugre_fit, pendulum):
     else:
         model = fit.joint_model(joint)
         assert model.model == "lugre"
+
+
+@pytest.mark.slow
+def test_robot_c_export_takes_a_lugre_joints_steady_state(lugre_fit, pendulum):
+    from fricid.export.robot import _lugre_steady_state, robot_c_code
+
+    joint = pendulum.joints[1]
+    model = lugre_fit.joint_model(joint)  # every parameter determined on this seed
+    code = robot_c_code({joint: model}, robot="arm")
+    assert "LuGre's steady state" in code.source
+    steady = _lugre_steady_state(model)
+    v = np.array([-1.0, -0.05, 0.02, 0.5])
+    assert np.allclose(steady.predict_point(v), model.predict_point(v))
