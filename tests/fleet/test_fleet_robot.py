@@ -131,7 +131,7 @@ def test_robot_row_paths_and_defaults(arm):
     [
         ("dp,arm,logs/dp.parquet,dp.urdf,stribeck,", "model", "a robot row"),
         ("dp,j1,logs/dp.parquet,,,stribeck_asym", "friction", "give the row its 'urdf'"),
-        ("dp,arm,logs/dp.parquet,dp.urdf,,lugre", "friction", "must be one of"),
+        ("dp,arm,logs/dp.parquet,dp.urdf,,dahl", "friction", "must be one of"),
     ],
 )
 def test_manifest_refuses_columns_of_the_other_kind_of_row(arm, row, column, words):

@@ -41,8 +41,9 @@ def test_schema_mirrors_the_registries():
     assert PROPERTIES["direction"]["enum"] == list(DIRECTIONS)
     assert PROPERTIES["samples"]["enum"] == list(SAMPLE_SETS)
     from fricid.identify.dynamic.arm._friction import FAMILIES
+    from fricid.identify.dynamic.arm._lugre import LUGRE
 
-    assert PROPERTIES["friction"]["enum"] == sorted(FAMILIES)  # a robot row's families
+    assert PROPERTIES["friction"]["enum"] == sorted((*FAMILIES, LUGRE))  # a robot row's
     options = {o for opts in READER_OPTIONS.values() for o in opts}
     reader_fields = {f.option for f in FIELDS.values() if f.group == "reader"}
     assert reader_fields <= options  # every reader column fills some reader's option
