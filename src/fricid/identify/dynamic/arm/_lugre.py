@@ -7,41 +7,44 @@ at constant velocity), which gives the base inertial parameters ``beta`` and the
 each LuGre joint's seven parameters by the equation error of its own torque on *every* row
 (the slow rows and reversals the static fit may leave out are where the bristles show)::
 
-    L(tau_j) - L(Y_b,j) beta = L(F_LuGre(theta; v_j))
+    L(tau_j) - L(Y_b,j) beta = L(F_LuGre(theta; v_j)) + a_j L(d tau_j)
 
-``L`` what the torque went through (:meth:`._signals.ArmSignals.parallel`), ``F_LuGre`` the
-period means of LuGre's friction (:func:`fricid.models.lugre.mean_friction`) driven by the
-joint's friction velocity at the log's rate (``ArmSignals.full_dq``), from the steady state at
-the first sample: the parallel filtering of the single-joint ``filtered`` route
-(:mod:`.._filtered`), with the rigid body known. A joint's friction enters its own torque only,
-so one joint at a time is one problem of seven parameters. sigma_0 and sigma_1 are searched as
-log10 in the single-joint route's box (:data:`.._filtered.LOG_BOX`), from the best of a grid
-of sigma_0 (sigma_1 as :func:`fricid.sim.robot_lugre.lugre_like` sets it), by
+``L`` what the torque went through (:meth:`._signals.ArmSignals.parallel`); ``F_LuGre`` at the
+sample instants, as the regressor is (:func:`friction_at_samples`: the bristle state stepped
+exactly over each period at the period's mean velocity; friction taken as period means lagged
+the regressor by half a sample, which left a misfit of 0.4 times the filtered noise on the
+open-loop truth); the velocity the position through the cut-off's low-pass
+(:func:`bristle_velocity`: through the wider band the static columns use, the encoder's steps
+biased the bristles, whose travel is a few counts); ``a_j`` a change of the torque's delay, a
+nuisance projected out (the stand-in's delay takes some of the bristles' lag). A joint's
+friction enters its own torque only, so each LuGre joint is one problem of seven parameters.
+sigma_0 and sigma_1 are searched as log10 in the single-joint route's box
+(:data:`.._filtered.LOG_BOX`), from the best starts of a grid (sigma_0, w_s, delta) by
 ``scipy.optimize.least_squares`` within bounds.
 
-Intervals: the covariance of the joint's rows with the filter's own correlation and the
-residuals' (:func:`._solve.arm_covariance`), with ``beta``'s uncertainty carried in (the
-two-step covariance of Murphy and Topel 1985: ``+ G cov(beta) G'``, ``G`` the estimate's
-sensitivity to ``beta``); sigma_0 and sigma_1 on the log scale.
+Intervals: tau_c's and sigma_2's from the covariance of the joint's rows with the filter's own
+correlation and the residuals' (:func:`._solve.arm_covariance`) and ``beta``'s uncertainty
+carried in (Murphy and Topel 1985: ``+ G cov(beta) G'``, ``G`` the estimate's sensitivity to
+``beta``). sigma_0, sigma_1, tau_s, w_s and delta trade against each other at a reversal,
+where the low-pass (some hertz) smooths what happens in milliseconds; their intervals are the
+profile likelihood's (:mod:`._lugre_profile`), each the projection of the five's joint 95 %
+region (chi-square with :data:`PROFILE_DOF` degrees of freedom, scaled by what the correlated
+rows and ``beta`` add). Each parameter's own profile (one degree of freedom) covered the truth
+in 73-80 % of the seeds for sigma_0, tau_s and w_s with a Stribeck velocity of 0.03 rad/s
+(``benchmarks/bench_arm_lugre.py --law e``, 15 determined of 20), while 95-100 % at 0.08.
 
-The Stribeck velocity must be resolved. On the tests' open-loop truth with a Stribeck velocity
-of 0.008 rad/s and sigma_0 = 1e5 N m/rad (``benchmarks/bench_arm_lugre.py --law c``), which the
-joint crosses in milliseconds at a reversal, far below the low-pass's resolution, the profile
-intervals of sigma_0, tau_s and w_s covered the truth in 55-60 % of 20 seeds: the rise is seen
-there only as an impulse, and the weakly identified parameters trade against each other where
-the profile's chi-square calibration does not hold. Those fits all had a w_s interval reaching
-the box's lower end or spanning more than a factor of 30 (:data:`W_S_SPAN`), while with
-Stribeck velocities of 0.08 rad/s (laws ``a`` and ``b``, 50 seeds) the widest spanned 14.7:
-beyond it sigma_0, sigma_1, tau_s, w_s and delta are reported not determined
-(:func:`_unresolved_rise`; chosen on those three laws, checked on law ``e`` and on the
-closed-loop truth).
+The Stribeck velocity must be resolved. With a Stribeck velocity of 0.008 rad/s and sigma_0 =
+1e5 N m/rad (``--law c``), which the joint crosses in milliseconds at a reversal, the
+one-degree profiles of sigma_0, tau_s and w_s covered the truth in 55-60 % of 20 seeds: the rise
+is seen only as an impulse there. Those fits all had a w_s interval reaching the box's lower
+end or spanning more than a factor of 30 (:data:`W_S_SPAN`), while at 0.08 rad/s (laws ``a``
+and ``b``, 50 seeds) the widest spanned 14.7: beyond it sigma_0, sigma_1, tau_s, w_s and
+delta are reported not determined (:func:`_unresolved_rise`). Both choices were made on laws
+``a``, ``b``, ``c`` and ``e``; law ``f`` and the closed-loop truth (``--truth sim``) check them.
 
-Where the data inform it: the arm's low-pass (a cut-off of some hertz, chosen for the rigid
-body) smooths the bristles' transient at a reversal, which lasts milliseconds, so sigma_0 and
-sigma_1 are often not determined. A parameter at its search box's edge
-(:data:`EDGE_DECADES`), or whose 95 % interval spans more than :data:`MAX_DECADES` decades
-either side, is reported not determined, with the reason; the joint's steady state (tau_c,
-tau_s, w_s, delta, sigma_2) is then still LuGre's, determined as the stand-in's was.
+A parameter at its search box's edge (:data:`EDGE_DECADES`), or whose profile stays flat to
+both ends of the box, is not determined; one flat on one side is not bounded there, its
+interval ending at the box.
 """
 
 from __future__ import annotations
@@ -54,6 +57,7 @@ from typing import Any
 
 import numpy as np
 import scipy.optimize
+import scipy.stats
 
 from ....models import get_model, lugre
 from .._filtered import LOG_BOX
@@ -77,14 +81,16 @@ DELTA_GRID = (1.0, 2.0)
 LOCAL_SEARCHES = 4
 #: A log-searched parameter within this many decades of its box's edge is not determined.
 EDGE_DECADES = 0.05
-#: ... nor one whose 95 % interval reaches more than this many decades either side.
-MAX_DECADES = 1.0
 #: The parameters whose intervals are their profiles' (:mod:`._lugre_profile`): sigma_0,
 #: sigma_1, tau_s, w_s, delta; tau_c and sigma_2 enter about linearly (Wald's).
 PROFILED = (1, 0, 4, 5, 6)
 #: A Stribeck velocity whose 95 % interval spans more than this factor is not resolved:
 #: then the bristles' and the rise's parameters are not determined (:func:`_unresolved_rise`).
 W_S_SPAN = 30.0
+#: Degrees of freedom of the profiles' threshold: the five weakly identified parameters
+#: (sigma_0, sigma_1, tau_s, w_s, delta), each interval the projection of their joint 95 %
+#: region (module notes).
+PROFILE_DOF = 5
 #: The grid [decades] of sigma_0's and sigma_1's profiles.
 GRID_STEP = 1.0
 #: Searches restarted from a profile point that fits better, at most (then the profiles are
@@ -274,7 +280,8 @@ def fit_lugre_joint(
             for k in PROFILED:
                 inflation = cov[k, k] / naive[k] if naive[k] > 0 else 1.0
                 inflation = float(inflation) if np.isfinite(inflation) else 1.0
-                limit = t**2 * max(inflation, 1.0) * (sigma / scale) ** 2
+                q = float(scipy.stats.chi2.ppf(0.95, PROFILE_DOF))
+                limit = q * max(inflation, 1.0) * (sigma / scale) ** 2
                 if k in _LOG:  # long flat valleys: the whole box (._lugre_profile)
                     grid = np.arange(lo[k], hi[k] + 1e-9, GRID_STEP)
                     low, high, calls = grid_interval(residual, x, k, grid, limit, lo, hi, restart)

@@ -9,17 +9,17 @@ is flat on one side and a cliff on the other (the bristles' damping acts only du
 transient at a reversal).
 
 A parameter's interval is where its profile, the least cost with it fixed and every other
-parameter free (:func:`profile_interval`), stays within ``t^2 c`` of the least cost in units
-of the noise's variance: ``t`` the quantile the Wald intervals use, ``c >= 1`` the ratio of the
-parameter's variance with the filter's and the residuals' correlation (and ``beta``'s
-uncertainty) to the variance without them (what the correlated rows add,
-:func:`._solve.arm_covariance`). Each side is stepped out from the Wald half-width, doubling,
-until the profile crosses; the crossing is then interpolated on the signed root of the
-profile (twice). A side that reaches the search box's end below the threshold is open. A
-profile point below the least cost means the search had stopped short or in another valley:
-the fit restarts from it (:class:`Better`), a few times at most; then the profiles are taken
-about the best point the search found (an interval about a point above the least cost is
-wider than the least cost's).
+parameter free (:func:`profile_interval`), stays within ``q c`` of the least cost in units
+of the noise's variance: ``q`` a chi-square quantile (the caller's: :data:`._lugre.PROFILE_DOF`),
+``c >= 1`` the ratio of the parameter's variance with the filter's and the residuals'
+correlation (and ``beta``'s uncertainty) to the variance without them (what the correlated
+rows add, :func:`._solve.arm_covariance`). Each side is stepped out from the Wald
+half-width, doubling, until the profile crosses; the crossing is then interpolated on the
+signed root of the profile (twice). A side that reaches the search box's end below the
+threshold is open. A profile point below the least cost means the search had stopped short or
+in another valley: the fit restarts from it (:class:`Better`), a few times at most; then the
+profiles are taken about the best point the search found (an interval about a point above the
+least cost is wider than the least cost's).
 
 sigma_0 and sigma_1 are profiled over a grid across their whole box instead
 (:func:`grid_interval`): their valleys are long and flat (sigma_1's cost changed by a few
