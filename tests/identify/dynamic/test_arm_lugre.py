@@ -14,7 +14,12 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _arm_truth import CV_LAWS, lugre_torque, make_lugre_log, reference
 
 from fricid.errors import ConfigError
-from fricid.identify.dynamic.arm._lugre import _unresolved_rise, friction_at_samples, stand_ins
+from fricid.identify.dynamic.arm._lugre import (
+    _unresolved_rise,
+    _untold_viscous,
+    friction_at_samples,
+    stand_ins,
+)
 from fricid.identify.dynamic.arm._lugre_profile import Better, profile_interval
 from fricid.models.lugre import PARAM_NAMES
 
@@ -48,6 +53,16 @@ def test_an_unresolved_stribeck_velocity_leaves_the_bristles_and_rise_undetermin
         assert nd == {"sigma_0", "sigma_1", "tau_s", "w_s", "delta"}
         assert recs["tau_s"]["value"] is None
         assert "Stribeck velocity is not resolved" in recs["sigma_0"]["note"]
+
+
+def test_a_viscous_level_not_determined_leaves_the_coulomb_level_undetermined():
+    recs = _records([0.005, 0.02])
+    _untold_viscous(recs)
+    assert not recs["tau_c"]["not_determined"]
+    recs["sigma_2"] = {**recs["sigma_2"], "value": None, "not_determined": True}
+    _untold_viscous(recs)
+    assert recs["tau_c"]["not_determined"] and recs["tau_c"]["value"] is None
+    assert "sigma_2" in recs["tau_c"]["note"]
 
 
 def test_friction_at_samples_matches_an_independent_integrator(pendulum):

@@ -90,7 +90,7 @@ class JointFriction:
     def __post_init__(self) -> None:
         if self.family not in FAMILIES:
             raise ConfigError(
-                f"friction family {self.family!r} is not one of {', '.join(FAMILIES)}"
+                f"friction family {self.family!r} is not one of {', '.join(FAMILIES)} or lugre"
             )
         if self.stribeck and not self.shapes:
             self.shapes = {d: (W_S_START, DELTA_START) for d in self.directions}

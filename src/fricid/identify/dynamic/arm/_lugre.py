@@ -304,6 +304,7 @@ def fit_lugre_joint(
         for k, name in enumerate(_NAMES)
     }
     _unresolved_rise(records, lo[5])
+    _untold_viscous(records)
     provenance = {
         "stage": "equation error given the arm's base parameters, every row",
         "start_sigma_0": float(10.0 ** starts[0][1][0]),
@@ -396,6 +397,21 @@ def _unresolved_rise(records: dict[str, dict[str, Any]], w_s_low: float) -> None
         unit = records[name]["unit"]
         records[name] = {"value": None, "unit": unit, "stderr": None, "ci95": [None, None],
                          "not_determined": True, "note": why}  # fmt: skip
+
+
+def _untold_viscous(records: dict[str, dict[str, Any]]) -> None:
+    """tau_c not determined where sigma_2 is not: the search holds sigma_2 at zero, and the
+    Coulomb level then takes what the viscous term would (a tight interval about a biased
+    level, measured on a PD-tracked light arm that stuck at more than half its samples:
+    tau_c 27 % high, six standard errors from the truth)."""
+    if not records["sigma_2"]["not_determined"] or records["tau_c"]["not_determined"]:
+        return
+    unit = records["tau_c"]["unit"]
+    records["tau_c"] = {
+        "value": None, "unit": unit, "stderr": None, "ci95": [None, None], "not_determined": True,
+        "note": "not determined: the viscous level sigma_2 is not, and the Coulomb level takes "
+        "what the viscous term would",
+    }  # fmt: skip
 
 
 def _span(name: str, lo: float, hi: float, k: int) -> str:
