@@ -58,11 +58,11 @@ LAWS = {
     "a": dict(sigma_0=1e4, sigma_1=2.0, sigma_2=0.3, tau_c=0.6, tau_s=0.9, w_s=0.08, delta=2.0),
     "b": dict(sigma_0=1e3, sigma_1=0.5, sigma_2=0.3, tau_c=0.6, tau_s=0.9, w_s=0.08, delta=2.0),
     "c": dict(sigma_0=1e5, sigma_1=1.0, sigma_2=0.2, tau_c=0.4, tau_s=0.6, w_s=0.008, delta=1.0),
-    # the light arm's own scale: lugre_like of example_friction([12, 12])'s joint 2, + side
     # between a and c: its seeds 1, 3, 6 and 8 chose the profiles' degrees of freedom
     "e": dict(sigma_0=3e4, sigma_1=1.5, sigma_2=0.25, tau_c=0.5, tau_s=0.75, w_s=0.03, delta=1.5),
     # checked only, never tuned on
     "f": dict(sigma_0=5e3, sigma_1=1.0, sigma_2=0.2, tau_c=0.45, tau_s=0.7, w_s=0.05, delta=1.2),
+    # the light arm's own scale: lugre_like of example_friction([12, 12])'s joint 2, + side
     "d": dict(
         sigma_0=1324.8,
         sigma_1=0.0897,

@@ -31,6 +31,7 @@ from pathlib import Path
 
 from .. import __version__
 from ..fitted import FittedModel
+from ..models.lugre import STRIBECK_NAMES
 from ..models.smoothing import Smoothing
 from ._common import ExportError, check_identifier, plain, trust_of
 from .c import c_code
@@ -153,8 +154,7 @@ def _joint_block(code, header_name: str, tag: str) -> str:
 def _lugre_steady_state(fitted: FittedModel) -> FittedModel:
     """A LuGre joint's steady state as the ``stribeck`` model it is at constant velocity
     ([CW95]; ``tau_v = sigma_2``): what a friction feed-forward can hold."""
-    names = {"tau_c": "tau_c", "tau_s": "tau_s", "w_s": "w_s", "tau_v": "sigma_2", "delta": "delta"}
-    params = {new: replace(fitted.parameters[old], name=new) for new, old in names.items()}
+    params = {new: replace(fitted.parameters[old], name=new) for new, old in STRIBECK_NAMES.items()}
     return replace(fitted, model="stribeck", parameters=params)
 
 

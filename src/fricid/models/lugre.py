@@ -65,6 +65,7 @@ __all__ = [
     "PARAMETERS",
     "PARAM_NAMES",
     "ROW_THREADS",
+    "STRIBECK_NAMES",
     "LuGre",
     "in_row_threads",
     "mean_friction",
@@ -93,6 +94,15 @@ PARAMETERS: tuple[Parameter, ...] = (
     Parameter("delta", "1", "one", 1.0, 0.2, 4.0, "Stribeck exponent", "positive"),
 )
 PARAM_NAMES: tuple[str, ...] = tuple(p.name for p in PARAMETERS)
+#: LuGre's steady state as the static ``stribeck`` model ([CW95]: at constant velocity LuGre
+#: is the Stribeck law with ``tau_v = sigma_2``): stribeck name -> LuGre name.
+STRIBECK_NAMES: dict[str, str] = {
+    "tau_c": "tau_c",
+    "tau_s": "tau_s",
+    "w_s": "w_s",
+    "tau_v": "sigma_2",
+    "delta": "delta",
+}
 
 _TINY = 1e-12
 

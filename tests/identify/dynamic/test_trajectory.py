@@ -170,7 +170,6 @@ def test_only_the_reported_stages_decide_a_trajectory_fits_convergence():
     from types import SimpleNamespace
 
     from fricid.identify.dynamic._outcome import _deciding
-    from fricid.identify.dynamic.trajectory import _STATIC_OF_LUGRE
     from fricid.models import lugre
 
     regression = SimpleNamespace(names=[*Stribeck().param_names, "inertia", "p_x", "p_y"])
@@ -182,11 +181,11 @@ def test_only_the_reported_stages_decide_a_trajectory_fits_convergence():
         ("refinement_1", regression),
         ("simulation after refinement_1", simulation),
     ]
-    assert _deciding(two_stage, _STATIC_OF_LUGRE) == [False, False, True, True]
+    assert _deciding(two_stage, lugre.STRIBECK_NAMES) == [False, False, True, True]
     joint = [*two_stage, ("simulation_joint", every)]
-    assert _deciding(joint, _STATIC_OF_LUGRE) == [False] * 4 + [True]
+    assert _deciding(joint, lugre.STRIBECK_NAMES) == [False] * 4 + [True]
     filtered = [("regression", regression), ("filtered", every)]
-    assert _deciding(filtered, _STATIC_OF_LUGRE) == [False, True]
+    assert _deciding(filtered, lugre.STRIBECK_NAMES) == [False, True]
     assert _deciding(filtered, {}) == [True, True]  # without the renaming tau_v is not covered
     assert _deciding([("regression", regression)], {}) == [True]
 

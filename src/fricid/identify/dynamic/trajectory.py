@@ -155,7 +155,7 @@ from typing import Any
 
 from ...errors import ConfigError, DataError
 from ...fitted import FittedModel
-from ...models import get_model
+from ...models import get_model, lugre
 from ...samples import RawLog, check_trajectory_log
 from ._data import DerivativeFilter, check_dissipates, guarded_sliding, sliding, uniform_series
 from ._encoder import measurement
@@ -209,15 +209,6 @@ DYNAMIC_MODELS = ("lugre", "dahl")
 
 #: The Dahl static part, as named in the ``coulomb_viscous`` model.
 _STATIC_OF_DAHL = {"f_c": "tau_c", "beta": "sigma_2"}
-
-#: The LuGre static part, as named in the ``stribeck`` model.
-_STATIC_OF_LUGRE = {
-    "tau_c": "tau_c",
-    "tau_s": "tau_s",
-    "w_s": "w_s",
-    "tau_v": "sigma_2",
-    "delta": "delta",
-}
 
 
 def fit_trajectory(
@@ -417,7 +408,7 @@ def fit_trajectory(
     if key == "coulomb_viscous":  # a per-direction law fits better? (._outcome)
         direction = direction_caveat(per_direction(series, derivative, vf, acc, mask, args))
     stages = {"regression": stage1}
-    rename = {"lugre": _STATIC_OF_LUGRE, "dahl": _STATIC_OF_DAHL}.get(key, {})
+    rename = {"lugre": lugre.STRIBECK_NAMES, "dahl": _STATIC_OF_DAHL}.get(key, {})
     joint_vals = dict(zip(JOINT_PARAMS, [*list(c), 0.0, 0.0], strict=False))
     fits = [("regression", stage1)] if stage1.result is not None else []
     # the static part as the result states it: from the regression or the sweeps

@@ -275,12 +275,12 @@ def fit_lugre_joint(
         cov = cov + G @ cov_beta @ G.T
         se = np.sqrt(np.clip(np.diag(cov), 0.0, None))
         naive = np.diag(np.linalg.pinv(J_w.T @ J_w))
+        q = float(scipy.stats.chi2.ppf(0.95, PROFILE_DOF))
         try:
             ends = {}
             for k in PROFILED:
                 inflation = cov[k, k] / naive[k] if naive[k] > 0 else 1.0
                 inflation = float(inflation) if np.isfinite(inflation) else 1.0
-                q = float(scipy.stats.chi2.ppf(0.95, PROFILE_DOF))
                 limit = q * max(inflation, 1.0) * (sigma / scale) ** 2
                 if k in _LOG:  # long flat valleys: the whole box (._lugre_profile)
                     grid = np.arange(lo[k], hi[k] + 1e-9, GRID_STEP)
