@@ -8,6 +8,8 @@ Lischinsky 1995, eq. 2-4 and 8, with a Stribeck exponent ``delta`` and a gravity
     dz/dt = v - sigma0 |v| z / g(v),   g(v) = Fc + (Fs - Fc) exp(-|v / vs|^delta)
     F     = sigma0 z + sigma1 dz/dt + sigma2 v
 
+(``Fc`` and ``Fs`` times ``neg`` where ``v < 0``: a joint whose friction differs by
+direction; 1 by default)
 integrated by classic fixed-step Runge-Kutta 4 on ``(q, v, z)`` at a fine internal step
 (``h``, default 5 us, at most half of the bristle rate's stability limit at 6 rad/s:
 :func:`internal_steps`), compiled by numba, the torque held over each drive period
@@ -56,6 +58,9 @@ class Truth:
     vs: float
     delta: float
     noise: float
+    #: The negative direction's Coulomb and break-away levels over the positive's (1:
+    #: symmetric; real joints often differ by direction).
+    neg: float = 1.0
 
     def fricid_names(self) -> dict[str, float]:
         """The same truth in fricid's names and gravity convention."""
@@ -76,7 +81,7 @@ class Truth:
         return np.array(
             [
                 *(self.J, self.mgl, self.phi, self.sigma0, self.sigma1, self.sigma2),
-                *(self.Fc, self.Fs, self.vs, self.delta),
+                *(self.Fc, self.Fs, self.vs, self.delta, self.neg),
             ]
         )
 
@@ -107,6 +112,8 @@ def _rhs(p, q, v, z, u):  # pragma: no cover - compiled
         p[8],
         p[9],
     )
+    if v < 0.0:  # the negative direction's levels
+        fc, fs = fc * p[10], fs * p[10]
     g = fc + (fs - fc) * math.exp(-(abs(v / vs) ** dl))
     zd = v - s0 * abs(v) * z / g
     f = s0 * z + s1 * zd + s2 * v

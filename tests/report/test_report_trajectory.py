@@ -72,8 +72,10 @@ def test_cli_reports_a_trajectory_model_with_a_held_out_log(files, tmp_path):
 
 @pytest.mark.slow  # 3-5 s measured under load: four figures rendered
 def test_the_document_without_a_held_out_log():
-    pred = predict_trajectory(truth_model(), multisine_log(7, 1.5))
-    doc = trajectory_report(truth_model(), pred, log_label="traj5.parquet")
+    model = truth_model()
+    model.provenance["trajectory"]["gravity_note"] = "the gravity rests on ..."  # the fit's
+    pred = predict_trajectory(model, multisine_log(7, 1.5))
+    doc = trajectory_report(model, pred, log_label="traj5.parquet")
     assert {f.name for f in doc.figures()} == {
         "torque_log",
         "residual_velocity_log",
@@ -84,6 +86,8 @@ def test_the_document_without_a_held_out_log():
     assert list(metrics.columns) == ["metric", "traj5.parquet"]
     joint = next(t for t in doc.tables() if t.name == "joint").frame
     assert joint["value"].tolist() == [0.01, 0.3, 0.1]
+    caption = next(t for t in doc.tables() if t.name == "joint").caption
+    assert caption == "the gravity rests on ..."
     assert doc.meta["RMS torque error on it [N m]"] == pred.metrics()["rmse"]
     assert np.isfinite(pred.metrics()["rmse_filtered"])
 

@@ -89,6 +89,8 @@ def trajectory_text(fitted) -> str:
     why = "the fit did not converge" if conv and not conv.get("converged") else "not determined"
     for name, row in info.get("joint", {}).items():
         lines.append(f"    {name}: {row['value']:.6g} {_interval(row, why)}")
+    if info.get("gravity_note"):
+        lines.append(f"    gravity: {info['gravity_note']}")
     for name, route in info.get("routes", {}).items():
         rms = ", ".join(f"{k} {v:.3g}" for k, v in route.get("rms", {}).items())
         lines.append(

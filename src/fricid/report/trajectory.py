@@ -297,5 +297,7 @@ def trajectory_report(
     say("parameters")
     sec = doc.section("Parameters")
     sec.add(Table("parameters", "Friction parameters", parameter_table(fitted), digits=5))
-    sec.add(Table("joint", "The joint's inertia and gravity", joint_frame(fitted), digits=5))
+    note = fitted.provenance["trajectory"].get("gravity_note") or ""
+    title = "The joint's inertia and gravity"
+    sec.add(Table("joint", title, joint_frame(fitted), caption=note, digits=5))
     return doc

@@ -19,10 +19,10 @@ from fricid.errors import ConfigError, FricidError
 from fricid.identify import fit
 from fricid.identify.dynamic import _rate
 from fricid.identify.dynamic._data import uniform_series
-from fricid.identify.dynamic._encoder import encoder_quantum, measurement, quantise
 from fricid.identify.dynamic._filtered import ParallelFilter
 from fricid.identify.dynamic._outcome import calibrate, estimator
 from fricid.identify.dynamic._output import needs_output_error
+from fricid.identify.dynamic._rate import encoder_quantum, measurement, quantise
 from fricid.identify.dynamic._routes import _Stage
 from fricid.sim import Joint
 from fricid.sim import trajectory as tr

@@ -37,7 +37,6 @@ __all__ = [
     "RateBiasWarning",
     "calibrate",
     "converged",
-    "direction_caveat",
     "estimator",
     "lugre_caveat",
     "passivity",
@@ -144,38 +143,6 @@ def lugre_caveat() -> str:
         f"logs with quantised encoders, and on other logs of it they held the truth in {kinds} "
         f"of the claims, not 95 % everywhere; per parameter, the inertia's and the gravity's "
         f"too: {each} (benchmarks/bench_lugre.py)"
-    )
-
-
-#: Largest p-value of the test that a per-direction law fits better, below which a symmetric
-#: static law's fit says so (:func:`direction_caveat`).
-DIRECTION_P = 1e-3
-
-
-def direction_caveat(asym) -> str:
-    """The caveat when the friction differs by direction beyond a symmetric law: the Wald
-    test, with the cluster-robust covariance, that ``asym`` (the ``coulomb_viscous_asym``
-    regression on the same samples) has equal levels and slopes both ways, at p <=
-    :data:`DIRECTION_P`. Fitted with a symmetric law, a per-direction one's difference is
-    taken up by the gravity and the levels (a new user's log: p_x -1.2464 [-1.2492,
-    -1.2436] for -1.2, no caveat); '' otherwise."""
-    from scipy.stats import chi2
-
-    i = [asym.names.index(n) for n in ("f_c_pos", "beta_pos", "f_c_neg", "beta_neg")]
-    A = np.array([[1.0, 0.0, -1.0, 0.0], [0.0, 1.0, 0.0, -1.0]])
-    d = A @ asym.values[i]
-    C = A @ asym.cov[np.ix_(i, i)] @ A.T
-    if not np.all(np.isfinite(C)) or np.linalg.det(C) <= 0:
-        return ""
-    p = float(chi2.sf(float(d @ np.linalg.solve(C, d)), 2))
-    if p > DIRECTION_P:
-        return ""
-    f = dict(zip(asym.names, asym.values, strict=True))
-    return (
-        f"the friction differs by direction (per direction: f_c {f['f_c_pos']:.4g} / "
-        f"{f['f_c_neg']:.4g} N m, beta {f['beta_pos']:.4g} / {f['beta_neg']:.4g} N m s/rad; "
-        f"p {'< 1e-12' if p < 1e-12 else f'= {p:.2g}'}): this symmetric law's levels and "
-        "gravity take up the difference; fit coulomb_viscous_asym"
     )
 
 

@@ -91,9 +91,9 @@ from ..problem import ResidualProblem
 from ..static.convergence import POLISH_EVALS_PER_PARAM, RESOLVE_SE, noise_ftol
 from ..static.uncertainty import jacobian
 from ._data import Series, blocks, cluster_covariance, torque_noise
-from ._encoder import quantise
 from ._filtered import LOG_BOX, ParallelFilter
 from ._outcome import GROSS, WIDEN
+from ._rate import quantise
 from ._routes import SEARCH_SHARE, _run, _Stage, _t975
 
 __all__ = ["CUTOFF", "MIN_SPAN_COUNTS", "NAMES", "RESOLVED_COUNTS", "presliding_route"]

@@ -170,11 +170,13 @@ def build_result(
     }
     caveats = [
         bias_caveat(options.get("window_bias")),
-        options.get("direction", ""),
+        options.get("direction", ("", ""))[0],
         lugre_caveat() if key == "lugre" else "",
     ]
     if any(caveats):
         info["caveats"] = [c for c in caveats if c]
+    if options.get("direction", ("", ""))[1]:
+        info["gravity_note"] = options["direction"][1]
     if key == "lugre":
         info["passivity"] = passivity(param_names, values, low, high)
         if not info["passivity"]["passive"]:

@@ -78,10 +78,8 @@ import numpy as np
 from scipy import signal
 
 from ...errors import FricidWarning, user_stacklevel
-from ...models import get_model
 from ..static.uncertainty import DETERMINED_RCOND
 from ._data import DerivativeFilter, Series
-from ._routes import _regression
 
 __all__ = [
     "BIAS_SHARE",
@@ -89,7 +87,6 @@ __all__ = [
     "bias_caveat",
     "choose_window",
     "corrected",
-    "per_direction",
     "predicted_bias",
 ]
 
@@ -215,17 +212,6 @@ def predicted_bias(
         "velocity": dict(zip(stage.names, map(float, -c_friction), strict=True)),
         "noise_over_stderr": float(np.max(np.abs(inertia * c_noise + c_friction) / se)),
     }
-
-
-def per_direction(series: Series, filt: DerivativeFilter, vf, acc, mask, args: tuple):
-    """The ``coulomb_viscous_asym`` regression on a ``coulomb_viscous`` fit's samples and
-    window (``args``: :func:`._routes._regression`'s after the model), corrected as the fit
-    is (:func:`corrected`): for :func:`._outcome.direction_caveat`. Uncorrected, the noise of
-    a 1024-count encoder at 100 Hz had put a symmetric truth's levels (0.3 N m) at 0.19 and
-    0.36 both ways, a difference of p = 1e-8."""
-    model = get_model("coulomb_viscous_asym")
-    stage = _regression(series, vf, acc, mask, model, *args[1:])[0]
-    return corrected(stage, predicted_bias(series, filt, stage, mask, model))
 
 
 def _worst(record: dict[str, Any]) -> float:

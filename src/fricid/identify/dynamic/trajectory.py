@@ -96,7 +96,7 @@ standard errors by 0.5-1.5 % and no coverage: CR1 is kept (:mod:`._trajectory_da
 Rate bias and measurement (``rate_bias="warn"``, the default of the filtered route): the
 break-away between samples biases sigma_0 up and sigma_1 down at 1 kHz (seeds 10-49, 60 s:
 +2.9 % and -18 %; noise-free 20 s: +3.8 % and -21 %). The encoder's counts per revolution are
-read from the position steps or given (``encoder_counts``, :mod:`._encoder`). A simulation at
+read from the position steps or given (``encoder_counts``, :mod:`._rate`). A simulation at
 the estimate through that encoder (:mod:`._rate`) gives every parameter's bias, recorded and
 warned about (:class:`RateBiasWarning`; not applied, it over-corrects sigma_1 by about half);
 an interval it exceeds by a standard error is widened, one it biases grossly is flagged not
@@ -158,14 +158,13 @@ from ...fitted import FittedModel
 from ...models import get_model, lugre
 from ...samples import RawLog, check_trajectory_log
 from ._data import DerivativeFilter, check_dissipates, guarded_sliding, sliding, uniform_series
-from ._encoder import measurement
+from ._direction import direction_caveat, per_direction
 from ._filtered import ParallelFilter, dahl_start, filtered_route, lugre_start
 from ._outcome import (
     RATE_BIAS,
     PassivityWarning,
     RateBiasWarning,
     calibrate,
-    direction_caveat,
     estimator,
     warn_rate_bias,
     widen_calibrated,
@@ -173,12 +172,13 @@ from ._outcome import (
 from ._output import needs_output_error
 from ._output import output_error as _output_error
 from ._presliding_fit import fit_presliding
+from ._rate import measurement
 from ._rate import rate_bias as _rate_bias
 from ._response import follows, reidentifier, response_notes
 from ._result import build_result
 from ._routes import JOINT_PARAMS, _regression
 from ._simroute import simulation_route
-from ._window import DerivativeBiasWarning, choose_window, corrected, per_direction
+from ._window import DerivativeBiasWarning, choose_window, corrected
 
 __all__ = [
     "ROUTES",
@@ -206,6 +206,9 @@ STATIC_MODELS = ("stribeck", "coulomb_viscous", "stribeck_asym", "coulomb_viscou
 
 #: Dynamic models a trajectory identifies.
 DYNAMIC_MODELS = ("lugre", "dahl")
+#: Laws with one level for both directions, whose fit tests whether the friction differs by
+#: direction (:func:`._direction.direction_caveat`).
+SYMMETRIC = ("coulomb_viscous", "stribeck", *DYNAMIC_MODELS)
 
 #: The Dahl static part, as named in the ``coulomb_viscous`` model.
 _STATIC_OF_DAHL = {"f_c": "tau_c", "beta": "sigma_2"}
@@ -286,7 +289,7 @@ def fit_trajectory(
         truth (:mod:`._response`, ``provenance["trajectory"]["follows"]``); ``off`` skips it.
     encoder_counts : float, optional
         The encoder's counts per revolution; default: read from the position steps
-        (:func:`._encoder.encoder_quantum`; none when the steps share no quantum). Recorded
+        (:func:`._rate.encoder_quantum`; none when the steps share no quantum). Recorded
         in ``provenance["trajectory"]["encoder"]``.
     output_error : {"auto", "on", "off"}
         LuGre's filtered route: refine every parameter by the output error of the joint
@@ -404,9 +407,10 @@ def fit_trajectory(
             series, derivative, fit, regress if chosen else lambda filt: None, static_model
         )
     vf, acc, mask, stage1, _theta_s, c, r1 = fit
-    stage1, direction = corrected(stage1, window_bias), ""
-    if key == "coulomb_viscous":  # a per-direction law fits better? (._outcome)
-        direction = direction_caveat(per_direction(series, derivative, vf, acc, mask, args))
+    stage1, direction = corrected(stage1, window_bias), ("", "")
+    if key in SYMMETRIC:  # a per-direction law fits better? (._outcome)
+        asym = per_direction(series, derivative, vf, acc, mask, args, stage1)
+        direction = direction_caveat(asym, key, stage1)
     stages = {"regression": stage1}
     rename = {"lugre": lugre.STRIBECK_NAMES, "dahl": _STATIC_OF_DAHL}.get(key, {})
     joint_vals = dict(zip(JOINT_PARAMS, [*list(c), 0.0, 0.0], strict=False))

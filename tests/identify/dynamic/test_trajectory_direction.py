@@ -1,0 +1,90 @@
+"""A symmetric law (stribeck, lugre) fitted to friction that differs by direction says so,
+or says that the log cannot tell (:func:`fricid.identify.dynamic._outcome.direction_caveat`).
+
+The logs come from the independent simulator of ``benchmarks/bench_lugre.py``
+(``benchmarks/_lugre_truth.py``: its own RK4 joint and PD drive, a 2^20-count encoder), the
+negative direction's Coulomb and break-away levels ``neg`` times the positive's. Before,
+only ``coulomb_viscous`` was tested: a LuGre joint 30 % weaker backwards got p_x -0.776
+[-0.778, -0.774] for -0.591, and nothing said why.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import sys
+import warnings
+
+import pytest
+from tests._paths import REPO
+
+from fricid.cli.trajectory import trajectory_text
+from fricid.identify import fit
+from fricid.identify.trust import assess_trust
+from fricid.io import read_rawlog
+
+sys.path.insert(0, str(REPO / "benchmarks"))
+import _lugre_truth as lt
+
+
+def fit_log(truth: str, kind: str, neg: float, seed: int, model: str, tmp_path):
+    """(the fit, its trajectory provenance, the truth in fricid's names) of a 10 s log."""
+    t = dataclasses.replace(lt.TRUTHS[truth], neg=neg)
+    log = lt.simulate(t, kind, 10.0, 1000.0, 2**20, seed)
+    path = lt.write_log(log, tmp_path / "a.csv", t, {})
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        fitted = fit(read_rawlog(path), model, seed=seed)
+    return fitted, fitted.provenance["trajectory"], t.fricid_names()
+
+
+def gravity_held(info: dict, truth: dict) -> bool:
+    j = info["joint"]
+    return all(j[n]["ci95_low"] <= truth[n] <= j[n]["ci95_high"] for n in ("p_x", "p_y"))
+
+
+def test_a_stribeck_fit_of_a_joint_weaker_backwards_says_the_friction_differs(tmp_path):
+    fitted, info, truth = fit_log("geared", "chirp_pd", 0.7, 3, "stribeck", tmp_path)
+    assert not gravity_held(info, truth)  # the gravity took up the difference
+    caveats = info.get("caveats", [])
+    assert any(c.startswith("the friction differs by direction") for c in caveats), caveats
+    assert any("fit stribeck_asym" in c for c in caveats)
+    trust = assess_trust(fitted, None)  # as fit --trajectory
+    assert trust.level == "with caveats"
+    assert any(r.startswith("the friction differs by direction") for r in trust.reasons)
+
+
+def test_a_symmetric_joint_on_a_small_range_gets_a_note_on_the_gravity_only(tmp_path):
+    """The chirp moves 0.3 rad: cos q hardly changes, so the gravity's p_x is told from a
+    difference by direction only by taking the friction symmetric. No caveat (the log shows
+    no difference), a note that says what p_x rests on."""
+    fitted, info, _ = fit_log("geared", "chirp_pd", 1.0, 3, "stribeck", tmp_path)
+    assert not any("direction" in c for c in info.get("caveats", []))
+    note = info["gravity_note"]
+    assert "rests on the friction being the same both ways" in note and "p_x" in note
+    assert "p_y" not in note  # sin q changes: p_y is told apart
+    assert f"    gravity: {note}" in trajectory_text(fitted)
+
+
+def test_a_symmetric_joint_over_its_range_gets_neither(tmp_path):
+    _, info, _ = fit_log("geared", "trapezoid_pd", 1.0, 3, "stribeck", tmp_path)
+    assert not any("direction" in c for c in info.get("caveats", []))
+    assert "gravity_note" not in info
+
+
+@pytest.mark.slow
+def test_lugre_on_a_joint_weaker_backwards_says_so_and_what_it_takes_up(tmp_path):
+    _, info, truth = fit_log("slow_stribeck", "trapezoid_pd", 0.8, 4, "lugre", tmp_path)
+    caveats = info.get("caveats", [])
+    assert any(c.startswith("the friction differs by direction") for c in caveats), caveats
+    assert any("fricid's LuGre has one Coulomb and break-away level" in c for c in caveats)
+    assert not gravity_held(info, truth)
+
+
+@pytest.mark.slow
+def test_lugre_on_a_small_range_with_a_hint_of_a_difference_says_it_may_differ(tmp_path):
+    """The case of the module notes: 30 % weaker backwards, a 0.3 rad chirp; the levels'
+    difference about two standard errors from zero, the gravity unable to tell."""
+    _, info, truth = fit_log("geared", "chirp_pd", 0.7, 3, "lugre", tmp_path)
+    assert not gravity_held(info, truth)
+    caveats = info.get("caveats", [])
+    assert any(c.startswith("the friction may differ by direction") for c in caveats), caveats
