@@ -43,11 +43,8 @@ def test_the_second_start_runs_only_for_a_first_on_a_face():
     had spent their budgets, and the fit was the first's, polished, bit for bit)."""
     box = np.array([[0.0, 1.0], [-3.0, 3.0]])
     inside, face = np.array([0.5, 0.0]), np.array([0.5, -3.0])
-    converged, spent = SimpleNamespace(success=True), SimpleNamespace(success=False)
-    assert not _doubtful(inside, inside, box, converged)
-    assert not _doubtful(inside, inside, box, spent)
-    assert _doubtful(face, inside, box, converged) and _doubtful(inside, face, box, converged)
-    assert _doubtful(inside, face, box, spent)
+    assert not _doubtful(inside, inside, box)
+    assert _doubtful(face, inside, box) and _doubtful(inside, face, box)
 
 
 @pytest.mark.slow  # a 20 s log at 1 kHz identified by output error: about 6 s

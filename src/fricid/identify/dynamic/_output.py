@@ -172,7 +172,7 @@ def output_error(
     search = ResidualProblem(residuals, box, names, y)
     ftol = noise_ftol(search, SEARCH_SHARE)  # each evaluation a simulation (module notes)
     result = _run(search, method, x0, seed, max_evals or MAX_EVALS, 1, ftol)
-    if second and _doubtful(x0, np.asarray(result.x, dtype=float), box, result):
+    if second and _doubtful(x0, np.asarray(result.x, dtype=float), box):
         x1 = _second_start(x0, names, second, box)
         other = _run(search, method, x1, seed, max_evals or MAX_EVALS, 1, ftol)
         nfev = int(result.nfev) + int(other.nfev)
@@ -206,7 +206,7 @@ def output_error(
     return out, y, r0
 
 
-def _doubtful(x0: np.ndarray, x: np.ndarray, box: np.ndarray, result: Any) -> bool:
+def _doubtful(x0: np.ndarray, x: np.ndarray, box: np.ndarray) -> bool:
     """Whether the first start calls for the second: it began or ended on a face of the box
     (where the first start's log-scale sigma_1 column vanishes, :data:`SECOND_DAMPING`). A
     first start that spent its budget inside the box is carried on by :func:`settle`'s
@@ -214,7 +214,8 @@ def _doubtful(x0: np.ndarray, x: np.ndarray, box: np.ndarray, result: Any) -> bo
     ``benchmarks/bench_lugre.py``, seed 10) both starts had spent their 1000 evaluations in
     a flat valley, the second ended higher, and the fit was the first's polished, bit for
     bit the same without the second: 57.7 s instead of 86.4 s
-    (``benchmarks/results/lugre_speed60.txt``). ``result`` is kept for the callers."""
+    (``benchmarks/results/lugre_speed60.txt``): whether the search converged or spent its
+    budget does not enter."""
     width = box[:, 1] - box[:, 0]
 
     def on_face(p: np.ndarray) -> bool:

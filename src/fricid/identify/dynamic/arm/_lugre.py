@@ -258,7 +258,7 @@ def fit_lugre_joint(
         starts.append((float(r @ r), x))
     starts.sort(key=lambda s: s[0])
     sols = [_search(residual, x, lo, hi) for _, x in starts[:LOCAL_SEARCHES]]
-    evaluations = sum(int(s_.nfev) for s_ in sols) + len(starts)
+    evaluations = sum(_evaluations(s_) for s_ in sols) + len(starts)
     sol = min(sols, key=lambda s_: float(s_.cost))
     restarts = 0
     for attempt in range(MAX_RESTARTS + 1):
@@ -296,7 +296,7 @@ def fit_lugre_joint(
         except Better as better:  # another valley, lower: search from there
             restarts += 1
             sol = _search(residual, better.x, lo, hi)
-            evaluations += int(sol.nfev)
+            evaluations += _evaluations(sol)
     theta = _theta(x)
     units = {p_.name: p_.unit for p_ in get_model(LUGRE).parameters}
     records = {
@@ -318,6 +318,12 @@ def fit_lugre_joint(
         ),
     }
     return LuGreJoint(joint, j, theta, records, float(sigma), provenance)
+
+
+def _evaluations(sol) -> int:
+    """The residual evaluations of a scipy least-squares search, its finite-difference
+    Jacobians' included (its ``nfev`` leaves them out)."""
+    return int(sol.nfev) + int(sol.njev or 0) * int(sol.x.size)
 
 
 def _search(residual, x, lo, hi):

@@ -82,7 +82,7 @@ class _Profile:
             max_nfev=POINT_EVALS,
             ftol=POINT_FTOL,
         )
-        self.calls += int(sol.nfev)
+        self.calls += int(sol.nfev) + int(sol.njev or 0) * len(free)  # FD Jacobians too
         z = x.copy()
         z[free], z[k] = sol.x, value
         return 2.0 * float(sol.cost), z
