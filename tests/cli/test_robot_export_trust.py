@@ -68,6 +68,10 @@ def test_a_whole_arm_fit_exports_every_joint_in_the_urdf_order(arm_file, tmp_pat
         assert f"trust verdict: {level}" in source
     assert source.count("the model file gives the reasons") == 2  # one line per joint
     assert "arm.json (joint2)" in source and "identified by IDIM-WLS (whole arm)" in source
+    args = ["robot", "export", str(arm_file), "--to", "c", "-o", str(tmp_path / "c2")]
+    res = runner.invoke(app, [*args, "--robot", "double_pendulum"])  # was ignored silently
+    assert res.exit_code == 0, res.output
+    assert "--robot applies to urdf and mjcf only; ignored for c" in " ".join(res.output.split())
 
 
 def test_a_joint_whose_verdict_is_no_is_not_exported_unless_told(arm_file, tmp_path):

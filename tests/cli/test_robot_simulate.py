@@ -80,7 +80,9 @@ def test_the_integrator_step_is_the_one_taken(tmp_path):
         "--out", out, "--truth", truth,
     )  # fmt: skip
     assert result.exit_code == 0, result.output
-    assert json.loads(truth.read_text())["integrator_step_s"] == pytest.approx(1.25e-4)
+    record = json.loads(truth.read_text())
+    assert record["integrator_step_s"] == pytest.approx(1.25e-4)
+    assert record["friction_model"] == "stribeck_asym"  # every joint's
 
 
 def test_a_lugre_joint(tmp_path):
@@ -92,6 +94,7 @@ def test_a_lugre_joint(tmp_path):
     assert result.exit_code == 0, result.output
     record = json.loads(truth.read_text())
     assert record["friction_models"] == {"joint1": "stribeck_asym", "joint2": "lugre"}
+    assert record["friction_model"] == "per joint"  # was "stribeck_asym" whatever the joints
     assert set(record["friction"]["joint2"]) >= {"sigma_0", "sigma_1", "sigma_2"}
     assert "joint2: LuGre friction" in mjcf.read_text()
     bad = run("--robot", "double_pendulum", "--duration", 0.2, "--lugre", "elbow", "--out", out)

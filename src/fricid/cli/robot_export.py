@@ -217,6 +217,9 @@ def robot_export_command(
     target = "ros2_control" if target == "yaml" else target  # the single-joint export's name
     if target not in ROBOT_TARGETS:
         raise ConfigError(f"unknown target '{to}'; choose one of: {', '.join(ROBOT_TARGETS)}")
+    for flag, value in (("--urdf", urdf), ("--robot", robot)):
+        if value is not None and target not in ("urdf", "mjcf"):
+            err_console.print(f"note: {flag} applies to urdf and mjcf only; ignored for {target}")
     where = {"out_dirs" if target == "c" else "out_files": {"--out": out}}
     check_paths(inputs={"--urdf": urdf} if urdf is not None else {}, **where)
     files = _model_files(models)

@@ -89,10 +89,12 @@ def _duration(reference, duration: float | None) -> float:
 
 
 def _truth_json(run, model) -> dict:
+    from ..sim.robot import shared_model
+
     t = run.truth
     return {
         "joints": list(model.joints),
-        "friction_model": "stribeck_asym",
+        "friction_model": shared_model(t.friction_models),
         "friction": t.friction_parameters,
         "friction_models": t.friction_models,
         "friction_smoothing_rad_s": None if t.friction is None else t.friction.smoothing,

@@ -78,8 +78,17 @@ __all__ = [
     "default_gains",
     "quantise",
     "run_robot",
+    "shared_model",
     "simulate_robot",
 ]
+
+
+def shared_model(kinds: dict[str, str]) -> str:
+    """The friction model every joint of ``kinds`` (joint -> model) has, or ``"per joint"``
+    (the log's ``friction_models`` then says which)."""
+    models = set(kinds.values())
+    return models.pop() if len(models) == 1 else "per joint"
+
 
 #: A sign change of the true velocity between consecutive samples, both beyond this speed
 #: [rad/s], in more than this share of the samples is chatter (:func:`_warn_chatter`).
@@ -449,7 +458,7 @@ def _assemble(model, friction, lugre, out, time, ref, noise, rng, h, rate, count
         "rate_hz": float(rate),
         "torque_noise": [float(x) for x in noise[:n]],
         "integrator_step": float(h),
-        "friction_model": "stribeck_asym",
+        "friction_model": shared_model(kinds),
         "friction": params,
         "friction_models": kinds,
     }
