@@ -14,11 +14,11 @@ friction is the same both ways (:func:`fricid.identify.dynamic._outcome.directio
 
 Per truth, kind and ``neg`` it prints: the fits; how many carry the caveat that the friction
 differs by direction (``differs``, p <= 1e-3) or may (``may``: the levels' difference two
-standard errors from zero where the log cannot tell it from the gravity); how many carry only
-the gravity note (``note``: the log cannot tell); how many said nothing (``silent``); the
-fits whose 95 % intervals of p_x and p_y both held the truth (``grav ok``); and the fits that
-missed the gravity and said nothing (``silent miss``, the confident wrong answer this check
-exists for). On symmetric truths ``differs`` and ``may`` are false alarms.
+standard errors from zero where the log cannot tell it from the gravity); how many carry the
+gravity note (``note``: the log cannot tell; beside a caveat or alone); how many said nothing
+(``silent``); the fits whose 95 % intervals of p_x and p_y both held the truth (``grav ok``);
+and the fits that missed the gravity and said nothing (``silent miss``, the confident wrong
+answer this check exists for). On symmetric truths ``differs`` and ``may`` are false alarms.
 """
 
 from __future__ import annotations

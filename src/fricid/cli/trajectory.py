@@ -58,9 +58,10 @@ def _derivative_lines(d: dict) -> list[str]:
             else ""
         )
         lines.append(
-            f"    derivative window: {wider}the noise is {100 * b['noise_share']:.2f} % of the "
-            f"acceleration's variance, the filter bends the motion {100 * b['distortion']:+.2f} "
-            f"%: predicted inertia bias {100 * b['relative']:+.2f} %, the largest "
+            f"    derivative window: {wider}the encoder's noise biases the inertia by "
+            f"{-100 * b['noise_share']:+.2f} %, the filter's bending of the motion by "
+            f"{100 * b['distortion']:+.2f} %: predicted inertia bias {100 * b['relative']:+.2f} "
+            "%, the largest "
             f"{b['over_stderr'][worst]:.2f} standard errors ({worst})"
             + ("; corrected" if b.get("applied") else "")
         )

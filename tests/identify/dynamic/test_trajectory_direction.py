@@ -48,6 +48,13 @@ def test_a_stribeck_fit_of_a_joint_weaker_backwards_says_the_friction_differs(tm
     caveats = info.get("caveats", [])
     assert any(c.startswith("the friction differs by direction") for c in caveats), caveats
     assert any("fit stribeck_asym" in c for c in caveats)
+    # each difference with its standard error: the test's p may come from either (a new
+    # user's LuGre fit printed backwards-stronger levels, bare, the significance the viscous
+    # difference's)
+    assert any("their difference" in c and "+/- one standard error" in c for c in caveats)
+    # the small motion cannot tell the gravity from the difference: said too (it was left
+    # out where the difference showed)
+    assert "rests on the friction being the same both ways" in info["gravity_note"]
     trust = assess_trust(fitted, None)  # as fit --trajectory
     assert trust.level == "with caveats"
     assert any(r.startswith("the friction differs by direction") for r in trust.reasons)

@@ -14,7 +14,7 @@ simulator's logs, three joints, PD-tracked chirps and trapezoids and open-loop t
 the thresholds set on seeds 3-4; ``benchmarks/results/direction.txt``): with the friction 10 %
 or 20 % weaker backwards, a ``lugre`` fit's gravity intervals missed the truth in 69 of 72
 logs, none of which said anything before; now 3 say nothing (2 of them missed). Of 36
-symmetric logs, 4 got a caveat (1 'differs', 3 'may differ'), 17 the note alone.
+symmetric logs, 4 got a caveat (1 'differs', 3 'may differ'), 15 nothing.
 """
 
 from __future__ import annotations
@@ -97,17 +97,18 @@ def direction_caveat(asym, law: str = "coulomb_viscous", symmetric=None) -> tupl
         return "", ""
     p = float(chi2.sf(float(d @ np.linalg.solve(C, d)), 2))
     c_pos, v_pos, c_neg, v_neg = (float(asym.values[j]) for j in i)
+    se_c, se_v = (math.sqrt(C[k, k]) for k in (0, 1))
     advice = _DIRECTION_ADVICE.get(law, _DIRECTION_ADVICE["coulomb_viscous"])
+    note = _gravity_by_symmetry(asym, symmetric, d[0], se_c, c_pos + c_neg)
     if p <= DIRECTION_P:
         return (
-            f"the friction differs by direction (per direction: Coulomb {c_pos:.4g} / "
-            f"{c_neg:.4g} N m, viscous {v_pos:.4g} / {v_neg:.4g} N m s/rad; "
-            f"p {'< 1e-12' if p < 1e-12 else f'= {p:.2g}'}): this symmetric law's levels "
-            f"and gravity take up the difference; {advice}"
-        ), ""
-    se = math.sqrt(C[0, 0])
-    note = _gravity_by_symmetry(asym, symmetric, d[0], se, c_pos + c_neg)
-    if note and abs(d[0]) > 2.0 * se:
+            f"the friction differs by direction (p {'< 1e-12' if p < 1e-12 else f'= {p:.2g}'}; "
+            f"per direction: Coulomb {c_pos:.4g} / {c_neg:.4g} N m, their difference "
+            f"{d[0]:.3g} +/- {se_c:.2g}; viscous {v_pos:.4g} / {v_neg:.4g} N m s/rad, their "
+            f"difference {d[1]:.3g} +/- {se_v:.2g}; +/- one standard error): this symmetric "
+            f"law's levels and gravity take up the difference; {advice}"
+        ), note
+    if note and abs(d[0]) > 2.0 * se_c:
         return f"the friction may differ by direction: {note}; {advice}", ""
     return "", note
 
@@ -126,16 +127,19 @@ def _gravity_by_symmetry(asym, symmetric, diff: float, diff_se: float, levels: f
         own = float(symmetric.stderr[symmetric.names.index(name)])
         if own > 0 and wide > GRAVITY_BY_SYMMETRY * own:
             value = float(asym.values[asym.names.index(name)])
-            parts.append(f"{name} {value:.4g} +/- {wide:.2g} instead of +/- {own:.2g}")
+            parts.append(
+                f"{name} {value:.4g} +/- {wide:.2g} with a level per direction, +/- "
+                f"{own:.2g} with one"
+            )
     if not parts:
         return ""
     return (
         "the log does not tell the gravity from a difference of the friction by direction "
-        f"(the Coulomb levels differ by {diff:.3g} +/- {diff_se:.2g} N m, a 95 % half-width "
-        f"of {100 * open_share:.0f} % of their mean; half of a difference is a constant "
-        "torque the gravity takes up): the gravity rests on the friction being the same both "
-        f"ways (with a level per direction: {'; '.join(parts)}); a motion over more of the "
-        "joint's range tells them apart"
+        f"(the Coulomb levels' difference is {diff:.3g} N m with a standard error of "
+        f"{diff_se:.2g}, its 95 % interval +/- {100 * open_share:.0f} % of their mean; half of "
+        "a difference is a constant torque the gravity takes up): the gravity rests on the "
+        "friction being the same both ways (the regression on the same samples gives "
+        f"{'; '.join(parts)}); a motion over more of the joint's range tells them apart"
     )
 
 

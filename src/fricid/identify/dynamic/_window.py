@@ -320,9 +320,9 @@ def bias_caveat(record: dict[str, Any] | None) -> str:
     named = ", ".join(f"{n} {record['parameters'][n]:+.3g} ({r:.1f} se)" for n, r in over.items())
     text = (
         f"the derivative window ({1e3 * record['window']:.0f} ms) biases {named}: the "
-        f"encoder's noise takes {100 * record['noise_share']:.1f} % of the acceleration, the "
-        f"filter bends the motion by {100 * record['distortion']:+.2f} %; corrected, and a "
-        f"quarter of each correction added to its standard error"
+        f"encoder's noise biases the inertia by {-100 * record['noise_share']:+.1f} %, the "
+        f"filter's bending of the motion by {100 * record['distortion']:+.2f} %; corrected, "
+        "and a quarter of each correction added to its standard error"
     )
     warnings.warn(text, DerivativeBiasWarning, stacklevel=user_stacklevel())
     return text
