@@ -95,3 +95,10 @@ def test_lugre_on_a_small_range_with_a_hint_of_a_difference_says_it_may_differ(t
     assert not gravity_held(info, truth)
     caveats = info.get("caveats", [])
     assert any(c.startswith("the friction may differ by direction") for c in caveats), caveats
+
+
+def test_dahl_on_a_joint_weaker_backwards_says_so(tmp_path):
+    _, info, _ = fit_log("slow_stribeck", "trapezoid_pd", 0.8, 4, "dahl", tmp_path)
+    caveats = info.get("caveats", [])
+    assert any(c.startswith("the friction differs by direction") for c in caveats), caveats
+    assert any("fricid's Dahl has one Coulomb level" in c for c in caveats)
