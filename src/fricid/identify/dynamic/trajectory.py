@@ -408,7 +408,7 @@ def fit_trajectory(
         )
     vf, acc, mask, stage1, _theta_s, c, r1 = fit
     stage1, direction = corrected(stage1, window_bias), ("", "")
-    if key in SYMMETRIC:  # a per-direction law fits better? (._outcome)
+    if key in SYMMETRIC:  # a per-direction law fits better? (._direction)
         asym = per_direction(series, derivative, vf, acc, mask, args, stage1)
         direction = direction_caveat(asym, key, stage1)
     stages = {"regression": stage1}
