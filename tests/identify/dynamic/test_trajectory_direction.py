@@ -13,6 +13,7 @@ from __future__ import annotations
 import dataclasses
 import sys
 import warnings
+from pathlib import Path
 
 import pytest
 from tests._paths import REPO
@@ -102,3 +103,27 @@ def test_dahl_on_a_joint_weaker_backwards_says_so(tmp_path):
     caveats = info.get("caveats", [])
     assert any(c.startswith("the friction differs by direction") for c in caveats), caveats
     assert any("fricid's Dahl has one Coulomb level" in c for c in caveats)
+
+
+#: The shared foreign logs: another simulator's symmetric LuGre joint (their README).
+FOREIGN = Path(__file__).resolve().parents[3].parent / "shared" / "data" / "foreign" / "lugre"
+
+
+@pytest.mark.slow  # 4-5 s a log: 20 s at 1 kHz
+@pytest.mark.parametrize(
+    "name",
+    [
+        f"{kind}_1000Hz_{cpr}cpr"
+        for kind in ("chirp_pd", "trapezoid_pd")
+        for cpr in (131072, 1048576)
+    ],
+)
+def test_no_false_alarm_on_another_simulators_symmetric_joint(name):
+    """A second opinion on the false alarms: the foreign logs' joint has one level both ways."""
+    from fricid.identify.dynamic.trajectory import fit_trajectory
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        fitted = fit_trajectory(read_rawlog(FOREIGN / f"{name}.csv"), "stribeck")
+    caveats = fitted.provenance["trajectory"].get("caveats", [])
+    assert not any("by direction" in c for c in caveats), caveats
