@@ -11,6 +11,7 @@ only ``coulomb_viscous`` was tested: a LuGre joint 30 % weaker backwards got p_x
 from __future__ import annotations
 
 import dataclasses
+import re
 import sys
 import warnings
 from pathlib import Path
@@ -127,3 +128,32 @@ def test_no_false_alarm_on_another_simulators_symmetric_joint(name):
         fitted = fit_trajectory(read_rawlog(FOREIGN / f"{name}.csv"), "stribeck")
     caveats = fitted.provenance["trajectory"].get("caveats", [])
     assert not any("by direction" in c for c in caveats), caveats
+
+
+def test_the_mirrored_log_swaps_the_levels(tmp_path):
+    """Mirroring the joint (q, v, torque -> -q, -v, -torque) swaps the directions: the
+    per-direction levels come out swapped, the difference of opposite sign, the same test."""
+    from fricid.identify.dynamic.trajectory import fit_trajectory
+    from fricid.samples import RawLog
+
+    t = dataclasses.replace(lt.TRUTHS["slow_stribeck"], neg=0.8)
+    log = read_rawlog(lt.write_log(lt.simulate(t, "trapezoid_pd", 10.0, 1000.0, 2**20, 4),
+                                   tmp_path / "a.csv", t, {}))  # fmt: skip
+    mirror = RawLog(
+        time=log.time,
+        position=-log.position,
+        velocity=-log.velocity,
+        torque=-log.motor_torque,
+        temperature=log.temperature,
+    )
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        texts = [
+            fit_trajectory(x, "stribeck").provenance["trajectory"]["caveats"][0]
+            for x in (log, mirror)
+        ]
+    levels = [re.search(r"Coulomb ([\d.]+) / ([\d.]+) N m", c).groups() for c in texts]
+    assert texts[0].startswith("the friction differs by direction")
+    assert texts[1].startswith("the friction differs by direction")
+    (a, b), (c, d) = ((float(x), float(y)) for x, y in levels)
+    assert a > b and c == pytest.approx(b, rel=1e-3) and d == pytest.approx(a, rel=1e-3)
