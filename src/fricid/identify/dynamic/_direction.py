@@ -12,7 +12,7 @@ gravity where the log cannot tell.
 Measured (``benchmarks/bench_direction.py --seeds 4 --first-seed 10``, the independent LuGre
 simulator's logs, three joints, PD-tracked chirps and trapezoids and open-loop torque steps;
 the thresholds set on seeds 3-4; ``benchmarks/results/direction.txt``): with the friction 10 %
-or 20 % weaker backwards, a ``lugre`` fit's gravity intervals missed the truth in 69 of 72
+or 20 % weaker backwards, a ``lugre`` fit's gravity intervals missed the truth in 68 of 72
 logs, none of which said anything before; now 3 say nothing (2 of them missed). Of 36
 symmetric logs, 4 got a caveat (1 'differs', 3 'may differ'), 15 nothing.
 """
