@@ -168,15 +168,16 @@ def build_result(
         "seconds": time.perf_counter() - t_start,
         **sim_info,
     }
+    direction, gravity_note = options.get("direction", ("", ""))
     caveats = [
         bias_caveat(options.get("window_bias")),
-        options.get("direction", ("", ""))[0],
+        direction,
         lugre_caveat() if key == "lugre" else "",
     ]
     if any(caveats):
         info["caveats"] = [c for c in caveats if c]
-    if options.get("direction", ("", ""))[1]:
-        info["gravity_note"] = options["direction"][1]
+    if gravity_note:
+        info["gravity_note"] = gravity_note
     if key == "lugre":
         info["passivity"] = passivity(param_names, values, low, high)
         if not info["passivity"]["passive"]:

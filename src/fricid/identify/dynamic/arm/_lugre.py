@@ -366,8 +366,7 @@ def _record(name, k, x, se, t, lo, hi, ends, unit, cutoff) -> dict[str, Any]:
     if nd:
         if k in _LOG:
             nd += f"; the low-pass at {cutoff:.3g} Hz smooths the bristles' transient at reversals"
-        return {"value": None, "unit": unit, "stderr": None, "ci95": [None, None],
-                "not_determined": True, "note": nd}  # fmt: skip
+        return _undetermined(unit, nd)
     v = scale(value)
     stderr = v * math.log(10.0) * s if log else s
     if k not in ends:
@@ -400,9 +399,7 @@ def _unresolved_rise(records: dict[str, dict[str, Any]], w_s_low: float) -> None
         "there were measured to miss (module notes)"
     )
     for name in ("sigma_0", "sigma_1", "tau_s", "w_s", "delta"):
-        unit = records[name]["unit"]
-        records[name] = {"value": None, "unit": unit, "stderr": None, "ci95": [None, None],
-                         "not_determined": True, "note": why}  # fmt: skip
+        records[name] = _undetermined(records[name]["unit"], why)
 
 
 def _untold_viscous(records: dict[str, dict[str, Any]]) -> None:
@@ -412,12 +409,17 @@ def _untold_viscous(records: dict[str, dict[str, Any]]) -> None:
     tau_c 27 % high, six standard errors from the truth)."""
     if not records["sigma_2"]["not_determined"] or records["tau_c"]["not_determined"]:
         return
-    unit = records["tau_c"]["unit"]
-    records["tau_c"] = {
-        "value": None, "unit": unit, "stderr": None, "ci95": [None, None], "not_determined": True,
-        "note": "not determined: the viscous level sigma_2 is not, and the Coulomb level takes "
-        "what the viscous term would",
-    }  # fmt: skip
+    records["tau_c"] = _undetermined(
+        records["tau_c"]["unit"],
+        "not determined: the viscous level sigma_2 is not, and the Coulomb level takes what the "
+        "viscous term would",
+    )
+
+
+def _undetermined(unit: str, note: str) -> dict[str, Any]:
+    """A parameter's record when the data do not determine it: no value, the reason."""
+    return {"value": None, "unit": unit, "stderr": None, "ci95": [None, None],
+            "not_determined": True, "note": note}  # fmt: skip
 
 
 def _span(name: str, lo: float, hi: float, k: int) -> str:
