@@ -52,9 +52,11 @@ def track_lugre(
     """The three runs of :func:`fricid.control.dynamic.lugre_compensation_study` (row 0 PD
     only, 1 static feed-forward, 2 LuGre observer on row 2's measured velocity).
 
-    ``model`` is (1, 7); ``noise`` (n,) is added to the measured velocity (the D term and
-    the observer's input); ``Q``, ``V``, ``U``, ``FR``, ``FF`` (3, n) receive position, true
-    velocity, command, true friction and feed-forward at each step's start.
+    ``model`` is (1, 10), the kernel's per-direction columns
+    (:func:`fricid.models.lugre.wide`); ``noise`` (n,) is added to the measured velocity
+    (the D term and the observer's input); ``Q``, ``V``, ``U``, ``FR``, ``FF`` (3, n)
+    receive position, true velocity, command, true friction and feed-forward at each step's
+    start.
     """
     k, n = Q.shape
     q = np.zeros(k)

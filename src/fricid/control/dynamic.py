@@ -225,7 +225,7 @@ def _simulate(
     out = {name: np.empty((len(RUNS), t.size)) for name in names}
     track_lugre(
         np.ascontiguousarray(truth, dtype=float),
-        np.ascontiguousarray(model, dtype=float)[None, :],
+        lugre.wide(model),
         q_r,
         v_r,
         a_r,

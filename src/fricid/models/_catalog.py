@@ -10,7 +10,7 @@ from ._asymmetric import Asymmetric
 from ._base import FrictionModel
 from ._temperature import WithTemperature
 from .dahl import Dahl
-from .lugre import LuGre
+from .lugre import LuGre, LuGreAsym
 
 __all__ = ["DYNAMIC", "MODELS", "get_model"]
 
@@ -24,22 +24,30 @@ MODELS: dict[str, type[FrictionModel]] = {
 #: Dynamic models by registry name (their ``predict`` is the steady state; identified from
 #: trajectories by :mod:`fricid.identify.dynamic.trajectory`); kept out of :data:`MODELS`, whose
 #: families are fitted to friction samples.
-DYNAMIC: dict[str, type[FrictionModel]] = {cls.name: cls for cls in (LuGre, Dahl)}
+DYNAMIC: dict[str, type[FrictionModel]] = {cls.name: cls for cls in (LuGre, LuGreAsym, Dahl)}
 
 
 def get_model(name: str | FrictionModel, asymmetric: bool = False) -> FrictionModel:
     """The model called ``name`` (see :data:`MODELS`); ``name_asym`` or ``asymmetric=True``
     gives its per-direction variant, ``name_temp`` its temperature-dependent viscous term
     (:class:`WithTemperature`; ``name_temp_asym`` both, one activation temperature shared by
-    the directions). A model instance is passed through."""
+    the directions). The dynamic models (:data:`DYNAMIC`) by name; ``lugre_asym`` is LuGre
+    with its levels per direction. A model instance is passed through."""
     if isinstance(name, FrictionModel):
         model = name
     else:
         key = name.strip().lower()
+        if asymmetric and key in DYNAMIC and not key.endswith("_asym"):
+            key += "_asym"
+        if key in DYNAMIC:
+            return DYNAMIC[key]()
         if key.endswith("_asym"):
             key, asymmetric = key[: -len("_asym")], True
-        if key in DYNAMIC and not asymmetric:
-            return DYNAMIC[key]()
+        if key in DYNAMIC:  # dahl_asym: no such model
+            raise ConfigError(
+                f"'{name}': {key} has one level for both directions (per direction: "
+                f"{', '.join(k for k in DYNAMIC if k.endswith('_asym'))})"
+            )
         temperature = key.endswith("_temp")
         if temperature:
             key = key[: -len("_temp")]

@@ -1,7 +1,13 @@
-"""The compiled time loop of :func:`fricid.models.lugre.simulate` (numba, cached on disk).
+"""The compiled time loops of :mod:`fricid.models.lugre` (numba, cached on disk).
 
 A module of its own so that importing :mod:`fricid.models.lugre` does not import numba, and so
-that the kernel is a module-level function numba can cache across processes.
+that the kernels are module-level functions numba can cache across processes.
+
+Every kernel takes LuGre's parameters per direction, 10 columns (:data:`WIDE`): sigma_0,
+sigma_1, then sigma_2, tau_c, tau_s for v >= 0, w_s, delta (shared), then sigma_2, tau_c,
+tau_s for v < 0. Each use of the Stribeck curve g(v) and of sigma_2 takes the set of the
+velocity's sign; the symmetric model repeats its levels (:func:`fricid.models.lugre.wide`),
+which gives the same arithmetic, bit for bit, as a kernel with one set.
 """
 
 from __future__ import annotations
@@ -10,7 +16,10 @@ import math
 
 from .._jit import njit
 
-__all__ = ["run", "run_mean"]
+__all__ = ["WIDE", "run", "run_joint", "run_mean"]
+
+#: Columns of the kernels' parameters.
+WIDE = 10
 
 
 @njit(cache=True)
@@ -19,13 +28,16 @@ def run(theta, v, dt, z0, F, Z):  # pragma: no cover - compiled
     k = theta.shape[0]
     n = v.shape[0]
     for j in range(k):
-        s0, s1, s2 = theta[j, 0], theta[j, 1], theta[j, 2]
-        tau_c, tau_s, w_s, delta = theta[j, 3], theta[j, 4], theta[j, 5], theta[j, 6]
+        s0, s1 = theta[j, 0], theta[j, 1]
+        s2p, tcp, tsp = theta[j, 2], theta[j, 3], theta[j, 4]
+        s2n, tcn, tsn = theta[j, 7], theta[j, 8], theta[j, 9]
+        w_s, delta = theta[j, 5], theta[j, 6]
         ws = max(abs(w_s), 1e-12)
         z = z0[j]
         for i in range(n):
             vi = v[i]
             av = abs(vi)
+            s2, tau_c, tau_s = (s2p, tcp, tsp) if vi >= 0.0 else (s2n, tcn, tsn)
             if av > 0.0 and s0 > 0.0:
                 g = max(tau_c + (tau_s - tau_c) * math.exp(-((av / ws) ** delta)), 1e-12)
                 rate = s0 * av / g
@@ -49,25 +61,30 @@ def run_mean(theta, v, h, up, z0, F):  # pragma: no cover - compiled
     the bristle state follows the exact update of :func:`run`, and its mean over a sub-step
     is exact too (``z_ss + (z0 - z_ss) (1 - exp(-a h)) / (a h)``). ``F[j, i]`` (``i >= 1``)
     is the mean friction over the period ending at sample ``i``: ``sigma_0 mean(z) +
-    sigma_1 (z_i - z_{i-1}) / (up h) + sigma_2 mean(v)``; ``F[j, 0]`` the friction at the
+    sigma_1 (z_i - z_{i-1}) / (up h) + mean(sigma_2 v)`` (sigma_2 of each sub-step's
+    direction); ``F[j, 0]`` the friction at the
     first sample in the steady state of ``v[0]``.
     """
     k = theta.shape[0]
     n = F.shape[1]
     period = up * h
     for j in range(k):
-        s0, s1, s2 = theta[j, 0], theta[j, 1], theta[j, 2]
-        tau_c, tau_s, w_s, delta = theta[j, 3], theta[j, 4], theta[j, 5], theta[j, 6]
+        s0, s1 = theta[j, 0], theta[j, 1]
+        s2p, tcp, tsp = theta[j, 2], theta[j, 3], theta[j, 4]
+        s2n, tcn, tsn = theta[j, 7], theta[j, 8], theta[j, 9]
+        w_s, delta = theta[j, 5], theta[j, 6]
         ws = max(abs(w_s), 1e-12)
         z = z0[j]
-        F[j, 0] = s0 * z + s2 * v[0]
+        F[j, 0] = s0 * z + (s2p if v[0] >= 0.0 else s2n) * v[0]
         for i in range(1, n):
             z_start = z
             acc_z = 0.0
             acc_v = 0.0
+            acc_back = 0.0  # the backward velocities' sum: sigma_2's second set
             for m in range(up):
                 vi = v[(i - 1) * up + 1 + m]
                 av = abs(vi)
+                tau_c, tau_s = (tcp, tsp) if vi >= 0.0 else (tcn, tsn)
                 if av > 0.0 and s0 > 0.0:
                     g = max(tau_c + (tau_s - tau_c) * math.exp(-((av / ws) ** delta)), 1e-12)
                     x = s0 * av / g * h
@@ -83,7 +100,14 @@ def run_mean(theta, v, h, up, z0, F):  # pragma: no cover - compiled
                     acc_z += z + 0.5 * vi * h
                     z = z + vi * h
                 acc_v += vi
-            F[j, i] = s0 * acc_z / up + s1 * (z - z_start) / period + s2 * acc_v / up
+                if vi < 0.0:
+                    acc_back += vi
+            F[j, i] = (
+                s0 * acc_z / up
+                + s1 * (z - z_start) / period
+                + s2p * acc_v / up
+                + (s2n - s2p) * acc_back / up
+            )
     return 0
 
 
@@ -133,7 +157,8 @@ def _linear_step(s0, s1, s2, a, inv_j, beta, z, v, h):  # pragma: no cover - com
 def run_joint(
     theta, phys, tau, qref, vref, gains, dt, n_sub, reset, q_meas, v_meas, a_meas, x0, Q, V, Z, F, U
 ):  # pragma: no cover - compiled
-    """A joint with LuGre friction, ``J qdd = u + p_x cos q - p_y sin q - F``, for every row.
+    """A joint with LuGre friction, ``J qdd = u + p_x cos q - p_y sin q - F``, for every row
+    (the levels and sigma_2 of each direction taken by the sign of the velocity they act at).
 
     ``u = tau + kp (qref - q) + kd (vref - v)`` is computed at each sample from the state
     there and held until the next (zero-order hold); each sample period is cut into ``n_sub``
@@ -152,10 +177,12 @@ def run_joint(
     n = tau.shape[0]
     kp, kd = gains[0], gains[1]
     for j in range(k):
-        s0, s1, s2 = theta[j, 0], theta[j, 1], theta[j, 2]
-        tau_c, tau_s, w_s, delta = theta[j, 3], theta[j, 4], theta[j, 5], theta[j, 6]
+        s0, s1 = theta[j, 0], theta[j, 1]
+        s2p, tcp, tsp = theta[j, 2], theta[j, 3], theta[j, 4]
+        s2n, tcn, tsn = theta[j, 7], theta[j, 8], theta[j, 9]
+        w_s, delta = theta[j, 5], theta[j, 6]
         inertia, p_x, p_y = phys[j, 0], phys[j, 1], phys[j, 2]
-        if not (s0 > 0.0 and inertia > 0.0 and tau_c > 0.0 and w_s > 0.0):
+        if not (s0 > 0.0 and inertia > 0.0 and min(tcp, tcn) > 0.0 and w_s > 0.0):
             for i in range(n):
                 Q[j, i] = math.nan
                 V[j, i] = math.nan
@@ -171,6 +198,7 @@ def run_joint(
                 q = q_meas[i]
                 v = v_meas[i]
                 av = abs(v)
+                s2, tau_c, tau_s = (s2p, tcp, tsp) if v >= 0.0 else (s2n, tcn, tsn)
                 g = max(tau_c + (tau_s - tau_c) * math.exp(-((av / w_s) ** delta)), 1e-12)
                 grav = p_x * math.cos(q) - p_y * math.sin(q)
                 # F = s0 z + s1 (v - s0 |v| / g z) + s2 v solved for z (the damping term
@@ -181,18 +209,25 @@ def run_joint(
                     z = (tau[i] + grav - inertia * a_meas[i] - (s1 + s2) * v) / (s0 * lever)
                 else:
                     z = math.copysign(g / s0, v)
-                z = min(max(z, -g / s0), g / s0)
+                # at rest, the break-away deflection of each direction bounds its side
+                g_back = g if v != 0.0 else max(tcn + (tsn - tcn) * 1.0, 1e-12)
+                z = min(max(z, -g_back / s0), g / s0)
             elif i > 0:
                 h = dt[i] / n_sub
                 for _ in range(n_sub):
                     # predictor with the rate at the start, corrector with the rate and the
                     # gravity torque at the predicted mid-point (exponential mid-point rule)
                     av = abs(v)
+                    beta = (u + p_x * math.cos(q) - p_y * math.sin(q)) * inv_j
+                    # at rest, the direction the applied torque starts it in
+                    ahead = v > 0.0 or (v == 0.0 and beta >= 0.0)
+                    s2, tau_c, tau_s = (s2p, tcp, tsp) if ahead else (s2n, tcn, tsn)
                     g = max(tau_c + (tau_s - tau_c) * math.exp(-((av / w_s) ** delta)), 1e-12)
                     a = s0 * av / g
-                    beta = (u + p_x * math.cos(q) - p_y * math.sin(q)) * inv_j
                     _, vp, moved = _linear_step(s0, s1, s2, a, inv_j, beta, z, v, h)
-                    av = abs(0.5 * (v + vp))
+                    vm = 0.5 * (v + vp)
+                    av = abs(vm)
+                    s2, tau_c, tau_s = (s2p, tcp, tsp) if vm >= 0.0 else (s2n, tcn, tsn)
                     g = max(tau_c + (tau_s - tau_c) * math.exp(-((av / w_s) ** delta)), 1e-12)
                     a = s0 * av / g
                     qm = q + 0.5 * moved
@@ -203,6 +238,7 @@ def run_joint(
                     q = q_meas[i]
                     v = v_meas[i]
             av = abs(v)
+            s2, tau_c, tau_s = (s2p, tcp, tsp) if v >= 0.0 else (s2n, tcn, tsn)
             g = max(tau_c + (tau_s - tau_c) * math.exp(-((av / w_s) ** delta)), 1e-12)
             Q[j, i] = q
             V[j, i] = v

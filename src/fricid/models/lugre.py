@@ -30,6 +30,13 @@ which is unconditionally stable however stiff the bristles are (sigma_0 of 1e5 N
 state reached at its end, with ``dz/dt`` from the same formula. Candidates (rows of ``theta``)
 are simulated together: the loop runs over time only, compiled by numba.
 
+Per direction (``lugre_asym``, :class:`LuGreAsym`): sigma_2, tau_c and tau_s are given once
+for each direction of motion (the sign of v), sigma_0, sigma_1, w_s and delta once; the
+steady state is then ``stribeck_asym``'s with the shape shared. Real joints differ by
+direction (gear backlash preload, seals, cable routing), and a symmetric law fitted with the
+gravity lets the gravity coefficients take up half the difference
+(:mod:`fricid.identify.dynamic._direction`). Every function here takes either width.
+
 Passivity ([BO00]): the map from velocity to friction is passive if and only if
 ``sigma_1 <= 4 sigma_2 tau_c / (tau_s - tau_c)`` (always, when ``tau_s <= tau_c``), with every
 parameter positive (:func:`passivity_margin`).
@@ -62,11 +69,14 @@ from ..errors import ConfigError
 from ._base import FrictionModel, Parameter, parameter_batch, simulation_inputs
 
 __all__ = [
+    "ASYM_NAMES",
+    "ASYM_PARAMETERS",
     "PARAMETERS",
     "PARAM_NAMES",
     "ROW_THREADS",
     "STRIBECK_NAMES",
     "LuGre",
+    "LuGreAsym",
     "in_row_threads",
     "mean_friction",
     "passivity_margin",
@@ -74,6 +84,7 @@ __all__ = [
     "simulate_joint",
     "steady_state",
     "stribeck_curve",
+    "wide",
 ]
 
 #: LuGre's parameters, in the order of ``theta`` columns. The Stribeck part is named as the
@@ -104,28 +115,85 @@ STRIBECK_NAMES: dict[str, str] = {
     "delta": "delta",
 }
 
+#: The parameters a per-direction LuGre (``lugre_asym``) has one of for each direction of
+#: motion; the bristles (sigma_0, sigma_1) and the Stribeck curve's shape (w_s, delta) are
+#: shared.
+PER_DIRECTION: tuple[str, ...] = ("sigma_2", "tau_c", "tau_s")
+
+
+def _directed(p: Parameter, suffix: str, word: str) -> Parameter:
+    return Parameter(
+        f"{p.name}{suffix}",
+        p.unit,
+        p.kind,
+        p.default,
+        p.lower,
+        p.upper,
+        f"{p.description} ({word} direction)",
+        p.region,
+    )
+
+
+_BY_NAME = {p.name: p for p in PARAMETERS}
+#: Per-direction LuGre's parameters, in the order of the compiled kernels' columns: sigma_0,
+#: sigma_1, the forward set (``_pos``, v >= 0), w_s, delta, the backward set (``_neg``, v < 0).
+#: Like the static ``_asym`` models, the backward set holds magnitudes.
+ASYM_PARAMETERS: tuple[Parameter, ...] = (
+    _BY_NAME["sigma_0"],
+    _BY_NAME["sigma_1"],
+    *(_directed(_BY_NAME[n], "_pos", "positive") for n in PER_DIRECTION),
+    _BY_NAME["w_s"],
+    _BY_NAME["delta"],
+    *(_directed(_BY_NAME[n], "_neg", "negative") for n in PER_DIRECTION),
+)
+ASYM_NAMES: tuple[str, ...] = tuple(p.name for p in ASYM_PARAMETERS)
+
 _TINY = 1e-12
 
 
 def _batch(theta) -> tuple[np.ndarray, bool]:
-    return parameter_batch(theta, PARAM_NAMES, "LuGre")
+    """``theta`` as a batch of 7 (symmetric) or 10 (per direction, :data:`ASYM_NAMES`)
+    columns, and whether it was one vector."""
+    width = np.shape(theta)[-1] if np.ndim(theta) else 0
+    names = ASYM_NAMES if width == len(ASYM_NAMES) else PARAM_NAMES
+    return parameter_batch(theta, names, "LuGre")
+
+
+def wide(theta) -> np.ndarray:
+    """A batch ``(k, 7)`` or ``(k, 10)`` as the kernels' ``(k, 10)``: the symmetric levels
+    repeated for the backward direction (:mod:`._lugre_kernel`)."""
+    batch = np.atleast_2d(np.asarray(theta, dtype=float))
+    if batch.shape[1] == len(ASYM_NAMES):
+        return np.ascontiguousarray(batch)
+    return np.ascontiguousarray(np.hstack([batch, batch[:, 2:5]]))
+
+
+def _of_direction(w: np.ndarray, v: np.ndarray, column: int) -> np.ndarray:
+    """Column ``column`` of the forward set (2-4) of the wide batch ``w``, or its backward
+    counterpart where ``v < 0``, ``(k, n)``."""
+    return np.where(v >= 0, w[:, column : column + 1], w[:, column + 5 : column + 6])
 
 
 def stribeck_curve(theta, v) -> np.ndarray:
-    """``g(v)`` of [CW95] eq. 3 with [B] eq. 2's exponent, ``(k, n)`` for a batch (k, 7)."""
+    """``g(v)`` of [CW95] eq. 3 with [B] eq. 2's exponent, ``(k, n)`` for a batch (k, 7), or
+    (k, 10) with the levels of each velocity's direction."""
     batch, single = _batch(theta)
+    w = wide(batch)
     v = np.asarray(v, dtype=float)[None, :]
-    tau_c, tau_s, w_s, delta = (batch[:, j : j + 1] for j in (3, 4, 5, 6))
+    tau_c, tau_s = _of_direction(w, v, 3), _of_direction(w, v, 4)
+    w_s, delta = w[:, 5:6], w[:, 6:7]
     a = np.abs(v) / np.maximum(np.abs(w_s), _TINY)
     g = tau_c + (tau_s - tau_c) * np.exp(-(a**delta))
     return g[0] if single else g
 
 
 def steady_state(theta, v) -> np.ndarray:
-    """Friction at constant velocity: ``sign(v) g(v) + sigma_2 v`` (the static Stribeck law)."""
+    """Friction at constant velocity: ``sign(v) g(v) + sigma_2 v`` (the static Stribeck law;
+    per direction, ``stribeck_asym``'s)."""
     batch, single = _batch(theta)
     v = np.asarray(v, dtype=float)
-    out = np.sign(v)[None, :] * stribeck_curve(batch, v) + batch[:, 2:3] * v[None, :]
+    sigma_2 = _of_direction(wide(batch), v[None, :], 2)
+    out = np.sign(v)[None, :] * stribeck_curve(batch, v) + sigma_2 * v[None, :]
     return out[0] if single else out
 
 
@@ -133,15 +201,21 @@ def passivity_margin(theta) -> np.ndarray:
     """``4 sigma_2 tau_c / (tau_s - tau_c) - sigma_1`` ([BO00]): passive where >= 0.
 
     ``inf`` when ``tau_s <= tau_c`` (passive for any damping); ``-inf`` when a parameter that
-    must be positive is not (sigma_0, tau_c, w_s) or sigma_1, sigma_2 are negative.
+    must be positive is not (sigma_0, tau_c, w_s) or sigma_1, sigma_2 are negative. Per
+    direction (10 columns) the smaller of the two directions' margins: the condition applies
+    to each direction's branch of the velocity-to-friction map.
     """
     batch, single = _batch(theta)
-    s0, s1, s2, tau_c, tau_s, w_s = (batch[:, j] for j in range(6))
-    gap = tau_s - tau_c
-    with np.errstate(divide="ignore", invalid="ignore"):
-        margin = np.where(gap > 0, 4.0 * s2 * tau_c / np.where(gap > 0, gap, 1.0) - s1, np.inf)
-    bad = (s0 <= 0) | (tau_c <= 0) | (w_s <= 0) | (s1 < 0) | (s2 < 0)
-    margin = np.where(bad, -np.inf, margin)
+    w = wide(batch)
+    s0, s1, w_s = w[:, 0], w[:, 1], w[:, 5]
+    margin = np.full(len(w), np.inf)
+    for first in (2, 7):
+        s2, tau_c, tau_s = (w[:, first + j] for j in range(3))
+        gap = tau_s - tau_c
+        with np.errstate(divide="ignore", invalid="ignore"):
+            side = np.where(gap > 0, 4.0 * s2 * tau_c / np.where(gap > 0, gap, 1.0) - s1, np.inf)
+        bad = (s0 <= 0) | (tau_c <= 0) | (w_s <= 0) | (s1 < 0) | (s2 < 0)
+        margin = np.minimum(margin, np.where(bad, -np.inf, side))
     return margin[0] if single else margin
 
 
@@ -151,7 +225,8 @@ def simulate(theta, v, dt, z0=None) -> tuple[np.ndarray, np.ndarray]:
     Parameters
     ----------
     theta : array_like
-        ``(7,)`` or ``(k, 7)`` in the order of :data:`PARAM_NAMES`.
+        ``(7,)`` or ``(k, 7)`` in the order of :data:`PARAM_NAMES`, or 10 columns per
+        direction (:data:`ASYM_NAMES`).
     v : array_like
         ``(n,)`` velocity [rad/s], held constant over each sample.
     dt : float or array_like
@@ -172,7 +247,7 @@ def simulate(theta, v, dt, z0=None) -> tuple[np.ndarray, np.ndarray]:
     Z = np.empty((k, n))
     from ._lugre_kernel import run  # lazy: importing numba takes a while
 
-    run(batch, v, dt, z0, F, Z)
+    run(wide(batch), v, dt, z0, F, Z)
     return (F[0], Z[0]) if single else (F, Z)
 
 
@@ -187,7 +262,8 @@ def mean_friction(theta, v_sub, dt: float, up: int, z0=None) -> np.ndarray:
     Parameters
     ----------
     theta : array_like
-        ``(7,)`` or ``(k, 7)`` in the order of :data:`PARAM_NAMES`.
+        ``(7,)`` or ``(k, 7)`` in the order of :data:`PARAM_NAMES`, or 10 columns per
+        direction (:data:`ASYM_NAMES`).
     v_sub : array_like
         ``((n - 1) up + 1,)`` velocity [rad/s]: entry 0 at the first sample, then ``up``
         sub-step velocities per period, each held over ``dt / up``.
@@ -214,6 +290,7 @@ def mean_friction(theta, v_sub, dt: float, up: int, z0=None) -> np.ndarray:
     k = batch.shape[0]
     z0 = np.ascontiguousarray(np.broadcast_to(np.asarray(0.0 if z0 is None else z0, float), (k,)))
     F = np.empty((k, (v.size - 1) // up + 1))
+    batch = wide(batch)
     from ._lugre_kernel import run_mean  # lazy: importing numba takes a while
 
     in_row_threads(lambda a, b: run_mean(batch[a:b], v, float(dt) / up, up, z0[a:b], F[a:b]), k)
@@ -243,7 +320,8 @@ def simulate_joint(
     Parameters
     ----------
     theta : array_like
-        LuGre parameters ``(7,)`` or ``(k, 7)`` (:data:`PARAM_NAMES`).
+        LuGre parameters ``(7,)`` or ``(k, 7)`` (:data:`PARAM_NAMES`), or 10 columns per
+        direction (:data:`ASYM_NAMES`).
     inertia, p_x, p_y : float or array_like
         J [kg m^2] and the gravity coefficients [N m], scalar or ``(k,)``.
     dt : float or array_like
@@ -316,6 +394,7 @@ def simulate_joint(
     from ._lugre_kernel import run_joint  # lazy: importing numba takes a while
 
     flags = np.ascontiguousarray(flags)
+    batch = wide(batch)
     pd = np.array([float(gains[0]), float(gains[1])])
     names = ("position", "velocity", "state", "friction", "torque")
 
@@ -376,6 +455,20 @@ class LuGre(FrictionModel):
     equation = "Canudas de Wit et al. 1995, eq. 2-4"
     inputs = ("velocity",)
     parameters = PARAMETERS
+
+    def _predict(self, theta, X):
+        return steady_state(theta, X[:, 0])
+
+
+class LuGreAsym(FrictionModel):
+    """Per-direction LuGre's static projection: the steady state ``stribeck_asym`` with w_s
+    and delta shared (module notes); parameters :data:`ASYM_NAMES`."""
+
+    name = "lugre_asym"
+    title = "LuGre per direction (dynamic; steady state shown)"
+    equation = "Canudas de Wit et al. 1995, eq. 2-4, levels per direction"
+    inputs = ("velocity",)
+    parameters = ASYM_PARAMETERS
 
     def _predict(self, theta, X):
         return steady_state(theta, X[:, 0])
