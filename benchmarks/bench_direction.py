@@ -19,6 +19,11 @@ gravity note (``note``: the log cannot tell; beside a caveat or alone); how many
 (``silent``); the fits whose 95 % intervals of p_x and p_y both held the truth (``grav ok``);
 and the fits that missed the gravity and said nothing (``silent miss``, the confident wrong
 answer this check exists for). On symmetric truths ``differs`` and ``may`` are false alarms.
+
+``--model lugre_asym`` fits the levels per direction instead (no direction check: it has a
+level each way); ``levels ok`` counts the fits whose every Coulomb level's interval held its
+truth (``tau_c``, or ``tau_c_pos`` and ``tau_c_neg``), ``apart`` those whose two Coulomb
+intervals do not overlap (on symmetric truths a difference invented).
 """
 
 from __future__ import annotations
@@ -58,12 +63,21 @@ def task(args: tuple) -> dict:
         info["joint"][n]["ci95_low"] <= truth_names[n] <= info["joint"][n]["ci95_high"]
         for n in ("p_x", "p_y")
     )
+    levels = {"tau_c_pos": t.Fc, "tau_c_neg": t.Fc * t.neg}
+    if "tau_c_pos" not in fitted.parameters:
+        levels = {"tau_c": t.Fc, **({"tau_c ": t.Fc * t.neg} if neg != 1.0 else {})}
+    cis = {n: fitted.parameters[n.strip()].ci95 for n in levels}
+    levels_ok = all(lo <= levels[n] <= hi for n, (lo, hi) in cis.items())
+    (lo_a, hi_a), (lo_b, hi_b) = (cis.get(n, (0.0, 0.0)) for n in ("tau_c_pos", "tau_c_neg"))
+    apart = "tau_c_pos" in cis and (hi_b < lo_a or hi_a < lo_b)
     return {
         "key": (truth, kind, neg),
         "differs": any(c.startswith("the friction differs by direction") for c in caveats),
         "may": any(c.startswith("the friction may differ by direction") for c in caveats),
         "note": bool(info.get("gravity_note")),
         "held": held,
+        "levels_ok": levels_ok,
+        "apart": apart,
         "seconds": seconds,
     }
 
@@ -99,6 +113,7 @@ def main() -> None:
     print(f"# {a.duration:g} s logs at 1 kHz, {a.cpr} counts/rev, seeds {a.first_seed}-"
           f"{a.first_seed + a.seeds - 1}")  # fmt: skip
     head = ("setting", "fits", "differs", "may", "note", "silent", "grav ok", "silent miss")
+    head = (*head, "levels ok", "apart")
     print(f"{head[0]:<34}" + "".join(f"{h:>12}" for h in head[1:]))
     groups: dict = {}
     for r in rows:
@@ -125,6 +140,8 @@ def _counts(rs: list[dict]) -> dict:
         "silent": sum(silent),
         "grav ok": sum(r["held"] for r in rs),
         "silent miss": sum(s and not r["held"] for s, r in zip(silent, rs, strict=True)),
+        "levels ok": sum(r["levels_ok"] for r in rs),
+        "apart": sum(r["apart"] for r in rs),
     }
 
 

@@ -70,14 +70,24 @@ FRICTIONLOSS_LINES = (
 
 
 def frictionloss_lines(fitted: FittedModel) -> tuple[str, ...]:
-    """:data:`FRICTIONLOSS_LINES` for ``fitted``; a Dahl model's second line says that its
-    bristle dynamics are what the steady-state projection leaves out (it is not static)."""
+    """:data:`FRICTIONLOSS_LINES` for ``fitted``; a Dahl or per-direction LuGre model's second
+    line says that its bristle dynamics are what the steady-state projection leaves out (it
+    is not static)."""
     if isinstance(fitted.model, str) and fitted.model.strip().lower() == "dahl":
         return (
             FRICTIONLOSS_LINES[0],
             "this is the steady state of a Dahl model (dynamic): its bristle stiffness sigma_0 "
             "(pre-sliding, the lag after each reversal) is not exported, frictionloss has none; "
             "MuJoCo >= 4.0's LuGre (dcmotor actuator) carries it for a lugre model",
+        )
+    if isinstance(fitted.model, str) and fitted.model.strip().lower() == "lugre_asym":
+        return (
+            FRICTIONLOSS_LINES[0],
+            "this is the steady state of a LuGre model with its levels per direction "
+            "(dynamic): its bristles (sigma_0, sigma_1: pre-sliding, the lag after each "
+            "reversal) are not exported, frictionloss has none; MuJoCo >= 4.0's LuGre "
+            "(dcmotor actuator) has one level for both directions and carries them for a "
+            "lugre model",
         )
     return FRICTIONLOSS_LINES
 

@@ -153,9 +153,20 @@ def _joint_block(code, header_name: str, tag: str) -> str:
 
 def _lugre_steady_state(fitted: FittedModel) -> FittedModel:
     """A LuGre joint's steady state as the ``stribeck`` model it is at constant velocity
-    ([CW95]; ``tau_v = sigma_2``): what a friction feed-forward can hold."""
-    params = {new: replace(fitted.parameters[old], name=new) for new, old in STRIBECK_NAMES.items()}
-    return replace(fitted, model="stribeck", parameters=params)
+    ([CW95]; ``tau_v = sigma_2``), or per direction the ``stribeck_asym`` model (w_s and
+    delta the same both ways): what a friction feed-forward can hold."""
+    if fitted.model == "lugre":
+        names = STRIBECK_NAMES
+        model = "stribeck"
+    else:
+        names = {
+            f"{new}_{side}": old if old in ("w_s", "delta") else f"{old}_{side}"
+            for side in ("pos", "neg")
+            for new, old in STRIBECK_NAMES.items()
+        }
+        model = "stribeck_asym"
+    params = {new: replace(fitted.parameters[old], name=new) for new, old in names.items()}
+    return replace(fitted, model=model, parameters=params)
 
 
 def robot_c_code(
@@ -198,7 +209,7 @@ def robot_c_code(
     guard = f"{robot.upper()}_FRICTION_H"
     blocks, functions, about = [], [], []
     for i, ((joint, fitted), ident) in enumerate(zip(models.items(), idents, strict=True)):
-        steady = fitted.model == "lugre"
+        steady = fitted.model in ("lugre", "lugre_asym")
         fitted = _lugre_steady_state(fitted) if steady else fitted
         try:
             code = c_code(

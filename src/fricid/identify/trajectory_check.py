@@ -100,7 +100,7 @@ from ..metrics import verdict
 from ..samples import RawLog
 from ._scatter import SECOND_DIFFERENCES
 from .dynamic._data import DerivativeFilter, sliding, uniform_series
-from .dynamic._filtered import DAHL, LUGRE, _sub_velocity
+from .dynamic._filtered import DAHL, LUGRE, LUGRE_ASYM, _sub_velocity
 from .trust import SECOND_LOG, Trust, _grade
 
 __all__ = [
@@ -255,7 +255,7 @@ def _derivative_filter(info: dict[str, Any]) -> DerivativeFilter:
 def _friction(fitted: FittedModel, series, velocity: np.ndarray, n_sub: int) -> np.ndarray:
     """The model's mean friction over each period, entry ``i`` the period ending at ``i``."""
     name = str(fitted.model).strip().lower()
-    laws = {"lugre": LUGRE, "dahl": DAHL}
+    laws = {"lugre": LUGRE, "lugre_asym": LUGRE_ASYM, "dahl": DAHL}
     if name in laws:
         law = laws[name]
         theta = np.array([[float(fitted.params[k]) for k in law.names]])
@@ -277,7 +277,7 @@ def predict_trajectory(fitted: FittedModel, log: RawLog) -> TrajectoryPrediction
     J, p_x, p_y = _joint(fitted, source)
     info = fitted.provenance["trajectory"]
     series = uniform_series(log)
-    static = str(fitted.model).strip().lower() not in ("lugre", "dahl")
+    static = str(fitted.model).strip().lower() not in DYNAMIC
     v_slide = float(info.get("v_slide") or 0.02)
     v, a, slides = sliding(series, _derivative_filter(info), v_slide, 0.2, short=static)
     n_sub = max(int(info.get("n_sub") or 4), 1)
@@ -343,7 +343,7 @@ def _low_pass(recorded: dict | None, dt: float, n: int):
 
 
 #: The laws with a friction state (module notes).
-DYNAMIC = ("lugre", "dahl")
+DYNAMIC = ("lugre", "lugre_asym", "dahl")
 
 #: The caveat of a dynamic law graded on a second log.
 PRESLIDING_UNGRADED = (

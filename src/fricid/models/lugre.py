@@ -73,6 +73,7 @@ __all__ = [
     "ASYM_PARAMETERS",
     "PARAMETERS",
     "PARAM_NAMES",
+    "PER_DIRECTION",
     "ROW_THREADS",
     "STRIBECK_NAMES",
     "LuGre",
@@ -84,6 +85,7 @@ __all__ = [
     "simulate_joint",
     "steady_state",
     "stribeck_curve",
+    "symmetric_name",
     "wide",
 ]
 
@@ -149,6 +151,15 @@ ASYM_PARAMETERS: tuple[Parameter, ...] = (
 ASYM_NAMES: tuple[str, ...] = tuple(p.name for p in ASYM_PARAMETERS)
 
 _TINY = 1e-12
+
+
+def symmetric_name(name: str) -> str:
+    """The symmetric model's name of a per-direction parameter (``tau_c_neg`` -> ``tau_c``);
+    any other name unchanged."""
+    for suffix in ("_pos", "_neg"):
+        if name.endswith(suffix) and name[: -len(suffix)] in PER_DIRECTION:
+            return name[: -len(suffix)]
+    return name
 
 
 def _batch(theta) -> tuple[np.ndarray, bool]:

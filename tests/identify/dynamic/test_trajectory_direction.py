@@ -85,7 +85,8 @@ def test_lugre_on_a_joint_weaker_backwards_says_so_and_what_it_takes_up(tmp_path
     _, info, truth = fit_log("slow_stribeck", "trapezoid_pd", 0.8, 4, "lugre", tmp_path)
     caveats = info.get("caveats", [])
     assert any(c.startswith("the friction differs by direction") for c in caveats), caveats
-    assert any("fricid's LuGre has one Coulomb and break-away level" in c for c in caveats)
+    assert any("this LuGre has one Coulomb and break-away level" in c for c in caveats)
+    assert any("fit lugre_asym" in c for c in caveats)
     assert not gravity_held(info, truth)
 
 

@@ -40,9 +40,9 @@ _DIRECTION_ADVICE = {
     "coulomb_viscous": "fit coulomb_viscous_asym",
     "stribeck": "fit stribeck_asym",
     "lugre": (
-        "fricid's LuGre has one Coulomb and break-away level for both directions, so its "
-        "tau_c is about their mean and p_x, p_y are off by about half the difference; "
-        "stribeck_asym fits the steady state per direction"
+        "this LuGre has one Coulomb and break-away level for both directions, so its tau_c "
+        "is about their mean and p_x, p_y are off by about half the difference; fit "
+        "lugre_asym (the levels per direction)"
     ),
     "dahl": (
         "fricid's Dahl has one Coulomb level for both directions, so its tau_c is about their "

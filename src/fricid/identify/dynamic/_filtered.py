@@ -60,7 +60,18 @@ from ..static.uncertainty import jacobian
 from ._data import Series, blocks, cluster_covariance
 from ._routes import JOINT_PARAMS, SEARCH_SHARE, _run, _Stage, _t975
 
-__all__ = ["DAHL", "LUGRE", "Law", "ParallelFilter", "dahl_start", "filtered_route", "lugre_start"]
+__all__ = [
+    "DAHL",
+    "LUGRE",
+    "LUGRE_ASYM",
+    "Law",
+    "ParallelFilter",
+    "dahl_start",
+    "filtered_route",
+    "law_of",
+    "lugre_asym_start",
+    "lugre_start",
+]
 
 #: Output rate of the decimation, in multiples of the cut-off.
 DECIMATED_RATE = 5.0
@@ -90,7 +101,8 @@ class Law:
 
 
 def _lugre_mean(th: np.ndarray, v_sub: np.ndarray, dt: float, up: int) -> np.ndarray:
-    """LuGre's exact period means (:func:`fricid.models.lugre.mean_friction`)."""
+    """LuGre's exact period means (:func:`fricid.models.lugre.mean_friction`), symmetric or
+    per direction."""
     z0 = np.sign(v_sub[0]) * lugre.stribeck_curve(th, v_sub[:1])[:, 0] / th[:, 0]
     return np.atleast_2d(lugre.mean_friction(th, v_sub, dt, up, z0))
 
@@ -107,7 +119,15 @@ def _dahl_mean(th: np.ndarray, v_sub: np.ndarray, dt: float, up: int) -> np.ndar
 
 #: The laws of the filtered route.
 LUGRE = Law("lugre", lugre.PARAM_NAMES, _lugre_mean)
+LUGRE_ASYM = Law("lugre_asym", lugre.ASYM_NAMES, _lugre_mean)
 DAHL = Law("dahl", dahl.PARAM_NAMES, _dahl_mean)
+
+
+def law_of(names) -> Law:
+    """The LuGre law whose parameters lead ``names`` (a stage's: the law's, then J, p_x,
+    p_y)."""
+    names = tuple(names)
+    return LUGRE_ASYM if names[: len(LUGRE_ASYM.names)] == LUGRE_ASYM.names else LUGRE
 
 
 @dataclass(frozen=True)
@@ -327,6 +347,34 @@ def lugre_start(stage1, static_tab):
     start = np.array([1e4, 1.0] + [static_tab[n]["value"] for n in lugre.PARAM_NAMES[2:]])
     order = [stage1.names.index(n) for n in ("tau_v", "tau_c", "tau_s", "w_s", "delta")]
     return start, stage1.bounds[order], LUGRE
+
+
+def lugre_asym_start(stage1, static_tab, asym):
+    """Per-direction LuGre's start, box and law: the symmetric start (:func:`lugre_start`)
+    with each direction's Coulomb level and viscous coefficient from ``asym``, the
+    ``coulomb_viscous_asym`` regression on the samples beyond the rise
+    (:func:`._direction.per_direction`), and the break-away level moved with the Coulomb
+    one. Each direction's box is the symmetric one's (a per-direction Stribeck regression
+    leaves the levels ill-determined where the rise is narrow: ``_direction`` notes)."""
+    start, box, _ = lugre_start(stage1, static_tab)
+    sym = dict(zip(lugre.PARAM_NAMES, start, strict=True))
+    rows = dict(zip(lugre.PARAM_NAMES[2:], box, strict=True))
+    a = dict(zip(asym.names, asym.values, strict=True))
+    values, bounds = [sym["sigma_0"], sym["sigma_1"]], []
+    for name in lugre.ASYM_NAMES[2:]:
+        base, side = lugre.symmetric_name(name), name[-3:]
+        lo, hi = rows[base]
+        if base == "tau_c":
+            value = a[f"f_c_{side}"]
+        elif base == "tau_s":
+            value = sym["tau_s"] + a[f"f_c_{side}"] - sym["tau_c"]
+        elif base == "sigma_2":
+            value = a[f"beta_{side}"]
+        else:
+            value = sym[base]
+        values.append(float(np.clip(value, lo, hi)) if np.isfinite(value) else sym[base])
+        bounds.append((lo, hi))
+    return np.array(values), np.array(bounds, dtype=float), LUGRE_ASYM
 
 
 def dahl_start(stage1, static_tab):

@@ -104,7 +104,7 @@ def widen_calibrated(stage) -> dict[str, Any]:
     standard errors are scaled alike, so that the printed +- and interval agree."""
     before = {}
     for i, name in enumerate(stage.names):
-        k = CALIBRATED_WIDENING.get(name)
+        k = CALIBRATED_WIDENING.get(lugre.symmetric_name(name))  # per direction: as one
         lo, hi, v = float(stage.low[i]), float(stage.high[i]), float(stage.values[i])
         if k is None or not all(math.isfinite(x) for x in (lo, hi, v)):
             continue
@@ -132,9 +132,10 @@ def _items(key: str) -> list[tuple[str, tuple[int, int]]]:
     return list(LUGRE_COVERAGE[key].items())
 
 
-def lugre_caveat() -> str:
+def lugre_caveat(per_direction: bool = False) -> str:
     """The caveat every LuGre fit from a trajectory carries: its intervals' coverage on logs
-    fricid did not simulate, after the calibrated widening (:data:`LUGRE_COVERAGE`)."""
+    fricid did not simulate, after the calibrated widening (:data:`LUGRE_COVERAGE`, measured
+    on symmetric fits; ``per_direction`` says so for ``lugre_asym``)."""
     kinds = [f"{100 * c / n:.0f} % ({k})" for k, (c, n) in _items("kinds")]
     kinds = ", ".join(kinds[:-1]) + " and " + kinds[-1]
     each = ", ".join(f"{k} {100 * c / n:.0f} %" for k, (c, n) in _items("parameters"))
@@ -143,6 +144,12 @@ def lugre_caveat() -> str:
         f"logs with quantised encoders, and on other logs of it they held the truth in {kinds} "
         f"of the claims, not 95 % everywhere; per parameter, the inertia's and the gravity's "
         f"too: {each} (benchmarks/bench_lugre.py)"
+        + (
+            "; measured on symmetric LuGre fits, and a level per direction has each level "
+            "told by half the log"
+            if per_direction
+            else ""
+        )
     )
 
 
@@ -286,22 +293,29 @@ def estimator(
     return {"name": name, "bias": check}
 
 
+#: The side of each parameter's interval at which LuGre is least passive.
+_LEAST_PASSIVE = {"sigma_1": 1, "sigma_2": 0, "tau_c": 0, "tau_s": 1}
+
+
 def passivity(names: list[str], values, low, high) -> dict[str, Any]:
     """[BO00] margin at the estimate and at the least favourable corner of the intervals
     (``margin_worst_in_ci95`` and ``passive_across_ci95`` None when there are no intervals:
-    a fit that did not converge)."""
+    a fit that did not converge); per direction, the smaller margin of the two."""
     p = dict(zip(names, values, strict=True))
     worst = dict(p)
-    lo, hi = dict(zip(names, low, strict=True)), dict(zip(names, high, strict=True))
+    ends = dict(zip(names, zip(low, high, strict=True), strict=True))
     sides = 0
-    for n, side in (("sigma_1", hi), ("sigma_2", lo), ("tau_c", lo), ("tau_s", hi)):
-        if np.isfinite(side[n]):
-            worst[n] = side[n]
+    for n in names:
+        side = _LEAST_PASSIVE.get(lugre.symmetric_name(n))
+        if side is not None and np.isfinite(ends[n][side]):
+            worst[n] = ends[n][side]
             sides += 1
-    at = float(lugre.passivity_margin(np.array([p[n] for n in lugre.PARAM_NAMES])))
-    corner = float(lugre.passivity_margin(np.array([worst[n] for n in lugre.PARAM_NAMES])))
+    law = lugre.ASYM_NAMES if "tau_c_pos" in p else lugre.PARAM_NAMES
+    at = float(lugre.passivity_margin(np.array([p[n] for n in law])))
+    corner = float(lugre.passivity_margin(np.array([worst[n] for n in law])))
     return {
-        "condition": "sigma_1 <= 4 sigma_2 tau_c / (tau_s - tau_c) (Barabanov and Ortega 2000)",
+        "condition": "sigma_1 <= 4 sigma_2 tau_c / (tau_s - tau_c) (Barabanov and Ortega 2000)"
+        + (", in each direction" if law is lugre.ASYM_NAMES else ""),
         "margin": at if np.isfinite(at) else None,
         "passive": bool(at >= 0),
         "margin_worst_in_ci95": corner if sides and np.isfinite(corner) else None,
@@ -319,7 +333,7 @@ def _deciding(fits: list[tuple[str, Any]], rename: dict[str, str]) -> list[bool]
     for _, stage in reversed(fits):
         names = {rename.get(n, n) for n in stage.names}
         out.append(not names <= covered)
-        covered |= names
+        covered |= names | {lugre.symmetric_name(n) for n in names}  # per direction: both
     return out[::-1]
 
 

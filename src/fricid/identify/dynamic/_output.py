@@ -88,7 +88,8 @@ def needs_output_error(stage: _Stage, encoder: dict[str, Any], dt: float) -> dic
     if not quantum:
         return {"needed": False, "why": "no quantisation found"}
     v = dict(zip(stage.names, stage.values, strict=True))
-    counts = v["tau_s"] / (v["sigma_0"] * quantum)
+    tau_s = min(x for n, x in v.items() if lugre.symmetric_name(n) == "tau_s")  # the weaker
+    counts = tau_s / (v["sigma_0"] * quantum)
     per_sample = quantum / dt
     needed = bool(counts < RESOLVED_COUNTS or per_sample > SPEED_FRACTION * v["w_s"])
     return {
@@ -118,9 +119,9 @@ def output_error(
     ``second``: values by name for a second start (the regression's static part and J; its
     sigma_1 at :data:`SECOND_DAMPING` of the bristles' critical damping), run when the first
     is doubtful (:func:`_doubtful`: on a face of the box); the start with the lower SSE is
-    carried on (both SSEs in the result's ``starts``). Returns the stage (LuGre's seven
-    parameters then J, p_x, p_y as ``stage``'s), the filtered measured torque and the
-    residual at the estimate (decimated samples).
+    carried on (both SSEs in the result's ``starts``). Returns the stage (LuGre's
+    parameters, symmetric or per direction, then J, p_x, p_y as ``stage``'s), the filtered
+    measured torque and the residual at the estimate (decimated samples).
     """
 
     t0 = time.perf_counter()
@@ -131,10 +132,11 @@ def output_error(
     reference = (q, np.gradient(q, dt))
     y = low(u)[keep]
     names = list(stage.names)
-    nd = len(names) - 7
+    d = names.index("inertia")  # the law's parameters come first
+    nd = len(names) - d
     is_log = np.array([nm in LOG_BOX for nm in names])
     start = np.asarray(stage.values, dtype=float)
-    J0 = float(start[7])
+    J0 = float(start[d])
     wn = 2.0 * math.pi * BANDWIDTH
     gains = (J0 * wn**2, 2.0 * DAMPING * J0 * wn)
 
@@ -145,11 +147,11 @@ def output_error(
     def simulated(U):
         P = natural(U)
         k = len(P)
-        p_x = P[:, 8] if nd >= 2 else np.zeros(k)
-        p_y = P[:, 9] if nd >= 3 else np.zeros(k)
+        p_x = P[:, d + 1] if nd >= 2 else np.zeros(k)
+        p_y = P[:, d + 2] if nd >= 3 else np.zeros(k)
         sim = lugre.simulate_joint(
-            P[:, :7],
-            P[:, 7],
+            P[:, :d],
+            P[:, d],
             p_x,
             p_y,
             np.full(n, dt),

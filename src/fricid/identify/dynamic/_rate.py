@@ -73,7 +73,7 @@ from ...errors import ConfigError, FricidError
 from ...models import lugre
 from ...samples import encoder_quantum
 from ._data import Series
-from ._filtered import LOG_BOX, ParallelFilter, filtered_route
+from ._filtered import LOG_BOX, ParallelFilter, filtered_route, law_of
 from ._routes import _Stage
 
 __all__ = [
@@ -250,17 +250,18 @@ def rate_bias(
         re-identification's route; or, instead of the estimates, ``skipped`` with the reason
         (the simulation at the estimate diverged, or its identification failed).
     """
-    theta = np.asarray(stage.values[:7], dtype=float)
+    law = law_of(stage.names)
+    theta = np.asarray(stage.values[: len(law.names)], dtype=float)
     quantum = (encoder or {}).get("quantum")
     out: dict[str, Any] = {"internal_rate": SUB_STEPS / series.dt, "log_rate": 1.0 / series.dt}
     out["quantised"] = (encoder or {}).get("counts_per_rev") if quantum else None
-    again = simulated_log(series, stage.values, encoder)
+    again = simulated_log(series, stage.values, encoder, width=len(law.names))
     if again is None:
         return {**out, "skipped": "the simulation at the estimate diverged"}
     try:
         if refine is None:
             redo, _, _ = filtered_route(
-                again, theta, static_bounds, gravity, method, seed, None, 0.5, n_sub, filt
+                again, theta, static_bounds, gravity, method, seed, None, 0.5, n_sub, filt, law=law
             )
         else:  # the step that gave the estimate, from it (the simulation's truth)
             redo, _, _ = refine(again, stage)
@@ -285,14 +286,16 @@ def simulated_log(
     encoder: dict[str, Any] | None = None,
     feed: np.ndarray | None = None,
     noise: np.ndarray | None = None,
+    width: int = 7,
 ) -> Series | None:
-    """The log a joint with ``values`` (LuGre's seven, then J, p_x, p_y) would have given:
+    """The log a joint with ``values`` (LuGre's ``width`` parameters, 10 per direction, then
+    J, p_x, p_y) would have given:
     simulated at :data:`SUB_STEPS` sub-steps per period under ``feed`` (default the logged
     torque) with PD tracking (:data:`GAINS`) of the measured position, read through the log's
     ``encoder`` (its velocity formed as the log's was), the applied torque logged plus
     ``noise`` (``(n,)``, default none). None when the simulation diverges."""
-    theta = np.asarray(values[:7], dtype=float)
-    joint = [*values[7:], 0.0, 0.0]
+    theta = np.asarray(values[:width], dtype=float)
+    joint = [*values[width:], 0.0, 0.0]
     dt, q = series.dt, series.position
     sim = lugre.simulate_joint(
         theta,

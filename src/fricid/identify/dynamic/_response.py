@@ -63,8 +63,9 @@ from typing import Any
 import numpy as np
 
 from ...errors import FricidError
+from ...models import lugre
 from ._data import Series, torque_noise
-from ._filtered import ParallelFilter, filtered_route
+from ._filtered import ParallelFilter, filtered_route, law_of
 from ._output import output_error
 from ._rate import simulated_log
 from ._routes import _Stage
@@ -135,8 +136,11 @@ def reidentifier(
             return output_error(
                 data, start, gravity, method, seed, CHECK_EVALS, cluster_time, n_sub, filt
             )[0]
-        theta = start.values[:7]
-        return filtered_route(data, theta, box, gravity, method, seed, None, 0.5, n_sub, filt)[0]
+        law = law_of(start.names)
+        theta = start.values[: len(law.names)]
+        return filtered_route(
+            data, theta, box, gravity, method, seed, None, 0.5, n_sub, filt, law=law
+        )[0]
 
     return reidentify
 
@@ -162,6 +166,7 @@ def follows(
     noise = torque_noise(series.torque)
     rng = np.random.default_rng([int(seed), 29])
     out: dict[str, Any] = {"noise": noise, "shifts": []}
+    width = len(law_of(stage.names).names)
     for k in range(2):
         values = np.array(stage.values, dtype=float)
         rows = {}
@@ -178,7 +183,7 @@ def follows(
             values[i] *= 10.0**shift
             rows[name] = {"shift": shift, "truth": float(values[i])}
         again = simulated_log(
-            series, values, encoder, feed, rng.standard_normal(series.time.size) * noise
+            series, values, encoder, feed, rng.standard_normal(series.time.size) * noise, width
         )
         if again is None:
             return {"skipped": "the simulation at a shifted truth diverged"}
@@ -210,7 +215,8 @@ def response_notes(stage: _Stage, check: dict[str, Any]) -> dict[str, str]:
             elif name == "w_s" and sane and "w_s" not in notes and moved <= STRIBECK_FOLLOW:
                 why = _told_apart(stage, name, row, f" (it moved {moved:.0%} of the way)")
                 notes["w_s"] = f"not determined: {why}"
-                for other in (n for n in STRIBECK if n != "w_s"):
+                rise = (n for n in stage.names if lugre.symmetric_name(n) in STRIBECK)
+                for other in (n for n in rise if n != "w_s"):
                     notes[other] = (
                         f"not determined: the Stribeck rise's shape is not told by the log ({why})"
                     )

@@ -85,7 +85,8 @@ def build_result(
     v_slide, gravity, t_start = options["v_slide"], options["gravity"], options["t_start"]
     rate = 1.0 / series.dt
     stage1 = stages["regression"]
-    param_names = list(lugre.PARAM_NAMES) if key == "lugre" else list(get_model(key).param_names)
+    param_names = list(get_model(key).param_names)
+    is_lugre = key in ("lugre", "lugre_asym")
     values = np.array([final[n]["value"] for n in param_names])
     low = np.array([final[n]["ci95_low"] for n in param_names])
     high = np.array([final[n]["ci95_high"] for n in param_names])
@@ -172,13 +173,13 @@ def build_result(
     caveats = [
         bias_caveat(options.get("window_bias")),
         direction,
-        lugre_caveat() if key == "lugre" else "",
+        lugre_caveat(key == "lugre_asym") if is_lugre else "",
     ]
     if any(caveats):
         info["caveats"] = [c for c in caveats if c]
     if gravity_note:
         info["gravity_note"] = gravity_note
-    if key == "lugre":
+    if is_lugre:
         info["passivity"] = passivity(param_names, values, low, high)
         if not info["passivity"]["passive"]:
             warnings.warn(
@@ -221,9 +222,12 @@ def unresolved_rise(params: dict[str, Parameter]) -> dict[str, Parameter]:
     it now flags, 25 had claimed a closed interval for ``tau_s`` in a converged fit, and 6 of
     those covered the truth (cdw95, w_s = 1 mrad/s: tau_s at tau_c, 58 to 390 half-widths
     off)."""
-    w_s, tau_s = params.get("w_s"), params.get("tau_s")
-    if w_s is None or tau_s is None or tau_s.not_determined or not np.isfinite(w_s.value):
+    w_s = params.get("w_s")
+    rise = [n for n in params if lugre.symmetric_name(n) in ("tau_s", "delta")]
+    if w_s is None or not rise or not np.isfinite(w_s.value):
         return params
+    if all(params[n].not_determined for n in rise if n.startswith("tau_s")):
+        return params  # said already (the rate bias's check)
     if not (w_s.low_open or w_s.note.startswith("not identified")):
         return params
     out = dict(params)
@@ -232,8 +236,8 @@ def unresolved_rise(params: dict[str, Parameter]) -> dict[str, Parameter]:
         "interval reaches the search range's lower end), so a narrower, taller rise fits as "
         "well; the value is the friction at the slowest speeds the log resolves"
     )
-    for n in ("tau_s", "delta"):
-        if n in out and not out[n].not_determined:
+    for n in rise:
+        if not out[n].not_determined:
             out[n] = replace(out[n], note=why, not_determined=True)
     return out
 

@@ -6,7 +6,9 @@ timing).
 Every stage's search is a problem of the problem protocol
 (:class:`fricid.identify.problem.Problem`): a :class:`~fricid.identify.problem.ResidualProblem`
 of the projected equation error, or :class:`_SimProblem` of the simulation error, so that its
-convergence is certified as an analytic fit's is (:func:`._outcome.converged`).
+convergence is certified as an analytic fit's is (:func:`._outcome.converged`). Which route
+a model takes (:func:`route_for`) is decided here too; the module is longer than 500 lines
+because the two routes share their stage, covariance and search-box code.
 """
 
 from __future__ import annotations
@@ -24,7 +26,51 @@ from ..problem import Problem, ResidualProblem
 from ..static.uncertainty import jacobian
 from ._data import Series, blocks, cluster_covariance, low_speed_windows
 
-__all__ = ["JOINT_PARAMS", "LSQ_STARTS"]
+__all__ = [
+    "DYNAMIC_MODELS",
+    "JOINT_PARAMS",
+    "LSQ_STARTS",
+    "LUGRE_LAWS",
+    "ROUTES",
+    "STATIC_MODELS",
+    "route_for",
+]
+
+#: Routes of :func:`.trajectory.fit_trajectory` (the first is LuGre's default; LuGre's
+#: ``presliding`` is taken by the default too when the log never slides).
+ROUTES = ("filtered", "two_stage", "joint", "regression", "presliding")
+
+#: Static models a trajectory identifies by regression.
+STATIC_MODELS = ("stribeck", "coulomb_viscous", "stribeck_asym", "coulomb_viscous_asym")
+
+#: Dynamic models a trajectory identifies.
+DYNAMIC_MODELS = ("lugre", "lugre_asym", "dahl")
+#: The LuGre laws: one set of levels, or one per direction (the filtered route only).
+LUGRE_LAWS = ("lugre", "lugre_asym")
+
+
+def route_for(key: str, route: str, with_static: bool) -> str:
+    """The route :func:`.trajectory.fit_trajectory` takes for the model ``key`` asked for
+    ``route`` (``with_static``: a static part from sweeps given), or a ConfigError: static
+    models by the regression, Dahl and per-direction LuGre by the filtered route only,
+    LuGre's filtered route with sweeps becomes ``two_stage``."""
+    if key not in (*DYNAMIC_MODELS, *STATIC_MODELS):
+        raise ConfigError(
+            f"a trajectory identifies {', '.join(DYNAMIC_MODELS)} or a static model "
+            f"({', '.join(STATIC_MODELS)}); got '{key}'"
+        )
+    if route not in ROUTES:
+        raise ConfigError(f"unknown route '{route}'; one of: {', '.join(ROUTES)}")
+    if key in ("dahl", "lugre_asym") and (route != "filtered" or with_static):
+        raise ConfigError(f"{key} is identified by the filtered route only (no static= either)")
+    if key in STATIC_MODELS:
+        return "regression"
+    if key == "lugre" and route == "filtered" and with_static:
+        return "two_stage"
+    if key == "lugre" and route == "regression":
+        raise ConfigError("LuGre's sigma_0 and sigma_1 need the simulation route (two_stage)")
+    return route
+
 
 #: Starts of the least-squares methods (the first at the given start: the static part's
 #: defaults, or the first stage's estimate; the second at random in the box).

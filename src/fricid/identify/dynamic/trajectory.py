@@ -159,7 +159,7 @@ from ...models import get_model, lugre
 from ...samples import RawLog, check_trajectory_log
 from ._data import DerivativeFilter, check_dissipates, guarded_sliding, sliding, uniform_series
 from ._direction import direction_caveat, per_direction
-from ._filtered import ParallelFilter, dahl_start, filtered_route, lugre_start
+from ._filtered import ParallelFilter, dahl_start, filtered_route, lugre_asym_start, lugre_start
 from ._outcome import (
     RATE_BIAS,
     PassivityWarning,
@@ -176,7 +176,15 @@ from ._rate import measurement
 from ._rate import rate_bias as _rate_bias
 from ._response import follows, reidentifier, response_notes
 from ._result import build_result
-from ._routes import JOINT_PARAMS, _regression
+from ._routes import (
+    DYNAMIC_MODELS,
+    JOINT_PARAMS,
+    LUGRE_LAWS,
+    ROUTES,
+    STATIC_MODELS,
+    _regression,
+    route_for,
+)
 from ._simroute import simulation_route
 from ._window import DerivativeBiasWarning, choose_window, corrected
 
@@ -190,10 +198,6 @@ __all__ = [
     "fit_trajectory",
 ]
 
-#: Routes of :func:`fit_trajectory` (the first is LuGre's default; LuGre's ``presliding``
-#: is taken by the default too when the log never slides).
-ROUTES = ("filtered", "two_stage", "joint", "regression", "presliding")
-
 #: Fewest sliding samples (``|v| >= v_slide``, away from the stretches below it) for the
 #: routes that identify the sliding friction; below it LuGre takes the pre-sliding route.
 MIN_SLIDING = 50
@@ -201,14 +205,9 @@ MIN_SLIDING = 50
 #: Settings of the output-error step (``output_error=``).
 OUTPUT_ERROR = ("auto", "on", "off")
 
-#: Static models a trajectory identifies by regression.
-STATIC_MODELS = ("stribeck", "coulomb_viscous", "stribeck_asym", "coulomb_viscous_asym")
-
-#: Dynamic models a trajectory identifies.
-DYNAMIC_MODELS = ("lugre", "dahl")
 #: Laws with one level for both directions, whose fit tests whether the friction differs by
 #: direction (:func:`._direction.direction_caveat`).
-SYMMETRIC = ("coulomb_viscous", "stribeck", *DYNAMIC_MODELS)
+SYMMETRIC = ("coulomb_viscous", "stribeck", "lugre", "dahl")
 
 #: The Dahl static part, as named in the ``coulomb_viscous`` model.
 _STATIC_OF_DAHL = {"f_c": "tau_c", "beta": "sigma_2"}
@@ -243,15 +242,17 @@ def fit_trajectory(
     log : RawLog
         Time, position, velocity, torque (or current with K), temperature; any reader's.
     model : str
-        ``lugre`` or ``dahl`` (dynamic), or a static model: ``stribeck``, ``coulomb_viscous``
-        or either per direction (``stribeck_asym``, ``coulomb_viscous_asym``).
+        ``lugre``, ``lugre_asym`` (its levels and viscous coefficient per direction) or
+        ``dahl`` (dynamic), or a static model: ``stribeck``, ``coulomb_viscous`` or either
+        per direction (``stribeck_asym``, ``coulomb_viscous_asym``).
     method : str
         Any fricid optimiser (:data:`fricid.optim.METHODS`), used by both routes.
     route : str
         ``filtered`` (default for LuGre: every parameter at once by the parallel-filtered
         equation error), ``two_stage``, ``joint`` (then every parameter by simulation
         error), ``regression`` (static models; the only route for them). With ``static=``
-        the ``filtered`` route becomes ``two_stage``. Dahl: ``filtered`` only.
+        the ``filtered`` route becomes ``two_stage``. Dahl and ``lugre_asym``: ``filtered``
+        only.
     gravity : str
         ``fit`` (p_x, p_y estimated) or ``none`` (a horizontal joint).
     derivative : DerivativeFilter, optional
@@ -317,21 +318,7 @@ def fit_trajectory(
         Too short a log, too few sliding, a reversed sign, or (LuGre) no low-speed stretch.
     """
     key = str(model).strip().lower()
-    if key not in (*DYNAMIC_MODELS, *STATIC_MODELS):
-        raise ConfigError(
-            f"a trajectory identifies lugre, dahl or a static model "
-            f"({', '.join(STATIC_MODELS)}); got '{model}'"
-        )
-    if route not in ROUTES:
-        raise ConfigError(f"unknown route '{route}'; one of: {', '.join(ROUTES)}")
-    if key == "dahl" and (route != "filtered" or static is not None):
-        raise ConfigError("dahl is identified by the filtered route only (no static= either)")
-    if key in STATIC_MODELS and route != "regression":
-        route = "regression"
-    if key == "lugre" and route == "filtered" and static is not None:
-        route = "two_stage"
-    if key == "lugre" and route == "regression":
-        raise ConfigError("LuGre's sigma_0 and sigma_1 need the simulation route (two_stage)")
+    route = route_for(key, route, static is not None)
     if gravity not in ("fit", "none"):
         raise ConfigError(f"gravity must be 'fit' or 'none', got '{gravity}'")
     if output_error not in OUTPUT_ERROR:
@@ -383,7 +370,8 @@ def fit_trajectory(
             f"slower stretches ({moving} before the guards): too few for the static friction",
             file=log.source,
         )
-    static_model = get_model({"lugre": "stribeck", "dahl": "coulomb_viscous"}.get(key, key))
+    static_of = {"lugre": "stribeck", "lugre_asym": "stribeck", "dahl": "coulomb_viscous"}
+    static_model = get_model(static_of.get(key, key))
     fixed = None
     if static is not None:
         if static.model != "stribeck":
@@ -408,11 +396,12 @@ def fit_trajectory(
         )
     vf, acc, mask, stage1, _theta_s, c, r1 = fit
     stage1, direction = corrected(stage1, window_bias), ("", "")
-    if key in SYMMETRIC:  # a per-direction law fits better? (._direction)
+    if key in (*SYMMETRIC, "lugre_asym"):  # a per-direction law fits better? (._direction)
         asym = per_direction(series, derivative, vf, acc, mask, args, stage1)
-        direction = direction_caveat(asym, key, stage1)
+        if key in SYMMETRIC:
+            direction = direction_caveat(asym, key, stage1)
     stages = {"regression": stage1}
-    rename = {"lugre": lugre.STRIBECK_NAMES, "dahl": _STATIC_OF_DAHL}.get(key, {})
+    rename = {"dahl": _STATIC_OF_DAHL}.get(key, lugre.STRIBECK_NAMES if key in LUGRE_LAWS else {})
     joint_vals = dict(zip(JOINT_PARAMS, [*list(c), 0.0, 0.0], strict=False))
     fits = [("regression", stage1)] if stage1.result is not None else []
     # the static part as the result states it: from the regression or the sweeps
@@ -444,10 +433,13 @@ def fit_trajectory(
             "chirp)",
             file=log.source,
         )
-    if key == "dahl" or (key == "lugre" and route == "filtered"):
+    if key in ("dahl", "lugre_asym") or (key == "lugre" and route == "filtered"):
         parallel = parallel or ParallelFilter()
         say(f"filtered route: every {'Dahl' if key == 'dahl' else 'LuGre'} parameter")
-        start, box, law = (dahl_start if key == "dahl" else lugre_start)(stage1, static_tab)
+        if key == "lugre_asym":
+            start, box, law = lugre_asym_start(stage1, static_tab, asym)
+        else:
+            start, box, law = (dahl_start if key == "dahl" else lugre_start)(stage1, static_tab)
         stage, y, r = filtered_route(
             series,
             start,
@@ -469,7 +461,7 @@ def fit_trajectory(
         bounds_out.update({n: list(b) for n, b in zip(stage.names, stage.bounds, strict=True)})
         sim_info = {"parallel_filter": parallel.describe(rate), "n_sub": int(n_sub)}
         refine = None
-        if key == "lugre":
+        if key in LUGRE_LAWS:
             say("output error, when the encoder is too coarse")
             decide = needs_output_error(stage, encoder, series.dt)
             decide["applied"] = output_error == "on" or (
@@ -489,7 +481,7 @@ def fit_trajectory(
                 stages["output_error"] = stage
                 fits.append(("output_error", stage))
                 final.update(stage.table())
-        if key == "lugre" and rate_bias == "warn":
+        if key in LUGRE_LAWS and rate_bias == "warn":
             say("rate bias, by simulation at the estimate")
             rb = _rate_bias(
                 series, stage, box, gravity, method, seed, n_sub, parallel, encoder, refine
@@ -505,7 +497,7 @@ def fit_trajectory(
             check = follows(series, stage, encoder, parallel.cutoff, seed, again)
             sim_info["follows"] = check
             notes = {**notes, **response_notes(stage, check)}
-        if key == "lugre":
+        if key in LUGRE_LAWS:
             sim_info["calibration"] = widen_calibrated(stage)
             final.update(stage.table())
     elif key == "lugre":
@@ -580,7 +572,7 @@ def _stages(
     """``say(label)``: the next stage of the route, told to ``progress`` with its place
     (``i`` of ``n``: the log, the regression, the route's own stages, the intervals)."""
     n = 3
-    if key == "lugre":
+    if key in LUGRE_LAWS:
         n += 1 + (route == "filtered") * (1 + 2 * (rate_bias == "warn"))
     else:  # Dahl's filtered route; a static model's derivative window
         n += 1
