@@ -294,6 +294,29 @@ def test_lugre_parameters_and_truth_checks():
         lugre_compensation_study(theta, TrackingConfig(**FAST), truth=LuGreTruth(LUGRE))
 
 
+def test_a_per_direction_model_drives_the_observer_with_its_own_levels():
+    """A ``lugre_asym`` model file feeds the observer its 10 parameters: with the same levels
+    both ways it is the symmetric model to the bit; weaker backwards it changes the run."""
+    names = lugre.ASYM_NAMES
+    same = dict(zip(names, lugre.wide(np.array(LUGRE))[0], strict=True))
+    fitted = FittedModel.from_values("lugre_asym", same)
+    theta = lugre_parameters(fitted)
+    assert theta.size == 10
+    config, truth = TrackingConfig(**FAST), LuGreTruth(LUGRE)
+    a = lugre_compensation_study(theta, config, truth=truth)
+    b = lugre_compensation_study(LUGRE, config, truth=truth)
+    assert a.rms == b.rms and a.rms_crossing == b.rms_crossing
+    assert a.to_dict()["lugre_parameters"]["tau_c_neg"] == LUGRE[3]
+    weaker = dict(same, tau_c_neg=0.2, tau_s_neg=0.35)
+    c = lugre_compensation_study(
+        lugre_parameters(FittedModel.from_values("lugre_asym", weaker)), config, truth=truth
+    )
+    assert c.rms_crossing[RUNS[2]] != b.rms_crossing[RUNS[2]]
+    assert c.rms[RUNS[0]] == b.rms[RUNS[0]]  # PD alone does not read the model
+    with pytest.raises(ConfigError, match="7 finite LuGre parameters are needed"):
+        LuGreTruth(tuple(theta))  # the plant has one level both ways
+
+
 def test_cli_compensate_lugre_truth(tmp_path):
     stribeck_of_lugre().save(tmp_path / "s.json")
     args = ["compensate", str(tmp_path / "s.json"), "--truth", "lugre", "--frequency", "0.5"]

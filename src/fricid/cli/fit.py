@@ -157,8 +157,9 @@ def fit_command(
         bool,
         typer.Option(
             "--trajectory",
-            help="SAMPLES is a raw log of any motion: identify lugre (or dahl, stribeck, "
-            "coulomb_viscous) with J and gravity from it (fricid.identify.dynamic.trajectory).",
+            help="SAMPLES is a raw log of any motion: identify lugre (or lugre_asym, its "
+            "levels per direction; dahl, stribeck, coulomb_viscous) with J and gravity from it "
+            "(fricid.identify.dynamic.trajectory).",
         ),
     ] = False,
     log_format: Annotated[

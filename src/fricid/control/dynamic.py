@@ -23,8 +23,9 @@ Three runs advance together, each with the controller
     controller's one-step delay, as on a real drive. The measured velocity is exact unless
     ``velocity_noise`` adds white noise to it (the D term's and the observer's input).
 
-The model's parameters (7, :data:`fricid.models.lugre.PARAM_NAMES`) come from the caller:
-:func:`lugre_parameters` builds them from a fitted ``lugre`` model, or from a static
+The model's parameters (7, :data:`fricid.models.lugre.PARAM_NAMES`, or 10 per direction,
+``ASYM_NAMES``) come from the caller: :func:`lugre_parameters` builds them from a fitted
+``lugre`` or ``lugre_asym`` model, or from a static
 ``stribeck`` or ``coulomb_viscous`` model (its static part, identified from sweeps) plus
 ``sigma_0`` and ``sigma_1``.
 
@@ -60,15 +61,21 @@ __all__ = [
 RUNS = ("PD only", "static feed-forward", "LuGre observer")
 
 
-def _theta(theta, what: str) -> np.ndarray:
+def _names(th: np.ndarray) -> tuple[str, ...]:
+    return lugre.ASYM_NAMES if th.size == len(lugre.ASYM_NAMES) else lugre.PARAM_NAMES
+
+
+def _theta(theta, what: str, widths: tuple[int, ...] = (7, 10)) -> np.ndarray:
+    """``theta`` checked: 7 LuGre parameters (or 10 per direction, where ``widths`` has
+    10), finite and in the model's domain."""
     th = np.asarray(theta, dtype=float)
-    margin = lugre.passivity_margin(th)  # checks the shape (ConfigError)
-    if th.ndim != 1 or not np.all(np.isfinite(th)):
-        raise ConfigError(f"{what}: 7 finite LuGre parameters are needed, got {theta!r}")
-    if margin == -np.inf:
+    if th.ndim != 1 or th.size not in widths or not np.all(np.isfinite(th)):
+        per = " (or 10 per direction)" if 10 in widths else ""
+        raise ConfigError(f"{what}: 7 finite LuGre parameters{per} are needed, got {theta!r}")
+    if lugre.passivity_margin(th) == -np.inf:
         raise ConfigError(
             f"{what}: sigma_0, tau_c and w_s must be > 0 and sigma_1, sigma_2 >= 0 "
-            f"({dict(zip(lugre.PARAM_NAMES, th.tolist(), strict=True))})"
+            f"({dict(zip(_names(th), th.tolist(), strict=True))})"
         )
     return th
 
@@ -90,7 +97,8 @@ class LuGreTruth:
     inertia: float | None = None
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "theta", tuple(_theta(self.theta, "LuGreTruth").tolist()))
+        theta = _theta(self.theta, "LuGreTruth", (7,))
+        object.__setattr__(self, "theta", tuple(theta.tolist()))
         inertia = self.inertia
         if inertia is not None and not (math.isfinite(inertia) and inertia > 0):
             raise ConfigError(f"LuGreTruth: 'inertia' must be a number > 0, got {inertia!r}")
@@ -104,10 +112,10 @@ class LuGreTruth:
 def lugre_parameters(
     fitted: FittedModel, sigma_0: float | None = None, sigma_1: float | None = None
 ) -> np.ndarray:
-    """The 7 LuGre parameters of a model, for the observer.
+    """The LuGre parameters of a model, for the observer (7, or 10 for ``lugre_asym``).
 
-    A ``lugre`` model gives its own (``sigma_0``, ``sigma_1`` override them when given). A
-    ``stribeck`` model gives the static part (``tau_v`` as ``sigma_2``) and a
+    A ``lugre`` or ``lugre_asym`` model gives its own (``sigma_0``, ``sigma_1`` override
+    them when given). A ``stribeck`` model gives the static part (``tau_v`` as ``sigma_2``) and a
     ``coulomb_viscous`` one ``tau_c = tau_s = f_c``, ``sigma_2 = beta``; both need
     ``sigma_0`` and ``sigma_1``. Other models have no Stribeck curve ``g(v)`` to build the
     bristle dynamics on (:class:`ConfigError`).
@@ -115,18 +123,20 @@ def lugre_parameters(
     name = fitted.model.strip().lower()
     p = fitted.params
     try:
-        if name == "lugre":
-            th = [float(p[k]) for k in lugre.PARAM_NAMES]
+        if name in ("lugre", "lugre_asym"):
+            names = lugre.PARAM_NAMES if name == "lugre" else lugre.ASYM_NAMES
+            th = [float(p[k]) for k in names]
             th[0] = th[0] if sigma_0 is None else sigma_0
             th[1] = th[1] if sigma_1 is None else sigma_1
-            return _theta(th, "model 'lugre'")
+            return _theta(th, f"model '{name}'")
         if name == "stribeck":
             static = [p["tau_v"], p["tau_c"], p["tau_s"], p["w_s"], p["delta"]]
         elif name == "coulomb_viscous":
             static = [p["beta"], p["f_c"], p["f_c"], 1.0, 1.0]
         else:
             raise ConfigError(
-                f"the LuGre observer needs a 'lugre', 'stribeck' or 'coulomb_viscous' model "
+                "the LuGre observer needs a 'lugre', 'lugre_asym', 'stribeck' or "
+                f"'coulomb_viscous' model "
                 f"(a Stribeck curve g(v) for the bristles), not '{fitted.model}'"
             )
     except KeyError as exc:
@@ -194,7 +204,7 @@ class DynamicCompensationResult:
         return {
             "model": self.model,
             "truth": self.truth,
-            "lugre_parameters": dict(zip(lugre.PARAM_NAMES, self.theta, strict=True)),
+            "lugre_parameters": dict(zip(_names(np.asarray(self.theta)), self.theta, strict=True)),
             "rms_error_rad": dict(self.rms),
             "max_error_rad": dict(self.max),
             "crossing_rms_error_rad": dict(self.rms_crossing),
@@ -259,8 +269,8 @@ def lugre_compensation_study(
     Parameters
     ----------
     theta : array_like
-        The model's 7 LuGre parameters (:func:`lugre_parameters`): the observer's, and the
-        static feed-forward's steady state.
+        The model's 7 LuGre parameters, or 10 per direction (:func:`lugre_parameters`): the
+        observer's, and the static feed-forward's steady state.
     config : TrackingConfig, optional
         The experiment (default :class:`TrackingConfig`); a ``truth`` with an inertia
         replaces ``config.inertia``. Load and temperature do not enter LuGre friction.
