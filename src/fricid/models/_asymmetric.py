@@ -10,7 +10,23 @@ import numpy as np
 
 from ._base import FrictionModel, Parameter
 
-__all__ = ["Asymmetric"]
+__all__ = ["Asymmetric", "directed"]
+
+
+def directed(p: Parameter, suffix: str) -> Parameter:
+    """``p`` for one direction of motion: ``suffix`` ``_pos`` (v >= 0) or ``_neg`` (v < 0)
+    appended to its name, the direction said in its description."""
+    word = {"_pos": "positive", "_neg": "negative"}[suffix]
+    return Parameter(
+        f"{p.name}{suffix}",
+        p.unit,
+        p.kind,
+        p.default,
+        p.lower,
+        p.upper,
+        f"{p.description} ({word} direction)",
+        p.region,
+    )
 
 
 class Asymmetric(FrictionModel):
@@ -29,18 +45,7 @@ class Asymmetric(FrictionModel):
         self.equation = base.equation
         self.inputs = base.inputs
         self.parameters = tuple(
-            Parameter(
-                f"{p.name}{suffix}",
-                p.unit,
-                p.kind,
-                p.default,
-                p.lower,
-                p.upper,
-                f"{p.description} ({word} direction)",
-                p.region,
-            )
-            for suffix, word in (("_pos", "positive"), ("_neg", "negative"))
-            for p in base.parameters
+            directed(p, suffix) for suffix in ("_pos", "_neg") for p in base.parameters
         )
         self.linear_params = tuple(
             f"{name}{suffix}" for suffix in ("_pos", "_neg") for name in base.linear_params

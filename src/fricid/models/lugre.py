@@ -66,6 +66,7 @@ import os
 import numpy as np
 
 from ..errors import ConfigError
+from ._asymmetric import directed
 from ._base import FrictionModel, Parameter, parameter_batch, simulation_inputs
 
 __all__ = [
@@ -123,19 +124,6 @@ STRIBECK_NAMES: dict[str, str] = {
 PER_DIRECTION: tuple[str, ...] = ("sigma_2", "tau_c", "tau_s")
 
 
-def _directed(p: Parameter, suffix: str, word: str) -> Parameter:
-    return Parameter(
-        f"{p.name}{suffix}",
-        p.unit,
-        p.kind,
-        p.default,
-        p.lower,
-        p.upper,
-        f"{p.description} ({word} direction)",
-        p.region,
-    )
-
-
 _BY_NAME = {p.name: p for p in PARAMETERS}
 #: Per-direction LuGre's parameters, in the order of the compiled kernels' columns: sigma_0,
 #: sigma_1, the forward set (``_pos``, v >= 0), w_s, delta, the backward set (``_neg``, v < 0).
@@ -143,10 +131,10 @@ _BY_NAME = {p.name: p for p in PARAMETERS}
 ASYM_PARAMETERS: tuple[Parameter, ...] = (
     _BY_NAME["sigma_0"],
     _BY_NAME["sigma_1"],
-    *(_directed(_BY_NAME[n], "_pos", "positive") for n in PER_DIRECTION),
+    *(directed(_BY_NAME[n], "_pos") for n in PER_DIRECTION),
     _BY_NAME["w_s"],
     _BY_NAME["delta"],
-    *(_directed(_BY_NAME[n], "_neg", "negative") for n in PER_DIRECTION),
+    *(directed(_BY_NAME[n], "_neg") for n in PER_DIRECTION),
 )
 ASYM_NAMES: tuple[str, ...] = tuple(p.name for p in ASYM_PARAMETERS)
 
