@@ -157,3 +157,35 @@ def test_the_command_line_fits_and_exports_it(tmp_path):
     text = xml.read_text()
     assert "has one level for both directions" in text
     assert "the direction asymmetry" in text  # lost in the projection, and said
+
+
+def test_the_passivity_record_names_the_direction_that_fails():
+    """A new user read "margin -3.23 ... in each direction" and could not tell which."""
+    from fricid.identify.dynamic._outcome import passivity
+    from fricid.models import lugre
+
+    values = [1e4, 1.0, 0.2, 0.5, 0.8, 0.1, 1.0, 0.001, 0.35, 0.56]  # backwards: no damping
+    nan = [float("nan")] * 10
+    record = passivity(list(lugre.ASYM_NAMES), values, nan, nan)
+    assert not record["passive"]
+    assert "forwards 0.333, backwards -0.993 N m s/rad" in record["condition"]
+
+
+def test_a_rate_bias_of_a_value_not_told_from_zero_is_given_in_its_unit():
+    """ "p_x -57 % (0.58 se)" for p_x of -0.001 N m said nothing; the bias in N m does."""
+    from types import SimpleNamespace
+
+    from fricid.identify.dynamic._outcome import RateBiasWarning, warn_rate_bias
+
+    stage = SimpleNamespace(
+        names=["p_x", "p_y"], values=np.array([-0.001, 1.5]), stderr=np.array([0.002, 0.001])
+    )
+    rows = {
+        "p_x": {"bias": 0.0012, "relative": -1.2, "scale": "linear"},
+        "p_y": {"bias": 0.0009, "relative": 0.0006, "scale": "linear"},
+    }
+    with pytest.warns(RateBiasWarning) as caught:
+        warn_rate_bias(stage, {"parameters": rows, "log_rate": 1000.0, "quantised": None})
+    text = str(caught[0].message)
+    assert "p_x +0.0012 N m (0.6 se; it is -0.001)" in text
+    assert "p_y +0.06 % (0.9 se)" in text

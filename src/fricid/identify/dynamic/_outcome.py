@@ -218,6 +218,14 @@ def calibrate(stage, rb: dict[str, Any]) -> dict[str, str]:
     return notes
 
 
+def _unit(name: str) -> str:
+    """The unit of a LuGre trajectory fit's parameter (a law's, per direction too, or the
+    joint's)."""
+    joint = {"inertia": "kg m^2", "p_x": "N m", "p_y": "N m"}
+    law = {p.name: p.unit for p in lugre.PARAMETERS}
+    return joint.get(name) or law.get(lugre.symmetric_name(name), "")
+
+
 def warn_rate_bias(stage, rb: dict[str, Any], notes: dict[str, str] | None = None) -> None:
     """One line when the simulated bias of a parameter is a sizeable part of its interval,
     with the numbers and what was done to the intervals."""
@@ -229,9 +237,16 @@ def warn_rate_bias(stage, rb: dict[str, Any], notes: dict[str, str] | None = Non
         row = rows.get(n)
         if row is None:
             continue
-        se = _search_se(stage, i, row.get("scale", "log10"))
+        scale = row.get("scale", "log10")
+        se = _search_se(stage, i, scale)
         if abs(row["bias"]) > RATE_BIAS_WARN * se:
-            parts.append(f"{n} {100 * row['relative']:+.2g} % ({abs(row['bias']) / se:.2g} se)")
+            size = f"{abs(row['bias']) / se:.2g} se"
+            value = float(stage.values[i])
+            if scale == "linear" and not abs(value) > 2.0 * float(stage.stderr[i]):
+                # a value not told from zero: its relative bias says nothing (p_x -57 %)
+                parts.append(f"{n} {row['bias']:+.2g} {_unit(n)} ({size}; it is {value:.2g})")
+            else:
+                parts.append(f"{n} {100 * row['relative']:+.2g} % ({size})")
     if not parts:
         return
     cpr = rb.get("quantised")
@@ -313,9 +328,22 @@ def passivity(names: list[str], values, low, high) -> dict[str, Any]:
     law = lugre.ASYM_NAMES if "tau_c_pos" in p else lugre.PARAM_NAMES
     at = float(lugre.passivity_margin(np.array([p[n] for n in law])))
     corner = float(lugre.passivity_margin(np.array([worst[n] for n in law])))
+    condition = "sigma_1 <= 4 sigma_2 tau_c / (tau_s - tau_c) (Barabanov and Ortega 2000)"
+    if law is lugre.ASYM_NAMES:  # which direction, as each direction's own LuGre
+        each = [
+            float(
+                lugre.passivity_margin(
+                    np.array([p.get(f"{n}_{side}", p.get(n)) for n in lugre.PARAM_NAMES])
+                )
+            )
+            for side in ("pos", "neg")
+        ]
+        condition += (
+            f", in each direction (margin at the estimate forwards {each[0]:.3g}, backwards "
+            f"{each[1]:.3g} N m s/rad)"
+        )
     return {
-        "condition": "sigma_1 <= 4 sigma_2 tau_c / (tau_s - tau_c) (Barabanov and Ortega 2000)"
-        + (", in each direction" if law is lugre.ASYM_NAMES else ""),
+        "condition": condition,
         "margin": at if np.isfinite(at) else None,
         "passive": bool(at >= 0),
         "margin_worst_in_ci95": corner if sides and np.isfinite(corner) else None,
