@@ -98,6 +98,20 @@ def test_projection_is_least_squares_over_the_grid():
     assert any("Stribeck break-away" in x for x in p.lost)
 
 
+def test_a_per_direction_models_break_away_is_given_for_each_direction():
+    """The slowest point of each direction: a new user's lugre_asym export gave only the
+    backward break-away (0.8575 N m; forwards 1.217)."""
+    both = {f"{k}{side}": v for side in ("_pos", "_neg") for k, v in PAPER2.items()}
+    both["tau_s_neg"] = 0.5 * PAPER2["tau_s"]
+    f = FittedModel.from_values("stribeck_asym", both, operating_range=RANGE)
+    (line,) = (x for x in project(f).lost if "Stribeck break-away" in x)
+    X, _ = operating_grid(f)
+    F = f.predict(X)
+    for word, side in (("forwards", X[:, 0] > 0), ("backwards", X[:, 0] < 0)):
+        slow = side & (np.abs(X[:, 0]) == np.abs(X[side, 0]).min())
+        assert f"{np.abs(F[slow]).max():.4g} N m {word}" in line
+
+
 def test_load_and_temperature_dependence_reported_lost():
     f = FittedModel.from_values(
         "msk",

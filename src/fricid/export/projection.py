@@ -190,10 +190,21 @@ def _lost(
     elif model_name(fitted).split("_asym")[0] not in ("coulomb_viscous", "dahl"):
         # (a Dahl model's steady state is Coulomb-viscous: its dynamics are said by the format)
         v = X[:, 0]
-        slow = np.abs(v) == np.abs(v).min()
+        if model_name(fitted).endswith("_asym"):  # each direction's own slowest point
+            parts = []
+            for word, side in (("forwards", v > 0), ("backwards", v < 0)):
+                if side.any():
+                    slow = side & (np.abs(v) == np.abs(v[side]).min())
+                    parts.append(
+                        f"{np.abs(F[slow]).max():.4g} N m {word} at "
+                        f"{np.abs(v[slow]).min():.4g} rad/s"
+                    )
+            at = ", ".join(parts)
+        else:
+            slow = np.abs(v) == np.abs(v).min()
+            at = f"{np.abs(F[slow]).max():.4g} N m at the lowest speed {np.abs(v).min():.4g} rad/s"
         lost.append(
-            f"the velocity shape of '{model_name(fitted)}' (e.g. the Stribeck break-away: "
-            f"{np.abs(F[slow]).max():.4g} N m at the lowest speed {np.abs(v).min():.4g} rad/s)"
+            f"the velocity shape of '{model_name(fitted)}' (e.g. the Stribeck break-away: {at})"
         )
     for name in ("load", "temperature"):
         lo, hi = info[name]
