@@ -94,14 +94,19 @@ def exports_as_before(fitted: FittedModel, path: Path) -> dict[str, str]:
 
 
 def as_before(fitted) -> str:
-    """The fit report without the line added since the files were written (the RMSE, from
-    the file's own metrics, checked here), to compare with what that fricid printed."""
+    """The fit report without the lines added since the files were written (the RMSE, from
+    the file's own metrics, and a per-direction model's legend, checked here), to compare
+    with what that fricid printed."""
+    from fricid.fitted._report import DIRECTIONS
+
     lines = fitted.report().splitlines()
     added = [ln for ln in lines if ln.startswith("    RMSE [N m]         = ")]
     assert len(added) == (fitted.metrics.get("rmse") is not None)
     for ln in added:
         assert float(ln.split("=")[1]) == pytest.approx(fitted.metrics["rmse"], rel=1e-7)
-    return "\n".join(ln for ln in lines if ln not in added)
+    legend = [ln for ln in lines if ln == f"    {DIRECTIONS}"]
+    assert len(legend) == any(n.endswith("_pos") for n in fitted.parameters)
+    return "\n".join(ln for ln in lines if ln not in added + legend)
 
 
 def same(a, b) -> bool:

@@ -74,10 +74,15 @@ def fit_report(fitted: Any, min_correl: float = MIN_CORREL) -> str:
     for name, p in fitted.parameters.items():
         lines.append(f"    {name + ':':<{width}} {p.value: .8g} {p.unit}")
         lines[-1] = lines[-1].rstrip() + _variable_note(p, fitted.ci_method)
+    if any(name.endswith(("_pos", "_neg")) for name in fitted.parameters):
+        lines.append(f"    {DIRECTIONS}")
     lines += _shared_lines(fitted.provenance.get("shared_error"))
     lines += _correlation_lines(fitted, min_correl)
     return "\n".join(lines)
 
+
+#: The legend of a per-direction model's parameters (a new user found it in the docs only).
+DIRECTIONS = "(_pos: moving forwards, v >= 0; _neg: backwards, v < 0, given as magnitudes)"
 
 #: An interval side longer than this many times 1.96 standard errors is said to be so (a
 #: profile interval at a bound: a new user read "0.0215 +/- 0.00357 (95 % CI [0, 0.0537])"
@@ -115,6 +120,11 @@ def _variable_note(p: Parameter, ci_method: str) -> str:
         flags.append("at initial value")
     if p.not_determined and not p.note.startswith("not identified"):
         flags.append("not determined")  # a "not identified" note says it itself
+    ends = [side for side, is_open in (("lower", p.low_open), ("upper", p.high_open)) if is_open]
+    if ends and not (p.note or p.at_bound):  # a note says why (both open: not identified)
+        flags.append(
+            f"not bounded by the data: the interval reaches the search range's {ends[0]} end"
+        )
     if p.note:
         flags.append(p.note.removeprefix("not determined: "))
     return note + "".join(f" [{f}]" for f in flags)
