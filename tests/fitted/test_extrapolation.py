@@ -102,6 +102,11 @@ def test_range_check_kinds():
     assert out.kind == "outside" and "-3 rad/s is outside the identified range -0.5 to 0.5" in (
         out.message
     )
+    # how far out against the speed identified that way (a new user's lugre_asym, identified
+    # to -2.37 and 2.532 rad/s, had -3 called 1.19x, against the forward 2.532)
+    lopsided = vlt(directions=(-1, 1), velocity=[-2.37, 2.532])
+    (out,) = lopsided.range_check(np.array([[-3.0, 0.18, 25.0]]))
+    assert "(1.27x the largest speed identified backwards, 2.37 rad/s)" in out.message
     # inputs the model does not use are not checked; nor inputs without a range
     cv = FittedModel.from_values(
         "coulomb_viscous", {"f_c": 0.1, "beta": 0.05}, operating_range=RANGE

@@ -234,7 +234,11 @@ def _pair(ranges: Any, name: str) -> tuple[float, float] | None:
 
 
 def _times(x: float, ref: float) -> str:
-    return f" ({abs(x) / ref:.3g}x the largest identified speed {ref:.4g} rad/s)" if ref > 0 else ""
+    """How far out ``x`` is against ``ref``, the largest speed identified in its direction."""
+    if not ref > 0:
+        return ""
+    way = "forwards" if x > 0 else "backwards"
+    return f" ({abs(x) / ref:.3g}x the largest speed identified {way}, {ref:.4g} rad/s)"
 
 
 def _velocity_violations(
@@ -245,7 +249,6 @@ def _velocity_violations(
     out = []
     span = hi - lo
     tol = RANGE_TOLERANCE * (span if span > 0 else max(abs(lo), abs(hi)))
-    top = max(abs(lo), abs(hi))
     if lo < 0 < hi or lo == hi == 0:
         for mask, edge in ((v > hi + tol, hi), (v < lo - tol, lo)):
             if mask.any():
@@ -259,7 +262,7 @@ def _velocity_violations(
                         lo,
                         hi,
                         f"velocity {w:.4g} rad/s is outside the identified range {lo:.4g} to "
-                        f"{hi:.4g} rad/s{_times(w, top)}: extrapolated",
+                        f"{hi:.4g} rad/s{_times(w, abs(edge))}: extrapolated",
                     )
                 )
         return out
