@@ -333,6 +333,8 @@ def test_cli_compensate_lugre_truth(tmp_path):
     plot = tmp_path / "lugre.png"
     res = runner.invoke(app, [*args[:-1], "--lugre", "1000,0.5", "--plot", str(plot)])
     assert res.exit_code == 0, res.output
+    # the true joint is named: a new user took it for the one the model was identified on
+    assert "True joint: the built-in LuGre joint (sigma_0 1000, sigma_1 0.5" in res.stdout
     assert plot.stat().st_size > 10_000
     assert "LuGre observer's RMS error is" in " ".join(res.stdout.split())
 

@@ -288,6 +288,7 @@ def _dynamic(fitted, config, plant, lugre, options, model, plot, no_plot, as_jso
     from ..control import lugre_compensation_study, lugre_parameters, plot_lugre_compensation
     from ..control.dynamic import RUNS
     from ..errors import FricidWarning
+    from ..models.lugre import PARAM_NAMES
 
     theta = lugre_parameters(fitted, *_sigmas(lugre))
     with warnings.catch_warnings(record=True) as caught:
@@ -330,6 +331,13 @@ def _dynamic(fitted, config, plant, lugre, options, model, plot, no_plot, as_jso
         f"Settings: K_p {k_p:.4g} N m/rad, K_d {k_d:.4g} N m s/rad, J {cfg.inertia:g} kg m^2, "
         f"dt {cfg.dt:g} s; crossings: within {window:g} periods of each velocity reversal "
         f"({100 * result.crossing.mean():.3g} % of the run)",
+        highlight=False,
+    )
+    truth = ", ".join(f"{k} {v:.4g}" for k, v in zip(PARAM_NAMES, plant.theta, strict=True))
+    console.print(
+        f"True joint: the built-in LuGre joint ({truth}; J {cfg.inertia:g} kg m^2), the same "
+        "for every model: how this model compensates that joint, not the one it was "
+        "identified on",
         highlight=False,
     )
     for note in result.notes:
