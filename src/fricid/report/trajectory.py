@@ -19,6 +19,7 @@ import numpy as np
 import pandas as pd
 
 from ..fitted import FittedModel
+from ..fitted._report import DIRECTIONS
 from ..identify.trajectory_check import REVERSAL_SPEED, TrajectoryPrediction, heldout_grading
 from .document import Document, Figure, Note, Table
 from .model import parameter_table
@@ -296,7 +297,10 @@ def trajectory_report(
         _log_figures(doc, heldout, "heldout", heldout_label)
     say("parameters")
     sec = doc.section("Parameters")
-    sec.add(Table("parameters", "Friction parameters", parameter_table(fitted), digits=5))
+    directions = any(n.endswith(("_pos", "_neg")) for n in fitted.parameters)
+    legend = f"{DIRECTIONS[1:-1]}." if directions else ""
+    table = parameter_table(fitted)
+    sec.add(Table("parameters", "Friction parameters", table, caption=legend, digits=5))
     note = fitted.provenance["trajectory"].get("gravity_note") or ""
     title = "The joint's inertia and gravity"
     sec.add(Table("joint", title, joint_frame(fitted), caption=note, digits=5))

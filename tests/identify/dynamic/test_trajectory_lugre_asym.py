@@ -157,6 +157,11 @@ def test_the_command_line_fits_and_exports_it(tmp_path):
     text = xml.read_text()
     assert "has one level for both directions" in text
     assert "the direction asymmetry" in text  # lost in the projection, and said
+    assert "N m forwards at" in text and "N m backwards at" in text  # each break-away
+    out = tmp_path / "report"
+    done = runner.invoke(app, ["report", str(model), str(tmp_path / "a.csv"), "-o", str(out)])
+    assert done.exit_code == 0, done.output
+    assert r"\_pos: moving forwards, v \>= 0" in (out / "report.md").read_text()
 
 
 def test_the_passivity_record_names_the_direction_that_fails():
