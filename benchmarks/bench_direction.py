@@ -37,6 +37,8 @@ import time
 import warnings
 from pathlib import Path
 
+import numpy as np
+
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import _lugre_truth as lt
@@ -70,6 +72,7 @@ def task(args: tuple) -> dict:
     levels_ok = all(lo <= levels[n] <= hi for n, (lo, hi) in cis.items())
     (lo_a, hi_a), (lo_b, hi_b) = (cis.get(n, (0.0, 0.0)) for n in ("tau_c_pos", "tau_c_neg"))
     apart = "tau_c_pos" in cis and (hi_b < lo_a or hi_a < lo_b)
+    claims = _claims(fitted, t) if model == "lugre_asym" or (model == "lugre" and neg == 1) else {}
     return {
         "key": (truth, kind, neg),
         "differs": any(c.startswith("the friction differs by direction") for c in caveats),
@@ -78,8 +81,33 @@ def task(args: tuple) -> dict:
         "held": held,
         "levels_ok": levels_ok,
         "apart": apart,
+        "claims": claims,
         "seconds": seconds,
     }
+
+
+def _claims(fitted, t) -> dict[str, list[int]]:
+    """Per parameter (both directions' under the symmetric name), [covered, claimed]: the
+    closed 95 % intervals (not open at the search box, not flagged not determined) and those
+    that held the truth (``neg`` times the forward Coulomb and break-away levels backwards)."""
+    truth = t.fricid_names()
+    back = {"tau_c": t.neg, "tau_s": t.neg}
+    out: dict[str, list[int]] = {}
+    rows = [
+        (n, p.ci95, p.low_open or p.high_open or p.not_determined)
+        for n, p in fitted.parameters.items()
+    ]
+    joint = fitted.provenance["trajectory"]["joint"]
+    rows += [(n, (r["ci95_low"], r["ci95_high"]), False) for n, r in joint.items()]
+    for name, (lo, hi), open_ in rows:
+        base = name.removesuffix("_pos").removesuffix("_neg")
+        if open_ or not (np.isfinite(lo) and np.isfinite(hi)) or base not in truth:
+            continue
+        value = truth[base] * (back.get(base, 1.0) if name.endswith("_neg") else 1.0)
+        row = out.setdefault(base, [0, 0])
+        row[0] += int(lo <= value <= hi)
+        row[1] += 1
+    return out
 
 
 def main() -> None:
@@ -128,6 +156,15 @@ def main() -> None:
     print()
     for neg, counts in totals.items():
         print(f"{f'all neg {neg:g}':<34}" + _cells(counts))
+    claims: dict = {}
+    for r in rows:
+        for name, (c, n) in r["claims"].items():
+            row = claims.setdefault(name, [0, 0])
+            row[0], row[1] = row[0] + c, row[1] + n
+    if claims:
+        c, n = (sum(v[i] for v in claims.values()) for i in (0, 1))
+        print("\n# the closed 95 % intervals that held the truth (per direction under one name)")
+        print("  ".join(f"{k} {v[0]}/{v[1]}" for k, v in claims.items()) + f"; all {c}/{n}")
 
 
 def _counts(rs: list[dict]) -> dict:

@@ -171,3 +171,21 @@ def test_the_quoted_coverage_is_the_benchmarks_last_result():
     for name, (covered, claimed) in LUGRE_COVERAGE["parameters"].items():
         cells = [row[columns[name]].split("+")[0].split("/") for row in per.values()]
         assert (sum(int(c) for c, _ in cells), sum(int(n) for _, n in cells)) == (covered, claimed)
+
+
+def test_the_per_direction_coverage_is_the_direction_benchmarks_last_result():
+    """``LUGRE_ASYM_COVERAGE`` is the coverage line of the last ``--model lugre_asym`` block of
+    ``benchmarks/results/direction.txt``, not typed apart from it."""
+    from fricid.identify.dynamic._outcome import LUGRE_ASYM_COVERAGE
+
+    text = (REPO / "benchmarks" / "results" / "direction.txt").read_text()
+    block = text.split("--model lugre_asym")[-1]
+    head = "# the closed 95 % intervals that held the truth"
+    line = block.split(head)[1].splitlines()[1]
+    cells, total = line.split("; all ")
+    found = {}
+    for cell in cells.split("  "):
+        name, frac = cell.split()
+        found["J" if name == "inertia" else name] = tuple(map(int, frac.split("/")))
+    assert found == LUGRE_ASYM_COVERAGE["parameters"]
+    assert tuple(map(int, total.split("/"))) == LUGRE_ASYM_COVERAGE["all"]
