@@ -67,8 +67,8 @@ def covers(fitted: FittedModel, truth: dict[str, float], names) -> dict[str, boo
 def test_a_joint_weaker_backwards_gets_both_levels_and_its_gravity(tmp_path):
     """The log on which the symmetric fit's p_x missed (geared joint, 30 % weaker backwards,
     PD-tracked 0.3 rad chirp, seed 3): each level and the gravity within their intervals,
-    the levels told apart, no direction caveat, and the coverage caveat saying it was
-    measured on symmetric fits."""
+    the levels told apart, no direction caveat, and the coverage caveat giving the
+    per-direction fits' own coverage."""
     log, t = simulated("geared", "chirp_pd", 0.7, 3, tmp_path / "a.csv")
     fitted = quiet_fit(log, "lugre_asym", 3)
     truth = per_direction_truth(t)
@@ -80,7 +80,7 @@ def test_a_joint_weaker_backwards_gets_both_levels_and_its_gravity(tmp_path):
     info = fitted.provenance["trajectory"]
     caveats = info.get("caveats", [])
     assert not any("by direction" in c for c in caveats), caveats
-    assert any("measured on symmetric LuGre fits" in c for c in caveats)
+    assert any("with the levels per direction" in c and "bench_direction.py" in c for c in caveats)
     assert "in each direction" in info["passivity"]["condition"]
     # held out on the next seed's log: the per-direction law along it (the held-out check's
     # law table knows it)
