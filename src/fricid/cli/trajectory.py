@@ -123,7 +123,10 @@ def trajectory_text(fitted) -> str:
         )
     p = info.get("passivity")
     if p:
-        rests = sorted(undetermined & {"sigma_0", "sigma_1", "sigma_2", "tau_c", "tau_s"})
+        from ..models.lugre import symmetric_name
+
+        condition = {"sigma_0", "sigma_1", "sigma_2", "tau_c", "tau_s"}  # its parameters
+        rests = sorted(n for n in undetermined if symmetric_name(n) in condition)
         caveat = f" (it rests on {', '.join(rests)}, not determined)" if rests else ""
         lines.append(f"    passivity: {_passivity(p)}{caveat}")
     return "\n".join(lines)

@@ -194,3 +194,39 @@ def test_a_rate_bias_of_a_value_not_told_from_zero_is_given_in_its_unit():
     text = str(caught[0].message)
     assert "p_x +0.0012 N m (0.6 se; it is -0.001)" in text
     assert "p_y +0.06 % (0.9 se)" in text
+
+
+@pytest.mark.slow
+def test_a_log_that_never_moves_backwards_leaves_the_backward_set_not_identified():
+    """Torque that only ever pushes forwards: the forward set is identified, the backward one
+    is said not to be, and the passivity line says what it rests on (a margin from the
+    backward set's arbitrary values said "NOT passive" alone)."""
+    from fricid.cli.trajectory import trajectory_text
+    from fricid.models import lugre
+
+    n, dt = 10000, 1e-3
+    t = np.arange(n) * dt
+    theta = np.array([2e4, 3.0, 0.4, 1.2, 1.8, 0.05, 2.0, 0.4, 0.84, 1.26])
+    tau = 2.5 + np.sin(2 * np.pi * 0.5 * t) + 0.8 * np.sin(2 * np.pi * 1.7 * t)
+    sim = lugre.simulate_joint(theta, 0.05, 0.0, 0.5, dt, tau)
+    count = 2 * np.pi / 2**20
+    q = np.round(sim["position"] / count) * count
+    noise = 0.01 * np.random.default_rng(0).standard_normal(n)
+    log = RawLog(
+        time=t,
+        position=q,
+        velocity=np.concatenate([[0.0], np.diff(q) / dt]),
+        torque=tau + noise,
+        temperature=np.full(n, 25.0),
+    )
+    assert not np.any(sim["velocity"] < -0.02)  # never slides backwards
+    fitted = quiet_fit(log, "lugre_asym", 0)
+    for name in ("sigma_2_neg", "tau_c_neg", "tau_s_neg"):
+        assert fitted.parameters[name].not_determined, name
+    for name in ("sigma_2_pos", "tau_c_pos"):
+        p = fitted.parameters[name]
+        assert (
+            not p.not_determined and p.ci95[0] <= theta[lugre.ASYM_NAMES.index(name)] <= p.ci95[1]
+        )
+    line = next(ln for ln in trajectory_text(fitted).splitlines() if "passivity:" in ln)
+    assert "sigma_2_neg, tau_c_neg, tau_s_neg, not determined" in line
