@@ -62,7 +62,8 @@ def route_for(key: str, route: str, with_static: bool) -> str:
     if route not in ROUTES:
         raise ConfigError(f"unknown route '{route}'; one of: {', '.join(ROUTES)}")
     if key in ("dahl", "lugre_asym") and (route != "filtered" or with_static):
-        raise ConfigError(f"{key} is identified by the filtered route only (no static= either)")
+        why = ", not from a static part given (static=)" if with_static else ""
+        raise ConfigError(f"{key} is identified by the filtered route only{why}")
     if key in STATIC_MODELS:
         return "regression"
     if key == "lugre" and route == "filtered" and with_static:
