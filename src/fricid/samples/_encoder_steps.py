@@ -28,6 +28,13 @@ __all__ = ["encoder_quantum", "position_unit_problem"]
 #: position has steps at every fraction of a count).
 COUNT_TOLERANCE = 0.05
 
+#: The most a step's rounding when the file was written widens :data:`COUNT_TOLERANCE`, in
+#: counts.
+MAX_WRITTEN = 0.2
+
+#: Steps of at most this many counts refine the candidate quantum (:func:`_refined`).
+SMALL_COUNTS = 8
+
 #: Fewest non-zero position steps from which a quantum is read.
 MIN_STEPS = 20
 
@@ -52,19 +59,28 @@ def encoder_quantum(position: np.ndarray) -> float | None:
     no common quantum (a continuous or interpolated position) or are too few.
 
     The smallest non-zero step, or its half, third or quarter (a fast motion may never move
-    by one count between samples), is the candidate; the log is quantised when every step is
-    a whole multiple of it (within :data:`COUNT_TOLERANCE` of a count: positions written with
-    a few decimals keep that).
+    by one count between samples), refined on the small steps, is the candidate; the log is
+    quantised when every step is a whole multiple of it, within :data:`COUNT_TOLERANCE` of a
+    count plus the step's rounding when the file was written (read from the digits each
+    position was written with: a 2^18-count log written with 7 significant digits is 0.04
+    counts off by its rounding alone, and had been read as continuous).
     """
-    steps = np.abs(np.diff(np.asarray(position, dtype=float)))
+    position = np.asarray(position, dtype=float)
+    steps = np.abs(np.diff(position))
     scale = float(np.max(np.abs(position))) if np.size(position) else 0.0
-    nonzero = steps[steps > 1e-12 * max(scale, 1.0)]
+    moved = steps > 1e-12 * max(scale, 1.0)
+    nonzero = steps[moved]
     if nonzero.size < MIN_STEPS:
         return None
+    grain = _decimal_grain(position)
+    written = (0.5 * (grain[:-1] + grain[1:]))[moved]  # each step's rounding, at most
     for split in range(1, MAX_SPLIT + 1):
-        quantum = float(np.min(nonzero)) / split
+        quantum = _refined(nonzero, float(np.min(nonzero)) / split)
         counts = np.round(nonzero / quantum)
-        if np.max(np.abs(nonzero / quantum - counts)) <= COUNT_TOLERANCE:
+        off = np.abs(nonzero / quantum - counts)
+        # capped: a value that happens to end in zeros ("0.5") reads a coarse grain, and
+        # steps that are whole multiples of the digits themselves need no allowance
+        if np.all(off <= COUNT_TOLERANCE + np.minimum(written / quantum, MAX_WRITTEN)):
             break
     else:
         return None
@@ -77,6 +93,35 @@ def encoder_quantum(position: np.ndarray) -> float | None:
         return quantum
     slope = np.polyfit(c, q, 1)[0]
     return float(slope)
+
+
+def _refined(steps: np.ndarray, quantum: float) -> float:
+    """The candidate ``quantum`` refined on the steps of at most :data:`SMALL_COUNTS` counts
+    (their counts cannot be miscounted by its error): the smallest step carries the file's
+    rounding, and a large step's count multiplies it (a 2^18-count log written with 9
+    significant digits read its smallest step 0.99965 counts, and a step of 150 counts then
+    0.05 off a whole one)."""
+    for _ in range(3):
+        small = steps[steps <= (SMALL_COUNTS + 0.5) * quantum]
+        counts = np.round(small / quantum)
+        if small.size == 0 or counts.sum() <= 0:
+            break
+        quantum = float(small.sum() / counts.sum())
+    return quantum
+
+
+def _decimal_grain(values: np.ndarray) -> np.ndarray:
+    """Each value's last written decimal place (``10^-k`` for the fewest decimals ``k`` that
+    give it; 0 for a value written to full precision): its rounding when the file was
+    written is at most half of it."""
+    grain = np.zeros(values.shape)
+    left = np.ones(values.shape, dtype=bool)
+    for k in range(13):
+        scaled = values * 10.0**k
+        whole = np.abs(scaled - np.round(scaled)) <= 1e-6 + 4e-16 * np.abs(scaled)
+        grain[left & whole] = 10.0**-k
+        left &= ~whole
+    return grain
 
 
 def _power_of_two(counts: float) -> int | None:
