@@ -77,6 +77,13 @@ def trajectory_text(fitted) -> str:
         f"    route: {info.get('route')} (static part from {info.get('static_from')}); "
         f"{info.get('seconds', float('nan')):.2f} s",
     ]
+    if info.get("resampled"):
+        rate = info.get("sample_rate")
+        lines.append(
+            "    resampled: the time stamps' steps vary by more than 1 % of their median, so "
+            f"every column was interpolated linearly onto a uniform {rate:.6g} Hz grid (the "
+            "encoder read from the rows as written)"
+        )
     if d:
         lines.extend(_derivative_lines(d))
     lines.extend(_presliding_lines(info.get("presliding")))

@@ -209,3 +209,31 @@ def test_output_error_recovers_what_a_coarse_encoder_hides_from_the_equation_err
     assert not a0 and a1
     assert abs(e0["sigma_1"]) > 1.0 and abs(e0["tau_s"]) > 0.3
     assert abs(e1["sigma_1"]) < 0.6 and abs(e1["tau_s"]) < 0.1
+
+
+def test_a_log_with_rows_dropped_reads_its_encoder_from_the_rows_as_written():
+    """An attacker's log with two rows dropped at 20 places was resampled, and its encoder
+    read from the interpolated positions: 786432 counts/rev for 2^18. The raw rows give it."""
+    from fricid.samples import RawLog
+
+    t = np.arange(6000) * 1e-3
+    step = 2 * math.pi / 2**18
+    q = np.round(0.8 * np.sin(2 * np.pi * 0.4 * t) / step) * step
+    v = np.concatenate([[0.0], np.diff(q) / 1e-3])
+    keep = np.ones(t.size, dtype=bool)
+    for k in range(20):
+        keep[250 * k + 100 : 250 * k + 102] = False
+    log = RawLog(
+        time=t[keep],
+        position=q[keep],
+        velocity=v[keep],
+        torque=np.sin(t[keep]),
+        temperature=np.full(keep.sum(), 25.0),
+    )
+    series = uniform_series(log)
+    assert series.resampled
+    raw = (log.time, log.position, log.velocity)
+    enc = measurement(series.position, series.velocity, series.dt, None, raw)
+    assert enc["counts_per_rev"] == 2**18
+    wrong = measurement(series.position, series.velocity, series.dt, None)
+    assert wrong["counts_per_rev"] != 2**18  # what the interpolated positions read

@@ -101,15 +101,17 @@ FINER = 0.01
 VELOCITY_FORMS = ("backward", "central", "logged")
 
 
-def velocity_form(position: np.ndarray, velocity: np.ndarray, dt: float) -> str:
+def velocity_form(position: np.ndarray, velocity: np.ndarray, dt, time=None) -> str:
     """How the logged velocity relates to the positions: ``backward`` (``(q_k - q_{k-1}) /
-    dt``), ``central`` (:func:`numpy.gradient`) or ``logged`` (neither: the drive's own)."""
+    dt``), ``central`` (:func:`numpy.gradient`) or ``logged`` (neither: the drive's own).
+    ``dt``: the sample period, or each step's (``(n - 1,)``) with the stamps ``time``."""
     scale = max(float(np.max(np.abs(velocity))), 1e-12)
     back = np.diff(position) / dt
     tol = 1e-3 * scale  # the columns' rounding in a written log
     if np.max(np.abs(velocity[1:] - back)) <= tol:
         return "backward"
-    if np.max(np.abs(velocity - np.gradient(position, dt))) <= tol:
+    central = np.gradient(position, dt if time is None else time)
+    if np.max(np.abs(velocity - central)) <= tol:
         return "central"
     return "logged"
 
@@ -121,7 +123,11 @@ def quantise(position: np.ndarray, quantum: float, offset: float = 0.0) -> np.nd
 
 
 def measurement(
-    position: np.ndarray, velocity: np.ndarray, dt: float, encoder_counts: float | None
+    position: np.ndarray,
+    velocity: np.ndarray,
+    dt: float,
+    encoder_counts: float | None,
+    raw: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
 ) -> dict[str, Any]:
     """The log's measurement model (module notes), as recorded in the provenance.
 
@@ -133,6 +139,11 @@ def measurement(
         Sample period [s].
     encoder_counts : float, optional
         Counts per revolution given by the user; None reads them from the position steps.
+    raw : (time, position, velocity), optional
+        The log as written, when ``position`` and ``velocity`` were resampled onto the
+        uniform grid: the steps and the velocity's form are read from it (interpolated
+        positions sit between counts: a log with rows dropped had read three times its
+        encoder's counts).
 
     Returns
     -------
@@ -148,7 +159,11 @@ def measurement(
         ``encoder_counts`` not a positive finite number, or coarser than the position's own
         steps.
     """
-    form = velocity_form(position, velocity, dt)
+    if raw is not None:
+        t_raw, position, v_raw = (np.asarray(x, dtype=float) for x in raw)
+        form = velocity_form(position, v_raw, np.diff(t_raw), t_raw)
+    else:
+        form = velocity_form(position, velocity, dt)
     if encoder_counts is not None:
         if not (math.isfinite(encoder_counts) and encoder_counts > 0):
             raise ConfigError(f"encoder_counts must be a positive number, got {encoder_counts}")

@@ -332,7 +332,8 @@ def fit_trajectory(
     check_trajectory_log(log)  # holes, grid size, stuck torque: before any allocation
     series = uniform_series(log)
     rate = 1.0 / series.dt
-    encoder = measurement(series.position, series.velocity, series.dt, encoder_counts)
+    raw = (log.time, log.position, log.velocity) if series.resampled else None
+    encoder = measurement(series.position, series.velocity, series.dt, encoder_counts, raw)
     vf, acc, mask, short, moving = guarded_sliding(
         series, derivative, v_slide, guard, key in STATIC_MODELS, MIN_SLIDING
     )
