@@ -230,6 +230,11 @@ def test_a_log_that_never_moves_backwards_leaves_the_backward_set_not_identified
         )
     line = next(ln for ln in trajectory_text(fitted).splitlines() if "passivity:" in ln)
     assert "sigma_2_neg, tau_c_neg, tau_s_neg, not determined" in line
+    # one side identified: a prediction backwards is said to be on the other side (it was
+    # recorded as both, and -1 rad/s passed without a word)
+    assert fitted.provenance["directions"] == [1]
+    (out,) = fitted.range_check(np.array([[-1.0, 0.0, 25.0]]))
+    assert out.kind == "side"
 
 
 #: Another simulator's joint whose viscous coefficient is 5x backwards (its README).

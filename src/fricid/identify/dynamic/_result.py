@@ -191,7 +191,8 @@ def build_result(
     fitted.provenance = {
         "source": log.source,
         "n_samples": int(series.time.size),
-        "directions": [-1, 1],
+        # the directions it moved in: a log that never reverses identifies one side only
+        "directions": [d for d in (-1, 1) if np.any(np.sign(vf) == d)] or [-1, 1],
         "fricid_version": __version__,
         "created": created_timestamp(),
         "trajectory": info,
