@@ -76,13 +76,6 @@ __all__ = [
 #: Output rate of the decimation, in multiples of the cut-off.
 DECIMATED_RATE = 5.0
 
-#: The share of the first start's SSE below which a later start's search is carried on
-#: instead (:func:`filtered_route`): another minimum, not the first found more precisely.
-#: Carrying on whichever ended lowest had, on ``benchmarks/bench_direction.py``'s logs
-#: (seeds 10-13), held the gravity in 98 fits of 108 instead of 103 and told a symmetric
-#: joint's levels apart once; the attacker's joint it is for ended 12 times lower.
-OTHER_MINIMUM = 0.5
-
 #: Search box of sigma_0 and sigma_1, as log10 (as the simulation route's).
 LOG_BOX = {"sigma_0": (2.0, 7.0), "sigma_1": (-3.0, 3.0)}
 
@@ -229,9 +222,8 @@ def filtered_route(
     series : Series
         The log on a uniform grid.
     start : ndarray (d,) or (k, d)
-        Start of the search, the law's parameters in ``law.names`` order; with ``k``
-        starts, a search from each, the first carried on unless another ends below
-        :data:`OTHER_MINIMUM` of its SSE (their SSEs in the result's ``starts``).
+        Start of the search, the law's parameters in ``law.names`` order; of ``k``
+        candidates, the one with the lowest equation error.
     static_bounds : ndarray (d - l, 2)
         Search box of the law's parameters not searched on a log scale, in order (LuGre:
         sigma_2, tau_c, tau_s, w_s, delta; Dahl: tau_c, alpha, sigma_2).
@@ -304,16 +296,10 @@ def filtered_route(
     starts = np.atleast_2d(np.asarray(start, dtype=float))
     x0 = np.where(is_log, np.log10(np.maximum(starts, 1e-300)), starts)
     x0 = np.clip(x0, box[:, 0], box[:, 1])
+    x0 = x0[int(np.argmin(np.sum(projected(x0) ** 2, axis=1)))] if len(x0) > 1 else x0[0]
     search = ResidualProblem(projected, box, law.names, y)
     ftol = noise_ftol(search, SEARCH_SHARE)  # each evaluation a simulation (module notes)
-    runs = [_run(search, method, x, seed, max_evals, 1, ftol) for x in x0]
-    result = runs[0]
-    for other in runs[1:]:  # another minimum, not the same one found more precisely
-        if float(other.fun) < OTHER_MINIMUM * float(result.fun):
-            result = other
-    if len(runs) > 1:
-        nfev = sum(int(r.nfev) for r in runs)
-        result = type(result)({**result, "nfev": nfev, "starts": [float(r.fun) for r in runs]})
+    result = _run(search, method, x0, seed, max_evals, 1, ftol)
     result = settle(search, result, method, max_evals)
     u_hat = np.asarray(result.x, dtype=float)
     c = np.linalg.lstsq(Phi, y - friction(u_hat)[0], rcond=None)[0]
@@ -373,8 +359,7 @@ def lugre_asym_start(stage1, static_tab, asym, rises=None):
     (:func:`._direction.per_direction`), and the break-away level moved with the Coulomb
     one; then, from ``rises`` (the ``stribeck_asym`` regression's values by name), one start
     with each direction's rise (its w_s and delta for both, each direction's break-away).
-    The filtered route searches from each and keeps the first unless another ends at less
-    than half its SSE (:data:`OTHER_MINIMUM`). Where the
+    The filtered route starts from the one with the lowest equation error. Where the
     viscous coefficient differs by direction the symmetric regression bends its rise to
     take it up (an attacker's joint, 0.05 and 0.25 N m s/rad: w_s 0.66 for 0.05), and the
     search from it had ended in another minimum, every level then "not identified". Each
