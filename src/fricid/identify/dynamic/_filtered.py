@@ -221,9 +221,8 @@ def filtered_route(
     ----------
     series : Series
         The log on a uniform grid.
-    start : ndarray (d,) or (k, d)
-        Start of the search, the law's parameters in ``law.names`` order; of ``k``
-        candidates, the one with the lowest equation error.
+    start : ndarray (d,)
+        Start of the search, the law's parameters in ``law.names`` order.
     static_bounds : ndarray (d - l, 2)
         Search box of the law's parameters not searched on a log scale, in order (LuGre:
         sigma_2, tau_c, tau_s, w_s, delta; Dahl: tau_c, alpha, sigma_2).
@@ -293,10 +292,8 @@ def filtered_route(
 
     rows = iter(np.asarray(static_bounds, dtype=float))
     box = np.array([LOG_BOX[n] if n in LOG_BOX else next(rows) for n in law.names], float)
-    starts = np.atleast_2d(np.asarray(start, dtype=float))
-    x0 = np.where(is_log, np.log10(np.maximum(starts, 1e-300)), starts)
+    x0 = np.where(is_log, np.log10(np.maximum(start, 1e-300)), start)
     x0 = np.clip(x0, box[:, 0], box[:, 1])
-    x0 = x0[int(np.argmin(np.sum(projected(x0) ** 2, axis=1)))] if len(x0) > 1 else x0[0]
     search = ResidualProblem(projected, box, law.names, y)
     ftol = noise_ftol(search, SEARCH_SHARE)  # each evaluation a simulation (module notes)
     result = _run(search, method, x0, seed, max_evals, 1, ftol)
@@ -352,19 +349,13 @@ def lugre_start(stage1, static_tab):
     return start, stage1.bounds[order], LUGRE
 
 
-def lugre_asym_start(stage1, static_tab, asym, rises=None):
-    """Per-direction LuGre's starts, box and law: the symmetric start (:func:`lugre_start`)
+def lugre_asym_start(stage1, static_tab, asym):
+    """Per-direction LuGre's start, box and law: the symmetric start (:func:`lugre_start`)
     with each direction's Coulomb level and viscous coefficient from ``asym``, the
     ``coulomb_viscous_asym`` regression on the samples beyond the rise
     (:func:`._direction.per_direction`), and the break-away level moved with the Coulomb
-    one; then, from ``rises`` (the ``stribeck_asym`` regression's values by name), one start
-    with each direction's rise (its w_s and delta for both, each direction's break-away).
-    The filtered route starts from the one with the lowest equation error. Where the
-    viscous coefficient differs by direction the symmetric regression bends its rise to
-    take it up (an attacker's joint, 0.05 and 0.25 N m s/rad: w_s 0.66 for 0.05), and the
-    search from it had ended in another minimum, every level then "not identified". Each
-    direction's box is the symmetric one's (a per-direction Stribeck regression leaves the
-    levels ill-determined where the rise is narrow: ``_direction`` notes)."""
+    one. Each direction's box is the symmetric one's (a per-direction Stribeck regression
+    leaves the levels ill-determined where the rise is narrow: ``_direction`` notes)."""
     start, box, _ = lugre_start(stage1, static_tab)
     sym = dict(zip(lugre.PARAM_NAMES, start, strict=True))
     rows = dict(zip(lugre.PARAM_NAMES[2:], box, strict=True))
@@ -383,15 +374,7 @@ def lugre_asym_start(stage1, static_tab, asym, rises=None):
             value = sym[base]
         values.append(float(np.clip(value, lo, hi)) if np.isfinite(value) else sym[base])
         bounds.append((lo, hi))
-    starts = [np.array(values)]
-    for side in ("pos", "neg") if rises else ():
-        other = dict(zip(lugre.ASYM_NAMES, values, strict=True))
-        other.update(w_s=rises[f"w_s_{side}"], delta=rises[f"delta_{side}"])
-        other.update({f"tau_s_{s}": rises[f"tau_s_{s}"] for s in ("pos", "neg")})
-        row = np.array([other[n] for n in lugre.ASYM_NAMES])
-        if np.all(np.isfinite(row)):
-            starts.append(row)
-    return np.array(starts), np.array(bounds, dtype=float), LUGRE_ASYM
+    return np.array(values), np.array(bounds, dtype=float), LUGRE_ASYM
 
 
 def dahl_start(stage1, static_tab):

@@ -438,9 +438,7 @@ def fit_trajectory(
         parallel = parallel or ParallelFilter()
         say(f"filtered route: every {'Dahl' if key == 'dahl' else 'LuGre'} parameter")
         if key == "lugre_asym":
-            rises = _regression(series, vf, acc, mask, get_model("stribeck_asym"), *args[1:])
-            rises = dict(zip(rises[0].names, rises[0].values, strict=True))
-            start, box, law = lugre_asym_start(stage1, static_tab, asym, rises)
+            start, box, law = lugre_asym_start(stage1, static_tab, asym)
         else:
             start, box, law = (dahl_start if key == "dahl" else lugre_start)(stage1, static_tab)
         stage, y, r = filtered_route(
