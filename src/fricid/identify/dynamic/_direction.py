@@ -133,10 +133,16 @@ def _gravity_by_symmetry(asym, symmetric, diff: float, diff_se: float, levels: f
             )
     if not parts:
         return ""
+    mean = 0.5 * abs(levels)
+    share = (  # a share of 1e17 % says nothing: levels near zero are given as they are
+        f"+/- {100 * open_share:.0f} % of their mean"
+        if open_share <= 10.0
+        else f"+/- {1.96 * diff_se:.2g} N m against their mean {mean:.2g} N m"
+    )
     return (
         "the log does not tell the gravity from a difference of the friction by direction "
         f"(the Coulomb levels' difference is {diff:.3g} N m with a standard error of "
-        f"{diff_se:.2g}, its 95 % interval +/- {100 * open_share:.0f} % of their mean; half of "
+        f"{diff_se:.2g}, its 95 % interval {share}; half of "
         "a difference is a constant torque the gravity takes up): the gravity rests on the "
         "friction being the same both ways (the regression on the same samples gives "
         f"{'; '.join(parts)}); a motion over more of the joint's range tells them apart"

@@ -1,0 +1,63 @@
+"""A dynamic law's parameter whose 95 % interval reaches one end of its search range is not
+determined (issue 26), and the printouts give no absurd percentages.
+
+The log comes from the independent simulator of ``benchmarks/bench_lugre.py``
+(``benchmarks/_lugre_truth.py``): Canudas de Wit 1995's joint, a PD-tracked trapezoid at
+1 kHz through 2^20 counts/rev. Its fit put sigma_2 at 7e-7 N m s/rad in [0, 1.31] (truth 0.4)
+and tau_c at 1.47 N m in [0, 3.7] (truth 1) with only an "at boundary" flag.
+"""
+
+from __future__ import annotations
+
+import re
+import sys
+import warnings
+from types import SimpleNamespace
+
+import numpy as np
+from tests._paths import REPO
+
+from fricid.fitted import Parameter
+from fricid.identify import fit
+from fricid.identify.dynamic._direction import _gravity_by_symmetry
+from fricid.identify.dynamic._result import one_sided
+from fricid.io import read_rawlog
+
+sys.path.insert(0, str(REPO / "benchmarks"))
+import _lugre_truth as lt
+
+
+def test_an_interval_open_at_one_end_leaves_a_dynamic_parameter_not_determined(tmp_path):
+    truth = lt.TRUTHS["cdw95"]
+    log = lt.simulate(truth, "trapezoid_pd", 10.0, 1000.0, 2**20, 0)
+    raw = read_rawlog(lt.write_log(log, tmp_path / "cdw.csv", truth, {}))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        fitted = fit(raw, "lugre", seed=0)
+    one_end = {n: p for n, p in fitted.parameters.items() if p.low_open != p.high_open}
+    assert {"sigma_2", "tau_c"} <= set(one_end)  # the fit this test was written for
+    for name, p in one_end.items():
+        assert p.not_determined, name
+    sigma_2 = fitted.parameters["sigma_2"]
+    assert "at most" in sigma_2.note and "lower end (0)" in sigma_2.note
+    assert sigma_2.ci95[0] == 0.0 and sigma_2.ci95[1] > 0.4  # the one bound is kept
+    note = fitted.provenance["trajectory"].get("gravity_note") or ""
+    assert not re.search(r"\d{4,} %", note), note  # no 8e17 % of levels near zero
+
+
+def test_a_static_law_keeps_an_open_end_as_a_flag():
+    p = Parameter("tau_v", 1e-9, bounds=(0.0, 1.0), stderr=0.1, ci95=(0.0, 0.2), low_open=True)
+    assert one_sided({"tau_v": p}, dynamic=False)["tau_v"] is p
+    flagged = one_sided({"tau_v": p}, dynamic=True)["tau_v"]
+    assert flagged.not_determined and "at most 0.2" in flagged.note
+
+
+def test_levels_near_zero_are_given_in_newton_metres():
+    def stage(se):
+        return SimpleNamespace(names=["p_x"], stderr=np.array([se]), values=np.array([0.01]))
+
+    text = _gravity_by_symmetry(stage(1.0), stage(0.01), 1e-15, 2.7, 1e-17)
+    assert "+/- 5.3 N m against their mean 5e-18 N m" in text
+    assert "% of their mean" not in text  # no share of a mean near zero
+    share = _gravity_by_symmetry(stage(1.0), stage(0.01), 0.1, 0.3, 2.0)
+    assert "+/- 59 % of their mean" in share
