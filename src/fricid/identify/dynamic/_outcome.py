@@ -58,21 +58,21 @@ __all__ = [
 #: 350 times; on no one else's.
 LUGRE_COVERAGE = {
     "kinds": {
-        "PD-tracked chirps": (192, 229),
-        "PD-tracked trapezoids": (206, 247),
-        "open-loop torque steps": (201, 250),
+        "PD-tracked chirps": (203, 233),
+        "PD-tracked trapezoids": (206, 224),
+        "open-loop torque steps": (181, 246),
     },
     "parameters": {
-        "sigma_0": (85, 98),
-        "sigma_1": (26, 51),
-        "sigma_2": (79, 98),
-        "tau_c": (84, 94),
-        "tau_s": (10, 17),
-        "w_s": (7, 32),
-        "delta": (2, 12),
-        "J": (104, 108),
-        "p_x": (101, 108),
-        "p_y": (101, 108),
+        "sigma_0": (83, 95),
+        "sigma_1": (25, 47),
+        "sigma_2": (78, 86),
+        "tau_c": (80, 86),
+        "tau_s": (12, 23),
+        "w_s": (10, 25),
+        "delta": (4, 17),
+        "J": (101, 108),
+        "p_x": (98, 108),
+        "p_y": (99, 108),
     },
 }
 
