@@ -238,8 +238,8 @@ def summary_lines(
     estimator = trajectory.get("estimator")
     if isinstance(estimator, dict):  # {"name": ..., "bias": ...}
         estimator = estimator.get("name")
-    if isinstance(estimator, str) and estimator:
-        lines.append(f"estimator: {plain(estimator)}")
+    if isinstance(estimator, str) and estimator:  # fricid's own names run to 160 characters
+        lines.append(f"estimator: {plain(estimator, limit=2 * PLAIN_LIMIT)}")
     if parts and trajectory:
         lines.append(
             "fit on its data: " + ", ".join(parts) + " (rmse, max error in N m, of the residual "
@@ -252,7 +252,7 @@ def summary_lines(
     if undetermined:
         lines.append(
             "NOT DETERMINED by the trajectory, exported as identified: "
-            + ", ".join(plain(n) for n in undetermined)
+            + ", ".join(plain(n) + _one_bound(fitted.parameters[n]) for n in undetermined)
         )
     level, _ = trust_of(fitted)
     if level in ("yes", "with caveats", "no"):  # fixed words and a number only
@@ -310,6 +310,16 @@ def refuse_untrusted(fitted: FittedModel, allow: bool, joint: str | None = None)
             "fit another model, or export anyway with --allow-untrusted (the file's comment "
             "then says so)"
         )
+
+
+def _one_bound(p) -> str:
+    """`` (the data: at most 1.106)``: the one bound a parameter's interval open at one end of
+    its search range sets (its model file keeps the interval), else ``""``."""
+    low, high = (float(x) for x in p.ci95)
+    if p.low_open == p.high_open or not (math.isfinite(low) and math.isfinite(high)):
+        return ""
+    bound = f"at most {high:.4g}" if p.low_open else f"at least {low:.4g}"
+    return f" (the data: {bound}{' ' + plain(p.unit) if p.unit else ''})"
 
 
 def undetermined_parameters(fitted: FittedModel) -> list[str]:

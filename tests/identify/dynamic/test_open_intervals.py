@@ -17,6 +17,7 @@ from types import SimpleNamespace
 import numpy as np
 from tests._paths import REPO
 
+from fricid.export._common import summary_lines
 from fricid.fitted import Parameter
 from fricid.identify import fit
 from fricid.identify.dynamic._direction import _gravity_by_symmetry
@@ -41,8 +42,16 @@ def test_an_interval_open_at_one_end_leaves_a_dynamic_parameter_not_determined(t
     sigma_2 = fitted.parameters["sigma_2"]
     assert "at most" in sigma_2.note and "lower end (0)" in sigma_2.note
     assert sigma_2.ci95[0] == 0.0 and sigma_2.ci95[1] > 0.4  # the one bound is kept
+    w_s = fitted.parameters["w_s"].note  # the follow check's re-estimate moved the other way
+    assert "(away from that joint's value, not towards it)" in w_s, w_s  # not "-395% of the way"
     note = fitted.provenance["trajectory"].get("gravity_note") or ""
     assert not re.search(r"\d{4,} %", note), note  # no 8e17 % of levels near zero
+    lines = summary_lines(fitted)  # an export's comment, when told to export it anyway
+    (said,) = [line for line in lines if line.startswith("NOT DETERMINED")]
+    high = f"{sigma_2.ci95[1]:.4g}"
+    assert f"sigma_2 (the data: at most {high} N m s/rad)" in said
+    (estimator,) = [line for line in lines if line.startswith("estimator:")]
+    assert "more characters" not in estimator  # fricid's own name, whole
 
 
 def test_a_static_law_keeps_an_open_end_as_a_flag():

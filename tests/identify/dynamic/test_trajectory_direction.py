@@ -87,6 +87,10 @@ def test_lugre_on_a_joint_weaker_backwards_says_so_and_what_it_takes_up(tmp_path
     assert any(c.startswith("the friction differs by direction") for c in caveats), caveats
     assert any("this LuGre has one Coulomb and break-away level" in c for c in caveats)
     assert any("fit lugre_asym" in c for c in caveats)
+    # the bristles too (a new user's joint with a torque offset: sigma_0, sigma_1 9x and 3x
+    # low inside closed intervals, the caveat naming the levels and gravity only)
+    assert any("sigma_0, sigma_1 take up the misfit" in c for c in caveats)
+    assert any("a torque sensor's offset looks the same" in c for c in caveats)
     assert not gravity_held(info, truth)
 
 

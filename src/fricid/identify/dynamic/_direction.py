@@ -41,8 +41,9 @@ _DIRECTION_ADVICE = {
     "stribeck": "fit stribeck_asym",
     "lugre": (
         "this LuGre has one Coulomb and break-away level for both directions, so its tau_c "
-        "is about their mean and p_x, p_y are off by about half the difference; fit "
-        "lugre_asym (the levels per direction)"
+        "is about their mean, p_x, p_y are off by about half the difference, and sigma_0, "
+        "sigma_1 take up the misfit at each reversal (their intervals may not hold); fit "
+        "lugre_asym (the levels per direction; a torque sensor's offset looks the same)"
     ),
     "dahl": (
         "fricid's Dahl has one Coulomb level for both directions, so its tau_c is about their "

@@ -213,7 +213,12 @@ def response_notes(stage: _Stage, check: dict[str, Any]) -> dict[str, str]:
             if name in JUDGED and name not in notes and moved <= FOLLOW:
                 notes[name] = "not determined: " + _told_apart(stage, name, row)
             elif name == "w_s" and sane and "w_s" not in notes and moved <= STRIBECK_FOLLOW:
-                why = _told_apart(stage, name, row, f" (it moved {moved:.0%} of the way)")
+                how = (
+                    " (away from that joint's value, not towards it)"
+                    if moved < 0
+                    else f" (it moved {moved:.0%} of the way from the estimate to that value)"
+                )
+                why = _told_apart(stage, name, row, how)
                 notes["w_s"] = f"not determined: {why}"
                 rise = (n for n in stage.names if lugre.symmetric_name(n) in STRIBECK)
                 for other in (n for n in rise if n != "w_s"):
