@@ -105,8 +105,11 @@ def test_a_stribeck_velocity_that_moves_less_than_half_its_shift_voids_the_rise(
     notes = response_notes(stage, {"shifts": [{"w_s": row}]})
     assert set(notes) == ({"w_s", "tau_s", "delta"} if flagged else set())
     assert STRIBECK_FOLLOW == 0.5
-    if flagged:
-        assert f"it moved {(miss + 0.6) / 0.6:.0%} of the way" in notes["w_s"]
+    moved = (miss + 0.6) / 0.6
+    if flagged and moved >= 0:
+        assert f"it moved {moved:.0%} of the way from the estimate to that value" in notes["w_s"]
+    elif flagged:  # "-50% of the way" had told a new user nothing
+        assert "(away from that joint's value, not towards it)" in notes["w_s"]
 
 
 def test_a_log_whose_sigma_0_went_astray_is_not_read_for_the_stribeck_velocity():
