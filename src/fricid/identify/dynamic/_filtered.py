@@ -201,6 +201,21 @@ def _sub_velocity(series: Series, up: int) -> np.ndarray:
     return out
 
 
+def joint_columns(series: Series, low, keep: np.ndarray, gravity: str):
+    """The filtered route's joint columns (J's acceleration, and the gravity's ``-cos q``,
+    ``sin q`` where it is fitted) and its filtered torque (each sample's held over the period
+    that ends there), low-passed alike and decimated: ``(Phi (m, nd), y (m,))``."""
+    dt, q = series.dt, series.position
+    q_mid = np.concatenate([q[:1], 0.5 * (q[1:] + q[:-1])])
+    u = np.concatenate([series.torque[:1], series.torque[:-1]])  # held over period i
+    vl = np.gradient(low(q), dt)
+    acc = np.concatenate([[0.0], np.diff(vl) / dt])
+    cols = [acc[keep]] + (
+        [-low(np.cos(q_mid))[keep], low(np.sin(q_mid))[keep]] if gravity == "fit" else []
+    )
+    return np.column_stack(cols), low(u)[keep]
+
+
 def filtered_route(
     series: Series,
     start: np.ndarray,
@@ -263,18 +278,9 @@ def filtered_route(
             f"needs {2 * filt.trim:g} s trimmed and 30 decimated samples besides",
             file=source,
         )
-    q = series.position
-    q_mid = np.concatenate([q[:1], 0.5 * (q[1:] + q[:-1])])
-    u = np.concatenate([series.torque[:1], series.torque[:-1]])  # held over period i
-    vl = np.gradient(low(q), dt)
-    acc = np.concatenate([[0.0], np.diff(vl) / dt])
-    cols = [acc[keep]] + (
-        [-low(np.cos(q_mid))[keep], low(np.sin(q_mid))[keep]] if gravity == "fit" else []
-    )
-    Phi = np.column_stack(cols)
+    Phi, y = joint_columns(series, low, keep, gravity)
     nd = Phi.shape[1]
     Qphi, _ = np.linalg.qr(Phi)
-    y = low(u)[keep]
     up = max(int(n_sub), 1)
     v_sub = _sub_velocity(series, up)
     is_log, d = law.is_log, len(law.names)

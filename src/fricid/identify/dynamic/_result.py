@@ -27,6 +27,7 @@ from ...models import get_model, lugre
 from ...samples import RawLog
 from ._data import Series
 from ._outcome import PassivityWarning, converged, lugre_caveat, passivity
+from ._rate import delay_caveat
 from ._routes import DYNAMIC_MODELS, JOINT_PARAMS
 from ._window import bias_caveat
 
@@ -177,6 +178,7 @@ def build_result(
         bias_caveat(options.get("window_bias")),
         direction,
         lugre_caveat(key == "lugre_asym") if is_lugre else "",
+        delay_caveat(sim_info.get("torque_delay")),
     ]
     if any(caveats):
         info["caveats"] = [c for c in caveats if c]

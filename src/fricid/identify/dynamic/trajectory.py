@@ -172,7 +172,7 @@ from ._outcome import (
 from ._output import needs_output_error
 from ._output import output_error as _output_error
 from ._presliding_fit import fit_presliding
-from ._rate import measurement
+from ._rate import measurement, torque_delay, warn_delay
 from ._rate import rate_bias as _rate_bias
 from ._response import follows, reidentifier, response_notes
 from ._result import build_result
@@ -501,6 +501,8 @@ def fit_trajectory(
         if key in LUGRE_LAWS:
             sim_info["calibration"] = widen_calibrated(stage)
             final.update(stage.table())
+        sim_info["torque_delay"] = torque_delay(series, stage, parallel, gravity, cluster_time)
+        warn_delay(sim_info["torque_delay"])
     elif key == "lugre":
         say(f"{route} route: sigma_0, sigma_1 by simulation error")
         sim_info, static_tab = simulation_route(
