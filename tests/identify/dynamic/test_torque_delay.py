@@ -61,4 +61,7 @@ def test_a_delay_is_said_past_both_thresholds(samples, z, said):
     assert bool(text) is said
     if said:
         assert ("late behind" if samples > 0 else "early before") in text
+        # an early reading came from the model's misfit on aligned logs in a trial: said first
+        misfit_first = "most often the model misses the joint where its torque changes"
+        assert (misfit_first in text) is (samples < 0)
     assert delay_caveat({"skipped": "the stage searched nothing"}) == ""
