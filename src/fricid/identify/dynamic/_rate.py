@@ -382,8 +382,8 @@ def torque_delay(
     out (Frisch and Waugh 1933: the estimate refitted with the delay, to first order), its
     standard error cluster-robust over blocks of ``cluster_time`` like the stage's own.
     Costs one Jacobian of the stage: its parameters' count of simulations or filtered
-    friction evaluations. Returns ``{"seconds", "stderr", "samples", "z", "clusters"}`` or
-    ``{"skipped": why}``."""
+    friction evaluations. Returns ``{"seconds", "stderr", "samples", "z", "clusters",
+    "route"}`` or ``{"skipped": why}``."""
     problem = stage.problem
     if problem is None or stage.result is None:
         return {"skipped": "the stage searched nothing"}
@@ -392,7 +392,8 @@ def torque_delay(
     low, keep = filt.lowpass(rate), filt.kept(rate, n)
     Jm, r = jacobian(problem.residuals, np.asarray(stage.result.x, dtype=float))
     Phi, _ = joint_columns(series, low, keep, gravity)
-    if "inertia" in problem.names:  # the output error: the joint searched, its torque as is
+    output = "inertia" in problem.names
+    if output:  # the output error: the joint searched, its torque as is
         basis, y_full = Jm, low(series.torque)
     else:  # the filtered route: the joint's columns projected out of its residual
         basis = np.column_stack([Jm, Phi])
@@ -409,20 +410,24 @@ def torque_delay(
     _, se, g = cluster_covariance(xm[:, None], rm - d * xm, labels)
     stderr = float(se[0])
     z = d / stderr if stderr > 0 else float("inf")
-    return {"seconds": d, "stderr": stderr, "samples": d / dt, "z": z, "clusters": int(g)}
+    route = "output error" if output else "equation error"
+    out = {"seconds": d, "stderr": stderr, "samples": d / dt, "z": z, "clusters": int(g)}
+    return {**out, "route": route}
 
 
 #: A torque delay is said where it exceeds :data:`DELAY_Z` standard errors and
-#: :data:`DELAY_SAMPLES` sample periods. Chosen on ``benchmarks/_lugre_truth.py``'s logs (seed
-#: 0: three joints, PD-tracked chirps and trapezoids, torque steps, 1 kHz and 200 Hz, 2^17
-#: and 2^20 counts/rev, 10 s; a throwaway script): as logged, 1 of 36 said (0.41 samples,
-#: z 4.4; 3 of 36 past z 4 alone); the torque 2 samples late, 27 of 36 said. On seed 1, not
-#: tuned on: 1 of 36 as logged (-1.33 samples, z -6.9: a 200 Hz trapezoid the model misfits,
-#: so the caveat names that cause too), 26 of 36 late. The output error reads a delay short
-#: (0.3-0.9 samples of 2: its loop takes part of it up), the equation error about whole
-#: (1.3-2.0).
+#: :data:`DELAY_SAMPLES` sample periods. fricid takes each torque sample to act over the
+#: period after it, so a torque sampled with the position reads up to half a sample late
+#: (a second new-user trial: 0.3-0.5 samples, z up to 105, on logs sampled together). Measured
+#: on ``benchmarks/_lugre_truth.py``'s logs (three joints, PD-tracked chirps and trapezoids,
+#: torque steps, 1 kHz and 200 Hz, 2^17 and 2^20 counts/rev, 10 s; a throwaway script), said
+#: as logged / with the torque 2 samples late: seed 0, 0 / 27 of 36; seed 1, 1 / 26 of 36 (the
+#: one a 200 Hz trapezoid the model misfits, -1.33 samples). The trial's own simulator (LuGre
+#: fits): 5 of 57 aligned logs, 36 of 72 logs 1-5 samples late, 4 of 17 sampled together (13
+#: of 17 at a quarter sample, the first threshold). The output error reads a delay short (as
+#: little as a fiftieth of it), the equation error at 0.7-1.0 of it on chirps and steps.
 DELAY_Z = 4.0
-DELAY_SAMPLES = 0.25
+DELAY_SAMPLES = 0.5
 
 
 class TorqueDelayWarning(FricidWarning):
@@ -444,12 +449,18 @@ def delay_caveat(record: dict[str, Any] | None) -> str:
     read = (
         f"the residual follows the torque's rate of change as a torque logged {abs(s):.2g} "
         f"sample periods ({1e3 * abs(record['seconds']):.2g} ms) "
-        f"{'late behind' if s > 0 else 'early before'} the position would leave it (z = {z:.2g})"
+        f"{'late behind' if s > 0 else 'early before'} the position would leave it (z = "
+        f"{z:.3g}; fricid takes each torque sample to act over the period after it)"
+    )
+    short = (  # the output error's loop takes part of a delay up
+        "; this fit's output error reads a delay short, as little as a fiftieth of it"
+        if record.get("route") == "output error"
+        else ""
     )
     timing = (
-        "if the drive does not sample its torque and position together, J and the viscous term "
-        "are biased (a new user's log 2 ms late at 1 kHz: J -1.1 %, sigma_2 +2.9 % inside "
-        "closed intervals; the output error reads a delay at a third to a half of its size)"
+        "if the drive logs its torque late (a bus or a sensor's low-pass filter), J and the "
+        "viscous term are biased (a log 2 ms late at 1 kHz: J -1.1 %, sigma_2 +2.9 % inside "
+        f"closed intervals{short})"
     )
     misfit = "the model misses the joint where its torque changes"
     if s > 0:
