@@ -64,6 +64,7 @@ def test_a_delay_is_said_past_both_thresholds(samples, z, said):
         # an early reading came from the model's misfit on aligned logs in a trial: said first
         misfit_first = "most often the model misses the joint where its torque changes"
         assert (misfit_first in text) is (samples < 0)
+        assert ("logs its torque late" in text) is (samples > 0)  # else its position late
         assert "a fiftieth" not in text  # the output error's shortfall, said for that route only
     output = {"samples": 0.9, "z": 9.0, "seconds": 9e-4, "route": "output error"}
     assert "this fit's output error reads a delay short" in delay_caveat(output)

@@ -457,10 +457,11 @@ def delay_caveat(record: dict[str, Any] | None) -> str:
         if record.get("route") == "output error"
         else ""
     )
+    late = "its torque late (a bus, a sensor's low-pass filter)"
     timing = (
-        "if the drive logs its torque late (a bus or a sensor's low-pass filter), J and the "
-        "viscous term are biased (a log 2 ms late at 1 kHz: J -1.1 %, sigma_2 +2.9 % inside "
-        f"closed intervals{short})"
+        f"if the drive logs {late if s > 0 else 'its position late'}, J and the viscous term "
+        "are biased (a log 2 ms late at 1 kHz: J -1.1 %, sigma_2 +2.9 % inside closed "
+        f"intervals{short})"
     )
     misfit = "the model misses the joint where its torque changes"
     if s > 0:
