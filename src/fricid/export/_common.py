@@ -313,13 +313,11 @@ def refuse_untrusted(fitted: FittedModel, allow: bool, joint: str | None = None)
 
 
 def _one_bound(p) -> str:
-    """`` (the data: at most 1.106)``: the one bound a parameter's interval open at one end of
-    its search range sets (its model file keeps the interval), else ``""``."""
-    low, high = (float(x) for x in p.ci95)
-    if p.low_open == p.high_open or not (math.isfinite(low) and math.isfinite(high)):
+    """`` (the data: at most 1.106 N m s/rad)``: the one bound a parameter's interval open at
+    one end of its search range sets (:attr:`fricid.fitted.Parameter.one_bound`), else ``""``."""
+    if not p.one_bound:
         return ""
-    bound = f"at most {high:.4g}" if p.low_open else f"at least {low:.4g}"
-    return f" (the data: {bound}{' ' + plain(p.unit) if p.unit else ''})"
+    return f" (the data: {p.one_bound}{' ' + plain(p.unit) if p.unit else ''})"
 
 
 def undetermined_parameters(fitted: FittedModel) -> list[str]:

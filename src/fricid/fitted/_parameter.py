@@ -104,6 +104,15 @@ class Parameter:
         """Both ends of the 95 % interval are recorded."""
         return math.isfinite(self.ci95[0]) and math.isfinite(self.ci95[1])
 
+    @property
+    def one_bound(self) -> str:
+        """``"at most 1.31"`` (or ``"at least ..."``): the one bound an interval open at one
+        end of the search range sets; ``""`` for any other interval."""
+        if self.low_open == self.high_open or not self.has_interval:
+            return ""
+        low, high = (float(x) for x in self.ci95)
+        return f"at most {high:.4g}" if self.low_open else f"at least {low:.4g}"
+
     def to_dict(self) -> dict[str, Any]:
         """The record as the model file holds it (without the name, its key); NaN stays NaN
         here and becomes null when the file is written."""

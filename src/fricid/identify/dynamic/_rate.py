@@ -391,12 +391,11 @@ def torque_delay(
     rate = 1.0 / dt
     low, keep = filt.lowpass(rate), filt.kept(rate, n)
     Jm, r = jacobian(problem.residuals, np.asarray(stage.result.x, dtype=float))
-    Phi, _ = joint_columns(series, low, keep, gravity)
     output = "inertia" in problem.names
     if output:  # the output error: the joint searched, its torque as is
         basis, y_full = Jm, low(series.torque)
     else:  # the filtered route: the joint's columns projected out of its residual
-        basis = np.column_stack([Jm, Phi])
+        basis = np.column_stack([Jm, joint_columns(series, low, keep, gravity)[0]])
         y_full = low(np.concatenate([series.torque[:1], series.torque[:-1]]))
     x = -np.gradient(y_full, dt)[keep]
     Q, _ = np.linalg.qr(np.nan_to_num(basis))

@@ -232,16 +232,12 @@ def one_sided(params: dict[str, Parameter], dynamic: bool) -> dict[str, Paramete
         return params
     out = dict(params)
     for name, p in params.items():
-        if p.not_determined or p.low_open == p.high_open or p.bounds is None:
+        if p.not_determined or not p.one_bound or p.bounds is None:
             continue
-        low, high = p.ci95
-        side, bound = (
-            ("lower", f"at most {high:.4g}") if p.low_open else ("upper", f"at least {low:.4g}")
-        )
-        end = p.bounds[0] if p.low_open else p.bounds[1]
+        side, end = ("lower", p.bounds[0]) if p.low_open else ("upper", p.bounds[1])
         why = (
             f"not determined: its 95 % interval reaches the search range's {side} end "
-            f"({end:.4g}), so the data bound it on one side only ({bound}"
+            f"({end:.4g}), so the data bound it on one side only ({p.one_bound}"
             + (f" {p.unit})" if p.unit else ")")
         )
         out[name] = replace(p, note=why if not p.note else f"{why}; {p.note}", not_determined=True)
