@@ -4,7 +4,10 @@ determined (issue 26), and the printouts give no absurd percentages.
 The log comes from the independent simulator of ``benchmarks/bench_lugre.py``
 (``benchmarks/_lugre_truth.py``): Canudas de Wit 1995's joint, a PD-tracked trapezoid at
 1 kHz through 2^20 counts/rev. Its fit put sigma_2 at 7e-7 N m s/rad in [0, 1.31] (truth 0.4)
-and tau_c at 1.47 N m in [0, 3.7] (truth 1) with only an "at boundary" flag.
+and tau_c at 1.47 N m in [0, 3.7] (truth 1) with only an "at boundary" flag. Since the search
+also starts from a falling Stribeck curve (``test_falling_start.py``) those two are found
+(0.4026 and 0.9978 in closed intervals) and w_s is the parameter the data bound on one side
+only (truth 1 mrad/s, interval from the box's lower end to 2.3 mrad/s).
 """
 
 from __future__ import annotations
@@ -36,20 +39,18 @@ def test_an_interval_open_at_one_end_leaves_a_dynamic_parameter_not_determined(t
         warnings.simplefilter("ignore")
         fitted = fit(raw, "lugre", seed=0)
     one_end = {n: p for n, p in fitted.parameters.items() if p.low_open != p.high_open}
-    assert {"sigma_2", "tau_c"} <= set(one_end)  # the fit this test was written for
+    assert "w_s" in one_end  # the fit this test is written for
     for name, p in one_end.items():
         assert p.not_determined, name
-    sigma_2 = fitted.parameters["sigma_2"]
-    assert "at most" in sigma_2.note and "lower end (0)" in sigma_2.note
-    assert sigma_2.ci95[0] == 0.0 and sigma_2.ci95[1] > 0.4  # the one bound is kept
-    w_s = fitted.parameters["w_s"].note  # the follow check's re-estimate moved the other way
-    assert "(away from that joint's value, not towards it)" in w_s, w_s  # not "-395% of the way"
+    w_s = fitted.parameters["w_s"]
+    assert "at most" in w_s.note and "lower end" in w_s.note, w_s.note
+    assert w_s.ci95[0] == w_s.bounds[0] and w_s.ci95[1] > 0.001  # the one bound is kept
     note = fitted.provenance["trajectory"].get("gravity_note") or ""
     assert not re.search(r"\d{4,} %", note), note  # no 8e17 % of levels near zero
     lines = summary_lines(fitted)  # an export's comment, when told to export it anyway
     (said,) = [line for line in lines if line.startswith("NOT DETERMINED")]
-    high = f"{sigma_2.ci95[1]:.4g}"
-    assert f"sigma_2 (the data: at most {high} N m s/rad)" in said
+    high = f"{w_s.ci95[1]:.4g}"
+    assert f"w_s (the data: at most {high} rad/s)" in said, said
     (estimator,) = [line for line in lines if line.startswith("estimator:")]
     assert "more characters" not in estimator  # fricid's own name, whole
 

@@ -67,6 +67,7 @@ __all__ = [
     "Law",
     "ParallelFilter",
     "dahl_start",
+    "falling_start",
     "filtered_route",
     "law_of",
     "lugre_asym_start",
@@ -78,6 +79,10 @@ DECIMATED_RATE = 5.0
 
 #: Search box of sigma_0 and sigma_1, as log10 (as the simulation route's).
 LOG_BOX = {"sigma_0": (2.0, 7.0), "sigma_1": (-3.0, 3.0)}
+
+#: :func:`falling_start`'s break-away level over the Coulomb one (a start, not a prior: the
+#: search moves it; the benchmark's truths all have 1.5).
+FALLING_RATIO = 1.25
 
 
 @dataclass(frozen=True)
@@ -393,3 +398,65 @@ def dahl_start(stage1, static_tab):
     tau_c = float(np.clip(static_tab["tau_c"]["value"], *bounds[0]))
     sigma_2 = float(np.clip(static_tab["sigma_2"]["value"], *bounds[2]))
     return np.array([1e4, tau_c, alpha.default, sigma_2]), bounds, DAHL
+
+
+def _directions(names) -> list[tuple[str, str, str]]:
+    """The (sigma_2, tau_c, tau_s) names of each direction of a LuGre law's ``names``."""
+    if "tau_c" in names:
+        return [("sigma_2", "tau_c", "tau_s")]
+    return [(f"sigma_2_{d}", f"tau_c_{d}", f"tau_s_{d}") for d in ("pos", "neg")]
+
+
+def rises(names, values) -> bool:
+    """Whether a LuGre estimate's Stribeck curve rises in some direction (``tau_s < tau_c``)."""
+    v = dict(zip(names, values, strict=False))
+    return any(v[s] < v[c] for _, c, s in _directions(names))
+
+
+def falling_start(start: np.ndarray, names, box: np.ndarray, asym) -> np.ndarray:
+    """A second start for a LuGre search whose estimate rose (:func:`rises`): each direction's
+    viscous coefficient and Coulomb level from ``asym`` (the ``coulomb_viscous_asym``
+    regression, :func:`._direction.per_direction`; their mean for a symmetric law), the
+    break-away level :data:`FALLING_RATIO` times the Coulomb one, ``w_s`` a hundredth of the
+    top of its box (on the log scale, the middle of a box four decades high) and ``delta`` 2.
+
+    Why. On a chirp or a trapezoid the static regression on the sliding samples sees the
+    bristles' lag after each reversal as friction that rises with speed, and starts the search
+    on a rising curve with no viscous term (tau_s < tau_c, sigma_2 = 0, w_s of the order of
+    the motion's speed). The search stays in that valley, although the falling one is far
+    lower: ``benchmarks/_lugre_truth.py``'s geared chirp at 1 kHz, 2^20 counts/rev, seed 11,
+    filtered residual 0.115 N m there and 0.034 from this start, which the fit then refines to
+    within 1 % of the truth's levels. 36 of 108 fits of the report seeds ended rising, those
+    with sigma_2 at 0 among the worst under the drive (2-9 times the noise)."""
+    a = dict(zip(asym.names, asym.values, strict=True))
+    at = {n: i for i, n in enumerate(names)}
+    x = np.array(start, dtype=float)
+    first = len(LOG_BOX)  # ``box``: the rows after the log-scale ones, in names' order
+
+    def put(name: str, value: float) -> None:
+        lo, hi = box[at[name] - first]
+        if np.isfinite(value):
+            x[at[name]] = float(np.clip(value, lo, hi))
+
+    for (s2, c, s), side in zip(_directions(names), ("pos", "neg"), strict=False):
+        sides = [side] if s2.endswith(("_pos", "_neg")) else ["pos", "neg"]
+        tau_c = float(np.mean([a[f"f_c_{d}"] for d in sides]))
+        put(s2, float(np.mean([a[f"beta_{d}"] for d in sides])))
+        put(c, tau_c)
+        put(s, FALLING_RATIO * tau_c)
+    put("w_s", 0.01 * box[at["w_s"] - first][1])
+    put("delta", 2.0)
+    return x
+
+
+def best_start(run, start: np.ndarray, names, box: np.ndarray, asym):
+    """``run(start)`` (a filtered or output-error search returning ``(stage, y, r)``), and again
+    from :func:`falling_start` when its estimate rises; the lower filtered residual wins, the
+    other's recorded in the winner's ``rms`` (``torque_filtered_other_start``)."""
+    first = run(start)
+    if asym is None or not rises(names, first[0].values[: len(names)]):
+        return first
+    second = run(falling_start(start, names, box, asym))
+    best, other = sorted((first, second), key=lambda f: f[0].rms["torque_filtered"])
+    best[0].rms["torque_filtered_other_start"] = other[0].rms["torque_filtered"]
+    return best

@@ -58,21 +58,21 @@ __all__ = [
 #: 350 times; on no one else's.
 LUGRE_COVERAGE = {
     "kinds": {
-        "PD-tracked chirps": (203, 233),
-        "PD-tracked trapezoids": (206, 224),
-        "open-loop torque steps": (181, 246),
+        "PD-tracked chirps": (250, 259),
+        "PD-tracked trapezoids": (221, 242),
+        "open-loop torque steps": (203, 257),
     },
     "parameters": {
-        "sigma_0": (83, 95),
-        "sigma_1": (25, 47),
-        "sigma_2": (78, 86),
-        "tau_c": (80, 86),
-        "tau_s": (12, 23),
-        "w_s": (10, 25),
-        "delta": (4, 17),
-        "J": (101, 108),
-        "p_x": (98, 108),
-        "p_y": (99, 108),
+        "sigma_0": (95, 101),
+        "sigma_1": (32, 48),
+        "sigma_2": (102, 108),
+        "tau_c": (100, 104),
+        "tau_s": (17, 26),
+        "w_s": (14, 29),
+        "delta": (8, 18),
+        "J": (104, 108),
+        "p_x": (99, 108),
+        "p_y": (103, 108),
     },
 }
 

@@ -159,7 +159,14 @@ from ...models import get_model, lugre
 from ...samples import RawLog, check_trajectory_log
 from ._data import DerivativeFilter, check_dissipates, guarded_sliding, sliding, uniform_series
 from ._direction import direction_caveat, per_direction
-from ._filtered import ParallelFilter, dahl_start, filtered_route, lugre_asym_start, lugre_start
+from ._filtered import (
+    ParallelFilter,
+    best_start,
+    dahl_start,
+    filtered_route,
+    lugre_asym_start,
+    lugre_start,
+)
 from ._outcome import (
     RATE_BIAS,
     PassivityWarning,
@@ -441,20 +448,13 @@ def fit_trajectory(
             start, box, law = lugre_asym_start(stage1, static_tab, asym)
         else:
             start, box, law = (dahl_start if key == "dahl" else lugre_start)(stage1, static_tab)
-        stage, y, r = filtered_route(
-            series,
-            start,
-            box,
-            gravity,
-            method,
-            seed,
-            max_evals,
-            cluster_time,
-            n_sub,
-            parallel,
-            log.source,
-            law=law,
-        )
+
+        def search(x0):  # from ``x0``; best_start: and from a falling curve where it rose
+            rest = (gravity, method, seed, max_evals, cluster_time, n_sub, parallel)
+            return filtered_route(series, x0, box, *rest, log.source, law=law)
+
+        levels = asym if key in LUGRE_LAWS else None
+        stage, y, r = best_start(search, start, law.names, box, levels)
         yhat = y - r
         stages["filtered"] = stage
         fits.append(("filtered", stage))
