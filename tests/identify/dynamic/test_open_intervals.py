@@ -5,7 +5,7 @@ The log comes from the independent simulator of ``benchmarks/bench_lugre.py``
 (``benchmarks/_lugre_truth.py``): Canudas de Wit 1995's joint, a PD-tracked trapezoid at
 1 kHz through 2^20 counts/rev. Its fit put sigma_2 at 7e-7 N m s/rad in [0, 1.31] (truth 0.4)
 and tau_c at 1.47 N m in [0, 3.7] (truth 1) with only an "at boundary" flag. Since the search
-also starts from a falling Stribeck curve (``test_falling_start.py``) those two are found
+also starts from a falling Stribeck curve (``test_lugre_search.py``) those two are found
 (0.4026 and 0.9978 in closed intervals) and w_s is the parameter the data bound on one side
 only (truth 1 mrad/s, interval from the box's lower end to 2.3 mrad/s).
 """

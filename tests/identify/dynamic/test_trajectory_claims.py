@@ -111,7 +111,7 @@ def test_break_away_below_the_resolution_is_not_claimed(tmp_path):
     """cdw95 (w_s = 1 mrad/s) through 2^17 counts/rev at 1 kHz: tau_s came out at tau_c,
     1.0002 [0.9925, 1.0079] against 1.5, 127 half-widths off; then not determined for the
     rise narrower than w_s's interval allows (:func:`unresolved_rise`). Since the search also
-    starts from a falling curve (``test_falling_start.py``) it lands at 1.8 with an interval
+    starts from a falling curve (``test_lugre_search.py``) it lands at 1.8 with an interval
     over its whole search range: not determined, for that reason."""
     fitted, _truth = fit_bench_log("cdw95", "chirp_pd", 1000.0, 2**17, 1, tmp_path)
     p = fitted.parameters["tau_s"]
