@@ -7,7 +7,7 @@ The log comes from the independent simulator of ``benchmarks/bench_lugre.py``
 and tau_c at 1.47 N m in [0, 3.7] (truth 1) with only an "at boundary" flag. Since the search
 also starts from a falling Stribeck curve (``test_lugre_search.py``) those two are found
 (0.4026 and 0.9978 in closed intervals) and w_s is the parameter the data bound on one side
-only (truth 1 mrad/s, interval from the box's lower end to 2.3 mrad/s).
+only (truth 1 mrad/s, interval from the box's lower end to 6.9 mrad/s, widened).
 """
 
 from __future__ import annotations

@@ -66,12 +66,14 @@ __all__ = [
     "LUGRE_ASYM",
     "Law",
     "ParallelFilter",
+    "best_start",
     "dahl_start",
     "falling_start",
     "filtered_route",
     "law_of",
     "lugre_asym_start",
     "lugre_start",
+    "rises",
 ]
 
 #: Output rate of the decimation, in multiples of the cut-off.
@@ -450,9 +452,10 @@ def falling_start(start: np.ndarray, names, box: np.ndarray, asym) -> np.ndarray
 
 
 def best_start(run, start: np.ndarray, names, box: np.ndarray, asym):
-    """``run(start)`` (a filtered or output-error search returning ``(stage, y, r)``), and again
-    from :func:`falling_start` when its estimate rises; the lower filtered residual wins, the
-    other's recorded in the winner's ``rms`` (``torque_filtered_other_start``)."""
+    """``run(start)`` (the filtered search, returning ``(stage, y, r)``), and again from
+    :func:`falling_start` when its estimate rises and ``asym`` is given (LuGre laws); the lower
+    filtered residual wins, the other's recorded in the winner's ``rms``
+    (``torque_filtered_other_start``, in the provenance's routes)."""
     first = run(start)
     if asym is None or not rises(names, first[0].values[: len(names)]):
         return first

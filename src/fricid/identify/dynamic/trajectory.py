@@ -449,7 +449,7 @@ def fit_trajectory(
         else:
             start, box, law = (dahl_start if key == "dahl" else lugre_start)(stage1, static_tab)
 
-        def search(x0):  # from ``x0``; best_start: and from a falling curve where it rose
+        def search(x0):  # best_start runs it again from a falling curve where it rose
             rest = (gravity, method, seed, max_evals, cluster_time, n_sub, parallel)
             return filtered_route(series, x0, box, *rest, log.source, law=law)
 
