@@ -1,6 +1,6 @@
 """How the held-out simulation under a PD drive answers a small error of the model, through the
 log's own encoder and through an ideal one (``bench_lugre.py``'s ``enc-held`` and
-``sim-held`` columns).
+``sim-held`` columns); ``benchmarks/results/heldout_chaos.txt``.
 
 Usage: ``python benchmarks/bench_heldout_chaos.py [--duration 10] [--seed 1011]``.
 
