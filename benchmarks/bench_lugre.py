@@ -29,9 +29,10 @@ simulator (PD-tracked kinds: ``sim-held``, the RMS of its applied torque minus t
 both through an ideal encoder, plus the log's noise, over the noise: 1 for the truth;
 ``enc-held``, its applied torque through the log's own encoder minus the logged torque over the
 noise, also 1 for the truth but chaotic in the parameters where the loop feeds the
-quantisation back: the truth with J 0.1 % off gives 1.9-2.8 on the 2^17 encoder at 1 kHz and
-up to 53 on cdw95; open-loop kinds, the RMS position error in encoder counts, ``cnt``; ``-``
-when the fitted joint is too stiff to simulate there); and the seconds
+quantisation back: the truth with J 0.1 % off gives 1.6-2.8 on the 2^17 encoder at 1 kHz and
+up to 53 on cdw95 (``bench_heldout_chaos.py``); open-loop kinds, the RMS position error in
+encoder counts, ``cnt``; ``-`` when the fitted joint is too stiff to simulate there); and the
+seconds
 per identification scaled to 60 s at 1 kHz (linearly in the samples). The foreign logs in the
 shared data folder (``data/foreign/lugre`` beside the repository, with their ``truth.json``)
 are identified as extra rows, the other kind of the same encoder held out.
