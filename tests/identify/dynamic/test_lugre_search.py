@@ -14,34 +14,21 @@ torque.
 
 from __future__ import annotations
 
-import sys
-import warnings
 from types import SimpleNamespace
 
 import numpy as np
 import pytest
-from tests._paths import REPO
+from _bench_fit import fit_bench_log
 
-from fricid.identify import fit
 from fricid.identify.dynamic._filtered import falling_start, rises
-from fricid.io import read_rawlog
 from fricid.models import lugre
-
-sys.path.insert(0, str(REPO / "benchmarks"))
-import _lugre_truth as lt
 
 
 @pytest.mark.slow
 def test_a_chirp_that_starts_on_a_rising_curve_finds_the_falling_one(tmp_path):
-    truth = lt.TRUTHS["geared"]
-    log = lt.simulate(truth, "chirp_pd", 10.0, 1000.0, 2**20, 11)
-    raw = read_rawlog(lt.write_log(log, tmp_path / "chirp.csv", truth, {}))
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        fitted = fit(raw, "lugre", seed=11)
+    fitted, values = fit_bench_log("geared", "chirp_pd", 1000.0, 2**20, 11, tmp_path)
     p = fitted.parameters
     assert p["tau_s"].value > p["tau_c"].value
-    values = truth.fricid_names()
     for name in ("sigma_2", "tau_c"):  # the levels the rising curve had swapped
         low, high = p[name].ci95
         assert not p[name].not_determined and low <= values[name] <= high, (name, p[name])
@@ -85,14 +72,8 @@ def test_a_search_crawling_along_an_unresolved_rise_is_carried_on_to_a_certifica
     """Open-loop torque steps of the geared joint at 200 Hz through 2^17 counts/rev (seed 12):
     with three rounds of the certificate's polish the output error ended 0.23 standard errors
     short and every interval was withheld; the claims it makes then hold the truth."""
-    truth = lt.TRUTHS["geared"]
-    log = lt.simulate(truth, "torque_steps", 10.0, 200.0, 2**17, 12)
-    raw = read_rawlog(lt.write_log(log, tmp_path / "steps.csv", truth, {}))
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        fitted = fit(raw, "lugre", seed=12)
+    fitted, values = fit_bench_log("geared", "torque_steps", 200.0, 2**17, 12, tmp_path)
     assert fitted.converged
-    values = truth.fricid_names()
     for name in ("sigma_0", "sigma_2", "tau_c"):
         low, high = fitted.parameters[name].ci95
         assert not fitted.parameters[name].not_determined and low <= values[name] <= high

@@ -429,7 +429,8 @@ def falling_start(start: np.ndarray, names, box: np.ndarray, asym) -> np.ndarray
     lower: ``benchmarks/_lugre_truth.py``'s geared chirp at 1 kHz, 2^20 counts/rev, seed 11,
     filtered residual 0.115 N m there and 0.034 from this start, which the fit then refines to
     within 1 % of the truth's levels. 36 of 108 fits of the report seeds ended rising, those
-    with sigma_2 at 0 among the worst under the drive (2-9 times the noise)."""
+    with sigma_2 at 0 among the worst under the drive (1.5-9 times the noise through an ideal
+    encoder, ``bench_lugre.py``'s ``sim-held``)."""
     a = dict(zip(asym.names, asym.values, strict=True))
     at = {n: i for i, n in enumerate(names)}
     x = np.array(start, dtype=float)
