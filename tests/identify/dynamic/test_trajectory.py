@@ -465,7 +465,12 @@ def test_filtered_route_covers_the_truth_with_noise_and_the_cli_selects_routes(t
     log = tr.simulate_trajectory(tr.multisine(duration=15.0, seed=22), TRUTH, JOINT, seed=22)
     fitted = fit_trajectory(log, "lugre")
     hits = covered(fitted, TRUTH.params())
-    assert not any(p.low_open or p.high_open for p in fitted.parameters.values())
+    # sigma_1's calibrated widening (x4.43 on a log scale, _outcome.CALIBRATED_WIDENING) takes
+    # its interval over the whole box here: reported not determined, no claim
+    sigma_1 = fitted.parameters["sigma_1"]
+    assert sigma_1.not_determined and sigma_1.low_open and sigma_1.high_open
+    others = (p for n, p in fitted.parameters.items() if n != "sigma_1")
+    assert not any(p.low_open or p.high_open for p in others)
     assert sum(hits.values()) >= 6, hits  # 7 intervals of 95 %: at most one miss
     from fricid.io.tables import write_rawlog
 

@@ -122,15 +122,13 @@ def test_break_away_below_the_resolution_is_not_claimed(tmp_path):
 def test_short_search_settles_and_intervals_are_given(tmp_path):
     """geared, PD-tracked chirp at 200 Hz through 2^17 counts/rev: the output-error search
     stopped 1.97 standard errors short and every interval was withheld; now certified, and
-    the intervals cover the truth."""
+    the intervals cover the truth (five claims since sigma_1's calibrated widening takes it
+    over most of its box, reported not determined; every claim holds)."""
     fitted, truth = fit_bench_log("geared", "chirp_pd", 200.0, 2**17, 0, tmp_path)
     assert fitted.converged
-    covered = [
-        n
-        for n, p in fitted.parameters.items()
-        if not p.not_determined and p.ci95[0] <= truth[n] <= p.ci95[1]
-    ]
-    assert len(covered) >= 6
+    claims = {n: p for n, p in fitted.parameters.items() if not p.not_determined}
+    missed = [n for n, p in claims.items() if not p.ci95[0] <= truth[n] <= p.ci95[1]]
+    assert len(claims) >= 5 and not missed, (sorted(claims), missed)
 
 
 @pytest.mark.slow  # about 2 s: a 10 s log at 200 Hz identified
