@@ -23,6 +23,7 @@ import dataclasses
 import numpy as np
 
 import _lugre_truth as lt
+from bench_lugre import IDEAL_CPR
 
 #: Parameters moved, by their relative change.
 MOVES = (
@@ -33,8 +34,6 @@ MOVES = (
     ("Fc", 3e-3),
     ("sigma2", 3e-3),
 )
-
-IDEAL_CPR = 2**40
 
 
 def ratios(truth: lt.Truth, kind: str, duration: float, rate: float, cpr: int, seed: int):

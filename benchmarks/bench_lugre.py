@@ -289,7 +289,7 @@ def heldout(result: dict, truth: dict, log, noise: float) -> dict:
 IDEAL_CPR = 2**40
 
 
-def simulated_heldout(result: dict, truth: lt.Truth, setting: tuple) -> dict:
+def simulated_heldout(result: dict, truth: lt.Truth, setting: tuple, held=None) -> dict:
     """The fitted joint under the held-out log's drive plan (the independent simulator).
 
     Closed loop (``_pd`` kinds), two numbers over the noise: ``torque_over_noise``, the RMS of
@@ -299,10 +299,12 @@ def simulated_heldout(result: dict, truth: lt.Truth, setting: tuple) -> dict:
     the truth driven through an ideal encoder (:data:`IDEAL_CPR`), the RMS of their applied
     torques' difference plus the log's noise (1 for the truth, continuous in the parameters:
     the model's error under the drive). Open loop, the RMS position error in encoder counts.
+    ``held``: the held-out log as :func:`_lugre_truth.simulate` gave it (simulated again when
+    not given).
     """
     kind, duration, rate, cpr, seed = setting
     values = {n: r["value"] for n, r in result["estimates"].items()}
-    held = lt.simulate(truth, kind, duration, rate, cpr, seed)
+    held = held or lt.simulate(truth, kind, duration, rate, cpr, seed)
     try:
         plant = lt.from_fricid(values)
         sim = lt.simulate(truth, kind, duration, rate, cpr, seed, plant=plant, max_steps=4000)
@@ -344,6 +346,7 @@ def task(args: tuple) -> dict:
             log = lt.simulate(truth, kind, duration, rate, cpr, s)
             meta = {"kind": kind, "rate_hz": rate, "counts_per_rev": cpr, "seed": s}
             paths.append(lt.write_log(log, Path(tmp) / f"{kind}_{s}.csv", truth, meta))
+        held_log = log  # the last: seed + 1000
         fit_log, held = _read(paths[0]), _read(paths[1])
     out = {"truth": truth_name, "kind": kind, "rate": rate, "cpr": cpr, "seed": seed}
     out["n"] = int(fit_log.time.size)
@@ -351,7 +354,7 @@ def task(args: tuple) -> dict:
     if "estimates" in out and out["route"] != "presliding":  # J, gravity: not determined
         out["heldout"] = heldout(out, truth.fricid_names(), held, truth.noise)
         out["heldout"]["simulated"] = simulated_heldout(
-            out, truth, (kind, duration, rate, cpr, seed + 1000)
+            out, truth, (kind, duration, rate, cpr, seed + 1000), held_log
         )
     return out
 

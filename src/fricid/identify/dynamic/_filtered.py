@@ -405,8 +405,8 @@ def dahl_start(stage1, static_tab):
 def _directions(names) -> list[tuple[str, str, str]]:
     """The (sigma_2, tau_c, tau_s) names of each direction of a LuGre law's ``names``."""
     if "tau_c" in names:
-        return [("sigma_2", "tau_c", "tau_s")]
-    return [(f"sigma_2_{d}", f"tau_c_{d}", f"tau_s_{d}") for d in ("pos", "neg")]
+        return [lugre.PER_DIRECTION]
+    return [tuple(f"{n}_{d}" for n in lugre.PER_DIRECTION) for d in ("pos", "neg")]
 
 
 def rises(names, values) -> bool:
