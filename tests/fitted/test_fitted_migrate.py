@@ -1,7 +1,11 @@
 """Model files of schema version 1 (``fricid.fitted._migrate``): files an earlier fricid wrote
-load, predict the same numbers bit for bit, print the same fit report, exports, parameter
-table, fleet row and trust lists as that fricid did (``tests/data/model_files_v1``), and save
-again in the current layout."""
+load, predict the same numbers, print the same fit report, exports, parameter table, fleet
+row and trust lists as that fricid did (``tests/data/model_files_v1``), and save again in the
+current layout.
+
+The same numbers to :data:`REL`: not bit for bit, since numpy's vector kernels (exp, tanh,
+sums) round the last bit differently on different processors (AVX-512 or AVX2), and the
+predictions and a LuGre export's numbers came out 4e-14 apart on the next machine."""
 
 from __future__ import annotations
 
@@ -109,6 +113,35 @@ def as_before(fitted) -> str:
     return "\n".join(ln for ln in lines if ln not in added + legend)
 
 
+#: How near a number must be to the one that fricid printed or predicted: a relative error,
+#: and in a text an absolute one for numbers that are rounding (a projection's rms error of
+#: 1.05e-16 printed 1.09e-16 with numpy's plain kernels).
+REL, TINY = 1e-12, 1e-12
+
+_NUMBER = re.compile(r"[-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?")
+
+
+def same_text(a: str, b: str) -> bool:
+    """``a`` and ``b`` alike but for the last bits of their numbers (:data:`REL`)."""
+    if _NUMBER.split(a) != _NUMBER.split(b):
+        return False
+    pairs = zip(_NUMBER.findall(a), _NUMBER.findall(b), strict=True)  # as many: same split
+    return all(math.isclose(float(u), float(v), rel_tol=REL, abs_tol=TINY) for u, v in pairs)
+
+
+_ROUNDING_MAX = re.compile(r"max (\S+) N m at velocity \S+ rad/s")
+
+
+def _at_rounding(text: str) -> str:
+    """``text`` without the place of a maximum error that is rounding (an exact projection's:
+    the processor's last bits choose it)."""
+
+    def drop(m: re.Match) -> str:
+        return f"max {m[1]} N m" if abs(float(m[1])) < TINY else m[0]
+
+    return _ROUNDING_MAX.sub(drop, text)
+
+
 def same(a, b) -> bool:
     both_nan = isinstance(a, float) and isinstance(b, float) and math.isnan(a) and math.isnan(b)
     return both_nan or a == b
@@ -119,9 +152,12 @@ def test_version_1_files_predict_and_print_as_before(family):
     expected, path = EXPECTED[family], V1_FILES / f"{family}.json"
     fitted = load(family)
     y = quiet(fitted.predict, np.array(expected["X"]))
-    assert np.array_equal(y, np.array(expected["y"]))  # bit for bit
-    assert as_before(fitted) == expected["report"]
-    assert exports_as_before(fitted, path) == expected["exports"]
+    np.testing.assert_allclose(y, np.array(expected["y"]), rtol=REL, atol=0)
+    assert same_text(as_before(fitted), expected["report"])
+    exported = exports_as_before(fitted, path)
+    assert exported.keys() == expected["exports"].keys()
+    for target, text in exported.items():
+        assert same_text(_at_rounding(text), _at_rounding(expected["exports"][target])), target
     table = parameter_table(fitted).to_csv(index=False) if fitted.parameters else ""
     assert table == expected["parameter_table"]
     spec = JointSpec(robot="r", joint="j", log=Path("/nonexistent/log.csv"), log_text="log.csv")
