@@ -158,7 +158,7 @@ from ...fitted import FittedModel
 from ...models import get_model, lugre
 from ...samples import RawLog, check_trajectory_log
 from ._data import DerivativeFilter, check_dissipates, guarded_sliding, sliding, uniform_series
-from ._direction import direction_caveat, per_direction
+from ._direction import direction_caveat, per_direction, start_levels
 from ._filtered import (
     ParallelFilter,
     best_start,
@@ -453,7 +453,9 @@ def fit_trajectory(
             rest = (gravity, method, seed, max_evals, cluster_time, n_sub, parallel)
             return filtered_route(series, x0, box, *rest, log.source, law=law)
 
-        levels = asym if key in LUGRE_LAWS else None
+        levels = None
+        if key in LUGRE_LAWS:  # a falling start's levels (._direction.start_levels)
+            levels = start_levels(series, derivative, vf, acc, mask, args, asym)
         stage, y, r = best_start(search, start, law.names, box, levels)
         yhat = y - r
         stages["filtered"] = stage
