@@ -58,13 +58,13 @@ __all__ = [
 #: 350 times; on no one else's.
 LUGRE_COVERAGE = {
     "kinds": {
-        "PD-tracked chirps": (245, 250),
+        "PD-tracked chirps": (244, 249),
         "PD-tracked trapezoids": (219, 233),
-        "open-loop torque steps": (204, 225),
+        "open-loop torque steps": (203, 224),
     },
     "parameters": {
         "sigma_0": (94, 102),
-        "sigma_1": (37, 37),
+        "sigma_1": (35, 35),
         "sigma_2": (102, 108),
         "tau_c": (103, 105),
         "tau_s": (12, 13),
