@@ -440,6 +440,7 @@ def test_steady_sliding_torque_is_the_law_at_the_sampled_velocity(tmp_path):
     assert errors[0] / errors[1] > 3.0  # second order, not first
 
 
+@pytest.mark.slow  # 7 s under the default run's load
 def test_a_light_arm_chattering_at_a_coarse_step_is_warned_of():
     """The double pendulum's light joints overshoot zero velocity at every friction step of
     0.5 ms (the linearised smoothed sign is flat away from zero): their true velocity flips

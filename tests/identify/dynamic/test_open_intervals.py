@@ -20,6 +20,7 @@ import warnings
 from types import SimpleNamespace
 
 import numpy as np
+import pytest
 from tests._paths import REPO
 
 from fricid.export._common import summary_lines
@@ -33,6 +34,7 @@ sys.path.insert(0, str(REPO / "benchmarks"))
 import _lugre_truth as lt
 
 
+@pytest.mark.slow  # 19 s under the default run's load: a LuGre fit with its checks
 def test_an_interval_open_at_one_end_leaves_a_dynamic_parameter_not_determined(tmp_path):
     truth = lt.TRUTHS["cdw95"]
     log = lt.simulate(truth, "trapezoid_pd", 10.0, 1000.0, 2**20, 0)

@@ -46,6 +46,7 @@ def test_coulomb_viscous_per_direction_from_a_trajectory():
         assert joint[name]["ci95_low"] <= truth <= joint[name]["ci95_high"], (name, joint[name])
 
 
+@pytest.mark.slow  # 7 s under the default run's load
 def test_stribeck_per_direction_keeps_every_value_in_its_box_and_interval():
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")

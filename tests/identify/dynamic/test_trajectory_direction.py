@@ -135,6 +135,7 @@ def test_no_false_alarm_on_another_simulators_symmetric_joint(name):
     assert not any("by direction" in c for c in caveats), caveats
 
 
+@pytest.mark.slow  # 11 s under the default run's load: two LuGre fits
 def test_the_mirrored_log_swaps_the_levels(tmp_path):
     """Mirroring the joint (q, v, torque -> -q, -v, -torque) swaps the directions: the
     per-direction levels come out swapped, the difference of opposite sign, the same test."""

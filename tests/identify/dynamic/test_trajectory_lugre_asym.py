@@ -64,6 +64,7 @@ def covers(fitted: FittedModel, truth: dict[str, float], names) -> dict[str, boo
     return out
 
 
+@pytest.mark.slow  # 13 s under the default run's load: a lugre_asym fit with its checks
 def test_a_joint_weaker_backwards_gets_both_levels_and_its_gravity(tmp_path):
     """The log on which the symmetric fit's p_x missed (geared joint, 30 % weaker backwards,
     PD-tracked 0.3 rad chirp, seed 3): each level and the gravity within their intervals,

@@ -90,6 +90,7 @@ def test_a_fast_small_oscillation_keeps_its_samples(seed):
     assert abs(got["f_c"][0] / TRUTH["f_c"] - 1) < 0.02
 
 
+@pytest.mark.slow  # 6 s under the default run's load
 def test_stribeck_without_a_rise_keeps_every_interval_around_its_value():
     """A correction is not applied where the interval reaches the search box: a delta with a
     standard error of 25 in [0.2, 4] had been moved to the far bound, its interval [0.2,
