@@ -105,10 +105,8 @@ EXTRA_TRUTHS = {
     "damped": Truth("damped", 0.05, 2.0, 0.3, 1e4, 50.0, 0.1, 0.8, 1.0, 0.05, 2.0, 0.02),
 }
 
-
-def truth_named(name: str) -> Truth:
-    """A truth of :data:`TRUTHS` or :data:`EXTRA_TRUTHS` by its name."""
-    return {**TRUTHS, **EXTRA_TRUTHS}[name]
+#: Every truth by its name, those of the default grid and those run only when named.
+ALL_TRUTHS = {**TRUTHS, **EXTRA_TRUTHS}
 
 
 @njit(cache=True)

@@ -329,17 +329,17 @@ def simulated_heldout(result: dict, truth: lt.Truth, setting: tuple, held=None) 
 
 def resimulate(row: dict) -> dict:
     """``row`` (a saved run's) with :func:`simulated_heldout` computed again (``--resimulate``)."""
-    if "heldout" in row and row["truth"] in {**lt.TRUTHS, **lt.EXTRA_TRUTHS}:
+    if "heldout" in row and row["truth"] in lt.ALL_TRUTHS:
         duration = row["n"] / row["rate"]
         setting = (row["kind"], duration, row["rate"], row["cpr"], row["seed"] + 1000)
-        row["heldout"]["simulated"] = simulated_heldout(row, lt.truth_named(row["truth"]), setting)
+        row["heldout"]["simulated"] = simulated_heldout(row, lt.ALL_TRUTHS[row["truth"]], setting)
     return row
 
 
 def task(args: tuple) -> dict:
     """One identification: simulate, write, read, fit, hold out."""
     truth_name, kind, rate, cpr, seed, duration, max_evals, output_error = args
-    truth = lt.truth_named(truth_name)
+    truth = lt.ALL_TRUTHS[truth_name]
     with tempfile.TemporaryDirectory() as tmp:
         paths = []
         for s in (seed, seed + 1000):
@@ -384,7 +384,7 @@ def foreign_tasks(max_evals: int | None, output_error: str = "auto") -> list[dic
 
 
 def _truth_of(row: dict) -> dict:
-    return row.get("truth_values") or lt.truth_named(row["truth"]).fricid_names()
+    return row.get("truth_values") or lt.ALL_TRUTHS[row["truth"]].fricid_names()
 
 
 def _error(row: dict, n: str) -> float:

@@ -58,7 +58,7 @@ def main() -> None:
             super().__init__(traced, *args, **kwargs)
 
     output.ResidualProblem = Traced
-    truth = lt.truth_named(a.truth)
+    truth = lt.ALL_TRUTHS[a.truth]
     log = lt.simulate(truth, a.kind, a.duration, a.rate, a.cpr, a.seed)
     marks: list[tuple[float, str]] = []
     with tempfile.TemporaryDirectory() as tmp:

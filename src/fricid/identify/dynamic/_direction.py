@@ -178,6 +178,11 @@ def per_direction(series: Series, filt: DerivativeFilter, vf, acc, mask, args: t
         beyond = v["w_s"] * np.log(1.0 / RISE_LEFT) ** (1.0 / max(v["delta"], 1e-3))
         fast = mask & (np.abs(vf) >= beyond)
         mask = fast if fast.sum() >= MIN_BEYOND_RISE else mask
+    return _levels(series, filt, vf, acc, mask, args)
+
+
+def _levels(series: Series, filt: DerivativeFilter, vf, acc, mask, args: tuple):
+    """The ``coulomb_viscous_asym`` regression on the samples ``mask``, corrected."""
     model = get_model("coulomb_viscous_asym")
     stage = _regression(series, vf, acc, mask, model, *args[1:-1], None)[0]
     return corrected(stage, predicted_bias(series, filt, stage, mask, model))
@@ -199,6 +204,4 @@ def start_levels(series: Series, filt: DerivativeFilter, vf, acc, mask, args: tu
     rows = asym.table()
     if all(rows[f"f_c_{d}"]["ci95_low"] > 0 for d in ("pos", "neg")):
         return asym
-    model = get_model("coulomb_viscous_asym")
-    stage = _regression(series, vf, acc, mask, model, *args[1:-1], None)[0]
-    return corrected(stage, predicted_bias(series, filt, stage, mask, model))
+    return _levels(series, filt, vf, acc, mask, args)
