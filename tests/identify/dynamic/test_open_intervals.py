@@ -73,8 +73,12 @@ def test_levels_near_zero_are_given_in_newton_metres():
     def stage(se):
         return SimpleNamespace(names=["p_x"], stderr=np.array([se]), values=np.array([0.01]))
 
-    text = _gravity_by_symmetry(stage(1.0), stage(0.01), 1e-15, 2.7, 1e-17)
+    text = _gravity_by_symmetry(stage(1.0), stage(0.01), 1e-15, 2.7, 1e-17, True)
     assert "+/- 5.3 N m against their mean 5e-18 N m" in text
     assert "% of their mean" not in text  # no share of a mean near zero
-    share = _gravity_by_symmetry(stage(1.0), stage(0.01), 0.1, 0.3, 2.0)
+    # levels the regression did not determine: no mean at all (test_trajectory_direction.py)
+    text = _gravity_by_symmetry(stage(1.0), stage(0.01), 1e-15, 2.7, 1e-17, False)
+    assert "+/- 5.3 N m, the levels themselves not determined" in text
+    assert "mean" not in text
+    share = _gravity_by_symmetry(stage(1.0), stage(0.01), 0.1, 0.3, 2.0, True)
     assert "+/- 59 % of their mean" in share

@@ -163,3 +163,48 @@ def test_the_mirrored_log_swaps_the_levels(tmp_path):
     assert texts[1].startswith("the friction differs by direction")
     (a, b), (c, d) = ((float(x), float(y)) for x, y in levels)
     assert a > b and c == pytest.approx(b, rel=1e-3) and d == pytest.approx(a, rel=1e-3)
+
+
+def _stage(values: dict[str, float], stderr: dict[str, float]):
+    """A regression's estimate (:class:`fricid.identify.dynamic._routes._Stage`) with
+    independent parameters of the given standard errors."""
+    import numpy as np
+
+    from fricid.identify.dynamic._routes import _Stage
+
+    names = list(values)
+    v = np.array([values[n] for n in names])
+    s = np.array([stderr[n] for n in names])
+    return _Stage(names, v, s, v - 1.96 * s, v + 1.96 * s, np.diag(s**2), None, 0.0, 20, {}, None)
+
+
+def test_the_gravity_note_does_not_quote_levels_the_regression_left_undetermined():
+    """Beyond a Stribeck rise a trapezoid slides at its plateaus' speeds only, where the
+    Coulomb levels and the viscous terms are one number each: the cdw95 trapezoid (1 kHz, 2^20
+    counts/rev, seed 0) put both levels at 3.4e-13 N m with a standard error of 2.7, and the
+    note read "its 95 % interval +/- 5.2 N m against their mean 3.4e-13 N m". The note holds
+    (the gravity rests on the symmetry), without a mean that means nothing."""
+    from fricid.identify.dynamic._direction import direction_caveat
+
+    se = {"f_c_pos": 1.9, "beta_pos": 0.5, "f_c_neg": 1.9, "beta_neg": 0.5, "p_x": 0.094}
+    asym = _stage(
+        {"f_c_pos": 3.4e-13, "beta_pos": 1.4, "f_c_neg": 3.4e-13, "beta_neg": 1.4, "p_x": -0.04},
+        se,
+    )
+    symmetric = _stage(
+        {"f_c": 1.1, "beta": 0.3, "p_x": -0.04}, {"f_c": 0.01, "beta": 0.01, "p_x": 0.0041}
+    )
+    caveat, note = direction_caveat(asym, "lugre", symmetric)
+    assert caveat == ""
+    assert "does not tell the gravity" in note and "p_x -0.04 +/- 0.094" in note
+    assert "e-13" not in note and "mean" not in note, note
+    assert "too few speeds" in note, note
+    assert "difference is 0 N m with a standard error of 1.9" not in note  # 2.7 = 1.9 sqrt 2
+    assert "difference is 0 N m with a standard error of 2.7" in note, note
+    # where the levels are determined, their mean is the yardstick the note gives
+    se = {**se, "f_c_pos": 0.2, "f_c_neg": 0.2}
+    asym = _stage(
+        {"f_c_pos": 1.0, "beta_pos": 0.4, "f_c_neg": 1.05, "beta_neg": 0.4, "p_x": -0.04}, se
+    )
+    _, note = direction_caveat(asym, "lugre", symmetric)
+    assert "its 95 % interval +/- 54 % of their mean" in note, note

@@ -100,7 +100,7 @@ def direction_caveat(asym, law: str = "coulomb_viscous", symmetric=None) -> tupl
     c_pos, v_pos, c_neg, v_neg = (float(asym.values[j]) for j in i)
     se_c, se_v = (math.sqrt(C[k, k]) for k in (0, 1))
     advice = _DIRECTION_ADVICE.get(law, _DIRECTION_ADVICE["coulomb_viscous"])
-    note = _gravity_by_symmetry(asym, symmetric, d[0], se_c, c_pos + c_neg)
+    note = _gravity_by_symmetry(asym, symmetric, d[0], se_c, c_pos + c_neg, splits_levels(asym))
     if p <= DIRECTION_P:
         return (
             f"the friction differs by direction (p {'< 1e-12' if p < 1e-12 else f'= {p:.2g}'}; "
@@ -114,9 +114,13 @@ def direction_caveat(asym, law: str = "coulomb_viscous", symmetric=None) -> tupl
     return "", note
 
 
-def _gravity_by_symmetry(asym, symmetric, diff: float, diff_se: float, levels: float) -> str:
+def _gravity_by_symmetry(
+    asym, symmetric, diff: float, diff_se: float, levels: float, split: bool
+) -> str:
     """The 'cannot tell' part of :func:`direction_caveat` (``levels``: the Coulomb levels'
-    sum)."""
+    sum; ``split``: whether ``asym`` determines them, :func:`splits_levels`; where it does
+    not, their mean is no yardstick and the note says why instead: the cdw95 trapezoid of
+    :func:`start_levels` read "+/- 5.2 N m against their mean 3.4e-13 N m")."""
     open_share = 1.96 * diff_se / max(0.5 * abs(levels), 1e-300)
     if symmetric is None or not open_share > DIRECTION_OPEN:
         return ""
@@ -135,19 +139,32 @@ def _gravity_by_symmetry(asym, symmetric, diff: float, diff_se: float, levels: f
     if not parts:
         return ""
     mean = 0.5 * abs(levels)
-    share = (  # a share of 1e17 % says nothing: levels near zero are given as they are
-        f"+/- {100 * open_share:.0f} % of their mean"
-        if open_share <= 10.0
-        else f"+/- {1.96 * diff_se:.2g} N m against their mean {mean:.2g} N m"
-    )
+    if not split:
+        share = (
+            f"+/- {1.96 * diff_se:.2g} N m, the levels themselves not determined: the samples "
+            "slide at too few speeds to tell a Coulomb level from a viscous term"
+        )
+    elif open_share <= 10.0:
+        share = f"+/- {100 * open_share:.0f} % of their mean"
+    else:  # a share of 1e17 % says nothing: levels near zero are given as they are
+        share = f"+/- {1.96 * diff_se:.2g} N m against their mean {mean:.2g} N m"
     return (
         "the log does not tell the gravity from a difference of the friction by direction "
-        f"(the Coulomb levels' difference is {diff:.3g} N m with a standard error of "
+        f"(the Coulomb levels' difference is {_to_its_error(diff, diff_se):.3g} N m with a "
+        "standard error of "
         f"{diff_se:.2g}, its 95 % interval {share}; half of "
         "a difference is a constant torque the gravity takes up): the gravity rests on the "
         "friction being the same both ways (the regression on the same samples gives "
         f"{'; '.join(parts)}); a motion over more of the joint's range tells them apart"
     )
+
+
+def _to_its_error(value: float, stderr: float) -> float:
+    """``value`` rounded to two significant digits of its standard error (a difference of
+    6.9e-13 N m with a standard error of 2.7 is 0)."""
+    if not (math.isfinite(value) and math.isfinite(stderr) and stderr > 0):
+        return value
+    return round(value, 1 - math.floor(math.log10(stderr))) + 0.0
 
 
 #: Where a Stribeck law's rise is below this share of its height, the per-direction test
@@ -201,7 +218,13 @@ def start_levels(series: Series, filt: DerivativeFilter, vf, acc, mask, args: tu
     rising valley it was to test (0.44 against 0.052 N m). Every sliding sample, the ramps'
     too, gives 1.12 and 0.28, from where the search finds tau_c 0.998 and sigma_2 0.402
     (0.018 N m)."""
-    rows = asym.table()
-    if all(rows[f"f_c_{d}"]["ci95_low"] > 0 for d in ("pos", "neg")):
+    if splits_levels(asym):
         return asym
     return _levels(series, filt, vf, acc, mask, args)
+
+
+def splits_levels(asym) -> bool:
+    """Whether the ``coulomb_viscous_asym`` regression ``asym`` determines both Coulomb
+    levels (each 95 % interval above 0) rather than trading them for the viscous terms."""
+    rows = asym.table()
+    return all(rows[f"f_c_{d}"]["ci95_low"] > 0 for d in ("pos", "neg"))
