@@ -12,7 +12,7 @@ from _bench_fit import fit_bench_log
 from tests._paths import REPO
 
 from fricid.fitted import Parameter
-from fricid.identify.dynamic._outcome import LUGRE_COVERAGE
+from fricid.identify.dynamic._outcome import LUGRE_COVERAGE, lugre_caveat
 from fricid.identify.dynamic._result import unresolved_rise
 from fricid.identify.problem import ResidualProblem
 from fricid.identify.static.convergence import certify, settle
@@ -154,10 +154,14 @@ def _last_block(lines: list[str], title: str) -> dict[str, list[str]]:
     return rows
 
 
-def test_the_quoted_coverage_is_the_benchmarks_last_result():
-    """The caveat's numbers (``LUGRE_COVERAGE``) are the last report block of
-    ``benchmarks/results/lugre_claims.txt``, not typed apart from it."""
-    lines = (REPO / "benchmarks" / "results" / "lugre_claims.txt").read_text().splitlines()
+def test_the_quoted_coverage_is_the_ten_seed_report():
+    """The caveat's numbers (``LUGRE_COVERAGE``) are the report block of
+    ``benchmarks/results/lugre_report10.txt`` (seeds 10-19), not typed apart from it: per
+    kind, per parameter, and every kind's parameter below the goal."""
+    from fricid.identify.dynamic._outcome import COVERAGE_GOAL
+
+    text = (REPO / "benchmarks" / "results" / "lugre_report10.txt").read_text()
+    lines = text.splitlines()
     kinds = _last_block(lines, "## per kind")
     names = {"PD-tracked chirps": "chirp_pd", "PD-tracked trapezoids": "trapezoid_pd"}
     names["open-loop torque steps"] = "torque_steps"
@@ -171,6 +175,17 @@ def test_the_quoted_coverage_is_the_benchmarks_last_result():
     for name, (covered, claimed) in LUGRE_COVERAGE["parameters"].items():
         cells = [row[columns[name]].split("+")[0].split("/") for row in per.values()]
         assert (sum(int(c) for c, _ in cells), sum(int(n) for _, n in cells)) == (covered, claimed)
+    short = []
+    for label, kind in names.items():
+        for name in order:
+            c, n = map(int, per[kind][columns[name]].split("+")[0].split("/"))
+            if n and c < COVERAGE_GOAL * n:
+                short.append((label, name, c, n))
+    assert sorted(LUGRE_COVERAGE["short"]) == sorted(short)
+    caveat = lugre_caveat()
+    assert "sigma_0 on PD-tracked trapezoids 100 of 115 (87 %)" in caveat, caveat
+    assert "w_s on open-loop torque steps 0 of 1," in caveat  # no share of one claim
+    assert "0 of 1 (0 %)" not in caveat
 
 
 def test_the_per_direction_coverage_is_the_direction_benchmarks_last_result():
