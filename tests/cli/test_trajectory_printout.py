@@ -64,7 +64,7 @@ def test_an_ordinary_rate_bias_stays_relative_and_the_box_edge_is_inside():
     assert "passive (margin 1.39 N m s/rad; across the 95 % intervals: not guaranteed)" in text
 
 
-def test_an_undetermined_parameter_gets_no_bias_and_passivity_says_what_it_rests_on():
+def test_an_undetermined_parameter_gets_no_corrected_value_and_passivity_says_what_it_rests_on():
     """sigma_1 at the search box's edge, flagged not determined: no corrected value is
     offered for it, and the passivity line says it rests on it (a new user's trial found
     both printed as if sigma_1 were known)."""
@@ -79,7 +79,24 @@ def test_an_undetermined_parameter_gets_no_bias_and_passivity_says_what_it_rests
     fitted.parameters["sigma_1"] = dataclasses.replace(par, not_determined=True)
     text = trajectory_text(fitted)
     line = next(x for x in text.splitlines() if "rate bias" in x)
-    assert "sigma_1 not determined: no bias or corrected value to give" in line
+    # the move is given, as the rate-bias warning gives it (a new user read the two as
+    # contradicting each other), but no corrected value
+    assert "sigma_1 not determined (the simulation at the estimate moved it +58 %; " in line
+    assert "no corrected value to give)" in line and "corrected 0.00158" not in line
     assert "sigma_0 -2.1 % (corrected 1.216e+04)" in line
     line = next(x for x in text.splitlines() if "passivity" in x)
     assert line.endswith("(it rests on sigma_1, not determined)")
+
+
+def test_the_joints_parameters_carry_their_units():
+    """A new user read "inertia: 0.0201348 +/- 0.00018" without a unit."""
+    fitted = fitted_with(
+        {"skipped": "off"}, {"margin": 1.0, "passive": True, "condition": CONDITION}
+    )
+    fitted.provenance["trajectory"]["joint"] = {
+        n: {"value": v, "stderr": 0.1, "ci95_low": v - 0.2, "ci95_high": v + 0.2}
+        for n, v in (("inertia", 0.02), ("p_x", -0.5), ("p_y", 1.5))
+    }
+    text = trajectory_text(fitted)
+    assert "    inertia: 0.02 kg m^2 +/- 0.1 (95 % CI [-0.18, 0.22])" in text
+    assert "    p_x: -0.5 N m +/- 0.1" in text and "    p_y: 1.5 N m +/- 0.1" in text

@@ -96,7 +96,10 @@ def trajectory_text(fitted) -> str:
     conv = fitted.convergence or {}
     why = "the fit did not converge" if conv and not conv.get("converged") else "not determined"
     for name, row in info.get("joint", {}).items():
-        lines.append(f"    {name}: {row['value']:.6g} {_interval(row, why)}")
+        unit = _JOINT_UNITS.get(name, "")
+        lines.append(
+            f"    {name}: {row['value']:.6g} {unit + ' ' if unit else ''}{_interval(row, why)}"
+        )
     if info.get("gravity_note"):
         lines.append(f"    gravity: {info['gravity_note']}")
     for name, route in info.get("routes", {}).items():
@@ -114,7 +117,7 @@ def trajectory_text(fitted) -> str:
             f"    rate bias at {rb['log_rate']:.6g} Hz (simulated at the estimate, "
             f"{rb['internal_rate']:.6g} Hz inside; not applied): "
             + ", ".join(
-                f"{n} not determined: no bias or corrected value to give"
+                _undetermined_bias(n, rb[n])
                 if n in undetermined
                 else _rate_bias(n, rb[n], fitted.params.get(n))
                 for n in ("sigma_0", "sigma_1")
@@ -200,6 +203,9 @@ def _interval(row: dict, why: str) -> str:
     return f"+/- {se:.2g} (95 % CI [{low:.5g}, {high:.5g}])"
 
 
+#: Units of the joint's parameters fitted beside the law.
+_JOINT_UNITS = {"inertia": "kg m^2", "p_x": "N m", "p_y": "N m"}
+
 #: Units of the parameters whose rate bias is estimated.
 _BIAS_UNITS = {"sigma_0": "N m/rad", "sigma_1": "N m s/rad"}
 
@@ -222,6 +228,21 @@ def _rate_bias(name: str, row: dict, estimate) -> str:
     if not lo * (1 - 1e-9) <= corrected <= hi * (1 + 1e-9):  # the box's edges are inside
         text += f", outside the search box [{lo:.3g}, {hi:.3g}]: not a usable value"
     return text + ")"
+
+
+def _undetermined_bias(name: str, row: dict) -> str:
+    """A parameter not determined: the move the simulation at the estimate found (the rate-bias
+    warning gives it too), without a corrected value (there is no value to correct)."""
+    rel = row.get("relative")
+    if rel is None or not math.isfinite(rel):
+        return f"{name} not determined: no bias or corrected value to give"
+    moved = (
+        f"{100 * rel:+.2g} %" if abs(rel) < 1.0 else f"by a factor {10.0 ** row['log10_bias']:.3g}"
+    )
+    return (
+        f"{name} not determined (the simulation at the estimate moved it {moved}; no corrected "
+        "value to give)"
+    )
 
 
 def _passivity(p: dict) -> str:
