@@ -190,3 +190,16 @@ def test_cli_prints_the_recommendation(tmp_path, mujoco):
     # MuJoCo's soft frictionloss creeps: its break-away is far below the friction, said so
     assert "soft constraint that creeps" in notes
     assert "<option " in res.stdout
+
+
+def test_the_creep_line_names_the_level_it_measures_against():
+    """A static law's MJCF has one level, its frictionloss (the Coulomb level): a new user read
+    "off the model's static friction 0.002852 N m" for a Stribeck law breaking away at 0.00365."""
+    common = dict(integrator="implicitfast", timestep=None, measured=True, inertia=1e-3, span=1.0)
+    static = ms.StepAdvice(**common, reference_breakaway=0.00124, static_level=0.002852)
+    (line,) = [x for x in static.lines() if x.startswith("MuJoCo itself")]
+    assert "-56.5 % off the exported frictionloss (the model's Coulomb level" in line
+    assert "static friction" not in line and "solreffriction" in line
+    lugre = ms.StepAdvice(**common, reference_breakaway=1.5, static_level=1.8, bristles=True)
+    (line,) = [x for x in lugre.lines() if x.startswith("MuJoCo itself")]
+    assert "off the exported LuGre's break-away torque max(tau_c, tau_s) 1.8 N m" in line

@@ -201,9 +201,14 @@ class StepAdvice:
         lines = [head]
         off = self.reference_breakaway / self.static_level - 1.0
         if math.isfinite(off) and abs(off) > BREAKAWAY_TOLERANCE:
+            level = (
+                "the exported LuGre's break-away torque max(tau_c, tau_s)"
+                if self.bristles
+                else "the exported frictionloss (the model's Coulomb level, as MuJoCo takes it)"
+            )
             lines.append(
                 f"MuJoCo itself (the reference) breaks away at {self.reference_breakaway:.4g} "
-                f"N m, {100 * off:+.3g} % off the model's static friction "
+                f"N m, {100 * off:+.3g} % off {level} "
                 f"{self.static_level:.4g} N m, at any timestep"
                 + (
                     ": frictionloss is a soft constraint that creeps below it; a stiffer "
