@@ -247,6 +247,7 @@ def _identify(log, seed: int, max_evals: int | None, output_error: str = "auto")
         "output_error": bool(info.get("output_error", {}).get("applied")),
         "follows": info.get("follows", {}).get("shifts"),
         "starts": info.get("output_error", {}).get("starts_sse"),
+        "rest": (info.get("calibration") or {}).get("rest_share"),
         "converged": bool(fitted.converged),
         "seconds": seconds,
         "warnings": sorted({w.category.__name__ for w in caught}),

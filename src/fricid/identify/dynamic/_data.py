@@ -57,6 +57,7 @@ __all__ = [
     "cluster_covariance",
     "derivatives",
     "low_speed_windows",
+    "rest_share",
     "sliding",
     "torque_noise",
     "uniform_series",
@@ -243,6 +244,32 @@ def runs(mask: np.ndarray) -> list[tuple[int, int]]:
     m = np.concatenate([[False], mask, [False]]).astype(np.int8)
     d = np.diff(m)
     return list(zip(np.flatnonzero(d == 1), np.flatnonzero(d == -1), strict=True))
+
+
+#: :func:`rest_share`: the speed [rad/s] below which the joint rests, the shortest rest [s],
+#: and the Savitzky-Golay window [s] of its velocity (order 3, at least 7 samples).
+REST_SPEED = 0.02
+REST_MIN = 0.1
+REST_WINDOW = 0.021
+
+
+def rest_share(series: Series) -> float:
+    """The share of the log's time the joint rests: stretches of at least :data:`REST_MIN`
+    seconds with the speed below :data:`REST_SPEED`, the velocity a Savitzky-Golay derivative
+    of the position (its own window, :data:`REST_WINDOW`, so that the share does not depend
+    on the fit's derivative settings). It chooses LuGre's calibrated widening
+    (:func:`fricid.identify.dynamic._outcome.widen_calibrated`). On
+    ``benchmarks/_lugre_truth.py``'s 10 s logs: PD-tracked chirps 0-0.08, trapezoids with
+    their dwells 0.37-0.45, open-loop torque steps 0.10-0.92."""
+    from scipy.signal import savgol_filter
+
+    q, dt = np.asarray(series.position, dtype=float), float(series.dt)
+    window = max(round(REST_WINDOW / dt) | 1, 7)
+    if q.size < window:
+        return 0.0
+    v = savgol_filter(q, window, 3, deriv=1, delta=dt)
+    rests = [b - a for a, b in runs(np.abs(v) < REST_SPEED) if (b - a) * dt >= REST_MIN]
+    return float(sum(rests)) / q.size
 
 
 def low_speed_windows(

@@ -35,6 +35,8 @@ __all__ = [
     "LUGRE_COVERAGE",
     "RATE_BIAS",
     "RATE_BIAS_WARN",
+    "RESTING",
+    "RESTING_WIDENING",
     "PassivityWarning",
     "RateBiasWarning",
     "calibrate",
@@ -141,18 +143,48 @@ CALIBRATED_WIDENING = {
     "p_y": 1.28,
 }
 
+#: A log that rests (:func:`fricid.identify.dynamic._data.rest_share`) at least this share of
+#: its time takes :data:`RESTING_WIDENING`.
+RESTING = 0.2
+
+#: The widening of a log that rests (PD-tracked trapezoids with their dwells, most open-loop
+#: torque steps): each factor the larger of :data:`CALIBRATED_WIDENING`'s and the 0.95
+#: quantile over the tuning claims of such logs alone (the tuning seeds 0-5 of
+#: ``benchmarks/bench_lugre.py`` rerun at 878de01's fit code, 128 of the 216 logs resting:
+#: every trapezoid, 56 of 72 torque steps; ``benchmarks/calib_lugre_widening.py --by-rest``,
+#: its table in ``benchmarks/results/lugre_claims.txt``; the Stribeck trio's, on 8 claims or
+#: none, CALIBRATED_WIDENING's). On the report seeds 10-19 the pooled factors had held the
+#: trapezoids' sigma_0 in 100 of 115 claims and sigma_1 in 23 of 29
+#: (``benchmarks/results/lugre_report10.txt``). The chirps (rest shares 0-0.08) and the
+#: moving torque steps (0-0.10) needed less than the pooled factors (sigma_0 1.67, sigma_2
+#: 0.92, the inertia 0.89) and keep them.
+RESTING_WIDENING = {
+    **CALIBRATED_WIDENING,
+    "sigma_0": 2.94,
+    "sigma_1": 5.62,
+    "sigma_2": 1.63,
+    "tau_c": 1.80,
+    "inertia": 1.61,
+    "p_x": 1.37,
+    "p_y": 1.52,
+}
+
 #: The widened parameters whose intervals are formed on a log10 scale.
 LOG_WIDENED = ("sigma_0", "sigma_1")
 
 
-def widen_calibrated(stage) -> dict[str, Any]:
-    """Widen ``stage``'s intervals (in place) by :data:`CALIBRATED_WIDENING`; returns the
-    record for the provenance: the factors and each parameter's interval before. The
+def widen_calibrated(stage, rest: float = 0.0) -> dict[str, Any]:
+    """Widen ``stage``'s intervals (in place) by :data:`CALIBRATED_WIDENING`, or by
+    :data:`RESTING_WIDENING` where the log rests at least :data:`RESTING` of its time
+    (``rest``, :func:`fricid.identify.dynamic._data.rest_share`); returns the record for the
+    provenance: the factors, the rest share, and each parameter's interval before. The
     standard errors are scaled alike, so that the printed +- and interval agree."""
+    resting = rest >= RESTING
+    factors = RESTING_WIDENING if resting else CALIBRATED_WIDENING
     before = {}
     for i, name in enumerate(stage.names):
         base = lugre.symmetric_name(name)  # per direction: as one
-        k = CALIBRATED_WIDENING.get(base)
+        k = factors.get(base)
         lo, hi, v = float(stage.low[i]), float(stage.high[i]), float(stage.values[i])
         if k is None or not all(math.isfinite(x) for x in (lo, hi, v)):
             continue
@@ -166,13 +198,22 @@ def widen_calibrated(stage) -> dict[str, Any]:
         stage.low[i], stage.high[i] = max(lo, box[0]), min(hi, box[1])
         stage.stderr[i] = k * float(stage.stderr[i])
     return {
-        "factors": dict(CALIBRATED_WIDENING),
+        "factors": dict(factors),
+        "rest_share": float(rest),
+        "resting": bool(resting),
         "before": before,
         "how": (
             "each side of the 95 % interval widened about the estimate (log10 scale for "
             "sigma_0 and sigma_1), within the search box, by the factor that held the truth in "
             "95 % of an independent simulator's claims (benchmarks/bench_lugre.py, tuning "
             "seeds 0-5)"
+            + (
+                f"; the log rests {100 * rest:.0f} % of its time, so the factors of logs "
+                f"resting {100 * RESTING:.0f} % or more (the larger of the pooled ones and "
+                "theirs)"
+                if resting
+                else ""
+            )
         ),
     }
 

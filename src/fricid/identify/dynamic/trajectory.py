@@ -157,7 +157,14 @@ from ...errors import ConfigError, DataError
 from ...fitted import FittedModel
 from ...models import get_model, lugre
 from ...samples import RawLog, check_trajectory_log
-from ._data import DerivativeFilter, check_dissipates, guarded_sliding, sliding, uniform_series
+from ._data import (
+    DerivativeFilter,
+    check_dissipates,
+    guarded_sliding,
+    rest_share,
+    sliding,
+    uniform_series,
+)
 from ._direction import direction_caveat, per_direction, start_levels
 from ._filtered import (
     ParallelFilter,
@@ -501,7 +508,7 @@ def fit_trajectory(
             sim_info["follows"] = check
             notes = {**notes, **response_notes(stage, check)}
         if key in LUGRE_LAWS:
-            sim_info["calibration"] = widen_calibrated(stage)
+            sim_info["calibration"] = widen_calibrated(stage, rest_share(series))
             final.update(stage.table())
         sim_info["torque_delay"] = torque_delay(series, stage, parallel, gravity, cluster_time)
         warn_delay(sim_info["torque_delay"])
