@@ -100,3 +100,17 @@ def test_the_joints_parameters_carry_their_units():
     text = trajectory_text(fitted)
     assert "    inertia: 0.02 kg m^2 +/- 0.1 (95 % CI [-0.18, 0.22])" in text
     assert "    p_x: -0.5 N m +/- 0.1" in text and "    p_y: 1.5 N m +/- 0.1" in text
+
+
+def test_the_intervals_line_says_which_widening_the_log_took():
+    fitted = fitted_with(
+        {"skipped": "off"}, {"margin": 1.0, "passive": True, "condition": CONDITION}
+    )
+    fitted.provenance["trajectory"]["calibration"] = {
+        "factors": {"sigma_0": 2.94},
+        "rest_share": 0.43,
+        "resting": True,
+    }
+    line = next(x for x in trajectory_text(fitted).splitlines() if "intervals:" in x)
+    assert "(sigma_0 x2.94; sigma_0 on a log scale; the log rests 43 % of its time: the " in line
+    assert "factors of logs that rest;" in line

@@ -127,9 +127,16 @@ def trajectory_text(fitted) -> str:
     cal = info.get("calibration")
     if isinstance(cal, dict) and cal.get("factors"):
         factors = ", ".join(f"{n} x{k:g}" for n, k in cal["factors"].items())
+        rest = cal.get("rest_share")
+        which = (
+            ""
+            if rest is None
+            else f"; the log rests {100 * rest:.0f} % of its time: the factors of logs that "
+            + ("rest" if cal.get("resting") else "do not")
+        )
         lines.append(
             f"    intervals: calibrated on an independent simulator's logs, each side widened "
-            f"({factors}; sigma_0 on a log scale; before: provenance 'calibration')"
+            f"({factors}; sigma_0 on a log scale{which}; before: provenance 'calibration')"
         )
     p = info.get("passivity")
     if p:
