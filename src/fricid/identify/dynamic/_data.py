@@ -258,7 +258,7 @@ def rest_share(series: Series) -> float:
     seconds with the speed below :data:`REST_SPEED`, the velocity a Savitzky-Golay derivative
     of the position (its own window, :data:`REST_WINDOW`, so that the share does not depend
     on the fit's derivative settings). It chooses LuGre's calibrated widening
-    (:func:`fricid.identify.dynamic._outcome.widen_calibrated`). On
+    (:func:`fricid.identify.dynamic._claims.widen_calibrated`). On
     ``benchmarks/_lugre_truth.py``'s 10 s logs: PD-tracked chirps 0-0.08, trapezoids with
     their dwells 0.37-0.45, open-loop torque steps 0.10-0.92."""
     from scipy.signal import savgol_filter
