@@ -259,8 +259,9 @@ def rest_share(series: Series) -> float:
     of the position (its own window, :data:`REST_WINDOW`, so that the share does not depend
     on the fit's derivative settings). It chooses LuGre's calibrated widening
     (:func:`fricid.identify.dynamic._claims.widen_calibrated`). On
-    ``benchmarks/_lugre_truth.py``'s 10 s logs: PD-tracked chirps 0-0.08, trapezoids with
-    their dwells 0.37-0.45, open-loop torque steps 0.10-0.92."""
+    tuning logs of ``benchmarks/bench_lugre.py`` (seeds 0-5, 10 s, as the fit reads them):
+    PD-tracked chirps 0-0.08, trapezoids with their dwells 0.27-0.59, open-loop torque steps
+    0-0.10 or 0.24-0.76; on the shared foreign logs, another simulator's, trapezoids 0.15."""
     from scipy.signal import savgol_filter
 
     q, dt = np.asarray(series.position, dtype=float), float(series.dt)
