@@ -17,7 +17,7 @@ The product is exact where the widened interval stayed inside the search box; a 
 widened interval reached the box became not determined and is no claim here.
 
 ``--by-rest``: the quantiles for the logs that rest at least
-:data:`fricid.identify.dynamic._claims.RESTING` of their time and for the others apart, each
+:data:`fricid.identify.dynamic._outcome.RESTING` of their time and for the others apart, each
 log's rest share the fit's own (:func:`fricid.identify.dynamic._data.rest_share`; a row that
 does not record it, ``rest``, is simulated again and read as the fit reads it). A run's
 ``FACTORS`` may then be ``resting`` (the factors the fit applied were the current
@@ -74,7 +74,7 @@ def table(title: str, pooled: dict[str, list[float]]) -> None:
 
 
 def main() -> None:
-    from fricid.identify.dynamic._claims import CALIBRATED_WIDENING, RESTING, RESTING_WIDENING
+    from fricid.identify.dynamic._outcome import CALIBRATED_WIDENING, RESTING, RESTING_WIDENING
 
     args = sys.argv[1:]
     by_rest = "--by-rest" in args

@@ -1,6 +1,6 @@
 """LuGre's calibrated widening chooses its factors by how much the log rests
 (:func:`fricid.identify.dynamic._data.rest_share`,
-:func:`fricid.identify.dynamic._claims.widen_calibrated`): on the independent simulator's
+:func:`fricid.identify.dynamic._outcome.widen_calibrated`): on the independent simulator's
 tuning logs the resting ones (trapezoids with dwells, most torque steps) needed wider intervals
 than the pooled factors gave, and the report's trapezoids missed sigma_0 and sigma_1 more
 often than 10 %."""
@@ -16,13 +16,13 @@ import numpy as np
 import pytest
 from tests._paths import REPO
 
-from fricid.identify.dynamic._claims import (
+from fricid.identify.dynamic._data import rest_share, uniform_series
+from fricid.identify.dynamic._outcome import (
     CALIBRATED_WIDENING,
     RESTING,
     RESTING_WIDENING,
     widen_calibrated,
 )
-from fricid.identify.dynamic._data import rest_share, uniform_series
 from fricid.identify.dynamic._routes import _Stage
 from fricid.io import read_rawlog
 from fricid.samples import RawLog

@@ -465,7 +465,7 @@ def test_filtered_route_covers_the_truth_with_noise_and_the_cli_selects_routes(t
     log = tr.simulate_trajectory(tr.multisine(duration=15.0, seed=22), TRUTH, JOINT, seed=22)
     fitted = fit_trajectory(log, "lugre")
     hits = covered(fitted, TRUTH.params())
-    # sigma_1's calibrated widening (x4.43 on a log scale, _claims.CALIBRATED_WIDENING) takes
+    # sigma_1's calibrated widening (x4.43 on a log scale, _outcome.CALIBRATED_WIDENING) takes
     # its interval over the whole box here: reported not determined, no claim
     sigma_1 = fitted.parameters["sigma_1"]
     assert sigma_1.not_determined and sigma_1.low_open and sigma_1.high_open

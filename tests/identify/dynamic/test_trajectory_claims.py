@@ -12,7 +12,7 @@ from _bench_fit import fit_bench_log
 from tests._paths import REPO
 
 from fricid.fitted import Parameter
-from fricid.identify.dynamic._claims import LUGRE_COVERAGE, lugre_caveat
+from fricid.identify.dynamic._outcome import LUGRE_COVERAGE, lugre_caveat
 from fricid.identify.dynamic._result import unresolved_rise
 from fricid.identify.problem import ResidualProblem
 from fricid.identify.static.convergence import certify, settle
@@ -158,7 +158,7 @@ def test_the_quoted_coverage_is_the_ten_seed_report():
     """The caveat's numbers (``LUGRE_COVERAGE``) are the last report block of
     ``benchmarks/results/lugre_report10.txt`` (seeds 10-19), not typed apart from it: per
     kind, per parameter, and every kind's parameter below the goal."""
-    from fricid.identify.dynamic._claims import COVERAGE_GOAL
+    from fricid.identify.dynamic._outcome import COVERAGE_GOAL
 
     text = (REPO / "benchmarks" / "results" / "lugre_report10.txt").read_text()
     lines = text.splitlines()
@@ -191,7 +191,7 @@ def test_the_quoted_coverage_is_the_ten_seed_report():
 def test_the_per_direction_coverage_is_the_direction_benchmarks_last_result():
     """``LUGRE_ASYM_COVERAGE`` is the coverage line of the last ``--model lugre_asym`` block of
     ``benchmarks/results/direction.txt``, not typed apart from it."""
-    from fricid.identify.dynamic._claims import LUGRE_ASYM_COVERAGE
+    from fricid.identify.dynamic._outcome import LUGRE_ASYM_COVERAGE
 
     text = (REPO / "benchmarks" / "results" / "direction.txt").read_text()
     block = text.split("--model lugre_asym")[-1]

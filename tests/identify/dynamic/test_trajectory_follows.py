@@ -149,7 +149,7 @@ def test_damping_the_log_cannot_tell_is_not_claimed(tmp_path):
     """slow_stribeck, PD-tracked trapezoid, 1 kHz, 2^17 counts/rev: sigma_1 was claimed as
     19.8 [15.5, 25.3] against 5, and the check at the estimate read -0.5 %. (The interval the
     record keeps now reaches the truth: the trapezoid rests, so it takes the wider factors of
-    :data:`fricid.identify.dynamic._claims.RESTING_WIDENING`; the check flags it all the
+    :data:`fricid.identify.dynamic._outcome.RESTING_WIDENING`; the check flags it all the
     same, since the estimate does not follow a shifted truth.)"""
     fitted, truth = fit_bench_log("slow_stribeck", "trapezoid_pd", 1000.0, 2**17, 0, tmp_path)
     p = fitted.parameters["sigma_1"]

@@ -258,7 +258,7 @@ def rest_share(series: Series) -> float:
     seconds with the speed below :data:`REST_SPEED`, the velocity a Savitzky-Golay derivative
     of the position (its own window, :data:`REST_WINDOW`, so that the share does not depend
     on the fit's derivative settings). It chooses LuGre's calibrated widening
-    (:func:`fricid.identify.dynamic._claims.widen_calibrated`). On
+    (:func:`fricid.identify.dynamic._outcome.widen_calibrated`). On
     tuning logs of ``benchmarks/bench_lugre.py`` (seeds 0-5, 10 s, as the fit reads them):
     PD-tracked chirps 0-0.08, trapezoids with their dwells 0.27-0.59, open-loop torque steps
     0-0.10 or 0.24-0.76; on the shared foreign logs, another simulator's, trapezoids 0.15."""

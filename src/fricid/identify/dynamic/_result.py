@@ -25,9 +25,8 @@ from ...io.atomic import created_timestamp
 from ...metrics import fit_statistics, metrics
 from ...models import get_model, lugre
 from ...samples import RawLog
-from ._claims import lugre_caveat
 from ._data import Series
-from ._outcome import PassivityWarning, converged, passivity
+from ._outcome import PassivityWarning, converged, lugre_caveat, passivity
 from ._rate import delay_caveat
 from ._routes import DYNAMIC_MODELS, JOINT_PARAMS
 from ._window import bias_caveat

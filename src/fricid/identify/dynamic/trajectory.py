@@ -67,7 +67,7 @@ of ``cluster_time`` seconds, or the simulation windows), t quantiles with G - 1 
 freedom; sigma_0 and sigma_1 are searched and their intervals formed on a log scale (asymmetric
 intervals; the standard error shown is the delta method's). Every fricid optimiser works on
 every route (through :func:`fricid.optim.minimize`; least-squares methods get the residuals);
-LuGre's intervals are then widened, :func:`._claims.widen_calibrated`.
+LuGre's intervals are then widened, :func:`._outcome.widen_calibrated`.
 
 Convergence: each stage's search is a problem of the problem protocol
 (:class:`fricid.identify.problem.Problem`), and every stage whose estimate is reported is
@@ -157,7 +157,6 @@ from ...errors import ConfigError, DataError
 from ...fitted import FittedModel
 from ...models import get_model, lugre
 from ...samples import RawLog, check_trajectory_log
-from ._claims import widen_calibrated
 from ._data import (
     DerivativeFilter,
     check_dissipates,
@@ -182,6 +181,7 @@ from ._outcome import (
     calibrate,
     estimator,
     warn_rate_bias,
+    widen_calibrated,
 )
 from ._output import needs_output_error
 from ._output import output_error as _output_error
