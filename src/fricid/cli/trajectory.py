@@ -95,8 +95,10 @@ def trajectory_text(fitted) -> str:
         )
     conv = fitted.convergence or {}
     why = "the fit did not converge" if conv and not conv.get("converged") else "not determined"
+    from ..identify.dynamic._routes import JOINT_UNITS
+
     for name, row in info.get("joint", {}).items():
-        unit = _JOINT_UNITS.get(name, "")
+        unit = JOINT_UNITS.get(name, "")
         lines.append(
             f"    {name}: {row['value']:.6g} {unit + ' ' if unit else ''}{_interval(row, why)}"
         )
@@ -209,9 +211,6 @@ def _interval(row: dict, why: str) -> str:
         return f"(no interval: {why})"
     return f"+/- {se:.2g} (95 % CI [{low:.5g}, {high:.5g}])"
 
-
-#: Units of the joint's parameters fitted beside the law.
-_JOINT_UNITS = {"inertia": "kg m^2", "p_x": "N m", "p_y": "N m"}
 
 #: Units of the parameters whose rate bias is estimated.
 _BIAS_UNITS = {"sigma_0": "N m/rad", "sigma_1": "N m s/rad"}

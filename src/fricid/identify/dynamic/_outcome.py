@@ -33,6 +33,7 @@ import numpy as np
 
 from ...errors import FricidWarning, user_stacklevel
 from ...models import lugre
+from ._routes import JOINT_UNITS
 
 __all__ = [
     "CALIBRATED_WIDENING",
@@ -328,9 +329,8 @@ def calibrate(stage, rb: dict[str, Any]) -> dict[str, str]:
 def _unit(name: str) -> str:
     """The unit of a LuGre trajectory fit's parameter (a law's, per direction too, or the
     joint's)."""
-    joint = {"inertia": "kg m^2", "p_x": "N m", "p_y": "N m"}
     law = {p.name: p.unit for p in lugre.PARAMETERS}
-    return joint.get(name) or law.get(lugre.symmetric_name(name), "")
+    return JOINT_UNITS.get(name) or law.get(lugre.symmetric_name(name), "")
 
 
 def warn_rate_bias(stage, rb: dict[str, Any], notes: dict[str, str] | None = None) -> None:

@@ -29,6 +29,7 @@ from ._data import Series, blocks, cluster_covariance, low_speed_windows
 __all__ = [
     "DYNAMIC_MODELS",
     "JOINT_PARAMS",
+    "JOINT_UNITS",
     "LSQ_STARTS",
     "LUGRE_LAWS",
     "ROUTES",
@@ -92,7 +93,7 @@ SIM_STARTS = 1
 
 #: Names of the joint's rigid-body parameters.
 JOINT_PARAMS = ("inertia", "p_x", "p_y")
-_JOINT_UNITS = {"inertia": "kg m^2", "p_x": "N m", "p_y": "N m"}
+JOINT_UNITS = {"inertia": "kg m^2", "p_x": "N m", "p_y": "N m"}
 
 
 @dataclass
