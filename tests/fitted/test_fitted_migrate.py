@@ -121,6 +121,15 @@ REL, TINY = 1e-12, 1e-12
 _NUMBER = re.compile(r"[-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?")
 
 
+_UNIT_ONE = re.compile(r"^(    \w+:\s+\S+) 1(?= |$)", re.MULTILINE)
+
+
+def printed_now(report: str) -> str:
+    """A report as printed then, in today's form: a dimensionless parameter's unit "1" after
+    its value is no longer printed ("delta: 4 1 +/- 19.5" was read as one number)."""
+    return _UNIT_ONE.sub(r"\1", report)
+
+
 def same_text(a: str, b: str) -> bool:
     """``a`` and ``b`` alike but for the last bits of their numbers (:data:`REL`)."""
     if _NUMBER.split(a) != _NUMBER.split(b):
@@ -153,7 +162,7 @@ def test_version_1_files_predict_and_print_as_before(family):
     fitted = load(family)
     y = quiet(fitted.predict, np.array(expected["X"]))
     np.testing.assert_allclose(y, np.array(expected["y"]), rtol=REL, atol=0)
-    assert same_text(as_before(fitted), expected["report"])
+    assert same_text(as_before(fitted), printed_now(expected["report"]))
     exported = exports_as_before(fitted, path)
     assert exported.keys() == expected["exports"].keys()
     for target, text in exported.items():
@@ -228,7 +237,7 @@ def test_a_correlation_in_another_order_is_reordered_to_the_free_parameters(tmp_
     path = tmp_path / "reordered.json"
     path.write_text(json.dumps(d))
     assert FittedModel.load(path).correlation == load("stribeck").correlation
-    assert as_before(FittedModel.load(path)) == EXPECTED["stribeck"]["report"]
+    assert as_before(FittedModel.load(path)) == printed_now(EXPECTED["stribeck"]["report"])
 
 
 def test_an_unconverged_block_without_a_reason_keeps_its_message():

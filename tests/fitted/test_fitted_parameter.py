@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 from dataclasses import FrozenInstanceError, replace
 
 import numpy as np
@@ -135,3 +136,12 @@ def test_near_zero_value_prints_its_absolute_error_only():
     m = FittedModel(model="coulomb_viscous", parameters={"f_c": Parameter("f_c", 0.4), "beta": q})
     line = next(ln for ln in m.report().splitlines() if ln.strip().startswith("beta"))
     assert "+/- 0.0036 (0.72%)" in line, line
+
+
+def test_a_dimensionless_parameter_prints_no_unit():
+    """A new user read "delta_pos:  4 1 +/- 19.5" (the unit "1" of a dimensionless exponent)
+    as the digits of one number."""
+    p = Parameter("delta", 4.0, unit="1", stderr=0.5, bounds=(0.2, 4.0))
+    m = FittedModel(model="stribeck", parameters={"delta": p, "f_c": Parameter("f_c", 0.4)})
+    line = next(ln for ln in m.report().splitlines() if ln.strip().startswith("delta"))
+    assert re.match(r"^\s*delta:\s+4 \+/- 0\.5\b", line), line

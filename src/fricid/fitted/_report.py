@@ -72,7 +72,8 @@ def fit_report(fitted: Any, min_correl: float = MIN_CORREL) -> str:
     lines.append("[[Variables]]")
     width = max((len(name) for name in fitted.parameters), default=0) + 1
     for name, p in fitted.parameters.items():
-        lines.append(f"    {name + ':':<{width}} {p.value: .8g} {p.unit}")
+        unit = "" if p.unit == "1" else p.unit  # dimensionless: "4 1 +/-" read as one number
+        lines.append(f"    {name + ':':<{width}} {p.value: .8g} {unit}")
         lines[-1] = lines[-1].rstrip() + _variable_note(p, fitted.ci_method)
     if any(name.endswith(("_pos", "_neg")) for name in fitted.parameters):
         lines.append(f"    {DIRECTIONS}")

@@ -39,6 +39,10 @@ NO_INTERVAL = "no interval: the fit did not converge (see the convergence block)
 #: The entries of a parameter's table that an unconverged fit does not give.
 _INTERVAL_KEYS = ("stderr", "ci95_low", "ci95_high")
 
+#: An interval's end within this share of its search range's width from the range's end is at
+#: that end (rounding in the search's coordinates).
+EDGE = 1e-9
+
 
 def _withheld(table: dict[str, dict[str, float]]) -> dict[str, dict[str, float]]:
     """A parameter table without its standard errors and intervals (NaN)."""
@@ -284,18 +288,20 @@ def _records(
     notes: dict[str, str] | None = None,
 ) -> dict[str, Parameter]:
     """One :class:`~fricid.fitted.Parameter` per name of the final table: value, standard
-    error, the cluster-robust 95 % interval (its ends open where they reach the search box),
-    and at a bound where the value is within ``1e-6`` relative of one; ``note`` says why an
-    interval is missing (an unconverged fit's: no end is then open); ``notes`` a parameter's
-    own (the bias check's: widened, or not determined). A parameter whose
-    interval spans the whole search box is not identified, as an analytic fit says it."""
+    error, the cluster-robust 95 % interval (its ends open where they reach the search box,
+    within :data:`EDGE` of its width: an end 0.20000000000000018 of a range from 0.2 is the
+    range's), and at a bound where the value is within ``1e-6`` relative of one; ``note``
+    says why an interval is missing (an unconverged fit's: no end is then open); ``notes`` a
+    parameter's own (the bias check's: widened, or not determined). A parameter whose interval
+    spans the whole search box is not identified, as an analytic fit says it."""
     out = {}
     for n in names:
         row, box = final[n], bounds.get(n)
         value, se = float(row["value"]), float(row["stderr"])
         low, high = float(row["ci95_low"]), float(row["ci95_high"])
-        low_open = box is not None and not note and bool(low <= box[0])
-        high_open = box is not None and not note and bool(high >= box[1])
+        reach = 0.0 if box is None else EDGE * (box[1] - box[0])  # rounding at the ends
+        low_open = box is not None and not note and bool(low <= box[0] + reach)
+        high_open = box is not None and not note and bool(high >= box[1] - reach)
         why = note or (notes or {}).get(n, "")
         if low_open and high_open:  # as an analytic fit says it (static.uncertainty)
             why = (
