@@ -53,6 +53,23 @@ def test_unit_factors_and_signs_are_named(seed, factor, sign, inverse):
     assert ("reversed sign" in text) == (sign < 0)
 
 
+@pytest.mark.parametrize(
+    ("factor", "says"),
+    [
+        (1e3, "seconds under a header in ms"),
+        (1e-3, "ms under a header in seconds"),
+        (60.0, "min under a header in seconds"),
+        (1 / 60, "seconds under a header in min"),
+    ],
+)
+def test_a_time_column_in_the_wrong_unit_is_a_suspect(factor, says):
+    """A log in seconds whose header said ``time [ms]``: the message blamed the position and
+    velocity columns alone (a new user's trial); the time's unit scales the integral too."""
+    t, q, v = motion(5)
+    text = velocity_mismatch(t / factor, q, v)
+    assert text is not None and f"the time column: times in {says}" in text, text
+
+
 def test_a_reversed_sign_alone_and_an_unknown_factor():
     t, q, v = motion(3)
     assert "sign reversed" in velocity_mismatch(t, q, -v)

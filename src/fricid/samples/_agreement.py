@@ -53,6 +53,9 @@ UNIT_FACTORS: dict[float, str] = {
     60.0 / (2.0 * math.pi): "rpm against rad/s",
     1000.0: "milli-units against units (mm or mrad)",
 }
+#: Time units whose factor to seconds is a factor above: a time column read in the wrong one
+#: scales the integral of the velocity by it.
+TIME_UNITS = {"ms": 1000.0, "min": 1.0 / 60.0}
 #: Relative tolerance for a known unit factor (the nearest one; 57.3 and 60 are 4.7 % apart).
 FACTOR_TOLERANCE = 0.02
 
@@ -109,7 +112,7 @@ def _cause(scale: float) -> str:
     if abs(math.log(size / f)) <= math.log1p(FACTOR_TOLERANCE):
         return (
             f"{sign}units {meaning} (the {big} is {max(f, 1 / f):.4g}x too large for the "
-            f"{small}, or the {small} as much too small)"
+            f"{small}, or the {small} as much too small)" + _time_unit(f)
         )
     if scale < 0 and abs(size - 1.0) <= 1.0 - AGREEMENT[0]:
         return "one of the two columns has its sign reversed"
@@ -117,6 +120,18 @@ def _cause(scale: float) -> str:
         f"{sign}a factor that is no known unit: a gear ratio between a motor-side and a "
         "joint-side channel, or a wrong unit or scale"
     )
+
+
+def _time_unit(factor: float) -> str:
+    """The time column as a suspect for a factor that is a time unit's (:data:`TIME_UNITS`):
+    the integral of the velocity scales with the time (a log in seconds under ``time [ms]``
+    reads 1000x)."""
+    for unit, f in TIME_UNITS.items():
+        if math.isclose(factor, f, rel_tol=FACTOR_TOLERANCE):
+            return f"; or the time column: times in seconds under a header in {unit}"
+        if math.isclose(factor, 1 / f, rel_tol=FACTOR_TOLERANCE):
+            return f"; or the time column: times in {unit} under a header in seconds"
+    return ""
 
 
 def velocity_mismatch(time, position, velocity, *, column: str | None = None) -> str | None:
