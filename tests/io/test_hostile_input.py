@@ -312,6 +312,9 @@ def files(tmp_path_factory):
         (["predict", "{f}/missing.json", "-v", "1"], ["MODEL: no such file"]),
         (["export", "{f}/m.json", "--to", "urdf", "--out", "{f}/a_folder"], ["existing folder"]),
         (["export", "{f}/m.json", "--to", "c", "--out", "{f}/s.csv"], ["existing file"]),
+        # a trailing separator means a folder (it used to write a file named new_folder)
+        (["export", "{f}/m.json", "--to", "mjcf", "--out", "{f}/new_folder/"], ["--out", "folder"]),
+        (["fit", "{f}/s.csv", "--out", "{f}/new_folder/"], ["--out", "folder"]),
         (["extract", "{f}/log.csv", "--out", "{f}/a_folder"], ["--out", "existing folder"]),
         (["extract", "{f}/a_folder"], ["LOG", "is a folder"]),
         (["extract", "{f}/empty", "--format", "rosbag", "--joint", "j"], ["metadata.yaml"]),

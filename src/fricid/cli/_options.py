@@ -12,6 +12,7 @@ into a :class:`typer.BadParameter` naming the flag (exit status 2).
 
 from __future__ import annotations
 
+import os
 from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Annotated, Any, TypeVar
@@ -134,9 +135,27 @@ TemperatureOption = Annotated[
 ]
 
 
+class OutPath(type(Path())):  # type: ignore[misc]  # the platform's concrete path class
+    """A path given to ``--out``, remembering whether it ended with a separator
+    (``folder_meant``): the path itself drops it, and ``export --to mjcf --out d/`` wrote a
+    file named ``d``."""
+
+    folder_meant = False
+
+
+def out_path(raw: str | Path) -> Path:
+    """``--out``'s value as an :class:`OutPath` (checked by ``_paths.check_paths``); a
+    command's default (a path already) as it is."""
+    if isinstance(raw, Path):
+        return raw
+    path = OutPath(raw)
+    path.folder_meant = raw.endswith(("/", os.sep))
+    return path
+
+
 def out_option(help: str, **kwargs: Any) -> Any:
     """The ``--out``/``-o`` option with its command's own help text."""
-    return typer.Option("--out", "-o", help=help, **kwargs)
+    return typer.Option("--out", "-o", help=help, parser=out_path, **kwargs)
 
 
 def robot_urdf(

@@ -11,6 +11,7 @@ the library's own check prints a three-line usage screen instead.
 
 from __future__ import annotations
 
+import os
 from collections.abc import Collection, Mapping
 from pathlib import Path
 
@@ -35,6 +36,11 @@ def _input(name: str, path: Path, folders: bool) -> None:
 
 
 def _out_file(name: str, path: Path) -> None:
+    if getattr(path, "folder_meant", False):  # ``--out d/``: ``_options.OutPath``
+        raise ConfigError(
+            f"{name}: '{path}{os.sep}' names a folder (it ends with '{os.sep}'); give the name "
+            f"of a file to write (e.g. '{path / 'model'}' with its extension)"
+        )
     if path.is_dir():
         raise ConfigError(
             f"{name}: '{path}' is an existing folder; give the name of a file to write"
@@ -83,7 +89,7 @@ def check_paths(
             _input(name, Path(path), ok)
     for name, path in (out_files or {}).items():
         if path is not None:
-            _out_file(name, Path(path))
+            _out_file(name, path if isinstance(path, Path) else Path(path))  # keeps an OutPath
     for name, path in (out_dirs or {}).items():
         if path is not None:
             _out_dir(name, Path(path))
