@@ -22,6 +22,12 @@ log's rest share the fit's own (:func:`fricid.identify.dynamic._data.rest_share`
 does not record it, ``rest``, is simulated again and read as the fit reads it). A run's
 ``FACTORS`` may then be ``resting`` (the factors the fit applied were the current
 ``RESTING_WIDENING`` for the resting logs and ``CALIBRATED_WIDENING`` for the others).
+
+``--hold FACTORS``: also how many of the closed claims a candidate factor set would hold (the
+widening each needed at most the candidate's factor; a parameter not named: 1), per group, e.g.
+whether the moving logs' own quantiles would still hold another simulator's claims. Claims that
+the fit's factors sent to the search box (not determined) are not counted; a narrower factor
+could have kept some of them closed.
 """
 
 from __future__ import annotations
@@ -73,11 +79,25 @@ def table(title: str, pooled: dict[str, list[float]]) -> None:
         print(f"{n:10s} {len(xs):6d} " + " ".join(f"{x:6.3g}" for x in q))
 
 
+def held(title: str, pooled: dict[str, list[float]], candidate: dict[str, float]) -> None:
+    print(f"## {title}: claims held by the candidate factors (widening needed <= factor)")
+    print(f"{'parameter':10s} {'factor':>6s} {'held':>9s}")
+    for n, xs in pooled.items():
+        if xs:
+            f = candidate.get(n, 1.0)
+            print(f"{n:10s} {f:6.3g} {sum(x <= f for x in xs):4d}/{len(xs):<4d}")
+
+
 def main() -> None:
     from fricid.identify.dynamic._outcome import CALIBRATED_WIDENING, RESTING, RESTING_WIDENING
 
     args = sys.argv[1:]
     by_rest = "--by-rest" in args
+    candidate = None
+    if "--hold" in args:
+        i = args.index("--hold")
+        candidate = factors(args[i + 1])
+        del args[i : i + 2]
     runs = [arg.split("=", 1) for arg in args if arg != "--by-rest"]
     if not runs:
         sys.exit(__doc__)
@@ -100,7 +120,10 @@ def main() -> None:
     print(f"# {len(runs)} runs: " + " ".join(path for path, _ in runs))
     for g in groups:
         title = {"all": "every log", "resting": f"logs resting >= {RESTING:g} of their time"}
-        table(title.get(g, f"logs resting < {RESTING:g} of their time"), pooled[g])
+        name = title.get(g, f"logs resting < {RESTING:g} of their time")
+        table(name, pooled[g])
+        if candidate is not None:
+            held(name, pooled[g], candidate)
 
 
 if __name__ == "__main__":
