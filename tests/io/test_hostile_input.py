@@ -349,3 +349,23 @@ def test_damaged_samples_through_the_cli(files, tmp_path):
     assert_one_line_exit_2(code, err, "bad.csv")
     assert not (tmp_path / "m.json").exists()
     assert Path(files / "s.csv").exists()
+
+
+@pytest.mark.parametrize(
+    ("column", "value", "said"),
+    [("direction", "-3", "got -3.0"), ("std", "-3", "got -3.0"), ("count", "0.5", "got 0.5")],
+)
+def test_a_bad_cell_is_quoted_as_a_number_not_a_numpy_repr(files, tmp_path, column, value, said):
+    """A new user's trial: 'direction must be -1, 0 or +1, got np.float64(-3.0)'."""
+    lines = (files / "s.csv").read_text().splitlines()
+    h = next(k for k, line in enumerate(lines) if not line.startswith("#"))  # after the meta
+    header = lines[h].split(",")
+    (i,) = [k for k, name in enumerate(header) if name.split(" [")[0] == column]
+    row = lines[h + 1].split(",")
+    row[i] = value
+    lines[h + 1] = ",".join(row)
+    path = tmp_path / "bad.csv"
+    path.write_text("\n".join(lines) + "\n")
+    code, err = cli("fit", path)
+    assert_one_line_exit_2(code, err, said, column)
+    assert "np." not in err, err

@@ -246,9 +246,10 @@ def project(
     F = fitted.predict(X)
     if not np.isfinite(F).all():
         k = int(np.argmin(np.isfinite(F)))
+        v, load, temp = (float(x) for x in X[k])
         raise DataError(
-            f"model '{model_name(fitted)}' gives a non-finite friction ({F[k]!r}) at velocity "
-            f"{X[k, 0]!r} rad/s, load {X[k, 1]!r} N m, temperature {X[k, 2]!r} degC of its "
+            f"model '{model_name(fitted)}' gives a non-finite friction ({float(F[k])!r}) at "
+            f"velocity {v!r} rad/s, load {load!r} N m, temperature {temp!r} degC of its "
             "operating range; it cannot be projected"
         )
     v = X[:, 0]

@@ -226,7 +226,7 @@ def _to_float(table: pa.Table, labels: list[str], path: Path, first: int) -> dic
         if bad.any():
             row = int(np.flatnonzero(bad)[0])
             raise DataError(
-                f"non-finite value {values[row]!r} (NaN and infinities are not data)",
+                f"non-finite value {float(values[row])!r} (NaN and infinities are not data)",
                 file=path,
                 row=first + row,
                 column=label,
@@ -351,7 +351,7 @@ class _Filled(dict):
             if not np.isfinite(values).all():
                 row = int(np.flatnonzero(~np.isfinite(values))[0])
                 raise DataError(
-                    f"non-finite value {values[row]!r} (NaN and infinities are not data)",
+                    f"non-finite value {float(values[row])!r} (NaN and infinities are not data)",
                     file=path,
                     row=first + row,
                     column=label,

@@ -108,7 +108,9 @@ def read_samples(path: PathLike) -> FrictionSamples:
     if count is not None and (count != np.round(count)).any():
         row = int(np.flatnonzero(count != np.round(count))[0])
         raise relocate(
-            DataError(f"count must be a whole number, got {count[row]!r}", row=row, column="count"),
+            DataError(
+                f"count must be a whole number, got {float(count[row])!r}", row=row, column="count"
+            ),
             opened,
             0,
         )

@@ -174,7 +174,7 @@ def check_bounds(bounds) -> np.ndarray:
     if bad.size:
         i = int(bad[0])
         raise ConfigError(
-            f"bounds[{i}] has lower >= upper ({b[i, 0]!r} >= {b[i, 1]!r}); "
+            f"bounds[{i}] has lower >= upper ({float(b[i, 0])!r} >= {float(b[i, 1])!r}); "
             "fix the parameter's range (fixed parameters are passed separately)"
         )
     return b

@@ -154,7 +154,7 @@ class FrictionSamples:
         if bad.size:
             row = int(bad[0])
             raise DataError(
-                f"direction must be -1, 0 or +1, got {direction[row]!r}",
+                f"direction must be -1, 0 or +1, got {float(direction[row])!r}",
                 file=src,
                 row=row,
                 column="direction",
@@ -175,13 +175,13 @@ class FrictionSamples:
         if (count < 1).any():
             row = int(np.flatnonzero(count < 1)[0])
             raise DataError(
-                f"count must be >= 1, got {count[row]!r}", file=src, row=row, column="count"
+                f"count must be >= 1, got {float(count[row])!r}", file=src, row=row, column="count"
             )
         _check_range("count", count, src)
         if (count != np.round(count)).any():
             row = int(np.flatnonzero(count != np.round(count))[0])
             raise DataError(
-                f"count must be a whole number, got {count[row]!r}",
+                f"count must be a whole number, got {float(count[row])!r}",
                 file=src,
                 row=row,
                 column="count",
@@ -190,7 +190,9 @@ class FrictionSamples:
         std = np.zeros(n) if self.std is None else _as_column("std", self.std, n, src)
         if (std < 0).any():
             row = int(np.flatnonzero(std < 0)[0])
-            raise DataError(f"std must be >= 0, got {std[row]!r}", file=src, row=row, column="std")
+            raise DataError(
+                f"std must be >= 0, got {float(std[row])!r}", file=src, row=row, column="std"
+            )
         _check_range("std", std, src)
         set_(self, "std", std)
         set_(self, "meta", dict(self.meta))

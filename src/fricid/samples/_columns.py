@@ -95,7 +95,7 @@ def _as_column(name: str, values: Any, n: int | None, source: str | None) -> np.
     bad = ~np.isfinite(arr)
     if bad.any():
         row = int(np.flatnonzero(bad)[0])
-        raise DataError(f"non-finite value {arr[row]!r}", file=source, row=row, column=name)
+        raise DataError(f"non-finite value {float(arr[row])!r}", file=source, row=row, column=name)
     if name in LIMITS and name not in ("count", "std"):  # checked after their own rules
         _check_range(name, arr, source)
     return arr

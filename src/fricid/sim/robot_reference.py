@@ -136,7 +136,8 @@ def sweep_reference(
     if not (np.isfinite(span) and span > 0 and acceleration > 0 and dwell >= 0):
         raise ConfigError("sweeps need lower < upper, acceleration > 0 and dwell >= 0")
     if speeds.size == 0 or not (np.isfinite(speeds).all() and (speeds > 0).all()):
-        raise ConfigError(f"sweep velocities must be > 0 rad/s; got {speeds}")
+        got = ", ".join(f"{x:g}" for x in speeds)
+        raise ConfigError(f"sweep velocities must be > 0 rad/s; got {got or 'none'}")
     if (speeds**2 / acceleration >= span).any():
         raise ConfigError(
             f"a speed of {speeds.max():g} rad/s is not reached over {span:g} rad with "
