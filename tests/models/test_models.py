@@ -90,7 +90,7 @@ def test_data_scaled_defaults_lie_within_data_scaled_bounds(scale_f, scale_v, na
 
 
 def test_bad_model_name_lists_choices():
-    with pytest.raises(ConfigError, match="choose one of: coulomb_viscous"):
+    with pytest.raises(ConfigError, match="choose one of analytic: coulomb_viscous"):
         get_model("coulomb")
 
 
@@ -107,3 +107,27 @@ def test_wrong_input_shape():
 def test_param_vector_names_missing_and_unknown():
     with pytest.raises(ConfigError, match="missing: beta; unknown: b"):
         get_model("coulomb_viscous").param_vector({"f_c": 1.0, "b": 2.0})
+
+
+def test_an_unknown_model_is_told_every_family_and_the_nearest_name():
+    """A new user's trial: '--model strbeck' was offered four analytic families, none of
+    the dynamic ones, and no nearest name."""
+
+    with pytest.raises(ConfigError) as info:
+        get_model("strbeck")
+    text = str(info.value)
+    assert "did you mean 'stribeck'" in text, text
+    for name in ("coulomb_viscous", "stribeck", "msk", "vlt", "lugre", "lugre_asym", "dahl"):
+        assert name in text, (name, text)
+
+
+def test_fit_names_the_learned_families_too():
+    from fricid.identify import fit
+    from fricid.samples import FrictionSamples
+
+    v = np.linspace(-1, 1, 20)
+    s = FrictionSamples(velocity=v, load=0.0, temperature=25.0, friction=0.1 * np.sign(v))
+    with pytest.raises(ConfigError) as info:
+        fit(s, "rbff")
+    text = str(info.value)
+    assert "did you mean 'rbf'" in text and "hybrid" in text and "auto" in text, text

@@ -14,7 +14,7 @@ import numpy as np
 
 from ..errors import ConfigError
 from ..fitted import FittedModel
-from ..models import STATEFUL, FrictionModel
+from ..models import STATEFUL, FrictionModel, get_model, unknown_model
 from ..samples import FrictionSamples, RawLog, RobotLog
 
 __all__ = ["KINDS", "LEARNED", "SETTINGS", "fit_named", "kind_of"]
@@ -90,6 +90,18 @@ def _settings(kind: str, model: Any, settings: Mapping[str, Any] | None) -> dict
     return given
 
 
+def _known(name: str) -> None:
+    """Raise the catalog's error for an unknown analytic name, with the learned families and
+    ``auto`` among those it offers."""
+    try:
+        get_model(name)
+    except ConfigError as exc:
+        if not str(exc).startswith("unknown model"):
+            raise
+        more = {"learned": LEARNED, "selection": ("auto",)}
+        raise ConfigError(unknown_model(name, more)) from None
+
+
 def fit_named(
     samples: FrictionSamples,
     model: str | FrictionModel,
@@ -108,6 +120,8 @@ def fit_named(
     if kind == "analytic":
         from .static.least_squares import fit as fit_analytic
 
+        if isinstance(model, str):
+            _known(model)
         if arguments.get("options") is not None:
             arguments["options"] = dict(arguments["options"])
         return fit_analytic(samples, model, method or "lm", **arguments)

@@ -15,7 +15,7 @@ from __future__ import annotations
 from ._analytic import CoulombViscous, LoadDependent, Stribeck, VelocityLoadTemperature
 from ._asymmetric import Asymmetric
 from ._base import INPUTS, FrictionModel, Parameter, data_scales
-from ._catalog import DYNAMIC, MODELS, get_model
+from ._catalog import DYNAMIC, MODELS, get_model, unknown_model
 from ._temperature import T_REF, WithTemperature
 from .gp import GP, GaussianProcess
 from .hybrid import HYBRID, HybridModel
@@ -40,6 +40,7 @@ __all__ = [
     "data_scales",
     "get_model",
     "get_predictor",
+    "unknown_model",
 ]
 
 

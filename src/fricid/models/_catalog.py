@@ -4,6 +4,9 @@ backbone) can look a family up without importing the package that registers them
 
 from __future__ import annotations
 
+import difflib
+from collections.abc import Mapping, Sequence
+
 from ..errors import ConfigError
 from ._analytic import CoulombViscous, LoadDependent, Stribeck, VelocityLoadTemperature
 from ._asymmetric import Asymmetric
@@ -12,7 +15,7 @@ from ._temperature import WithTemperature
 from .dahl import Dahl
 from .lugre import LuGre, LuGreAsym
 
-__all__ = ["DYNAMIC", "MODELS", "get_model"]
+__all__ = ["DYNAMIC", "MODELS", "get_model", "unknown_model"]
 
 
 #: The analytic models by registry name, in the order of the BAS-RBFNN paper's Table 1.
@@ -25,6 +28,26 @@ MODELS: dict[str, type[FrictionModel]] = {
 #: trajectories by :mod:`fricid.identify.dynamic.trajectory`); kept out of :data:`MODELS`, whose
 #: families are fitted to friction samples.
 DYNAMIC: dict[str, type[FrictionModel]] = {cls.name: cls for cls in (LuGre, LuGreAsym, Dahl)}
+
+
+def unknown_model(name: str, more: Mapping[str, Sequence[str]] | None = None) -> str:
+    """The message for a model name that is none: every family by kind (``more``: the
+    kinds a caller adds, e.g. the learned ones) and the nearest known name."""
+    kinds = {
+        "analytic": list(MODELS),
+        "dynamic, from a trajectory": list(DYNAMIC),
+        **{k: list(v) for k, v in (more or {}).items()},
+    }
+    known = [n for names in kinds.values() for n in names]
+    known += [f"{n}_{end}" for n in MODELS for end in ("asym", "temp")]
+    near = difflib.get_close_matches(name.strip().lower(), known, n=1)
+    hint = f" (did you mean '{near[0]}'?)" if near else ""
+    listed = "; ".join(f"{kind}: {', '.join(names)}" for kind, names in kinds.items())
+    return (
+        f"unknown model '{name}'{hint}; choose one of {listed} (an analytic name takes _asym "
+        "for separate parameters per direction, _temp for a temperature-dependent viscous "
+        "term, _temp_asym for both)"
+    )
 
 
 def get_model(name: str | FrictionModel, asymmetric: bool = False) -> FrictionModel:
@@ -52,11 +75,7 @@ def get_model(name: str | FrictionModel, asymmetric: bool = False) -> FrictionMo
         if temperature:
             key = key[: -len("_temp")]
         if key not in MODELS:
-            raise ConfigError(
-                f"unknown model '{name}'; choose one of: {', '.join(MODELS)} "
-                "(append _asym for separate parameters per direction, _temp for a "
-                "temperature-dependent viscous term, _temp_asym for both)"
-            )
+            raise ConfigError(unknown_model(name))
         model = MODELS[key]()
         if temperature:
             return WithTemperature(Asymmetric(model) if asymmetric else model)
