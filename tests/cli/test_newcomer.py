@@ -102,3 +102,19 @@ def test_predict_prints_numbers_with_the_digits_they_deserve(samples_csv, tmp_pa
     assert float(rows[1].split(",")[3]) == exact  # exact: reads back to the same float
     res = run("predict", model, "-v", "0.2", "--digits", "3")
     assert res.stdout.splitlines()[1].split(",")[3] == f"{exact:.3g}"
+
+
+def test_predict_says_a_load_or_temperature_the_model_ignores(samples_csv, tmp_path):
+    """A new user's trial: 'predict m.json -v 0.5 --temperature 80' on a velocity-only model
+    echoed 80 degC beside the friction of the 25 degC data, silently."""
+    from fricid.identify import fit
+    from fricid.io import read_samples
+
+    model = fit(read_samples(samples_csv), "coulomb_viscous").save(tmp_path / "m.json")
+    res = run("predict", model, "-v", "0.5", "--temperature", "80", "--load", "0.3")
+    assert res.exit_code == 0, res.output
+    assert "does not depend on load" in res.stderr and "does not depend on temperature" in (
+        res.stderr
+    ), res.stderr
+    res = run("predict", model, "-v", "0.5")  # nothing given: nothing said
+    assert "does not depend" not in res.stderr, res.stderr

@@ -154,6 +154,7 @@ def predict_command(
             raise ConfigError("give the points: --velocity (repeatable), or --input FILE")
         X = points_matrix(fitted, si["velocity"], si["load"], si["temperature"])
     zone_si = float(to_si(zone, velocity_unit or "rad/s", "velocity"))
+    _say_ignored(fitted, X, given, cols if input_file is not None else {})
     loose = [n for n, p in fitted.parameters.items() if p.not_determined and not p.fixed]
     if loose and fitted.kind != "rbf":  # as export refuses them: said, not hidden
         err_console.print(
@@ -217,3 +218,22 @@ def predict_command(
     else:
         write_text(text, out)
         err_console.print(f"wrote {out} ({len(X)} points)")
+
+
+def _say_ignored(fitted, X, given: dict, cols: dict) -> None:
+    """A note for each load or temperature given (flag or column) that the model does not
+    depend on: the friction is the same whatever it is, though the output echoes it."""
+    used = fitted.inputs_used()
+    for k, name in ((1, "load"), (2, "temperature")):
+        if name in used or not (given.get(name) or name in cols):
+            continue
+        unit = "N m" if name == "load" else "degC"
+        low, high = float(X[:, k].min()), float(X[:, k].max())
+        shown = f"{low:g} {unit}" if low == high else f"{low:g} to {high:g} {unit}"
+        err_console.print(
+            f"note: model '{fitted.model}' does not depend on {name}: the friction is the same "
+            f"at the {name} given ({shown}), which is written beside it as given",
+            markup=False,
+            highlight=False,
+            soft_wrap=True,
+        )
