@@ -44,6 +44,9 @@ from .varpro import varpro
 
 __all__ = ["evaluate", "fit"]
 
+#: A correlation smaller than this is rounding (the covariance's arithmetic), written as 0.
+ROUNDING = 1e-10
+
 
 def fit(
     samples: FrictionSamples,
@@ -249,7 +252,14 @@ def fit(
     if cov is not None:
         d = np.sqrt(np.diag(cov))
         with np.errstate(invalid="ignore", divide="ignore"):
-            corr = (cov / np.outer(d, d)).tolist()
+            r = cov / np.outer(d, d)
+        # the parameters' correlations, not the arithmetic's: 1 on the diagonal (was
+        # 0.9999999999999998), 0 below ROUNDING (forwards and backwards levels, which share no
+        # sample, were written as correlated by -2.79e-16)
+        r[np.abs(r) < ROUNDING] = 0.0
+        ok = np.isfinite(d) & (d > 0)
+        r[ok, ok] = 1.0
+        corr = r.tolist()
 
     y_hat = model.predict(theta, X)
     return FittedModel(
