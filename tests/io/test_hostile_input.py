@@ -369,3 +369,10 @@ def test_a_bad_cell_is_quoted_as_a_number_not_a_numpy_repr(files, tmp_path, colu
     code, err = cli("fit", path)
     assert_one_line_exit_2(code, err, said, column)
     assert "np." not in err, err
+
+
+def test_a_samples_file_given_to_extract_names_the_commands_that_take_it(files):
+    """A new user's trial: 'this is a fricid-samples/1 file ...; read it with read_samples' (a
+    Python function) to a command-line user."""
+    code, err = cli("extract", files / "s.csv")
+    assert_one_line_exit_2(code, err, "fricid fit", "s.csv")

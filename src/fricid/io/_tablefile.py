@@ -136,10 +136,13 @@ def _check_format(found: str | None, expected: str, path: Path) -> None:
             f"file format '{found}' is not supported by this fricid (reads '{expected}')",
             file=path,
         )
-    reader = {"fricid-samples": "read_samples", "fricid-rawlog": "read_rawlog"}.get(
-        kind, "another reader"
-    )
-    raise DataError(f"this is a '{found}' file, not '{expected}'; read it with {reader}", file=path)
+    what = {
+        "fricid-samples": "friction samples: fricid fit, evaluate and report take them "
+        "(Python: read_samples)",
+        "fricid-rawlog": "a raw log: fricid extract, or fricid fit --trajectory, takes it "
+        "(Python: read_rawlog)",
+    }.get(kind, "read by another command")
+    raise DataError(f"this is a '{found}' file, not '{expected}': {what}", file=path)
 
 
 def open_table(
