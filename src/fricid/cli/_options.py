@@ -45,7 +45,7 @@ T = TypeVar("T")
 #: A model file argument (JSON written by ``fricid fit``), which must exist.
 ModelFile = Annotated[
     Path,
-    typer.Argument(help="Model file (JSON, from `fricid fit`); checked by `check_paths`."),
+    typer.Argument(help="Model file (JSON, from `fricid fit`)."),
 ]
 
 #: ``--fix NAME=VALUE`` (repeatable), parsed by :func:`parse_assignments`.

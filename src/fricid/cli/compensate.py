@@ -154,15 +154,14 @@ def compensate_command(
 
     The plant sticks at zero velocity until the applied torque exceeds the break-away
     friction (fixed-step Karnopp scheme); the feed-forward is the model at the reference
-    velocity. See `fricid.control.tracking` for every detail.
+    velocity.
 
     With --truth lugre the joint's friction is dynamic (LuGre, bristles in pre-sliding at the
     reversals), and three runs are shown: PD only, static feed-forward (the model's
     steady state at the reference velocity) and a LuGre friction observer (the bristle state
     estimated from the measured velocity with the model's own update); the error is given
     over the run and at the zero-velocity crossings. The model is a lugre file, or a
-    stribeck / coulomb_viscous one with --lugre SIGMA_0,SIGMA_1. See
-    `fricid.control.dynamic`.
+    stribeck / coulomb_viscous one with --lugre SIGMA_0,SIGMA_1.
 
     "RMS error N x smaller" is printed only when the feed-forward shrank the error; when it
     made tracking worse, a warning line on stderr says so and by how much. A reference that

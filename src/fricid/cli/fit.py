@@ -158,12 +158,16 @@ def fit_command(
         typer.Option(
             "--trajectory",
             help="SAMPLES is a raw log of any motion: identify lugre (or lugre_asym, its "
-            "levels per direction; dahl, stribeck, coulomb_viscous) with J and gravity from it "
-            "(fricid.identify.dynamic.trajectory).",
+            "levels per direction; dahl, stribeck, coulomb_viscous) with J and gravity from it.",
         ),
     ] = False,
     log_format: Annotated[
-        str, typer.Option("--format", help="--trajectory: the log's reader (fricid.io.READERS).")
+        str,
+        typer.Option(
+            "--format",
+            help="--trajectory: the log's format (table: CSV or Parquet with unit headers; "
+            "fricid extract --help lists every format).",
+        ),
     ] = "table",
     route: Annotated[
         str,
@@ -190,11 +194,10 @@ def fit_command(
     """Identify a friction model from samples (or, with --trajectory, a log) and write it as a
     JSON model file.
 
-    One identification for every kind (fricid.identify.fit): analytic laws by least squares
-    (--model stribeck, vlt, ...: fricid.identify.static), learned models (--model rbf, hybrid,
-    gp: fricid.identify.learned), the family chosen by held-out error (--model auto), and
-    friction with inertia and gravity from any trajectory (--trajectory:
-    fricid.identify.dynamic).
+    One identification for every kind: analytic laws by least squares (--model stribeck, vlt,
+    ...), learned models (--model rbf, hybrid, gp), the family chosen by held-out error
+    (--model auto), and friction with inertia and gravity from any trajectory
+    (--trajectory).
 
     Prints the fit report (after lmfit's): method, evaluations and convergence status; data
     points, variables, chi-square (SSE [N^2 m^2]), reduced chi-square, AIC, BIC, R^2; each
@@ -205,7 +208,7 @@ def fit_command(
     the friction's magnitude per direction (the R-squared above is the BAS-RBFNN paper's
     Table 1 fitness, of the signed friction, which flatters per-direction data); with
     --validate or --model auto, the held-out RMSE and a verdict; with auto, the candidates
-    compared. Last, [[Trust]]: the trust verdict (fricid.identify.trust; held-out error from
+    compared. Last, [[Trust]]: the trust verdict (held-out error from
     --validate, else leave one velocity level out run there when small enough, else in-sample,
     labelled), saved in the model file, where `fricid report` on the same samples reads it.
     Warnings print as one line each on stderr and are saved in the model file
@@ -426,7 +429,7 @@ def _rbf_settings(centers: int | None, inputs: str | None, backbone: str | None 
 @app.command("methods")
 def methods_command() -> None:
     """List every model (analytic with its _temp variants, dynamic, learned) and every
-    optimiser, one line each, from the registries (fricid.models, fricid.optim)."""
+    optimiser, one line each."""
     from rich.markup import escape as esc
 
     for line in methods_lines():

@@ -72,7 +72,7 @@ def report_command(
     log_format: Annotated[
         str,
         typer.Option(
-            "--format", help="Trajectory models: the logs' reader (fricid.io.READERS), as in fit."
+            "--format", help="Trajectory models: the logs' format, as in fit --trajectory."
         ),
     ] = "table",
     reader_option: Annotated[
@@ -91,7 +91,7 @@ def report_command(
     metrics, measured against predicted friction over velocity, residuals against each input
     and the optimiser's convergence. The verdict line is printed on stderr too.
 
-    The verdict is fricid.identify.trust's record: the one the model file carries (from
+    The verdict is the fit's trust record: the one the model file carries (from
     `fricid fit` or the fleet) when it was computed on the same samples with the same
     options, else computed now; the report renders it and computes no verdict of its own.
 

@@ -138,9 +138,9 @@ def robot_extract_command(
         typer.Argument(
             help="The robot's sweeps: a wide CSV/Parquet table (q1, dq1, tau1, ... or "
             "<joint>.position, ...), a ROS 2 bag with a JointState topic, or a folder of "
-            "per-channel files (each read by fricid.io.read_robot_log). Several recordings of "
+            "per-channel files. Several recordings of "
             "one robot (one joint swept per file, say) are read as one log, each after the "
-            "previous (fricid.samples.join_robot_logs): same joints and rate, and the gravity "
+            "previous: same joints and rate, and the gravity "
             "they share identified from all.",
             metavar="LOG",
         ),

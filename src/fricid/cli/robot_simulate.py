@@ -144,7 +144,7 @@ def robot_simulate_command(
         str,
         typer.Option(
             help="example: per-joint, per-direction Stribeck friction scaled to each joint's "
-            "effort limit (fricid.sim.robot_friction.example_friction); none."
+            "effort limit; none."
         ),
     ] = "example",
     controller: Annotated[str, typer.Option(help="pd or torque (computed torque).")] = "pd",

@@ -119,7 +119,7 @@ def simulate_command(
         str | None,
         typer.Option(
             help="Instead of the campaign, one trajectory experiment on a joint with LuGre "
-            "friction (fricid.sim.trajectory; the truth's parameters in the log's metadata): "
+            "friction (the truth's parameters in the log's metadata): "
             "sine, chirp, multisine, slow_multisine, stick_slip or presliding. For "
             "`fricid fit LOG --trajectory`; --preset, --size and --coverage do not apply.",
         ),
@@ -134,7 +134,7 @@ def simulate_command(
     temperature [degC], with the torque constant K in the file's metadata. Progress goes to
     stderr (a bar on a terminal, a line per tenth with the time left otherwise; --quiet: none).
     With --trajectory, one experiment of any motion instead (J 0.01 kg m^2, gravity p_x 0.3,
-    p_y 0.1 N m, LuGre friction with the defaults of fricid.sim.trajectory.LuGreTruth)."""
+    p_y 0.1 N m, LuGre friction: its parameters in the log's metadata)."""
     from ..io import write_rawlog
 
     _check_kind(trajectory, preset, size, coverage, duration)
