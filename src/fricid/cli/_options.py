@@ -27,6 +27,7 @@ __all__ = [
     "BoundOption",
     "DirectionOption",
     "FixOption",
+    "LogFormatOption",
     "MaxEvalsOption",
     "ModelFile",
     "SeedOption",
@@ -41,6 +42,16 @@ __all__ = [
 ]
 
 T = TypeVar("T")
+
+#: ``--format`` of ``fit --trajectory``: the log's reader.
+LogFormatOption = Annotated[
+    str,
+    typer.Option(
+        "--format",
+        help="--trajectory: the log's format (table: CSV or Parquet with unit headers; "
+        "fricid extract --help lists every format).",
+    ),
+]
 
 #: A model file argument (JSON written by ``fricid fit``), which must exist.
 ModelFile = Annotated[

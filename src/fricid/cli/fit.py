@@ -14,6 +14,7 @@ from ._options import (
     BoundOption,
     DirectionOption,
     FixOption,
+    LogFormatOption,
     MaxEvalsOption,
     SeedOption,
     out_option,
@@ -161,14 +162,7 @@ def fit_command(
             "levels per direction; dahl, stribeck, coulomb_viscous) with J and gravity from it.",
         ),
     ] = False,
-    log_format: Annotated[
-        str,
-        typer.Option(
-            "--format",
-            help="--trajectory: the log's format (table: CSV or Parquet with unit headers; "
-            "fricid extract --help lists every format).",
-        ),
-    ] = "table",
+    log_format: LogFormatOption = "table",
     route: Annotated[
         str,
         typer.Option(
