@@ -393,11 +393,12 @@ def extract_command(
     elif fmt == "epos":
         reader_options = {
             "flip_sign": flip_sign,
-            "temperature": temperature,
             "nominal_torque": nominal_torque * 1e-3,
             "torque_constant": torque_constant,
             "skip_bad_rows": skip_bad_rows,
         }
+        if "temperature" in given or not log.is_dir():  # a folder's samples: none made up
+            reader_options["temperature"] = temperature
     elif fmt == "channels":
         patterns, units = parse_column_map(channel_patterns, "--channels", "PATTERN")
         reader_options = {

@@ -84,14 +84,16 @@ def warn_steady(folder: str, quality: list[dict[str, Any]], lines: dict[str, lis
         )
 
 
-def quality_rows(names, velocity, keep, std, flagged, temperature: float) -> list[dict[str, Any]]:
+def quality_rows(
+    names, velocity, keep, std, flagged, temperature: float | None
+) -> list[dict[str, Any]]:
     """One quality-table row per file (the columns of :data:`fricid.extract.QUALITY_COLUMNS`;
     :mod:`fricid.io` sits below :mod:`fricid.extract`, so the names are spelled here)."""
     return [
         {
             "kind": "setpoint",
             "label": name,
-            "temperature": float(temperature),
+            "temperature": None if temperature is None else float(temperature),
             "velocity": float(v),
             "direction": int(np.sign(v)),
             "runs": 1,

@@ -299,13 +299,18 @@ def _read_dir(folder, pattern: str, **options: Any) -> list[tuple[RawLog, np.nda
     return sorted(read, key=lambda item: float(np.mean(item[0].velocity)))
 
 
+#: The per-file logs' placeholder temperature [degC] when none is given (a raw log needs one;
+#: the steady samples built from them record none).
+NO_TEMPERATURE = 25.0
+
+
 def epos_steady_samples(
     folder: str | os.PathLike[str],
     *,
     pattern: str = "*.csv",
     nominal_torque: float = DEFAULT_NOMINAL_TORQUE,
     flip_sign: bool = False,
-    temperature: float = 25.0,
+    temperature: float | None = None,
     load: float = 0.0,
     torque_constant: float | None = None,
     outlier_sigmas: float | None = OUTLIER_SIGMAS,
@@ -317,7 +322,9 @@ def epos_steady_samples(
     (as in the lead-screw recordings): friction is the mean motor torque over the file's rows
     that are not outliers, velocity the mean velocity over the same rows, direction the sign of
     the mean velocity, count the rows averaged and std their torque's sample standard
-    deviation. Load and temperature are the given constants (the recorder logs neither).
+    deviation. Load and temperature are the given constants (the recorder logs neither); with
+    no temperature given the samples have none (not measured, ``meta["temperature_source"]``
+    says so), rather than a made-up one printed as data downstream.
 
     Parameters
     ----------
@@ -377,7 +384,7 @@ def epos_steady_samples(
         pattern,
         nominal_torque=nominal_torque,
         flip_sign=flip_sign,
-        temperature=temperature,
+        temperature=NO_TEMPERATURE if temperature is None else temperature,  # the logs' own
         torque_constant=torque_constant,
         skip_bad_rows=skip_bad_rows,
     )
@@ -404,6 +411,11 @@ def epos_steady_samples(
         if not k.all()
     }
     quality = quality_rows(names, velocity, keep, std, flagged, temperature)
+    source = (
+        f"constant {temperature:g} degC, given (the recorder logs none)"
+        if temperature is not None
+        else "none: the recorder logs no temperature (give the joint's with --temperature)"
+    )
     warn_steady(str(folder), quality, dropped_lines)
     sem = [sem_autocorrelated(t) for t in torque]
     return FrictionSamples(
@@ -421,6 +433,7 @@ def epos_steady_samples(
             "files": names,
             "flip_sign": bool(flip_sign),
             "nominal_torque [N m]": float(nominal_torque),
+            "temperature_source": source,
             "outlier_sigmas": outlier_sigmas,
             "outlier_lines": dropped_lines,
             "skipped_rows": {
