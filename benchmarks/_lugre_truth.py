@@ -191,15 +191,15 @@ def _chirp(t: Truth, time, rng) -> Plan:
     return Plan("chirp_pd", q, v, _feedforward(t, q, a), kp, kd)
 
 
-def _trapezoid(t: Truth, time, rng) -> Plan:
-    """Moves between random targets at up to 1 rad/s, 4 rad/s^2, dwelling 0.2-0.6 s at each:
-    reversals and rests."""
+def _trapezoid(t: Truth, time, rng, dwell: tuple[float, float] = (0.2, 0.6)) -> Plan:
+    """Moves between random targets at up to 1 rad/s, 4 rad/s^2, dwelling 0.2-0.6 s (or
+    ``dwell``) at each: reversals and rests."""
     dt = time[1] - time[0]
     a = np.zeros_like(time)
     k, pos, at = 0, 0.0, 0.0
     vmax, amax = 1.0, 4.0
     while k < time.size:
-        k += round(rng.uniform(0.2, 0.6) / dt)  # dwell
+        k += round(rng.uniform(*dwell) / dt)
         target = rng.uniform(-0.8, 0.8)
         dist = target - pos
         if abs(dist) < 0.05:
@@ -215,7 +215,8 @@ def _trapezoid(t: Truth, time, rng) -> Plan:
     v = np.cumsum(a) * dt
     q = np.cumsum(v) * dt + at
     kp, kd = _pd_gains(t, 1.0 / dt)
-    return Plan("trapezoid_pd", q, v, _feedforward(t, q, a), kp, kd)
+    name = "trapezoid_pd" if dwell == (0.2, 0.6) else "trapezoid_brief_pd"
+    return Plan(name, q, v, _feedforward(t, q, a), kp, kd)
 
 
 def _torque_steps(t: Truth, time, rng) -> Plan:
@@ -245,6 +246,14 @@ def _creep(t: Truth, time, rng) -> Plan:
 
 _PLANS = {"chirp_pd": _chirp, "trapezoid_pd": _trapezoid, "torque_steps": _torque_steps}
 _PLANS["creep"] = _creep
+#: Trapezoids with brief dwells (0.05-0.25 s), resting under :data:`fricid.identify.dynamic.
+#: _outcome.RESTING` of their time like the foreign simulator's (15 %): the pooled widening's
+#: side of the threshold, as close to it as the simulator's dwells allow.
+_PLANS["trapezoid_brief_pd"] = lambda t, time, rng: _trapezoid(t, time, rng, BRIEF_DWELL)
+
+
+#: The dwell range [s] of ``trapezoid_brief_pd``.
+BRIEF_DWELL = (0.05, 0.25)
 
 
 def plan(truth: Truth, kind: str, seconds: float, rate: float, seed: int) -> Plan:
