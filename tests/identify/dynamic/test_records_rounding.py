@@ -27,3 +27,18 @@ def test_an_interval_reaching_the_range_up_to_rounding_is_open():
 def test_an_interval_inside_the_range_stays_closed():
     p = _one(0.25, 3.9, value=3.0, se=0.4)
     assert not (p.low_open or p.high_open or p.not_determined)
+
+
+def test_a_value_a_hair_above_a_zero_bound_is_at_the_bound():
+    """A new user's trial: ``stribeck_asym`` from a foreign log printed tau_c_pos 3.4e-36 N m
+    in [0, 2] without "at boundary" (a relative test against 0 never holds)."""
+    final = {"tau_c": {"value": 3.4e-36, "stderr": 0.3, "ci95_low": 0.0, "ci95_high": 0.6}}
+    p = _records(["tau_c"], final, {"tau_c": "N m"}, {"tau_c": [0.0, 2.0]}, True)["tau_c"]
+    assert p.at_bound and p.low_open
+
+
+def test_a_value_near_a_log_scaled_lower_bound_is_not_at_it():
+    final = {"sigma_0": {"value": 150.0, "stderr": 10.0, "ci95_low": 130.0, "ci95_high": 170.0}}
+    box = {"sigma_0": [100.0, 1e8]}
+    p = _records(["sigma_0"], final, {"sigma_0": "N m/rad"}, box, True)["sigma_0"]
+    assert not (p.at_bound or p.low_open)

@@ -43,6 +43,9 @@ _INTERVAL_KEYS = ("stderr", "ci95_low", "ci95_high")
 #: that end (rounding in the search's coordinates).
 EDGE = 1e-9
 
+#: A value within this share of a bound (of the range's width for a bound of 0) is at it.
+AT_BOUND = 1e-6
+
 
 def _withheld(table: dict[str, dict[str, float]]) -> dict[str, dict[str, float]]:
     """A parameter table without its standard errors and intervals (NaN)."""
@@ -278,6 +281,14 @@ def unresolved_rise(params: dict[str, Parameter]) -> dict[str, Parameter]:
     return out
 
 
+def _at(value: float, bound: float, box) -> bool:
+    """Whether ``value`` is at ``bound`` (:data:`AT_BOUND`): relative to the bound, or for a
+    bound of 0 to the range's width (3.4e-36 in [0, 2] is at 0; 150 in [100, 1e8] is not at
+    100, as a test against the width would have it on a log-scaled range)."""
+    scale = abs(bound) if bound != 0 else box[1] - box[0]
+    return bool(abs(value - bound) <= AT_BOUND * scale)
+
+
 def _records(
     names: list[str],
     final: dict[str, dict[str, float]],
@@ -290,10 +301,10 @@ def _records(
     """One :class:`~fricid.fitted.Parameter` per name of the final table: value, standard
     error, the cluster-robust 95 % interval (its ends open where they reach the search box,
     within :data:`EDGE` of its width: an end 0.20000000000000018 of a range from 0.2 is the
-    range's), and at a bound where the value is within ``1e-6`` relative of one; ``note``
-    says why an interval is missing (an unconverged fit's: no end is then open); ``notes`` a
-    parameter's own (the bias check's: widened, or not determined). A parameter whose interval
-    spans the whole search box is not identified, as an analytic fit says it."""
+    range's), and at a bound where the value is at one (:func:`_at`); ``note`` says why an
+    interval is missing (an unconverged fit's: no end is then open); ``notes`` a parameter's
+    own (the bias check's: widened, or not determined). A parameter whose interval spans the
+    whole search box is not identified, as an analytic fit says it."""
     out = {}
     for n in names:
         row, box = final[n], bounds.get(n)
@@ -318,11 +329,7 @@ def _records(
             ci95_halfwidth=(high - low) / 2,
             low_open=low_open,
             high_open=high_open,
-            at_bound=box is not None
-            and bool(
-                np.isclose(value, box[0], rtol=1e-6, atol=0)
-                or np.isclose(value, box[1], rtol=1e-6, atol=0)
-            ),
+            at_bound=box is not None and any(_at(value, b, box) for b in box),
             note=why,
             not_determined=is_not_determined(why, se, converged),
         )
