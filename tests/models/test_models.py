@@ -131,3 +131,10 @@ def test_fit_names_the_learned_families_too():
         fit(s, "rbff")
     text = str(info.value)
     assert "did you mean 'rbf'" in text and "hybrid" in text and "auto" in text, text
+
+
+def test_a_trajectory_model_typo_is_told_the_nearest_name():
+    from fricid.identify.dynamic._routes import route_for
+
+    with pytest.raises(ConfigError, match="did you mean 'lugre'"):
+        route_for("lugree", "filtered", False)

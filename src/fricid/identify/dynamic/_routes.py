@@ -13,6 +13,7 @@ because the two routes share their stage, covariance and search-box code.
 
 from __future__ import annotations
 
+import difflib
 import time
 from dataclasses import dataclass
 from typing import Any
@@ -56,9 +57,11 @@ def route_for(key: str, route: str, with_static: bool) -> str:
     models by the regression, Dahl and per-direction LuGre by the filtered route only,
     LuGre's filtered route with sweeps becomes ``two_stage``."""
     if key not in (*DYNAMIC_MODELS, *STATIC_MODELS):
+        near = difflib.get_close_matches(key, (*DYNAMIC_MODELS, *STATIC_MODELS), n=1)
         raise ConfigError(
             f"a trajectory identifies {', '.join(DYNAMIC_MODELS)} or a static model "
             f"({', '.join(STATIC_MODELS)}); got '{key}'"
+            + (f" (did you mean '{near[0]}'?)" if near else "")
         )
     if route not in ROUTES:
         raise ConfigError(f"unknown route '{route}'; one of: {', '.join(ROUTES)}")
