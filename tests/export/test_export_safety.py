@@ -593,3 +593,21 @@ def test_the_trust_line_names_an_in_sample_error_as_such():
     assert "in-sample (no held-out validation) error 0.0103 times the scatter" in line
     (line,) = [x for x in summary_lines(held) if x.startswith("trust verdict")]
     assert "(held-out error 1.23 times the scatter)" in line
+
+
+def test_a_dynamic_model_to_c_is_told_the_targets_that_take_it(tmp_path):
+    """A new user's trial: a LuGre model to C was first refused for its undetermined
+    parameters ("export anyway with --allow-undetermined"), and with that flag refused again
+    for having no C template: the first message sent the user to a flag that cannot help."""
+    from fricid.fitted import FittedModel
+    from fricid.models.lugre import PARAM_NAMES
+
+    values = dict(zip(PARAM_NAMES, (1e4, 1.0, 0.1, 1.0, 1.5, 0.05, 2.0), strict=True))
+    m = FittedModel.from_values("lugre", values)
+    m.parameters["w_s"] = replace(m.parameters["w_s"], not_determined=True, note="not determined")
+    path = m.save(tmp_path / "lugre.json")
+    res = CliRunner().invoke(app, ["export", str(path), "--to", "c", "--out", str(tmp_path / "c")])
+    assert res.exit_code == 2, res.output
+    assert "no template" in res.stderr and "--to mjcf" in res.stderr, res.stderr
+    assert "--allow-undetermined" not in res.stderr, res.stderr
+    assert not (tmp_path / "c").exists()

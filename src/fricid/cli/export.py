@@ -134,6 +134,7 @@ def export_command(
     from ..errors import ConfigError, DataError
     from ..export import (
         TARGETS,
+        ExportError,
         Smoothing,
         description_text,
         export_c,
@@ -142,6 +143,7 @@ def export_command(
         refuse_untrusted,
         write_text,
     )
+    from ..export.c import no_c_template
     from ..export.mjcf import is_lugre, lugre_mapping
     from ..fitted import FittedModel
 
@@ -158,6 +160,8 @@ def export_command(
             "MJCF are written from Python (the robots how-to)"
         )
     fitted = FittedModel.load(model)
+    if target == "c" and (why := no_c_template(fitted)):  # before a flag that would not help
+        raise ExportError(why)
     refuse_undetermined(fitted, allow_undetermined)
     refuse_untrusted(fitted, allow_untrusted)
     sha256 = file_sha256(model)

@@ -111,6 +111,25 @@ _FAMILIES: dict[str, tuple[Callable, tuple[str, ...]]] = {
 }
 
 
+def no_c_template(fitted: FittedModel) -> str:
+    """Why the C export cannot write ``fitted`` ("" when it can): a family it has no template
+    for (a dynamic model), said before any other check sends the user to a flag that would
+    not help."""
+    if fitted.model in ("hybrid", "gp") or fitted.kind == "rbf":
+        return ""
+    model = fitted.friction_model()
+    inner = model.inner if isinstance(model, WithTemperature) else model
+    base = inner.base if isinstance(inner, Asymmetric) else inner
+    if base.name in _FAMILIES and base.name in VISCOUS_TERM:
+        return ""
+    return (
+        f"the C export has no template for the model family '{base.name}' (it knows "
+        f"{', '.join(_FAMILIES)}, rbf, hybrid and gp); nothing was written; a dynamic model "
+        "exports --to mjcf (mapped to MuJoCo's friction), or --to yaml or urdf (its "
+        "Coulomb-viscous projection)"
+    )
+
+
 def _analytic_parts(fitted: FittedModel, smoothing: Smoothing) -> tuple[list[str], list[str]]:
     """(constant declarations, function definitions) of an analytic model."""
     model = fitted.friction_model()
@@ -118,11 +137,9 @@ def _analytic_parts(fitted: FittedModel, smoothing: Smoothing) -> tuple[list[str
     inner = model.inner if temp else model
     asym = isinstance(inner, Asymmetric)
     base = inner.base if asym else inner
-    if base.name not in _FAMILIES or base.name not in VISCOUS_TERM:
-        raise ExportError(
-            f"the C export has no template for the model family '{base.name}' (it knows "
-            f"{', '.join(_FAMILIES)} and rbf); nothing was written"
-        )
+    why = no_c_template(fitted)
+    if why:
+        raise ExportError(why)
     builder, guarded = _FAMILIES[base.name]
     viscous = VISCOUS_TERM[base.name]
     theta = fitted.theta()
