@@ -18,7 +18,7 @@ from pathlib import Path
 from ..errors import ConfigError, DataError
 from ..io._files import check_input
 
-__all__ = ["check_paths"]
+__all__ = ["check_paths", "read_samples_file"]
 
 Paths = Mapping[str, Path | None]
 
@@ -93,3 +93,23 @@ def check_paths(
     for name, path in (out_dirs or {}).items():
         if path is not None:
             _out_dir(name, Path(path))
+
+
+def read_samples_file(path: Path):
+    """:func:`fricid.io.read_samples` of ``path``; a raw log (time, position, torque) given
+    where samples go is told the commands that take it."""
+    from ..io import read_samples
+
+    try:
+        return read_samples(path)
+    except DataError as exc:
+        raw = exc.column == "friction" and "'time" in exc.message and "found" in exc.message
+        if not raw:
+            raise
+        raise DataError(
+            f"{exc.message}; a log of time, position and torque is a raw log: identify from "
+            "it with fricid fit LOG --trajectory, or extract samples from its constant-velocity "
+            "runs with fricid extract LOG",
+            file=exc.file,
+            column=exc.column,
+        ) from None

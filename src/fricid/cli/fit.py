@@ -21,7 +21,7 @@ from ._options import (
     parse_assignments,
     parse_ranges,
 )
-from ._paths import check_paths
+from ._paths import check_paths, read_samples_file
 from ._progress import QuietOption, fit_progress
 from ._trust_text import trust_lines
 
@@ -254,11 +254,10 @@ def fit_command(
             quiet=quiet,
             encoder_counts=encoder_counts,
         )
-    from ..io import read_samples
     from ..workflow import fit_samples, select_direction
 
     check_paths(inputs={"SAMPLES": samples}, out_files={"--out": out})
-    data = select_direction(read_samples(samples), direction)
+    data = select_direction(read_samples_file(samples), direction)
     settings = _rbf_settings(centers, inputs, backbone if key == "hybrid" else None) if rbf else {}
     if key == "auto" and learned:
         settings["learned"] = True

@@ -278,7 +278,17 @@ def read_trajectory_log(path: Path, reader: str = "table", reader_options: dict 
     from ..io import open_log
     from ..samples import RawLog
 
-    opened = open_log(path, reader, reader_options or {})
+    try:
+        opened = open_log(path, reader, reader_options or {})
+    except DataError as exc:  # friction samples where a log goes: the commands that take them
+        if "'fricid-samples/" not in exc.message:
+            raise
+        raise DataError(
+            "this is a friction-samples file (fricid extract's output), not a raw log: a "
+            "trajectory's identification and its report take a log of time, position, "
+            "velocity and torque; samples are fitted by fricid fit SAMPLES without --trajectory",
+            file=str(path),
+        ) from None
     if not isinstance(opened, RawLog) and not hasattr(opened, "__next__"):
         raise DataError(
             "this reader gives friction samples (steady-state means), not a time series: a "
