@@ -95,3 +95,17 @@ def test_a_coarse_encoders_static_fit_is_judged_by_the_fits_acceleration():
     # times the fit's here); the reversals, where a static law has no break-away, keep the
     # raw RMS up, not the median
     assert own["median_abs_error"] < fit_rms and held["median_abs_error"] < fit_rms
+
+
+@pytest.mark.parametrize(
+    ("column", "factor", "said"),
+    [("velocity", np.pi / 180, "degrees against radians"), ("time", 1e-3, "the time column")],
+)
+def test_a_log_with_a_wrong_unit_is_refused_as_the_fit_refuses_it(log, column, factor, said):
+    """A new user's trial: ``fricid report`` scored a log whose velocity header said deg/s on
+    rad/s data better than the right log, where ``fit`` refused it."""
+    from dataclasses import replace
+
+    bad = replace(log, **{column: getattr(log, column) * factor})
+    with pytest.raises(DataError, match=said):
+        predict_trajectory(truth_model(), bad)

@@ -97,7 +97,7 @@ import numpy as np
 from ..errors import DataError
 from ..fitted import FittedModel
 from ..metrics import verdict
-from ..samples import RawLog
+from ..samples import RawLog, check_trajectory_log
 from ._scatter import SECOND_DIFFERENCES
 from .dynamic._data import DerivativeFilter, sliding, uniform_series
 from .dynamic._filtered import DAHL, LUGRE, LUGRE_ASYM, _sub_velocity
@@ -271,10 +271,13 @@ def predict_trajectory(fitted: FittedModel, log: RawLog) -> TrajectoryPrediction
     Raises
     ------
     DataError
-        ``fitted`` holds no joint from a trajectory fit, or the log is too short.
+        ``fitted`` holds no joint from a trajectory fit, the log is too short, or it fails
+        the fit's own checks (:func:`fricid.samples.check_trajectory_log`: a column's unit or
+        sign, holes in the time).
     """
     source = None if log.source is None else str(log.source)
     J, p_x, p_y = _joint(fitted, source)
+    check_trajectory_log(log)  # as the fit checks it: a unit, a sign, a hole in the time
     info = fitted.provenance["trajectory"]
     series = uniform_series(log)
     static = str(fitted.model).strip().lower() not in DYNAMIC
