@@ -5,6 +5,7 @@ from __future__ import annotations
 import hashlib
 import logging
 import math
+import re
 from pathlib import Path
 
 import numpy as np
@@ -318,3 +319,19 @@ def test_real_recording_resaved_by_a_spreadsheet_reads_as_recorded(leadscrew_dir
     copy = tmp_path / "20.csv"
     copy.write_bytes("\r\n".join(line + ",," if line else line for line in lines).encode())
     np.testing.assert_array_equal(read_epos(copy).torque, read_epos(src).torque)
+
+
+def test_a_recording_resaved_with_decimal_commas_reads_as_recorded(leadscrew_dir, tmp_path):
+    """A new user's trial: the folder re-saved by a spreadsheet in a European locale (decimal
+    commas, the fields still ';'-separated) failed on every file ("malformed number '0,000'"),
+    with or without ``--decimal ,``."""
+    src = leadscrew_dir / "10.csv"
+    text = src.read_bytes().decode("latin-1")
+    comma = re.sub(r"(\d)\.(\d)", r"\1,\2", text).replace("\n", "\r\n")
+    assert "0,000" in comma
+    path = tmp_path / "10.csv"
+    path.write_bytes(comma.encode("latin-1"))
+    a, b = read_epos(src), read_epos(path)
+    np.testing.assert_array_equal(a.time, b.time)
+    np.testing.assert_array_equal(a.velocity, b.velocity)
+    np.testing.assert_array_equal(a.torque, b.torque)

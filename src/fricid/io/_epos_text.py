@@ -121,6 +121,20 @@ def _parse_header(lines: list[str], path: Path) -> tuple[dict[str, Any], int]:
     )
 
 
+_COMMA_NUMBER = r"^\s*[+-]?\d*,\d+(?:[eE][+-]?\d+)?\s*$"
+
+
+def _decimal_comma(text: pd.DataFrame) -> bool:
+    """Whether the data cells write a decimal comma: no cell holds a point, and a cell reads
+    as a number with a comma for it ('0,000', '-32,6'). The fields are ';'-separated, so a
+    comma within one is no separator (a spreadsheet in a European locale re-saves EPOS Studio's
+    '51.200' as '51,200')."""
+    cells = text.stack().astype(str)
+    return not cells.str.contains(".", regex=False).any() and bool(
+        cells.str.match(_COMMA_NUMBER).any()
+    )
+
+
 def _parse_data(
     lines: list[str], start: int, channels: list[str], path: Path, skip_bad_rows: bool
 ) -> tuple[np.ndarray, np.ndarray, list[dict[str, Any]]]:
@@ -152,6 +166,8 @@ def _parse_data(
             skipped.append({"line": int(line_no), "column": None, "text": str(text)})
         rows = rows[widths == k]
     text = rows.str.split(";", expand=True)
+    if _decimal_comma(text):  # a spreadsheet's European re-save: ';' between, ',' within
+        text = text.apply(lambda column: column.str.replace(",", ".", regex=False))
     data = np.empty((len(rows), k))
     for j in range(k):
         data[:, j] = pd.to_numeric(text[j].str.strip(), errors="coerce").to_numpy(float)
