@@ -27,7 +27,6 @@ from __future__ import annotations
 
 import os
 import re
-from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -37,6 +36,7 @@ from .. import __version__
 from ..fitted import FittedModel
 from ..models import Asymmetric, WithTemperature
 from ..models.smoothing import VISCOUS_TERM, Smoothing
+from ._c_families import FAMILIES, TINY, base_family, no_c_template
 from ._c_gp import gp_parts
 from ._c_hybrid import hybrid_parts, tail_code
 from ._c_temperature import ARRHENIUS_C, temperature_const
@@ -53,8 +53,6 @@ from .clamp import clamp_code
 
 __all__ = ["CCode", "c_code", "export_c"]
 
-_TINY = 1e-12  # the guard of fricid.models._analytic
-
 
 @dataclass(frozen=True)
 class CCode:
@@ -67,80 +65,15 @@ class CCode:
     function: str
 
 
-# -- analytic families: G(|v|, load, T) in C, operation for operation as in _analytic.py --------
-
-
-def _g_coulomb_viscous(p: dict[str, str], g: Callable[[str], str]) -> list[str]:
-    return [f"return {g('f_c')};"]
-
-
-def _g_stribeck(p: dict[str, str], g: Callable[[str], str]) -> list[str]:
-    return [
-        f"const double a = av / {p['w_s_guard']};",
-        f"return {g('tau_c')} + ({g('tau_s')} - {g('tau_c')}) * exp(-pow(a, {g('delta')}));",
-    ]
-
-
-def _g_msk(p: dict[str, str], g: Callable[[str], str]) -> list[str]:
-    return [
-        "const double al = fabs(load);",
-        f"const double a = av / {p['v_s_guard']};",
-        f"return {g('f_c')} + {g('f_ck')} * al + ({g('f_s')} - {g('f_c')} + "
-        f"({g('f_sk')} - {g('f_ck')}) * al) * exp(-pow(a, {g('xi')}));",
-    ]
-
-
-def _g_vlt(p: dict[str, str], g: Callable[[str], str]) -> list[str]:
-    return [
-        f"const double coulomb = {g('f_c')} + ({g('f_ctl')} + {g('f_stl')} * "
-        f"exp(-av / {p['v_tl0_guard']})) * fabs(load);",
-        f"const double denom = fmax(fabs({g('v_v0')} + {g('v_vT')} * temperature), "
-        f"{fmt_float(_TINY)});",
-        f"const double viscous = ({g('f_v0')} + {g('f_vT')} * temperature) * "
-        "(1.0 - exp(-av / denom));",
-        "return coulomb + viscous;",
-    ]
-
-
-_FAMILIES: dict[str, tuple[Callable, tuple[str, ...]]] = {
-    # family: (G body builder, parameters guarded by max(|x|, 1e-12) as in the Python model)
-    "coulomb_viscous": (_g_coulomb_viscous, ()),
-    "stribeck": (_g_stribeck, ("w_s",)),
-    "msk": (_g_msk, ("v_s",)),
-    "vlt": (_g_vlt, ("v_tl0",)),
-}
-
-
-def no_c_template(fitted: FittedModel) -> str:
-    """Why the C export cannot write ``fitted`` ("" when it can): a family it has no template
-    for (a dynamic model), said before any other check sends the user to a flag that would
-    not help."""
-    if fitted.model in ("hybrid", "gp") or fitted.kind == "rbf":
-        return ""
-    model = fitted.friction_model()
-    inner = model.inner if isinstance(model, WithTemperature) else model
-    base = inner.base if isinstance(inner, Asymmetric) else inner
-    if base.name in _FAMILIES and base.name in VISCOUS_TERM:
-        return ""
-    return (
-        f"the C export has no template for the model family '{base.name}' (it knows "
-        f"{', '.join(_FAMILIES)}, rbf, hybrid and gp); nothing was written; a dynamic model "
-        "exports --to mjcf (mapped to MuJoCo's friction), or --to yaml or urdf (its "
-        "Coulomb-viscous projection)"
-    )
-
-
 def _analytic_parts(fitted: FittedModel, smoothing: Smoothing) -> tuple[list[str], list[str]]:
     """(constant declarations, function definitions) of an analytic model."""
     model = fitted.friction_model()
     temp = isinstance(model, WithTemperature)  # the Arrhenius viscous term scales c by phi(T)
-    inner = model.inner if temp else model
-    asym = isinstance(inner, Asymmetric)
-    base = inner.base if asym else inner
-    why = no_c_template(fitted)
-    if why:
+    asym = isinstance(model.inner if temp else model, Asymmetric)
+    base = base_family(model)
+    if why := no_c_template(fitted):
         raise ExportError(why)
-    builder, guarded = _FAMILIES[base.name]
+    builder, guarded = FAMILIES[base.name]
     viscous = VISCOUS_TERM[base.name]
     theta = fitted.theta()
     d = base.n_params
@@ -159,7 +92,7 @@ def _analytic_parts(fitted: FittedModel, smoothing: Smoothing) -> tuple[list[str
                 f"static const double {prefix}{par.name} = {fmt_float(params[par.name], key)};"
                 f"  /* [{par.unit}] {what} */"
             )
-        p = {f"{name}_guard": f"fmax(fabs({prefix}{name}), {fmt_float(_TINY)})" for name in guarded}
+        p = {f"{name}_guard": f"fmax(fabs({prefix}{name}), {fmt_float(TINY)})" for name in guarded}
 
         def g(name: str, prefix: str = prefix) -> str:
             return f"{prefix}{name}"
