@@ -42,6 +42,7 @@ from fricid.export import (
 )
 from fricid.export._common import PLAIN_LIMIT, fmt_float, plain
 from fricid.export.clamp import clamp_inputs
+from fricid.export.mjcf import STIFF_SOLIMP
 from fricid.fitted import FittedModel, OptimizerRecord
 from fricid.models.smoothing import smooth_predict
 
@@ -215,6 +216,7 @@ def test_xml_exports_parse_back(method, data, name):
         "name": "elbow",
         "frictionloss": repr(proj.coulomb["both"]),
         "damping": repr(proj.viscous["both"]),
+        "solimpfriction": STIFF_SOLIMP,
     }
 
 

@@ -32,7 +32,7 @@ from ._common import (
     summary_lines,
     write_lines_checked,
 )
-from .mjcf import frictionloss_lines, is_lugre, mjcf_lugre_elements
+from .mjcf import STIFF_SOLIMP, frictionloss_lines, is_lugre, mjcf_lugre_elements
 from .projection import Projection, project
 
 __all__ = [
@@ -183,7 +183,7 @@ def mjcf_text(
             *summary_lines(fitted, source, sha256),
             *proj.summary(),
             *frictionloss_lines(fitted),
-            "copy frictionloss [N m] and damping [N m s/rad] onto your <joint>",
+            "copy frictionloss [N m], damping [N m s/rad] and solimpfriction onto your <joint>",
         ]
         elements = [
             ET.Element(
@@ -192,6 +192,7 @@ def mjcf_text(
                     "name": name,
                     "frictionloss": fmt_float(proj.coulomb["both"], "frictionloss"),
                     "damping": fmt_float(proj.viscous["both"], "damping"),
+                    "solimpfriction": STIFF_SOLIMP,
                 },
             )
         ]

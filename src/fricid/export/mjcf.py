@@ -49,6 +49,7 @@ from .projection import _nnls, operating_grid
 __all__ = [
     "FRICTIONLOSS_LINES",
     "MUJOCO_STRIBECK_EXPONENT",
+    "STIFF_SOLIMP",
     "LuGreMapping",
     "frictionloss_lines",
     "is_lugre",
@@ -59,11 +60,18 @@ __all__ = [
 #: The exponent of MuJoCo's LuGre Stribeck curve (module docstring; mujoco 4.0.0).
 MUJOCO_STRIBECK_EXPONENT = 2.0
 
+#: The ``solimpfriction`` a static MJCF export writes on its joint: the friction constraint's
+#: impedance 0.99-0.999 instead of MuJoCo's default 0.9-0.95, under which the joint creeps
+#: below ``frictionloss`` and breaks away far under it (the lead screw's model,
+#: ``benchmarks/results/mujoco_static.txt``: at 0.44 of it with the default, 1.04 with this,
+#: where a joint that sticks exactly reads 1.05 by the check's own ramp).
+STIFF_SOLIMP = "0.99 0.999 0.001"
+
 #: How MuJoCo applies the exported static friction, for the comment of a static MJCF export.
 FRICTIONLOSS_LINES = (
-    "MuJoCo applies frictionloss as a soft constraint (solreffriction, solimpfriction; default "
-    "solref 0.02 s): below frictionloss the joint creeps instead of sticking; a smaller time "
-    "constant (at least 2 timesteps) holds it closer",
+    "MuJoCo applies frictionloss as a soft constraint (solreffriction, solimpfriction): with "
+    "its default solimpfriction (0.9 0.95) the joint creeps below frictionloss and breaks away "
+    f'far under it; this joint\'s solimpfriction="{STIFF_SOLIMP}" holds it: keep it',
     "MuJoCo >= 4.0 also has LuGre friction (dcmotor actuator, lugre attribute): a dynamic "
     "model (fricid's lugre) exports to it; this static model has no bristle dynamics",
 )

@@ -40,9 +40,12 @@ from 0.2 ms (0.34 / 0.86), breaks away right at 2 ms (0.48 %) but diverges on th
 there, and 89 % low at 1 ms: recommended RK4 at 0.2 ms (implicitfast 0.1 ms); four times
 those steps miss (RK4 0.8 ms: 89.5 / 4.7; implicitfast 0.4 ms: 92 / 7.8). The virtual joint's
 truth (sigma_0 1e4, sigma_1 1): every integrator passes from 0.2 ms (implicitfast 0.42 /
-0.65). Static and Dahl fragments (``frictionloss``): 5 ms passes against the reference, but
-MuJoCo's soft ``frictionloss`` creeps so that the reference itself breaks away at 22-29 % of
-the friction (the comment says so).
+0.65). Static and Dahl fragments (``frictionloss``): 5 ms passes against the reference; with
+MuJoCo's default ``solimpfriction`` its soft ``frictionloss`` crept so that the reference
+itself broke away at 22-44 % of the friction; the export's stiffer one
+(:data:`fricid.export.mjcf.STIFF_SOLIMP`) holds it at 1.044 where a joint that sticks exactly
+reads 1.05 by this ramp (``benchmarks/results/mujoco_static.txt``). A reference still off by
+more than :data:`BREAKAWAY_TOLERANCE` is said in the comment.
 
 Without MuJoCo, :func:`default_timestep` gives the documented conservative default:
 ``implicitfast`` at the largest ladder step below ``0.05 sqrt(J / sigma_0)`` for a LuGre
@@ -212,7 +215,7 @@ class StepAdvice:
                 f"{self.static_level:.4g} N m, at any timestep"
                 + (
                     ": frictionloss is a soft constraint that creeps below it; a stiffer "
-                    "solreffriction (time constant of 2 timesteps) holds it closer"
+                    "solimpfriction holds it closer"
                     if self.static_level > 0 and not self.bristles
                     else ""
                 )
