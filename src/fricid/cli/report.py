@@ -243,7 +243,7 @@ def _trajectory_report(
     the reader's name and options for both."""
     from ..identify.trajectory_check import predict_trajectory
     from ..report import write_document
-    from ..report.trajectory import trajectory_report
+    from ..report.trajectory import output_error_note, trajectory_report
     from .trajectory import read_trajectory_log
 
     with tracker("report", None, quiet=quiet, timed=False) as track:
@@ -277,6 +277,9 @@ def _trajectory_report(
             highlight=False,
             soft_wrap=True,
         )
+    note = output_error_note(fitted)
+    if note:  # the errors above are not the fit's own residual
+        err_console.print(f"note: {note}", markup=False, highlight=False, soft_wrap=True)
     if held is not None:  # the verdict graded on the held-out log, or why not
         lines = [f"held-out {doc.meta['held-out grading']}"]
         if "torque scatter of the held-out log [N m]" in doc.meta:

@@ -25,7 +25,7 @@ from .document import Document, Figure, Note, Table
 from .model import parameter_table
 from .style import COLORS, new_figure, png, styled, torque_scale
 
-__all__ = ["trajectory_report"]
+__all__ = ["output_error_note", "trajectory_report"]
 
 #: Reversal windows drawn in a hysteresis figure (the first ones of the log, evenly spread).
 MAX_LOOPS = 12
@@ -158,7 +158,9 @@ def joint_frame(fitted: FittedModel) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
-def _log_figures(doc: Document, pred: TrajectoryPrediction, key: str, label: str) -> None:
+def _log_figures(
+    doc: Document, pred: TrajectoryPrediction, key: str, label: str, minimised: str
+) -> None:
     sec = doc.section(f"Torque on {label}")
     sec.add(
         Figure(
@@ -168,8 +170,8 @@ def _log_figures(doc: Document, pred: TrajectoryPrediction, key: str, label: str
             caption="The model along the measured motion (inverse dynamics: J times the "
             "acceleration, the friction law driven by the measured velocity, gravity). "
             "Residual = measured − predicted; the raw one holds the noise and, at each "
-            "break-away, the derivative filter's smoothing of the acceleration's jump; the "
-            "low-passed one is what the identification minimised.",
+            "break-away, the derivative filter's smoothing of the acceleration's jump; "
+            + minimised,
         )
     )
     sec.add(
@@ -195,6 +197,23 @@ def _trust_line(fitted: FittedModel) -> str:
         return Trust.from_dict(record).line()
     except (KeyError, TypeError, ValueError):
         return ""
+
+
+def output_error_note(fitted: FittedModel) -> str:
+    """Why the low-passed residual of the log is not what the identification minimised ("" when
+    it is): the fit refined its estimate by output error (an encoder too coarse to drive the
+    law with the measured velocity), whose residual was the simulated joint's."""
+    info = fitted.provenance.get("trajectory", {})
+    if not (info.get("output_error") or {}).get("applied"):
+        return ""
+    rms = (fitted.metrics or {}).get("rmse")
+    own = f": RMS {rms:.4g} N m" if isinstance(rms, int | float) else ""
+    return (
+        "the fit minimised the low-passed torque error of the joint simulated along the log "
+        f"(output error, as the encoder is too coarse to drive the law with the measured "
+        f"velocity){own}; the law driven by the log's quantised velocity misses by more where "
+        "the quantisation bites"
+    )
 
 
 def trajectory_report(
@@ -262,7 +281,9 @@ def trajectory_report(
             else "Give a second log (fricid report MODEL LOG HELDOUT_LOG) for held-out validation.",
         )
     )
-    _log_figures(doc, prediction, "log", log_label)
+    note = output_error_note(fitted)
+    minimised = f"{note}." if note else "the low-passed one is what the identification minimised."
+    _log_figures(doc, prediction, "log", log_label, minimised)
     say("figures: hysteresis at the reversals")
     sec = doc.section("Hysteresis at the reversals")
     n_rev = len(prediction.reversals())
@@ -294,7 +315,7 @@ def trajectory_report(
         )
     if heldout is not None:
         say("figures: the held-out log")
-        _log_figures(doc, heldout, "heldout", heldout_label)
+        _log_figures(doc, heldout, "heldout", heldout_label, minimised)
     say("parameters")
     sec = doc.section("Parameters")
     directions = any(n.endswith(("_pos", "_neg")) for n in fitted.parameters)
