@@ -204,3 +204,19 @@ def test_the_per_direction_coverage_is_the_direction_benchmarks_last_result():
         found["J" if name == "inertia" else name] = tuple(map(int, frac.split("/")))
     assert found == LUGRE_ASYM_COVERAGE["parameters"]
     assert tuple(map(int, total.split("/"))) == LUGRE_ASYM_COVERAGE["all"]
+
+
+def test_the_foreign_coverage_is_the_foreign_benchmarks_last_result():
+    """The caveat's foreign numbers (``LUGRE_FOREIGN_COVERAGE``) are the last "coverage per
+    truth" block of ``benchmarks/results/lugre_foreign.txt``."""
+    from fricid.identify.dynamic._outcome import COVERAGE_GOAL, LUGRE_FOREIGN_COVERAGE
+
+    lines = (REPO / "benchmarks" / "results" / "lugre_foreign.txt").read_text().splitlines()
+    row = _last_block(lines, "## coverage per truth")["foreign"]
+    order = ("sigma_0", "sigma_1", "sigma_2", "tau_c", "tau_s", "w_s", "delta", "J", "p_x", "p_y")
+    cells = {n: tuple(map(int, row[i].split("+")[0].split("/"))) for i, n in enumerate(order)}
+    total = (sum(c for c, _ in cells.values()), sum(n for _, n in cells.values()))
+    assert LUGRE_FOREIGN_COVERAGE["all"] == total
+    short = [(n, c, k) for n, (c, k) in cells.items() if k and c < COVERAGE_GOAL * k]
+    assert LUGRE_FOREIGN_COVERAGE["short"] == short
+    assert f"foreign data) {total[0]} of {total[1]}, J 2 of 4" in lugre_caveat()
