@@ -379,3 +379,8 @@ def test_a_samples_file_given_to_extract_names_the_commands_that_take_it(files):
     Python function) to a command-line user."""
     code, err = cli("extract", files / "s.csv")
     assert_one_line_exit_2(code, err, "fricid fit", "s.csv")
+
+
+def test_an_export_target_typo_is_told_the_nearest(files):
+    code, err = cli("export", files / "m.json", "--to", "mujoco")
+    assert_one_line_exit_2(code, err, "did you mean 'mjcf'")

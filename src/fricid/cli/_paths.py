@@ -39,7 +39,8 @@ def _out_file(name: str, path: Path) -> None:
     if getattr(path, "folder_meant", False):  # ``--out d/``: ``_options.OutPath``
         raise ConfigError(
             f"{name}: '{path}{os.sep}' names a folder (it ends with '{os.sep}'); give the name "
-            f"of a file to write (e.g. '{path / 'model'}' with its extension)"
+            f"of a file to write in it (e.g. '{path / 'model'}' with the format's extension: "
+            ".json, .csv, .xml, .urdf, .yaml)"
         )
     if path.is_dir():
         raise ConfigError(

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import difflib
 import sys
 from pathlib import Path
 from typing import Annotated
@@ -152,7 +153,12 @@ def export_command(
         inputs={"MODEL": model}, **{"out_dirs" if target == "c" else "out_files": {"--out": out}}
     )
     if target not in TARGETS:
-        raise ConfigError(f"unknown export target '{to}'; choose one of: {', '.join(TARGETS)}")
+        near = {"mujoco": "mjcf", "yml": "yaml", "ros": "yaml", "ros2": "yaml"}.get(target)
+        near = near or next(iter(difflib.get_close_matches(target, list(TARGETS), n=1)), None)
+        hint = f" (did you mean '{near}'?)" if near else ""
+        raise ConfigError(
+            f"unknown export target '{to}'{hint}; choose one of: {', '.join(TARGETS)}"
+        )
     if _is_arm_fit(model):
         raise ConfigError(
             f"{model} is a whole-arm fit (fricid robot fit's output): export its joints with "
