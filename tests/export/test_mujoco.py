@@ -57,7 +57,8 @@ def rms(a: np.ndarray, b: np.ndarray) -> float:
 @pytest.mark.slow  # 3 s measured under load (default run kept short)
 def test_cli_export_runs_in_mujoco_and_tracks_the_karnopp_joint(tmp_path, mujoco):
     """Coulomb-viscous truth, exported exactly: MuJoCo's trajectory follows the Python joint's;
-    frictionloss is a soft constraint, and a stiffer solreffriction follows it closer."""
+    frictionloss is a soft constraint, and the export's stiffer solimpfriction follows it
+    closer than MuJoCo's default (0.18 % of the span against 0.38 %, measured)."""
     cv = FittedModel.from_values(
         "coulomb_viscous", {"f_c": 0.3, "beta": 0.1}, operating_range=RANGE
     )
@@ -73,14 +74,13 @@ def test_cli_export_runs_in_mujoco_and_tracks_the_karnopp_joint(tmp_path, mujoco
     dt = 1e-3
     u = sine(dt, 2.0, 0.6)  # twice the Coulomb friction: stick, slip, stick
     ref = drive(u, dt, J, law=fitted_law(cv))
-    soft = run_torque(one_joint_xml(fragment, J, dt), u)
-    stiff = run_torque(
-        one_joint_xml(fragment, J, dt, joint_overrides={"solreffriction": "0.002 1"}), u
-    )
+    exported = run_torque(one_joint_xml(fragment, J, dt), u)
+    default = {"solimpfriction": "0.9 0.95 0.001"}  # MuJoCo's own
+    soft = run_torque(one_joint_xml(fragment, J, dt, joint_overrides=default), u)
     span = np.ptp(ref["position"])
     assert span > 0.3
-    assert rms(soft["position"], ref["position"]) < 0.01 * span
-    assert rms(stiff["position"], ref["position"]) < 0.5 * rms(soft["position"], ref["position"])
+    assert rms(exported["position"], ref["position"]) < 0.005 * span
+    assert rms(exported["position"], ref["position"]) < 0.6 * rms(soft["position"], ref["position"])
     # without frictionloss the joint runs away: the check sees friction at all
     free = run_torque(one_joint_xml('<joint name="elbow" />', J, dt), u)
     assert rms(free["position"], ref["position"]) > 0.1 * span

@@ -28,6 +28,7 @@ from fricid.export import (
     urdf_text,
     validate_model_dict,
 )
+from fricid.export.mjcf import FRICTIONLOSS_LINES, STIFF_SOLIMP
 from fricid.fitted import SCHEMA_VERSION, FittedModel
 from fricid.fleet.job import fit_row
 from fricid.fleet.manifest import JointSpec
@@ -75,10 +76,32 @@ def exports(fitted: FittedModel, path: Path) -> dict[str, str]:
 #: The exports' comment lines changed since the files were written, and how each was written
 #: then: a trajectory model's fit error says of which residual (and its estimator is named, on
 #: a line of its own, where the file records one), and an input the model does not read has
-#: no range (it had "load 0 to 0 N m").
+#: no range (it had "load 0 to 0 N m"). A static MJCF joint carries a stiffer
+#: solimpfriction, said in its comment, and the C export's refusal of a dynamic model names
+#: the targets that take it (:data:`_NOW_THEN`).
+_THEN_FRICTIONLOSS = (
+    "MuJoCo applies frictionloss as a soft constraint (solreffriction, solimpfriction; default "
+    "solref 0.02 s): below frictionloss the joint creeps instead of sticking; a smaller time "
+    "constant (at least 2 timesteps) holds it closer"
+)
 _LABEL = (
     ", of the residual the estimator fitted: low-passed and decimated, or a simulation's; "
     "fricid report gives the torque error on a log)"
+)
+
+
+_NOW_THEN = (
+    (FRICTIONLOSS_LINES[0], _THEN_FRICTIONLOSS),
+    (
+        "copy frictionloss [N m], damping [N m s/rad] and solimpfriction onto your <joint>",
+        "copy frictionloss [N m] and damping [N m s/rad] onto your <joint>",
+    ),
+    (f' solimpfriction="{STIFF_SOLIMP}"', ""),
+    (
+        "stribeck, msk, vlt, rbf, hybrid and gp); nothing was written; a dynamic model exports "
+        "--to mjcf (MuJoCo's friction), yaml or urdf (its Coulomb-viscous projection)",
+        "stribeck, msk, vlt and rbf); nothing was written",
+    ),
 )
 
 
@@ -89,6 +112,8 @@ def exports_as_before(fitted: FittedModel, path: Path) -> dict[str, str]:
     for target, text in exports(fitted, path).items():
         assert (_LABEL in text) == (trajectory and "fit on its data" in text), target
         text = text.replace(_LABEL, ")")
+        for now, then in _NOW_THEN:
+            text = text.replace(now, then)
         text = "\n".join(ln for ln in text.split("\n") if "estimator: " not in ln)
         if "load: not read by the model" in text:
             text = text.replace("load: not read by the model", "load 0 to 0 N m")
