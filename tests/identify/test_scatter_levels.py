@@ -155,3 +155,14 @@ def test_an_exact_copy_of_a_row_is_not_a_repeated_run():
     )
     assert not exact_copies(repeated).any()
     assert measurement_scatter(repeated).method == "between repeated runs"
+
+
+def test_samples_without_their_header_are_told_what_it_held():
+    """A new user's trial: the lead screw's samples with their '# meta' lines dropped (a
+    spreadsheet re-save) fell back to std/sqrt(count) and the verdict changed, unexplained."""
+    v = np.geomspace(0.1, 2, 8)
+    kw = dict(velocity=v, load=0.0, temperature=25.0, friction=0.1 + 0.01 * v, source="s")
+    bare = FrictionSamples(**kw, count=np.full(8, 100), std=np.full(8, 0.01))
+    assert "'# meta' header" in measurement_scatter(bare).caveat
+    told = FrictionSamples(**kw, count=np.full(8, 100), std=np.full(8, 0.01), meta={"x": 1})
+    assert "'# meta' header" not in measurement_scatter(told).caveat

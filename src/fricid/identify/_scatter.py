@@ -315,10 +315,16 @@ def measurement_scatter(
             np.full(n, s), "between repeated runs", f"{k} operating points repeated{said}"
         )
     if (samples.std > 0).any():
+        lost = (
+            "; fricid extract records autocorrelation-corrected errors in the samples file's "
+            "'# meta' header, which these samples lack (a spreadsheet re-save drops it)"
+            if not samples.meta
+            else ""
+        )
         return _scatter(
             samples.std / np.sqrt(samples.count),
             "within-run, std/sqrt(count)",
-            f"ignores autocorrelation of the raw samples: a lower bound{said}",
+            f"ignores autocorrelation of the raw samples: a lower bound{said}{lost}",
         )
     out = second_difference_scatter(samples)
     return Scatter(out.value, out.per_sample, out.method, out.caveat + said) if said else out
