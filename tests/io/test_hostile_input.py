@@ -315,6 +315,7 @@ def files(tmp_path_factory):
         # a trailing separator means a folder (it used to write a file named new_folder)
         (["export", "{f}/m.json", "--to", "mjcf", "--out", "{f}/new_folder/"], ["--out", "folder"]),
         (["fit", "{f}/s.csv", "--out", "{f}/new_folder/"], ["--out", "folder"]),
+        (["predict", "{f}/m.json", "-v", "1", "--out", "{f}/new_folder/"], ["--out", "folder"]),
         # a raw log where samples go, and samples where a log goes: the commands that take them
         (["fit", "{f}/log.csv"], ["fit LOG --trajectory", "fricid extract LOG"]),
         (["fit", "{f}/s.csv", "--trajectory"], ["friction-samples", "without --trajectory"]),

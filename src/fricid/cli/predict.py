@@ -10,6 +10,7 @@ from typing import Annotated
 import typer
 
 from ._app import app, err_console, handle_errors
+from ._options import out_option
 from ._paths import check_paths
 
 #: Significant digits of ``predict``'s numbers on a terminal (read by eye).
@@ -76,10 +77,7 @@ def predict_command(
         float, typer.Option(help="Half-width of the smoothing zone, in the velocity unit.")
     ] = 0.0,
     out: Annotated[
-        Path | None,
-        typer.Option(
-            "--out", "-o", help=("CSV file to write (atomically). Default: CSV on stdout.")
-        ),
+        Path | None, out_option("CSV file to write (atomically). Default: CSV on stdout.")
     ] = None,
     interval: Annotated[
         float | None,

@@ -11,6 +11,7 @@ import typer
 
 from ..errors import ConfigError
 from ._app import console, handle_errors, robot_app
+from ._options import out_option
 from ._paths import check_paths
 from .robot_simulate import _ROBOTS, _model
 
@@ -93,7 +94,7 @@ def _table(fit) -> None:
 @handle_errors
 def robot_fit_command(
     log: Annotated[Path, typer.Argument(help="The robot log (CSV, Parquet, ROS 2 bag, folder).")],
-    out: Annotated[Path, typer.Option("--out", "-o", help="The fit file to write (JSON).")],
+    out: Annotated[Path, out_option("The fit file to write (JSON).")],
     urdf: Annotated[Path | None, typer.Option(help="The robot's URDF.")] = None,
     robot: Annotated[
         str | None,
