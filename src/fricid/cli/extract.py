@@ -473,8 +473,12 @@ def extract_command(
         skipped = data.samples.meta.get("skipped_rows") or {}
         n_bad = sum(len(rows) for rows in skipped.values())
         err_console.print(
-            f"{len(data.samples)} steady operating points (directions "
-            f"{data.samples.directions()})"
+            f"{len(data.samples)} steady operating points ("
+            + " and ".join(
+                {-1: "backwards", 1: "forwards"}.get(int(d), "at rest")
+                for d in data.samples.directions()
+            )
+            + ")"
             + (f"; {n_bad} bad rows skipped in {len(skipped)} files" if n_bad else ""),
             markup=False,
             highlight=False,

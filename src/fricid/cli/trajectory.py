@@ -286,7 +286,8 @@ def read_trajectory_log(path: Path, reader: str = "table", reader_options: dict 
         raise DataError(
             "this is a friction-samples file (fricid extract's output), not a raw log: a "
             "trajectory's identification and its report take a log of time, position, "
-            "velocity and torque; samples are fitted by fricid fit SAMPLES without --trajectory",
+            "velocity and torque; samples go to fricid fit SAMPLES (without --trajectory), and "
+            "to fricid report with a model fitted on samples",
             file=str(path),
         ) from None
     if not isinstance(opened, RawLog) and not hasattr(opened, "__next__"):

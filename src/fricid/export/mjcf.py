@@ -69,9 +69,10 @@ STIFF_SOLIMP = "0.99 0.999 0.001"
 
 #: How MuJoCo applies the exported static friction, for the comment of a static MJCF export.
 FRICTIONLOSS_LINES = (
-    "MuJoCo applies frictionloss as a soft constraint (solreffriction, solimpfriction): with "
-    "its default solimpfriction (0.9 0.95) the joint creeps below frictionloss and breaks away "
-    f'far under it; this joint\'s solimpfriction="{STIFF_SOLIMP}" holds it: keep it',
+    "MuJoCo applies frictionloss as a soft constraint (solreffriction, solimpfriction): under "
+    "any torque the joint creeps; with MuJoCo's default solimpfriction (0.9 0.95) a slow "
+    "torque ramp sets it sliding well below frictionloss, with this joint's "
+    f'solimpfriction="{STIFF_SOLIMP}" it creeps far less and slides at frictionloss: keep it',
     "MuJoCo >= 4.0 also has LuGre friction (dcmotor actuator, lugre attribute): a dynamic "
     "model (fricid's lugre) exports to it; this static model has no bristle dynamics",
 )
