@@ -58,7 +58,7 @@ def rms(a: np.ndarray, b: np.ndarray) -> float:
 def test_cli_export_runs_in_mujoco_and_tracks_the_karnopp_joint(tmp_path, mujoco):
     """Coulomb-viscous truth, exported exactly: MuJoCo's trajectory follows the Python joint's;
     frictionloss is a soft constraint, and the export's stiffer solimpfriction follows it
-    closer than MuJoCo's default (0.18 % of the span against 0.38 %, measured)."""
+    closer than MuJoCo's default."""
     cv = FittedModel.from_values(
         "coulomb_viscous", {"f_c": 0.3, "beta": 0.1}, operating_range=RANGE
     )

@@ -133,6 +133,7 @@ def predict_command(
         for k, v in given.items()
     }
     units = {k: u for k, u in flags.items() if u}
+    cols: dict = {}  # the --input file's columns
     if input_file is not None:
         if velocity:
             raise ConfigError("give points either with --velocity or with --input, not both")
@@ -152,7 +153,7 @@ def predict_command(
             raise ConfigError("give the points: --velocity (repeatable), or --input FILE")
         X = points_matrix(fitted, si["velocity"], si["load"], si["temperature"])
     zone_si = float(to_si(zone, velocity_unit or "rad/s", "velocity"))
-    _say_ignored(fitted, X, given, cols if input_file is not None else {})
+    _say_ignored(fitted, X, given, cols)
     loose = [n for n, p in fitted.parameters.items() if p.not_determined and not p.fixed]
     if loose and fitted.kind != "rbf":  # as export refuses them: said, not hidden
         err_console.print(
