@@ -11,7 +11,7 @@ Angles are in radians (``<compiler angle="radian"/>``) and gravity is the model'
 
 Friction goes to MuJoCo's joint ``frictionloss`` [N m] (dry friction, a soft constraint: see
 :data:`fricid.export.mjcf.FRICTIONLOSS_LINES`) and ``damping`` [N m s/rad] (viscous), with
-``solreffriction`` at two timesteps on every joint (:data:`SOLREF_LINE`): with MuJoCo's default
+``solreffriction`` at two timesteps on every joint (:data:`SOLREF_LINES`): with MuJoCo's default
 time constant of 0.02 s a light joint's friction stays far below its ``frictionloss`` while it
 slides, the constraint's force being the joint's inertia times the velocity over the time
 constant until it reaches the level. Measured with mujoco 4.0.0 (``mj_forward`` on the
@@ -19,7 +19,12 @@ exported Panda at the middle of its ranges, one joint moving): joint 7 (friction
 N m) held 0.004, 0.042 and 0.174 N m at 0.1, 0.3 and 1 rad/s with the default, and 0.157,
 0.555 and 0.559 N m at 0.03, 0.1 and 0.3 rad/s with the 2 ms written at the file's 1 ms
 timestep (0.559 from 0.03 rad/s at 0.125 ms); joint 1 (0.682 N m) its level from 0.1 rad/s
-with the default, from 0.01 with the 2 ms. ``tests/export/test_robot_mjcf.py`` checks it.
+with the default, from 0.01 with the 2 ms. Every joint also gets the static export's stiffer
+``solimpfriction`` (:data:`fricid.export.mjcf.STIFF_SOLIMP`): under a slow torque ramp to 1.5
+times a frictionloss of 0.6 N m (gravity off, the arm at rest mid-range, the break-away test of
+:mod:`fricid.export.mujoco_step`), the Panda's joints 1, 4 and 7 set sliding at 0.13, 0.55 and
+1.01 of it with MuJoCo's default (0.9 0.95), at 1.008, 1.044 and 1.029 with the stiffer one.
+``tests/export/test_robot_mjcf.py`` checks both.
 MuJoCo cannot hold the rest of fricid's laws: a Stribeck rise (``tau_s`` above ``tau_c``) and
 different levels per direction are lost (the mean of the two directions is written); each
 loss is one of the returned notes and a line of the file's comment. Data never becomes code
@@ -44,14 +49,17 @@ from ..robot._pin import pinocchio
 from ..sim.robot_friction import ArmFriction
 from ._common import ExportError, fmt_float, plain
 from .descriptions import _check_joint, _xml, write_text
-from .mjcf import FRICTIONLOSS_LINES
+from .mjcf import STIFF_SOLIMP
 from .projection import project
 
-#: The exported comment's line on ``solreffriction`` (module notes).
-SOLREF_LINE = (
+#: The exported comment's lines on ``solreffriction`` and ``solimpfriction`` (module notes).
+SOLREF_LINES = (
     "solreffriction = 2 timesteps on every joint (the stiffest MuJoCo allows by default): "
     "with the default 0.02 s a light joint's friction stays far below frictionloss while it "
-    "slides; keep it at 2 timesteps if you change the timestep"
+    "slides; keep it at 2 timesteps if you change the timestep",
+    f'solimpfriction = "{STIFF_SOLIMP}" on every joint: MuJoCo applies frictionloss as a soft '
+    "constraint under which a joint creeps; with the default (0.9 0.95) a heavy joint set "
+    "sliding by a slow torque ramp well below frictionloss, with this one at it: keep it",
 )
 
 __all__ = ["joint_friction", "robot_mjcf_text", "write_robot_mjcf"]
@@ -197,6 +205,7 @@ def _joint_attributes(
         attrs["frictionloss"] = fmt_float(fl, "frictionloss")
         attrs["damping"] = fmt_float(damping, "damping")
         attrs["solreffriction"] = f"{fmt_float(2 * timestep, 'timestep')} 1"
+        attrs["solimpfriction"] = STIFF_SOLIMP
     return attrs, notes
 
 
@@ -272,8 +281,7 @@ def robot_mjcf_text(
         "friction: frictionloss = Coulomb [N m], damping = viscous [N m s/rad]"
         if frictions
         else "no friction written",
-        *(FRICTIONLOSS_LINES[:1] if frictions else ()),
-        *((SOLREF_LINE,) if frictions else ()),
+        *(SOLREF_LINES if frictions else ()),
         *notes,
     ]
     ET.indent(root)
