@@ -69,3 +69,47 @@ def test_cli_refuses_then_names_an_undetermined_parameter(tmp_path):
         app, ["export", str(determined), "--to", "mjcf", "-o", str(out), "--no-timestep-check"]
     )
     assert res.exit_code == 0 and "NOT DETERMINED" not in out.read_text()
+
+
+def test_the_projection_says_which_undetermined_parameters_it_rests_on(tmp_path):
+    """A Coulomb-viscous projection (yaml, urdf, the MJCF line without dcmotor) is a function
+    of the steady state: an undetermined tau_s moves it, an undetermined sigma_1 does not."""
+    fitted = trajectory_model(("tau_s", "sigma_1"))
+    fitted.parameters["tau_s"] = dataclasses.replace(fitted.parameters["tau_s"], bounds=(0.0, 2.0))
+    path = tmp_path / "lugre.json"
+    fitted.save(path)
+    for target, name in (("yaml", "f.yaml"), ("urdf", "f.urdf"), ("mjcf", "f.xml")):
+        out = tmp_path / name
+        args = ["export", str(path), "--to", target, "-o", str(out), "--allow-undetermined"]
+        res = runner.invoke(app, [*args, *(NO_CHECK if target == "mjcf" else ())])
+        assert res.exit_code == 0, res.output
+        text = " ".join(out.read_text().split()).replace("# ", "")
+        assert "rests on tau_s, which the trajectory does not determine" in text, target
+        assert "search range 0 to 2 N m" in text
+        assert "rests on sigma_1" not in text
+    determined = trajectory_model(("sigma_1",))
+    determined.save(path)
+    out = tmp_path / "g.yaml"
+    res = runner.invoke(
+        app, ["export", str(path), "--to", "yaml", "-o", str(out), "--allow-undetermined"]
+    )
+    assert res.exit_code == 0 and "rests on" not in out.read_text()
+
+
+def test_the_span_is_the_projection_at_the_ends_of_the_search_range():
+    from fricid.export import project
+
+    fitted = trajectory_model(("tau_s",))
+    fitted.parameters["tau_s"] = dataclasses.replace(fitted.parameters["tau_s"], bounds=(0.0, 2.0))
+    (line,) = project(fitted, False).rests_on
+    pairs = []
+    for tau_s in (0.0, 0.5, 2.0):
+        other = FittedModel.from_values(
+            "lugre", {**LUGRE, "tau_s": tau_s}, operating_range={"velocity": [-2.0, 2.0]}
+        )
+        proj = project(other, False)
+        pairs.append((proj.coulomb["both"], proj.viscous["both"]))
+    fc, b = zip(*pairs, strict=True)
+    assert f"F_c spans {min(fc):.4g} to {max(fc):.4g} N m" in line
+    assert f"b {min(b):.4g} to {max(b):.4g} N m s/rad" in line
+    assert max(fc) - min(fc) > 0.1  # the Stribeck level moves the Coulomb level

@@ -44,7 +44,7 @@ from ..errors import ConfigError
 from ..fitted import FittedModel
 from ..models import lugre
 from ._common import ExportError, fmt_float, plain, summary_lines
-from .projection import _nnls, operating_grid
+from .projection import _nnls, operating_grid, rests_on
 
 __all__ = [
     "FRICTIONLOSS_LINES",
@@ -120,6 +120,8 @@ class LuGreMapping:
     static : ``(frictionloss, damping)``, the Coulomb-viscous projection of the steady state.
     static_rms_error, static_max_error : N m, that projection's error over the grid (the
         bristle dynamics are lost on top of it).
+    static_rests_on : lines on the undetermined parameters that projection rests on
+        (:func:`fricid.export.projection.rests_on`).
     speed : the ``|v|`` range of the grid [rad/s].
     """
 
@@ -133,6 +135,7 @@ class LuGreMapping:
     static_rms_error: float
     static_max_error: float
     speed: tuple[float, float]
+    static_rests_on: tuple[str, ...] = ()
 
     @property
     def relative_error(self) -> float:
@@ -169,7 +172,7 @@ class LuGreMapping:
             f"{self.static_max_error:.4g} N m, and the bristle dynamics (pre-sliding, "
             "break-away, hysteresis) are lost"
         )
-        return lines
+        return lines + list(self.static_rests_on)
 
 
 def _params(fitted: FittedModel) -> np.ndarray:
@@ -230,6 +233,7 @@ def lugre_mapping(fitted: FittedModel, velocity_range=None) -> LuGreMapping:
         static_rms_error=float(np.sqrt(np.mean(static_resid**2))),
         static_max_error=float(np.abs(static_resid).max()),
         speed=info["speed"],
+        static_rests_on=tuple(rests_on(fitted, X, False)),
     )
 
 

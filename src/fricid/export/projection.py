@@ -27,9 +27,9 @@ import numpy as np
 
 from ..errors import DataError
 from ..fitted import FittedModel
-from ._common import ExportError, model_name, percent
+from ._common import ExportError, model_name, percent, plain, undetermined_parameters
 
-__all__ = ["N_LEVELS", "N_VELOCITY", "Projection", "operating_grid", "project"]
+__all__ = ["N_LEVELS", "N_VELOCITY", "Projection", "operating_grid", "project", "rests_on"]
 
 #: Velocity points per direction, and load / temperature levels, of the projection grid.
 N_VELOCITY = 200
@@ -62,6 +62,7 @@ class Projection:
     relative_error: float
     ranges: dict[str, Any] = field(default_factory=dict)
     lost: list[str] = field(default_factory=list)
+    rests_on: list[str] = field(default_factory=list)
 
     def summary(self) -> list[str]:
         """Lines for a comment in the exported file."""
@@ -93,7 +94,7 @@ class Projection:
         ]
         if self.lost:
             lines.append("lost in this format: " + "; ".join(self.lost))
-        return lines
+        return lines + self.rests_on
 
 
 def _range(fitted: FittedModel, name: str, override) -> tuple[float, float]:
@@ -255,21 +256,16 @@ def project(
     v = X[:, 0]
     s = np.sign(v)
     pos = v > 0
-    side_fits = {
-        "positive": _nnls(np.column_stack([s[pos], v[pos]]), F[pos]),
-        "negative": _nnls(np.column_stack([-s[~pos], -v[~pos]]), -F[~pos]),
-    }
+    side_fits = _pairs(F, v, True)
+    fits = side_fits if per_direction else _pairs(F, v, False)
     if per_direction:
-        fits = side_fits
         approx = np.where(
             pos,
             fits["positive"][0] * s + fits["positive"][1] * v,
             fits["negative"][0] * s + fits["negative"][1] * v,
         )
     else:
-        both = _nnls(np.column_stack([s, v]), F)
-        fits = {"both": both}
-        approx = both[0] * s + both[1] * v
+        approx = fits["both"][0] * s + fits["both"][1] * v
     resid = approx - F
     k = int(np.argmax(np.abs(resid)))
     rms_f = float(np.sqrt(np.mean(F**2)))
@@ -285,4 +281,73 @@ def project(
         relative_error=rms_e / rms_f if rms_f > 0 else 0.0,
         ranges=info,
         lost=_lost(fitted, X, F, info, per_direction, side_fits),
+        rests_on=rests_on(fitted, X, per_direction),
     )
+
+
+def _pairs(F: np.ndarray, v: np.ndarray, per_direction: bool) -> dict[str, np.ndarray]:
+    """The least-squares ``(F_c, b)``, both >= 0, of friction ``F`` at velocities ``v``: per
+    direction (``positive``, ``negative``: magnitudes) or for both (``both``)."""
+    s = np.sign(v)
+    if not per_direction:
+        return {"both": _nnls(np.column_stack([s, v]), F)}
+    pos = v > 0
+    return {
+        "positive": _nnls(np.column_stack([s[pos], v[pos]]), F[pos]),
+        "negative": _nnls(np.column_stack([-s[~pos], -v[~pos]]), -F[~pos]),
+    }
+
+
+def rests_on(fitted: FittedModel, X: np.ndarray, per_direction: bool) -> list[str]:
+    """One line per parameter the trajectory does not determine
+    (:func:`fricid.export.undetermined_parameters`, exported with ``--allow-undetermined``)
+    that moves the Coulomb-viscous projection over the grid ``X``: how far ``F_c`` and ``b``
+    move as it spans its search range, the others held. A LuGre model's sigma_0 and sigma_1
+    shape only its transients and never appear; a parameter whose search range the file does
+    not record is named without a span."""
+    names = undetermined_parameters(fitted)
+    if not names or fitted.kind == "rbf":
+        return []
+    model = fitted.friction_model()
+    order = list(model.param_names)
+    theta = fitted.theta()
+    v = X[:, 0]
+
+    def pairs_at(name: str, value: float) -> np.ndarray:
+        th = theta.copy()
+        th[order.index(name)] = value
+        with np.errstate(all="ignore"):
+            F = np.asarray(model.predict(th, X), dtype=float)
+        if not np.isfinite(F).all():
+            return np.full((2, 2), np.nan)
+        return np.array(list(_pairs(F, v, per_direction).values()))
+
+    lines = []
+    here = np.array(list(_pairs(fitted.predict(X, warn=False), v, per_direction).values()))
+    for name in names:
+        p = fitted.parameters[name]
+        unit = p.unit or model.units.get(name, "")
+        unit = f" {plain(unit)}" if unit and unit != "1" else ""
+        ends = [float(b) for b in (p.bounds or ()) if math.isfinite(float(b))]
+        if len(ends) < 2:
+            moved = pairs_at(name, 1.01 * p.value + 1e-12)
+            if np.allclose(moved, here, rtol=1e-9, atol=1e-15):
+                continue
+            lines.append(
+                f"the projection rests on {plain(name)}, which the trajectory does not "
+                "determine (its search range is not recorded): F_c and b are no better "
+                "determined"
+            )
+            continue
+        every = np.stack([here, *(pairs_at(name, x) for x in ends)])
+        every = every[np.isfinite(every).all(axis=(1, 2))]
+        if np.allclose(every, here, rtol=1e-9, atol=1e-15):
+            continue  # the steady state does not read it
+        fc, b = every[..., 0], every[..., 1]
+        lines.append(
+            f"the projection rests on {plain(name)}, which the trajectory does not determine: "
+            f"across its search range {ends[0]:.4g} to {ends[1]:.4g}{unit} (the others as "
+            f"identified) F_c spans {fc.min():.4g} to {fc.max():.4g} N m and b "
+            f"{b.min():.4g} to {b.max():.4g} N m s/rad"
+        )
+    return lines
