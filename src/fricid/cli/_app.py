@@ -51,6 +51,16 @@ __all__ = [
     "signal_handlers",
 ]
 
+
+def _argument_type(self, ctx) -> str | None:
+    """An argument with a metavar shows it alone, as an option does; typer would add its
+    Python type (``LOG <list[Path]>``), which means nothing on a command line."""
+    return None if self.metavar is not None else _typer_argument_type(self, ctx)
+
+
+_typer_argument_type = typer.core.TyperArgument.display_type_rich
+typer.core.TyperArgument.display_type_rich = _argument_type
+
 app = typer.Typer(
     name="fricid",
     help=(

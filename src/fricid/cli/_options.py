@@ -64,6 +64,7 @@ FixOption = Annotated[
     list[str] | None,
     typer.Option(
         "--fix",
+        metavar="NAME=VALUE",
         help="Hold a parameter at a value, NAME=VALUE (SI units), e.g. --fix delta=1. Repeatable.",
     ),
 ]
@@ -73,6 +74,7 @@ BoundOption = Annotated[
     list[str] | None,
     typer.Option(
         "--bound",
+        metavar="NAME=LOW:HIGH",
         help=(
             "Search range of a parameter, NAME=LOW:HIGH (SI units). Repeatable. Default ranges "
             "scale with the data."

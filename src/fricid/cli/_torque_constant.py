@@ -49,6 +49,7 @@ UrdfPositionOption = Annotated[
     list[str] | None,
     typer.Option(
         "--urdf-position",
+        metavar="NAME=VALUE",
         help="The position of another URDF joint during the log, NAME=VALUE in rad (m for a "
         "prismatic joint), e.g. --urdf-position shoulder=0.5; repeatable; joints not given "
         "are at zero.",

@@ -126,9 +126,9 @@ def export_command(
     libm only, no allocation. URDF, MJCF and YAML hold Coulomb plus viscous friction, so they
     get the least-squares projection over the model's operating range, with its error and
     what is lost stated in a comment. Every file names the model by its file name (escaped)
-    and the SHA-256 of its bytes; no other text of the model file is written except through
-    an escaper, and every number is checked finite. Files are written atomically; on error
-    nothing is.
+    and the SHA-256 of its bytes; no other text of the model file is written except as
+    escaped plain text, and every number is checked finite. A file is written whole or not at
+    all: on error nothing is.
     """
     from rich.markup import escape
 

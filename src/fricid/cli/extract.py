@@ -209,6 +209,7 @@ def extract_command(
         list[str] | None,
         typer.Option(
             "--map",
+            metavar="QUANTITY=COLUMN[:UNIT]",
             help="generic: QUANTITY=COLUMN[:UNIT], repeatable, e.g. --map time=t:ms --map "
             "velocity=dq:deg/s --map current=i:A --map position=q:deg --map "
             "temperature=T:degC. time, velocity and torque or current are required; a unit "
@@ -220,6 +221,7 @@ def extract_command(
         list[str] | None,
         typer.Option(
             "--channels",
+            metavar="QUANTITY=PATTERN:UNIT",
             help="channels: QUANTITY=PATTERN:UNIT, repeatable, one per quantity (velocity or "
             "position, torque or current, optionally temperature). In PATTERN, {field} matches "
             "part of a file name and * any text: --channels "
@@ -230,6 +232,7 @@ def extract_command(
         list[str] | None,
         typer.Option(
             "--var",
+            metavar="QUANTITY=NAME:UNIT",
             help="mat: QUANTITY=NAME:UNIT, repeatable; a struct field as a.b, variables "
             "joined end to end as a,b. A log: time, velocity, torque or current (position, "
             "temperature optional). A table of means: velocity and friction (load, "
@@ -347,9 +350,9 @@ def extract_command(
     """Extract friction samples from a raw log: segment the constant-velocity traverses, median
     filter the current, torque = K I (eq. 13), average the repetitions per position bin,
     separate friction and gravity (eq. 9-11), fit p_x, p_y (eq. 7) and take the gravity torque
-    as the load (eq. 12). Writes samples with velocity [rad/s], load [N m], temperature [degC],
-    friction [N m], direction, count, std [N m]. A flag that the format does not use is an
-    error."""
+    as the load (eq. 12; equations of the BAS-RBFNN paper). Writes samples with velocity
+    [rad/s], load [N m], temperature [degC], friction [N m], direction, count, std [N m]. A
+    flag that the format does not use is an error."""
     from ..io import write_samples
     from ..io.registry import gives_samples
     from ..units import to_si

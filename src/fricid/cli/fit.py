@@ -174,7 +174,9 @@ def fit_command(
     ] = "filtered",
     reader_option: Annotated[
         list[str] | None,
-        typer.Option("--reader-option", help="--trajectory: a reader option KEY=VALUE."),
+        typer.Option(
+            "--reader-option", metavar="KEY=VALUE", help="--trajectory: a reader option KEY=VALUE."
+        ),
     ] = None,
     encoder_counts: Annotated[
         float | None,
@@ -193,7 +195,7 @@ def fit_command(
     (--model auto), and friction with inertia and gravity from any trajectory
     (--trajectory).
 
-    Prints the fit report (after lmfit's): method, evaluations and convergence status; data
+    Prints a least-squares fit report: method, evaluations and convergence status; data
     points, variables, chi-square (SSE [N^2 m^2]), reduced chi-square, AIC, BIC, R^2; each
     parameter with its standard error, 95 % confidence interval and start, flagged at a
     boundary, at its initial value or not determined; correlations above 0.1. The RBF network

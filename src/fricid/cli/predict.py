@@ -32,20 +32,27 @@ def predict_command(
     ],
     velocity: Annotated[
         list[float] | None,
-        typer.Option("--velocity", "-v", help="Velocity of a point (repeat for several points)."),
+        typer.Option(
+            "--velocity",
+            "-v",
+            metavar="<float>",
+            help="Velocity of a point (repeat for several points).",
+        ),
     ] = None,
     load: Annotated[
         list[float] | None,
         typer.Option(
+            metavar="<float>",
             help="Joint load [N m by default]: one value for all points, or one per --velocity. "
-            "Needed when the model depends on load."
+            "Needed when the model depends on load.",
         ),
     ] = None,
     temperature: Annotated[
         list[float] | None,
         typer.Option(
+            metavar="<float>",
             help="Temperature [degC by default]: one value, or one per --velocity. Needed when "
-            "the model depends on temperature."
+            "the model depends on temperature.",
         ),
     ] = None,
     input_file: Annotated[
@@ -77,7 +84,7 @@ def predict_command(
         float, typer.Option(help="Half-width of the smoothing zone, in the velocity unit.")
     ] = 0.0,
     out: Annotated[
-        Path | None, out_option("CSV file to write (atomically). Default: CSV on stdout.")
+        Path | None, out_option("CSV file to write (whole or not at all). Default: CSV on stdout.")
     ] = None,
     interval: Annotated[
         float | None,

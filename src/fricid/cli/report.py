@@ -79,6 +79,7 @@ def report_command(
         list[str] | None,
         typer.Option(
             "--reader-option",
+            metavar="KEY=VALUE",
             help="Trajectory models: a reader option KEY=VALUE for both logs, as given to "
             "`fricid fit --trajectory` (e.g. temperature=25 for a log without that column).",
         ),

@@ -142,9 +142,10 @@ def robot_export_command(
     models: Annotated[
         list[str],
         typer.Argument(
+            metavar="MODEL",
             help="The joints' model files: JOINT=FILE, or FILE (the joint is its name without "
             ".json), or a folder of them (every *.json, joints in file-name order), or a "
-            "whole-arm fit (fricid robot fit's output: every joint, in the URDF's order)."
+            "whole-arm fit (fricid robot fit's output: every joint, in the URDF's order).",
         ),
     ],
     to: Annotated[

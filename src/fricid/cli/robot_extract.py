@@ -167,6 +167,7 @@ def robot_extract_command(
         list[str] | None,
         typer.Option(
             "--joints",
+            metavar="NAMES",
             help="Joints to extract (comma-separated or repeated); default every joint of the "
             "log that has a constant-velocity sweep.",
         ),
@@ -186,6 +187,7 @@ def robot_extract_command(
         list[str] | None,
         typer.Option(
             "--torque-constant",
+            metavar="JOINT=K",
             help="JOINT=K [N m/A] (repeatable): tau = K I (eq. 13) for a log of currents.",
         ),
     ] = None,

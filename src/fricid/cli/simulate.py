@@ -111,8 +111,8 @@ def simulate_command(
         str,
         typer.Option(
             help="both (each direction over the whole range) or split (forward runs logged on "
-            "the lower half of the range, backward runs on the upper half: eq. 11 cannot pair "
-            "them, extract identifies gravity jointly)."
+            "the lower half of the range, backward runs on the upper half: the BAS-RBFNN paper's "
+            "eq. 11 cannot pair them, extract identifies gravity jointly)."
         ),
     ] = "both",
     trajectory: Annotated[
