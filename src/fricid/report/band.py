@@ -4,7 +4,7 @@ where the model follows the data and wide where it misses them."""
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 
 import numpy as np
 
@@ -15,7 +15,16 @@ from .document import Figure, Note
 from .plots import plot_measured, speed_sides
 from .style import COLORS, new_figure, png, styled, torque_scale, velocity_scale
 
-__all__ = ["prediction_band", "prediction_band_figure"]
+__all__ = ["held_at", "prediction_band", "prediction_band_figure"]
+
+
+def held_at(inputs: Sequence[str], whose: str = "the") -> str:
+    """A caption's words for the inputs besides velocity that a curve over velocity holds
+    at their median: ``"the median load and temperature"`` (``whose`` first) for a model of
+    all three, ``"the median load"`` for one of velocity and load, ``""`` for a model of
+    velocity alone (nothing is held)."""
+    held = [name for name in ("load", "temperature") if name in inputs]
+    return f"{whose} median {' and '.join(held)}" if held else ""
 
 
 def prediction_band(
@@ -27,9 +36,9 @@ def prediction_band(
     title: str = "Where a new measurement falls: the 95 % prediction interval",
 ) -> bytes:
     """The friction magnitude against speed on a log axis, per direction: the model
-    (line) and its ``level`` prediction interval (band) at the median load and temperature,
-    the measured samples (markers). ``interval(X)`` returns ``(friction, low, high)`` [N m]
-    (:meth:`fricid.fitted.FittedModel.predict_interval`)."""
+    (line) and its ``level`` prediction interval (band) at the median load and temperature
+    (those the model uses), the measured samples (markers). ``interval(X)`` returns
+    ``(friction, low, high)`` [N m] (:meth:`fricid.fitted.FittedModel.predict_interval`)."""
     vf, vunit = velocity_scale(velocity_unit)
     tf, tunit = torque_scale(samples.friction)
     with styled():
@@ -85,12 +94,13 @@ def prediction_band_figure(
             ", and the error every sample shares (the arm's identified gravity, which the "
             "residuals cannot show), added as it is"
         )
+    held = held_at(fitted.inputs_used())
     return Figure(
         "prediction_interval",
         "Where a new measurement falls: the 95 % prediction interval",
         prediction_band(moving, interval, velocity_unit=velocity_unit),
         caption="The band holds 95 % of new measured samples at each speed (noise "
-        f"included), at the median load and temperature; its width follows {how}: narrow "
+        f"included){f', at {held}' if held else ''}; its width follows {how}: narrow "
         "where the model follows the data, wide where it misses them. There is no band inside "
         "a gap between measured speeds: nothing measured backs one there.",
     )

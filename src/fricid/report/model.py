@@ -27,7 +27,7 @@ from ..identify import evaluate
 from ..identify.trust import Trust, not_determined
 from ..samples import FrictionSamples
 from . import interactive, plots
-from .band import prediction_band_figure
+from .band import held_at, prediction_band_figure
 from .document import Document, Figure, Note, Table
 from .trust import quality_frame, scatter_explanation, trust_text
 
@@ -172,9 +172,11 @@ def _model_description(fitted: FittedModel) -> str:
 
         return get_predictor(fitted.model).describe(fitted.state) + "."
     if fitted.kind == "rbf":
+        *first, last = fitted.inputs_used()
+        of = f"{', '.join(first)} and {last}" if first else last
         return (
             "RBF neural network (BAS-RBFNN paper, eq. 14-15): Gaussian basis functions of "
-            "velocity, load and temperature, linear output layer."
+            f"{of}, linear output layer."
         )
     m = fitted.friction_model()
     return f"{m.title} ({m.equation}); parameters {', '.join(m.param_names)}."
@@ -263,7 +265,7 @@ def model_report(
                 velocity_unit=velocity_unit,
                 title=f"{fitted.model}: friction against velocity",
             ),
-            caption=_curves_caption(samples),
+            caption=_curves_caption(samples, fitted.inputs_used()),
             plotly=interactive.friction_figure(
                 samples,
                 fitted.predict,
@@ -471,10 +473,13 @@ def _param_text(fitted: FittedModel) -> str:
     return " ".join(bits)
 
 
-def _curves_caption(samples: FrictionSamples) -> str:
+def _curves_caption(samples: FrictionSamples, inputs: tuple[str, ...]) -> str:
+    """The caption of the friction against velocity; ``inputs`` are the model's (a curve
+    holds at the band's median only those of load and temperature that the model uses)."""
+    held = held_at(inputs, "each band's")
     parts = [
-        "Markers are the measured friction samples, lines the model evaluated at each "
-        "band's median load and temperature."
+        "Markers are the measured friction samples, lines the model"
+        + (f" evaluated at {held}." if held else ".")
     ]
     if np.ptp(samples.temperature) > 0 or np.ptp(samples.load) > 0:
         parts.append(

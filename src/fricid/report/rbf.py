@@ -35,6 +35,7 @@ from ..models.rbf import (
     tail_order,
 )
 from ..samples import FrictionSamples
+from .band import held_at
 from .document import Note, Table
 
 __all__ = ["coefficient_names", "hidden_layer", "rbf_bootstrap", "rbf_parameter_items"]
@@ -274,14 +275,16 @@ def rbf_parameter_items(
             "'Can I trust this?')."
         )
     hybrid = fitted.model == "hybrid"
+    held = held_at(fitted.inputs_used())
     main: list = [
         Table(
             "prediction_ci",
             "Predicted friction with bootstrap 95 % intervals over the operating range",
             pd.DataFrame(table),
             caption=(
-                f"At {N_SPEEDS} speeds spread over the measured ones, on each side of motion, "
-                f"median load and temperature of the samples. Residual bootstrap, {n_boot} "
+                f"At {N_SPEEDS} speeds spread over the measured ones, on each side of motion"
+                + (f", at {held} of the samples" if held else "")
+                + f". Residual bootstrap, {n_boot} "
                 "resamples, hidden layer held fixed (percentile intervals): it understates "
                 "the uncertainty of searched centres"
                 + (", and the backbone is held at its fit" if hybrid else "")
