@@ -214,9 +214,18 @@ def test_report_for_the_rbf_network_with_bootstrap(paper1_samples, tmp_path):
 
 
 def _trust_section(doc: Document):
+    """The "Can I trust this?" section and the verdict line (the document's first row)."""
     sec = doc.sections[0]
     assert sec.title == "Can I trust this?"
-    return sec, sec.items[0].text
+    return sec, doc.meta["trust"]
+
+
+def _says_once(doc: Document, line: str) -> None:
+    """The verdict is stated once in the Markdown and once in the HTML (a note in the trust
+    section repeated the first row word for word)."""
+    verdict = line.split(",")[0]  # "Trust: yes" (the rest is escaped differently)
+    assert render_markdown(doc).count(verdict) == 1
+    assert render_html(doc).count(verdict) == 1
 
 
 def test_report_validation_limit_is_a_size_not_a_time(leadscrew):
@@ -235,7 +244,8 @@ def test_trust_yes_for_a_converged_fit_within_noise(leadscrew, tmp_path):
     doc = model_report(fitted, leadscrew, trust=assess_trust(fitted, leadscrew))
     sec, line = _trust_section(doc)
     assert line.startswith("Trust: yes, because the fit converged")
-    assert doc.meta["trust"] == line and next(iter(doc.meta)) == "trust"
+    assert next(iter(doc.meta)) == "trust"
+    _says_once(doc, line)
     # the trust check ran lovo itself, and says so; the quality table of the EPOS reader is shown
     assert "held-out RMSE (lovo, interior levels, lovo run here)" in sec.text, sec.text
     assert "lovo run here: 16 folds" in sec.text
@@ -245,6 +255,7 @@ def test_trust_yes_for_a_converged_fit_within_noise(leadscrew, tmp_path):
     write_document(doc, tmp_path / "rep")
     md = (tmp_path / "rep" / "report.md").read_text()
     assert md.index("Can I trust this?") < md.index("## Parameters")
+    assert md.count("Trust: yes") == 1
     params = __import__("pandas").read_csv(tmp_path / "rep" / "parameters.csv")
     assert params["95% interval"].str.match(r"^\[.+, .+\]$").all()
     assert (params["95% CI low"] <= params["value"]).all()
@@ -291,6 +302,7 @@ def test_trust_no_for_a_bas_fit_with_a_tiny_budget(leadscrew):
     doc = model_report(fitted, leadscrew, trust=assess_trust(fitted, leadscrew))
     sec, line = _trust_section(doc)
     assert line.startswith("Trust: no, because the fit did NOT converge")
+    _says_once(doc, line)
     assert "--method bas+lm" in line
     assert "NOT converged: method 'bas' ended after 200 of 200 evaluations" in sec.text
     params = next(s for s in doc.sections if s.title == "Parameters")

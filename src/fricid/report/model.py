@@ -427,9 +427,9 @@ def model_report(
 
 
 def _trust_section(doc: Document, trust: Trust) -> None:
-    """The "Can I trust this?" section (first): the verdict, then the diagnostics."""
+    """The "Can I trust this?" section (first): the diagnostics behind the verdict, which
+    the document's first row states (once: a note here repeated it word for word)."""
     sec = doc.section("Can I trust this?", trust_text(trust))
-    sec.items.insert(0, Note(trust.line(), kind="text" if trust.level == "yes" else "warning"))
     if trust.quality:
         sec.add(
             Table(
