@@ -179,6 +179,10 @@ def report_command(
         path = write_document(doc, out)
     console.print(str(path), highlight=False, soft_wrap=True)
     err_console.print(str(doc.meta["trust"]), markup=False, highlight=False, soft_wrap=True)
+    if "torque unit" in doc.meta:
+        err_console.print(
+            str(doc.meta["torque unit"]), markup=False, highlight=False, soft_wrap=True
+        )
     err_console.print(_wrote(doc, out))
 
 

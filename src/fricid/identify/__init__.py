@@ -23,6 +23,7 @@ from __future__ import annotations
 
 from ..samples import samples_hash
 from ._scatter import Scatter, measurement_scatter, sample_weights
+from ._torque_unit import torque_unit_mismatch
 from .dispatch import KINDS, fit, kind_of
 from .problem import IdentificationProblem
 from .static.least_squares import evaluate
@@ -48,5 +49,6 @@ __all__ = [
     "sample_weights",
     "samples_hash",
     "select",
+    "torque_unit_mismatch",
     "validate",
 ]

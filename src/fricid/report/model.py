@@ -23,7 +23,7 @@ import numpy as np
 import pandas as pd
 
 from ..fitted import FittedModel, Parameter
-from ..identify import evaluate
+from ..identify import evaluate, torque_unit_mismatch
 from ..identify.trust import Trust, not_determined
 from ..samples import FrictionSamples
 from . import interactive, plots
@@ -249,7 +249,10 @@ def model_report(
         if trust.reused
         else "computed for this report"
     )
-    doc.meta = {"trust": trust.line(), "trust record": record, **doc.meta}
+    unit = torque_unit_mismatch(fitted, samples)
+    # beside the verdict: every error below compares two units
+    warn = {"torque unit": f"warning: {unit}."} if unit else {}
+    doc.meta = {"trust": trust.line(), "trust record": record, **warn, **doc.meta}
     _trust_section(doc, trust)
 
     appendix: list = []
@@ -399,6 +402,8 @@ def model_report(
             "paper's Table 3 measures.",
         )
     )
+    if unit:
+        sec.add(Note(f"The errors on {label} do not measure the model: {unit}.", "warning"))
     note = _range_note(fitted, samples)
     if note is not None:
         sec.add(note)

@@ -1,0 +1,76 @@
+"""A samples file whose friction header names the wrong torque unit (N m numbers under
+``friction [mN m]``) is told as such where a model meets it, instead of a 1e5 % relative error
+and R² near minus a million with no hint; honest samples, and a drive whose friction is merely
+larger, are told nothing."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from fricid.cli import app
+from fricid.identify import fit, torque_unit_mismatch
+from fricid.identify.trust import assess_trust
+from fricid.io import epos_steady_samples, read_samples, write_samples
+from fricid.report import model_report
+
+
+@pytest.fixture(scope="module")
+def files(leadscrew_dir, tmp_path_factory):
+    """The lead screw's samples as written (N m), the same under ``friction [mN m]``, and a
+    model identified on the honest ones."""
+    folder = tmp_path_factory.mktemp("unit")
+    honest = write_samples(epos_steady_samples(leadscrew_dir), folder / "honest.csv")
+    text = honest.read_text(encoding="utf-8")
+    assert text.count("friction [N m]") == 1
+    damaged = folder / "damaged.csv"
+    damaged.write_text(text.replace("friction [N m]", "friction [mN m]"), encoding="utf-8")
+    fitted = fit(read_samples(honest), "stribeck_asym")
+    model = folder / "model.json"
+    fitted.save(model)
+    return honest, damaged, fitted, model
+
+
+def test_a_header_in_the_wrong_unit_is_named(files):
+    honest, damaged, fitted, _ = files
+    assert torque_unit_mismatch(fitted, read_samples(honest)) is None
+    said = torque_unit_mismatch(fitted, read_samples(damaged))
+    assert said is not None
+    assert "predicts 1000x the measured friction" in said
+    assert "friction column's header in damaged.csv" in said
+    assert "numbers in N m under a header in mN m" in said
+
+
+def test_the_reverse_factor_and_an_honest_larger_friction(files):
+    honest, _, fitted, _ = files
+    samples = read_samples(honest)
+    mnm = samples.__class__(
+        velocity=samples.velocity, load=None, temperature=None, friction=1e3 * samples.friction
+    )
+    said = torque_unit_mismatch(fitted, mnm)
+    assert said is not None and "numbers in mN m under a header in N m" in said
+    # another drive, 1000x the friction but its own shape: no ratio close to 1000 everywhere
+    speed = np.abs(samples.velocity) / np.abs(samples.velocity).max()
+    other = samples.__class__(
+        velocity=samples.velocity,
+        load=None,
+        temperature=None,
+        friction=1e3 * samples.friction * (0.7 + 0.6 * speed),
+    )
+    assert torque_unit_mismatch(fitted, other) is None
+
+
+def test_report_says_why_its_errors_mean_nothing(files, tmp_path):
+    honest, damaged, fitted, model = files
+    for path, told in ((honest, False), (damaged, True)):
+        samples = read_samples(path)
+        doc = model_report(fitted, samples, trust=assess_trust(fitted, samples, max_work=1))
+        assert ("torque unit" in doc.meta) is told
+        notes = [i.text for s in doc.sections for i in s.items if hasattr(i, "kind")]
+        assert any("do not measure the model" in n for n in notes) is told
+    out = tmp_path / "rep"
+    result = CliRunner().invoke(app, ["-q", "report", str(model), str(damaged), "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    assert "warning: the model predicts 1000x" in result.stderr
+    assert "header in damaged.csv" in (out / "report.md").read_text(encoding="utf-8")
