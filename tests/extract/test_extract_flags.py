@@ -89,6 +89,22 @@ def test_epos_folder_output_holds_both_directions_as_the_help_says(leadscrew_dir
     assert samples.directions() == (-1, 1) and len(samples) == 32
 
 
+def test_one_epos_recording_records_no_temperature_unless_given(leadscrew_dir, tmp_path):
+    out = tmp_path / "s.csv"
+    res = run("extract", leadscrew_dir / "10.csv", "--format", "epos", "-o", out)
+    assert res.exit_code == 0, res.output
+    assert "no temperature logged" in res.output
+    samples = read_samples(out)
+    assert "temperature" not in samples.measured  # 25 degC was written, made up
+    header = next(line for line in out.read_text().splitlines() if line.startswith("velocity"))
+    assert "temperature" not in header
+    res = run(
+        "extract", leadscrew_dir / "10.csv", "--format", "epos", "--temperature", "30", "-o", out
+    )
+    assert res.exit_code == 0, res.output
+    assert np.all(read_samples(out).temperature == 30.0)
+
+
 def test_skip_bad_rows_on_a_resaved_real_folder(leadscrew_dir, tmp_path):
     folder = tmp_path / "resaved"
     shutil.copytree(leadscrew_dir, folder)

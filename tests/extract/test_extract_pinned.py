@@ -153,7 +153,10 @@ def _epos(name: str) -> Any:
 #: (:func:`fricid.extract.segment`: the cut had followed the clock's rounding, so a shifted clock
 #: changed the samples): the per-direction frictions moved by at most 0.09 % (paper2+faults, three
 #: set-points 10 samples larger), paper1's not at all (its trimming counts did); the EPOS
-#: recordings' are unchanged.
+#: recordings' are unchanged. The EPOS pins once more when a single recording given no
+#: temperature stopped recording a made-up 25 degC: its samples' and quality table's temperature,
+#: the diagnostics' temperature set-point and the set-point labels' "25 degC" are gone, and the
+#: samples' meta says ``temperature_source``; every other number is the same.
 CASES = {
     "paper1": lambda: _simulated("paper1"),
     "paper1+faults": lambda: _simulated("paper1+faults", 7_777),

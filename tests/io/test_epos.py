@@ -18,6 +18,7 @@ from fricid.io import (
     read_epos,
     read_epos_dir,
 )
+from fricid.workflow import load_joint
 
 RPM = 2 * math.pi / 60
 
@@ -66,9 +67,25 @@ def test_real_file_header_units_and_position(leadscrew_dir):
     # first row: 0.000;-1;-32.8  (rpm, % of 9.84 mNm)
     assert log.velocity[0] == pytest.approx(-RPM)
     assert log.torque[0] == pytest.approx(-0.328 * DEFAULT_NOMINAL_TORQUE)
-    assert log.current is None and np.all(log.temperature == 25.0)
+    assert log.current is None
     assert log.position[0] == 0.0 and log.meta["position_source"] == "integrated velocity"
     np.testing.assert_allclose(log.position[-1], np.trapezoid(log.velocity, log.time))
+
+
+def test_real_file_given_no_temperature_says_so_and_its_samples_record_none(leadscrew_dir):
+    log = read_epos(leadscrew_dir / "10.csv")
+    # the recorder logs no temperature: the log's column is a placeholder, and says so
+    assert not log.temperature_measured
+    assert log.meta["temperature_source"].startswith("none")
+    samples = load_joint(leadscrew_dir / "10.csv", "epos").samples
+    assert "temperature" not in samples.measured and np.isnan(samples.temperature).all()
+    assert samples.meta["temperature_source"].startswith("none")
+    assert all(row["temperature"] is None for row in samples.meta["quality"])
+    assert not any("degC" in row["label"] for row in samples.meta["quality"])
+    given = read_epos(leadscrew_dir / "10.csv", temperature=30.0)
+    assert given.temperature_measured and np.all(given.temperature == 30.0)
+    samples = load_joint(leadscrew_dir / "10.csv", "epos", reader_options={"temperature": 30.0})
+    assert "temperature" in samples.samples.measured and np.all(samples.samples.temperature == 30)
 
 
 def test_real_folder_steady_samples_and_asymmetry(leadscrew_dir):

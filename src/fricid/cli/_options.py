@@ -143,8 +143,8 @@ TemperatureOption = Annotated[
     typer.Option(
         "--temperature",
         help="The temperature [degC] to record when the log has none (a table log without a "
-        "temperature column: give it explicitly; a folder of EPOS steady recordings records "
-        "none unless given; the default is for the other readers).",
+        "temperature column: give it explicitly; an EPOS recording, file or folder, records none "
+        "unless given; the default is for the other readers).",
     ),
 ]
 

@@ -400,7 +400,7 @@ def extract_command(
             "torque_constant": torque_constant,
             "skip_bad_rows": skip_bad_rows,
         }
-        if "temperature" in given or not log.is_dir():  # a folder's samples: none made up
+        if "temperature" in given:  # the recorder logs none: none made up
             reader_options["temperature"] = temperature
     elif fmt == "channels":
         patterns, units = parse_column_map(channel_patterns, "--channels", "PATTERN")

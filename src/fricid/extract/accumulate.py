@@ -361,12 +361,15 @@ def _speeds(speeds: list[float], limit: int = 6) -> str:
 
 def _label(members: list[Record], files: set, velocity: float | None, temperature) -> str:
     """A row's label: the files of its runs when the log came from several files, else its
-    set-point (``+0.2 rad/s, 25 degC``) or, for dropped runs, their speeds."""
+    set-point (``+0.2 rad/s, 25 degC``; ``+0.2 rad/s`` without a temperature) or, for dropped
+    runs, their speeds."""
     if len(files) > 1:
         names = sorted({str(r.source).replace("\\", "/").rsplit("/", 1)[-1] for r in members})
         return ", ".join(names[:3]) + (f" and {len(names) - 3} more" if len(names) > 3 else "")
     if velocity is None:
         return f"runs at {_speeds([r.speed for r in members], 3)} rad/s"
+    if not np.isfinite(temperature):  # the log has none
+        return f"{velocity:+.4g} rad/s"
     return f"{velocity:+.4g} rad/s, {temperature:.4g} degC"
 
 

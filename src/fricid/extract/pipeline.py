@@ -22,6 +22,7 @@ import numpy as np
 
 from ..errors import ConfigError, DataError, DataQualityWarning, user_stacklevel
 from ..samples import (
+    NO_TEMPERATURE_SOURCE,
     RawLog,
     coarse_velocity,
     position_unit_problem,
@@ -66,12 +67,15 @@ class _Source:
     says so there, a position channel is assumed otherwise) and, per source, a logged
     velocity that is not its position channel's derivative (``problems``:
     :func:`fricid.samples.velocity_mismatch`, judged on each log or chunk that moves) and
-    a coarse encoder's finite-difference velocity (``coarse``: judged on the first chunk)."""
+    a coarse encoder's finite-difference velocity (``coarse``: judged on the first chunk);
+    ``temperature_source`` is the first log's ``meta["temperature_source"]``, when it has one
+    (:data:`fricid.samples.NO_TEMPERATURE_SOURCE`: the samples record no temperature)."""
 
     def __init__(self, logs: RawLog | Iterable[RawLog]) -> None:
         self.logs = logs
         self.name: str | None = None
         self.position_source: str | None = None
+        self.temperature_source: str | None = None
         self.problems: dict[str, str] = {}
         self.units: dict[str, str | None] = {}  # per source: position_unit_problem's finding
         self.coarse: dict[str, str | None] = {}  # per source: coarse_velocity's finding
@@ -104,6 +108,7 @@ class _Source:
             if self.name is None:
                 self.name = log.source
                 self.position_source = str(meta.get("position_source", "channel"))
+                self.temperature_source = meta.get("temperature_source")
             source = log.source or "the log"
             own = meta.get("position_source", "channel") == "channel"
             if own and "velocity_from" not in meta and source not in self.problems:
@@ -306,6 +311,9 @@ def extract(
     )
     shape = (t_set.size, v_set.size, bins.n_bins)
     cells = acc.table(keep, t_label, v_label, shape)
+    measured = stream.temperature_source != NO_TEMPERATURE_SOURCE
+    if not measured:  # the log's placeholder: one set-point, no temperature recorded
+        t_set = np.full(t_set.size, np.nan)
     pooled = pool_cells(cells, int(np.prod(shape)) * 2)
     if not (pooled.count > 0).any():
         raise DataError(
@@ -335,6 +343,8 @@ def extract(
         cells,
         (counts.dropped_samples, counts.unsteady_samples),
     )
+    if not measured:  # the rest and unsteady rows too
+        unflagged = replace(unflagged, temperature=np.full(len(unflagged), np.nan))
     meta = {"extract": options, "quality": unflagged.rows()}
     forward = np.array([r.direction > 0 for r in kept], dtype=np.intp)
     group = (t_label * v_set.size + v_label) * 2 + forward
@@ -377,11 +387,13 @@ def extract(
     samples, by_direction = (
         replace(
             x,
+            **({} if measured else {"temperature": None}),
             meta={
                 **x.meta,
                 "quality": quality.rows(),
                 "extract": options,
                 **({"notes": list(notes)} if notes else {}),
+                **({"temperature_source": NO_TEMPERATURE_SOURCE} if not measured else {}),
                 **({} if residual is None else {"gravity_residual": residual.as_meta()}),
                 **({"channel_problems": stream.found()} if stream.found() else {}),
             },

@@ -234,8 +234,9 @@ class QualityTable:
         lines = [head]
         for i in order:
             scatter = f"{self.scatter[i]:.3g}" if np.isfinite(self.scatter[i]) else "-"
+            t = f"{self.temperature[i]:.4g}" if np.isfinite(self.temperature[i]) else "-"
             lines.append(
-                f"{self.kind[i]:<9}{self.temperature[i]:>8.4g}{self.velocity[i]:>12.4g}"
+                f"{self.kind[i]:<9}{t:>8}{self.velocity[i]:>12.4g}"
                 f"{int(self.direction[i]):>4}{int(self.runs[i]):>5}{int(self.kept[i]):>8}"
                 f"{int(self.dropped_rest[i]):>7}{int(self.dropped_transient[i]):>7}"
                 f"{int(self.dropped_outlier[i]):>6}{int(self.dropped_saturated[i]):>6}"
@@ -263,7 +264,7 @@ def flag_scatter(table: QualityTable, ratio: float = SCATTER_RATIO) -> QualityTa
     flagged = np.zeros(len(table), dtype=bool)
     note = table.note.copy()
     sp = np.flatnonzero(table.setpoints & np.isfinite(table.scatter))
-    temps = np.round(table.temperature[sp], 6)
+    temps = np.round(np.nan_to_num(table.temperature[sp], nan=np.inf), 6)  # none: one group
     spread = np.fmax(table.scatter, table.run_scatter)
     typical = float(np.median(spread[sp])) if sp.size else np.nan
     for key in set(zip(temps.tolist(), table.direction[sp].tolist(), strict=True)):
@@ -296,7 +297,8 @@ def _append(text: str, more: str) -> str:
 
 def _name(table: QualityTable, i: int) -> str:
     v = float(table.velocity[i])
-    where = f"{v:+.4g} rad/s at {table.temperature[i]:.4g} degC"
+    t = float(table.temperature[i])
+    where = f"{v:+.4g} rad/s" + (f" at {t:.4g} degC" if np.isfinite(t) else "")
     return f"{table.label[i]} ({where})" if table.label[i] else where
 
 

@@ -117,7 +117,7 @@ class ExtractionResult:
             f"{_count(d.rows, 'row')}; {_count(d.spikes, 'spike')} filtered",
             f"{_count(d.velocity_setpoints.size, 'velocity set-point')} "
             f"({d.velocity_setpoints.min():.4g}-{d.velocity_setpoints.max():.4g} rad/s), "
-            f"{_count(d.temperature_setpoints.size, 'temperature')}, "
+            f"{_temperatures(d.temperature_setpoints)}, "
             f"{_passes(d.passes_min, d.passes_max)} per sample",
         ]
         if d.samples:
@@ -157,8 +157,16 @@ class ExtractionResult:
             iv, fwd = divmod(rem, 2)
             v = d.velocity_setpoints[iv] * (1 if fwd else -1)
             temperature = d.temperature_setpoints[it]
-            parts.append(f"{temperature:.4g} degC {v:+.4g} rad/s {f:+.4g}+-{se:.2g}")
+            at = f"{temperature:.4g} degC " if np.isfinite(temperature) else ""
+            parts.append(f"{at}{v:+.4g} rad/s {f:+.4g}+-{se:.2g}")
         return "set-point friction [N m] (joint fit): " + "; ".join(parts)
+
+
+def _temperatures(setpoints: np.ndarray) -> str:
+    """``2 temperatures``, or ``no temperature logged`` (a log without one)."""
+    if setpoints.size and not np.isfinite(setpoints).any():
+        return "no temperature logged"
+    return _count(setpoints.size, "temperature")
 
 
 def _count(n: int, noun: str, plural: str | None = None) -> str:

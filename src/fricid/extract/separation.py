@@ -66,7 +66,9 @@ def missing_message(has: np.ndarray, t_set, v_set) -> str:
                 parts.append(f"no {name}-direction data in {lacking} of {int(other.sum())} bins")
         v = v_set[iv]
         lines.append(
-            f"{t_set[it]:.4g} degC, {v:.4g} rad/s ({np.degrees(v):.4g} deg/s): " + ", ".join(parts)
+            (f"{t_set[it]:.4g} degC, " if np.isfinite(t_set[it]) else "")
+            + f"{v:.4g} rad/s ({np.degrees(v):.4g} deg/s): "
+            + ", ".join(parts)
         )
     more = f"; and {len(lines) - 5} more" if len(lines) > 5 else ""
     return (

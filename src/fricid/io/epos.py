@@ -34,7 +34,7 @@ import numpy as np
 
 from ..errors import ConfigError, DataError
 from ..metrics import sem_autocorrelated
-from ..samples import FrictionSamples, RawLog
+from ..samples import NO_TEMPERATURE_SOURCE, FrictionSamples, RawLog
 from ..units import UNITS, to_si
 from ._epos_text import (
     _COUNT_UNITS,
@@ -70,6 +70,10 @@ __all__ = [
 ]
 
 logger = logging.getLogger(__name__)
+
+#: The logs' placeholder temperature [degC] when none is given (a raw log needs one; its
+#: ``meta["temperature_source"]`` says it is none, and the samples built from it record none).
+NO_TEMPERATURE = 25.0
 
 #: Nominal torque [N m] of the Maxon motor in the lead-screw recordings of
 #: Mablekos-Alexiou et al. (IEEE T-RO 2021), 9.84 mNm: the reference of their ``%`` torque.
@@ -147,7 +151,7 @@ def read_epos(
     *,
     nominal_torque: float = DEFAULT_NOMINAL_TORQUE,
     flip_sign: bool = False,
-    temperature: float = 25.0,
+    temperature: float | None = None,
     torque_constant: float | None = None,
     counts_per_turn: float | None = None,
     joint: str = "joint",
@@ -163,7 +167,10 @@ def read_epos(
     flip_sign : negate every motion and effort channel. The lead-screw recordings need it to
         match their file names (``N.csv`` is +N rpm): their authors' converter flips both
         velocity and torque (motor convention).
-    temperature : [degC], constant; the recorder has no temperature channel.
+    temperature : [degC], constant; the recorder has no temperature channel. Without one the
+        log's temperature column is a placeholder (:data:`NO_TEMPERATURE`),
+        ``meta["temperature_source"]`` says it is none, and the samples extracted from the log
+        record no temperature rather than a made-up one.
     torque_constant : K [N m/A], needed when only a current channel was recorded.
     counts_per_turn : encoder counts per revolution, needed for a position channel in counts.
     joint : name for the log.
@@ -205,7 +212,7 @@ def _read(
     *,
     nominal_torque: float = DEFAULT_NOMINAL_TORQUE,
     flip_sign: bool = False,
-    temperature: float = 25.0,
+    temperature: float | None = None,
     torque_constant: float | None = None,
     counts_per_turn: float | None = None,
     joint: str = "joint",
@@ -248,14 +255,14 @@ def _read(
         "flip_sign": bool(flip_sign),
         "nominal_torque [N m]": float(nominal_torque),
         "position_source": "channel" if position is not None else "integrated velocity",
-        "temperature_source": "constant parameter (no channel)",
+        "temperature_source": _temperature_source(temperature),
         "skipped_rows": rec.skipped,
     }
     log = RawLog(
         time=time,
         position=integrate_velocity(time, values["velocity"]) if position is None else position,
         velocity=values["velocity"],
-        temperature=temperature,
+        temperature=NO_TEMPERATURE if temperature is None else temperature,
         torque=values.get("torque"),
         current=values.get("current"),
         torque_constant=torque_constant,
@@ -264,6 +271,13 @@ def _read(
         meta=meta,
     )
     return log, rec.lines
+
+
+def _temperature_source(temperature: float | None) -> str:
+    """``meta["temperature_source"]``: the temperature given, or none."""
+    if temperature is None:
+        return NO_TEMPERATURE_SOURCE
+    return f"constant {temperature:g} degC, given (the recorder logs none)"
 
 
 def _files(folder: str | os.PathLike[str], pattern: str) -> list[Path]:
@@ -297,11 +311,6 @@ def _read_dir(folder, pattern: str, **options: Any) -> list[tuple[RawLog, np.nda
     """(log, data line numbers) of every file, sorted by mean velocity."""
     read = [_read(path, **options) for path in _files(folder, pattern)]
     return sorted(read, key=lambda item: float(np.mean(item[0].velocity)))
-
-
-#: The per-file logs' placeholder temperature [degC] when none is given (a raw log needs one;
-#: the steady samples built from them record none).
-NO_TEMPERATURE = 25.0
 
 
 def epos_steady_samples(
@@ -384,7 +393,7 @@ def epos_steady_samples(
         pattern,
         nominal_torque=nominal_torque,
         flip_sign=flip_sign,
-        temperature=NO_TEMPERATURE if temperature is None else temperature,  # the logs' own
+        temperature=temperature,
         torque_constant=torque_constant,
         skip_bad_rows=skip_bad_rows,
     )
@@ -411,11 +420,6 @@ def epos_steady_samples(
         if not k.all()
     }
     quality = quality_rows(names, velocity, keep, std, flagged, temperature)
-    source = (
-        f"constant {temperature:g} degC, given (the recorder logs none)"
-        if temperature is not None
-        else "none: the recorder logs no temperature (give the joint's with --temperature)"
-    )
     warn_steady(str(folder), quality, dropped_lines)
     sem = [sem_autocorrelated(t) for t in torque]
     return FrictionSamples(
@@ -433,7 +437,7 @@ def epos_steady_samples(
             "files": names,
             "flip_sign": bool(flip_sign),
             "nominal_torque [N m]": float(nominal_torque),
-            "temperature_source": source,
+            "temperature_source": _temperature_source(temperature),
             "outlier_sigmas": outlier_sigmas,
             "outlier_lines": dropped_lines,
             "skipped_rows": {

@@ -12,10 +12,17 @@ import numpy as np
 from ..errors import DataError
 from ._columns import LIMITS, _as_column
 
-__all__ = ["RawLog"]
+__all__ = ["NO_TEMPERATURE_SOURCE", "RawLog"]
 
 #: The array columns of a :class:`RawLog`.
 _COLUMNS = ("time", "position", "velocity", "temperature", "torque", "current")
+
+#: ``meta["temperature_source"]`` of a log whose recorder logs no temperature and that was
+#: given none: its temperature column is a placeholder (a log needs one), not a measurement,
+#: and the samples extracted from it record no temperature (:attr:`RawLog.temperature_measured`).
+NO_TEMPERATURE_SOURCE = (
+    "none: the recorder logs no temperature (give the joint's with --temperature)"
+)
 
 
 @dataclass(frozen=True, eq=False)
@@ -130,6 +137,13 @@ class RawLog:
 
     def __len__(self) -> int:
         return int(self.time.shape[0])
+
+    @property
+    def temperature_measured(self) -> bool:
+        """bool: whether the temperature column is the joint's (logged or given), not the
+        placeholder of a log without one (``meta["temperature_source"]`` is
+        :data:`NO_TEMPERATURE_SOURCE`)."""
+        return self.meta.get("temperature_source") != NO_TEMPERATURE_SOURCE
 
     @property
     def motor_torque(self) -> np.ndarray:
