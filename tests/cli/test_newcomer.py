@@ -101,7 +101,7 @@ def test_predict_prints_numbers_with_the_digits_they_deserve(samples_csv, tmp_pa
     exact = fitted.predict(np.array([[0.2, 0.3, 25.0]]))[0]
     assert float(rows[1].split(",")[3]) == exact  # exact: reads back to the same float
     res = run("predict", model, "-v", "0.2", "--digits", "3")
-    assert res.stdout.splitlines()[1].split(",")[3] == f"{exact:.3g}"
+    assert res.stdout.splitlines()[1].split(",")[-1] == f"{exact:.3g}"
 
 
 def test_predict_says_a_load_or_temperature_the_model_ignores(samples_csv, tmp_path):
@@ -118,3 +118,38 @@ def test_predict_says_a_load_or_temperature_the_model_ignores(samples_csv, tmp_p
     ), res.stderr
     res = run("predict", model, "-v", "0.5")  # nothing given: nothing said
     assert "does not depend" not in res.stderr, res.stderr
+
+
+def test_predict_writes_no_made_up_temperature_for_a_model_without_one(samples_csv, tmp_path):
+    """A velocity-only model's predictions carried a temperature column of 25 degC that no one
+    gave and the friction does not depend on; written only when given or used."""
+    from fricid.fitted import FittedModel
+    from fricid.identify import fit
+    from fricid.io import read_samples
+
+    samples = read_samples(samples_csv)
+    model = fit(samples, "stribeck").save(tmp_path / "m.json")
+    res = run("predict", model, "-v", "0.5", "-v", "-0.5")
+    assert res.exit_code == 0, res.output
+    rows = res.stdout.splitlines()
+    assert rows[0] == "velocity [rad/s],load [N m],friction [N m]"
+    friction = [float(row.split(",")[-1]) for row in rows[1:]]
+    exact = FittedModel.load(model).predict(np.array([[0.5, 0, 25], [-0.5, 0, 25]]))
+    np.testing.assert_array_equal(friction, exact)
+    res = run("predict", model, "-v", "0.5", "--temperature", "80")  # given: echoed, as said
+    assert res.stdout.splitlines()[0].split(",")[2] == "temperature [degC]"
+    assert res.stdout.splitlines()[1].split(",")[2] == "80"
+    points = tmp_path / "points.csv"
+    points.write_text("velocity [rad/s],temperature [degC]\n0.5,40\n")
+    res = run("predict", model, "--input", points)
+    assert res.stdout.splitlines()[1].split(",")[2] == "40"
+    hot = type(samples)(  # two temperatures: a model that uses temperature
+        velocity=np.tile(samples.velocity, 2),
+        load=0.0,
+        temperature=np.repeat([20.0, 60.0], len(samples)),
+        friction=np.concatenate([samples.friction, 0.9 * samples.friction]),
+    )
+    temp_model = fit(hot, "stribeck_temp").save(tmp_path / "t.json")
+    res = run("predict", temp_model, "-v", "0.5", "--temperature", "30")
+    assert res.exit_code == 0, res.output
+    assert res.stdout.splitlines()[0].split(",")[2] == "temperature [degC]"

@@ -254,10 +254,11 @@ def test_predict_points_with_units(model_file):
     )
     assert res.exit_code == 0, res.output
     lines = res.stdout.strip().splitlines()
-    assert lines[0] == "velocity [deg/s],load [N m],temperature [degC],friction [mNm]"
+    # stribeck does not depend on temperature: no made-up 25 degC column
+    assert lines[0] == "velocity [deg/s],load [N m],friction [mNm]"
     got = np.array([[float(x) for x in line.split(",")] for line in lines[1:]])
     want = stribeck().predict_point(np.deg2rad([1.0, -2.0])) * 1e3
-    np.testing.assert_allclose(got[:, 3], want, rtol=1e-15)
+    np.testing.assert_allclose(got[:, 2], want, rtol=1e-15)
     np.testing.assert_array_equal(got[:, 0], [1.0, -2.0])
 
 
@@ -272,13 +273,13 @@ def test_predict_file_of_points(tmp_path, model_file):
     res = run("predict", model_file, "--input", csv, "--out", out)
     assert res.exit_code == 0, res.output
     table = np.loadtxt(out, delimiter=",", skiprows=1)
-    np.testing.assert_allclose(table[:, 3], stribeck().predict_point(v), rtol=1e-15)
+    np.testing.assert_allclose(table[:, -1], stribeck().predict_point(v), rtol=1e-15)
     pq_path = tmp_path / "points.parquet"
     pq.write_table(pa.table({"velocity": v}), pq_path)
     res = run("predict", model_file, "--input", pq_path, "--velocity-unit", "rpm")
     assert res.exit_code == 0, res.output
     got = np.loadtxt(res.stdout.splitlines()[1:], delimiter=",")
-    np.testing.assert_allclose(got[:, 3], stribeck().predict_point(v * np.pi / 30), rtol=1e-15)
+    np.testing.assert_allclose(got[:, -1], stribeck().predict_point(v * np.pi / 30), rtol=1e-15)
 
 
 def test_predict_refuses_mixed_units_and_missing_inputs(tmp_path, model_file):
@@ -317,7 +318,7 @@ def test_rbf_network_projects_and_predicts(tmp_path):
     path = fitted.save(tmp_path / "rbf.json")
     res = run("predict", path, "--velocity", "0.1", "--load", "0.2")
     assert res.exit_code == 0, res.output
-    value = float(res.stdout.splitlines()[1].split(",")[3])
+    value = float(res.stdout.splitlines()[1].split(",")[-1])
     assert value == pytest.approx(fitted.predict_point(0.1, 0.2), rel=1e-15)
     res = run("predict", path, "--velocity", "0.1")
     assert res.exit_code == 2 and "depends on load" in res.output

@@ -130,7 +130,7 @@ def test_cli_predict_writes_the_interval(stribeck, tmp_path):
     assert res.exit_code == 0, res.output
     head, row = res.stdout.strip().splitlines()
     assert head.endswith("friction [N m],low [N m],high [N m]")
-    _, _, _, f, low, high = (float(x) for x in row.split(","))
+    *_, f, low, high = (float(x) for x in row.split(","))
     pi = stribeck.predict_interval(np.array([[0.5, 0.0, 25.0]]))
     assert (low, f, high) == pytest.approx((pi.low[0], pi.friction[0], pi.high[0]))
 

@@ -110,7 +110,8 @@ def predict_command(
     ] = None,
 ) -> None:
     """Friction of a model at operating points: CSV with velocity, load, temperature and
-    friction columns, each labelled with its unit.
+    friction columns, each labelled with its unit (no temperature column for a model that does
+    not depend on it, unless one is given).
 
     Points outside the operating range the model was identified on (above the identified
     speeds, below the smallest one of their direction, in a gap between measured speeds, on a
@@ -126,7 +127,7 @@ def predict_command(
     from ..errors import ConfigError, ExtrapolationWarning
     from ..export import Smoothing, smooth_predict, write_text
     from ..export._common import printable_reasons, trust_of
-    from ..export.points import points_matrix, points_table, read_points
+    from ..export.points import default_filled, points_matrix, points_table, read_points
     from ..fitted import FittedModel
     from ..units import to_si
 
@@ -217,7 +218,9 @@ def predict_command(
     units["friction"] = friction_unit
     if digits is None and out is None and sys.stdout.isatty():
         digits = DISPLAY_DIGITS
-    text = points_table(X, friction, units, extra, digits)
+    # a temperature the model ignores and no one gave is 25 degC made up: not written
+    made_up = not (temperature or "temperature" in cols) and default_filled(fitted, "temperature")
+    text = points_table(X, friction, units, extra, digits, ("temperature",) if made_up else ())
     if out is None:
         sys.stdout.write(text)
         sys.stdout.flush()

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import io
 import os
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any
 
@@ -26,7 +26,14 @@ from ..io._parquet import open_parquet, read_columns, schema_meta
 from ..models import get_model
 from ..units import SI_UNITS, UNITS, from_si, to_si
 
-__all__ = ["INPUT_QUANTITY", "model_inputs", "points_matrix", "points_table", "read_points"]
+__all__ = [
+    "INPUT_QUANTITY",
+    "default_filled",
+    "model_inputs",
+    "points_matrix",
+    "points_table",
+    "read_points",
+]
 
 #: The model inputs and the physical quantity of each (for unit conversion).
 INPUT_QUANTITY: dict[str, str] = {
@@ -86,6 +93,16 @@ def _dropped_value(fitted: FittedModel, name: str) -> float | None:
         if isinstance(leaf.get("dropped_inputs"), dict) and name in leaf["dropped_inputs"]
     }
     return seen.pop() if len(seen) == 1 else None
+
+
+def default_filled(fitted: FittedModel, name: str) -> bool:
+    """Whether :func:`points_matrix` fills input ``name`` (load or temperature), when it is not
+    given, with its fixed default (0 N m, 25 degC) rather than a value of the model's: the model
+    does not use it and, for a learned model, dropped it at no value of its own. Such a value is
+    no measurement, and the friction does not depend on it."""
+    if name in model_inputs(fitted):
+        return False
+    return fitted.kind != "rbf" or _dropped_value(fitted, name) is None
 
 
 def _unit_of(name: str, label: str, given: str | None, path: Path, meta_units) -> str:
@@ -226,10 +243,12 @@ def points_table(
     units: Mapping[str, str],
     extra: Mapping[str, np.ndarray] | None = None,
     digits: int | None = None,
+    without: Iterable[str] = (),
 ) -> str:
     """CSV text of points and friction, each column in ``units`` (SI where not given) and
     labelled with it. ``extra`` columns (e.g. a prediction interval's ends) are torques [N m],
-    written after the friction in its unit.
+    written after the friction in its unit; the inputs named in ``without`` are not written
+    (a value the model neither uses nor was given).
 
     ``digits`` None writes every number exactly in the fewest digits that read back to the
     same float (``0.2``, not ``0.20000000000000001``); an int rounds to that many significant
@@ -242,6 +261,8 @@ def points_table(
     }
     quantity = {**INPUT_QUANTITY, "friction": "torque"}
     data = {"velocity": X[:, 0], "load": X[:, 1], "temperature": X[:, 2], "friction": friction}
+    for name in without:
+        del data[name]
     for name, col in (extra or {}).items():
         data[name] = col
         out_units[name] = out_units["friction"]
