@@ -283,3 +283,38 @@ def test_a_gap_between_measured_speeds_is_a_caveat():
     even = _linear_joint(np.linspace(0.1, 6.0, 13), 5)
     reasons = assess_trust(fit(even, "coulomb_viscous"), even).reasons
     assert not any("no speed measured" in r for r in reasons)
+
+
+def test_a_temperature_law_at_one_temperature_is_told_to_record_another(leadscrew_dir):
+    """stribeck_temp on the lead screw at its one temperature was told to fit a learned model
+    ("more data will not help"): a second temperature, or no temperature law, is the remedy."""
+    from fricid.identify._advice import misfit_advice
+
+    at_25 = epos_steady_samples(leadscrew_dir, temperature=25.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        model = fit(at_25, "stribeck_temp")
+    record = assess_trust(model, at_25)
+    assert record.level == "no"
+    advice = record.what_to_do
+    assert "the samples hold one temperature (25 degC)" in advice and "at least two" in advice
+    assert "record at another temperature" in advice
+    assert "--model stribeck or --model stribeck_asym" in advice
+    assert "learned" not in advice and "will not help" not in advice
+    # the model file alone (its operating range) tells the same
+    assert misfit_advice(model, None, record.scatter, 3.0) == advice
+    # at two temperatures the law is determined: the other readings, as before
+    two = FrictionSamples(
+        velocity=np.tile(at_25.velocity, 2),
+        load=0.0,
+        temperature=np.repeat([25.0, 45.0], len(at_25)),
+        friction=np.tile(at_25.friction, 2),
+        count=np.tile(at_25.count, 2),
+        std=np.tile(at_25.std, 2),
+    )
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        both = fit(two, "stribeck_temp")
+    other = misfit_advice(both, None, record.scatter, 3.0, two)
+    assert "one temperature" not in other
+    assert other.startswith("the stribeck_temp family cannot follow these data")

@@ -15,6 +15,10 @@ the interior folds (:func:`fricid.identify.validate.interior_rmse`):
 - it follows the set-points and the interior levels, and misses only when the slowest or the
   fastest level is held out: an extrapolation; its predictions inside the measured speeds
   held up.
+
+Before them, a model with a temperature law fitted on samples at one temperature is told so:
+the law needs two temperatures or more, so the remedy is a recording at another temperature or
+the model without the law, not a learned model.
 """
 
 from __future__ import annotations
@@ -26,6 +30,7 @@ import numpy as np
 from ..fitted import FittedModel
 from ..metrics import rmse
 from ..samples import FrictionSamples
+from .static.checks import _levels
 from .validate import interior_rmse
 
 __all__ = ["misfit_advice"]
@@ -41,6 +46,30 @@ def _in_sample_ratio(fitted: FittedModel, samples: FrictionSamples | None, scatt
     if samples is None or not np.isfinite(scatter) or scatter <= 0:
         return float("nan")
     return rmse(samples.y, fitted.predict(samples.X, warn=False)) / scatter
+
+
+def _one_temperature(fitted: FittedModel, samples: FrictionSamples | None) -> float | None:
+    """The one temperature [degC] a model with a temperature law was fitted at (the samples',
+    else the file's operating range), None when it uses no temperature or saw two or more."""
+    if fitted.kind == "rbf" or "temperature" not in fitted.inputs_used():
+        return None
+    if samples is not None:
+        levels = _levels(samples.temperature[np.isfinite(samples.temperature)])
+        return float(levels[0]) if levels.size == 1 else None
+    span = (fitted.operating_range or {}).get("temperature")
+    if isinstance(span, list | tuple) and len(span) == 2 and span[0] == span[1]:
+        return float(span[0])
+    return None
+
+
+def _without_temperature(model: str) -> str:
+    """``--model`` options without a temperature law to fit instead of ``model``: its own
+    family's (``stribeck_temp`` -> ``stribeck``, ``stribeck_temp_asym`` -> ``stribeck_asym``),
+    else stribeck's."""
+    if model.endswith("_temp_asym"):
+        return f"--model {model[: -len('_temp_asym')]}_asym"
+    base = model[: -len("_temp")] if model.endswith("_temp") else "stribeck"
+    return f"--model {base} or --model {base}_asym"
 
 
 def misfit_advice(
@@ -74,6 +103,13 @@ def misfit_advice(
         One sentence (module notes), ``""`` when no reading applies.
     """
     name = "SAMPLES"
+    one = _one_temperature(fitted, samples)
+    if one is not None:
+        return (
+            f"the samples hold one temperature ({one:g} degC), and the temperature law of "
+            f"{fitted.model} needs at least two: record at another temperature, or fit a model "
+            f"without temperature (fricid fit {name} {_without_temperature(fitted.model)})"
+        )
     learned = fitted.kind == "rbf"
     r_in = _in_sample_ratio(fitted, samples, scatter)
     auto = f"compare every family by held-out error (fricid fit {name} --model auto --learned)"
