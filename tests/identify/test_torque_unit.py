@@ -74,3 +74,13 @@ def test_report_says_why_its_errors_mean_nothing(files, tmp_path):
     assert result.exit_code == 0, result.output
     assert "warning: the model predicts 1000x" in result.stderr
     assert "header in damaged.csv" in (out / "report.md").read_text(encoding="utf-8")
+
+
+def test_evaluate_says_so_too(files):
+    honest, damaged, _, model = files
+    runner = CliRunner()
+    for path, told in ((honest, False), (damaged, True)):
+        res = runner.invoke(app, ["evaluate", str(model), str(path)], terminal_width=200)
+        assert res.exit_code == 0, res.output
+        text = " ".join(res.output.split())
+        assert ("likely names the wrong torque unit" in text) is told

@@ -318,3 +318,13 @@ def test_a_temperature_law_at_one_temperature_is_told_to_record_another(leadscre
     other = misfit_advice(both, None, record.scatter, 3.0, two)
     assert "one temperature" not in other
     assert other.startswith("the stribeck_temp family cannot follow these data")
+
+
+def test_vlt_at_one_temperature_is_offered_the_load_law_without_temperature():
+    """vlt (load and temperature, eq. 4) at one temperature keeps its load law in msk (eq. 3):
+    stribeck would drop it."""
+    from fricid.identify._advice import _without_temperature
+
+    assert _without_temperature("vlt") == "--model msk"
+    assert _without_temperature("vlt_asym") == "--model msk_asym"
+    assert _without_temperature("stribeck_temp_asym") == "--model stribeck_asym"

@@ -22,8 +22,8 @@ record, which ``fricid fit``, the fleet and ``fricid report`` read and never rec
 from __future__ import annotations
 
 from ..samples import samples_hash
+from ._advice import torque_unit_mismatch
 from ._scatter import Scatter, measurement_scatter, sample_weights
-from ._torque_unit import torque_unit_mismatch
 from .dispatch import KINDS, fit, kind_of
 from .problem import IdentificationProblem
 from .static.least_squares import evaluate
