@@ -59,6 +59,7 @@ __all__ = [
     "low_speed_windows",
     "rest_share",
     "sliding",
+    "temperature_range",
     "torque_noise",
     "uniform_series",
 ]
@@ -145,6 +146,14 @@ def uniform_series(log: RawLog) -> Series:
         return Series(t, *cols, dt=dt, resampled=False)
     grid = t[0] + dt * np.arange(int(np.floor((t[-1] - t[0]) / dt)) + 1)
     return Series(grid, *(np.interp(grid, t, c) for c in cols), dt=dt, resampled=True)
+
+
+def temperature_range(log: RawLog, series: Series) -> dict[str, list[float]]:
+    """``{"temperature": [low, high]}`` [degC] of the log for a model's operating range; empty
+    for a log that logged none (its column a placeholder: :attr:`RawLog.temperature_measured`)."""
+    if not log.temperature_measured:
+        return {}
+    return {"temperature": [float(series.temperature.min()), float(series.temperature.max())]}
 
 
 def derivatives(series: Series, filt: DerivativeFilter) -> tuple[np.ndarray, np.ndarray]:

@@ -43,7 +43,7 @@ from ...io.atomic import created_timestamp
 from ...metrics import fit_statistics, metrics
 from ...models import get_model, lugre
 from ...samples import RawLog
-from ._data import Series
+from ._data import Series, temperature_range
 from ._filtered import ParallelFilter
 from ._outcome import converged
 from ._presliding import CUTOFF, RESOLVED_COUNTS, bias_check, presliding_route, widen
@@ -157,7 +157,7 @@ def fit_presliding(
         statistics_note="torque as sigma_0 times the low-passed position error (pre-sliding)",
         operating_range={
             "velocity": [-info["max_speed"], info["max_speed"]],
-            "temperature": [float(series.temperature.min()), float(series.temperature.max())],
+            **temperature_range(log, series),
         },
     )
     fitted.provenance = {

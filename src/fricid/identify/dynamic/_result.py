@@ -25,7 +25,7 @@ from ...io.atomic import created_timestamp
 from ...metrics import fit_statistics, metrics
 from ...models import get_model, lugre
 from ...samples import RawLog
-from ._data import Series
+from ._data import Series, temperature_range
 from ._outcome import PassivityWarning, converged, lugre_caveat, passivity
 from ._rate import delay_caveat
 from ._routes import DYNAMIC_MODELS, JOINT_PARAMS
@@ -139,7 +139,7 @@ def build_result(
         statistics=fit_statistics(y, yhat, len(param_names) + n_joint),
         operating_range={
             "velocity": [float(vf.min()), float(vf.max())],
-            "temperature": [float(series.temperature.min()), float(series.temperature.max())],
+            **temperature_range(log, series),
         },
     )
     last_regression = [st for name, st in stages.items() if name.startswith("refinement")]
