@@ -328,3 +328,19 @@ def test_vlt_at_one_temperature_is_offered_the_load_law_without_temperature():
     assert _without_temperature("vlt") == "--model msk"
     assert _without_temperature("vlt_asym") == "--model msk_asym"
     assert _without_temperature("stribeck_temp_asym") == "--model stribeck_asym"
+
+
+def test_a_verdict_on_interior_levels_names_the_end_levels_it_leaves_out(fitted, leadscrew):
+    """The lead screw's stribeck_asym is graded on its interior speed levels (0.41x); held
+    out, its slowest level misses by 2.25x the scatter: the verdict says so, with the speeds,
+    and that those folds are extrapolations it does not grade."""
+    record = assess_trust(fitted, leadscrew)
+    assert record.level == "yes" and record.heldout_scheme == LOVO_INTERIOR
+    folds = sorted(record.validation["folds"], key=lambda f: f["speed"])
+    ratios = [folds[i]["rmse"] / record.scatter for i in (0, -1)]
+    assert ratios[0] > 2.0  # the measured miss the verdict must not hide
+    (reason,) = record.reasons
+    assert f"on the {len(folds) - 2} interior speed levels" in reason
+    assert f"slowest ({folds[0]['speed']:.3g} rad/s) is missed by {ratios[0]:.3g}x" in reason
+    assert f"fastest ({folds[-1]['speed']:.3g} rad/s) by {ratios[1]:.3g}x" in reason
+    assert "extrapolations, not graded" in reason

@@ -36,6 +36,7 @@ __all__ = [
     "RANK_RTOL",
     "TINY_SAMPLES",
     "VALIDATE_WORK",
+    "end_levels",
     "graded_rmse",
     "own_cv",
     "run_kfold",
@@ -215,6 +216,26 @@ def graded_rmse(validation: dict[str, Any]) -> tuple[float, str]:
         if np.isfinite(inner):
             return inner, LOVO_INTERIOR
     return err, scheme
+
+
+def end_levels(validation: dict[str, Any] | None, scatter: float) -> str:
+    """What a verdict graded on the interior levels (:data:`LOVO_INTERIOR`) leaves out:
+    ``" on the 14 interior speed levels; held out, the slowest (0.221 rad/s) is missed by 2.25x
+    the scatter and the fastest (20.8 rad/s) by 0.961x: extrapolations, not graded"``; ``""``
+    without folds to name."""
+    rows = sorted(
+        (f for f in (validation or {}).get("folds") or [] if f.get("rmse") is not None),
+        key=lambda f: float(f["speed"]),
+    )
+    if len(rows) < 3 or not (np.isfinite(scatter) and scatter > 0):
+        return ""
+    (slow, fast), s = (rows[0], rows[-1]), float(scatter)
+    return (
+        f" on the {len(rows) - 2} interior speed levels; held out, the slowest "
+        f"({float(slow['speed']):.3g} rad/s) is missed by {float(slow['rmse']) / s:.3g}x the "
+        f"scatter and the fastest ({float(fast['speed']):.3g} rad/s) by "
+        f"{float(fast['rmse']) / s:.3g}x: extrapolations, not graded"
+    )
 
 
 def worse_kfold(

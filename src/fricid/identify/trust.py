@@ -103,6 +103,7 @@ from ._heldout import (
     MIN_LEVELS,
     TINY_SAMPLES,
     VALIDATE_WORK,
+    end_levels,
     graded_rmse,
     own_cv,
     run_validation,
@@ -548,6 +549,9 @@ def _grade(trust: Trust, fitted: FittedModel, sample_caveats: list[str], no: lis
         trust.level, trust.reasons = "with caveats", caveats + said
         return
     which = f"the scatter {ESTIMATED}" if estimated else "the scatter"
-    held = f"{kind} error is within noise ({ratio:.2f}x {which})"
+    ends = (
+        end_levels(trust.validation, trust.scatter) if trust.heldout_scheme == LOVO_INTERIOR else ""
+    )
+    held = f"{kind} error is within noise ({ratio:.2f}x {which}{ends})"
     det = "every parameter is determined" if free else "the network fits"
     trust.level, trust.reasons = "yes", [f"the fit converged, {det} and the {held}"]
