@@ -132,17 +132,17 @@ def test_predict_writes_no_made_up_temperature_for_a_model_without_one(samples_c
     res = run("predict", model, "-v", "0.5", "-v", "-0.5")
     assert res.exit_code == 0, res.output
     rows = res.stdout.splitlines()
-    assert rows[0] == "velocity [rad/s],load [N m],friction [N m]"
+    assert rows[0] == "velocity [rad/s],friction [N m]"
     friction = [float(row.split(",")[-1]) for row in rows[1:]]
     exact = FittedModel.load(model).predict(np.array([[0.5, 0, 25], [-0.5, 0, 25]]))
     np.testing.assert_array_equal(friction, exact)
     res = run("predict", model, "-v", "0.5", "--temperature", "80")  # given: echoed, as said
-    assert res.stdout.splitlines()[0].split(",")[2] == "temperature [degC]"
-    assert res.stdout.splitlines()[1].split(",")[2] == "80"
+    assert res.stdout.splitlines()[0].split(",")[1] == "temperature [degC]"
+    assert res.stdout.splitlines()[1].split(",")[1] == "80"
     points = tmp_path / "points.csv"
     points.write_text("velocity [rad/s],temperature [degC]\n0.5,40\n")
     res = run("predict", model, "--input", points)
-    assert res.stdout.splitlines()[1].split(",")[2] == "40"
+    assert res.stdout.splitlines()[1].split(",")[1] == "40"
     hot = type(samples)(  # two temperatures: a model that uses temperature
         velocity=np.tile(samples.velocity, 2),
         load=0.0,
@@ -152,4 +152,17 @@ def test_predict_writes_no_made_up_temperature_for_a_model_without_one(samples_c
     temp_model = fit(hot, "stribeck_temp").save(tmp_path / "t.json")
     res = run("predict", temp_model, "-v", "0.5", "--temperature", "30")
     assert res.exit_code == 0, res.output
-    assert res.stdout.splitlines()[0].split(",")[2] == "temperature [degC]"
+    assert res.stdout.splitlines()[0] == "velocity [rad/s],temperature [degC],friction [N m]"
+
+
+def test_predict_writes_no_made_up_load_for_a_model_without_one(samples_csv, tmp_path):
+    """The same for load: a velocity-only model's output carried load 0 N m no one gave."""
+    from fricid.identify import fit
+    from fricid.io import read_samples
+
+    model = fit(read_samples(samples_csv), "stribeck").save(tmp_path / "m.json")
+    res = run("predict", model, "-v", "0.5", "-v", "-0.5")
+    assert res.exit_code == 0, res.output
+    assert res.stdout.splitlines()[0] == "velocity [rad/s],friction [N m]"
+    res = run("predict", model, "-v", "0.5", "--load", "2")  # given: echoed
+    assert res.stdout.splitlines()[0] == "velocity [rad/s],load [N m],friction [N m]"

@@ -110,8 +110,8 @@ def predict_command(
     ] = None,
 ) -> None:
     """Friction of a model at operating points: CSV with velocity, load, temperature and
-    friction columns, each labelled with its unit (no temperature column for a model that does
-    not depend on it, unless one is given).
+    friction columns, each labelled with its unit (no load or temperature column for a model
+    that does not depend on it, unless one is given).
 
     Points outside the operating range the model was identified on (above the identified
     speeds, below the smallest one of their direction, in a gap between measured speeds, on a
@@ -218,9 +218,14 @@ def predict_command(
     units["friction"] = friction_unit
     if digits is None and out is None and sys.stdout.isatty():
         digits = DISPLAY_DIGITS
-    # a temperature the model ignores and no one gave is 25 degC made up: not written
-    made_up = not (temperature or "temperature" in cols) and default_filled(fitted, "temperature")
-    text = points_table(X, friction, units, extra, digits, ("temperature",) if made_up else ())
+    # a load or temperature the model ignores and no one gave (0 N m, 25 degC) is made up
+    given = {"load": load, "temperature": temperature}
+    made_up = tuple(
+        name
+        for name in ("load", "temperature")
+        if not (given[name] or name in cols) and default_filled(fitted, name)
+    )
+    text = points_table(X, friction, units, extra, digits, made_up)
     if out is None:
         sys.stdout.write(text)
         sys.stdout.flush()
