@@ -22,6 +22,8 @@ from fricid.identify.trust import (
     FROM_FIT,
     IN_SAMPLE,
     LOVO_INTERIOR,
+    MISS_RATIO,
+    NEW_SAMPLES,
     RUN_HERE,
     Trust,
     assess_trust,
@@ -344,3 +346,30 @@ def test_a_verdict_on_interior_levels_names_the_end_levels_it_leaves_out(fitted,
     assert f"slowest ({folds[0]['speed']:.3g} rad/s) is missed by {ratios[0]:.3g}x" in reason
     assert f"fastest ({folds[-1]['speed']:.3g} rad/s) by {ratios[1]:.3g}x" in reason
     assert "extrapolations, not graded" in reason
+
+
+def test_samples_the_model_was_not_identified_on_grade_the_model_itself(
+    fitted, leadscrew, tmp_path
+):
+    """A report of the lead screw's model on samples of a worn joint (friction x1.3) said
+    "Trust: yes (0.53x)": it re-ran leave-one-velocity-out, which refits the family on the new
+    samples, while the model file itself misses them by about 15x the scatter. On samples it
+    was not identified on, the model's own error is the held-out one graded."""
+    worn = replace(leadscrew, friction=1.3 * leadscrew.friction)
+    record = assess_trust(fitted, worn)
+    error = float(np.sqrt(np.mean((fitted.predict(worn.X, warn=False) - worn.y) ** 2)))
+    assert record.heldout_source == NEW_SAMPLES and record.held_out
+    assert record.heldout_rmse == pytest.approx(error, rel=1e-12)
+    assert record.heldout_ratio > MISS_RATIO and record.level == "no"
+    assert "on these samples, not the set it was identified on" in record.line()
+    # its own samples: as before (lovo, interior levels)
+    own = assess_trust(fitted, leadscrew)
+    assert own.heldout_source == RUN_HERE and own.level == "yes"
+    # one direction's model on both directions: the other side is left out of the grade
+    pos = fit(leadscrew.subset(leadscrew.velocity > 0), "stribeck")
+    both = assess_trust(pos, leadscrew)
+    assert both.heldout_source == NEW_SAMPLES
+    inside = leadscrew.subset(leadscrew.velocity > 0)
+    error = float(np.sqrt(np.mean((pos.predict(inside.X, warn=False) - inside.y) ** 2)))
+    assert both.heldout_rmse == pytest.approx(error, rel=1e-12)
+    assert any(r.startswith("16 of 32 samples lie outside the range") for r in both.reasons)

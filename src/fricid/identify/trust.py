@@ -24,7 +24,9 @@ reads the model file (and, where given, the samples the model was identified on)
   :data:`LEARNED_VALIDATE_WORK`, each fold retrained as ``fit`` trains it); else
   :data:`OWN_CV` (a learned model's own cross-validation, with its caveat); else
   :data:`IN_SAMPLE` (the fit's ``rmse_over_scatter``): an in-sample number is never labelled
-  held out. Leave-one-velocity-out is graded on its interior folds (:data:`LOVO_INTERIOR`,
+  held out. Samples other than the model's own (a report of a model on a new recording) grade
+  the model's own error on them (:data:`NEW_SAMPLES`), inside its operating range.
+  Leave-one-velocity-out is graded on its interior folds (:data:`LOVO_INTERIOR`,
   :func:`._heldout.graded_rmse`: the slowest and fastest held-out levels are extrapolations).
   On tiny data (at most :data:`TINY_SAMPLES` samples) random folds are run too
   (:func:`._heldout.worse_kfold`) and the worse ratio graded (:data:`KFOLD_HERE` when theirs);
@@ -123,6 +125,7 @@ __all__ = [
     "LOVO_INTERIOR",
     "MIN_LEVELS",
     "MISS_RATIO",
+    "NEW_SAMPLES",
     "OWN_CV",
     "RUN_HERE",
     "SECOND_LOG",
@@ -155,11 +158,14 @@ FROM_FIT = "the fit's --validate"
 OWN_CV = "the learned model's own CV"
 #: ... no held-out error: the fit's in-sample RMSE over the scatter.
 IN_SAMPLE = "in-sample only"
+#: ... the model file's own error on samples other than the set it was identified on (their
+#: content hash differs: :func:`_on_new_samples`; they may share rows with it).
+NEW_SAMPLES = "the model on other samples than its own"
 #: Said in the reasons when the scatter is estimated (:func:`._scatter.second_difference_scatter`).
 ESTIMATED = "estimated from second differences: no repeated runs, so not measured"
 SECOND_LOG = "a second log"  #: ... run along by :func:`.trajectory_check.heldout_grading`
 #: The sources whose ratio is a held-out one.
-HELD_OUT = (RUN_HERE, FROM_FIT, OWN_CV, KFOLD_HERE, SECOND_LOG)
+HELD_OUT = (RUN_HERE, FROM_FIT, OWN_CV, KFOLD_HERE, SECOND_LOG, NEW_SAMPLES)
 
 
 @dataclass
@@ -339,7 +345,9 @@ def assess_trust(
         The model.
     samples : FrictionSamples, optional
         The samples it was identified on: their quality table, and the held-out validation
-        when the fit has none.
+        when the fit has none. Others (a content hash other than the file's
+        ``provenance["samples_sha256_16"]``): the model's own error on them is graded
+        (:data:`NEW_SAMPLES`), not a refit.
     validate : bool, default True
         Run :func:`fricid.identify.validate` (``lovo``) when the fit holds no validation, or
         only a learned model's own cross-validation, and the problem is small enough (module
@@ -364,6 +372,18 @@ def assess_trust(
     trust = _base(fitted, samples)
     trust.samples_hash, trust.samples_detail_hash = key["samples_hash"], key["samples_detail_hash"]
     trust.model_hash, trust.options = key["model_hash"], options
+    if _new_samples(fitted, trust.samples_hash):
+        outside = _on_new_samples(trust, fitted, samples)
+        trust.quality, trust.quality_summary, quality_caveat = quality_rows(samples)
+        problems = channel_problems(samples)
+        _grade(trust, fitted, [outside, quality_caveat, *gravity_caveat(samples)], problems)
+        if trust.heldout_ratio > MISS_RATIO and not problems:
+            trust.what_to_do = (
+                "check that these samples come from the same joint, in the same units; if the "
+                "joint has changed (wear, temperature, load), identify it again on them "
+                f"(fricid fit SAMPLES --model {fitted.model})"
+            )
+        return trust
     mine = own_cv(fitted.validation)
     can_run = samples is not None and validate and trust.converged
     low, trust.downweighted = downweighted(fitted, samples)
@@ -406,6 +426,62 @@ def assess_trust(
         held = trust.validation if trust.held_out else None
         trust.what_to_do = misfit_advice(fitted, held, trust.scatter, MISS_RATIO, judged)
     return trust
+
+
+def _new_samples(fitted: FittedModel, digest: str | None) -> bool:
+    """Whether the samples (content hash ``digest``) are not those the model was identified
+    on: the file records the hash of its own (``provenance["samples_sha256_16"]``) and it
+    differs. A file without it (older, or of a trajectory) counts them as its own."""
+    own = (fitted.provenance or {}).get("samples_sha256_16")
+    return digest is not None and isinstance(own, str) and own != digest
+
+
+def _on_new_samples(trust: Trust, fitted: FittedModel, samples: FrictionSamples) -> str:
+    """Grade the model file's own error on samples it was not identified on
+    (:data:`NEW_SAMPLES`): a held-out error of the model itself, where leave-one-velocity-out
+    would refit its family on them and grade the family (a worn joint's samples, friction
+    x1.3, passed the lead screw's model at 0.53x while the model missed them by 15x). Samples
+    outside the model's operating range (an extrapolation: another side, slower, faster, other
+    loads or temperatures; a gap between its speeds is not) are left out of the error graded
+    while any inside remain. Returns the caveat on them ("" when none)."""
+    trust.heldout_source = NEW_SAMPLES
+    trust.heldout_scheme = "no refit"
+    trust.validation_note = (
+        f"these samples (content hash {trust.samples_hash}) are not those the model was "
+        f"identified on ({fitted.provenance['samples_sha256_16']}): the model's own error on "
+        "them is graded, not a refit of its family"
+    )
+    out = np.array([_extrapolated(fitted, x) for x in samples.X], dtype=bool)
+    judged = samples.subset(~out) if 0 < out.sum() < len(samples) else samples
+    sc = measurement_scatter(judged)
+    trust.scatter_method = sc.method
+    if np.isfinite(sc.value) and sc.value > 0:
+        trust.heldout_rmse = rmse(judged.y, fitted.predict(judged.X, warn=False))
+        trust.scatter = sc.value
+        trust.heldout_ratio = trust.heldout_rmse / sc.value
+    trust.verdict = verdict(trust.heldout_ratio)
+    if not out.any():
+        return ""
+    why = "; ".join(v.message for v in fitted.range_check(samples.X[out]))
+    if judged is samples:
+        return f"every sample lies outside the range the model was identified on: {why}"
+    return (
+        f"{int(out.sum())} of {len(samples)} samples lie outside the range the model was "
+        f"identified on, left out of the error graded: {why}"
+    )
+
+
+def _extrapolated(fitted: FittedModel, x: np.ndarray) -> bool:
+    """Whether one input row lies outside the model's operating range (not in a gap)."""
+    return any(v.kind != "gap" for v in fitted.range_check(x[None, :]))
+
+
+def _on_new(trust: Trust) -> str:
+    """The clause that says the error graded is the model's on samples it was not identified
+    on (:data:`NEW_SAMPLES`), else ``""``."""
+    if trust.heldout_source != NEW_SAMPLES:
+        return ""
+    return " on these samples, not the set it was identified on"
 
 
 def _base(fitted: FittedModel, samples: FrictionSamples | None) -> Trust:
@@ -506,11 +582,15 @@ def _grade(trust: Trust, fitted: FittedModel, sample_caveats: list[str], no: lis
         caveats.append(f"not bounded by the data: {', '.join(trust.open_sides)}")
     ratio = trust.heldout_ratio
     kind = "held-out" if trust.held_out else "in-sample"
+    if trust.heldout_source == NEW_SAMPLES:
+        kind = "model's"
     shared = _shared_reading(trust)
     if np.isfinite(ratio) and ratio > MISS_RATIO and not shared:
-        no.append(f"the {kind} error {trust.verdict} the measurement scatter")
+        no.append(f"the {kind} error {trust.verdict} the measurement scatter{_on_new(trust)}")
     elif np.isfinite(ratio) and ratio > NOISE_RATIO:
-        caveats.append(f"the {kind} error {trust.verdict} the measurement scatter{shared}")
+        caveats.append(
+            f"the {kind} error {trust.verdict} the measurement scatter{_on_new(trust)}{shared}"
+        )
     elif not np.isfinite(ratio):
         caveats.append("no measurement scatter to compare the error with")
     if not shared and np.isfinite(ratio) and trust.shared_rms > trust.scatter:
@@ -552,6 +632,6 @@ def _grade(trust: Trust, fitted: FittedModel, sample_caveats: list[str], no: lis
     ends = (
         end_levels(trust.validation, trust.scatter) if trust.heldout_scheme == LOVO_INTERIOR else ""
     )
-    held = f"{kind} error is within noise ({ratio:.2f}x {which}{ends})"
+    held = f"{kind} error is within noise ({ratio:.2f}x {which}{ends}){_on_new(trust)}"
     det = "every parameter is determined" if free else "the network fits"
     trust.level, trust.reasons = "yes", [f"the fit converged, {det} and the {held}"]
