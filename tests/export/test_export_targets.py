@@ -352,3 +352,19 @@ def test_learned_models_ask_only_for_the_inputs_they_use(tmp_path):
         row = res.stdout.splitlines()[1].split(",")
         assert (float(row[1]), float(row[2])) == (2.0, 40.0)  # as measured, no range warning
         assert "outside the identified range" not in res.stderr
+
+
+def test_a_one_direction_model_says_its_other_side_is_not_measured():
+    """Samples of one direction (direction +1) give a model whose other side the projection
+    mirrors: the comment said "mirrored: direction-combined model", as if both were measured."""
+    combined = stribeck()
+    combined.provenance = {"directions": [0]}
+    assert "(mirrored: direction-combined model)" in project(combined).summary()[0]
+    one = stribeck()
+    one.provenance = {"directions": [1]}
+    head = project(one).summary()[0]
+    assert "direction-combined" not in head
+    assert "identified for positive velocity only: the negative side is its mirror image" in head
+    assert "not measured" in head
+    one.provenance = {"directions": [-1]}
+    assert "identified for negative velocity only" in project(one).summary()[0]

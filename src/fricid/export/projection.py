@@ -86,7 +86,7 @@ class Projection:
         lines = [
             "least-squares Coulomb-viscous projection (F_c, b >= 0) over the operating range: "
             f"|velocity| {v['speed'][0]:.4g} to {v['speed'][1]:.4g} rad/s"
-            f"{' (mirrored: direction-combined model)' if v['mirrored'] else ''}, "
+            f"{_mirrored(v)}, "
             f"{span('load', 'N m')}, {span('temperature', 'degC')}",
             f"projection error: RMS {self.rms_error:.4g} N m "
             f"({percent(self.relative_error)} of the RMS friction {self.rms_friction:.4g} N m), "
@@ -151,14 +151,33 @@ def operating_grid(
     v = np.concatenate([neg, pos])
     V, L, T = np.meshgrid(v, levels["load"], levels["temperature"], indexing="ij")
     X = np.column_stack([V.ravel(), L.ravel(), T.ravel()])
+    directions = (fitted.provenance or {}).get("directions")
+    sides = {1: "positive", -1: "negative"}
+    one = directions[0] if isinstance(directions, list) and len(directions) == 1 else 0
     info = {
         "speed": (a, b),
         "mirrored": mirrored,
+        "one_side": sides.get(one) if mirrored else None,
         "load": (float(levels["load"][0]), float(levels["load"][-1])),
         "temperature": (float(levels["temperature"][0]), float(levels["temperature"][-1])),
         "unused": unused,
     }
     return X, info
+
+
+def _mirrored(info: dict[str, Any]) -> str:
+    """The grid's note on a side it mirrors: a direction-combined model is odd in velocity by
+    construction; a model of one direction's samples was not measured on the other."""
+    if not info["mirrored"]:
+        return ""
+    side = info.get("one_side")
+    if side is None:
+        return " (mirrored: direction-combined model)"
+    other = "negative" if side == "positive" else "positive"
+    return (
+        f" (mirrored: identified for {side} velocity only: the {other} side is its mirror "
+        "image, not measured)"
+    )
 
 
 def _nnls(A: np.ndarray, y: np.ndarray) -> np.ndarray:
