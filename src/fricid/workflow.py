@@ -88,8 +88,8 @@ class JointData:
     ----------
     samples : FrictionSamples
         The combined samples (direction 0, eq. 11 of the BAS-RBFNN paper); for a reader that
-        gives samples directly (a folder of steady-state EPOS recordings, a MATLAB table of
-        means), the per-direction operating points as recorded.
+        gives samples directly (a folder of steady-state EPOS recordings or one of them, a
+        MATLAB table of means), the per-direction operating points as recorded.
     by_direction : FrictionSamples
         The per-direction samples (+1 and -1).
     extraction : ExtractionResult or None
@@ -271,7 +271,7 @@ def load_joint(
     check_keys(eopts, EXTRACT_OPTIONS, "extraction option")
     if gives_samples(reader, path, ropts) and eopts:
         what = (
-            "a folder of steady-state EPOS recordings gives one operating point per file"
+            "steady-state EPOS recordings give one operating point per file"
             if reader == "epos"
             else f"reader '{reader}' gives friction samples directly"
         )

@@ -31,9 +31,9 @@ import numpy as np
 import pytest
 
 from fricid.extract import extract
+from fricid.io import read_epos
 from fricid.samples import RawLog
 from fricid.sim import preset, simulate
-from fricid.workflow import load_joint
 
 #: The real lead-screw recordings, ``../shared/data/real/epos-leadscrew/`` beside the repo.
 LEADSCREW = Path(__file__).resolve().parents[2].parent / "shared" / "data" / "real"
@@ -134,7 +134,7 @@ def _clipped() -> Any:
 def _epos(name: str) -> Any:
     if not LEADSCREW.is_dir():
         pytest.skip(f"real recordings not found at {LEADSCREW}")
-    return load_joint(LEADSCREW / name, "epos").extraction
+    return extract(read_epos(LEADSCREW / name), gravity="auto")
 
 
 #: name -> what is extracted. Pinned as digests of the bits until they moved to a new machine; the
@@ -156,7 +156,9 @@ def _epos(name: str) -> Any:
 #: recordings' are unchanged. The EPOS pins once more when a single recording given no
 #: temperature stopped recording a made-up 25 degC: its samples' and quality table's temperature,
 #: the diagnostics' temperature set-point and the set-point labels' "25 degC" are gone, and the
-#: samples' meta says ``temperature_source``; every other number is the same.
+#: samples' meta says ``temperature_source``; every other number is the same. The EPOS cases call
+#: :func:`fricid.extract.extract` on the recording since ``load_joint`` reads a steady recording
+#: as its folder does (one operating point, no extraction): the same extraction, same numbers.
 CASES = {
     "paper1": lambda: _simulated("paper1"),
     "paper1+faults": lambda: _simulated("paper1+faults", 7_777),

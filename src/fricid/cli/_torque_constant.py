@@ -62,7 +62,7 @@ def print_torque_constant(log: Path, fmt: str, reader_options: dict, chunk_rows:
     from ..extract.torque_constant import fit_torque_constant
     from ..io import open_log
 
-    opened = open_log(log, fmt, reader_options, chunk_rows=chunk_rows)
+    opened = open_log(log, fmt, reader_options, chunk_rows=chunk_rows, steady=False)
     if not hasattr(opened, "__next__"):
         raise ConfigError(
             "--identify-torque-constant needs a log of samples over time with both a current "

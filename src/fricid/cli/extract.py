@@ -135,7 +135,7 @@ def check_flags(ctx: typer.Context, fmt: str, log: Path, variables: list[str] | 
     probe = {"variables": parse_column_map(variables, "--var", "NAME")[0]} if variables else {}
     if gives_samples(fmt, log, probe):
         what = (
-            "a folder of steady-state EPOS recordings gives one operating point per file"
+            "steady-state EPOS recordings give one operating point per file"
             if fmt == "epos"
             else "a MATLAB table of means (--var friction=...) is read straight into samples"
         )
@@ -186,8 +186,8 @@ def extract_command(
         out_option(
             "Samples to write (.csv or .parquet): direction 0, combined by eq. 11, for a log "
             "that is extracted; the operating points as recorded (+1 and -1 rows) for a "
-            "format that gives samples directly (a folder of EPOS recordings, a MATLAB table "
-            "of means)."
+            "format that gives samples directly (EPOS recordings at one steady velocity each, "
+            "a MATLAB table of means)."
         ),
     ] = Path("samples.csv"),
     by_direction: Annotated[
@@ -199,10 +199,10 @@ def extract_command(
             "--format",
             help="table (fricid's CSV/Parquet raw log), generic (any CSV/Parquet table, with "
             "--map), rosbag (a ROS 2 bag folder or .mcap/.db3 file with "
-            "sensor_msgs/msg/JointState; needs --joint), epos (a Maxon EPOS recorder CSV, or a "
-            "folder of them, one steady velocity per file), channels (a folder of headerless "
-            "'time value' files, one per channel and run, with --channels) or mat (a MATLAB "
-            "v5/v7.3 file, with --var). Examples below.",
+            "sensor_msgs/msg/JointState; needs --joint), epos (a Maxon EPOS recorder CSV or a "
+            "folder of them; a file at one steady velocity gives one point), channels (a folder "
+            "of headerless 'time value' files, one per channel and run, with --channels) or mat "
+            "(a MATLAB v5/v7.3 file, with --var). Examples below.",
         ),
     ] = "table",
     column_map: Annotated[
@@ -476,12 +476,12 @@ def extract_command(
         skipped = data.samples.meta.get("skipped_rows") or {}
         n_bad = sum(len(rows) for rows in skipped.values())
         err_console.print(
-            f"{len(data.samples)} steady operating points ("
+            f"{plural(len(data.samples), 'steady operating point')} ("
             + " and ".join(
                 {-1: "backwards", 1: "forwards"}.get(int(d), "at rest")
                 for d in data.samples.directions()
             )
-            + ")"
+            + (f", {data.samples.velocity[0]:+.4g} rad/s)" if len(data.samples) == 1 else ")")
             + (f"; {n_bad} bad rows skipped in {len(skipped)} files" if n_bad else ""),
             markup=False,
             highlight=False,

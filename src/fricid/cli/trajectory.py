@@ -279,7 +279,7 @@ def read_trajectory_log(path: Path, reader: str = "table", reader_options: dict 
     from ..samples import RawLog
 
     try:
-        opened = open_log(path, reader, reader_options or {})
+        opened = open_log(path, reader, reader_options or {}, steady=False)
     except DataError as exc:  # friction samples where a log goes: the commands that take them
         if "'fricid-samples/" not in exc.message:
             raise

@@ -136,18 +136,24 @@ def _decimal_comma(text: pd.DataFrame) -> bool:
 
 
 def _parse_data(
-    lines: list[str], start: int, channels: list[str], path: Path, skip_bad_rows: bool
+    lines: list[str],
+    start: int,
+    channels: list[str],
+    path: Path,
+    skip_bad_rows: bool,
+    quiet: bool = False,
 ) -> tuple[np.ndarray, np.ndarray, list[dict[str, Any]]]:
     """Numeric rows from ``lines[start:]``, their line numbers, and the bad rows skipped.
 
-    Text lines are skipped with a warning. A row of the wrong width or with a malformed cell
-    is an error naming its line and column, or with ``skip_bad_rows`` dropped and listed as
-    ``{"line", "column", "text"}``.
+    Text lines are skipped with a warning (none when ``quiet``: a look before the read). A row
+    of the wrong width or with a malformed cell is an error naming its line and column, or with
+    ``skip_bad_rows`` dropped and listed as ``{"line", "column", "text"}``.
     """
     body = pd.Series(lines[start:], index=np.arange(start + 1, len(lines) + 1), dtype=object)
     body = body[body.str.strip() != ""].str.strip().str.rstrip(";").str.strip()
     is_row = body.str.match(_NUMBER_START)
-    _warn_skipped(path, "non-numeric", list(body[~is_row].items()))
+    if not quiet:
+        _warn_skipped(path, "non-numeric", list(body[~is_row].items()))
     rows = body[is_row]
     if rows.empty:
         raise DataError("no data rows after the units line", file=path)
@@ -211,7 +217,7 @@ def _warn_bad_rows(path: Path, skipped: list[dict[str, Any]]) -> None:
     )
 
 
-def _parse(path: Path, skip_bad_rows: bool = False) -> _Recording:
+def _parse(path: Path, skip_bad_rows: bool = False, quiet: bool = False) -> _Recording:
     lines = _read_text(path)
     if not any(line.strip() for line in lines):
         raise DataError("empty file", file=path)
@@ -233,5 +239,5 @@ def _parse(path: Path, skip_bad_rows: bool = False) -> _Recording:
             file=path,
             row=at + 2,
         )
-    data, line_numbers, skipped = _parse_data(lines, at + 2, channels, path, skip_bad_rows)
+    data, line_numbers, skipped = _parse_data(lines, at + 2, channels, path, skip_bad_rows, quiet)
     return _Recording(header, channels, units[: len(channels)], at + 2, data, line_numbers, skipped)

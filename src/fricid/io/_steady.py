@@ -1,7 +1,8 @@
 """Robust statistics of steady-state recordings (one constant velocity per file), for the
-readers that average whole files (:func:`fricid.io.epos_steady_samples`): outlier rows by
-median/MAD, scatter far above the neighbours', and the warning that names them (issue 11,
-defect 4). The segment-level checks of a raw log live in :mod:`fricid.extract.steady`.
+readers that average whole files (:func:`fricid.io.epos_steady_samples`): whether a recording
+holds one steady operating point, outlier rows by median/MAD, scatter far above the
+neighbours', and the warning that names them (issue 11, defect 4). The segment-level checks of
+a raw log live in :mod:`fricid.extract.steady`.
 """
 
 from __future__ import annotations
@@ -16,7 +17,9 @@ from ..errors import DataQualityWarning, user_stacklevel
 __all__ = [
     "OUTLIER_SIGMAS",
     "SCATTER_RATIO",
+    "STEADY_SPREAD",
     "high_scatter",
+    "one_operating_point",
     "outlier_rows",
     "quality_rows",
     "warn_steady",
@@ -32,6 +35,30 @@ OUTLIER_SIGMAS = 8.0
 #: (same direction, up to two set-points on each side) is flagged and warned about (as
 #: :data:`fricid.extract.SCATTER_RATIO`).
 SCATTER_RATIO = 4.0
+
+
+#: A recording holds one steady operating point when each quarter of it has a mean velocity
+#: within this fraction of the whole recording's (and no row moves the other way). The
+#: lead-screw recordings' quarters are within 0.5 % of their file's mean, and within 10 % at
+#: 2 rpm, where the recorder's 1 rpm resolution shows; a staircase, a ramp or a start from
+#: rest is not one point, and is extracted as a log.
+STEADY_SPREAD = 0.25
+
+
+def one_operating_point(velocity: np.ndarray) -> bool:
+    """Whether a recording's velocity holds one steady operating point: every row at rest or
+    moving one way, each quarter's mean velocity within :data:`STEADY_SPREAD` of the whole
+    recording's (rows further than :data:`OUTLIER_SIGMAS` robust sigmas from the median
+    velocity, glitches, left out)."""
+    v = np.asarray(velocity, dtype=float)
+    v = v[~outlier_rows(v, OUTLIER_SIGMAS)] if v.size else v
+    if v.size < 4 or not np.isfinite(v).all():
+        return False
+    mean = float(np.mean(v))
+    if mean == 0.0 or (np.sign(v) == -np.sign(mean)).any():
+        return False
+    quarters = np.array([np.mean(q) for q in np.array_split(v, 4)])
+    return bool(np.all(np.abs(quarters - mean) <= STEADY_SPREAD * abs(mean)))
 
 
 def outlier_rows(torque: np.ndarray, sigmas: float) -> np.ndarray:

@@ -14,8 +14,9 @@ The format, as EPOS Studio 3.x writes it (``;``-separated, CRLF line ends)::
 
 :func:`read_epos` turns one file into a :class:`~fricid.samples.RawLog` in SI units;
 :func:`read_epos_dir` reads a folder of them; :func:`epos_steady_samples` turns a folder of
-steady-state recordings (one constant velocity per file) into friction samples, dropping
-outlier rows and warning about them (the robust statistics are in :mod:`._steady`).
+steady-state recordings (one constant velocity per file), or one such recording, into friction
+samples, dropping outlier rows and warning about them (the robust statistics are in
+:mod:`._steady`); :func:`steady_recording` says whether a recording is one steady point.
 
 The file's text (its header, data rows and a spreadsheet's re-save with ``skip_bad_rows``) is
 parsed by :mod:`._epos_text`; this module gives the parsed channels their units and meaning.
@@ -32,7 +33,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import ConfigError, DataError
+from ..errors import ConfigError, DataError, FricidError
 from ..metrics import sem_autocorrelated
 from ..samples import NO_TEMPERATURE_SOURCE, FrictionSamples, RawLog
 from ..units import UNITS, to_si
@@ -52,6 +53,7 @@ from ._steady import (
     OUTLIER_SIGMAS,
     SCATTER_RATIO,
     high_scatter,
+    one_operating_point,
     outlier_rows,
     quality_rows,
     warn_steady,
@@ -67,6 +69,7 @@ __all__ = [
     "epos_steady_samples",
     "read_epos",
     "read_epos_dir",
+    "steady_recording",
 ]
 
 logger = logging.getLogger(__name__)
@@ -282,11 +285,34 @@ def _temperature_source(temperature: float | None) -> str:
 
 def _files(folder: str | os.PathLike[str], pattern: str) -> list[Path]:
     folder = Path(folder)
+    if folder.is_file():  # one recording
+        check_input(folder, what="EPOS recording")
+        return [folder]
     check_input(folder, folder=True, what="folder of EPOS recordings")
     files = sorted(p for p in folder.glob(pattern) if p.is_file())
     if not files:
         raise DataError(f"no files matching '{pattern}'", file=folder)
     return files
+
+
+def steady_recording(path: str | os.PathLike[str]) -> bool:
+    """Whether the EPOS recording at ``path`` holds one steady operating point (its velocity
+    at rest or moving one way in every row, at one level: :func:`._steady.one_operating_point`),
+    as each file of a folder of steady-state recordings is taken to be; then its samples are
+    :func:`epos_steady_samples` of it, the same as its folder gives for it. False for a folder
+    and for a file that cannot be read as a recording (reading it says why)."""
+    path = Path(path)
+    if not path.is_file():
+        return False
+    try:
+        rec = _parse(path, skip_bad_rows=True, quiet=True)
+        j = _pick_channels(rec.channels).get("velocity")
+        if j is None:
+            return False
+        velocity = _convert(rec, j, "velocity", path, DEFAULT_NOMINAL_TORQUE, None)
+    except (FricidError, OSError):
+        return False
+    return one_operating_point(velocity)
 
 
 def read_epos_dir(
@@ -322,10 +348,12 @@ def epos_steady_samples(
     temperature: float | None = None,
     load: float = 0.0,
     torque_constant: float | None = None,
+    counts_per_turn: float | None = None,
     outlier_sigmas: float | None = OUTLIER_SIGMAS,
     skip_bad_rows: bool = False,
 ) -> FrictionSamples:
-    """Friction samples from a folder of steady-state EPOS recordings, one point per file.
+    """Friction samples from a folder of steady-state EPOS recordings, one point per file
+    (or from one such recording, :func:`steady_recording`).
 
     Each file is taken as one constant-velocity operating point already in steady state
     (as in the lead-screw recordings): friction is the mean motor torque over the file's rows
@@ -338,10 +366,10 @@ def epos_steady_samples(
     Parameters
     ----------
     folder : str or os.PathLike
-        The folder of recordings (never modified).
+        The folder of recordings, or one recording (never modified).
     pattern : str
-        Glob of the files to read.
-    nominal_torque, flip_sign, temperature, torque_constant
+        Glob of the files to read in a folder.
+    nominal_torque, flip_sign, temperature, torque_constant, counts_per_turn
         As for :func:`read_epos`.
     load : float
         N m, the load recorded with every sample.
@@ -395,6 +423,7 @@ def epos_steady_samples(
         flip_sign=flip_sign,
         temperature=temperature,
         torque_constant=torque_constant,
+        counts_per_turn=counts_per_turn,
         skip_bad_rows=skip_bad_rows,
     )
     logs = [log for log, _ in read]

@@ -35,7 +35,8 @@ __all__ = [
 #: writes), ``generic`` (any CSV/Parquet through a column mapping and units,
 #: :func:`fricid.io.read_table_log`), ``rosbag`` (a ROS 2 bag or MCAP file with
 #: ``sensor_msgs/msg/JointState``, :func:`fricid.io.iter_rosbag`) and ``epos`` (a Maxon EPOS
-#: recorder CSV, or a folder of steady-state recordings, one operating point per file).
+#: recorder CSV, or a folder of steady-state recordings, one operating point per file; a single
+#: steady recording gives its point as its folder does).
 #: ``channels`` (a folder of headerless ``time value`` files, one per channel and run, by
 #: file-name patterns, :func:`fricid.io.channels.read_channels`) and ``mat`` (a MATLAB v5 or
 #: v7.3 file, variables by name, :func:`fricid.io.matlab.read_mat`).
@@ -102,12 +103,16 @@ READER_EXAMPLES: dict[str, str] = {
 def gives_samples(reader: str, path: str | os.PathLike[str], options: Mapping[str, Any]) -> bool:
     """Whether ``reader`` gives friction samples directly (no extraction to apply).
 
-    True for a folder of steady-state EPOS recordings (one operating point per file) and a
-    MATLAB table of means (a ``friction`` variable); every other log is extracted by
-    :func:`fricid.extract.extract`, so extraction options apply to it.
+    True for a folder of steady-state EPOS recordings (one operating point per file), one
+    EPOS recording that holds one steady operating point (:func:`fricid.io.epos.steady_recording`:
+    the same sample as its folder gives for it) and a MATLAB table of means (a ``friction``
+    variable); every other log is extracted by :func:`fricid.extract.extract`, so extraction
+    options apply to it.
     """
     if reader == "epos":
-        return Path(path).is_dir()
+        from .epos import steady_recording
+
+        return Path(path).is_dir() or steady_recording(path)
     if reader == "mat":
         return "friction" in dict(options.get("variables") or {})
     return False
@@ -166,6 +171,7 @@ def open_log(
     options: Mapping[str, Any] | None = None,
     *,
     chunk_rows: int = 1_000_000,
+    steady: bool = True,
 ) -> FrictionSamples | Iterator[RawLog]:
     """Open a joint's log with a reader of :data:`READERS`.
 
@@ -182,12 +188,17 @@ def open_log(
         The reader's options (:data:`READER_OPTIONS`, SI units).
     chunk_rows : int
         Rows read at a time from a ``table`` log or a bag (bounded memory).
+    steady : bool
+        Whether one EPOS recording that holds one steady operating point gives that point's
+        samples (:func:`gives_samples`); False reads it as a time series (a trajectory's
+        identification).
 
     Returns
     -------
     FrictionSamples or iterator of RawLog
-        Samples for a folder of steady-state EPOS recordings (one operating point per file)
-        and a MATLAB table of means (:func:`gives_samples`), else the log as a stream of
+        Samples for a folder of steady-state EPOS recordings (one operating point per file),
+        one steady recording (with ``steady``) and a MATLAB table of means
+        (:func:`gives_samples`), else the log as a stream of
         chunks (one chunk for ``generic``, an EPOS file and a MATLAB log; one per run for
         ``channels``, each run's time starting again).
 
@@ -203,16 +214,16 @@ def open_log(
     path = Path(path)
     opts = dict(options or {})
     check_reader(reader, opts)
-    if reader == "epos" and path.is_dir():
-        from .epos import epos_steady_samples
-
-        return epos_steady_samples(path, **opts)
     if reader == "epos":
-        from .epos import read_epos
+        from .epos import epos_steady_samples, read_epos, steady_recording
 
+        if path.is_dir():
+            return epos_steady_samples(path, **opts)
         extra = [k for k in EPOS_FOLDER_ONLY if k in opts]
         if extra:
             raise ConfigError(f"reader option '{extra[0]}' applies to a folder of EPOS recordings")
+        if steady and steady_recording(path):  # the sample its folder gives for it
+            return epos_steady_samples(path, **opts)
         return iter([read_epos(path, **opts)])
     if reader == "generic":
         from .generic import read_table_log
