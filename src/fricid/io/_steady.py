@@ -1,8 +1,8 @@
 """Robust statistics of steady-state recordings (one constant velocity per file), for the
 readers that average whole files (:func:`fricid.io.epos_steady_samples`): whether a recording
-holds one steady operating point, outlier rows by median/MAD, scatter far above the
-neighbours', and the warning that names them (issue 11, defect 4). The segment-level checks of
-a raw log live in :mod:`fricid.extract.steady`.
+holds one steady operating point, outlier rows by median/MAD (in torque and in velocity),
+scatter far above the neighbours', and the warning that names them (issue 11, defect 4). The
+segment-level checks of a raw log live in :mod:`fricid.extract.steady`.
 """
 
 from __future__ import annotations
@@ -21,6 +21,7 @@ __all__ = [
     "high_scatter",
     "one_operating_point",
     "outlier_rows",
+    "outliers",
     "quality_rows",
     "warn_steady",
 ]
@@ -74,6 +75,18 @@ def outlier_rows(torque: np.ndarray, sigmas: float) -> np.ndarray:
     return dev > sigmas * scale
 
 
+def outliers(
+    torque: np.ndarray, velocity: np.ndarray, sigmas: float | None
+) -> tuple[np.ndarray, np.ndarray]:
+    """A file's rows dropped from its means: (torque outliers, velocity outliers), each
+    :func:`outlier_rows` of its channel at ``sigmas`` (none when ``sigmas`` is None). The
+    velocity is averaged as the torque is: a glitch row at 100x the set-point would move it."""
+    if sigmas is None:
+        none = np.zeros(len(torque), dtype=bool)
+        return none, none
+    return outlier_rows(torque, sigmas), outlier_rows(velocity, sigmas)
+
+
 def high_scatter(velocity: np.ndarray, scatter: np.ndarray, ratio: float) -> np.ndarray:
     """Files whose scatter exceeds ``ratio`` times the median of their neighbours' (same sign
     of velocity, ordered by speed, up to two on each side)."""
@@ -89,17 +102,28 @@ def high_scatter(velocity: np.ndarray, scatter: np.ndarray, ratio: float) -> np.
     return flagged
 
 
-def warn_steady(folder: str, quality: list[dict[str, Any]], lines: dict[str, list[int]]) -> None:
-    """One DataQualityWarning for the outliers dropped and the files flagged, naming them."""
+def warn_steady(
+    folder: str,
+    quality: list[dict[str, Any]],
+    lines: dict[str, list[int]],
+    velocity_lines: dict[str, list[int]] | None = None,
+) -> None:
+    """One DataQualityWarning for the outliers dropped and the files flagged, naming them:
+    ``lines`` and ``velocity_lines`` are the lines of each file's torque and velocity
+    outliers."""
     parts = []
     for row in quality:
         where = f"{row['label']} ({row['velocity']:+.4g} rad/s)"
-        if row["dropped_outlier"]:
-            shown = ", ".join(str(x) for x in lines[row["label"]][:5])
-            parts.append(
-                f"{where}: dropped {row['dropped_outlier']} outlier row(s) (line {shown}), "
-                f"more than {OUTLIER_SIGMAS:g} robust sigmas from the file's median torque"
-            )
+        for channel, found in (("torque", lines), ("velocity", velocity_lines or {})):
+            dropped = found.get(row["label"])
+            if dropped:
+                shown = ", ".join(str(x) for x in dropped[:5])
+                more = f" and {len(dropped) - 5} more" if len(dropped) > 5 else ""
+                parts.append(
+                    f"{where}: dropped {len(dropped)} outlier row(s) (line {shown}{more}), "
+                    f"more than {OUTLIER_SIGMAS:g} robust sigmas from the file's median "
+                    f"{channel}"
+                )
         if row["flagged"]:
             parts.append(
                 f"{where}: torque scatter {row['scatter']:.3g} N m is more than "

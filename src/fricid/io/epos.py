@@ -54,7 +54,7 @@ from ._steady import (
     SCATTER_RATIO,
     high_scatter,
     one_operating_point,
-    outlier_rows,
+    outliers,
     quality_rows,
     warn_steady,
 )
@@ -357,7 +357,8 @@ def epos_steady_samples(
 
     Each file is taken as one constant-velocity operating point already in steady state
     (as in the lead-screw recordings): friction is the mean motor torque over the file's rows
-    that are not outliers, velocity the mean velocity over the same rows, direction the sign of
+    that are not outliers (in torque or in velocity), velocity the mean velocity over the same
+    rows, direction the sign of
     the mean velocity, count the rows averaged and std their torque's sample standard
     deviation. Load and temperature are the given constants (the recorder logs neither); with
     no temperature given the samples have none (not measured, ``meta["temperature_source"]``
@@ -374,9 +375,9 @@ def epos_steady_samples(
     load : float
         N m, the load recorded with every sample.
     outlier_sigmas : float or None
-        Rows whose torque is further than this many robust standard deviations (1.4826 MAD)
-        from the file's median are dropped (default :data:`OUTLIER_SIGMAS`, 8); None keeps
-        every row.
+        Rows whose torque, or velocity, is further than this many robust standard deviations
+        (1.4826 MAD) from the file's median are dropped (default :data:`OUTLIER_SIGMAS`, 8);
+        None keeps every row.
     skip_bad_rows : bool
         As for :func:`read_epos`; ``meta["skipped_rows"]`` lists the rows dropped, per file.
 
@@ -386,7 +387,8 @@ def epos_steady_samples(
         ``meta["quality"]`` holds one row per file (the columns of
         :data:`fricid.extract.QUALITY_COLUMNS`: rows kept, outliers dropped, scatter, and
         whether the scatter is far above the neighbours'); ``meta["outlier_lines"]`` the
-        1-based line numbers of the dropped rows, per file; ``meta["sem"]`` each file's
+        1-based line numbers of the dropped rows, per file (``meta["velocity_outlier_lines"]``
+        those dropped for their velocity); ``meta["sem"]`` each file's
         standard error of the mean torque [N m] (:func:`fricid.metrics.sem_autocorrelated` of
         its kept rows, in time order; None for fewer than 4 rows), with ``meta["sem_method"]``
         and ``meta["sem_caveat"]`` saying how it was estimated
@@ -426,14 +428,12 @@ def epos_steady_samples(
         counts_per_turn=counts_per_turn,
         skip_bad_rows=skip_bad_rows,
     )
-    logs = [log for log, _ in read]
-    keep = [
-        ~outlier_rows(log.motor_torque, outlier_sigmas)
-        if outlier_sigmas is not None
-        else np.ones(len(log), dtype=bool)
-        for log in logs
-    ]
-    velocity = np.array([np.mean(log.velocity[k]) for log, k in zip(logs, keep, strict=True)])
+    out = [outliers(log.motor_torque, log.velocity, outlier_sigmas) for log, _ in read]
+    keep = [~(t | v) for t, v in out]
+    velocity = np.array([np.mean(log.velocity[k]) for (log, _), k in zip(read, keep, strict=True)])
+    order = np.argsort(velocity, kind="stable")  # by the velocity without its glitches
+    read, out, keep = ([x[i] for i in order] for x in (read, out, keep))
+    logs, velocity = [log for log, _ in read], velocity[order]
     zero = np.flatnonzero(velocity == 0)
     if zero.size:
         raise DataError(
@@ -443,13 +443,16 @@ def epos_steady_samples(
     std = np.array([np.std(t, ddof=1) if len(t) > 1 else 0.0 for t in torque])
     flagged = high_scatter(velocity, std, SCATTER_RATIO)
     names = [Path(log.source).name for log in logs]
-    dropped_lines = {
-        name: [int(x) for x in lines[~k]]
-        for name, (_, lines), k in zip(names, read, keep, strict=True)
-        if not k.all()
-    }
+    dropped_lines, torque_lines, velocity_lines = (
+        {
+            name: [int(x) for x in lines[rows]]
+            for name, (_, lines), rows in zip(names, read, masks, strict=True)
+            if rows.any()
+        }
+        for masks in ([~k for k in keep], [t for t, _ in out], [v for _, v in out])
+    )
     quality = quality_rows(names, velocity, keep, std, flagged, temperature)
-    warn_steady(str(folder), quality, dropped_lines)
+    warn_steady(str(folder), quality, torque_lines, velocity_lines)
     sem = [sem_autocorrelated(t) for t in torque]
     return FrictionSamples(
         velocity=velocity,
@@ -469,6 +472,7 @@ def epos_steady_samples(
             "temperature_source": _temperature_source(temperature),
             "outlier_sigmas": outlier_sigmas,
             "outlier_lines": dropped_lines,
+            "velocity_outlier_lines": velocity_lines,
             "skipped_rows": {
                 name: log.meta["skipped_rows"]
                 for name, log in zip(names, logs, strict=True)
