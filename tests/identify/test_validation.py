@@ -338,7 +338,7 @@ def test_cli_fit_validate_auto_robust(tmp_path):
     )
     assert res.exit_code == 0, res.output
     assert "R^2 of |F|" in res.stdout and "paper fitness" in res.stdout
-    assert "try stribeck_asym" in res.stdout and "held-out RMSE (lovo)" in res.stdout
+    assert "try stribeck_asym" in res.stdout and "held-out RMSE (lovo, every level)" in res.stdout
     d = json.loads(out.read_text())
     assert d["validation"]["verdict"].startswith("misses by")
     assert d["metrics"]["r2_magnitude"] < 0.5

@@ -23,7 +23,7 @@ from ._options import (
 )
 from ._paths import check_paths, read_samples_file
 from ._progress import QuietOption, fit_progress
-from ._trust_text import trust_lines
+from ._trust_text import heldout_lines, trust_lines
 
 
 def _method_help() -> str:
@@ -370,29 +370,7 @@ def goodness_text(fitted, samples=None) -> str:
             + (f" (scale {scale:.3g} N m)" if scale else "")
             + f", weights {fitted.loss.get('weights')}"
         )
-    v = fitted.validation
-    if v:
-        sc = f"{v['scatter']:.3g} N m" if v.get("scatter") is not None else "unknown"
-        rm = f"{v['rmse']:.4g} N m" if v.get("rmse") is not None else "n/a"
-        lines += [
-            "[[Validation]]",
-            f"    held-out RMSE ({v['scheme']}) = {rm}, scatter {sc}: {v['verdict']}",
-        ]
-        if v.get("failed"):
-            lines.append(f"    {v['failed']} of {len(v['folds'])} folds could not be fitted")
-        if v.get("not_converged"):
-            lines.append(f"    {v['not_converged']} fold fits did not converge")
-        if v.get("note"):
-            lines.append(f"    note: {v['note']}")
-    sel = fitted.selection
-    if sel:
-        lines += ["[[Model selection]]", f"    chosen: {sel['reason']}"]
-        for r in sel["table"]:
-            err = r.get("heldout_rmse")
-            cell = f"{err:.4g} N m" if err is not None else "-"
-            lines.append(f"    {r['model']:<22} {r['n_params']:>3} par  {cell:>14}  {r['note']}")
-        if sel.get("advice"):
-            lines.append(f"    advice: {sel['advice']}")
+    lines += heldout_lines(fitted)
     return "\n".join(lines)
 
 

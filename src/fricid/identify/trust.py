@@ -629,9 +629,10 @@ def _grade(trust: Trust, fitted: FittedModel, sample_caveats: list[str], no: lis
         trust.level, trust.reasons = "with caveats", caveats + said
         return
     which = f"the scatter {ESTIMATED}" if estimated else "the scatter"
-    ends = (
-        end_levels(trust.validation, trust.scatter) if trust.heldout_scheme == LOVO_INTERIOR else ""
-    )
+    scheme = str(trust.heldout_scheme or "")
+    ends = end_levels(trust.validation, trust.scatter) if scheme == LOVO_INTERIOR else ""
+    if trust.held_out and scheme.startswith("kfold"):  # not the lovo figure printed beside it
+        ends = f" in random folds, {scheme}"
     held = f"{kind} error is within noise ({ratio:.2f}x {which}{ends}){_on_new(trust)}"
     det = "every parameter is determined" if free else "the network fits"
     trust.level, trust.reasons = "yes", [f"the fit converged, {det} and the {held}"]

@@ -47,6 +47,7 @@ from ._scatter import (
 
 __all__ = [
     "ASYMMETRY_SCATTERS",
+    "LOVO_EVERY",
     "SCHEMES",
     "WEIGHTS",
     "Scatter",
@@ -58,6 +59,7 @@ __all__ = [
     "measurement_scatter",
     "parse_scheme",
     "sample_weights",
+    "scheme_label",
     "sem_autocorrelated",
     "validate",
 ]
@@ -67,6 +69,16 @@ SCHEMES = ("lovo", "kfold")
 
 #: Folds of ``kfold`` without ``:K``.
 DEFAULT_K = 5
+
+#: How a pooled ``lovo`` figure is named where it is printed: every fold, the end levels too,
+#: unlike the trust verdict's interior figure (``fricid.identify._heldout.LOVO_INTERIOR``).
+LOVO_EVERY = "lovo, every level"
+
+
+def scheme_label(scheme: str) -> str:
+    """How a validation's pooled held-out RMSE is named: ``"lovo, every level"`` for ``lovo``
+    (:data:`LOVO_EVERY`), the scheme itself (``"kfold:5"``) otherwise."""
+    return LOVO_EVERY if scheme == "lovo" else scheme
 
 
 def parse_scheme(scheme: str) -> tuple[str, int | None]:
@@ -169,7 +181,8 @@ class Validation:
         return sum(1 for f in self.folds if f["rmse"] is None)
 
     def line(self) -> str:
-        """``"held-out RMSE (lovo) 2.1e-05 N m, scatter 1.5e-05 N m: misses by 1.37x"``."""
+        """``"held-out RMSE (lovo, every level) 2.1e-05 N m, scatter 1.5e-05 N m: misses by
+        1.37x"``."""
         extra = []
         if self.failed:
             extra.append(f"{self.failed} of {len(self.folds)} folds could not be fitted")
@@ -178,7 +191,8 @@ class Validation:
         tail = f" ({'; '.join(extra)})" if extra else ""
         sc = f"{self.scatter.value:.3g} N m" if np.isfinite(self.scatter.value) else "unknown"
         return (
-            f"held-out RMSE ({self.scheme}) {self.rmse:.3g} N m, scatter {sc}: {self.verdict}{tail}"
+            f"held-out RMSE ({scheme_label(self.scheme)}) {self.rmse:.3g} N m, scatter {sc}: "
+            f"{self.verdict}{tail}"
         )
 
     def to_dict(self) -> dict[str, Any]:

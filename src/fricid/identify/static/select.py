@@ -46,7 +46,7 @@ from ...optim import single_blas_thread
 from ...samples import FrictionSamples
 from .._named import fit_named
 from .._scatter import Scatter, measurement_scatter
-from ..validate import validate
+from ..validate import scheme_label, validate
 from .candidates import FAMILIES, LEARNED, PREFER_SIMPLER, Candidate, candidates
 
 __all__ = [
@@ -287,15 +287,21 @@ def _reason(
     noise: float,
     n_samples: int,
 ) -> str:
-    """Why ``chosen`` won, in one sentence."""
+    """Why ``chosen`` won, in one sentence; a ratio it prints is the held-out RMSE it prints
+    over the scatter it prints (the noise bar, :data:`fricid.metrics.NOISE_RATIO` times the
+    scatter, is named as such)."""
     name, err = chosen["model"], chosen["heldout_rmse"]
-    head = f"{name} ({chosen['n_params']} parameters): held-out RMSE ({scheme}) {err:.3g} N m"
+    label = scheme_label(scheme)
+    head = f"{name} ({chosen['n_params']} parameters): held-out RMSE ({label}) {err:.3g} N m"
     if chosen is best:
         return f"{head}, the lowest of the candidates"
     if err <= best["heldout_rmse"] * (1.0 + PREFER_SIMPLER):
         why = f"within {PREFER_SIMPLER:.0%} of the best"
     elif err <= noise:
-        why = f"within the noise ({NOISE_RATIO:g}x the scatter {sc.value:.3g} N m)"
+        why = (
+            f"within the noise ({err / sc.value:.2f}x the scatter {sc.value:.3g} N m; within "
+            f"noise is up to {NOISE_RATIO:g}x)"
+        )
     else:
         why = (
             f"on {n_samples} samples not significantly worse (by {TINY_SIGMAS:g} standard "
