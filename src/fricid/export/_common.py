@@ -48,6 +48,7 @@ __all__ = [
     "file_sha256",
     "fmt_float",
     "model_name",
+    "model_scatter",
     "model_sha256",
     "operating_pair",
     "percent",
@@ -187,7 +188,12 @@ def _display(value: object) -> str | None:
 
 
 def summary_lines(
-    fitted: FittedModel, source: str | None = None, sha256: str | None = None
+    fitted: FittedModel,
+    source: str | None = None,
+    sha256: str | None = None,
+    *,
+    projection_rms: float | None = None,
+    projection: str = "projection",
 ) -> list[str]:
     """The fixed-format provenance lines at the top of every exported file.
 
@@ -200,6 +206,12 @@ def summary_lines(
     sha256 : str, optional
         SHA-256 (64 lower-case hex digits) of the model file's bytes; without it, the SHA-256
         of the model's canonical JSON is given and labelled so.
+    projection_rms : float, optional
+        N m, the RMS error over the operating range of what is exported when that is not the
+        model itself (a Coulomb-viscous projection: :attr:`fricid.export.Projection.
+        rms_error`). When it exceeds the model's measurement scatter (:func:`model_scatter`),
+        the trust line says that its verdict is the model's and how many times the scatter
+        the ``projection`` (fixed text: what was exported) misses the model by.
 
     Returns
     -------
@@ -264,12 +276,39 @@ def summary_lines(
                 if str(rec.get("heldout_source", "")).startswith("in-sample"):
                     which = "in-sample (no held-out validation)"
                 break
+        said = [f"{which} error {shown} times the scatter"] if shown is not None else []
+        misses = _projection_miss(fitted, projection_rms, projection)
+        if misses:  # the verdict above is the model's, not what this file holds
+            said = [f"the model's{': ' + said[0] if said else ''}", misses]
         lines.append(
             f"trust verdict: {'NO, exported anyway' if level == 'no' else level}"
-            + (f" ({which} error {shown} times the scatter)" if shown is not None else "")
+            + (f" ({'; '.join(said)})" if said else "")
             + "; the model file gives the reasons"
         )
     return lines
+
+
+def model_scatter(fitted: FittedModel) -> float | None:
+    """N m, the measurement scatter the model's trust verdict compared its error with (its
+    trust record's ``scatter``, else its validation's); None when not recorded."""
+    for rec in (fitted.trust, fitted.validation):
+        if isinstance(rec, dict) and _display(rec.get("scatter")) is not None:
+            value = float(rec["scatter"])
+            return value if value > 0 else None
+    return None
+
+
+def _projection_miss(fitted: FittedModel, rms: float | None, projection: str) -> str:
+    """``"this projection misses the model by 5.91 times the scatter, RMS 0.000377 N m over
+    the operating range"`` when ``rms`` [N m] exceeds :func:`model_scatter`; else ``""`` (a
+    lossless projection, or no scatter recorded)."""
+    scatter = model_scatter(fitted)
+    if scatter is None or rms is None or not (math.isfinite(rms) and rms > scatter):
+        return ""
+    return (
+        f"this {projection} misses the model by {rms / scatter:.3g} times the scatter, RMS "
+        f"{rms:.3g} N m over the operating range"
+    )
 
 
 def trust_of(fitted: FittedModel) -> tuple[str | None, list[str]]:

@@ -118,7 +118,7 @@ def urdf_text(
     name = _check_joint(joint)
     proj = _checked(fitted, "URDF <dynamics>", False, max_loss, ranges)
     lines = [
-        *summary_lines(fitted, source, sha256),
+        *summary_lines(fitted, source, sha256, projection_rms=proj.rms_error),
         *proj.summary(),
         f"place inside the joint named {plain(name)}; friction [N m], damping [N m s/rad]",
     ]
@@ -180,7 +180,7 @@ def mjcf_text(
     else:
         proj = _checked(fitted, "MJCF frictionloss/damping", False, max_loss, ranges)
         lines = [
-            *summary_lines(fitted, source, sha256),
+            *summary_lines(fitted, source, sha256, projection_rms=proj.rms_error),
             *proj.summary(),
             *frictionloss_lines(fitted),
             "copy frictionloss [N m], damping [N m s/rad] and solimpfriction onto your <joint>",
@@ -224,7 +224,10 @@ def ros2_yaml_block(
     if name == "joints":
         raise ExportError("joint name 'joints' is taken by the list of joints in the YAML")
     proj = _checked(fitted, "the per-direction Coulomb-viscous YAML", True, max_loss, ranges)
-    lines = [*summary_lines(fitted, source, sha256), *proj.summary()]
+    lines = [
+        *summary_lines(fitted, source, sha256, projection_rms=proj.rms_error),
+        *proj.summary(),
+    ]
     write_lines_checked(lines, ())
     c, b = proj.coulomb, proj.viscous
     values = {

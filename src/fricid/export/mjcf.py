@@ -237,9 +237,19 @@ def lugre_mapping(fitted: FittedModel, velocity_range=None) -> LuGreMapping:
     )
 
 
-def _summary(fitted: FittedModel, source: str | None, sha256: str | None) -> list[str]:
+def _summary(
+    fitted: FittedModel, source: str | None, sha256: str | None, rms_error: float
+) -> list[str]:
+    """:func:`summary_lines`, its trust line saying when the mapping onto MuJoCo's LuGre
+    (``rms_error`` [N m] from the model's steady state) misses the model beyond its scatter."""
     try:
-        return summary_lines(fitted, source, sha256)
+        return summary_lines(
+            fitted,
+            source,
+            sha256,
+            projection_rms=rms_error,
+            projection="mapping onto MuJoCo's LuGre",
+        )
     except ConfigError:  # 'lugre' not in this build's model registry: the fixed lines only
         lines = ["fricid export of a LuGre model ('lugre')"]
         if sha256 is not None:
@@ -273,7 +283,7 @@ def mjcf_lugre_elements(
         )
     s0, s1, s2, tau_c, tau_s = mapping.theta[:5]
     lines = [
-        *_summary(fitted, source, sha256),
+        *_summary(fitted, source, sha256, mapping.rms_error),
         *mapping.summary(),
         f"copy damping onto your <joint> {plain(name)} and the dcmotor into <actuator>",
     ]
