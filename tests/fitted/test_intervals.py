@@ -147,3 +147,22 @@ def test_no_interval_for_a_fit_without_spare_samples_says_why():
     assert f.prediction_interval is None
     with pytest.raises(ConfigError, match="4 samples for 4 free parameters leave no residual"):
         f.predict_interval(np.array([[0.5, 0.0, 25.0]]))
+
+
+def test_no_interval_outside_the_operating_range(stribeck, tmp_path):
+    """A 95 % interval at twice the largest measured speed, or below the slowest, was as
+    narrow as inside (an RBF network's a constant +/-7e-5 N m at 40 rad/s, missing the
+    measured friction): nothing measured backs one there, so none is given, and predict says
+    why."""
+    X = np.array([[8.0, 0.0, 25.0], [-0.05, 0.0, 25.0], [0.5, 0.0, 25.0], [-2.0, 0.0, 25.0]])
+    pi = stribeck.predict_interval(X, warn=False)
+    assert np.isnan(pi.half_width[:2]).all() and np.isfinite(pi.half_width[2:]).all()
+    assert np.isfinite(pi.friction).all()  # the prediction itself stays (with its warning)
+    path = stribeck.save(tmp_path / "m.json")
+    res = CliRunner().invoke(
+        app, ["predict", str(path), "-v", "8", "-v", "0.5", "--interval", "0.95"]
+    )
+    assert res.exit_code == 0, res.output
+    text = " ".join(res.output.split())
+    assert "no prediction interval at 1 of 2 points: outside the range the model was" in text
+    assert "in a gap" not in text

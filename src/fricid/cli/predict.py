@@ -200,10 +200,13 @@ def predict_command(
                 raise ConfigError(f"{model}: {err}") from None
             extra = {"low": friction - half, "high": friction + half}
             rest = X[:, 0] == 0
+            outside = fitted.outside_range(X) & ~rest
             why = {
                 "at rest, where the friction is whatever holds the joint, up to break-away": rest,
+                "outside the range the model was identified on (above), where nothing "
+                "measured backs one": outside,
                 "in a gap between measured speeds (above), where nothing measured backs one": (
-                    np.isnan(half) & ~rest
+                    np.isnan(half) & ~rest & ~outside
                 ),
             }
             for reason, where in why.items():

@@ -310,6 +310,15 @@ class FittedModel:
             X, self.operating_range, self.inputs_used(), prov.get("directions"), prov.get("speeds")
         )
 
+    def outside_range(self, X) -> np.ndarray:
+        """Per row of ``X (n, 3)``: whether it lies outside the operating range
+        (:meth:`range_check`: another side, above or below the measured speeds, other loads
+        or temperatures; a gap between measured speeds is not outside)."""
+        X = np.atleast_2d(np.asarray(X, dtype=float))
+        if not any(v.kind != "gap" for v in self.range_check(X)):
+            return np.zeros(len(X), dtype=bool)
+        return np.array([any(v.kind != "gap" for v in self.range_check(x[None])) for x in X])
+
     # -- text ----------------------------------------------------------------------------
     def report(self, min_correl: float = MIN_CORREL) -> str:
         """A plain-text fit report after lmfit's ``fit_report``, from what the file stores.

@@ -53,7 +53,11 @@ was seen there, and a family that bends inside the gap goes unseen (``auto``'s c
 the verdict benchmark's gapped designs covered 82.9 % there and outside together; the
 leave-out error of the gap's two edge speeds, tried as the spread inside, raised it to 85.6
 %: a decade without samples hid a Stribeck dip of 5 noise std that the edges never showed).
-Outside the operating range none of these says anything a measurement backs.
+Outside the operating range (:meth:`fricid.fitted.FittedModel.outside_range`: above or
+below the measured speeds, on a side not measured, at other loads or temperatures) none of
+these says anything a measurement backs, and none is given either (NaN): a network's
+conformal half-width was as narrow at twice the largest measured speed as inside, and missed
+the measured friction there.
 """
 
 from __future__ import annotations
@@ -460,7 +464,9 @@ def prediction_interval(fitted, X, level: float = 0.95) -> PredictionInterval:
         F = fitted.predict(X, warn=False)
         half, method = analytic_half_width(fitted.model, fitted.theta(), record, X, level), "delta"
     # at rest the friction is whatever holds the joint, up to break-away: no interval; nor
-    # inside a gap between measured speeds, where nothing measured backs one
+    # inside a gap between measured speeds or outside the operating range, where nothing
+    # measured backs one
     rest = X[:, 0] == 0
-    half = np.where(rest | in_gap(X[:, 0], (fitted.provenance or {}).get("speeds")), np.nan, half)
+    gap = in_gap(X[:, 0], (fitted.provenance or {}).get("speeds"))
+    half = np.where(rest | gap | fitted.outside_range(X), np.nan, half)
     return PredictionInterval(F, F - half, F + half, level, method)

@@ -451,7 +451,7 @@ def _on_new_samples(trust: Trust, fitted: FittedModel, samples: FrictionSamples)
         f"identified on ({fitted.provenance['samples_sha256_16']}): the model's own error on "
         "them is graded, not a refit of its family"
     )
-    out = np.array([_extrapolated(fitted, x) for x in samples.X], dtype=bool)
+    out = fitted.outside_range(samples.X)
     judged = samples.subset(~out) if 0 < out.sum() < len(samples) else samples
     sc = measurement_scatter(judged)
     trust.scatter_method = sc.method
@@ -469,11 +469,6 @@ def _on_new_samples(trust: Trust, fitted: FittedModel, samples: FrictionSamples)
         f"{int(out.sum())} of {len(samples)} samples lie outside the range the model was "
         f"identified on, left out of the error graded: {why}"
     )
-
-
-def _extrapolated(fitted: FittedModel, x: np.ndarray) -> bool:
-    """Whether one input row lies outside the model's operating range (not in a gap)."""
-    return any(v.kind != "gap" for v in fitted.range_check(x[None, :]))
 
 
 def _on_new(trust: Trust) -> str:
