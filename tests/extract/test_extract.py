@@ -237,9 +237,26 @@ def test_one_direction_only(quick1, quick1_log):
     message = str(info.value)
     assert "no negative-direction data in 5 of 5 bins" in message
     assert "gravity='none'" in message
-    # a horizontal-joint reading takes the single direction as measured
+    # a horizontal-joint reading takes the single direction as measured: that direction's
+    # samples (direction +1), not "both directions combined" (direction 0 made an export
+    # mirror the unmeasured side as a direction-combined model's)
     r = extract(forward, **{**quick1.extract_options(), "gravity": "none"})
     assert (r.by_direction.direction == 1).all() and len(r.samples) == len(r.by_direction)
+    assert (r.samples.direction == 1).all() and (r.samples.velocity > 0).all()
+    np.testing.assert_array_equal(r.samples.friction, r.by_direction.friction)
+    assert "(one direction only;" in r.summary() and "(both directions" not in r.summary()
+    assert any("measured forwards only" in n for n in r.notes)
+    rows = np.flatnonzero(quick1_log.velocity <= 0)
+    backward = replace(
+        quick1_log,
+        **{
+            k: getattr(quick1_log, k)[rows]
+            for k in ("time", "position", "velocity", "temperature", "current")
+        },
+    )
+    r = extract(backward, **{**quick1.extract_options(), "gravity": "none"})
+    assert (r.samples.direction == -1).all() and (r.samples.velocity < 0).all()
+    assert (r.samples.friction < 0).all()
 
 
 def test_missing_direction_at_one_setpoint_is_named(quick1, quick1_log):

@@ -159,6 +159,10 @@ def _epos(name: str) -> Any:
 #: samples' meta says ``temperature_source``; every other number is the same. The EPOS cases call
 #: :func:`fricid.extract.extract` on the recording since ``load_joint`` reads a steady recording
 #: as its folder does (one operating point, no extraction): the same extraction, same numbers.
+#: The EPOS pins once more when a log measured in one direction only stopped being written as
+#: "both directions combined" (direction 0, the backward recording's velocity and friction made
+#: positive): its samples are that direction's (+1 for 10.csv, -1 with both signs kept for
+#: n200.csv), with a note saying so; every magnitude is the same.
 CASES = {
     "paper1": lambda: _simulated("paper1"),
     "paper1+faults": lambda: _simulated("paper1+faults", 7_777),

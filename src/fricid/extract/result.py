@@ -111,8 +111,13 @@ class ExtractionResult:
     def summary(self) -> str:
         """A few lines describing the result (for a report or the CLI)."""
         d = self.diagnostics
+        combined = (
+            "both directions combined"
+            if (np.asarray(self.samples.direction) == 0).any()
+            else "one direction only"
+        )
         lines = [
-            f"{_count(len(self.samples), 'sample')} (both directions combined; "
+            f"{_count(len(self.samples), 'sample')} ({combined}; "
             f"{_per_direction(self.by_direction)}) from {_count(d.segments, 'segment')} of "
             f"{_count(d.rows, 'row')}; {_count(d.spikes, 'spike')} filtered",
             f"{_count(d.velocity_setpoints.size, 'velocity set-point')} "

@@ -195,4 +195,12 @@ def assemble(pooled, shape, t_set, v_set, gravity, source, meta, joint_fit, note
         source=source,
         meta={**meta, **sem_meta(by_sem, by_passes)},
     )
+    one_way = not b2.any() and (h[:, 0].all() or h[:, 1].all())
+    if one_way:  # nothing to combine: that direction's samples, not "both directions combined"
+        word, sign = ("forwards", "+1") if h[:, 1].all() else ("backwards", "-1")
+        notes.append(
+            f"every set-point was measured {word} only: the samples are that direction's "
+            f"(direction {sign}), not both directions combined; the other side was not measured"
+        )
+        samples = by_direction
     return samples, by_direction, fit, sem_c, by_sem, position
