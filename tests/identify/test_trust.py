@@ -21,6 +21,7 @@ from fricid.identify import fit, trust
 from fricid.identify.trust import (
     FROM_FIT,
     IN_SAMPLE,
+    KFOLD_HERE,
     LOVO_INTERIOR,
     MISS_RATIO,
     NEW_SAMPLES,
@@ -365,11 +366,14 @@ def test_samples_the_model_was_not_identified_on_grade_the_model_itself(
     # its own samples: as before (lovo, interior levels)
     own = assess_trust(fitted, leadscrew)
     assert own.heldout_source == RUN_HERE and own.level == "yes"
-    # one direction's model on both directions: the other side is left out of the grade
-    pos = fit(leadscrew.subset(leadscrew.velocity > 0), "stribeck")
-    both = assess_trust(pos, leadscrew)
+    # one direction's model (fit --direction pos) on a file of both: its own rows are judged
+    pos = fit(leadscrew.subset(leadscrew.direction > 0), "stribeck")
+    mine = assess_trust(pos, leadscrew)
+    assert mine.heldout_source in (RUN_HERE, KFOLD_HERE)  # its own rows: validated as fit
+    # ... and on a worn joint's file of both: the other side is left out of the grade
+    both = assess_trust(pos, worn)
     assert both.heldout_source == NEW_SAMPLES
-    inside = leadscrew.subset(leadscrew.velocity > 0)
+    inside = worn.subset(worn.velocity > 0)
     error = float(np.sqrt(np.mean((pos.predict(inside.X, warn=False) - inside.y) ** 2)))
     assert both.heldout_rmse == pytest.approx(error, rel=1e-12)
     assert any(r.startswith("16 of 32 samples lie outside the range") for r in both.reasons)

@@ -85,7 +85,7 @@ import numpy as np
 from ..fitted import FittedModel
 from ..fitted._file import _convergence_line
 from ..metrics import NOISE_RATIO, rmse, verdict
-from ..samples import FrictionSamples
+from ..samples import FrictionSamples, samples_hash
 from ._diagnostics import (
     DROPS,
     channel_problems,
@@ -364,6 +364,7 @@ def assess_trust(
         The level and its reasons, each number with its source (module notes).
     """
     options = trust_options(validate, max_work)
+    samples = _own_directions(fitted, samples)
     key = record_key(fitted, samples, options, TRUST_VERSION)
     if reuse:
         stored = _stored(fitted, key)
@@ -426,6 +427,21 @@ def assess_trust(
         held = trust.validation if trust.held_out else None
         trust.what_to_do = misfit_advice(fitted, held, trust.scatter, MISS_RATIO, judged)
     return trust
+
+
+def _own_directions(fitted: FittedModel, samples: FrictionSamples | None) -> FrictionSamples | None:
+    """``samples``, or the rows of the directions the model was identified on when those are
+    its own set (``fricid fit --direction pos`` on a file of both: a report of that file
+    judges the model on its own rows, not on rows it never saw as "other samples")."""
+    prov = fitted.provenance or {}
+    own, dirs = prov.get("samples_sha256_16"), prov.get("directions")
+    if samples is None or not isinstance(own, str) or not isinstance(dirs, list):
+        return samples
+    keep = np.isin(samples.direction, np.asarray(dirs, dtype=float))
+    if keep.all() or not keep.any():
+        return samples
+    subset = samples.subset(keep)
+    return subset if samples_hash(subset) == own else samples
 
 
 def _new_samples(fitted: FittedModel, digest: str | None) -> bool:
