@@ -24,8 +24,9 @@ import numpy as np
 
 from ..errors import FricidError
 from ..fitted import FittedModel
-from ..samples import FrictionSamples
-from ._scatter import level_labels
+from ..metrics import rmse, verdict
+from ..samples import FrictionSamples, samples_hash
+from ._scatter import level_labels, measurement_scatter
 from .learned._trust import CV_SOURCE, LEARNED_VALIDATE_WORK
 from .validate import interior_rmse
 
@@ -33,18 +34,26 @@ __all__ = [
     "LEARNED_VALIDATE_WORK",
     "LOVO_INTERIOR",
     "MIN_LEVELS",
+    "NEW_SAMPLES",
     "RANK_RTOL",
     "TINY_SAMPLES",
     "VALIDATE_WORK",
     "end_levels",
+    "grade_new_samples",
     "graded_rmse",
+    "is_new_samples",
+    "on_new_clause",
     "own_cv",
+    "own_directions",
     "run_kfold",
     "run_validation",
     "shared_mse",
     "worse_kfold",
 ]
 
+#: ... the model file's own error on samples other than the set it was identified on (their
+#: content hash differs: :func:`grade_new_samples`; they may share rows with it).
+NEW_SAMPLES = "the model on other samples than its own"
 #: The scheme the verdict names for leave-one-velocity-out graded on its interior folds.
 LOVO_INTERIOR = "lovo, interior levels"
 
@@ -338,3 +347,69 @@ def shared_mse(
         total += float(np.trace(B @ sigma @ B.T))
         count += int(held.sum())
     return total / count if count else 0.0
+
+
+def own_directions(fitted: FittedModel, samples: FrictionSamples | None) -> FrictionSamples | None:
+    """``samples``, or the rows of the directions the model was identified on when those are
+    its own set (``fricid fit --direction pos`` on a file of both: a report of that file
+    judges the model on its own rows, not on rows it never saw as "other samples")."""
+    prov = fitted.provenance or {}
+    own, dirs = prov.get("samples_sha256_16"), prov.get("directions")
+    if samples is None or not isinstance(own, str) or not isinstance(dirs, list):
+        return samples
+    keep = np.isin(samples.direction, np.asarray(dirs, dtype=float))
+    if keep.all() or not keep.any():
+        return samples
+    subset = samples.subset(keep)
+    return subset if samples_hash(subset) == own else samples
+
+
+def is_new_samples(fitted: FittedModel, digest: str | None) -> bool:
+    """Whether the samples (content hash ``digest``) are not those the model was identified
+    on: the file records the hash of its own (``provenance["samples_sha256_16"]``) and it
+    differs. A file without it (older, or of a trajectory) counts them as its own."""
+    own = (fitted.provenance or {}).get("samples_sha256_16")
+    return digest is not None and isinstance(own, str) and own != digest
+
+
+def grade_new_samples(trust: Any, fitted: FittedModel, samples: FrictionSamples) -> str:
+    """Grade the model file's own error on samples it was not identified on
+    (:data:`NEW_SAMPLES`): a held-out error of the model itself, where leave-one-velocity-out
+    would refit its family on them and grade the family (a worn joint's samples, friction
+    x1.3, passed the lead screw's model at 0.53x while the model missed them by 15x). Samples
+    outside the model's operating range (an extrapolation: another side, slower, faster, other
+    loads or temperatures; a gap between its speeds is not) are left out of the error graded
+    while any inside remain. Returns the caveat on them ("" when none)."""
+    trust.heldout_source = NEW_SAMPLES
+    trust.heldout_scheme = "no refit"
+    trust.validation_note = (
+        f"these samples (content hash {trust.samples_hash}) are not those the model was "
+        f"identified on ({fitted.provenance['samples_sha256_16']}): the model's own error on "
+        "them is graded, not a refit of its family"
+    )
+    out = fitted.outside_range(samples.X)
+    judged = samples.subset(~out) if 0 < out.sum() < len(samples) else samples
+    sc = measurement_scatter(judged)
+    trust.scatter_method = sc.method
+    if np.isfinite(sc.value) and sc.value > 0:
+        trust.heldout_rmse = rmse(judged.y, fitted.predict(judged.X, warn=False))
+        trust.scatter = sc.value
+        trust.heldout_ratio = trust.heldout_rmse / sc.value
+    trust.verdict = verdict(trust.heldout_ratio)
+    if not out.any():
+        return ""
+    why = "; ".join(v.message for v in fitted.range_check(samples.X[out]))
+    if judged is samples:
+        return f"every sample lies outside the range the model was identified on: {why}"
+    return (
+        f"{int(out.sum())} of {len(samples)} samples lie outside the range the model was "
+        f"identified on, left out of the error graded: {why}"
+    )
+
+
+def on_new_clause(trust: Any) -> str:
+    """The clause that says the error graded is the model's on samples it was not identified
+    on (:data:`NEW_SAMPLES`), else ``""``."""
+    if trust.heldout_source != NEW_SAMPLES:
+        return ""
+    return " on these samples, not the set it was identified on"

@@ -85,7 +85,7 @@ import numpy as np
 from ..fitted import FittedModel
 from ..fitted._file import _convergence_line
 from ..metrics import NOISE_RATIO, rmse, verdict
-from ..samples import FrictionSamples, samples_hash
+from ..samples import FrictionSamples
 from ._diagnostics import (
     DROPS,
     channel_problems,
@@ -103,11 +103,16 @@ from ._heldout import (
     LEARNED_VALIDATE_WORK,
     LOVO_INTERIOR,
     MIN_LEVELS,
+    NEW_SAMPLES,
     TINY_SAMPLES,
     VALIDATE_WORK,
     end_levels,
+    grade_new_samples,
     graded_rmse,
+    is_new_samples,
+    on_new_clause,
     own_cv,
+    own_directions,
     run_validation,
     shared_mse,
     worse_kfold,
@@ -158,9 +163,6 @@ FROM_FIT = "the fit's --validate"
 OWN_CV = "the learned model's own CV"
 #: ... no held-out error: the fit's in-sample RMSE over the scatter.
 IN_SAMPLE = "in-sample only"
-#: ... the model file's own error on samples other than the set it was identified on (their
-#: content hash differs: :func:`_on_new_samples`; they may share rows with it).
-NEW_SAMPLES = "the model on other samples than its own"
 #: Said in the reasons when the scatter is estimated (:func:`._scatter.second_difference_scatter`).
 ESTIMATED = "estimated from second differences: no repeated runs, so not measured"
 SECOND_LOG = "a second log"  #: ... run along by :func:`.trajectory_check.heldout_grading`
@@ -364,7 +366,7 @@ def assess_trust(
         The level and its reasons, each number with its source (module notes).
     """
     options = trust_options(validate, max_work)
-    samples = _own_directions(fitted, samples)
+    samples = own_directions(fitted, samples)
     key = record_key(fitted, samples, options, TRUST_VERSION)
     if reuse:
         stored = _stored(fitted, key)
@@ -373,8 +375,8 @@ def assess_trust(
     trust = _base(fitted, samples)
     trust.samples_hash, trust.samples_detail_hash = key["samples_hash"], key["samples_detail_hash"]
     trust.model_hash, trust.options = key["model_hash"], options
-    if _new_samples(fitted, trust.samples_hash):
-        outside = _on_new_samples(trust, fitted, samples)
+    if is_new_samples(fitted, trust.samples_hash):
+        outside = grade_new_samples(trust, fitted, samples)
         trust.quality, trust.quality_summary, quality_caveat = quality_rows(samples)
         problems = channel_problems(samples)
         _grade(trust, fitted, [outside, quality_caveat, *gravity_caveat(samples)], problems)
@@ -427,72 +429,6 @@ def assess_trust(
         held = trust.validation if trust.held_out else None
         trust.what_to_do = misfit_advice(fitted, held, trust.scatter, MISS_RATIO, judged)
     return trust
-
-
-def _own_directions(fitted: FittedModel, samples: FrictionSamples | None) -> FrictionSamples | None:
-    """``samples``, or the rows of the directions the model was identified on when those are
-    its own set (``fricid fit --direction pos`` on a file of both: a report of that file
-    judges the model on its own rows, not on rows it never saw as "other samples")."""
-    prov = fitted.provenance or {}
-    own, dirs = prov.get("samples_sha256_16"), prov.get("directions")
-    if samples is None or not isinstance(own, str) or not isinstance(dirs, list):
-        return samples
-    keep = np.isin(samples.direction, np.asarray(dirs, dtype=float))
-    if keep.all() or not keep.any():
-        return samples
-    subset = samples.subset(keep)
-    return subset if samples_hash(subset) == own else samples
-
-
-def _new_samples(fitted: FittedModel, digest: str | None) -> bool:
-    """Whether the samples (content hash ``digest``) are not those the model was identified
-    on: the file records the hash of its own (``provenance["samples_sha256_16"]``) and it
-    differs. A file without it (older, or of a trajectory) counts them as its own."""
-    own = (fitted.provenance or {}).get("samples_sha256_16")
-    return digest is not None and isinstance(own, str) and own != digest
-
-
-def _on_new_samples(trust: Trust, fitted: FittedModel, samples: FrictionSamples) -> str:
-    """Grade the model file's own error on samples it was not identified on
-    (:data:`NEW_SAMPLES`): a held-out error of the model itself, where leave-one-velocity-out
-    would refit its family on them and grade the family (a worn joint's samples, friction
-    x1.3, passed the lead screw's model at 0.53x while the model missed them by 15x). Samples
-    outside the model's operating range (an extrapolation: another side, slower, faster, other
-    loads or temperatures; a gap between its speeds is not) are left out of the error graded
-    while any inside remain. Returns the caveat on them ("" when none)."""
-    trust.heldout_source = NEW_SAMPLES
-    trust.heldout_scheme = "no refit"
-    trust.validation_note = (
-        f"these samples (content hash {trust.samples_hash}) are not those the model was "
-        f"identified on ({fitted.provenance['samples_sha256_16']}): the model's own error on "
-        "them is graded, not a refit of its family"
-    )
-    out = fitted.outside_range(samples.X)
-    judged = samples.subset(~out) if 0 < out.sum() < len(samples) else samples
-    sc = measurement_scatter(judged)
-    trust.scatter_method = sc.method
-    if np.isfinite(sc.value) and sc.value > 0:
-        trust.heldout_rmse = rmse(judged.y, fitted.predict(judged.X, warn=False))
-        trust.scatter = sc.value
-        trust.heldout_ratio = trust.heldout_rmse / sc.value
-    trust.verdict = verdict(trust.heldout_ratio)
-    if not out.any():
-        return ""
-    why = "; ".join(v.message for v in fitted.range_check(samples.X[out]))
-    if judged is samples:
-        return f"every sample lies outside the range the model was identified on: {why}"
-    return (
-        f"{int(out.sum())} of {len(samples)} samples lie outside the range the model was "
-        f"identified on, left out of the error graded: {why}"
-    )
-
-
-def _on_new(trust: Trust) -> str:
-    """The clause that says the error graded is the model's on samples it was not identified
-    on (:data:`NEW_SAMPLES`), else ``""``."""
-    if trust.heldout_source != NEW_SAMPLES:
-        return ""
-    return " on these samples, not the set it was identified on"
 
 
 def _base(fitted: FittedModel, samples: FrictionSamples | None) -> Trust:
@@ -597,11 +533,10 @@ def _grade(trust: Trust, fitted: FittedModel, sample_caveats: list[str], no: lis
         kind = "model's"
     shared = _shared_reading(trust)
     if np.isfinite(ratio) and ratio > MISS_RATIO and not shared:
-        no.append(f"the {kind} error {trust.verdict} the measurement scatter{_on_new(trust)}")
+        no.append(f"the {kind} error {trust.verdict} the measurement scatter{on_new_clause(trust)}")
     elif np.isfinite(ratio) and ratio > NOISE_RATIO:
-        caveats.append(
-            f"the {kind} error {trust.verdict} the measurement scatter{_on_new(trust)}{shared}"
-        )
+        new = on_new_clause(trust)
+        caveats.append(f"the {kind} error {trust.verdict} the measurement scatter{new}{shared}")
     elif not np.isfinite(ratio):
         caveats.append("no measurement scatter to compare the error with")
     if not shared and np.isfinite(ratio) and trust.shared_rms > trust.scatter:
@@ -644,6 +579,6 @@ def _grade(trust: Trust, fitted: FittedModel, sample_caveats: list[str], no: lis
     ends = end_levels(trust.validation, trust.scatter) if scheme == LOVO_INTERIOR else ""
     if trust.held_out and scheme.startswith("kfold"):  # not the lovo figure printed beside it
         ends = f" in random folds, {scheme}"
-    held = f"{kind} error is within noise ({ratio:.2f}x {which}{ends}){_on_new(trust)}"
+    held = f"{kind} error is within noise ({ratio:.2f}x {which}{ends}){on_new_clause(trust)}"
     det = "every parameter is determined" if free else "the network fits"
     trust.level, trust.reasons = "yes", [f"the fit converged, {det} and the {held}"]
