@@ -366,14 +366,29 @@ def test_samples_the_model_was_not_identified_on_grade_the_model_itself(
     # its own samples: as before (lovo, interior levels)
     own = assess_trust(fitted, leadscrew)
     assert own.heldout_source == RUN_HERE and own.level == "yes"
-    # one direction's model (fit --direction pos) on a file of both: its own rows are judged
+    # its own rows in another order are its own samples, not other samples
+    reordered = assess_trust(fitted, leadscrew.subset(np.arange(len(leadscrew))[::-1]))
+    assert reordered.heldout_source != NEW_SAMPLES and reordered.level == "yes"
+    # some of its own rows among others: judged on the others only
+    half = np.arange(len(leadscrew)) % 2 == 0
+    mixed = type(leadscrew).concatenate([leadscrew.subset(half), worn.subset(~half)])
+    record = assess_trust(fitted, mixed)
+    new = worn.subset(~half)
+    error = float(np.sqrt(np.mean((fitted.predict(new.X, warn=False) - new.y) ** 2)))
+    assert record.heldout_source == NEW_SAMPLES
+    assert record.heldout_rmse == pytest.approx(error, rel=1e-12)
+    assert any(r.startswith(f"{half.sum()} of 32 rows are rows the model") for r in record.reasons)
+    # one direction's model (fit --direction pos) on a file of both: its own rows are judged,
+    # and what it makes of the other side is said
     pos = fit(leadscrew.subset(leadscrew.direction > 0), "stribeck")
     mine = assess_trust(pos, leadscrew)
     assert mine.heldout_source in (RUN_HERE, KFOLD_HERE)  # its own rows: validated as fit
+    assert mine.level != "yes"
+    assert any("16 rows of a direction the model was not identified on" in r for r in mine.reasons)
     # ... and on a worn joint's file of both: the other side is left out of the grade
     both = assess_trust(pos, worn)
     assert both.heldout_source == NEW_SAMPLES
     inside = worn.subset(worn.velocity > 0)
     error = float(np.sqrt(np.mean((pos.predict(inside.X, warn=False) - inside.y) ** 2)))
     assert both.heldout_rmse == pytest.approx(error, rel=1e-12)
-    assert any(r.startswith("16 of 32 samples lie outside the range") for r in both.reasons)
+    assert any(r.startswith("16 of 32 rows lie outside the range") for r in both.reasons)

@@ -25,7 +25,7 @@ import numpy as np
 from ..errors import FricidError
 from ..fitted import FittedModel
 from ..metrics import rmse, verdict
-from ..samples import FrictionSamples, samples_hash
+from ..samples import FrictionSamples, row_digests, samples_hash
 from ._scatter import level_labels, measurement_scatter
 from .learned._trust import CV_SOURCE, LEARNED_VALIDATE_WORK
 from .validate import interior_rmse
@@ -43,8 +43,10 @@ __all__ = [
     "graded_rmse",
     "is_new_samples",
     "on_new_clause",
+    "other_side_caveat",
     "own_cv",
     "own_directions",
+    "own_rows",
     "run_kfold",
     "run_validation",
     "shared_mse",
@@ -349,27 +351,61 @@ def shared_mse(
     return total / count if count else 0.0
 
 
-def own_directions(fitted: FittedModel, samples: FrictionSamples | None) -> FrictionSamples | None:
-    """``samples``, or the rows of the directions the model was identified on when those are
-    its own set (``fricid fit --direction pos`` on a file of both: a report of that file
-    judges the model on its own rows, not on rows it never saw as "other samples")."""
+def own_directions(
+    fitted: FittedModel, samples: FrictionSamples | None
+) -> tuple[FrictionSamples | None, FrictionSamples | None]:
+    """``(samples, None)``, or the rows of the directions the model was identified on when
+    those are its own set and the other rows (``fricid fit --direction pos`` on a file of
+    both: a report of that file judges the model on its own rows, and says what it makes of
+    the others: :func:`other_side_caveat`)."""
     prov = fitted.provenance or {}
     own, dirs = prov.get("samples_sha256_16"), prov.get("directions")
     if samples is None or not isinstance(own, str) or not isinstance(dirs, list):
-        return samples
+        return samples, None
     keep = np.isin(samples.direction, np.asarray(dirs, dtype=float))
     if keep.all() or not keep.any():
-        return samples
+        return samples, None
     subset = samples.subset(keep)
-    return subset if samples_hash(subset) == own else samples
+    if samples_hash(subset) != own:
+        return samples, None
+    return subset, samples.subset(~keep)
 
 
-def is_new_samples(fitted: FittedModel, digest: str | None) -> bool:
-    """Whether the samples (content hash ``digest``) are not those the model was identified
+def other_side_caveat(fitted: FittedModel, others: FrictionSamples | None, scatter: float) -> str:
+    """What the model makes of the rows of a direction it was not identified on, beside its
+    own (:func:`own_directions`): their error over ``scatter``, an extrapolation."""
+    if others is None or not len(others):
+        return ""
+    error = rmse(others.y, fitted.predict(others.X, warn=False))
+    told = f"{error / scatter:.3g}x the scatter" if scatter > 0 else f"{error:.3g} N m RMS"
+    return (
+        f"the samples also hold {len(others)} rows of a direction the model was not identified "
+        f"on, which it predicts as its mirror image: they are missed by {told} (an "
+        "extrapolation, not graded)"
+    )
+
+
+def own_rows(fitted: FittedModel, samples: FrictionSamples) -> np.ndarray | None:
+    """Which rows of ``samples`` are rows the model was identified on (its file's
+    ``provenance["rows_sha256_12"]``, whatever their order), or None when it keeps none."""
+    digests = (fitted.provenance or {}).get("rows_sha256_12")
+    if not isinstance(digests, list):
+        return None
+    return np.isin(row_digests(samples), np.asarray(digests, dtype=object))
+
+
+def is_new_samples(
+    fitted: FittedModel, samples: FrictionSamples | None, digest: str | None
+) -> bool:
+    """Whether ``samples`` (content hash ``digest``) are not those the model was identified
     on: the file records the hash of its own (``provenance["samples_sha256_16"]``) and it
-    differs. A file without it (older, or of a trajectory) counts them as its own."""
+    differs, unless every row is one of its own rows in another order (:func:`own_rows`). A
+    file without the hash (older, or of a trajectory) counts them as its own."""
     own = (fitted.provenance or {}).get("samples_sha256_16")
-    return digest is not None and isinstance(own, str) and own != digest
+    if samples is None or digest is None or not isinstance(own, str) or own == digest:
+        return False
+    mine = own_rows(fitted, samples)
+    return mine is None or not bool(mine.all())
 
 
 def grade_new_samples(trust: Any, fitted: FittedModel, samples: FrictionSamples) -> str:
@@ -387,8 +423,11 @@ def grade_new_samples(trust: Any, fitted: FittedModel, samples: FrictionSamples)
         f"identified on ({fitted.provenance['samples_sha256_16']}): the model's own error on "
         "them is graded, not a refit of its family"
     )
-    out = fitted.outside_range(samples.X)
-    judged = samples.subset(~out) if 0 < out.sum() < len(samples) else samples
+    mine = own_rows(fitted, samples)
+    mine = np.zeros(len(samples), dtype=bool) if mine is None else mine
+    out = fitted.outside_range(samples.X) & ~mine
+    rest = ~mine & ~out
+    judged = samples.subset(rest) if rest.any() else samples.subset(~mine)
     sc = measurement_scatter(judged)
     trust.scatter_method = sc.method
     if np.isfinite(sc.value) and sc.value > 0:
@@ -396,15 +435,21 @@ def grade_new_samples(trust: Any, fitted: FittedModel, samples: FrictionSamples)
         trust.scatter = sc.value
         trust.heldout_ratio = trust.heldout_rmse / sc.value
     trust.verdict = verdict(trust.heldout_ratio)
-    if not out.any():
-        return ""
-    why = "; ".join(v.message for v in fitted.range_check(samples.X[out]))
-    if judged is samples:
-        return f"every sample lies outside the range the model was identified on: {why}"
-    return (
-        f"{int(out.sum())} of {len(samples)} samples lie outside the range the model was "
-        f"identified on, left out of the error graded: {why}"
-    )
+    said = []
+    if mine.any():
+        said.append(
+            f"{int(mine.sum())} of {len(samples)} rows are rows the model was identified on, "
+            "left out of the error graded (it is judged on the others)"
+        )
+    if out.any():
+        why = "; ".join(v.message for v in fitted.range_check(samples.X[out]))
+        said.append(
+            f"every row it is judged on lies outside the range it was identified on: {why}"
+            if not rest.any()
+            else f"{int(out.sum())} of {len(samples)} rows lie outside the range the model was "
+            f"identified on, left out of the error graded: {why}"
+        )
+    return "; ".join(said)
 
 
 def on_new_clause(trust: Any) -> str:

@@ -10,9 +10,14 @@ from .. import __version__
 from ..io.atomic import created_timestamp
 from ..models import INPUTS
 from ..models._range import speed_coverage
-from ..samples import FrictionSamples, samples_hash
+from ..samples import FrictionSamples, row_digests, samples_hash
 
-__all__ = ["operating_range", "provenance"]
+__all__ = ["ROW_DIGESTS_MAX", "operating_range", "provenance"]
+
+#: Samples up to this many keep one digest per row in the provenance (``rows_sha256_12``,
+#: sorted): a report on other samples tells the model's own rows among them, whatever their
+#: order (:func:`fricid.identify._heldout.is_new_samples`); larger sets keep the set's hash only.
+ROW_DIGESTS_MAX = 5000
 
 
 def provenance(samples: FrictionSamples, **extra: Any) -> dict[str, Any]:
@@ -23,6 +28,11 @@ def provenance(samples: FrictionSamples, **extra: Any) -> dict[str, Any]:
         "source": samples.source,
         "n_samples": len(samples),
         "samples_sha256_16": samples_hash(samples),
+        **(
+            {"rows_sha256_12": sorted(row_digests(samples).tolist())}
+            if len(samples) <= ROW_DIGESTS_MAX
+            else {}
+        ),
         "directions": list(samples.directions()),
         "speeds": speed_coverage(samples.velocity, samples.directions()),
         "fricid_version": __version__,

@@ -111,6 +111,7 @@ from ._heldout import (
     graded_rmse,
     is_new_samples,
     on_new_clause,
+    other_side_caveat,
     own_cv,
     own_directions,
     run_validation,
@@ -366,7 +367,7 @@ def assess_trust(
         The level and its reasons, each number with its source (module notes).
     """
     options = trust_options(validate, max_work)
-    samples = own_directions(fitted, samples)
+    samples, others = own_directions(fitted, samples)
     key = record_key(fitted, samples, options, TRUST_VERSION)
     if reuse:
         stored = _stored(fitted, key)
@@ -375,7 +376,7 @@ def assess_trust(
     trust = _base(fitted, samples)
     trust.samples_hash, trust.samples_detail_hash = key["samples_hash"], key["samples_detail_hash"]
     trust.model_hash, trust.options = key["model_hash"], options
-    if is_new_samples(fitted, trust.samples_hash):
+    if is_new_samples(fitted, samples, trust.samples_hash):
         outside = grade_new_samples(trust, fitted, samples)
         trust.quality, trust.quality_summary, quality_caveat = quality_rows(samples)
         problems = channel_problems(samples)
@@ -422,7 +423,8 @@ def assess_trust(
         )
     trust.quality, trust.quality_summary, quality_caveat = quality_rows(samples)
     problems = channel_problems(samples)
-    _grade(trust, fitted, [quality_caveat, *gravity_caveat(samples)], problems)
+    side = other_side_caveat(fitted, others, trust.scatter)
+    _grade(trust, fitted, [side, quality_caveat, *gravity_caveat(samples)], problems)
     if trust.converged is not False and trust.heldout_ratio > MISS_RATIO and not problems:
         from ._advice import misfit_advice
 

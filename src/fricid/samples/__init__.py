@@ -56,6 +56,8 @@ __all__ = [
     "encoder_quantum",
     "join_robot_logs",
     "position_unit_problem",
+    "row_digests",
+    "samples_hash",
     "standstill_rows",
     "velocity_mismatch",
     "windowed_velocity",
@@ -326,6 +328,26 @@ class FrictionSamples:
             raise DataError("no samples to concatenate")
         cols = {name: np.concatenate([getattr(p, name) for p in parts]) for name in SAMPLE_COLUMNS}
         return cls(**cols, source=parts[0].source, meta=parts[0].meta)
+
+
+def row_digests(samples: FrictionSamples) -> np.ndarray:
+    """One short content hash per row (12 hexadecimal digits of the SHA-256 of its velocity,
+    load, temperature, friction and direction): which rows two sets share, whatever their
+    order (:func:`samples_hash` is of the whole set, in order)."""
+    rows = np.column_stack(
+        [
+            np.asarray(a, dtype=float)
+            for a in (
+                samples.velocity,
+                samples.load,
+                samples.temperature,
+                samples.friction,
+                samples.direction.astype(float),
+            )
+        ]
+    )
+    rows = np.ascontiguousarray(rows)
+    return np.array([hashlib.sha256(r.tobytes()).hexdigest()[:12] for r in rows], dtype=object)
 
 
 def samples_hash(samples: FrictionSamples) -> str:
