@@ -113,3 +113,48 @@ def test_the_span_is_the_projection_at_the_ends_of_the_search_range():
     assert f"F_c spans {min(fc):.4g} to {max(fc):.4g} N m" in line
     assert f"b {min(b):.4g} to {max(b):.4g} N m s/rad" in line
     assert max(fc) - min(fc) > 0.1  # the Stribeck level moves the Coulomb level
+
+
+def test_a_projection_is_refused_only_for_what_its_numbers_depend_on(tmp_path):
+    """yaml and urdf hold the steady-state Coulomb-viscous projection, which a LuGre model's
+    sigma_1 does not move: exported without the flag, the comment saying sigma_1 is not in
+    the file; an undetermined tau_s (which moves it) is refused, named alone; MJCF (the
+    dcmotor holds sigma_0 and sigma_1) still refuses sigma_1."""
+    path = tmp_path / "lugre.json"
+    trajectory_model(("sigma_1",)).save(path)
+    for target in ("yaml", "urdf"):
+        out = tmp_path / f"f.{target}"
+        res = runner.invoke(app, ["export", str(path), "--to", target, "-o", str(out)])
+        assert res.exit_code == 0, res.output
+        text = " ".join(out.read_text().split()).replace("# ", "")
+        assert "not in this file (its numbers do not depend on it): sigma_1" in text, target
+        assert "exported as identified: sigma_1" not in text
+    res = runner.invoke(app, ["export", str(path), "--to", "mjcf", *NO_CHECK])
+    assert res.exit_code == 2 and "does not determine sigma_1" in " ".join(res.output.split())
+    fitted = trajectory_model(("sigma_0", "tau_s"))
+    fitted.parameters["tau_s"] = dataclasses.replace(fitted.parameters["tau_s"], bounds=(0.0, 2.0))
+    fitted.save(path)
+    res = runner.invoke(app, ["export", str(path), "--to", "yaml"])
+    said = " ".join(res.output.split())
+    assert res.exit_code == 2 and "does not determine tau_s of the 'lugre'" in said
+    out = tmp_path / "g.yaml"
+    args = ["export", str(path), "--to", "yaml", "-o", str(out), "--allow-undetermined"]
+    assert runner.invoke(app, args).exit_code == 0
+    text = " ".join(out.read_text().split()).replace("# ", "")
+    assert "exported as identified: tau_s" in text and "identified: sigma_0" not in text
+    assert "not in this file (its numbers do not depend on it): sigma_0" in text
+
+
+def test_a_static_mjcf_of_another_family_refuses_what_its_projection_reads(tmp_path):
+    fitted = FittedModel.from_values(
+        "stribeck",
+        {"tau_c": 0.3, "tau_s": 0.5, "w_s": 0.05, "tau_v": 0.1, "delta": 2.0},
+        operating_range={"velocity": [-2.0, 2.0]},
+        provenance={"trajectory": {"route": "filtered"}},
+    )
+    fitted.parameters["tau_s"] = dataclasses.replace(
+        fitted.parameters["tau_s"], note=NOTE, not_determined=True, bounds=(0.0, 2.0)
+    )
+    path = fitted.save(tmp_path / "s.json")
+    res = runner.invoke(app, ["export", str(path), "--to", "mjcf", *NO_CHECK])
+    assert res.exit_code == 2 and "does not determine tau_s" in " ".join(res.output.split())

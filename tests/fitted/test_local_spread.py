@@ -328,3 +328,55 @@ def test_a_trajectory_model_says_why_it_has_no_interval():
     )
     with pytest.raises(ConfigError, match="identified from a trajectory"):
         model.predict_interval(_grid()[:3], 0.95, warn=False)
+
+
+def _trajectory_lugre(tmp_path, *undetermined: str):
+    """A LuGre model file as a trajectory fit writes it, ``undetermined`` marked so."""
+    from dataclasses import replace
+
+    model = FittedModel.from_values(
+        "lugre",
+        dict(sigma_0=1e3, sigma_1=0.5, sigma_2=0.1, tau_c=0.3, tau_s=0.5, w_s=0.05, delta=2.0),
+        operating_range={"velocity": [-2.0, 2.0]},
+        provenance={"trajectory": {"route": "filtered"}},
+    )
+    for name in undetermined:
+        model.parameters[name] = replace(
+            model.parameters[name], not_determined=True, bounds=(1e-3, 1e3)
+        )
+    return model.save(tmp_path / "lugre.json")
+
+
+def test_predict_warns_only_of_undetermined_parameters_the_friction_reads(tmp_path):
+    """Steady friction does not read LuGre's sigma_1 (its transients): no warning for it; its
+    tau_s (the Stribeck level, at a speed near w_s) is read."""
+    from typer.testing import CliRunner
+
+    from fricid.cli import app
+
+    path = _trajectory_lugre(tmp_path, "sigma_1", "tau_s")
+    got = CliRunner().invoke(app, ["predict", str(path), "-v", "0.05"])
+    assert got.exit_code == 0, got.output
+    assert "do not determine tau_s:" in got.stderr and "sigma_1" not in got.stderr
+    got = CliRunner().invoke(
+        app, ["predict", str(_trajectory_lugre(tmp_path, "sigma_1")), "-v", "0.5"]
+    )
+    assert got.exit_code == 0 and "do not determine" not in got.stderr
+
+
+def test_predict_interval_of_a_trajectory_model_writes_the_friction_and_says_why(tmp_path):
+    from typer.testing import CliRunner
+
+    from fricid.cli import app
+
+    path = _trajectory_lugre(tmp_path)
+    args = ["predict", str(path), "-v", "0.5", "-v", "-0.3", "--interval", "0.95"]
+    got = CliRunner().invoke(app, args)
+    assert got.exit_code == 0, got.output
+    rows = got.stdout.strip().splitlines()
+    assert len(rows) == 3 and all(r.endswith(",nan,nan") for r in rows[1:])
+    friction = FittedModel.load(path).predict(np.array([[0.5, 0.0, 25.0]]), warn=False)[0]
+    assert float(rows[1].split(",")[1]) == pytest.approx(friction)
+    assert "identified from a trajectory" in " ".join(got.stderr.split())
+    bad = CliRunner().invoke(app, [*args[:-1], "1.5"])
+    assert bad.exit_code == 2 and "(0, 1)" in bad.output

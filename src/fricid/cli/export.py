@@ -142,6 +142,7 @@ def export_command(
         file_sha256,
         refuse_undetermined,
         refuse_untrusted,
+        undetermined_held,
         write_text,
     )
     from ..export.c import no_c_template
@@ -168,7 +169,8 @@ def export_command(
     fitted = FittedModel.load(model)
     if target == "c" and (why := no_c_template(fitted)):  # before a flag that would not help
         raise ExportError(why)
-    refuse_undetermined(fitted, allow_undetermined)
+    # only what the file's numbers depend on (a projection does not read LuGre's sigma_1)
+    refuse_undetermined(fitted, allow_undetermined, undetermined_held(fitted, target))
     refuse_untrusted(fitted, allow_untrusted)
     sha256 = file_sha256(model)
     try:

@@ -128,7 +128,9 @@ def predict_command(
     from ..export import Smoothing, smooth_predict, write_text
     from ..export._common import printable_reasons, trust_of
     from ..export.points import default_filled, points_matrix, points_table, read_points
+    from ..export.projection import friction_reads
     from ..fitted import FittedModel
+    from ..fitted._interval import no_steady_interval
     from ..units import to_si
 
     check_paths(inputs={"MODEL": model, "--input": input_file}, out_files={"--out": out})
@@ -163,6 +165,8 @@ def predict_command(
     zone_si = float(to_si(zone, velocity_unit or "rad/s", "velocity"))
     _say_ignored(fitted, X, given, cols)
     loose = [n for n, p in fitted.parameters.items() if p.not_determined and not p.fixed]
+    if fitted.kind != "rbf":  # those the friction at these points reads (not LuGre's sigma_1)
+        loose = friction_reads(fitted, X, loose)
     if loose and fitted.kind != "rbf":  # as export refuses them: said, not hidden
         err_console.print(
             f"warning: the model's data do not determine {', '.join(loose)}: the friction "
@@ -193,7 +197,18 @@ def predict_command(
         warnings.simplefilter("ignore", ExtrapolationWarning)  # said above, once per quantity
         friction = smooth_predict(fitted, X, Smoothing(smooth, zone_si))
         extra = None
-        if interval is not None:  # its half-width around the friction written
+        unbacked = no_steady_interval(fitted) if interval is not None else ""
+        if unbacked:  # the friction, with its interval columns empty and why
+            if not 0.0 < interval < 1.0:
+                raise ConfigError(f"the interval's level must lie in (0, 1); got {interval!r}")
+            extra = {"low": np.full(len(X), np.nan), "high": np.full(len(X), np.nan)}
+            err_console.print(
+                f"note: no prediction interval (low and high are nan): the model {unbacked}",
+                markup=False,
+                highlight=False,
+                soft_wrap=True,
+            )
+        elif interval is not None:  # its half-width around the friction written
             try:
                 half = fitted.predict_interval(X, interval, warn=False).half_width
             except ConfigError as err:  # a malformed record: named with its file

@@ -50,6 +50,7 @@ from .descriptions import (
     description_text,
     mjcf_text,
     ros2_yaml_text,
+    undetermined_held,
     urdf_text,
     write_text,
 )
@@ -87,6 +88,7 @@ __all__ = [
     "ros2_yaml_text",
     "schema_path",
     "smooth_predict",
+    "undetermined_held",
     "undetermined_parameters",
     "urdf_text",
     "validate_model_dict",

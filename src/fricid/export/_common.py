@@ -34,6 +34,7 @@ import numbers
 import os
 import re
 import string
+from collections.abc import Collection
 from pathlib import Path
 
 from .. import __version__
@@ -194,6 +195,7 @@ def summary_lines(
     *,
     projection_rms: float | None = None,
     projection: str = "projection",
+    held: Collection[str] | None = None,
 ) -> list[str]:
     """The fixed-format provenance lines at the top of every exported file.
 
@@ -212,6 +214,10 @@ def summary_lines(
         rms_error`). When it exceeds the model's measurement scatter (:func:`model_scatter`),
         the trust line says that its verdict is the model's and how many times the scatter
         the ``projection`` (fixed text: what was exported) misses the model by.
+    held : collection of str, optional
+        The undetermined parameters (:func:`undetermined_parameters`) the exported numbers
+        depend on (a projection's: :attr:`fricid.export.Projection.rests_on_names`); the others
+        are said not to be in the file. Default: every one (the file holds the model).
 
     Returns
     -------
@@ -261,10 +267,16 @@ def summary_lines(
     elif parts:
         lines.append("fit on its data: " + ", ".join(parts) + " (rmse, max error in N m)")
     undetermined = undetermined_parameters(fitted)
-    if undetermined:
+    inside = [n for n in undetermined if held is None or n in held]
+    if inside:
         lines.append(
             "NOT DETERMINED by the trajectory, exported as identified: "
-            + ", ".join(plain(n) + _one_bound(fitted.parameters[n]) for n in undetermined)
+            + ", ".join(plain(n) + _one_bound(fitted.parameters[n]) for n in inside)
+        )
+    if len(inside) < len(undetermined):
+        lines.append(
+            "NOT DETERMINED by the trajectory, not in this file (its numbers do not depend on "
+            "it): " + ", ".join(plain(n) for n in undetermined if n not in inside)
         )
     level, _ = trust_of(fitted)
     if level in ("yes", "with caveats", "no"):  # fixed words and a number only
@@ -369,16 +381,19 @@ def undetermined_parameters(fitted: FittedModel) -> list[str]:
     return [n for n, p in fitted.parameters.items() if p.not_determined]
 
 
-def refuse_undetermined(fitted: FittedModel, allow: bool) -> None:
-    """Refuse to export a trajectory model with an undetermined parameter unless ``allow``
-    (then :func:`summary_lines` names them in the file's comment).
+def refuse_undetermined(
+    fitted: FittedModel, allow: bool, held: Collection[str] | None = None
+) -> None:
+    """Refuse to export a trajectory model with an undetermined parameter that the exported
+    numbers depend on (``held``; default every undetermined one) unless ``allow`` (then
+    :func:`summary_lines` names them in the file's comment).
 
     Raises
     ------
     ExportError
         Such a parameter, not allowed.
     """
-    undetermined = undetermined_parameters(fitted)
+    undetermined = [n for n in undetermined_parameters(fitted) if held is None or n in held]
     if undetermined and not allow:
         raise ExportError(
             "the trajectory does not determine "

@@ -30,10 +30,11 @@ from ._common import (
     model_name,
     plain,
     summary_lines,
+    undetermined_parameters,
     write_lines_checked,
 )
 from .mjcf import STIFF_SOLIMP, frictionloss_lines, is_lugre, mjcf_lugre_elements
-from .projection import Projection, project
+from .projection import Projection, operating_grid, project, rests_on_names
 
 __all__ = [
     "DEFAULT_MAX_LOSS",
@@ -41,6 +42,7 @@ __all__ = [
     "description_text",
     "mjcf_text",
     "ros2_yaml_text",
+    "undetermined_held",
     "urdf_text",
     "write_text",
 ]
@@ -118,7 +120,9 @@ def urdf_text(
     name = _check_joint(joint)
     proj = _checked(fitted, "URDF <dynamics>", False, max_loss, ranges)
     lines = [
-        *summary_lines(fitted, source, sha256, projection_rms=proj.rms_error),
+        *summary_lines(
+            fitted, source, sha256, projection_rms=proj.rms_error, held=proj.rests_on_names
+        ),
         *proj.summary(),
         f"place inside the joint named {plain(name)}; friction [N m], damping [N m s/rad]",
     ]
@@ -180,7 +184,9 @@ def mjcf_text(
     else:
         proj = _checked(fitted, "MJCF frictionloss/damping", False, max_loss, ranges)
         lines = [
-            *summary_lines(fitted, source, sha256, projection_rms=proj.rms_error),
+            *summary_lines(
+                fitted, source, sha256, projection_rms=proj.rms_error, held=proj.rests_on_names
+            ),
             *proj.summary(),
             *frictionloss_lines(fitted),
             "copy frictionloss [N m], damping [N m s/rad] and solimpfriction onto your <joint>",
@@ -225,7 +231,9 @@ def ros2_yaml_block(
         raise ExportError("joint name 'joints' is taken by the list of joints in the YAML")
     proj = _checked(fitted, "the per-direction Coulomb-viscous YAML", True, max_loss, ranges)
     lines = [
-        *summary_lines(fitted, source, sha256, projection_rms=proj.rms_error),
+        *summary_lines(
+            fitted, source, sha256, projection_rms=proj.rms_error, held=proj.rests_on_names
+        ),
         *proj.summary(),
     ]
     write_lines_checked(lines, ())
@@ -309,6 +317,21 @@ def description_text(target: str, fitted: FittedModel, **options) -> str:
             + ", ".join(DESCRIPTION_TARGETS)
         ) from None
     return builder(fitted, **options)
+
+
+def undetermined_held(fitted: FittedModel, target: str, **ranges) -> list[str]:
+    """The parameters the trajectory does not determine
+    (:func:`~fricid.export._common.undetermined_parameters`) that an export to ``target``
+    holds or depends on: every one for C (the full model) and for a LuGre model's MJCF (its
+    dcmotor holds sigma_0 and sigma_1); for a Coulomb-viscous projection (yaml, urdf, the
+    MJCF of any other model) those that move it over the operating range
+    (:func:`~fricid.export.projection.rests_on_names`: never a LuGre model's sigma_0 or
+    sigma_1, which its steady state does not read). ``ranges`` as for :func:`urdf_text`."""
+    names = undetermined_parameters(fitted)
+    if not names or target not in DESCRIPTION_TARGETS or (target == "mjcf" and is_lugre(fitted)):
+        return names
+    X, _ = operating_grid(fitted, **ranges)
+    return rests_on_names(fitted, X, target == "yaml")
 
 
 def write_text(text: str, path: str | os.PathLike[str]) -> Path:

@@ -29,7 +29,16 @@ from ..errors import DataError
 from ..fitted import FittedModel
 from ._common import ExportError, model_name, percent, plain, undetermined_parameters
 
-__all__ = ["N_LEVELS", "N_VELOCITY", "Projection", "operating_grid", "project", "rests_on"]
+__all__ = [
+    "N_LEVELS",
+    "N_VELOCITY",
+    "Projection",
+    "friction_reads",
+    "operating_grid",
+    "project",
+    "rests_on",
+    "rests_on_names",
+]
 
 #: Velocity points per direction, and load / temperature levels, of the projection grid.
 N_VELOCITY = 200
@@ -50,6 +59,8 @@ class Projection:
     relative_error : ``rms_error / rms_friction``.
     ranges : the grid's velocity (per side), load and temperature ranges.
     lost : what the projection cannot hold, one phrase each, with numbers.
+    rests_on : one line per undetermined parameter that moves the projection
+        (:func:`rests_on`); ``rests_on_names`` names them.
     """
 
     per_direction: bool
@@ -63,6 +74,7 @@ class Projection:
     ranges: dict[str, Any] = field(default_factory=dict)
     lost: list[str] = field(default_factory=list)
     rests_on: list[str] = field(default_factory=list)
+    rests_on_names: list[str] = field(default_factory=list)
 
     def summary(self) -> list[str]:
         """Lines for a comment in the exported file."""
@@ -277,6 +289,7 @@ def project(
     pos = v > 0
     side_fits = _pairs(F, v, True)
     fits = side_fits if per_direction else _pairs(F, v, False)
+    resting = _resting(fitted, X, per_direction)
     if per_direction:
         approx = np.where(
             pos,
@@ -300,7 +313,8 @@ def project(
         relative_error=rms_e / rms_f if rms_f > 0 else 0.0,
         ranges=info,
         lost=_lost(fitted, X, F, info, per_direction, side_fits),
-        rests_on=rests_on(fitted, X, per_direction),
+        rests_on=[line for _, line in resting],
+        rests_on_names=[name for name, _ in resting],
     )
 
 
@@ -324,6 +338,18 @@ def rests_on(fitted: FittedModel, X: np.ndarray, per_direction: bool) -> list[st
     move as it spans its search range, the others held. A LuGre model's sigma_0 and sigma_1
     shape only its transients and never appear; a parameter whose search range the file does
     not record is named without a span."""
+    return [line for _, line in _resting(fitted, X, per_direction)]
+
+
+def rests_on_names(fitted: FittedModel, X: np.ndarray, per_direction: bool) -> list[str]:
+    """The names of the parameters :func:`rests_on` writes a line for: the undetermined
+    parameters the projection over ``X`` depends on (a LuGre model's sigma_0 and sigma_1
+    never)."""
+    return [name for name, _ in _resting(fitted, X, per_direction)]
+
+
+def _resting(fitted: FittedModel, X: np.ndarray, per_direction: bool) -> list[tuple[str, str]]:
+    """``(name, line)`` of :func:`rests_on`."""
     names = undetermined_parameters(fitted)
     if not names or fitted.kind == "rbf":
         return []
@@ -353,9 +379,12 @@ def rests_on(fitted: FittedModel, X: np.ndarray, per_direction: bool) -> list[st
             if np.allclose(moved, here, rtol=1e-9, atol=1e-15):
                 continue
             lines.append(
-                f"the projection rests on {plain(name)}, which the trajectory does not "
-                "determine (its search range is not recorded): F_c and b are no better "
-                "determined"
+                (
+                    name,
+                    f"the projection rests on {plain(name)}, which the trajectory does not "
+                    "determine (its search range is not recorded): F_c and b are no better "
+                    "determined",
+                )
             )
             continue
         every = np.stack([here, *(pairs_at(name, x) for x in ends)])
@@ -364,9 +393,39 @@ def rests_on(fitted: FittedModel, X: np.ndarray, per_direction: bool) -> list[st
             continue  # the steady state does not read it
         fc, b = every[..., 0], every[..., 1]
         lines.append(
-            f"the projection rests on {plain(name)}, which the trajectory does not determine: "
-            f"across its search range {ends[0]:.4g} to {ends[1]:.4g}{unit} (the others as "
-            f"identified) F_c spans {fc.min():.4g} to {fc.max():.4g} N m and b "
-            f"{b.min():.4g} to {b.max():.4g} N m s/rad"
+            (
+                name,
+                f"the projection rests on {plain(name)}, which the trajectory does not "
+                f"determine: across its search range {ends[0]:.4g} to {ends[1]:.4g}{unit} (the "
+                f"others as identified) F_c spans {fc.min():.4g} to {fc.max():.4g} N m and b "
+                f"{b.min():.4g} to {b.max():.4g} N m s/rad",
+            )
         )
     return lines
+
+
+def friction_reads(fitted: FittedModel, X: np.ndarray, names: list[str]) -> list[str]:
+    """Those of ``names`` (parameters of an analytic model) that move its predicted friction
+    at the points ``X`` (n, 3): set to either end of its recorded search range, or 1 % off
+    its value, the others as identified. A LuGre model's friction at a speed is its steady
+    state, which sigma_0 and sigma_1 (its transients) do not move."""
+    if not names or fitted.kind == "rbf":
+        return list(names)
+    model = fitted.friction_model()
+    order = list(model.param_names)
+    theta = fitted.theta()
+    X = np.asarray(X, dtype=float)
+    here = np.asarray(model.predict(theta, X), dtype=float)
+    read = []
+    for name in names:
+        p = fitted.parameters[name]
+        tries = [float(b) for b in (p.bounds or ()) if math.isfinite(float(b))]
+        for value in [*tries, 1.01 * p.value + 1e-12]:
+            th = theta.copy()
+            th[order.index(name)] = value
+            with np.errstate(all="ignore"):
+                F = np.asarray(model.predict(th, X), dtype=float)
+            if np.isfinite(F).all() and not np.allclose(F, here, rtol=1e-9, atol=1e-15):
+                read.append(name)
+                break
+    return read

@@ -75,7 +75,13 @@ from ..models._spread import biased_half_width, local_bias_std, local_variance
 from ..models.gp import gp_sides
 from ..models.rbf import interval_half_width
 
-__all__ = ["PredictionInterval", "analytic_half_width", "gradient", "prediction_interval"]
+__all__ = [
+    "PredictionInterval",
+    "analytic_half_width",
+    "gradient",
+    "no_steady_interval",
+    "prediction_interval",
+]
 
 
 def _t_ppf(q: float, dof: int) -> float:
@@ -407,6 +413,25 @@ def _excess_latent_variance(
     return np.maximum(var - np.where(np.isfinite(near), near, 0.0), 0.0)
 
 
+def no_steady_interval(fitted) -> str:
+    """Why a model identified from a trajectory gives no prediction interval of steady
+    friction (``"was identified from a trajectory: ..."``), or ``""`` when it is not such a
+    model or stores one."""
+    record = fitted.prediction_interval
+    stored = isinstance(record, Mapping) and record.get("method") in ("heldout", "delta")
+    if (
+        stored
+        or not (fitted.provenance or {}).get("trajectory")
+        or fitted.model == "gp"
+        or get_predictor(fitted.model).stateful
+    ):
+        return ""
+    return (
+        "was identified from a trajectory: its torque is predicted along a motion (fricid "
+        "report), and it gives no prediction interval of steady friction"
+    )
+
+
 def prediction_interval(fitted, X, level: float = 0.95) -> PredictionInterval:
     """The interval of ``fitted`` (a :class:`~fricid.fitted.FittedModel`) at ``X (n, 3)``;
     see :meth:`fricid.fitted.FittedModel.predict_interval`."""
@@ -443,12 +468,8 @@ def prediction_interval(fitted, X, level: float = 0.95) -> PredictionInterval:
             half = _with_backbone(fitted.state, X, half, level)
     else:
         if not isinstance(record, Mapping) or record.get("method") != "delta":
-            if (fitted.provenance or {}).get("trajectory"):
-                raise ConfigError(
-                    f"model '{fitted.model}' was identified from a trajectory: its torque "
-                    "is predicted along a motion (fricid report), and it gives no prediction "
-                    "interval of steady friction"
-                )
+            if why := no_steady_interval(fitted):
+                raise ConfigError(f"model '{fitted.model}' {why}")
             stats = fitted.statistics or {}
             n, p = stats.get("ndata"), stats.get("nvarys")
             if isinstance(n, int | float) and isinstance(p, int | float) and n <= p:
