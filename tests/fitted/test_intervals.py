@@ -166,3 +166,11 @@ def test_no_interval_outside_the_operating_range(stribeck, tmp_path):
     text = " ".join(res.output.split())
     assert "no prediction interval at 1 of 2 points: outside the range the model was" in text
     assert "in a gap" not in text
+    # below the slowest speed: the note must not read as 'above the range'
+    res = CliRunner().invoke(
+        app, ["predict", str(path), "-v", "-0.05", "-v", "0.5", "--interval", "0.95"]
+    )
+    assert res.exit_code == 0, res.output
+    (note,) = [x for x in res.stderr.splitlines() if x.startswith("note: no prediction")]
+    assert "outside the range" in note and "above" not in note, note
+    assert "the warnings before this note say where" in note

@@ -218,11 +218,10 @@ def predict_command(
             outside = fitted.outside_range(X) & ~rest
             why = {
                 "at rest, where the friction is whatever holds the joint, up to break-away": rest,
-                "outside the range the model was identified on (above), where nothing "
-                "measured backs one": outside,
-                "in a gap between measured speeds (above), where nothing measured backs one": (
-                    np.isnan(half) & ~rest & ~outside
-                ),
+                "outside the range the model was identified on, where nothing measured "
+                "backs one (the warnings before this note say where)": outside,
+                "in a gap between measured speeds, where nothing measured backs one (the "
+                "warnings before this note say where)": np.isnan(half) & ~rest & ~outside,
             }
             for reason, where in why.items():
                 if where.any():
