@@ -178,9 +178,9 @@ def predict_command(
         )
     level, reasons = trust_of(fitted)
     if level == "no":  # as export refuses it: said, not hidden
-        why = printable_reasons(reasons[:2])
+        why = printable_reasons(reasons, limit=500)  # whole reasons: no name cut off
         err_console.print(
-            f"warning: the model's trust verdict is 'no' ({why[:300] or 'no reason recorded'}): "
+            f"warning: the model's trust verdict is 'no' ({why or 'no reason recorded'}): "
             "its own check rejects it, so neither the friction nor its interval is backed",
             markup=False,
             highlight=False,

@@ -334,10 +334,24 @@ def trust_of(fitted: FittedModel) -> tuple[str | None, list[str]]:
     return None, []
 
 
-def printable_reasons(reasons: list[str]) -> str:
+def printable_reasons(reasons: list[str], limit: int | None = None) -> str:
     """A record's reasons joined by ``"; "``, each character that is not printable (a
-    terminal control from a file) shown as ``?``."""
-    return "; ".join("".join(c if c.isprintable() else "?" for c in r) for r in reasons)
+    terminal control from a file) shown as ``?``. With ``limit``, whole reasons only while
+    they fit in ``limit`` characters (a first reason longer than that is cut at a space and
+    ends in ``...``), then how many more the model file gives: a reason is never cut short
+    silently (a parameter's name lost at the end)."""
+    shown = ["".join(c if c.isprintable() else "?" for c in r) for r in reasons]
+    if limit is None:
+        return "; ".join(shown)
+    kept: list[str] = []
+    for reason in shown:
+        if len("; ".join([*kept, reason])) > limit:
+            break
+        kept.append(reason)
+    if not kept and shown:  # the first alone is too long
+        kept = [shown[0][:limit].rsplit(" ", 1)[0] + " ..."]
+    more = len(shown) - len(kept)
+    return "; ".join(kept) + (f"; {more} more in the model file" if more else "")
 
 
 def refuse_untrusted(fitted: FittedModel, allow: bool, joint: str | None = None) -> None:
@@ -351,9 +365,8 @@ def refuse_untrusted(fitted: FittedModel, allow: bool, joint: str | None = None)
     """
     level, reasons = trust_of(fitted)
     if level == "no" and not allow:
-        # printable characters only (no terminal controls from a file), at most 300
-        why = printable_reasons(reasons[:3])
-        why = (why[:300] + " ...") if len(why) > 300 else why or "no reason recorded"
+        # printable characters only (no terminal controls from a file), whole reasons
+        why = printable_reasons(reasons, limit=500) or "no reason recorded"
         whose = f"joint {plain(joint)}: the" if joint else "the"
         raise ExportError(
             f"{whose} '{model_name(fitted)}' model's trust verdict is 'no' ({why}): a controller "

@@ -297,6 +297,32 @@ def test_predict_names_the_file_and_says_a_no_verdict(tmp_path):
     assert "trust verdict is 'no' (misses the law)" in res.stderr
 
 
+def test_a_no_verdicts_reasons_are_never_cut_short(tmp_path):
+    """`fricid predict` cut the reasons at 300 characters, and a parameter's name after a
+    long first reason was lost ("not bounded by the data: )"): whole reasons, then how many
+    more the file gives; an export refused for it likewise."""
+    from typer.testing import CliRunner
+
+    from fricid.cli import app
+    from fricid.export import ExportError, refuse_untrusted
+    from fricid.fitted import FittedModel
+
+    d = _law_fit(_samples(np.random.default_rng(5), 0.002, _meta(_velocity()))).to_dict()
+    first = "the log's velocity is not its position's derivative: " + "a long reason " * 17
+    named = "not bounded by the data: tau_s"
+    reasons = [first.strip(), named, "misses by 1.38x", "gravity may be left in " * 10]
+    d["trust"] = {**(d.get("trust") or {}), "level": "no", "reasons": reasons}
+    model = FittedModel.from_dict(d)
+    res = CliRunner().invoke(app, ["predict", str(model.save(tmp_path / "no.json")), "-v", "0.3"])
+    assert res.exit_code == 0, res.output
+    said = " ".join(res.stderr.split())
+    assert f"{first.strip()}; {named}; misses by 1.38x; 1 more in the model file)" in said
+    d["trust"]["reasons"] = ["word " * 200, named]
+    with pytest.raises(ExportError) as err:
+        refuse_untrusted(FittedModel.from_dict(d), allow=False)
+    assert "word ...; 1 more in the model file" in str(err.value)
+
+
 def test_the_report_band_says_why_it_is_missing_and_names_the_shared_error():
     from fricid.fitted import FittedModel
     from fricid.report.band import prediction_band_figure
