@@ -41,6 +41,7 @@ from .. import __version__
 from ..errors import ConfigError, DataError
 from ..fitted import FittedModel
 from ..models import STATEFUL
+from ._trust import printable_reasons, trust_line, trust_of
 
 __all__ = [
     "ExportError",
@@ -49,7 +50,6 @@ __all__ = [
     "file_sha256",
     "fmt_float",
     "model_name",
-    "model_scatter",
     "model_sha256",
     "operating_pair",
     "percent",
@@ -211,9 +211,12 @@ def summary_lines(
     projection_rms : float, optional
         N m, the RMS error over the operating range of what is exported when that is not the
         model itself (a Coulomb-viscous projection: :attr:`fricid.export.Projection.
-        rms_error`). When it exceeds the model's measurement scatter (:func:`model_scatter`),
-        the trust line says that its verdict is the model's and how many times the scatter
-        the ``projection`` (fixed text: what was exported) misses the model by.
+        rms_error`). When it exceeds the model's measurement scatter
+        (:func:`fricid.export._trust.model_scatter`), the trust line says how many times the
+        scatter the ``projection`` (fixed text: what was exported) misses the model by; beyond
+        what the trust check passes (3 times: ``NO``, 1.2 times: ``with caveats``) it leads
+        with that grade of the file's numbers, the model's own verdict after it
+        (:func:`fricid.export._trust.trust_line`).
     held : collection of str, optional
         The undetermined parameters (:func:`undetermined_parameters`) the exported numbers
         depend on (a projection's: :attr:`fricid.export.Projection.rests_on_names`); the others
@@ -278,80 +281,8 @@ def summary_lines(
             "NOT DETERMINED by the trajectory, not in this file (its numbers do not depend on "
             "it): " + ", ".join(plain(n) for n in undetermined if n not in inside)
         )
-    level, _ = trust_of(fitted)
-    if level in ("yes", "with caveats", "no"):  # fixed words and a number only
-        shown, which = None, "held-out"
-        for rec, key in ((fitted.trust, "heldout_ratio"), (fitted.validation, "ratio")):
-            if isinstance(rec, dict) and isinstance(rec.get(key), int | float):
-                ratio = float(rec[key])
-                shown = f"{ratio:.3g}" if math.isfinite(ratio) else None
-                if str(rec.get("heldout_source", "")).startswith("in-sample"):
-                    which = "in-sample (no held-out validation)"
-                break
-        said = [f"{which} error {shown} times the scatter"] if shown is not None else []
-        misses = _projection_miss(fitted, projection_rms, projection)
-        if misses:  # the verdict above is the model's, not what this file holds
-            said = [f"the model's{': ' + said[0] if said else ''}", misses]
-        lines.append(
-            f"trust verdict: {'NO, exported anyway' if level == 'no' else level}"
-            + (f" ({'; '.join(said)})" if said else "")
-            + "; the model file gives the reasons"
-        )
-    return lines
-
-
-def model_scatter(fitted: FittedModel) -> float | None:
-    """N m, the measurement scatter the model's trust verdict compared its error with (its
-    trust record's ``scatter``, else its validation's); None when not recorded."""
-    for rec in (fitted.trust, fitted.validation):
-        if isinstance(rec, dict) and _display(rec.get("scatter")) is not None:
-            value = float(rec["scatter"])
-            return value if value > 0 else None
-    return None
-
-
-def _projection_miss(fitted: FittedModel, rms: float | None, projection: str) -> str:
-    """``"this projection misses the model by 5.91 times the scatter, RMS 0.000377 N m over
-    the operating range"`` when ``rms`` [N m] exceeds :func:`model_scatter`; else ``""`` (a
-    lossless projection, or no scatter recorded)."""
-    scatter = model_scatter(fitted)
-    if scatter is None or rms is None or not (math.isfinite(rms) and rms > scatter):
-        return ""
-    return (
-        f"this {projection} misses the model by {rms / scatter:.3g} times the scatter, RMS "
-        f"{rms:.3g} N m over the operating range"
-    )
-
-
-def trust_of(fitted: FittedModel) -> tuple[str | None, list[str]]:
-    """The model's trust level (``yes``, ``with caveats``, ``no``) and its reasons as its file
-    records them: its trust verdict (:class:`fricid.identify.trust.Trust`) or, for a joint of
-    a whole-arm fit, its validation's; ``(None, [])`` when it records none."""
-    for rec in (fitted.trust, fitted.validation):
-        if isinstance(rec, dict) and isinstance(rec.get("level"), str):
-            reasons = rec.get("reasons")
-            return rec["level"], [str(r) for r in reasons] if isinstance(reasons, list) else []
-    return None, []
-
-
-def printable_reasons(reasons: list[str], limit: int | None = None) -> str:
-    """A record's reasons joined by ``"; "``, each character that is not printable (a
-    terminal control from a file) shown as ``?``. With ``limit``, whole reasons only while
-    they fit in ``limit`` characters (a first reason longer than that is cut at a space and
-    ends in ``...``), then how many more the model file gives: a reason is never cut short
-    silently (a parameter's name lost at the end)."""
-    shown = ["".join(c if c.isprintable() else "?" for c in r) for r in reasons]
-    if limit is None:
-        return "; ".join(shown)
-    kept: list[str] = []
-    for reason in shown:
-        if len("; ".join([*kept, reason])) > limit:
-            break
-        kept.append(reason)
-    if not kept and shown:  # the first alone is too long
-        kept = [shown[0][:limit].rsplit(" ", 1)[0] + " ..."]
-    more = len(shown) - len(kept)
-    return "; ".join(kept) + (f"; {more} more in the model file" if more else "")
+    verdict = trust_line(fitted, projection_rms, projection)
+    return lines + ([verdict] if verdict else [])
 
 
 def refuse_untrusted(fitted: FittedModel, allow: bool, joint: str | None = None) -> None:
