@@ -95,7 +95,8 @@ DirectionOption = Annotated[
     str,
     typer.Option(
         "--direction",
-        help="Which samples to use: all, combined (direction 0), both (+1 and -1), pos, neg.",
+        help="Which samples to use: all, combined (direction 0: forwards and backwards "
+        "averaged into one magnitude), both (+1 and -1: each direction's own), pos, neg.",
     ),
 ]
 

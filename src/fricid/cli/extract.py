@@ -184,10 +184,10 @@ def extract_command(
     out: Annotated[
         Path,
         out_option(
-            "Samples to write (.csv or .parquet): direction 0, combined by eq. 11, for a log "
-            "that is extracted; the operating points as recorded (+1 and -1 rows) for a "
-            "format that gives samples directly (EPOS recordings at one steady velocity each, "
-            "a MATLAB table of means)."
+            "Samples to write (.csv or .parquet): from a log, direction 0 (forwards and "
+            "backwards averaged into one magnitude, the BAS-RBFNN paper's eq. 11) or the one "
+            "direction measured; the operating points as recorded (+1 and -1 rows) from EPOS "
+            "recordings at one steady velocity each or a MATLAB table of means."
         ),
     ] = Path("samples.csv"),
     by_direction: Annotated[

@@ -49,9 +49,11 @@ def fit_command(
             "--model",
             "-m",
             help=(
-                "Model: coulomb_viscous (eq. 1), stribeck (eq. 2 / RWSAVSBAS eq. 7), msk (eq. 3, "
-                "load), vlt (eq. 4, load and temperature); append _asym for parameters per "
-                "direction; rbf, the RBF neural network (eq. 14-15; --method lsq, bas for "
+                "Model: coulomb_viscous (Coulomb plus viscous), stribeck (with the Stribeck "
+                "dip at low speed), msk (Coulomb growing with the joint's load), vlt (load and "
+                "temperature dependent), stribeck_temp (stribeck whose levels follow "
+                "temperature); append _asym for parameters per direction; rbf, the RBF neural "
+                "network (BAS-RBFNN paper eq. 14-15; --method lsq, bas for "
                 "BAS-RBFNN or ga for GA-RBFNN); hybrid, an analytic backbone plus an RBF "
                 "residual (the learned model to start with: nearest the noise floor on "
                 "held-out laws, physics outside the data); gp, a Gaussian process; or "
