@@ -368,3 +368,27 @@ def test_a_one_direction_model_says_its_other_side_is_not_measured():
     assert "not measured" in head
     one.provenance = {"directions": [-1]}
     assert "identified for negative velocity only" in project(one).summary()[0]
+
+
+def test_a_both_direction_model_is_projected_over_its_measured_speeds(tmp_path):
+    """A model of both directions (a range spanning zero) was projected from 1/200 of its
+    largest speed: the lead screw's from 0.104 rad/s, below its slowest measured 0.217, where
+    predict calls it an extrapolation; each side now starts at its slowest measured speed."""
+    rng = np.random.default_rng(0)
+    speeds = np.geomspace(0.2, 4.0, 8)
+    v = np.r_[speeds, -1.1 * speeds]
+    samples = FrictionSamples(
+        velocity=v,
+        load=np.zeros(v.size),
+        temperature=np.full(v.size, 25.0),
+        friction=np.sign(v) * (0.3 + 0.05 * np.abs(v)) + 0.001 * rng.standard_normal(v.size),
+        direction=np.sign(v),
+    )
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        fitted = fit(samples, "coulomb_viscous_asym")
+    X, info = operating_grid(fitted)
+    assert np.abs(X[X[:, 0] > 0, 0]).min() == pytest.approx(0.2)
+    assert np.abs(X[X[:, 0] < 0, 0]).min() == pytest.approx(0.22)
+    assert info["speed"][0] == pytest.approx(0.2)
+    assert "|velocity| 0.2 to 4.4 rad/s" in project(fitted, True).summary()[0]

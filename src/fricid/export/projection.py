@@ -142,11 +142,14 @@ def operating_grid(
         mirrored = True
         pos = np.linspace(a, b, N_VELOCITY) if b > a else np.full(1, b)
         neg = -pos
-    else:
+    else:  # each side from its slowest measured speed, where the file records it
         mirrored = False
-        pos = np.linspace(v_hi / N_VELOCITY, v_hi, N_VELOCITY)
-        neg = np.linspace(v_lo, v_lo / N_VELOCITY, N_VELOCITY)
-        a, b = 0.0, max(-v_lo, v_hi)
+        cover = (fitted.provenance or {}).get("speeds") if velocity_range is None else None
+        slow_pos = _slowest(cover, "pos", v_hi)
+        slow_neg = _slowest(cover, "neg", -v_lo)
+        pos = np.linspace(slow_pos or v_hi / N_VELOCITY, v_hi, N_VELOCITY)
+        neg = np.linspace(v_lo, -(slow_neg or -v_lo / N_VELOCITY), N_VELOCITY)
+        a, b = min(slow_pos or 0.0, slow_neg or 0.0), max(-v_lo, v_hi)
     if b <= 0:
         raise ExportError("the velocity range is zero; there is no motion to project over")
     levels, unused = {}, []
@@ -175,6 +178,16 @@ def operating_grid(
         "unused": unused,
     }
     return X, info
+
+
+def _slowest(cover: Any, side: str, top: float) -> float | None:
+    """The slowest measured speed of ``side`` (``"pos"``, ``"neg"``) [rad/s] of a file's
+    ``provenance["speeds"]`` when it is below ``top``, the side's largest; else None."""
+    try:
+        low = float(cover[side]["range"][0])
+    except (KeyError, TypeError, ValueError, IndexError):
+        return None
+    return low if 0.0 < low < top else None
 
 
 def _mirrored(info: dict[str, Any]) -> str:
