@@ -59,6 +59,10 @@ TIME_UNITS = {"ms": 1000.0, "min": 1.0 / 60.0}
 #: Relative tolerance for a known unit factor (the nearest one; 57.3 and 60 are 4.7 % apart).
 FACTOR_TOLERANCE = 0.02
 
+#: A step in time over this many median periods is a cut in the log (rows removed, a pause
+#: in the recording), not a sample period.
+TIME_JUMP = 5.0
+
 
 def velocity_scale(time, position, velocity) -> float | None:
     """The factor ``s`` with ``delta position = s * integral of velocity`` (module notes).
@@ -80,9 +84,15 @@ def velocity_scale(time, position, velocity) -> float | None:
     n = t.size
     if n < 2 * MIN_WINDOWS:
         return None
-    integral = np.concatenate([[0.0], np.cumsum(0.5 * (v[1:] + v[:-1]) * np.diff(t))])
+    # across a jump in time (rows cut out of the log) the velocity's integral is unknown:
+    # such a step is left out of both sums
+    steps = np.diff(t)
+    cut = steps > TIME_JUMP * float(np.median(steps))
+    moved = np.where(cut, 0.0, 0.5 * (v[1:] + v[:-1]) * steps)
+    integral = np.concatenate([[0.0], np.cumsum(moved)])
+    position = np.concatenate([[0.0], np.cumsum(np.where(cut, 0.0, np.diff(q)))])
     edges = np.unique(np.linspace(0, n - 1, min(WINDOWS, n // 2) + 1).astype(int))
-    dq, di = np.diff(q[edges]), np.diff(integral[edges])
+    dq, di = np.diff(position[edges]), np.diff(integral[edges])
     top = float(np.max(np.abs(di)))
     if not top > 0:
         return None
