@@ -166,3 +166,22 @@ def test_samples_without_their_header_are_told_what_it_held():
     assert "'# meta' header" in measurement_scatter(bare).caveat
     told = FrictionSamples(**kw, count=np.full(8, 100), std=np.full(8, 0.01), meta={"x": 1})
     assert "'# meta' header" not in measurement_scatter(told).caveat
+
+
+def test_a_header_that_no_longer_matches_its_rows_is_said_and_the_verdict_says_lower_bound():
+    """A trial: the lead screw's forward rows kept under the whole file's '# meta' header (32
+    per-row errors for 16 rows) fell back to std/sqrt(count), 1.52e-5 against about 6.0e-5,
+    silently: the verdict went from "yes" to "with caveats, 1.22x" without saying why."""
+    from fricid.identify import fit
+    from fricid.identify.trust import assess_trust
+
+    v = np.geomspace(0.1, 2, 8)
+    kw = dict(velocity=v, load=0.0, temperature=25.0, friction=0.1 + 0.01 * v, source="s")
+    stale = FrictionSamples(
+        **kw, count=np.full(8, 100), std=np.full(8, 0.01), meta={"sem": [0.002] * 16}
+    )
+    caveat = measurement_scatter(stale).caveat
+    assert "'# meta' header holds 16 per-row errors for these 8 rows" in caveat
+    assert "a lower bound" in caveat
+    record = assess_trust(fit(stale, "coulomb_viscous"), stale, validate=False)
+    assert any("std/sqrt(count), a lower bound" in r for r in record.reasons)

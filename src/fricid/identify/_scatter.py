@@ -77,6 +77,9 @@ _MEDIAN_ABS_NORMAL = 0.6744897501960817
 
 #: ``Scatter.method`` of :func:`second_difference_scatter`.
 SECOND_DIFFERENCES = "estimated from second differences, no repeats"
+#: ... the samples' own std / sqrt(count), which ignores the raw samples' autocorrelation: a
+#: lower bound of the scatter.
+STD_OVER_ROOT_COUNT = "within-run, std/sqrt(count)"
 
 
 @dataclass(frozen=True)
@@ -275,8 +278,14 @@ def measurement_scatter(
         ``raw`` or ``sem`` of a length other than the number of samples.
     """
     n = len(samples)
+    stale = ""
     if sem is None and "sem" in samples.meta:
         given = np.asarray(samples.meta["sem"], dtype=float)
+        if given.shape != (n,):  # rows removed or added by hand under the file's header
+            stale = (
+                f"; the samples file's '# meta' header holds {given.size} per-row errors for "
+                f"these {n} rows (rows removed or added under it?), so they were not used"
+            )
         if given.shape == (n,):
             how = samples.meta.get("sem_method")
             if isinstance(how, str) and how:  # the reader or extraction says how
@@ -323,8 +332,8 @@ def measurement_scatter(
         )
         return _scatter(
             samples.std / np.sqrt(samples.count),
-            "within-run, std/sqrt(count)",
-            f"ignores autocorrelation of the raw samples: a lower bound{said}{lost}",
+            STD_OVER_ROOT_COUNT,
+            f"ignores autocorrelation of the raw samples: a lower bound{said}{lost}{stale}",
         )
     out = second_difference_scatter(samples)
     return Scatter(out.value, out.per_sample, out.method, out.caveat + said) if said else out

@@ -118,7 +118,7 @@ from ._heldout import (
     shared_mse,
     worse_kfold,
 )
-from ._scatter import SECOND_DIFFERENCES, measurement_scatter
+from ._scatter import SECOND_DIFFERENCES, STD_OVER_ROOT_COUNT, measurement_scatter
 
 __all__ = [
     "DROPS",
@@ -166,6 +166,8 @@ OWN_CV = "the learned model's own CV"
 IN_SAMPLE = "in-sample only"
 #: Said in the reasons when the scatter is estimated (:func:`._scatter.second_difference_scatter`).
 ESTIMATED = "estimated from second differences: no repeated runs, so not measured"
+#: ... when it is the samples' std / sqrt(count) (their autocorrelation-aware errors missing).
+LOWER_BOUND = "std/sqrt(count), a lower bound (it ignores the raw samples' autocorrelation)"
 SECOND_LOG = "a second log"  #: ... run along by :func:`.trajectory_check.heldout_grading`
 #: The sources whose ratio is a held-out one.
 HELD_OUT = (RUN_HERE, FROM_FIT, OWN_CV, KFOLD_HERE, SECOND_LOG, NEW_SAMPLES)
@@ -570,6 +572,8 @@ def _grade(trust: Trust, fitted: FittedModel, sample_caveats: list[str], no: lis
         )
     estimated = trust.scatter_method == SECOND_DIFFERENCES and np.isfinite(ratio)
     said = [f"the scatter is {ESTIMATED}"] if estimated else []
+    if trust.scatter_method == STD_OVER_ROOT_COUNT and np.isfinite(ratio):
+        said.append(f"the scatter is {LOWER_BOUND}")
     if no:
         trust.level, trust.reasons = "no", no + caveats + said
         return
@@ -577,6 +581,8 @@ def _grade(trust: Trust, fitted: FittedModel, sample_caveats: list[str], no: lis
         trust.level, trust.reasons = "with caveats", caveats + said
         return
     which = f"the scatter {ESTIMATED}" if estimated else "the scatter"
+    if trust.scatter_method == STD_OVER_ROOT_COUNT:
+        which = f"the scatter, {LOWER_BOUND}"
     scheme = str(trust.heldout_scheme or "")
     ends = end_levels(trust.validation, trust.scatter) if scheme == LOVO_INTERIOR else ""
     if trust.held_out and scheme.startswith("kfold"):  # not the lovo figure printed beside it
