@@ -158,3 +158,19 @@ def test_a_static_mjcf_of_another_family_refuses_what_its_projection_reads(tmp_p
     path = fitted.save(tmp_path / "s.json")
     res = runner.invoke(app, ["export", str(path), "--to", "mjcf", *NO_CHECK])
     assert res.exit_code == 2 and "does not determine tau_s" in " ".join(res.output.split())
+
+
+def test_robot_export_refuses_only_what_its_target_holds(tmp_path):
+    """fricid robot export refused any undetermined parameter, also for ros2_control and
+    URDF, which hold each joint's Coulomb-viscous projection (never a LuGre model's sigma_1);
+    C holds the full model and still refuses it."""
+    path = tmp_path / "elbow.json"
+    trajectory_model().save(path)
+    out = tmp_path / "arm.yaml"
+    res = runner.invoke(app, ["robot", "export", f"elbow={path}", "--to", "yaml", "-o", str(out)])
+    assert res.exit_code == 0, res.output
+    assert "not in this file" in " ".join(out.read_text().split())
+    res = runner.invoke(
+        app, ["robot", "export", f"elbow={path}", "--to", "c", "-o", str(tmp_path / "c")]
+    )
+    assert res.exit_code != 0 and "--allow-undetermined" in " ".join(res.output.split())

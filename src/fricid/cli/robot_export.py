@@ -210,7 +210,13 @@ def robot_export_command(
     from rich.markup import escape
 
     from ..errors import ConfigError
-    from ..export import Smoothing, refuse_undetermined, refuse_untrusted, write_text
+    from ..export import (
+        Smoothing,
+        refuse_undetermined,
+        refuse_untrusted,
+        undetermined_held,
+        write_text,
+    )
     from ..export.robot import export_robot_c, robot_ros2_yaml_text
     from ._paths import check_paths
 
@@ -226,9 +232,14 @@ def robot_export_command(
     files = _model_files(models)
     fitted, sources, sha256, refused = _joint_models(files)
 
+    # ros2_control and URDF hold each joint's Coulomb-viscous projection (as the single-joint
+    # yaml and urdf: never a LuGre model's sigma_0 or sigma_1); C and MJCF the parameters
+    held_as = {"ros2_control": "yaml", "urdf": "urdf"}.get(target, "c")
+
     def refuse(joint: str) -> None:
         try:
-            refuse_undetermined(fitted[joint], allow_undetermined)
+            held = undetermined_held(fitted[joint], held_as)
+            refuse_undetermined(fitted[joint], allow_undetermined, held)
         except ConfigError as exc:
             raise type(exc)(f"joint {joint}: {exc}") from None
         refuse_untrusted(fitted[joint], allow_untrusted, joint)
