@@ -42,6 +42,7 @@ __all__ = [
     "grade_new_samples",
     "graded_rmse",
     "is_new_samples",
+    "model_error",
     "on_new_clause",
     "other_side_caveat",
     "own_cv",
@@ -428,12 +429,7 @@ def grade_new_samples(trust: Any, fitted: FittedModel, samples: FrictionSamples)
     out = fitted.outside_range(samples.X) & ~mine
     rest = ~mine & ~out
     judged = samples.subset(rest) if rest.any() else samples.subset(~mine)
-    sc = measurement_scatter(judged)
-    trust.scatter_method = sc.method
-    if np.isfinite(sc.value) and sc.value > 0:
-        trust.heldout_rmse = rmse(judged.y, fitted.predict(judged.X, warn=False))
-        trust.scatter = sc.value
-        trust.heldout_ratio = trust.heldout_rmse / sc.value
+    model_error(trust, fitted, judged)
     trust.verdict = verdict(trust.heldout_ratio)
     said = []
     if mine.any():
@@ -450,6 +446,19 @@ def grade_new_samples(trust: Any, fitted: FittedModel, samples: FrictionSamples)
             f"identified on, left out of the error graded: {why}"
         )
     return "; ".join(said)
+
+
+def model_error(trust: Any, fitted: FittedModel, samples: FrictionSamples) -> bool:
+    """Set ``trust``'s scatter method, and its RMSE, scatter and ratio from the model's own
+    error on ``samples`` when their scatter is known; whether it was."""
+    sc = measurement_scatter(samples)
+    trust.scatter_method = sc.method
+    if not (np.isfinite(sc.value) and sc.value > 0):
+        return False
+    trust.heldout_rmse = rmse(samples.y, fitted.predict(samples.X, warn=False))
+    trust.scatter = sc.value
+    trust.heldout_ratio = trust.heldout_rmse / sc.value
+    return True
 
 
 def on_new_clause(trust: Any) -> str:

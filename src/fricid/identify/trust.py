@@ -84,7 +84,7 @@ import numpy as np
 
 from ..fitted import FittedModel
 from ..fitted._file import _convergence_line
-from ..metrics import NOISE_RATIO, rmse, verdict
+from ..metrics import NOISE_RATIO, verdict
 from ..samples import FrictionSamples
 from ._diagnostics import (
     DROPS,
@@ -110,6 +110,7 @@ from ._heldout import (
     grade_new_samples,
     graded_rmse,
     is_new_samples,
+    model_error,
     on_new_clause,
     other_side_caveat,
     own_cv,
@@ -118,7 +119,7 @@ from ._heldout import (
     shared_mse,
     worse_kfold,
 )
-from ._scatter import SECOND_DIFFERENCES, STD_OVER_ROOT_COUNT, measurement_scatter
+from ._scatter import SECOND_DIFFERENCES, STD_OVER_ROOT_COUNT
 
 __all__ = [
     "DROPS",
@@ -481,14 +482,8 @@ def _ratio(
             trust.heldout_source = IN_SAMPLE
             recorded = (fitted.loss or {}).get("scatter") or {}
             trust.scatter_method = str(recorded.get("method") or "")
-        elif samples is not None:
-            sc = measurement_scatter(samples)
-            trust.scatter_method = sc.method
-            if np.isfinite(sc.value) and sc.value > 0:
-                trust.heldout_rmse = rmse(samples.y, fitted.predict(samples.X, warn=False))
-                trust.scatter = sc.value
-                trust.heldout_ratio = trust.heldout_rmse / sc.value
-                trust.heldout_source = IN_SAMPLE
+        elif samples is not None and model_error(trust, fitted, samples):
+            trust.heldout_source = IN_SAMPLE
     shared = (
         0.0 if trust.not_determined else shared_mse(fitted, samples, v if trust.held_out else None)
     )

@@ -330,23 +330,18 @@ class FrictionSamples:
         return cls(**cols, source=parts[0].source, meta=parts[0].meta)
 
 
+def _hashed_columns(samples: FrictionSamples) -> list[np.ndarray]:
+    """The columns the content hashes read: velocity, load, temperature, friction, direction
+    (float)."""
+    cols = (samples.velocity, samples.load, samples.temperature, samples.friction)
+    return [np.asarray(a, dtype=float) for a in (*cols, samples.direction.astype(float))]
+
+
 def row_digests(samples: FrictionSamples) -> np.ndarray:
     """One short content hash per row (12 hexadecimal digits of the SHA-256 of its velocity,
     load, temperature, friction and direction): which rows two sets share, whatever their
     order (:func:`samples_hash` is of the whole set, in order)."""
-    rows = np.column_stack(
-        [
-            np.asarray(a, dtype=float)
-            for a in (
-                samples.velocity,
-                samples.load,
-                samples.temperature,
-                samples.friction,
-                samples.direction.astype(float),
-            )
-        ]
-    )
-    rows = np.ascontiguousarray(rows)
+    rows = np.ascontiguousarray(np.column_stack(_hashed_columns(samples)))
     return np.array([hashlib.sha256(r.tobytes()).hexdigest()[:12] for r in rows], dtype=object)
 
 
@@ -365,12 +360,6 @@ def samples_hash(samples: FrictionSamples) -> str:
         direction (not count, std, source or meta).
     """
     h = hashlib.sha256()
-    for a in (
-        samples.velocity,
-        samples.load,
-        samples.temperature,
-        samples.friction,
-        samples.direction.astype(float),
-    ):
-        h.update(np.ascontiguousarray(a, dtype=float).tobytes())
+    for a in _hashed_columns(samples):
+        h.update(np.ascontiguousarray(a).tobytes())
     return h.hexdigest()[:16]
