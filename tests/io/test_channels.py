@@ -145,6 +145,12 @@ def test_cli_extracts_a_folder_of_channel_files(tmp_path):
     samples = read_samples(out)
     assert sorted(np.round(np.rad2deg(samples.velocity)).astype(int)) == list(SPEEDS)
     np.testing.assert_allclose(samples.friction, _friction(samples.velocity), rtol=1e-6)
+    # no temperature channel and none given: the samples record none (not a made-up 25 degC)
+    assert "temperature" not in samples.measured, samples.measured
+    (log, *_) = read_channels(folder, PATTERNS, UNITS)
+    assert not log.temperature_measured
+    (log, *_) = read_channels(folder, PATTERNS, UNITS, temperature=31.0)
+    assert log.temperature_measured and float(log.temperature[0]) == 31.0
 
 
 def test_open_log_without_patterns_says_what_is_needed(tmp_path):

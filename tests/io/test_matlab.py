@@ -88,13 +88,15 @@ def test_v5_log_with_units(tmp_path):
     np.testing.assert_allclose(log.time, t)
     np.testing.assert_allclose(log.velocity, np.pi / 2)
     np.testing.assert_allclose(log.motor_torque, 0.2 * (t + 1))
-    with pytest.raises(ConfigError, match="temperature"):
-        read_mat(
-            path,
-            {"time": "t", "velocity": "data.qd", "current": "data.i"},
-            {"time": "ms", "velocity": "deg/s", "current": "A"},
-            torque_constant=0.2,
-        )
+    assert log.temperature_measured and float(log.temperature[0]) == 30.0
+    # no temperature variable and none given: the log records none (not a made-up 25 degC)
+    none = read_mat(
+        path,
+        {"time": "t", "velocity": "data.qd", "current": "data.i"},
+        {"time": "ms", "velocity": "deg/s", "current": "A"},
+        torque_constant=0.2,
+    )
+    assert not none.temperature_measured
 
 
 def test_cli_reads_mean_tables_and_refuses_extraction_flags(tmp_path):

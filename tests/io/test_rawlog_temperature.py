@@ -49,3 +49,34 @@ def test_extract_takes_the_temperature_of_a_table_without_one(tmp_path):
     path = _table(tmp_path / "nt.csv", temperature=False)
     res = CliRunner().invoke(app, ["extract", str(path), "-o", str(tmp_path / "s.csv")])
     assert res.exit_code == 2 and "--temperature 25" in res.output, res.output
+
+
+def test_a_mapped_log_without_temperature_records_none(tmp_path):
+    """A vendor table (``--format generic``) without a temperature column and without
+    ``--temperature``: the log's column is a placeholder and the samples record no
+    temperature, not the 25 degC the option's default once made up."""
+    from fricid.io import read_samples, read_table_log
+    from fricid.samples import NO_TEMPERATURE_SOURCE
+
+    path = tmp_path / "vendor.csv"
+    t = np.arange(4000) * 0.005
+    v = np.where((t // 5) % 2 == 0, 0.5, -0.5) * (1 + (t // 10))
+    rows = "\n".join(
+        f"{a:.6f},{b:.6f},{0.2 * np.sign(b) + 0.05 * b:.6f}" for a, b in zip(t, v, strict=True)
+    )
+    path.write_text("t,dq,tau\n" + rows + "\n")
+    mapping = {"time": "t", "velocity": "dq", "torque": "tau"}
+    units = {"time": "s", "velocity": "rad/s", "torque": "N m"}
+    log = read_table_log(path, mapping, units)
+    assert not log.temperature_measured
+    assert log.meta["temperature_source"] == NO_TEMPERATURE_SOURCE
+    assert read_table_log(path, mapping, units, temperature=31.0).temperature_measured
+    maps = ["--map", "time=t:s", "--map", "velocity=dq:rad/s", "--map", "torque=tau:N m"]
+    base = ["extract", str(path), "--format", "generic", *maps, "--gravity", "none"]
+    res = CliRunner().invoke(app, [*base, "-o", str(tmp_path / "s.csv")])
+    assert res.exit_code == 0, res.output
+    assert "temperature" not in read_samples(tmp_path / "s.csv").measured
+    res = CliRunner().invoke(app, [*base, "--temperature", "31", "-o", str(tmp_path / "w.csv")])
+    assert res.exit_code == 0, res.output
+    warm = read_samples(tmp_path / "w.csv")
+    assert "temperature" in warm.measured and np.all(warm.temperature == 31.0)

@@ -224,10 +224,11 @@ def test_bad_options(mcap_bag, options, message):
         read_rosbag(mcap_bag, "elbow", temperature=25.0, **options)
 
 
-def test_temperature_must_be_given_once(mcap_bag):
-    with pytest.raises(ConfigError, match="not both and not neither"):
-        read_rosbag(mcap_bag, "elbow")
-    with pytest.raises(ConfigError, match="not both and not neither"):
+def test_temperature_is_given_at_most_once(mcap_bag):
+    # neither: the log records none (its column a placeholder, not a made-up 25 degC)
+    assert not read_rosbag(mcap_bag, "elbow").temperature_measured
+    assert read_rosbag(mcap_bag, "elbow", temperature=25.0).temperature_measured
+    with pytest.raises(ConfigError, match="not both"):
         read_rosbag(mcap_bag, "elbow", temperature=25.0, temperature_topic="/elbow/temperature")
 
 

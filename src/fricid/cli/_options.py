@@ -140,12 +140,12 @@ TorqueConstantOption = Annotated[
 
 #: ``--temperature``: a constant temperature [degC] for a log that records none.
 TemperatureOption = Annotated[
-    float,
+    float | None,
     typer.Option(
         "--temperature",
-        help="The temperature [degC] to record when the log has none (a table log without a "
-        "temperature column: give it explicitly; an EPOS recording, file or folder, records none "
-        "unless given; the default is for the other readers).",
+        help="The joint's temperature [degC], recorded with the samples, for a log that logs "
+        "none. Without it such a log records no temperature (none is made up); fricid's own "
+        "table log without a temperature column needs it.",
     ),
 ]
 

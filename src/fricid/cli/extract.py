@@ -267,7 +267,7 @@ def extract_command(
     temperature_topic: Annotated[
         str | None,
         typer.Option(
-            help="rosbag: a sensor_msgs/msg/Temperature topic [degC]; else --temperature is used."
+            help="rosbag: a sensor_msgs/msg/Temperature topic [degC]; else --temperature, or none."
         ),
     ] = None,
     effort: Annotated[
@@ -328,7 +328,7 @@ def extract_command(
             "stopping; the rows dropped are counted and listed (file, line, column)."
         ),
     ] = False,
-    temperature: TemperatureOption = 25.0,
+    temperature: TemperatureOption = None,
     chunk_rows: Annotated[
         int, typer.Option(help="Rows read at a time (bounded memory).")
     ] = 1_000_000,
@@ -378,7 +378,7 @@ def extract_command(
     elif fmt == "generic":
         columns, units = parse_column_map(column_map)
         reader_options = {"columns": columns, "units": units, "torque_constant": torque_constant}
-        if "temperature" not in columns or "temperature" in given:
+        if "temperature" in given:  # a log without one records none: none made up
             reader_options["temperature"] = temperature
     elif fmt == "rosbag":
         reader_options = {
@@ -391,7 +391,7 @@ def extract_command(
             reader_options["joint"] = joint
         if temperature_topic:
             reader_options["temperature_topic"] = temperature_topic
-        else:
+        if "temperature" in given:
             reader_options["temperature"] = temperature
     elif fmt == "epos":
         reader_options = {
@@ -413,7 +413,7 @@ def extract_command(
             "time_unit": time_unit,
             "torque_constant": torque_constant,
         }
-        if "temperature" not in patterns or "temperature" in given:
+        if "temperature" in given:
             reader_options["temperature"] = temperature
     else:  # mat (check_flags refused any other format)
         names, units = parse_column_map(variables, "--var", "NAME")
@@ -423,8 +423,7 @@ def extract_command(
             "joint": joint,
             "torque_constant": torque_constant,
         }
-        table_of_means = "friction" in names
-        if "temperature" in given or ("temperature" not in names and not table_of_means):
+        if "temperature" in given:
             reader_options["temperature"] = temperature
     if gives_samples(fmt, log, reader_options):
         extract_options = {}

@@ -42,7 +42,7 @@ import numpy as np
 import pandas as pd
 
 from ..errors import ConfigError, DataError, DataQualityWarning, user_stacklevel
-from ..samples import RawLog
+from ..samples import RawLog, constant_temperature
 from ..units import UNITS, to_si
 from ._files import check_input, read_capped
 from .generic import integrate_velocity
@@ -283,7 +283,8 @@ def read_channels(
     time_unit : str
         Unit of every file's time column (default s).
     temperature : float, optional
-        Constant temperature [degC] without a temperature channel.
+        Constant temperature [degC] without a temperature channel; without either, the log
+        records none (:data:`fricid.samples.NO_TEMPERATURE_SOURCE`).
     torque_constant : float, optional
         K [N m/A] of tau = K I (eq. 13 of the BAS-RBFNN paper) for a current channel.
 
@@ -338,10 +339,9 @@ def read_channels(
             raise ConfigError(f"unknown {q} unit '{unit}'; allowed: {', '.join(UNITS[q])}")
     if time_unit not in UNITS["time"]:
         raise ConfigError(f"unknown time unit '{time_unit}'; allowed: {', '.join(UNITS['time'])}")
-    if ("temperature" in patterns) == (temperature is not None):
+    if "temperature" in patterns and temperature is not None:
         raise ConfigError(
-            "give the temperature either as a channel or as a constant [degC], not both and "
-            "not neither"
+            "give the temperature either as a channel or as a constant [degC], not both"
         )
     runs, fields = _runs(folder, patterns)
     if "joint" in fields:
@@ -438,11 +438,12 @@ def _read_run(
     position = values.get("position")
     if position is None:
         position = integrate_velocity(t_ref, velocity)
+    constant, source = constant_temperature(temperature)
     return RawLog(
         time=t_ref,
         position=position,
         velocity=velocity,
-        temperature=values.get("temperature", temperature),
+        temperature=values.get("temperature", constant),
         torque=values.get("torque"),
         current=values.get("current"),
         torque_constant=torque_constant,
@@ -457,5 +458,6 @@ def _read_run(
             "rows_dropped": int((~keep).sum()),
             "velocity_source": "channel" if "velocity" in values else "central differences",
             "position_source": "channel" if "position" in values else "integrated velocity",
+            **({} if "temperature" in values else {"temperature_source": source}),
         },
     )

@@ -35,7 +35,7 @@ import numpy as np
 
 from ..errors import ConfigError, DataError, FricidError
 from ..metrics import sem_autocorrelated
-from ..samples import NO_TEMPERATURE_SOURCE, FrictionSamples, RawLog
+from ..samples import NO_TEMPERATURE, NO_TEMPERATURE_SOURCE, FrictionSamples, RawLog
 from ..units import UNITS, to_si
 from ._epos_text import (
     _COUNT_UNITS,
@@ -73,10 +73,6 @@ __all__ = [
 ]
 
 logger = logging.getLogger(__name__)
-
-#: The logs' placeholder temperature [degC] when none is given (a raw log needs one; its
-#: ``meta["temperature_source"]`` says it is none, and the samples built from it record none).
-NO_TEMPERATURE = 25.0
 
 #: Nominal torque [N m] of the Maxon motor in the lead-screw recordings of
 #: Mablekos-Alexiou et al. (IEEE T-RO 2021), 9.84 mNm: the reference of their ``%`` torque.

@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ConfigError, DataError
-from ..samples import RawLog
+from ..samples import RawLog, constant_temperature
 from ..units import UNITS, to_si
 from ._columns import split_label
 from ._csv import read_numeric, read_preamble, record_line
@@ -39,10 +39,10 @@ def _check_mapping(
             raise ConfigError(f"columns must map '{q}' (a column of the file)")
     if "torque" not in columns and "current" not in columns:
         raise ConfigError("columns must map 'torque' or 'current' (with torque_constant)")
-    if ("temperature" in columns) == (temperature is not None):
+    if "temperature" in columns and temperature is not None:
         raise ConfigError(
             "give the temperature either as a column (columns={'temperature': ...}) or as a "
-            "constant (temperature=...) [degC], not both and not neither"
+            "constant (temperature=...) [degC], not both"
         )
 
 
@@ -144,7 +144,9 @@ def read_table_log(
     torque_constant : float, optional
         K [N m/A] for a current column (tau = K I, eq. 13 of the BAS-RBFNN paper).
     temperature : float, optional
-        Constant temperature [degC] when the file has no temperature column.
+        Constant temperature [degC] when the file has no temperature column. Without a column
+        and without this, the log records none (``meta["temperature_source"]``:
+        :data:`fricid.samples.NO_TEMPERATURE_SOURCE`), nor do the samples extracted from it.
     joint : str, default "joint"
         The joint's name in the log.
 
@@ -200,12 +202,13 @@ def read_table_log(
     time, velocity = si["time"], si["velocity"]
     if len(time) == 0:
         raise DataError("no data rows after the header", file=path)
+    constant, source = constant_temperature(temperature)
     try:
         return RawLog(
             time=time,
             position=si["position"] if "position" in si else integrate_velocity(time, velocity),
             velocity=velocity,
-            temperature=si.get("temperature", temperature),
+            temperature=si.get("temperature", constant),
             torque=si.get("torque"),
             current=si.get("current"),
             torque_constant=torque_constant,
@@ -215,6 +218,7 @@ def read_table_log(
                 "columns": columns,
                 "units": unit_of,
                 "position_source": "channel" if "position" in si else "integrated velocity",
+                **({} if "temperature" in si else {"temperature_source": source}),
             },
         )
     except DataError as err:

@@ -27,7 +27,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import ConfigError, DataError
-from ..samples import FrictionSamples, RawLog, drop_standstill
+from ..samples import FrictionSamples, RawLog, constant_temperature, drop_standstill
 from ..units import UNITS, to_si
 from ._files import check_input
 from ._mat73 import h5_child, h5_kind, h5_values
@@ -351,9 +351,10 @@ def read_mat(
     joint : str, optional
         The 1-based column to read from variables with one column per joint.
     temperature : float, optional
-        A log: constant temperature [degC] without a temperature variable (one of the two is
-        needed). A table: the temperature of every row; without it and without a variable,
-        temperature is not measured.
+        A log: constant temperature [degC] without a temperature variable (without either,
+        the log records none: :data:`fricid.samples.NO_TEMPERATURE_SOURCE`). A table: the
+        temperature of every row; without it and without a variable, temperature is not
+        measured.
     torque_constant : float, optional
         K [N m/A] for a current variable (tau = K I, eq. 13 of the BAS-RBFNN paper).
 
@@ -447,8 +448,9 @@ def read_mat(
         )
         return drop_standstill(means, stacklevel=3)
     time, velocity = si["time"], si["velocity"]
-    if "temperature" not in si and temperature is None:
-        raise ConfigError("give the temperature as --var temperature=NAME:UNIT or --temperature")
+    constant, source = constant_temperature(temperature)
+    if "temperature" not in si:
+        meta["temperature_source"] = source
     position = si.get("position")
     meta = {**meta, "position_source": "integrated velocity" if position is None else "channel"}
     if position is None:
@@ -457,7 +459,7 @@ def read_mat(
         time=time,
         position=position,
         velocity=velocity,
-        temperature=si.get("temperature", temperature),
+        temperature=si.get("temperature", constant),
         torque=si.get("torque"),
         current=si.get("current"),
         torque_constant=torque_constant,

@@ -33,7 +33,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import ConfigError, DataError
-from ..samples import RawLog
+from ..samples import RawLog, constant_temperature
 from ..units import SI_UNITS, UNITS, to_si
 from ._bag import (
     JOINT_STATE,
@@ -161,11 +161,10 @@ def _check_options(
         raise ConfigError(
             f"time_source must be one of: {', '.join(_TIME_SOURCES)}; got '{time_source}'"
         )
-    if (temperature_topic is None) == (temperature is None):
+    if temperature_topic is not None and temperature is not None:
         raise ConfigError(
             "give the temperature either as a topic (temperature_topic=..., "
-            "sensor_msgs/msg/Temperature) or as a constant (temperature=... degC), "
-            "not both and not neither"
+            "sensor_msgs/msg/Temperature) or as a constant (temperature=... degC), not both"
         )
     if not isinstance(chunk_rows, int | np.integer) or chunk_rows < 1:
         raise ConfigError(f"chunk_rows must be a positive integer, got {chunk_rows!r}")
@@ -245,7 +244,8 @@ def iter_rosbag(
         A ``sensor_msgs/msg/Temperature`` topic [degC], interpolated to the joint's sample
         times. Give it or ``temperature``, not both.
     temperature : float, optional
-        Constant temperature [degC] when there is no temperature topic.
+        Constant temperature [degC] when there is no temperature topic; without either, the
+        log records none (:data:`fricid.samples.NO_TEMPERATURE_SOURCE`).
     effort : {"torque", "current"}, default "torque"
         What ``JointState.effort`` holds: the motor torque, or the motor current (which
         needs ``torque_constant``).
@@ -331,7 +331,7 @@ def _read_chunks(reader: Any, conns: list[Any], path: Path, opt: _Options) -> It
         "topic": topic,
         "effort": effort,
         "effort_unit": unit,
-        "temperature_source": temperature_topic or f"constant {temperature} degC",
+        "temperature_source": temperature_topic or constant_temperature(temperature)[1],
     }
 
     def emit() -> RawLog:
@@ -357,7 +357,7 @@ def _read_chunks(reader: Any, conns: list[Any], path: Path, opt: _Options) -> It
             )
         time = (t_ns - origin) * 1e-9
         if temps is None:
-            temp = np.full(chunk.n, float(temperature))
+            temp = np.full(chunk.n, constant_temperature(temperature)[0])
         else:
             temp = interp_temperature(temps, "header" if use_header else "receive", t_ns, origin)
         values = chunk.values[:, : chunk.n].copy()  # the buffer is reused for the next chunk

@@ -34,13 +34,14 @@ from ._columns import (
 from ._encoder_steps import encoder_quantum, position_unit_problem
 from ._standstill import drop_standstill, standstill_rows
 from ._trajectory_log import check_trajectory_log
-from .rawlog import NO_TEMPERATURE_SOURCE, RawLog
+from .rawlog import NO_TEMPERATURE, NO_TEMPERATURE_SOURCE, RawLog, constant_temperature
 from .robot_join import join_robot_logs
 from .robot_log import ROBOT_COLUMNS, RobotLog
 
 __all__ = [
     "DIRECTION_TOLERANCE",
     "LIMITS",
+    "NO_TEMPERATURE",
     "NO_TEMPERATURE_SOURCE",
     "OPTIONAL_INPUTS",
     "RAWLOG_COLUMNS",
@@ -52,6 +53,7 @@ __all__ = [
     "RobotLog",
     "check_trajectory_log",
     "coarse_velocity",
+    "constant_temperature",
     "drop_standstill",
     "encoder_quantum",
     "join_robot_logs",

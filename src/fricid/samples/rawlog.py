@@ -12,7 +12,7 @@ import numpy as np
 from ..errors import DataError
 from ._columns import LIMITS, _as_column
 
-__all__ = ["NO_TEMPERATURE_SOURCE", "RawLog"]
+__all__ = ["NO_TEMPERATURE", "NO_TEMPERATURE_SOURCE", "RawLog", "constant_temperature"]
 
 #: The array columns of a :class:`RawLog`.
 _COLUMNS = ("time", "position", "velocity", "temperature", "torque", "current")
@@ -23,6 +23,19 @@ _COLUMNS = ("time", "position", "velocity", "temperature", "torque", "current")
 NO_TEMPERATURE_SOURCE = (
     "none: the recorder logs no temperature (give the joint's with --temperature)"
 )
+
+#: The placeholder temperature column [degC] of such a log (never recorded as a measurement).
+NO_TEMPERATURE = 25.0
+
+
+def constant_temperature(temperature: float | None) -> tuple[float, str]:
+    """The temperature column of a log without a temperature channel and its
+    ``meta["temperature_source"]``: the constant given, or :data:`NO_TEMPERATURE` with
+    :data:`NO_TEMPERATURE_SOURCE` (the samples extracted from it then record none, rather
+    than a made-up 25 degC)."""
+    if temperature is None:
+        return NO_TEMPERATURE, NO_TEMPERATURE_SOURCE
+    return float(temperature), f"constant {float(temperature):g} degC, given (none logged)"
 
 
 @dataclass(frozen=True, eq=False)
