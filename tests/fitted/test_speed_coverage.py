@@ -60,6 +60,18 @@ def test_two_direction_model_reports_below_and_gap(model):
     assert not model.range_check(np.array([[1.0, 0, 25], [-10.0, 0, 25]]))
 
 
+def test_outside_range_marks_each_row_from_one_check(model, monkeypatch):
+    """Rows below, above, in a gap and inside, marked as row-by-row checks would, with the
+    range checked once for all the rows (it had been once per row when any row was out)."""
+    X = np.array([[0.001, 0, 25], [-3.0, 0, 25], [1.0, 0, 25], [40.0, 0, 25], [-0.05, 0, 25]])
+    one_by_one = [any(b.kind != "gap" for b in model.range_check(x[None])) for x in X]
+    calls = []
+    check = type(model).range_check
+    monkeypatch.setattr(type(model), "range_check", lambda m, X: calls.append(1) or check(m, X))
+    assert model.outside_range(X).tolist() == one_by_one == [True, False, False, True, True]
+    assert len(calls) == 1
+
+
 def test_range_survives_the_model_file(model, tmp_path):
     loaded = FittedModel.load(model.save(tmp_path / "m.json"))
     assert loaded.provenance["speeds"] == model.provenance["speeds"]

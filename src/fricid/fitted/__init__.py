@@ -315,9 +315,8 @@ class FittedModel:
         (:meth:`range_check`: another side, above or below the measured speeds, other loads
         or temperatures; a gap between measured speeds is not outside)."""
         X = np.atleast_2d(np.asarray(X, dtype=float))
-        if not any(v.kind != "gap" for v in self.range_check(X)):
-            return np.zeros(len(X), dtype=bool)
-        return np.array([any(v.kind != "gap" for v in self.range_check(x[None])) for x in X])
+        rows = [v.rows for v in self.range_check(X) if v.kind != "gap" and v.rows is not None]
+        return np.any([np.zeros(len(X), dtype=bool), *rows], axis=0)
 
     # -- text ----------------------------------------------------------------------------
     def report(self, min_correl: float = MIN_CORREL) -> str:

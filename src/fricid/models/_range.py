@@ -8,7 +8,7 @@ out); the model file, its warnings and the command line use it.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -165,6 +165,7 @@ def _coverage_violations(v: np.ndarray, coverage: dict) -> list[RangeViolation]:
                     hi,
                     f"velocity {w:.4g} rad/s is below the smallest identified speed {lo:.4g} "
                     f"rad/s ({where}): the low-speed (Stribeck) region is extrapolated",
+                    rows=below,
                 )
             )
         for a, b in gap_pairs(coverage, side):
@@ -183,6 +184,7 @@ def _coverage_violations(v: np.ndarray, coverage: dict) -> list[RangeViolation]:
                         b,
                         f"velocity {w:.4g} rad/s lies in a gap of the measured speeds (nothing "
                         f"between {a:.4g} and {b:.4g} rad/s; {where}): interpolated",
+                        rows=inside,
                     )
                 )
     return out
@@ -213,6 +215,8 @@ class RangeViolation:
         ``gap``).
     message : str
         One line naming the input and how far out it is.
+    rows : ndarray of bool, optional
+        Which rows of the inputs checked (``count`` of them are True).
     """
 
     quantity: str
@@ -222,6 +226,7 @@ class RangeViolation:
     low: float
     high: float
     message: str
+    rows: np.ndarray | None = field(default=None, repr=False, compare=False)
 
 
 def _pair(ranges: Any, name: str) -> tuple[float, float] | None:
@@ -263,6 +268,7 @@ def _velocity_violations(
                         hi,
                         f"velocity {w:.4g} rad/s is outside the identified range {lo:.4g} to "
                         f"{hi:.4g} rad/s{_times(w, abs(edge))}: extrapolated",
+                        rows=mask,
                     )
                 )
         return out
@@ -284,6 +290,7 @@ def _velocity_violations(
                     f"velocity {w:.4g} rad/s is on the side the model was not identified on (it "
                     f"was identified for {named} velocity only, {lo:.4g} to {hi:.4g} rad/s): "
                     "its value there is the mirror image, extrapolated",
+                    rows=wrong,
                 )
             )
         v = np.where(wrong, 0.0, v)
@@ -302,6 +309,7 @@ def _velocity_violations(
                 s_hi,
                 f"velocity {w:.4g} rad/s is {abs(w) / s_hi:.3g}x the largest identified speed "
                 f"{s_hi:.4g} rad/s: extrapolated",
+                rows=above,
             )
         )
     below = (speed > 0) & (speed < s_lo - tol)
@@ -317,6 +325,7 @@ def _velocity_violations(
                 s_hi,
                 f"velocity {w:.4g} rad/s is below the smallest identified speed {s_lo:.4g} "
                 "rad/s: the low-speed (Stribeck) region is extrapolated",
+                rows=below,
             )
         )
     return out
@@ -393,6 +402,7 @@ def range_violations(
                     f"{name} {w:.4g} {unit} is outside the identified range {lo:.4g} to "
                     f"{hi:.4g} {unit} ({float(far[bad].max()):.3g} {unit} beyond): "
                     "extrapolated",
+                    rows=bad,
                 )
             )
     return out
