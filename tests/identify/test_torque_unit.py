@@ -10,7 +10,7 @@ import pytest
 from typer.testing import CliRunner
 
 from fricid.cli import app
-from fricid.identify import fit, torque_unit_mismatch
+from fricid.identify import fit, torque_unit_mismatch, unit_mismatches, velocity_unit_mismatch
 from fricid.identify.trust import assess_trust
 from fricid.io import epos_steady_samples, read_samples, write_samples
 from fricid.report import model_report
@@ -84,3 +84,46 @@ def test_evaluate_says_so_too(files):
         assert res.exit_code == 0, res.output
         text = " ".join(res.output.split())
         assert ("likely names the wrong torque unit" in text) is told
+
+
+def _speeds_under(samples, factor):
+    """The samples with their velocities as a header ``factor`` times too small reads them."""
+    return samples.__class__(
+        velocity=samples.velocity * factor,
+        load=None,
+        temperature=None,
+        friction=samples.friction,
+        direction=samples.direction,
+        source="ls_rpm.csv",
+    )
+
+
+def test_a_velocity_header_in_the_wrong_unit_is_named(files, tmp_path):
+    """rad/s numbers under ``velocity [rpm]`` read 0.105x too slow: the model misses them by a
+    lot, and the samples' speeds times 9.549 follow it; honest samples, and the same samples
+    with the friction of another drive, are told nothing."""
+    honest, _, fitted, model = files
+    samples = read_samples(honest)
+    assert velocity_unit_mismatch(fitted, samples) is None
+    said = velocity_unit_mismatch(fitted, _speeds_under(samples, 2 * np.pi / 60))
+    assert said is not None and "times 9.549" in said
+    assert "numbers in rad/s under a header in rpm" in said and "ls_rpm.csv" in said
+    deg = velocity_unit_mismatch(fitted, _speeds_under(samples, np.pi / 180))
+    assert deg is not None and "numbers in rad/s under a header in deg/s" in deg
+    other = samples.__class__(
+        velocity=samples.velocity,
+        load=None,
+        temperature=None,
+        friction=samples.friction * (1.5 + np.abs(samples.velocity)),
+        direction=samples.direction,
+    )
+    assert unit_mismatches(fitted, other) == {}
+    text = honest.read_text(encoding="utf-8")
+    assert text.count("velocity [rad/s]") == 1
+    rpm = tmp_path / "rpm.csv"
+    rpm.write_text(text.replace("velocity [rad/s]", "velocity [rpm]"), encoding="utf-8")
+    res = CliRunner().invoke(app, ["evaluate", str(model), str(rpm)], terminal_width=200)
+    assert res.exit_code == 0, res.output
+    assert "likely names the wrong unit (numbers in rad/s under a header in rpm" in " ".join(
+        res.output.split()
+    )

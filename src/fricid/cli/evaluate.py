@@ -66,7 +66,7 @@ def evaluate_command(
     RMSPE [%], mean and max absolute error [N m], and the BAS-RBFNN paper's Table 1 fitness
     (R^2 of the signed friction, "fitness": it flatters per-direction samples)."""
     from ..fitted import FittedModel
-    from ..identify import evaluate, measurement_scatter, torque_unit_mismatch
+    from ..identify import evaluate, measurement_scatter, unit_mismatches
     from ..io import read_samples
     from ..metrics import verdict
 
@@ -74,9 +74,8 @@ def evaluate_command(
     fitted = FittedModel.load(model)
     data = read_samples(samples)
     result = evaluate(fitted, data)
-    unit = torque_unit_mismatch(fitted, data)
-    if unit:  # every error below compares two units
-        err_console.print(f"warning: {unit}.", markup=False, highlight=False, soft_wrap=True)
+    for why in unit_mismatches(fitted, data).values():  # every error below compares two units
+        err_console.print(f"warning: {why}.", markup=False, highlight=False, soft_wrap=True)
     if as_json:
         console.print_json(json.dumps(result))
         return

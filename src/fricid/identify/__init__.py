@@ -22,7 +22,7 @@ record, which ``fricid fit``, the fleet and ``fricid report`` read and never rec
 from __future__ import annotations
 
 from ..samples import samples_hash
-from ._advice import torque_unit_mismatch
+from ._advice import torque_unit_mismatch, unit_mismatches, velocity_unit_mismatch
 from ._scatter import Scatter, measurement_scatter, sample_weights
 from .dispatch import KINDS, fit, kind_of
 from .problem import IdentificationProblem
@@ -50,5 +50,7 @@ __all__ = [
     "samples_hash",
     "select",
     "torque_unit_mismatch",
+    "unit_mismatches",
+    "velocity_unit_mismatch",
     "validate",
 ]

@@ -30,7 +30,10 @@ model predicts a known unit factor (:data:`FACTORS`, the ratios between the torq
 header may name) times every moving sample, and the samples rescaled by it fit the model
 closely. A model of another drive, whose friction is merely larger, gives neither a ratio that
 close to 1000 at every sample nor that close a fit once rescaled, so honest data do not trigger
-it.
+it. A velocity column under the wrong unit (``velocity [rpm]`` over numbers in rad/s) is
+recognised alike (:func:`velocity_unit_mismatch`): the samples' velocities times a known unit
+factor (:data:`VELOCITY_FACTORS`) fall inside the model's operating range and fit it far more
+closely than as read. :func:`unit_mismatches` runs both checks.
 """
 
 from __future__ import annotations
@@ -48,7 +51,14 @@ from ..units import UNITS
 from .static.checks import _levels
 from .validate import interior_rmse
 
-__all__ = ["FACTORS", "misfit_advice", "torque_unit_mismatch"]
+__all__ = [
+    "FACTORS",
+    "VELOCITY_FACTORS",
+    "misfit_advice",
+    "torque_unit_mismatch",
+    "unit_mismatches",
+    "velocity_unit_mismatch",
+]
 
 
 def _in_sample_ratio(fitted: FittedModel, samples: FrictionSamples | None, scatter: float):
@@ -223,3 +233,84 @@ def torque_unit_mismatch(fitted: FittedModel, samples: FrictionSamples) -> str |
         f"{small}; or the model was identified on such a file), so the errors on these "
         "samples compare two units and say nothing about the model"
     )
+
+
+#: The factors a wrong velocity unit in a header scales the speeds by (9.55: rad/s under rpm).
+VELOCITY_FACTORS = sorted(
+    {a / b for (a, _), (b, _) in itertools.permutations(UNITS["velocity"].values(), 2) if a != b}
+)
+#: The rescaled samples must fit the model this many times closer than as read ...
+CLOSER = 3.0
+#: ... with this share of the moving rows, rescaled, inside the model's operating range.
+INSIDE_SHARE = 0.8
+
+
+def _miss(fitted: FittedModel, X: np.ndarray, measured: np.ndarray) -> float:
+    """RMS of the measured minus the predicted friction where the prediction is finite."""
+    predicted = np.asarray(fitted.predict(X, warn=False), dtype=float)
+    ok = np.isfinite(predicted)
+    return rmse(measured[ok], predicted[ok]) if ok.sum() >= MIN_SAMPLES else float("inf")
+
+
+def _velocity_units(factor: float) -> tuple[str, str]:
+    """The unit the numbers are in and the one the header names, for ``factor`` (the true
+    velocities over the velocities as read)."""
+    names = list(UNITS["velocity"])
+    return next(
+        (true, header)
+        for true, header in itertools.permutations(names, 2)
+        if math.isclose(UNITS["velocity"][true][0] / UNITS["velocity"][header][0], factor)
+    )
+
+
+def velocity_unit_mismatch(fitted: FittedModel, samples: FrictionSamples) -> str | None:
+    """Why the errors of ``fitted`` on ``samples`` compare two velocity units, else None.
+
+    Returns
+    -------
+    str or None
+        E.g. ``"the samples' velocities times 9.549 ... : the velocity column's header in
+        ls.csv likely names the wrong unit (numbers in rad/s under a header in rpm ...)"``:
+        the rescaled samples fall inside the model's operating range (:data:`INSIDE_SHARE`)
+        and fit it within :data:`FIT_SHARE` of the friction's size, :data:`CLOSER` times
+        closer than as read; None otherwise, or when too few samples move to tell.
+    """
+    moving = samples.velocity != 0
+    if int(moving.sum()) < MIN_SAMPLES:
+        return None
+    X, measured = np.array(samples.X[moving], dtype=float), samples.friction[moving]
+    size = float(np.sqrt(np.mean(measured**2)))
+    as_read = _miss(fitted, X, measured)
+    best: tuple[float, float] | None = None
+    for factor in VELOCITY_FACTORS:
+        scaled = X.copy()
+        scaled[:, 0] *= factor
+        if np.mean(~fitted.outside_range(scaled)) < INSIDE_SHARE:
+            continue
+        miss = _miss(fitted, scaled, measured)
+        if miss <= FIT_SHARE * size and CLOSER * miss <= as_read and (not best or miss < best[1]):
+            best = (factor, miss)
+    if best is None:
+        return None
+    factor, miss = best
+    true, header = _velocity_units(factor)
+    name = str(samples.source).rsplit("/", 1)[-1] if samples.source else "these samples"
+    return (
+        f"the samples' velocities times {factor:.4g} follow the model within "
+        f"{100 * miss / size:.2g} % of the friction's size, as read it misses by "
+        f"{100 * as_read / size:.3g} %: the velocity column's header in {name} likely names "
+        f"the wrong unit (numbers in {true} under a header in {header}; or the model was "
+        "identified on such a file), so the errors on these samples compare two units and say "
+        "nothing about the model"
+    )
+
+
+def unit_mismatches(fitted: FittedModel, samples: FrictionSamples) -> dict[str, str]:
+    """The unit checks that found a header naming the wrong unit: ``{"torque unit": why}``
+    (:func:`torque_unit_mismatch`), else ``{"velocity unit": why}``
+    (:func:`velocity_unit_mismatch`), else empty."""
+    torque = torque_unit_mismatch(fitted, samples)
+    if torque:
+        return {"torque unit": torque}
+    velocity = velocity_unit_mismatch(fitted, samples)
+    return {"velocity unit": velocity} if velocity else {}

@@ -23,7 +23,7 @@ import numpy as np
 import pandas as pd
 
 from ..fitted import FittedModel, Parameter
-from ..identify import evaluate, torque_unit_mismatch
+from ..identify import evaluate, unit_mismatches
 from ..identify.trust import Trust, not_determined
 from ..samples import FrictionSamples
 from . import interactive, plots
@@ -249,9 +249,8 @@ def model_report(
         if trust.reused
         else "computed for this report"
     )
-    unit = torque_unit_mismatch(fitted, samples)
-    # beside the verdict: every error below compares two units
-    warn = {"torque unit": f"warning: {unit}."} if unit else {}
+    units = unit_mismatches(fitted, samples)  # beside the verdict: every error compares two
+    warn = {what: f"warning: {why}." for what, why in units.items()}
     doc.meta = {"trust": trust.line(), "trust record": record, **warn, **doc.meta}
     _trust_section(doc, trust)
 
@@ -402,8 +401,8 @@ def model_report(
             "paper's Table 3 measures.",
         )
     )
-    if unit:
-        sec.add(Note(f"The errors on {label} do not measure the model: {unit}.", "warning"))
+    for why in units.values():
+        sec.add(Note(f"The errors on {label} do not measure the model: {why}.", "warning"))
     note = _range_note(fitted, samples)
     if note is not None:
         sec.add(note)
