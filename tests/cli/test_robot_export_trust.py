@@ -212,3 +212,27 @@ def test_a_whole_arm_fit_exports_as_the_robot_s_urdf_and_mjcf(arm_file, tmp_path
     res = runner.invoke(app, [*args[:5], "-o", str(tmp_path / "x.urdf")])
     assert res.exit_code == 2 and "give --urdf or --robot" in res.output
     assert not (tmp_path / "x.urdf").exists()
+
+
+def test_urdf_and_mjcf_say_each_joint_s_verdict(arm_file, tmp_path):
+    """Each joint's trust verdict is in the URDF's <dynamics> comment and the MJCF's first
+    comment, as in the C and YAML exports; a 'no' exported when told says so (both files
+    had carried friction fricid rejected without a mark)."""
+    arm = _with_joint2_no(arm_file, tmp_path)
+    path, _ = example_urdf("double_pendulum")
+    level = ArmFit.load(arm_file).verdict("joint1")
+    base = ["robot", "export", str(arm), "--allow-untrusted", "--urdf", str(path), "--to"]
+    out = tmp_path / "identified.urdf"
+    res = runner.invoke(app, [*base, "urdf", "-o", str(out)])
+    assert res.exit_code == 0, res.output
+    text = out.read_text()
+    joint1, joint2 = (ln for ln in text.splitlines() if "trust verdict: " in ln)
+    # joint1's symmetric projection of its two-sided model: graded as the numbers it holds
+    assert f"the model itself: {level}" in joint1 or f"trust verdict: {level}" in joint1
+    assert "trust verdict: NO, exported anyway" in joint2
+    xml = tmp_path / "arm.xml"
+    res = runner.invoke(app, [*base, "mjcf", "-o", str(xml)])
+    assert res.exit_code == 0, res.output
+    text = xml.read_text()
+    assert f"joint joint1: trust verdict: {level}" in text
+    assert "joint joint2: trust verdict: NO, exported anyway" in text

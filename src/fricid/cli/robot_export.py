@@ -254,8 +254,12 @@ def robot_export_command(
         else:
             from ..export.robot_mjcf import write_robot_mjcf
 
+            from ..export._trust import trust_line
+
             levels = {j: {n: p.value for n, p in m.parameters.items()} for j, m in fitted.items()}
-            written, notes = write_robot_mjcf(model.with_parameters(standard), out, levels)
+            trust = [f"joint {j}: {trust_line(m) or 'no trust verdict'}" for j, m in fitted.items()]
+            arm = model.with_parameters(standard)
+            written, notes = write_robot_mjcf(arm, out, levels, trust=trust)
             for note in notes:
                 err_console.print(f"note: {escape(note)}", highlight=False)
         err_console.print(f"wrote {escape(str(written))}", highlight=False)

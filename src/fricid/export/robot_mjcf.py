@@ -37,7 +37,7 @@ from __future__ import annotations
 
 import os
 import xml.etree.ElementTree as ET
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -215,6 +215,7 @@ def robot_mjcf_text(
     *,
     name: str = "fricid_robot",
     timestep: float = 1e-3,
+    trust: Sequence[str] = (),
 ) -> tuple[str, list[str]]:
     """The MJCF text of ``model`` with ``friction``, and the notes on what MuJoCo cannot hold.
 
@@ -229,6 +230,9 @@ def robot_mjcf_text(
         The ``<mujoco model>`` name (checked like a joint name).
     timestep : float
         MuJoCo's ``option/timestep`` [s].
+    trust : sequence of str
+        Lines for the comment: each joint's trust verdict
+        (:func:`fricid.export._trust.trust_line`), fixed words and numbers.
 
     Returns
     -------
@@ -282,6 +286,7 @@ def robot_mjcf_text(
         if frictions
         else "no friction written",
         *(SOLREF_LINES if frictions else ()),
+        *map(plain, trust),
         *notes,
     ]
     ET.indent(root)

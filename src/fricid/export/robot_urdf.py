@@ -42,6 +42,7 @@ from ._common import (
     plain,
     write_lines_checked,
 )
+from ._trust import trust_line
 from .descriptions import DEFAULT_MAX_LOSS, _checked
 
 __all__ = ["robot_urdf_text", "write_robot_urdf"]
@@ -161,7 +162,11 @@ def robot_urdf_text(
             "dynamics",
             element,
             f"fricid: Coulomb-viscous projection of model {plain(model_name(fitted))}, "
-            f"{percent(proj.relative_error)} RMS from it over its operating range",
+            f"{percent(proj.relative_error)} RMS from it over its operating range; "
+            + (
+                trust_line(fitted, proj.rms_error, "Coulomb-viscous projection")
+                or "no trust verdict recorded"
+            ),
         )
     if frictions:
         lines.append("friction: <dynamics> of " + ", ".join(map(plain, frictions)))
