@@ -84,6 +84,9 @@ def test_evaluate_says_so_too(files):
         assert res.exit_code == 0, res.output
         text = " ".join(res.output.split())
         assert ("likely names the wrong torque unit" in text) is told
+        # the model's own samples: an in-sample error, said so beside the verdict
+        own = "in-sample: these are the samples the model was identified on"
+        assert (own in text) is not told, text
 
 
 def _speeds_under(samples, factor):

@@ -66,7 +66,8 @@ def evaluate_command(
     RMSPE [%], mean and max absolute error [N m], and the BAS-RBFNN paper's Table 1 fitness
     (R^2 of the signed friction, "fitness": it flatters per-direction samples)."""
     from ..fitted import FittedModel
-    from ..identify import evaluate, measurement_scatter, unit_mismatches
+    from ..export._trust import trust_of
+    from ..identify import evaluate, is_own_samples, measurement_scatter, unit_mismatches
     from ..io import read_samples
     from ..metrics import verdict
 
@@ -87,9 +88,16 @@ def evaluate_command(
     console.print(table)
     if "rmse_over_scatter" in result:
         scatter = measurement_scatter(data)
+        level = trust_of(fitted)[0]
+        own = (
+            "; in-sample: these are the samples the model was identified on"
+            + (f" (its trust verdict: {level})" if level else "")
+            if is_own_samples(fitted, data)
+            else ""
+        )
         console.print(
             f"RMSE {result['rmse']:.4g} N m, scatter {scatter.describe()}: "
-            f"{verdict(result['rmse_over_scatter'])}",
+            f"{verdict(result['rmse_over_scatter'])}{own}",
             highlight=False,
             markup=False,
             soft_wrap=True,

@@ -23,6 +23,7 @@ from __future__ import annotations
 
 from ..samples import samples_hash
 from ._advice import torque_unit_mismatch, unit_mismatches, velocity_unit_mismatch
+from ._heldout import is_own_samples
 from ._scatter import Scatter, measurement_scatter, sample_weights
 from .dispatch import KINDS, fit, kind_of
 from .problem import IdentificationProblem
@@ -42,6 +43,7 @@ __all__ = [
     "assess_trust",
     "evaluate",
     "fit",
+    "is_own_samples",
     "jacobian_uncertainty",
     "kind_of",
     "measurement_scatter",

@@ -409,6 +409,13 @@ def is_new_samples(
     return mine is None or not bool(mine.all())
 
 
+def is_own_samples(fitted: FittedModel, samples: FrictionSamples) -> bool:
+    """Whether ``samples`` are those the model file says it was identified on (its content
+    hash, or every row one of its own rows in another order): an error on them is in-sample."""
+    own = (fitted.provenance or {}).get("samples_sha256_16")
+    return isinstance(own, str) and not is_new_samples(fitted, samples, samples_hash(samples))
+
+
 def grade_new_samples(trust: Any, fitted: FittedModel, samples: FrictionSamples) -> str:
     """Grade the model file's own error on samples it was not identified on
     (:data:`NEW_SAMPLES`): a held-out error of the model itself, where leave-one-velocity-out
