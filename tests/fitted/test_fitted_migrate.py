@@ -201,6 +201,17 @@ def test_version_1_files_predict_and_print_as_before(family):
     # the row is the old row
     want = {k: v for k, v in expected["fleet_row"].items() if k not in VERDICT_COLUMNS}
     assert row.pop("chosen") == fitted.model
+    # the rows now give the file's interval by its ends, and no half-width where an end is
+    # open (the search bound): a symmetric width had misstated it
+    for p in fitted.parameters.values():
+        low, high = row.pop(f"ci95_low_{p.name}"), row.pop(f"ci95_high_{p.name}")
+        if p.fixed:
+            continue
+        assert same(low, None if p.low_open else p.ci95[0])
+        assert same(high, None if p.high_open else p.ci95[1])
+        if p.low_open or p.high_open:
+            assert row[f"ci95_{p.name}"] is None
+            want[f"ci95_{p.name}"] = None
     assert row.keys() == want.keys()
     assert all(same(row[k], v) for k, v in want.items()), family
     assert not_determined(fitted) == expected["not_determined"]

@@ -7,6 +7,7 @@ Dask tests start a real ``LocalCluster`` on loopback.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import os
 import signal
@@ -191,6 +192,8 @@ def test_results_csv_headers_carry_units_and_old_headers_still_read(fleet, tmp_p
     for label in ("rmse [N m]", "speed_min [rad/s]", "load_max [N m]", "sse [N^2 m^2]"):
         assert label in header, label
     assert "param_tau_c [N m]" in header and "time_fit_s [s]" in header
+    assert "rmspe [fraction]" in header  # not a percentage, as commands print it
+    assert "ci95_low_tau_c [N m]" in header and "ci95_tau_c [N m]" in header
     assert "rmse" not in header and "robot" in header and "fitness" in header
     old = tmp_path / "results.csv"  # as written before the headers carried units
     lines = run.results_csv.read_text(encoding="utf-8").splitlines(keepends=True)
@@ -334,6 +337,12 @@ def test_outputs_and_failure_isolation(fleet):
         saved = json.loads((run.out / row.model_file).read_text())
         assert saved["parameters"]["tau_c"]["value"] == row.param_tau_c
         assert row.ci95_tau_c > 0 and len(row.input_hash) == 64
+        # the file's interval, end for end (an open end, the search bound, left empty)
+        for name, rec in saved["parameters"].items():
+            for end, key in ((0, "low"), (1, "high")):
+                got = getattr(row, f"ci95_{key}_{name}")
+                closed = not rec[f"{key}_open"] and rec["ci95"][end] is not None
+                assert got == rec["ci95"][end] if closed else pd.isna(got), (name, key)
     parts = sorted(p.relative_to(run.results).as_posix() for p in run.results.rglob("*.parquet"))
     assert parts[0] == "robot=r0/date=2026-03-01/part-0.parquet" and len(parts) == 3
     from_csv, from_parquet = read_results(run.results_csv), read_results(run.out)
@@ -697,3 +706,27 @@ def test_results_partitions_are_written_atomically(tmp_path, monkeypatch):
     pd.testing.assert_frame_equal(read_results(tmp_path / "results"), before)
     leftovers = [p.name for p in tmp_path.rglob("*") if p.name.startswith(".")]
     assert leftovers == []
+
+
+def test_an_interval_open_at_one_end_is_not_given_a_half_width():
+    """A profile interval closed by the search bound on one side (the data do not bound the
+    parameter there): the results row gives the closed end and no symmetric half-width (it
+    had given +/- 0.21 around 0.65, where the model file says 0.52 to the bound 1.13)."""
+    from fricid.fitted import Parameter
+    from fricid.fleet.job import _interval_columns
+
+    open_high = Parameter("tau_s", 0.65, ci95=(0.5198, 1.132), ci95_halfwidth=0.2078)
+    open_high = dataclasses.replace(open_high, high_open=True)
+    assert _interval_columns(open_high) == {
+        "ci95_low_tau_s": 0.5198,
+        "ci95_high_tau_s": None,
+        "ci95_tau_s": None,
+    }
+    closed = Parameter("tau_c", 0.08, ci95=(0.07, 0.09), ci95_halfwidth=0.01)
+    assert _interval_columns(closed) == {
+        "ci95_low_tau_c": 0.07,
+        "ci95_high_tau_c": 0.09,
+        "ci95_tau_c": 0.01,
+    }
+    fixed = dataclasses.replace(closed, fixed=True)
+    assert set(_interval_columns(fixed).values()) == {None}

@@ -27,7 +27,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import FricidError
-from ..fitted import FittedModel
+from ..fitted import FittedModel, Parameter
 from ..fitted.arm import ArmFit
 from ..identify.trust import Trust
 from ..metrics import verdict
@@ -177,9 +177,10 @@ def fit_row(
 ) -> dict[str, Any]:
     """One results-table row: a model's parameters, CIs, metrics and operating range.
 
-    Parameters are ``param_<name>``, their standard errors ``stderr_<name>`` and the
-    half-widths of their 95 % confidence intervals ``ci95_<name>`` (SI units, listed in
-    ``units``); the verdict columns of :func:`verdict_columns` of ``trust`` (the fit's trust
+    Parameters are ``param_<name>``, their standard errors ``stderr_<name>``, the ends of
+    their 95 % intervals ``ci95_low_<name>``, ``ci95_high_<name>`` and the half-widths
+    ``ci95_<name>`` (SI units, listed in ``units``; empty where an end is open); the verdict
+    columns of :func:`verdict_columns` of ``trust`` (the fit's trust
     record, default the one the model carries); a failed fit has ``status`` ``"failed"`` and
     its ``error``. ``chosen`` is the model fitted: the family selected where ``model`` is
     ``"auto"``.
@@ -219,8 +220,22 @@ def fit_row(
     records = fitted.parameters.values()
     row.update({f"param_{p.name}": p.value for p in records})
     row.update({f"stderr_{p.name}": None if p.fixed else p.stderr for p in records})
-    row.update({f"ci95_{p.name}": None if p.fixed else p.ci95_halfwidth for p in records})
+    for p in records:
+        row.update(_interval_columns(p))
     return row
+
+
+def _interval_columns(p: Parameter) -> dict[str, float | None]:
+    """A parameter's 95 % interval as the model file records it: its ends and half-width (NaN
+    where it has none), each empty for a fixed parameter or where an end is open (the search
+    bound closes it: the data do not bound the parameter there)."""
+    if p.fixed:
+        return {f"ci95_low_{p.name}": None, f"ci95_high_{p.name}": None, f"ci95_{p.name}": None}
+    return {
+        f"ci95_low_{p.name}": None if p.low_open else float(p.ci95[0]),
+        f"ci95_high_{p.name}": None if p.high_open else float(p.ci95[1]),
+        f"ci95_{p.name}": None if p.low_open or p.high_open else float(p.ci95_halfwidth),
+    }
 
 
 def verdict_columns(trust: Trust) -> dict[str, Any]:
@@ -232,8 +247,9 @@ def verdict_columns(trust: Trust) -> dict[str, Any]:
     (where it came from: ``lovo run here``, ``the fit's --validate``, ``the learned model's
     own CV``, or ``in-sample only``) and ``heldout_scheme`` (``lovo``, ``kfold:K``, ...;
     empty in-sample), ``verdict`` (within noise, or misses by a factor),
-    ``n_not_determined`` (free parameters the data do not determine) and
-    ``extrapolation_free_range`` (the operating range as text).
+    ``n_not_determined`` (free parameters the data do not determine), ``not_bounded`` (those
+    an end of the search range bounds instead) and ``extrapolation_free_range`` (the
+    operating range as text).
     """
     ratio = trust.heldout_ratio
     return {
@@ -244,6 +260,7 @@ def verdict_columns(trust: Trust) -> dict[str, Any]:
         "heldout_scheme": trust.heldout_scheme or None,
         "verdict": trust.verdict,
         "n_not_determined": len(trust.not_determined),
+        "not_bounded": ";".join(trust.open_sides) or None,
         "extrapolation_free_range": trust.range or None,
     }
 
@@ -296,7 +313,8 @@ def _arm_row(spec: JointSpec, fit: ArmFit, joint: str) -> dict[str, Any]:
     }
     row.update({f"param_{p.name}": _finite(p.value) for p in params})
     row.update({f"stderr_{p.name}": _finite(p.stderr) for p in params})
-    row.update({f"ci95_{p.name}": _finite(p.ci95_halfwidth) for p in params})
+    for p in params:
+        row.update(_interval_columns(p))
     return row
 
 

@@ -12,13 +12,17 @@ Columns (SI units; each parameter's unit in ``units``):
   ``with caveats``, ``no``), ``converged``, ``heldout_ratio`` (RMSE over the measurement
   scatter), ``heldout_source`` (``lovo run here``, ``the fit's --validate``, ``the learned
   model's own CV`` or ``in-sample only``), ``heldout_scheme``, ``verdict`` (within noise, or
-  misses by a factor), ``n_not_determined``,
+  misses by a factor), ``n_not_determined``, ``not_bounded`` (the parameters whose interval
+  an end of the search range closes, as the verdict names them),
   ``extrapolation_free_range`` (the operating range, as text); for a whole robot's joints,
   ``reasons`` (why the verdict is not yes, as the identification gave them);
 - fit: ``fitness`` (R^2), ``sse`` [N^2 m^2], ``rmse``, ``mae``, ``max_abs_error`` [N m],
   ``rmspe`` (a fraction: 0.021 is 2.1 %, as in the model file; commands and reports print
   it in percent), ``nfev``, ``at_bound``, ``fixed``, ``units``, ``model_file``;
-  ``param_<name>``, ``stderr_<name>``, ``ci95_<name>`` (half-width of the 95 % CI);
+  ``param_<name>``, ``stderr_<name>``, ``ci95_low_<name>`` and ``ci95_high_<name>`` (the
+  ends of the model file's 95 % interval, empty where an end is open: the data do not bound
+  the parameter on that side) and ``ci95_<name>`` (its half-width, empty where an end is
+  open: a symmetric width would misstate it);
 - run: ``time_extract_s``, ``time_fit_s``, ``time_total_s`` [s], ``worker``,
   ``peak_rss_mb`` [MB], ``fricid_version``.
 
@@ -92,6 +96,7 @@ _STRINGS = (
     "heldout_scheme",
     "verdict",
     "extrapolation_free_range",
+    "not_bounded",
     "reasons",
 )
 _INTS = ("seed", "n_samples", "nfev", "n_not_determined")
@@ -105,6 +110,7 @@ VERDICT_COLUMNS = (
     "heldout_scheme",
     "verdict",
     "n_not_determined",
+    "not_bounded",
     "extrapolation_free_range",
 )
 _FLOATS = (
@@ -148,7 +154,8 @@ _ORDER = (
     "units",
     "model_file",
 )
-_PREFIXES = ("param_", "stderr_", "ci95_")
+#: The per-parameter column prefixes, in the table's order; a column takes the first it starts with.
+_PREFIXES = ("param_", "stderr_", "ci95_low_", "ci95_high_", "ci95_")
 
 #: The unit of each results column that has one, as written in ``results.csv``'s header.
 CSV_UNITS = {
@@ -162,6 +169,7 @@ CSV_UNITS = {
     "rmse": "N m",
     "mae": "N m",
     "max_abs_error": "N m",
+    "rmspe": "fraction",  # 0.021 is 2.1 % (commands print it in percent)
     "time_extract_s": "s",
     "time_fit_s": "s",
     "time_total_s": "s",
@@ -183,7 +191,10 @@ def _columns(rows: list[dict[str, Any]]) -> list[str]:
     seen: dict[str, None] = {}
     for row in rows:
         seen.update(dict.fromkeys(row))
-    params = {p: [c for c in seen if c.startswith(p)] for p in _PREFIXES}
+    params: dict[str, list[str]] = {p: [] for p in _PREFIXES}
+    for c in seen:
+        if prefix := _prefix(c):
+            params[prefix].append(c)
     tail = [*RUN_COLUMNS, "fricid_version"]
     return [
         *(c for c in _ORDER if c in seen or c in ("robot", "joint", "date", "model", "status")),
@@ -286,10 +297,15 @@ def csv_labels(frame: pd.DataFrame) -> dict[str, str]:
     units = dict(CSV_UNITS)
     per_param = _param_units(frame)
     for column in frame.columns:
-        for prefix in _PREFIXES:
-            if column.startswith(prefix) and column[len(prefix) :] in per_param:
-                units[column] = per_param[column[len(prefix) :]]
+        prefix = _prefix(column)
+        if prefix and column[len(prefix) :] in per_param:
+            units[column] = per_param[column[len(prefix) :]]
     return {c: f"{c} [{units[c]}]" for c in frame.columns if c in units}
+
+
+def _prefix(column: str) -> str:
+    """The per-parameter prefix ``column`` starts with (:data:`_PREFIXES`), else ``""``."""
+    return next((p for p in _PREFIXES if column.startswith(p)), "")
 
 
 def _bare(label: str) -> str:
