@@ -226,6 +226,8 @@ def test_urdf_and_mjcf_say_each_joint_s_verdict(arm_file, tmp_path):
     res = runner.invoke(app, [*base, "urdf", "-o", str(out)])
     assert res.exit_code == 0, res.output
     text = out.read_text()
+    # the inertials are what reproduces the base parameters, not all identified
+    assert "what the data do not determine keeps the URDF's values" in " ".join(text.split())
     joint1, joint2 = (ln for ln in text.splitlines() if "trust verdict: " in ln)
     # joint1's symmetric projection of its two-sided model: graded as the numbers it holds
     assert f"the model itself: {level}" in joint1 or f"trust verdict: {level}" in joint1
@@ -236,3 +238,4 @@ def test_urdf_and_mjcf_say_each_joint_s_verdict(arm_file, tmp_path):
     text = xml.read_text()
     assert f"joint joint1: trust verdict: {level}" in text
     assert "joint joint2: trust verdict: NO, exported anyway" in text
+    assert "what the data do not determine keeps the URDF's values" in " ".join(text.split())

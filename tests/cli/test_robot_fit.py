@@ -50,6 +50,9 @@ def test_robot_fit_writes_the_file_and_prints_a_row_per_joint(pendulum_logs, tmp
     for joint in ("joint1", "joint2"):
         assert joint in res.output
     assert "Base inertial parameters:" in res.output
+    text = " ".join(res.output.split())
+    if "consistent_ls" in fit.standard:  # in words, not a Python bool
+        assert "least-squares estimate was" in text and "physical: True" not in text
     assert "IDIM-WLS" in res.output
     assert fit.provenance["reversal_window"] == 0.0
     assert fit.provenance["closed_loop"].startswith("not detected")  # decided from the data

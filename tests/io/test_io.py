@@ -589,7 +589,7 @@ def test_generic_log_errors(tmp_path):
         read_table_log(path, cols, {**units, "velocity": "N m"}, temperature=25.0)
     with pytest.raises(ConfigError, match="no unit for torque"):
         read_table_log(path, cols, {"time": "s", "velocity": "rad/s"}, temperature=25.0)
-    with pytest.raises(ConfigError, match="temperature.*not both"):
+    with pytest.raises(ConfigError, match=r"temperature.*not both"):
         read_table_log(path, {**cols, "temperature": "tau"}, units, temperature=25.0)
     with pytest.raises(DataError) as err:
         read_table_log(path, {**cols, "torque": "effort"}, units, temperature=25.0)

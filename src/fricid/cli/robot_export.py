@@ -21,10 +21,12 @@ from ._options import AllowUntrusted, SmoothZone, out_option
 ROBOT_TARGETS = {
     "ros2_control": "one YAML, a block per joint (Coulomb-viscous per direction, projected)",
     "c": "<robot>_friction.h and .c: a function per joint and <robot>_friction(joint, v, load, T)",
-    "urdf": "a whole-arm fit as the robot's URDF (--urdf or --robot): the identified inertials "
-    "and each joint's <dynamics> (its friction's Coulomb-viscous projection)",
-    "mjcf": "a whole-arm fit as MJCF for MuJoCo (--urdf or --robot): the identified inertials, "
-    "each joint's frictionloss and damping",
+    "urdf": "a whole-arm fit as the robot's URDF (--urdf or --robot): inertials that reproduce "
+    "the identified base parameters (the rest the URDF's) and each joint's <dynamics> (its "
+    "friction's Coulomb-viscous projection)",
+    "mjcf": "a whole-arm fit as MJCF for MuJoCo (--urdf or --robot): inertials that reproduce "
+    "the identified base parameters (the rest the URDF's), each joint's frictionloss and "
+    "damping",
 }
 
 
@@ -252,14 +254,18 @@ def robot_export_command(
 
             written = write_robot_urdf(out, model, standard, fitted, max_loss=max_loss)
         else:
-            from ..export.robot_mjcf import write_robot_mjcf
-
+            from ..export._common import plain
             from ..export._trust import trust_line
+            from ..export.robot_mjcf import write_robot_mjcf
+            from ..export.robot_urdf import INERTIALS
 
             levels = {j: {n: p.value for n, p in m.parameters.items()} for j, m in fitted.items()}
-            trust = [f"joint {j}: {trust_line(m) or 'no trust verdict'}" for j, m in fitted.items()]
+            lines = [INERTIALS] + [
+                f"joint {plain(j)}: {trust_line(m) or 'no trust verdict'}"
+                for j, m in fitted.items()
+            ]
             arm = model.with_parameters(standard)
-            written, notes = write_robot_mjcf(arm, out, levels, trust=trust)
+            written, notes = write_robot_mjcf(arm, out, levels, comments=lines)
             for note in notes:
                 err_console.print(f"note: {escape(note)}", highlight=False)
         err_console.print(f"wrote {escape(str(written))}", highlight=False)

@@ -76,7 +76,9 @@ def _table(fit) -> None:
         f"{int(well.sum())} well determined (|value| > 2 standard errors); standard parameters "
         f"{fit.standard.get('used', 'not made consistent')}"
         + (
-            f" (least squares already physical: {fit.standard['consistent_ls']})"
+            " (the least-squares estimate "
+            + ("was already" if fit.standard["consistent_ls"] else "was not")
+            + " physically consistent)"
             if "consistent_ls" in fit.standard
             else ""
         )

@@ -215,7 +215,7 @@ def robot_mjcf_text(
     *,
     name: str = "fricid_robot",
     timestep: float = 1e-3,
-    trust: Sequence[str] = (),
+    comments: Sequence[str] = (),
 ) -> tuple[str, list[str]]:
     """The MJCF text of ``model`` with ``friction``, and the notes on what MuJoCo cannot hold.
 
@@ -230,9 +230,11 @@ def robot_mjcf_text(
         The ``<mujoco model>`` name (checked like a joint name).
     timestep : float
         MuJoCo's ``option/timestep`` [s].
-    trust : sequence of str
-        Lines for the comment: each joint's trust verdict
-        (:func:`fricid.export._trust.trust_line`), fixed words and numbers.
+    comments : sequence of str
+        More lines for the first comment (each joint's trust verdict,
+        :func:`fricid.export._trust.trust_line`; where the inertials come from): fixed words,
+        numbers and :func:`~fricid.export._common.plain` text only (checked as the other
+        lines are).
 
     Returns
     -------
@@ -286,7 +288,7 @@ def robot_mjcf_text(
         if frictions
         else "no friction written",
         *(SOLREF_LINES if frictions else ()),
-        *map(plain, trust),
+        *comments,
         *notes,
     ]
     ET.indent(root)

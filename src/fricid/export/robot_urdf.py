@@ -5,8 +5,10 @@ The file written is the user's URDF, read again by the safe reader
 (:func:`fricid.io._urdf_text.parse_xml`: size cap, no DOCTYPE or entity) and re-serialised by
 :mod:`xml.etree.ElementTree`, with two kinds of change:
 
-- **inertials**: a joint's body (:attr:`fricid.robot.RigidBodyModel.bodies`: its child link and
-  the links fixed to it) is identified as one rigid body, so the whole body's mass, centre of
+- **inertials**: the standard parameters nearest the source's that reproduce the identified
+  base parameters (the data determine only those combinations; :data:`INERTIALS` says so in
+  the file). A joint's body (:attr:`fricid.robot.RigidBodyModel.bodies`: its child link and
+  the links fixed to it) is one rigid body, so the whole body's mass, centre of
   mass and inertia go into the child link's ``<inertial>`` and the other links of the body lose
   theirs (a comment in each says where the mass went); the torques of the arm are unchanged by
   that. Only physically consistent parameters are written (:mod:`fricid.robot.consistency`);
@@ -45,7 +47,7 @@ from ._common import (
 from ._trust import trust_line
 from .descriptions import DEFAULT_MAX_LOSS, _checked
 
-__all__ = ["robot_urdf_text", "write_robot_urdf"]
+__all__ = ["INERTIALS", "robot_urdf_text", "write_robot_urdf"]
 
 
 def _inertial(pi: np.ndarray) -> ET.Element:
@@ -76,6 +78,15 @@ def _replace(parent: ET.Element, tag: str, new: ET.Element | None, note: str) ->
     parent.insert(0, ET.Comment(f" {note} "))
     if new is not None:
         parent.insert(1, new)
+
+
+#: What the written inertials are: the data determine only the base parameters (combinations
+#: of the standard ones), the rest comes from the source URDF (the identification's
+#: ``standard`` record: :mod:`fricid.identify.dynamic.arm._consistent`).
+INERTIALS = (
+    "inertials: the standard parameters nearest the source URDF's that reproduce the identified "
+    "base parameters; what the data do not determine keeps the URDF's values"
+)
 
 
 def robot_urdf_text(
@@ -135,17 +146,17 @@ def robot_urdf_text(
                 links[child],
                 "inertial",
                 _inertial(pi[10 * k : 10 * k + 10]),
-                f"fricid: identified inertial of joint {plain(joint)}'s whole body "
-                f"({', '.join(plain(b) for b in body)})",
+                f"fricid: inertial of joint {plain(joint)}'s whole body "
+                f"({', '.join(plain(b) for b in body)}), see the note at the top",
             )
             for other in others:
                 _replace(
                     links[other],
                     "inertial",
                     None,
-                    f"fricid: this link's mass is in link {plain(child)}'s identified inertial",
+                    f"fricid: this link's mass is in link {plain(child)}'s inertial",
                 )
-        lines.append("inertials: the identified bodies of " + ", ".join(map(plain, model.joints)))
+        lines.append(f"{INERTIALS}: bodies of " + ", ".join(map(plain, model.joints)))
     for joint, fitted in (frictions or {}).items():
         if joint not in joints or joint not in model.joints:
             raise ExportError(f"no identified joint {plain(joint)} in the robot model")
