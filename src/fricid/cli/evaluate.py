@@ -65,8 +65,8 @@ def evaluate_command(
     (with a verdict), RMSE and R^2 of the friction's magnitude per direction, SSE [N^2 m^2],
     RMSPE [%], mean and max absolute error [N m], and the BAS-RBFNN paper's Table 1 fitness
     (R^2 of the signed friction, "fitness": it flatters per-direction samples)."""
-    from ..fitted import FittedModel
     from ..export._trust import trust_of
+    from ..fitted import FittedModel
     from ..identify import evaluate, is_own_samples, measurement_scatter, unit_mismatches
     from ..io import read_samples
     from ..metrics import verdict

@@ -53,6 +53,6 @@ __all__ = [
     "select",
     "torque_unit_mismatch",
     "unit_mismatches",
-    "velocity_unit_mismatch",
     "validate",
+    "velocity_unit_mismatch",
 ]
