@@ -28,6 +28,7 @@ __all__ = [
     "metrics",
     "rmse",
     "rmspe",
+    "rmspe_note",
     "sem_autocorrelated",
     "sse",
     "verdict",
@@ -76,6 +77,30 @@ def rmspe(y, y_hat) -> float:
         return float("nan")
     rel = (y[keep] - y_hat[keep]) / y[keep]
     return float(np.sqrt(np.mean(rel**2)))
+
+
+#: Measured friction under this share of its RMS is near zero for :func:`rmspe_note`.
+NEAR_ZERO = 0.1
+
+
+def rmspe_note(y, y_hat) -> str | None:
+    """Why :func:`rmspe` says little about ``y_hat``, else None: over half its mean square
+    comes from samples whose measured friction is near zero (under :data:`NEAR_ZERO` of the
+    RMS), where a relative error is large for any model (the paper's metric, kept as it is)."""
+    y, y_hat = _pair(y, y_hat)
+    keep = y != 0
+    if keep.sum() < 2:
+        return None
+    y, y_hat = y[keep], y_hat[keep]
+    rel2 = ((y - y_hat) / y) ** 2
+    near = np.abs(y) < NEAR_ZERO * np.sqrt(np.mean(y**2))
+    if not near.any() or near.all() or rel2[near].sum() <= 0.5 * rel2.sum():
+        return None
+    return (
+        f"RMSPE is dominated by {int(near.sum())} of {y.size} samples whose measured friction "
+        f"is near zero (under {NEAR_ZERO:g} of its RMS), where any error is large relative to "
+        f"it; without them it is {100 * np.sqrt(np.mean(rel2[~near])):.3g} %"
+    )
 
 
 def mae(y, y_hat) -> float:

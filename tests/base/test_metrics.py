@@ -40,3 +40,44 @@ def test_rmse_of_constant_offset(y, c):
 def test_shape_mismatch():
     with pytest.raises(ValueError, match="shapes differ"):
         M.sse([1, 2], [1, 2, 3])
+
+
+def test_rmspe_says_when_near_zero_friction_dominates_it():
+    """One sample whose measured friction is near zero (0.001 N m among 0.3) makes RMSPE huge
+    for any model; the note says so and gives it without those samples."""
+    y = np.array([0.30, 0.31, 0.29, 0.001, 0.32])
+    y_hat = y + np.array([0.003, -0.003, 0.003, 0.003, -0.003])
+    assert M.rmspe(y, y_hat) > 1.0  # 134 %: the near-zero sample alone
+    note = M.rmspe_note(y, y_hat)
+    assert note is not None and "1 of 5 samples" in note and "without them it is 0.986 %" in note
+    assert M.rmspe_note(y[[0, 1, 2, 4]], y_hat[[0, 1, 2, 4]]) is None
+    assert M.rmspe_note(np.full(3, 0.001), np.full(3, 0.002)) is None  # all near: no RMS to judge
+
+
+def test_evaluate_prints_the_rmspe_note(tmp_path):
+    from typer.testing import CliRunner
+
+    from fricid.cli import app
+    from fricid.identify import fit
+    from fricid.samples import FrictionSamples
+
+    v = np.r_[0.1, 0.2, 0.5, 1.0, 2.0]
+    rng = np.random.default_rng(1)
+    friction = 0.3 + 0.05 * v + 0.002 * rng.standard_normal(v.size)
+    model = tmp_path / "m.json"
+    samples = FrictionSamples(velocity=v, load=None, temperature=None, friction=friction)
+    fit(samples, "coulomb_viscous").save(model)
+    near = tmp_path / "near.csv"
+    rows = "".join(f"{a},{b}\n" for a, b in zip(v, [*friction[:-1], 0.001], strict=True))
+    near.write_text("velocity [rad/s],friction [N m]\n" + rows)
+    res = CliRunner().invoke(app, ["evaluate", str(model), str(near)], terminal_width=200)
+    assert res.exit_code == 0, res.output
+    assert "RMSPE is dominated by 1 of 5 samples" in " ".join(res.output.split())
+    from fricid.identify.trust import assess_trust
+    from fricid.io import read_samples
+    from fricid.report import model_report
+
+    fitted, data = fit(samples, "coulomb_viscous"), read_samples(near)
+    doc = model_report(fitted, data, trust=assess_trust(fitted, data, max_work=1))
+    notes = [i.text for s in doc.sections for i in s.items if hasattr(i, "kind")]
+    assert any("RMSPE is dominated by 1 of 5 samples" in n for n in notes)

@@ -69,7 +69,7 @@ def evaluate_command(
     from ..fitted import FittedModel
     from ..identify import evaluate, is_own_samples, measurement_scatter, unit_mismatches
     from ..io import read_samples
-    from ..metrics import verdict
+    from ..metrics import rmspe_note, verdict
 
     check_paths(inputs={"MODEL": model, "SAMPLES": samples})
     fitted = FittedModel.load(model)
@@ -86,6 +86,9 @@ def evaluate_command(
     for key, value in result.items():
         table.add_row(*metric_row(key, value))
     console.print(table)
+    said = rmspe_note(data.y, fitted.predict(data.X, warn=False))  # the RMSPE printed
+    if said:
+        console.print(f"note: {said}.", highlight=False, markup=False, soft_wrap=True)
     if "rmse_over_scatter" in result:
         scatter = measurement_scatter(data)
         level = trust_of(fitted)[0]

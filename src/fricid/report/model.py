@@ -25,6 +25,7 @@ import pandas as pd
 from ..fitted import FittedModel, Parameter
 from ..identify import evaluate, unit_mismatches
 from ..identify.trust import Trust, not_determined
+from ..metrics import rmspe_note
 from ..samples import FrictionSamples
 from . import interactive, plots
 from .band import held_at, prediction_band_figure
@@ -403,6 +404,9 @@ def model_report(
     )
     for why in units.values():
         sec.add(Note(f"The errors on {label} do not measure the model: {why}.", "warning"))
+    said = rmspe_note(samples.y, fitted.predict(samples.X, warn=False))
+    if said:
+        sec.add(Note(f"{said}.", "text"))
     note = _range_note(fitted, samples)
     if note is not None:
         sec.add(note)
