@@ -362,6 +362,16 @@ def test_predict_warns_only_of_undetermined_parameters_the_friction_reads(tmp_pa
         app, ["predict", str(_trajectory_lugre(tmp_path, "sigma_1")), "-v", "0.5"]
     )
     assert got.exit_code == 0 and "do not determine" not in got.stderr
+    # sigma_2 held at 0 with no search range: 1 % of 0 moves nothing, yet it sets the viscous
+    # part at 0.5 rad/s (it had been left out of the warning)
+    from dataclasses import replace
+
+    held = FittedModel.load(_trajectory_lugre(tmp_path))
+    held.parameters["sigma_2"] = replace(
+        held.parameters["sigma_2"], value=0.0, not_determined=True, bounds=None
+    )
+    got = CliRunner().invoke(app, ["predict", str(held.save(tmp_path / "h.json")), "-v", "0.5"])
+    assert got.exit_code == 0 and "do not determine sigma_2" in got.stderr, got.stderr
 
 
 def test_predict_interval_of_a_trajectory_model_writes_the_friction_and_says_why(tmp_path):

@@ -420,7 +420,7 @@ def _resting(fitted: FittedModel, X: np.ndarray, per_direction: bool) -> list[tu
 def friction_reads(fitted: FittedModel, X: np.ndarray, names: list[str]) -> list[str]:
     """Those of ``names`` (parameters of an analytic model) that move its predicted friction
     at the points ``X`` (n, 3): set to either end of its recorded search range, or 1 % off
-    its value, the others as identified. A LuGre model's friction at a speed is its steady
+    its value (1 at a value of 0), the others as identified. A LuGre model's friction at a speed is its steady
     state, which sigma_0 and sigma_1 (its transients) do not move."""
     if not names or fitted.kind == "rbf":
         return list(names)
@@ -433,7 +433,8 @@ def friction_reads(fitted: FittedModel, X: np.ndarray, names: list[str]) -> list
     for name in names:
         p = fitted.parameters[name]
         tries = [float(b) for b in (p.bounds or ()) if math.isfinite(float(b))]
-        for value in [*tries, 1.01 * p.value + 1e-12]:
+        # 1 % off, or 1 in its unit at 0 (where 1 % off is no change: sigma_2 held at 0)
+        for value in [*tries, 1.01 * p.value if p.value != 0 else 1.0]:
             th = theta.copy()
             th[order.index(name)] = value
             with np.errstate(all="ignore"):
