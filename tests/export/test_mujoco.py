@@ -132,6 +132,19 @@ def test_lugre_export_maps_another_exponent_and_states_the_error():
     assert exact.static_rms_error > 0  # the static fallback loses the Stribeck peak
 
 
+def test_lugre_export_says_whether_the_model_is_passive():
+    """A LuGre model that is not passive (sigma_1 above 4 sigma_2 tau_c / (tau_s - tau_c)) is
+    said so in the MJCF; the dcmotor's own 'passive' (no control input) no longer reads as an
+    assurance about the friction."""
+    said = " ".join(mjcf_text(lugre_model()).split())
+    assert "the LuGre model is passive (margin 0.1 N m s/rad)" in said
+    assert "actuator, passive" not in said and "without a control input" in said
+    loud = " ".join(mjcf_text(lugre_model(sigma_1=3.5)).split())
+    assert "the LuGre model is NOT passive (margin -2.9 N m s/rad" in loud
+    flat = " ".join(mjcf_text(lugre_model(tau_s=0.3)).split())
+    assert "passive for any sigma_1" in flat
+
+
 def test_fragment_checks():
     with pytest.raises(ConfigError, match="one <joint>"):
         one_joint_xml("<actuator/>")

@@ -149,9 +149,10 @@ class LuGreMapping:
             f"LuGre model: sigma_0 {s0:.6g} N m/rad, sigma_1 {s1:.6g} N m s/rad, sigma_2 "
             f"{s2:.6g} N m s/rad, tau_c {tau_c:.6g} N m, tau_s {tau_s:.6g} N m, w_s {w_s:.6g} "
             f"rad/s, delta {delta:.6g}",
-            "MuJoCo >= 4.0 dcmotor actuator, passive (input none, motorconst 0 0: no electrical "
-            "branch; resistance 1 is required and unused): lugre = sigma_0 sigma_1 tau_c tau_s "
-            "w_s; sigma_2 is the joint's damping",
+            "MuJoCo >= 4.0 dcmotor actuator without a control input (input none, motorconst "
+            "0 0: no electrical branch; resistance 1 is required and unused): lugre = sigma_0 "
+            "sigma_1 tau_c tau_s w_s; sigma_2 is the joint's damping",
+            _passivity_line(self.theta),
         ]
         if delta == MUJOCO_STRIBECK_EXPONENT:
             lines.append("MuJoCo's Stribeck exponent is 2, as this model's: the mapping is exact")
@@ -173,6 +174,20 @@ class LuGreMapping:
             "break-away, hysteresis) are lost"
         )
         return lines + list(self.static_rests_on)
+
+
+def _passivity_line(theta: np.ndarray) -> str:
+    """Whether the LuGre model is passive (Barabanov and Ortega 2000: ``sigma_1 <= 4 sigma_2
+    tau_c / (tau_s - tau_c)``): a model that is not can feed energy into the simulation."""
+    margin = float(lugre.passivity_margin(theta))
+    if margin == math.inf:
+        return "the LuGre model is passive for any sigma_1 (tau_s <= tau_c)"
+    if margin >= 0:
+        return f"the LuGre model is passive (margin {margin:.3g} N m s/rad)"
+    return (
+        f"the LuGre model is NOT passive (margin {margin:.3g} N m s/rad: sigma_1 above 4 "
+        "sigma_2 tau_c / (tau_s - tau_c)): its friction can feed energy into the simulation"
+    )
 
 
 def _params(fitted: FittedModel) -> np.ndarray:
