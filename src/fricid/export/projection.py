@@ -420,8 +420,8 @@ def _resting(fitted: FittedModel, X: np.ndarray, per_direction: bool) -> list[tu
 def friction_reads(fitted: FittedModel, X: np.ndarray, names: list[str]) -> list[str]:
     """Those of ``names`` (parameters of an analytic model) that move its predicted friction
     at the points ``X`` (n, 3): set to either end of its recorded search range, or 1 % off
-    its value (1 at a value of 0), the others as identified. A LuGre model's friction at a speed is its steady
-    state, which sigma_0 and sigma_1 (its transients) do not move."""
+    its value (1 at a value of 0), the others as identified. A LuGre model's friction at a
+    speed is its steady state, which sigma_0 and sigma_1 (its transients) do not move."""
     if not names or fitted.kind == "rbf":
         return list(names)
     model = fitted.friction_model()
