@@ -28,7 +28,7 @@ from ._data import DerivativeFilter, Series
 from ._routes import _regression
 from ._window import corrected, predicted_bias
 
-__all__ = ["DIRECTION_P", "direction_caveat", "per_direction"]
+__all__ = ["DIRECTION_P", "direction_caveat", "per_direction", "wald_p"]
 
 #: Largest p-value of the test that a per-direction law fits better, below which a symmetric
 #: law's fit says so (:func:`direction_caveat`).
@@ -88,15 +88,13 @@ def direction_caveat(asym, law: str = "coulomb_viscous", symmetric=None) -> tupl
     1.019 [1.016, 1.023] for 1.2 / 0.84 and p_x -0.776 [-0.778, -0.774] for -0.591, and no
     caveat; with a level per direction p_x was -0.592 +/- 0.086, 78 times the symmetric
     fit's standard error, and the levels' difference 0.359 +/- 0.17 N m."""
-    from scipy.stats import chi2
-
     i = [asym.names.index(n) for n in ("f_c_pos", "beta_pos", "f_c_neg", "beta_neg")]
     A = np.array([[1.0, 0.0, -1.0, 0.0], [0.0, 1.0, 0.0, -1.0]])
     d = A @ asym.values[i]
     C = A @ asym.cov[np.ix_(i, i)] @ A.T
     if not np.all(np.isfinite(C)) or np.linalg.det(C) <= 0:
         return "", ""
-    p = float(chi2.sf(float(d @ np.linalg.solve(C, d)), 2))
+    p = wald_p(float(d @ np.linalg.solve(C, d)), 2, int(getattr(asym, "clusters", 0) or 0))
     c_pos, v_pos, c_neg, v_neg = (float(asym.values[j]) for j in i)
     se_c, se_v = (math.sqrt(C[k, k]) for k in (0, 1))
     advice = _DIRECTION_ADVICE.get(law, _DIRECTION_ADVICE["coulomb_viscous"])
@@ -112,6 +110,23 @@ def direction_caveat(asym, law: str = "coulomb_viscous", symmetric=None) -> tupl
     if note and abs(d[0]) > 2.0 * se_c:
         return f"the friction may differ by direction: {note}; {advice}", ""
     return "", note
+
+
+def wald_p(statistic: float, q: int, clusters: int) -> float:
+    """The p-value of a Wald ``statistic`` of ``q`` restrictions with a cluster-robust
+    covariance of ``clusters`` clusters: ``F = W (G - q) / (q (G - 1))`` against F(q, G - q)
+    (the small-sample form of the cluster-robust Wald test; chi-square(q) where the clusters
+    are not recorded, 1 where there are no more clusters than restrictions). With the
+    chi-square, four clusters (a 2 s log in blocks of 0.5 s) called four of five symmetric
+    logs' friction different by direction at p down to 9e-9 (``fricid simulate --trajectory
+    multisine --duration 2``, seeds 0-4)."""
+    from scipy.stats import chi2, f
+
+    if clusters <= 0:
+        return float(chi2.sf(statistic, q))
+    if clusters <= q:
+        return 1.0
+    return float(f.sf(statistic * (clusters - q) / (q * (clusters - 1)), q, clusters - q))
 
 
 def _gravity_by_symmetry(
