@@ -188,6 +188,14 @@ def test_the_quoted_coverage_is_the_ten_seed_report():
         assert f"{name} on {kind} {c} of {n}{share}" in caveat, caveat
 
 
+def test_a_per_direction_fit_says_an_offset_looks_like_a_difference():
+    """lugre_asym's levels take up a torque sensor's offset as their difference (0.2 N m read
+    0.669 / 0.332 for 0.5 both ways, with no word of it): its caveat says so, as lugre's
+    direction caveat does."""
+    assert "offset looks the same" in lugre_caveat(per_direction=True)
+    assert "offset" not in lugre_caveat()
+
+
 def test_the_per_direction_coverage_is_the_direction_benchmarks_last_result():
     """``LUGRE_ASYM_COVERAGE`` is the coverage line of the last ``--model lugre_asym`` block of
     ``benchmarks/results/direction.txt``, not typed apart from it."""

@@ -276,7 +276,9 @@ def _per_direction_coverage() -> str:
     return (
         "; those were symmetric fits: with the levels per direction, on that simulator's 1 kHz "
         "logs (2^20 counts/rev) with the friction the same or 10-20 % weaker backwards, "
-        f"{100 * c / n:.0f} % of the claims held: {each} (benchmarks/bench_direction.py)"
+        f"{100 * c / n:.0f} % of the claims held: {each} (benchmarks/bench_direction.py); "
+        "the levels' difference takes up any constant torque as well: a torque sensor's "
+        "offset looks the same as friction that differs by direction"
     )
 
 
