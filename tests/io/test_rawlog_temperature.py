@@ -30,6 +30,7 @@ def test_no_temperature_column_says_how_to_give_one(tmp_path):
     with pytest.raises(DataError, match="--temperature 25") as err:
         read_rawlog(path)
     assert err.value.column == "temperature"
+    assert "fricid report: --reader-option temperature=25" in str(err.value)  # report too
     log = read_rawlog(path, temperature=22.5)
     np.testing.assert_array_equal(log.temperature, 22.5)
     chunks = list(iter_rawlog(path, chunk_rows=64, temperature=22.5))

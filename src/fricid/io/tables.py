@@ -138,7 +138,8 @@ def _open_rawlog(path: PathLike, temperature: float | None = None) -> Opened:
         raise DataError(
             "missing required column 'temperature' (e.g. 'temperature [degC]'); a log without "
             "one: give its constant temperature [degC] (fricid extract --temperature 25; fricid "
-            "fit --trajectory --reader-option temperature=25; Python: temperature=25.0)",
+            "fit --trajectory and fricid report: --reader-option temperature=25; Python: "
+            "temperature=25.0)",
             file=opened.path,
             column="temperature",
         )
