@@ -77,7 +77,7 @@ BoundOption = Annotated[
         metavar="NAME=LOW:HIGH",
         help=(
             "Search range of a parameter, NAME=LOW:HIGH (SI units). Repeatable. Default ranges "
-            "scale with the data."
+            "scale with the samples (friction samples only: a trajectory fit searches its own)."
         ),
     ),
 ]

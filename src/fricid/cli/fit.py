@@ -34,6 +34,18 @@ def _method_help() -> str:
     return "; ".join([*items, f"varpro: {SUMMARY}"])
 
 
+def _trajectory_ranges() -> str:
+    """Why a trajectory fit takes no --bound or --fix: its search ranges are its own."""
+    from ..identify.dynamic._filtered import LOG_BOX
+
+    (a, b), (c, d) = LOG_BOX["sigma_0"], LOG_BOX["sigma_1"]
+    return (
+        f"a trajectory fit searches its own ranges: LuGre's sigma_0 from 1e{a:g} to 1e{b:g} "
+        f"N m/rad and sigma_1 from 1e{c:g} to 1e{d:g} N m s/rad, the levels and J from the "
+        "log's torques; a parameter that ends at an edge of its range is marked not determined"
+    )
+
+
 @app.command("fit")
 @handle_errors
 def fit_command(
@@ -237,10 +249,17 @@ def fit_command(
         }
         ignored = [flag for flag, value in samples_only.items() if value is not None]
         if ignored:
+            why = {
+                "--validate": "a trajectory model is validated on a second log: fricid report "
+                "MODEL LOG HELDOUT",
+                "--fix": "ranges",
+                "--bound": "ranges",
+            }
+            reasons = dict.fromkeys(why[f] for f in ignored if f in why)
+            reasons = [_trajectory_ranges() if r == "ranges" else r for r in reasons]
             raise ConfigError(
                 f"{', '.join(ignored)} {'applies' if len(ignored) == 1 else 'apply'} to friction "
-                "samples, not to --trajectory (a "
-                "trajectory model is validated on a second log: fricid report MODEL LOG HELDOUT)"
+                "samples, not to --trajectory" + (f" ({'; '.join(reasons)})" if reasons else "")
             )
 
         check_paths(inputs={"LOG": samples}, folders=True, out_files={"--out": out})

@@ -208,6 +208,12 @@ def test_sample_options_with_trajectory_are_refused(clean, tmp_path):
     assert res.exit_code == 2, res.output
     assert "--validate, --loss apply to friction samples, not to --trajectory" in res.output
     assert not (tmp_path / "x.json").exists()
+    # --bound is refused for its own reason (the ranges a trajectory fit searches), not the
+    # held-out log's
+    res = CliRunner().invoke(app, ["fit", str(path), "--trajectory", "--bound", "sigma_0=1:1e6"])
+    text = " ".join(res.output.split())
+    assert res.exit_code == 2 and "sigma_0 from 1e2 to 1e7 N m/rad" in text, text
+    assert "second log" not in text
 
 
 @pytest.mark.parametrize(
