@@ -47,6 +47,19 @@ EDGE = 1e-9
 AT_BOUND = 1e-6
 
 
+#: The caveat of a Dahl or static law fitted to a trajectory: its intervals, unlike LuGre's,
+#: are not calibrated on another simulator's logs. Measured: ``dahl`` on the foreign
+#: trapezoid (``../shared/data/foreign/lugre``, 1 kHz, 2^20 counts/rev; a LuGre joint, J
+#: 0.02) put J at 0.01965 [0.01937, 0.01993] under "with caveats" for want of a scatter only.
+LAW_CAVEAT = (
+    "these intervals hold where the joint's friction follows this law: they are not "
+    "calibrated on another simulator's logs as LuGre's are, and a law that is not the "
+    "joint's (Dahl's or a static law on a joint with bristle dynamics) moves the inertia, the "
+    "gravity and the levels beyond them (on another simulator's LuGre joint, Dahl's J "
+    "0.01965 [0.01937, 0.01993] for 0.02); a LuGre fit of the same log says how far"
+)
+
+
 def _withheld(table: dict[str, dict[str, float]]) -> dict[str, dict[str, float]]:
     """A parameter table without its standard errors and intervals (NaN)."""
     nan = float("nan")
@@ -184,7 +197,7 @@ def build_result(
     caveats = [
         bias_caveat(options.get("window_bias")),
         direction,
-        lugre_caveat(key == "lugre_asym") if is_lugre else "",
+        lugre_caveat(key == "lugre_asym") if is_lugre else LAW_CAVEAT,
         delay_caveat(sim_info.get("torque_delay")),
     ]
     if any(caveats):
