@@ -297,7 +297,29 @@ def read_trajectory_log(path: Path, reader: str = "table", reader_options: dict 
             file=str(path),
         )
     chunks = list(opened)
-    return chunks[0] if len(chunks) == 1 else RawLog.concatenate(chunks)
+    log = chunks[0] if len(chunks) == 1 else RawLog.concatenate(chunks)
+    from ..samples import check_trajectory_log
+
+    try:  # as the fit checks it, with a CSV's rows and columns as the file writes them
+        check_trajectory_log(log)
+    except DataError as exc:
+        raise _as_in_file(exc, Path(path)) from None
+    return log
+
+
+def _as_in_file(exc: DataError, path: Path) -> DataError:
+    """``exc`` (a row as the log's 0-based sample index, a column by its quantity) with the
+    CSV file's line and column label, as the reader's own errors give them (a hole in the
+    time had been 'row 4000, column time' for line 4002's 'time [s]'); other files as given."""
+    if path.suffix.lower() != ".csv" or (exc.row is None and exc.column is None):
+        return exc
+    from ..io._columns import split_label
+    from ..io._csv import read_preamble, record_line
+
+    pre = read_preamble(path)
+    row = exc.row if exc.row is None else record_line(pre, exc.row)
+    label = next((lab for lab in pre.labels if split_label(lab)[0] == exc.column), exc.column)
+    return DataError(exc.message, file=exc.file, row=row, column=label)
 
 
 def run_trajectory(

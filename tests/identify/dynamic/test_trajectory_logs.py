@@ -230,3 +230,18 @@ def test_a_position_and_velocity_both_in_another_unit_are_refused(clean, tmp_pat
     columns = {"position": counted * factor, "velocity": clean.velocity * factor}
     path = damaged(clean, tmp_path, f"in_{unit}", **columns)
     refused_by_fit(path, "column 'position'", "65536-count encoder", f"in {unit} labelled radians")
+
+
+def test_a_csv_log_s_hole_is_named_by_its_line_and_label(clean, tmp_path):
+    """A CSV log's hole in the time is named by the file's line and the column's label, as the
+    reader's own errors are (it had been 'row 500, column time', the sample's index)."""
+    path = tmp_path / "hole.csv"
+    write_rawlog(clean, path)
+    lines = path.read_text().splitlines()
+    header = next(i for i, line in enumerate(lines) if not line.startswith("#"))
+    cut = header + 1 + 500  # the 0-based index of the line of sample 500
+    path.write_text("\n".join(lines[:cut] + lines[cut + 50 :]) + "\n")
+    args = ["fit", str(path), "--trajectory", "--out", str(tmp_path / "o.json")]
+    res = CliRunner().invoke(app, args)
+    text = " ".join(res.output.split())
+    assert res.exit_code == 2 and f"row {cut + 1}, column 'time [s]'" in text, text
