@@ -39,6 +39,14 @@ def test_demo_writes_everything_and_prints_table1(demo_dir):
     ):
         assert (demo_dir / name).stat().st_size > 0, name
     assert "0.9783" in (demo_dir / "summary.md").read_text()  # the paper's number beside ours
+    # each model file keeps the verdict `fricid fit` gives (an export reads it; it had none,
+    # and `fricid export` wrote a model fricid's own fit rejects without a word)
+    from fricid.fitted import FittedModel
+
+    vlt = FittedModel.load(demo_dir / "vlt.json")
+    assert vlt.trust is not None and vlt.trust["level"] in ("yes", "with caveats", "no")
+    table = (demo_dir / "table1.csv").read_text()
+    assert "trust" in table.splitlines()[0]
 
 
 def test_fit_and_evaluate(demo_dir, tmp_path):

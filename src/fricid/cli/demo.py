@@ -34,9 +34,9 @@ def demo_command(
 ) -> None:
     """Simulate the BAS-RBFNN paper's experiment on the virtual joint, extract the friction
     samples, fit the four analytic models and print a table like the paper's Table 1
-    (fitness = R^2, RMSE, RMSPE in percent per model). Writes samples.csv,
-    samples_by_direction.csv, one JSON model file per model, table1.csv and summary.md into
-    --out."""
+    (fitness = R^2, RMSE, RMSPE in percent per model) with each model's trust verdict. Writes
+    samples.csv, samples_by_direction.csv, one JSON model file per model, table1.csv and
+    summary.md into --out."""
     from ..experiments.demo import run_demo
     from ..experiments.paper_numbers import table1_rmse_unit
     from ..report.studies.demo import write_demo
@@ -54,7 +54,8 @@ def demo_command(
     console.print(f"true gravity:    p_x = {px:.5g}, p_y = {py:.5g} N m", highlight=False)
 
     table = Table(title="Table 1: performance of the models (paper's values in brackets)")
-    for col in ("model", "fitness", "RMSE [mN m]", "RMSPE [%]", "max |err| [mN m]"):
+    columns = ("model", "fitness", "RMSE [mN m]", "RMSPE [%]", "max |err| [mN m]", "trust")
+    for col in columns:
         table.add_column(escape(col), justify="left" if col == "model" else "right")
 
     def both(ours: float, paper: float, fmt: str) -> str:
@@ -67,7 +68,12 @@ def demo_command(
             both(row.rmse_mNm, row.paper_rmse, ".4g"),
             both(row.rmspe_percent, row.paper_rmspe_percent, ".2f"),
             f"{row.max_abs_error_mNm:.3g}",
+            row.trust + (f" ({row.heldout_ratio:.3g}x)" if np.isfinite(row.heldout_ratio) else ""),
         )
     console.print(table)
-    console.print(f"[dim]{table1_rmse_unit()} Compare fitness, RMSPE and the ordering.[/]")
+    console.print(
+        f"[dim]{table1_rmse_unit()} Compare fitness, RMSPE and the ordering. Trust: each "
+        "model's verdict as `fricid fit` gives it (held-out error over the measurement "
+        "scatter), saved in its file.[/]"
+    )
     console.print(f"wrote {written}/ in {time.perf_counter() - t0:.1f} s")
