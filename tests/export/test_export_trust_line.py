@@ -92,3 +92,28 @@ def test_a_lugre_mapping_that_misses_the_steady_state_says_so():
     line = trust_line(mjcf_text(trusted(model, rms / 4.0)))
     assert "verdict: NO for this file's numbers (they miss the model by" in line, line
     assert missed_by(line) == pytest.approx(4.0, rel=1e-2)
+
+
+def test_the_command_says_a_line_that_is_not_yes_on_stderr(tmp_path):
+    """`fricid export` prints the file's trust line on stderr when it is not a plain yes (a
+    file whose numbers miss the model by 5x the scatter was written with 'wrote ...' only), and
+    a model file without a verdict gets a line saying so (it had none: read as trusted)."""
+    from typer.testing import CliRunner
+
+    from fricid.cli import app
+
+    model = FittedModel.from_values("stribeck", dict(STRIBECK), operating_range=RANGE)
+    scatter = project(model).rms_error / 5.0
+    path = trusted(model, scatter).save(tmp_path / "m.json")
+    runner = CliRunner()
+    res = runner.invoke(app, ["export", str(path), "--to", "urdf", "-o", str(tmp_path / "m.urdf")])
+    assert res.exit_code == 0, res.output
+    assert "warning: trust verdict: NO for this file's numbers" in res.stderr, res.stderr
+    bare = model.save(tmp_path / "bare.json")
+    res = runner.invoke(app, ["export", str(bare), "--to", "c", "-o", str(tmp_path / "c")])
+    assert res.exit_code == 0, res.output
+    assert "warning: trust verdict: not recorded in the model file" in res.stderr
+    assert "trust verdict: not recorded" in (tmp_path / "c" / "fricid_friction.c").read_text()
+    fine = trusted(model, 10.0).save(tmp_path / "fine.json")  # yes: nothing more on stderr
+    res = runner.invoke(app, ["export", str(fine), "--to", "yaml", "-o", str(tmp_path / "f.yaml")])
+    assert "trust verdict" not in res.stderr

@@ -96,7 +96,9 @@ def test_export_clamp_says_what_it_cannot_hold(model, tmp_path):
     )
     assert res.exit_code == 0, res.output
     lines = [ln for ln in res.stderr.splitlines() if ln.startswith("warning:")]
-    assert len(lines) == 1 and "nothing between 2 and 5" in lines[0], res.stderr
+    # the clamp's warning, then the trust line's (this file records no verdict)
+    assert len(lines) == 2 and "nothing between 2 and 5" in lines[0], res.stderr
+    assert "trust verdict: not recorded" in lines[1]
     header = (tmp_path / "c" / "fricid_friction.h").read_text()
     assert "not held: v > 0: measured 0.217 to 20.84 rad/s (nothing between 2 and 5)" in header
 

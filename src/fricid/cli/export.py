@@ -145,6 +145,7 @@ def export_command(
         undetermined_held,
         write_text,
     )
+    from ..export._trust import trust_line
     from ..export.c import no_c_template
     from ..export.mjcf import is_lugre, lugre_mapping
     from ..fitted import FittedModel
@@ -191,6 +192,7 @@ def export_command(
                 err_console.print(
                     f"warning: {unheld}", markup=False, highlight=False, soft_wrap=True
                 )
+            _say_trust([trust_line(fitted)])
             for path in paths:
                 err_console.print(f"wrote {escape(str(path))}", highlight=False)
             return
@@ -225,9 +227,19 @@ def export_command(
             err_console.print(f"note: {line}", markup=False, highlight=False, soft_wrap=True)
     for line in advice.lines() if advice is not None else ():
         err_console.print(f"note: {line}", markup=False, highlight=False, soft_wrap=True)
+    _say_trust(text.splitlines())
     if out is None:
         sys.stdout.write(text)
         sys.stdout.flush()
     else:
         write_text(text, out)
         err_console.print(f"wrote {escape(str(out))}", highlight=False)
+
+
+def _say_trust(lines: list[str]) -> None:
+    """The exported file's trust line on stderr unless it is a plain 'yes' (a script that
+    exports sees a 'NO for this file's numbers' or a missing verdict, not only the file)."""
+    said = next((ln for ln in lines if "trust verdict: " in ln), "")
+    said = said[said.find("trust verdict: ") :]
+    if said and not said.startswith("trust verdict: yes"):
+        err_console.print(f"warning: {said}", markup=False, highlight=False, soft_wrap=True)

@@ -13,14 +13,15 @@ import numbers
 
 from ..fitted import FittedModel
 
-__all__ = ["model_scatter", "printable_reasons", "trust_line", "trust_of"]
+__all__ = ["NOT_RECORDED", "model_scatter", "printable_reasons", "trust_line", "trust_of"]
 
 
 def trust_line(
     fitted: FittedModel, projection_rms: float | None = None, projection: str = "projection"
-) -> str | None:
+) -> str:
     """``"trust verdict: ..."`` for the file's comment (arguments as for
-    :func:`fricid.export._common.summary_lines`), or None when the model records no verdict.
+    :func:`fricid.export._common.summary_lines`); :data:`NOT_RECORDED` when the model records
+    no verdict.
 
     The verdict is the model's; when ``projection_rms`` misses the model by more than its
     scatter the line says by how many times, and beyond what the trust check passes
@@ -28,7 +29,7 @@ def trust_line(
     """
     level, _ = trust_of(fitted)
     if level not in _LEVELS:  # fixed words and a number only
-        return None
+        return NOT_RECORDED
     shown, which = None, "held-out"
     for rec, key in ((fitted.trust, "heldout_ratio"), (fitted.validation, "ratio")):
         if isinstance(rec, dict) and isinstance(rec.get(key), int | float):
@@ -57,6 +58,12 @@ def trust_line(
         + "; the model file gives the reasons"
     )
 
+
+#: The trust line of a model file that records no verdict (an older file, a model fitted in
+#: Python): said, not left out, so that a file without the line is never read as trusted.
+NOT_RECORDED = (
+    "trust verdict: not recorded in the model file (fricid report MODEL SAMPLES grades it)"
+)
 
 #: The trust levels, best first.
 _LEVELS = ("yes", "with caveats", "no")
