@@ -389,4 +389,5 @@ def test_predict_interval_of_a_trajectory_model_writes_the_friction_and_says_why
     assert float(rows[1].split(",")[1]) == pytest.approx(friction)
     assert "identified from a trajectory" in " ".join(got.stderr.split())
     bad = CliRunner().invoke(app, [*args[:-1], "1.5"])
-    assert bad.exit_code == 2 and "(0, 1)" in bad.output
+    assert bad.exit_code == 2 and "--interval must lie in (0, 1)" in bad.output
+    assert str(path) not in bad.output  # the option is at fault, not the model file

@@ -133,6 +133,8 @@ def predict_command(
     from ..fitted._interval import no_steady_interval
     from ..units import to_si
 
+    if interval is not None and not 0.0 < interval < 1.0:  # the option's, not the file's
+        raise ConfigError(f"--interval must lie in (0, 1), e.g. 0.95; got {interval!r}")
     check_paths(inputs={"MODEL": model, "--input": input_file}, out_files={"--out": out})
     fitted = FittedModel.load(model)
     flags = {"velocity": velocity_unit, "load": load_unit, "temperature": temperature_unit}
@@ -199,8 +201,6 @@ def predict_command(
         extra = None
         unbacked = no_steady_interval(fitted) if interval is not None else ""
         if unbacked:  # the friction, with its interval columns empty and why
-            if not 0.0 < interval < 1.0:
-                raise ConfigError(f"the interval's level must lie in (0, 1); got {interval!r}")
             extra = {"low": np.full(len(X), np.nan), "high": np.full(len(X), np.nan)}
             err_console.print(
                 f"note: no prediction interval (low and high are nan): the model {unbacked}",
