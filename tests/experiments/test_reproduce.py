@@ -202,6 +202,12 @@ def test_rwsavsbas_runs_on_the_leadscrew_per_direction(rwsavsbas, leadscrew_dir)
         t2 = pd.read_csv(out / f"{tag}_table2_parameters.csv").set_index("parameter")
         tau_s = abs(t2.iloc[1]["ours: RWSAVSBAS, best of 8 runs"])
         assert 1e-3 < tau_s < 1e-2  # a few mN m
+        # its methods ran the paper's iterations, not one budget: the table says so, and its
+        # caption no longer breaks off at "('equal budget') come first:"
+        t1 = pd.read_csv(out / f"{tag}_table1_fitness.csv")
+        assert set(t1["budget"]) == {"paper's iterations"}
+    report = (out / "report.html").read_text(encoding="utf-8")
+    assert "not equal budgets" in report and "sign convention" in report  # which way is +
 
 
 def test_unknown_paper_and_steps():

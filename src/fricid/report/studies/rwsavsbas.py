@@ -59,7 +59,9 @@ def _table1(tag: str, comp: Comparison, *, paper_numbers: bool) -> Table:
         rows.append(
             {
                 "algorithm": label if in_paper else f"{label} (not in the paper)",
-                "budget": groups.get(label, "paper budget"),
+                "budget": groups.get(
+                    label, "paper budget" if len(groups) else "paper's iterations"
+                ),
                 "paper: average": p["mean"] if p else np.nan,
                 "ours: average": f.mean(),
                 "paper: max": p["max"] if p else np.nan,
@@ -77,8 +79,13 @@ def _table1(tag: str, comp: Comparison, *, paper_numbers: bool) -> Table:
         f"{PAPER['runs']} runs per algorithm. The exact optimum (variable projection, "
         f"a baseline the paper did not have) is SSE {f_opt:.4g}: the ratio column says "
         "how close each algorithm gets. Every method evaluates the same compiled objective; "
-        "the rows at RWSAVSBAS's evaluation count ('equal budget') come first: "
-        + (headline(comp.study) if comp.study is not None else "")
+        + (
+            "the rows at RWSAVSBAS's evaluation count ('equal budget') come first: "
+            + headline(comp.study)
+            if comp.study is not None
+            else "each runs the paper's iterations, so their evaluations per run differ (that "
+            "column): this compares the paper's settings, not equal budgets."
+        )
     )
     notes = study_notes(comp.study) if comp.study is not None else []
     if notes:
@@ -102,8 +109,8 @@ def _table1(tag: str, comp: Comparison, *, paper_numbers: bool) -> Table:
 def _label(tag: str) -> str:
     return {
         "virtual": "virtual joint",
-        "leadscrew_pos": "lead screw, positive direction",
-        "leadscrew_neg": "lead screw, negative direction",
+        "leadscrew_pos": "lead screw, positive direction as the drive records it",
+        "leadscrew_neg": "lead screw, negative direction as the drive records it",
     }.get(tag, tag)
 
 
@@ -392,7 +399,10 @@ def compose_rwsavsbas(result: RwsavsbasResult) -> Document:
             "Mablekos-Alexiou et al. (IEEE T-RO 2021), a Maxon motor on a simple lead screw, "
             "one steady velocity per recording (2-200 rpm, both directions); friction = the mean "
             "motor torque of each recording. The paper's eq. 7 has one parameter set, so it is "
-            f"identified per direction{_asymmetry(result)}. The search box scales with the data "
+            f"identified per direction{_asymmetry(result)}. The directions are the drive's as it "
+            "records them (the motor's sign convention; fricid extract --flip-sign turns them "
+            "into the joint's, so the README's forwards is the negative direction here). The "
+            "search box scales with the data "
             "(fricid.experiments.rwsavsbas_paper.scaled_bounds); the paper's numbers are for its "
             "robot and are not repeated."
         ),
