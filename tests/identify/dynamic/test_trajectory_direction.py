@@ -211,15 +211,14 @@ def test_the_gravity_note_does_not_quote_levels_the_regression_left_undetermined
 
 
 def test_the_direction_test_weighs_its_few_clusters():
-    """The Wald test of the per-direction levels takes the cluster-robust covariance's few
-    clusters into account (F(q, G - q)): with the chi-square, four clusters (a 2 s log) had
-    called a symmetric virtual joint's friction different by direction at p = 9e-9."""
+    """The Wald test of the per-direction levels makes no claim with fewer than MIN_CLUSTERS
+    clusters: with the chi-square, four clusters (a 2 s log) had called a symmetric virtual
+    joint's friction different by direction at p = 9e-9."""
     from fricid.cli.simulate import _trajectory_log
     from fricid.identify.dynamic._direction import wald_p
 
-    assert wald_p(40.0, 2, 4) > 1e-3 > wald_p(40.0, 2, 400)
-    assert wald_p(40.0, 2, 0) == pytest.approx(2e-9, rel=0.1)  # chi-square: not recorded
-    assert wald_p(40.0, 2, 2) == 1.0  # no more clusters than restrictions: cannot tell
+    assert wald_p(40.0, 2, 4) == 1.0 > 1e-3 > wald_p(40.0, 2, 20)  # 4 clusters: no claim
+    assert wald_p(40.0, 2, 20) == wald_p(40.0, 2, 0) == pytest.approx(2e-9, rel=0.1)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         fitted = fit(_trajectory_log("multisine", 2.0, 0), "lugre")  # simulate's own log
