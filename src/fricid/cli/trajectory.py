@@ -104,6 +104,8 @@ def trajectory_text(fitted) -> str:
         )
     if info.get("gravity_note"):
         lines.append(f"    gravity: {info['gravity_note']}")
+    if info.get("intervals_note"):
+        lines.append(f"    intervals: {info['intervals_note']}")
     for name, route in info.get("routes", {}).items():
         rms = ", ".join(f"{k} {v:.3g}" for k, v in route.get("rms", {}).items())
         lines.append(

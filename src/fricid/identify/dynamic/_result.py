@@ -47,8 +47,10 @@ EDGE = 1e-9
 AT_BOUND = 1e-6
 
 
-#: The caveat of a Dahl or static law fitted to a trajectory: its intervals, unlike LuGre's,
-#: are not calibrated on another simulator's logs. Measured: ``dahl`` on the foreign
+#: The note on the intervals of a Dahl or static law fitted to a trajectory (printed beside
+#: them, ``provenance["trajectory"]["intervals_note"]``; not a caveat of the verdict, which a
+#: second log grades by the predictions): unlike LuGre's, they are not calibrated on another
+#: simulator's logs. Measured: ``dahl`` on the foreign
 #: trapezoid (``../shared/data/foreign/lugre``, 1 kHz, 2^20 counts/rev; a LuGre joint, J
 #: 0.02) put J at 0.01965 [0.01937, 0.01993] under "with caveats" for want of a scatter only.
 LAW_CAVEAT = (
@@ -197,13 +199,15 @@ def build_result(
     caveats = [
         bias_caveat(options.get("window_bias")),
         direction,
-        lugre_caveat(key == "lugre_asym") if is_lugre else LAW_CAVEAT,
+        lugre_caveat(key == "lugre_asym") if is_lugre else "",
         delay_caveat(sim_info.get("torque_delay")),
     ]
     if any(caveats):
         info["caveats"] = [c for c in caveats if c]
     if gravity_note:
         info["gravity_note"] = gravity_note
+    if not is_lugre:  # a note, not a caveat: a second log's verdict grades the predictions
+        info["intervals_note"] = LAW_CAVEAT
     if is_lugre:
         info["passivity"] = passivity(param_names, values, low, high)
         if not info["passivity"]["passive"]:
