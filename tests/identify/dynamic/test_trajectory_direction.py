@@ -211,16 +211,14 @@ def test_the_gravity_note_does_not_quote_levels_the_regression_left_undetermined
 
 
 def test_the_direction_test_weighs_its_few_clusters():
-    """The Wald test of the per-direction levels makes no claim with fewer than MIN_CLUSTERS
-    clusters: with the chi-square, four clusters (a 2 s log) had called a symmetric virtual
-    joint's friction different by direction at p = 9e-9."""
+    """With fewer than MIN_CLUSTERS clusters the test says the friction may differ, not that it
+    does: four clusters (a 2 s log) had called a symmetric virtual joint's friction different
+    by direction at p = 9e-9."""
     from fricid.cli.simulate import _trajectory_log
-    from fricid.identify.dynamic._direction import wald_p
 
-    assert wald_p(40.0, 2, 4) == 1.0 > 1e-3 > wald_p(40.0, 2, 20)  # 4 clusters: no claim
-    assert wald_p(40.0, 2, 20) == wald_p(40.0, 2, 0) == pytest.approx(2e-9, rel=0.1)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         fitted = fit(_trajectory_log("multisine", 2.0, 0), "lugre")  # simulate's own log
     caveats = " ".join(fitted.provenance["trajectory"].get("caveats", []))
     assert "friction differs by direction" not in caveats
+    assert "independent stretches of the log, too few to settle it" in caveats
