@@ -278,7 +278,7 @@ def _per_direction_coverage() -> str:
         "logs (2^20 counts/rev) with the friction the same or 10-20 % weaker backwards, "
         f"{100 * c / n:.0f} % of the claims held: {each} (benchmarks/bench_direction.py); "
         "the levels' difference takes up any constant torque as well: a torque sensor's "
-        "offset looks the same as friction that differs by direction"
+        "offset looks the same as a difference between the two directions' levels"
     )
 
 
