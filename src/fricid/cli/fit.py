@@ -249,14 +249,14 @@ def fit_command(
         }
         ignored = [flag for flag, value in samples_only.items() if value is not None]
         if ignored:
-            why = {
-                "--validate": "a trajectory model is validated on a second log: fricid report "
-                "MODEL LOG HELDOUT",
-                "--fix": "ranges",
-                "--bound": "ranges",
-            }
-            reasons = dict.fromkeys(why[f] for f in ignored if f in why)
-            reasons = [_trajectory_ranges() if r == "ranges" else r for r in reasons]
+            reasons = []
+            if "--validate" in ignored:
+                reasons.append(
+                    "a trajectory model is validated on a second log: fricid report MODEL LOG "
+                    "HELDOUT"
+                )
+            if {"--fix", "--bound"} & set(ignored):
+                reasons.append(_trajectory_ranges())
             raise ConfigError(
                 f"{', '.join(ignored)} {'applies' if len(ignored) == 1 else 'apply'} to friction "
                 "samples, not to --trajectory" + (f" ({'; '.join(reasons)})" if reasons else "")

@@ -260,10 +260,7 @@ def robot_export_command(
             from ..export.robot_urdf import INERTIALS
 
             levels = {j: {n: p.value for n, p in m.parameters.items()} for j, m in fitted.items()}
-            lines = [INERTIALS] + [
-                f"joint {plain(j)}: {trust_line(m) or 'no trust verdict'}"
-                for j, m in fitted.items()
-            ]
+            lines = [INERTIALS] + [f"joint {plain(j)}: {trust_line(m)}" for j, m in fitted.items()]
             arm = model.with_parameters(standard)
             written, notes = write_robot_mjcf(arm, out, levels, comments=lines)
             for note in notes:

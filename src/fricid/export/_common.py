@@ -282,7 +282,7 @@ def summary_lines(
             "it): " + ", ".join(plain(n) for n in undetermined if n not in inside)
         )
     verdict = trust_line(fitted, projection_rms, projection)
-    return lines + ([verdict] if verdict else [])
+    return [*lines, verdict]
 
 
 def refuse_untrusted(fitted: FittedModel, allow: bool, joint: str | None = None) -> None:

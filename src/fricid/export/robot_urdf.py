@@ -174,10 +174,7 @@ def robot_urdf_text(
             element,
             f"fricid: Coulomb-viscous projection of model {plain(model_name(fitted))}, "
             f"{percent(proj.relative_error)} RMS from it over its operating range; "
-            + (
-                trust_line(fitted, proj.rms_error, "Coulomb-viscous projection")
-                or "no trust verdict recorded"
-            ),
+            + trust_line(fitted, proj.rms_error, "Coulomb-viscous projection"),
         )
     if frictions:
         lines.append("friction: <dynamics> of " + ", ".join(map(plain, frictions)))

@@ -42,6 +42,7 @@ __all__ = [
     "grade_new_samples",
     "graded_rmse",
     "is_new_samples",
+    "is_own_samples",
     "model_error",
     "on_new_clause",
     "other_side_caveat",

@@ -35,7 +35,7 @@ import numpy as np
 
 from ..errors import ConfigError, DataError, FricidError
 from ..metrics import sem_autocorrelated
-from ..samples import NO_TEMPERATURE, NO_TEMPERATURE_SOURCE, FrictionSamples, RawLog
+from ..samples import FrictionSamples, RawLog, constant_temperature
 from ..units import UNITS, to_si
 from ._epos_text import (
     _COUNT_UNITS,
@@ -167,7 +167,7 @@ def read_epos(
         match their file names (``N.csv`` is +N rpm): their authors' converter flips both
         velocity and torque (motor convention).
     temperature : [degC], constant; the recorder has no temperature channel. Without one the
-        log's temperature column is a placeholder (:data:`NO_TEMPERATURE`),
+        log's temperature column is a placeholder (:data:`fricid.samples.NO_TEMPERATURE`),
         ``meta["temperature_source"]`` says it is none, and the samples extracted from the log
         record no temperature rather than a made-up one.
     torque_constant : K [N m/A], needed when only a current channel was recorded.
@@ -254,14 +254,14 @@ def _read(
         "flip_sign": bool(flip_sign),
         "nominal_torque [N m]": float(nominal_torque),
         "position_source": "channel" if position is not None else "integrated velocity",
-        "temperature_source": _temperature_source(temperature),
+        "temperature_source": constant_temperature(temperature)[1],
         "skipped_rows": rec.skipped,
     }
     log = RawLog(
         time=time,
         position=integrate_velocity(time, values["velocity"]) if position is None else position,
         velocity=values["velocity"],
-        temperature=NO_TEMPERATURE if temperature is None else temperature,
+        temperature=constant_temperature(temperature)[0],
         torque=values.get("torque"),
         current=values.get("current"),
         torque_constant=torque_constant,
@@ -270,13 +270,6 @@ def _read(
         meta=meta,
     )
     return log, rec.lines
-
-
-def _temperature_source(temperature: float | None) -> str:
-    """``meta["temperature_source"]``: the temperature given, or none."""
-    if temperature is None:
-        return NO_TEMPERATURE_SOURCE
-    return f"constant {temperature:g} degC, given (the recorder logs none)"
 
 
 def _files(folder: str | os.PathLike[str], pattern: str) -> list[Path]:
@@ -465,7 +458,7 @@ def epos_steady_samples(
             "files": names,
             "flip_sign": bool(flip_sign),
             "nominal_torque [N m]": float(nominal_torque),
-            "temperature_source": _temperature_source(temperature),
+            "temperature_source": constant_temperature(temperature)[1],
             "outlier_sigmas": outlier_sigmas,
             "outlier_lines": dropped_lines,
             "velocity_outlier_lines": velocity_lines,

@@ -240,13 +240,13 @@ def test_a_dahl_or_static_law_s_intervals_say_they_are_not_calibrated():
     from fricid.cli.simulate import _trajectory_log
     from fricid.cli.trajectory import trajectory_text
     from fricid.identify import fit
-    from fricid.identify.dynamic._result import LAW_CAVEAT
+    from fricid.identify.dynamic._result import INTERVALS_NOTE
 
     log = _trajectory_log("multisine", 2.0, 1)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         for model in ("dahl", "stribeck"):
             fitted = fit(log, model)
-            assert fitted.provenance["trajectory"]["intervals_note"] == LAW_CAVEAT, model
-            assert f"intervals: {LAW_CAVEAT}" in trajectory_text(fitted)
-    assert "not calibrated" in LAW_CAVEAT
+            assert fitted.provenance["trajectory"]["intervals_note"] == INTERVALS_NOTE, model
+            assert f"intervals: {INTERVALS_NOTE}" in trajectory_text(fitted)
+    assert "not calibrated" in INTERVALS_NOTE

@@ -53,7 +53,7 @@ AT_BOUND = 1e-6
 #: simulator's logs. Measured: ``dahl`` on the foreign
 #: trapezoid (``../shared/data/foreign/lugre``, 1 kHz, 2^20 counts/rev; a LuGre joint, J
 #: 0.02) put J at 0.01965 [0.01937, 0.01993] under "with caveats" for want of a scatter only.
-LAW_CAVEAT = (
+INTERVALS_NOTE = (
     "these intervals hold where the joint's friction follows this law: they are not "
     "calibrated on another simulator's logs as LuGre's are, and a law that is not the "
     "joint's (Dahl's or a static law on a joint with bristle dynamics) moves the inertia, the "
@@ -207,7 +207,7 @@ def build_result(
     if gravity_note:
         info["gravity_note"] = gravity_note
     if not is_lugre:  # a note, not a caveat: a second log's verdict grades the predictions
-        info["intervals_note"] = LAW_CAVEAT
+        info["intervals_note"] = INTERVALS_NOTE
     if is_lugre:
         info["passivity"] = passivity(param_names, values, low, high)
         if not info["passivity"]["passive"]:
